@@ -1,0 +1,43 @@
+# Helpers that keep each module's CMakeLists.txt to a few lines.
+
+# softsight_add_library(<module> SOURCES ... DEPS ...)
+# Creates target softsight_<module>. Public headers live in include/softsight/<module>/,
+# private ones beside the sources in src/<module>/ (included as "<module>/x.h").
+function(softsight_add_library module)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  set(target softsight_${module})
+  add_library(${target} STATIC ${ARG_SOURCES})
+  target_include_directories(${target}
+    PUBLIC ${PROJECT_SOURCE_DIR}/include
+    PRIVATE ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PUBLIC ${ARG_DEPS})
+  add_library(softsight::${module} ALIAS ${target})
+endfunction()
+
+# softsight_add_test(<module> SOURCES ... DEPS ...)
+# One GoogleTest executable per module (softsight_<module>_test), every TEST registered with ctest.
+function(softsight_add_test module)
+  if(NOT SOFTSIGHT_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  set(target softsight_${module}_test)
+  add_executable(${target} ${ARG_SOURCES})
+  target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
+  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60
+    PROPERTIES ENVIRONMENT "SOFTSIGHT_SOURCE_DIR=${PROJECT_SOURCE_DIR};SOFTSIGHT_BINARY=$<TARGET_FILE:softsight>")
+endfunction()
+
+# softsight_add_benchmark(<name> SOURCES ... DEPS ...)
+# A Google Benchmark program (softsight_<name>_benchmark). Benchmarks never run as tests.
+function(softsight_add_benchmark name)
+  if(NOT SOFTSIGHT_BUILD_BENCHMARKS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  set(target softsight_${name}_benchmark)
+  add_executable(${target} ${ARG_SOURCES})
+  target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} benchmark::benchmark benchmark::benchmark_main)
+endfunction()

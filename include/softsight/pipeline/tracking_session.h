@@ -1,0 +1,52 @@
+// Wires the per-frame stages: Frame -> one Tracker per marker -> Observations -> Measurement.
+// Sinks (CSV, overlay, video, controller) consume the FrameResult; this class owns no I/O.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "softsight/core/types.h"
+#include "softsight/geometry/measurement.h"
+#include "softsight/io/config.h"
+#include "softsight/track/tracker.h"
+
+namespace softsight {
+
+struct FrameResult {
+  int64_t frame_index = 0;
+  double time_s = 0.0;
+  std::vector<MarkerObservation> markers;  // In config order.
+  Measurement measurement;
+  double proc_ms = 0.0;                    // Tracking + measurement time for this frame.
+};
+
+class TrackingSession {
+ public:
+  // Builds one tracker per configured marker. Throws InputError on a bad spec.
+  explicit TrackingSession(const TrackingConfig& config);
+  ~TrackingSession();
+
+  // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
+  // frame) trackers are initialised from the config's ROIs and template rectangles.
+  const FrameResult& process(const Frame& frame);
+
+  // Live recalibration: the marker is inside `rect` on `frame` (re-cuts a template, or restricts
+  // the colour tracker's next acquisition). Throws InputError for an unknown marker.
+  void reselect(const std::string& marker, const cv::Mat& frame, const cv::Rect& rect);
+  // Replace a marker's spec (new HSV ranges or method) and rebuild its tracker.
+  void respec(const MarkerSpec& spec);
+  void reset_tip_reference();
+
+  const TrackingConfig& config() const { return config_; }
+
+ private:
+  TrackingConfig config_;
+  std::vector<std::unique_ptr<Tracker>> trackers_;
+  std::vector<bool> initialised_;
+  Measurer measurer_;
+  FrameResult result_;
+};
+
+}  // namespace softsight

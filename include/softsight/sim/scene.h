@@ -1,0 +1,113 @@
+// Synthetic scenes with exact ground truth: a planar soft actuator with coloured disc markers on
+// a textured background, rendered anti-aliased (supersampled), with optional sensor noise, blur,
+// illumination gain and occluders. Scene, noise and rendering options are kept apart.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/geometry/measurement.h"
+
+namespace softsight {
+
+enum class SceneKind {
+  kBending,  // A silicone band whose centre line is a constant-curvature arc, fixed at its base.
+  kWedge1,   // The paper's 1-segment triangle (wedge) actuator, opening to 20 degrees.
+  kWedge4,   // The paper's 4-segment triangle actuator, opening to 80 degrees.
+};
+
+struct SceneMarker {
+  std::string name;
+  cv::Vec3b bgr;            // Marker colour (saturated, so HSV thresholds separate it).
+  double body_fraction;     // Position along the body, 0 = base, 1 = tip.
+};
+
+struct SceneOptions {
+  SceneKind kind = SceneKind::kBending;
+  cv::Size size{640, 480};
+  int frame_count = 300;
+  double fps = 30.0;
+  // Bending over time, from straight (0) to `max_bend_deg` total turning of the centre line
+  // (> 180: well past a half circle). The profile is smooth and monotonic unless `oscillate`.
+  double max_bend_deg = 240.0;
+  bool oscillate = false;   // Bend and unbend (a sine) instead of one monotonic sweep.
+  double length_px = 300.0; // Centre-line length of the body.
+  double width_px = 40.0;
+  double marker_radius_px = 9.0;
+  // Default markers: red at the base, blue in the middle, green at the tip (the paper's R, B, G),
+  // placed symmetrically so the middle marker sits mid-arc between the end markers.
+  std::vector<SceneMarker> markers = {{"red", {40, 40, 220}, 0.1},
+                                      {"blue", {220, 90, 40}, 0.5},
+                                      {"green", {60, 200, 60}, 0.9}};
+  uint64_t seed = 1;        // Background texture.
+};
+
+struct NoiseOptions {
+  double sigma = 0.0;         // Gaussian sensor noise, in 8-bit grey levels.
+  double blur_sigma_px = 0.0; // Optical blur (Gaussian), applied before noise.
+  double gain_start = 1.0;    // Illumination gain at the first frame ...
+  double gain_end = 1.0;      // ... ramping linearly to this at the last frame.
+  uint64_t seed = 7;
+};
+
+struct RenderOptions {
+  int supersample = 4;        // Sub-samples per pixel side; the truth is exact at this resolution.
+};
+
+// A rectangle drawn over everything else during frames [first_frame, last_frame].
+struct Occluder {
+  cv::Rect2d rect_px;
+  int first_frame = 0;
+  int last_frame = 0;
+  cv::Vec3b bgr{128, 128, 128};
+};
+
+struct MarkerTruth {
+  std::string name;
+  // Centroid of the marker's rendered visible area (pixel-centre convention); absent when the
+  // marker is fully hidden.
+  std::optional<cv::Point2d> centroid_px;
+  double visible_fraction = 1.0;  // Visible area / unoccluded area.
+};
+
+struct SceneTruth {
+  int64_t frame_index = 0;
+  double time_s = 0.0;
+  double bend_deg = 0.0;                 // Total turning of the centre line (the actuator state).
+  std::optional<double> centreline_radius_px;  // Radius of the centre-line arc; absent when straight.
+  std::vector<MarkerTruth> markers;
+  Measurement measurement;               // The paper's measurements from the true centroids.
+};
+
+class SyntheticScene {
+ public:
+  // Throws InputError naming the option when options are unusable.
+  SyntheticScene(SceneOptions scene, NoiseOptions noise = {}, RenderOptions render = {},
+                 std::vector<Occluder> occluders = {});
+  ~SyntheticScene();
+  SyntheticScene(SyntheticScene&&) noexcept;
+  SyntheticScene& operator=(SyntheticScene&&) noexcept;
+
+  const SceneOptions& options() const;
+  int frame_count() const;
+
+  // Renders frame `index` of the time profile into `image` (CV_8UC3, buffer reused).
+  SceneTruth render(int index, cv::Mat& image);
+  // Renders the actuator at an explicit bend (used by the simulated control rig).
+  SceneTruth render_at_bend(double bend_deg, double time_s, int index, cv::Mat& image);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Parses "bending", "wedge1", "wedge4"; throws InputError listing the choices.
+SceneKind ParseSceneKind(const std::string& name);
+const char* SceneKindName(SceneKind kind);
+
+}  // namespace softsight

@@ -1,0 +1,53 @@
+// The one interface every marker tracker implements, and the table that builds them by name.
+//
+// A tracker follows one marker. It knows nothing of files, windows or serial ports: it is given
+// images and answers with Observations. Modelled on OpenCV's cv::Tracker (init + update).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/core/types.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
+
+namespace softsight {
+
+class Tracker {
+ public:
+  virtual ~Tracker() = default;
+
+  // Tells the tracker where its marker is on `frame_bgr`: the rectangle a person dragged around it.
+  // Colour trackers restrict their next acquisition to `hint` and learn the marker's reference
+  // area there; template trackers cut their template from `hint`. Throws InputError when the hint
+  // cannot be used (empty, or outside the frame).
+  virtual void init(const cv::Mat& frame_bgr, const cv::Rect& hint) = 0;
+
+  // Finds the marker in the next frame (CV_8UC3 BGR). found() == false is a normal result; a
+  // tracker never reports a stale or predicted position.
+  virtual Observation update(const cv::Mat& frame_bgr) = 0;
+
+  // Forgets position and velocity; the next update() acquires on the full frame (or the ROI).
+  virtual void reset() = 0;
+};
+
+// Everything needed to build the tracker of one marker.
+struct MarkerSpec {
+  std::string name;                   // Unique; prefixes the marker's CSV columns.
+  std::string method = "colour";      // A name from TrackerMethods(): colour, sad, ssd, zncc.
+  ColourParams colour;                // Used by the colour method.
+  TemplateParams templ;               // Used by the template methods.
+};
+
+// Builds the tracker for `spec.method`. Throws InputError naming the marker when the method is
+// unknown or its parameters fail their Check().
+std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec);
+
+// The names CreateTracker accepts, in the order --help lists them.
+std::vector<std::string> TrackerMethods();
+
+}  // namespace softsight

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs every Debian package softsight needs to build, test, benchmark and run its demo.
+# Non-interactive and idempotent: packages already present are left alone. Run as root or with sudo.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libopencv-dev          # image processing, video I/O, calibration, GUI (OpenCV 4.6)
+  libyaml-cpp-dev        # configuration files
+  libcli11-dev           # command-line parsing
+  libserial-dev          # serial link to the pneumatic board
+  libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev       # benchmarks
+  xvfb xauth xdotool     # the live window's tests run under a virtual X server
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,19 @@
+// The softsight program is a table of subcommands (main.cc). Each subcommand lives in its own
+// <name>_command.cc: its Setup function adds the options to `sub` and returns the function that
+// runs the command once the command line is parsed. That function returns the exit code; user
+// errors are thrown as InputError and reported once, by main().
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace softsight {
+
+using CommandRunner = std::function<int()>;
+
+CommandRunner SetupTrackCommand(CLI::App& sub);
+CommandRunner SetupSynthCommand(CLI::App& sub);
+CommandRunner SetupDemoCommand(CLI::App& sub);
+
+}  // namespace softsight

@@ -1,0 +1,64 @@
+// softsight: measure soft robots with a camera. See README.md.
+#include <iostream>
+#include <map>
+
+#include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
+
+#include "app/commands.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+struct CommandEntry {
+  const char* name;
+  const char* summary;
+  CommandRunner (*setup)(CLI::App& sub);
+};
+
+// The subcommands, in the order --help lists them.
+const CommandEntry kCommands[] = {
+    {"demo", "Render the built-in demo scene, track it and write a CSV (start here)",
+     SetupDemoCommand},
+    {"track", "Track markers in a video or image sequence and write per-frame measurements",
+     SetupTrackCommand},
+    {"synth", "Render a synthetic actuator video with exact ground truth", SetupSynthCommand},
+};
+
+int Main(int argc, char** argv) {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_WARNING);
+  CLI::App app{
+      "softsight measures soft robots with a camera: it finds coloured markers on an actuator,\n"
+      "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
+      "close the control loop over a serial link. Run `softsight <command> --help` for details."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "softsight 0.1.0");
+  std::map<const CLI::App*, CommandRunner> runners;
+  for (const CommandEntry& entry : kCommands) {
+    CLI::App* sub = app.add_subcommand(entry.name, entry.summary);
+    runners[sub] = entry.setup(*sub);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kInputErrorExitCode;
+  }
+  const CLI::App* chosen = app.get_subcommands().front();
+  try {
+    return runners.at(chosen)();
+  } catch (const InputError& e) {
+    std::cerr << "softsight " << chosen->get_name() << ": error: " << e.what() << "\n";
+    return kInputErrorExitCode;
+  } catch (const cv::Exception& e) {
+    std::cerr << "softsight " << chosen->get_name() << ": OpenCV error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace
+}  // namespace softsight
+
+int main(int argc, char** argv) { return softsight::Main(argc, argv); }

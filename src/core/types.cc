@@ -1,0 +1,2 @@
+#include "softsight/core/types.h"
+#include "softsight/core/error.h"

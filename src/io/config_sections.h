@@ -1,0 +1,27 @@
+// Readers and writers of the config's sections, one pair per module that owns the settings.
+// Each Read function consumes its keys from `map` (so YamlMap::finish() can reject unknown keys)
+// and throws InputError naming file, line and key. Each Write function emits the same keys.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include "io/yaml_map.h"
+#include "softsight/geometry/measurement.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
+
+namespace softsight {
+
+// colour_config.cc: a marker's colour keys (hsv, auto_colour, filter, morphology, blob, roi, ...).
+void ReadColourParams(YamlMap& marker, ColourParams* params);
+void WriteColourParams(const ColourParams& params, YAML::Emitter& out);
+
+// template_config.cc: a marker's `template:` key and matching options.
+void ReadTemplateParams(YamlMap& marker, TemplateParams* params);
+void WriteTemplateParams(const TemplateParams& params, YAML::Emitter& out);
+
+// metric_config.cc: top-level scale_mm_per_px / plane keys.
+void ReadMetricModel(YamlMap& top, MetricModel* metric);
+void WriteMetricModel(const MetricModel& metric, YAML::Emitter& out);
+
+}  // namespace softsight

@@ -1,0 +1,199 @@
+#include "io/yaml_map.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+std::string LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  if (mark.line < 0) return "";
+  return std::to_string(mark.line + 1) + ":";
+}
+
+std::string Shown(const YAML::Node& node) {
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+template <typename T>
+std::string Range(T min, T max) {
+  std::ostringstream out;
+  out << min << ".." << max;
+  return out.str();
+}
+
+}  // namespace
+
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {
+  if (!node_.IsMap()) {
+    throw InputError(file_ + ":" + LineOf(node_) + " " + (path_.empty() ? "top level" : path_) +
+                     ": expected a mapping of keys, got " + Shown(node_));
+  }
+}
+
+std::string YamlMap::key_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void YamlMap::fail(const std::string& key, const std::string& problem) const {
+  const YAML::Node child = node_[key];
+  const std::string line = child.IsDefined() ? LineOf(child) : LineOf(node_);
+  throw InputError(file_ + ":" + line + " " + key_path(key) + ": " + problem);
+}
+
+bool YamlMap::has(const std::string& key) const {
+  known_.insert(key);
+  const YAML::Node child = node_[key];
+  return child.IsDefined() && !child.IsNull();
+}
+
+YAML::Node YamlMap::node(const std::string& key) {
+  known_.insert(key);
+  return node_[key];
+}
+
+YamlMap YamlMap::map(const std::string& key) {
+  known_.insert(key);
+  return YamlMap(node_[key], file_, key_path(key));
+}
+
+std::optional<double> YamlMap::number(const std::string& key, double min, double max) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  double value = 0;
+  if (!child.IsScalar() || !YAML::convert<double>::decode(child, value) || !std::isfinite(value)) {
+    fail(key, "expected a number, got " + Shown(child));
+  }
+  if (value < min || value > max) {
+    fail(key, "value " + child.Scalar() + " is outside " + Range(min, max));
+  }
+  return value;
+}
+
+std::optional<int> YamlMap::integer(const std::string& key, int min, int max) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  int value = 0;
+  if (!child.IsScalar() || !YAML::convert<int>::decode(child, value)) {
+    fail(key, "expected a whole number, got " + Shown(child));
+  }
+  if (value < min || value > max) {
+    fail(key, "value " + child.Scalar() + " is outside " + Range(min, max));
+  }
+  return value;
+}
+
+std::optional<bool> YamlMap::boolean(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  bool value = false;
+  if (!child.IsScalar() || !YAML::convert<bool>::decode(child, value)) {
+    fail(key, "expected true or false, got " + Shown(child));
+  }
+  return value;
+}
+
+std::optional<std::string> YamlMap::string(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  if (!child.IsScalar()) fail(key, "expected text, got " + Shown(child));
+  return child.Scalar();
+}
+
+std::optional<std::string> YamlMap::choice(const std::string& key,
+                                           const std::vector<std::string>& choices) {
+  std::optional<std::string> value = string(key);
+  if (!value) return std::nullopt;
+  for (const std::string& c : choices) {
+    if (*value == c) return value;
+  }
+  std::string list;
+  for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
+  fail(key, "'" + *value + "' is not one of: " + list);
+}
+
+std::optional<std::vector<int>> YamlMap::integers(const std::string& key, size_t count, int min,
+                                                  int max) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  if (!child.IsSequence() || (count > 0 && child.size() != count)) {
+    fail(key, "expected a list of " + (count > 0 ? std::to_string(count) + " " : std::string()) +
+                  "whole numbers, got " + Shown(child));
+  }
+  std::vector<int> values;
+  for (const YAML::Node& item : child) {
+    int value = 0;
+    if (!item.IsScalar() || !YAML::convert<int>::decode(item, value)) {
+      fail(key, "expected whole numbers, got " + Shown(item));
+    }
+    if (value < min || value > max) {
+      fail(key, "value " + item.Scalar() + " is outside " + Range(min, max));
+    }
+    values.push_back(value);
+  }
+  return values;
+}
+
+std::optional<std::vector<double>> YamlMap::numbers(const std::string& key, size_t count,
+                                                    double min, double max) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  if (!child.IsSequence() || (count > 0 && child.size() != count)) {
+    fail(key, "expected a list of " + (count > 0 ? std::to_string(count) + " " : std::string()) +
+                  "numbers, got " + Shown(child));
+  }
+  std::vector<double> values;
+  for (const YAML::Node& item : child) {
+    double value = 0;
+    if (!item.IsScalar() || !YAML::convert<double>::decode(item, value) || !std::isfinite(value)) {
+      fail(key, "expected numbers, got " + Shown(item));
+    }
+    if (value < min || value > max) {
+      fail(key, "value " + item.Scalar() + " is outside " + Range(min, max));
+    }
+    values.push_back(value);
+  }
+  return values;
+}
+
+std::optional<std::vector<std::string>> YamlMap::strings(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node child = node_[key];
+  if (!child.IsSequence()) fail(key, "expected a list of names, got " + Shown(child));
+  std::vector<std::string> values;
+  for (const YAML::Node& item : child) {
+    if (!item.IsScalar()) fail(key, "expected names, got " + Shown(item));
+    values.push_back(item.Scalar());
+  }
+  return values;
+}
+
+void YamlMap::finish() const {
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string key = it->first.as<std::string>();
+    if (known_.count(key) == 0) {
+      throw InputError(file_ + ":" + LineOf(it->first) + " " + key_path(key) +
+                       ": unknown key (check the spelling; examples/markers.yaml lists every key)");
+    }
+  }
+}
+
+YAML::Node LoadYamlFile(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot open config file (does it exist?)");
+  try {
+    return YAML::Load(in);
+  } catch (const YAML::Exception& e) {
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+  }
+}
+
+}  // namespace softsight
