@@ -1,1 +1,139 @@
-// Placeholder: being written.
+#include "softsight/io/config.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <set>
+
+#include "io/config_sections.h"
+#include "io/yaml_map.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override) {
+  MarkerSpec spec;
+  spec.name = marker.string("name").value_or("");
+  if (spec.name.empty()) marker.fail("name", "every marker needs a name");
+  for (char c : spec.name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
+      marker.fail("name", "'" + spec.name +
+                              "' must use letters, digits, '_' or '-' (it prefixes CSV columns)");
+    }
+  }
+  const bool has_template = marker.has("template");
+  const std::vector<std::string> methods = TrackerMethods();
+  spec.method = marker.choice("method", methods).value_or(has_template ? "zncc" : "colour");
+  if (method_override) spec.method = *method_override;
+  ReadColourParams(marker, &spec.colour);
+  ReadTemplateParams(marker, &spec.templ);
+  marker.finish();
+
+  std::string problem;
+  if (!spec.colour.Check(&problem) || !spec.templ.Check(&problem)) {
+    throw InputError(marker.file() + ": marker '" + spec.name + "': " + problem);
+  }
+  return spec;
+}
+
+}  // namespace
+
+TrackingConfig LoadTrackingConfig(const std::string& file,
+                                  const std::optional<std::string>& method_override) {
+  if (method_override) {
+    const std::vector<std::string> methods = TrackerMethods();
+    if (std::find(methods.begin(), methods.end(), *method_override) == methods.end()) {
+      std::string list;
+      for (const std::string& m : methods) list += (list.empty() ? "" : ", ") + m;
+      throw InputError("--method " + *method_override + ": unknown method (choose " + list + ")");
+    }
+  }
+  const YAML::Node root = LoadYamlFile(file);
+  if (!root.IsDefined() || root.IsNull()) throw InputError(file + ": config file is empty");
+  YamlMap top(root, file, "");
+  TrackingConfig config;
+  config.source_file = file;
+
+  const YAML::Node markers = top.node("markers");
+  if (!markers.IsDefined() || !markers.IsSequence() || markers.size() == 0) {
+    top.fail("markers", "expected a list of markers, each with at least a name");
+  }
+  std::set<std::string> names;
+  for (size_t i = 0; i < markers.size(); ++i) {
+    YamlMap marker(markers[i], file, "markers[" + std::to_string(i) + "]");
+    MarkerSpec spec = ReadMarker(marker, method_override);
+    if (!names.insert(spec.name).second) {
+      marker.fail("name", "marker name '" + spec.name + "' is used twice");
+    }
+    config.markers.push_back(std::move(spec));
+  }
+
+  auto check_names = [&](const std::string& key, const std::vector<std::string>& list) {
+    for (const std::string& name : list) {
+      if (names.count(name) == 0) {
+        top.fail(key, "'" + name + "' is not the name of a marker in this file");
+      }
+    }
+  };
+  if (const auto triple = top.strings("triple")) {
+    if (triple->size() != 3) top.fail("triple", "expected three marker names: [base, middle, tip]");
+    check_names("triple", *triple);
+    if ((*triple)[0] == (*triple)[1] || (*triple)[1] == (*triple)[2] ||
+        (*triple)[0] == (*triple)[2]) {
+      top.fail("triple", "the three markers must be different");
+    }
+    config.measure.base = (*triple)[0];
+    config.measure.middle = (*triple)[1];
+    config.measure.tip = (*triple)[2];
+  }
+  if (const auto chain = top.strings("chain")) {
+    if (chain->size() < 3) top.fail("chain", "a chain lists at least three markers, base to tip");
+    check_names("chain", *chain);
+    config.measure.chain = *chain;
+  }
+  if (const auto reference = top.numbers("tip_reference", 2, -1e6, 1e6)) {
+    config.measure.tip_reference_px = cv::Point2d((*reference)[0], (*reference)[1]);
+  }
+  ReadMetricModel(top, &config.measure.metric);
+  config.camera_file = top.string("camera");
+  top.finish();
+  return config;
+}
+
+void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
+  YAML::Emitter out;
+  out << YAML::Comment("softsight tracking config (see examples/markers.yaml for every key)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "markers" << YAML::Value << YAML::BeginSeq;
+  for (const MarkerSpec& spec : config.markers) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << spec.name;
+    out << YAML::Key << "method" << YAML::Value << spec.method;
+    WriteColourParams(spec.colour, out);
+    WriteTemplateParams(spec.templ, out);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  const MeasureOptions& m = config.measure;
+  if (!m.base.empty()) {
+    out << YAML::Key << "triple" << YAML::Value << YAML::Flow << YAML::BeginSeq << m.base
+        << m.middle << m.tip << YAML::EndSeq;
+  }
+  if (!m.chain.empty()) {
+    out << YAML::Key << "chain" << YAML::Value << YAML::Flow << m.chain;
+  }
+  if (m.tip_reference_px) {
+    out << YAML::Key << "tip_reference" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << m.tip_reference_px->x << m.tip_reference_px->y << YAML::EndSeq;
+  }
+  WriteMetricModel(m.metric, out);
+  if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
+  out << YAML::EndMap;
+
+  std::ofstream stream(file);
+  stream << out.c_str() << "\n";
+  if (!stream) throw InputError(file + ": cannot write config");
+}
+
+}  // namespace softsight

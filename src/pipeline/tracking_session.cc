@@ -1,1 +1,85 @@
-// Placeholder: being written.
+#include "softsight/pipeline/tracking_session.h"
+
+#include <opencv2/core/utility.hpp>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+bool UsesTemplate(const MarkerSpec& spec) { return spec.method != "colour"; }
+
+}  // namespace
+
+TrackingSession::TrackingSession(const TrackingConfig& config)
+    : config_(config), measurer_(config.measure) {
+  for (const MarkerSpec& spec : config_.markers) {
+    trackers_.push_back(CreateTracker(spec));
+    initialised_.push_back(false);
+    result_.markers.push_back({spec.name, {}});
+  }
+}
+
+TrackingSession::~TrackingSession() = default;
+
+const FrameResult& TrackingSession::process(const Frame& frame) {
+  const int64_t start = cv::getTickCount();
+  result_.frame_index = frame.index;
+  result_.time_s = frame.time_s;
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    const MarkerSpec& spec = config_.markers[i];
+    if (!initialised_[i]) {
+      if (!UsesTemplate(spec)) {
+        if (spec.colour.roi) trackers_[i]->init(frame.image, *spec.colour.roi);
+        initialised_[i] = true;
+      } else if (!spec.templ.image.empty()) {
+        trackers_[i]->init(frame.image, cv::Rect());
+        initialised_[i] = true;
+      } else if (spec.templ.rect && frame.index >= spec.templ.template_frame) {
+        trackers_[i]->init(frame.image, *spec.templ.rect);
+        initialised_[i] = true;
+      }
+    }
+    // A template tracker without a template yet (none configured, or its reference frame is
+    // still ahead) has nothing to look for: its marker is not found.
+    result_.markers[i].observation =
+        initialised_[i] ? trackers_[i]->update(frame.image) : Observation{};
+  }
+  result_.measurement = measurer_.measure(result_.markers);
+  result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
+                    cv::getTickFrequency();
+  return result_;
+}
+
+void TrackingSession::reselect(const std::string& marker, const cv::Mat& frame,
+                               const cv::Rect& rect) {
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    if (config_.markers[i].name != marker) continue;
+    trackers_[i]->init(frame, rect);
+    initialised_[i] = true;
+    // Saved configs must reproduce what the mouse did.
+    if (UsesTemplate(config_.markers[i])) {
+      config_.markers[i].templ.rect = rect;
+      config_.markers[i].templ.image.release();
+    } else {
+      config_.markers[i].colour.roi = rect;
+    }
+    return;
+  }
+  throw InputError("no marker named '" + marker + "'");
+}
+
+void TrackingSession::respec(const MarkerSpec& spec) {
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    if (config_.markers[i].name != spec.name) continue;
+    trackers_[i] = CreateTracker(spec);
+    config_.markers[i] = spec;
+    initialised_[i] = false;
+    return;
+  }
+  throw InputError("no marker named '" + spec.name + "'");
+}
+
+void TrackingSession::reset_tip_reference() { measurer_.reset_tip_reference(); }
+
+}  // namespace softsight

@@ -38,4 +38,31 @@ struct MarkerObservation {
   Observation observation;
 };
 
+// One frame's measurements. Absent where undefined (a marker missing, a straight actuator has
+// no radius), never 0. The _mm twins are present only when a metric model is configured.
+struct Measurement {
+  std::optional<double> angle_deg;        // Eq. 7 at the middle marker; 180 when straight.
+  std::optional<double> chord_px;         // c = |base - tip|.
+  std::optional<double> sagitta_px;       // d = distance of the middle marker from the chord.
+  std::optional<double> radius_px;        // Eq. 8, or the circle fit with more than 3 markers.
+  std::optional<double> arc_length_px;    // Eq. 9 (major arc when d > R); = c when straight.
+  std::optional<double> circumradius_px;  // Circle through the three points: a cross-check.
+  std::optional<double> tip_disp_px;      // Bending distance: tip displacement from reference.
+
+  std::optional<double> chord_mm;
+  std::optional<double> sagitta_mm;
+  std::optional<double> radius_mm;
+  std::optional<double> arc_length_mm;
+  std::optional<double> tip_disp_mm;
+};
+
+// Everything the pipeline learned from one frame, as sinks (CSV, overlay, controller) see it.
+struct FrameResult {
+  int64_t frame_index = 0;
+  double time_s = 0.0;
+  std::vector<MarkerObservation> markers;  // In config order.
+  Measurement measurement;
+  double proc_ms = 0.0;                    // Tracking + measurement time for this frame.
+};
+
 }  // namespace softsight

@@ -11,23 +11,7 @@
 
 namespace softsight {
 
-// One frame's measurements. Absent where undefined (a marker missing, a straight actuator has
-// no radius), never 0. The _mm twins are present only when a metric model is configured.
-struct Measurement {
-  std::optional<double> angle_deg;        // Eq. 7 at the middle marker; 180 when straight.
-  std::optional<double> chord_px;         // c = |base - tip|.
-  std::optional<double> sagitta_px;       // d = distance of the middle marker from the chord.
-  std::optional<double> radius_px;        // Eq. 8, or the circle fit with more than 3 markers.
-  std::optional<double> arc_length_px;    // Eq. 9 (major arc when d > R); = c when straight.
-  std::optional<double> circumradius_px;  // Circle through the three points: a cross-check.
-  std::optional<double> tip_disp_px;      // Bending distance: tip displacement from reference.
-
-  std::optional<double> chord_mm;
-  std::optional<double> sagitta_mm;
-  std::optional<double> radius_mm;
-  std::optional<double> arc_length_mm;
-  std::optional<double> tip_disp_mm;
-};
+// Measurement (the per-frame values) is a core value type: softsight/core/types.h.
 
 // How pixels become millimetres. Either one scale (camera axis orthogonal to the actuator's
 // plane) or a homography from undistorted image pixels to plane millimetres (chessboard in the
@@ -35,7 +19,17 @@ struct Measurement {
 struct MetricModel {
   std::optional<double> scale_mm_per_px;
   std::optional<cv::Matx33d> plane_mm_from_image;
+
+  bool empty() const { return !scale_mm_per_px && !plane_mm_from_image; }
+  // At most one of the two; the scale finite and > 0; the homography finite and invertible.
+  // On failure names the bad field in `error`.
+  bool Check(std::string* error) const;
 };
+
+// Maps an (undistorted) image point into the plane through a homography. Absent when the point
+// maps to infinity (it lies on the plane's vanishing line).
+std::optional<cv::Point2d> MapToPlane(const cv::Matx33d& plane_from_image,
+                                      const cv::Point2d& image_px);
 
 struct MeasureOptions {
   std::string base, middle, tip;          // The triple, by marker name.
@@ -45,11 +39,19 @@ struct MeasureOptions {
   // Reference for the bending distance; absent: the tip's position in the first frame where found.
   std::optional<cv::Point2d> tip_reference_px;
   MetricModel metric;
+
+  // base, middle and tip named and distinct; chain empty or at least 3 distinct names; the tip
+  // reference finite; the metric model valid. Unknown marker names are the config's business.
+  bool Check(std::string* error) const;
 };
 
 // Stateful only in the tip reference; everything else is a pure function of the positions.
+// The angle is measured on the image positions in every case (the paper's eq. 7); lengths get
+// _mm twins when options.metric is set: with a scale the pixel lengths are multiplied, with a
+// plane homography the points are mapped into the plane and every length is measured there.
 class Measurer {
  public:
+  // Throws InputError when options.Check fails.
   explicit Measurer(MeasureOptions options);
   Measurement measure(const std::vector<MarkerObservation>& markers);
   // Next frame where the tip is found becomes the reference (or the configured point again).

@@ -34,3 +34,30 @@ class FrameSource {
 };
 
 }  // namespace softsight
+
+namespace softsight {
+
+struct SceneOptions;
+struct NoiseOptions;
+
+// How to open a source. Exactly one of `input` or `camera` is used.
+struct FrameSourceSpec {
+  // A video file (anything FFmpeg reads), a folder of images (sorted by name), or a printf
+  // pattern such as "frames/%04d.png".
+  std::string input;
+  std::optional<int> camera;           // V4L2 camera index (live).
+  // Frame rate for image sequences, whose files carry no timestamps (frames per second).
+  double sequence_fps = 30.0;
+};
+
+// Opens the source; throws InputError naming the file or camera when it cannot be read.
+std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec);
+
+// A synthetic scene as a source (frames rendered on demand, exact timestamps from the scene).
+std::unique_ptr<FrameSource> OpenSyntheticSource(const SceneOptions& scene,
+                                                 const NoiseOptions& noise);
+
+// True when every pixel of a BGR frame has B == G == R (a grayscale video decoded as BGR).
+bool IsGrayscale(const cv::Mat& frame_bgr);
+
+}  // namespace softsight

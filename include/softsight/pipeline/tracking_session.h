@@ -14,13 +14,7 @@
 
 namespace softsight {
 
-struct FrameResult {
-  int64_t frame_index = 0;
-  double time_s = 0.0;
-  std::vector<MarkerObservation> markers;  // In config order.
-  Measurement measurement;
-  double proc_ms = 0.0;                    // Tracking + measurement time for this frame.
-};
+// FrameResult (one frame's observations + measurement) is a core value type: core/types.h.
 
 class TrackingSession {
  public:

@@ -1,0 +1,150 @@
+#include "softsight/io/config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::TempDir;
+
+const char* kValid = R"(markers:
+  - name: red
+    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
+    roi: [150, 300, 40, 40]
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+  - name: green
+    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
+triple: [red, blue, green]
+scale_mm_per_px: 0.2
+)";
+
+// Loads `text` as a config file and returns the error message (empty when it loads).
+std::string ErrorOf(const std::string& text) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), text);
+  try {
+    LoadTrackingConfig(dir.file("markers.yaml"));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, LoadsTheDocumentedExample) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kValid);
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+  ASSERT_EQ(config.markers.size(), 3u);
+  EXPECT_EQ(config.markers[0].name, "red");
+  EXPECT_EQ(config.markers[0].method, "colour");
+  EXPECT_EQ(config.markers[0].colour.h.lo, 170);
+  EXPECT_EQ(config.markers[0].colour.h.hi, 10);
+  ASSERT_TRUE(config.markers[0].colour.roi.has_value());
+  EXPECT_EQ(*config.markers[0].colour.roi, cv::Rect(150, 300, 40, 40));
+  EXPECT_FALSE(config.markers[1].colour.roi.has_value());
+  EXPECT_EQ(config.measure.base, "red");
+  EXPECT_EQ(config.measure.middle, "blue");
+  EXPECT_EQ(config.measure.tip, "green");
+  ASSERT_TRUE(config.measure.metric.scale_mm_per_px.has_value());
+  EXPECT_DOUBLE_EQ(*config.measure.metric.scale_mm_per_px, 0.2);
+}
+
+TEST(Config, MethodOverrideAppliesToEveryMarkerAndUnknownMethodIsRejected) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kValid);
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"), "zncc");
+  for (const MarkerSpec& spec : config.markers) EXPECT_EQ(spec.method, "zncc");
+  EXPECT_THROW(LoadTrackingConfig(dir.file("markers.yaml"), "magic"), InputError);
+}
+
+TEST(Config, SavedConfigLoadsBackToTheSameValues) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kValid);
+  const TrackingConfig original = LoadTrackingConfig(dir.file("markers.yaml"));
+  SaveTrackingConfig(original, dir.file("saved.yaml"));
+  const TrackingConfig again = LoadTrackingConfig(dir.file("saved.yaml"));
+  ASSERT_EQ(again.markers.size(), original.markers.size());
+  for (size_t i = 0; i < again.markers.size(); ++i) {
+    EXPECT_EQ(again.markers[i].name, original.markers[i].name);
+    EXPECT_EQ(again.markers[i].method, original.markers[i].method);
+    EXPECT_EQ(again.markers[i].colour.h.lo, original.markers[i].colour.h.lo);
+    EXPECT_EQ(again.markers[i].colour.h.hi, original.markers[i].colour.h.hi);
+    EXPECT_EQ(again.markers[i].colour.s.lo, original.markers[i].colour.s.lo);
+    EXPECT_EQ(again.markers[i].colour.roi, original.markers[i].colour.roi);
+  }
+  EXPECT_EQ(again.measure.middle, "blue");
+  EXPECT_EQ(again.measure.metric.scale_mm_per_px, original.measure.metric.scale_mm_per_px);
+}
+
+TEST(Config, UnknownKeyIsNamedWithFileAndLine) {
+  const std::string error = ErrorOf(std::string(kValid) + "scale_mm_per_pix: 0.3\n");
+  EXPECT_THAT(error, HasSubstr("markers.yaml:11:"));
+  EXPECT_THAT(error, HasSubstr("scale_mm_per_pix"));
+  EXPECT_THAT(error, HasSubstr("unknown key"));
+}
+
+TEST(Config, UnknownKeyInsideAMarkerIsNamedWithItsPath) {
+  const std::string error = ErrorOf(R"(markers:
+  - name: red
+    colour_of_marker: red
+)");
+  EXPECT_THAT(error, HasSubstr("markers[0].colour_of_marker"));
+  EXPECT_THAT(error, HasSubstr(":3:"));
+}
+
+TEST(Config, WrongTypeIsNamed) {
+  std::string text = kValid;
+  text.replace(text.find("0.2"), 3, "lots");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("scale_mm_per_px"));
+  EXPECT_THAT(error, HasSubstr("'lots'"));
+}
+
+TEST(Config, HueOutsideRangeIsNamed) {
+  std::string text = kValid;
+  text.replace(text.find("[100, 130]"), 10, "[100, 200]");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("markers[1]"));
+  EXPECT_THAT(error, HasSubstr("200"));
+}
+
+TEST(Config, TripleNamingAnUnknownMarkerIsRejected) {
+  std::string text = kValid;
+  text.replace(text.find("[red, blue, green]"), 18, "[red, blue, yellow]");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("triple"));
+  EXPECT_THAT(error, HasSubstr("yellow"));
+}
+
+TEST(Config, StructuralMistakesAreRejected) {
+  EXPECT_THAT(ErrorOf(""), HasSubstr("empty"));
+  EXPECT_THAT(ErrorOf("markers: []\n"), HasSubstr("markers"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: a\n  - name: a\n"), HasSubstr("used twice"));
+  EXPECT_THAT(ErrorOf("markers:\n  - hsv: {h: [1, 2]}\n"), HasSubstr("name"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: a b\n"), HasSubstr("letters"));
+  EXPECT_THAT(ErrorOf(std::string(kValid) + "triple: [red, red, green]\n"), HasSubstr("triple"));
+}
+
+TEST(Config, InvalidYamlReportsTheLine) {
+  const std::string error = ErrorOf("markers:\n  - name: red\n    hsv: {h: [1, 2\n");
+  EXPECT_THAT(error, HasSubstr("markers.yaml:"));
+  EXPECT_THAT(error, HasSubstr("invalid YAML"));
+}
+
+TEST(Config, MissingFileIsNamed) {
+  try {
+    LoadTrackingConfig("/no/such/markers.yaml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/no/such/markers.yaml"));
+  }
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,60 @@
+#include "softsight/io/csv_writer.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::ElementsAre;
+using testing::TempDir;
+
+FrameResult TwoMarkers(bool second_found) {
+  FrameResult result;
+  result.frame_index = 7;
+  result.time_s = 0.25;
+  result.markers.push_back({"red", {cv::Point2d(10.5, 20.25), 0.97}});
+  result.markers.push_back(
+      {"blue", second_found ? Observation{cv::Point2d(1, 2), 0.5} : Observation{}});
+  result.measurement.angle_deg = 135.0;
+  result.measurement.chord_px = 100.0;
+  result.measurement.chord_mm = 20.0;
+  result.proc_ms = 0.125;
+  return result;
+}
+
+TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
+  TempDir dir;
+  { CsvWriter csv(dir.file("a.csv"), {"red", "blue"}, /*metric=*/false); }
+  EXPECT_EQ(testing::ReadLines(dir.file("a.csv")).at(0),
+            "frame,time_s,red_x,red_y,red_found,red_score,blue_x,blue_y,blue_found,blue_score,"
+            "angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,proc_ms");
+  { CsvWriter csv(dir.file("b.csv"), {"red"}, /*metric=*/true, {"target_deg"}); }
+  EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).at(0),
+            "frame,time_s,red_x,red_y,red_found,red_score,angle_deg,chord_px,sagitta_px,"
+            "radius_px,arc_length_px,tip_disp_px,chord_mm,sagitta_mm,radius_mm,arc_length_mm,"
+            "tip_disp_mm,target_deg,proc_ms");
+}
+
+TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
+  TempDir dir;
+  CsvWriter csv(dir.file("run.csv"), {"red", "blue"}, /*metric=*/true);
+  csv.write(TwoMarkers(/*second_found=*/false));
+  // Read while the writer is still open: the row must already be on disk.
+  const std::vector<std::string> lines = testing::ReadLines(dir.file("run.csv"));
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_THAT(testing::SplitCsv(lines[1]),
+              ElementsAre("7", "0.250000", "10.5000", "20.2500", "1", "0.9700", "", "", "0", "",
+                          "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
+                          "0.1250"));
+}
+
+TEST(CsvWriter, UnwritablePathIsAnInputError) {
+  EXPECT_THROW(CsvWriter("/nonexistent-folder/run.csv", {"red"}, false), InputError);
+}
+
+}  // namespace
+}  // namespace softsight
