@@ -26,7 +26,7 @@ function(softsight_add_test module)
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
   gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60
-    PROPERTIES ENVIRONMENT "SOFTSIGHT_SOURCE_DIR=${PROJECT_SOURCE_DIR};SOFTSIGHT_BINARY=$<TARGET_FILE:softsight>")
+    PROPERTIES ENVIRONMENT "SOFTSIGHT_SOURCE_DIR=${PROJECT_SOURCE_DIR};SOFTSIGHT_BINARY=${PROJECT_BINARY_DIR}/src/app/softsight")
 endfunction()
 
 # softsight_add_benchmark(<name> SOURCES ... DEPS ...)

@@ -1,0 +1,186 @@
+// End-to-end tests of `softsight track`: rendered video in, CSV out, checked against the truth.
+#include "app/track_command.h"
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::TempDir;
+
+const char* kConfig = R"(markers:
+  - name: red
+    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+  - name: green
+    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
+triple: [red, blue, green]
+scale_mm_per_px: 0.2
+)";
+
+struct RenderedClip {
+  std::string video;
+  std::vector<SceneTruth> truth;
+};
+
+// Renders a short bending sequence into a lossless video.
+RenderedClip RenderClip(const TempDir& dir, int frames, bool gray = false) {
+  SceneOptions scene;
+  scene.frame_count = frames;
+  scene.max_bend_deg = 200;
+  SyntheticScene renderer(scene);
+  RenderedClip clip;
+  clip.video = dir.file("clip.avi");
+  cv::VideoWriter writer(clip.video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'),
+                         scene.fps, scene.size, /*isColor=*/!gray);
+  EXPECT_TRUE(writer.isOpened());
+  cv::Mat image, gray_image;
+  for (int i = 0; i < frames; ++i) {
+    clip.truth.push_back(renderer.render(i, image));
+    if (gray) {
+      cv::cvtColor(image, gray_image, cv::COLOR_BGR2GRAY);
+      writer << gray_image;
+    } else {
+      writer << image;
+    }
+  }
+  return clip;
+}
+
+struct Run {
+  int exit_code;
+  std::string stderr_text;
+};
+
+Run RunBinary(const std::string& args, const TempDir& dir) {
+  const std::string command =
+      testing::SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::ReadTextFile(dir.file("stderr.txt"))};
+}
+
+TEST(TrackCommand, RenderedVideoGivesTruthWithinTolerances) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 40);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  TrackOptions options;
+  options.config_file = dir.file("markers.yaml");
+  options.source.input = clip.video;
+  options.csv_file = dir.file("out.csv");
+  options.quiet = true;
+  const TrackSummary summary = RunTrack(options);
+  EXPECT_EQ(summary.frames, 40);
+  EXPECT_EQ(summary.stop_reason, "end of input");
+  for (int64_t found : summary.found) EXPECT_EQ(found, 40);
+
+  const std::vector<std::string> lines = testing::ReadLines(options.csv_file);
+  ASSERT_EQ(lines.size(), 41u);
+  const std::vector<std::string> header = testing::SplitCsv(lines[0]);
+  auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  double squared_error = 0, angle_squared_error = 0;
+  for (int i = 0; i < 40; ++i) {
+    const std::vector<std::string> row = testing::SplitCsv(lines[i + 1]);
+    ASSERT_EQ(row.size(), header.size());
+    EXPECT_EQ(row[column("frame")], std::to_string(i));
+    for (const MarkerTruth& marker : clip.truth[i].markers) {
+      ASSERT_TRUE(marker.centroid_px.has_value());
+      const double dx = std::stod(row[column(marker.name + "_x")]) - marker.centroid_px->x;
+      const double dy = std::stod(row[column(marker.name + "_y")]) - marker.centroid_px->y;
+      squared_error += dx * dx + dy * dy;
+    }
+    const double angle = std::stod(row[column("angle_deg")]);
+    angle_squared_error += std::pow(angle - *clip.truth[i].measurement.angle_deg, 2);
+    // Millimetres are the configured scale times pixels.
+    EXPECT_NEAR(std::stod(row[column("chord_mm")]), 0.2 * std::stod(row[column("chord_px")]),
+                1e-3);
+  }
+  EXPECT_LT(std::sqrt(squared_error / (40 * 3)), 0.1) << "centroid RMS error, px";
+  EXPECT_LT(std::sqrt(angle_squared_error / 40), 0.2) << "angle RMS error, deg";
+}
+
+TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 30);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  {  // Cut the file short: the rows of the frames before the cut must survive.
+    std::ifstream in(clip.video, std::ios::binary);
+    std::string data((std::istreambuf_iterator<char>(in)), {});
+    in.close();
+    data.resize(data.size() * 2 / 3);
+    std::ofstream(clip.video, std::ios::binary).write(data.data(), data.size());
+  }
+  const Run run = RunBinary("track -q -c " + dir.file("markers.yaml") + " -i " + clip.video +
+                                " -o " + dir.file("out.csv"),
+                            dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.stderr_text, HasSubstr(clip.video));
+  EXPECT_EQ(std::count(run.stderr_text.begin(), run.stderr_text.end(), '\n'), 1)
+      << "one error line, got: " << run.stderr_text;
+  const std::vector<std::string> lines = testing::ReadLines(dir.file("out.csv"));
+  ASSERT_GT(lines.size(), 10u);
+  ASSERT_LT(lines.size(), 31u);
+  const size_t columns = testing::SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << "row " << i << " is damaged";
+  }
+}
+
+TEST(TrackCommand, GrayVideoWithColourTrackingIsRefusedWithAHint) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 3, /*gray=*/true);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  const Run run = RunBinary("track -c " + dir.file("markers.yaml") + " -i " + clip.video +
+                                " -o " + dir.file("out.csv"),
+                            dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.stderr_text, HasSubstr("grayscale"));
+  EXPECT_THAT(run.stderr_text, HasSubstr(clip.video));
+}
+
+TEST(TrackCommand, BadConfigAndMissingInputExitWithCodeTwo) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("bad.yaml"), "markers:\n  - name: red\n    hsv: {h: [0, 300]}\n");
+  testing::WriteTextFile(dir.file("good.yaml"), kConfig);
+  Run run = RunBinary("track -c " + dir.file("bad.yaml") + " -i x.avi -o " + dir.file("o.csv"), dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.stderr_text, HasSubstr("bad.yaml:3"));
+  run = RunBinary("track -c " + dir.file("good.yaml") + " -i " + dir.file("none.avi") + " -o " +
+                      dir.file("o.csv"),
+                  dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.stderr_text, HasSubstr("none.avi"));
+  run = RunBinary("track -c " + dir.file("good.yaml"), dir);
+  EXPECT_EQ(run.exit_code, 2) << "missing required options";
+}
+
+TEST(TrackCommand, TemplateMethodWithoutTemplateIsRefused) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 2);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  TrackOptions options;
+  options.config_file = dir.file("markers.yaml");
+  options.source.input = clip.video;
+  options.csv_file = dir.file("out.csv");
+  options.method = "zncc";
+  options.quiet = true;
+  EXPECT_THROW(RunTrack(options), InputError);
+}
+
+}  // namespace
+}  // namespace softsight
