@@ -61,12 +61,12 @@ RenderedClip RenderClip(const TempDir& dir, int frames, bool gray = false) {
   return clip;
 }
 
-struct Run {
+struct ProgramRun {
   int exit_code;
   std::string stderr_text;
 };
 
-Run RunBinary(const std::string& args, const TempDir& dir) {
+ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
   const std::string command =
       testing::SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
   const int status = std::system(command.c_str());
@@ -125,7 +125,7 @@ TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
     data.resize(data.size() * 2 / 3);
     std::ofstream(clip.video, std::ios::binary).write(data.data(), data.size());
   }
-  const Run run = RunBinary("track -q -c " + dir.file("markers.yaml") + " -i " + clip.video +
+  const ProgramRun run = RunBinary("track -q -c " + dir.file("markers.yaml") + " -i " + clip.video +
                                 " -o " + dir.file("out.csv"),
                             dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -145,7 +145,7 @@ TEST(TrackCommand, GrayVideoWithColourTrackingIsRefusedWithAHint) {
   TempDir dir;
   const RenderedClip clip = RenderClip(dir, 3, /*gray=*/true);
   testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
-  const Run run = RunBinary("track -c " + dir.file("markers.yaml") + " -i " + clip.video +
+  const ProgramRun run = RunBinary("track -c " + dir.file("markers.yaml") + " -i " + clip.video +
                                 " -o " + dir.file("out.csv"),
                             dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -157,7 +157,7 @@ TEST(TrackCommand, BadConfigAndMissingInputExitWithCodeTwo) {
   TempDir dir;
   testing::WriteTextFile(dir.file("bad.yaml"), "markers:\n  - name: red\n    hsv: {h: [0, 300]}\n");
   testing::WriteTextFile(dir.file("good.yaml"), kConfig);
-  Run run = RunBinary("track -c " + dir.file("bad.yaml") + " -i x.avi -o " + dir.file("o.csv"), dir);
+  ProgramRun run = RunBinary("track -c " + dir.file("bad.yaml") + " -i x.avi -o " + dir.file("o.csv"), dir);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.stderr_text, HasSubstr("bad.yaml:3"));
   run = RunBinary("track -c " + dir.file("good.yaml") + " -i " + dir.file("none.avi") + " -o " +
