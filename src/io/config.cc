@@ -96,7 +96,14 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
     config.measure.tip_reference_px = cv::Point2d((*reference)[0], (*reference)[1]);
   }
   ReadMetricModel(top, &config.measure.metric);
-  config.camera_file = top.string("camera");
+  if (const auto camera = top.string("camera")) {
+    config.camera_file = *camera;
+    try {
+      config.camera = LoadCameraIntrinsics(ResolveBesideFile(file, *camera));
+    } catch (const InputError& e) {
+      top.fail("camera", e.what());
+    }
+  }
   top.finish();
   return config;
 }

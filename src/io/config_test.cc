@@ -128,7 +128,11 @@ TEST(Config, StructuralMistakesAreRejected) {
   EXPECT_THAT(ErrorOf("markers:\n  - name: a\n  - name: a\n"), HasSubstr("used twice"));
   EXPECT_THAT(ErrorOf("markers:\n  - hsv: {h: [1, 2]}\n"), HasSubstr("name"));
   EXPECT_THAT(ErrorOf("markers:\n  - name: a b\n"), HasSubstr("letters"));
-  EXPECT_THAT(ErrorOf(std::string(kValid) + "triple: [red, red, green]\n"), HasSubstr("triple"));
+  std::string same_twice = kValid;
+  same_twice.replace(same_twice.find("[red, blue, green]"), 18, "[red, red, green]");
+  EXPECT_THAT(ErrorOf(same_twice), HasSubstr("different"));
+  EXPECT_THAT(ErrorOf(std::string(kValid) + "triple: [green, blue, red]\n"),
+              HasSubstr("given twice"));
 }
 
 TEST(Config, InvalidYamlReportsTheLine) {

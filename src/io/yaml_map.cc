@@ -1,6 +1,7 @@
 #include "io/yaml_map.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -36,6 +37,15 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
   if (!node_.IsMap()) {
     throw InputError(file_ + ":" + LineOf(node_) + " " + (path_.empty() ? "top level" : path_) +
                      ": expected a mapping of keys, got " + Shown(node_));
+  }
+  // YAML parsers keep one of two equal keys silently; a config with both is a mistake.
+  std::set<std::string> seen;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string key = it->first.Scalar();
+    if (!seen.insert(key).second) {
+      throw InputError(file_ + ":" + LineOf(it->first) + " " + key_path(key) +
+                       ": key given twice");
+    }
   }
 }
 
@@ -184,6 +194,12 @@ void YamlMap::finish() const {
                        ": unknown key (check the spelling; examples/markers.yaml lists every key)");
     }
   }
+}
+
+std::string ResolveBesideFile(const std::string& config_file, const std::string& path) {
+  const std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  return (std::filesystem::path(config_file).parent_path() / p).lexically_normal().string();
 }
 
 YAML::Node LoadYamlFile(const std::string& file) {

@@ -51,6 +51,9 @@ class YamlMap {
   mutable std::set<std::string> known_;
 };
 
+// A path written in a config file, relative to that file's folder unless absolute.
+std::string ResolveBesideFile(const std::string& config_file, const std::string& path);
+
 // Loads a YAML file; throws InputError naming the file (and line) when it is missing or invalid.
 YAML::Node LoadYamlFile(const std::string& file);
 

@@ -18,6 +18,10 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
     initialised_.push_back(false);
     result_.markers.push_back({spec.name, {}});
   }
+  if (config_.camera) {
+    undistorter_.emplace(*config_.camera);
+    undistorted_ = result_.markers;
+  }
 }
 
 TrackingSession::~TrackingSession() = default;
@@ -45,7 +49,25 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     result_.markers[i].observation =
         initialised_[i] ? trackers_[i]->update(frame.image) : Observation{};
   }
-  result_.measurement = measurer_.measure(result_.markers);
+  if (undistorter_) {
+    if (frame.image.size() != undistorter_->camera().image_size) {
+      const cv::Size calibrated = undistorter_->camera().image_size;
+      throw InputError(config_.camera_file.value_or("camera") + ": calibrated for " +
+                       std::to_string(calibrated.width) + "x" + std::to_string(calibrated.height) +
+                       " images, but frame " + std::to_string(frame.index) + " is " +
+                       std::to_string(frame.image.cols) + "x" + std::to_string(frame.image.rows));
+    }
+    for (size_t i = 0; i < result_.markers.size(); ++i) {
+      undistorted_[i].observation = result_.markers[i].observation;
+      if (undistorted_[i].observation.found()) {
+        undistorted_[i].observation.position_px =
+            undistorter_->undistort_point(*result_.markers[i].observation.position_px);
+      }
+    }
+    result_.measurement = measurer_.measure(undistorted_);
+  } else {
+    result_.measurement = measurer_.measure(result_.markers);
+  }
   result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
                     cv::getTickFrequency();
   return result_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "softsight/calib/camera_calibration.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
 
@@ -15,7 +16,10 @@ namespace softsight {
 struct TrackingConfig {
   std::vector<MarkerSpec> markers;
   MeasureOptions measure;              // Triple, chain, tip reference, metric model.
-  std::optional<std::string> camera_file;  // Intrinsics + distortion (softsight calibrate).
+  // Lens model from `softsight calibrate` (the `camera:` key, relative to the config file).
+  // Trackers work on the frames as recorded; measurements use undistorted marker positions.
+  std::optional<std::string> camera_file;
+  std::optional<CameraIntrinsics> camera;
   std::string source_file;             // Where this config was read from ("" if built in code).
 };
 

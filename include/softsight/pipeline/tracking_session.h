@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "softsight/calib/camera_calibration.h"
 #include "softsight/core/types.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/io/config.h"
@@ -23,7 +24,10 @@ class TrackingSession {
   ~TrackingSession();
 
   // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
-  // frame) trackers are initialised from the config's ROIs and template rectangles.
+  // frame) trackers are initialised from the config's ROIs and template rectangles. With a camera
+  // model, observations stay in recorded-image pixels (where the overlay draws them) and the
+  // measurement uses their undistorted positions. Throws InputError when the frame size differs
+  // from the calibrated one.
   const FrameResult& process(const Frame& frame);
 
   // Live recalibration: the marker is inside `rect` on `frame` (re-cuts a template, or restricts
@@ -40,6 +44,8 @@ class TrackingSession {
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;
   Measurer measurer_;
+  std::optional<Undistorter> undistorter_;     // Present when the config names a camera file.
+  std::vector<MarkerObservation> undistorted_; // Reused: what the measurer sees with a lens model.
   FrameResult result_;
 };
 

@@ -1,0 +1,134 @@
+#include "softsight/pipeline/tracking_session.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/core/error.h"
+#include "softsight/geometry/triangle.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
+  MarkerSpec spec;
+  spec.name = name;
+  spec.colour.h = hue;
+  spec.colour.s = {80, 255};
+  spec.colour.v = {40, 255};
+  return spec;
+}
+
+TrackingConfig SceneConfig() {
+  TrackingConfig config;
+  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
+                    ColourMarker("green", {45, 85})};
+  config.measure.base = "red";
+  config.measure.middle = "blue";
+  config.measure.tip = "green";
+  return config;
+}
+
+struct Clip {
+  std::vector<Frame> frames;
+  std::vector<SceneTruth> truth;
+};
+
+Clip Render(int count) {
+  SceneOptions options;
+  options.frame_count = count;
+  options.max_bend_deg = 120;
+  SyntheticScene scene(options);
+  Clip clip;
+  for (int i = 0; i < count; ++i) {
+    Frame frame;
+    clip.truth.push_back(scene.render(i, frame.image));
+    frame.index = i;
+    frame.time_s = clip.truth.back().time_s;
+    clip.frames.push_back(frame);
+  }
+  return clip;
+}
+
+TEST(TrackingSession, TracksEveryMarkerAndMeasuresLikeTheTruth) {
+  const Clip clip = Render(6);
+  TrackingSession session(SceneConfig());
+  for (size_t i = 0; i < clip.frames.size(); ++i) {
+    const FrameResult& result = session.process(clip.frames[i]);
+    EXPECT_EQ(result.frame_index, static_cast<int64_t>(i));
+    EXPECT_DOUBLE_EQ(result.time_s, clip.truth[i].time_s);
+    ASSERT_EQ(result.markers.size(), 3u);
+    for (size_t m = 0; m < 3; ++m) {
+      EXPECT_EQ(result.markers[m].name, clip.truth[i].markers[m].name);
+      ASSERT_TRUE(result.markers[m].observation.found());
+      EXPECT_LT(cv::norm(*result.markers[m].observation.position_px -
+                         *clip.truth[i].markers[m].centroid_px),
+                0.2);
+    }
+    ASSERT_TRUE(result.measurement.angle_deg.has_value());
+    EXPECT_NEAR(*result.measurement.angle_deg, *clip.truth[i].measurement.angle_deg, 0.3);
+    EXPECT_GE(result.proc_ms, 0.0);
+  }
+}
+
+TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
+  const Clip clip = Render(5);
+  TrackingConfig config = SceneConfig();
+  const cv::Point2d blue = *clip.truth[2].markers[1].centroid_px;
+  config.markers[1].method = "zncc";
+  config.markers[1].templ.template_frame = 2;
+  config.markers[1].templ.rect = cv::Rect(static_cast<int>(blue.x) - 12,
+                                          static_cast<int>(blue.y) - 12, 25, 25);
+  TrackingSession session(config);
+  for (int i = 0; i < 5; ++i) {
+    const FrameResult& result = session.process(clip.frames[i]);
+    EXPECT_EQ(result.markers[1].observation.found(), i >= 2) << "frame " << i;
+    EXPECT_EQ(result.measurement.angle_deg.has_value(), i >= 2) << "frame " << i;
+  }
+}
+
+TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
+  const Clip clip = Render(1);
+  TrackingSession session(SceneConfig());
+  session.reselect("blue", clip.frames[0].image, cv::Rect(10, 20, 30, 40));
+  EXPECT_EQ(session.config().markers[1].colour.roi, cv::Rect(10, 20, 30, 40));
+  EXPECT_THROW(session.reselect("yellow", clip.frames[0].image, cv::Rect(0, 0, 5, 5)),
+               InputError);
+}
+
+TEST(TrackingSession, CameraModelMeasuresUndistortedPositionsButReportsRecordedOnes) {
+  const Clip clip = Render(1);
+  TrackingConfig config = SceneConfig();
+  CameraIntrinsics camera;
+  camera.image_size = clip.frames[0].image.size();
+  camera.camera_matrix = cv::Matx33d(500, 0, 320, 0, 500, 240, 0, 0, 1);
+  camera.distortion = {-0.3, 0.1, 0, 0, 0};
+  config.camera = camera;
+  TrackingSession plain(SceneConfig());
+  TrackingSession corrected(config);
+  const FrameResult raw = plain.process(clip.frames[0]);
+  const FrameResult& result = corrected.process(clip.frames[0]);
+  // Positions are where the markers are in the recorded image.
+  for (size_t m = 0; m < 3; ++m) {
+    EXPECT_EQ(*result.markers[m].observation.position_px, *raw.markers[m].observation.position_px);
+  }
+  // The chord is measured between the undistorted base and tip (computed independently here).
+  std::vector<cv::Point2d> ends = {*raw.markers[0].observation.position_px,
+                                   *raw.markers[2].observation.position_px};
+  std::vector<cv::Point2d> undistorted;
+  cv::undistortPoints(ends, undistorted, camera.camera_matrix, camera.distortion, cv::noArray(),
+                      camera.camera_matrix);
+  ASSERT_TRUE(result.measurement.chord_px.has_value());
+  EXPECT_NEAR(*result.measurement.chord_px, cv::norm(undistorted[0] - undistorted[1]), 1e-3);
+  EXPECT_GT(std::abs(*result.measurement.chord_px - *raw.measurement.chord_px), 0.5)
+      << "this lens bends lines visibly: undistortion must change the chord";
+
+  cv::Mat small;
+  cv::resize(clip.frames[0].image, small, {320, 240});
+  EXPECT_THROW(corrected.process(Frame{small, 1, 0.1}), InputError);
+}
+
+}  // namespace
+}  // namespace softsight
