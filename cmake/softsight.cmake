@@ -25,8 +25,12 @@ function(softsight_add_test module)
   add_executable(${target} ${ARG_SOURCES})
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
-  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60
-    PROPERTIES ENVIRONMENT "SOFTSIGHT_SOURCE_DIR=${PROJECT_SOURCE_DIR};SOFTSIGHT_BINARY=${PROJECT_BINARY_DIR}/src/app/softsight")
+  # End-to-end tests find the program and the repository through these (env vars of the same
+  # names override them).
+  target_compile_definitions(${target} PRIVATE
+    SOFTSIGHT_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    SOFTSIGHT_TEST_BINARY="${PROJECT_BINARY_DIR}/src/app/softsight")
+  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60)
 endfunction()
 
 # softsight_add_benchmark(<name> SOURCES ... DEPS ...)

@@ -12,6 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks
   xvfb xauth xdotool     # the live window's tests run under a virtual X server
+  libx11-dev             # the live window checks the X display before opening a window
 )
 
 missing=()

@@ -13,7 +13,12 @@ namespace softsight {
 using CommandRunner = std::function<int()>;
 
 CommandRunner SetupTrackCommand(CLI::App& sub);
+CommandRunner SetupControlCommand(CLI::App& sub);
+CommandRunner SetupRigCommand(CLI::App& sub);
 CommandRunner SetupSynthCommand(CLI::App& sub);
 CommandRunner SetupDemoCommand(CLI::App& sub);
+CommandRunner SetupCalibrateCommand(CLI::App& sub);
+CommandRunner SetupPlotCommand(CLI::App& sub);
+CommandRunner SetupLiveCommand(CLI::App& sub);
 
 }  // namespace softsight

@@ -25,6 +25,16 @@ const CommandEntry kCommands[] = {
     {"track", "Track markers in a video or image sequence and write per-frame measurements",
      SetupTrackCommand},
     {"synth", "Render a synthetic actuator video with exact ground truth", SetupSynthCommand},
+    {"calibrate", "Calibrate the camera from chessboard views, or the plane's mm per pixel",
+     SetupCalibrateCommand},
+    {"live", "Live window on a camera or video: overlay, mouse recalibration, recording",
+     SetupLiveCommand},
+    {"control", "Close the loop: bend the actuator to a target angle over the serial link",
+     SetupControlCommand},
+    {"rig", "Simulated pressure-control board + actuator on a pseudo-terminal (no hardware)",
+     SetupRigCommand},
+    {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",
+     SetupPlotCommand},
 };
 
 int Main(int argc, char** argv) {

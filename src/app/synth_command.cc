@@ -1,4 +1,317 @@
+#include "app/synth_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <regex>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
 #include "app/commands.h"
+#include "softsight/core/error.h"
+
 namespace softsight {
-CommandRunner SetupSynthCommand(CLI::App& sub) { (void)sub; return [] { return 0; }; }
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+void AppendNumber(std::string* line, const std::optional<double>& value) {
+  *line += ',';
+  if (!value) return;
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.6f", *value);
+  *line += buffer;
+}
+
+// Fails early, with the path, when the folder an output goes to does not exist.
+void CheckParentFolder(const std::string& path, const std::string& what) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent)) {
+    throw InputError(path + ": cannot write the " + what + ": folder '" + parent.string() +
+                     "' does not exist");
+  }
+}
+
+// Where frames go: a video through cv::VideoWriter, or numbered image files.
+class FrameSink {
+ public:
+  explicit FrameSink(const SynthOptions& options) : path_(options.out) {
+    if (path_.empty()) throw InputError("--out: give the output video or image pattern");
+    const SceneOptions& scene = options.scene;
+    CheckParentFolder(path_, "output");
+    if (path_.find('%') != std::string::npos) {
+      // Exactly one integer conversion, so snprintf with the frame index is safe.
+      static const std::regex kPattern(R"([^%]*%0?[0-9]*d[^%]*)");
+      if (!std::regex_match(path_, kPattern)) {
+        throw InputError("--out " + path_ +
+                         ": an image pattern needs exactly one %d-style field, e.g. frames/%04d.png");
+      }
+      const std::string ext = Lower(fs::path(path_).extension().string());
+      if (!cv::haveImageWriter("x" + ext)) {
+        throw InputError("--out " + path_ + ": no image writer for '" + ext + "' (use .png)");
+      }
+      images_ = true;
+      format_ = (ext == ".png" ? "PNG images (lossless)" : "images " + ext);
+      return;
+    }
+    const std::string ext = Lower(fs::path(path_).extension().string());
+    std::string codec = Lower(options.codec);
+    if (codec.empty()) {
+      if (ext == ".avi" || ext == ".mkv") {
+        codec = "ffv1";
+      } else if (ext == ".mp4") {
+        codec = "mp4v";
+      } else {
+        throw InputError("--out " + path_ + ": unknown video type '" + ext +
+                         "' (use .avi or .mkv for lossless FFV1, .mp4, or an image pattern such "
+                         "as frames/%04d.png)");
+      }
+    }
+    int fourcc = 0;
+    if (codec == "ffv1") {
+      fourcc = cv::VideoWriter::fourcc('F', 'F', 'V', '1');
+      format_ = "FFV1 video (lossless)";
+    } else if (codec == "hfyu") {
+      fourcc = cv::VideoWriter::fourcc('H', 'F', 'Y', 'U');
+      format_ = "HuffYUV video (lossless)";
+    } else if (codec == "mjpg") {
+      fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
+      format_ = "Motion JPEG video (lossy)";
+    } else if (codec == "mp4v") {
+      fourcc = cv::VideoWriter::fourcc('m', 'p', '4', 'v');
+      format_ = "MPEG-4 video (lossy)";
+    } else {
+      throw InputError("--codec '" + options.codec + "': unknown (choose ffv1, hfyu, mjpg or mp4v)");
+    }
+    writer_.open(path_, cv::CAP_FFMPEG, fourcc, scene.fps, scene.size, true);
+    if (!writer_.isOpened()) {
+      throw InputError(path_ + ": cannot open for writing as " + format_ +
+                       " (check the folder is writable and the codec fits the container)");
+    }
+  }
+
+  void write(const cv::Mat& image, int index) {
+    if (!images_) {
+      writer_.write(image);
+      return;
+    }
+    std::vector<char> name(path_.size() + 32);
+    std::snprintf(name.data(), name.size(), path_.c_str(), index);
+    bool ok = false;
+    try {
+      ok = cv::imwrite(name.data(), image);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    if (!ok) throw InputError(std::string(name.data()) + ": cannot write frame " + std::to_string(index));
+  }
+
+  void close() {
+    if (!images_) writer_.release();
+  }
+
+  const std::string& format() const { return format_; }
+
+ private:
+  std::string path_;
+  bool images_ = false;
+  std::string format_;
+  cv::VideoWriter writer_;
+};
+
+// Parses "x,y,w,h,first,last".
+Occluder ParseOccluder(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) v.clear(), v.resize(7);
+    } catch (const std::exception&) {
+      v.resize(7);
+      break;
+    }
+  }
+  if (v.size() != 6 || v[4] != std::floor(v[4]) || v[5] != std::floor(v[5])) {
+    throw InputError("--occlude '" + text +
+                     "': expected x,y,w,h,first,last (pixels, then whole frame numbers)");
+  }
+  Occluder o;
+  o.rect_px = cv::Rect2d(v[0], v[1], v[2], v[3]);
+  o.first_frame = static_cast<int>(v[4]);
+  o.last_frame = static_cast<int>(v[5]);
+  return o;
+}
+
+cv::Size ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
+    throw InputError("--size '" + text + "': expected WIDTHxHEIGHT, e.g. 640x480");
+  }
+  return cv::Size(w, h);
+}
+
+}  // namespace
+
+std::string TruthCsvHeader(const SceneOptions& scene) {
+  std::string header = "frame,time_s,bend_deg";
+  for (const SceneMarker& m : scene.markers) {
+    header += "," + m.name + "_x," + m.name + "_y," + m.name + "_visible";
+  }
+  header += ",angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,centreline_radius_px";
+  return header;
+}
+
+std::string TruthCsvRow(const SceneTruth& truth) {
+  std::string line = std::to_string(truth.frame_index);
+  AppendNumber(&line, truth.time_s);
+  AppendNumber(&line, truth.bend_deg);
+  for (const MarkerTruth& m : truth.markers) {
+    AppendNumber(&line, m.centroid_px ? std::optional<double>(m.centroid_px->x) : std::nullopt);
+    AppendNumber(&line, m.centroid_px ? std::optional<double>(m.centroid_px->y) : std::nullopt);
+    AppendNumber(&line, m.visible_fraction);
+  }
+  const Measurement& r = truth.measurement;
+  for (const std::optional<double>& v :
+       {r.angle_deg, r.chord_px, r.sagitta_px, r.radius_px, r.arc_length_px, r.tip_disp_px,
+        truth.centreline_radius_px}) {
+    AppendNumber(&line, v);
+  }
+  return line;
+}
+
+std::string FormatSynthSummary(const SynthSummary& s, const SynthOptions& options) {
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "synth: %lld frames %dx%d of scene %s -> %s (%s)%s%s in %.1f s (render %.2f ms/frame)",
+                static_cast<long long>(s.frames), s.size.width, s.size.height, s.scene.c_str(),
+                options.out.c_str(), s.format.c_str(), options.truth_csv ? ", truth -> " : "",
+                options.truth_csv ? options.truth_csv->c_str() : "", s.wall_s, s.render_ms_mean);
+  return line;
+}
+
+SynthSummary RunSynth(const SynthOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.scene.frame_count < 1) {
+    throw InputError("--frames: must be at least 1, got " + std::to_string(options.scene.frame_count));
+  }
+  // Everything is checked before any file is created.
+  SyntheticScene scene(options.scene, options.noise, options.render, options.occluders);
+  if (options.truth_csv) CheckParentFolder(*options.truth_csv, "truth CSV");
+  FrameSink sink(options);
+  std::ofstream truth_file;
+  if (options.truth_csv) {
+    truth_file.open(*options.truth_csv, std::ios::out | std::ios::trunc);
+    if (!truth_file) throw InputError(*options.truth_csv + ": cannot open for writing");
+    truth_file << TruthCsvHeader(options.scene) << "\n";
+  }
+
+  SynthSummary summary;
+  summary.size = options.scene.size;
+  summary.scene = SceneKindName(options.scene.kind);
+  summary.format = sink.format();
+  cv::Mat image;
+  double render_ms = 0.0;
+  for (int i = 0; i < scene.frame_count(); ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const SceneTruth truth = scene.render(i, image);
+    render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    sink.write(image, i);
+    if (truth_file.is_open()) {
+      truth_file << TruthCsvRow(truth) << "\n";
+      if (!truth_file) throw InputError(*options.truth_csv + ": write failed at frame " + std::to_string(i));
+    }
+    ++summary.frames;
+  }
+  sink.close();
+  if (truth_file.is_open()) {
+    truth_file.close();
+    if (!truth_file) throw InputError(*options.truth_csv + ": write failed");
+  }
+  summary.render_ms_mean = render_ms / std::max<int64_t>(1, summary.frames);
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+CommandRunner SetupSynthCommand(CLI::App& sub) {
+  auto options = std::make_shared<SynthOptions>();
+  auto scene_name = std::make_shared<std::string>("bending");
+  auto size = std::make_shared<std::string>("640x480");
+  auto occlusions = std::make_shared<std::vector<std::string>>();
+  SceneOptions& scene = options->scene;
+  NoiseOptions& noise = options->noise;
+  sub.description(
+      "Render a synthetic soft actuator carrying red, blue and green disc markers on a textured\n"
+      "background, with exact ground truth: every marker's centroid (of its visible area), the\n"
+      "bend and the paper's measurements, per frame. Use it to try `softsight track` or to check\n"
+      "accuracy. Example:\n"
+      "  softsight synth --scene bending --frames 300 --out demo.avi --truth truth.csv");
+  sub.add_option("--scene", *scene_name,
+                 "bending: a silicone band bending from straight to --max-bend degrees; "
+                 "wedge1 / wedge4: the paper's triangle actuators (1 segment opening 20 degrees, "
+                 "4 segments opening 80)")
+      ->capture_default_str();
+  sub.add_option("-o,--out", options->out,
+                 "Video (.avi/.mkv: lossless FFV1; .mp4: lossy) or image pattern "
+                 "(frames/%04d.png)")
+      ->required();
+  sub.add_option("--truth", options->truth_csv, "Ground-truth CSV (one row per frame)");
+  sub.add_option("-n,--frames", scene.frame_count, "Number of frames")->capture_default_str();
+  sub.add_option("--size", *size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  sub.add_option("--fps", scene.fps, "Frame rate (sets time_s and the video's rate)")
+      ->capture_default_str();
+  sub.add_option("--max-bend", scene.max_bend_deg,
+                 "bending: total turning of the centre line at full bend, degrees (<= 330)")
+      ->capture_default_str();
+  sub.add_flag("--oscillate", scene.oscillate, "Bend and unbend instead of one sweep");
+  sub.add_option("--cycles", scene.oscillate_cycles, "With --oscillate: bend-unbend cycles")
+      ->capture_default_str();
+  sub.add_option("--length", scene.length_px, "Body length along its centre line, pixels")
+      ->capture_default_str();
+  sub.add_option("--width", scene.width_px, "Body width, pixels")->capture_default_str();
+  sub.add_option("--marker-radius", scene.marker_radius_px, "Marker disc radius, pixels")
+      ->capture_default_str();
+  sub.add_option("--seed", scene.seed, "Background texture (and noise) seed")
+      ->capture_default_str();
+  sub.add_option("--noise", noise.sigma, "Gaussian sensor noise sigma, grey levels")
+      ->capture_default_str();
+  sub.add_option("--blur", noise.blur_sigma_px, "Optical blur (Gaussian sigma), pixels")
+      ->capture_default_str();
+  sub.add_option("--gain-start", noise.gain_start, "Illumination gain at the first frame")
+      ->capture_default_str();
+  sub.add_option("--gain-end", noise.gain_end, "Illumination gain at the last frame (linear ramp)")
+      ->capture_default_str();
+  sub.add_option("--occlude", *occlusions,
+                 "x,y,w,h,first,last: a grey rectangle over everything during frames "
+                 "first..last (repeatable)");
+  sub.add_option("--supersample", options->render.supersample,
+                 "Anti-aliasing sub-samples per pixel side (truth is exact at this resolution)")
+      ->capture_default_str();
+  sub.add_option("--codec", options->codec, "Video codec override: ffv1, hfyu, mjpg or mp4v");
+  sub.add_flag("-q,--quiet", options->quiet, "No summary line");
+  return [options, scene_name, size, occlusions] {
+    options->scene.kind = ParseSceneKind(*scene_name);
+    options->scene.size = ParseSize(*size);
+    options->noise.seed = options->scene.seed;
+    options->occluders.clear();
+    for (const std::string& text : *occlusions) options->occluders.push_back(ParseOccluder(text));
+    const SynthSummary summary = RunSynth(*options);
+    if (!options->quiet) std::cerr << FormatSynthSummary(summary, *options) << "\n";
+    return 0;
+  };
+}
+
 }  // namespace softsight

@@ -9,6 +9,9 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "softsight/core/error.h"
+#include <opencv2/videoio.hpp>
+
+#include "softsight/gui/overlay.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/pipeline/tracking_session.h"
 
@@ -26,9 +29,38 @@ void CheckRunnable(const TrackingConfig& config, const TrackOptions& options) {
   }
 }
 
+// The annotated video: every frame with the overlay drawn on it. Opened on the first frame,
+// when the size is known; MJPG keeps files small (the overlay is for people, not measurement).
+class AnnotatedVideo {
+ public:
+  AnnotatedVideo(std::string path, double fps, OverlayOptions overlay)
+      : path_(std::move(path)), fps_(fps), overlay_(std::move(overlay)) {}
+
+  void write(const Frame& frame, const FrameResult& result) {
+    if (!writer_.isOpened()) {
+      if (!writer_.open(path_, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_,
+                        frame.image.size())) {
+        throw InputError(path_ + ": cannot write the annotated video (use a .avi name in a "
+                         "writable folder)");
+      }
+    }
+    frame.image.copyTo(canvas_);
+    DrawOverlay(canvas_, result, overlay_);
+    writer_.write(canvas_);
+  }
+
+ private:
+  std::string path_;
+  double fps_;
+  OverlayOptions overlay_;
+  cv::VideoWriter writer_;
+  cv::Mat canvas_;
+};
+
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
-    if (spec.method == "colour" || spec.templ.colour) return true;
+    const bool template_method = spec.method != "colour";
+    if (!template_method || spec.templ.colour) return true;
   }
   return false;
 }
@@ -49,7 +81,10 @@ TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out) {
   TrackSummary& summary = summary_out != nullptr ? *summary_out : local;
   summary = TrackSummary{};
 
-  const TrackingConfig config = LoadTrackingConfig(options.config_file, options.method);
+  TrackingConfig config = LoadTrackingConfig(options.config_file, options.method);
+  if (options.template_colour) {
+    for (MarkerSpec& spec : config.markers) spec.templ.colour = *options.template_colour;
+  }
   CheckRunnable(config, options);
   std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
   TrackingSession session(config);
@@ -58,6 +93,11 @@ TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out) {
   const MetricModel& metric = config.measure.metric;
   CsvWriter csv(options.csv_file, names, metric.scale_mm_per_px || metric.plane_mm_from_image);
 
+  std::optional<AnnotatedVideo> annotated;
+  if (options.annotated_file) {
+    annotated.emplace(*options.annotated_file, source->fps().value_or(30.0),
+                      OverlayOptionsFor(config.measure));
+  }
   summary.marker_names = names;
   summary.found.assign(names.size(), 0);
   std::optional<int64_t> total = source->frame_count();
@@ -85,6 +125,7 @@ TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out) {
       }
       const FrameResult& result = session.process(frame);
       csv.write(result);
+      if (annotated) annotated->write(frame, result);
       for (size_t i = 0; i < result.markers.size(); ++i) {
         summary.found[i] += result.markers[i].observation.found() ? 1 : 0;
       }
@@ -140,6 +181,14 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("-m,--method", options->method,
                  "Use this method for every marker: colour, sad, ssd or zncc");
+  CLI::Option* gray = sub.add_flag_function(
+      "--gray", [options](int64_t) { options->template_colour = false; },
+      "Template matching on gray frames (the default unless the config says colour)");
+  sub.add_flag_function(
+         "--colour", [options](int64_t) { options->template_colour = true; },
+         "Template matching on BGR frames: 3x the work, tells same-shape markers of different "
+         "colours apart")
+      ->excludes(gray);
   sub.add_option("--annotated", options->annotated_file,
                  "Also write a video with the overlay drawn on each frame (.avi)");
   sub.add_option("--fps", options->source.sequence_fps,

@@ -17,6 +17,8 @@ struct TrackOptions {
   FrameSourceSpec source;
   std::string csv_file;
   std::optional<std::string> method;         // Overrides every marker's method.
+  // Overrides every template marker's mode: true matches BGR, false gray (--colour / --gray).
+  std::optional<bool> template_colour;
   std::optional<std::string> annotated_file; // Annotated video (overlay drawn on each frame).
   std::optional<int64_t> max_frames;
   bool quiet = false;                        // No progress bar, no summary.

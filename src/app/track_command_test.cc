@@ -114,6 +114,37 @@ TEST(TrackCommand, RenderedVideoGivesTruthWithinTolerances) {
   EXPECT_LT(std::sqrt(angle_squared_error / 40), 0.2) << "angle RMS error, deg";
 }
 
+TEST(TrackCommand, AnnotatedVideoHasEveryFrameWithTheOverlayOnTheMarkers) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 5);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  TrackOptions options;
+  options.config_file = dir.file("markers.yaml");
+  options.source.input = clip.video;
+  options.csv_file = dir.file("out.csv");
+  options.annotated_file = dir.file("annotated.avi");
+  options.quiet = true;
+  RunTrack(options);
+  cv::VideoCapture annotated(*options.annotated_file);
+  ASSERT_TRUE(annotated.isOpened());
+  EXPECT_EQ(annotated.get(cv::CAP_PROP_FRAME_COUNT), 5);
+  cv::VideoCapture original(clip.video);
+  cv::Mat drawn, plain;
+  ASSERT_TRUE(annotated.read(drawn));
+  ASSERT_TRUE(original.read(plain));
+  // The overlay changes pixels around each marker, and leaves a far corner alone.
+  for (const MarkerTruth& marker : clip.truth[0].markers) {
+    const cv::Rect around(cv::Point(static_cast<int>(marker.centroid_px->x) - 16,
+                                    static_cast<int>(marker.centroid_px->y) - 16),
+                          cv::Size(33, 33));
+    EXPECT_GT(cv::norm(drawn(around), plain(around), cv::NORM_L1) / around.area(), 10.0)
+        << marker.name << ": nothing drawn around the marker";
+  }
+  const cv::Rect corner(drawn.cols - 40, drawn.rows - 40, 30, 30);
+  EXPECT_LT(cv::norm(drawn(corner), plain(corner), cv::NORM_L1) / corner.area(), 12.0)
+      << "only JPEG noise expected far from the overlay";
+}
+
 TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
   TempDir dir;
   const RenderedClip clip = RenderClip(dir, 30);

@@ -1,1 +1,154 @@
-// Placeholder: being written.
+#include "softsight/calib/hsv_picker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+constexpr int kHueCount = 180;  // OpenCV's 8-bit hue: 0..179, two degrees per step.
+
+// Linear-interpolated percentile of sorted values, `percent` in [0, 100].
+double Percentile(const std::vector<double>& sorted, double percent) {
+  const double position = percent / 100.0 * (sorted.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(position));
+  const size_t above = std::min(below + 1, sorted.size() - 1);
+  const double frac = position - below;
+  return sorted[below] * (1 - frac) + sorted[above] * frac;
+}
+
+HsvRange LinearRange(std::vector<double> values, const HsvPickOptions& o, int margin,
+                     int floor_at) {
+  std::sort(values.begin(), values.end());
+  const double lo = Percentile(values, o.low_percentile) - margin;
+  const double hi = Percentile(values, o.high_percentile) + margin;
+  return {std::clamp(static_cast<int>(std::floor(lo)), floor_at, 255),
+          std::clamp(static_cast<int>(std::ceil(hi)), 0, 255)};
+}
+
+int WrapHue(int h) { return ((h % kHueCount) + kHueCount) % kHueCount; }
+
+}  // namespace
+
+bool HsvPickOptions::Check(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    *error = message;
+    return false;
+  };
+  if (radius_px < 0 || radius_px > 100) {
+    return fail("radius_px must be in 0..100, got " + std::to_string(radius_px));
+  }
+  if (!(low_percentile >= 0 && low_percentile < high_percentile && high_percentile <= 100)) {
+    return fail("low_percentile and high_percentile must satisfy 0 <= low < high <= 100, got " +
+                std::to_string(low_percentile) + " and " + std::to_string(high_percentile));
+  }
+  if (hue_margin < 0 || hue_margin > 89) {
+    return fail("hue_margin must be in 0..89, got " + std::to_string(hue_margin));
+  }
+  if (saturation_margin < 0 || saturation_margin > 255) {
+    return fail("saturation_margin must be in 0..255, got " + std::to_string(saturation_margin));
+  }
+  if (value_margin < 0 || value_margin > 255) {
+    return fail("value_margin must be in 0..255, got " + std::to_string(value_margin));
+  }
+  if (min_saturation < 0 || min_saturation > 255) {
+    return fail("min_saturation must be in 0..255, got " + std::to_string(min_saturation));
+  }
+  return true;
+}
+
+std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samples,
+                                          const HsvPickOptions& options, std::string* why_not) {
+  std::string error;
+  CV_Assert(options.Check(&error));
+  auto fail = [&](const std::string& message) -> std::optional<HsvPick> {
+    if (why_not != nullptr) *why_not = message;
+    return std::nullopt;
+  };
+  if (hsv_samples.empty()) return fail("no pixels to sample");
+
+  // Only saturated pixels carry a hue; grey rim or background pixels would scatter it.
+  std::vector<cv::Vec3b> coloured;
+  coloured.reserve(hsv_samples.size());
+  for (const cv::Vec3b& p : hsv_samples) {
+    if (p[1] >= options.min_saturation) coloured.push_back(p);
+  }
+  if (coloured.size() * 2 < hsv_samples.size()) {
+    return fail("not a coloured marker: only " + std::to_string(coloured.size()) + " of " +
+                std::to_string(hsv_samples.size()) +
+                " pixels have saturation >= " + std::to_string(options.min_saturation));
+  }
+
+  // Circular mean of the hue, then every hue as a signed offset from it in [-90, 90): the
+  // percentiles of the offsets are well defined whether or not the colour straddles 0.
+  double sum_sin = 0, sum_cos = 0;
+  for (const cv::Vec3b& p : coloured) {
+    const double angle = p[0] * (2 * CV_PI / kHueCount);
+    sum_sin += std::sin(angle);
+    sum_cos += std::cos(angle);
+  }
+  double mean_hue = std::atan2(sum_sin, sum_cos) * (kHueCount / (2 * CV_PI));
+  if (mean_hue < 0) mean_hue += kHueCount;
+  std::vector<double> offsets, sat, val;
+  offsets.reserve(coloured.size());
+  sat.reserve(coloured.size());
+  val.reserve(coloured.size());
+  for (const cv::Vec3b& p : coloured) {
+    double offset = std::fmod(p[0] - mean_hue + 1.5 * kHueCount, kHueCount) - 0.5 * kHueCount;
+    offsets.push_back(offset);
+    sat.push_back(p[1]);
+    val.push_back(p[2]);
+  }
+  std::sort(offsets.begin(), offsets.end());
+  const double lo_offset = Percentile(offsets, options.low_percentile);
+  const double hi_offset = Percentile(offsets, options.high_percentile);
+
+  HsvPick pick;
+  pick.sample_count = static_cast<int>(hsv_samples.size());
+  pick.hue_spread = hi_offset - lo_offset;
+  const int lo = static_cast<int>(std::floor(mean_hue + lo_offset)) - options.hue_margin;
+  const int hi = static_cast<int>(std::ceil(mean_hue + hi_offset)) + options.hue_margin;
+  if (hi - lo + 1 >= kHueCount) {
+    pick.h = {0, kHueCount - 1};  // Covers every hue: saturation and value do the separating.
+  } else {
+    pick.h = {WrapHue(lo), WrapHue(hi)};
+  }
+  // Saturation never goes below min_saturation: below it the hue test means nothing.
+  pick.s = LinearRange(std::move(sat), options, options.saturation_margin, options.min_saturation);
+  pick.v = LinearRange(std::move(val), options, options.value_margin, 0);
+  return pick;
+}
+
+std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
+                                    const HsvPickOptions& options, std::string* why_not) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  const int r = options.radius_px;
+  const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
+  const cv::Rect box = cv::Rect(centre.x - r, centre.y - r, 2 * r + 1, 2 * r + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  std::vector<cv::Vec3b> samples;
+  if (!box.empty()) {
+    cv::Mat hsv;
+    cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+    for (int y = 0; y < hsv.rows; ++y) {
+      for (int x = 0; x < hsv.cols; ++x) {
+        const double dx = box.x + x - click_px.x, dy = box.y + y - click_px.y;
+        if (dx * dx + dy * dy <= (r + 0.5) * (r + 0.5)) samples.push_back(hsv.at<cv::Vec3b>(y, x));
+      }
+    }
+  }
+  if (samples.empty()) {
+    if (why_not != nullptr) *why_not = "the click is outside the image";
+    return std::nullopt;
+  }
+  return PickHsvFromSamples(samples, options, why_not);
+}
+
+bool HsvInRange(const cv::Vec3b& hsv, const HsvRange& h, const HsvRange& s, const HsvRange& v) {
+  const bool hue_ok =
+      h.lo <= h.hi ? (hsv[0] >= h.lo && hsv[0] <= h.hi) : (hsv[0] >= h.lo || hsv[0] <= h.hi);
+  return hue_ok && hsv[1] >= s.lo && hsv[1] <= s.hi && hsv[2] >= v.lo && hsv[2] <= v.hi;
+}
+
+}  // namespace softsight

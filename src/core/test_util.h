@@ -65,12 +65,12 @@ inline std::vector<std::string> SplitCsv(const std::string& line) {
 // Path of the built `softsight` program (set by ctest), for end-to-end tests.
 inline std::string SoftsightBinary() {
   const char* path = std::getenv("SOFTSIGHT_BINARY");
-  return path != nullptr ? path : "softsight";
+  return path != nullptr ? path : SOFTSIGHT_TEST_BINARY;
 }
 
 inline std::string SourceDir() {
   const char* path = std::getenv("SOFTSIGHT_SOURCE_DIR");
-  return path != nullptr ? path : ".";
+  return path != nullptr ? path : SOFTSIGHT_TEST_SOURCE_DIR;
 }
 
 }  // namespace softsight::testing

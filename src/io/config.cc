@@ -6,6 +6,7 @@
 #include <set>
 
 #include "io/config_sections.h"
+#include "io/control_config.h"
 #include "io/yaml_map.h"
 #include "softsight/core/error.h"
 
@@ -103,6 +104,11 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
     } catch (const InputError& e) {
       top.fail("camera", e.what());
     }
+  }
+  if (top.has("control")) {
+    YamlMap control = top.map("control");
+    config.control.emplace();
+    ReadControlConfig(control, &*config.control);
   }
   top.finish();
   return config;

@@ -141,6 +141,26 @@ TEST(Config, InvalidYamlReportsTheLine) {
   EXPECT_THAT(error, HasSubstr("invalid YAML"));
 }
 
+// The shipped examples are documentation: they must stay loadable.
+TEST(Config, ShippedMarkerExamplesLoad) {
+  const std::string dir = testing::SourceDir() + "/examples/";
+  const TrackingConfig config = LoadTrackingConfig(dir + "markers.yaml");
+  EXPECT_EQ(config.markers.size(), 3u);
+  EXPECT_EQ(config.measure.middle, "blue");
+  EXPECT_TRUE(config.measure.metric.scale_mm_per_px.has_value());
+}
+
+TEST(Config, ShippedRigExampleLoadsWithItsControlSection) {
+  const TrackingConfig config = LoadTrackingConfig(testing::SourceDir() + "/examples/rig.yaml");
+  EXPECT_TRUE(config.control.has_value());
+  EXPECT_FALSE(config.markers.empty());
+}
+
+TEST(Config, ControlSectionIsCheckedToo) {
+  const std::string error = ErrorOf(std::string(kValid) + "control:\n  gainz: 3\n");
+  EXPECT_THAT(error, HasSubstr("control.gainz"));
+}
+
 TEST(Config, MissingFileIsNamed) {
   try {
     LoadTrackingConfig("/no/such/markers.yaml");

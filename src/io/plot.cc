@@ -1,1 +1,552 @@
-// Placeholder: being written.
+#include "softsight/io/plot.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <tuple>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+// ---- Layout constants (figure pixels)
+// ------------------------------------------------------------
+constexpr int kLeftMargin = 78;  // Room for y tick labels.
+constexpr int kRightMargin = 24;
+constexpr int kTitleHeight = 38;
+constexpr int kPanelLabelHeight = 26;  // Strip above each plot area holding its y label + legend.
+constexpr int kTickLabelHeight = 24;   // Strip below each plot area holding the x tick labels.
+constexpr int kBottomMargin = 30;      // The x axis title under the last panel.
+constexpr int kYTicks = 5;
+constexpr int kXTicks = 10;
+
+const cv::Scalar kBlack(0, 0, 0);
+const cv::Scalar kGrid(225, 225, 225);
+const cv::Scalar kWhite(255, 255, 255);
+// Series colours (BGR), chosen to stay distinct in print and for common colour blindness.
+const cv::Scalar kMeasured(178, 114, 0);  // blue
+const cv::Scalar kTarget(0, 94, 213);     // vermilion
+const cv::Scalar kBending(115, 158, 0);   // bluish green
+const cv::Scalar kArc(167, 121, 204);     // reddish purple
+const cv::Scalar kPalette[] = {{0, 159, 230}, {233, 180, 86}, {66, 228, 240}, {0, 0, 0}};
+
+std::string Trim(const std::string& s) {
+  const size_t begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  const size_t end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> SplitFields(const std::string& line) {
+  std::vector<std::string> fields;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = line.find(',', start);
+    fields.push_back(Trim(line.substr(start, comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return fields;
+}
+
+bool StartsWith(const std::string& s, const std::string& prefix) {
+  return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+// The unit a column name carries in its suffix, as a person writes it.
+std::string UnitOf(const std::string& column) {
+  const size_t underscore = column.rfind('_');
+  if (underscore == std::string::npos) return "";
+  const std::string suffix = column.substr(underscore + 1);
+  static const std::pair<const char*, const char*> kUnits[] = {
+      {"deg", "deg"}, {"px", "px"},   {"mm", "mm"}, {"s", "s"},
+      {"ms", "ms"},   {"kpa", "kPa"}, {"pa", "Pa"}, {"mbar", "mbar"},
+      {"bar", "bar"}, {"psi", "psi"}, {"pct", "%"}, {"percent", "%"}};
+  for (const auto& [name, shown] : kUnits) {
+    if (suffix == name) return shown;
+  }
+  return "";
+}
+
+std::string WithUnit(const std::string& label, const std::string& unit) {
+  return unit.empty() ? label : label + " [" + unit + "]";
+}
+
+// 1, 2 or 5 times a power of ten, the smallest not below span / max_ticks.
+double NiceStep(double span, int max_ticks) {
+  const double raw = span / std::max(1, max_ticks);
+  if (!(raw > 0) || !std::isfinite(raw)) return 1.0;
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * magnitude >= raw * (1 - 1e-9)) return m * magnitude;
+  }
+  return 10 * magnitude;
+}
+
+struct Range {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  bool empty() const { return lo > hi; }
+  void add(double v) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+};
+
+// Rows where both time and value are present, split into unbroken runs.
+std::vector<std::vector<cv::Point2d>> Runs(const CsvTable& table, size_t time_column,
+                                           const PlotPanel& panel, const PlotSeries& series) {
+  std::vector<std::vector<cv::Point2d>> runs;
+  std::vector<cv::Point2d> run;
+  const auto& t = table.values[time_column];
+  const auto& v = table.values[series.column];
+  for (size_t row = 0; row < table.row_count(); ++row) {
+    if (t[row] && v[row]) {
+      run.push_back(panel.to_pixel(*t[row], *v[row]));
+    } else if (!run.empty()) {
+      runs.push_back(std::move(run));
+      run.clear();
+    }
+  }
+  if (!run.empty()) runs.push_back(std::move(run));
+  return runs;
+}
+
+PlotPanel MakePanel(std::string y_label) {
+  PlotPanel panel;
+  panel.y_label = std::move(y_label);
+  return panel;
+}
+
+// The panels the table supports, in Figure 4's order, then the controller's.
+std::vector<PlotPanel> ChoosePanels(const CsvTable& table) {
+  std::vector<PlotPanel> panels;
+  const auto angle = table.find("angle_deg");
+  const auto target = table.find("target_deg");
+  if (angle || target) {
+    PlotPanel panel = MakePanel("angle [deg]");
+    if (target) panel.series.push_back({"target", *target, kTarget});
+    if (angle) panel.series.push_back({target ? "measured" : "angle", *angle, kMeasured});
+    panels.push_back(panel);
+  }
+  // Millimetres when the CSV has them (a metric model was configured), pixels otherwise.
+  for (const auto& [stem, label, colour] : {std::tuple{"tip_disp", "bending distance", kBending},
+                                            std::tuple{"arc_length", "arc length", kArc}}) {
+    const auto mm = table.find(std::string(stem) + "_mm");
+    const auto px = table.find(std::string(stem) + "_px");
+    if (mm || px) {
+      PlotPanel panel = MakePanel(WithUnit(label, mm ? "mm" : "px"));
+      panel.series.push_back({label, mm ? *mm : *px, colour});
+      panels.push_back(panel);
+    }
+  }
+  // Controller columns: every pressure_* column in one panel, every duty_* column in another.
+  for (const auto& [prefix, label] :
+       {std::pair{"pressure", "pressure"}, std::pair{"duty", "duty"}}) {
+    PlotPanel panel;
+    std::string unit;
+    for (size_t c = 0; c < table.columns.size(); ++c) {
+      if (!StartsWith(table.columns[c], prefix)) continue;
+      if (panel.series.empty()) unit = UnitOf(table.columns[c]);
+      const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
+      panel.series.push_back({table.columns[c], c, colour});
+    }
+    if (!panel.series.empty()) {
+      panel.y_label = WithUnit(label, unit);
+      panels.push_back(panel);
+    }
+  }
+  return panels;
+}
+
+std::string SvgEscape(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    switch (ch) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += ch;
+    }
+  }
+  return out;
+}
+
+std::string SvgColour(const cv::Scalar& bgr) {
+  char buffer[8];
+  std::snprintf(buffer, sizeof(buffer), "#%02x%02x%02x", static_cast<int>(bgr[2]),
+                static_cast<int>(bgr[1]), static_cast<int>(bgr[0]));
+  return buffer;
+}
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2f", v);
+  return buffer;
+}
+
+// ---- Raster text helpers -----------------------------------------------------------------------
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.45;
+
+void Text(cv::Mat& image, const std::string& text, cv::Point anchor, double h_align,
+          double scale = kFontScale, int thickness = 1) {
+  int baseline = 0;
+  const cv::Size size = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  const cv::Point origin(anchor.x - static_cast<int>(h_align * size.width),
+                         anchor.y + size.height / 2);
+  cv::putText(image, text, origin, kFont, scale, kBlack, thickness, cv::LINE_AA);
+}
+
+}  // namespace
+
+std::optional<size_t> CsvTable::find(const std::string& column) const {
+  for (size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c] == column) return c;
+  }
+  return std::nullopt;
+}
+
+CsvTable ReadCsvTable(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot read CSV (" + std::strerror(errno) + ")");
+  CsvTable table;
+  table.source = file;
+  std::string line;
+  if (!std::getline(in, line) || Trim(line).empty()) {
+    throw InputError(file + ": empty CSV, expected a header line");
+  }
+  table.columns = SplitFields(line);
+  table.values.resize(table.columns.size());
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitFields(line);
+    if (fields.size() != table.columns.size()) {
+      throw InputError(file + ":" + std::to_string(line_number) + ": expected " +
+                       std::to_string(table.columns.size()) + " fields, found " +
+                       std::to_string(fields.size()));
+    }
+    for (size_t c = 0; c < fields.size(); ++c) {
+      std::optional<double> value;
+      if (!fields[c].empty()) {
+        char* end = nullptr;
+        const double parsed = std::strtod(fields[c].c_str(), &end);
+        if (end != fields[c].c_str() + fields[c].size()) {
+          throw InputError(file + ":" + std::to_string(line_number) + ": column " +
+                           table.columns[c] + ": '" + fields[c] + "' is not a number");
+        }
+        if (std::isfinite(parsed)) value = parsed;
+      }
+      table.values[c].push_back(value);
+    }
+  }
+  return table;
+}
+
+bool PlotOptions::Check(std::string* error) const {
+  if (width_px < 300 || width_px > 10000) {
+    *error = "width_px must be in 300..10000, got " + std::to_string(width_px);
+    return false;
+  }
+  if (panel_height_px < 100 || panel_height_px > 5000) {
+    *error = "panel_height_px must be in 100..5000, got " + std::to_string(panel_height_px);
+    return false;
+  }
+  return true;
+}
+
+cv::Point2d PlotPanel::to_pixel(double time_s, double value) const {
+  const double fx = (time_s - x_min) / (x_max - x_min);
+  const double fy = (value - y_min) / (y_max - y_min);
+  return {plot_rect.x + fx * (plot_rect.width - 1),
+          plot_rect.y + (1.0 - fy) * (plot_rect.height - 1)};
+}
+
+std::vector<double> NiceTicks(double lo, double hi, int max_ticks) {
+  std::vector<double> ticks;
+  if (!(hi > lo)) return ticks;
+  const double step = NiceStep(hi - lo, max_ticks);
+  const double eps = step * 1e-9;
+  for (double k = std::ceil((lo - eps) / step); k * step <= hi + eps; k += 1) {
+    double tick = k * step;
+    if (std::abs(tick) < eps) tick = 0.0;  // No "-0".
+    ticks.push_back(tick);
+  }
+  return ticks;
+}
+
+std::string FormatTick(double value, double step) {
+  const int decimals =
+      step > 0 ? std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9))) : 0;
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  std::string text = buffer;
+  if (text.find_first_not_of("-0.") == std::string::npos && text[0] == '-') text.erase(0, 1);
+  return text;
+}
+
+PlotLayout ComputePlotLayout(const CsvTable& table, const PlotOptions& options) {
+  std::string error;
+  if (!options.Check(&error)) throw InputError("plot options: " + error);
+  const auto time_column = table.find("time_s");
+  if (!time_column) throw InputError(table.source + ": no time_s column to plot against");
+  if (table.row_count() == 0) throw InputError(table.source + ": no rows to plot");
+
+  PlotLayout layout;
+  layout.time_column = *time_column;
+  layout.panels = ChoosePanels(table);
+  if (layout.panels.empty()) {
+    throw InputError(table.source +
+                     ": nothing to plot (no angle_deg, tip_disp_*, arc_length_*, target_deg, "
+                     "pressure* or duty* column)");
+  }
+  if (options.title.empty()) {
+    const size_t slash = table.source.find_last_of('/');
+    layout.title = slash == std::string::npos ? table.source : table.source.substr(slash + 1);
+  } else {
+    layout.title = options.title;
+  }
+
+  Range time;
+  for (const auto& t : table.values[*time_column]) {
+    if (t) time.add(*t);
+  }
+  if (time.empty()) throw InputError(table.source + ": every time_s value is empty");
+  if (time.hi - time.lo < 1e-9) {  // One instant: centre it in a one-second axis.
+    time.lo -= 0.5;
+    time.hi += 0.5;
+  }
+
+  const int n = static_cast<int>(layout.panels.size());
+  layout.size =
+      cv::Size(options.width_px, kTitleHeight + n * options.panel_height_px + kBottomMargin);
+  for (int i = 0; i < n; ++i) {
+    PlotPanel& panel = layout.panels[i];
+    const int top = kTitleHeight + i * options.panel_height_px;
+    panel.plot_rect = cv::Rect(kLeftMargin, top + kPanelLabelHeight,
+                               options.width_px - kLeftMargin - kRightMargin,
+                               options.panel_height_px - kPanelLabelHeight - kTickLabelHeight);
+    panel.x_min = time.lo;
+    panel.x_max = time.hi;
+    panel.x_ticks = NiceTicks(time.lo, time.hi, kXTicks);
+
+    Range values;
+    for (const PlotSeries& series : panel.series) {
+      for (size_t row = 0; row < table.row_count(); ++row) {
+        const auto& v = table.values[series.column][row];
+        if (v && table.values[*time_column][row]) values.add(*v);
+      }
+    }
+    panel.has_data = !values.empty();
+    if (!panel.has_data) {
+      values.lo = 0.0;
+      values.hi = 1.0;
+    } else if (values.hi - values.lo < 1e-9) {
+      const double pad = std::max(1.0, std::abs(values.lo) * 0.05);
+      values.lo -= pad;
+      values.hi += pad;
+    }
+    // Round axis ends at the enclosing ticks, with a little headroom so lines clear the frame.
+    const double pad = 0.04 * (values.hi - values.lo);
+    const double step = NiceStep(values.hi - values.lo + 2 * pad, kYTicks);
+    panel.y_min = std::floor((values.lo - pad) / step) * step;
+    panel.y_max = std::ceil((values.hi + pad) / step) * step;
+    panel.y_ticks = NiceTicks(panel.y_min, panel.y_max, kYTicks);
+  }
+  return layout;
+}
+
+cv::Mat RenderPlotImage(const CsvTable& table, const PlotLayout& layout) {
+  cv::Mat image(layout.size, CV_8UC3, kWhite);
+  Text(image, layout.title, {layout.size.width / 2, kTitleHeight / 2}, 0.5, 0.6, 1);
+  for (size_t p = 0; p < layout.panels.size(); ++p) {
+    const PlotPanel& panel = layout.panels[p];
+    const cv::Rect& r = panel.plot_rect;
+    const int bottom = r.y + r.height - 1;
+    const int right = r.x + r.width - 1;
+    const double x_step = panel.x_ticks.size() > 1 ? panel.x_ticks[1] - panel.x_ticks[0] : 1.0;
+    const double y_step = panel.y_ticks.size() > 1 ? panel.y_ticks[1] - panel.y_ticks[0] : 1.0;
+    for (double t : panel.x_ticks) {
+      const int x = cvRound(panel.to_pixel(t, panel.y_min).x);
+      cv::line(image, {x, r.y}, {x, bottom}, kGrid, 1);
+      cv::line(image, {x, bottom}, {x, bottom + 4}, kBlack, 1);
+      Text(image, FormatTick(t, x_step), {x, bottom + 13}, 0.5);
+    }
+    for (double v : panel.y_ticks) {
+      const int y = cvRound(panel.to_pixel(panel.x_min, v).y);
+      cv::line(image, {r.x, y}, {right, y}, kGrid, 1);
+      cv::line(image, {r.x - 4, y}, {r.x, y}, kBlack, 1);
+      Text(image, FormatTick(v, y_step), {r.x - 7, y}, 1.0);
+    }
+    cv::rectangle(image, r, kBlack, 1);
+    Text(image, panel.y_label, {r.x, r.y - kPanelLabelHeight / 2}, 0.0, 0.5, 1);
+    if (!panel.has_data) {
+      Text(image, "(no values)", {r.x + r.width / 2, r.y + r.height / 2}, 0.5);
+    }
+
+    // Legend, right-aligned in the label strip: a line sample and the series label.
+    int legend_right = right;
+    for (auto it = panel.series.rbegin(); it != panel.series.rend(); ++it) {
+      int baseline = 0;
+      const int width = cv::getTextSize(it->label, kFont, kFontScale, 1, &baseline).width;
+      const int y = r.y - kPanelLabelHeight / 2;
+      Text(image, it->label, {legend_right, y}, 1.0);
+      cv::line(image, {legend_right - width - 30, y}, {legend_right - width - 6, y}, it->bgr, 2,
+               cv::LINE_AA);
+      legend_right -= width + 46;
+    }
+
+    // Curves, sub-pixel (shift) and anti-aliased, clipped to the plot area.
+    cv::Mat area = image(r);
+    constexpr int kShift = 4;
+    for (const PlotSeries& series : panel.series) {
+      for (const auto& run : Runs(table, layout.time_column, panel, series)) {
+        std::vector<cv::Point> points;
+        points.reserve(run.size());
+        for (const cv::Point2d& p : run) {
+          points.emplace_back(cvRound((p.x - r.x) * (1 << kShift)),
+                              cvRound((p.y - r.y) * (1 << kShift)));
+        }
+        if (points.size() == 1) {
+          cv::circle(area, points[0], 3 << kShift, series.bgr, cv::FILLED, cv::LINE_AA, kShift);
+        } else {
+          cv::polylines(area, points, false, series.bgr, 2, cv::LINE_AA, kShift);
+        }
+      }
+    }
+  }
+  if (!layout.panels.empty()) {
+    const cv::Rect& r = layout.panels.back().plot_rect;
+    Text(image, "time [s]", {r.x + r.width / 2, layout.size.height - kBottomMargin / 2}, 0.5, 0.5);
+  }
+  return image;
+}
+
+std::string RenderPlotSvg(const CsvTable& table, const PlotLayout& layout) {
+  std::ostringstream svg;
+  const int w = layout.size.width, h = layout.size.height;
+  svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
+      << "\" viewBox=\"0 0 " << w << ' ' << h << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+      << "<rect x=\"0\" y=\"0\" width=\"" << w << "\" height=\"" << h << "\" fill=\"white\"/>\n"
+      << "<text x=\"" << w / 2 << "\" y=\"" << kTitleHeight / 2 + 5
+      << "\" text-anchor=\"middle\" font-size=\"15\">" << SvgEscape(layout.title) << "</text>\n";
+  for (const PlotPanel& panel : layout.panels) {
+    const cv::Rect& r = panel.plot_rect;
+    const double bottom = r.y + r.height - 1, right = r.x + r.width - 1;
+    const double x_step = panel.x_ticks.size() > 1 ? panel.x_ticks[1] - panel.x_ticks[0] : 1.0;
+    const double y_step = panel.y_ticks.size() > 1 ? panel.y_ticks[1] - panel.y_ticks[0] : 1.0;
+    svg << "<g>\n";
+    for (double t : panel.x_ticks) {
+      const double x = panel.to_pixel(t, panel.y_min).x;
+      svg << "<line x1=\"" << Num(x) << "\" y1=\"" << r.y << "\" x2=\"" << Num(x) << "\" y2=\""
+          << Num(bottom) << "\" stroke=\"#e1e1e1\"/>\n"
+          << "<text x=\"" << Num(x) << "\" y=\"" << Num(bottom + 17) << "\" text-anchor=\"middle\">"
+          << FormatTick(t, x_step) << "</text>\n";
+    }
+    for (double v : panel.y_ticks) {
+      const double y = panel.to_pixel(panel.x_min, v).y;
+      svg << "<line x1=\"" << r.x << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(right) << "\" y2=\""
+          << Num(y) << "\" stroke=\"#e1e1e1\"/>\n"
+          << "<text x=\"" << r.x - 7 << "\" y=\"" << Num(y + 4) << "\" text-anchor=\"end\">"
+          << FormatTick(v, y_step) << "</text>\n";
+    }
+    svg << "<rect x=\"" << r.x << "\" y=\"" << r.y << "\" width=\"" << r.width - 1 << "\" height=\""
+        << r.height - 1 << "\" fill=\"none\" stroke=\"black\"/>\n"
+        << "<text x=\"" << r.x << "\" y=\"" << r.y - 8 << "\" font-size=\"13\">"
+        << SvgEscape(panel.y_label) << "</text>\n";
+    if (!panel.has_data) {
+      svg << "<text x=\"" << r.x + r.width / 2 << "\" y=\"" << r.y + r.height / 2
+          << "\" text-anchor=\"middle\">(no values)</text>\n";
+    }
+    int legend_right = r.x + r.width - 1;
+    for (auto it = panel.series.rbegin(); it != panel.series.rend(); ++it) {
+      // Approximate width of sans-serif at 12 px: 6.5 px per character.
+      const int width = static_cast<int>(6.5 * it->label.size());
+      svg << "<text x=\"" << legend_right << "\" y=\"" << r.y - 8 << "\" text-anchor=\"end\">"
+          << SvgEscape(it->label) << "</text>\n"
+          << "<line x1=\"" << legend_right - width - 30 << "\" y1=\"" << r.y - 12 << "\" x2=\""
+          << legend_right - width - 6 << "\" y2=\"" << r.y - 12 << "\" stroke=\""
+          << SvgColour(it->bgr) << "\" stroke-width=\"2\"/>\n";
+      legend_right -= width + 46;
+    }
+    for (const PlotSeries& series : panel.series) {
+      const std::string colour = SvgColour(series.bgr);
+      for (const auto& run : Runs(table, layout.time_column, panel, series)) {
+        if (run.size() == 1) {
+          svg << "<circle cx=\"" << Num(run[0].x) << "\" cy=\"" << Num(run[0].y)
+              << "\" r=\"3\" fill=\"" << colour << "\"/>\n";
+          continue;
+        }
+        svg << "<polyline fill=\"none\" stroke=\"" << colour
+            << "\" stroke-width=\"2\" stroke-linejoin=\"round\" points=\"";
+        for (size_t i = 0; i < run.size(); ++i) {
+          svg << (i ? " " : "") << Num(run[i].x) << ',' << Num(run[i].y);
+        }
+        svg << "\"/>\n";
+      }
+    }
+    svg << "</g>\n";
+  }
+  if (!layout.panels.empty()) {
+    const cv::Rect& r = layout.panels.back().plot_rect;
+    svg << "<text x=\"" << r.x + r.width / 2 << "\" y=\"" << h - kBottomMargin / 2 + 5
+        << "\" text-anchor=\"middle\" font-size=\"13\">time [s]</text>\n";
+  }
+  svg << "</svg>\n";
+  return svg.str();
+}
+
+void WritePlot(const std::string& csv_file, const std::string& out_file,
+               const PlotOptions& options) {
+  const CsvTable table = ReadCsvTable(csv_file);
+  const PlotLayout layout = ComputePlotLayout(table, options);
+  std::string extension;
+  const size_t dot = out_file.find_last_of('.');
+  if (dot != std::string::npos && out_file.find('/', dot) == std::string::npos) {
+    extension = out_file.substr(dot + 1);
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  }
+  if (extension == "svg") {
+    std::ofstream out(out_file);
+    out << RenderPlotSvg(table, layout);
+    out.close();
+    if (!out) throw InputError(out_file + ": cannot write SVG (" + std::strerror(errno) + ")");
+    return;
+  }
+  if (extension.empty() || !cv::haveImageWriter(out_file)) {
+    throw InputError(out_file + ": unknown image type '." + extension +
+                     "' (use .png, .jpg or .svg)");
+  }
+  bool written = false;
+  try {
+    written = cv::imwrite(out_file, RenderPlotImage(table, layout));
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  if (!written) throw InputError(out_file + ": cannot write image");
+}
+
+}  // namespace softsight

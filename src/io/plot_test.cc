@@ -1,15 +1,15 @@
 #include "softsight/io/plot.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <sstream>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "softsight/core/error.h"
 
@@ -129,9 +129,8 @@ TEST(NiceTicksTest, RoundStepsCoverRange) {
   EXPECT_EQ(NiceTicks(0, 10, 5), (std::vector<double>{0, 2, 4, 6, 8, 10}));
   EXPECT_EQ(NiceTicks(0, 10, 10), (std::vector<double>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
   const std::vector<double> ticks = NiceTicks(-0.37, 1.23, 5);
-  ASSERT_EQ(ticks.size(), 4u);  // step 0.5: 0, 0.5, 1 ... plus nothing below -0.37 but 0
-  EXPECT_DOUBLE_EQ(ticks.front(), 0.0);
-  EXPECT_DOUBLE_EQ(ticks.back(), 1.0);
+  // Span 1.6 over at most ~5 ticks: step 0.5, ticks inside the range only.
+  EXPECT_EQ(ticks, (std::vector<double>{0.0, 0.5, 1.0}));
   EXPECT_TRUE(NiceTicks(3, 3, 5).empty());
   EXPECT_EQ(FormatTick(0.5, 0.5), "0.5");
   EXPECT_EQ(FormatTick(120, 20), "120");
@@ -140,7 +139,8 @@ TEST(NiceTicksTest, RoundStepsCoverRange) {
 }
 
 TEST_F(PlotTest, PngCurvesLieWhereTheDataSays) {
-  const std::string csv = WriteCsv("run.csv", 101, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);
+  const std::string csv =
+      WriteCsv("run.csv", 101, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);
   const std::string png = Path("run.png");
   WritePlot(csv, png);
   const cv::Mat image = cv::imread(png);
@@ -245,13 +245,13 @@ TEST_F(PlotTest, MillimetreColumnsWinWhenPresent) {
 }
 
 TEST_F(PlotTest, ControllerColumnsAddTargetAndPressurePanels) {
-  const std::string csv = WriteCsv(
-      "control.csv", 31, 0.1, kLinearAngle, kLinearTip, kLinearArc, false,
-      ",target_deg,pressure_setpoint_kpa,pressure_kpa,duty_pct", [](double t) {
-        std::ostringstream s;
-        s << "," << 120 << "," << 20 + t << "," << 18 + t << "," << 50;
-        return s.str();
-      });
+  const std::string csv =
+      WriteCsv("control.csv", 31, 0.1, kLinearAngle, kLinearTip, kLinearArc, false,
+               ",target_deg,pressure_setpoint_kpa,pressure_kpa,duty_pct", [](double t) {
+                 std::ostringstream s;
+                 s << "," << 120 << "," << 20 + t << "," << 18 + t << "," << 50;
+                 return s.str();
+               });
   const CsvTable table = ReadCsvTable(csv);
   const PlotLayout layout = ComputePlotLayout(table, PlotOptions{});
   ASSERT_EQ(layout.panels.size(), 5u);
@@ -265,9 +265,9 @@ TEST_F(PlotTest, ControllerColumnsAddTargetAndPressurePanels) {
   WritePlot(csv, Path("control.png"));
   const cv::Mat image = cv::imread(Path("control.png"));
   EXPECT_EQ(image.size(), layout.size);
-  // The target line is flat at 120 deg.
+  // The target line is flat at 120 deg (the measured one crosses it at t = 2.5 s).
   const PlotPanel& angle = layout.panels[0];
-  for (double t : {0.5, 1.5, 2.5}) {
+  for (double t : {0.2, 1.0, 1.8}) {
     EXPECT_TRUE(ColourNear(image, angle.to_pixel(t, 120.0), angle.series[0].bgr, 1)) << t;
   }
 }
@@ -302,7 +302,8 @@ TEST_F(PlotTest, BadInputIsOneLineNamingTheFile) {
   std::ofstream(ragged) << "frame,time_s,angle_deg\n0,0\n";
   expect_error([&] { WritePlot(ragged, Path("x.png")); }, "ragged.csv:2: expected 3 fields");
 
-  const std::string good = WriteCsv("good.csv", 5, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);
+  const std::string good =
+      WriteCsv("good.csv", 5, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);
   expect_error([&] { WritePlot(good, Path("x.unknownext")); }, "x.unknownext");
   expect_error([&] { WritePlot(good, Path("no_such_dir/x.png")); }, "no_such_dir/x.png");
 }

@@ -1,1 +1,67 @@
-// Placeholder: being written.
+// The name -> factory table behind CreateTracker: adding a method is one row.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "softsight/core/error.h"
+#include "softsight/track/tracker.h"
+#include "track/colour_tracker_impl.h"
+
+namespace softsight {
+namespace {
+
+using Factory = std::unique_ptr<Tracker> (*)(const MarkerSpec& spec);
+
+struct Method {
+  const char* name;
+  Factory create;
+};
+
+// Each factory checks its own parameters, so the error names the marker and the bad field.
+[[noreturn]] void BadParams(const MarkerSpec& spec, const std::string& problem) {
+  throw InputError("marker '" + spec.name + "': " + problem);
+}
+
+std::unique_ptr<Tracker> CreateColour(const MarkerSpec& spec) {
+  std::string problem;
+  if (!spec.colour.Check(&problem)) BadParams(spec, problem);
+  return std::make_unique<ColourTracker>(spec.colour);
+}
+
+// Template matching: the method name picks the measure.
+template <MatchMeasure kMeasure>
+std::unique_ptr<Tracker> CreateTemplate(const MarkerSpec& spec) {
+  TemplateParams params = spec.templ;
+  params.measure = kMeasure;
+  std::string problem;
+  if (!params.Check(&problem)) BadParams(spec, problem);
+  return CreateTemplateTracker(params);
+}
+
+// In the order --help lists them.
+const Method kMethods[] = {
+    {"colour", &CreateColour},
+    {"sad", &CreateTemplate<MatchMeasure::kSad>},
+    {"ssd", &CreateTemplate<MatchMeasure::kSsd>},
+    {"zncc", &CreateTemplate<MatchMeasure::kZncc>},
+};
+
+}  // namespace
+
+std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec) {
+  for (const Method& method : kMethods) {
+    if (spec.method == method.name) return method.create(spec);
+  }
+  std::string list;
+  for (const Method& method : kMethods) list += (list.empty() ? "" : ", ") + std::string(method.name);
+  throw InputError("marker '" + spec.name + "': unknown method '" + spec.method + "' (choose " +
+                   list + ")");
+}
+
+std::vector<std::string> TrackerMethods() {
+  std::vector<std::string> names;
+  for (const Method& method : kMethods) names.emplace_back(method.name);
+  return names;
+}
+
+}  // namespace softsight

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "softsight/calib/camera_calibration.h"
+#include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
 
@@ -20,6 +21,8 @@ struct TrackingConfig {
   // Trackers work on the frames as recorded; measurements use undistorted marker positions.
   std::optional<std::string> camera_file;
   std::optional<CameraIntrinsics> camera;
+  // The `control:` section (gains, limits, rig), when the file has one: `softsight control`.
+  std::optional<ControlConfig> control;
   std::string source_file;             // Where this config was read from ("" if built in code).
 };
 

@@ -33,9 +33,12 @@ struct SceneOptions {
   int frame_count = 300;
   double fps = 30.0;
   // Bending over time, from straight (0) to `max_bend_deg` total turning of the centre line
-  // (> 180: well past a half circle). The profile is smooth and monotonic unless `oscillate`.
+  // (> 180: well past a half circle; at most 330, beyond that the band would touch itself).
+  // The profile is smooth (a raised cosine) and monotonic unless `oscillate`.
+  // The wedge scenes ignore it: they open to their design angle (20 / 80 degrees in total).
   double max_bend_deg = 240.0;
   bool oscillate = false;   // Bend and unbend (a sine) instead of one monotonic sweep.
+  int oscillate_cycles = 1; // With `oscillate`: bend-unbend cycles over the whole sequence.
   double length_px = 300.0; // Centre-line length of the body.
   double width_px = 40.0;
   double marker_radius_px = 9.0;
@@ -45,6 +48,9 @@ struct SceneOptions {
                                       {"blue", {220, 90, 40}, 0.5},
                                       {"green", {60, 200, 60}, 0.9}};
   uint64_t seed = 1;        // Background texture.
+
+  // False with a one-line message naming the bad field.
+  bool Check(std::string* error) const;
 };
 
 struct NoiseOptions {
@@ -52,14 +58,22 @@ struct NoiseOptions {
   double blur_sigma_px = 0.0; // Optical blur (Gaussian), applied before noise.
   double gain_start = 1.0;    // Illumination gain at the first frame ...
   double gain_end = 1.0;      // ... ramping linearly to this at the last frame.
-  uint64_t seed = 7;
+  uint64_t seed = 7;         // Noise is a function of (seed, frame index): any order, same frames.
+
+  bool Check(std::string* error) const;
 };
 
 struct RenderOptions {
   int supersample = 4;        // Sub-samples per pixel side; the truth is exact at this resolution.
+                              // 1..16; cost grows with its square (4 keeps 640x480 near 5 ms).
+
+  bool Check(std::string* error) const;
 };
 
-// A rectangle drawn over everything else during frames [first_frame, last_frame].
+// A rectangle drawn over everything else during frames [first_frame, last_frame] (inclusive).
+// It covers the area [x - 0.5, x + width - 0.5) x [y - 0.5, y + height - 0.5) in the pixel-centre
+// convention: integer values cover exactly the pixels of the cv::Rect (x, y, width, height),
+// fractional ones give anti-aliased edges.
 struct Occluder {
   cv::Rect2d rect_px;
   int first_frame = 0;
@@ -79,9 +93,13 @@ struct SceneTruth {
   int64_t frame_index = 0;
   double time_s = 0.0;
   double bend_deg = 0.0;                 // Total turning of the centre line (the actuator state).
-  std::optional<double> centreline_radius_px;  // Radius of the centre-line arc; absent when straight.
+  // Radius of the centre-line arc; absent when straight and for the wedge scenes (no arc).
+  std::optional<double> centreline_radius_px;
   std::vector<MarkerTruth> markers;
-  Measurement measurement;               // The paper's measurements from the true centroids.
+  // The paper's measurements from the true centroids: base, middle and tip are the markers with
+  // the smallest, median and largest body_fraction (all of them as a chain when more than 3);
+  // the tip reference is the tip marker's centre when the actuator is straight.
+  Measurement measurement;
 };
 
 class SyntheticScene {
@@ -95,10 +113,16 @@ class SyntheticScene {
 
   const SceneOptions& options() const;
   int frame_count() const;
+  // The largest bend this scene renders: max_bend_deg, or the wedge's design opening.
+  double max_bend_deg() const;
+  // The actuator state of frame `index` (the time profile).
+  double bend_at(int index) const;
 
   // Renders frame `index` of the time profile into `image` (CV_8UC3, buffer reused).
   SceneTruth render(int index, cv::Mat& image);
-  // Renders the actuator at an explicit bend (used by the simulated control rig).
+  // Renders the actuator at an explicit bend (used by the simulated control rig). The bend is
+  // clamped to the physical range [0, max_bend_deg()], and the truth reports the rendered bend.
+  // `index` selects the occluders, the gain and the noise, as for frame `index`.
   SceneTruth render_at_bend(double bend_deg, double time_s, int index, cv::Mat& image);
 
  private:

@@ -1,0 +1,61 @@
+// HSV ranges from pixels a person points at: click a marker in the live window and its colour
+// tracker gets H, S and V ranges from the pixels around the click.
+//
+// Robust statistics: the range is the [low, high] percentile interval of each channel widened by
+// a margin, so a few background pixels at the disc's rim do not stretch it. Hue is circular
+// (OpenCV's 8-bit hue runs 0..179): the percentiles are taken around the circular mean, so a red
+// marker straddling 0 gives a wrapped range with lo > hi (e.g. {172, 8}).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "softsight/track/colour_tracker.h"
+
+namespace softsight {
+
+struct HsvPickOptions {
+  // Radius of the disc of pixels sampled around the click, px. Default 5 (97 pixels). Larger is
+  // steadier on noisy video but must stay inside the marker.
+  int radius_px = 5;
+  // Percentiles bounding the sampled values, in percent. Default 5 / 95: up to 5 % of the
+  // samples on either side (rim pixels, specular highlights) do not widen the range.
+  double low_percentile = 5.0;
+  double high_percentile = 95.0;
+  // Margins added on each side of the percentile interval, in 8-bit HSV units. Wider tolerates
+  // more lighting change, narrower rejects more of the background. Defaults 6 / 40 / 50.
+  int hue_margin = 6;
+  int saturation_margin = 40;
+  int value_margin = 50;
+  // Pixels less saturated than this have no meaningful hue; they do not vote for the hue range.
+  // A patch where fewer than half the pixels reach it is not a coloured marker. Default 40.
+  int min_saturation = 40;
+
+  // Returns true when every field is usable; otherwise false with `error` naming the field.
+  bool Check(std::string* error) const;
+};
+
+struct HsvPick {
+  HsvRange h, s, v;         // Ready for ColourParams (h.lo > h.hi when the range wraps through 0).
+  int sample_count = 0;     // Pixels sampled inside the image.
+  double hue_spread = 0.0;  // Width of the hue percentile interval before margins, hue units.
+};
+
+// Picks ranges from HSV samples (CV_8UC3 pixels as produced by cv::cvtColor(BGR2HSV)). Returns
+// nothing, with `why_not` saying why, when there are no samples or they are not coloured.
+std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samples,
+                                          const HsvPickOptions& options,
+                                          std::string* why_not = nullptr);
+
+// Picks ranges from the disc of `options.radius_px` around `click_px` (pixel-centre convention)
+// in a BGR image. Pixels outside the image are skipped.
+std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
+                                    const HsvPickOptions& options, std::string* why_not = nullptr);
+
+// True when an 8-bit HSV pixel lies inside the three ranges (hue wrap included). The reference the
+// tests and the live window's preview use; the colour tracker has its own vectorised threshold.
+bool HsvInRange(const cv::Vec3b& hsv, const HsvRange& h, const HsvRange& s, const HsvRange& v);
+
+}  // namespace softsight

@@ -1,0 +1,77 @@
+// The host's outer loop, run once per camera frame: bending-angle error -> pressure setpoint for the
+// board's inner loop (the paper's cascade, section 3.3).
+//
+// Sign convention: the paper's angle at the middle marker is 180 deg when straight and decreases as
+// the actuator bends, so error_deg = measured_deg - target_deg is positive when the actuator must
+// bend more, and a positive error asks for more pressure. All gains are therefore >= 0.
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace softsight {
+
+struct ControllerOptions {
+  // Proportional gain, kPa of setpoint per degree of error. The paper's law is P only.
+  double kp_kpa_per_deg = 0.25;
+  // Integral gain, kPa per (degree * s). Removes the steady-state error a pressure setpoint leaves
+  // with P only; 0 disables it.
+  double ki_kpa_per_deg_s = 1.3;
+  // Derivative gain on the measurement (no kick on target steps), kPa * s / degree. Default 0: the
+  // camera's angle is noisy.
+  double kd_kpa_s_per_deg = 0.0;
+  double derivative_filter_s = 0.05;  // First-order filter of the derivative. Default 0.05 s.
+  // Feed-forward: bias_kpa + ff_kpa_per_deg * (180 - target_deg) is added to the output. bias_kpa
+  // is the pressure at which the actuator starts to bend; ff_kpa_per_deg the inverse of its
+  // static gain (kPa per degree of angle) when known from an open-loop characterisation. With a
+  // good feed-forward the PI only corrects the residual, and targets that move are followed with
+  // much less lag. Defaults 3 kPa and 0 (off).
+  double bias_kpa = 3.0;
+  double ff_kpa_per_deg = 0.0;
+  // Output limits, kPa. The board enforces its own hard limit as well; max_kpa is clamped to it.
+  double min_kpa = 0.0;
+  double max_kpa = 45.0;
+  // Setpoint slew limit, kPa/s; 0 = unlimited. Default 60: protects the silicone on target steps.
+  double max_rate_kpa_per_s = 60.0;
+  // Vision loss: keep the last setpoint (integral frozen) while the measurement has been missing
+  // for at most this long (from the first frame without one), then vent. Default 0.5 s.
+  double hold_s = 0.5;
+
+  // Returns false and names the bad field in `error`.
+  bool Check(std::string* error) const;
+};
+
+struct ControllerOutput {
+  enum class Action { kTrack, kHold, kVent };
+  Action action = Action::kVent;
+  double setpoint_kpa = 0.0;          // To send to the board (0 when venting).
+  std::optional<double> error_deg;    // measured - target, when measured.
+};
+
+const char* ActionName(ControllerOutput::Action action);
+
+class AngleController {
+ public:
+  explicit AngleController(const ControllerOptions& options);
+
+  // One frame at `time_s` (monotonic). `measured_deg` absent = the tracker lost a marker.
+  ControllerOutput update(double time_s, double target_deg, std::optional<double> measured_deg);
+  void reset();
+
+  double integral_kpa() const { return integral_kpa_; }
+  const ControllerOptions& options() const { return options_; }
+  // Clamps max_kpa to the board's limit (learned at the handshake).
+  void limit_max_kpa(double max_kpa);
+
+ private:
+  ControllerOptions options_;
+  std::optional<double> last_time_s_;
+  std::optional<double> loss_start_s_;  // First frame of the current vision loss.
+  std::optional<double> last_measured_deg_;
+  double integral_kpa_ = 0.0;
+  double derivative_deg_per_s_ = 0.0;
+  double setpoint_kpa_ = 0.0;
+  bool vented_ = true;
+};
+
+}  // namespace softsight

@@ -1,0 +1,160 @@
+// The live window's logic as a state machine, free of any window system: it is fed frames and
+// user events (mouse, keys, trackbars) and produces the image to show. The highgui adapter
+// (live_window.h) only forwards events and shows canvas(); tests drive the controller directly.
+//
+// Mouse: drag a rectangle over a marker to (re)select it (template / colour ROI, the paper's
+// real-time recalibration); click a marker to calibrate its HSV ranges from the pixels around
+// the click. Trackbars adjust the active marker's ranges. Keys: see kLiveKeys.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "softsight/calib/hsv_picker.h"
+#include "softsight/gui/frame_grabber.h"
+#include "softsight/gui/overlay.h"
+#include "softsight/gui/strip_chart.h"
+#include "softsight/io/config.h"
+#include "softsight/pipeline/tracking_session.h"
+
+namespace softsight {
+
+struct UiEvent {
+  enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
+  Type type = Type::kKey;
+  cv::Point2d position_px;  // Mouse events: canvas pixel (the image occupies the top rows).
+  int key = 0;              // kKey: the character ('q', ' ', '1') or 27 for Escape.
+  int trackbar = 0;         // kTrackbar: index into kHsvTrackbars.
+  int value = 0;            // kTrackbar: new position.
+
+  static UiEvent Mouse(Type type, double x, double y) { return {type, {x, y}, 0, 0, 0}; }
+  static UiEvent Key(int key) { return {Type::kKey, {}, key, 0, 0}; }
+  static UiEvent Trackbar(int index, int value) { return {Type::kTrackbar, {}, 0, index, value}; }
+};
+
+// The six trackbars of the active marker's HSV ranges: name and maximum.
+struct TrackbarSpec {
+  const char* name;
+  int max;
+};
+inline constexpr std::array<TrackbarSpec, 6> kHsvTrackbars = {
+    {{"H lo", 179}, {"H hi", 179}, {"S lo", 255}, {"S hi", 255}, {"V lo", 255}, {"V hi", 255}}};
+
+struct LiveKey {
+  int key;
+  const char* what;
+};
+// The keys, as the on-screen help (`h`) lists them.
+inline constexpr std::array<LiveKey, 9> kLiveKeys = {{
+    {'h', "show / hide this help"},
+    {' ', "pause / resume"},
+    {'r', "start / stop recording (CSV, annotated + raw video, config)"},
+    {'s', "save the config"},
+    {'b', "reset the bending-distance reference"},
+    {'m', "switch method (colour, sad, ssd, zncc)"},
+    {'1', "1..9: choose the active marker (trackbars, clicks)"},
+    {'q', "quit (also Esc)"},
+    {0, "mouse: drag a box over a marker to reselect it, click it to pick its colour"},
+}};
+
+struct LiveOptions {
+  // Where `s` writes the config. Default: empty, which makes the command choose
+  // <config stem>.live.yaml beside the loaded config.
+  std::string save_config_path;
+  // Recordings go to <prefix>-NNN.csv, .avi (annotated), .raw.avi (frames as captured, for
+  // `softsight track`) and .yaml (the config reproducing the run on the raw video).
+  std::string record_prefix = "live";
+  // Side of the box cut around a marker when it needs a new template (method switch, start of a
+  // recording), px. Default 32: a 10-20 px marker plus context.
+  int select_box_px = 32;
+  // Frame rate written into recorded videos, frames per second: the source's nominal rate when
+  // known (absent: the measured processing rate). The CSV's time_s is always the source's.
+  std::optional<double> record_fps;
+  // A press and release closer than this is a click (colour pick), farther a drag (reselect), px.
+  int click_slop_px = 4;
+  StripChartOptions chart;
+  HsvPickOptions picker;
+  OverlayOptions overlay;  // base/middle/tip filled from the config by the controller.
+
+  bool Check(std::string* error) const;
+};
+
+class LiveController {
+ public:
+  // Builds the tracking session. Throws InputError on a bad config.
+  LiveController(const TrackingConfig& config, LiveOptions options);
+  ~LiveController();
+
+  // A new frame (ignored while paused). Tracks, measures, records, redraws.
+  void on_frame(const Frame& frame, SteadyClock::time_point captured);
+  void on_event(const UiEvent& event);
+  // The source has ended: the last frame stays on screen until the user quits.
+  void on_end_of_input();
+
+  // The image to show: the annotated frame with the UI on top, the strip chart under it.
+  const cv::Mat& canvas();
+
+  bool quit_requested() const { return quit_; }
+  bool paused() const { return paused_; }
+  bool recording() const { return recording_ != nullptr; }
+  bool help_shown() const { return help_; }
+  int active_marker() const { return active_; }
+  // The config as edited live (what `s` saves).
+  const TrackingConfig& config() const { return config_; }
+  const std::optional<FrameResult>& last_result() const { return last_result_; }
+  const std::string& message() const { return message_; }
+  std::optional<double> latency_ms() const { return latency_ms_; }
+  std::optional<double> fps() const { return fps_; }
+  // The active marker's ranges in kHsvTrackbars order, and a counter that changes whenever they
+  // or the active marker change, so the adapter knows when to move its trackbars.
+  std::array<int, 6> active_hsv() const;
+  int hsv_revision() const { return hsv_revision_; }
+  // Where the previous recording's files went (prefix without extension); empty if none.
+  const std::string& last_recording() const { return last_recording_; }
+
+ private:
+  struct Recording;
+
+  void click(const cv::Point2d& p);
+  void drag(const cv::Rect& rect);
+  void switch_method();
+  void set_hsv(int trackbar, int value);
+  void toggle_recording();
+  void save_config();
+  void select_marker(int index);
+  std::optional<int> marker_at(const cv::Point2d& p, double max_distance) const;
+  std::optional<cv::Point2d> position_of(int marker) const;
+  cv::Rect box_around(const cv::Point2d& p) const;
+  void apply_spec(int marker, const MarkerSpec& spec, const std::optional<cv::Rect>& hint);
+  void redraw_annotated();
+  void record_frame(const FrameResult& result);
+  void say(const std::string& message);
+
+  TrackingConfig config_;
+  LiveOptions options_;
+  std::unique_ptr<TrackingSession> session_;
+  StripChart chart_;
+  cv::Mat frame_;  // The frame on screen, as captured.
+  int64_t frame_index_ = -1;
+  cv::Mat annotated_;  // frame_ + overlay (what annotated video records).
+  cv::Mat canvas_;
+  bool dirty_ = true;
+  std::optional<FrameResult> last_result_;
+  std::optional<double> latency_ms_, fps_;
+  std::vector<SteadyClock::time_point> frame_times_;  // Ring of recent result times, for fps.
+  size_t frame_times_next_ = 0;
+
+  bool paused_ = false, help_ = false, quit_ = false, ended_ = false;
+  int active_ = 0;
+  int hsv_revision_ = 0;
+  std::optional<cv::Point2d> press_, pointer_;
+  std::string message_;
+  std::unique_ptr<Recording> recording_;
+  std::string last_recording_;
+};
+
+}  // namespace softsight

@@ -1,0 +1,28 @@
+// The thin highgui adapter around LiveController: one window, its mouse callback, six trackbars
+// and the key loop. Everything it decides is the controller's; this file only moves events in
+// and images out.
+#pragma once
+
+#include <string>
+
+#include "softsight/gui/frame_grabber.h"
+#include "softsight/gui/live_controller.h"
+
+namespace softsight {
+
+// True when a window can be opened (an X display answers, or a Wayland socket is named);
+// otherwise false with `why` saying what is missing.
+bool HaveDisplay(std::string* why);
+
+struct LiveWindowOptions {
+  std::string title = "softsight live";
+  bool trackbars = true;  // The six HSV trackbars of the active marker.
+};
+
+// Runs the window until the controller asks to quit or the window is closed. Frames come from
+// `grabber` (newest wins). Prints "end of input" on stdout once the last frame of a file source
+// is on screen. Returns the exit code (0).
+int RunLiveWindow(LiveController& controller, FrameGrabber& grabber,
+                  const LiveWindowOptions& options = {});
+
+}  // namespace softsight

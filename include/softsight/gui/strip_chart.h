@@ -1,0 +1,60 @@
+// A scrolling strip chart of the last seconds: angle, bending distance and arc length, one lane
+// each, drawn under the live image. Keeps the recent samples; absent values are gaps.
+#pragma once
+
+#include <deque>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "softsight/pipeline/tracking_session.h"
+
+namespace softsight {
+
+struct StripChartOptions {
+  double window_s = 10.0;  // Time span shown, seconds. Longer shows slower trends, less detail.
+  int height_px = 180;     // Height of the whole chart (three lanes) under the image.
+  bool Check(std::string* error) const;
+};
+
+class StripChart {
+ public:
+  explicit StripChart(StripChartOptions options = {});
+
+  // Appends a frame's measurements (mm when the frame has them, else px) and forgets samples
+  // older than the window. Time going backwards (a new source) restarts the chart.
+  void add(const FrameResult& result);
+  void clear();
+
+  // Draws into `area` (CV_8UC3, any size; usually width of the image x options.height_px).
+  void draw(cv::Mat& area) const;
+
+  // The lane rectangles and value ranges of the last draw(), for tests: lane 0 angle,
+  // 1 bending distance, 2 arc length.
+  struct Lane {
+    cv::Rect rect;
+    double y_min = 0, y_max = 1;
+    std::string label;
+  };
+  const Lane& lane(int i) const { return lanes_[i]; }
+  // Horizontal pixel of time `time_s` in the last draw() (the newest sample at the right edge).
+  double x_of(double time_s) const;
+
+  size_t size() const { return samples_.size(); }
+  const StripChartOptions& options() const { return options_; }
+
+  static const cv::Scalar kColours[3];
+
+ private:
+  struct Sample {
+    double time_s;
+    std::optional<double> values[3];
+    bool metric;
+  };
+  StripChartOptions options_;
+  std::deque<Sample> samples_;
+  mutable Lane lanes_[3];
+  mutable double x_left_ = 0, x_width_ = 1, t_right_ = 0;
+};
+
+}  // namespace softsight

@@ -1,0 +1,183 @@
+// End to end: chessboard views rendered with a known camera, written as files, calibrated by
+// the command's typed function; the files it writes are read back and checked against truth.
+#include "app/calibrate_command.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "calib/calibration_test_views.h"
+#include "softsight/calib/camera_calibration.h"
+#include "softsight/core/error.h"
+#include "softsight/sim/chessboard.h"
+
+namespace softsight {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+class CalibrateCommandTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("softsight_calibrate_command_test_" + std::to_string(getpid())));
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_ / "views");
+    const ChessboardRenderer renderer(testviews::Camera(), testviews::Pattern());
+    for (const testviews::View& view : testviews::RenderViews(renderer, 10)) {
+      cv::imwrite((*dir_ / "views" / view.name).string(), view.image);
+    }
+    // A view without the board, which must be listed, not fatal.
+    cv::imwrite((*dir_ / "views" / "blank.png").string(),
+                cv::Mat(testviews::Camera().image_size, CV_8UC1, cv::Scalar(128)));
+    cv::Mat plane;
+    renderer.render(LookAtBoard(testviews::Pattern(), kPlaneDistanceMm, 0, 0, 0), plane);
+    cv::imwrite((*dir_ / "plane.png").string(), plane);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+
+  static CalibrateOptions CameraOptions() {
+    CalibrateOptions options;
+    options.input = (*dir_ / "views").string();
+    options.chessboard = "9x6";
+    options.square_mm = 25.0;
+    options.out_file = (*dir_ / "camera.yaml").string();
+    return options;
+  }
+
+  static constexpr double kPlaneDistanceMm = 560.0;
+  static fs::path* dir_;
+};
+fs::path* CalibrateCommandTest::dir_ = nullptr;
+
+TEST_F(CalibrateCommandTest, FolderOfViewsGivesTheCameraWithinOnePercent) {
+  std::ostringstream report;
+  const CalibrateSummary summary = RunCalibrate(CameraOptions(), report);
+  EXPECT_EQ(summary.images, 11);
+  EXPECT_THAT(summary.not_found, ElementsAre("blank.png"));
+  EXPECT_THAT(report.str(), HasSubstr("found in 10 of 11 images"));
+  EXPECT_THAT(report.str(), HasSubstr("board not found in 1: blank.png"));
+  EXPECT_THAT(report.str(), HasSubstr("reprojection RMS"));
+  EXPECT_LT(summary.rms_px, 0.15);
+
+  const CameraIntrinsics camera = LoadCameraIntrinsics(CameraOptions().out_file);
+  const cv::Matx33d truth = testviews::Camera().camera_matrix;
+  EXPECT_EQ(camera.image_size, testviews::Camera().image_size);
+  EXPECT_NEAR(camera.camera_matrix(0, 0), truth(0, 0), 0.01 * truth(0, 0));
+  EXPECT_NEAR(camera.camera_matrix(1, 1), truth(1, 1), 0.01 * truth(1, 1));
+  EXPECT_DOUBLE_EQ(camera.camera_matrix(0, 0), summary.fx_px);
+
+  // Then the plane, undistorted with that file: a fronto-parallel board at distance Z has
+  // Z / f millimetres per pixel.
+  CalibrateOptions plane;
+  plane.plane_image = (*dir_ / "plane.png").string();
+  plane.camera_file = CameraOptions().out_file;
+  plane.chessboard = "9x6";
+  plane.square_mm = 25.0;
+  plane.out_file = (*dir_ / "plane.yaml").string();
+  std::ostringstream plane_report;
+  const CalibrateSummary plane_summary = RunCalibrate(plane, plane_report);
+  const double expected = kPlaneDistanceMm / std::sqrt(truth(0, 0) * truth(1, 1));
+  EXPECT_NEAR(plane_summary.mm_per_px, expected, 0.005 * expected);
+  EXPECT_NEAR(LoadPlaneCalibration(plane.out_file).mm_per_px, plane_summary.mm_per_px, 1e-9);
+  EXPECT_THAT(plane_report.str(), HasSubstr("mm/px"));
+  std::cout << report.str() << plane_report.str();
+}
+
+TEST_F(CalibrateCommandTest, PrintfPatternAndVideoInputs) {
+  CalibrateOptions options = CameraOptions();
+  options.input = (*dir_ / "views" / "view%d.png").string();
+  std::ostringstream report;
+  EXPECT_EQ(RunCalibrate(options, report).images, 10);
+
+  // A lossless video of the views, every second frame used.
+  const std::string video_file = (*dir_ / "views.avi").string();
+  {
+    cv::VideoWriter writer(video_file, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 10.0,
+                           testviews::Camera().image_size, /*isColor=*/false);
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < 10; ++i) {
+      const cv::Mat image =
+          cv::imread((*dir_ / "views" / ("view" + std::to_string(i) + ".png")).string(),
+                     cv::IMREAD_GRAYSCALE);
+      writer.write(image);
+      writer.write(image);  // Each view twice, as a slow-moving video would show it.
+    }
+  }
+  options.input = video_file;
+  options.step = 2;
+  const CalibrateSummary summary = RunCalibrate(options, report);
+  EXPECT_EQ(summary.images, 10);
+  EXPECT_TRUE(summary.not_found.empty());
+  const double fx = testviews::Camera().camera_matrix(0, 0);
+  EXPECT_NEAR(summary.fx_px, fx, 0.01 * fx);
+}
+
+std::string ErrorOf(const CalibrateOptions& options) {
+  std::ostringstream report;
+  try {
+    RunCalibrate(options, report);
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+    return message;
+  }
+  return "(no error)";
+}
+
+TEST_F(CalibrateCommandTest, BadInputIsOneLineNamingTheCulprit) {
+  CalibrateOptions options = CameraOptions();
+  options.input = (*dir_ / "no_such_folder").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("no_such_folder: no such file or folder"));
+
+  options = CameraOptions();
+  options.chessboard = "9*6";
+  EXPECT_THAT(ErrorOf(options), HasSubstr("--chessboard: expected inner corners"));
+
+  options = CameraOptions();
+  options.chessboard = "7x5";  // Wrong count: the board is found nowhere.
+  EXPECT_THAT(ErrorOf(options), HasSubstr("found in 0 of 11 images"));
+
+  options = CameraOptions();
+  options.square_mm = 0;
+  EXPECT_THAT(ErrorOf(options), HasSubstr("--square-mm"));
+
+  options = CameraOptions();
+  options.plane_image = (*dir_ / "plane.png").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("either --input"));
+
+  fs::create_directories(*dir_ / "empty");
+  options = CameraOptions();
+  options.input = (*dir_ / "empty").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("holds no image files"));
+
+  const std::string corrupt = (*dir_ / "corrupt" / "a.png").string();
+  fs::create_directories(*dir_ / "corrupt");
+  std::ofstream(corrupt) << "not a png";
+  options.input = (*dir_ / "corrupt").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("a.png: cannot read"));
+
+  options = CameraOptions();
+  options.input.reset();
+  options.plane_image = (*dir_ / "views" / "blank.png").string();
+  options.out_file = (*dir_ / "plane_blank.yaml").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("blank.png: the 9x6 chessboard was not found"));
+
+  options.plane_image = (*dir_ / "plane.png").string();
+  options.camera_file = (*dir_ / "missing_camera.yaml").string();
+  EXPECT_THAT(ErrorOf(options), HasSubstr("missing_camera.yaml: cannot open"));
+}
+
+}  // namespace
+}  // namespace softsight

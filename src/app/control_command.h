@@ -1,0 +1,53 @@
+// `softsight control`: closes the loop. Frames -> tracker -> measured angle -> outer loop ->
+// pressure setpoint -> serial link -> board (inner loop), one CSV row per frame with the tracking
+// columns and the controller's.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "softsight/control/session.h"
+
+namespace softsight {
+
+struct ControlOptions {
+  std::string config_file;              // Markers + `control:` section (examples/rig.yaml).
+  // Where the board is: a serial device (/dev/ttyACM0, /dev/pts/N), or `simulate` for an
+  // in-process simulated rig behind a real pseudo-terminal, advanced in lock-step with the frames.
+  std::optional<std::string> port;
+  bool simulate = false;
+  // Frames (not with simulate): a camera index, or a file the rig rewrites (`rig --frames`).
+  std::optional<int> camera;
+  std::optional<std::string> rig_frames;
+  // What to do (one of): target angle, profile file, open-loop pressure, open-loop duty.
+  std::optional<double> target_deg;
+  std::optional<std::string> profile_file;
+  std::optional<double> pressure_kpa;
+  std::optional<double> pwm;
+  std::string csv_file;
+  std::optional<double> duration_s;     // Default: the profile's length + 2 s, or 10 s.
+  double fps = 30.0;                    // Frame rate of simulate / rig_frames.
+  int sim_supersample = 2;              // Renderer supersampling in simulate (speed vs fidelity).
+  bool quiet = false;
+};
+
+struct ControlSummary {
+  int64_t frames = 0;
+  int64_t measured = 0;                 // Frames with an angle.
+  double duration_s = 0.0;              // Covered by the frames' timestamps.
+  std::optional<double> rms_error_deg;  // measured - target over frames with both, angle mode.
+  std::optional<double> final_error_deg;
+  double max_pressure_kpa = 0.0;        // Highest pressure the board reported.
+  uint64_t link_rejected = 0;           // Lines from the board the host rejected.
+  uint32_t board_rejected = 0;          // Lines from the host the board rejected.
+  uint64_t resends = 0;
+  std::string stop_reason;
+};
+
+// Runs the loop. Throws InputError for bad input or a failed link (e.g. the port disappears);
+// every CSV row written before stays intact. `summary_out` receives the summary even then.
+ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary_out = nullptr);
+std::string FormatControlSummary(const ControlSummary& summary);
+
+}  // namespace softsight

@@ -1,0 +1,204 @@
+// End-to-end tests of `softsight control` and `softsight rig`: the whole loop, rig -> rendered
+// frames -> tracker -> controller -> serial (a real pseudo-terminal) -> rig.
+#include "app/control_command.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/io/control_config.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::ReadLines;
+using testing::ReadTextFile;
+using testing::SplitCsv;
+using testing::TempDir;
+using testing::WriteTextFile;
+
+std::string Example() {
+  return testing::SourceDir() + "/examples/rig.yaml";
+}
+
+// The markers of examples/rig.yaml (the synthetic scene's); the control section stays at its
+// defaults, which are the example's values.
+const char* kMarkers = R"(markers:
+  - name: red
+    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+  - name: green
+    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
+triple: [red, blue, green]
+)";
+
+TEST(ControlConfig, ReadsTheExampleAndRejectsBadKeys) {
+  const ControlConfig config = LoadControlConfig(Example());
+  EXPECT_DOUBLE_EQ(config.controller.kp_kpa_per_deg, 0.25);
+  EXPECT_DOUBLE_EQ(config.controller.hold_s, 0.5);
+  EXPECT_EQ(config.link.baud, 115200);
+  EXPECT_EQ(config.rig.board.pressure_limit_pa, 50000);
+  EXPECT_EQ(config.rig.board.deadband_pa, 150);
+  EXPECT_DOUBLE_EQ(config.rig.plant.chamber_volume_ml, 20.0);
+
+  TempDir dir;
+  auto error_of = [&](const std::string& text) {
+    WriteTextFile(dir.file("c.yaml"), text);
+    try {
+      LoadControlConfig(dir.file("c.yaml"));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(error_of("control:\n  controller:\n    kp: 1\n"),
+              HasSubstr("c.yaml:3: control.controller.kp"));
+  EXPECT_THAT(error_of("control:\n  controller:\n    kp_kpa_per_deg: -1\n"),
+              HasSubstr("control.controller.kp_kpa_per_deg: value -1 is outside"));
+  EXPECT_THAT(error_of("control:\n  controller:\n    min_kpa: 10\n    max_kpa: 5\n"),
+              HasSubstr("control.controller.max_kpa must be > min_kpa"));
+  EXPECT_THAT(error_of("control:\n  link:\n    baud: 12345\n"), HasSubstr("control.link.baud"));
+  EXPECT_THAT(error_of("control:\n  rig:\n    board:\n      loop_hz: 100\n"),
+              HasSubstr("control.rig.board.loop_hz: value 100 is outside"));
+  EXPECT_THAT(error_of("control:\n  rig:\n    plant: {chamber_volume_ml: 0}\n"),
+              HasSubstr("chamber_volume_ml"));
+}
+
+TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  ControlOptions options;
+  options.config_file = dir.file("rig.yaml");
+  options.simulate = true;
+  options.target_deg = 120.0;
+  options.duration_s = 4.0;
+  options.csv_file = dir.file("run.csv");
+  options.quiet = true;
+  const ControlSummary summary = RunControl(options);
+  EXPECT_EQ(summary.frames, 121);
+  EXPECT_EQ(summary.measured, 121);
+  ASSERT_TRUE(summary.final_error_deg);
+  EXPECT_LT(std::abs(*summary.final_error_deg), 2.0);
+  EXPECT_EQ(summary.link_rejected, 0u);
+
+  const std::vector<std::string> lines = ReadLines(options.csv_file);
+  ASSERT_EQ(lines.size(), 122u);
+  const std::vector<std::string> header = SplitCsv(lines[0]);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<size_t>(it - header.begin());
+  };
+  const size_t angle = column("angle_deg"), truth = column("rig_true_angle_deg"),
+               target = column("target_deg"), pressure = column("board_pressure_kpa");
+  // The tracker's angle against the rig's truth, and the settled result.
+  double worst_tracking_deg = 0.0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = SplitCsv(lines[i]);
+    ASSERT_GT(row.size(), pressure);
+    worst_tracking_deg =
+        std::max(worst_tracking_deg, std::abs(std::stod(row[angle]) - std::stod(row[truth])));
+    EXPECT_DOUBLE_EQ(std::stod(row[target]), 120.0);
+  }
+  const std::vector<std::string> last = SplitCsv(lines.back());
+  std::printf("simulated loop through the tracker: final true angle %.2f deg, worst tracking "
+              "error %.2f deg\n", std::stod(last[truth]), worst_tracking_deg);
+  EXPECT_NEAR(std::stod(last[truth]), 120.0, 2.0);
+  EXPECT_LT(worst_tracking_deg, 1.5);
+  EXPECT_GT(std::stod(last[pressure]), 20.0);
+}
+
+TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
+  ControlOptions options;
+  options.config_file = Example();
+  options.simulate = true;
+  options.csv_file = "/nonexistent/x.csv";
+  EXPECT_THROW(RunControl(options), InputError);  // No target.
+  options.target_deg = 120.0;
+  options.pwm = 0.5;
+  EXPECT_THROW(RunControl(options), InputError);  // Two targets.
+  options.pwm.reset();
+  options.port = "/dev/ttyACM0";
+  EXPECT_THROW(RunControl(options), InputError);  // Board and simulation.
+}
+
+// Starts `softsight rig --pty ...`; returns its pid and the pty path it printed.
+pid_t StartRig(const std::string& args, const std::string& stderr_file, std::string* port) {
+  int out[2];
+  if (pipe(out) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out[1], STDOUT_FILENO);
+    const int err = open(stderr_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(err, STDERR_FILENO);
+    close(out[0]);
+    const std::string command = std::string("exec \"") + testing::SoftsightBinary() +
+                                "\" rig --pty " + args;
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(out[1]);
+  std::string line;
+  char c;
+  while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
+  close(out[0]);
+  const std::string prefix = "rig: serving on ";
+  if (line.rfind(prefix, 0) == 0) *port = line.substr(prefix.size());
+  return pid;
+}
+
+TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  std::string port;
+  const std::string frames = dir.file("rig.png");
+  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 1.5 "
+                             "--duration-s 2.5",
+                             dir.file("rig.err"), &port);
+  ASSERT_GT(rig, 0);
+  ASSERT_THAT(port, HasSubstr("/dev/pts/"));
+  const std::string command = std::string("\"") + testing::SoftsightBinary() +
+                              "\" control --config " + dir.file("rig.yaml") + " --port " + port +
+                              " --rig-frames " + frames + " --fps 20 --target-deg 120 --csv " +
+                              dir.file("run.csv") + " --duration-s 10 2> " + dir.file("ctl.err");
+  const int status = std::system(command.c_str());
+  int rig_status = 0;
+  waitpid(rig, &rig_status, 0);
+
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::string ctl_err = ReadTextFile(dir.file("ctl.err"));
+  const std::vector<std::string> err_lines = ReadLines(dir.file("ctl.err"));
+  int error_lines = 0;
+  for (const std::string& l : err_lines) error_lines += l.find("error") != std::string::npos;
+  EXPECT_EQ(error_lines, 1) << ctl_err;
+  EXPECT_THAT(ctl_err, HasSubstr("serial port " + port + ": "));
+  EXPECT_THAT(ctl_err, HasSubstr("disconnected"));
+
+  // Every row written before the error is complete.
+  const std::vector<std::string> lines = ReadLines(dir.file("run.csv"));
+  ASSERT_GT(lines.size(), 10u);
+  const size_t columns = SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(SplitCsv(lines[i] + ",x").size(), columns + 1) << "row " << i << ": " << lines[i];
+  }
+  // The rig saw the port go and its watchdog vent the actuator.
+  const std::string rig_err = ReadTextFile(dir.file("rig.err"));
+  EXPECT_THAT(rig_err, HasSubstr("port closed"));
+  EXPECT_THAT(rig_err, HasSubstr("board watchdog (vented)"));
+  EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 0) << rig_err;
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,114 @@
+// softsight live: the overlay window on a camera or a video, with mouse recalibration, live
+// HSV picking, recording and the strip chart.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/commands.h"
+#include "softsight/core/error.h"
+#include "softsight/gui/frame_grabber.h"
+#include "softsight/gui/live_controller.h"
+#include "softsight/gui/live_window.h"
+#include "softsight/io/config.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/track/tracker.h"
+
+namespace softsight {
+namespace {
+
+struct LiveArgs {
+  std::optional<int> camera;
+  std::string input;
+  std::string config;
+  std::optional<std::string> method;
+  std::string save_config;
+  std::string record_prefix = "live";
+  double window_s = 10.0;
+  bool no_pace = false;
+  bool no_trackbars = false;
+};
+
+// markers.yaml -> markers.live.yaml beside it: saving never overwrites the hand-written config.
+std::string DefaultSavePath(const std::string& config) {
+  std::filesystem::path path(config);
+  return (path.parent_path() / (path.stem().string() + ".live.yaml")).string();
+}
+
+int RunLive(const LiveArgs& args) {
+  if (args.camera.has_value() == !args.input.empty()) {
+    throw InputError("give exactly one of --camera N or --input VIDEO");
+  }
+  std::string why;
+  if (!HaveDisplay(&why)) {
+    throw InputError(why +
+                     ": the live window needs a display; to measure without one run "
+                     "`softsight track --config " +
+                     args.config + " --input VIDEO --csv out.csv`");
+  }
+  const TrackingConfig config = LoadTrackingConfig(args.config, args.method);
+  FrameSourceSpec spec;
+  spec.camera = args.camera;
+  spec.input = args.input;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+
+  LiveOptions options;
+  options.save_config_path =
+      args.save_config.empty() ? DefaultSavePath(args.config) : args.save_config;
+  options.record_prefix = args.record_prefix;
+  options.chart.window_s = args.window_s;
+  options.record_fps = source->fps();
+  LiveController controller(config, options);
+  std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
+            << " markers; press h in the window for help\n";
+  FrameGrabber grabber(std::move(source), !args.no_pace);
+  LiveWindowOptions window;
+  window.trackbars = !args.no_trackbars;
+  const int code = RunLiveWindow(controller, grabber, window);
+  if (!controller.last_recording().empty()) {
+    std::cerr << "softsight live: last recording " << controller.last_recording() << ".*\n";
+  }
+  return code;
+}
+
+}  // namespace
+
+CommandRunner SetupLiveCommand(CLI::App& sub) {
+  auto args = std::make_shared<LiveArgs>();
+  std::string methods;
+  for (const std::string& m : TrackerMethods()) methods += (methods.empty() ? "" : ", ") + m;
+  sub.footer(
+      "The window shows each marker, the base-middle-tip triangle, the fitted arc, the\n"
+      "measurements (mm when the config has a scale), fps, processing time and capture-to-result\n"
+      "latency, and a strip chart of the last seconds under the image.\n"
+      "Mouse: drag a box over a marker to reselect it (template / search region); click a marker\n"
+      "to pick its HSV ranges from the pixels around the click (keys 1..9 choose which marker).\n"
+      "Trackbars adjust the active marker's ranges. Keys: h help, space pause, r record, s save\n"
+      "config, b reset the bending-distance reference, m switch method, q quit.\n"
+      "A recording writes <prefix>-NNN.csv, .avi (annotated), .raw.avi (lossless) and .yaml;\n"
+      "`softsight track --config <prefix>-NNN.yaml --input <prefix>-NNN.raw.avi` reproduces it.\n"
+      "Needs a display; without one use `softsight track`.\n"
+      "Example: softsight live --camera 0 --config markers.yaml");
+  auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
+  auto* input = sub.add_option("-i,--input", args->input,
+                               "Video file or image sequence instead of a camera (played at its "
+                               "frame rate)");
+  camera->excludes(input);
+  sub.add_option("-c,--config", args->config, "Marker configuration (YAML, see examples/)")
+      ->required();
+  sub.add_option("--method", args->method, "Override every marker's method: " + methods);
+  sub.add_option("--save-config", args->save_config,
+                 "Where `s` saves the config (default: <config>.live.yaml beside it)");
+  sub.add_option("--record-prefix", args->record_prefix,
+                 "Recordings go to <prefix>-NNN.csv/.avi/.raw.avi/.yaml")
+      ->capture_default_str();
+  sub.add_option("--chart-seconds", args->window_s, "Time span of the strip chart, seconds")
+      ->capture_default_str();
+  sub.add_flag("--no-pace", args->no_pace,
+               "Read a video file as fast as it decodes instead of at its frame rate");
+  sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");
+  return [args] { return RunLive(*args); };
+}
+
+}  // namespace softsight

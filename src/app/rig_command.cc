@@ -1,0 +1,160 @@
+#include "app/rig_command.h"
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "app/commands.h"
+#include "softsight/control/rig.h"
+#include "softsight/core/error.h"
+#include "softsight/io/control_config.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void OnStopSignal(int) { g_stop = true; }
+
+const char* ModeName(Board::Mode mode) {
+  switch (mode) {
+    case Board::Mode::kIdle: return "idle (vented)";
+    case Board::Mode::kPressure: return "pressure";
+    case Board::Mode::kDuty: return "duty";
+    case Board::Mode::kStopped: return "stopped (vented)";
+    case Board::Mode::kWatchdog: return "watchdog (vented)";
+  }
+  return "?";
+}
+
+// Writes the frame so that a reader never sees half a file: a temporary, then rename().
+void WriteAtomically(const std::string& file, const cv::Mat& image) {
+  const std::string tmp = file + ".tmp.png";
+  if (!cv::imwrite(tmp, image) || std::rename(tmp.c_str(), file.c_str()) != 0) {
+    throw InputError(file + ": cannot write the rig's frame");
+  }
+}
+
+}  // namespace
+
+RigCommandSummary RunRig(const RigCommandOptions& options) {
+  if (!options.pty) throw InputError("rig: give --pty (the rig serves on a pseudo-terminal)");
+  if (!(options.fps > 0.0 && options.fps <= 240.0)) {
+    throw InputError("--fps " + std::to_string(options.fps) + ": must be in (0, 240]");
+  }
+  const ControlConfig config =
+      options.config_file ? LoadControlConfig(*options.config_file) : ControlConfig{};
+  SimulatedRig rig(config.rig);
+  RigServer server(rig, /*realtime=*/true);
+  std::unique_ptr<SyntheticScene> scene;
+  cv::Mat image;
+  if (options.frames_file) {
+    SceneOptions scene_options;
+    scene_options.fps = options.fps;
+    RenderOptions render;
+    render.supersample = options.supersample;
+    scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
+    const RigSnapshot s = rig.snapshot();
+    scene->render_at_bend(s.bend_deg, s.time_s, 0, image);
+    WriteAtomically(*options.frames_file, image);  // A first frame before anyone connects.
+  }
+  std::printf("rig: serving on %s\n", server.port().c_str());
+  std::fflush(stdout);
+
+  g_stop = false;
+  auto old_int = std::signal(SIGINT, OnStopSignal);
+  auto old_term = std::signal(SIGTERM, OnStopSignal);
+  const auto start = std::chrono::steady_clock::now();
+  auto next_frame = start;
+  const auto frame_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / options.fps));
+  Board::Mode last_mode = Board::Mode::kIdle;
+  bool last_limit = false;
+  int frame_index = 1;
+  RigCommandSummary summary;
+  try {
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      const double wall_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const RigSnapshot s = rig.snapshot();
+      const bool limit = (s.flags & wire::kFlagLimit) != 0;
+      if (!options.quiet && (s.mode != last_mode || limit != last_limit)) {
+        std::fprintf(stderr, "rig: t=%.3f s: board %s%s, pressure %.2f kPa, angle %.1f deg\n",
+                     s.time_s, ModeName(s.mode), limit ? ", limit guard venting" : "",
+                     s.pressure_kpa, s.angle_deg);
+      }
+      last_mode = s.mode;
+      last_limit = limit;
+      if (options.disconnect_after_s && server.connected() &&
+          wall_s >= *options.disconnect_after_s) {
+        server.disconnect();
+        if (!options.quiet) {
+          std::fprintf(stderr, "rig: t=%.3f s: port closed (cable pulled), rig keeps running\n",
+                       s.time_s);
+        }
+      }
+      if (scene && std::chrono::steady_clock::now() >= next_frame) {
+        next_frame += frame_period;
+        scene->render_at_bend(s.bend_deg, s.time_s, frame_index++, image);
+        WriteAtomically(*options.frames_file, image);
+      }
+      if (options.duration_s && wall_s >= *options.duration_s) break;
+    }
+  } catch (...) {
+    std::signal(SIGINT, old_int);
+    std::signal(SIGTERM, old_term);
+    throw;
+  }
+  std::signal(SIGINT, old_int);
+  std::signal(SIGTERM, old_term);
+  const RigSnapshot s = rig.snapshot();
+  summary.time_s = s.time_s;
+  summary.peak_pressure_kpa = s.peak_pressure_kpa;
+  summary.board_rejected = s.board_rejected;
+  summary.final_mode = ModeName(s.mode);
+  if (!options.quiet) {
+    std::fprintf(stderr,
+                 "rig: stopped after %.2f s; board %s, pressure %.2f kPa (peak %.2f), %u lines "
+                 "rejected\n",
+                 s.time_s, summary.final_mode.c_str(), s.pressure_kpa, s.peak_pressure_kpa,
+                 s.board_rejected);
+  }
+  return summary;
+}
+
+CommandRunner SetupRigCommand(CLI::App& sub) {
+  auto o = std::make_shared<RigCommandOptions>();
+  sub.description(
+      "A simulated rig for trying the control loop without hardware: the board's own firmware\n"
+      "logic (protocol, inner pressure loop, pressure limit, watchdog) driving a simulated\n"
+      "pneumatic actuator (pump, valves, chamber; bending with lag and hysteresis), in real time\n"
+      "on a pseudo-terminal. It prints the device path; drive it with\n"
+      "  softsight control --config examples/rig.yaml --port /dev/pts/N --rig-frames rig.png "
+      "--target-deg 120 --csv run.csv\n"
+      "or type commands by hand (docs/protocol.md). Stops on Ctrl-C.");
+  sub.add_flag("--pty", o->pty, "Serve on a new pseudo-terminal and print its path")->required();
+  sub.add_option("-c,--config", o->config_file, "Config whose `control: rig:` section sets the "
+                 "board and plant (defaults without)")
+      ->check(CLI::ExistingFile);
+  sub.add_option("--frames", o->frames_file,
+                 "Render the actuator to this image file at --fps (rewritten atomically), for "
+                 "`softsight control --rig-frames`");
+  sub.add_option("--fps", o->fps, "Frame rate of --frames")->capture_default_str();
+  sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds");
+  sub.add_option("--disconnect-after-s", o->disconnect_after_s,
+                 "Close the port after this many seconds (a pulled cable) and keep running, to "
+                 "watch the watchdog vent");
+  sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
+  return [o] {
+    RunRig(*o);
+    return 0;
+  };
+}
+
+}  // namespace softsight

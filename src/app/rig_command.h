@@ -1,0 +1,31 @@
+// `softsight rig --pty`: the simulated board + pneumatic actuator on a pseudo-terminal, in real
+// time, for driving by hand (a terminal program) or by `softsight control --port /dev/pts/N`.
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace softsight {
+
+struct RigCommandOptions {
+  bool pty = false;                          // Serve on a new pseudo-terminal (the only transport).
+  std::optional<std::string> config_file;    // Its `control: rig:` section; defaults without.
+  std::optional<std::string> frames_file;    // Render the actuator here at `fps` (atomic rewrite).
+  double fps = 30.0;
+  int supersample = 2;
+  std::optional<double> duration_s;          // Default: until Ctrl-C / SIGTERM.
+  std::optional<double> disconnect_after_s;  // Close the port then (a pulled cable), keep running.
+  bool quiet = false;                        // No state-change lines on stderr.
+};
+
+struct RigCommandSummary {
+  double time_s = 0.0;
+  double peak_pressure_kpa = 0.0;
+  uint32_t board_rejected = 0;
+  std::string final_mode;
+};
+
+// Prints "rig: serving on /dev/pts/N" on stdout (flushed), then runs. Throws InputError.
+RigCommandSummary RunRig(const RigCommandOptions& options);
+
+}  // namespace softsight

@@ -1,0 +1,55 @@
+// `softsight synth`: render a synthetic actuator scene to a video (or an image sequence) and write
+// its exact ground truth to a CSV.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+
+struct SynthOptions {
+  SceneOptions scene;
+  NoiseOptions noise;
+  RenderOptions render;
+  std::vector<Occluder> occluders;
+  // Output, chosen by its name:
+  //   *.avi, *.mkv   FFV1, lossless (what FFmpeg-based readers decode bit-exactly);
+  //   *.mp4          MPEG-4 part 2, lossy (for sharing, not for accuracy tests);
+  //   a printf pattern such as frames/%04d.png: one image per frame (PNG is lossless).
+  std::string out;
+  // Overrides the codec of a video: ffv1 (lossless), hfyu (HuffYUV, lossless, larger, faster),
+  // mjpg (Motion JPEG, lossy), mp4v (lossy). Empty: chosen by the extension as above.
+  std::string codec;
+  std::optional<std::string> truth_csv;
+  bool quiet = false;  // No summary line.
+};
+
+struct SynthSummary {
+  int64_t frames = 0;
+  cv::Size size;
+  std::string scene;        // "bending", "wedge1", "wedge4".
+  std::string format;       // "FFV1 video (lossless)", "PNG images", ...
+  double render_ms_mean = 0.0;
+  double wall_s = 0.0;
+};
+
+// Renders and writes every frame. Throws InputError (one line naming the option or file) for
+// bad options or an unwritable output, before any frame is written when it can tell.
+SynthSummary RunSynth(const SynthOptions& options);
+
+// The truth CSV: frame, time_s, bend_deg, per marker <name>_x, <name>_y, <name>_visible (the
+// visible fraction, 0..1), then angle_deg, chord_px, sagitta_px, radius_px, arc_length_px,
+// tip_disp_px, centreline_radius_px. Absent values are empty fields.
+std::string TruthCsvHeader(const SceneOptions& scene);
+std::string TruthCsvRow(const SceneTruth& truth);
+
+// One line for a person.
+std::string FormatSynthSummary(const SynthSummary& summary, const SynthOptions& options);
+
+}  // namespace softsight

@@ -1,0 +1,176 @@
+#include "app/synth_command.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("softsight_synth_" + std::to_string(getpid()) + "_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> ReadLines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  for (std::string f; std::getline(in, f, ',');) fields.push_back(f);
+  if (!line.empty() && line.back() == ',') fields.push_back("");
+  return fields;
+}
+
+SynthOptions SmallRun(const fs::path& out) {
+  SynthOptions o;
+  o.scene.size = cv::Size(320, 240);
+  o.scene.frame_count = 8;
+  o.scene.length_px = 150;
+  o.scene.width_px = 20;
+  o.scene.marker_radius_px = 6;
+  o.noise.sigma = 2;
+  o.out = out.string();
+  o.quiet = true;
+  return o;
+}
+
+// The video is lossless: what OpenCV reads back is exactly what the renderer drew, so accuracy
+// tests on video files measure the tracker, not the codec.
+TEST(SynthCommandTest, VideoReadsBackExactlyWithTruthCsv) {
+  const fs::path dir = FreshDir("video");
+  SynthOptions options = SmallRun(dir / "scene.avi");
+  options.truth_csv = (dir / "truth.csv").string();
+  options.occluders = {Occluder{cv::Rect2d(0, 0, 320, 240), 5, 5}};  // Frame 5: all hidden.
+  const SynthSummary summary = RunSynth(options);
+  EXPECT_EQ(summary.frames, 8);
+
+  SyntheticScene scene(options.scene, options.noise, options.render, options.occluders);
+  cv::VideoCapture capture(options.out);
+  ASSERT_TRUE(capture.isOpened());
+  cv::Mat frame, expected;
+  int frames = 0;
+  while (capture.read(frame)) {
+    ASSERT_EQ(frame.size(), cv::Size(320, 240));
+    ASSERT_EQ(frame.type(), CV_8UC3);
+    scene.render(frames, expected);
+    EXPECT_EQ(cv::norm(frame, expected, cv::NORM_INF), 0.0) << "frame " << frames;
+    ++frames;
+  }
+  EXPECT_EQ(frames, 8);
+
+  const std::vector<std::string> lines = ReadLines(*options.truth_csv);
+  ASSERT_EQ(lines.size(), 9u);
+  EXPECT_EQ(lines[0],
+            "frame,time_s,bend_deg,red_x,red_y,red_visible,blue_x,blue_y,blue_visible,green_x,"
+            "green_y,green_visible,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,"
+            "tip_disp_px,centreline_radius_px");
+  const size_t columns = SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> fields = SplitCsv(lines[i]);
+    ASSERT_EQ(fields.size(), columns) << lines[i];
+    EXPECT_EQ(fields[0], std::to_string(i - 1));
+  }
+  // Straight at frame 0: angle 180, no radius.
+  const std::vector<std::string> first = SplitCsv(lines[1]);
+  EXPECT_NEAR(std::stod(first[12]), 180.0, 0.01);
+  EXPECT_EQ(first[15], "");
+  EXPECT_EQ(first[18], "");
+  // Frame 5 is fully occluded: empty coordinates, visible 0, no measurements.
+  const std::vector<std::string> hidden = SplitCsv(lines[6]);
+  EXPECT_EQ(hidden[3], "");
+  EXPECT_EQ(hidden[4], "");
+  EXPECT_EQ(std::stod(hidden[5]), 0.0);
+  EXPECT_EQ(hidden[12], "");
+  // The rows are the scene's truth.
+  EXPECT_EQ(lines[4], TruthCsvRow(scene.render(3, expected)));
+}
+
+TEST(SynthCommandTest, ImageSequenceIsLossless) {
+  const fs::path dir = FreshDir("images");
+  SynthOptions options = SmallRun(dir / "f_%03d.png");
+  options.scene.kind = SceneKind::kWedge4;
+  options.scene.frame_count = 3;
+  RunSynth(options);
+  SyntheticScene scene(options.scene, options.noise);
+  cv::Mat expected;
+  for (int i = 0; i < 3; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "f_%03d.png", i);
+    const cv::Mat image = cv::imread((dir / name).string());
+    ASSERT_FALSE(image.empty()) << name;
+    scene.render(i, expected);
+    EXPECT_EQ(cv::norm(image, expected, cv::NORM_INF), 0.0) << name;
+  }
+  EXPECT_FALSE(fs::exists(dir / "f_003.png"));
+}
+
+TEST(SynthCommandTest, BadInputIsOneLineInputError) {
+  const fs::path dir = FreshDir("bad");
+  auto expect_error = [](const SynthOptions& options, const std::string& needle) {
+    try {
+      RunSynth(options);
+      ADD_FAILURE() << "no error for " << needle;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  };
+  SynthOptions zero = SmallRun(dir / "a.avi");
+  zero.scene.frame_count = 0;
+  expect_error(zero, "--frames");
+  SynthOptions missing_folder = SmallRun(dir / "no_such_folder" / "a.avi");
+  missing_folder.truth_csv = (dir / "truth.csv").string();
+  expect_error(missing_folder, "no_such_folder");
+  EXPECT_FALSE(fs::exists(dir / "truth.csv"));  // Nothing written before the error.
+  expect_error(SmallRun(dir / "a.xyz"), ".xyz");
+  expect_error(SmallRun(dir / "f_%s.png"), "%d");
+  SynthOptions codec = SmallRun(dir / "a.avi");
+  codec.codec = "h265";
+  expect_error(codec, "h265");
+  SynthOptions bad_truth = SmallRun(dir / "a.avi");
+  bad_truth.truth_csv = (dir / "nowhere" / "t.csv").string();
+  expect_error(bad_truth, "nowhere");
+  EXPECT_THROW(ParseSceneKind("spiral"), InputError);
+}
+
+// Through the real program: an unknown scene is one line on stderr and exit code 2.
+TEST(SynthCommandTest, ProgramReportsBadSceneOnce) {
+  const std::string binary = testing::SoftsightBinary();
+  const fs::path dir = FreshDir("program");
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = binary + " synth --scene spiral --out " +
+                              (dir / "a.avi").string() + " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::vector<std::string> lines = ReadLines(err);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("spiral"), std::string::npos) << lines[0];
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,173 @@
+#include "softsight/calib/hsv_picker.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+// A 61x61 HSV image: grey-green textured background with a disc of radius 12 at (30, 30) whose
+// hue is `hue` +- `hue_jitter` (wrapping through 0), saturation ~200, value ~180, plus noise.
+cv::Mat HsvPatchImage(int hue, int hue_jitter, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> jitter(-hue_jitter, hue_jitter);
+  std::uniform_int_distribution<int> noise(-12, 12);
+  cv::Mat hsv(61, 61, CV_8UC3);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool inside = (x - 30) * (x - 30) + (y - 30) * (y - 30) <= 12 * 12;
+      if (inside) {
+        const int h = ((hue + jitter(rng)) % 180 + 180) % 180;
+        hsv.at<cv::Vec3b>(y, x) = cv::Vec3b(h, cv::saturate_cast<uchar>(200 + noise(rng)),
+                                            cv::saturate_cast<uchar>(180 + noise(rng)));
+      } else {
+        hsv.at<cv::Vec3b>(y, x) = cv::Vec3b(70, cv::saturate_cast<uchar>(20 + noise(rng)),
+                                            cv::saturate_cast<uchar>(120 + noise(rng)));
+      }
+    }
+  }
+  return hsv;
+}
+
+cv::Mat ToBgr(const cv::Mat& hsv) {
+  cv::Mat bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  return bgr;
+}
+
+// Fraction of pixels (in BGR image `bgr`, converted to HSV) accepted by the pick, inside or
+// outside the disc of radius `r` around `c`.
+double AcceptedFraction(const cv::Mat& bgr, const HsvPick& pick, cv::Point2d c, double r,
+                        bool inside) {
+  cv::Mat hsv;
+  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+  int total = 0, accepted = 0;
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const double d2 = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
+      if ((d2 <= r * r) != inside) continue;
+      ++total;
+      accepted += HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v);
+    }
+  }
+  return total ? static_cast<double>(accepted) / total : 0.0;
+}
+
+TEST(HsvPickerTest, GreenMarkerGivesPlainRangeAroundItsHue) {
+  const cv::Mat bgr = ToBgr(HsvPatchImage(60, 3, 1));
+  const auto pick = PickHsvRange(bgr, {30, 30}, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  EXPECT_LT(pick->h.lo, pick->h.hi);
+  // Hue 57..63 (+-1 from the BGR round trip), widened by the 6-unit margin.
+  EXPECT_GE(pick->h.lo, 48);
+  EXPECT_LE(pick->h.lo, 56);
+  EXPECT_GE(pick->h.hi, 64);
+  EXPECT_LE(pick->h.hi, 72);
+  EXPECT_GE(pick->s.lo, 40);  // Never below min_saturation.
+  EXPECT_LE(pick->s.lo, 190 - 40);
+  EXPECT_EQ(pick->sample_count, 97);  // Pixels whose centres lie within 5.5 px of the click.
+  EXPECT_DOUBLE_EQ(AcceptedFraction(bgr, *pick, {30, 30}, 11, true), 1.0);
+  EXPECT_DOUBLE_EQ(AcceptedFraction(bgr, *pick, {30, 30}, 13, false), 0.0);
+}
+
+TEST(HsvPickerTest, RedMarkerStraddlingZeroGivesWrappedRange) {
+  const cv::Mat bgr = ToBgr(HsvPatchImage(0, 4, 2));  // Hues 176..179 and 0..4.
+  const auto pick = PickHsvRange(bgr, {30, 30}, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  EXPECT_GT(pick->h.lo, pick->h.hi) << pick->h.lo << ".." << pick->h.hi;
+  // 5th..95th percentile of 176..4 (+-1 from the BGR round trip), widened by the 6-unit margin.
+  EXPECT_GE(pick->h.lo, 163);
+  EXPECT_LE(pick->h.lo, 172);
+  EXPECT_GE(pick->h.hi, 8);
+  EXPECT_LE(pick->h.hi, 17);
+  EXPECT_LE(pick->hue_spread, 10.0);  // Measured around the circle, not 0..179.
+  EXPECT_DOUBLE_EQ(AcceptedFraction(bgr, *pick, {30, 30}, 11, true), 1.0);
+  EXPECT_DOUBLE_EQ(AcceptedFraction(bgr, *pick, {30, 30}, 13, false), 0.0);
+}
+
+TEST(HsvPickerTest, RedMarkerJustBelowZeroWrapsOnlyThroughMargin) {
+  const cv::Mat bgr = ToBgr(HsvPatchImage(174, 3, 3));  // 171..177, margin reaches past 179.
+  const auto pick = PickHsvRange(bgr, {30, 30}, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  EXPECT_GT(pick->h.lo, pick->h.hi);
+  EXPECT_GE(pick->h.lo, 160);
+  EXPECT_LE(pick->h.hi, 5);
+}
+
+TEST(HsvPickerTest, FewRimOutliersDoNotStretchTheRange) {
+  // Radius 5 disc around a point 4 px from the edge of the red disc: some background pixels and a
+  // few blue specks are sampled, but the hue range stays red.
+  cv::Mat hsv = HsvPatchImage(0, 2, 4);
+  hsv.at<cv::Vec3b>(28, 30) = cv::Vec3b(120, 220, 200);  // Blue specks inside the sampled disc.
+  hsv.at<cv::Vec3b>(32, 31) = cv::Vec3b(120, 220, 200);
+  std::vector<cv::Vec3b> samples;
+  for (int y = 25; y <= 35; ++y) {
+    for (int x = 25; x <= 35; ++x) samples.push_back(hsv.at<cv::Vec3b>(y, x));
+  }
+  const auto pick = PickHsvFromSamples(samples, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  EXPECT_GT(pick->h.lo, pick->h.hi);
+  EXPECT_FALSE(HsvInRange(cv::Vec3b(120, 220, 200), pick->h, pick->s, pick->v));
+  EXPECT_TRUE(HsvInRange(cv::Vec3b(179, 200, 180), pick->h, pick->s, pick->v));
+  EXPECT_TRUE(HsvInRange(cv::Vec3b(1, 200, 180), pick->h, pick->s, pick->v));
+}
+
+TEST(HsvPickerTest, GreyPatchOrClickOutsideGivesNoRange) {
+  const cv::Mat bgr = ToBgr(HsvPatchImage(0, 2, 5));
+  std::string why;
+  EXPECT_FALSE(PickHsvRange(bgr, {5, 5}, HsvPickOptions{}, &why));  // Background: grey.
+  EXPECT_NE(why.find("not a coloured marker"), std::string::npos) << why;
+  EXPECT_FALSE(PickHsvRange(bgr, {-50, 10}, HsvPickOptions{}, &why));
+  EXPECT_NE(why.find("outside the image"), std::string::npos) << why;
+  EXPECT_FALSE(PickHsvFromSamples({}, HsvPickOptions{}, &why));
+}
+
+TEST(HsvPickerTest, OptionsCheckNamesTheField) {
+  std::string error;
+  EXPECT_TRUE(HsvPickOptions{}.Check(&error));
+  HsvPickOptions o;
+  o.low_percentile = 60;
+  o.high_percentile = 40;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("low_percentile"), std::string::npos);
+  o = {};
+  o.hue_margin = 95;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("hue_margin"), std::string::npos);
+  o = {};
+  o.radius_px = -1;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("radius_px"), std::string::npos);
+}
+
+TEST(HsvPickerTest, RenderedSceneMarkersArePickedAndSeparated) {
+  SceneOptions scene;
+  scene.size = cv::Size(320, 240);
+  scene.length_px = 160;
+  scene.width_px = 24;
+  scene.marker_radius_px = 8;
+  scene.frame_count = 2;
+  SyntheticScene renderer(scene, NoiseOptions{.sigma = 3.0});
+  cv::Mat image;
+  const SceneTruth truth = renderer.render(1, image);
+  ASSERT_EQ(truth.markers.size(), 3u);
+  for (const MarkerTruth& marker : truth.markers) {
+    ASSERT_TRUE(marker.centroid_px) << marker.name;
+    const auto pick = PickHsvRange(image, *marker.centroid_px, HsvPickOptions{});
+    ASSERT_TRUE(pick) << marker.name;
+    if (marker.name == "red") {
+      EXPECT_GT(pick->h.lo, pick->h.hi) << "red wraps through 0";
+    }
+    // The marker's interior is accepted, everything away from it (background, body, the other
+    // markers) is not.
+    EXPECT_GE(AcceptedFraction(image, *pick, *marker.centroid_px, 6, true), 0.97) << marker.name;
+    EXPECT_LE(AcceptedFraction(image, *pick, *marker.centroid_px, 11, false), 0.002) << marker.name;
+  }
+}
+
+}  // namespace
+}  // namespace softsight

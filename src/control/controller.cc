@@ -1,0 +1,125 @@
+#include "softsight/control/controller.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace softsight {
+
+bool ControllerOptions::Check(std::string* error) const {
+  auto fail = [&](const char* what) {
+    if (error) *error = what;
+    return false;
+  };
+  auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!finite_nonneg(kp_kpa_per_deg)) return fail("kp_kpa_per_deg must be >= 0");
+  if (!finite_nonneg(ki_kpa_per_deg_s)) return fail("ki_kpa_per_deg_s must be >= 0");
+  if (!finite_nonneg(kd_kpa_s_per_deg)) return fail("kd_kpa_s_per_deg must be >= 0");
+  if (!finite_nonneg(derivative_filter_s)) return fail("derivative_filter_s must be >= 0");
+  if (!std::isfinite(bias_kpa)) return fail("bias_kpa must be finite");
+  if (!finite_nonneg(ff_kpa_per_deg)) return fail("ff_kpa_per_deg must be >= 0");
+  if (!finite_nonneg(min_kpa)) return fail("min_kpa must be >= 0");
+  if (!std::isfinite(max_kpa) || max_kpa <= min_kpa) return fail("max_kpa must be > min_kpa");
+  if (!finite_nonneg(max_rate_kpa_per_s)) return fail("max_rate_kpa_per_s must be >= 0");
+  if (!finite_nonneg(hold_s)) return fail("hold_s must be >= 0");
+  return true;
+}
+
+const char* ActionName(ControllerOutput::Action action) {
+  switch (action) {
+    case ControllerOutput::Action::kTrack: return "track";
+    case ControllerOutput::Action::kHold: return "hold";
+    case ControllerOutput::Action::kVent: return "vent";
+  }
+  return "?";
+}
+
+AngleController::AngleController(const ControllerOptions& options) : options_(options) {
+  assert(options_.Check(nullptr));
+}
+
+void AngleController::limit_max_kpa(double max_kpa) {
+  options_.max_kpa = std::max(options_.min_kpa + 1e-3, std::min(options_.max_kpa, max_kpa));
+}
+
+void AngleController::reset() {
+  last_time_s_.reset();
+  loss_start_s_.reset();
+  last_measured_deg_.reset();
+  integral_kpa_ = 0.0;
+  derivative_deg_per_s_ = 0.0;
+  setpoint_kpa_ = 0.0;
+  vented_ = true;
+}
+
+ControllerOutput AngleController::update(double time_s, double target_deg,
+                                         std::optional<double> measured_deg) {
+  const double dt_s = last_time_s_ ? std::max(0.0, time_s - *last_time_s_) : 0.0;
+  last_time_s_ = time_s;
+  ControllerOutput out;
+
+  if (!measured_deg) {
+    // Hold the last setpoint with the integral frozen; vent once the loss lasts too long.
+    last_measured_deg_.reset();  // No derivative across the gap.
+    if (!loss_start_s_) loss_start_s_ = time_s;
+    // Holding for hold_s means: the first frame without a measurement plus hold_s.
+    if (!vented_ && time_s - *loss_start_s_ <= options_.hold_s + 1e-9) {
+      out.action = ControllerOutput::Action::kHold;
+      out.setpoint_kpa = setpoint_kpa_;
+      return out;
+    }
+    vented_ = true;
+    integral_kpa_ = 0.0;
+    setpoint_kpa_ = 0.0;
+    out.action = ControllerOutput::Action::kVent;
+    return out;
+  }
+
+  loss_start_s_.reset();
+  vented_ = false;
+  const double error_deg = *measured_deg - target_deg;
+  out.error_deg = error_deg;
+
+  // Derivative on the measurement: bending (angle decreasing) reduces the setpoint's rise.
+  if (last_measured_deg_ && dt_s > 0.0) {
+    const double raw = -(*measured_deg - *last_measured_deg_) / dt_s;  // d(error)/dt at fixed target.
+    const double a = options_.derivative_filter_s > 0.0
+                         ? dt_s / (options_.derivative_filter_s + dt_s)
+                         : 1.0;
+    derivative_deg_per_s_ += a * (raw - derivative_deg_per_s_);
+  } else {
+    derivative_deg_per_s_ = 0.0;
+  }
+  last_measured_deg_ = measured_deg;
+
+  const double feedforward_kpa =
+      options_.bias_kpa + options_.ff_kpa_per_deg * (180.0 - target_deg);
+  const double pd_kpa = feedforward_kpa + options_.kp_kpa_per_deg * error_deg -
+                        options_.kd_kpa_s_per_deg * derivative_deg_per_s_;
+  const double candidate_integral =
+      integral_kpa_ + options_.ki_kpa_per_deg_s * error_deg * dt_s;
+  double wanted = pd_kpa + candidate_integral;
+
+  // Output limits, then the slew limit from the previous setpoint.
+  double limited = std::clamp(wanted, options_.min_kpa, options_.max_kpa);
+  if (options_.max_rate_kpa_per_s > 0.0) {  // From the previous setpoint (0 at the start).
+    const double step = options_.max_rate_kpa_per_s * dt_s;
+    limited = std::clamp(limited, setpoint_kpa_ - step, setpoint_kpa_ + step);
+  }
+  // Anti-windup (conditional integration): keep the new integral only when the output is not held
+  // back by a limit in the direction the error pushes it.
+  const bool pushing_up = error_deg > 0.0 && limited < wanted - 1e-9;
+  const bool pushing_down = error_deg < 0.0 && limited > wanted + 1e-9;
+  if (!pushing_up && !pushing_down) {
+    integral_kpa_ = candidate_integral;
+  }
+  // The integral alone never needs to exceed the output range.
+  integral_kpa_ = std::clamp(integral_kpa_, options_.min_kpa - options_.max_kpa,
+                             options_.max_kpa - options_.min_kpa);
+  setpoint_kpa_ = limited;
+  out.action = ControllerOutput::Action::kTrack;
+  out.setpoint_kpa = limited;
+  return out;
+}
+
+}  // namespace softsight

@@ -1,0 +1,152 @@
+#include "softsight/control/controller.h"
+
+#include <gtest/gtest.h>
+
+#include "softsight/control/profile.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+ControllerOptions POnly(double kp) {
+  ControllerOptions o;
+  o.kp_kpa_per_deg = kp;
+  o.ki_kpa_per_deg_s = 0.0;
+  o.bias_kpa = 0.0;
+  o.max_rate_kpa_per_s = 0.0;
+  return o;
+}
+
+TEST(AngleController, ProportionalLawWithThePapersSign) {
+  AngleController c(POnly(0.5));
+  // Target 120, measured 150: must bend 30 degrees more -> 15 kPa.
+  ControllerOutput out = c.update(0.0, 120.0, 150.0);
+  EXPECT_EQ(out.action, ControllerOutput::Action::kTrack);
+  EXPECT_DOUBLE_EQ(*out.error_deg, 30.0);
+  EXPECT_DOUBLE_EQ(out.setpoint_kpa, 15.0);
+  // Bent too far: the setpoint drops, clamped at min_kpa.
+  EXPECT_DOUBLE_EQ(c.update(0.1, 120.0, 100.0).setpoint_kpa, 0.0);
+}
+
+TEST(AngleController, OutputAndRateLimits) {
+  ControllerOptions o = POnly(10.0);
+  o.max_kpa = 40.0;
+  o.max_rate_kpa_per_s = 50.0;
+  AngleController c(o);
+  EXPECT_DOUBLE_EQ(c.update(0.0, 120.0, 180.0).setpoint_kpa, 0.0);  // First frame: no dt yet.
+  EXPECT_NEAR(c.update(0.1, 120.0, 180.0).setpoint_kpa, 5.0, 1e-9);  // 50 kPa/s * 0.1 s.
+  double sp = 0.0;
+  for (int k = 2; k < 20; ++k) sp = c.update(0.1 * k, 120.0, 180.0).setpoint_kpa;
+  EXPECT_DOUBLE_EQ(sp, 40.0);
+}
+
+TEST(AngleController, IntegralDoesNotWindUpAgainstTheOutputLimit) {
+  ControllerOptions o = POnly(0.1);
+  o.ki_kpa_per_deg_s = 2.0;
+  o.max_kpa = 20.0;
+  AngleController c(o);
+  // The actuator cannot reach the target (stuck at 170): the output saturates at 20 kPa.
+  for (int k = 0; k < 300; ++k) c.update(0.033 * k, 100.0, 170.0);
+  EXPECT_LE(c.integral_kpa(), 20.0);
+  // Once the target is reached and passed, the setpoint leaves the limit within a few frames
+  // (a wound-up integral would keep it there for seconds).
+  double sp = 20.0;
+  int frames = 0;
+  for (int k = 300; k < 400 && sp >= 20.0 - 1e-9; ++k, ++frames) {
+    sp = c.update(0.033 * k, 100.0, 95.0).setpoint_kpa;
+  }
+  EXPECT_LT(frames, 5);
+}
+
+TEST(AngleController, RemovesSteadyStateErrorWithIntegral) {
+  ControllerOptions o = POnly(0.2);
+  o.ki_kpa_per_deg_s = 1.0;
+  AngleController c(o);
+  // Static plant: angle = 180 - 2.4 * (p - 3).
+  double p = 0.0;
+  double angle = 180.0;
+  for (int k = 0; k < 600; ++k) {
+    p = c.update(k / 30.0, 120.0, angle).setpoint_kpa;
+    angle = 180.0 - 2.4 * std::max(0.0, p - 3.0);
+  }
+  EXPECT_NEAR(angle, 120.0, 0.05);
+}
+
+TEST(AngleController, HoldsThenVentsOnVisionLoss) {
+  ControllerOptions o = POnly(0.5);
+  o.ki_kpa_per_deg_s = 1.0;
+  o.hold_s = 0.5;
+  AngleController c(o);
+  ControllerOutput out;
+  for (int k = 0; k < 30; ++k) out = c.update(k / 30.0, 120.0, 140.0);
+  const double held = out.setpoint_kpa;
+  const double integral = c.integral_kpa();
+  for (int k = 30; k <= 45; ++k) {  // 0.5 s without a measurement.
+    out = c.update(k / 30.0, 100.0, std::nullopt);
+    EXPECT_EQ(out.action, ControllerOutput::Action::kHold);
+    EXPECT_DOUBLE_EQ(out.setpoint_kpa, held);
+  }
+  EXPECT_DOUBLE_EQ(c.integral_kpa(), integral);  // Frozen.
+  out = c.update(46 / 30.0, 100.0, std::nullopt);
+  EXPECT_EQ(out.action, ControllerOutput::Action::kVent);
+  EXPECT_DOUBLE_EQ(out.setpoint_kpa, 0.0);
+  EXPECT_DOUBLE_EQ(c.integral_kpa(), 0.0);
+  // Never measured at all: no inflation.
+  AngleController fresh(o);
+  EXPECT_EQ(fresh.update(0.0, 120.0, std::nullopt).action, ControllerOutput::Action::kVent);
+}
+
+TEST(AngleController, CheckNamesTheBadField) {
+  ControllerOptions o;
+  std::string error;
+  EXPECT_TRUE(o.Check(&error));
+  o.max_kpa = -1.0;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("max_kpa"), std::string::npos);
+  o = ControllerOptions{};
+  o.kp_kpa_per_deg = -0.1;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("kp_kpa_per_deg"), std::string::npos);
+}
+
+TEST(TargetProfile, StepsRampsAndSines) {
+  const TargetProfile p = TargetProfile::Parse(
+      "# a test\nstart 170\nhold 1   # stay\nstep 120\nhold 1\nramp 150 2\nsine 150 10 0.5 2\n",
+      "p.txt");
+  EXPECT_DOUBLE_EQ(p.at(0.0), 170.0);
+  EXPECT_DOUBLE_EQ(p.at(0.99), 170.0);
+  EXPECT_DOUBLE_EQ(p.at(1.0), 120.0);
+  EXPECT_DOUBLE_EQ(p.at(1.5), 120.0);
+  EXPECT_DOUBLE_EQ(p.at(3.0), 135.0);  // Half-way up the ramp.
+  EXPECT_DOUBLE_EQ(p.at(4.0), 150.0);
+  EXPECT_NEAR(p.at(4.5), 160.0, 1e-9);  // Quarter period of 0.5 Hz.
+  EXPECT_NEAR(p.at(5.5), 140.0, 1e-9);
+  EXPECT_DOUBLE_EQ(p.duration_s(), 6.0);
+  EXPECT_NEAR(p.at(100.0), 150.0, 1e-9);  // Holds the final value.
+  EXPECT_DOUBLE_EQ(TargetProfile::Constant(120.0).at(5.0), 120.0);
+  EXPECT_DOUBLE_EQ(TargetProfile::Parse("step 100\n", "x").at(3.0), 100.0);
+}
+
+TEST(TargetProfile, ErrorsNameFileLineAndProblem) {
+  auto error_of = [](const std::string& text) {
+    try {
+      TargetProfile::Parse(text, "prof.txt");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of("hold 1\nstep 200\n"),
+            "prof.txt:2: step: angle 200.000000 deg is outside 0..180 (the angle at the middle "
+            "marker)");
+  EXPECT_NE(error_of("ramp 120\n").find("prof.txt:1: ramp: expected 'ramp ANGLE_DEG SECONDS'"),
+            std::string::npos);
+  EXPECT_NE(error_of("hold x\n").find("prof.txt:1: hold: 'x' is not a number"), std::string::npos);
+  EXPECT_NE(error_of("jump 3\n").find("unknown segment 'jump'"), std::string::npos);
+  EXPECT_NE(error_of("sine 170 20 1 1\n").find("outside 0..180"), std::string::npos);
+  EXPECT_NE(error_of("# nothing\n").find("no segments"), std::string::npos);
+  EXPECT_NE(error_of("hold -1\n").find("must be > 0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,171 @@
+#include "softsight/control/profile.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+constexpr double kMinAngleDeg = 0.0;
+constexpr double kMaxAngleDeg = 180.0;
+
+}  // namespace
+
+TargetProfile TargetProfile::Constant(double angle_deg) {
+  TargetProfile p;
+  p.start_deg_ = angle_deg;
+  return p;
+}
+
+TargetProfile TargetProfile::Parse(std::string_view text, const std::string& source) {
+  TargetProfile p;
+  double t = 0.0;
+  double current = 180.0;
+  bool started = false;
+  std::istringstream lines{std::string(text)};
+  std::string line;
+  int line_no = 0;
+  while (std::getline(lines, line)) {
+    ++line_no;
+    const size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line);
+    std::string keyword;
+    if (!(words >> keyword)) continue;
+    const std::string where = source + ":" + std::to_string(line_no) + ": ";
+    std::vector<double> values;
+    std::string word;
+    while (words >> word) {
+      size_t used = 0;
+      double v = 0.0;
+      try {
+        v = std::stod(word, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != word.size() || !std::isfinite(v)) {
+        throw InputError(where + keyword + ": '" + word + "' is not a number");
+      }
+      values.push_back(v);
+    }
+    auto expect = [&](size_t n, const char* usage) {
+      if (values.size() != n) {
+        throw InputError(where + keyword + ": expected " + usage + ", got " +
+                         std::to_string(values.size()) + " value(s)");
+      }
+    };
+    auto angle = [&](double v) {
+      if (v < kMinAngleDeg || v > kMaxAngleDeg) {
+        throw InputError(where + keyword + ": angle " + std::to_string(v) +
+                         " deg is outside 0..180 (the angle at the middle marker)");
+      }
+      return v;
+    };
+    auto duration = [&](double v) {
+      if (!(v > 0.0)) {
+        throw InputError(where + keyword + ": duration " + std::to_string(v) + " s must be > 0");
+      }
+      return v;
+    };
+    Segment s;
+    s.start_s = t;
+    s.from_deg = current;
+    if (keyword == "start") {
+      expect(1, "'start ANGLE_DEG'");
+      if (started) throw InputError(where + "start: must come before every other segment");
+      current = p.start_deg_ = angle(values[0]);
+      started = true;
+      continue;
+    } else if (keyword == "hold") {
+      expect(1, "'hold SECONDS'");
+      s.kind = Segment::Kind::kHold;
+      s.duration_s = duration(values[0]);
+      s.to_deg = current;
+    } else if (keyword == "step") {
+      expect(1, "'step ANGLE_DEG'");
+      current = angle(values[0]);
+      // A step is a zero-length jump: the next segments start from the new value.
+      started = true;
+      if (p.segments_.empty()) p.start_deg_ = current;
+      else p.segments_.push_back({Segment::Kind::kHold, t, 0.0, current, current, 0.0, 0.0});
+      continue;
+    } else if (keyword == "ramp") {
+      expect(2, "'ramp ANGLE_DEG SECONDS'");
+      s.kind = Segment::Kind::kRamp;
+      s.to_deg = angle(values[0]);
+      s.duration_s = duration(values[1]);
+      current = s.to_deg;
+    } else if (keyword == "sine") {
+      expect(4, "'sine CENTRE_DEG AMPLITUDE_DEG FREQUENCY_HZ SECONDS'");
+      s.kind = Segment::Kind::kSine;
+      s.to_deg = angle(values[0]);
+      s.amplitude_deg = values[1];
+      if (s.amplitude_deg < 0.0) {
+        throw InputError(where + "sine: amplitude " + std::to_string(values[1]) + " must be >= 0");
+      }
+      angle(s.to_deg - s.amplitude_deg);
+      angle(s.to_deg + s.amplitude_deg);
+      s.frequency_hz = duration(values[2]);
+      s.duration_s = duration(values[3]);
+      current = s.to_deg + s.amplitude_deg *
+                               std::sin(2.0 * M_PI * s.frequency_hz * s.duration_s);
+    } else {
+      throw InputError(where + "unknown segment '" + keyword +
+                       "' (use start, hold, step, ramp or sine)");
+    }
+    started = true;
+    p.segments_.push_back(s);
+    t += s.duration_s;
+  }
+  if (p.segments_.empty() && !started) {
+    throw InputError(source + ": the profile has no segments (e.g. 'step 120' then 'hold 5')");
+  }
+  p.duration_s_ = t;
+  // A trailing step with nothing after it defines the final value.
+  if (!p.segments_.empty()) {
+    Segment tail;
+    tail.kind = Segment::Kind::kHold;
+    tail.start_s = t;
+    tail.from_deg = tail.to_deg = current;
+    p.segments_.push_back(tail);
+  } else {
+    p.start_deg_ = current;
+  }
+  return p;
+}
+
+TargetProfile TargetProfile::Load(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot read the target profile");
+  std::stringstream text;
+  text << in.rdbuf();
+  return Parse(text.str(), file);
+}
+
+double TargetProfile::at(double time_s) const {
+  if (segments_.empty() || time_s < 0.0) return start_deg_;
+  // Segments are few (a profile file is written by hand): a linear scan is fine.
+  const Segment* active = &segments_.front();
+  for (const Segment& s : segments_) {
+    if (s.start_s <= time_s) active = &s;
+    else break;
+  }
+  const double u = time_s - active->start_s;
+  switch (active->kind) {
+    case Segment::Kind::kHold:
+      return active->to_deg;
+    case Segment::Kind::kRamp:
+      if (u >= active->duration_s) return active->to_deg;
+      return active->from_deg + (active->to_deg - active->from_deg) * u / active->duration_s;
+    case Segment::Kind::kSine:
+      return active->to_deg +
+             active->amplitude_deg * std::sin(2.0 * M_PI * active->frequency_hz *
+                                              std::min(u, active->duration_s));
+  }
+  return active->to_deg;
+}
+
+}  // namespace softsight

@@ -1,0 +1,172 @@
+#include "softsight/control/rig.h"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+
+bool RigOptions::Check(std::string* error) const {
+  if (const char* problem = CheckBoardConfig(board)) {
+    if (error) *error = std::string("board: ") + problem;
+    return false;
+  }
+  std::string plant_error;
+  if (!plant.Check(&plant_error)) {
+    if (error) *error = "plant: " + plant_error;
+    return false;
+  }
+  if (!(end_marker_span > 0.0 && end_marker_span <= 1.0)) {
+    if (error) *error = "end_marker_span must be in (0, 1]";
+    return false;
+  }
+  if (!(sensor_noise_kpa >= 0.0)) {
+    if (error) *error = "sensor_noise_kpa must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+const RigOptions& Checked(const RigOptions& options) {
+  std::string error;
+  if (!options.Check(&error)) throw InputError("simulated rig: " + error);
+  return options;
+}
+
+}  // namespace
+
+SimulatedRig::SimulatedRig(const RigOptions& options)
+    : options_(Checked(options)), board_(options.board), plant_(options.plant), rng_(options.seed) {}
+
+uint32_t SimulatedRig::now_ms_locked() const {
+  return static_cast<uint32_t>(tick_ * 1000 / options_.board.loop_hz);
+}
+
+void SimulatedRig::advance(double dt_s) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double period_s = 1.0 / options_.board.loop_hz;
+  const int64_t ticks = std::llround(dt_s / period_s);
+  for (int64_t i = 0; i < ticks; ++i) {
+    // The board samples the sensor and sets the valves once per period; the plant runs under
+    // that drive until the next period.
+    const double sensed_pa =
+        plant_.pressure_pa() + options_.sensor_noise_kpa * 1e3 * noise_(rng_);
+    drive_ = board_.update(now_ms_locked(), static_cast<int32_t>(std::lround(sensed_pa)));
+    plant_.step(period_s, drive_);
+    peak_pressure_pa_ = std::max(peak_pressure_pa_, plant_.pressure_pa());
+    ++tick_;
+  }
+}
+
+void SimulatedRig::receive(std::string_view bytes, std::string* replies) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const uint32_t now = now_ms_locked();
+  for (char c : bytes) {
+    const size_t n = board_.receive(c, now);
+    if (n > 0) replies->append(board_.reply(), n);
+  }
+}
+
+RigSnapshot SimulatedRig::snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  RigSnapshot s;
+  s.time_s = static_cast<double>(tick_) / options_.board.loop_hz;
+  s.pressure_kpa = plant_.pressure_pa() * 1e-3;
+  s.peak_pressure_kpa = peak_pressure_pa_ * 1e-3;
+  s.bend_deg = plant_.bend_deg();
+  s.angle_deg = PaperAngleFromBend(s.bend_deg, options_.end_marker_span);
+  s.drive = drive_;
+  s.mode = board_.mode();
+  s.flags = board_.flags();
+  s.board_rejected = board_.rejected();
+  return s;
+}
+
+RigServer::RigServer(SimulatedRig& rig, bool realtime) : rig_(rig) {
+  server_ = std::thread([this] { serve(); });
+  if (realtime) clock_ = std::thread([this] { run_clock(); });
+}
+
+RigServer::~RigServer() { stop_threads(); }
+
+void RigServer::stop_threads() {
+  shutdown_ = true;
+  if (server_.joinable()) server_.join();
+  if (clock_.joinable()) clock_.join();
+}
+
+void RigServer::set_reply_filter(std::function<std::string(const std::string&)> filter) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  filter_ = std::move(filter);
+}
+
+void RigServer::inject(std::string_view bytes) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  if (port_closed_) return;
+  const ssize_t n = ::write(pty_.master_fd(), bytes.data(), bytes.size());
+  (void)n;  // A full pty buffer drops test garbage; nothing to recover.
+}
+
+void RigServer::disconnect() {
+  // The clock keeps nothing of the port; only the serving thread must stop before the close.
+  port_closed_ = true;
+  if (server_.joinable()) server_.join();
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  pty_.close();
+}
+
+void RigServer::serve() {
+  std::string replies;
+  char buffer[256];
+  while (!port_closed_ && !shutdown_) {
+    pollfd p{pty_.master_fd(), POLLIN, 0};
+    const int ready = ::poll(&p, 1, 5);
+    if (ready <= 0 || (p.revents & POLLIN) == 0) {
+      // POLLHUP without data: nobody has the port open (we keep the slave, so rarely). Wait.
+      if (ready > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      continue;
+    }
+    const ssize_t n = ::read(pty_.master_fd(), buffer, sizeof(buffer));
+    if (n <= 0) continue;
+    replies.clear();
+    rig_.receive(std::string_view(buffer, static_cast<size_t>(n)), &replies);
+    if (replies.empty()) continue;
+    std::lock_guard<std::mutex> lock(write_mutex_);
+    size_t start = 0;
+    while (start < replies.size()) {
+      const size_t end = replies.find('\n', start);
+      std::string line = replies.substr(start, end == std::string::npos ? end : end - start + 1);
+      start = end == std::string::npos ? replies.size() : end + 1;
+      if (filter_) line = filter_(line);
+      size_t done = 0;
+      while (done < line.size()) {
+        const ssize_t w = ::write(pty_.master_fd(), line.data() + done, line.size() - done);
+        if (w <= 0) break;
+        done += static_cast<size_t>(w);
+      }
+    }
+  }
+}
+
+void RigServer::run_clock() {
+  using Clock = std::chrono::steady_clock;
+  const auto period = std::chrono::microseconds(1000000 / rig_.options().board.loop_hz);
+  auto next = Clock::now();
+  const double period_s = 1.0 / rig_.options().board.loop_hz;
+  while (!shutdown_) {
+    next += period;
+    std::this_thread::sleep_until(next);
+    rig_.advance(period_s);
+    // After a stall (a suspended process), catch up without a burst of thousands of periods.
+    if (Clock::now() - next > std::chrono::milliseconds(100)) next = Clock::now();
+  }
+}
+
+}  // namespace softsight

@@ -1,0 +1,529 @@
+#include "softsight/gui/live_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "softsight/core/error.h"
+#include "softsight/io/csv_writer.h"
+
+namespace softsight {
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr size_t kFpsWindow = 30;          // Frames averaged for the fps figure.
+constexpr double kLatencySmoothing = 0.2;  // Exponential smoothing of the shown latency.
+const cv::Scalar kDragColour(0, 255, 0);
+
+std::string RangeText(const HsvRange& r) {
+  return std::to_string(r.lo) + ".." + std::to_string(r.hi);
+}
+
+bool IsTemplateMethod(const std::string& method) { return method != "colour"; }
+
+}  // namespace
+
+// The files of one recording. The raw video is lossless (FFV1) so that `softsight track` with
+// the saved config sees exactly the pixels the live session saw.
+struct LiveController::Recording {
+  std::string prefix;
+  std::unique_ptr<CsvWriter> csv;
+  cv::VideoWriter annotated, raw;
+  int64_t frames = 0;
+  int64_t first_index = 0;
+  double first_time_s = 0.0;
+};
+
+bool LiveOptions::Check(std::string* error) const {
+  if (select_box_px < 4 || select_box_px > 1000) {
+    *error = "select_box_px must be in 4..1000, got " + std::to_string(select_box_px);
+    return false;
+  }
+  if (click_slop_px < 0 || click_slop_px > 100) {
+    *error = "click_slop_px must be in 0..100, got " + std::to_string(click_slop_px);
+    return false;
+  }
+  if (record_fps && !(*record_fps > 0 && *record_fps <= 100000)) {
+    *error = "record_fps must be in (0, 100000], got " + std::to_string(*record_fps);
+    return false;
+  }
+  if (record_prefix.empty()) {
+    *error = "record_prefix must not be empty";
+    return false;
+  }
+  return chart.Check(error) && picker.Check(error) && overlay.Check(error);
+}
+
+LiveController::LiveController(const TrackingConfig& config, LiveOptions options)
+    : config_(config), options_(std::move(options)), chart_(options_.chart) {
+  std::string error;
+  if (!options_.Check(&error)) throw InputError("live options: " + error);
+  if (config_.markers.empty()) throw InputError(config_.source_file + ": no markers to track");
+  options_.overlay.base = config_.measure.base;
+  options_.overlay.middle = config_.measure.middle;
+  options_.overlay.tip = config_.measure.tip;
+  session_ = std::make_unique<TrackingSession>(config_);
+  frame_times_.reserve(kFpsWindow);
+  say("press h for help");
+}
+
+LiveController::~LiveController() = default;
+
+void LiveController::say(const std::string& message) {
+  message_ = message;
+  dirty_ = true;
+}
+
+void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captured) {
+  if (paused_) return;
+  CV_Assert(frame.image.type() == CV_8UC3);
+  frame.image.copyTo(frame_);
+  frame_index_ = frame.index;
+  ended_ = false;
+  const FrameResult& result = session_->process(frame);
+  chart_.add(result);
+
+  // Frame rate over the last frames that produced a result, latency from capture to result.
+  const SteadyClock::time_point now = SteadyClock::now();
+  if (frame_times_.size() < kFpsWindow) {
+    frame_times_.push_back(now);
+  } else {
+    frame_times_[frame_times_next_] = now;
+  }
+  frame_times_next_ = (frame_times_next_ + 1) % kFpsWindow;
+  if (frame_times_.size() >= 2) {
+    const auto oldest =
+        frame_times_.size() < kFpsWindow ? frame_times_.front() : frame_times_[frame_times_next_];
+    const double span_s = std::chrono::duration<double>(now - oldest).count();
+    if (span_s > 0) fps_ = (frame_times_.size() - 1) / span_s;
+  }
+  record_frame(result);
+  // Latency: from capture to the annotated (and recorded) result, as the window is about to show
+  // it. The overlay shows the smoothed value up to the previous frame.
+  const double latency =
+      std::chrono::duration<double, std::milli>(SteadyClock::now() - captured).count();
+  latency_ms_ = latency_ms_ ? *latency_ms_ + kLatencySmoothing * (latency - *latency_ms_) : latency;
+  dirty_ = true;
+}
+
+void LiveController::redraw_annotated() {
+  if (frame_.empty()) return;
+  frame_.copyTo(annotated_);
+  if (!last_result_) return;
+  OverlayStatus status;
+  status.fps = fps_;
+  status.latency_ms = latency_ms_;
+  DrawOverlay(annotated_, *last_result_, options_.overlay, status);
+}
+
+void LiveController::on_end_of_input() {
+  ended_ = true;
+  say("end of input: the last frame stays; q quits");
+}
+
+std::optional<cv::Point2d> LiveController::position_of(int marker) const {
+  if (!last_result_ || marker < 0 || marker >= static_cast<int>(last_result_->markers.size())) {
+    return std::nullopt;
+  }
+  return last_result_->markers[marker].observation.position_px;
+}
+
+std::optional<int> LiveController::marker_at(const cv::Point2d& p, double max_distance) const {
+  std::optional<int> best;
+  double best_distance = max_distance;
+  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
+    const auto position = position_of(i);
+    if (!position) continue;
+    const double d = std::hypot(position->x - p.x, position->y - p.y);
+    if (d <= best_distance) {
+      best_distance = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+cv::Rect LiveController::box_around(const cv::Point2d& p) const {
+  const int side = options_.select_box_px;
+  const cv::Rect box(cvRound(p.x) - side / 2, cvRound(p.y) - side / 2, side, side);
+  return box & cv::Rect(0, 0, frame_.cols, frame_.rows);
+}
+
+void LiveController::select_marker(int index) {
+  if (index < 0 || index >= static_cast<int>(config_.markers.size())) {
+    say("no marker " + std::to_string(index + 1) + " (the config has " +
+        std::to_string(config_.markers.size()) + ")");
+    return;
+  }
+  active_ = index;
+  ++hsv_revision_;
+  say("active marker: " + config_.markers[index].name);
+}
+
+void LiveController::apply_spec(int marker, const MarkerSpec& spec,
+                                const std::optional<cv::Rect>& hint) {
+  try {
+    session_->respec(spec);
+    config_.markers[marker] = spec;
+    if (hint && !hint->empty() && !frame_.empty()) session_->reselect(spec.name, frame_, *hint);
+  } catch (const InputError& e) {
+    // A live edit that cannot be used is reported on screen; the session keeps running.
+    say(e.what());
+    return;
+  }
+  if (marker == active_) ++hsv_revision_;
+}
+
+void LiveController::click(const cv::Point2d& p) {
+  if (frame_.empty()) return;
+  const int marker = marker_at(p, 2.0 * options_.overlay.marker_ring_px).value_or(active_);
+  std::string why;
+  const auto pick = PickHsvRange(frame_, p, options_.picker, &why);
+  if (!pick) {
+    say("colour pick for " + config_.markers[marker].name + ": " + why);
+    return;
+  }
+  active_ = marker;
+  MarkerSpec spec = config_.markers[marker];
+  spec.colour.h = pick->h;
+  spec.colour.s = pick->s;
+  spec.colour.v = pick->v;
+  spec.colour.auto_bgr.reset();
+  const cv::Rect box = box_around(p);
+  spec.colour.roi = box;
+  // The colour tracker looks for the marker around the click first; a template tracker keeps
+  // its template (the ranges are stored for the colour method).
+  apply_spec(marker, spec, IsTemplateMethod(spec.method) ? std::nullopt : std::optional(box));
+  ++hsv_revision_;
+  say(spec.name + ": h " + RangeText(pick->h) + " s " + RangeText(pick->s) + " v " +
+      RangeText(pick->v) + (IsTemplateMethod(spec.method) ? " (used by the colour method)" : ""));
+}
+
+void LiveController::drag(const cv::Rect& dragged) {
+  const cv::Rect rect = dragged & cv::Rect(0, 0, frame_.cols, frame_.rows);
+  if (rect.width < 3 || rect.height < 3) {
+    say("box too small");
+    return;
+  }
+  // The marker inside the box, if exactly one is; else the active marker.
+  std::optional<int> inside;
+  int count = 0;
+  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
+    const auto position = position_of(i);
+    if (position && rect.contains(cv::Point(cvRound(position->x), cvRound(position->y)))) {
+      inside = i;
+      ++count;
+    }
+  }
+  const int marker = count == 1 ? *inside : active_;
+  MarkerSpec& spec = config_.markers[marker];
+  try {
+    session_->reselect(spec.name, frame_, rect);
+  } catch (const InputError& e) {
+    say(e.what());
+    return;
+  }
+  // Remember the selection in the config, so that `s` saves it.
+  if (IsTemplateMethod(spec.method)) {
+    spec.templ.rect = rect;
+    spec.templ.template_frame = static_cast<int>(frame_index_);
+    spec.templ.image = frame_(rect).clone();
+  } else {
+    spec.colour.roi = rect;
+  }
+  if (active_ != marker) ++hsv_revision_;
+  active_ = marker;
+  say(spec.name + ": reselected in [" + std::to_string(rect.x) + ", " + std::to_string(rect.y) +
+      ", " + std::to_string(rect.width) + ", " + std::to_string(rect.height) + "]");
+}
+
+void LiveController::switch_method() {
+  const std::vector<std::string> methods = TrackerMethods();
+  const auto current = std::find(methods.begin(), methods.end(), config_.markers[active_].method);
+  const std::string next =
+      current == methods.end() || current + 1 == methods.end() ? methods.front() : *(current + 1);
+  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
+    MarkerSpec spec = config_.markers[i];
+    spec.method = next;
+    std::optional<cv::Rect> hint;
+    if (const auto position = position_of(i); position && !frame_.empty()) {
+      hint = box_around(*position);
+      if (IsTemplateMethod(next)) {
+        // A new template from the frame on screen, where the marker is now.
+        spec.templ.rect = *hint;
+        spec.templ.template_frame = static_cast<int>(frame_index_);
+        spec.templ.image = frame_(*hint).clone();
+      } else {
+        spec.colour.roi = *hint;
+      }
+    }
+    apply_spec(i, spec, hint);
+  }
+  say("method: " + next);
+}
+
+void LiveController::set_hsv(int trackbar, int value) {
+  if (trackbar < 0 || trackbar >= static_cast<int>(kHsvTrackbars.size())) return;
+  value = std::clamp(value, 0, kHsvTrackbars[trackbar].max);
+  MarkerSpec spec = config_.markers[active_];
+  HsvRange* ranges[3] = {&spec.colour.h, &spec.colour.s, &spec.colour.v};
+  int& field = trackbar % 2 == 0 ? ranges[trackbar / 2]->lo : ranges[trackbar / 2]->hi;
+  if (field == value) return;  // The adapter moving its own trackbar: nothing changed.
+  field = value;
+  spec.colour.auto_bgr.reset();
+  apply_spec(active_, spec, std::nullopt);
+  say(spec.name + ": h " + RangeText(spec.colour.h) + " s " + RangeText(spec.colour.s) + " v " +
+      RangeText(spec.colour.v));
+}
+
+std::array<int, 6> LiveController::active_hsv() const {
+  const ColourParams& c = config_.markers[active_].colour;
+  return {c.h.lo, c.h.hi, c.s.lo, c.s.hi, c.v.lo, c.v.hi};
+}
+
+void LiveController::save_config() {
+  const std::string path =
+      options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
+  try {
+    SaveTrackingConfig(config_, path);
+    say("saved " + path);
+  } catch (const InputError& e) {
+    say(e.what());
+  }
+}
+
+void LiveController::toggle_recording() {
+  if (recording_) {
+    const int64_t frames = recording_->frames;
+    last_recording_ = recording_->prefix;
+    recording_.reset();  // Closes the CSV and both videos.
+    say("recorded " + std::to_string(frames) + " frames to " + last_recording_ + ".*");
+    return;
+  }
+  if (frame_.empty()) {
+    say("nothing to record yet");
+    return;
+  }
+  std::string prefix;
+  for (int n = 1; n < 1000; ++n) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "-%03d", n);
+    prefix = options_.record_prefix + name;
+    if (!std::filesystem::exists(prefix + ".csv")) break;
+  }
+  try {
+    // The recording must be reproducible: `softsight track --config <prefix>.yaml --input
+    // <prefix>.raw.avi` has to give the same rows. So the recording starts with the frame on
+    // screen as its frame 0, every tracker is rebuilt from the saved config exactly as `track`
+    // builds it (a search box, or a template cut on frame 0, around where each marker is now),
+    // and the bending-distance reference restarts at that frame.
+    TrackingConfig snapshot = config_;
+    for (int i = 0; i < static_cast<int>(snapshot.markers.size()); ++i) {
+      MarkerSpec& spec = snapshot.markers[i];
+      const auto position = position_of(i);
+      if (!position) continue;
+      const cv::Rect box = box_around(*position);
+      spec.colour.roi = box;
+      if (IsTemplateMethod(spec.method)) {
+        spec.templ.rect = box;
+        spec.templ.template_frame = 0;
+        spec.templ.image = cv::Mat();
+      }
+    }
+    auto recording = std::make_unique<Recording>();
+    recording->prefix = prefix;
+    std::vector<std::string> names;
+    for (const MarkerSpec& spec : config_.markers) names.push_back(spec.name);
+    const MetricModel& metric = config_.measure.metric;
+    recording->csv = std::make_unique<CsvWriter>(
+        prefix + ".csv", names, metric.scale_mm_per_px || metric.plane_mm_from_image);
+    const double fps = options_.record_fps.value_or(fps_.value_or(30.0));
+    recording->annotated.open(prefix + ".avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+                              frame_.size());
+    recording->raw.open(prefix + ".raw.avi", cv::VideoWriter::fourcc('F', 'F', 'V', '1'), fps,
+                        frame_.size());
+    if (!recording->annotated.isOpened() || !recording->raw.isOpened()) {
+      throw InputError(prefix + ".avi: cannot open a video writer (FFmpeg with MJPG and FFV1)");
+    }
+    SaveTrackingConfig(snapshot, prefix + ".yaml");
+
+    for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
+    session_->reset_tip_reference();
+    config_ = snapshot;
+    recording->first_index = frame_index_;
+    recording->first_time_s = last_result_ ? last_result_->time_s : 0.0;
+    recording_ = std::move(recording);
+    Frame again{frame_.clone(), frame_index_, recording_->first_time_s};
+    record_frame(session_->process(again));
+    ++hsv_revision_;
+    say("recording to " + prefix + ".*");
+  } catch (const InputError& e) {
+    recording_.reset();
+    say(e.what());
+  }
+}
+
+void LiveController::record_frame(const FrameResult& result) {
+  last_result_ = result;
+  redraw_annotated();
+  if (!recording_) return;
+  // Rows and frames count from the start of the recording, like the raw video they describe.
+  FrameResult row = result;
+  row.frame_index -= recording_->first_index;
+  row.time_s -= recording_->first_time_s;
+  recording_->csv->write(row);
+  recording_->annotated.write(annotated_);
+  recording_->raw.write(frame_);
+  ++recording_->frames;
+}
+
+void LiveController::on_event(const UiEvent& event) {
+  using Type = UiEvent::Type;
+  const bool in_image = event.position_px.x >= 0 && event.position_px.y >= 0 &&
+                        event.position_px.x < frame_.cols && event.position_px.y < frame_.rows;
+  switch (event.type) {
+    case Type::kMouseDown:
+      if (in_image) press_ = pointer_ = event.position_px;
+      break;
+    case Type::kMouseMove:
+      if (press_) {
+        pointer_ = event.position_px;
+        dirty_ = true;
+      }
+      break;
+    case Type::kMouseUp: {
+      if (!press_) break;
+      const cv::Point2d start = *press_;
+      press_.reset();
+      pointer_.reset();
+      dirty_ = true;
+      const cv::Point2d end = event.position_px;
+      if (std::hypot(end.x - start.x, end.y - start.y) <= options_.click_slop_px) {
+        click(start);
+      } else {
+        const cv::Point a(cvRound(std::min(start.x, end.x)), cvRound(std::min(start.y, end.y)));
+        const cv::Point b(cvRound(std::max(start.x, end.x)), cvRound(std::max(start.y, end.y)));
+        drag(cv::Rect(a, b));
+      }
+      break;
+    }
+    case Type::kTrackbar:
+      set_hsv(event.trackbar, event.value);
+      break;
+    case Type::kKey:
+      switch (event.key) {
+        case 'h':
+          help_ = !help_;
+          dirty_ = true;
+          break;
+        case ' ':
+        case 'p':
+          paused_ = !paused_;
+          say(paused_ ? "paused" : "running");
+          break;
+        case 'r':
+          toggle_recording();
+          break;
+        case 's':
+          save_config();
+          break;
+        case 'b':
+          session_->reset_tip_reference();
+          say("bending distance: the next tip position is the new reference");
+          break;
+        case 'm':
+          switch_method();
+          break;
+        case 'q':
+        case 27:
+          if (recording_) toggle_recording();
+          quit_ = true;
+          break;
+        default:
+          if (event.key >= '1' && event.key <= '9') select_marker(event.key - '1');
+      }
+      break;
+  }
+}
+
+const cv::Mat& LiveController::canvas() {
+  if (!dirty_ && !canvas_.empty()) return canvas_;
+  const cv::Size image_size = frame_.empty() ? cv::Size(640, 480) : frame_.size();
+  canvas_.create(image_size.height + options_.chart.height_px, image_size.width, CV_8UC3);
+  cv::Mat top = canvas_(cv::Rect(0, 0, image_size.width, image_size.height));
+  if (annotated_.empty()) {
+    top.setTo(cv::Scalar(0, 0, 0));
+    cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
+  } else {
+    // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
+    annotated_.copyTo(top);
+  }
+  const double scale = std::max(0.4, image_size.width / 640.0 * 0.5);
+  std::vector<std::string> lines;
+  std::string state;
+  if (recording_) state += "REC " + recording_->prefix + "  ";
+  if (paused_) state += "PAUSED  ";
+  if (ended_) state += "END  ";
+  state +=
+      "active: " + config_.markers[active_].name + " (" + config_.markers[active_].method + ")";
+  lines.push_back(state);
+  if (!message_.empty()) lines.push_back(message_);
+  int y = image_size.height - 10 - 22 * static_cast<int>(lines.size() - 1);
+  for (const std::string& text : lines) {
+    cv::putText(top, text, {8, y}, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+    cv::putText(
+        top, text, {8, y}, kFont, scale,
+        recording_ && &text == &lines.front() ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255),
+        1, cv::LINE_AA);
+    y += 22;
+  }
+  if (press_ && pointer_) {
+    cv::rectangle(top, cv::Point(cvRound(press_->x), cvRound(press_->y)),
+                  cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kDragColour, 1);
+  }
+  if (help_) {
+    // The key list, scaled down until it fits the image, centred on a darkened block.
+    std::vector<std::string> help;
+    for (const LiveKey& k : kLiveKeys) {
+      std::string text = k.key == ' ' ? "space  "
+                         : k.key != 0 ? std::string(1, char(k.key)) + "  "
+                                      : "";
+      help.push_back(text + k.what);
+    }
+    double help_scale = 0.5;
+    int baseline = 0, width = 0;
+    for (const std::string& text : help) {
+      width = std::max(width, cv::getTextSize(text, kFont, help_scale, 1, &baseline).width);
+    }
+    const int line_height_at_scale = 24;
+    const double fit =
+        std::min((image_size.width - 24.0) / width,
+                 (image_size.height - 16.0) / (line_height_at_scale * (help.size() + 0.5)));
+    if (fit < 1.0) help_scale *= fit;
+    const int line_height = std::max(8, cvRound(line_height_at_scale * help_scale / 0.5));
+    const int block_w = cvRound(width * help_scale / 0.5) + 20;
+    const int block_h = line_height * static_cast<int>(help.size()) + line_height / 2;
+    const cv::Rect block = cv::Rect((image_size.width - block_w) / 2,
+                                    (image_size.height - block_h) / 2, block_w, block_h) &
+                           cv::Rect(0, 0, image_size.width, image_size.height);
+    cv::Mat shade = top(block);
+    shade.convertTo(shade, -1, 0.25, 0);
+    int line_y = block.y + line_height;
+    for (const std::string& text : help) {
+      cv::putText(top, text, {block.x + 10, line_y}, kFont, help_scale, cv::Scalar(255, 255, 255),
+                  1, cv::LINE_AA);
+      line_y += line_height;
+    }
+  }
+  cv::Mat bottom =
+      canvas_(cv::Rect(0, image_size.height, image_size.width, options_.chart.height_px));
+  chart_.draw(bottom);
+  dirty_ = false;
+  return canvas_;
+}
+
+}  // namespace softsight

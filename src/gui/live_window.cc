@@ -1,0 +1,123 @@
+#include "softsight/gui/live_window.h"
+
+#include <X11/Xlib.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <opencv2/highgui.hpp>
+
+namespace softsight {
+namespace {
+
+struct CallbackContext {
+  LiveController* controller;
+};
+
+void OnMouse(int event, int x, int y, int /*flags*/, void* user) {
+  auto* context = static_cast<CallbackContext*>(user);
+  UiEvent::Type type;
+  switch (event) {
+    case cv::EVENT_LBUTTONDOWN:
+      type = UiEvent::Type::kMouseDown;
+      break;
+    case cv::EVENT_MOUSEMOVE:
+      type = UiEvent::Type::kMouseMove;
+      break;
+    case cv::EVENT_LBUTTONUP:
+      type = UiEvent::Type::kMouseUp;
+      break;
+    default:
+      return;
+  }
+  context->controller->on_event(UiEvent::Mouse(type, x, y));
+}
+
+struct TrackbarContext {
+  LiveController* controller;
+  int index;
+};
+
+void OnTrackbar(int value, void* user) {
+  auto* context = static_cast<TrackbarContext*>(user);
+  context->controller->on_event(UiEvent::Trackbar(context->index, value));
+}
+
+}  // namespace
+
+bool HaveDisplay(std::string* why) {
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if (wayland != nullptr && *wayland != '\0') return true;
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0') {
+    *why = "no display (DISPLAY is not set)";
+    return false;
+  }
+  // Ask the X server itself: a stale DISPLAY would otherwise abort inside the GUI toolkit.
+  Display* connection = XOpenDisplay(nullptr);
+  if (connection == nullptr) {
+    *why = std::string("cannot open display '") + display + "'";
+    return false;
+  }
+  XCloseDisplay(connection);
+  return true;
+}
+
+int RunLiveWindow(LiveController& controller, FrameGrabber& grabber,
+                  const LiveWindowOptions& options) {
+  const std::string& title = options.title;
+  // GUI_NORMAL: no toolbar or status bar, so image pixels are canvas pixels.
+  cv::namedWindow(title, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
+  CallbackContext mouse{&controller};
+  cv::setMouseCallback(title, OnMouse, &mouse);
+  std::array<TrackbarContext, kHsvTrackbars.size()> trackbars;
+  int shown_revision = -1;
+  if (options.trackbars) {
+    const std::array<int, 6> hsv = controller.active_hsv();
+    for (size_t i = 0; i < kHsvTrackbars.size(); ++i) {
+      trackbars[i] = {&controller, static_cast<int>(i)};
+      cv::createTrackbar(kHsvTrackbars[i].name, title, nullptr, kHsvTrackbars[i].max, OnTrackbar,
+                         &trackbars[i]);
+      cv::setTrackbarPos(kHsvTrackbars[i].name, title, hsv[i]);
+    }
+    shown_revision = controller.hsv_revision();
+  }
+
+  bool end_shown = false, end_announced = false;
+  GrabbedFrame grabbed;
+  while (!controller.quit_requested()) {
+    bool got = false;
+    if (!controller.paused()) {
+      got = grabber.take(grabbed);
+      if (got) controller.on_frame(grabbed.frame, grabbed.captured);
+    }
+    if (!got && !end_shown && grabber.finished()) {
+      controller.on_end_of_input();
+      end_shown = true;
+    }
+    cv::imshow(title, controller.canvas());
+    const int key = cv::waitKeyEx(got ? 1 : 15);
+    if (end_shown && !end_announced) {
+      // The last frame has been shown and the window has processed its events: tell whoever
+      // watches stdout (scripts, the test under Xvfb) that the picture is final.
+      std::cout << "end of input" << std::endl;
+      end_announced = true;
+    }
+    if (key >= 0) {
+      const int code = key & 0xFFFF;
+      if (code < 0x100) controller.on_event(UiEvent::Key(code));
+    }
+    if (options.trackbars && controller.hsv_revision() != shown_revision) {
+      const std::array<int, 6> hsv = controller.active_hsv();
+      for (size_t i = 0; i < kHsvTrackbars.size(); ++i) {
+        cv::setTrackbarPos(kHsvTrackbars[i].name, title, hsv[i]);
+      }
+      shown_revision = controller.hsv_revision();
+    }
+    if (cv::getWindowProperty(title, cv::WND_PROP_VISIBLE) < 1) break;  // Closed by the user.
+  }
+  cv::destroyWindow(title);
+  cv::waitKey(1);
+  return 0;
+}
+
+}  // namespace softsight

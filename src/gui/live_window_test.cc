@@ -1,0 +1,392 @@
+// End-to-end: the real `softsight live` window on a virtual X server (Xvfb), fed a rendered video.
+// The screenshot is Xvfb's own framebuffer (-fbdir writes the screen as an XWD file), so no
+// screenshot tool is needed; keys reach the window through xdotool (XTEST), as a person's would.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <sstream>
+#include <thread>
+
+#include "softsight/gui/overlay.h"
+#include "softsight/io/config.h"
+#include "softsight/sim/scene.h"
+
+extern char** environ;
+
+namespace softsight {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// A child process with its stdout (and optionally stderr) on a pipe.
+struct Child {
+  pid_t pid = -1;
+  int out = -1;
+};
+
+Child Spawn(const std::vector<std::string>& argv, const std::vector<std::string>& extra_env,
+            bool capture_stderr = false) {
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry = *e;
+    bool overridden = false;
+    for (const std::string& x : extra_env) {
+      overridden |= entry.substr(0, entry.find('=') + 1) == x.substr(0, x.find('=') + 1);
+    }
+    if (!overridden) env_strings.push_back(entry);
+  }
+  for (const std::string& x : extra_env) {
+    if (x.back() != '=') env_strings.push_back(x);  // "NAME=" removes NAME.
+  }
+  std::vector<char*> args, envp;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  for (std::string& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  int pipe_fds[2];
+  if (pipe(pipe_fds) != 0) return {};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
+  if (capture_stderr) posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 2);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  Child child;
+  if (posix_spawnp(&child.pid, args[0], &actions, nullptr, args.data(), envp.data()) != 0) {
+    child.pid = -1;
+  }
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  child.out = pipe_fds[0];
+  fcntl(child.out, F_SETFL, O_NONBLOCK);
+  return child;
+}
+
+// Reads the child's output until `needle` appears or `timeout` passes.
+bool WaitForOutput(const Child& child, const std::string& needle, std::chrono::seconds timeout,
+                   std::string* seen) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  char buffer[4096];
+  while (std::chrono::steady_clock::now() < deadline) {
+    const ssize_t n = read(child.out, buffer, sizeof(buffer));
+    if (n > 0) {
+      seen->append(buffer, n);
+      if (seen->find(needle) != std::string::npos) return true;
+    } else if (n == 0) {
+      return seen->find(needle) != std::string::npos;  // EOF: the child exited.
+    } else {
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+  return false;
+}
+
+// Exit status of the child, or -1 if it did not exit within `timeout` (then it is killed).
+int WaitExit(Child& child, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (waitpid(child.pid, &status, WNOHANG) == child.pid) {
+      close(child.out);
+      child.pid = -1;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  kill(child.pid, SIGKILL);
+  waitpid(child.pid, &status, 0);
+  close(child.out);
+  child.pid = -1;
+  return -1;
+}
+
+int RunProcess(const std::vector<std::string>& argv, const std::vector<std::string>& env,
+               std::string* output) {
+  Child child = Spawn(argv, env, true);
+  if (child.pid < 0) return -2;
+  WaitForOutput(child, "\x01never", 30s, output);
+  return WaitExit(child, 10s);
+}
+
+uint32_t ReadU32(const std::string& data, size_t offset, bool big_endian) {
+  const auto* b = reinterpret_cast<const unsigned char*>(data.data() + offset);
+  return big_endian ? (uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3])
+                    : (uint32_t(b[3]) << 24 | uint32_t(b[2]) << 16 | uint32_t(b[1]) << 8 | b[0]);
+}
+
+// Xvfb's -fbdir screen file: an XWD header, a colour map, then ZPixmap pixels (32 bits each).
+cv::Mat ReadXwdScreen(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  const std::string data = s.str();
+  if (data.size() < 100) return {};
+  const bool big = ReadU32(data, 0, true) < 4096;  // header_size is small in the right order.
+  const uint32_t header_size = ReadU32(data, 0, big);
+  const uint32_t width = ReadU32(data, 16, big), height = ReadU32(data, 20, big);
+  const uint32_t pixel_byte_order = ReadU32(data, 28, big);  // 0 = LSBFirst.
+  const uint32_t bits_per_pixel = ReadU32(data, 44, big);
+  const uint32_t bytes_per_line = ReadU32(data, 48, big);
+  const uint32_t red_mask = ReadU32(data, 56, big), green_mask = ReadU32(data, 60, big),
+                 blue_mask = ReadU32(data, 64, big);
+  const uint32_t ncolors = ReadU32(data, 76, big);
+  const size_t pixels = header_size + 12 * ncolors;
+  if (bits_per_pixel != 32 || data.size() < pixels + size_t(bytes_per_line) * height) return {};
+  auto shift_of = [](uint32_t mask) {
+    int shift = 0;
+    while (mask != 0 && (mask & 1) == 0) {
+      mask >>= 1;
+      ++shift;
+    }
+    return shift;
+  };
+  cv::Mat image(height, width, CV_8UC3);
+  for (uint32_t y = 0; y < height; ++y) {
+    for (uint32_t x = 0; x < width; ++x) {
+      const uint32_t p = ReadU32(data, pixels + y * bytes_per_line + 4 * x, pixel_byte_order != 0);
+      image.at<cv::Vec3b>(y, x) =
+          cv::Vec3b((p & blue_mask) >> shift_of(blue_mask),
+                    (p & green_mask) >> shift_of(green_mask), (p & red_mask) >> shift_of(red_mask));
+    }
+  }
+  return image;
+}
+
+// How many of 24 points around `centre` at `radius` have a yellow pixel (the overlay's marker
+// ring, overlay_colour::kMarker) within one pixel.
+int RingPixels(const cv::Mat& image, cv::Point2d centre, int radius) {
+  int ring = 0;
+  for (int deg = 0; deg < 360; deg += 15) {
+    const cv::Point p(cvRound(centre.x + radius * std::cos(deg * CV_PI / 180)),
+                      cvRound(centre.y + radius * std::sin(deg * CV_PI / 180)));
+    bool yellow = false;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const cv::Point q = p + cv::Point(dx, dy);
+        if (q.x < 0 || q.y < 0 || q.x >= image.cols || q.y >= image.rows) continue;
+        const cv::Vec3b px = image.at<cv::Vec3b>(q);
+        yellow |= px[0] < 80 && px[1] > 200 && px[2] > 200;
+      }
+    }
+    ring += yellow;
+  }
+  return ring;
+}
+
+class LiveWindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // The build sets SOFTSIGHT_BINARY; without it, the program sits beside this test's folder
+    // (build/src/gui/ -> build/src/app/softsight).
+    const char* binary = std::getenv("SOFTSIGHT_BINARY");
+    binary_ =
+        binary != nullptr
+            ? std::string(binary)
+            : (fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "app" / "softsight")
+                  .string();
+    ASSERT_TRUE(fs::exists(binary_)) << "no softsight program at " << binary_;
+    dir_ = fs::temp_directory_path() /
+           ("softsight_live_window_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (live_.pid > 0) {  // A failed assertion left the window open.
+      kill(live_.pid, SIGTERM);
+      WaitExit(live_, 5s);
+    }
+    if (xvfb_.pid > 0) {
+      kill(xvfb_.pid, SIGTERM);
+      WaitExit(xvfb_, 5s);
+    }
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+
+  // Starts Xvfb on a free display (-displayfd picks it) writing its screen to dir_.
+  std::string StartXvfb() {
+    xvfb_ = Spawn({"Xvfb", "-displayfd", "1", "-screen", "0", "800x720x24", "-fbdir", dir_.string(),
+                   "-nolisten", "tcp"},
+                  {});
+    if (xvfb_.pid < 0) return "";
+    std::string seen;
+    if (!WaitForOutput(xvfb_, "\n", 20s, &seen)) return "";
+    return ":" + seen.substr(0, seen.find('\n'));
+  }
+
+  std::string binary_;
+  fs::path dir_;
+  Child xvfb_;
+  Child live_;
+};
+
+TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
+  // A short rendered video and a config for its three markers.
+  SceneOptions scene;
+  scene.size = cv::Size(320, 240);
+  scene.length_px = 160;
+  scene.width_px = 24;
+  scene.marker_radius_px = 8;
+  scene.frame_count = 12;
+  scene.max_bend_deg = 90;
+  SyntheticScene renderer(scene);
+  const std::string video = (dir_ / "scene.avi").string();
+  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
+  ASSERT_TRUE(writer.isOpened());
+  cv::Mat image, last;
+  SceneTruth truth;
+  for (int i = 0; i < scene.frame_count; ++i) {
+    truth = renderer.render(i, image);
+    writer.write(image);
+  }
+  writer.release();
+  last = image.clone();
+  const std::string config = (dir_ / "markers.yaml").string();
+  std::ofstream(config) << "markers:\n"
+                           "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
+                           "  - name: blue\n    hsv: {h: [95, 125], s: [80, 255], v: [40, 255]}\n"
+                           "  - name: green\n    hsv: {h: [45, 75], s: [80, 255], v: [40, 255]}\n"
+                           "triple: [red, blue, green]\n";
+
+  const std::string display = StartXvfb();
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  Child& live = live_;
+  live = Spawn({binary_, "live", "--input", video, "--config", config, "--no-trackbars",
+                      "--record-prefix", (dir_ / "rec").string()},
+                     {"DISPLAY=" + display}, true);
+  ASSERT_GT(live.pid, 0);
+  std::string output;
+  ASSERT_TRUE(WaitForOutput(live, "end of input", 60s, &output)) << output;
+  std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
+
+  const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+  ASSERT_FALSE(screen.empty()) << "cannot read Xvfb's screen file";
+  EXPECT_EQ(screen.size(), cv::Size(800, 720));
+  // Where is the window's image? Match the raw last frame: the overlay covers only a little.
+  cv::Mat score;
+  cv::matchTemplate(screen, last, score, cv::TM_CCOEFF_NORMED);
+  double best = 0;
+  cv::Point offset;
+  cv::minMaxLoc(score, nullptr, &best, nullptr, &offset);
+  const cv::Rect shown(offset, last.size());
+  ASSERT_TRUE((cv::Rect(0, 0, screen.cols, screen.rows) & shown) == shown);
+  // Where the overlay does not draw, the screen shows the frame's pixels exactly (lossless video,
+  // 24-bit screen): most of the frame must match there.
+  cv::Mat same;
+  cv::inRange(cv::abs(cv::Mat(screen(shown)) - last) + cv::abs(last - cv::Mat(screen(shown))),
+              cv::Scalar::all(0), cv::Scalar::all(2), same);
+  EXPECT_GT(cv::countNonZero(same), 0.5 * last.total())
+      << "the frame is not on screen, best " << best << " at " << offset;
+  // The frame itself carries no overlay; on screen, each marker has its ring around the truth.
+  for (const MarkerTruth& marker : truth.markers) {
+    ASSERT_TRUE(marker.centroid_px);
+    EXPECT_EQ(RingPixels(last, *marker.centroid_px, 12), 0) << marker.name;
+    EXPECT_GE(RingPixels(screen, *marker.centroid_px + cv::Point2d(offset), 12), 20)
+        << marker.name << " at " << *marker.centroid_px << " + " << offset;
+  }
+  // The strip chart is drawn under the image: its dark background.
+  const cv::Rect chart(shown.x, shown.y + shown.height, shown.width, 180);
+  ASSERT_LE(chart.y + chart.height, screen.rows);
+  const cv::Scalar chart_mean = cv::mean(screen(chart));
+  EXPECT_LT(chart_mean[0], 70);
+
+  // Keys through the real window: h shows the help over the image, q quits cleanly.
+  std::string xdotool_output;
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--name", "softsight live", "windowfocus",
+                        "--sync"},
+                       env, &xdotool_output),
+            0)
+      << xdotool_output;
+  ASSERT_EQ(RunProcess({"xdotool", "key", "h"}, env, &xdotool_output), 0) << xdotool_output;
+  std::this_thread::sleep_for(700ms);
+  const cv::Mat with_help = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+  ASSERT_FALSE(with_help.empty());
+  const cv::Rect help_block(shown.x + shown.width / 4, shown.y + shown.height / 2 - 20,
+                            shown.width / 2, 40);  // The help is centred on the image.
+  EXPECT_LT(cv::mean(with_help(help_block))[1], 0.6 * cv::mean(screen(help_block))[1])
+      << "the help block (darkened) did not appear";
+
+  // The mouse through the real window: choose blue (key 2), click its centre, save (key s). The
+  // saved config carries the range picked from the pixels around the click.
+  const cv::Point2d blue = *truth.markers[1].centroid_px + cv::Point2d(offset);
+  ASSERT_EQ(RunProcess({"xdotool", "key", "2", "mousemove", std::to_string(cvRound(blue.x)),
+                        std::to_string(cvRound(blue.y)), "click", "1", "sleep", "0.3", "key", "s"},
+                       env, &xdotool_output),
+            0)
+      << xdotool_output;
+  const std::string saved = (dir_ / "markers.live.yaml").string();
+  for (int i = 0; i < 50 && !fs::exists(saved); ++i) std::this_thread::sleep_for(100ms);
+  std::this_thread::sleep_for(200ms);
+  const TrackingConfig picked = LoadTrackingConfig(saved);
+  ASSERT_EQ(picked.markers.size(), 3u);
+  const HsvRange h = picked.markers[1].colour.h;
+  EXPECT_TRUE(h.lo != 95 || h.hi != 125) << "the click did not change blue's range";
+  EXPECT_LT(h.lo, 107);  // Blue's hue, about 107.
+  EXPECT_GT(h.hi, 107);
+
+  ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &xdotool_output), 0) << xdotool_output;
+  EXPECT_EQ(WaitExit(live, 20s), 0);
+}
+
+TEST_F(LiveWindowTest, WithoutADisplayOneErrorSuggestsTrack) {
+  std::string output;
+  const int code = RunProcess({binary_, "live", "--input", "x.avi", "--config", "markers.yaml"},
+                              {"DISPLAY=", "WAYLAND_DISPLAY="}, &output);
+  EXPECT_EQ(code, 2) << output;
+  EXPECT_NE(output.find("softsight track"), std::string::npos) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+
+  output.clear();
+  EXPECT_EQ(RunProcess({binary_, "live", "--input", "x.avi", "--config", "markers.yaml"},
+                       {"DISPLAY=:59999", "WAYLAND_DISPLAY="}, &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("cannot open display ':59999'"), std::string::npos) << output;
+}
+
+TEST_F(LiveWindowTest, PlotCommandWritesTheFigure) {
+  const std::string csv = (dir_ / "run.csv").string();
+  {
+    std::ofstream out(csv);
+    out << "frame,time_s,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,proc_"
+           "ms\n";
+    for (int i = 0; i < 50; ++i) {
+      out << i << "," << i / 25.0 << "," << 180 - i << ",100,5,80," << 120 + i << ",";
+      if (i % 10 != 5) out << i * 0.5;  // A few empty fields.
+      out << ",1.0\n";
+    }
+  }
+  std::string output;
+  EXPECT_EQ(RunProcess({binary_, "plot", csv, "-o", (dir_ / "run.png").string()}, {}, &output), 0)
+      << output;
+  EXPECT_TRUE(fs::exists(dir_ / "run.png"));
+  EXPECT_EQ(RunProcess({binary_, "plot", csv, "-o", (dir_ / "run.svg").string(), "--width", "600"},
+                       {}, &output),
+            0)
+      << output;
+  std::ifstream svg(dir_ / "run.svg");
+  std::stringstream text;
+  text << svg.rdbuf();
+  EXPECT_NE(text.str().find("width=\"600\""), std::string::npos);
+  output.clear();
+  EXPECT_EQ(
+      RunProcess({binary_, "plot", (dir_ / "missing.csv").string(), "-o", "x.png"}, {}, &output),
+      2);
+  EXPECT_NE(output.find("missing.csv"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,201 @@
+#include "softsight/gui/overlay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr int kShift = 4;  // Sub-pixel drawing: coordinates in 1/16 px.
+
+cv::Point Fixed(const cv::Point2d& p) {
+  return {cvRound(p.x * (1 << kShift)), cvRound(p.y * (1 << kShift))};
+}
+
+const std::optional<cv::Point2d>* Find(const FrameResult& result, const std::string& name) {
+  for (const MarkerObservation& m : result.markers) {
+    if (m.name == name) return &m.observation.position_px;
+  }
+  return nullptr;
+}
+
+std::string Value(const char* label, const std::optional<double>& value_mm,
+                  const std::optional<double>& value_px, const char* format = "%.1f") {
+  char number[32];
+  std::string text = label;
+  if (value_mm) {
+    std::snprintf(number, sizeof(number), format, *value_mm);
+    text += std::string(number) + " mm";
+  } else if (value_px) {
+    std::snprintf(number, sizeof(number), format, *value_px);
+    text += std::string(number) + " px";
+  } else {
+    text += "--";
+  }
+  return text;
+}
+
+// One line of text with a dark outline so it stays readable on any background.
+void OutlinedText(cv::Mat& image, const std::string& text, cv::Point origin, double scale,
+                  const cv::Scalar& colour) {
+  const int thickness = std::max(1, cvRound(scale * 2));
+  cv::putText(image, text, origin, kFont, scale, cv::Scalar(0, 0, 0), thickness + 2, cv::LINE_AA);
+  cv::putText(image, text, origin, kFont, scale, colour, thickness, cv::LINE_AA);
+}
+
+}  // namespace
+
+bool OverlayOptions::Check(std::string* error) const {
+  if (marker_ring_px < 2 || marker_ring_px > 200) {
+    *error = "marker_ring_px must be in 2..200, got " + std::to_string(marker_ring_px);
+    return false;
+  }
+  if (text_scale < 0 || text_scale > 10) {
+    *error = "text_scale must be in 0..10 (0: automatic), got " + std::to_string(text_scale);
+    return false;
+  }
+  return true;
+}
+
+OverlayOptions OverlayOptionsFor(const MeasureOptions& measure) {
+  OverlayOptions options;
+  options.base = measure.base;
+  options.middle = measure.middle;
+  options.tip = measure.tip;
+  return options;
+}
+
+std::vector<cv::Point2d> ArcPoints(const cv::Point2d& base, const cv::Point2d& middle,
+                                   const cv::Point2d& tip, double radius_px, int count) {
+  std::vector<cv::Point2d> points;
+  const cv::Point2d chord = tip - base;
+  const double c = std::hypot(chord.x, chord.y);
+  if (!(c > 0) || !(radius_px >= c / 2 * (1 - 1e-9)) || !std::isfinite(radius_px) || count < 2) {
+    return points;
+  }
+  const cv::Point2d mid = (base + tip) * 0.5;
+  cv::Point2d normal(-chord.y / c, chord.x / c);
+  double sagitta = (middle - mid).dot(normal);
+  if (sagitta < 0) {
+    normal = -normal;
+    sagitta = -sagitta;
+  }
+  if (sagitta == 0) return points;  // Collinear: no side to bend to.
+  const double h = std::sqrt(std::max(0.0, radius_px * radius_px - c * c / 4));
+  // Minor arc: the centre lies across the chord from the middle marker; major arc: on its side.
+  const cv::Point2d centre = sagitta <= radius_px ? mid - normal * h : mid + normal * h;
+  const double a_base = std::atan2(base.y - centre.y, base.x - centre.x);
+  const double a_tip = std::atan2(tip.y - centre.y, tip.x - centre.x);
+  double sweep = std::fmod(a_tip - a_base + 4 * CV_PI, 2 * CV_PI);  // Counter-clockwise, [0, 2pi).
+  const double a_half = a_base + sweep / 2;
+  const cv::Point2d halfway = centre + radius_px * cv::Point2d(std::cos(a_half), std::sin(a_half));
+  if ((halfway - mid).dot(normal) < 0) sweep -= 2 * CV_PI;  // The other way round.
+  points.reserve(count);
+  for (int k = 0; k < count; ++k) {
+    const double a = a_base + sweep * k / (count - 1);
+    points.push_back(centre + radius_px * cv::Point2d(std::cos(a), std::sin(a)));
+  }
+  return points;
+}
+
+void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOptions& options,
+                 const OverlayStatus& status) {
+  CV_Assert(frame_bgr.type() == CV_8UC3);
+  const double scale =
+      options.text_scale > 0 ? options.text_scale : std::max(0.35, frame_bgr.cols / 640.0 * 0.5);
+  const int line = std::max(1, cvRound(scale * 2));
+  const int ring_thickness = std::max(2, line);  // Thin AA rings vanish on small frames.
+  const Measurement& m = result.measurement;
+
+  // The text block first, so that markers moving under it stay visible.
+  std::string lost;
+  for (const MarkerObservation& marker : result.markers) {
+    if (!marker.observation.found()) lost += (lost.empty() ? "" : ", ") + marker.name;
+  }
+  if (options.show_measurements) {
+    std::vector<std::pair<std::string, cv::Scalar>> lines;
+    char buffer[96];
+    if (m.angle_deg) {
+      std::snprintf(buffer, sizeof(buffer), "angle %.1f deg", *m.angle_deg);
+      lines.emplace_back(buffer, overlay_colour::kText);
+    } else {
+      lines.emplace_back("angle --", overlay_colour::kText);
+    }
+    lines.emplace_back(Value("radius ", m.radius_mm, m.radius_px), overlay_colour::kText);
+    lines.emplace_back(Value("arc length ", m.arc_length_mm, m.arc_length_px),
+                       overlay_colour::kText);
+    lines.emplace_back(Value("bending dist ", m.tip_disp_mm, m.tip_disp_px), overlay_colour::kText);
+    std::string timing;
+    if (status.fps) {
+      std::snprintf(buffer, sizeof(buffer), "%.1f fps  ", *status.fps);
+      timing += buffer;
+    }
+    std::snprintf(buffer, sizeof(buffer), "proc %.2f ms", result.proc_ms);
+    timing += buffer;
+    if (status.latency_ms) {
+      std::snprintf(buffer, sizeof(buffer), "  latency %.0f ms", *status.latency_ms);
+      timing += buffer;
+    }
+    lines.emplace_back(timing, overlay_colour::kText);
+    if (!lost.empty()) lines.emplace_back("LOST: " + lost, overlay_colour::kLost);
+    for (const std::string& note : status.notes) lines.emplace_back(note, overlay_colour::kText);
+
+    // Darken the block behind the text so it reads on any background.
+    int baseline = 0;
+    const int height = cv::getTextSize("Ag", kFont, scale, line, &baseline).height + baseline + 4;
+    int width = 0;
+    for (const auto& [text, colour] : lines) {
+      width = std::max(width, cv::getTextSize(text, kFont, scale, line, &baseline).width);
+    }
+    const cv::Rect block = cv::Rect(0, 0, width + 12, height * static_cast<int>(lines.size()) + 8) &
+                           cv::Rect(0, 0, frame_bgr.cols, frame_bgr.rows);
+    cv::Mat shade = frame_bgr(block);
+    shade.convertTo(shade, -1, 0.4, 0);
+    for (size_t i = 0; i < lines.size(); ++i) {
+      OutlinedText(frame_bgr, lines[i].first,
+                   cv::Point(6, 4 + height * static_cast<int>(i + 1) - baseline), scale,
+                   lines[i].second);
+    }
+  }
+
+  // Then the triangle and the arc, and the marker rings on top of everything.
+  const auto* base = Find(result, options.base);
+  const auto* middle = Find(result, options.middle);
+  const auto* tip = Find(result, options.tip);
+  if (base && middle && tip && *base && *middle && *tip) {
+    const cv::Point2d b = **base, md = **middle, t = **tip;
+    cv::line(frame_bgr, Fixed(b), Fixed(md), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
+    cv::line(frame_bgr, Fixed(md), Fixed(t), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
+    cv::line(frame_bgr, Fixed(t), Fixed(b), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
+    std::vector<cv::Point2d> arc;
+    if (m.radius_px) arc = ArcPoints(b, md, t, *m.radius_px);
+    if (arc.empty() && m.sagitta_px && *m.sagitta_px == 0) arc = {b, t};  // Straight.
+    if (!arc.empty()) {
+      std::vector<cv::Point> fixed;
+      fixed.reserve(arc.size());
+      for (const cv::Point2d& p : arc) fixed.push_back(Fixed(p));
+      cv::polylines(frame_bgr, fixed, false, overlay_colour::kArc, line, cv::LINE_AA, kShift);
+    }
+  }
+
+  // Markers: ring, cross and name at each found centroid; nothing where a marker was not found.
+  for (const MarkerObservation& marker : result.markers) {
+    if (!marker.observation.found()) continue;
+    const cv::Point2d p = *marker.observation.position_px;
+    const int r = options.marker_ring_px;
+    cv::circle(frame_bgr, Fixed(p), r << kShift, overlay_colour::kMarker, ring_thickness,
+               cv::LINE_AA, kShift);
+    const cv::Point2d dx(r / 2.0, 0), dy(0, r / 2.0);
+    cv::line(frame_bgr, Fixed(p - dx), Fixed(p + dx), overlay_colour::kMarker, 1, cv::LINE_AA,
+             kShift);
+    cv::line(frame_bgr, Fixed(p - dy), Fixed(p + dy), overlay_colour::kMarker, 1, cv::LINE_AA,
+             kShift);
+    OutlinedText(frame_bgr, marker.name, cv::Point(cvRound(p.x) + r + 3, cvRound(p.y) - r), scale,
+                 overlay_colour::kMarker);
+  }
+}
+
+}  // namespace softsight

@@ -1,0 +1,197 @@
+#include "softsight/gui/overlay.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "softsight/gui/strip_chart.h"
+
+namespace softsight {
+namespace {
+
+bool IsColour(const cv::Mat& image, cv::Point2d p, const cv::Scalar& bgr, int tolerance = 50) {
+  const int x = cvRound(p.x), y = cvRound(p.y);
+  if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) return false;
+  const cv::Vec3b px = image.at<cv::Vec3b>(y, x);
+  return std::abs(px[0] - bgr[0]) <= tolerance && std::abs(px[1] - bgr[1]) <= tolerance &&
+         std::abs(px[2] - bgr[2]) <= tolerance;
+}
+
+bool ColourWithin(const cv::Mat& image, cv::Point2d p, const cv::Scalar& bgr, int radius) {
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      if (IsColour(image, p + cv::Point2d(dx, dy), bgr)) return true;
+    }
+  }
+  return false;
+}
+
+int CountColour(const cv::Mat& image, const cv::Scalar& bgr, int tolerance = 50) {
+  int n = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x)
+      n += IsColour(image, {double(x), double(y)}, bgr, tolerance);
+  }
+  return n;
+}
+
+cv::Point2d OnCircle(cv::Point2d centre, double r, double deg) {
+  return centre + r * cv::Point2d(std::cos(deg * CV_PI / 180), std::sin(deg * CV_PI / 180));
+}
+
+double MinDistance(const std::vector<cv::Point2d>& points, cv::Point2d p) {
+  double best = 1e9;
+  for (const auto& q : points) best = std::min(best, std::hypot(q.x - p.x, q.y - p.y));
+  return best;
+}
+
+TEST(ArcPointsTest, MinorArcRunsFromBaseToTipThroughTheMiddle) {
+  const cv::Point2d centre(100, 100);
+  const double r = 50;
+  const cv::Point2d base = OnCircle(centre, r, 200), tip = OnCircle(centre, r, 340);
+  const cv::Point2d middle = OnCircle(centre, r, 270);
+  const auto arc = ArcPoints(base, middle, tip, r, 64);
+  ASSERT_EQ(arc.size(), 64u);
+  EXPECT_NEAR(cv::norm(arc.front() - base), 0, 1e-9);
+  EXPECT_NEAR(cv::norm(arc.back() - tip), 0, 1e-9);
+  for (const auto& p : arc) EXPECT_NEAR(cv::norm(p - centre), r, 1e-9);
+  EXPECT_LT(MinDistance(arc, middle), 1.5);  // 140 deg in 63 steps: 1.9 px apart.
+  // Never on the far side of the circle.
+  EXPECT_GT(MinDistance(arc, OnCircle(centre, r, 90)), 40);
+}
+
+TEST(ArcPointsTest, MajorArcWhenTheMiddleIsFartherThanTheRadius) {
+  const cv::Point2d centre(200, 150);
+  const double r = 40;
+  const cv::Point2d base = OnCircle(centre, r, 60), tip = OnCircle(centre, r, 120);
+  const cv::Point2d middle = OnCircle(centre, r, 270);  // Past a half circle.
+  const auto arc = ArcPoints(base, middle, tip, r, 200);
+  ASSERT_EQ(arc.size(), 200u);
+  EXPECT_NEAR(cv::norm(arc.front() - base), 0, 1e-9);
+  EXPECT_NEAR(cv::norm(arc.back() - tip), 0, 1e-9);
+  for (const auto& p : arc) EXPECT_NEAR(cv::norm(p - centre), r, 1e-9);
+  EXPECT_LT(MinDistance(arc, middle), 1.0);
+  EXPECT_GT(MinDistance(arc, OnCircle(centre, r, 90)), 10);  // The gap between the ends.
+}
+
+TEST(ArcPointsTest, NoArcWhenItCannotBeDrawn) {
+  EXPECT_TRUE(ArcPoints({0, 0}, {50, 0}, {100, 0}, 80).empty());   // Collinear.
+  EXPECT_TRUE(ArcPoints({0, 0}, {50, 10}, {100, 0}, 30).empty());  // Radius < half chord.
+  EXPECT_TRUE(ArcPoints({5, 5}, {5, 5}, {5, 5}, 30).empty());      // Coincident.
+}
+
+FrameResult ThreeMarkers(bool tip_found) {
+  // Base, middle and tip on a circle of radius 80 around (160, 200).
+  const cv::Point2d centre(160, 200);
+  FrameResult result;
+  result.frame_index = 7;
+  result.time_s = 0.25;
+  result.markers = {{"red", {OnCircle(centre, 80, 200), 1.0}},
+                    {"blue", {OnCircle(centre, 80, 270), 1.0}},
+                    {"green", {}}};
+  if (tip_found) result.markers[2].observation.position_px = OnCircle(centre, 80, 340);
+  result.measurement.angle_deg = 110.0;
+  result.measurement.radius_px = 80.0;
+  result.measurement.sagitta_px = 80.0 * (1 - std::cos(70 * CV_PI / 180));
+  result.proc_ms = 1.25;
+  return result;
+}
+
+OverlayOptions Triple() {
+  MeasureOptions measure;
+  measure.base = "red";
+  measure.middle = "blue";
+  measure.tip = "green";
+  return OverlayOptionsFor(measure);
+}
+
+TEST(DrawOverlayTest, RingsAtFoundMarkersArcAndTriangleBetweenThem) {
+  cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  const FrameResult result = ThreeMarkers(true);
+  DrawOverlay(frame, result, Triple(), OverlayStatus{30.0, 12.0, {}});
+  for (const MarkerObservation& m : result.markers) {
+    const cv::Point2d p = *m.observation.position_px;
+    for (double deg = 0; deg < 360; deg += 30) {
+      EXPECT_TRUE(ColourWithin(frame, OnCircle(p, 12, deg), overlay_colour::kMarker, 1))
+          << m.name << " ring at " << deg;
+    }
+    // The centroid is marked by the cross.
+    EXPECT_TRUE(IsColour(frame, p, overlay_colour::kMarker, 80)) << m.name;
+  }
+  // Arc through the three markers (away from the rings), and the triangle's chord base-tip.
+  const cv::Point2d centre(160, 200);
+  for (double deg : {225.0, 250.0, 290.0, 315.0}) {
+    EXPECT_TRUE(ColourWithin(frame, OnCircle(centre, 80, deg), overlay_colour::kArc, 1)) << deg;
+  }
+  const cv::Point2d chord_mid =
+      (*result.markers[0].observation.position_px + *result.markers[2].observation.position_px) / 2;
+  EXPECT_TRUE(ColourWithin(frame, chord_mid, overlay_colour::kTriangle, 1));
+  EXPECT_EQ(CountColour(frame, overlay_colour::kLost, 60), 0);  // Nobody lost.
+}
+
+TEST(DrawOverlayTest, LostMarkerIsFlaggedInRedAndNotDrawn) {
+  cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  const FrameResult result = ThreeMarkers(false);
+  DrawOverlay(frame, result, Triple());
+  EXPECT_GT(CountColour(frame, overlay_colour::kLost, 60), 30);  // "LOST: green".
+  // No triangle and no arc without the tip; no ring where the tip would have been.
+  const cv::Point2d centre(160, 200);
+  for (double deg : {225.0, 250.0, 290.0, 315.0}) {
+    EXPECT_FALSE(ColourWithin(frame, OnCircle(centre, 80, deg), overlay_colour::kArc, 2)) << deg;
+  }
+  EXPECT_FALSE(ColourWithin(frame, OnCircle(centre, 80, 340), overlay_colour::kMarker, 13));
+}
+
+TEST(DrawOverlayTest, OptionsCheckNamesTheField) {
+  OverlayOptions options;
+  std::string error;
+  EXPECT_TRUE(options.Check(&error));
+  options.marker_ring_px = 0;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("marker_ring_px"), std::string::npos);
+}
+
+TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
+  StripChart chart(StripChartOptions{.window_s = 10.0, .height_px = 180});
+  for (int i = 0; i <= 600; ++i) {  // 20 s at 30 fps; the chart keeps the last 10 s.
+    FrameResult r;
+    r.time_s = i / 30.0;
+    if (i < 450 || i > 480) r.measurement.angle_deg = 90.0 + 2.0 * r.time_s;  // Gap 15..16 s.
+    r.measurement.tip_disp_px = 5.0;
+    r.measurement.arc_length_px = 100.0 + r.time_s;
+    chart.add(r);
+  }
+  EXPECT_EQ(chart.size(), 301u);  // 10..20 s inclusive.
+  cv::Mat area(180, 600, CV_8UC3);
+  chart.draw(area);
+  const auto& lane = chart.lane(0);
+  auto y_of = [&](double v) {
+    return lane.rect.y + (lane.y_max - v) / (lane.y_max - lane.y_min) * (lane.rect.height - 1);
+  };
+  EXPECT_LE(lane.y_min, 110.0);
+  EXPECT_GE(lane.y_max, 130.0);
+  for (double t : {11.0, 13.0, 17.5, 19.5}) {
+    EXPECT_TRUE(ColourWithin(area, {chart.x_of(t), y_of(90.0 + 2 * t)}, StripChart::kColours[0], 1))
+        << t;
+  }
+  // In the gap, the lane's column has no curve pixel.
+  const int x = cvRound(chart.x_of(15.5));
+  for (int y = lane.rect.y + 18; y < lane.rect.y + lane.rect.height; ++y) {
+    ASSERT_FALSE(IsColour(area, {double(x), double(y)}, StripChart::kColours[0], 30)) << y;
+  }
+  // A constant lane (bending distance 5 px) still draws a flat line in the middle of its lane.
+  const auto& flat = chart.lane(1);
+  EXPECT_EQ(flat.label, "bending dist [px]");
+  const double y_flat =
+      flat.rect.y + (flat.y_max - 5.0) / (flat.y_max - flat.y_min) * (flat.rect.height - 1);
+  EXPECT_TRUE(ColourWithin(area, {chart.x_of(12.0), y_flat}, StripChart::kColours[1], 1));
+
+  // Time going backwards (a new source) restarts the chart.
+  FrameResult restart;
+  restart.time_s = 0.0;
+  chart.add(restart);
+  EXPECT_EQ(chart.size(), 1u);
+}
+
+}  // namespace
+}  // namespace softsight

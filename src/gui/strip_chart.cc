@@ -1,0 +1,156 @@
+#include "softsight/gui/strip_chart.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "softsight/io/plot.h"
+
+namespace softsight {
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.4;
+constexpr int kLeft = 56;  // Room for value labels.
+constexpr int kRight = 8;
+constexpr int kShift = 4;
+const cv::Scalar kBackground(32, 32, 32);
+const cv::Scalar kGridColour(70, 70, 70);
+const cv::Scalar kLabel(220, 220, 220);
+
+}  // namespace
+
+// Same hues as the plot command's series, brightened for a dark background.
+const cv::Scalar StripChart::kColours[3] = {{255, 170, 60}, {120, 220, 60}, {220, 150, 240}};
+
+bool StripChartOptions::Check(std::string* error) const {
+  if (!(window_s > 0.1 && window_s <= 3600)) {
+    *error = "window_s must be in (0.1, 3600] s, got " + std::to_string(window_s);
+    return false;
+  }
+  if (height_px < 60 || height_px > 2000) {
+    *error = "height_px must be in 60..2000, got " + std::to_string(height_px);
+    return false;
+  }
+  return true;
+}
+
+StripChart::StripChart(StripChartOptions options) : options_(options) {
+  std::string error;
+  CV_Assert(options_.Check(&error));
+}
+
+void StripChart::add(const FrameResult& result) {
+  if (!samples_.empty() && result.time_s < samples_.back().time_s) samples_.clear();
+  const Measurement& m = result.measurement;
+  const bool metric = m.tip_disp_mm.has_value() || m.arc_length_mm.has_value();
+  Sample sample{result.time_s,
+                {m.angle_deg, metric ? m.tip_disp_mm : m.tip_disp_px,
+                 metric ? m.arc_length_mm : m.arc_length_px},
+                metric};
+  samples_.push_back(sample);
+  while (!samples_.empty() && samples_.front().time_s < result.time_s - options_.window_s) {
+    samples_.pop_front();
+  }
+}
+
+void StripChart::clear() { samples_.clear(); }
+
+double StripChart::x_of(double time_s) const {
+  return x_left_ + (time_s - (t_right_ - options_.window_s)) / options_.window_s * x_width_;
+}
+
+void StripChart::draw(cv::Mat& area) const {
+  CV_Assert(area.type() == CV_8UC3);
+  area.setTo(kBackground);
+  const bool metric = !samples_.empty() && samples_.back().metric;
+  const char* unit = metric ? "mm" : "px";
+  const std::string names[3] = {"angle [deg]", std::string("bending dist [") + unit + "]",
+                                std::string("arc length [") + unit + "]"};
+  const int lane_height = area.rows / 3;
+  x_left_ = kLeft;
+  x_width_ = std::max(1, area.cols - kLeft - kRight);
+  t_right_ = samples_.empty() ? 0.0 : samples_.back().time_s;
+
+  std::vector<cv::Point> run;
+  for (int i = 0; i < 3; ++i) {
+    Lane& lane = lanes_[i];
+    lane.rect = cv::Rect(kLeft, i * lane_height + 3, static_cast<int>(x_width_), lane_height - 6);
+    lane.label = names[i];
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Sample& s : samples_) {
+      if (s.values[i]) {
+        lo = std::min(lo, *s.values[i]);
+        hi = std::max(hi, *s.values[i]);
+      }
+    }
+    if (lo > hi) {
+      lo = 0;
+      hi = 1;
+    } else if (const double min_span = std::max(1.0, 0.05 * std::max(std::abs(lo), std::abs(hi)));
+               hi - lo < min_span) {
+      // A near-constant value: a fixed span around it, so that rounding noise stays flat.
+      const double centre = (lo + hi) / 2;
+      lo = centre - min_span / 2;
+      hi = centre + min_span / 2;
+    } else {
+      const double pad = 0.08 * (hi - lo);
+      lo -= pad;
+      hi += pad;
+    }
+    lane.y_min = lo;
+    lane.y_max = hi;
+    const cv::Rect& r = lane.rect;
+    auto y_of = [&](double v) { return r.y + (hi - v) / (hi - lo) * (r.height - 1); };
+
+    cv::rectangle(area, r, kGridColour, 1);
+    const std::vector<double> ticks = NiceTicks(lo, hi, 3);
+    const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
+    for (double v : ticks) {
+      const int y = cvRound(y_of(v));
+      cv::line(area, {r.x, y}, {r.x + r.width - 1, y}, kGridColour, 1);
+      cv::putText(area, FormatTick(v, step), {4, y + 4}, kFont, kFontScale, kLabel, 1, cv::LINE_AA);
+    }
+    // Current value in the lane's label, so the chart reads without the overlay.
+    std::string label = names[i];
+    if (!samples_.empty()) {
+      char value[32];
+      if (samples_.back().values[i]) {
+        std::snprintf(value, sizeof(value), "  %.1f", *samples_.back().values[i]);
+      } else {
+        std::snprintf(value, sizeof(value), "  --");
+      }
+      label += value;
+    }
+    cv::putText(area, label, {r.x + 6, r.y + 14}, kFont, kFontScale, kColours[i], 1, cv::LINE_AA);
+
+    cv::Mat lane_area = area(r);
+    run.clear();
+    auto flush = [&] {
+      if (run.size() == 1) {
+        cv::circle(lane_area, run[0], 2 << kShift, kColours[i], cv::FILLED, cv::LINE_AA, kShift);
+      } else if (run.size() > 1) {
+        cv::polylines(lane_area, run, false, kColours[i], 1, cv::LINE_AA, kShift);
+      }
+      run.clear();
+    };
+    for (const Sample& s : samples_) {
+      if (!s.values[i]) {
+        flush();
+        continue;
+      }
+      run.emplace_back(cvRound((x_of(s.time_s) - r.x) * (1 << kShift)),
+                       cvRound((y_of(*s.values[i]) - r.y) * (1 << kShift)));
+    }
+    flush();
+  }
+  char span[32];
+  std::snprintf(span, sizeof(span), "last %g s", options_.window_s);
+  cv::putText(area, span, {area.cols - kRight - 70, area.rows - 6}, kFont, kFontScale, kLabel, 1,
+              cv::LINE_AA);
+}
+
+}  // namespace softsight

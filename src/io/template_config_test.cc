@@ -1,0 +1,120 @@
+// The `template:` section of a marker: every key read, written back and read again to the same
+// values; template images relative to the config file; errors naming the key.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/io/config.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::TempDir;
+
+std::string ErrorOf(const std::string& text) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), text);
+  try {
+    LoadTrackingConfig(dir.file("markers.yaml"));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), R"(markers:
+  - name: blue
+    method: ssd
+    template:
+      frame: 3
+      rect: [205, 186, 25, 27]
+      colour: true
+      round: true
+      centre_on_symmetry: true
+      min_zncc: 0.7
+      max_sad: 12.5
+      max_ssd: 18
+      search_margin_px: 12
+      acquire_radius_px: 0
+      pyramid_levels: 2
+      update_rate: 0.05
+      drift_min_zncc: 0.85
+)");
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+  ASSERT_EQ(config.markers.size(), 1u);
+  for (const TrackingConfig& c : {config, [&] {
+                                    SaveTrackingConfig(config, dir.file("saved.yaml"));
+                                    return LoadTrackingConfig(dir.file("saved.yaml"));
+                                  }()}) {
+    const TemplateParams& t = c.markers[0].templ;
+    EXPECT_EQ(c.markers[0].method, "ssd");
+    EXPECT_EQ(t.template_frame, 3);
+    ASSERT_TRUE(t.rect.has_value());
+    EXPECT_EQ(*t.rect, cv::Rect(205, 186, 25, 27));
+    EXPECT_TRUE(t.colour);
+    EXPECT_TRUE(t.round_mask);
+    EXPECT_TRUE(t.centre_on_symmetry);
+    EXPECT_DOUBLE_EQ(t.min_zncc, 0.7);
+    EXPECT_DOUBLE_EQ(t.max_sad, 12.5);
+    EXPECT_DOUBLE_EQ(t.max_ssd, 18);
+    EXPECT_EQ(t.search_margin_px, 12);
+    EXPECT_EQ(t.acquire_radius_px, 0);
+    EXPECT_EQ(t.pyramid_levels, 2);
+    EXPECT_DOUBLE_EQ(t.update_rate, 0.05);
+    EXPECT_DOUBLE_EQ(t.drift_min_zncc, 0.85);
+  }
+}
+
+TEST(TemplateConfig, TemplateWithoutMethodMeansZnccAndDefaultsStay) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"),
+                         "markers:\n  - name: red\n    template: {rect: [10, 20, 21, 21]}\n");
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+  EXPECT_EQ(config.markers[0].method, "zncc");
+  const TemplateParams& t = config.markers[0].templ;
+  const TemplateParams defaults;
+  EXPECT_FALSE(t.colour);
+  EXPECT_EQ(t.template_frame, 0);
+  EXPECT_DOUBLE_EQ(t.min_zncc, defaults.min_zncc);
+  EXPECT_EQ(t.search_margin_px, defaults.search_margin_px);
+}
+
+TEST(TemplateConfig, ImageFileIsRelativeToTheConfig) {
+  TempDir dir;
+  cv::Mat image(21, 23, CV_8UC3, cv::Scalar(30, 60, 90));
+  image(cv::Rect(5, 5, 10, 10)).setTo(cv::Scalar(200, 10, 10));
+  ASSERT_TRUE(cv::imwrite(dir.file("marker.png"), image));
+  testing::WriteTextFile(dir.file("markers.yaml"),
+                         "markers:\n  - name: red\n    method: sad\n"
+                         "    template: {file: marker.png}\n");
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+  const TemplateParams& t = config.markers[0].templ;
+  ASSERT_EQ(t.image.size(), image.size());
+  EXPECT_EQ(t.image.type(), CV_8UC3);
+  EXPECT_EQ(cv::norm(t.image, image, cv::NORM_INF), 0.0);
+  EXPECT_EQ(t.image_file, "marker.png");
+  EXPECT_FALSE(t.rect.has_value());
+}
+
+TEST(TemplateConfig, ErrorsNameTheKey) {
+  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {file: nothere.png}\n"),
+              HasSubstr("markers[0].template.file: cannot read image"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 3]}\n"),
+              HasSubstr("markers[0].template.rect"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
+                      "min_zncc: 2}\n"),
+              HasSubstr("markers[0].template.min_zncc"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
+                      "colur: true}\n"),
+              HasSubstr("colur"));
+  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 2, 30]}\n"),
+              HasSubstr("template.rect [1, 2, 2, 30]"));
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,131 @@
+// Colour tracking of the three markers of a rendered bending actuator, per frame:
+//   FullFrame   every frame searched whole (window 0: coarse-to-fine acquisition);
+//   Reacquire   every frame a re-acquisition after reset() (cost-based choice, whole frame);
+//   Roi         windowed tracking (the normal case);
+//   GrayReference  one cv::cvtColor BGR->GRAY of the same frame: a one-pass yardstick.
+// Each tracking benchmark reports ms_per_frame and x_gray = its time / the gray conversion's,
+// which stays meaningful on a noisy or slower machine. Frames are rendered before timing.
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/sim/scene.h"
+#include "track/colour_tracker_impl.h"
+
+namespace softsight {
+namespace {
+
+constexpr int kFrames = 32;
+
+const std::vector<cv::Mat>& Frames(cv::Size size) {
+  static std::map<int, std::vector<cv::Mat>> cache;
+  std::vector<cv::Mat>& frames = cache[size.width];
+  if (frames.empty()) {
+    SceneOptions options;
+    options.size = size;
+    options.frame_count = kFrames;
+    NoiseOptions noise;
+    noise.sigma = 2.0;
+    SyntheticScene scene(options, noise);
+    for (int i = 0; i < kFrames; ++i) {
+      cv::Mat image;
+      scene.render(i, image);
+      frames.push_back(image);
+    }
+  }
+  return frames;
+}
+
+// Median time of one BGR->GRAY conversion over the frames, in ms.
+double GrayMs(cv::Size size) {
+  static std::map<int, double> cache;
+  auto it = cache.find(size.width);
+  if (it != cache.end()) return it->second;
+  const std::vector<cv::Mat>& frames = Frames(size);
+  cv::Mat gray;
+  std::vector<double> times;
+  for (int rep = 0; rep < 400; ++rep) {
+    const auto start = std::chrono::steady_clock::now();
+    cv::cvtColor(frames[rep % kFrames], gray, cv::COLOR_BGR2GRAY);
+    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                               start).count());
+  }
+  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
+  return cache[size.width] = times[times.size() / 2];
+}
+
+std::vector<std::unique_ptr<ColourTracker>> Trackers(int window_px) {
+  const HsvRange hues[] = {{170, 10}, {100, 130}, {45, 85}};
+  std::vector<std::unique_ptr<ColourTracker>> trackers;
+  for (const HsvRange& h : hues) {
+    ColourParams p;
+    p.h = h;
+    p.s = {80, 255};
+    p.v = {40, 255};
+    p.window_px = window_px;
+    trackers.push_back(std::make_unique<ColourTracker>(p));
+  }
+  return trackers;
+}
+
+enum class Mode { kFullFrame, kReacquire, kRoi };
+
+void TrackMarkers(benchmark::State& state, Mode mode) {
+  const cv::Size size(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const std::vector<cv::Mat>& frames = Frames(size);
+  auto trackers = Trackers(mode == Mode::kFullFrame ? 0 : 64);
+  for (auto& t : trackers) {
+    if (!t->update(frames[0]).found()) state.SkipWithError("marker not found on frame 0");
+  }
+  int i = 0;
+  int64_t found = 0, looked = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    // Forth and back through the sequence: the motion stays smooth (no jump to frame 0).
+    const int k = i++ % (2 * kFrames - 2);
+    const cv::Mat& frame = frames[k < kFrames ? k : 2 * kFrames - 2 - k];
+    for (auto& t : trackers) {
+      if (mode == Mode::kReacquire) t->reset();
+      const Observation obs = t->update(frame);
+      found += obs.found();
+      ++looked;
+      benchmark::DoNotOptimize(obs);
+    }
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                              start).count();
+  const double per_frame = ms / static_cast<double>(state.iterations());
+  state.counters["ms_per_frame"] = per_frame;
+  state.counters["x_gray"] = per_frame / GrayMs(size);
+  state.counters["found_rate"] = static_cast<double>(found) / static_cast<double>(looked);
+}
+
+void BM_ColourFullFrame3(benchmark::State& state) { TrackMarkers(state, Mode::kFullFrame); }
+void BM_ColourReacquire3(benchmark::State& state) { TrackMarkers(state, Mode::kReacquire); }
+void BM_ColourRoi3(benchmark::State& state) { TrackMarkers(state, Mode::kRoi); }
+
+void BM_GrayReference(benchmark::State& state) {
+  const cv::Size size(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const std::vector<cv::Mat>& frames = Frames(size);
+  cv::Mat gray;
+  int i = 0;
+  for (auto _ : state) {
+    cv::cvtColor(frames[i++ % kFrames], gray, cv::COLOR_BGR2GRAY);
+    benchmark::DoNotOptimize(gray.data);
+  }
+  state.counters["ms_per_frame"] = GrayMs(size);
+}
+
+#define SOFTSIGHT_SIZES Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_GrayReference)->SOFTSIGHT_SIZES;
+BENCHMARK(BM_ColourFullFrame3)->SOFTSIGHT_SIZES;
+BENCHMARK(BM_ColourReacquire3)->SOFTSIGHT_SIZES;
+BENCHMARK(BM_ColourRoi3)->SOFTSIGHT_SIZES;
+
+}  // namespace
+}  // namespace softsight

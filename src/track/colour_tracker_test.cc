@@ -1,0 +1,619 @@
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/core/error.h"
+#include "softsight/geometry/measurement.h"
+#include "softsight/sim/scene.h"
+#include "softsight/track/tracker.h"
+#include "track/colour_tracker_impl.h"
+
+namespace softsight {
+namespace {
+
+const cv::Vec3b kRed(40, 40, 220);
+const cv::Vec3b kBlue(220, 90, 40);
+const cv::Vec3b kGreen(60, 200, 60);
+
+// Lightly textured, unsaturated background (fixed seed): never passes a saturation >= 80 test.
+cv::Mat Background(cv::Size size = {320, 240}) {
+  cv::Mat image(size, CV_8UC3);
+  cv::RNG rng(12345);
+  cv::Mat grey(size, CV_8U);
+  rng.fill(grey, cv::RNG::UNIFORM, 90, 160);
+  cv::GaussianBlur(grey, grey, cv::Size(5, 5), 0);
+  cv::cvtColor(grey, image, cv::COLOR_GRAY2BGR);
+  return image;
+}
+
+// Paints every pixel whose centre lies within `radius_px` of `centre` and returns the exact
+// centroid of the painted pixels (the truth a binary tracker must reproduce).
+cv::Point2d PaintDisc(cv::Mat& image, cv::Point2d centre, double radius_px, cv::Vec3b bgr) {
+  double sx = 0, sy = 0, n = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) <= radius_px) {
+        image.at<cv::Vec3b>(y, x) = bgr;
+        sx += x;
+        sy += y;
+        n += 1;
+      }
+    }
+  }
+  return {sx / n, sy / n};
+}
+
+// Centroid of the pixels of colour `bgr` (what is visible of a marker after occlusion).
+cv::Point2d CentroidOfColour(const cv::Mat& image, cv::Vec3b bgr, double* area = nullptr) {
+  double sx = 0, sy = 0, n = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      if (image.at<cv::Vec3b>(y, x) == bgr) {
+        sx += x;
+        sy += y;
+        n += 1;
+      }
+    }
+  }
+  if (area) *area = n;
+  return {sx / n, sy / n};
+}
+
+ColourParams RedParams() {
+  ColourParams p;
+  p.h = {170, 10};
+  p.s = {80, 255};
+  p.v = {40, 255};
+  p.morph_size = 1;  // Analytic discs: the mask is exactly the painted pixels.
+  return p;
+}
+
+ColourParams ParamsFor(const std::string& name) {
+  ColourParams p;
+  p.s = {80, 255};
+  p.v = {40, 255};
+  if (name == "red") p.h = {170, 10};
+  if (name == "blue") p.h = {100, 130};
+  if (name == "green") p.h = {45, 85};
+  return p;
+}
+
+cv::Vec3b BgrOfHsv(int h, int s, int v) {
+  cv::Mat hsv(1, 1, CV_8UC3, cv::Scalar(h, s, v)), bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  return bgr.at<cv::Vec3b>(0, 0);
+}
+
+TEST(ColourTracker, CentroidOfAnalyticDiscIsExact) {
+  ColourTracker tracker(RedParams());
+  for (const cv::Point2d centre : {cv::Point2d(100.3, 80.7), cv::Point2d(200.5, 150.25),
+                                   cv::Point2d(61.9, 170.1)}) {
+    cv::Mat image = Background();
+    const cv::Point2d truth = PaintDisc(image, centre, 8.5, kRed);
+    const Observation obs = tracker.update(image);
+    ASSERT_TRUE(obs.found());
+    EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+    EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+    ASSERT_TRUE(obs.score);
+    EXPECT_NEAR(*obs.score, 1.0, 0.05);  // Same disc radius, slightly different pixel counts.
+  }
+}
+
+TEST(ColourTracker, MarkerAbsentIsNotFoundWithNoValues) {
+  ColourTracker tracker(RedParams());
+  cv::Mat image = Background();
+  PaintDisc(image, {100, 100}, 8, kBlue);  // Another colour only.
+  const Observation obs = tracker.update(image);
+  EXPECT_FALSE(obs.found());
+  EXPECT_FALSE(obs.position_px);
+  EXPECT_FALSE(obs.score);
+}
+
+TEST(ColourTracker, WrappingHueRangeIsOneRange) {
+  // Left half of the disc has hue 175, right half hue 4: one marker across the wrap.
+  cv::Mat image = Background();
+  const cv::Point2d centre(150.4, 120.6);
+  const cv::Point2d truth = PaintDisc(image, centre, 10, BgrOfHsv(175, 200, 220));
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = static_cast<int>(std::ceil(centre.x)); x < image.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) <= 10) {
+        image.at<cv::Vec3b>(y, x) = BgrOfHsv(4, 200, 220);
+      }
+    }
+  }
+  ColourTracker wrapped(RedParams());
+  const Observation obs = wrapped.update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+  EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+
+  // Half of the range sees half of the disc: the wrap really joined two halves.
+  ColourParams upper = RedParams();
+  upper.h = {170, 179};
+  ColourTracker half(upper);
+  const Observation left = half.update(image);
+  ASSERT_TRUE(left.found());
+  EXPECT_LT(left.position_px->x, centre.x - 3);
+}
+
+TEST(ColourTracker, MorphologyRemovesSpecksAndFillsHoles) {
+  cv::Mat image = Background();
+  const cv::Point2d truth = PaintDisc(image, {120.2, 100.6}, 9, kRed);
+  image.at<cv::Vec3b>(101, 120) = cv::Vec3b(128, 128, 128);  // A hole (glare) inside.
+  for (int i = 0; i < 12; ++i) image.at<cv::Vec3b>(30 + 15 * i % 180, 200 + 7 * i) = kRed;
+
+  ColourParams raw = RedParams();
+  raw.min_area_px = 1;
+  raw.min_circularity = 0;
+  ColourTracker without(raw);
+  std::vector<ColourBlob> blobs;
+  without.find_blobs(image, 1, &blobs);
+  EXPECT_EQ(blobs.size(), 13u);  // The disc and 12 specks.
+
+  ColourParams cleaned = raw;
+  cleaned.morph_size = 3;
+  cleaned.morph_shape = ColourParams::Shape::kCross;
+  ColourTracker with(cleaned);
+  with.find_blobs(image, 1, &blobs);
+  ASSERT_EQ(blobs.size(), 1u);
+  // The hole is filled: the blob's centroid moves back onto the disc's (within the few boundary
+  // pixels that opening and closing may reshape).
+  EXPECT_NEAR(blobs[0].centroid_px.x, truth.x, 0.05);
+  EXPECT_NEAR(blobs[0].centroid_px.y, truth.y, 0.05);
+}
+
+TEST(ColourTracker, ThinLineOfSameColourIsNotChosen) {
+  cv::Mat image = Background();
+  // A cable: 2 px wide, 150 px long, far more pixels than the marker.
+  cv::rectangle(image, cv::Rect(20, 40, 150, 2), cv::Scalar(kRed[0], kRed[1], kRed[2]),
+                cv::FILLED);
+  const cv::Point2d truth = PaintDisc(image, {220.3, 170.8}, 6.5, kRed);
+  ColourTracker tracker(RedParams());
+  std::vector<ColourBlob> blobs;
+  tracker.find_blobs(image, 1, &blobs);
+  ASSERT_EQ(blobs.size(), 2u);
+  EXPECT_LT(blobs[0].circularity, 0.1);  // The line (sorted first: smaller y).
+  EXPECT_GT(blobs[1].circularity, 0.95);
+  const Observation obs = tracker.update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+  EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+}
+
+TEST(ColourTracker, MostlyCoveredMarkerIsNotFound) {
+  ColourTracker tracker(RedParams());
+  const cv::Point2d centre(150.5, 120.5);
+  cv::Mat image = Background();
+  PaintDisc(image, centre, 10, kRed);
+  ASSERT_TRUE(tracker.update(image).found());
+  const double reference = *tracker.reference_area_px();
+
+  // Over 80 % covered: less than a quarter of the reference area is not enough.
+  cv::Mat covered = image.clone();
+  cv::rectangle(covered, cv::Rect(100, 100, 200, 26), cv::Scalar(128, 128, 128), cv::FILLED);
+  double area = 0;
+  CentroidOfColour(covered, kRed, &area);
+  ASSERT_LT(area, 0.25 * reference);
+  const Observation hidden = tracker.update(covered);
+  EXPECT_FALSE(hidden.found());
+  EXPECT_FALSE(hidden.score);
+
+  // Half covered: found, at the centroid of what is visible, with score ~0.5.
+  cv::Mat half = image.clone();
+  cv::rectangle(half, cv::Rect(100, 100, 200, 21), cv::Scalar(128, 128, 128), cv::FILLED);
+  const cv::Point2d visible = CentroidOfColour(half, kRed, &area);
+  const Observation seen = tracker.update(half);
+  ASSERT_TRUE(seen.found());
+  EXPECT_NEAR(seen.position_px->x, visible.x, 1e-9);
+  EXPECT_NEAR(seen.position_px->y, visible.y, 1e-9);
+  EXPECT_NEAR(*seen.score, area / reference, 1e-12);
+  EXPECT_GT(*seen.score, 0.25);
+  EXPECT_LT(*seen.score, 0.75);
+}
+
+TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {
+  cv::Mat image = Background();
+  PaintDisc(image, {60, 60}, 12, kRed);                        // Larger: chosen without an ROI.
+  const cv::Point2d right = PaintDisc(image, {250.5, 180.5}, 8, kRed);
+
+  ColourTracker plain(RedParams());
+  EXPECT_LT(plain.update(image).position_px->x, 100);
+
+  ColourParams with_roi = RedParams();
+  with_roi.roi = cv::Rect(230, 160, 40, 40);
+  ColourTracker restricted(with_roi);
+  const Observation obs = restricted.update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, right.x, 1e-9);
+
+  // A hint that cuts the marker still gives its whole centroid (the search grows around it).
+  ColourTracker hinted(RedParams());
+  hinted.init(image, cv::Rect(245, 175, 20, 20));
+  const Observation next = hinted.update(image);
+  ASSERT_TRUE(next.found());
+  EXPECT_NEAR(next.position_px->x, right.x, 1e-9);
+  EXPECT_NEAR(next.position_px->y, right.y, 1e-9);
+  EXPECT_NEAR(*next.score, 1.0, 1e-12);
+}
+
+TEST(ColourTracker, BadFramesAndHintsAreInputErrors) {
+  ColourTracker tracker(RedParams());
+  cv::Mat image = Background();
+  EXPECT_THROW(tracker.init(image, cv::Rect(10, 10, 0, 5)), InputError);
+  EXPECT_THROW(tracker.init(image, cv::Rect(400, 300, 20, 20)), InputError);
+  cv::Mat gray;
+  cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  EXPECT_THROW(tracker.update(gray), InputError);
+  EXPECT_THROW(tracker.update(cv::Mat()), InputError);
+}
+
+TEST(ColourTracker, BlobCutByTheWindowWidensInsteadOfClipping) {
+  ColourParams p = RedParams();
+  p.window_px = 32;
+  ColourTracker tracker(p);
+  cv::Mat image = Background();
+  PaintDisc(image, {100.5, 100.5}, 7, kRed);
+  ASSERT_TRUE(tracker.update(image).found());
+  tracker.update(image);  // Velocity 0.
+  // The marker jumps 20 px: it now straddles the 32 px window's border.
+  image = Background();
+  const cv::Point2d truth = PaintDisc(image, {120.5, 100.5}, 7, kRed);
+  const Observation obs = tracker.update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+  EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+  EXPECT_GT(tracker.last_search_px().width, 32);
+}
+
+TEST(ColourTracker, ConstantVelocityKeepsAFastMarkerInTheSmallWindow) {
+  ColourParams p = RedParams();
+  p.window_px = 32;
+  ColourTracker tracker(p);
+  for (int i = 0; i < 10; ++i) {
+    cv::Mat image = Background();
+    const cv::Point2d truth = PaintDisc(image, {30.0 + 25.0 * i, 60.0 + 15.0 * i}, 6, kRed);
+    const Observation obs = tracker.update(image);
+    ASSERT_TRUE(obs.found()) << "frame " << i;
+    EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+    EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+    if (i >= 2) {
+      EXPECT_EQ(tracker.last_search_px().width, 32) << "frame " << i;
+    }
+  }
+}
+
+TEST(ColourTracker, MarkerLeavingThroughTheFrameEdge) {
+  // Filter and morphology near the frame's edge: the window, the whole-frame search and the
+  // full-resolution search must agree exactly, and a marker gone from the frame is not found.
+  ColourParams p = RedParams();
+  p.filter = ColourParams::Filter::kGaussian;
+  p.morph_size = 3;
+  p.window_px = 32;
+  ColourParams whole = p;
+  whole.window_px = 0;
+  ColourParams full_res = whole;
+  full_res.acquire_downsample = 1;
+  ColourTracker a(p), b(whole), c(full_res);
+  for (int i = 0; i < 14; ++i) {
+    cv::Mat image = Background();
+    const cv::Point2d centre(40.3 - 4.0 * i, 120.6 + 1.5 * i);
+    PaintDisc(image, centre, 8, kRed);
+    const Observation oa = a.update(image), ob = b.update(image), oc = c.update(image);
+    ASSERT_EQ(oa.found(), ob.found()) << "frame " << i;
+    ASSERT_EQ(oa.found(), oc.found()) << "frame " << i;
+    if (centre.x > 4) {
+      EXPECT_TRUE(oa.found()) << "frame " << i;  // Mostly inside.
+    }
+    if (centre.x < -8.5) {
+      EXPECT_FALSE(oa.found()) << "frame " << i;  // Gone.
+    }
+    if (!oa.found()) continue;
+    EXPECT_EQ(oa.position_px->x, ob.position_px->x) << "frame " << i;
+    EXPECT_EQ(oa.position_px->y, ob.position_px->y) << "frame " << i;
+    EXPECT_EQ(oa.position_px->x, oc.position_px->x) << "frame " << i;
+    EXPECT_EQ(oa.position_px->y, oc.position_px->y) << "frame " << i;
+  }
+}
+
+TEST(ColourTracker, ReacquisitionPrefersMatchingBlobNearLastPosition) {
+  ColourTracker tracker(RedParams());
+  cv::Mat image = Background();
+  PaintDisc(image, {100, 100}, 8, kRed);
+  ASSERT_TRUE(tracker.update(image).found());
+  // The marker is gone; elsewhere: a far twin, a near twin, and a near blob three times too big.
+  image = Background();
+  PaintDisc(image, {280, 200}, 8, kRed);
+  const cv::Point2d near_twin = PaintDisc(image, {150, 60}, 8, kRed);
+  PaintDisc(image, {60, 170}, 14, kRed);
+  const Observation obs = tracker.update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, near_twin.x, 1e-9);
+  EXPECT_NEAR(obs.position_px->y, near_twin.y, 1e-9);
+}
+
+TEST(ColourTracker, ParamsCheckNamesTheBadField) {
+  std::string error;
+  ColourParams p;
+  EXPECT_TRUE(p.Check(&error));
+  p.h = {170, 200};
+  EXPECT_FALSE(p.Check(&error));
+  EXPECT_NE(error.find("hsv.h"), std::string::npos) << error;
+  p = ColourParams();
+  p.filter = ColourParams::Filter::kGaussian;
+  p.filter_ksize = 4;
+  EXPECT_FALSE(p.Check(&error));
+  EXPECT_NE(error.find("filter.ksize"), std::string::npos) << error;
+  p = ColourParams();
+  p.s = {200, 100};
+  EXPECT_FALSE(p.Check(&error));
+  EXPECT_NE(error.find("hsv.s"), std::string::npos) << error;
+  p = ColourParams();
+  p.min_area_fraction = 1.5;
+  EXPECT_FALSE(p.Check(&error));
+  EXPECT_NE(error.find("min_area_fraction"), std::string::npos) << error;
+  p = ColourParams();
+  p.acquire_downsample = 3;
+  EXPECT_FALSE(p.Check(&error));
+  EXPECT_NE(error.find("acquire_downsample"), std::string::npos) << error;
+}
+
+TEST(TrackerRegistry, BuildsColourTrackersAndRejectsBadSpecs) {
+  MarkerSpec spec;
+  spec.name = "tip";
+  spec.method = "colour";
+  spec.colour = RedParams();
+  std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+  cv::Mat image = Background();
+  const cv::Point2d truth = PaintDisc(image, {77.7, 55.5}, 6, kRed);
+  const Observation obs = tracker->update(image);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+
+  const std::vector<std::string> methods = TrackerMethods();
+  EXPECT_EQ(methods.front(), "colour");
+
+  spec.method = "telepathy";
+  try {
+    CreateTracker(spec);
+    FAIL() << "unknown method accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("telepathy"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("'tip'"), std::string::npos);
+  }
+  spec.method = "colour";
+  spec.colour.window_px = 3;
+  try {
+    CreateTracker(spec);
+    FAIL() << "bad window accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("window"), std::string::npos) << e.what();
+  }
+}
+
+// ---- Rendered scenes: exact ground truth -----------------------------------------------------------
+
+struct SceneRun {
+  double rms_px = 0;        // Over every (marker, frame) with the marker fully visible.
+  double angle_rms_deg = 0; // Measured vs true angle, frames where all three are found.
+  int missed = 0;           // Visible (>= 50 %) but not found.
+  int false_found = 0;      // Fully hidden but found.
+  int hidden = 0;           // (marker, frame) pairs fully hidden.
+  int samples = 0;
+};
+
+// Tracks the scene's markers with one tracker each and compares with the truth.
+SceneRun RunScene(SyntheticScene& scene, const std::vector<ColourParams>& params, int frames,
+                  int stride = 1) {
+  std::vector<std::unique_ptr<ColourTracker>> trackers;
+  for (const ColourParams& p : params) trackers.push_back(std::make_unique<ColourTracker>(p));
+  MeasureOptions measure;
+  measure.base = "red";
+  measure.middle = "blue";
+  measure.tip = "green";
+  Measurer measurer(measure);
+  SceneRun run;
+  double sum2 = 0, angle_sum2 = 0;
+  int angle_samples = 0;
+  cv::Mat image;
+  for (int f = 0; f < frames; f += stride) {
+    const SceneTruth truth = scene.render(f, image);
+    std::vector<MarkerObservation> observed;
+    for (size_t m = 0; m < trackers.size(); ++m) {
+      const MarkerTruth& t = truth.markers[m];
+      const Observation obs = trackers[m]->update(image);
+      observed.push_back({t.name, obs});
+      if (!t.centroid_px) {
+        ++run.hidden;
+        if (obs.found()) ++run.false_found;
+        continue;
+      }
+      if (t.visible_fraction >= 0.5 && !obs.found()) ++run.missed;
+      if (t.visible_fraction >= 0.999 && obs.found()) {
+        sum2 += std::pow(cv::norm(*obs.position_px - *t.centroid_px), 2);
+        ++run.samples;
+      }
+    }
+    const Measurement measured = measurer.measure(observed);
+    if (measured.angle_deg && truth.measurement.angle_deg) {
+      angle_sum2 += std::pow(*measured.angle_deg - *truth.measurement.angle_deg, 2);
+      ++angle_samples;
+    }
+  }
+  run.rms_px = std::sqrt(sum2 / std::max(1, run.samples));
+  run.angle_rms_deg = std::sqrt(angle_sum2 / std::max(1, angle_samples));
+  return run;
+}
+
+std::vector<ColourParams> SceneParams() {
+  return {ParamsFor("red"), ParamsFor("blue"), ParamsFor("green")};
+}
+
+SceneOptions BendingScene(int frames) {
+  SceneOptions options;
+  options.kind = SceneKind::kBending;
+  options.frame_count = frames;
+  return options;
+}
+
+TEST(ColourTrackerScene, CleanBendingSceneIsSubPixelAccurate) {
+  SyntheticScene scene(BendingScene(80));
+  const SceneRun run = RunScene(scene, SceneParams(), 80);
+  EXPECT_EQ(run.missed, 0);
+  EXPECT_EQ(run.samples, 240);
+  EXPECT_LE(run.rms_px, 0.1);
+  EXPECT_LE(run.angle_rms_deg, 0.2);
+  RecordProperty("rms_px", std::to_string(run.rms_px));
+  RecordProperty("angle_rms_deg", std::to_string(run.angle_rms_deg));
+  std::printf("clean: centroid RMS %.4f px, angle RMS %.4f deg over %d samples\n", run.rms_px,
+              run.angle_rms_deg, run.samples);
+}
+
+TEST(ColourTrackerScene, NoisySceneWithGaussianFilter) {
+  NoiseOptions noise;
+  noise.sigma = 5.0;
+  SyntheticScene scene(BendingScene(80), noise);
+  std::vector<ColourParams> params = SceneParams();
+  for (ColourParams& p : params) {
+    p.filter = ColourParams::Filter::kGaussian;
+    p.filter_ksize = 5;
+  }
+  const SceneRun run = RunScene(scene, params, 80);
+  EXPECT_EQ(run.missed, 0);
+  EXPECT_LE(run.rms_px, 0.3);
+  std::printf("noise 5: centroid RMS %.4f px, angle RMS %.4f deg\n", run.rms_px,
+              run.angle_rms_deg);
+}
+
+TEST(ColourTrackerScene, OccludedMarkerIsNotFoundAndReacquired) {
+  // Find where the middle marker sits mid-sequence, then hide it for frames 30..45.
+  SyntheticScene probe(BendingScene(80));
+  cv::Mat image;
+  const SceneTruth at = probe.render(38, image);
+  const cv::Point2d blue = *at.markers[1].centroid_px;
+  Occluder occluder;
+  occluder.rect_px = cv::Rect2d(blue.x - 40, blue.y - 40, 80, 80);
+  occluder.first_frame = 30;
+  occluder.last_frame = 45;
+  SyntheticScene scene(BendingScene(80), {}, {}, {occluder});
+  const SceneRun run = RunScene(scene, SceneParams(), 80);
+  EXPECT_GE(run.hidden, 10);  // The occluder really hid the marker, in most of its frames.
+  EXPECT_EQ(run.false_found, 0);
+  EXPECT_EQ(run.missed, 0);     // Includes the frames after the occluder: re-acquired.
+  EXPECT_LE(run.rms_px, 0.1);
+}
+
+TEST(ColourTrackerScene, WindowedEqualsWholeFrameAndCoarseEqualsFullResolution) {
+  NoiseOptions noise;
+  noise.sigma = 5.0;
+  SyntheticScene scene(BendingScene(60), noise);
+  for (const char* name : {"red", "blue", "green"}) {
+    ColourParams windowed = ParamsFor(name);
+    windowed.filter = ColourParams::Filter::kGaussian;
+    ColourParams whole = windowed;
+    whole.window_px = 0;
+    ColourParams full_res = whole;
+    full_res.acquire_downsample = 1;
+    ColourTracker a(windowed), b(whole), c(full_res);
+    cv::Mat image;
+    int compared = 0;
+    for (int f = 0; f < 60; f += 2) {
+      scene.render(f, image);
+      const Observation oa = a.update(image), ob = b.update(image), oc = c.update(image);
+      ASSERT_TRUE(oa.found() && ob.found() && oc.found()) << name << " frame " << f;
+      // Bit-identical: same pixels, same moments, same integer offsets.
+      EXPECT_EQ(oa.position_px->x, ob.position_px->x) << name << " frame " << f;
+      EXPECT_EQ(oa.position_px->y, ob.position_px->y) << name << " frame " << f;
+      EXPECT_EQ(ob.position_px->x, oc.position_px->x) << name << " frame " << f;
+      EXPECT_EQ(ob.position_px->y, oc.position_px->y) << name << " frame " << f;
+      EXPECT_EQ(*oa.score, *oc.score);
+      ++compared;
+    }
+    EXPECT_EQ(compared, 30);
+    EXPECT_GT(b.acquire_downsample(), 1);  // The coarse path really ran.
+  }
+}
+
+TEST(ColourTrackerScene, CoarseCandidatesFindEveryAcceptableBlob) {
+  // Noise and a half-covered marker: the coarse-to-fine search must return exactly the blobs
+  // of the full-resolution search that are large and round enough to count as the marker.
+  NoiseOptions noise;
+  noise.sigma = 5.0;
+  SyntheticScene probe(BendingScene(30));
+  cv::Mat image;
+  const cv::Point2d red = *probe.render(20, image).markers[0].centroid_px;
+  Occluder occluder;
+  occluder.rect_px = cv::Rect2d(red.x - 30, red.y + 1, 60, 40);  // Hides the lower half.
+  occluder.first_frame = 15;
+  occluder.last_frame = 25;
+  SyntheticScene scene(BendingScene(30), noise, {}, {occluder});
+  for (const char* name : {"red", "blue", "green"}) {
+    ColourParams p = ParamsFor(name);
+    p.filter = ColourParams::Filter::kGaussian;
+    ColourTracker tracker(p);
+    scene.render(0, image);
+    ASSERT_TRUE(tracker.update(image).found());
+    const double min_area = p.min_area_fraction * *tracker.reference_area_px();
+    ASSERT_EQ(tracker.acquire_downsample(), 4);
+    for (int f = 0; f < 30; f += 3) {
+      scene.render(f, image);
+      std::vector<ColourBlob> reference, coarse;
+      tracker.find_blobs(image, 1, &reference);
+      auto countable = [&](const ColourBlob& b) {
+        return b.area_px >= min_area && b.circularity >= p.min_circularity;
+      };
+      std::erase_if(reference, [&](const ColourBlob& b) { return !countable(b); });
+      ASSERT_FALSE(reference.empty()) << name << " frame " << f;
+      for (int factor : {2, 4}) {
+        tracker.find_blobs(image, factor, &coarse);
+        std::erase_if(coarse, [&](const ColourBlob& b) { return !countable(b); });
+        ASSERT_EQ(coarse.size(), reference.size()) << name << " frame " << f << " x" << factor;
+        for (size_t i = 0; i < coarse.size(); ++i) {
+          EXPECT_EQ(coarse[i].centroid_px, reference[i].centroid_px) << name << " frame " << f;
+          EXPECT_EQ(coarse[i].area_px, reference[i].area_px) << name << " frame " << f;
+        }
+      }
+    }
+  }
+}
+
+TEST(ColourTrackerScene, NoisySceneWithMedianFilter) {
+  NoiseOptions noise;
+  noise.sigma = 5.0;
+  SyntheticScene scene(BendingScene(40), noise);
+  std::vector<ColourParams> params = SceneParams();
+  for (ColourParams& p : params) {
+    p.filter = ColourParams::Filter::kMedian;
+    p.filter_ksize = 5;
+  }
+  const SceneRun run = RunScene(scene, params, 40);
+  EXPECT_EQ(run.missed, 0);
+  EXPECT_LE(run.rms_px, 0.3);
+  std::printf("noise 5, median: centroid RMS %.4f px\n", run.rms_px);
+}
+
+TEST(ColourTrackerScene, AutomaticThresholdFromNominalColour) {
+  SyntheticScene scene(BendingScene(40));
+  cv::Mat image;
+  const SceneTruth first = scene.render(0, image);
+  std::vector<ColourParams> params;
+  const cv::Vec3b colours[] = {kRed, kBlue, kGreen};
+  for (int m = 0; m < 3; ++m) {
+    ColourParams p;
+    p.auto_bgr = colours[m];
+    const cv::Point2d c = *first.markers[m].centroid_px;
+    p.roi = cv::Rect(cvRound(c.x) - 20, cvRound(c.y) - 20, 40, 40);
+    params.push_back(p);
+  }
+  const SceneRun run = RunScene(scene, params, 40);
+  EXPECT_EQ(run.missed, 0);
+  EXPECT_LE(run.rms_px, 0.1);
+  std::printf("auto threshold: centroid RMS %.4f px\n", run.rms_px);
+}
+
+}  // namespace
+}  // namespace softsight

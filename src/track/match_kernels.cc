@@ -1,0 +1,574 @@
+#include "track/match_kernels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+
+namespace {
+
+// The longest template row the 16-bit SAD accumulators take between two flushes (128 chunks of
+// 16 bytes, each adding two values <= 255 to a lane: 256 * 255 < 65536).
+constexpr int kMaxRowBytes = 2048;
+
+void CheckInputs(const cv::Mat& image, const cv::Mat& templ, const cv::Mat& mask) {
+  CV_Assert(image.depth() == CV_8U && templ.depth() == CV_8U);
+  CV_Assert(image.channels() == templ.channels());
+  CV_Assert(templ.channels() == 1 || templ.channels() == 3);
+  CV_Assert(!templ.empty() && image.cols >= templ.cols && image.rows >= templ.rows);
+  CV_Assert(templ.total() * templ.channels() <= static_cast<size_t>(kMaxTemplateValues));
+  CV_Assert(mask.empty() || (mask.type() == CV_8UC1 && mask.size() == templ.size()));
+}
+
+cv::Size ResultSize(const cv::Mat& image, const cv::Size& templ) {
+  return {image.cols - templ.width + 1, image.rows - templ.height + 1};
+}
+
+bool Counts(const cv::Mat& mask, int r, int c) { return mask.empty() || mask.at<uint8_t>(r, c); }
+
+// Plain scalar loops, shared by the references and by the fast kernels' scalar fallback (rows
+// shorter than 8 bytes, or a build without 128-bit SIMD).
+template <typename Op>
+void ScalarMap(const cv::Mat& image, const cv::Mat& templ, const cv::Mat& mask, cv::Mat& result,
+               Op op) {
+  CheckInputs(image, templ, mask);
+  result.create(ResultSize(image, templ.size()), CV_32S);
+  const int cn = templ.channels();
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    for (int x = 0; x < result.cols; ++x) {
+      int total = 0;
+      for (int r = 0; r < templ.rows; ++r) {
+        const uint8_t* a = image.ptr<uint8_t>(y + r) + x * cn;
+        const uint8_t* b = templ.ptr<uint8_t>(r);
+        for (int i = 0; i < templ.cols * cn; ++i) {
+          if (Counts(mask, r, i / cn)) total += op(int{a[i]}, int{b[i]});
+        }
+      }
+      out[x] = total;
+    }
+  }
+}
+
+int AbsDiff(int a, int b) { return std::abs(a - b); }
+int SqDiff(int a, int b) { return (a - b) * (a - b); }
+int Product(int a, int b) { return a * b; }
+
+// ZNCC from exact integer sums over the N counted pixels of one placement: cross = sum I*T,
+// sum[c] = sum I_c, sum_sq = sum I^2 over all channels. NaN when the window is flat.
+float ZnccFromSums(int64_t n, int64_t cross, const int64_t* sum, int64_t sum_sq, int cn,
+                   const PreparedTemplate& t) {
+  int64_t num = n * cross;
+  int64_t variance = n * sum_sq;
+  for (int c = 0; c < cn; ++c) {
+    num -= sum[c] * t.sum()[c];
+    variance -= sum[c] * sum[c];
+  }
+  if (variance <= 0) return std::numeric_limits<float>::quiet_NaN();
+  const double z = static_cast<double>(num) / std::sqrt(static_cast<double>(variance) *
+                                                        static_cast<double>(t.scaled_variance()));
+  return static_cast<float>(std::clamp(z, -1.0, 1.0));
+}
+
+// Masked ZNCC, scalar: the window sums must be taken over the mask, so no integral images.
+void ScalarMaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result) {
+  const cv::Mat& templ = t.image();
+  const cv::Mat& mask = t.mask();
+  const int cn = templ.channels();
+  result.create(ResultSize(image, templ.size()), CV_32F);
+  for (int y = 0; y < result.rows; ++y) {
+    for (int x = 0; x < result.cols; ++x) {
+      int64_t cross = 0, sum[3] = {0, 0, 0}, sum_sq = 0;
+      for (int r = 0; r < templ.rows; ++r) {
+        const uint8_t* a = image.ptr<uint8_t>(y + r) + x * cn;
+        const uint8_t* b = templ.ptr<uint8_t>(r);
+        for (int i = 0; i < templ.cols * cn; ++i) {
+          if (!mask.at<uint8_t>(r, i / cn)) continue;
+          cross += a[i] * b[i];
+          sum[i % cn] += a[i];
+          sum_sq += a[i] * a[i];
+        }
+      }
+      result.at<float>(y, x) = ZnccFromSums(t.count(), cross, sum, sum_sq, cn, t);
+    }
+  }
+}
+
+}  // namespace
+
+// Gives the kernels access to the layout without making it public API.
+struct KernelAccess {
+  static bool Vectorised(const PreparedTemplate& t) { return t.chunks_per_row_ > 0; }
+  static int FullChunks(const PreparedTemplate& t) { return t.full_chunks_; }
+  static bool HasTail(const PreparedTemplate& t) { return t.has_tail_; }
+  static int TailLo(const PreparedTemplate& t) { return t.tail_lo_; }
+  static int TailHi(const PreparedTemplate& t) { return t.tail_hi_; }
+  static int ChunksPerRow(const PreparedTemplate& t) { return t.chunks_per_row_; }
+  static int Rows(const PreparedTemplate& t) { return t.image_.rows; }
+  static const uint8_t* Bytes(const PreparedTemplate& t) { return t.bytes_.data(); }
+  static const uint8_t* Mask(const PreparedTemplate& t) { return t.mask_.data(); }
+  static const int16_t* Words(const PreparedTemplate& t) { return t.words_.data(); }
+  static const int16_t* MaskWords(const PreparedTemplate& t) { return t.mask_words_.data(); }
+  static const int16_t* ChannelWords(const PreparedTemplate& t, int c) {
+    return t.channel_words_.data() + static_cast<size_t>(c) * t.words_.size();
+  }
+};
+
+bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
+  CV_Assert(templ.depth() == CV_8U && (templ.channels() == 1 || templ.channels() == 3));
+  CV_Assert(!templ.empty());
+  CV_Assert(templ.total() * templ.channels() <= static_cast<size_t>(kMaxTemplateValues));
+  CV_Assert(templ.cols * templ.channels() <= kMaxRowBytes);
+  CV_Assert(mask.empty() || (mask.type() == CV_8UC1 && mask.size() == templ.size()));
+  // Buffers keep their capacity, so re-preparing a same-size template (the slow template
+  // update) allocates nothing.
+  bytes_.clear();
+  mask_.clear();
+  words_.clear();
+  mask_words_.clear();
+  channel_words_.clear();
+
+  const int cn = templ.channels();
+  int64_t n = 0;
+  int64_t sum[3] = {0, 0, 0};
+  int64_t sum_sq[3] = {0, 0, 0};
+  for (int r = 0; r < templ.rows; ++r) {
+    const uint8_t* p = templ.ptr<uint8_t>(r);
+    for (int i = 0; i < templ.cols * cn; ++i) {
+      if (!Counts(mask, r, i / cn)) continue;
+      sum[i % cn] += p[i];
+      sum_sq[i % cn] += int64_t{p[i]} * p[i];
+    }
+    for (int j = 0; j < templ.cols; ++j) n += Counts(mask, r, j) ? 1 : 0;
+  }
+  int64_t variance = 0;
+  for (int c = 0; c < cn; ++c) variance += n * sum_sq[c] - sum[c] * sum[c];
+  if (n == 0 || variance <= 0) {
+    image_.release();
+    mask_image_.release();
+    return false;
+  }
+
+  templ.copyTo(image_);  // Continuous.
+  if (!mask.empty() && cv::countNonZero(mask) < static_cast<int>(mask.total())) {
+    mask.copyTo(mask_image_);
+  } else {
+    mask_image_.release();
+  }
+  count_ = static_cast<int>(n);
+  for (int c = 0; c < 3; ++c) {
+    sum_[c] = sum[c];
+    sum_sq_[c] = sum_sq[c];
+  }
+  scaled_variance_ = variance;
+
+  row_bytes_ = templ.cols * cn;
+  full_chunks_ = 0;
+  has_tail_ = false;
+  chunks_per_row_ = 0;
+  if (row_bytes_ < 8) return true;  // Too narrow for 8-byte loads: scalar kernels.
+  full_chunks_ = row_bytes_ / 16;
+  const int covered = full_chunks_ * 16;
+  const int rem = row_bytes_ - covered;
+  has_tail_ = rem > 0;
+  if (rem >= 8) {
+    tail_lo_ = covered;
+    tail_hi_ = row_bytes_ - 8;
+  } else if (rem > 0) {
+    tail_lo_ = row_bytes_ - 8;
+    tail_hi_ = row_bytes_ - 8;
+  }
+  chunks_per_row_ = full_chunks_ + (has_tail_ ? 1 : 0);
+  const size_t total = static_cast<size_t>(chunks_per_row_) * templ.rows * 16;
+  bytes_.assign(total, 0);
+  mask_.assign(total, 0);
+  words_.assign(total, 0);
+  std::vector<int> byte_of(total, -1);  // Row byte index each lane reads, -1 when masked off.
+  size_t k = 0;
+  for (int r = 0; r < templ.rows; ++r) {
+    for (int c = 0; c < full_chunks_; ++c, k += 16) {
+      for (int i = 0; i < 16; ++i) byte_of[k + i] = c * 16 + i;
+    }
+    if (has_tail_) {
+      for (int i = 0; i < 8; ++i) {
+        // Low half: counts the bytes not yet covered by the full chunks.
+        if (tail_lo_ + i >= covered) byte_of[k + i] = tail_lo_ + i;
+        // High half: only when the tail is 8 bytes or more, beyond what the low half took.
+        if (rem >= 8 && tail_hi_ + i >= covered + 8) byte_of[k + 8 + i] = tail_hi_ + i;
+      }
+      k += 16;
+    }
+  }
+  const bool masked = !mask_image_.empty();
+  if (masked) {
+    mask_words_.assign(total, 0);
+    channel_words_.assign(total * cn, 0);
+  }
+  const size_t per_row = static_cast<size_t>(chunks_per_row_) * 16;
+  for (size_t i = 0; i < total; ++i) {
+    const int r = static_cast<int>(i / per_row);
+    const int b = byte_of[i];
+    if (b < 0 || !Counts(mask_image_, r, b / cn)) continue;
+    bytes_[i] = image_.ptr<uint8_t>(r)[b];
+    mask_[i] = 0xFF;
+    words_[i] = bytes_[i];
+    if (masked) {
+      mask_words_[i] = -1;
+      channel_words_[static_cast<size_t>(b % cn) * total + i] = 1;
+    }
+  }
+  return true;
+}
+
+void MatchSadReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& result,
+                       const cv::Mat& mask) {
+  ScalarMap(image, templ, mask, result, AbsDiff);
+}
+
+void MatchSsdReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& result,
+                       const cv::Mat& mask) {
+  ScalarMap(image, templ, mask, result, SqDiff);
+}
+
+void MatchZnccReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& result,
+                        const cv::Mat& mask) {
+  CheckInputs(image, templ, mask);
+  result.create(ResultSize(image, templ.size()), CV_32F);
+  const int cn = templ.channels();
+  double n = 0;
+  double mean_t[3] = {0, 0, 0};
+  for (int r = 0; r < templ.rows; ++r) {
+    for (int i = 0; i < templ.cols * cn; ++i) {
+      if (Counts(mask, r, i / cn)) mean_t[i % cn] += templ.ptr<uint8_t>(r)[i];
+    }
+    for (int j = 0; j < templ.cols; ++j) n += Counts(mask, r, j) ? 1 : 0;
+  }
+  for (int c = 0; c < cn; ++c) mean_t[c] /= n;
+  for (int y = 0; y < result.rows; ++y) {
+    for (int x = 0; x < result.cols; ++x) {
+      double mean_i[3] = {0, 0, 0};
+      for (int r = 0; r < templ.rows; ++r) {
+        const uint8_t* a = image.ptr<uint8_t>(y + r) + x * cn;
+        for (int i = 0; i < templ.cols * cn; ++i) {
+          if (Counts(mask, r, i / cn)) mean_i[i % cn] += a[i];
+        }
+      }
+      for (int c = 0; c < cn; ++c) mean_i[c] /= n;
+      double num = 0, var_i = 0, var_t = 0;
+      for (int r = 0; r < templ.rows; ++r) {
+        const uint8_t* a = image.ptr<uint8_t>(y + r) + x * cn;
+        const uint8_t* b = templ.ptr<uint8_t>(r);
+        for (int i = 0; i < templ.cols * cn; ++i) {
+          if (!Counts(mask, r, i / cn)) continue;
+          const double di = a[i] - mean_i[i % cn];
+          const double dt = b[i] - mean_t[i % cn];
+          num += di * dt;
+          var_i += di * di;
+          var_t += dt * dt;
+        }
+      }
+      result.at<float>(y, x) = (var_i > 0 && var_t > 0)
+                                   ? static_cast<float>(num / std::sqrt(var_i * var_t))
+                                   : std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+}
+
+#if CV_SIMD128
+
+namespace {
+
+using KA = KernelAccess;
+
+// Loads the image bytes of chunk `c` of a row (the tail chunk as two in-row 8-byte halves).
+inline cv::v_uint8x16 LoadChunk(const uint8_t* p, int c, int full, int lo, int hi) {
+  return c < full ? cv::v_load(p + 16 * c) : cv::v_load_halves(p + lo, p + hi);
+}
+
+// SAD of one placement. v_reduce_sad (psadbw on x86) sums 16 absolute differences in one step;
+// masked bytes are zeroed on both sides, so they add |0 - 0| = 0.
+template <bool kMasked>
+inline int SadAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const bool tail = KA::HasTail(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const uint8_t* tb = KA::Bytes(t);
+  const uint8_t* tm = KA::Mask(t);
+  unsigned acc0 = 0, acc1 = 0;  // Two chains for instruction-level parallelism.
+  for (int r = 0; r < rows; ++r, p += step) {
+    int c = 0;
+    for (; c + 1 < full; c += 2, tb += 32, tm += 32) {
+      cv::v_uint8x16 a0 = cv::v_load(p + 16 * c), a1 = cv::v_load(p + 16 * c + 16);
+      if (kMasked) {
+        a0 &= cv::v_load(tm);
+        a1 &= cv::v_load(tm + 16);
+      }
+      acc0 += cv::v_reduce_sad(a0, cv::v_load(tb));
+      acc1 += cv::v_reduce_sad(a1, cv::v_load(tb + 16));
+    }
+    for (; c < full; ++c, tb += 16, tm += 16) {
+      cv::v_uint8x16 a = cv::v_load(p + 16 * c);
+      if (kMasked) a &= cv::v_load(tm);
+      acc0 += cv::v_reduce_sad(a, cv::v_load(tb));
+    }
+    if (tail) {
+      acc1 += cv::v_reduce_sad(cv::v_load_halves(p + lo, p + hi) & cv::v_load(tm), cv::v_load(tb));
+      tb += 16;
+      tm += 16;
+    }
+  }
+  return static_cast<int>(acc0 + acc1);
+}
+
+// SAD of two neighbouring placements (x and x + 1) at once: each template chunk is loaded once
+// for both, and the two sums are independent chains.
+template <bool kMasked>
+inline void SadPairAt(const uint8_t* p, int cn, size_t step, const PreparedTemplate& t,
+                      int* out) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const bool tail = KA::HasTail(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const uint8_t* tb = KA::Bytes(t);
+  const uint8_t* tm = KA::Mask(t);
+  unsigned acc0 = 0, acc1 = 0;
+  for (int r = 0; r < rows; ++r, p += step) {
+    const uint8_t* q = p + cn;
+    for (int c = 0; c < full; ++c, tb += 16, tm += 16) {
+      const cv::v_uint8x16 tv = cv::v_load(tb);
+      cv::v_uint8x16 a0 = cv::v_load(p + 16 * c), a1 = cv::v_load(q + 16 * c);
+      if (kMasked) {
+        const cv::v_uint8x16 m = cv::v_load(tm);
+        a0 &= m;
+        a1 &= m;
+      }
+      acc0 += cv::v_reduce_sad(a0, tv);
+      acc1 += cv::v_reduce_sad(a1, tv);
+    }
+    if (tail) {
+      const cv::v_uint8x16 tv = cv::v_load(tb), m = cv::v_load(tm);
+      acc0 += cv::v_reduce_sad(cv::v_load_halves(p + lo, p + hi) & m, tv);
+      acc1 += cv::v_reduce_sad(cv::v_load_halves(q + lo, q + hi) & m, tv);
+      tb += 16;
+      tm += 16;
+    }
+  }
+  out[0] = static_cast<int>(acc0);
+  out[1] = static_cast<int>(acc1);
+}
+
+template <bool kMasked>
+void VectorSadMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result) {
+  const int cn = t.channels();
+  const size_t step = image.step[0];
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    const uint8_t* p = image.ptr<uint8_t>(y);
+    int x = 0;
+    for (; x + 1 < result.cols; x += 2) SadPairAt<kMasked>(p + x * cn, cn, step, t, out + x);
+    if (x < result.cols) out[x] = SadAt<kMasked>(p + x * cn, step, t);
+  }
+}
+
+template <bool kMasked>
+inline int SsdAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const int chunks = KA::ChunksPerRow(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const uint8_t* tb = KA::Bytes(t);
+  const uint8_t* tm = KA::Mask(t);
+  cv::v_int32x4 acc = cv::v_setzero_s32();
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < chunks; ++c, tb += 16, tm += 16) {
+      cv::v_uint8x16 d = cv::v_absdiff(LoadChunk(p, c, full, lo, hi), cv::v_load(tb));
+      if (kMasked || c >= full) d &= cv::v_load(tm);
+      cv::v_uint16x8 a, b;
+      cv::v_expand(d, a, b);
+      const cv::v_int16x8 sa = cv::v_reinterpret_as_s16(a), sb = cv::v_reinterpret_as_s16(b);
+      acc = cv::v_dotprod(sa, sa, acc);
+      acc = cv::v_dotprod(sb, sb, acc);
+    }
+  }
+  return cv::v_reduce_sum(acc);
+}
+
+// sum I * T: the template words are zero where masked, so no mask is needed.
+inline int CrossAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const int chunks = KA::ChunksPerRow(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const int16_t* tw = KA::Words(t);
+  cv::v_int32x4 acc = cv::v_setzero_s32();
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < chunks; ++c, tw += 16) {
+      cv::v_uint16x8 a, b;
+      cv::v_expand(LoadChunk(p, c, full, lo, hi), a, b);
+      acc = cv::v_dotprod(cv::v_reinterpret_as_s16(a), cv::v_load(tw), acc);
+      acc = cv::v_dotprod(cv::v_reinterpret_as_s16(b), cv::v_load(tw + 8), acc);
+    }
+  }
+  return cv::v_reduce_sum(acc);
+}
+
+template <int (*At)(const uint8_t*, size_t, const PreparedTemplate&)>
+void VectorMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result) {
+  const int cn = t.channels();
+  const size_t step = image.step[0];
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    const uint8_t* p = image.ptr<uint8_t>(y);
+    for (int x = 0; x < result.cols; ++x) out[x] = At(p + x * cn, step, t);
+  }
+}
+
+// Masked ZNCC of one placement, fused: sum I*T, sum I^2 and per-channel sum I over the mask.
+template <int kChannels>
+inline float MaskedZnccAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const int chunks = KA::ChunksPerRow(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const int16_t* tw = KA::Words(t);
+  const int16_t* mw = KA::MaskWords(t);
+  const int16_t* cw[3] = {KA::ChannelWords(t, 0), kChannels == 3 ? KA::ChannelWords(t, 1) : nullptr,
+                          kChannels == 3 ? KA::ChannelWords(t, 2) : nullptr};
+  cv::v_int32x4 cross = cv::v_setzero_s32(), sq = cv::v_setzero_s32();
+  cv::v_int32x4 sum[3] = {cv::v_setzero_s32(), cv::v_setzero_s32(), cv::v_setzero_s32()};
+  size_t k = 0;
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < chunks; ++c, k += 16) {
+      cv::v_uint16x8 ua, ub;
+      cv::v_expand(LoadChunk(p, c, full, lo, hi), ua, ub);
+      const cv::v_int16x8 a = cv::v_reinterpret_as_s16(ua), b = cv::v_reinterpret_as_s16(ub);
+      cross = cv::v_dotprod(a, cv::v_load(tw + k), cross);
+      cross = cv::v_dotprod(b, cv::v_load(tw + k + 8), cross);
+      sq = cv::v_dotprod(a, a & cv::v_load(mw + k), sq);
+      sq = cv::v_dotprod(b, b & cv::v_load(mw + k + 8), sq);
+      for (int ch = 0; ch < kChannels; ++ch) {
+        sum[ch] = cv::v_dotprod(a, cv::v_load(cw[ch] + k), sum[ch]);
+        sum[ch] = cv::v_dotprod(b, cv::v_load(cw[ch] + k + 8), sum[ch]);
+      }
+    }
+  }
+  int64_t sums[3] = {0, 0, 0};
+  for (int ch = 0; ch < kChannels; ++ch) sums[ch] = cv::v_reduce_sum(sum[ch]);
+  return ZnccFromSums(t.count(), cv::v_reduce_sum(cross), sums, cv::v_reduce_sum(sq), kChannels, t);
+}
+
+template <int kChannels>
+void VectorMaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result) {
+  const size_t step = image.step[0];
+  for (int y = 0; y < result.rows; ++y) {
+    float* out = result.ptr<float>(y);
+    const uint8_t* p = image.ptr<uint8_t>(y);
+    for (int x = 0; x < result.cols; ++x)
+      out[x] = MaskedZnccAt<kChannels>(p + x * kChannels, step, t);
+  }
+}
+
+}  // namespace
+
+#endif  // CV_SIMD128
+
+void MatchSad(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+  CV_Assert(!templ.empty());
+  CheckInputs(image, templ.image(), templ.mask());
+#if CV_SIMD128
+  if (KernelAccess::Vectorised(templ)) {
+    result.create(ResultSize(image, templ.size()), CV_32S);
+    if (templ.masked()) {
+      VectorSadMap<true>(image, templ, result);
+    } else {
+      VectorSadMap<false>(image, templ, result);
+    }
+    return;
+  }
+#endif
+  ScalarMap(image, templ.image(), templ.mask(), result, AbsDiff);
+}
+
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+  CV_Assert(!templ.empty());
+  CheckInputs(image, templ.image(), templ.mask());
+#if CV_SIMD128
+  if (KernelAccess::Vectorised(templ)) {
+    result.create(ResultSize(image, templ.size()), CV_32S);
+    if (templ.masked()) {
+      VectorMap<SsdAt<true>>(image, templ, result);
+    } else {
+      VectorMap<SsdAt<false>>(image, templ, result);
+    }
+    return;
+  }
+#endif
+  ScalarMap(image, templ.image(), templ.mask(), result, SqDiff);
+}
+
+void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+  CV_Assert(!templ.empty());
+  CheckInputs(image, templ.image(), templ.mask());
+#if CV_SIMD128
+  if (KernelAccess::Vectorised(templ)) {
+    result.create(ResultSize(image, templ.size()), CV_32S);
+    VectorMap<CrossAt>(image, templ, result);
+    return;
+  }
+#endif
+  ScalarMap(image, templ.image(), templ.mask(), result, Product);
+}
+
+void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+               ZnccScratch& scratch) {
+  CV_Assert(!templ.empty());
+  CheckInputs(image, templ.image(), templ.mask());
+  const int cn = templ.channels();
+  if (templ.masked()) {
+    result.create(ResultSize(image, templ.size()), CV_32F);
+#if CV_SIMD128
+    if (KernelAccess::Vectorised(templ)) {
+      if (cn == 1) {
+        VectorMaskedZncc<1>(image, templ, result);
+      } else {
+        VectorMaskedZncc<3>(image, templ, result);
+      }
+      return;
+    }
+#endif
+    ScalarMaskedZncc(image, templ, result);
+    return;
+  }
+  MatchCrossCorrelation(image, templ, scratch.cross);
+  // Window sums from integral images: exact (32-bit sums, 64-bit float squares < 2^53).
+  cv::integral(image, scratch.sum, scratch.sum_sq, CV_32S, CV_64F);
+  result.create(scratch.cross.size(), CV_32F);
+  const int w = templ.size().width, h = templ.size().height;
+  const int64_t n = templ.count();
+  for (int y = 0; y < result.rows; ++y) {
+    const int* cross = scratch.cross.ptr<int>(y);
+    const int* s0 = scratch.sum.ptr<int>(y);
+    const int* s1 = scratch.sum.ptr<int>(y + h);
+    const double* q0 = scratch.sum_sq.ptr<double>(y);
+    const double* q1 = scratch.sum_sq.ptr<double>(y + h);
+    float* out = result.ptr<float>(y);
+    for (int x = 0; x < result.cols; ++x) {
+      int64_t sums[3] = {0, 0, 0};
+      int64_t sum_sq = 0;
+      for (int c = 0; c < cn; ++c) {
+        const int a = x * cn + c, b = (x + w) * cn + c;
+        sums[c] = int64_t{s1[b]} - s1[a] - s0[b] + s0[a];
+        sum_sq += static_cast<int64_t>(q1[b] - q1[a] - q0[b] + q0[a]);
+      }
+      out[x] = ZnccFromSums(n, cross[x], sums, sum_sq, cn, templ);
+    }
+  }
+}
+
+}  // namespace softsight

@@ -1,0 +1,249 @@
+// The fast matching kernels against their brute-force references on random images and templates
+// of odd and even sizes, gray and colour, including placements touching every image border.
+#include "track/match_kernels.h"
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+cv::Mat RandomImage(cv::RNG& rng, cv::Size size, int channels) {
+  cv::Mat image(size, CV_8UC(channels));
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  return image;
+}
+
+// Number of places where two integer maps differ.
+int CountDifferent(const cv::Mat& a, const cv::Mat& b) {
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.type(), b.type());
+  if (a.size() != b.size() || a.type() != b.type()) return -1;
+  return cv::countNonZero(a.reshape(1) != b.reshape(1));
+}
+
+// Largest |a - b| over the map; NaN must sit at the same places in both (counted in
+// `nan_mismatch`).
+double MaxZnccError(const cv::Mat& a, const cv::Mat& b, int* nan_mismatch) {
+  double worst = 0.0;
+  *nan_mismatch = 0;
+  for (int y = 0; y < a.rows; ++y) {
+    for (int x = 0; x < a.cols; ++x) {
+      const float u = a.at<float>(y, x), v = b.at<float>(y, x);
+      if (std::isnan(u) || std::isnan(v)) {
+        if (std::isnan(u) != std::isnan(v)) ++*nan_mismatch;
+        continue;
+      }
+      worst = std::max(worst, static_cast<double>(std::abs(u - v)));
+    }
+  }
+  return worst;
+}
+
+struct Case {
+  int width, height, channels;
+};
+
+// Widths cover every layout: too narrow for vectors (scalar path), exactly 8, 16-byte chunks
+// only, a tail of 1..7 bytes, a tail of 8..15 bytes; odd and even in both directions.
+const Case kCases[] = {{5, 4, 1},  {8, 8, 1},   {9, 7, 1},   {15, 6, 1},  {16, 16, 1},
+                       {17, 9, 1}, {21, 21, 1}, {24, 11, 1}, {31, 32, 1}, {32, 32, 1},
+                       {33, 5, 1}, {47, 3, 1},  {2, 3, 3},   {3, 3, 3},   {5, 4, 3},
+                       {6, 7, 3},  {11, 11, 3}, {16, 9, 3},  {21, 20, 3}, {32, 32, 3}};
+
+std::string Name(const Case& c) {
+  return std::to_string(c.width) + "x" + std::to_string(c.height) + "x" +
+         std::to_string(c.channels);
+}
+
+TEST(MatchKernelsTest, RandomImagesMatchReferencesExactlyOrWithin1e4) {
+  cv::RNG rng(20261122);
+  PreparedTemplate prepared;
+  ZnccScratch scratch;
+  cv::Mat fast, reference;
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(Name(c));
+    // Odd and even image sizes; the result map spans every placement, so the first and last
+    // rows and columns of the map are placements touching the image borders.
+    const cv::Size image_size(c.width + 19 + rng.uniform(0, 2), c.height + 14 + rng.uniform(0, 2));
+    const cv::Mat image = RandomImage(rng, image_size, c.channels);
+    const cv::Mat templ = RandomImage(rng, {c.width, c.height}, c.channels);
+    // Unmasked, and with a random mask keeping about 70 % of the pixels.
+    cv::Mat random_mask(templ.size(), CV_8UC1);
+    rng.fill(random_mask, cv::RNG::UNIFORM, 0, 10);
+    random_mask = random_mask < 7;
+    random_mask.at<uint8_t>(0, 0) = 0;  // Never all ones.
+    for (const cv::Mat& mask : {cv::Mat(), random_mask}) {
+      SCOPED_TRACE(mask.empty() ? "unmasked" : "masked");
+      ASSERT_TRUE(prepared.Prepare(templ, mask));
+      EXPECT_EQ(prepared.masked(), !mask.empty());
+
+      MatchSad(image, prepared, fast);
+      MatchSadReference(image, templ, reference, mask);
+      EXPECT_EQ(CountDifferent(fast, reference), 0) << "SAD";
+
+      MatchSsd(image, prepared, fast);
+      MatchSsdReference(image, templ, reference, mask);
+      EXPECT_EQ(CountDifferent(fast, reference), 0) << "SSD";
+
+      MatchZncc(image, prepared, fast, scratch);
+      MatchZnccReference(image, templ, reference, mask);
+      int nan_mismatch = 0;
+      EXPECT_LE(MaxZnccError(fast, reference, &nan_mismatch), 1e-4) << "ZNCC";
+      EXPECT_EQ(nan_mismatch, 0);
+    }
+  }
+}
+
+TEST(MatchKernelsTest, MaskedPixelsDoNotMatter) {
+  // Changing the image under masked-out template pixels changes no score.
+  cv::RNG rng(99);
+  const cv::Mat templ = RandomImage(rng, {21, 19}, 3);
+  cv::Mat mask(templ.size(), CV_8UC1, cv::Scalar(0));
+  cv::circle(mask, {10, 9}, 8, cv::Scalar(255), cv::FILLED);
+  cv::Mat image = RandomImage(rng, {40, 30}, 3);
+  PreparedTemplate prepared;
+  ASSERT_TRUE(prepared.Prepare(templ, mask));
+  const cv::Point at(7, 5);
+  templ.copyTo(image(cv::Rect(at, templ.size())));
+  cv::Mat changed = image.clone();
+  cv::Mat outside;
+  cv::bitwise_not(mask, outside);
+  RandomImage(rng, templ.size(), 3).copyTo(changed(cv::Rect(at, templ.size())), outside);
+  ZnccScratch scratch;
+  cv::Mat a, b;
+  MatchSad(image, prepared, a);
+  MatchSad(changed, prepared, b);
+  EXPECT_EQ(a.at<int>(at), 0);
+  EXPECT_EQ(b.at<int>(at), 0);
+  MatchSsd(changed, prepared, b);
+  EXPECT_EQ(b.at<int>(at), 0);
+  MatchZncc(changed, prepared, b, scratch);
+  EXPECT_NEAR(b.at<float>(at), 1.0f, 1e-6);
+}
+
+TEST(MatchKernelsTest, TemplateCutAtEachBorderIsFoundThereExactly) {
+  cv::RNG rng(7);
+  PreparedTemplate prepared;
+  ZnccScratch scratch;
+  cv::Mat sad, ssd, zncc;
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(Name(c));
+    const cv::Mat image = RandomImage(rng, {c.width + 12, c.height + 9}, c.channels);
+    const cv::Point corners[] = {{0, 0},
+                                 {image.cols - c.width, 0},
+                                 {0, image.rows - c.height},
+                                 {image.cols - c.width, image.rows - c.height}};
+    for (const cv::Point& at : corners) {
+      ASSERT_TRUE(prepared.Prepare(image(cv::Rect(at, cv::Size(c.width, c.height)))));
+      MatchSad(image, prepared, sad);
+      MatchSsd(image, prepared, ssd);
+      MatchZncc(image, prepared, zncc, scratch);
+      EXPECT_EQ(sad.at<int>(at), 0);
+      EXPECT_EQ(ssd.at<int>(at), 0);
+      EXPECT_NEAR(zncc.at<float>(at), 1.0f, 1e-6);
+      double min_sad, min_ssd, max_zncc;
+      cv::Point min_sad_at, min_ssd_at, max_zncc_at;
+      cv::minMaxLoc(sad, &min_sad, nullptr, &min_sad_at);
+      cv::minMaxLoc(ssd, &min_ssd, nullptr, &min_ssd_at);
+      cv::minMaxLoc(zncc, nullptr, &max_zncc, nullptr, &max_zncc_at);
+      EXPECT_EQ(min_sad_at, at);
+      EXPECT_EQ(min_ssd_at, at);
+      EXPECT_EQ(max_zncc_at, at);
+    }
+  }
+}
+
+TEST(MatchKernelsTest, ImageOfTemplateSizeGivesOneScore) {
+  cv::RNG rng(3);
+  const cv::Mat image = RandomImage(rng, {20, 13}, 1);
+  const cv::Mat templ = RandomImage(rng, {20, 13}, 1);
+  PreparedTemplate prepared;
+  ASSERT_TRUE(prepared.Prepare(templ));
+  cv::Mat fast, reference;
+  MatchSad(image, prepared, fast);
+  MatchSadReference(image, templ, reference);
+  ASSERT_EQ(fast.size(), cv::Size(1, 1));
+  EXPECT_EQ(fast.at<int>(0, 0), reference.at<int>(0, 0));
+  MatchSsd(image, prepared, fast);
+  MatchSsdReference(image, templ, reference);
+  EXPECT_EQ(fast.at<int>(0, 0), reference.at<int>(0, 0));
+}
+
+TEST(MatchKernelsTest, ExtremeValuesDoNotOverflow) {
+  // The largest template the accumulators are sized for, with maximal differences everywhere.
+  const int side = 181;  // 181 * 181 = 32761 <= kMaxTemplateValues
+  cv::Mat image(side + 2, side + 3, CV_8UC1, cv::Scalar(255));
+  cv::Mat templ(side, side, CV_8UC1, cv::Scalar(0));
+  templ.at<uint8_t>(0, 0) = 1;  // Not flat.
+  PreparedTemplate prepared;
+  ASSERT_TRUE(prepared.Prepare(templ));
+  cv::Mat fast, reference;
+  MatchSad(image, prepared, fast);
+  MatchSadReference(image, templ, reference);
+  EXPECT_EQ(CountDifferent(fast, reference), 0);
+  EXPECT_EQ(fast.at<int>(0, 0), 255 * side * side - 1);
+  MatchSsd(image, prepared, fast);
+  MatchSsdReference(image, templ, reference);
+  EXPECT_EQ(CountDifferent(fast, reference), 0);
+  EXPECT_EQ(fast.at<int>(0, 0), 255 * 255 * (side * side - 1) + 254 * 254);
+}
+
+TEST(MatchKernelsTest, FlatWindowsGiveUndefinedZncc) {
+  cv::RNG rng(11);
+  cv::Mat image = RandomImage(rng, {60, 40}, 1);
+  image(cv::Rect(10, 5, 30, 25)).setTo(77);  // A flat patch larger than the template.
+  const cv::Mat templ = RandomImage(rng, {12, 10}, 1);
+  PreparedTemplate prepared;
+  ASSERT_TRUE(prepared.Prepare(templ));
+  ZnccScratch scratch;
+  cv::Mat fast, reference;
+  MatchZncc(image, prepared, fast, scratch);
+  MatchZnccReference(image, templ, reference);
+  // Placements fully inside the flat patch: x in 10..28, y in 5..20.
+  for (int y = 0; y < fast.rows; ++y) {
+    for (int x = 0; x < fast.cols; ++x) {
+      const bool flat = x >= 10 && x <= 28 && y >= 5 && y <= 20;
+      EXPECT_EQ(std::isnan(fast.at<float>(y, x)), flat) << x << "," << y;
+      EXPECT_EQ(std::isnan(reference.at<float>(y, x)), flat) << x << "," << y;
+    }
+  }
+}
+
+TEST(MatchKernelsTest, FlatTemplateIsRefused) {
+  PreparedTemplate prepared;
+  EXPECT_FALSE(prepared.Prepare(cv::Mat(9, 9, CV_8UC1, cv::Scalar(40))));
+  EXPECT_TRUE(prepared.empty());
+  EXPECT_FALSE(prepared.Prepare(cv::Mat(9, 9, CV_8UC3, cv::Scalar(40, 90, 200))));
+  // One channel varying is enough for colour ZNCC to be defined.
+  cv::Mat colour(9, 9, CV_8UC3, cv::Scalar(40, 90, 200));
+  colour.at<cv::Vec3b>(4, 4)[1] = 91;
+  EXPECT_TRUE(prepared.Prepare(colour));
+}
+
+TEST(MatchKernelsTest, AgreesWithOpenCvMatchTemplateDefinitions) {
+  // Same definitions as cv::matchTemplate (TM_SQDIFF, TM_CCOEFF_NORMED), which computes in float.
+  cv::RNG rng(5);
+  PreparedTemplate prepared;
+  ZnccScratch scratch;
+  for (int channels : {1, 3}) {
+    const cv::Mat image = RandomImage(rng, {70, 50}, channels);
+    const cv::Mat templ = RandomImage(rng, {13, 12}, channels);
+    ASSERT_TRUE(prepared.Prepare(templ));
+    cv::Mat ssd, zncc, cv_ssd, cv_zncc;
+    MatchSsd(image, prepared, ssd);
+    MatchZncc(image, prepared, zncc, scratch);
+    cv::matchTemplate(image, templ, cv_ssd, cv::TM_SQDIFF);
+    cv::matchTemplate(image, templ, cv_zncc, cv::TM_CCOEFF_NORMED);
+    cv::Mat ssd_f;
+    ssd.convertTo(ssd_f, CV_32F);
+    EXPECT_LE(cv::norm(ssd_f, cv_ssd, cv::NORM_RELATIVE | cv::NORM_INF), 1e-5);
+    EXPECT_LE(cv::norm(zncc, cv_zncc, cv::NORM_INF), 1e-3);
+  }
+}
+
+}  // namespace
+}  // namespace softsight
