@@ -16,6 +16,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub);
 CommandRunner SetupControlCommand(CLI::App& sub);
 CommandRunner SetupRigCommand(CLI::App& sub);
 CommandRunner SetupSynthCommand(CLI::App& sub);
+CommandRunner SetupEvaluateCommand(CLI::App& sub);
 CommandRunner SetupDemoCommand(CLI::App& sub);
 CommandRunner SetupCalibrateCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "app/commands.h"
+#include "app/scene_config.h"
 #include "app/synth_command.h"
 #include "app/track_command.h"
 #include "softsight/core/error.h"
@@ -25,27 +26,15 @@ struct DemoOptions {
   bool quiet = false;
 };
 
-// HSV thresholds a person would pick for a saturated marker colour: its hue +-12 (wrapping
-// around 0 for red), any strong saturation and brightness.
-ColourParams ThresholdsFor(const cv::Vec3b& bgr) {
-  cv::Mat pixel(1, 1, CV_8UC3, cv::Scalar(bgr[0], bgr[1], bgr[2])), hsv;
-  cv::cvtColor(pixel, hsv, cv::COLOR_BGR2HSV);
-  const int hue = hsv.at<cv::Vec3b>(0, 0)[0];
-  ColourParams params;
-  params.h = {(hue + 180 - 12) % 180, (hue + 12) % 180};
-  params.s = {80, 255};
-  params.v = {40, 255};
-  params.filter = ColourParams::Filter::kGaussian;
-  params.filter_ksize = 3;
-  return params;
-}
-
 TrackingConfig ConfigFor(const SceneOptions& scene) {
   TrackingConfig config;
   for (const SceneMarker& marker : scene.markers) {
     MarkerSpec spec;
     spec.name = marker.name;
     spec.colour = ThresholdsFor(marker.bgr);
+    // The demo renders with sensor noise: a light smoothing, as a person would add.
+    spec.colour.filter = ColourParams::Filter::kGaussian;
+    spec.colour.filter_ksize = 3;
     config.markers.push_back(spec);
   }
   config.measure.base = scene.markers.front().name;

@@ -25,6 +25,8 @@ const CommandEntry kCommands[] = {
     {"track", "Track markers in a video or image sequence and write per-frame measurements",
      SetupTrackCommand},
     {"synth", "Render a synthetic actuator video with exact ground truth", SetupSynthCommand},
+    {"evaluate", "Compare the tracking methods' accuracy and speed on a rendered scene",
+     SetupEvaluateCommand},
     {"calibrate", "Calibrate the camera from chessboard views, or the plane's mm per pixel",
      SetupCalibrateCommand},
     {"live", "Live window on a camera or video: overlay, mouse recalibration, recording",

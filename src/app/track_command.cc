@@ -176,7 +176,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       ->required()
       ->check(CLI::ExistingFile);
   sub.add_option("-i,--input", options->source.input,
-                 "Video file, folder of images, or printf pattern such as frames/%04d.png")
+                 "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
+                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4")
       ->required();
   sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("-m,--method", options->method,

@@ -245,6 +245,11 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
   const std::string& input = spec.input;
   if (input.empty()) throw InputError("no input given (use --input VIDEO|FOLDER|PATTERN)");
   if (!(spec.sequence_fps > 0)) throw InputError("--fps must be positive");
+  if (input.rfind(kSyntheticPrefix, 0) == 0) {
+    SceneOptions scene;
+    scene.kind = ParseSceneKind(input.substr(std::string(kSyntheticPrefix).size()));
+    return OpenSyntheticSource(scene, NoiseOptions{});
+  }
   if (input.find('%') != std::string::npos) return OpenPattern(input, spec.sequence_fps);
   if (fs::is_directory(input)) return OpenFolder(input, spec.sequence_fps);
   if (!fs::exists(input)) throw InputError(input + ": no such file or folder");

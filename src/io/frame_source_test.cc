@@ -155,6 +155,20 @@ TEST(ImageSequenceSource, EmptyFolderOrUnmatchedPatternIsAnError) {
   EXPECT_THROW(OpenFrameSource({dir.file("x%04d.png"), {}, 30.0}), InputError);
 }
 
+TEST(SyntheticSource, RendersTheNamedSceneWithItsTimestamps) {
+  auto source = OpenFrameSource({"synth:wedge1", {}, 30.0});
+  ASSERT_TRUE(source->frame_count().has_value());
+  EXPECT_THAT(source->description(), HasSubstr("wedge1"));
+  Frame frame;
+  ASSERT_TRUE(source->read(frame));
+  ASSERT_TRUE(source->read(frame));
+  EXPECT_EQ(frame.index, 1);
+  EXPECT_NEAR(frame.time_s, 1.0 / *source->fps(), 1e-9);
+  EXPECT_EQ(frame.image.type(), CV_8UC3);
+  EXPECT_FALSE(IsGrayscale(frame.image));
+  EXPECT_THROW(OpenFrameSource({"synth:spiral", {}, 30.0}), InputError);
+}
+
 TEST(IsGrayscale, TellsGrayFromColour) {
   cv::Mat gray(8, 8, CV_8UC3, cv::Scalar(77, 77, 77));
   EXPECT_TRUE(IsGrayscale(gray));

@@ -37,13 +37,6 @@ namespace {
 
 constexpr int kMaxInt = std::numeric_limits<int>::max();
 
-// Relative image paths are relative to the config file's folder, so a config and its templates
-// move together.
-std::string ResolvePath(const std::string& config_file, const std::string& path) {
-  const std::filesystem::path p(path);
-  if (p.is_absolute()) return path;
-  return (std::filesystem::path(config_file).parent_path() / p).string();
-}
 
 }  // namespace
 
@@ -56,7 +49,7 @@ void ReadTemplateParams(YamlMap& marker, TemplateParams* params) {
   }
   if (const auto file = t.string("file")) {
     if (params->rect) t.fail("file", "give either rect or file, not both");
-    const std::string path = ResolvePath(t.file(), *file);
+    const std::string path = ResolveBesideFile(t.file(), *file);
     params->image = cv::imread(path, cv::IMREAD_COLOR);
     if (params->image.empty()) {
       t.fail("file", "cannot read image '" + path + "' (missing, or not an image)");

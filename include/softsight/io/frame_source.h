@@ -41,9 +41,12 @@ struct SceneOptions;
 struct NoiseOptions;
 
 // How to open a source. Exactly one of `input` or `camera` is used.
+// `input` naming a built-in synthetic scene: "synth:bending", "synth:wedge1", "synth:wedge4".
+inline constexpr const char* kSyntheticPrefix = "synth:";
+
 struct FrameSourceSpec {
-  // A video file (anything FFmpeg reads), a folder of images (sorted by name), or a printf
-  // pattern such as "frames/%04d.png".
+  // A video file (anything FFmpeg reads), a folder of images (sorted by name), a printf
+  // pattern such as "frames/%04d.png", or a synthetic scene ("synth:bending").
   std::string input;
   std::optional<int> camera;           // V4L2 camera index (live).
   // Frame rate for image sequences, whose files carry no timestamps (frames per second).

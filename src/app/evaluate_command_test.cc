@@ -1,0 +1,180 @@
+#include "app/evaluate_command.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "softsight/core/error.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small bending scene, 40 frames: seconds for every method.
+EvaluateOptions SmallScene() {
+  EvaluateOptions options;
+  options.scene.size = cv::Size(320, 240);
+  options.scene.frame_count = 40;
+  options.scene.length_px = 160;
+  options.scene.width_px = 30;
+  options.scene.marker_radius_px = 9;
+  options.scene.max_bend_deg = 120;
+  options.quiet = true;
+  return options;
+}
+
+const MethodResult& Find(const EvaluateReport& report, const std::string& label) {
+  for (const MethodResult& m : report.methods) {
+    if (m.label() == label) return m;
+  }
+  ADD_FAILURE() << "no row " << label;
+  static const MethodResult kNone;
+  return kNone;
+}
+
+TEST(EvaluateTest, ColourIsSubPixelWithoutMissesAndZnccColourKeepsEveryMarker) {
+  EvaluateOptions options = SmallScene();
+  options.methods = {"colour", "zncc"};
+  options.modes = {"colour"};
+  const EvaluateReport report = RunEvaluate(options);
+  SCOPED_TRACE(FormatEvaluateMarkdown(report));
+  ASSERT_EQ(report.methods.size(), 2u);
+  EXPECT_EQ(report.frames, 40);
+
+  const MethodResult& colour = Find(report, "colour");
+  EXPECT_EQ(colour.visible, 3 * 40);
+  EXPECT_EQ(colour.misses, 0);
+  EXPECT_EQ(colour.found_visible, colour.visible);
+  ASSERT_TRUE(colour.centroid_rms_px.has_value());
+  EXPECT_LT(*colour.centroid_rms_px, 0.1);
+  ASSERT_TRUE(colour.angle_rms_deg.has_value());
+  EXPECT_EQ(colour.angle_frames, 40);
+  EXPECT_LT(*colour.angle_rms_deg, 0.3);
+
+  const MethodResult& zncc = Find(report, "zncc colour");
+  EXPECT_EQ(zncc.misses, 0);
+  EXPECT_EQ(zncc.found_visible, 3 * 40);
+  ASSERT_TRUE(zncc.centroid_rms_px && zncc.precision_rms_px);
+  // The dragged template is off by up to half a pixel per axis; removing that constant offset
+  // leaves the tracking precision, which is much finer.
+  EXPECT_LT(*zncc.centroid_rms_px, 0.75);
+  EXPECT_LT(*zncc.precision_rms_px, 0.3);
+  EXPECT_LE(*zncc.precision_rms_px, *zncc.centroid_rms_px + 1e-9);
+  EXPECT_GT(zncc.proc_ms_median, 0.0);
+  EXPECT_GE(zncc.proc_ms_p99, zncc.proc_ms_median);
+}
+
+TEST(EvaluateTest, FullyOccludedMarkerIsNeverReported) {
+  EvaluateOptions options = SmallScene();
+  options.scene.frame_count = 30;
+  options.methods = {"colour", "sad", "ssd", "zncc"};
+  options.modes = {"gray", "colour"};
+  // A grey card over the tip marker's whole path during frames 10..19 (found from the truth of an
+  // unoccluded rendering), so it is fully hidden there while the other markers stay in view.
+  constexpr int kFirst = 10, kLast = 19;
+  SyntheticScene plain(options.scene);
+  cv::Mat image;
+  cv::Rect2d path;
+  for (int i = kFirst; i <= kLast; ++i) {
+    const cv::Point2d tip = *plain.render(i, image).markers.back().centroid_px;
+    const double r = options.scene.marker_radius_px + 2;
+    const cv::Rect2d around(tip.x - r, tip.y - r, 2 * r, 2 * r);
+    path = i == kFirst ? around : (path | around);
+  }
+  Occluder card;
+  card.rect_px = cv::Rect2d(std::floor(path.x), std::floor(path.y), std::ceil(path.width) + 1,
+                            std::ceil(path.height) + 1);
+  card.first_frame = kFirst;
+  card.last_frame = kLast;
+  options.occluders = {card};
+  const EvaluateReport report = RunEvaluate(options);
+  SCOPED_TRACE(FormatEvaluateMarkdown(report));
+  for (const MethodResult& m : report.methods) {
+    EXPECT_EQ(m.hidden, kLast - kFirst + 1) << m.label();
+    // Not asserted for zncc gray: in gray the red, blue and green discs are all dark discs on a
+    // light band and ZNCC cancels gain and offset, so while the tip is hidden its template
+    // matches the middle marker, which lies within acquire_radius_px (64 px) on this small scene
+    // (the limitation template_tracker.h documents). Its false reports are in the table.
+    if (m.label() == "zncc gray") continue;
+    EXPECT_EQ(m.false_reports, 0) << m.label();
+  }
+  // The other markers are never lost, and the colour tracker re-finds the tip once uncovered.
+  EXPECT_EQ(Find(report, "colour").misses, 0);
+}
+
+TEST(EvaluateTest, WritesTheTableAsCsvAndMarkdown) {
+  EvaluateOptions options = SmallScene();
+  options.scene.frame_count = 5;
+  options.methods = {"colour", "sad"};
+  options.modes = {"gray", "colour"};
+  const fs::path csv = fs::path(::testing::TempDir()) /
+                       ("softsight_evaluate_" + std::to_string(getpid()) + ".csv");
+  options.csv_file = csv.string();
+  const EvaluateReport report = RunEvaluate(options);
+  ASSERT_EQ(report.methods.size(), 3u);  // colour, sad gray, sad colour.
+  std::ifstream in(csv);
+  std::string header, line;
+  ASSERT_TRUE(std::getline(in, header));
+  EXPECT_EQ(header.rfind("method,mode,frames,", 0), 0u) << header;
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 3);
+  fs::remove(csv);
+
+  const std::string table = FormatEvaluateMarkdown(report);
+  EXPECT_NE(table.find("| sad gray |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| sad colour |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| colour |"), std::string::npos) << table;
+}
+
+// The one-line message names the option and the value.
+template <typename F>
+std::string InputErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no InputError";
+}
+
+TEST(EvaluateTest, BadOptionsAreOneLineInputErrors) {
+  EvaluateOptions unknown = SmallScene();
+  unknown.methods = {"colour", "ncc"};
+  std::string message = InputErrorOf([&] { RunEvaluate(unknown); });
+  EXPECT_NE(message.find("--methods"), std::string::npos) << message;
+  EXPECT_NE(message.find("'ncc'"), std::string::npos) << message;
+
+  EvaluateOptions bad_mode = SmallScene();
+  bad_mode.modes = {"grey"};
+  message = InputErrorOf([&] { RunEvaluate(bad_mode); });
+  EXPECT_NE(message.find("--modes"), std::string::npos) << message;
+
+  EvaluateOptions no_frames = SmallScene();
+  no_frames.scene.frame_count = 0;
+  message = InputErrorOf([&] { RunEvaluate(no_frames); });
+  EXPECT_NE(message.find("--frames"), std::string::npos) << message;
+  EXPECT_NE(message.find("0"), std::string::npos) << message;
+
+  for (const std::string text : {"0.6", "0.6,", "a,1.4", "0.6,1.4,2", "-1,1", "0.6;1.4"}) {
+    NoiseOptions noise;
+    message = InputErrorOf([&] { ParseGainRamp(text, &noise); });
+    EXPECT_NE(message.find("--gain-ramp"), std::string::npos) << text << ": " << message;
+    EXPECT_NE(message.find(text), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  NoiseOptions noise;
+  ParseGainRamp("0.6,1.4", &noise);
+  EXPECT_DOUBLE_EQ(noise.gain_start, 0.6);
+  EXPECT_DOUBLE_EQ(noise.gain_end, 1.4);
+}
+
+}  // namespace
+}  // namespace softsight
