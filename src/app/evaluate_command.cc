@@ -195,7 +195,8 @@ std::string Conditions(const EvaluateOptions& options) {
        << scene.size.height << ", " << scene.frame_count << " frames, markers of radius "
        << scene.marker_radius_px << " px; noise sigma " << noise.sigma << ", blur sigma "
        << noise.blur_sigma_px << " px, gain " << noise.gain_start << " -> " << noise.gain_end
-       << ", seeds " << scene.seed << "/" << noise.seed << (options.occluders.empty() ? "" : ", with occluders")
+       << ", seeds " << scene.seed << "/" << noise.seed
+       << (options.occluders.empty() ? "" : ", with occluders")
        << (options.centre_on_symmetry ? "; templates centred on symmetry" : "")
        << (options.round_mask ? "; round template masks" : "") << ".";
   return text.str();
@@ -224,8 +225,9 @@ void EvaluateOptions::Check() const {
 
 void ParseGainRamp(const std::string& text, NoiseOptions* noise) {
   const auto fail = [&text]() {
-    return InputError("--gain-ramp: expected START,END (two positive gains such as 0.6,1.4), got '" +
-                      text + "'");
+    return InputError(
+        "--gain-ramp: expected START,END (two positive gains such as 0.6,1.4), got '" + text +
+        "'");
   };
   const size_t comma = text.find(',');
   if (comma == std::string::npos) throw fail();
@@ -258,7 +260,8 @@ EvaluateReport RunEvaluate(const EvaluateOptions& options) {
 
   if (options.csv_file && !std::ofstream(*options.csv_file, std::ios::app)) {
     // Said before the work rather than after it.
-    throw InputError(*options.csv_file + ": cannot write the CSV (check the folder and permissions)");
+    throw InputError(*options.csv_file +
+                     ": cannot write the CSV (check the folder and permissions)");
   }
   SyntheticScene scene(options.scene, options.noise, RenderOptions{}, options.occluders);
   const int frames = scene.frame_count();

@@ -26,6 +26,7 @@ struct LiveArgs {
   std::string save_config;
   std::string record_prefix = "live";
   double window_s = 10.0;
+  std::optional<double> scale_distance_mm;
   bool no_pace = false;
   bool no_trackbars = false;
 };
@@ -59,6 +60,7 @@ int RunLive(const LiveArgs& args) {
   options.record_prefix = args.record_prefix;
   options.chart.window_s = args.window_s;
   options.record_fps = source->fps();
+  options.scale_distance_mm = args.scale_distance_mm;
   LiveController controller(config, options);
   std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
             << " markers; press h in the window for help\n";
@@ -85,7 +87,10 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "Mouse: drag a box over a marker to reselect it (template / search region); click a marker\n"
       "to pick its HSV ranges from the pixels around the click (keys 1..9 choose which marker).\n"
       "Trackbars adjust the active marker's ranges. Keys: h help, space pause, r record, s save\n"
-      "config, b reset the bending-distance reference, m switch method, q quit.\n"
+      "config, b reset the bending-distance reference, m switch method, c mm scale, q quit.\n"
+      "Scale: with --scale-distance-mm D, press c and click two points D mm apart (e.g. the ends\n"
+      "of a ruler in the actuator's plane); the mm values appear at once and `s` saves the points\n"
+      "as scale_from_points, so `softsight track` with the saved config gives the same mm.\n"
       "A recording writes <prefix>-NNN.csv, .avi (annotated), .raw.avi (lossless) and .yaml;\n"
       "`softsight track --config <prefix>-NNN.yaml --input <prefix>-NNN.raw.avi` reproduces it.\n"
       "Needs a display; without one use `softsight track`.\n"
@@ -105,6 +110,10 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--chart-seconds", args->window_s, "Time span of the strip chart, seconds")
       ->capture_default_str();
+  sub.add_option("--scale-distance-mm", args->scale_distance_mm,
+                 "Known distance between the two points clicked after `c` (mm), e.g. 50 for two "
+                 "ruler marks 50 mm apart; sets the mm scale live")
+      ->check(CLI::PositiveNumber);
   sub.add_flag("--no-pace", args->no_pace,
                "Read a video file as fast as it decodes instead of at its frame rate");
   sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");

@@ -65,6 +65,10 @@ bool MetricModel::Check(std::string* error) const {
              std::to_string(*scale_mm_per_px);
     return false;
   }
+  if (scale_points && !scale_mm_per_px) {
+    *error = "scale_points: given without the scale_mm_per_px they define";
+    return false;
+  }
   if (plane_mm_from_image) {
     const cv::Matx33d& h = *plane_mm_from_image;
     for (int i = 0; i < 9; ++i) {
@@ -124,6 +128,12 @@ Measurer::Measurer(MeasureOptions options) : options_(std::move(options)) {
 }
 
 void Measurer::reset_tip_reference() { tip_reference_px_ = options_.tip_reference_px; }
+
+void Measurer::set_metric(const MetricModel& metric) {
+  std::string error;
+  if (!metric.Check(&error)) throw InputError("metric model: " + error);
+  options_.metric = metric;
+}
 
 Measurement Measurer::measure(const std::vector<MarkerObservation>& markers) {
   Measurement out;

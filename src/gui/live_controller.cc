@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_writer.h"
 
@@ -17,6 +18,23 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr size_t kFpsWindow = 30;          // Frames averaged for the fps figure.
 constexpr double kLatencySmoothing = 0.2;  // Exponential smoothing of the shown latency.
 const cv::Scalar kDragColour(0, 255, 0);
+const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
+// Two clicks closer than this give no usable scale: each click is good to about 1 px, so the
+// scale would be off by several percent. A ruler across much of the image is best.
+constexpr double kMinScaleSpanPx = 20.0;
+
+std::string Number(double value, int precision) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.*f", precision, value);
+  return text;
+}
+
+// 50 -> "50", 12.5 -> "12.5": the distance as a person typed it.
+std::string Distance(double mm) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", mm);
+  return text;
+}
 
 std::string RangeText(const HsvRange& r) {
   return std::to_string(r.lo) + ".." + std::to_string(r.hi);
@@ -48,6 +66,11 @@ bool LiveOptions::Check(std::string* error) const {
   }
   if (record_fps && !(*record_fps > 0 && *record_fps <= 100000)) {
     *error = "record_fps must be in (0, 100000], got " + std::to_string(*record_fps);
+    return false;
+  }
+  if (scale_distance_mm && !(std::isfinite(*scale_distance_mm) && *scale_distance_mm > 0 &&
+                            *scale_distance_mm <= 1e6)) {
+    *error = "scale_distance_mm must be in (0, 1e6] mm, got " + std::to_string(*scale_distance_mm);
     return false;
   }
   if (record_prefix.empty()) {
@@ -295,6 +318,92 @@ void LiveController::save_config() {
   }
 }
 
+std::string LiveController::scale_hint() const {
+  const std::string d = Distance(*options_.scale_distance_mm);
+  return scale_clicks_.empty()
+             ? "scale: click point 1 of 2, " + d + " mm apart; Esc cancels"
+             : "scale: click point 2, " + d + " mm from point 1; Esc cancels";
+}
+
+void LiveController::start_scale() {
+  if (!options_.scale_distance_mm) {
+    say("scale: start live with --scale-distance-mm D, the true distance of the points to click");
+    return;
+  }
+  if (recording_) {
+    // The CSV's columns (with or without _mm) are fixed when a recording starts.
+    say("scale: stop the recording first (r)");
+    return;
+  }
+  scale_mode_ = true;
+  scale_clicks_.clear();
+  say(scale_hint());
+}
+
+void LiveController::cancel_scale() {
+  scale_mode_ = false;
+  scale_clicks_.clear();
+  pointer_.reset();
+  say("scale: cancelled, unchanged");
+}
+
+void LiveController::scale_point(const cv::Point2d& p) {
+  scale_clicks_.push_back(p);
+  if (scale_clicks_.size() < 2) {
+    say(scale_hint());
+    return;
+  }
+  // The scale is in the pixels the measurements use (undistorted with a camera model), and
+  // those are the points a saved config holds as scale_from_points.
+  const double distance_mm = *options_.scale_distance_mm;
+  const cv::Point2d a = session_->measurement_point(scale_clicks_[0]);
+  const cv::Point2d b = session_->measurement_point(scale_clicks_[1]);
+  const double span_px = cv::norm(a - b);
+  if (span_px < kMinScaleSpanPx) {
+    scale_clicks_.clear();
+    say("scale: the points are " + Number(span_px, 1) + " px apart, too close (at least " +
+        Number(kMinScaleSpanPx, 0) + "); click the first point again");
+    return;
+  }
+  MetricModel metric;
+  try {
+    metric.scale_mm_per_px = ScaleFromTwoPoints(a, b, distance_mm, "scale points");
+    metric.scale_points = MetricModel::ScalePoints{a, b, distance_mm};
+    session_->set_metric(metric);
+  } catch (const InputError& e) {
+    scale_clicks_.clear();
+    say(std::string(e.what()) + "; click the first point again");
+    return;
+  }
+  const bool replaced_plane = config_.measure.metric.plane_mm_from_image.has_value();
+  config_.measure.metric = metric;
+  scale_mode_ = false;
+  scale_clicks_.clear();
+  pointer_.reset();
+  // Measure the frame on screen again, so the mm values appear now, also while paused. The
+  // strip chart restarts in mm: its px history cannot share the new axis.
+  if (!frame_.empty()) {
+    record_frame(session_->process(
+        Frame{frame_, frame_index_, last_result_ ? last_result_->time_s : 0.0}));
+    chart_.clear();
+    chart_.add(*last_result_);
+  }
+  say("scale " + Number(*metric.scale_mm_per_px, 4) + " mm/px (" + Distance(distance_mm) +
+      " mm over " + Number(span_px, 1) + " px" +
+      (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
+}
+
+void LiveController::draw_scale_points(cv::Mat& top) const {
+  for (const cv::Point2d& p : scale_clicks_) {
+    cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS, 15,
+                   1, cv::LINE_AA);
+  }
+  if (scale_clicks_.size() == 1 && pointer_) {
+    cv::line(top, cv::Point(cvRound(scale_clicks_[0].x), cvRound(scale_clicks_[0].y)),
+             cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kScaleColour, 1, cv::LINE_AA);
+  }
+}
+
 void LiveController::toggle_recording() {
   if (recording_) {
     const int64_t frames = recording_->frames;
@@ -389,7 +498,8 @@ void LiveController::on_event(const UiEvent& event) {
       if (in_image) press_ = pointer_ = event.position_px;
       break;
     case Type::kMouseMove:
-      if (press_) {
+      // In scale mode the pointer is followed without a button too: the line to the first point.
+      if (press_ || scale_mode_) {
         pointer_ = event.position_px;
         dirty_ = true;
       }
@@ -401,6 +511,11 @@ void LiveController::on_event(const UiEvent& event) {
       pointer_.reset();
       dirty_ = true;
       const cv::Point2d end = event.position_px;
+      if (scale_mode_) {
+        // Where the button is released, so a person can press, aim and let go.
+        scale_point(in_image ? end : start);
+        break;
+      }
       if (std::hypot(end.x - start.x, end.y - start.y) <= options_.click_slop_px) {
         click(start);
       } else {
@@ -437,8 +552,16 @@ void LiveController::on_event(const UiEvent& event) {
         case 'm':
           switch_method();
           break;
-        case 'q':
+        case 'c':
+          start_scale();
+          break;
         case 27:
+          if (scale_mode_) {
+            cancel_scale();
+            break;
+          }
+          [[fallthrough]];
+        case 'q':
           if (recording_) toggle_recording();
           quit_ = true;
           break;
@@ -470,8 +593,13 @@ const cv::Mat& LiveController::canvas() {
   if (ended_) state += "END  ";
   state +=
       "active: " + config_.markers[active_].name + " (" + config_.markers[active_].method + ")";
+  if (const auto& scale = config_.measure.metric.scale_mm_per_px) {
+    state += "  " + Number(*scale, 4) + " mm/px";
+  }
   lines.push_back(state);
   if (!message_.empty()) lines.push_back(message_);
+  // The hint stays while picking, whatever other keys say meanwhile.
+  if (scale_mode_ && message_ != scale_hint()) lines.push_back(scale_hint());
   int y = image_size.height - 10 - 22 * static_cast<int>(lines.size() - 1);
   for (const std::string& text : lines) {
     cv::putText(top, text, {8, y}, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
@@ -481,7 +609,9 @@ const cv::Mat& LiveController::canvas() {
         1, cv::LINE_AA);
     y += 22;
   }
-  if (press_ && pointer_) {
+  if (scale_mode_) {
+    draw_scale_points(top);
+  } else if (press_ && pointer_) {
     cv::rectangle(top, cv::Point(cvRound(press_->x), cvRound(press_->y)),
                   cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kDragColour, 1);
   }

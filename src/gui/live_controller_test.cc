@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "softsight/core/error.h"
@@ -310,9 +311,161 @@ TEST_F(LiveControllerTest, RecordingIsReproducedByTrackingTheRawVideoWithItsConf
   EXPECT_EQ(live.last_recording(), (dir_ / "rec-002").string());
 }
 
+// Scale mode takes the point where the button is released; press and release at one spot.
+void ScaleClick(LiveController& live, cv::Point2d p) {
+  live.on_event(UiEvent::Mouse(Type::kMouseDown, p.x, p.y));
+  live.on_event(UiEvent::Mouse(Type::kMouseUp, p.x, p.y));
+}
+
+TEST_F(LiveControllerTest, TwoClickedPointsSetTheMillimetreScaleThatSavingAndRecordingKeep) {
+  LiveOptions options = Options();
+  options.scale_distance_mm = 50;
+  LiveController live(SceneConfig(), options);
+  for (int i = 0; i < 3; ++i) Feed(live, i);
+  EXPECT_FALSE(live.last_result()->measurement.chord_mm.has_value());
+
+  live.on_event(UiEvent::Key('c'));
+  EXPECT_TRUE(live.scale_mode());
+  EXPECT_NE(live.message().find("click point 1 of 2, 50 mm apart"), std::string::npos)
+      << live.message();
+  ScaleClick(live, {100, 120});
+  EXPECT_NE(live.message().find("click point 2, 50 mm from point 1"), std::string::npos) << live.message();
+  // While picking, a cyan line follows the pointer from the first point.
+  live.on_event(UiEvent::Mouse(Type::kMouseMove, 200, 120));
+  const cv::Vec3b on_line = live.canvas().at<cv::Vec3b>(120, 150);
+  EXPECT_TRUE(on_line[0] > 200 && on_line[1] > 200 && on_line[2] < 80) << on_line;
+  ScaleClick(live, {200, 120});  // 100 px from the first: 0.5 mm/px.
+  EXPECT_FALSE(live.scale_mode());
+  EXPECT_NE(live.message().find("scale 0.5000 mm/px"), std::string::npos) << live.message();
+  EXPECT_EQ(live.config().measure.metric.scale_mm_per_px, 0.5);
+
+  // Applied at once (the frame on screen is measured again) and to every following frame.
+  ASSERT_TRUE(live.last_result()->measurement.chord_mm.has_value());
+  EXPECT_EQ(live.last_result()->frame_index, 2);
+  for (int i = 3; i < 5; ++i) {
+    Feed(live, i);
+    const Measurement& m = live.last_result()->measurement;
+    ASSERT_TRUE(m.chord_px && m.chord_mm && m.arc_length_mm);
+    EXPECT_DOUBLE_EQ(*m.chord_mm, 0.5 * *m.chord_px);
+    EXPECT_DOUBLE_EQ(*m.arc_length_mm, 0.5 * *m.arc_length_px);
+  }
+  const double live_chord_mm = *live.last_result()->measurement.chord_mm;
+
+  // `s` writes the points; the saved config loads to the same scale, and a batch session with
+  // it measures the same millimetres.
+  live.on_event(UiEvent::Key('s'));
+  const std::string saved_path = (dir_ / "saved.yaml").string();
+  const TrackingConfig saved = LoadTrackingConfig(saved_path);
+  ASSERT_TRUE(saved.measure.metric.scale_points.has_value());
+  EXPECT_EQ(saved.measure.metric.scale_points->a_px, cv::Point2d(100, 120));
+  EXPECT_EQ(saved.measure.metric.scale_points->b_px, cv::Point2d(200, 120));
+  EXPECT_EQ(saved.measure.metric.scale_mm_per_px, 0.5);
+  TrackingSession batch(saved);
+  for (int i = 0; i < 5; ++i) {
+    Frame frame;
+    scene_->render(i, frame.image);
+    frame.index = i;
+    const FrameResult& result = batch.process(frame);
+    if (i == 4) {
+      ASSERT_TRUE(result.measurement.chord_mm.has_value());
+      EXPECT_NEAR(*result.measurement.chord_mm, live_chord_mm, 1e-9);
+    }
+  }
+
+  // A recording started afterwards has the _mm columns.
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  // Changing the scale mid-recording would change the CSV's meaning: refused.
+  live.on_event(UiEvent::Key('c'));
+  EXPECT_FALSE(live.scale_mode());
+  EXPECT_NE(live.message().find("stop the recording first"), std::string::npos);
+  Feed(live, 5);
+  live.on_event(UiEvent::Key('r'));
+  const CsvTable table = ReadCsvTable(live.last_recording() + ".csv");
+  ASSERT_EQ(table.row_count(), 2u);
+  ASSERT_TRUE(table.find("chord_mm"));
+  for (size_t row = 0; row < 2; ++row) {
+    EXPECT_NEAR(*table.values[*table.find("chord_mm")][row],
+                0.5 * *table.values[*table.find("chord_px")][row], 1e-3);
+  }
+}
+
+TEST_F(LiveControllerTest, ScaleModeEscCancelsTooCloseRetriesAndNoDistanceOnlyHints) {
+  {
+    LiveController live(SceneConfig(), Options());  // No --scale-distance-mm.
+    Feed(live, 0);
+    live.on_event(UiEvent::Key('c'));
+    EXPECT_FALSE(live.scale_mode());
+    EXPECT_NE(live.message().find("--scale-distance-mm"), std::string::npos) << live.message();
+    Click(live, {5, 5});  // An ordinary click: a colour pick on the background, refused.
+    EXPECT_NE(live.message().find("not a coloured marker"), std::string::npos) << live.message();
+    Feed(live, 1);
+    EXPECT_TRUE(live.config().measure.metric.empty());
+    EXPECT_FALSE(live.last_result()->measurement.chord_mm.has_value());
+  }
+  LiveOptions options = Options();
+  options.scale_distance_mm = 50;
+  LiveController live(SceneConfig(), options);
+  Feed(live, 0);
+  live.on_event(UiEvent::Key('c'));
+  ScaleClick(live, {100, 100});
+  ScaleClick(live, {105, 100});  // 5 px: no usable scale; pick again.
+  EXPECT_TRUE(live.scale_mode());
+  EXPECT_NE(live.message().find("too close"), std::string::npos) << live.message();
+  EXPECT_TRUE(live.config().measure.metric.empty());
+  ScaleClick(live, {100, 100});
+  live.on_event(UiEvent::Key(27));  // Esc cancels scale mode; it does not quit.
+  EXPECT_FALSE(live.scale_mode());
+  EXPECT_FALSE(live.quit_requested());
+  EXPECT_NE(live.message().find("cancelled"), std::string::npos) << live.message();
+  Click(live, {5, 5});  // Back to normal clicks: a colour pick on the background, refused.
+  EXPECT_NE(live.message().find("not a coloured marker"), std::string::npos) << live.message();
+  Feed(live, 1);
+  EXPECT_TRUE(live.config().measure.metric.empty());
+  EXPECT_FALSE(live.last_result()->measurement.chord_mm.has_value());
+  live.on_event(UiEvent::Key(27));
+  EXPECT_TRUE(live.quit_requested());
+}
+
+TEST_F(LiveControllerTest, ClickedScaleIsInUndistortedPixelsWithACameraModel) {
+  TrackingConfig config = SceneConfig();
+  CameraIntrinsics camera;
+  camera.image_size = {320, 240};
+  camera.camera_matrix = cv::Matx33d(300, 0, 160, 0, 300, 120, 0, 0, 1);
+  camera.distortion = {-0.3, 0.1, 0, 0, 0};
+  config.camera = camera;
+  LiveOptions options = Options();
+  options.scale_distance_mm = 50;
+  LiveController live(config, options);
+  Feed(live, 0);
+  live.on_event(UiEvent::Key('c'));
+  const std::vector<cv::Point2d> raw = {{20, 20}, {300, 20}};
+  ScaleClick(live, raw[0]);
+  ScaleClick(live, raw[1]);
+  const MetricModel& metric = live.config().measure.metric;
+  ASSERT_TRUE(metric.scale_points && metric.scale_mm_per_px) << live.message();
+  // The stored points are the undistorted clicks: the lens maps them back onto the clicks.
+  const std::vector<cv::Point2d> stored = {metric.scale_points->a_px, metric.scale_points->b_px};
+  for (size_t i = 0; i < 2; ++i) {
+    const std::vector<cv::Point3d> ray = {
+        {(stored[i].x - 160) / 300, (stored[i].y - 120) / 300, 1.0}};
+    std::vector<cv::Point2d> projected;
+    cv::projectPoints(ray, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix,
+                      camera.distortion, projected);
+    EXPECT_NEAR(projected[0].x, raw[i].x, 1e-3);
+    EXPECT_NEAR(projected[0].y, raw[i].y, 1e-3);
+  }
+  const double span_px = cv::norm(stored[0] - stored[1]);
+  EXPECT_GT(std::abs(span_px - 280.0), 5.0) << "this lens must change the corner distance";
+  EXPECT_DOUBLE_EQ(*metric.scale_mm_per_px, 50.0 / span_px);
+}
+
 TEST_F(LiveControllerTest, BadOptionsOrConfigAreInputErrors) {
   LiveOptions options = Options();
   options.select_box_px = 1;
+  EXPECT_THROW(LiveController(SceneConfig(), options), InputError);
+  options = Options();
+  options.scale_distance_mm = 0.0;
   EXPECT_THROW(LiveController(SceneConfig(), options), InputError);
   TrackingConfig empty;
   EXPECT_THROW(LiveController(empty, Options()), InputError);

@@ -58,9 +58,11 @@ void ReadMetricModel(YamlMap& top, MetricModel* metric) {
     if (!b) points.fail("b", "missing: the second point [x, y] in image pixels");
     if (!distance) points.fail("distance_mm", "missing: the true distance between a and b");
     points.finish();
+    const MetricModel::ScalePoints given_points{{(*a)[0], (*a)[1]}, {(*b)[0], (*b)[1]}, *distance};
     try {
-      metric->scale_mm_per_px = ScaleFromTwoPoints({(*a)[0], (*a)[1]}, {(*b)[0], (*b)[1]},
-                                                   *distance, "two points");
+      metric->scale_mm_per_px = ScaleFromTwoPoints(given_points.a_px, given_points.b_px,
+                                                   given_points.distance_mm, "two points");
+      metric->scale_points = given_points;
     } catch (const InputError& e) {
       points.fail("a", e.what());
     }
@@ -71,7 +73,18 @@ void ReadMetricModel(YamlMap& top, MetricModel* metric) {
 }
 
 void WriteMetricModel(const MetricModel& metric, YAML::Emitter& out) {
-  if (metric.scale_mm_per_px) {
+  if (metric.scale_points) {
+    // The points, not the number: reading them back recomputes the identical scale, and the
+    // file says how it was measured.
+    const MetricModel::ScalePoints& p = *metric.scale_points;
+    out << YAML::Key << "scale_from_points" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "a" << YAML::Value << YAML::Flow << YAML::BeginSeq << p.a_px.x << p.a_px.y
+        << YAML::EndSeq;
+    out << YAML::Key << "b" << YAML::Value << YAML::Flow << YAML::BeginSeq << p.b_px.x << p.b_px.y
+        << YAML::EndSeq;
+    out << YAML::Key << "distance_mm" << YAML::Value << p.distance_mm;
+    out << YAML::EndMap;
+  } else if (metric.scale_mm_per_px) {
     out << YAML::Key << "scale_mm_per_px" << YAML::Value << *metric.scale_mm_per_px;
   }
   if (metric.plane_mm_from_image) {

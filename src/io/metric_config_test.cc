@@ -73,6 +73,9 @@ TEST(MetricConfigTest, ScaleFromTwoPoints) {
   const MetricModel m = Read("scale_from_points: {a: [10, 10], b: [310, 410], distance_mm: 100}\n");
   ASSERT_TRUE(m.scale_mm_per_px.has_value());
   EXPECT_DOUBLE_EQ(*m.scale_mm_per_px, 0.2);
+  ASSERT_TRUE(m.scale_points.has_value());  // Remembered, so a saved config writes the points.
+  EXPECT_EQ(m.scale_points->b_px, cv::Point2d(310, 410));
+  EXPECT_EQ(m.scale_points->distance_mm, 100.0);
   EXPECT_THAT(ErrorOf("scale_from_points: {a: [10, 10], b: [10, 10], distance_mm: 100}\n"),
               HasSubstr("scale_from_points.a"));
   EXPECT_THAT(ErrorOf("scale_from_points: {a: [10, 10], distance_mm: 100}\n"),
@@ -89,6 +92,25 @@ TEST(MetricConfigTest, BadValuesAndConflictsAreErrors) {
   EXPECT_THAT(ErrorOf("plane_mm_from_image: [1, 2, 3, 2, 4, 6, 0, 0, 1]\n"),
               HasSubstr("singular"));
   EXPECT_THAT(ErrorOf("plane_mm_from_image: [1, 2, 3]\n"), HasSubstr("list of 9 numbers"));
+}
+
+TEST(MetricConfigTest, ScalePointsAreWrittenAsPointsAndReadBackToTheSameScale) {
+  MetricModel original;
+  original.scale_points = MetricModel::ScalePoints{{101.25, 40.0 / 3}, {250.5, 77.125}, 50};
+  original.scale_mm_per_px = ScaleFromTwoPoints(original.scale_points->a_px,
+                                                original.scale_points->b_px, 50);
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  WriteMetricModel(original, out);
+  out << YAML::EndMap;
+  const std::string yaml = out.c_str();
+  EXPECT_THAT(yaml, HasSubstr("scale_from_points"));
+  EXPECT_THAT(yaml, ::testing::Not(HasSubstr("scale_mm_per_px")));
+  const MetricModel again = Read(yaml + "\n");
+  EXPECT_EQ(again.scale_mm_per_px, original.scale_mm_per_px);
+  ASSERT_TRUE(again.scale_points.has_value());
+  EXPECT_EQ(again.scale_points->a_px, original.scale_points->a_px);
+  EXPECT_EQ(again.scale_points->b_px, original.scale_points->b_px);
 }
 
 TEST(MetricConfigTest, WrittenModelReadsBackExactly) {

@@ -10,6 +10,7 @@
 //         rect: [205, 186, 25, 25] # x, y, width, height in pixels (what the mouse drags)
 //         # file: blue.png         # ... or a template image, relative to this config file
 //         colour: false            # match BGR, not gray (3x the work; tells the discs apart)
+//         contrast_gray: true      # gray: match BGR projected on the template's colour axis
 //         round: false             # match only the ellipse inscribed in the rectangle
 //         centre_on_symmetry: false  # report the template's centre of symmetry (disc centre)
 //         min_zncc: 0.8            # below: not found (all methods; SAD/SSD: shape check)
@@ -57,6 +58,7 @@ void ReadTemplateParams(YamlMap& marker, TemplateParams* params) {
     params->image_file = *file;
   }
   if (const auto colour = t.boolean("colour")) params->colour = *colour;
+  if (const auto v = t.boolean("contrast_gray")) params->contrast_gray = *v;
   if (const auto round = t.boolean("round")) params->round_mask = *round;
   if (const auto v = t.boolean("centre_on_symmetry")) params->centre_on_symmetry = *v;
   if (const auto v = t.number("min_zncc", -1.0, 1.0)) params->min_zncc = *v;
@@ -75,6 +77,7 @@ void WriteTemplateParams(const TemplateParams& params, YAML::Emitter& out) {
   const bool any = params.rect || !params.image_file.empty() ||
                    params.template_frame != defaults.template_frame ||
                    params.colour != defaults.colour || params.round_mask != defaults.round_mask ||
+                   params.contrast_gray != defaults.contrast_gray ||
                    params.centre_on_symmetry != defaults.centre_on_symmetry ||
                    params.min_zncc != defaults.min_zncc || params.max_sad != defaults.max_sad ||
                    params.max_ssd != defaults.max_ssd ||
@@ -93,6 +96,7 @@ void WriteTemplateParams(const TemplateParams& params, YAML::Emitter& out) {
     out << YAML::Key << "file" << YAML::Value << params.image_file;
   }
   out << YAML::Key << "colour" << YAML::Value << params.colour;
+  out << YAML::Key << "contrast_gray" << YAML::Value << params.contrast_gray;
   out << YAML::Key << "round" << YAML::Value << params.round_mask;
   out << YAML::Key << "centre_on_symmetry" << YAML::Value << params.centre_on_symmetry;
   out << YAML::Key << "min_zncc" << YAML::Value << params.min_zncc;

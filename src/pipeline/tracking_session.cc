@@ -2,6 +2,7 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include "pipeline/coincident_markers.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -16,6 +17,7 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
   for (const MarkerSpec& spec : config_.markers) {
     trackers_.push_back(CreateTracker(spec));
     initialised_.push_back(false);
+    previous_px_.emplace_back();
     result_.markers.push_back({spec.name, {}});
   }
   if (config_.camera) {
@@ -48,6 +50,15 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     // still ahead) has nothing to look for: its marker is not found.
     result_.markers[i].observation =
         initialised_[i] ? trackers_[i]->update(frame.image) : Observation{};
+  }
+  // Two markers cannot be at one place: a report that jumped onto another marker (a look-alike
+  // re-acquired while its own marker is covered) is dropped, and its tracker searches afresh.
+  for (size_t i : FindCoincidentMarkers(result_.markers, previous_px_)) {
+    result_.markers[i].observation = Observation{};
+    trackers_[i]->reset();
+  }
+  for (size_t i = 0; i < result_.markers.size(); ++i) {
+    previous_px_[i] = result_.markers[i].observation.position_px;
   }
   if (undistorter_) {
     if (frame.image.size() != undistorter_->camera().image_size) {
@@ -103,5 +114,14 @@ void TrackingSession::respec(const MarkerSpec& spec) {
 }
 
 void TrackingSession::reset_tip_reference() { measurer_.reset_tip_reference(); }
+
+void TrackingSession::set_metric(const MetricModel& metric) {
+  measurer_.set_metric(metric);  // Checks first: throws before anything changes.
+  config_.measure.metric = metric;
+}
+
+cv::Point2d TrackingSession::measurement_point(const cv::Point2d& image_px) const {
+  return undistorter_ ? undistorter_->undistort_point(image_px) : image_px;
+}
 
 }  // namespace softsight

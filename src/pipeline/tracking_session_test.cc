@@ -130,5 +130,61 @@ TEST(TrackingSession, CameraModelMeasuresUndistortedPositionsButReportsRecordedO
   EXPECT_THROW(corrected.process(Frame{small, 1, 0.1}), InputError);
 }
 
+TEST(TrackingSession, SetMetricAppliesToTheNextFrameAndKeepsTheBendingReference) {
+  const Clip clip = Render(4);
+  TrackingSession plain(SceneConfig());
+  TrackingSession session(SceneConfig());
+  for (int i = 0; i < 2; ++i) {
+    plain.process(clip.frames[i]);
+    EXPECT_FALSE(session.process(clip.frames[i]).measurement.chord_mm.has_value());
+  }
+  MetricModel metric;
+  metric.scale_mm_per_px = 0.25;
+  session.set_metric(metric);
+  EXPECT_EQ(session.config().measure.metric.scale_mm_per_px, 0.25);
+  for (int i = 2; i < 4; ++i) {
+    const FrameResult expected = plain.process(clip.frames[i]);
+    const Measurement& m = session.process(clip.frames[i]).measurement;
+    ASSERT_TRUE(m.chord_mm && m.arc_length_mm && m.tip_disp_mm);
+    EXPECT_DOUBLE_EQ(*m.chord_mm, 0.25 * *m.chord_px);
+    EXPECT_DOUBLE_EQ(*m.arc_length_mm, 0.25 * *m.arc_length_px);
+    // The reference is still frame 0's tip: the displacement continues, it does not restart.
+    EXPECT_EQ(m.tip_disp_px, expected.measurement.tip_disp_px);
+    EXPECT_GT(*m.tip_disp_px, 1.0);
+    EXPECT_DOUBLE_EQ(*m.tip_disp_mm, 0.25 * *m.tip_disp_px);
+  }
+
+  // An invalid model is refused and the old one stays.
+  MetricModel bad;
+  bad.scale_mm_per_px = 0.0;
+  EXPECT_THROW(session.set_metric(bad), InputError);
+  bad.scale_mm_per_px.reset();
+  bad.scale_points = MetricModel::ScalePoints{{0, 0}, {10, 0}, 5};
+  EXPECT_THROW(session.set_metric(bad), InputError);
+  EXPECT_EQ(session.config().measure.metric.scale_mm_per_px, 0.25);
+  EXPECT_DOUBLE_EQ(*session.process(clip.frames[3]).measurement.chord_mm,
+                   0.25 * *session.process(clip.frames[3]).measurement.chord_px);
+}
+
+TEST(TrackingSession, MeasurementPointIsTheUndistortedPointWithACameraModel) {
+  TrackingConfig config = SceneConfig();
+  EXPECT_EQ(TrackingSession(config).measurement_point({12.5, 300.25}), cv::Point2d(12.5, 300.25));
+  CameraIntrinsics camera;
+  camera.image_size = {640, 480};
+  camera.camera_matrix = cv::Matx33d(500, 0, 320, 0, 500, 240, 0, 0, 1);
+  camera.distortion = {-0.3, 0.1, 0, 0, 0};
+  config.camera = camera;
+  const cv::Point2d raw(40, 60);
+  const cv::Point2d p = TrackingSession(config).measurement_point(raw);
+  EXPECT_GT(cv::norm(p - raw), 1.0);  // This lens moves corner points visibly.
+  // Truth: the lens maps the undistorted point back onto the recorded one.
+  const std::vector<cv::Point3d> ray = {{(p.x - 320) / 500, (p.y - 240) / 500, 1.0}};
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(ray, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix,
+                    camera.distortion, projected);
+  EXPECT_NEAR(projected[0].x, raw.x, 1e-3);
+  EXPECT_NEAR(projected[0].y, raw.y, 1e-3);
+}
+
 }  // namespace
 }  // namespace softsight

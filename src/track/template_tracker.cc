@@ -158,6 +158,7 @@ class TemplateTracker final : public Tracker {
   std::vector<cv::Mat> levels_;
   std::vector<cv::Point> candidates_;
   cv::Mat level_sim_, mask_;  // mask_: the level-0 round mask (or empty).
+  cv::Mat projection_;        // Gray only: 1x4 BGR weights + offset, or empty for plain luma.
   PreparedTemplate updated_;
   ZnccScratch zncc_;
 };
@@ -165,9 +166,33 @@ class TemplateTracker final : public Tracker {
 void TemplateTracker::ToNative(const cv::Mat& bgr, cv::Mat& out) const {
   if (params_.colour) {
     out = bgr;  // A header only: the kernels read strided regions.
+  } else if (!projection_.empty()) {
+    cv::transform(bgr, out, projection_);
   } else {
     cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
   }
+}
+
+// The single channel that shows the template best: BGR projected on the template's principal
+// colour axis (the direction of largest colour variance, i.e. marker against band), with weights
+// of L1 norm 1 and an offset that keeps every value in 0..255. On a gray template (B = G = R, a
+// mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
+cv::Mat ContrastProjection(const cv::Mat& bgr) {
+  const cv::Mat samples = bgr.clone().reshape(1, static_cast<int>(bgr.total()));
+  cv::Mat covariance, mean;
+  cv::calcCovarMatrix(samples, covariance, mean,
+                      cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE, CV_64F);
+  cv::Mat values, vectors;
+  cv::eigen(covariance, values, vectors);
+  cv::Vec3d axis(vectors.at<double>(0, 0), vectors.at<double>(0, 1), vectors.at<double>(0, 2));
+  const double l1 = std::abs(axis[0]) + std::abs(axis[1]) + std::abs(axis[2]);
+  if (!(l1 > 0)) return {};
+  if (axis[0] + axis[1] + axis[2] < 0) axis = -axis;  // Mostly positive: light stays light.
+  axis /= l1;
+  double offset = 0;
+  for (int c = 0; c < 3; ++c) offset -= 255.0 * std::min(0.0, axis[c]);
+  cv::Mat m = (cv::Mat_<float>(1, 4) << axis[0], axis[1], axis[2], offset);
+  return m;
 }
 
 // The ellipse inscribed in the template (pixel centres within it count), or none.
@@ -228,9 +253,17 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
                        std::to_string(frame_bgr.cols) + "x" + std::to_string(frame_bgr.rows) +
                        " frame");
     }
+    const cv::Mat previous = projection_;  // Kept if the new selection is refused.
+    projection_.release();
+    if (!params_.colour && params_.contrast_gray) projection_ = ContrastProjection(frame_bgr(hint));
     cv::Mat native;
     ToNative(frame_bgr(hint), native);
-    SetTemplate(native.clone(), "template rect " + RectText(hint));
+    try {
+      SetTemplate(native.clone(), "template rect " + RectText(hint));
+    } catch (const InputError&) {
+      projection_ = previous;
+      throw;
+    }
     last_px_ = cv::Point2d(hint.x, hint.y) + anchor_px_;
   } else {
     const std::string where =
@@ -241,15 +274,24 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
           "marker on a frame)");
     }
     cv::Mat native;
+    const cv::Mat previous = projection_;  // Kept if the image is refused.
+    projection_.release();
     if (params_.image.type() == CV_8UC3) {
+      if (!params_.colour && params_.contrast_gray) projection_ = ContrastProjection(params_.image);
       ToNative(params_.image, native);
     } else if (params_.image.type() == CV_8UC1 && !params_.colour) {
       native = params_.image;
     } else {
+      projection_ = previous;
       throw InputError(where + ": template image must be 8-bit BGR" +
                        std::string(params_.colour ? " for colour matching" : " or gray"));
     }
-    SetTemplate(native.clone(), where);
+    try {
+      SetTemplate(native.clone(), where);
+    } catch (const InputError&) {
+      projection_ = previous;
+      throw;
+    }
     last_px_.reset();  // Position unknown: the first update searches the whole frame.
   }
   tracking_ = false;

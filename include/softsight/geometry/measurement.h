@@ -17,12 +17,21 @@ namespace softsight {
 // plane) or a homography from undistorted image pixels to plane millimetres (chessboard in the
 // actuator's plane); the latter maps the points first and measures in the plane.
 struct MetricModel {
+  // Two (undistorted) image points a known distance apart, e.g. the ends of a ruler clicked live.
+  struct ScalePoints {
+    cv::Point2d a_px, b_px;
+    double distance_mm = 0.0;
+  };
+
   std::optional<double> scale_mm_per_px;
   std::optional<cv::Matx33d> plane_mm_from_image;
+  // Where scale_mm_per_px came from, when it was measured between two points: kept so that a
+  // saved config states the points (`scale_from_points`), not only the number they gave.
+  std::optional<ScalePoints> scale_points;
 
   bool empty() const { return !scale_mm_per_px && !plane_mm_from_image; }
-  // At most one of the two; the scale finite and > 0; the homography finite and invertible.
-  // On failure names the bad field in `error`.
+  // At most one of the two; the scale finite and > 0; the homography finite and invertible;
+  // scale_points only beside a scale. On failure names the bad field in `error`.
   bool Check(std::string* error) const;
 };
 
@@ -56,6 +65,10 @@ class Measurer {
   Measurement measure(const std::vector<MarkerObservation>& markers);
   // Next frame where the tip is found becomes the reference (or the configured point again).
   void reset_tip_reference();
+  // A new metric model (e.g. a scale clicked live). The tip reference is kept: it is an image
+  // point, independent of the model, so the bending distance does not restart. Throws
+  // InputError (and changes nothing) when metric.Check fails.
+  void set_metric(const MetricModel& metric);
   const MeasureOptions& options() const { return options_; }
 
  private:

@@ -49,13 +49,14 @@ struct LiveKey {
   const char* what;
 };
 // The keys, as the on-screen help (`h`) lists them.
-inline constexpr std::array<LiveKey, 9> kLiveKeys = {{
+inline constexpr std::array<LiveKey, 10> kLiveKeys = {{
     {'h', "show / hide this help"},
     {' ', "pause / resume"},
     {'r', "start / stop recording (CSV, annotated + raw video, config)"},
     {'s', "save the config"},
     {'b', "reset the bending-distance reference"},
     {'m', "switch method (colour, sad, ssd, zncc)"},
+    {'c', "mm scale: click two points --scale-distance-mm apart (Esc cancels)"},
     {'1', "1..9: choose the active marker (trackbars, clicks)"},
     {'q', "quit (also Esc)"},
     {0, "mouse: drag a box over a marker to reselect it, click it to pick its colour"},
@@ -76,6 +77,9 @@ struct LiveOptions {
   std::optional<double> record_fps;
   // A press and release closer than this is a click (colour pick), farther a drag (reselect), px.
   int click_slop_px = 4;
+  // The true distance between the two points clicked in scale mode (`c`), e.g. the ends of a
+  // ruler lying in the actuator's plane, mm. Absent (default): `c` only says how to set it.
+  std::optional<double> scale_distance_mm;
   StripChartOptions chart;
   HsvPickOptions picker;
   OverlayOptions overlay;  // base/middle/tip filled from the config by the controller.
@@ -102,6 +106,8 @@ class LiveController {
   bool paused() const { return paused_; }
   bool recording() const { return recording_ != nullptr; }
   bool help_shown() const { return help_; }
+  // Scale mode (`c`): the next left clicks are the two scale points.
+  bool scale_mode() const { return scale_mode_; }
   int active_marker() const { return active_; }
   // The config as edited live (what `s` saves).
   const TrackingConfig& config() const { return config_; }
@@ -125,6 +131,11 @@ class LiveController {
   void set_hsv(int trackbar, int value);
   void toggle_recording();
   void save_config();
+  void start_scale();
+  void cancel_scale();
+  void scale_point(const cv::Point2d& p);
+  std::string scale_hint() const;
+  void draw_scale_points(cv::Mat& top) const;
   void select_marker(int index);
   std::optional<int> marker_at(const cv::Point2d& p, double max_distance) const;
   std::optional<cv::Point2d> position_of(int marker) const;
@@ -152,6 +163,8 @@ class LiveController {
   int active_ = 0;
   int hsv_revision_ = 0;
   std::optional<cv::Point2d> press_, pointer_;
+  bool scale_mode_ = false;
+  std::vector<cv::Point2d> scale_clicks_;  // Scale mode: the points so far, image pixels.
   std::string message_;
   std::unique_ptr<Recording> recording_;
   std::string last_recording_;

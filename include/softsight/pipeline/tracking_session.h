@@ -36,6 +36,14 @@ class TrackingSession {
   // Replace a marker's spec (new HSV ranges or method) and rebuild its tracker.
   void respec(const MarkerSpec& spec);
   void reset_tip_reference();
+  // Live calibration: a new metric model (e.g. a scale from two clicked points) for the next
+  // measurements and in config(). The bending-distance reference is kept (it is an image point,
+  // whatever the model), so tip_disp_px continues and tip_disp_mm is that distance in the new
+  // model. Throws InputError and changes nothing when the model is invalid.
+  void set_metric(const MetricModel& metric);
+  // The pixels measurements use for a point of the recorded image: undistorted with the
+  // config's camera model, else the point itself (e.g. clicks to become scale_from_points).
+  cv::Point2d measurement_point(const cv::Point2d& image_px) const;
 
   const TrackingConfig& config() const { return config_; }
 
@@ -43,6 +51,7 @@ class TrackingSession {
   TrackingConfig config_;
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;
+  std::vector<std::optional<cv::Point2d>> previous_px_;  // Last frame's positions.
   Measurer measurer_;
   std::optional<Undistorter> undistorter_;     // Present when the config names a camera file.
   std::vector<MarkerObservation> undistorted_; // Reused: what the measurer sees with a lens model.

@@ -20,9 +20,10 @@
 //   ssd:  sqrt(SSD / (N * C)), the RMS difference per pixel and channel, in grey levels.
 // (N = template pixels, C = channels.) SAD and SSD scores are thus in the same unit.
 //
-// Gray or colour: in gray the red, green and blue discs are all dark discs on a light band, and
-// ZNCC (which cancels gain and offset) cannot tell them apart; a whole-frame search may find
-// another marker. Acquisition therefore looks around the last known position (acquire_radius_px),
+// Gray or colour: gray matches one channel, by default the template's best-contrast projection
+// of BGR (contrast_gray), else luma. In gray the red, green and blue discs are all dark discs on
+// a light band, and ZNCC (which cancels gain and offset) cannot tell them apart; a whole-frame
+// search may find another marker. Acquisition therefore looks around the last known position (acquire_radius_px),
 // and colour matching is the choice when markers must be told apart on the whole frame.
 #pragma once
 
@@ -65,6 +66,21 @@ struct TemplateParams {
   // (a disc) the centre of symmetry is its centroid. Off by default (the documented contract is
   // the rectangle's centre).
   bool centre_on_symmetry = false;
+  // Gray mode only: the single channel matched is not luma but BGR projected on the template's
+  // principal colour axis (largest colour variance in the template: the marker against what is
+  // around it), weights of L1 norm 1 plus an offset, so values stay 0..255 grey levels and SAD/SSD
+  // thresholds keep their meaning. Why: in luma a green disc (gray 142) is only ~50 levels below
+  // the pale band around it, so the band's own structure right at the disc's rim (highlight, ribs,
+  // background through the silicone) shifts where the rim appears, and that shift turns with the
+  // body: measured on the rendered bending scene (25 px templates, 100 frames) luma gives
+  // 0.18-0.19 px RMS and 6 misses, the projection 0.084-0.090 px and none (colour: 0.087-0.090).
+  // Matching costs the same (one channel); converting the window with cv::transform instead of
+  // cvtColor adds ~2 us per window (benchmark: +4-8 us per frame for 3 markers). Gain and offset
+  // still cancel in ZNCC (the projection is linear). With a mono camera (B = G = R) it is the
+  // channel mean, i.e. luma. The weights are fixed when the template is selected: light whose
+  // colour changes a lot afterwards lowers the contrast they were chosen for. Default true;
+  // false: plain luma (the paper's gray).
+  bool contrast_gray = true;
 
   // ---- Loss detection: a best match worse than these is "not found" ----------------------------
   // Default 0.8: the paper's "realistic match". Higher rejects more partly covered markers and
