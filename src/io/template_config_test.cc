@@ -44,6 +44,7 @@ TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
       pyramid_levels: 2
       update_rate: 0.05
       drift_min_zncc: 0.85
+      contrast_gray: false
 )");
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
   ASSERT_EQ(config.markers.size(), 1u);
@@ -67,6 +68,7 @@ TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
     EXPECT_EQ(t.pyramid_levels, 2);
     EXPECT_DOUBLE_EQ(t.update_rate, 0.05);
     EXPECT_DOUBLE_EQ(t.drift_min_zncc, 0.85);
+    EXPECT_FALSE(t.contrast_gray);
   }
 }
 

@@ -23,8 +23,9 @@
 // Gray or colour: gray matches one channel, by default the template's best-contrast projection
 // of BGR (contrast_gray), else luma. In gray the red, green and blue discs are all dark discs on
 // a light band, and ZNCC (which cancels gain and offset) cannot tell them apart; a whole-frame
-// search may find another marker. Acquisition therefore looks around the last known position (acquire_radius_px),
-// and colour matching is the choice when markers must be told apart on the whole frame.
+// search may find another marker. Acquisition therefore looks around the last known position
+// (acquire_radius_px), and colour matching is the choice when markers must be told apart on the
+// whole frame.
 #pragma once
 
 #include <memory>
