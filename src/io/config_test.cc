@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
+#include "io/config_test_util.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -23,18 +24,6 @@ const char* kValid = R"(markers:
 triple: [red, blue, green]
 scale_mm_per_px: 0.2
 )";
-
-// Loads `text` as a config file and returns the error message (empty when it loads).
-std::string ErrorOf(const std::string& text) {
-  TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), text);
-  try {
-    LoadTrackingConfig(dir.file("markers.yaml"));
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(Config, LoadsTheDocumentedExample) {
   TempDir dir;
@@ -83,14 +72,14 @@ TEST(Config, SavedConfigLoadsBackToTheSameValues) {
 }
 
 TEST(Config, UnknownKeyIsNamedWithFileAndLine) {
-  const std::string error = ErrorOf(std::string(kValid) + "scale_mm_per_pix: 0.3\n");
+  const std::string error = testing::ConfigErrorOf(std::string(kValid) + "scale_mm_per_pix: 0.3\n");
   EXPECT_THAT(error, HasSubstr("markers.yaml:11:"));
   EXPECT_THAT(error, HasSubstr("scale_mm_per_pix"));
   EXPECT_THAT(error, HasSubstr("unknown key"));
 }
 
 TEST(Config, UnknownKeyInsideAMarkerIsNamedWithItsPath) {
-  const std::string error = ErrorOf(R"(markers:
+  const std::string error = testing::ConfigErrorOf(R"(markers:
   - name: red
     colour_of_marker: red
 )");
@@ -101,7 +90,7 @@ TEST(Config, UnknownKeyInsideAMarkerIsNamedWithItsPath) {
 TEST(Config, WrongTypeIsNamed) {
   std::string text = kValid;
   text.replace(text.find("0.2"), 3, "lots");
-  const std::string error = ErrorOf(text);
+  const std::string error = testing::ConfigErrorOf(text);
   EXPECT_THAT(error, HasSubstr("scale_mm_per_px"));
   EXPECT_THAT(error, HasSubstr("'lots'"));
 }
@@ -109,7 +98,7 @@ TEST(Config, WrongTypeIsNamed) {
 TEST(Config, HueOutsideRangeIsNamed) {
   std::string text = kValid;
   text.replace(text.find("[100, 130]"), 10, "[100, 200]");
-  const std::string error = ErrorOf(text);
+  const std::string error = testing::ConfigErrorOf(text);
   EXPECT_THAT(error, HasSubstr("markers[1]"));
   EXPECT_THAT(error, HasSubstr("200"));
 }
@@ -117,26 +106,26 @@ TEST(Config, HueOutsideRangeIsNamed) {
 TEST(Config, TripleNamingAnUnknownMarkerIsRejected) {
   std::string text = kValid;
   text.replace(text.find("[red, blue, green]"), 18, "[red, blue, yellow]");
-  const std::string error = ErrorOf(text);
+  const std::string error = testing::ConfigErrorOf(text);
   EXPECT_THAT(error, HasSubstr("triple"));
   EXPECT_THAT(error, HasSubstr("yellow"));
 }
 
 TEST(Config, StructuralMistakesAreRejected) {
-  EXPECT_THAT(ErrorOf(""), HasSubstr("empty"));
-  EXPECT_THAT(ErrorOf("markers: []\n"), HasSubstr("markers"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: a\n  - name: a\n"), HasSubstr("used twice"));
-  EXPECT_THAT(ErrorOf("markers:\n  - hsv: {h: [1, 2]}\n"), HasSubstr("name"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: a b\n"), HasSubstr("letters"));
+  EXPECT_THAT(testing::ConfigErrorOf(""), HasSubstr("empty"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers: []\n"), HasSubstr("markers"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: a\n  - name: a\n"), HasSubstr("used twice"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - hsv: {h: [1, 2]}\n"), HasSubstr("name"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: a b\n"), HasSubstr("letters"));
   std::string same_twice = kValid;
   same_twice.replace(same_twice.find("[red, blue, green]"), 18, "[red, red, green]");
-  EXPECT_THAT(ErrorOf(same_twice), HasSubstr("different"));
-  EXPECT_THAT(ErrorOf(std::string(kValid) + "triple: [green, blue, red]\n"),
+  EXPECT_THAT(testing::ConfigErrorOf(same_twice), HasSubstr("different"));
+  EXPECT_THAT(testing::ConfigErrorOf(std::string(kValid) + "triple: [green, blue, red]\n"),
               HasSubstr("given twice"));
 }
 
 TEST(Config, InvalidYamlReportsTheLine) {
-  const std::string error = ErrorOf("markers:\n  - name: red\n    hsv: {h: [1, 2\n");
+  const std::string error = testing::ConfigErrorOf("markers:\n  - name: red\n    hsv: {h: [1, 2\n");
   EXPECT_THAT(error, HasSubstr("markers.yaml:"));
   EXPECT_THAT(error, HasSubstr("invalid YAML"));
 }
@@ -157,7 +146,7 @@ TEST(Config, ShippedRigExampleLoadsWithItsControlSection) {
 }
 
 TEST(Config, ControlSectionIsCheckedToo) {
-  const std::string error = ErrorOf(std::string(kValid) + "control:\n  gainz: 3\n");
+  const std::string error = testing::ConfigErrorOf(std::string(kValid) + "control:\n  gainz: 3\n");
   EXPECT_THAT(error, HasSubstr("control.gainz"));
 }
 

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/test_util.h"
+#include "io/config_test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/io/config.h"
 
@@ -13,17 +14,6 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::TempDir;
-
-std::string ErrorOf(const std::string& text) {
-  TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), text);
-  try {
-    LoadTrackingConfig(dir.file("markers.yaml"));
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
   TempDir dir;
@@ -104,17 +94,17 @@ TEST(TemplateConfig, ImageFileIsRelativeToTheConfig) {
 }
 
 TEST(TemplateConfig, ErrorsNameTheKey) {
-  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {file: nothere.png}\n"),
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {file: nothere.png}\n"),
               HasSubstr("markers[0].template.file: cannot read image"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 3]}\n"),
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 3]}\n"),
               HasSubstr("markers[0].template.rect"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
                       "min_zncc: 2}\n"),
               HasSubstr("markers[0].template.min_zncc"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
                       "colur: true}\n"),
               HasSubstr("colur"));
-  EXPECT_THAT(ErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 2, 30]}\n"),
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 2, 30]}\n"),
               HasSubstr("template.rect [1, 2, 2, 30]"));
 }
 
