@@ -3,6 +3,8 @@
 // screenshot tool is needed; keys reach the window through xdotool (XTEST), as a person's would.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+
+#include "core/test_util.h"
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -188,14 +190,7 @@ int RingPixels(const cv::Mat& image, cv::Point2d centre, int radius) {
 class LiveWindowTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    // The build sets SOFTSIGHT_BINARY; without it, the program sits beside this test's folder
-    // (build/src/gui/ -> build/src/app/softsight).
-    const char* binary = std::getenv("SOFTSIGHT_BINARY");
-    binary_ =
-        binary != nullptr
-            ? std::string(binary)
-            : (fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "app" / "softsight")
-                  .string();
+    binary_ = softsight::testing::SoftsightBinary();
     ASSERT_TRUE(fs::exists(binary_)) << "no softsight program at " << binary_;
     dir_ = fs::temp_directory_path() /
            ("softsight_live_window_" + std::to_string(getpid()) + "_" +
