@@ -1,9 +1,7 @@
 #include "app/control_command.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -13,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/stop_request.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
 #include "softsight/control/transport.h"
@@ -26,10 +25,6 @@
 
 namespace softsight {
 namespace {
-
-std::atomic<bool> g_interrupted{false};
-
-extern "C" void OnInterrupt(int) { g_interrupted = true; }
 
 // Frames of a rig running in another process (`softsight rig --pty --frames FILE`), which
 // rewrites FILE atomically (write + rename) at its frame rate: read it at `fps`, wall clock.
@@ -179,15 +174,14 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  c.ff_kpa_per_deg, c.min_kpa, c.max_kpa, c.max_rate_kpa_per_s, c.hold_s);
   }
 
-  g_interrupted = false;
-  auto previous_handler = std::signal(SIGINT, OnInterrupt);
+  const StopRequest stop;
   double sum_sq = 0.0;
   int64_t errors = 0;
   Frame frame;
   std::vector<std::optional<double>> row(extra.size());
   try {
     for (int64_t k = 0;; ++k) {
-      if (g_interrupted) {
+      if (stop.requested()) {
         summary.stop_reason = "interrupted";
         break;
       }
@@ -240,13 +234,11 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     if (summary.stop_reason.empty()) summary.stop_reason = "duration reached";
     session.stop();  // Vent at the end of the run.
   } catch (const InputError&) {
-    std::signal(SIGINT, previous_handler);
     summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
     summary.link_rejected = link.stats().rejected_lines;
     summary.resends = link.stats().resends;
     throw;
   }
-  std::signal(SIGINT, previous_handler);
   if (errors > 0) summary.rms_error_deg = std::sqrt(sum_sq / static_cast<double>(errors));
   summary.link_rejected = link.stats().rejected_lines;
   summary.resends = link.stats().resends;

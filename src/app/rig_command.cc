@@ -1,8 +1,6 @@
 #include "app/rig_command.h"
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <thread>
@@ -10,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/stop_request.h"
 #include "softsight/control/rig.h"
 #include "softsight/core/error.h"
 #include "softsight/io/control_config.h"
@@ -17,9 +16,6 @@
 
 namespace softsight {
 namespace {
-
-std::atomic<bool> g_stop{false};
-extern "C" void OnStopSignal(int) { g_stop = true; }
 
 const char* ModeName(Board::Mode mode) {
   switch (mode) {
@@ -66,9 +62,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   std::printf("rig: serving on %s\n", server.port().c_str());
   std::fflush(stdout);
 
-  g_stop = false;
-  auto old_int = std::signal(SIGINT, OnStopSignal);
-  auto old_term = std::signal(SIGTERM, OnStopSignal);
+  const StopRequest stop;
   const auto start = std::chrono::steady_clock::now();
   auto next_frame = start;
   const auto frame_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -77,8 +71,8 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   bool last_limit = false;
   int frame_index = 1;
   RigCommandSummary summary;
-  try {
-    while (!g_stop) {
+  {
+    while (!stop.requested()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       const double wall_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -106,13 +100,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
       }
       if (options.duration_s && wall_s >= *options.duration_s) break;
     }
-  } catch (...) {
-    std::signal(SIGINT, old_int);
-    std::signal(SIGTERM, old_term);
-    throw;
   }
-  std::signal(SIGINT, old_int);
-  std::signal(SIGTERM, old_term);
   const RigSnapshot s = rig.snapshot();
   summary.time_s = s.time_s;
   summary.peak_pressure_kpa = s.peak_pressure_kpa;

@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
+#include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include <opencv2/videoio.hpp>
 
@@ -115,8 +116,14 @@ TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out) {
   };
 
   Frame frame;
+  const StopRequest stop;  // Ctrl-C ends a camera run (or a long file) with its summary.
+  bool interrupted = false;
   try {
     while (!options.max_frames || summary.frames < *options.max_frames) {
+      if (stop.requested()) {
+        interrupted = true;
+        break;
+      }
       if (!source->read(frame)) break;
       if (summary.frames == 0 && NeedsColour(config) && IsGrayscale(frame.image)) {
         throw InputError(source->description() +
@@ -138,8 +145,9 @@ TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out) {
     finish("stopped by an error at frame " + std::to_string(summary.frames));
     throw;
   }
-  finish(options.max_frames && summary.frames >= *options.max_frames ? "--max-frames reached"
-                                                                      : "end of input");
+  finish(interrupted ? "stopped by Ctrl-C"
+         : options.max_frames && summary.frames >= *options.max_frames ? "--max-frames reached"
+                                                                       : "end of input");
   return summary;
 }
 
@@ -171,14 +179,19 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       "Track the markers of a config in a video (or image sequence) and write one CSV row per\n"
       "frame: every marker's centroid, the bending angle, chord, sagitta, radius of curvature,\n"
       "arc length and bending distance (in mm too when the config gives a scale).\n"
-      "Example: softsight track --config examples/markers.yaml --input run.avi --csv run.csv");
+      "Examples:\n"
+      "  softsight track --config examples/markers.yaml --input run.avi --csv run.csv\n"
+      "  softsight track --config markers.yaml --camera 0 --csv bench.csv   (Ctrl-C stops)");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
-  sub.add_option("-i,--input", options->source.input,
+  CLI::Option* input = sub.add_option("-i,--input", options->source.input,
                  "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
                  "built-in scene: synth:bending, synth:wedge1, synth:wedge4")
-      ->required();
+      ;
+  sub.add_option("--camera", options->source.camera,
+                 "Camera index (V4L2) instead of --input: tracks until Ctrl-C or --max-frames")
+      ->excludes(input);
   sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("-m,--method", options->method,
                  "Use this method for every marker: colour, sad, ssd or zncc");

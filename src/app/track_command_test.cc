@@ -1,7 +1,9 @@
 // End-to-end tests of `softsight track`: rendered video in, CSV out, checked against the truth.
 #include "app/track_command.h"
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -198,6 +200,38 @@ TEST(TrackCommand, BadConfigAndMissingInputExitWithCodeTwo) {
   EXPECT_THAT(run.stderr_text, HasSubstr("none.avi"));
   run = RunBinary("track -c " + dir.file("good.yaml"), dir);
   EXPECT_EQ(run.exit_code, 2) << "missing required options";
+}
+
+TEST(TrackCommand, CtrlCStopsWithASummaryAndEveryRowComplete) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  const std::string csv = dir.file("out.csv");
+  const std::string command = "exec " + testing::SoftsightBinary() + " track -c " +
+                              dir.file("markers.yaml") + " -i synth:bending -o " + csv + " 2> " +
+                              dir.file("stderr.txt");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Interrupt once a few rows are on disk (the handler is installed by then).
+  for (int wait_ms = 0; wait_ms < 20000 && testing::ReadLines(csv).size() < 6; wait_ms += 5) {
+    usleep(5000);
+  }
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stopped by Ctrl-C"));
+  const std::vector<std::string> lines = testing::ReadLines(csv);
+  ASSERT_GE(lines.size(), 6u);
+  ASSERT_LT(lines.size(), 301u) << "the run ended before the interrupt arrived";
+  const size_t columns = testing::SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << "row " << i;
+  }
 }
 
 TEST(TrackCommand, TemplateMethodWithoutTemplateIsRefused) {

@@ -243,7 +243,9 @@ bool IsGrayscale(const cv::Mat& frame_bgr) {
 std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
   if (spec.camera) return std::make_unique<CameraSource>(*spec.camera);
   const std::string& input = spec.input;
-  if (input.empty()) throw InputError("no input given (use --input VIDEO|FOLDER|PATTERN)");
+  if (input.empty()) {
+    throw InputError("no input given (use --input VIDEO|FOLDER|PATTERN or --camera N)");
+  }
   if (!(spec.sequence_fps > 0)) throw InputError("--fps must be positive");
   if (input.rfind(kSyntheticPrefix, 0) == 0) {
     SceneOptions scene;
