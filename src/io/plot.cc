@@ -149,13 +149,22 @@ std::vector<PlotPanel> ChoosePanels(const CsvTable& table) {
       panels.push_back(panel);
     }
   }
-  // Controller columns: every pressure_* column in one panel, every duty_* column in another.
-  for (const auto& [prefix, label] :
-       {std::pair{"pressure", "pressure"}, std::pair{"duty", "duty"}}) {
+  // Controller columns: every pressure (a name with "pressure" or a pressure unit, such as
+  // `softsight control`'s setpoint_kpa and board_pressure_kpa) in one panel, every duty* column
+  // in another.
+  const auto is_pressure = [](const std::string& column) {
+    const std::string unit = UnitOf(column);
+    return column.find("pressure") != std::string::npos || unit == "kPa" || unit == "Pa" ||
+           unit == "mbar" || unit == "bar" || unit == "psi";
+  };
+  const auto is_duty = [](const std::string& column) { return StartsWith(column, "duty"); };
+  const std::pair<const char*, bool (*)(const std::string&)> kControllerPanels[] = {
+      {"pressure", +is_pressure}, {"duty", +is_duty}};
+  for (const auto& [label, belongs] : kControllerPanels) {
     PlotPanel panel;
     std::string unit;
     for (size_t c = 0; c < table.columns.size(); ++c) {
-      if (!StartsWith(table.columns[c], prefix)) continue;
+      if (!belongs(table.columns[c])) continue;
       if (panel.series.empty()) unit = UnitOf(table.columns[c]);
       const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
       panel.series.push_back({table.columns[c], c, colour});

@@ -244,6 +244,24 @@ TEST_F(PlotTest, MillimetreColumnsWinWhenPresent) {
   EXPECT_LE(layout.panels[1].y_max, 4.0);
 }
 
+// The columns `softsight control` writes: setpoints and pressures in kPa share one panel.
+TEST_F(PlotTest, ControlCommandColumnsGiveAPressurePanel) {
+  const std::string csv =
+      WriteCsv("control_cmd.csv", 11, 0.1, kLinearAngle, kLinearTip, kLinearArc, false,
+               ",target_deg,setpoint_kpa,board_pressure_kpa,duty,board_flags", [](double t) {
+                 std::ostringstream s;
+                 s << "," << 120 << "," << 20 + t << "," << 18 + t << "," << 0.5 << "," << 0;
+                 return s.str();
+               });
+  const PlotLayout layout = ComputePlotLayout(ReadCsvTable(csv), PlotOptions{});
+  ASSERT_EQ(layout.panels.size(), 5u);
+  EXPECT_EQ(layout.panels[3].y_label, "pressure [kPa]");
+  ASSERT_EQ(layout.panels[3].series.size(), 2u);
+  EXPECT_EQ(layout.panels[3].series[0].label, "setpoint_kpa");
+  EXPECT_EQ(layout.panels[3].series[1].label, "board_pressure_kpa");
+  EXPECT_EQ(layout.panels[4].y_label, "duty");
+}
+
 TEST_F(PlotTest, ControllerColumnsAddTargetAndPressurePanels) {
   const std::string csv =
       WriteCsv("control.csv", 31, 0.1, kLinearAngle, kLinearTip, kLinearArc, false,
