@@ -37,9 +37,7 @@ TrackingConfig ConfigFor(const SceneOptions& scene) {
     spec.colour.filter_ksize = 3;
     config.markers.push_back(spec);
   }
-  config.measure.base = scene.markers.front().name;
-  config.measure.middle = scene.markers[scene.markers.size() / 2].name;
-  config.measure.tip = scene.markers.back().name;
+  config.measure = SceneMeasureOptions(scene);
   // As if the camera saw the actuator's plane at 0.25 mm per pixel.
   config.measure.metric.scale_mm_per_px = 0.25;
   return config;

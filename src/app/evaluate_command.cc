@@ -116,7 +116,7 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
     }
     config.markers.push_back(spec);
   }
-  config.measure = MeasureFor(scene);
+  config.measure = SceneMeasureOptions(scene);
   return config;
 }
 

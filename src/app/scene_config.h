@@ -4,8 +4,6 @@
 
 #include <opencv2/core.hpp>
 
-#include "softsight/geometry/measurement.h"
-#include "softsight/sim/scene.h"
 #include "softsight/track/colour_tracker.h"
 
 namespace softsight {
@@ -14,9 +12,5 @@ namespace softsight {
 // 0 for red), any strong saturation (>= 80) and brightness (>= 40). No pre-filter: the caller
 // adds one to suit the noise it expects.
 ColourParams ThresholdsFor(const cv::Vec3b& bgr);
-
-// The measured triple as the renderer's truth defines it: base, middle and tip are the markers
-// with the smallest, median and largest body_fraction (the whole chain when more than three).
-MeasureOptions MeasureFor(const SceneOptions& scene);
 
 }  // namespace softsight

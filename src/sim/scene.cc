@@ -39,22 +39,6 @@ uint64_t Mix(uint64_t seed, uint64_t index) {
   return z ^ (z >> 31);
 }
 
-// Base, middle and tip by body fraction; the full chain when there are more than three.
-MeasureOptions TruthMeasureOptions(const SceneOptions& scene) {
-  std::vector<size_t> order(scene.markers.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return scene.markers[a].body_fraction < scene.markers[b].body_fraction;
-  });
-  MeasureOptions options;
-  options.base = scene.markers[order.front()].name;
-  options.middle = scene.markers[order[order.size() / 2]].name;
-  options.tip = scene.markers[order.back()].name;
-  if (order.size() > 3) {
-    for (size_t i : order) options.chain.push_back(scene.markers[i].name);
-  }
-  return options;
-}
 
 }  // namespace
 
@@ -213,7 +197,7 @@ SyntheticScene::SyntheticScene(SceneOptions scene, NoiseOptions noise, RenderOpt
   m.canvas_ss.create(image_ss.size(), CV_8UC3);
   m.mask_ss.create(image_ss.size(), CV_8U);
   if (m.scene.markers.size() >= 3) {
-    MeasureOptions measure = TruthMeasureOptions(m.scene);
+    MeasureOptions measure = SceneMeasureOptions(m.scene);
     // Bending distance from the rest pose, the first frame of every time profile.
     m.model.pose(0.0, &m.pose);
     for (size_t i = 0; i < m.scene.markers.size(); ++i) {
@@ -372,6 +356,23 @@ void SyntheticScene::Impl::compute_truth(SceneTruth* truth) {
     observations[i].observation = Observation{m.centroid_px, std::nullopt};
   }
   if (measurer) truth->measurement = measurer->measure(observations);
+}
+
+MeasureOptions SceneMeasureOptions(const SceneOptions& scene) {
+  std::vector<size_t> order(scene.markers.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return scene.markers[a].body_fraction < scene.markers[b].body_fraction;
+  });
+  MeasureOptions options;
+  if (order.empty()) return options;
+  options.base = scene.markers[order.front()].name;
+  options.middle = scene.markers[order[order.size() / 2]].name;
+  options.tip = scene.markers[order.back()].name;
+  if (order.size() > 3) {
+    for (size_t i : order) options.chain.push_back(scene.markers[i].name);
+  }
+  return options;
 }
 
 }  // namespace softsight

@@ -130,6 +130,11 @@ class SyntheticScene {
   std::unique_ptr<Impl> impl_;
 };
 
+// The markers a scene's truth measures: base, middle and tip are those with the smallest, median
+// and largest body_fraction, and the whole chain when there are more than three. Tools that track
+// a rendered scene use it so they measure exactly what the truth does. Empty without markers.
+MeasureOptions SceneMeasureOptions(const SceneOptions& scene);
+
 // Parses "bending", "wedge1", "wedge4"; throws InputError listing the choices.
 SceneKind ParseSceneKind(const std::string& name);
 const char* SceneKindName(SceneKind kind);
