@@ -213,8 +213,7 @@ void EvaluateOptions::Check() const {
   if (methods.empty()) throw InputError("--methods: no method given");
   CheckNames(methods, kMethods, "--methods");
   CheckNames(modes, kModes, "--modes");
-  const bool templates = std::any_of(methods.begin(), methods.end(),
-                                     [](const std::string& m) { return m != "colour"; });
+  const bool templates = std::any_of(methods.begin(), methods.end(), IsTemplateMethod);
   if (templates && modes.empty()) {
     throw InputError("--modes: no mode given for the template methods (choose gray, colour)");
   }

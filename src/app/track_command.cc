@@ -21,7 +21,7 @@ namespace {
 
 void CheckRunnable(const TrackingConfig& config, const TrackOptions& options) {
   for (const MarkerSpec& spec : config.markers) {
-    if (spec.method != "colour" && spec.templ.image.empty() && !spec.templ.rect) {
+    if (IsTemplateMethod(spec.method) && spec.templ.image.empty() && !spec.templ.rect) {
       throw InputError(options.config_file + ": marker '" + spec.name + "' uses template matching (" +
                        spec.method +
                        ") but has no template: give `template: {frame: 0, rect: [x, y, w, h]}` "
@@ -60,8 +60,7 @@ class AnnotatedVideo {
 
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
-    const bool template_method = spec.method != "colour";
-    if (!template_method || spec.templ.colour) return true;
+    if (!IsTemplateMethod(spec.method) || spec.templ.colour) return true;
   }
   return false;
 }

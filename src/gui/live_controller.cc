@@ -40,8 +40,6 @@ std::string RangeText(const HsvRange& r) {
   return std::to_string(r.lo) + ".." + std::to_string(r.hi);
 }
 
-bool IsTemplateMethod(const std::string& method) { return method != "colour"; }
-
 }  // namespace
 
 // The files of one recording. The raw video is lossless (FFV1) so that `softsight track` with

@@ -6,12 +6,6 @@
 #include "softsight/core/error.h"
 
 namespace softsight {
-namespace {
-
-bool UsesTemplate(const MarkerSpec& spec) { return spec.method != "colour"; }
-
-}  // namespace
-
 TrackingSession::TrackingSession(const TrackingConfig& config)
     : config_(config), measurer_(config.measure) {
   for (const MarkerSpec& spec : config_.markers) {
@@ -35,7 +29,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     const MarkerSpec& spec = config_.markers[i];
     if (!initialised_[i]) {
-      if (!UsesTemplate(spec)) {
+      if (!IsTemplateMethod(spec.method)) {
         if (spec.colour.roi) trackers_[i]->init(frame.image, *spec.colour.roi);
         initialised_[i] = true;
       } else if (!spec.templ.image.empty()) {
@@ -91,7 +85,7 @@ void TrackingSession::reselect(const std::string& marker, const cv::Mat& frame,
     trackers_[i]->init(frame, rect);
     initialised_[i] = true;
     // Saved configs must reproduce what the mouse did.
-    if (UsesTemplate(config_.markers[i])) {
+    if (IsTemplateMethod(config_.markers[i].method)) {
       config_.markers[i].templ.rect = rect;
       config_.markers[i].templ.image.release();
     } else {

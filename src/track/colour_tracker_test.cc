@@ -362,6 +362,13 @@ TEST(ColourTracker, ParamsCheckNamesTheBadField) {
   EXPECT_NE(error.find("acquire_downsample"), std::string::npos) << error;
 }
 
+TEST(TrackerRegistry, TellsTemplateMethodsFromColour) {
+  for (const std::string& method : TrackerMethods()) {
+    EXPECT_EQ(IsTemplateMethod(method), method != "colour") << method;
+  }
+  EXPECT_FALSE(IsTemplateMethod("magic"));
+}
+
 TEST(TrackerRegistry, BuildsColourTrackersAndRejectsBadSpecs) {
   MarkerSpec spec;
   spec.name = "tip";

@@ -15,6 +15,7 @@ using Factory = std::unique_ptr<Tracker> (*)(const MarkerSpec& spec);
 struct Method {
   const char* name;
   Factory create;
+  bool uses_template;
 };
 
 // Each factory checks its own parameters, so the error names the marker and the bad field.
@@ -40,10 +41,10 @@ std::unique_ptr<Tracker> CreateTemplate(const MarkerSpec& spec) {
 
 // In the order --help lists them.
 const Method kMethods[] = {
-    {"colour", &CreateColour},
-    {"sad", &CreateTemplate<MatchMeasure::kSad>},
-    {"ssd", &CreateTemplate<MatchMeasure::kSsd>},
-    {"zncc", &CreateTemplate<MatchMeasure::kZncc>},
+    {"colour", &CreateColour, false},
+    {"sad", &CreateTemplate<MatchMeasure::kSad>, true},
+    {"ssd", &CreateTemplate<MatchMeasure::kSsd>, true},
+    {"zncc", &CreateTemplate<MatchMeasure::kZncc>, true},
 };
 
 }  // namespace
@@ -56,6 +57,13 @@ std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec) {
   for (const Method& method : kMethods) list += (list.empty() ? "" : ", ") + std::string(method.name);
   throw InputError("marker '" + spec.name + "': unknown method '" + spec.method + "' (choose " +
                    list + ")");
+}
+
+bool IsTemplateMethod(const std::string& method) {
+  for (const Method& m : kMethods) {
+    if (method == m.name) return m.uses_template;
+  }
+  return false;
 }
 
 std::vector<std::string> TrackerMethods() {

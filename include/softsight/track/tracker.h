@@ -50,4 +50,8 @@ std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec);
 // The names CreateTracker accepts, in the order --help lists them.
 std::vector<std::string> TrackerMethods();
 
+// True for the methods that match a template (sad, ssd, zncc): they need a template rectangle or
+// image, and a person selects the marker by dragging a box. False for colour and unknown names.
+bool IsTemplateMethod(const std::string& method);
+
 }  // namespace softsight
