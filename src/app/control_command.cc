@@ -17,7 +17,6 @@
 #include "softsight/control/transport.h"
 #include "softsight/core/error.h"
 #include "softsight/io/config.h"
-#include "softsight/io/control_config.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -105,7 +104,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   const ControlTarget target = MakeTarget(options);
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
-  const ControlConfig config = LoadControlConfig(options.config_file);
+  // LoadTrackingConfig has read and checked the `control:` section; defaults without one.
+  const ControlConfig config = tracking_config.control.value_or(ControlConfig{});
   const double duration_s =
       options.duration_s.value_or(target.mode == ControlMode::kAngle &&
                                           target.profile.duration_s() > 0.0
