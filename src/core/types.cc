@@ -1,2 +1,19 @@
 #include "softsight/core/types.h"
 #include "softsight/core/error.h"
+
+namespace softsight {
+
+const char* MarkerStatusName(MarkerStatus status) {
+  switch (status) {
+    case MarkerStatus::kFound: return "found";
+    case MarkerStatus::kLost: return "lost";
+    case MarkerStatus::kAmbiguous: return "ambiguous";
+    case MarkerStatus::kImplausible: return "implausible";
+    case MarkerStatus::kCovered: return "covered";
+    case MarkerStatus::kOutOfFrame: return "out_of_frame";
+    case MarkerStatus::kNotStarted: return "not_started";
+  }
+  return "lost";
+}
+
+}  // namespace softsight

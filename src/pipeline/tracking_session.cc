@@ -43,12 +43,13 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     // A template tracker without a template yet (none configured, or its reference frame is
     // still ahead) has nothing to look for: its marker is not found.
     result_.markers[i].observation =
-        initialised_[i] ? trackers_[i]->update(frame.image) : Observation{};
+        initialised_[i] ? trackers_[i]->update(frame.image)
+                       : Observation::NotFound(MarkerStatus::kNotStarted);
   }
   // Two markers cannot be at one place: a report that jumped onto another marker (a look-alike
   // re-acquired while its own marker is covered) is dropped, and its tracker searches afresh.
   for (size_t i : FindCoincidentMarkers(result_.markers, previous_px_)) {
-    result_.markers[i].observation = Observation{};
+    result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
     trackers_[i]->reset();
   }
   for (size_t i = 0; i < result_.markers.size(); ++i) {

@@ -23,13 +23,41 @@ struct Frame {
   double time_s = 0.0;  // Timestamp given by the source (video PTS, file rate, or wall clock).
 };
 
+// Why a marker has (or has no) position in a frame: the per-marker `<name>_status` CSV column.
+// "found" means verified: a tracker or the session that is unsure reports one of the others.
+enum class MarkerStatus : uint8_t {
+  kFound,        // Position reported: the candidate fitted the marker's model and the arrangement.
+  kLost,         // No candidate fitted the marker's model in the searched region.
+  kAmbiguous,    // Several candidates fitted about equally well: none is reported.
+  kImplausible,  // A candidate fitted, but its position contradicts the motion so far or the
+                 // other markers (a jump, a segment length, the order along the body).
+  kCovered,      // The marker is where expected but too little of it is visible to measure.
+  kOutOfFrame,   // The marker's expected position lies outside the image.
+  kNotStarted,   // The tracker has nothing to look for yet (its template frame is still ahead).
+};
+
+// "found", "lost", "ambiguous", "implausible", "covered", "out_of_frame", "not_started".
+const char* MarkerStatusName(MarkerStatus status);
+
 // What one tracker says about its marker in one frame. A marker that was not found has no
 // position: trackers never report a stale or predicted position as an observation.
 struct Observation {
   std::optional<cv::Point2d> position_px;  // Sub-pixel, pixel-centre convention.
   std::optional<double> score;             // Tracker-specific quality (see each tracker's header).
+  // Why there is no position (ignored while position_px is set): see status().
+  MarkerStatus not_found_reason = MarkerStatus::kLost;
+  // With kAmbiguous: how many candidates fitted about equally (for the summary's "2 candidates").
+  int candidates = 0;
 
   bool found() const { return position_px.has_value(); }
+  MarkerStatus status() const { return found() ? MarkerStatus::kFound : not_found_reason; }
+  // A not-found observation with its reason.
+  static Observation NotFound(MarkerStatus reason, int candidates = 0) {
+    Observation o;
+    o.not_found_reason = reason;
+    o.candidates = candidates;
+    return o;
+  }
 };
 
 // A named observation, as the pipeline hands it to measurement and sinks.
