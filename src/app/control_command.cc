@@ -147,16 +147,49 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   TrackingSession tracking(tracking_config);
   std::vector<std::string> names;
   for (const MarkerSpec& spec : tracking_config.markers) names.push_back(spec.name);
-  std::vector<std::string> extra = {"target_deg",     "setpoint_kpa", "board_pressure_kpa",
-                                    "board_setpoint_kpa", "duty",     "board_flags",
-                                    "control_action", "link_rejected", "board_rejected"};
+  // The controller's columns, by name, read from this frame's sample (and the rig's truth).
+  ControlSample sample;
+  std::optional<RigSnapshot> truth;
+  const auto sample_column = [&sample](const char* name, auto value) {
+    return NumberColumn(name, [&sample, value](const FrameResult&) -> std::optional<double> {
+      return value(sample);
+    });
+  };
+  std::vector<CsvColumn> extra = {
+      sample_column("target_deg", [](const ControlSample& s) { return s.target_deg; }),
+      sample_column("setpoint_kpa", [](const ControlSample& s) { return s.setpoint_kpa; }),
+      sample_column("board_pressure_kpa",
+                    [](const ControlSample& s) { return s.board.pressure_kpa; }),
+      sample_column("board_setpoint_kpa",
+                    [](const ControlSample& s) { return s.board.setpoint_kpa; }),
+      sample_column("duty", [](const ControlSample& s) { return s.board.duty; }),
+      sample_column("board_flags",
+                    [](const ControlSample& s) { return static_cast<double>(s.board.flags); }),
+      sample_column("control_action",
+                    [](const ControlSample& s) {
+                      return static_cast<double>(static_cast<int>(s.action));
+                    }),
+      NumberColumn("link_rejected",
+                   [&link](const FrameResult&) -> std::optional<double> {
+                     return static_cast<double>(link.stats().rejected_lines);
+                   }),
+      sample_column("board_rejected",
+                    [](const ControlSample& s) {
+                      return static_cast<double>(s.board.board_rejected);
+                    }),
+  };
   if (options.simulate) {
-    extra.push_back("rig_true_angle_deg");
-    extra.push_back("rig_pressure_kpa");
+    extra.push_back(NumberColumn("rig_true_angle_deg", [&truth](const FrameResult&) {
+      return truth ? std::optional<double>(truth->angle_deg) : std::nullopt;
+    }));
+    extra.push_back(NumberColumn("rig_pressure_kpa", [&truth](const FrameResult&) {
+      return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
+    }));
   }
   const MetricModel& metric = tracking_config.measure.metric;
-  CsvWriter csv(options.csv_file, names, metric.scale_mm_per_px || metric.plane_mm_from_image,
-                extra);
+  CsvWriter csv(options.csv_file,
+                TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image,
+                                extra));
 
   const BoardInfo info = session.start();
   if (!options.quiet) {
@@ -178,14 +211,13 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   double sum_sq = 0.0;
   int64_t errors = 0;
   Frame frame;
-  std::vector<std::optional<double>> row(extra.size());
   try {
     for (int64_t k = 0;; ++k) {
       if (stop.requested()) {
         summary.stop_reason = "interrupted";
         break;
       }
-      std::optional<RigSnapshot> truth;
+      truth.reset();
       if (scene) {
         const double t = static_cast<double>(k) / options.fps;
         if (t > duration_s + 1e-9) break;
@@ -201,22 +233,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
         }
       }
       const FrameResult& result = tracking.process(frame);
-      const ControlSample sample = session.step(frame.time_s, result.measurement.angle_deg);
-
-      row[0] = sample.target_deg;
-      row[1] = sample.setpoint_kpa;
-      row[2] = sample.board.pressure_kpa;
-      row[3] = sample.board.setpoint_kpa;
-      row[4] = sample.board.duty;
-      row[5] = static_cast<double>(sample.board.flags);
-      row[6] = static_cast<double>(static_cast<int>(sample.action));
-      row[7] = static_cast<double>(link.stats().rejected_lines);
-      row[8] = static_cast<double>(sample.board.board_rejected);
-      if (truth) {
-        row[9] = truth->angle_deg;
-        row[10] = truth->pressure_kpa;
-      }
-      csv.write(result, row);
+      sample = session.step(frame.time_s, result.measurement.angle_deg);
+      csv.write(result);
 
       ++summary.frames;
       summary.duration_s = sample.time_s;

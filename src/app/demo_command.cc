@@ -1,7 +1,6 @@
 // `softsight demo`: the whole job on a built-in scene whose truth is known exactly. Renders a
 // bending actuator to a video, writes the config a person would write for it, tracks the video
 // from the file, compares every number with the truth, and plots the run.
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -11,6 +10,7 @@
 #include "app/scene_config.h"
 #include "app/synth_command.h"
 #include "app/track_command.h"
+#include "app/truth_sink.h"
 #include "softsight/core/error.h"
 #include "softsight/io/config.h"
 #include "softsight/io/plot.h"
@@ -43,49 +43,6 @@ TrackingConfig ConfigFor(const SceneOptions& scene) {
   return config;
 }
 
-struct Comparison {
-  double centroid_rms_px = 0;
-  double centroid_max_px = 0;
-  double angle_rms_deg = 0;
-  int64_t compared = 0;
-};
-
-Comparison CompareWithTruth(const CsvTable& tracked, const CsvTable& truth,
-                            const SceneOptions& scene) {
-  Comparison result;
-  double squared = 0, angle_squared = 0;
-  int64_t points = 0, angles = 0;
-  auto column = [](const CsvTable& table, const std::string& name) {
-    const std::optional<size_t> index = table.find(name);
-    if (!index) throw InputError(table.source + ": no column " + name);
-    return *index;
-  };
-  const size_t rows = std::min(tracked.row_count(), truth.row_count());
-  for (size_t row = 0; row < rows; ++row) {
-    for (const SceneMarker& marker : scene.markers) {
-      const auto& tx = tracked.values[column(tracked, marker.name + "_x")][row];
-      const auto& ty = tracked.values[column(tracked, marker.name + "_y")][row];
-      const auto& gx = truth.values[column(truth, marker.name + "_x")][row];
-      const auto& gy = truth.values[column(truth, marker.name + "_y")][row];
-      if (!tx || !ty || !gx || !gy) continue;
-      const double error = std::hypot(*tx - *gx, *ty - *gy);
-      squared += error * error;
-      result.centroid_max_px = std::max(result.centroid_max_px, error);
-      ++points;
-    }
-    const auto& angle = tracked.values[column(tracked, "angle_deg")][row];
-    const auto& true_angle = truth.values[column(truth, "angle_deg")][row];
-    if (angle && true_angle) {
-      angle_squared += std::pow(*angle - *true_angle, 2);
-      ++angles;
-    }
-  }
-  result.centroid_rms_px = points > 0 ? std::sqrt(squared / points) : 0;
-  result.angle_rms_deg = angles > 0 ? std::sqrt(angle_squared / angles) : 0;
-  result.compared = static_cast<int64_t>(rows);
-  return result;
-}
-
 int RunDemo(const DemoOptions& options) {
   namespace fs = std::filesystem;
   std::error_code error;
@@ -102,8 +59,8 @@ int RunDemo(const DemoOptions& options) {
   synth.quiet = true;
   std::cerr << "demo: rendering " << options.frames << " frames of the '" << options.scene
             << "' scene to " << synth.out << "\n";
-  const SynthSummary rendered = RunSynth(synth);
-  (void)rendered;
+  std::vector<SceneTruth> truths;
+  RunSynth(synth, &truths);
 
   const std::string config_file = (dir / "markers.yaml").string();
   SaveTrackingConfig(ConfigFor(synth.scene), config_file);
@@ -114,18 +71,21 @@ int RunDemo(const DemoOptions& options) {
   track.csv_file = (dir / "tracking.csv").string();
   track.quiet = options.quiet;
   std::cerr << "demo: tracking with " << config_file << "\n";
-  const TrackSummary summary = RunTrack(track);
-  if (!options.quiet) std::cerr << FormatSummary(summary);
-
-  const Comparison comparison = CompareWithTruth(ReadCsvTable(track.csv_file),
-                                                 ReadCsvTable(*synth.truth_csv), synth.scene);
+  // Scored against the renderer's truth of each frame as it is tracked.
+  TruthScoreSink truth(truths, synth.scene.markers.size());
+  const RunSummary summary = RunTrack(track, nullptr, {&truth});
+  if (!options.quiet) std::cerr << summary.FullReport();
+  const TruthScore score = truth.score();
   const std::string plot_file = (dir / "run.png").string();
   WritePlot(track.csv_file, plot_file, PlotOptions{});
   std::printf(
       "demo: against the exact truth over %lld frames: centroid error RMS %.3f px (max %.3f px), "
-      "angle error RMS %.3f deg\n",
-      static_cast<long long>(comparison.compared), comparison.centroid_rms_px,
-      comparison.centroid_max_px, comparison.angle_rms_deg);
+      "angle error RMS %.3f deg; %lld misses of %lld visible marker-frames, %lld false reports "
+      "of %lld hidden\n",
+      static_cast<long long>(score.frames), score.centroid_rms_px.value_or(0.0),
+      score.centroid_max_px.value_or(0.0), score.angle_rms_deg.value_or(0.0),
+      static_cast<long long>(score.misses), static_cast<long long>(score.visible),
+      static_cast<long long>(score.false_reports), static_cast<long long>(score.hidden));
   std::printf("demo: wrote %s (video), %s (truth), %s (config), %s (CSV), %s (plot)\n",
               synth.out.c_str(), synth.truth_csv->c_str(), config_file.c_str(),
               track.csv_file.c_str(), plot_file.c_str());

@@ -16,9 +16,10 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/scene_config.h"
-#include "app/track_command.h"
+#include "app/truth_sink.h"
 #include "softsight/core/error.h"
 #include "softsight/io/config.h"
+#include "softsight/pipeline/run.h"
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {
@@ -27,8 +28,6 @@ namespace {
 const std::vector<std::string> kMethods = {"colour", "sad", "ssd", "zncc"};
 const std::vector<std::string> kModes = {"gray", "colour"};
 
-// A marker at least this visible must be found (else it is a miss) and is measured.
-constexpr double kVisibleFraction = 0.5;
 // Side of the dragged template square, in marker radii.
 constexpr double kTemplateSideRadii = 2.6;
 // Frames are rendered once and kept in memory up to this size; longer runs re-render them for
@@ -103,7 +102,7 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
       }
     } else {
       const std::optional<cv::Point2d>& centre = first.markers[i].centroid_px;
-      if (!centre || first.markers[i].visible_fraction < kVisibleFraction) {
+      if (!centre || first.markers[i].visible_fraction < kMustFindVisibleFraction) {
         throw InputError("marker '" + spec.name +
                          "' is hidden on frame 0: no template can be dragged around it");
       }
@@ -120,72 +119,68 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
   return config;
 }
 
-// Accumulates one run's figures, frame by frame.
-class Scorer {
+// The rendered frames as a source: from memory when they fit, else rendered again (rendering is
+// deterministic, noise included, so every method sees the same frames).
+class RenderedFrames : public FrameSource {
  public:
-  explicit Scorer(size_t markers) : offsets_(markers) {}
-
-  void add(const SceneTruth& truth, const FrameResult& result) {
-    for (size_t i = 0; i < truth.markers.size(); ++i) {
-      const MarkerTruth& marker = truth.markers[i];
-      const Observation& observation = result.markers[i].observation;
-      if (marker.visible_fraction == 0.0 || !marker.centroid_px) {
-        ++out_.hidden;
-        if (observation.found()) ++out_.false_reports;
-        continue;
-      }
-      if (marker.visible_fraction < kVisibleFraction) continue;
-      ++out_.visible;
-      if (!observation.found()) {
-        ++out_.misses;
-        continue;
-      }
-      ++out_.found_visible;
-      const cv::Point2d error = *observation.position_px - *marker.centroid_px;
-      if (!offsets_[i]) offsets_[i] = error;
-      const double absolute = std::hypot(error.x, error.y);
-      const cv::Point2d residual = error - *offsets_[i];
-      const double precise = std::hypot(residual.x, residual.y);
-      squared_ += absolute * absolute;
-      precise_squared_ += precise * precise;
-      max_ = std::max(max_, absolute);
-      precise_max_ = std::max(precise_max_, precise);
+  RenderedFrames(SyntheticScene& scene, const std::vector<SceneTruth>& truths,
+                 const std::vector<cv::Mat>& cached)
+      : scene_(scene), truths_(truths), cached_(cached) {}
+  bool read(Frame& frame) override {
+    if (next_ >= truths_.size()) return false;
+    if (!cached_.empty()) {
+      frame.image = cached_[next_];
+    } else {
+      scene_.render(static_cast<int>(next_), frame.image);
     }
-    const auto& angle = result.measurement.angle_deg;
-    const auto& true_angle = truth.measurement.angle_deg;
-    if (angle && true_angle) {
-      angle_squared_ += (*angle - *true_angle) * (*angle - *true_angle);
-      ++out_.angle_frames;
-    }
-    proc_ms_.push_back(result.proc_ms);
+    frame.index = static_cast<int64_t>(next_);
+    frame.time_s = truths_[next_].time_s;
+    ++next_;
+    return true;
   }
-
-  MethodResult finish(const Run& run) {
-    out_.method = run.method;
-    out_.mode = run.mode;
-    if (out_.found_visible > 0) {
-      const double n = static_cast<double>(out_.found_visible);
-      out_.centroid_rms_px = std::sqrt(squared_ / n);
-      out_.centroid_max_px = max_;
-      out_.precision_rms_px = std::sqrt(precise_squared_ / n);
-      out_.precision_max_px = precise_max_;
-    }
-    if (out_.angle_frames > 0) {
-      out_.angle_rms_deg = std::sqrt(angle_squared_ / static_cast<double>(out_.angle_frames));
-    }
-    TrackSummary times;
-    SummariseTimes(proc_ms_, &times);
-    out_.proc_ms_median = times.proc_ms_median;
-    out_.proc_ms_p99 = times.proc_ms_p99;
-    return out_;
+  std::string description() const override { return "rendered scene"; }
+  std::optional<int64_t> frame_count() const override {
+    return static_cast<int64_t>(truths_.size());
   }
+  std::optional<double> fps() const override { return scene_.options().fps; }
 
  private:
-  MethodResult out_;
-  std::vector<std::optional<cv::Point2d>> offsets_;  // Per marker, tracked - true, first found.
-  double squared_ = 0, precise_squared_ = 0, max_ = 0, precise_max_ = 0, angle_squared_ = 0;
-  std::vector<double> proc_ms_;
+  SyntheticScene& scene_;
+  const std::vector<SceneTruth>& truths_;
+  const std::vector<cv::Mat>& cached_;
+  size_t next_ = 0;
 };
+
+// One bar over the rendering and every method's run.
+class SharedProgress : public FrameSink {
+ public:
+  SharedProgress(ProgressBar& bar, int64_t& done) : bar_(bar), done_(done) {}
+  void consume(const Frame&, const FrameResult&) override { bar_.update(++done_); }
+
+ private:
+  ProgressBar& bar_;
+  int64_t& done_;
+};
+
+MethodResult ResultOf(const Run& run, const TruthScore& score, const RunSummary& summary) {
+  MethodResult out;
+  out.method = run.method;
+  out.mode = run.mode;
+  out.visible = score.visible;
+  out.found_visible = score.found_visible;
+  out.misses = score.misses;
+  out.hidden = score.hidden;
+  out.false_reports = score.false_reports;
+  out.centroid_rms_px = score.centroid_rms_px;
+  out.centroid_max_px = score.centroid_max_px;
+  out.precision_rms_px = score.precision_rms_px;
+  out.precision_max_px = score.precision_max_px;
+  out.angle_rms_deg = score.angle_rms_deg;
+  out.angle_frames = score.angle_frames;
+  out.proc_ms_median = summary.proc_ms_median;
+  out.proc_ms_p99 = summary.proc_ms_p99;
+  return out;
+}
 
 std::string Conditions(const EvaluateOptions& options) {
   const SceneOptions& scene = options.scene;
@@ -285,21 +280,12 @@ EvaluateReport RunEvaluate(const EvaluateOptions& options) {
   report.frames = frames;
   for (const Run& run : runs) {
     TrackingSession session(ConfigForRun(run, options, truths.front()));
-    Scorer scorer(options.scene.markers.size());
-    for (int i = 0; i < frames; ++i) {
-      Frame frame;
-      if (cache) {
-        frame.image = images[static_cast<size_t>(i)];
-      } else {
-        scene.render(i, buffer);
-        frame.image = buffer;
-      }
-      frame.index = i;
-      frame.time_s = truths[static_cast<size_t>(i)].time_s;
-      scorer.add(truths[static_cast<size_t>(i)], session.process(frame));
-      progress.update(++done);
-    }
-    report.methods.push_back(scorer.finish(run));
+    RenderedFrames source(scene, truths, images);
+    TruthScoreSink score(truths, options.scene.markers.size());
+    SharedProgress shared(progress, done);
+    const RunSummary summary = RunPipeline(source, session, {&score, &shared});
+    if (!summary.ok()) throw InputError(run.method + ": " + summary.error);
+    report.methods.push_back(ResultOf(run, score.score(), summary));
   }
   progress.finish();
   if (options.csv_file) WriteEvaluateCsv(report, *options.csv_file);

@@ -8,7 +8,7 @@
 
 #include "app/commands.h"
 #include "softsight/core/error.h"
-#include "softsight/gui/frame_grabber.h"
+#include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_controller.h"
 #include "softsight/gui/live_window.h"
 #include "softsight/io/config.h"

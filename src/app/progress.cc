@@ -50,4 +50,20 @@ void ProgressBar::finish() {
   if (enabled_ && terminal_) std::fprintf(stderr, "\r\033[K");
 }
 
+void ProgressSink::begin(const RunInfo& info) {
+  bar_.emplace(label_, info.frame_count, enabled_);
+  done_ = 0;
+}
+
+void ProgressSink::consume(const Frame& frame, const FrameResult& result) {
+  (void)frame;
+  (void)result;
+  bar_->update(++done_);
+}
+
+void ProgressSink::end(const RunSummary& summary) {
+  (void)summary;
+  if (bar_) bar_->finish();
+}
+
 }  // namespace softsight

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "softsight/pipeline/sink.h"
+
 namespace softsight {
 
 class ProgressBar {
@@ -24,6 +26,21 @@ class ProgressBar {
   int last_quarter_ = 0;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
+};
+
+// The progress bar as a sink: its total is the run's known frame count (none for a camera).
+class ProgressSink : public FrameSink {
+ public:
+  ProgressSink(std::string label, bool enabled) : label_(std::move(label)), enabled_(enabled) {}
+  void begin(const RunInfo& info) override;
+  void consume(const Frame& frame, const FrameResult& result) override;
+  void end(const RunSummary& summary) override;
+
+ private:
+  std::string label_;
+  bool enabled_;
+  std::optional<ProgressBar> bar_;
+  int64_t done_ = 0;
 };
 
 }  // namespace softsight

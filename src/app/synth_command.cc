@@ -6,24 +6,16 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <regex>
 #include <sstream>
-
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "app/commands.h"
 #include "softsight/core/error.h"
+#include "softsight/io/frame_writer.h"
 
 namespace softsight {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 void AppendNumber(std::string* line, const std::optional<double>& value) {
   *line += ',';
@@ -41,93 +33,6 @@ void CheckParentFolder(const std::string& path, const std::string& what) {
                      "' does not exist");
   }
 }
-
-// Where frames go: a video through cv::VideoWriter, or numbered image files.
-class FrameSink {
- public:
-  explicit FrameSink(const SynthOptions& options) : path_(options.out) {
-    if (path_.empty()) throw InputError("--out: give the output video or image pattern");
-    const SceneOptions& scene = options.scene;
-    CheckParentFolder(path_, "output");
-    if (path_.find('%') != std::string::npos) {
-      // Exactly one integer conversion, so snprintf with the frame index is safe.
-      static const std::regex kPattern(R"([^%]*%0?[0-9]*d[^%]*)");
-      if (!std::regex_match(path_, kPattern)) {
-        throw InputError("--out " + path_ +
-                         ": an image pattern needs exactly one %d-style field, e.g. frames/%04d.png");
-      }
-      const std::string ext = Lower(fs::path(path_).extension().string());
-      if (!cv::haveImageWriter("x" + ext)) {
-        throw InputError("--out " + path_ + ": no image writer for '" + ext + "' (use .png)");
-      }
-      images_ = true;
-      format_ = (ext == ".png" ? "PNG images (lossless)" : "images " + ext);
-      return;
-    }
-    const std::string ext = Lower(fs::path(path_).extension().string());
-    std::string codec = Lower(options.codec);
-    if (codec.empty()) {
-      if (ext == ".avi" || ext == ".mkv") {
-        codec = "ffv1";
-      } else if (ext == ".mp4") {
-        codec = "mp4v";
-      } else {
-        throw InputError("--out " + path_ + ": unknown video type '" + ext +
-                         "' (use .avi or .mkv for lossless FFV1, .mp4, or an image pattern such "
-                         "as frames/%04d.png)");
-      }
-    }
-    int fourcc = 0;
-    if (codec == "ffv1") {
-      fourcc = cv::VideoWriter::fourcc('F', 'F', 'V', '1');
-      format_ = "FFV1 video (lossless)";
-    } else if (codec == "hfyu") {
-      fourcc = cv::VideoWriter::fourcc('H', 'F', 'Y', 'U');
-      format_ = "HuffYUV video (lossless)";
-    } else if (codec == "mjpg") {
-      fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
-      format_ = "Motion JPEG video (lossy)";
-    } else if (codec == "mp4v") {
-      fourcc = cv::VideoWriter::fourcc('m', 'p', '4', 'v');
-      format_ = "MPEG-4 video (lossy)";
-    } else {
-      throw InputError("--codec '" + options.codec + "': unknown (choose ffv1, hfyu, mjpg or mp4v)");
-    }
-    writer_.open(path_, cv::CAP_FFMPEG, fourcc, scene.fps, scene.size, true);
-    if (!writer_.isOpened()) {
-      throw InputError(path_ + ": cannot open for writing as " + format_ +
-                       " (check the folder is writable and the codec fits the container)");
-    }
-  }
-
-  void write(const cv::Mat& image, int index) {
-    if (!images_) {
-      writer_.write(image);
-      return;
-    }
-    std::vector<char> name(path_.size() + 32);
-    std::snprintf(name.data(), name.size(), path_.c_str(), index);
-    bool ok = false;
-    try {
-      ok = cv::imwrite(name.data(), image);
-    } catch (const cv::Exception&) {
-      ok = false;
-    }
-    if (!ok) throw InputError(std::string(name.data()) + ": cannot write frame " + std::to_string(index));
-  }
-
-  void close() {
-    if (!images_) writer_.release();
-  }
-
-  const std::string& format() const { return format_; }
-
- private:
-  std::string path_;
-  bool images_ = false;
-  std::string format_;
-  cv::VideoWriter writer_;
-};
 
 // Parses "x,y,w,h,first,last".
 Occluder ParseOccluder(const std::string& text) {
@@ -203,7 +108,7 @@ std::string FormatSynthSummary(const SynthSummary& s, const SynthOptions& option
   return line;
 }
 
-SynthSummary RunSynth(const SynthOptions& options) {
+SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* truths) {
   const auto start = std::chrono::steady_clock::now();
   if (options.scene.frame_count < 1) {
     throw InputError("--frames: must be at least 1, got " + std::to_string(options.scene.frame_count));
@@ -211,7 +116,9 @@ SynthSummary RunSynth(const SynthOptions& options) {
   // Everything is checked before any file is created.
   SyntheticScene scene(options.scene, options.noise, options.render, options.occluders);
   if (options.truth_csv) CheckParentFolder(*options.truth_csv, "truth CSV");
-  FrameSink sink(options);
+  if (options.out.empty()) throw InputError("--out: give the output video or image pattern");
+  FrameWriter sink({options.out, options.codec, options.scene.fps});
+  sink.open(options.scene.size);  // Fails here, before the truth file is created.
   std::ofstream truth_file;
   if (options.truth_csv) {
     truth_file.open(*options.truth_csv, std::ios::out | std::ios::trunc);
@@ -230,6 +137,7 @@ SynthSummary RunSynth(const SynthOptions& options) {
     const SceneTruth truth = scene.render(i, image);
     render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     sink.write(image, i);
+    if (truths != nullptr) truths->push_back(truth);
     if (truth_file.is_open()) {
       truth_file << TruthCsvRow(truth) << "\n";
       if (!truth_file) throw InputError(*options.truth_csv + ": write failed at frame " + std::to_string(i));

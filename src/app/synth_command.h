@@ -41,7 +41,8 @@ struct SynthSummary {
 
 // Renders and writes every frame. Throws InputError (one line naming the option or file) for
 // bad options or an unwritable output, before any frame is written when it can tell.
-SynthSummary RunSynth(const SynthOptions& options);
+// `truths` (optional) receives every frame's truth, in order.
+SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* truths = nullptr);
 
 // The truth CSV: frame, time_s, bend_deg, per marker <name>_x, <name>_y, <name>_visible (the
 // visible fraction, 0..1), then angle_deg, chord_px, sagitta_px, radius_px, arc_length_px,

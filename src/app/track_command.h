@@ -1,4 +1,5 @@
-// `softsight track`: frames from a file -> trackers -> measurements -> CSV (+ annotated video).
+// `softsight track`: frames from a file or camera -> TrackingSession -> sinks (CSV, annotated
+// video, raw recording, progress), through RunPipeline.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,8 @@
 #include "softsight/core/types.h"
 #include "softsight/io/config.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/pipeline/sink.h"
+#include "softsight/pipeline/summary.h"
 
 namespace softsight {
 
@@ -20,30 +23,18 @@ struct TrackOptions {
   // Overrides every template marker's mode: true matches BGR, false gray (--colour / --gray).
   std::optional<bool> template_colour;
   std::optional<std::string> annotated_file; // Annotated video (overlay drawn on each frame).
+  // Raw recording: every processed frame as read (FFV1 .avi/.mkv, or an image pattern), so a
+  // camera run can be tracked again later and gives the same rows.
+  std::optional<std::string> record_file;
   std::optional<int64_t> max_frames;
   bool quiet = false;                        // No progress bar, no summary.
 };
 
-// What a run did, printed at its end (and returned to tests).
-struct TrackSummary {
-  int64_t frames = 0;
-  std::vector<std::string> marker_names;
-  std::vector<int64_t> found;                // Per marker, frames where it was found.
-  int64_t measured = 0;                      // Frames with an angle.
-  double proc_ms_median = 0.0;
-  double proc_ms_p99 = 0.0;
-  double wall_s = 0.0;
-  std::string stop_reason;                   // "end of input", "--max-frames reached", ...
-};
-
-// Runs the whole job. Throws InputError for bad input; every CSV row written before the error
-// stays intact. `summary_out` (optional) receives the summary even when an error is thrown.
-TrackSummary RunTrack(const TrackOptions& options, TrackSummary* summary_out = nullptr);
-
-// Summary lines for a person.
-std::string FormatSummary(const TrackSummary& summary);
-
-// Per-frame statistics: median and 99th percentile of the processing times.
-void SummariseTimes(std::vector<double> proc_ms, TrackSummary* summary);
+// Runs the whole job through RunPipeline. Throws InputError for bad input, before the run
+// (config, source, outputs) or from it (a corrupt frame, a full disk; every CSV row written
+// before stays intact). `summary_out` (optional) receives the summary even when it throws.
+// `more_sinks` see every frame after the command's own (e.g. demo's truth scorer).
+RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out = nullptr,
+                    const std::vector<FrameSink*>& more_sinks = {});
 
 }  // namespace softsight

@@ -84,10 +84,12 @@ TEST(TrackCommand, RenderedVideoGivesTruthWithinTolerances) {
   options.source.input = clip.video;
   options.csv_file = dir.file("out.csv");
   options.quiet = true;
-  const TrackSummary summary = RunTrack(options);
+  const RunSummary summary = RunTrack(options);
   EXPECT_EQ(summary.frames, 40);
-  EXPECT_EQ(summary.stop_reason, "end of input");
-  for (int64_t found : summary.found) EXPECT_EQ(found, 40);
+  EXPECT_EQ(summary.stop_reason, StopReason::kEndOfInput);
+  EXPECT_EQ(summary.dropped, 0);
+  ASSERT_EQ(summary.markers.size(), 3u);
+  for (const MarkerRunSummary& marker : summary.markers) EXPECT_EQ(marker.found, 40);
 
   const std::vector<std::string> lines = testing::ReadLines(options.csv_file);
   ASSERT_EQ(lines.size(), 41u);
@@ -145,6 +147,39 @@ TEST(TrackCommand, AnnotatedVideoHasEveryFrameWithTheOverlayOnTheMarkers) {
   const cv::Rect corner(drawn.cols - 40, drawn.rows - 40, 30, 30);
   EXPECT_LT(cv::norm(drawn(corner), plain(corner), cv::NORM_L1) / corner.area(), 12.0)
       << "only JPEG noise expected far from the overlay";
+}
+
+// Every column but proc_ms (a timing) of a CSV, row by row.
+std::vector<std::vector<std::string>> TrackingRows(const std::string& csv) {
+  std::vector<std::vector<std::string>> rows;
+  for (const std::string& line : testing::ReadLines(csv)) {
+    std::vector<std::string> fields = testing::SplitCsv(line);
+    fields.pop_back();  // proc_ms is last.
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+TEST(TrackCommand, RawRecordingTrackedAgainGivesTheSameRows) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 8);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  TrackOptions options;
+  options.config_file = dir.file("markers.yaml");
+  options.source.input = clip.video;
+  options.csv_file = dir.file("first.csv");
+  options.record_file = dir.file("raw.avi");
+  options.quiet = true;
+  RunTrack(options);
+  TrackOptions again = options;
+  again.source.input = *options.record_file;
+  again.csv_file = dir.file("again.csv");
+  again.record_file.reset();
+  RunTrack(again);
+  const auto first = TrackingRows(options.csv_file);
+  ASSERT_EQ(first.size(), 9u);
+  EXPECT_EQ(first.front().back(), "tip_disp_mm") << "header, without proc_ms";
+  EXPECT_EQ(TrackingRows(again.csv_file), first);
 }
 
 TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
@@ -224,7 +259,7 @@ TEST(TrackCommand, CtrlCStopsWithASummaryAndEveryRowComplete) {
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
   EXPECT_EQ(WEXITSTATUS(status), 0);
-  EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stopped by Ctrl-C"));
+  EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stop requested"));
   const std::vector<std::string> lines = testing::ReadLines(csv);
   ASSERT_GE(lines.size(), 6u);
   ASSERT_LT(lines.size(), 301u) << "the run ended before the interrupt arrived";

@@ -5,6 +5,9 @@
 
 #include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/io/csv_columns.h"
+
+#include <stdexcept>
 
 namespace softsight {
 namespace {
@@ -32,7 +35,13 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
   EXPECT_EQ(testing::ReadLines(dir.file("a.csv")).at(0),
             "frame,time_s,red_x,red_y,red_found,red_score,blue_x,blue_y,blue_found,blue_score,"
             "angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,proc_ms");
-  { CsvWriter csv(dir.file("b.csv"), {"red"}, /*metric=*/true, {"target_deg"}); }
+  {
+    CsvWriter csv(dir.file("b.csv"),
+                  TrackingColumns({"red"}, /*metric=*/true,
+                                  {NumberColumn("target_deg", [](const FrameResult&) {
+                                    return std::optional<double>(120.0);
+                                  })}));
+  }
   EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).at(0),
             "frame,time_s,red_x,red_y,red_found,red_score,angle_deg,chord_px,sagitta_px,"
             "radius_px,arc_length_px,tip_disp_px,chord_mm,sagitta_mm,radius_mm,arc_length_mm,"
@@ -50,6 +59,39 @@ TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
               ElementsAre("7", "0.250000", "10.5000", "20.2500", "1", "0.9700", "", "", "0", "",
                           "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
                           "0.1250"));
+}
+
+TEST(CsvColumnTable, HeaderAndRowsComeFromTheSameColumns) {
+  // Extra columns are found by name, wherever the table puts them.
+  const CsvColumnTable table = TrackingColumns(
+      {"red", "blue"}, /*metric=*/false,
+      {NumberColumn("target_deg", [](const FrameResult&) { return std::optional<double>(120.5); }),
+       NumberColumn("duty", [](const FrameResult&) { return std::optional<double>(); })});
+  const std::vector<std::string> header = testing::SplitCsv(table.header());
+  EXPECT_EQ(header, table.names());
+  std::string row;
+  table.append_row(TwoMarkers(/*second_found=*/true), row);
+  const std::vector<std::string> fields = testing::SplitCsv(row);
+  ASSERT_EQ(fields.size(), header.size());
+  const auto field = [&](const std::string& name) { return fields.at(*table.find(name)); };
+  EXPECT_EQ(field("frame"), "7");
+  EXPECT_EQ(field("blue_x"), "1.0000");
+  EXPECT_EQ(field("blue_found"), "1");
+  EXPECT_EQ(field("target_deg"), "120.5");
+  EXPECT_EQ(field("duty"), "");
+  EXPECT_EQ(field("proc_ms"), "0.1250");
+  EXPECT_EQ(header.back(), "proc_ms") << "extra columns go before proc_ms";
+  EXPECT_EQ(*table.find("target_deg") + 1, *table.find("duty"));
+  EXPECT_FALSE(table.find("chord_mm")) << "no _mm columns without a metric model";
+}
+
+TEST(CsvColumnTable, InsertBeforeNamesItsAnchor) {
+  CsvColumnTable table = TrackingColumns({"red"}, /*metric=*/false);
+  table.insert_before("angle_deg", NumberColumn("red_status_code", [](const FrameResult&) {
+                        return std::optional<double>(0.0);
+                      }));
+  EXPECT_EQ(*table.find("red_status_code") + 1, *table.find("angle_deg"));
+  EXPECT_THROW(table.insert_before("no_such_column", CsvColumn{"x", {}}), std::logic_error);
 }
 
 TEST(CsvWriter, UnwritablePathIsAnInputError) {

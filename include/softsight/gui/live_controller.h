@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "softsight/calib/hsv_picker.h"
-#include "softsight/gui/frame_grabber.h"
+#include "softsight/io/frame_grabber.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/gui/strip_chart.h"
 #include "softsight/io/config.h"

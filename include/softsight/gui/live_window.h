@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "softsight/gui/frame_grabber.h"
+#include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_controller.h"
 
 namespace softsight {

@@ -31,6 +31,10 @@ class FrameSource {
 
   // True for live sources (cameras): no progress bar, frames may be dropped.
   virtual bool is_live() const { return false; }
+
+  // Frames the source skipped so far because its reader was slower than it (newest frame wins,
+  // see NewestFrameSource). Files, image sequences and rendered scenes never drop: always 0.
+  virtual int64_t dropped_frames() const { return 0; }
 };
 
 }  // namespace softsight

@@ -1,7 +1,10 @@
-#include "softsight/gui/frame_grabber.h"
+#include "softsight/io/frame_grabber.h"
 
 #include <optional>
+#include <string>
 #include <utility>
+
+#include "softsight/core/error.h"
 
 namespace softsight {
 
@@ -75,6 +78,23 @@ bool FrameGrabber::wait_take(GrabbedFrame& out, std::chrono::milliseconds timeou
 bool FrameGrabber::finished() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return ended_ && !slot_full_ && !error_;
+}
+
+NewestFrameSource::NewestFrameSource(std::unique_ptr<FrameSource> source,
+                                     std::chrono::milliseconds stall_timeout)
+    : grabber_(std::move(source), /*pace=*/false), stall_timeout_(stall_timeout) {}
+
+bool NewestFrameSource::read(Frame& frame) {
+  const auto deadline = SteadyClock::now() + stall_timeout_;
+  while (!grabber_.wait_take(taken_, std::chrono::milliseconds(50))) {
+    if (grabber_.finished()) return false;
+    if (SteadyClock::now() > deadline) {
+      throw InputError(description() + ": no frame for " +
+                       std::to_string(stall_timeout_.count()) + " ms (unplugged?)");
+    }
+  }
+  std::swap(frame, taken_.frame);
+  return true;
 }
 
 }  // namespace softsight

@@ -1,8 +1,10 @@
-#include "softsight/gui/frame_grabber.h"
+#include "softsight/io/frame_grabber.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include "softsight/core/error.h"
@@ -95,6 +97,89 @@ TEST(FrameGrabberTest, DestructorStopsAnEndlessSource) {
     EXPECT_TRUE(grabber.wait_take(g, std::chrono::milliseconds(500)));
   }
   EXPECT_LT(SteadyClock::now() - start, std::chrono::seconds(5));
+}
+
+// A camera stand-in: delivers `burst` frames at once, then holds the next read until released,
+// so the test knows exactly how many frames arrived before the consumer looked.
+class BurstSource : public FrameSource {
+ public:
+  explicit BurstSource(int burst) : burst_(burst) {}
+  bool read(Frame& frame) override {
+    if (next_ == burst_) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      delivered_ = true;
+      changed_.notify_all();
+      changed_.wait(lock, [this] { return released_; });
+      return false;  // The camera is gone after the burst.
+    }
+    frame.image.create(4, 4, CV_8UC3);
+    frame.index = next_;
+    frame.time_s = next_ / 30.0;
+    ++next_;
+    return true;
+  }
+  std::string description() const override { return "camera 9"; }
+  std::optional<int64_t> frame_count() const override { return std::nullopt; }
+  std::optional<double> fps() const override { return 30.0; }
+  bool is_live() const override { return true; }
+
+  void wait_delivered() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return delivered_; });
+  }
+  void release() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    released_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  int burst_;
+  int next_ = 0;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool delivered_ = false, released_ = false;
+};
+
+struct ReleaseAtExit {
+  BurstSource& camera;
+  ~ReleaseAtExit() { camera.release(); }
+};
+
+TEST(NewestFrameSource, AStaleFrameIsDroppedCountedAndTheNewestKeepsItsIndex) {
+  auto burst = std::make_unique<BurstSource>(10);
+  BurstSource& camera = *burst;
+  NewestFrameSource source(std::move(burst));
+  const ReleaseAtExit guard{camera};  // Runs before the source's destructor joins its thread.
+  camera.wait_delivered();  // All 10 frames arrived before the consumer's first read.
+  Frame frame;
+  ASSERT_TRUE(source.read(frame));
+  EXPECT_EQ(frame.index, 9) << "newest frame wins";
+  EXPECT_NEAR(frame.time_s, 9 / 30.0, 1e-12);
+  EXPECT_EQ(source.dropped_frames(), 9);
+  EXPECT_TRUE(source.is_live());
+  EXPECT_EQ(source.description(), "camera 9");
+  camera.release();
+  EXPECT_FALSE(source.read(frame));
+  EXPECT_EQ(source.dropped_frames(), 9);
+}
+
+TEST(NewestFrameSource, ASilentCameraIsAnErrorNamingIt) {
+  auto burst = std::make_unique<BurstSource>(0);
+  BurstSource& camera = *burst;
+  NewestFrameSource source(std::move(burst), std::chrono::milliseconds(0));
+  const ReleaseAtExit guard{camera};
+  Frame frame;
+  EXPECT_THROW(
+      {
+        try {
+          source.read(frame);
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("camera 9"), std::string::npos);
+          throw;
+        }
+      },
+      InputError);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 // Capture in its own thread, newest frame wins: the consumer always gets the most recent frame
 // and frames it was too slow for are dropped, so latency never builds up behind a slow consumer.
+// This is how a camera is paced (NewestFrameSource below wraps it as a FrameSource); files and
+// image sequences are never read through it by batch commands, so they never drop a frame.
 #pragma once
 
 #include <atomic>
@@ -9,6 +11,8 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <thread>
 
 #include "softsight/core/types.h"
@@ -61,6 +65,30 @@ class FrameGrabber {
   std::atomic<int64_t> captured_{0};
   std::atomic<int64_t> dropped_{0};
   std::thread thread_;
+};
+
+// A live source (a camera) read in its own thread, newest frame wins: read() returns the most
+// recent frame not yet returned, waiting for one if needed; frames the pipeline was too slow for
+// are skipped and counted (dropped_frames()). Frames keep the source's index and timestamp, so
+// rows show where frames were skipped.
+class NewestFrameSource : public FrameSource {
+ public:
+  // `stall_timeout`: read() gives up with an InputError naming the source when no frame arrives
+  // for this long (an unplugged camera), instead of waiting forever.
+  explicit NewestFrameSource(std::unique_ptr<FrameSource> source,
+                             std::chrono::milliseconds stall_timeout = std::chrono::seconds(5));
+
+  bool read(Frame& frame) override;
+  std::string description() const override { return grabber_.source().description(); }
+  std::optional<int64_t> frame_count() const override { return grabber_.source().frame_count(); }
+  std::optional<double> fps() const override { return grabber_.source().fps(); }
+  bool is_live() const override { return true; }
+  int64_t dropped_frames() const override { return grabber_.dropped_count(); }
+
+ private:
+  FrameGrabber grabber_;
+  std::chrono::milliseconds stall_timeout_;
+  GrabbedFrame taken_;  // Swapped with the caller's frame: buffers are reused, not copied.
 };
 
 }  // namespace softsight

@@ -1,0 +1,59 @@
+// The per-frame CSV as one table of columns: each column has its name (the header) and the code
+// that writes its field for a frame (the row), so header and rows cannot disagree, and callers
+// add columns by name (the controller's), never by position. The tracking columns are the stable
+// contract other programs rely on (README "CSV columns"):
+//   frame, time_s, per marker <name>_x, <name>_y, <name>_found, <name>_score,
+//   angle_deg, chord_px, sagitta_px, radius_px, arc_length_px, tip_disp_px,
+//   chord_mm, sagitta_mm, radius_mm, arc_length_mm, tip_disp_mm (only with a metric model),
+//   any extra columns a caller adds (the controller's), proc_ms.
+// Undefined values are empty fields.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "softsight/core/types.h"
+
+namespace softsight {
+
+struct CsvColumn {
+  std::string name;
+  // Appends this column's field for `result` to `row` (nothing for an empty field). Fields must
+  // not contain commas, quotes or newlines (numbers and names).
+  std::function<void(const FrameResult& result, std::string& row)> append;
+};
+
+// A numeric column: the value printed with `format` (printf style), absent -> empty field.
+CsvColumn NumberColumn(std::string name,
+                       std::function<std::optional<double>(const FrameResult&)> value,
+                       const char* format = "%.6g");
+
+class CsvColumnTable {
+ public:
+  void add(CsvColumn column);
+  // Inserts before the column named `before` (e.g. "proc_ms"); throws std::logic_error when no
+  // column has that name.
+  void insert_before(const std::string& before, CsvColumn column);
+
+  size_t size() const { return columns_.size(); }
+  const CsvColumn& column(size_t i) const { return columns_[i]; }
+  std::optional<size_t> find(const std::string& name) const;
+  std::vector<std::string> names() const;
+
+  // The header line and one row, both without the newline; append_row clears `row` first.
+  std::string header() const;
+  void append_row(const FrameResult& result, std::string& row) const;
+
+ private:
+  std::vector<CsvColumn> columns_;
+};
+
+// The tracking columns above for these markers (in FrameResult::markers order), with the _mm
+// twins when `metric`, then `extra` (by name, before proc_ms), then proc_ms.
+CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
+                               const std::vector<CsvColumn>& extra = {});
+
+}  // namespace softsight

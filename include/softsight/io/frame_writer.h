@@ -1,0 +1,58 @@
+// Where frames go when they are saved: a video file (FFmpeg through cv::VideoWriter) or one image
+// per frame (a printf pattern such as frames/%04d.png). The one writer behind `synth`, the raw and
+// annotated videos of `track` and the live window's recordings.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace softsight {
+
+struct FrameWriterOptions {
+  // A video (*.avi, *.mkv: FFV1 lossless by default; *.mp4: MPEG-4, lossy) or a printf pattern
+  // with one integer field, frames/%04d.png (one image per frame, named by the frame's index).
+  std::string path;
+  // Video codec: ffv1 (lossless), hfyu (HuffYUV, lossless, larger, faster), mjpg (Motion JPEG,
+  // lossy, small: for videos people watch), mp4v (lossy). Empty: chosen by the extension.
+  std::string codec;
+  double fps = 30.0;  // The video's nominal rate (ignored for image patterns). > 0.
+};
+
+class FrameWriter {
+ public:
+  // Checks the path, folder, extension and codec at once (before any frame exists), so a bad
+  // output fails before work starts. Throws InputError naming the path or codec.
+  explicit FrameWriter(FrameWriterOptions options);
+  ~FrameWriter();
+  FrameWriter(const FrameWriter&) = delete;
+  FrameWriter& operator=(const FrameWriter&) = delete;
+
+  // Opens the video for frames of `size` (write() does it on the first frame otherwise).
+  // Throws InputError when FFmpeg cannot open it.
+  void open(cv::Size size);
+  // Writes one 8-bit BGR image; `index` names the file of an image pattern. Every image must have
+  // the size of the first. Throws InputError naming the file and frame on failure.
+  void write(const cv::Mat& image_bgr, int64_t index);
+  // Finishes the video (also done by the destructor).
+  void close();
+
+  // "FFV1 video (lossless)", "PNG images (lossless)", ...
+  const std::string& format() const { return format_; }
+  const std::string& path() const { return options_.path; }
+  int64_t written() const { return written_; }
+
+ private:
+  FrameWriterOptions options_;
+  bool images_ = false;
+  int fourcc_ = 0;
+  std::string format_;
+  cv::Size size_;
+  cv::VideoWriter video_;
+  std::string name_;  // Reused file name buffer for image patterns.
+  int64_t written_ = 0;
+};
+
+}  // namespace softsight

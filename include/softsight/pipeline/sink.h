@@ -1,0 +1,47 @@
+// Where a FrameResult goes: the CSV table, an annotated or raw video, a progress bar, the
+// controller, the live window. A sink only consumes; the data flows one way:
+//   FrameSource -> TrackingSession -> FrameResult -> every FrameSink, in the order given.
+// Sinks are called from the thread that runs RunPipeline, one frame at a time.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/core/types.h"
+#include "softsight/pipeline/summary.h"
+
+namespace softsight {
+
+// What a sink learns before the first frame.
+struct RunInfo {
+  std::string source;                   // FrameSource::description().
+  cv::Size frame_size;                  // Of the first frame; empty when the source had none.
+  std::optional<double> fps;            // The source's nominal rate, when known.
+  std::optional<int64_t> frame_count;   // Frames the run will process when known (the source's
+                                        // count, capped by RunOptions::max_frames).
+  bool live = false;                    // A camera (frames may be dropped, no known end).
+  std::vector<std::string> marker_names;  // In config order, as in FrameResult::markers.
+  bool metric = false;                  // The measurement has _mm twins (a metric model is set).
+};
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+
+  // Once, after the first frame has been read and before it is consumed (when the source is
+  // empty: once, with an empty frame_size, before end()). May throw InputError (a file that
+  // cannot be opened): the run then stops with StopReason::kError.
+  virtual void begin(const RunInfo& info) { (void)info; }
+  // Every processed frame, in source order. `frame` is the image as read (no overlay).
+  // May throw InputError (a full disk): the run stops with StopReason::kError.
+  virtual void consume(const Frame& frame, const FrameResult& result) = 0;
+  // Once at the end of every run that called begin(), whatever the reason, with the summary.
+  // Must not throw.
+  virtual void end(const RunSummary& summary) { (void)summary; }
+};
+
+}  // namespace softsight

@@ -1,0 +1,121 @@
+#include "softsight/io/csv_columns.h"
+
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+namespace softsight {
+namespace {
+
+void AppendNumber(std::string& row, const std::optional<double>& value, const char* format) {
+  if (!value) return;
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, *value);
+  row += buffer;
+}
+
+// A measurement field, 4 decimals as the contract has always had.
+CsvColumn MeasurementColumn(std::string name, std::optional<double> Measurement::*member) {
+  return {std::move(name), [member](const FrameResult& r, std::string& row) {
+            AppendNumber(row, r.measurement.*member, "%.4f");
+          }};
+}
+
+}  // namespace
+
+CsvColumn NumberColumn(std::string name,
+                       std::function<std::optional<double>(const FrameResult&)> value,
+                       const char* format) {
+  return {std::move(name), [value = std::move(value), format](const FrameResult& r,
+                                                              std::string& row) {
+            AppendNumber(row, value(r), format);
+          }};
+}
+
+void CsvColumnTable::add(CsvColumn column) { columns_.push_back(std::move(column)); }
+
+void CsvColumnTable::insert_before(const std::string& before, CsvColumn column) {
+  const std::optional<size_t> at = find(before);
+  if (!at) throw std::logic_error("CsvColumnTable: no column '" + before + "'");
+  columns_.insert(columns_.begin() + static_cast<std::ptrdiff_t>(*at), std::move(column));
+}
+
+std::optional<size_t> CsvColumnTable::find(const std::string& name) const {
+  for (size_t i = 0; i < columns_.size(); ++i) {
+    if (columns_[i].name == name) return i;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> CsvColumnTable::names() const {
+  std::vector<std::string> names;
+  names.reserve(columns_.size());
+  for (const CsvColumn& column : columns_) names.push_back(column.name);
+  return names;
+}
+
+std::string CsvColumnTable::header() const {
+  std::string line;
+  for (size_t i = 0; i < columns_.size(); ++i) {
+    if (i > 0) line += ',';
+    line += columns_[i].name;
+  }
+  return line;
+}
+
+void CsvColumnTable::append_row(const FrameResult& result, std::string& row) const {
+  row.clear();
+  for (size_t i = 0; i < columns_.size(); ++i) {
+    if (i > 0) row += ',';
+    columns_[i].append(result, row);
+  }
+}
+
+CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
+                               const std::vector<CsvColumn>& extra) {
+  CsvColumnTable table;
+  table.add({"frame", [](const FrameResult& r, std::string& row) {
+               row += std::to_string(r.frame_index);
+             }});
+  table.add({"time_s", [](const FrameResult& r, std::string& row) {
+               AppendNumber(row, r.time_s, "%.6f");
+             }});
+  for (size_t i = 0; i < marker_names.size(); ++i) {
+    const std::string& name = marker_names[i];
+    // Per-marker columns read markers[i]: the session reports every marker in config order.
+    table.add({name + "_x", [i](const FrameResult& r, std::string& row) {
+                 const Observation& o = r.markers.at(i).observation;
+                 if (o.found()) AppendNumber(row, o.position_px->x, "%.4f");
+               }});
+    table.add({name + "_y", [i](const FrameResult& r, std::string& row) {
+                 const Observation& o = r.markers.at(i).observation;
+                 if (o.found()) AppendNumber(row, o.position_px->y, "%.4f");
+               }});
+    table.add({name + "_found", [i](const FrameResult& r, std::string& row) {
+                 row += r.markers.at(i).observation.found() ? '1' : '0';
+               }});
+    table.add({name + "_score", [i](const FrameResult& r, std::string& row) {
+                 AppendNumber(row, r.markers.at(i).observation.score, "%.4f");
+               }});
+  }
+  table.add(MeasurementColumn("angle_deg", &Measurement::angle_deg));
+  table.add(MeasurementColumn("chord_px", &Measurement::chord_px));
+  table.add(MeasurementColumn("sagitta_px", &Measurement::sagitta_px));
+  table.add(MeasurementColumn("radius_px", &Measurement::radius_px));
+  table.add(MeasurementColumn("arc_length_px", &Measurement::arc_length_px));
+  table.add(MeasurementColumn("tip_disp_px", &Measurement::tip_disp_px));
+  if (metric) {
+    table.add(MeasurementColumn("chord_mm", &Measurement::chord_mm));
+    table.add(MeasurementColumn("sagitta_mm", &Measurement::sagitta_mm));
+    table.add(MeasurementColumn("radius_mm", &Measurement::radius_mm));
+    table.add(MeasurementColumn("arc_length_mm", &Measurement::arc_length_mm));
+    table.add(MeasurementColumn("tip_disp_mm", &Measurement::tip_disp_mm));
+  }
+  for (const CsvColumn& column : extra) table.add(column);
+  table.add({"proc_ms", [](const FrameResult& r, std::string& row) {
+               AppendNumber(row, r.proc_ms, "%.4f");
+             }});
+  return table;
+}
+
+}  // namespace softsight

@@ -1,0 +1,125 @@
+#include "softsight/io/frame_writer.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(options)) {
+  const std::string& path = options_.path;
+  if (path.empty()) throw InputError("no output file given for the frames");
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent)) {
+    throw InputError(path + ": cannot write the frames: folder '" + parent.string() +
+                     "' does not exist");
+  }
+  if (!(options_.fps > 0.0) || !std::isfinite(options_.fps)) {
+    throw InputError(path + ": frame rate " + std::to_string(options_.fps) + " is not > 0");
+  }
+  const std::string ext = Lower(fs::path(path).extension().string());
+  if (path.find('%') != std::string::npos) {
+    // Exactly one integer conversion, so snprintf with the frame index is safe.
+    static const std::regex kPattern(R"([^%]*%0?[0-9]*d[^%]*)");
+    if (!std::regex_match(path, kPattern)) {
+      throw InputError(path + ": an image pattern needs exactly one %d-style field, e.g. "
+                       "frames/%04d.png");
+    }
+    if (!cv::haveImageWriter("x" + ext)) {
+      throw InputError(path + ": no image writer for '" + ext + "' (use .png)");
+    }
+    images_ = true;
+    format_ = ext == ".png" ? "PNG images (lossless)" : "images " + ext;
+    return;
+  }
+  std::string codec = Lower(options_.codec);
+  if (codec.empty()) {
+    if (ext == ".avi" || ext == ".mkv") {
+      codec = "ffv1";
+    } else if (ext == ".mp4") {
+      codec = "mp4v";
+    } else {
+      throw InputError(path + ": unknown video type '" + ext +
+                       "' (use .avi or .mkv for lossless FFV1, .mp4, or an image pattern such "
+                       "as frames/%04d.png)");
+    }
+  }
+  if (codec == "ffv1") {
+    fourcc_ = cv::VideoWriter::fourcc('F', 'F', 'V', '1');
+    format_ = "FFV1 video (lossless)";
+  } else if (codec == "hfyu") {
+    fourcc_ = cv::VideoWriter::fourcc('H', 'F', 'Y', 'U');
+    format_ = "HuffYUV video (lossless)";
+  } else if (codec == "mjpg") {
+    fourcc_ = cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
+    format_ = "Motion JPEG video (lossy)";
+  } else if (codec == "mp4v") {
+    fourcc_ = cv::VideoWriter::fourcc('m', 'p', '4', 'v');
+    format_ = "MPEG-4 video (lossy)";
+  } else {
+    throw InputError("codec '" + options_.codec + "' for " + path +
+                     ": unknown (choose ffv1, hfyu, mjpg or mp4v)");
+  }
+}
+
+FrameWriter::~FrameWriter() { close(); }
+
+void FrameWriter::open(cv::Size size) {
+  size_ = size;
+  if (images_ || video_.isOpened()) return;
+  video_.open(options_.path, cv::CAP_FFMPEG, fourcc_, options_.fps, size, true);
+  if (!video_.isOpened()) {
+    throw InputError(options_.path + ": cannot open for writing as " + format_ +
+                     " (check the folder is writable and the codec fits the container)");
+  }
+}
+
+void FrameWriter::write(const cv::Mat& image_bgr, int64_t index) {
+  if (written_ == 0 && size_.empty()) open(image_bgr.size());
+  if (image_bgr.size() != size_ || image_bgr.type() != CV_8UC3) {
+    throw InputError(options_.path + ": frame " + std::to_string(index) + " is " +
+                     std::to_string(image_bgr.cols) + "x" + std::to_string(image_bgr.rows) +
+                     ", the video is " + std::to_string(size_.width) + "x" +
+                     std::to_string(size_.height) + " BGR");
+  }
+  if (!images_) {
+    video_.write(image_bgr);
+    ++written_;
+    return;
+  }
+  name_.resize(options_.path.size() + 32);
+  std::snprintf(name_.data(), name_.size(), options_.path.c_str(), static_cast<int>(index));
+  bool ok = false;
+  try {
+    ok = cv::imwrite(name_.c_str(), image_bgr);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) {
+    throw InputError(std::string(name_.c_str()) + ": cannot write frame " + std::to_string(index));
+  }
+  ++written_;
+}
+
+void FrameWriter::close() {
+  if (video_.isOpened()) video_.release();
+}
+
+}  // namespace softsight

@@ -1,0 +1,112 @@
+#include "softsight/pipeline/run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+bool NeedsColour(const TrackingConfig& config) {
+  for (const MarkerSpec& spec : config.markers) {
+    if (!IsTemplateMethod(spec.method) || spec.templ.colour) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
+                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const TrackingConfig& config = session.config();
+  RunSummary summary;
+  summary.source = source.description();
+  RunInfo info;
+  info.source = summary.source;
+  info.fps = source.fps();
+  info.live = source.is_live();
+  info.frame_count = source.frame_count();
+  if (options.max_frames && (!info.frame_count || *options.max_frames < *info.frame_count)) {
+    info.frame_count = options.max_frames;
+  }
+  for (const MarkerSpec& spec : config.markers) {
+    info.marker_names.push_back(spec.name);
+    summary.markers.push_back({spec.name, 0});
+  }
+  const MetricModel& metric = config.measure.metric;
+  info.metric = metric.scale_mm_per_px.has_value() || metric.plane_mm_from_image.has_value();
+
+  std::vector<double> proc_ms;
+  if (info.frame_count) {
+    // Reserved once: the loop does not reallocate for files (cameras grow it geometrically).
+    proc_ms.reserve(static_cast<size_t>(std::min<int64_t>(*info.frame_count, int64_t{1} << 22)));
+  }
+  size_t begun = 0;  // Sinks whose begin() has run: exactly these get end().
+  const auto begin_sinks = [&] {
+    for (; begun < sinks.size(); ++begun) sinks[begun]->begin(info);
+  };
+  const bool needs_colour = NeedsColour(config);
+
+  const auto finish = [&] {
+    summary.dropped = source.dropped_frames();
+    SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
+    summary.wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (size_t i = 0; i < begun; ++i) sinks[i]->end(summary);
+  };
+
+  Frame frame;
+  try {
+    for (;;) {
+      if (options.max_frames && summary.frames >= *options.max_frames) {
+        summary.stop_reason = StopReason::kMaxFrames;
+        break;
+      }
+      if (options.stop_requested && options.stop_requested()) {
+        summary.stop_reason = StopReason::kStopRequested;
+        break;
+      }
+      if (!source.read(frame)) {
+        summary.stop_reason = StopReason::kEndOfInput;
+        break;
+      }
+      if (summary.frames == 0) {
+        if (needs_colour && IsGrayscale(frame.image)) {
+          throw InputError(summary.source +
+                           ": the video is grayscale, but colour tracking needs colour (use "
+                           "--method zncc, which matches in gray)");
+        }
+        info.frame_size = frame.image.size();
+        begin_sinks();
+        summary.first_index = frame.index;
+      }
+      const FrameResult& result = session.process(frame);
+      for (size_t i = 0; i < result.markers.size(); ++i) {
+        summary.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
+      }
+      summary.measured += result.measurement.angle_deg ? 1 : 0;
+      proc_ms.push_back(result.proc_ms);
+      for (FrameSink* sink : sinks) sink->consume(frame, result);
+      ++summary.frames;
+      summary.last_index = frame.index;
+    }
+    if (begun == 0) begin_sinks();  // An empty source: sinks still see begin() and end().
+  } catch (const InputError& error) {
+    summary.stop_reason = StopReason::kError;
+    summary.error = error.what();
+  } catch (const std::exception& error) {
+    // Not a user error (a bug, or a caller's own exception such as a stop raised mid-wait):
+    // the sinks still close their files, then it goes on to the caller.
+    summary.stop_reason = StopReason::kError;
+    summary.error = error.what();
+    finish();
+    throw;
+  }
+  finish();
+  return summary;
+}
+
+}  // namespace softsight

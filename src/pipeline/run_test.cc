@@ -1,0 +1,316 @@
+// RunPipeline: every frame of a file reaches every sink with the source's index, the summary's
+// counts match the renderer's truth, and a stop request or an error ends the run with a summary.
+#include "softsight/pipeline/run.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/io/frame_writer.h"
+#include "softsight/pipeline/sinks.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::TempDir;
+
+MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
+  MarkerSpec spec;
+  spec.name = name;
+  spec.colour.h = hue;
+  spec.colour.s = {80, 255};
+  spec.colour.v = {40, 255};
+  return spec;
+}
+
+TrackingConfig SceneConfig() {
+  TrackingConfig config;
+  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
+                    ColourMarker("green", {45, 85})};
+  config.measure.base = "red";
+  config.measure.middle = "blue";
+  config.measure.tip = "green";
+  return config;
+}
+
+SceneOptions SmallScene(int frames) {
+  SceneOptions scene;
+  scene.size = {320, 240};
+  scene.length_px = 150;
+  scene.width_px = 24;
+  scene.marker_radius_px = 6;
+  scene.frame_count = frames;
+  scene.max_bend_deg = 120;
+  return scene;
+}
+
+// Remembers what it was given, and can ask the run to stop or fail after some frames.
+class RecordingSink : public FrameSink {
+ public:
+  void begin(const RunInfo& info) override {
+    ++begins;
+    this->info = info;
+  }
+  void consume(const Frame& frame, const FrameResult& result) override {
+    indices.push_back(frame.index);
+    times.push_back(frame.time_s);
+    result_indices.push_back(result.frame_index);
+    std::vector<bool> flags;
+    for (const MarkerObservation& m : result.markers) flags.push_back(m.observation.found());
+    found.push_back(flags);
+    if (fail_at && static_cast<int64_t>(indices.size()) == *fail_at) {
+      throw InputError("disk full at frame " + std::to_string(frame.index));
+    }
+  }
+  void end(const RunSummary& summary) override {
+    ++ends;
+    ended_with = summary;
+  }
+
+  int begins = 0, ends = 0;
+  RunInfo info;
+  std::vector<int64_t> indices, result_indices;
+  std::vector<double> times;
+  std::vector<std::vector<bool>> found;
+  std::optional<int64_t> fail_at;
+  RunSummary ended_with;
+};
+
+TEST(RunPipeline, VideoFileNeverDropsAFrameAndEveryRowCarriesTheSourceIndex) {
+  TempDir dir;
+  const SceneOptions options = SmallScene(12);
+  SyntheticScene scene(options);
+  {
+    FrameWriter writer({dir.file("clip.avi"), "", options.fps});
+    cv::Mat image;
+    for (int i = 0; i < options.frame_count; ++i) {
+      scene.render(i, image);
+      writer.write(image, i);
+    }
+  }
+  FrameSourceSpec spec;
+  spec.input = dir.file("clip.avi");
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  const RunSummary summary = RunPipeline(*source, session, {&sink});
+
+  EXPECT_EQ(summary.stop_reason, StopReason::kEndOfInput);
+  EXPECT_EQ(summary.frames, 12);
+  EXPECT_EQ(summary.dropped, 0);
+  EXPECT_EQ(summary.first_index, 0);
+  EXPECT_EQ(summary.last_index, 11);
+  ASSERT_EQ(sink.indices.size(), 12u);
+  for (size_t i = 0; i < sink.indices.size(); ++i) {
+    EXPECT_EQ(sink.indices[i], static_cast<int64_t>(i));
+    EXPECT_EQ(sink.result_indices[i], sink.indices[i]) << "the row names the source's frame";
+    EXPECT_NEAR(sink.times[i], static_cast<double>(i) / options.fps, 1e-6);
+  }
+  EXPECT_EQ(sink.begins, 1);
+  EXPECT_EQ(sink.ends, 1);
+  EXPECT_EQ(sink.info.frame_size, options.size);
+  EXPECT_EQ(sink.info.frame_count, 12);
+  EXPECT_THAT(sink.info.marker_names, ::testing::ElementsAre("red", "blue", "green"));
+}
+
+TEST(RunPipeline, ImageSequenceKeepsItsFileIndicesAndRate) {
+  TempDir dir;
+  const SceneOptions options = SmallScene(5);
+  SyntheticScene scene(options);
+  {
+    FrameWriter writer({dir.file("f%03d.png"), "", options.fps});
+    cv::Mat image;
+    for (int i = 0; i < options.frame_count; ++i) {
+      scene.render(i, image);
+      writer.write(image, i);
+    }
+  }
+  FrameSourceSpec spec;
+  spec.input = dir.file("f%03d.png");
+  spec.sequence_fps = 10.0;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  const RunSummary summary = RunPipeline(*source, session, {&sink});
+  EXPECT_EQ(summary.frames, 5);
+  EXPECT_EQ(summary.dropped, 0);
+  ASSERT_EQ(sink.indices.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(sink.indices[i], static_cast<int64_t>(i));
+    EXPECT_NEAR(sink.times[i], 0.1 * static_cast<double>(i), 1e-9);
+  }
+}
+
+TEST(RunPipeline, FoundCountsMatchTheRenderersTruth) {
+  // The tip marker is fully covered in frames 4..8 and fully visible otherwise, so "found" must
+  // be exactly "visible" (the colour tracker reports a covered marker as not found).
+  SceneOptions options = SmallScene(14);
+  SyntheticScene probe(options);
+  cv::Mat image;
+  cv::Rect2d around_tip;  // Where the tip marker is during frames 4..8, with a margin.
+  for (int i = 4; i <= 8; ++i) {
+    const cv::Point2d tip = *probe.render(i, image).markers[2].centroid_px;
+    const double r = options.marker_radius_px + 2;
+    const cv::Rect2d box(tip.x - r, tip.y - r, 2 * r, 2 * r);
+    around_tip = i == 4 ? box : (around_tip | box);
+  }
+  Occluder cover;
+  cover.rect_px = around_tip;
+  cover.first_frame = 4;
+  cover.last_frame = 8;
+  SyntheticScene scene(options, NoiseOptions{}, RenderOptions{}, {cover});
+
+  std::vector<Frame> frames;
+  std::vector<SceneTruth> truth;
+  for (int i = 0; i < options.frame_count; ++i) {
+    Frame frame;
+    truth.push_back(scene.render(i, frame.image));
+    frame.index = i;
+    frame.time_s = truth.back().time_s;
+    frames.push_back(frame);
+  }
+  // A source over the rendered frames.
+  class Frames : public FrameSource {
+   public:
+    explicit Frames(const std::vector<Frame>& frames) : frames_(frames) {}
+    bool read(Frame& frame) override {
+      if (next_ >= frames_.size()) return false;
+      frame = frames_[next_++];
+      return true;
+    }
+    std::string description() const override { return "rendered frames"; }
+    std::optional<int64_t> frame_count() const override {
+      return static_cast<int64_t>(frames_.size());
+    }
+    std::optional<double> fps() const override { return 30.0; }
+
+   private:
+    const std::vector<Frame>& frames_;
+    size_t next_ = 0;
+  } source(frames);
+
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  const RunSummary summary = RunPipeline(source, session, {&sink});
+  ASSERT_EQ(summary.frames, 14);
+  std::vector<int64_t> visible(3, 0);
+  for (size_t f = 0; f < truth.size(); ++f) {
+    for (size_t m = 0; m < 3; ++m) {
+      const double fraction = truth[f].markers[m].visible_fraction;
+      ASSERT_TRUE(fraction == 0.0 || fraction == 1.0) << "the cover must hide all or nothing";
+      visible[m] += fraction == 1.0 ? 1 : 0;
+      EXPECT_EQ(sink.found[f][m], fraction == 1.0) << "frame " << f << " marker " << m;
+    }
+  }
+  ASSERT_EQ(visible[2], 9);
+  for (size_t m = 0; m < 3; ++m) {
+    EXPECT_EQ(summary.markers[m].found, visible[m]) << summary.markers[m].name;
+  }
+  EXPECT_DOUBLE_EQ(summary.found_rate(2), 9.0 / 14.0);
+  EXPECT_EQ(summary.measured, 9) << "the angle needs all three markers";
+  EXPECT_THAT(summary.BriefReport(), HasSubstr("green 64.3 %"));
+  EXPECT_THAT(summary.FullReport(), HasSubstr("green"));
+}
+
+TEST(RunPipeline, StopRequestEndsCleanlyWithASummary) {
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  RunOptions options;
+  options.stop_requested = [&sink] { return sink.indices.size() >= 3; };
+  const RunSummary summary = RunPipeline(*source, session, {&sink}, options);
+  EXPECT_EQ(summary.stop_reason, StopReason::kStopRequested);
+  EXPECT_TRUE(summary.ok());
+  EXPECT_EQ(summary.frames, 3);
+  EXPECT_EQ(sink.ends, 1);
+  EXPECT_EQ(sink.ended_with.frames, 3);
+  EXPECT_EQ(sink.ended_with.stop_reason, StopReason::kStopRequested);
+  EXPECT_THAT(summary.FullReport(), HasSubstr("stop requested"));
+}
+
+TEST(RunPipeline, MaxFramesAndTheKnownCountReachTheSinks) {
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  RunOptions options;
+  options.max_frames = 4;
+  const RunSummary summary = RunPipeline(*source, session, {&sink}, options);
+  EXPECT_EQ(summary.stop_reason, StopReason::kMaxFrames);
+  EXPECT_EQ(summary.frames, 4);
+  EXPECT_EQ(sink.info.frame_count, 4);
+}
+
+TEST(RunPipeline, AnErrorInASinkEndsTheRunWithItsMessage) {
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
+  TrackingSession session(SceneConfig());
+  RecordingSink first, failing;
+  failing.fail_at = 3;
+  const RunSummary summary = RunPipeline(*source, session, {&first, &failing});
+  EXPECT_EQ(summary.stop_reason, StopReason::kError);
+  EXPECT_FALSE(summary.ok());
+  EXPECT_THAT(summary.error, HasSubstr("disk full at frame 2"));
+  EXPECT_EQ(summary.frames, 2) << "the failing frame did not reach every sink";
+  EXPECT_EQ(first.ends, 1);
+  EXPECT_EQ(failing.ends, 1);
+}
+
+TEST(RunPipeline, ARunOfNoFramesStillBeginsAndEndsEverySink) {
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(5), NoiseOptions{});
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  RunOptions options;
+  options.max_frames = 0;
+  const RunSummary summary = RunPipeline(*source, session, {&sink}, options);
+  EXPECT_EQ(summary.frames, 0);
+  EXPECT_EQ(sink.begins, 1);
+  EXPECT_TRUE(sink.info.frame_size.empty());
+  EXPECT_EQ(sink.ends, 1);
+  EXPECT_FALSE(summary.first_index);
+}
+
+TEST(RunPipeline, GrayFramesForColourTrackingAreAnErrorNamingTheSource) {
+  class GraySource : public FrameSource {
+   public:
+    bool read(Frame& frame) override {
+      frame.image = cv::Mat(48, 64, CV_8UC3, cv::Scalar(90, 90, 90));
+      frame.index = index_++;
+      return true;
+    }
+    std::string description() const override { return "video gray.avi"; }
+    std::optional<int64_t> frame_count() const override { return std::nullopt; }
+    std::optional<double> fps() const override { return std::nullopt; }
+
+   private:
+    int64_t index_ = 0;
+  } source;
+  TrackingSession session(SceneConfig());
+  RecordingSink sink;
+  const RunSummary summary = RunPipeline(source, session, {&sink});
+  EXPECT_EQ(summary.stop_reason, StopReason::kError);
+  EXPECT_THAT(summary.error, HasSubstr("video gray.avi"));
+  EXPECT_THAT(summary.error, HasSubstr("grayscale"));
+  EXPECT_TRUE(sink.indices.empty());
+}
+
+TEST(CsvSink, WritesOneCompleteRowPerFrameWithTheSourceIndex) {
+  TempDir dir;
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(6), NoiseOptions{});
+  TrackingSession session(SceneConfig());
+  CsvSink csv(dir.file("run.csv"), TrackingColumns({"red", "blue", "green"}, false));
+  const RunSummary summary = RunPipeline(*source, session, {&csv});
+  ASSERT_EQ(summary.frames, 6);
+  const std::vector<std::string> lines = testing::ReadLines(dir.file("run.csv"));
+  ASSERT_EQ(lines.size(), 7u);
+  const size_t columns = testing::SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = testing::SplitCsv(lines[i]);
+    ASSERT_EQ(row.size(), columns);
+    EXPECT_EQ(row[0], std::to_string(i - 1));
+  }
+}
+
+}  // namespace
+}  // namespace softsight
