@@ -105,7 +105,7 @@ TEST(TemplateConfig, ErrorsNameTheKey) {
                       "colur: true}\n"),
               HasSubstr("colur"));
   EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 2, 30]}\n"),
-              HasSubstr("template.rect [1, 2, 2, 30]"));
+              HasSubstr("template.rect: [1, 2, 2, 30]"));
 }
 
 }  // namespace

@@ -53,10 +53,23 @@ std::string YamlMap::key_path(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
 }
 
+// The line of the deepest part of the dotted `key` that `node` has ("" when none).
+static std::string LineOfPath(const YAML::Node& node, const std::string& key) {
+  if (key.empty() || !node.IsMap()) return "";
+  const size_t dot = key.find('.');
+  const YAML::Node child = node[key.substr(0, dot)];
+  if (!child.IsDefined()) return "";
+  if (dot == std::string::npos) return LineOf(child);
+  const std::string deeper = LineOfPath(child, key.substr(dot + 1));
+  return deeper.empty() ? LineOf(child) : deeper;
+}
+
 void YamlMap::fail(const std::string& key, const std::string& problem) const {
-  const YAML::Node child = node_[key];
-  const std::string line = child.IsDefined() ? LineOf(child) : LineOf(node_);
-  throw InputError(file_ + ":" + line + " " + key_path(key) + ": " + problem);
+  // A dotted key ("blob.max_area", from a Check() message) points into nested mappings.
+  std::string line = LineOfPath(node_, key);
+  if (line.empty()) line = LineOf(node_);
+  const std::string where = key.empty() ? (path_.empty() ? "top level" : path_) : key_path(key);
+  throw InputError(file_ + ":" + line + " " + where + ": " + problem);
 }
 
 bool YamlMap::has(const std::string& key) const {

@@ -10,6 +10,7 @@
 
 #include "softsight/core/error.h"
 #include "track/colour_tracker_impl.h"
+#include "track/track_options.h"
 
 namespace softsight {
 namespace {
@@ -86,60 +87,27 @@ HsvBox CoarseBox(const ColourParams& p) {
 }  // namespace
 
 bool ColourParams::Check(std::string* error) const {
+  // Each field's range is in its table row (track/colour_options.cc); only rules across fields
+  // are written here.
+  if (const auto problem = CheckOptions(ColourParamsOptions(), *this)) return Fail(error, *problem);
   std::ostringstream why;
-  auto range_ok = [&](const HsvRange& r, const char* name, int max, bool may_wrap) {
-    if (r.lo < 0 || r.lo > max || r.hi < 0 || r.hi > max) {
-      why << "hsv." << name << " [" << r.lo << ", " << r.hi << "] must lie within 0.." << max;
-      return false;
+  for (const auto& [name, r] : {std::pair{"s", s}, std::pair{"v", v}}) {
+    if (r.lo > r.hi) {
+      why << "hsv." << name << ": [" << r.lo << ", " << r.hi << "]: lower bound above upper bound";
+      return Fail(error, why.str());
     }
-    if (!may_wrap && r.lo > r.hi) {
-      why << "hsv." << name << " [" << r.lo << ", " << r.hi << "]: lower bound above upper bound";
-      return false;
-    }
-    return true;
-  };
-  bool ok = true;
-  if (filter != Filter::kNone && (filter_ksize < 3 || filter_ksize > 31 || filter_ksize % 2 == 0)) {
-    why << "filter.ksize " << filter_ksize << " must be odd, 3..31";
-    ok = false;
-  } else if (!range_ok(h, "h", 179, true) || !range_ok(s, "s", 255, false) ||
-             !range_ok(v, "v", 255, false)) {
-    ok = false;
-  } else if (morph_size < 1 || morph_size > 31 || morph_size % 2 == 0) {
-    why << "morphology.size " << morph_size << " must be odd, 1..31 (1 disables it)";
-    ok = false;
-  } else if (!(min_area_px >= 1.0)) {
-    why << "blob.min_area " << min_area_px << " must be at least 1 pixel";
-    ok = false;
-  } else if (!(max_area_px == 0.0 || max_area_px >= min_area_px)) {
-    why << "blob.max_area " << max_area_px << " must be 0 (no limit) or at least blob.min_area";
-    ok = false;
-  } else if (!(min_circularity >= 0.0 && min_circularity <= 1.0)) {
-    why << "blob.min_circularity " << min_circularity << " must lie within 0..1";
-    ok = false;
-  } else if (!(min_area_fraction >= 0.0 && min_area_fraction <= 1.0)) {
-    why << "blob.min_area_fraction " << min_area_fraction << " must lie within 0..1";
-    ok = false;
-  } else if (!(max_area_factor == 0.0 || max_area_factor >= 1.0)) {
-    why << "blob.max_area_factor " << max_area_factor << " must be 0 (no limit) or at least 1";
-    ok = false;
-  } else if (roi && (roi->x < 0 || roi->y < 0 || roi->width <= 0 || roi->height <= 0)) {
-    why << "roi [" << roi->x << ", " << roi->y << ", " << roi->width << ", " << roi->height
-        << "] needs x, y >= 0 and a positive width and height";
-    ok = false;
-  } else if (window_px != 0 && (window_px < 8 || window_px > 4096)) {
-    why << "window " << window_px << " must be 0 (whole frame) or 8..4096 pixels";
-    ok = false;
-  } else if (widen_steps < 0 || widen_steps > 8) {
-    why << "widen_steps " << widen_steps << " must lie within 0..8";
-    ok = false;
-  } else if (acquire_downsample != 0 && acquire_downsample != 1 && acquire_downsample != 2 &&
-             acquire_downsample != 4 && acquire_downsample != 8) {
-    why << "acquire_downsample " << acquire_downsample << " must be 0 (automatic), 1, 2, 4 or 8";
-    ok = false;
   }
-  if (!ok && error) *error = why.str();
-  return ok;
+  if (max_area_px != 0.0 && max_area_px < min_area_px) {
+    why << "blob.max_area: " << FormatDouble(max_area_px)
+        << " must be 0 (no limit) or at least blob.min_area (" << FormatDouble(min_area_px) << ")";
+    return Fail(error, why.str());
+  }
+  if (roi && (roi->width <= 0 || roi->height <= 0)) {
+    why << "roi: [" << roi->x << ", " << roi->y << ", " << roi->width << ", " << roi->height
+        << "] needs a positive width and height";
+    return Fail(error, why.str());
+  }
+  return true;
 }
 
 HsvBox HsvBox::Make(HsvRange h, HsvRange s, HsvRange v) {

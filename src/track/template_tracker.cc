@@ -10,6 +10,7 @@
 #include "softsight/core/error.h"
 #include "softsight/track/tracker.h"
 #include "track/match_kernels.h"
+#include "track/track_options.h"
 
 namespace softsight {
 
@@ -505,51 +506,24 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
 }  // namespace
 
 bool TemplateParams::Check(std::string* error) const {
-  auto fail = [error](const std::string& problem) {
-    if (error) *error = problem;
-    return false;
-  };
-  const int cn = colour ? 3 : 1;
-  if (template_frame < 0) {
-    return fail("template.frame " + std::to_string(template_frame) + " must be >= 0");
+  // Each field's range is in its table row (track/template_options.cc); only rules across fields
+  // are written here.
+  if (const auto problem = CheckOptions(TemplateParamsOptions(), *this)) {
+    return Fail(error, *problem);
   }
+  if (rect && !image_file.empty()) {
+    return Fail(error, "template.file: give either rect or file, not both");
+  }
+  const int cn = colour ? 3 : 1;
   if (rect) {
-    if (rect->x < 0 || rect->y < 0 || rect->width < kMinTemplatePx ||
-        rect->height < kMinTemplatePx) {
-      return fail("template.rect " + RectText(*rect) +
-                  " must start at x, y >= 0 and be at least 3x3 px");
+    if (rect->width < kMinTemplatePx || rect->height < kMinTemplatePx) {
+      return Fail(error, "template.rect: " + RectText(*rect) + " must be at least 3x3 px");
     }
     if (rect->area() * cn > kMaxTemplateValues || rect->width * cn > kMaxTemplateRowBytes) {
-      return fail("template.rect " + RectText(*rect) + " is too large (at most " +
-                  std::to_string(kMaxTemplateValues / cn) + " px" + (colour ? " in colour)" : ")"));
+      return Fail(error, "template.rect: " + RectText(*rect) + " is too large (at most " +
+                             std::to_string(kMaxTemplateValues / cn) + " px" +
+                             (colour ? " in colour)" : ")"));
     }
-  }
-  if (!(min_zncc >= -1.0 && min_zncc <= 1.0)) {
-    return fail("template.min_zncc " + std::to_string(min_zncc) + " must be in [-1, 1]");
-  }
-  if (!(max_sad > 0.0 && max_sad <= 255.0)) {
-    return fail("template.max_sad " + std::to_string(max_sad) + " must be in (0, 255]");
-  }
-  if (!(max_ssd > 0.0 && max_ssd <= 255.0)) {
-    return fail("template.max_ssd " + std::to_string(max_ssd) + " must be in (0, 255]");
-  }
-  if (search_margin_px < 1 || search_margin_px > 4096) {
-    return fail("template.search_margin_px " + std::to_string(search_margin_px) +
-                " must be in 1..4096");
-  }
-  if (acquire_radius_px < 0) {
-    return fail("template.acquire_radius_px " + std::to_string(acquire_radius_px) +
-                " must be >= 0 (0: whole frame)");
-  }
-  if (pyramid_levels < 1 || pyramid_levels > 6) {
-    return fail("template.pyramid_levels " + std::to_string(pyramid_levels) + " must be in 1..6");
-  }
-  if (!(update_rate >= 0.0 && update_rate < 1.0)) {
-    return fail("template.update_rate " + std::to_string(update_rate) + " must be in [0, 1)");
-  }
-  if (!(drift_min_zncc >= -1.0 && drift_min_zncc <= 1.0)) {
-    return fail("template.drift_min_zncc " + std::to_string(drift_min_zncc) +
-                " must be in [-1, 1]");
   }
   return true;
 }

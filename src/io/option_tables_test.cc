@@ -1,0 +1,92 @@
+// Every option of every table: YAML round trip, the same message from the file and from Check(),
+// sane int ranges, and the example configs mentioning every key (option_table_test_util.h).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/config_sections.h"
+#include "io/config_test_util.h"
+#include "io/option_table_test_util.h"
+#include "track/track_options.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string Example(const std::string& name) {
+  return testing::ReadTextFile(std::string(SOFTSIGHT_TEST_SOURCE_DIR) + "/examples/" + name);
+}
+
+TEST(OptionTables, ColourParams) {
+  testing::OptionTableSuite<ColourParams>{
+      ColourParamsOptions(), "markers[0]",
+      [](YamlMap& m, ColourParams* p) { ReadColourParams(m, p); },
+      [](const ColourParams& p, YAML::Emitter& out) { WriteColourParams(p, out); },
+      [](const ColourParams& p, std::string* e) { return p.Check(e); }}
+      .Run();
+}
+
+TEST(OptionTables, TemplateParams) {
+  testing::OptionTableSuite<TemplateParams>{
+      TemplateParamsOptions(), "markers[0]",
+      [](YamlMap& m, TemplateParams* p) { ReadTemplateParams(m, p); },
+      [](const TemplateParams& p, YAML::Emitter& out) { WriteTemplateParams(p, out); },
+      [](const TemplateParams& p, std::string* e) { return p.Check(e); }}
+      .Run();
+}
+
+TEST(OptionTables, TheExamplesMentionEveryKey) {
+  EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
+            std::vector<std::string>{});
+}
+
+TEST(OptionTables, MessageNamesFileLineAndFullKeyPath) {
+  const std::string error = testing::ConfigErrorOf(
+      "markers:\n  - name: red\n    blob:\n      min_area: 20\n      min_circularity: 1.5\n");
+  EXPECT_THAT(error, HasSubstr("markers.yaml:5: markers[0].blob.min_circularity: 1.5 must lie "
+                               "within 0..1"));
+  ColourParams p;
+  p.min_circularity = 1.5;
+  std::string problem;
+  EXPECT_FALSE(p.Check(&problem));
+  EXPECT_EQ(problem, "blob.min_circularity: 1.5 must lie within 0..1");
+}
+
+TEST(OptionTables, CrossFieldRulesNameTheirKeyAndLine) {
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    blob: {min_area: 50,\n"
+                                     "      max_area: 10}\n"),
+              HasSubstr("markers.yaml:4: markers[0].blob.max_area: 10 must be 0 (no limit) or at "
+                        "least blob.min_area (50)"));
+}
+
+TEST(OptionTables, UnknownAndDuplicateNestedKeysAreRejected) {
+  EXPECT_THAT(testing::ConfigErrorOf(
+                  "markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], colur: true}\n"),
+              HasSubstr("markers[0].template.colur: unknown key"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    blob:\n      min_area: 3\n"
+                                     "      min_area: 4\n"),
+              HasSubstr("markers[0].blob.min_area: key given twice"));
+}
+
+TEST(OptionTables, IntOverflowIsARangeError) {
+  // Issue 10, item 6: this used to overflow a signed int inside the tracker.
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [205, 186, 25, "
+                                     "25], acquire_radius_px: 2147483647}\n"),
+              HasSubstr("markers[0].template.acquire_radius_px: 2147483647 must lie within "
+                        "0..16384"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    window: 99999999999999999999\n"),
+              HasSubstr("markers[0].window: expected a whole number"));
+}
+
+TEST(OptionTables, DescriptionListsEveryKeyWithItsDefault) {
+  const std::string doc = DescribeOptions(ColourParamsOptions());
+  EXPECT_THAT(doc, HasSubstr("blob:\n"));
+  EXPECT_THAT(doc, HasSubstr("  min_circularity: 0.5"));
+  EXPECT_THAT(doc, HasSubstr("0..1"));
+  EXPECT_THAT(doc, HasSubstr("# roi:"));
+  const std::string templ = DescribeOptions(TemplateParamsOptions());
+  EXPECT_THAT(templ, HasSubstr("template:\n  frame: 0"));
+}
+
+}  // namespace
+}  // namespace softsight
