@@ -114,3 +114,154 @@ void RenderBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* ba
 }
 
 }  // namespace softsight::sim
+
+namespace softsight::sim {
+namespace {
+
+float Smoothstep(float edge0, float edge1, float x) {
+  const float t = std::clamp((x - edge0) / (edge1 - edge0), 0.f, 1.f);
+  return t * t * (3 - 2 * t);
+}
+
+// A patch's colour class, so that every seed has some of each.
+enum class PatchTint { kDark, kReddish, kGreenish, kBluish };
+
+cv::Vec3f PatchColour(PatchTint tint, const cv::Vec3f& wood, cv::RNG& rng) {
+  const float v = static_cast<float>(rng.uniform(0.6, 1.1));
+  switch (tint) {
+    case PatchTint::kDark: return wood * static_cast<float>(rng.uniform(0.3, 0.55));
+    // Hues near the marker colours, saturation from dull to marker-like.
+    case PatchTint::kReddish:
+      return cv::Vec3f(rng.uniform(35.f, 80.f), rng.uniform(35.f, 75.f), rng.uniform(120.f, 175.f)) * v;
+    case PatchTint::kGreenish:
+      return cv::Vec3f(rng.uniform(55.f, 95.f), rng.uniform(110.f, 160.f), rng.uniform(50.f, 100.f)) * v;
+    case PatchTint::kBluish:
+      return cv::Vec3f(rng.uniform(120.f, 175.f), rng.uniform(80.f, 120.f), rng.uniform(40.f, 85.f)) * v;
+  }
+  return wood;
+}
+
+}  // namespace
+
+void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* background_ss,
+                           cv::Mat* background) {
+  cv::RNG rng(seed * 0xD1B54A32D192ED03ull + 0x8CB92BA72F3D8DD7ull);
+  const int s = supersample;
+  const double w = size.width, h = size.height;
+  const double scale = std::min(w, h) / 480.0;
+
+  // Wood: a base colour between light oak and walnut, grain stripes along a near-horizontal
+  // direction warped by a smooth field, streaks stretched along the grain.
+  const double mix = rng.uniform(0.0, 1.0);
+  const cv::Vec3f oak(112, 160, 200), walnut(62, 96, 138);
+  const cv::Vec3f wood = oak * static_cast<float>(1 - mix) + walnut * static_cast<float>(mix);
+  const double grain_angle = rng.uniform(-0.25, 0.25);
+  const double period = rng.uniform(7.0, 13.0) * scale + 2.0;
+  const cv::Mat1f warp = SmoothField(size, 4, 1.0, rng);
+  const cv::Mat1f rings = SmoothField(size, 9, 1.0, rng);
+  cv::Mat1f streaks;
+  {
+    const int cols = std::max(2, size.width / 60), rows = std::max(2, size.height / 2);
+    cv::Mat1f coarse(rows, cols);
+    rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
+    cv::resize(coarse, streaks, size, 0, 0, cv::INTER_CUBIC);
+  }
+  const cv::Mat1f blotch = SmoothField(size, 6, 1.0, rng);
+  cv::Mat3f bench(size);
+  const float ca = static_cast<float>(std::cos(grain_angle)), sa = static_cast<float>(std::sin(grain_angle));
+  for (int y = 0; y < size.height; ++y) {
+    cv::Vec3f* out = bench.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const float across = -sa * x + ca * y + 30.f * static_cast<float>(scale) * warp(y, x) +
+                           8.f * rings(y, x);
+      const float g = 0.5f + 0.5f * std::sin(static_cast<float>(2 * CV_PI / period) * across);
+      const float m = 1.f - 0.16f * g * g - 0.05f * streaks(y, x) + 0.08f * blotch(y, x);
+      out[x] = wood * m;
+    }
+  }
+
+  // Patches: ragged blotches (an ellipse eaten by a smooth field), in every colour class.
+  const cv::Mat1f ragged = SmoothField(size, 16, 1.0, rng);
+  const int patches = std::max(8, static_cast<int>(std::lround(14 * w * h / (640.0 * 480.0))));
+  for (int i = 0; i < patches; ++i) {
+    const PatchTint tint = static_cast<PatchTint>((i + static_cast<int>(seed)) % 4);
+    const cv::Vec3f colour = PatchColour(tint, wood, rng);
+    const cv::Point2d c(rng.uniform(-0.05, 1.05) * w, rng.uniform(-0.05, 1.05) * h);
+    const double ra = rng.uniform(18.0, 75.0) * scale, rb = ra * rng.uniform(0.4, 1.0);
+    const double t = rng.uniform(0.0, CV_PI);
+    const double opacity = rng.uniform(0.45, 0.9);
+    const double ct = std::cos(t), st = std::sin(t);
+    const double reach = 1.6 * ra;
+    const int x0 = std::max(0, static_cast<int>(c.x - reach)), x1 = std::min(size.width - 1, static_cast<int>(c.x + reach));
+    const int y0 = std::max(0, static_cast<int>(c.y - reach)), y1 = std::min(size.height - 1, static_cast<int>(c.y + reach));
+    for (int y = y0; y <= y1; ++y) {
+      cv::Vec3f* out = bench.ptr<cv::Vec3f>(y);
+      for (int x = x0; x <= x1; ++x) {
+        const double dx = x - c.x, dy = y - c.y;
+        const double u = (ct * dx + st * dy) / ra, v = (-st * dx + ct * dy) / rb;
+        const float rho = static_cast<float>(std::sqrt(u * u + v * v));
+        const float alpha =
+            static_cast<float>(opacity) * Smoothstep(0.f, 0.35f, 1.f - rho + 0.45f * ragged(y, x));
+        if (alpha > 0) out[x] = out[x] * (1 - alpha) + colour * alpha;
+      }
+    }
+  }
+  cv::Mat1f grain(size);
+  rng.fill(grain, cv::RNG::NORMAL, 0.0, 4.0);
+  cv::Mat3b low(size);
+  for (int y = 0; y < size.height; ++y) {
+    const cv::Vec3f* in = bench.ptr<cv::Vec3f>(y);
+    cv::Vec3b* out = low.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < size.width; ++x) {
+      for (int k = 0; k < 3; ++k) out[x][k] = cv::saturate_cast<uchar>(in[x][k] + grain(y, x));
+    }
+  }
+  cv::resize(low, *background_ss, cv::Size(size.width * s, size.height * s), 0, 0,
+             cv::INTER_LINEAR);
+  cv::Mat& ss = *background_ss;
+  auto to_ss = [s](const cv::Point2d& p) {
+    return cv::Point(cvRound((p.x + 0.5) * s - 0.5), cvRound((p.y + 0.5) * s - 0.5));
+  };
+
+  // Tape strips: long rotated rectangles, slightly translucent, with a darker edge line.
+  const cv::Scalar tapes[] = {{150, 196, 214},   // masking tape
+                              {158, 160, 162},   // grey duct tape
+                              {228, 230, 232},   // white tape
+                              {200, 150, 70}};   // blue painter's tape
+  for (int i = 0; i < 2; ++i) {
+    const cv::Point2d c(rng.uniform(0.1, 0.9) * w, rng.uniform(0.1, 0.9) * h);
+    const double length = rng.uniform(0.3, 0.6) * std::max(w, h);
+    const double width = rng.uniform(14.0, 26.0) * scale + 2;
+    const double a = rng.uniform(0.0, CV_PI);
+    const cv::Point2d d(std::cos(a), std::sin(a)), n(-std::sin(a), std::cos(a));
+    const cv::Point corners[4] = {to_ss(c - d * (length / 2) - n * (width / 2)),
+                                  to_ss(c + d * (length / 2) - n * (width / 2)),
+                                  to_ss(c + d * (length / 2) + n * (width / 2)),
+                                  to_ss(c - d * (length / 2) + n * (width / 2))};
+    const cv::Scalar colour = tapes[rng.uniform(0, 4)];
+    cv::Mat layer = ss.clone();
+    cv::fillConvexPoly(layer, corners, 4, colour, cv::LINE_8);
+    cv::polylines(layer, std::vector<cv::Point>(corners, corners + 4), true, colour * 0.8,
+                  std::max(1, s / 2), cv::LINE_8);
+    cv::addWeighted(layer, 0.88, ss, 0.12, 0.0, ss);
+  }
+
+  // A cable: a long thin curve across the bench, dark with a highlight.
+  const cv::Point2d ctrl[4] = {{rng.uniform(-0.1, 0.3) * w, -10},
+                               {rng.uniform(-0.2, 1.2) * w, rng.uniform(0.2, 0.5) * h},
+                               {rng.uniform(-0.2, 1.2) * w, rng.uniform(0.5, 0.8) * h},
+                               {rng.uniform(0.7, 1.1) * w, h + 10}};
+  std::vector<cv::Point> cable;
+  for (int i = 0; i <= 96; ++i) cable.push_back(to_ss(Bezier(ctrl, i / 96.0)));
+  const double cable_px = rng.uniform(3.5, 6.0) * scale + 1;
+  const int grey = rng.uniform(22, 48);
+  cv::polylines(ss, cable, false, cv::Scalar(grey, grey, grey + 4), cvRound(cable_px * s),
+                cv::LINE_8);
+  std::vector<cv::Point> shine(cable);
+  for (cv::Point& p : shine) p.x -= cvRound(0.2 * cable_px * s);
+  cv::polylines(ss, shine, false, cv::Scalar(grey + 45, grey + 45, grey + 48),
+                std::max(1, cvRound(0.2 * cable_px * s)), cv::LINE_8);
+  cv::resize(ss, *background, size, 0, 0, cv::INTER_AREA);
+}
+
+}  // namespace softsight::sim

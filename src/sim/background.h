@@ -14,4 +14,10 @@ namespace softsight::sim {
 void RenderBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* background_ss,
                       cv::Mat* background);
 
+// The same for a blotchy wood-like bench (BackgroundKind::kBench): wood grain, irregular dark,
+// reddish, greenish and bluish patches (some as saturated as a marker, but large and ragged,
+// never compact discs), two tape strips and a cable. Deterministic from the seed.
+void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* background_ss,
+                           cv::Mat* background);
+
 }  // namespace softsight::sim

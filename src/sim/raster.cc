@@ -100,4 +100,74 @@ void FillDisc(const cv::Point2d& centre, double radius, const cv::Point& origin,
   }
 }
 
+Conic::Conic(double a, double b, double c, double d, double e, double g)
+    : a_(a), b_(b), c_(c), d_(d), e_(e), g_(g) {
+  if (a_ < 0) {  // Bounded region negative.
+    a_ = -a_, b_ = -b_, c_ = -c_, d_ = -d_, e_ = -e_, g_ = -g_;
+  }
+  a = a_, b = b_, c = c_, d = d_, e = e_;
+  // Centre: where the gradient vanishes; the ellipse is (p - p0)^T Q (p - p0) = -f(p0) with
+  // Q = [a b/2; b/2 c], and its extent along x is sqrt(-f(p0) (Q^-1)_xx) (same for y).
+  const double det = a * c - b * b / 4;
+  if (!(det > 0)) return;
+  const double x0 = (b * e / 2 - c * d) / (2 * det), y0 = (b * d / 2 - a * e) / (2 * det);
+  centre_ = cv::Point2d(x0, y0);
+  const double f0 = value(x0, y0);
+  if (!(f0 < 0)) return;
+  const double half_w = std::sqrt(-f0 * c / det);
+  const double half_h = std::sqrt(-f0 * a / det);
+  // One sub-pixel beyond the edge covers the ramp (and the first-order distance estimate).
+  const int bx0 = static_cast<int>(std::floor(x0 - half_w - 1.5));
+  const int by0 = static_cast<int>(std::floor(y0 - half_h - 1.5));
+  const int bx1 = static_cast<int>(std::ceil(x0 + half_w + 1.5));
+  const int by1 = static_cast<int>(std::ceil(y0 + half_h + 1.5));
+  bounds_ = cv::Rect(bx0, by0, bx1 - bx0 + 1, by1 - by0 + 1);
+}
+
+Conic Conic::Ellipse(const cv::Point2d& centre, const cv::Size2d& radii, double angle_deg) {
+  const double t = angle_deg * CV_PI / 180.0;
+  const double ct = std::cos(t), st = std::sin(t);
+  const double ia = 1.0 / (radii.width * radii.width), ib = 1.0 / (radii.height * radii.height);
+  // (u/ra)^2 + (v/rb)^2 - 1 with u = ct dx + st dy, v = -st dx + ct dy. Scaled by the mean radius
+  // squared only to keep the numbers near 1; the coverage does not depend on the scale.
+  const double k = radii.width * radii.height;
+  const double a = k * (ct * ct * ia + st * st * ib);
+  const double b = k * 2 * ct * st * (ia - ib);
+  const double c = k * (st * st * ia + ct * ct * ib);
+  const double x = centre.x, y = centre.y;
+  return Conic(a, b, c, -2 * a * x - b * y, -2 * c * y - b * x,
+               a * x * x + b * x * y + c * y * y - k);
+}
+
+Conic Conic::CircleThrough(const cv::Matx33d& image_from_plane, const cv::Point2d& centre,
+                           double radius) {
+  // The circle's matrix C (q^T C q = 0 for plane points q = (u, v, 1)); the image conic is
+  // H^-T C H^-1. Its sign is kept: for p = lambda H q, p^T C' p = lambda^2 q^T C q.
+  const cv::Matx33d circle(1, 0, -centre.x, 0, 1, -centre.y, -centre.x, -centre.y,
+                           centre.x * centre.x + centre.y * centre.y - radius * radius);
+  const cv::Matx33d inv = image_from_plane.inv();
+  cv::Matx33d m = inv.t() * circle * inv;
+  const double scale = 1.0 / std::max(std::abs(m(0, 0)), std::abs(m(1, 1)));
+  m *= scale;
+  return Conic(m(0, 0), m(0, 1) + m(1, 0), m(1, 1), m(0, 2) + m(2, 0), m(1, 2) + m(2, 1), m(2, 2));
+}
+
+void FillConic(const Conic& conic, const cv::Point& origin, const cv::Vec3b& bgr,
+               cv::Mat& canvas) {
+  const cv::Rect box = conic.bounds() & cv::Rect(origin, canvas.size());
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    cv::Vec3b* row = canvas.ptr<cv::Vec3b>(y - origin.y);
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      const double c = conic.coverage(x, y);
+      if (c <= 0) continue;
+      cv::Vec3b& p = row[x - origin.x];
+      if (c >= 1) {
+        p = bgr;
+      } else {
+        for (int k = 0; k < 3; ++k) p[k] = cv::saturate_cast<uchar>(p[k] + c * (bgr[k] - p[k]));
+      }
+    }
+  }
+}
+
 }  // namespace softsight::sim

@@ -51,4 +51,47 @@ void FillPolygon(const std::vector<cv::Point2d>& outline_px, int s, const cv::Po
 void FillDisc(const cv::Point2d& centre, double radius, const cv::Point& origin,
               const cv::Vec3b& bgr, cv::Mat& canvas);
 
+// A filled ellipse given as the conic f(x, y) = a x^2 + b xy + c y^2 + d x + e y + g, negative
+// inside, in supersampled coordinates. Every ellipse the renderer draws is one: an ellipse
+// drawn directly, or a circle on a plane seen through a homography (a conic stays a conic).
+// Its edge is drawn like a disc's: a sub-pixel at signed distance t from the boundary
+// (estimated to first order as f / |grad f|) is covered by clamp(0.5 - t, 0, 1). That field is
+// point-symmetric about the ellipse's centre, so the coverage centroid is the centre.
+class Conic {
+ public:
+  // An ellipse with centre, semi-axes (the first along angle_deg, clockwise in the image) in
+  // supersampled pixels.
+  static Conic Ellipse(const cv::Point2d& centre, const cv::Size2d& radii, double angle_deg);
+  // The image of the circle (centre, radius) of a plane under the homography `image_from_plane`
+  // (image = supersampled pixels). The circle must lie in front of the camera.
+  static Conic CircleThrough(const cv::Matx33d& image_from_plane, const cv::Point2d& centre,
+                             double radius);
+
+  double value(double x, double y) const {
+    return (a_ * x + b_ * y + d_) * x + (c_ * y + e_) * y + g_;
+  }
+  double coverage(int x, int y) const {
+    const double f = value(x, y);
+    const double gx = 2 * a_ * x + b_ * y + d_, gy = b_ * x + 2 * c_ * y + e_;
+    const double g2 = gx * gx + gy * gy;
+    // Deep inside (f < 0, far from the edge) the gradient may vanish at the centre.
+    if (f <= 0 && f * f >= 2.25 * g2) return 1.0;
+    if (f > 0 && f * f >= 0.25 * g2) return 0.0;
+    return std::min(1.0, std::max(0.0, 0.5 - f / std::sqrt(g2)));
+  }
+  // The ellipse's centre and the whole sub-pixels that may have non-zero coverage; empty when
+  // the conic is not a real ellipse.
+  cv::Point2d centre() const { return centre_; }
+  cv::Rect bounds() const { return bounds_; }
+
+ private:
+  Conic(double a, double b, double c, double d, double e, double g);
+  double a_, b_, c_, d_, e_, g_;
+  cv::Point2d centre_;
+  cv::Rect bounds_;
+};
+
+// Draws the filled ellipse into `canvas` (see FillPolygon), blending its edge by coverage.
+void FillConic(const Conic& conic, const cv::Point& origin, const cv::Vec3b& bgr, cv::Mat& canvas);
+
 }  // namespace softsight::sim

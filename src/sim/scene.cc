@@ -10,6 +10,7 @@
 
 #include "sim/actuator.h"
 #include "sim/background.h"
+#include "sim/camera.h"
 #include "sim/raster.h"
 #include "softsight/core/error.h"
 
@@ -29,14 +30,6 @@ std::string Num(double v) {
 bool Fail(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
   return false;
-}
-
-// Per-frame noise stream: a function of (seed, frame), so frames can be rendered in any order.
-uint64_t Mix(uint64_t seed, uint64_t index) {
-  uint64_t z = seed + 0x9E3779B97F4A7C15ull * (index + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
 }
 
 
@@ -80,6 +73,18 @@ bool SceneOptions::Check(std::string* error) const {
     return Fail(error, "length_px: " + Num(length_px) + " is too short for the " +
                            SceneKindName(kind) + " plates to carry markers of radius " +
                            Num(marker_radius_px));
+  }
+  for (size_t i = 0; i < distractors.size(); ++i) {
+    const Distractor& d = distractors[i];
+    if (!(std::isfinite(d.centre_px.x) && std::isfinite(d.centre_px.y) &&
+          std::isfinite(d.angle_deg) && std::isfinite(d.radii_px.width) &&
+          std::isfinite(d.radii_px.height) && d.radii_px.width > 0 && d.radii_px.height > 0)) {
+      return Fail(error, "distractors: distractor " + std::to_string(i + 1) +
+                             " needs a finite centre and angle and positive radii");
+    }
+  }
+  if (background != BackgroundKind::kDefault && background != BackgroundKind::kBench) {
+    return Fail(error, "background: unknown kind " + std::to_string(static_cast<int>(background)));
   }
   std::set<std::string> names;
   for (const SceneMarker& marker : markers) {
@@ -156,11 +161,7 @@ struct SyntheticScene::Impl {
   Impl(SceneOptions s, NoiseOptions n, RenderOptions r, std::vector<Occluder> o)
       : scene(std::move(s)), noise(n), render(r), occluders(std::move(o)), model(scene) {}
 
-  double gain(int index) const {
-    const double t =
-        scene.frame_count > 1 ? std::clamp(index / double(scene.frame_count - 1), 0.0, 1.0) : 0.0;
-    return noise.gain_start + (noise.gain_end - noise.gain_start) * t;
-  }
+  double gain(int index) const { return sim::GainAt(noise, index, scene.frame_count); }
 
   void compute_truth(SceneTruth* truth);
   SceneTruth render_pose(double bend_deg, double time_s, int index, cv::Mat& image);
@@ -193,7 +194,20 @@ SyntheticScene::SyntheticScene(SceneOptions scene, NoiseOptions noise, RenderOpt
   for (const Occluder& o : m.occluders) {
     m.occluder_ss.push_back(sim::SupersampledRect(o.rect_px, s) & image_ss);
   }
-  sim::RenderBackground(m.scene.size, s, m.scene.seed, &m.background_ss, &m.background);
+  if (m.scene.background == BackgroundKind::kBench) {
+    sim::RenderBenchBackground(m.scene.size, s, m.scene.seed, &m.background_ss, &m.background);
+  } else {
+    sim::RenderBackground(m.scene.size, s, m.scene.seed, &m.background_ss, &m.background);
+  }
+  if (!m.scene.distractors.empty()) {
+    const cv::Point origin(0, 0);
+    for (const Distractor& d : m.scene.distractors) {
+      const sim::Conic ellipse = sim::Conic::Ellipse(sim::ToSupersampled(d.centre_px, s),
+                                                     d.radii_px * double(s), d.angle_deg);
+      sim::FillConic(ellipse, origin, d.bgr, m.background_ss);
+    }
+    cv::resize(m.background_ss, m.background, m.scene.size, 0, 0, cv::INTER_AREA);
+  }
   m.canvas_ss.create(image_ss.size(), CV_8UC3);
   m.mask_ss.create(image_ss.size(), CV_8U);
   if (m.scene.markers.size() >= 3) {
@@ -285,16 +299,7 @@ SceneTruth SyntheticScene::Impl::render_pose(double bend_deg, double time_s, int
   cv::Mat out = image(dirty);
   cv::resize(canvas, out, dirty.size(), 0, 0, cv::INTER_AREA);
 
-  // The camera: optics, illumination, then sensor noise.
-  if (noise.blur_sigma_px > 0) cv::GaussianBlur(image, image, cv::Size(0, 0), noise.blur_sigma_px);
-  const double g = gain(index);
-  if (g != 1.0) image.convertTo(image, -1, g);
-  if (noise.sigma > 0) {
-    cv::RNG rng(Mix(noise.seed, static_cast<uint64_t>(index)));
-    noise_buffer.create(scene.size, CV_16SC3);
-    rng.fill(noise_buffer, cv::RNG::NORMAL, 0.0, noise.sigma);
-    cv::add(image, noise_buffer, image, cv::noArray(), CV_8U);
-  }
+  sim::ApplyCamera(noise, gain(index), index, image, noise_buffer);
 
   SceneTruth truth;
   truth.frame_index = index;
@@ -365,7 +370,7 @@ MeasureOptions SceneMeasureOptions(const SceneOptions& scene) {
     return scene.markers[a].body_fraction < scene.markers[b].body_fraction;
   });
   MeasureOptions options;
-  if (order.empty()) return options;
+  if (order.size() < 3) return options;
   options.base = scene.markers[order.front()].name;
   options.middle = scene.markers[order[order.size() / 2]].name;
   options.tip = scene.markers[order.back()].name;

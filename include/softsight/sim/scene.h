@@ -21,6 +21,25 @@ enum class SceneKind {
   kWedge4,   // The paper's 4-segment triangle actuator, opening to 80 degrees.
 };
 
+// The backdrop behind the actuator.
+enum class BackgroundKind {
+  kDefault,  // A grey lab bench: lighting gradient, soft blobs, grain, a cable, screws. Nothing
+             // in it has a marker's saturation.
+  kBench,    // A blotchy wood-like bench: grain, dark, reddish, greenish and bluish patches (some
+             // as saturated as a marker), tape strips and a cable. Made to tempt colour trackers.
+};
+
+// A filled, anti-aliased ellipse of one colour drawn on the backdrop, behind the actuator: a
+// blob a tracker must not take for a marker. Positions in output pixels (pixel-centre
+// convention); `radii_px` are the semi-axes, the first along `angle_deg` (clockwise in the
+// image, from the x axis).
+struct Distractor {
+  cv::Point2d centre_px{};
+  cv::Size2d radii_px{};
+  double angle_deg = 0.0;
+  cv::Vec3b bgr{};
+};
+
 struct SceneMarker {
   std::string name;
   cv::Vec3b bgr;            // Marker colour (saturated, so HSV thresholds separate it).
@@ -48,6 +67,9 @@ struct SceneOptions {
                                       {"blue", {220, 90, 40}, 0.5},
                                       {"green", {60, 200, 60}, 0.9}};
   uint64_t seed = 1;        // Background texture.
+  BackgroundKind background = BackgroundKind::kDefault;
+  // Drawn on the backdrop in order (later ones over earlier ones); see MakeMarkerDistractors.
+  std::vector<Distractor> distractors{};
 
   // False with a one-line message naming the bad field.
   bool Check(std::string* error) const;
@@ -98,7 +120,8 @@ struct SceneTruth {
   std::vector<MarkerTruth> markers;
   // The paper's measurements from the true centroids: base, middle and tip are the markers with
   // the smallest, median and largest body_fraction (all of them as a chain when more than 3);
-  // the tip reference is the tip marker's centre when the actuator is straight.
+  // the tip reference is the tip marker's centre when the actuator is straight. Default (empty)
+  // with fewer than three markers and for the plate scene.
   Measurement measurement;
 };
 
@@ -132,8 +155,19 @@ class SyntheticScene {
 
 // The markers a scene's truth measures: base, middle and tip are those with the smallest, median
 // and largest body_fraction, and the whole chain when there are more than three. Tools that track
-// a rendered scene use it so they measure exactly what the truth does. Empty without markers.
+// a rendered scene use it so they measure exactly what the truth does. Empty (no triple, no
+// chain) with fewer than three markers: one or two markers give positions only.
 MeasureOptions SceneMeasureOptions(const SceneOptions& scene);
+
+// Distractors for every marker colour of `scene`, the look-alikes a colour tracker meets on a
+// real bench: a larger blob (about 3 x 2.3 marker radii), an elongated one (2 x 0.75), a darker
+// one of the same hue and size (half the brightness), and circles of the wrong size (0.5 and 2
+// marker radii). Each lies inside the frame and at least a marker radius (and 6 px) away from
+// everything the actuator covers over its whole motion, and from the other distractors, so the
+// markers stay the only right answer. Deterministic in (scene, seed). Where the frame has no
+// room left, the remaining ones are left out (the result may be shorter, never overlapping).
+// Throws InputError when the actuator does not fit the image (as SyntheticScene does).
+std::vector<Distractor> MakeMarkerDistractors(const SceneOptions& scene, uint64_t seed);
 
 // Parses "bending", "wedge1", "wedge4"; throws InputError listing the choices.
 SceneKind ParseSceneKind(const std::string& name);
