@@ -97,7 +97,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       ->check(CLI::ExistingFile);
   CLI::Option* input = sub.add_option("-i,--input", options->source.input,
                  "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
-                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4")
+                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, synth:plate")
       ;
   sub.add_option("--camera", options->source.camera,
                  "Camera index (V4L2) instead of --input: tracks until Ctrl-C or --max-frames")

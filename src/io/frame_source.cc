@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <variant>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -11,7 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "softsight/core/error.h"
-#include "softsight/sim/scene.h"
+#include "softsight/sim/builtin_scenes.h"
 
 namespace softsight {
 namespace fs = std::filesystem;
@@ -204,9 +205,13 @@ class CameraSource : public FrameSource {
   std::chrono::steady_clock::time_point start_;
 };
 
+// Any rendered scene (SyntheticScene, PlateScene) as a source.
+template <class Scene>
 class SyntheticSource : public FrameSource {
  public:
-  SyntheticSource(const SceneOptions& scene, const NoiseOptions& noise) : scene_(scene, noise) {}
+  template <class Options>
+  SyntheticSource(const Options& scene, const NoiseOptions& noise, std::string description)
+      : scene_(scene, noise), description_(std::move(description)) {}
 
   bool read(Frame& frame) override {
     if (next_index_ >= scene_.frame_count()) return false;
@@ -215,14 +220,13 @@ class SyntheticSource : public FrameSource {
     frame.time_s = truth.time_s;
     return true;
   }
-  std::string description() const override {
-    return std::string("synthetic scene ") + SceneKindName(scene_.options().kind);
-  }
+  std::string description() const override { return description_; }
   std::optional<int64_t> frame_count() const override { return scene_.frame_count(); }
   std::optional<double> fps() const override { return scene_.options().fps; }
 
  private:
-  SyntheticScene scene_;
+  Scene scene_;
+  std::string description_;
   int next_index_ = 0;
 };
 
@@ -248,9 +252,9 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
   }
   if (!(spec.sequence_fps > 0)) throw InputError("--fps must be positive");
   if (input.rfind(kSyntheticPrefix, 0) == 0) {
-    SceneOptions scene;
-    scene.kind = ParseSceneKind(input.substr(std::string(kSyntheticPrefix).size()));
-    return OpenSyntheticSource(scene, NoiseOptions{});
+    const BuiltinSceneOptions scene =
+        ParseBuiltinScene(input.substr(std::string(kSyntheticPrefix).size()));
+    return std::visit([](const auto& o) { return OpenSyntheticSource(o, NoiseOptions{}); }, scene);
   }
   if (input.find('%') != std::string::npos) return OpenPattern(input, spec.sequence_fps);
   if (fs::is_directory(input)) return OpenFolder(input, spec.sequence_fps);
@@ -264,7 +268,14 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
 
 std::unique_ptr<FrameSource> OpenSyntheticSource(const SceneOptions& scene,
                                                  const NoiseOptions& noise) {
-  return std::make_unique<SyntheticSource>(scene, noise);
+  std::string description = std::string("synthetic scene ") + SceneKindName(scene.kind);
+  if (scene.background == BackgroundKind::kBench) description += " on the textured bench";
+  return std::make_unique<SyntheticSource<SyntheticScene>>(scene, noise, std::move(description));
+}
+
+std::unique_ptr<FrameSource> OpenSyntheticSource(const PlateSceneOptions& scene,
+                                                 const NoiseOptions& noise) {
+  return std::make_unique<SyntheticSource<PlateScene>>(scene, noise, "synthetic scene plate");
 }
 
 }  // namespace softsight

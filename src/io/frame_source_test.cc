@@ -10,6 +10,7 @@
 
 #include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/sim/plate_scene.h"
 
 namespace softsight {
 namespace {
@@ -167,6 +168,20 @@ TEST(SyntheticSource, RendersTheNamedSceneWithItsTimestamps) {
   EXPECT_EQ(frame.image.type(), CV_8UC3);
   EXPECT_FALSE(IsGrayscale(frame.image));
   EXPECT_THROW(OpenFrameSource({"synth:spiral", {}, 30.0}), InputError);
+}
+
+TEST(SyntheticSource, OpensTheBenchAndThePlate) {
+  auto bench = OpenFrameSource({"synth:bench", {}, 30.0});
+  EXPECT_THAT(bench->description(), HasSubstr("bench"));
+  Frame frame;
+  ASSERT_TRUE(bench->read(frame));
+  EXPECT_FALSE(IsGrayscale(frame.image));
+  auto plate = OpenFrameSource({"synth:plate", {}, 30.0});
+  EXPECT_THAT(plate->description(), HasSubstr("plate"));
+  ASSERT_TRUE(plate->read(frame));
+  EXPECT_EQ(frame.image.type(), CV_8UC3);
+  EXPECT_TRUE(IsGrayscale(frame.image));
+  EXPECT_EQ(plate->frame_count(), PlateSceneOptions{}.frame_count);
 }
 
 TEST(IsGrayscale, TellsGrayFromColour) {

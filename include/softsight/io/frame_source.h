@@ -42,10 +42,12 @@ class FrameSource {
 namespace softsight {
 
 struct SceneOptions;
+struct PlateSceneOptions;
 struct NoiseOptions;
 
 // How to open a source. Exactly one of `input` or `camera` is used.
-// `input` naming a built-in synthetic scene: "synth:bending", "synth:wedge1", "synth:wedge4".
+// `input` naming a built-in synthetic scene: "synth:bending", "synth:wedge1", "synth:wedge4",
+// "synth:bench", "synth:plate" (see softsight/sim/builtin_scenes.h).
 inline constexpr const char* kSyntheticPrefix = "synth:";
 
 struct FrameSourceSpec {
@@ -62,6 +64,8 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec);
 
 // A synthetic scene as a source (frames rendered on demand, exact timestamps from the scene).
 std::unique_ptr<FrameSource> OpenSyntheticSource(const SceneOptions& scene,
+                                                 const NoiseOptions& noise);
+std::unique_ptr<FrameSource> OpenSyntheticSource(const PlateSceneOptions& scene,
                                                  const NoiseOptions& noise);
 
 // True when every pixel of a BGR frame has B == G == R (a grayscale video decoded as BGR).
