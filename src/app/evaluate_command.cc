@@ -21,6 +21,7 @@
 #include "softsight/io/config.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "softsight/sim/builtin_scenes.h"
 
 namespace softsight {
 namespace {
@@ -346,7 +347,7 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
       "and with the template's constant placement offset removed), misses, false reports, angle\n"
       "error and time per frame. No video file is written. See docs/evaluation.md.\n"
       "Example: softsight evaluate --noise 5 --csv noise5.csv");
-  sub.add_option("--scene", *scene_name, "bending, wedge1 or wedge4")->capture_default_str();
+  sub.add_option("--scene", *scene_name, "bending, wedge1, wedge4 or bench (textured, with look-alike blobs)")->capture_default_str();
   sub.add_option("--frames", options->scene.frame_count, "Frames to render and track")
       ->capture_default_str();
   sub.add_option("--noise", options->noise.sigma, "Sensor noise sigma in grey levels")
@@ -374,7 +375,7 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", options->quiet, "No progress line");
   return [options, scene_name, gain_ramp] {
     EvaluateOptions run = *options;
-    run.scene.kind = ParseSceneKind(*scene_name);
+    SetActuatorScene(*scene_name, &run.scene);
     run.noise.seed = run.scene.seed;  // As `softsight synth` does, so both render the same frames.
     if (!gain_ramp->empty()) ParseGainRamp(*gain_ramp, &run.noise);
     std::cout << FormatEvaluateMarkdown(RunEvaluate(run));

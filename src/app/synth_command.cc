@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
+#include "softsight/sim/builtin_scenes.h"
 
 namespace softsight {
 namespace {
@@ -170,7 +171,8 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
   sub.add_option("--scene", *scene_name,
                  "bending: a silicone band bending from straight to --max-bend degrees; "
                  "wedge1 / wedge4: the paper's triangle actuators (1 segment opening 20 degrees, "
-                 "4 segments opening 80)")
+                 "4 segments opening 80); bench: bending on a textured bench with look-alike "
+                 "blobs of every marker colour")
       ->capture_default_str();
   sub.add_option("-o,--out", options->out,
                  "Video (.avi/.mkv: lossless FFV1; .mp4: lossy) or image pattern "
@@ -211,8 +213,8 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
   sub.add_option("--codec", options->codec, "Video codec override: ffv1, hfyu, mjpg or mp4v");
   sub.add_flag("-q,--quiet", options->quiet, "No summary line");
   return [options, scene_name, size, occlusions] {
-    options->scene.kind = ParseSceneKind(*scene_name);
     options->scene.size = ParseSize(*size);
+    SetActuatorScene(*scene_name, &options->scene);
     options->noise.seed = options->scene.seed;
     options->occluders.clear();
     for (const std::string& text : *occlusions) options->occluders.push_back(ParseOccluder(text));

@@ -18,6 +18,12 @@ using BuiltinSceneOptions = std::variant<SceneOptions, PlateSceneOptions>;
 
 // Throws InputError naming the scene and listing the choices.
 BuiltinSceneOptions ParseBuiltinScene(const std::string& name);
+
+// Makes `scene` the named actuator scene ("bending", "wedge1", "wedge4" or "bench") while keeping
+// its size, timing, body and seed: sets the kind, and for "bench" the textured bench and the
+// marker distractors, which depend on everything else, so call it when the rest is final.
+// Throws InputError listing the actuator scenes.
+void SetActuatorScene(const std::string& name, SceneOptions* scene);
 // "bending, wedge1, wedge4, bench or plate", for messages and help texts.
 const char* BuiltinSceneNames();
 
