@@ -42,9 +42,10 @@ struct EvaluateOptions {
   void Check() const;
 };
 
-// One method's figures over the whole sequence. "Visible" means visible_fraction >= 0.5 in the
-// renderer's truth; marker-frames with a smaller visible part count neither as misses nor in the
-// error, since finding or losing a mostly covered marker are both acceptable.
+// One method's figures over the whole sequence, from the one truth scorer (sim/truth_score.h):
+// "visible" means visible_fraction >= kMustFindVisibleFraction (0.5) in the renderer's truth;
+// marker-frames with a smaller visible part count neither as misses nor in the error, since
+// finding or losing a mostly covered marker are both acceptable.
 struct MethodResult {
   std::string method;               // colour, sad, ssd, zncc
   std::optional<std::string> mode;  // gray or colour for the template methods; absent for colour.

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "app/truth_sink.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/scene.h"
@@ -84,38 +85,38 @@ TEST(TrackCommand, RenderedVideoGivesTruthWithinTolerances) {
   options.source.input = clip.video;
   options.csv_file = dir.file("out.csv");
   options.quiet = true;
-  const RunSummary summary = RunTrack(options);
+  TruthScoreSink truth(clip.truth, 3);  // The one scorer against the renderer's truth.
+  const RunSummary summary = RunTrack(options, nullptr, {&truth});
   EXPECT_EQ(summary.frames, 40);
   EXPECT_EQ(summary.stop_reason, StopReason::kEndOfInput);
   EXPECT_EQ(summary.dropped, 0);
   ASSERT_EQ(summary.markers.size(), 3u);
   for (const MarkerRunSummary& marker : summary.markers) EXPECT_EQ(marker.found, 40);
+  const TruthScore score = truth.score();
+  EXPECT_EQ(score.visible, 120);
+  EXPECT_EQ(score.misses, 0);
+  EXPECT_EQ(score.false_reports, 0);
+  ASSERT_TRUE(score.centroid_rms_px && score.angle_rms_deg);
+  EXPECT_LT(*score.centroid_rms_px, 0.1) << "centroid RMS error, px";
+  EXPECT_LT(*score.angle_rms_deg, 0.2) << "angle RMS error, deg";
 
+  // The CSV says the same: one row per source frame, millimetres = scale x pixels.
   const std::vector<std::string> lines = testing::ReadLines(options.csv_file);
   ASSERT_EQ(lines.size(), 41u);
   const std::vector<std::string> header = testing::SplitCsv(lines[0]);
   auto column = [&](const std::string& name) {
     return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
   };
-  double squared_error = 0, angle_squared_error = 0;
   for (int i = 0; i < 40; ++i) {
     const std::vector<std::string> row = testing::SplitCsv(lines[i + 1]);
     ASSERT_EQ(row.size(), header.size());
     EXPECT_EQ(row[column("frame")], std::to_string(i));
-    for (const MarkerTruth& marker : clip.truth[i].markers) {
-      ASSERT_TRUE(marker.centroid_px.has_value());
-      const double dx = std::stod(row[column(marker.name + "_x")]) - marker.centroid_px->x;
-      const double dy = std::stod(row[column(marker.name + "_y")]) - marker.centroid_px->y;
-      squared_error += dx * dx + dy * dy;
-    }
-    const double angle = std::stod(row[column("angle_deg")]);
-    angle_squared_error += std::pow(angle - *clip.truth[i].measurement.angle_deg, 2);
-    // Millimetres are the configured scale times pixels.
+    const cv::Point2d red = *clip.truth[i].markers[0].centroid_px;
+    EXPECT_NEAR(std::stod(row[column("red_x")]), red.x, 0.3);
+    EXPECT_NEAR(std::stod(row[column("red_y")]), red.y, 0.3);
     EXPECT_NEAR(std::stod(row[column("chord_mm")]), 0.2 * std::stod(row[column("chord_px")]),
                 1e-3);
   }
-  EXPECT_LT(std::sqrt(squared_error / (40 * 3)), 0.1) << "centroid RMS error, px";
-  EXPECT_LT(std::sqrt(angle_squared_error / 40), 0.2) << "angle RMS error, deg";
 }
 
 TEST(TrackCommand, AnnotatedVideoHasEveryFrameWithTheOverlayOnTheMarkers) {

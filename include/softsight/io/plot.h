@@ -13,22 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "softsight/io/csv_reader.h"
+
 namespace softsight {
-
-// A CSV read into columns of optional numbers (an empty field, "nan" or "inf" is absent).
-struct CsvTable {
-  std::string source;                                      // File name, for messages and the title.
-  std::vector<std::string> columns;                        // Header names, in file order.
-  std::vector<std::vector<std::optional<double>>> values;  // values[column][row].
-
-  size_t row_count() const { return values.empty() ? 0 : values.front().size(); }
-  std::optional<size_t> find(const std::string& column) const;
-};
-
-// Reads a comma-separated file with a header line. Throws InputError (one line naming the file,
-// line and column) when the file is missing or unreadable, a row has the wrong number of fields,
-// or a field is not a number.
-CsvTable ReadCsvTable(const std::string& file);
 
 struct PlotOptions {
   int width_px = 1000;        // Figure width. Narrower than ~400 leaves no room for tick labels.
