@@ -65,12 +65,12 @@ TEST(ControlConfig, ReadsTheExampleAndRejectsBadKeys) {
   EXPECT_THAT(error_of("control:\n  controller:\n    kp: 1\n"),
               HasSubstr("c.yaml:3: control.controller.kp"));
   EXPECT_THAT(error_of("control:\n  controller:\n    kp_kpa_per_deg: -1\n"),
-              HasSubstr("control.controller.kp_kpa_per_deg: value -1 is outside"));
+              HasSubstr("control.controller.kp_kpa_per_deg: -1 must lie within 0..100"));
   EXPECT_THAT(error_of("control:\n  controller:\n    min_kpa: 10\n    max_kpa: 5\n"),
-              HasSubstr("control.controller.max_kpa must be > min_kpa"));
+              HasSubstr("control.controller.max_kpa: 5 must be above min_kpa (10)"));
   EXPECT_THAT(error_of("control:\n  link:\n    baud: 12345\n"), HasSubstr("control.link.baud"));
   EXPECT_THAT(error_of("control:\n  rig:\n    board:\n      loop_hz: 100\n"),
-              HasSubstr("control.rig.board.loop_hz: value 100 is outside"));
+              HasSubstr("control.rig.board.loop_hz: 100 must lie within 200..5000"));
   EXPECT_THAT(error_of("control:\n  rig:\n    plant: {chamber_volume_ml: 0}\n"),
               HasSubstr("chamber_volume_ml"));
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "softsight/core/error.h"
+#include "control/control_options.h"
 
 namespace softsight {
 namespace {
@@ -25,14 +26,8 @@ const char* ErrorName(int32_t code) {
 }  // namespace
 
 bool LinkOptions::Check(std::string* error) const {
-  if (reply_timeout_ms < 5 || reply_timeout_ms > 10000) {
-    if (error) *error = "reply_timeout_ms must be in 5..10000";
-    return false;
-  }
-  if (retries < 0 || retries > 10) {
-    if (error) *error = "retries must be in 0..10";
-    return false;
-  }
+  // Each field's range is its row in control/control_options.cc.
+  if (const auto problem = CheckOptions(LinkOptionsTable(), *this)) return Fail(error, *problem);
   return true;
 }
 

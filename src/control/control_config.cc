@@ -1,21 +1,15 @@
 #include "softsight/control/control_config.h"
 
+#include "core/option_table.h"
+
 namespace softsight {
 
 bool ControlConfig::Check(std::string* error) const {
+  // Each part checks its table and its own cross-field rules; the key gets the part's prefix.
   std::string problem;
-  if (!controller.Check(&problem)) {
-    if (error) *error = "controller." + problem;
-    return false;
-  }
-  if (!link.Check(&problem)) {
-    if (error) *error = "link." + problem;
-    return false;
-  }
-  if (!rig.Check(&problem)) {
-    if (error) *error = "rig." + problem;
-    return false;
-  }
+  if (!controller.Check(&problem)) return Fail(error, "controller." + problem);
+  if (!link.Check(&problem)) return Fail(error, "link." + problem);
+  if (!rig.Check(&problem)) return Fail(error, "rig." + problem);
   return true;
 }
 

@@ -4,24 +4,19 @@
 #include <cassert>
 #include <cmath>
 
+#include "control/control_options.h"
+
 namespace softsight {
 
 bool ControllerOptions::Check(std::string* error) const {
-  auto fail = [&](const char* what) {
-    if (error) *error = what;
-    return false;
-  };
-  auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
-  if (!finite_nonneg(kp_kpa_per_deg)) return fail("kp_kpa_per_deg must be >= 0");
-  if (!finite_nonneg(ki_kpa_per_deg_s)) return fail("ki_kpa_per_deg_s must be >= 0");
-  if (!finite_nonneg(kd_kpa_s_per_deg)) return fail("kd_kpa_s_per_deg must be >= 0");
-  if (!finite_nonneg(derivative_filter_s)) return fail("derivative_filter_s must be >= 0");
-  if (!std::isfinite(bias_kpa)) return fail("bias_kpa must be finite");
-  if (!finite_nonneg(ff_kpa_per_deg)) return fail("ff_kpa_per_deg must be >= 0");
-  if (!finite_nonneg(min_kpa)) return fail("min_kpa must be >= 0");
-  if (!std::isfinite(max_kpa) || max_kpa <= min_kpa) return fail("max_kpa must be > min_kpa");
-  if (!finite_nonneg(max_rate_kpa_per_s)) return fail("max_rate_kpa_per_s must be >= 0");
-  if (!finite_nonneg(hold_s)) return fail("hold_s must be >= 0");
+  // Each field's range is its row in control/control_options.cc; only rules across fields here.
+  if (const auto problem = CheckOptions(ControllerOptionsTable(), *this)) {
+    return Fail(error, *problem);
+  }
+  if (!(max_kpa > min_kpa)) {
+    return Fail(error, "max_kpa: " + FormatDouble(max_kpa) + " must be above min_kpa (" +
+                           FormatDouble(min_kpa) + ")");
+  }
   return true;
 }
 

@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "control/control_options.h"
+
 namespace softsight {
 namespace {
 
@@ -15,20 +17,8 @@ constexpr double kSubstepS = 0.0002;
 }  // namespace
 
 bool PlantOptions::Check(std::string* error) const {
-  auto fail = [&](const char* what) {
-    if (error) *error = what;
-    return false;
-  };
-  if (!(chamber_volume_ml > 0)) return fail("chamber_volume_ml must be > 0");
-  if (!(pump_flow_l_per_min >= 0)) return fail("pump_flow_l_per_min must be >= 0");
-  if (!(pump_stall_kpa > 0)) return fail("pump_stall_kpa must be > 0");
-  if (!(vent_flow_l_per_min > 0)) return fail("vent_flow_l_per_min must be > 0");
-  if (!(leak_l_per_min >= 0)) return fail("leak_l_per_min must be >= 0");
-  if (!(bend_start_kpa >= 0)) return fail("bend_start_kpa must be >= 0");
-  if (!(bend_deg_per_kpa > 0)) return fail("bend_deg_per_kpa must be > 0");
-  if (!(max_bend_deg > 0 && max_bend_deg <= 340)) return fail("max_bend_deg must be in (0, 340]");
-  if (!(bend_lag_s > 0)) return fail("bend_lag_s must be > 0");
-  if (!(hysteresis_deg >= 0)) return fail("hysteresis_deg must be >= 0");
+  // Each field's range is its row in control/control_options.cc.
+  if (const auto problem = CheckOptions(PlantOptionsTable(), *this)) return Fail(error, *problem);
   return true;
 }
 

@@ -8,27 +8,23 @@
 #include <cmath>
 
 #include "softsight/core/error.h"
+#include "control/control_options.h"
 
 namespace softsight {
 
 bool RigOptions::Check(std::string* error) const {
-  if (const char* problem = CheckBoardConfig(board)) {
-    if (error) *error = std::string("board: ") + problem;
-    return false;
+  // Each field's range (board.*, plant.* included) is its row in control/control_options.cc;
+  // only rules across fields here.
+  if (const auto problem = CheckOptions(RigOptionsTable(), *this)) return Fail(error, *problem);
+  if (board.guard_margin_pa + board.guard_release_pa >= board.pressure_limit_pa) {
+    return Fail(error, "board.guard_margin_kpa: " + FormatDouble(board.guard_margin_pa / 1e3) +
+                           " plus guard_release_kpa (" +
+                           FormatDouble(board.guard_release_pa / 1e3) +
+                           ") must stay below pressure_limit_kpa (" +
+                           FormatDouble(board.pressure_limit_pa / 1e3) + ")");
   }
-  std::string plant_error;
-  if (!plant.Check(&plant_error)) {
-    if (error) *error = "plant: " + plant_error;
-    return false;
-  }
-  if (!(end_marker_span > 0.0 && end_marker_span <= 1.0)) {
-    if (error) *error = "end_marker_span must be in (0, 1]";
-    return false;
-  }
-  if (!(sensor_noise_kpa >= 0.0)) {
-    if (error) *error = "sensor_noise_kpa must be >= 0";
-    return false;
-  }
+  // The board's own check (the firmware runs it too); the table's ranges are stricter.
+  if (const char* problem = CheckBoardConfig(board)) return Fail(error, std::string("board: ") + problem);
   return true;
 }
 

@@ -77,6 +77,15 @@ std::string FormatDouble(double value) {
   return std::string(buffer, result.ptr);
 }
 
+double FloatAsDouble(float value) {
+  if (!std::isfinite(value)) return static_cast<double>(value);
+  char buffer[64];
+  const auto written = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  double result = 0.0;
+  std::from_chars(buffer, written.ptr, result);
+  return result;
+}
+
 std::string OptionValueText(const OptionValue& value) {
   struct Visitor {
     std::string operator()(bool b) const { return b ? "true" : "false"; }

@@ -72,6 +72,8 @@ std::optional<std::string> OptionProblem(const OptionSpec& spec, const OptionVal
 // shortest text that reads back to the identical double.
 std::string OptionValueText(const OptionValue& value);
 std::string FormatDouble(double value);
+// The double whose shortest text is the float's shortest text (0.1f -> 0.1).
+double FloatAsDouble(float value);
 
 // "0..1", ">= 1", "odd, 3..31", "one of: none, gaussian, median", "0 (no limit) or 8..4096".
 std::string OptionRangeText(const OptionSpec& spec);
@@ -254,6 +256,14 @@ OptionBuilder<T> DoubleOption(std::string key, Access access) {
       } else {
         get_ref(t).reset();
       }
+    };
+  } else if constexpr (std::is_same_v<M, float>) {
+    // Through the float's shortest text, so 0.1f is 0.1 in a file, not 0.10000000149011612.
+    o.get = [get_ref](const T& t) -> std::optional<OptionValue> {
+      return OptionValue(FloatAsDouble(get_ref(const_cast<T&>(t))));
+    };
+    o.set = [get_ref](T& t, const std::optional<OptionValue>& v) {
+      if (v) get_ref(t) = static_cast<float>(std::get<double>(*v));
     };
   } else {
     o.get = [get_ref](const T& t) -> std::optional<OptionValue> {

@@ -142,6 +142,11 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   }
   WriteMetricModel(m.metric, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
+  if (config.control) {
+    out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;
+    WriteControlConfig(*config.control, out);
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
 
   std::ofstream stream(file);

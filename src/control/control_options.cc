@@ -1,0 +1,216 @@
+// The control section's settings, registered once: key, unit, range and doc of every field
+// (defaults: the structs). Ranges are what a person could sensibly mean, so that a typo (an
+// extra zero) is an error rather than a burst actuator.
+#include "control/control_options.h"
+
+#include <cmath>
+
+namespace softsight {
+namespace {
+
+OptionTable<ControllerOptions> MakeController() {
+  using P = ControllerOptions;
+  return {
+      DoubleOption<P>("kp_kpa_per_deg", &P::kp_kpa_per_deg)
+          .Range(0, 100)
+          .Unit("kPa/deg")
+          .Doc("proportional gain: kPa of setpoint per degree of error (the paper's P law)"),
+      DoubleOption<P>("ki_kpa_per_deg_s", &P::ki_kpa_per_deg_s)
+          .Range(0, 1000)
+          .Unit("kPa/(deg s)")
+          .Doc("integral gain; removes the steady-state error, 0 disables it"),
+      DoubleOption<P>("kd_kpa_s_per_deg", &P::kd_kpa_s_per_deg)
+          .Range(0, 100)
+          .Unit("kPa s/deg")
+          .Doc("derivative gain on the measurement (the camera's angle is noisy)"),
+      DoubleOption<P>("derivative_filter_s", &P::derivative_filter_s)
+          .Range(0, 10)
+          .Unit("s")
+          .Doc("first-order filter of the derivative"),
+      DoubleOption<P>("bias_kpa", &P::bias_kpa)
+          .Range(-100, 1000)
+          .Unit("kPa")
+          .Doc("feed-forward: the pressure at which the actuator starts to bend"),
+      DoubleOption<P>("ff_kpa_per_deg", &P::ff_kpa_per_deg)
+          .Range(0, 100)
+          .Unit("kPa/deg")
+          .Doc("feed-forward per degree of target bend (inverse static gain; 0: off)"),
+      DoubleOption<P>("min_kpa", &P::min_kpa)
+          .Range(0, 1000)
+          .Unit("kPa")
+          .Doc("lowest setpoint sent"),
+      DoubleOption<P>("max_kpa", &P::max_kpa)
+          .Range(0, 1000)
+          .Unit("kPa")
+          .Doc("highest setpoint sent (above min_kpa; the board clamps to its own limit too)"),
+      DoubleOption<P>("max_rate_kpa_per_s", &P::max_rate_kpa_per_s)
+          .Range(0, 100000)
+          .Unit("kPa/s")
+          .Doc("setpoint slew limit, protects the silicone on target steps (0: unlimited)"),
+      DoubleOption<P>("hold_s", &P::hold_s)
+          .Range(0, 60)
+          .Unit("s")
+          .Doc("vision lost: keep the last setpoint this long, then vent"),
+  };
+}
+
+OptionTable<LinkOptions> MakeLink() {
+  using P = LinkOptions;
+  return {
+      IntOption<P>("baud", &P::baud)
+          .OneOf({9600, 19200, 38400, 57600, 115200, 230400})
+          .Doc("serial baud rate (a 60-byte line takes ~5 ms at 115200)"),
+      IntOption<P>("reply_timeout_ms", &P::reply_timeout_ms)
+          .Range(5, 10000)
+          .Unit("ms")
+          .Doc("wait this long for an answer before re-sending"),
+      IntOption<P>("retries", &P::retries).Range(0, 10).Doc("re-sends before giving up with an error"),
+  };
+}
+
+// A board setting in kPa (the file) held in integer Pa (the board).
+Option<BoardConfig> KpaOption(const char* key, int32_t BoardConfig::*pa) {
+  return CustomOption<BoardConfig>(
+             key, OptionKind::kDouble,
+             [pa](const BoardConfig& b) -> std::optional<OptionValue> {
+               return OptionValue((b.*pa) / 1000.0);
+             },
+             [pa](BoardConfig& b, const std::optional<OptionValue>& v) {
+               if (v) b.*pa = static_cast<int32_t>(std::lround(std::get<double>(*v) * 1000.0));
+             })
+      .Unit("kPa");
+}
+
+OptionTable<BoardConfig> MakeBoard() {
+  using P = BoardConfig;
+  return {
+      OptionBuilder<P>(KpaOption("pressure_limit_kpa", &P::pressure_limit_pa))
+          .Range(1, 1000)
+          .Doc("hard gauge pressure limit the board's guard enforces"),
+      OptionBuilder<P>(KpaOption("guard_margin_kpa", &P::guard_margin_pa))
+          .Range(0, 100)
+          .Doc("the guard trips at limit - margin (one loop period of inflation must fit)"),
+      OptionBuilder<P>(KpaOption("guard_release_kpa", &P::guard_release_pa))
+          .Range(0, 100)
+          .Doc("hysteresis: the guard releases this far below its trip point"),
+      OptionBuilder<P>(KpaOption("deadband_kpa", &P::deadband_pa))
+          .Range(0, 100)
+          .Doc("|error| below this holds both valves closed (no chatter)"),
+      IntOption<P>("loop_hz", &P::loop_hz)
+          .Range(200, 5000)
+          .Unit("Hz")
+          .Doc("inner pressure loop rate, much faster than a camera"),
+      IntOption<P>("watchdog_ms", &P::watchdog_ms)
+          .Range(10, 10000)
+          .Unit("ms")
+          .Doc("no valid command for this long: vent to the safe state"),
+      DoubleOption<P>("kp_per_kpa", &P::kp_per_kpa)
+          .Range(0, 1000)
+          .Unit("duty/kPa")
+          .Doc("pressure loop proportional gain; higher is faster but chatters on/off valves"),
+      DoubleOption<P>("ki_per_kpa_s", &P::ki_per_kpa_s)
+          .Range(0, 1000)
+          .Unit("duty/(kPa s)")
+          .Doc("pressure loop integral gain"),
+  };
+}
+
+OptionTable<PlantOptions> MakePlant() {
+  using P = PlantOptions;
+  return {
+      DoubleOption<P>("chamber_volume_ml", &P::chamber_volume_ml)
+          .Range(0.1, 10000)
+          .Unit("mL")
+          .Doc("chamber + tubing; larger: slower pressure"),
+      DoubleOption<P>("pump_flow_l_per_min", &P::pump_flow_l_per_min)
+          .Range(0, 1000)
+          .Unit("L/min")
+          .Doc("free flow of the pump"),
+      DoubleOption<P>("pump_stall_kpa", &P::pump_stall_kpa)
+          .Range(1, 10000)
+          .Unit("kPa")
+          .Doc("pressure at which the pump's flow drops to 0"),
+      DoubleOption<P>("vent_flow_l_per_min", &P::vent_flow_l_per_min)
+          .Range(0.001, 1000)
+          .Unit("L/min")
+          .Doc("vent valve flow at 10 kPa, fully open"),
+      DoubleOption<P>("leak_l_per_min", &P::leak_l_per_min)
+          .Range(0, 1000)
+          .Unit("L/min")
+          .Doc("leak at 10 kPa (linear)"),
+      DoubleOption<P>("bend_start_kpa", &P::bend_start_kpa)
+          .Range(0, 1000)
+          .Unit("kPa")
+          .Doc("below this the actuator does not bend"),
+      DoubleOption<P>("bend_deg_per_kpa", &P::bend_deg_per_kpa)
+          .Range(0.001, 1000)
+          .Unit("deg/kPa")
+          .Doc("slope of the equilibrium bend"),
+      DoubleOption<P>("max_bend_deg", &P::max_bend_deg)
+          .Range(1, 340)
+          .Unit("deg")
+          .Doc("mechanical end stop of the bend"),
+      DoubleOption<P>("bend_lag_s", &P::bend_lag_s)
+          .Range(0.001, 100)
+          .Unit("s")
+          .Doc("time constant of the bending response"),
+      DoubleOption<P>("hysteresis_deg", &P::hysteresis_deg)
+          .Range(0, 90)
+          .Unit("deg")
+          .Doc("width of the play operator"),
+  };
+}
+
+OptionTable<RigOptions> MakeRig() {
+  using P = RigOptions;
+  OptionTable<P> table;
+  AppendOptions(&table, "board", &P::board, BoardConfigTable());
+  AppendOptions(&table, "plant", &P::plant, PlantOptionsTable());
+  table.push_back(DoubleOption<P>("end_marker_span", &P::end_marker_span)
+                      .Range(0.01, 1)
+                      .Doc("body fraction between the base and tip markers"));
+  table.push_back(DoubleOption<P>("sensor_noise_kpa", &P::sensor_noise_kpa)
+                      .Range(0, 100)
+                      .Unit("kPa")
+                      .Doc("pressure sensor noise, standard deviation"));
+  table.push_back(IntOption<P>("seed", &P::seed).Range(0, 1 << 30).Doc("of the sensor noise"));
+  return table;
+}
+
+OptionTable<ControlConfig> MakeControl() {
+  using P = ControlConfig;
+  OptionTable<P> table;
+  AppendOptions(&table, "controller", &P::controller, ControllerOptionsTable());
+  AppendOptions(&table, "link", &P::link, LinkOptionsTable());
+  AppendOptions(&table, "rig", &P::rig, RigOptionsTable());
+  return table;
+}
+
+}  // namespace
+
+const OptionTable<ControllerOptions>& ControllerOptionsTable() {
+  static const OptionTable<ControllerOptions> table = MakeController();
+  return table;
+}
+const OptionTable<LinkOptions>& LinkOptionsTable() {
+  static const OptionTable<LinkOptions> table = MakeLink();
+  return table;
+}
+const OptionTable<BoardConfig>& BoardConfigTable() {
+  static const OptionTable<BoardConfig> table = MakeBoard();
+  return table;
+}
+const OptionTable<PlantOptions>& PlantOptionsTable() {
+  static const OptionTable<PlantOptions> table = MakePlant();
+  return table;
+}
+const OptionTable<RigOptions>& RigOptionsTable() {
+  static const OptionTable<RigOptions> table = MakeRig();
+  return table;
+}
+const OptionTable<ControlConfig>& ControlConfigTable() {
+  static const OptionTable<ControlConfig> table = MakeControl();
+  return table;
+}
+
+}  // namespace softsight

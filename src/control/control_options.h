@@ -1,0 +1,19 @@
+// The option tables of the `control:` section (core/option_table.h): every key of the controller,
+// the link and the simulated rig, with its unit, range and doc. The structs' Check() functions run
+// them; the config reader and writer (io/control_config.cc) iterate them.
+#pragma once
+
+#include "core/option_table.h"
+#include "softsight/control/control_config.h"
+
+namespace softsight {
+
+const OptionTable<ControllerOptions>& ControllerOptionsTable();
+const OptionTable<LinkOptions>& LinkOptionsTable();
+const OptionTable<BoardConfig>& BoardConfigTable();  // in kPa where the board counts Pa
+const OptionTable<PlantOptions>& PlantOptionsTable();
+const OptionTable<RigOptions>& RigOptionsTable();    // with board.* and plant.*
+// controller.*, link.*, rig.*: the whole section.
+const OptionTable<ControlConfig>& ControlConfigTable();
+
+}  // namespace softsight
