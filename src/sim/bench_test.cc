@@ -1,11 +1,14 @@
 // The textured bench and the marker distractors: look-alikes that stay off the actuator's path,
 // and scenes with any number of markers.
 #include <cmath>
+#include <variant>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "sim/actuator.h"
+#include "softsight/core/error.h"
+#include "softsight/sim/builtin_scenes.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
@@ -258,6 +261,46 @@ TEST(SceneOptionsTest, DistractorsAreChecked) {
   EXPECT_FALSE(options.Check(&error));
   options.distractors = {{{10, 10}, {2, 3}, 0, {0, 0, 255}}};
   EXPECT_TRUE(options.Check(&error)) << error;
+}
+
+}  // namespace
+}  // namespace softsight
+
+namespace softsight {
+namespace {
+
+TEST(BuiltinScenesTest, NamesGiveTheirScenes) {
+  EXPECT_TRUE(std::holds_alternative<PlateSceneOptions>(ParseBuiltinScene("plate")));
+  const SceneOptions bench = std::get<SceneOptions>(ParseBuiltinScene("bench"));
+  EXPECT_EQ(bench.kind, SceneKind::kBending);
+  EXPECT_EQ(bench.background, BackgroundKind::kBench);
+  EXPECT_EQ(bench.distractors.size(), 5 * bench.markers.size());
+  const SceneOptions wedge = std::get<SceneOptions>(ParseBuiltinScene("wedge4"));
+  EXPECT_EQ(wedge.kind, SceneKind::kWedge4);
+  EXPECT_EQ(wedge.background, BackgroundKind::kDefault);
+  EXPECT_TRUE(wedge.distractors.empty());
+  try {
+    ParseBuiltinScene("spiral");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("spiral"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("plate"), std::string::npos);
+  }
+}
+
+// The bench on top of a run's own size and body: distractors fit that scene.
+TEST(BuiltinScenesTest, SetActuatorSceneKeepsTheRest) {
+  SceneOptions scene = BenchScene();
+  scene.background = BackgroundKind::kDefault;
+  SetActuatorScene("bench", &scene);
+  EXPECT_EQ(scene.size, cv::Size(320, 240));
+  EXPECT_EQ(scene.background, BackgroundKind::kBench);
+  ASSERT_EQ(scene.distractors.size(), 15u);
+  for (const Distractor& d : scene.distractors) {
+    EXPECT_LT(d.centre_px.x, 320);
+    EXPECT_LT(d.centre_px.y, 240);
+  }
+  EXPECT_THROW(SetActuatorScene("plate", &scene), InputError);
 }
 
 }  // namespace

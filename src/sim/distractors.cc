@@ -1,11 +1,15 @@
-// Distractor placement: look-alikes of every marker colour, kept off the actuator's path.
+// Distractor placement (look-alikes of every marker colour, kept off the actuator's path) and
+// drawing.
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "sim/distractors.h"
+
 #include "sim/actuator.h"
+#include "sim/raster.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
@@ -103,3 +107,32 @@ std::vector<Distractor> MakeMarkerDistractors(const SceneOptions& scene, uint64_
 }
 
 }  // namespace softsight
+
+namespace softsight::sim {
+
+std::string CheckDistractors(const std::vector<Distractor>& distractors) {
+  for (size_t i = 0; i < distractors.size(); ++i) {
+    const Distractor& d = distractors[i];
+    if (!(std::isfinite(d.centre_px.x) && std::isfinite(d.centre_px.y) &&
+          std::isfinite(d.angle_deg) && std::isfinite(d.radii_px.width) &&
+          std::isfinite(d.radii_px.height) && d.radii_px.width > 0 && d.radii_px.height > 0)) {
+      return "distractors: distractor " + std::to_string(i + 1) +
+             " needs a finite centre and angle and positive radii";
+    }
+  }
+  return "";
+}
+
+void DrawDistractors(const std::vector<Distractor>& distractors, int supersample,
+                     cv::Mat& background_ss, cv::Mat& background) {
+  if (distractors.empty()) return;
+  const double s = supersample;
+  for (const Distractor& d : distractors) {
+    const Conic ellipse = Conic::Ellipse(ToSupersampled(d.centre_px, supersample), d.radii_px * s,
+                                         d.angle_deg);
+    FillConic(ellipse, cv::Point(0, 0), d.bgr, background_ss);
+  }
+  cv::resize(background_ss, background, background.size(), 0, 0, cv::INTER_AREA);
+}
+
+}  // namespace softsight::sim

@@ -8,6 +8,7 @@
 
 #include "sim/background.h"
 #include "sim/camera.h"
+#include "sim/distractors.h"
 #include "sim/raster.h"
 #include "softsight/core/error.h"
 
@@ -74,6 +75,9 @@ bool PlateSceneOptions::Check(std::string* error) const {
   }
   if (!(std::isfinite(scale_end) && scale_end > 0 && scale_end <= kMaxScale)) {
     return Fail(error, "scale_end: must be in (0, " + Num(kMaxScale) + "], got " + Num(scale_end));
+  }
+  if (const std::string bad = sim::CheckDistractors(distractors); !bad.empty()) {
+    return Fail(error, bad);
   }
   return true;
 }
@@ -214,6 +218,7 @@ PlateScene::PlateScene(PlateSceneOptions options, NoiseOptions noise, RenderOpti
                cv::INTER_LINEAR);
     cv::resize(m.background_ss, m.background, o.size, 0, 0, cv::INTER_AREA);
   }
+  sim::DrawDistractors(o.distractors, s, m.background_ss, m.background);
   m.canvas_ss.create(m.background_ss.size(), CV_8UC3);
   m.mask_ss.create(m.background_ss.size(), CV_8U);
 }

@@ -201,6 +201,33 @@ TEST(PlateSceneTest, DeterministicAndColourOptional) {
   EXPECT_EQ(c.at<cv::Vec3b>(cvRound(p.y), cvRound(p.x)), cv::Vec3b(20, 20, 230));
 }
 
+// Light look-alike spots on the backdrop: drawn where asked, hidden when the plate passes over
+// them, and the dots' truth is unchanged.
+TEST(PlateSceneTest, DistractorsLieBehindThePlate) {
+  PlateSceneOptions options = SmallPlate();
+  options.frame_count = 5;
+  options.cluttered_background = false;
+  PlateScene plain(options);
+  cv::Mat a, b;
+  const SceneTruth truth = plain.render(0, a);
+  // One spot under the plate's centre in frame 0, one far from it.
+  const cv::Point2d under = Apply(plain.image_from_plate(0), cv::Point2d(0, 0));
+  options.distractors = {{under, {4, 4}, 0, {235, 235, 235}}, {{10, 10}, {4, 4}, 0, {235, 235, 235}}};
+  PlateScene with(options);
+  const SceneTruth truth_with = with.render(0, b);
+  for (size_t d = 0; d < truth.markers.size(); ++d) {
+    EXPECT_EQ(*truth.markers[d].centroid_px, *truth_with.markers[d].centroid_px);
+  }
+  EXPECT_EQ(b.at<cv::Vec3b>(10, 10), cv::Vec3b(235, 235, 235));
+  EXPECT_EQ(cv::norm(a(cv::Rect(cvRound(under.x) - 6, cvRound(under.y) - 6, 13, 13)),
+                     b(cv::Rect(cvRound(under.x) - 6, cvRound(under.y) - 6, 13, 13)), cv::NORM_INF),
+            0);
+  options.distractors = {{{10, 10}, {0, 4}, 0, {235, 235, 235}}};
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("distractors"), std::string::npos);
+}
+
 TEST(PlateSceneTest, CheckNamesTheBadField) {
   std::string error;
   PlateSceneOptions options = SmallPlate();

@@ -11,6 +11,7 @@
 #include "sim/actuator.h"
 #include "sim/background.h"
 #include "sim/camera.h"
+#include "sim/distractors.h"
 #include "sim/raster.h"
 #include "softsight/core/error.h"
 
@@ -74,14 +75,8 @@ bool SceneOptions::Check(std::string* error) const {
                            SceneKindName(kind) + " plates to carry markers of radius " +
                            Num(marker_radius_px));
   }
-  for (size_t i = 0; i < distractors.size(); ++i) {
-    const Distractor& d = distractors[i];
-    if (!(std::isfinite(d.centre_px.x) && std::isfinite(d.centre_px.y) &&
-          std::isfinite(d.angle_deg) && std::isfinite(d.radii_px.width) &&
-          std::isfinite(d.radii_px.height) && d.radii_px.width > 0 && d.radii_px.height > 0)) {
-      return Fail(error, "distractors: distractor " + std::to_string(i + 1) +
-                             " needs a finite centre and angle and positive radii");
-    }
+  if (const std::string bad = sim::CheckDistractors(distractors); !bad.empty()) {
+    return Fail(error, bad);
   }
   if (background != BackgroundKind::kDefault && background != BackgroundKind::kBench) {
     return Fail(error, "background: unknown kind " + std::to_string(static_cast<int>(background)));
@@ -199,15 +194,7 @@ SyntheticScene::SyntheticScene(SceneOptions scene, NoiseOptions noise, RenderOpt
   } else {
     sim::RenderBackground(m.scene.size, s, m.scene.seed, &m.background_ss, &m.background);
   }
-  if (!m.scene.distractors.empty()) {
-    const cv::Point origin(0, 0);
-    for (const Distractor& d : m.scene.distractors) {
-      const sim::Conic ellipse = sim::Conic::Ellipse(sim::ToSupersampled(d.centre_px, s),
-                                                     d.radii_px * double(s), d.angle_deg);
-      sim::FillConic(ellipse, origin, d.bgr, m.background_ss);
-    }
-    cv::resize(m.background_ss, m.background, m.scene.size, 0, 0, cv::INTER_AREA);
-  }
+  sim::DrawDistractors(m.scene.distractors, s, m.background_ss, m.background);
   m.canvas_ss.create(image_ss.size(), CV_8UC3);
   m.mask_ss.create(image_ss.size(), CV_8U);
   if (m.scene.markers.size() >= 3) {

@@ -1,6 +1,7 @@
 // Rendering speed of the synthetic scenes (the tests render hundreds of frames, so it matters).
 #include <benchmark/benchmark.h>
 
+#include "softsight/sim/plate_scene.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
@@ -46,6 +47,38 @@ void BM_ConstructScene(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ConstructScene)->Unit(benchmark::kMillisecond);
+
+// The textured bench with its distractors: the backdrop is built once, frames cost as usual.
+void BM_ConstructBenchScene(benchmark::State& state) {
+  SceneOptions options;
+  options.background = BackgroundKind::kBench;
+  for (auto _ : state) {
+    options.distractors = MakeMarkerDistractors(options, 1);
+    SyntheticScene scene{options};
+    benchmark::DoNotOptimize(scene);
+  }
+}
+BENCHMARK(BM_ConstructBenchScene)->Unit(benchmark::kMillisecond);
+
+// The plate scene at VGA and 720p (the plate's region is drawn supersampled every frame).
+void BM_RenderPlateFrame(benchmark::State& state) {
+  PlateSceneOptions options;
+  options.size = cv::Size(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  options.dot_radius_px *= options.size.height / 480.0;
+  PlateScene scene(options);
+  cv::Mat image;
+  int index = 0;
+  for (auto _ : state) {
+    SceneTruth truth = scene.render(index, image);
+    benchmark::DoNotOptimize(truth);
+    index = (index + 7) % options.frame_count;
+  }
+}
+BENCHMARK(BM_RenderPlateFrame)
+    ->ArgNames({"w", "h"})
+    ->Args({640, 480})
+    ->Args({1280, 720})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace softsight

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -34,6 +35,9 @@ struct PlateSceneOptions {
   double scale_start = 1.0, scale_end = 2.0;
   // The wood-like bench (BackgroundKind::kBench) behind the plate; false: a plain gray gradient.
   bool cluttered_background = true;
+  // Blobs drawn on the backdrop (the plate passes over them), e.g. light spots that look like
+  // dots; in output pixels as for SceneOptions::distractors.
+  std::vector<Distractor> distractors{};
   uint64_t seed = 1;  // Background and motion path.
 
   // False with a one-line message naming the bad field.
