@@ -33,7 +33,6 @@ bool Fail(std::string* error, const std::string& message) {
   return false;
 }
 
-
 }  // namespace
 
 bool SceneOptions::Check(std::string* error) const {
