@@ -102,6 +102,11 @@ std::string OptionValueText(const OptionValue& value) {
       for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + FormatDouble(list[i]);
       return text + "]";
     }
+    std::string operator()(const std::vector<std::string>& list) const {
+      std::string text = "[";
+      for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + list[i];
+      return text + "]";
+    }
   };
   return std::visit(Visitor{}, value);
 }
@@ -138,6 +143,13 @@ std::optional<std::string> OptionProblem(const OptionSpec& spec, const OptionVal
       }
       return std::nullopt;
     }
+    case OptionKind::kStrings: {
+      const auto& list = std::get<std::vector<std::string>>(value);
+      if (spec.count > 0 && list.size() != spec.count) {
+        return text + " must have " + std::to_string(spec.count) + " names";
+      }
+      return std::nullopt;
+    }
     case OptionKind::kDoubles: {
       const auto& list = std::get<std::vector<double>>(value);
       if (spec.count > 0 && list.size() != spec.count) {
@@ -157,6 +169,9 @@ std::string OptionRangeText(const OptionSpec& spec) {
   if (spec.kind == OptionKind::kEnum) return NamesText(spec.names);
   if (spec.kind == OptionKind::kBool) return "true or false";
   if (spec.kind == OptionKind::kString) return "";
+  if (spec.kind == OptionKind::kStrings) {
+    return spec.count > 0 ? std::to_string(spec.count) + " names" : "names";
+  }
   std::string range = Requirement(spec);
   for (const char* verb : {"lie within ", "be "}) {
     const std::string v = verb;

@@ -37,12 +37,13 @@ enum class OptionKind {
   kString,
   kInts,     // a list of whole numbers (exactly `count` of them when count > 0)
   kDoubles,  // a list of finite numbers
+  kStrings,  // a list of names (marker names)
 };
 
 // One option's value, in the form shared by the checks, the YAML adapter and the tests.
 // kEnum and kString hold std::string; lists hold their element vectors.
-using OptionValue =
-    std::variant<bool, int64_t, double, std::string, std::vector<int64_t>, std::vector<double>>;
+using OptionValue = std::variant<bool, int64_t, double, std::string, std::vector<int64_t>,
+                                 std::vector<double>, std::vector<std::string>>;
 
 // Everything about an option except how to reach it in the struct.
 struct OptionSpec {
@@ -344,7 +345,7 @@ void AppendOptions(OptionTable<T>* table, const std::string& prefix, Access part
   for (const Option<Part>& p : part_table) {
     Option<T> o;
     static_cast<OptionSpec&>(o) = p;
-    o.key = prefix + "." + p.key;
+    o.key = prefix.empty() ? p.key : prefix + "." + p.key;  // "": the part's keys at this level
     o.get = [get_part, g = p.get](const T& t) { return g(get_part(const_cast<T&>(t))); };
     o.set = [get_part, s = p.set](T& t, const std::optional<OptionValue>& v) {
       s(get_part(t), v);

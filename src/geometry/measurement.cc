@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "geometry/measure_options.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/circle_fit.h"
 #include "softsight/geometry/triangle.h"
@@ -56,6 +57,10 @@ std::optional<cv::Point2d> MapToPlane(const cv::Matx33d& plane_from_image,
 }
 
 bool MetricModel::Check(std::string* error) const {
+  std::string unused;
+  if (error == nullptr) error = &unused;  // Check(nullptr) asks only whether it passes
+  // Ranges are the table's (geometry/measure_options.cc); the rules across fields follow.
+  if (const auto problem = CheckOptions(MetricModelOptions(), *this)) return Fail(error, *problem);
   if (scale_mm_per_px && plane_mm_from_image) {
     *error = "scale_mm_per_px and plane: give one metric model, not both";
     return false;
@@ -88,6 +93,10 @@ bool MetricModel::Check(std::string* error) const {
 }
 
 bool MeasureOptions::Check(std::string* error) const {
+  std::string unused;
+  if (error == nullptr) error = &unused;  // Check(nullptr) asks only whether it passes
+  // Ranges are the table's (geometry/measure_options.cc); the rules across fields follow.
+  if (const auto problem = CheckOptions(MeasureOptionsTable(), *this)) return Fail(error, *problem);
   const std::pair<const char*, const std::string*> triple[] = {
       {"base", &base}, {"middle", &middle}, {"tip", &tip}};
   for (const auto& [field, name] : triple) {

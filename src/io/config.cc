@@ -77,26 +77,11 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
       }
     }
   };
-  if (const auto triple = top.strings("triple")) {
-    if (triple->size() != 3) top.fail("triple", "expected three marker names: [base, middle, tip]");
-    check_names("triple", *triple);
-    if ((*triple)[0] == (*triple)[1] || (*triple)[1] == (*triple)[2] ||
-        (*triple)[0] == (*triple)[2]) {
-      top.fail("triple", "the three markers must be different");
-    }
-    config.measure.base = (*triple)[0];
-    config.measure.middle = (*triple)[1];
-    config.measure.tip = (*triple)[2];
+  ReadMeasureOptions(top, &config.measure);  // triple, chain, tip_reference, metric keys
+  if (!config.measure.base.empty()) {
+    check_names("triple", {config.measure.base, config.measure.middle, config.measure.tip});
   }
-  if (const auto chain = top.strings("chain")) {
-    if (chain->size() < 3) top.fail("chain", "a chain lists at least three markers, base to tip");
-    check_names("chain", *chain);
-    config.measure.chain = *chain;
-  }
-  if (const auto reference = top.numbers("tip_reference", 2, -1e6, 1e6)) {
-    config.measure.tip_reference_px = cv::Point2d((*reference)[0], (*reference)[1]);
-  }
-  ReadMetricModel(top, &config.measure.metric);
+  check_names("chain", config.measure.chain);
   if (const auto camera = top.string("camera")) {
     config.camera_file = *camera;
     try {
@@ -128,19 +113,7 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
-  const MeasureOptions& m = config.measure;
-  if (!m.base.empty()) {
-    out << YAML::Key << "triple" << YAML::Value << YAML::Flow << YAML::BeginSeq << m.base
-        << m.middle << m.tip << YAML::EndSeq;
-  }
-  if (!m.chain.empty()) {
-    out << YAML::Key << "chain" << YAML::Value << YAML::Flow << m.chain;
-  }
-  if (m.tip_reference_px) {
-    out << YAML::Key << "tip_reference" << YAML::Value << YAML::Flow << YAML::BeginSeq
-        << m.tip_reference_px->x << m.tip_reference_px->y << YAML::EndSeq;
-  }
-  WriteMetricModel(m.metric, out);
+  WriteMeasureOptions(config.measure, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
   if (config.control) {
     out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;

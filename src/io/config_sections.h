@@ -24,4 +24,12 @@ void WriteTemplateParams(const TemplateParams& params, YAML::Emitter& out);
 void ReadMetricModel(YamlMap& top, MetricModel* metric);
 void WriteMetricModel(const MetricModel& metric, YAML::Emitter& out);
 
+// metric_config.cc too: the top-level measurement keys (triple, chain, tip_reference) and the
+// metric keys. Whether the named markers exist is checked by the caller, who knows them.
+void ReadMeasureOptions(YamlMap& top, MeasureOptions* measure);
+void WriteMeasureOptions(const MeasureOptions& measure, YAML::Emitter& out);
+// MeasureOptions::Check() for what a file may give: no triple is allowed (a config that only
+// tracks); the session refuses it if it needs the measurements.
+bool CheckMeasureOptionsOfAFile(const MeasureOptions& measure, std::string* error);
+
 }  // namespace softsight

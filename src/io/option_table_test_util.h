@@ -27,12 +27,14 @@ namespace softsight::testing {
 template <typename T>
 struct OptionTableSuite {
   const OptionTable<T>& table;
-  std::string path;  // key path of the mapping the reader reads ("markers[0]", "control")
+  std::string path;  // key path of the mapping the reader reads ("markers[0]", "control", "")
   std::function<void(YamlMap&, T*)> read;
   std::function<void(const T&, YAML::Emitter&)> write;
   std::function<bool(const T&, std::string*)> check;
   // Files a string option may name, created beside the YAML file (e.g. a template image).
   std::string string_value = "t.png";
+
+  std::string Prefix() const { return path.empty() ? "" : path + "."; }
 
   // Values to try, in order, to make `option` differ from its default.
   std::vector<OptionValue> Candidates(const Option<T>& option) const {
@@ -62,6 +64,16 @@ struct OptionTableSuite {
         for (const std::string& n : option.names) values.push_back(n);
         break;
       case OptionKind::kString: values.push_back(string_value); break;
+      case OptionKind::kStrings: {
+        std::vector<std::string> names;
+        for (size_t i = 0; i < (option.count > 0 ? option.count : 3); ++i) {
+          std::string name = "m";  // (operator+ on a literal trips GCC 12's -Wrestrict)
+          name += std::to_string(i);
+          names.push_back(name);
+        }
+        values.push_back(names);
+        break;
+      }
       case OptionKind::kInt:
         for (double v : numbers) values.push_back(static_cast<int64_t>(std::llround(v)));
         break;
@@ -88,6 +100,9 @@ struct OptionTableSuite {
           }
         }
         for (double v : numbers) lists.push_back(std::vector<double>(n, v));
+        if (n == 9) {  // a 3x3 matrix (a homography): equal entries are singular, try identities
+          for (double v : numbers) lists.push_back({v, 0, 0, 0, v, 0, 0, 0, v});
+        }
         for (const auto& l : lists) {
           if (option.kind == OptionKind::kInts) {
             std::vector<int64_t> ints;
@@ -189,7 +204,7 @@ struct OptionTableSuite {
       }
     };
     for (const Option<T>& option : table) {
-      SCOPED_TRACE(path + "." + option.key);
+      SCOPED_TRACE(Prefix() + option.key);
       if (option.kind == OptionKind::kInt || option.kind == OptionKind::kInts) {
         EXPECT_TRUE(option.min && option.max) << "an int option needs both bounds";
         if (option.min && option.max) {
@@ -208,7 +223,7 @@ struct OptionTableSuite {
         std::string from_check;
         EXPECT_FALSE(check(*bad, &from_check));
         EXPECT_EQ(from_check.rfind(option.key + ": ", 0), 0u) << from_check;
-        EXPECT_EQ(ReadError(option, *bad, dir), path + "." + from_check);
+        EXPECT_EQ(ReadError(option, *bad, dir), Prefix() + from_check);
       }
       if (option.kind == OptionKind::kDouble) {  // NaN and infinities, whatever the range
         for (double v : {std::numeric_limits<double>::quiet_NaN(),
@@ -219,7 +234,7 @@ struct OptionTableSuite {
           if (std::isfinite(std::get<double>(*option.get(bad)))) continue;
           std::string from_check;
           EXPECT_FALSE(check(bad, &from_check)) << v;
-          EXPECT_EQ(ReadError(option, bad, dir), path + "." + from_check);
+          EXPECT_EQ(ReadError(option, bad, dir), Prefix() + from_check);
         }
       }
       if (option.kind == OptionKind::kEnum) {
@@ -232,7 +247,7 @@ struct OptionTableSuite {
           ReadText(out.c_str(), dir);
           ADD_FAILURE() << "an unknown name was accepted";
         } catch (const InputError& e) {
-          EXPECT_NE(std::string(e.what()).find(path + "." + option.key + ": '" + bogus +
+          EXPECT_NE(std::string(e.what()).find(Prefix() + option.key + ": '" + bogus +
                                                "' is not one of"),
                     std::string::npos)
               << e.what();

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "control/control_options.h"
+#include "geometry/measure_options.h"
 #include "io/config_sections.h"
 #include "io/control_config.h"
 #include "io/config_test_util.h"
@@ -46,8 +47,19 @@ TEST(OptionTables, ControlConfig) {
       .Run();
 }
 
+TEST(OptionTables, MeasureOptions) {
+  testing::OptionTableSuite<MeasureOptions>{
+      MeasureOptionsTable(), "",
+      [](YamlMap& m, MeasureOptions* o) { ReadMeasureOptions(m, o); },
+      [](const MeasureOptions& o, YAML::Emitter& out) { WriteMeasureOptions(o, out); },
+      [](const MeasureOptions& o, std::string* e) { return CheckMeasureOptionsOfAFile(o, e); }}
+      .Run();
+}
+
 TEST(OptionTables, TheExamplesMentionEveryKey) {
   EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
+            std::vector<std::string>{});
+  EXPECT_EQ(testing::KeysMissingFrom(MeasureOptionsTable(), Example("markers.yaml")),
             std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(ControlConfigTable(), Example("rig.yaml")),
             std::vector<std::string>{});

@@ -61,6 +61,20 @@ std::optional<OptionValue> ReadOptionValue(YamlMap& map, const std::string& leaf
       if (!node.IsScalar()) map.fail(leaf, "expected text, got " + Shown(node));
       value = node.Scalar();
       break;
+    case OptionKind::kStrings: {
+      if (!node.IsSequence() || (spec.count > 0 && node.size() != spec.count)) {
+        map.fail(leaf, "expected a list of " +
+                           (spec.count > 0 ? std::to_string(spec.count) + " " : std::string()) +
+                           "names, got " + Shown(node));
+      }
+      std::vector<std::string> names;
+      for (const YAML::Node& item : node) {
+        if (!item.IsScalar()) map.fail(leaf, "expected names, got " + Shown(item));
+        names.push_back(item.Scalar());
+      }
+      value = names;
+      break;
+    }
     case OptionKind::kInts:
     case OptionKind::kDoubles: {
       const bool ints = spec.kind == OptionKind::kInts;
@@ -114,6 +128,12 @@ void PutOptionValue(YAML::Node& root, const std::string& key, const OptionValue&
     YAML::Node operator()(const std::vector<int64_t>& list) const {
       YAML::Node n(YAML::NodeType::Sequence);
       for (int64_t i : list) n.push_back(std::to_string(i));
+      n.SetStyle(YAML::EmitterStyle::Flow);
+      return n;
+    }
+    YAML::Node operator()(const std::vector<std::string>& list) const {
+      YAML::Node n(YAML::NodeType::Sequence);
+      for (const std::string& name : list) n.push_back(name);
       n.SetStyle(YAML::EmitterStyle::Flow);
       return n;
     }
