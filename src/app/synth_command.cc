@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <variant>
 
 #include "app/commands.h"
 #include "softsight/core/error.h"
@@ -73,9 +74,15 @@ cv::Size ParseSize(const std::string& text) {
 }  // namespace
 
 std::string TruthCsvHeader(const SceneOptions& scene) {
+  std::vector<std::string> names;
+  for (const SceneMarker& m : scene.markers) names.push_back(m.name);
+  return TruthCsvHeader(names);
+}
+
+std::string TruthCsvHeader(const std::vector<std::string>& marker_names) {
   std::string header = "frame,time_s,bend_deg";
-  for (const SceneMarker& m : scene.markers) {
-    header += "," + m.name + "_x," + m.name + "_y," + m.name + "_visible";
+  for (const std::string& name : marker_names) {
+    header += "," + name + "_x," + name + "_y," + name + "_visible";
   }
   header += ",angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,centreline_radius_px";
   return header;
@@ -111,31 +118,42 @@ std::string FormatSynthSummary(const SynthSummary& s, const SynthOptions& option
 
 SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* truths) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.scene.frame_count < 1) {
-    throw InputError("--frames: must be at least 1, got " + std::to_string(options.scene.frame_count));
-  }
+  const int frames = options.plate ? options.plate->frame_count : options.scene.frame_count;
+  if (frames < 1) throw InputError("--frames: must be at least 1, got " + std::to_string(frames));
   // Everything is checked before any file is created.
-  SyntheticScene scene(options.scene, options.noise, options.render, options.occluders);
+  std::optional<SyntheticScene> scene;
+  std::optional<PlateScene> plate;
+  std::vector<std::string> marker_names;
+  if (options.plate) {
+    plate.emplace(*options.plate, options.noise, options.render);
+    for (int i = 0; i < options.plate->dot_count; ++i) marker_names.push_back("dot" + std::to_string(i));
+  } else {
+    scene.emplace(options.scene, options.noise, options.render, options.occluders);
+    for (const SceneMarker& m : options.scene.markers) marker_names.push_back(m.name);
+  }
+  const cv::Size size = plate ? options.plate->size : options.scene.size;
+  const double fps = plate ? options.plate->fps : options.scene.fps;
+  const int frame_count = plate ? plate->frame_count() : scene->frame_count();
   if (options.truth_csv) CheckParentFolder(*options.truth_csv, "truth CSV");
   if (options.out.empty()) throw InputError("--out: give the output video or image pattern");
-  FrameWriter sink({options.out, options.codec, options.scene.fps});
-  sink.open(options.scene.size);  // Fails here, before the truth file is created.
+  FrameWriter sink({options.out, options.codec, fps});
+  sink.open(size);  // Fails here, before the truth file is created.
   std::ofstream truth_file;
   if (options.truth_csv) {
     truth_file.open(*options.truth_csv, std::ios::out | std::ios::trunc);
     if (!truth_file) throw InputError(*options.truth_csv + ": cannot open for writing");
-    truth_file << TruthCsvHeader(options.scene) << "\n";
+    truth_file << TruthCsvHeader(marker_names) << "\n";
   }
 
   SynthSummary summary;
-  summary.size = options.scene.size;
-  summary.scene = SceneKindName(options.scene.kind);
+  summary.size = size;
+  summary.scene = plate ? "plate" : SceneKindName(options.scene.kind);
   summary.format = sink.format();
   cv::Mat image;
   double render_ms = 0.0;
-  for (int i = 0; i < scene.frame_count(); ++i) {
+  for (int i = 0; i < frame_count; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    const SceneTruth truth = scene.render(i, image);
+    const SceneTruth truth = plate ? plate->render(i, image) : scene->render(i, image);
     render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     sink.write(image, i);
     if (truths != nullptr) truths->push_back(truth);
@@ -172,7 +190,8 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
                  "bending: a silicone band bending from straight to --max-bend degrees; "
                  "wedge1 / wedge4: the paper's triangle actuators (1 segment opening 20 degrees, "
                  "4 segments opening 80); bench: bending on a textured bench with look-alike "
-                 "blobs of every marker colour")
+                 "blobs of every marker colour; plate: a gray view of a plate with 5 white dots "
+                 "that tilts to 50 degrees and grows 1x to 2x (dot0..dot4)")
       ->capture_default_str();
   sub.add_option("-o,--out", options->out,
                  "Video (.avi/.mkv: lossless FFV1; .mp4: lossy) or image pattern "
@@ -214,7 +233,17 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", options->quiet, "No summary line");
   return [options, scene_name, size, occlusions] {
     options->scene.size = ParseSize(*size);
-    SetActuatorScene(*scene_name, &options->scene);
+    options->plate.reset();
+    // Names every built-in scene when the name is none of them.
+    if (std::holds_alternative<PlateSceneOptions>(ParseBuiltinScene(*scene_name))) {
+      PlateSceneOptions& plate = options->plate.emplace();
+      plate.size = options->scene.size;
+      plate.frame_count = options->scene.frame_count;
+      plate.fps = options->scene.fps;
+      plate.seed = options->scene.seed;
+    } else {
+      SetActuatorScene(*scene_name, &options->scene);
+    }
     options->noise.seed = options->scene.seed;
     options->occluders.clear();
     for (const std::string& text : *occlusions) options->occluders.push_back(ParseOccluder(text));

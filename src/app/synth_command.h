@@ -9,12 +9,16 @@
 
 #include <opencv2/core.hpp>
 
+#include "softsight/sim/plate_scene.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
 
 struct SynthOptions {
   SceneOptions scene;
+  // When set, the plate scene is rendered instead of `scene` (its size, frames, fps and seed
+  // come from here; `scene` and `occluders` are not used).
+  std::optional<PlateSceneOptions> plate;
   NoiseOptions noise;
   RenderOptions render;
   std::vector<Occluder> occluders;
@@ -33,7 +37,7 @@ struct SynthOptions {
 struct SynthSummary {
   int64_t frames = 0;
   cv::Size size;
-  std::string scene;        // "bending", "wedge1", "wedge4".
+  std::string scene;        // "bending", "wedge1", "wedge4", "plate".
   std::string format;       // "FFV1 video (lossless)", "PNG images", ...
   double render_ms_mean = 0.0;
   double wall_s = 0.0;
@@ -48,6 +52,7 @@ SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* trut
 // visible fraction, 0..1), then angle_deg, chord_px, sagitta_px, radius_px, arc_length_px,
 // tip_disp_px, centreline_radius_px. Absent values are empty fields.
 std::string TruthCsvHeader(const SceneOptions& scene);
+std::string TruthCsvHeader(const std::vector<std::string>& marker_names);
 std::string TruthCsvRow(const SceneTruth& truth);
 
 // One line for a person.

@@ -57,6 +57,36 @@ SynthOptions SmallRun(const fs::path& out) {
   return o;
 }
 
+// The plate scene through the same command: gray lossless frames and the dots' truth.
+TEST(SynthCommandTest, PlateSceneWritesGrayFramesAndDotTruth) {
+  const fs::path dir = FreshDir("plate");
+  SynthOptions options = SmallRun(dir / "plate.avi");
+  options.truth_csv = (dir / "truth.csv").string();
+  PlateSceneOptions& plate = options.plate.emplace();
+  plate.size = cv::Size(320, 240);
+  plate.frame_count = 4;
+  plate.dot_radius_px = 5;
+  const SynthSummary summary = RunSynth(options);
+  EXPECT_EQ(summary.frames, 4);
+  EXPECT_EQ(summary.scene, "plate");
+  const std::vector<std::string> lines = ReadLines(dir / "truth.csv");
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0].rfind("frame,time_s,bend_deg,dot0_x,dot0_y,dot0_visible,dot1_x", 0), 0u) << lines[0];
+  PlateScene scene(plate, options.noise, options.render);
+  cv::VideoCapture capture(options.out);
+  ASSERT_TRUE(capture.isOpened());
+  cv::Mat frame, expected;
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(capture.read(frame));
+    const SceneTruth truth = scene.render(i, expected);
+    EXPECT_EQ(cv::norm(frame, expected, cv::NORM_INF), 0.0) << "frame " << i;
+    const std::vector<std::string> fields = SplitCsv(lines[i + 1]);
+    ASSERT_EQ(fields.size(), 3 + 3 * 5 + 7u);
+    EXPECT_NEAR(std::stod(fields[3]), truth.markers[0].centroid_px->x, 1e-5);
+    EXPECT_NEAR(std::stod(fields[4]), truth.markers[0].centroid_px->y, 1e-5);
+  }
+}
+
 // The video is lossless: what OpenCV reads back is exactly what the renderer drew, so accuracy
 // tests on video files measure the tracker, not the codec.
 TEST(SynthCommandTest, VideoReadsBackExactlyWithTruthCsv) {
