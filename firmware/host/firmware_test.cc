@@ -113,5 +113,27 @@ TEST_F(Sketch, CorruptedCommandsAreNotAnsweredNorActedOn) {
   EXPECT_EQ(Command(Line(wire::MessageType::kRead, 2)).args[6], 2);  // Both counted.
 }
 
+TEST_F(Sketch, SpeaksVersion2WithACrcAndIgnoresTwoBitErrorsAnXorWouldPass) {
+  arduino_shim::SerialInput("$HELLO 2*0C18\n");  // Typed by hand, from docs/protocol.md.
+  Run(1);
+  EXPECT_EQ(arduino_shim::TakeSerialOutput(), "$HI 2 50000 500 250*4995\n");
+  // The sketch's board lives for the whole program: count from here.
+  const int32_t rejected_before = Command(Line(wire::MessageType::kRead, 1)).args[6];
+  // A version-1 line (XOR checksum) is not even well formed for this board: no answer.
+  EXPECT_EQ(Command("$HELLO 1*53\n").type, wire::MessageType::kNone);
+  // "$SETP 10 20000" with bit 0 flipped in two bytes ("$SETP 11 20001"): version 1's XOR was
+  // unchanged and the board inflated; the CRC rejects it.
+  std::string bad = Line(wire::MessageType::kSetPressure, 10, 20000);
+  bad[7] ^= 0x01;
+  bad[13] ^= 0x01;
+  ASSERT_EQ(bad.substr(0, 15), "$SETP 11 20001*");
+  EXPECT_EQ(Command(bad).type, wire::MessageType::kNone);
+  Run(10);
+  EXPECT_EQ(arduino_shim::Pwm(kInflate), 0);
+  EXPECT_EQ(arduino_shim::Pwm(kPump), 0);
+  EXPECT_EQ(arduino_shim::Pwm(kVent), 255);
+  EXPECT_EQ(Command(Line(wire::MessageType::kRead, 2)).args[6] - rejected_before, 2);  // Both.
+}
+
 }  // namespace
 }  // namespace softsight

@@ -2,7 +2,10 @@
 //
 // Everything that decides anything lives in the shared code (softsight/control/board.h and
 // protocol.h, unit-tested on the host): the serial protocol, the pressure loop, the pressure limit
-// guard and the watchdog. This sketch only binds it to pins and timers. Wiring (Arduino Uno):
+// guard and the watchdog. This sketch only binds it to pins and timers. It speaks protocol
+// version 2 (every line checked by a CRC-16, docs/protocol.md): after changing the shared code,
+// run firmware/copy_shared.sh again before building, or the board keeps the old version and the
+// host reports no answer to its handshake. Wiring (Arduino Uno):
 //   D5  PWM -> MOSFET -> inflate solenoid valve (pump -> chamber)
 //   D6  PWM -> MOSFET -> vent solenoid valve (chamber -> air)
 //   D9  PWM -> MOSFET -> pump motor

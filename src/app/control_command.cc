@@ -58,6 +58,37 @@ class RigFileSource : public FrameSource {
   std::chrono::steady_clock::time_point start_;
 };
 
+std::string FormatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", v);
+  return text;
+}
+
+// The one check of every number from the command line: finite and in [lo, hi] (or (lo, hi] with
+// `lo_open`), else one error naming the option. CLI11 reads "nan" and "inf" as numbers, and every
+// comparison with NaN is false, so the test is for the good range.
+void CheckOption(const char* option, const std::optional<double>& value, double lo, double hi,
+                 bool lo_open = false) {
+  if (!value) return;
+  const double v = *value;
+  const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
+  if (!ok) {
+    throw InputError(std::string(option) + " " + FormatNumber(v) + ": must be a number in " +
+                     (lo_open ? "(" : "[") + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+  }
+}
+
+void CheckOptions(const ControlOptions& o) {
+  CheckOption("--target-deg", o.target_deg, 0.0, 180.0);  // 180 = straight.
+  CheckOption("--pressure-kpa", o.pressure_kpa, 0.0, kMaxBoardPressureLimitKpa);
+  CheckOption("--pwm", o.pwm, -1.0, 1.0);
+  CheckOption("--duration-s", o.duration_s, 0.0, 7 * 86400.0, /*lo_open=*/true);  // A week.
+  CheckOption("--fps", o.fps, 0.0, 1000.0, /*lo_open=*/true);
+  if (o.sim_supersample < 1 || o.sim_supersample > 8) {
+    throw InputError("sim_supersample " + std::to_string(o.sim_supersample) + ": must be in 1..8");
+  }
+}
+
 ControlTarget MakeTarget(const ControlOptions& o) {
   const int chosen = (o.target_deg ? 1 : 0) + (o.profile_file ? 1 : 0) + (o.pressure_kpa ? 1 : 0) +
                      (o.pwm ? 1 : 0);
@@ -67,10 +98,6 @@ ControlTarget MakeTarget(const ControlOptions& o) {
   }
   ControlTarget target;
   if (o.target_deg) {
-    if (*o.target_deg < 0.0 || *o.target_deg > 180.0) {
-      throw InputError("--target-deg " + std::to_string(*o.target_deg) +
-                       ": the angle at the middle marker is in 0..180 (180 = straight)");
-    }
     target.profile = TargetProfile::Constant(*o.target_deg);
   } else if (o.profile_file) {
     target.profile = TargetProfile::Load(*o.profile_file);
@@ -99,9 +126,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (options.simulate == options.port.has_value()) {
     throw InputError("control: give --port DEVICE for a board, or --simulate (not both)");
   }
-  if (!(options.fps > 0.0 && options.fps <= 1000.0)) {
-    throw InputError("--fps " + std::to_string(options.fps) + ": must be in (0, 1000]");
-  }
+  CheckOptions(options);
   const ControlTarget target = MakeTarget(options);
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
   // LoadTrackingConfig has read and checked the `control:` section; defaults without one.
@@ -123,8 +148,14 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   } else {
     port = *options.port;
   }
+  // Ctrl-C and SIGTERM from here on: polled between frames and inside every wait for the board.
+  const StopRequest stop;
   std::unique_ptr<Transport> transport = OpenSerialTransport(port, config.link.baud);
-  BoardLink link(*transport, config.link);
+  LinkEnvironment environment;
+  environment.stop_requested = [&stop] { return stop.requested(); };
+  BoardLink link(*transport, config.link, environment);
+  // Declared after the link, so destroyed before it: from the handshake on, any way out of this
+  // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
 
   // Frames.
@@ -191,7 +222,22 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                 TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image,
                                 extra));
 
-  const BoardInfo info = session.start();
+  BoardInfo info;
+  try {
+    info = session.start();
+  } catch (const StopRequested&) {
+    summary.stop_reason = "interrupted";
+    return summary;
+  }
+  if (const std::optional<double> asked = session.pressure_clamped_from()) {
+    // Said once, even with --quiet: the run does not do what the command line says.
+    std::fprintf(stderr,
+                 "control: --pressure-kpa %s is above the limit of %s kPa (control.controller."
+                 "max_kpa, at most the board's limit); sending %s kPa\n",
+                 FormatNumber(*asked).c_str(),
+                 FormatNumber(session.controller().options().max_kpa).c_str(),
+                 FormatNumber(session.pressure_target_kpa()).c_str());
+  }
   if (!options.quiet) {
     std::fprintf(stderr,
                  "control: %s: board protocol %d, pressure limit %.1f kPa, inner loop %d Hz, "
@@ -207,7 +253,6 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  c.ff_kpa_per_deg, c.min_kpa, c.max_kpa, c.max_rate_kpa_per_s, c.hold_s);
   }
 
-  const StopRequest stop;
   double sum_sq = 0.0;
   int64_t errors = 0;
   Frame frame;
@@ -251,7 +296,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     }
     if (summary.stop_reason.empty()) summary.stop_reason = "duration reached";
     session.stop();  // Vent at the end of the run.
-  } catch (const InputError&) {
+  } catch (const StopRequested&) {
+    // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
+    summary.stop_reason = "interrupted";
+    session.stop();
+  } catch (const std::exception&) {
+    // The session's destructor sends STOP on the way out.
     summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
     summary.link_rejected = link.stats().rejected_lines;
     summary.resends = link.stats().resends;

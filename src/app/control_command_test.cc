@@ -3,17 +3,21 @@
 #include "app/control_command.h"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/syscall.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
+#include "softsight/control/protocol.h"
 #include "softsight/core/error.h"
 #include "softsight/io/control_config.h"
 
@@ -133,6 +137,92 @@ TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
   EXPECT_THROW(RunControl(options), InputError);  // Board and simulation.
 }
 
+TEST(ControlCommand, RefusesNonFiniteAndOutOfRangeNumbersNamingTheOption) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto error_of = [](ControlOptions options) {
+    options.config_file = Example();
+    options.simulate = true;
+    options.csv_file = "/nonexistent/never-written.csv";
+    try {
+      RunControl(options);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (double bad : {nan, inf, -inf, -1.0, 181.0}) {
+    ControlOptions o;
+    o.target_deg = bad;
+    EXPECT_THAT(error_of(o), HasSubstr("--target-deg ")) << bad;
+  }
+  for (double bad : {nan, inf, -1.0, 1e4}) {
+    ControlOptions o;
+    o.pressure_kpa = bad;
+    EXPECT_THAT(error_of(o), HasSubstr("--pressure-kpa ")) << bad;
+  }
+  for (double bad : {nan, inf, -1.5, 2.0}) {
+    ControlOptions o;
+    o.pwm = bad;
+    EXPECT_THAT(error_of(o), HasSubstr("--pwm ")) << bad;
+  }
+  for (double bad : {nan, inf, -1.0, 0.0}) {
+    ControlOptions o;
+    o.target_deg = 120.0;
+    o.duration_s = bad;
+    EXPECT_THAT(error_of(o), HasSubstr("--duration-s ")) << bad;
+  }
+  for (double bad : {nan, inf, 0.0}) {
+    ControlOptions o;
+    o.target_deg = 120.0;
+    o.fps = bad;
+    EXPECT_THAT(error_of(o), HasSubstr("--fps ")) << bad;
+  }
+  ControlOptions o;
+  o.duration_s = nan;
+  o.target_deg = 120.0;
+  EXPECT_EQ(error_of(o), "--duration-s nan: must be a number in (0, 604800]");
+  // Through the program: one line, exit code 2.
+  TempDir dir;
+  const std::string command = std::string("\"") + testing::SoftsightBinary() +
+                              "\" control --config " + Example() + " --simulate --pwm nan --csv " +
+                              dir.file("x.csv") + " 2> " + dir.file("err.txt");
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(ReadTextFile(dir.file("err.txt")),
+            "softsight control: error: --pwm nan: must be a number in [-1, 1]\n");
+}
+
+TEST(ControlCommand, APressureAboveMaxKpaIsClampedAndSaidOnce) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"),
+                std::string(kMarkers) + "control:\n  controller:\n    max_kpa: 45\n");
+  ControlOptions options;
+  options.config_file = dir.file("rig.yaml");
+  options.simulate = true;
+  options.pressure_kpa = 49.0;
+  options.duration_s = 0.2;
+  options.sim_supersample = 1;
+  options.csv_file = dir.file("run.csv");
+  options.quiet = true;
+  ::testing::internal::CaptureStderr();
+  RunControl(options);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err,
+            "control: --pressure-kpa 49 is above the limit of 45 kPa (control.controller.max_kpa, "
+            "at most the board's limit); sending 45 kPa\n");
+  const std::vector<std::string> lines = ReadLines(options.csv_file);
+  ASSERT_GT(lines.size(), 2u);
+  const std::vector<std::string> header = SplitCsv(lines[0]);
+  const size_t setpoint =
+      static_cast<size_t>(std::find(header.begin(), header.end(), "setpoint_kpa") - header.begin());
+  ASSERT_LT(setpoint, header.size());
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_DOUBLE_EQ(std::stod(SplitCsv(lines[i])[setpoint]), 45.0) << lines[i];
+  }
+}
+
 // Starts `softsight rig --pty ...`; returns its pid and the pty path it printed.
 pid_t StartRig(const std::string& args, const std::string& stderr_file, std::string* port) {
   int out[2];
@@ -163,8 +253,8 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   WriteTextFile(dir.file("rig.yaml"), kMarkers);
   std::string port;
   const std::string frames = dir.file("rig.png");
-  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 1.5 "
-                             "--duration-s 2.5",
+  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 2 "
+                             "--duration-s 3",
                              dir.file("rig.err"), &port);
   ASSERT_GT(rig, 0);
   ASSERT_THAT(port, HasSubstr("/dev/pts/"));
@@ -198,6 +288,46 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   EXPECT_THAT(rig_err, HasSubstr("port closed"));
   EXPECT_THAT(rig_err, HasSubstr("board watchdog (vented)"));
   EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 0) << rig_err;
+}
+
+TEST(RigCommand, SigtermEndsItWhileAHostFloodsAndNeverReads) {
+  TempDir dir;
+  std::string port;
+  const pid_t rig = StartRig("--quiet", dir.file("rig.err"), &port);
+  ASSERT_GT(rig, 0);
+  ASSERT_THAT(port, HasSubstr("/dev/pts/"));
+  const int fd = open(port.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  // PINGs (answered with ERR: no handshake) until the pty is full both ways: the rig's answers
+  // pile up unread, and it stops taking ours once its own queue is full too.
+  const std::string ping = "$PING 1*" + [] {
+    char crc[5];
+    const char body[] = "PING 1";
+    std::snprintf(crc, sizeof(crc), "%04X", wire::Crc16(body, body + 6));
+    return std::string(crc);
+  }() + "\n";
+  std::string batch;
+  for (int i = 0; i < 100; ++i) batch += ping;
+  size_t written = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const ssize_t n = write(fd, batch.data(), batch.size());
+    if (n > 0) written += static_cast<size_t>(n);
+    pollfd p{fd, POLLOUT, 0};
+    if (n <= 0 && poll(&p, 1, 200) == 0) break;  // The rig stopped reading: flooded.
+  }
+  EXPECT_GT(written, 100000u);  // Far more answers than any buffer holds.
+  kill(rig, SIGTERM);
+  int status = 0;
+  const int pidfd = static_cast<int>(syscall(SYS_pidfd_open, rig, 0));
+  ASSERT_GE(pidfd, 0);
+  pollfd p{pidfd, POLLIN, 0};
+  const bool ended = poll(&p, 1, 10000) == 1;  // Generous: it takes ~5 ms.
+  close(pidfd);
+  if (!ended) kill(rig, SIGKILL);
+  waitpid(rig, &status, 0);
+  close(fd);
+  EXPECT_TRUE(ended) << "the rig ignored SIGTERM while its answers were not read";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << ReadTextFile(dir.file("rig.err"));
 }
 
 }  // namespace

@@ -40,8 +40,18 @@ void WriteAtomically(const std::string& file, const cv::Mat& image) {
 
 RigCommandSummary RunRig(const RigCommandOptions& options) {
   if (!options.pty) throw InputError("rig: give --pty (the rig serves on a pseudo-terminal)");
+  // Tests for the good range: every comparison with NaN is false.
   if (!(options.fps > 0.0 && options.fps <= 240.0)) {
     throw InputError("--fps " + std::to_string(options.fps) + ": must be in (0, 240]");
+  }
+  if (options.duration_s && !(*options.duration_s > 0.0 && *options.duration_s <= 1e6)) {
+    throw InputError("--duration-s " + std::to_string(*options.duration_s) +
+                     ": must be a number in (0, 1e6]");
+  }
+  if (options.disconnect_after_s &&
+      !(*options.disconnect_after_s >= 0.0 && *options.disconnect_after_s <= 1e6)) {
+    throw InputError("--disconnect-after-s " + std::to_string(*options.disconnect_after_s) +
+                     ": must be a number in [0, 1e6]");
   }
   const ControlConfig config =
       options.config_file ? LoadControlConfig(*options.config_file) : ControlConfig{};

@@ -1,6 +1,9 @@
 #include "softsight/control/board_link.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "softsight/core/error.h"
 #include "control/control_options.h"
@@ -31,51 +34,98 @@ bool LinkOptions::Check(std::string* error) const {
   return true;
 }
 
-BoardLink::BoardLink(Transport& transport, LinkOptions options)
-    : transport_(transport), options_(options) {}
+BoardLink::BoardLink(Transport& transport, LinkOptions options, LinkEnvironment environment)
+    : transport_(transport), options_(options), environment_(std::move(environment)) {}
+
+int64_t BoardLink::now_ms() const {
+  if (environment_.now_ms) return environment_.now_ms();
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+std::optional<wire::Message> BoardLink::exchange(
+    const std::string& line, bool honour_stop,
+    const std::function<Verdict(const wire::Message&)>& classify) {
+  for (int attempt = 0; attempt <= options_.retries; ++attempt) {
+    if (attempt > 0) ++stats_.resends;
+    if (honour_stop && environment_.stop_requested && environment_.stop_requested()) {
+      throw StopRequested();
+    }
+    transport_.write_line(line);
+    // One deadline per try: lines that are not the answer (chatter, stale answers, garbage) are
+    // counted but never extend it.
+    const int64_t deadline_ms = now_ms() + options_.reply_timeout_ms;
+    while (true) {
+      if (honour_stop && environment_.stop_requested && environment_.stop_requested()) {
+        throw StopRequested();
+      }
+      const int64_t left_ms = deadline_ms - now_ms();
+      if (left_ms <= 0) break;
+      const auto reply =
+          transport_.read_line(static_cast<int>(std::min<int64_t>(left_ms, kStopPollMs)));
+      if (!reply) continue;
+      wire::Message m;
+      const wire::DecodeStatus status = wire::DecodeLine(reply->data(), reply->size(), &m);
+      if (status == wire::DecodeStatus::kEmpty) continue;
+      const Verdict verdict = status == wire::DecodeStatus::kOk ? classify(m) : Verdict::kRejected;
+      if (verdict == Verdict::kAnswer) return m;
+      if (verdict == Verdict::kStale) {
+        ++stats_.stale_answers;
+      } else {
+        ++stats_.rejected_lines;
+      }
+    }
+  }
+  return std::nullopt;
+}
 
 BoardInfo BoardLink::handshake() {
   wire::Message hello;
   hello.type = wire::MessageType::kHello;
   hello.argc = 1;
   hello.args[0] = wire::kProtocolVersion;
-  const std::string line = Encode(hello);
-  for (int attempt = 0; attempt <= options_.retries; ++attempt) {
-    if (attempt > 0) ++stats_.resends;
-    transport_.write_line(line);
-    while (auto reply = transport_.read_line(options_.reply_timeout_ms)) {
-      wire::Message m;
-      const wire::DecodeStatus status = wire::DecodeLine(reply->data(), reply->size(), &m);
-      if (status == wire::DecodeStatus::kEmpty) continue;
-      if (status != wire::DecodeStatus::kOk) {
-        ++stats_.rejected_lines;
-        continue;
-      }
-      if (m.type == wire::MessageType::kError && m.args[1] == wire::kErrVersion) {
-        throw InputError(port_name() + ": the board does not speak protocol version " +
-                         std::to_string(wire::kProtocolVersion) + "; update its firmware");
-      }
-      if (m.type != wire::MessageType::kHelloReply) {
-        ++stats_.stale_answers;
-        continue;
-      }
-      if (m.args[0] != wire::kProtocolVersion) {
-        throw InputError(port_name() + ": the board speaks protocol version " +
-                         std::to_string(m.args[0]) + ", softsight speaks " +
-                         std::to_string(wire::kProtocolVersion) + "; update its firmware");
-      }
-      BoardInfo info;
-      info.protocol_version = m.args[0];
-      info.pressure_limit_kpa = m.args[1] * 1e-3;
-      info.loop_hz = m.args[2];
-      info.watchdog_ms = m.args[3];
-      return info;
-    }
+  const std::optional<wire::Message> reply =
+      exchange(Encode(hello), /*honour_stop=*/true, [this](const wire::Message& m) {
+        if (m.type == wire::MessageType::kError && m.args[1] == wire::kErrVersion) {
+          throw InputError(port_name() + ": the board does not speak protocol version " +
+                           std::to_string(wire::kProtocolVersion) + "; update its firmware");
+        }
+        if (wire::IsHostCommand(m.type)) return Verdict::kRejected;
+        return m.type == wire::MessageType::kHelloReply ? Verdict::kAnswer : Verdict::kStale;
+      });
+  if (!reply) {
+    throw InputError(port_name() + ": no answer to the handshake after " +
+                     std::to_string(options_.retries + 1) + " tries of " +
+                     std::to_string(options_.reply_timeout_ms) +
+                     " ms; is the softsight firmware (protocol version " +
+                     std::to_string(wire::kProtocolVersion) + ") running, at " +
+                     std::to_string(options_.baud) + " baud?");
   }
-  throw InputError(port_name() + ": no answer to the handshake after " +
-                   std::to_string(options_.retries + 1) +
-                   " tries; is the softsight firmware running, at " +
-                   std::to_string(options_.baud) + " baud?");
+  const wire::Message& m = *reply;
+  if (m.args[0] != wire::kProtocolVersion) {
+    throw InputError(port_name() + ": the board speaks protocol version " +
+                     std::to_string(m.args[0]) + ", softsight speaks " +
+                     std::to_string(wire::kProtocolVersion) + "; update its firmware");
+  }
+  BoardInfo info;
+  info.protocol_version = m.args[0];
+  info.pressure_limit_kpa = m.args[1] * 1e-3;
+  info.loop_hz = m.args[2];
+  info.watchdog_ms = m.args[3];
+  // A limit the host cannot trust makes every later check meaningless: refuse to start.
+  if (!(info.pressure_limit_kpa > 0.0 && info.pressure_limit_kpa <= kMaxBoardPressureLimitKpa) ||
+      info.loop_hz <= 0 || info.watchdog_ms <= 0) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "pressure limit %.3f kPa, loop %d Hz, watchdog %d ms (expected a limit in "
+                  "(0, %.0f] kPa and a positive rate and watchdog)",
+                  info.pressure_limit_kpa, info.loop_hz, info.watchdog_ms,
+                  kMaxBoardPressureLimitKpa);
+    throw InputError(port_name() + ": the board's handshake reports a nonsensical " + text +
+                     "; check its firmware and configuration");
+  }
+  return info;
 }
 
 BoardState BoardLink::set_pressure_kpa(double setpoint_kpa) {
@@ -100,40 +150,33 @@ BoardState BoardLink::request(wire::MessageType type, int32_t value, const char*
   next_seq_ = next_seq_ >= 999999 ? 1 : next_seq_ + 1;
   command.args[0] = seq;
   command.args[1] = value;
-  const std::string line = Encode(command);
-  for (int attempt = 0; attempt <= options_.retries; ++attempt) {
-    if (attempt > 0) ++stats_.resends;
-    transport_.write_line(line);
-    while (auto reply = transport_.read_line(options_.reply_timeout_ms)) {
-      wire::Message m;
-      const wire::DecodeStatus status = wire::DecodeLine(reply->data(), reply->size(), &m);
-      if (status == wire::DecodeStatus::kEmpty) continue;
-      if (status != wire::DecodeStatus::kOk || wire::IsHostCommand(m.type)) {
-        ++stats_.rejected_lines;
-        continue;
-      }
-      if (m.type == wire::MessageType::kHelloReply || m.args[0] != seq) {
-        ++stats_.stale_answers;
-        continue;
-      }
-      if (m.type == wire::MessageType::kError) {
-        throw InputError(port_name() + ": the board refused " + std::string(what) + " " +
-                         std::to_string(value) + ": " + ErrorName(m.args[1]));
-      }
-      BoardState state;
-      state.seq = m.args[0];
-      state.time_ms = m.args[1];
-      state.pressure_kpa = m.args[2] * 1e-3;
-      state.setpoint_kpa = m.args[3] * 1e-3;
-      state.duty = m.args[4] * 1e-3;
-      state.flags = static_cast<uint16_t>(m.args[5]);
-      state.board_rejected = static_cast<uint32_t>(m.args[6]);
-      return state;
-    }
+  const bool honour_stop = type != wire::MessageType::kStop;
+  const std::optional<wire::Message> reply =
+      exchange(Encode(command), honour_stop, [seq](const wire::Message& m) {
+        if (wire::IsHostCommand(m.type)) return Verdict::kRejected;
+        if (m.type == wire::MessageType::kHelloReply || m.args[0] != seq) return Verdict::kStale;
+        return Verdict::kAnswer;
+      });
+  if (!reply) {
+    throw InputError(port_name() + ": no answer to " + what + " after " +
+                     std::to_string(options_.retries + 1) + " tries of " +
+                     std::to_string(options_.reply_timeout_ms) +
+                     " ms; is the board still powered and running the softsight firmware?");
   }
-  throw InputError(port_name() + ": no answer to " + what + " after " +
-                   std::to_string(options_.retries + 1) +
-                   " tries; is the board still powered and running the softsight firmware?");
+  const wire::Message& m = *reply;
+  if (m.type == wire::MessageType::kError) {
+    throw InputError(port_name() + ": the board refused " + std::string(what) + " " +
+                     std::to_string(value) + ": " + ErrorName(m.args[1]));
+  }
+  BoardState state;
+  state.seq = m.args[0];
+  state.time_ms = m.args[1];
+  state.pressure_kpa = m.args[2] * 1e-3;
+  state.setpoint_kpa = m.args[3] * 1e-3;
+  state.duty = m.args[4] * 1e-3;
+  state.flags = static_cast<uint16_t>(m.args[5]);
+  state.board_rejected = static_cast<uint32_t>(m.args[6]);
+  return state;
 }
 
 }  // namespace softsight

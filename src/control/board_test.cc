@@ -41,7 +41,7 @@ TEST(Board, RequiresTheVersionedHandshake) {
   EXPECT_EQ(m.args[1], wire::kErrNoHello);
   EXPECT_EQ(board.mode(), Board::Mode::kIdle);
 
-  m = Send(board, Line(wire::MessageType::kHello, 2), 0);
+  m = Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion + 1), 0);
   EXPECT_EQ(m.type, wire::MessageType::kError);
   EXPECT_EQ(m.args[1], wire::kErrVersion);
 

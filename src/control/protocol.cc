@@ -96,8 +96,8 @@ const char* DecodeStatusName(DecodeStatus status) {
     case DecodeStatus::kOk: return "ok";
     case DecodeStatus::kEmpty: return "empty line";
     case DecodeStatus::kNoStart: return "no '$' at the start";
-    case DecodeStatus::kNoChecksum: return "no '*HH' checksum (truncated?)";
-    case DecodeStatus::kBadChecksum: return "checksum mismatch";
+    case DecodeStatus::kNoChecksum: return "no '*HHHH' CRC (truncated?)";
+    case DecodeStatus::kBadChecksum: return "CRC mismatch";
     case DecodeStatus::kBadCharacter: return "non-printable byte";
     case DecodeStatus::kUnknownCommand: return "unknown command";
     case DecodeStatus::kBadArguments: return "bad arguments";
@@ -106,10 +106,18 @@ const char* DecodeStatusName(DecodeStatus status) {
   return "?";
 }
 
-uint8_t Checksum(const char* begin, const char* end) {
-  uint8_t sum = 0;
-  for (const char* p = begin; p < end; ++p) sum ^= static_cast<uint8_t>(*p);
-  return sum;
+uint16_t Crc16(const char* begin, const char* end) {
+  // Bit by bit rather than with a 512-byte table: an AVR has 2 KB of RAM, and a 96-byte line
+  // takes well under a millisecond.
+  uint16_t crc = 0xFFFF;
+  for (const char* p = begin; p < end; ++p) {
+    crc = static_cast<uint16_t>(crc ^ (static_cast<uint16_t>(static_cast<uint8_t>(*p)) << 8));
+    for (int bit = 0; bit < 8; ++bit) {
+      crc = (crc & 0x8000) != 0 ? static_cast<uint16_t>((crc << 1) ^ 0x1021)
+                                : static_cast<uint16_t>(crc << 1);
+    }
+  }
+  return crc;
 }
 
 size_t EncodeMessage(const Message& message, char* out, size_t capacity) {
@@ -127,11 +135,10 @@ size_t EncodeMessage(const Message& message, char* out, size_t capacity) {
     pos = AppendInt(message.args[i], out, pos, capacity);
     if (pos == 0) return 0;
   }
-  if (pos + 5 > capacity || pos + 3 > kMaxLineLength) return 0;  // "*HH\n" and the NUL.
-  const uint8_t sum = Checksum(out + 1, out + pos);
+  if (pos + 7 > capacity || pos + 5 > kMaxLineLength) return 0;  // "*HHHH\n" and the NUL.
+  const uint16_t crc = Crc16(out + 1, out + pos);
   out[pos++] = '*';
-  out[pos++] = kHex[sum >> 4];
-  out[pos++] = kHex[sum & 0x0F];
+  for (int shift = 12; shift >= 0; shift -= 4) out[pos++] = kHex[(crc >> shift) & 0x0F];
   out[pos++] = '\n';
   out[pos] = '\0';
   return pos;
@@ -150,14 +157,15 @@ DecodeStatus DecodeLine(const char* line, size_t length, Message* message) {
   if (blank) return DecodeStatus::kEmpty;
   if (length > kMaxLineLength) return DecodeStatus::kTooLong;
   if (line[0] != '$') return DecodeStatus::kNoStart;
-  if (length < 5 || line[length - 3] != '*') return DecodeStatus::kNoChecksum;
-  const int hi = HexValue(line[length - 2]);
-  const int lo = HexValue(line[length - 1]);
-  if (hi < 0 || lo < 0) return DecodeStatus::kNoChecksum;
-  const char* body_end = line + length - 3;
-  if (Checksum(line + 1, body_end) != static_cast<uint8_t>(hi * 16 + lo)) {
-    return DecodeStatus::kBadChecksum;
+  if (length < 7 || line[length - 5] != '*') return DecodeStatus::kNoChecksum;
+  uint16_t received = 0;
+  for (size_t i = length - 4; i < length; ++i) {
+    const int digit = HexValue(line[i]);
+    if (digit < 0) return DecodeStatus::kNoChecksum;
+    received = static_cast<uint16_t>((received << 4) | digit);
   }
+  const char* body_end = line + length - 5;
+  if (Crc16(line + 1, body_end) != received) return DecodeStatus::kBadChecksum;
 
   // Tokens separated by exactly one space: the encoder writes nothing else, so anything else is a
   // sign of corruption that happened to keep the checksum.

@@ -1,5 +1,6 @@
 #include "softsight/control/rig.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
 
@@ -86,6 +87,8 @@ RigSnapshot SimulatedRig::snapshot() const {
 }
 
 RigServer::RigServer(SimulatedRig& rig, bool realtime) : rig_(rig) {
+  const int flags = ::fcntl(pty_.master_fd(), F_GETFL);
+  ::fcntl(pty_.master_fd(), F_SETFL, flags | O_NONBLOCK);
   server_ = std::thread([this] { serve(); });
   if (realtime) clock_ = std::thread([this] { run_clock(); });
 }
@@ -106,8 +109,23 @@ void RigServer::set_reply_filter(std::function<std::string(const std::string&)> 
 void RigServer::inject(std::string_view bytes) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   if (port_closed_) return;
-  const ssize_t n = ::write(pty_.master_fd(), bytes.data(), bytes.size());
-  (void)n;  // A full pty buffer drops test garbage; nothing to recover.
+  enqueue_locked(bytes);  // Behind any queued answer, so never in the middle of one.
+  flush_locked();
+}
+
+bool RigServer::enqueue_locked(std::string_view bytes) {
+  if (pending_.size() + bytes.size() > kMaxPendingBytes) return false;
+  pending_.append(bytes.data(), bytes.size());
+  return true;
+}
+
+void RigServer::flush_locked() {
+  while (!pending_.empty()) {
+    const ssize_t w = ::write(pty_.master_fd(), pending_.data(), pending_.size());
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return;  // EAGAIN: the host is not reading; try again when the pty has room.
+    pending_.erase(0, static_cast<size_t>(w));
+  }
 }
 
 void RigServer::disconnect() {
@@ -122,11 +140,23 @@ void RigServer::serve() {
   std::string replies;
   char buffer[256];
   while (!port_closed_ && !shutdown_) {
-    pollfd p{pty_.master_fd(), POLLIN, 0};
+    bool waiting_to_write = false;
+    {
+      std::lock_guard<std::mutex> lock(write_mutex_);
+      waiting_to_write = !pending_.empty();
+    }
+    // A short timeout: shutdown and disconnect are seen within 5 ms whatever the host does.
+    pollfd p{pty_.master_fd(), static_cast<short>(POLLIN | (waiting_to_write ? POLLOUT : 0)), 0};
     const int ready = ::poll(&p, 1, 5);
+    if (ready > 0 && (p.revents & POLLOUT) != 0) {
+      std::lock_guard<std::mutex> lock(write_mutex_);
+      flush_locked();
+    }
     if (ready <= 0 || (p.revents & POLLIN) == 0) {
       // POLLHUP without data: nobody has the port open (we keep the slave, so rarely). Wait.
-      if (ready > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (ready > 0 && (p.revents & POLLOUT) == 0) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
       continue;
     }
     const ssize_t n = ::read(pty_.master_fd(), buffer, sizeof(buffer));
@@ -141,13 +171,9 @@ void RigServer::serve() {
       std::string line = replies.substr(start, end == std::string::npos ? end : end - start + 1);
       start = end == std::string::npos ? replies.size() : end + 1;
       if (filter_) line = filter_(line);
-      size_t done = 0;
-      while (done < line.size()) {
-        const ssize_t w = ::write(pty_.master_fd(), line.data() + done, line.size() - done);
-        if (w <= 0) break;
-        done += static_cast<size_t>(w);
-      }
+      if (!enqueue_locked(line)) ++dropped_replies_;
     }
+    flush_locked();
   }
 }
 

@@ -1,11 +1,18 @@
 #include "softsight/control/session.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "softsight/core/error.h"
 
 namespace softsight {
 namespace {
+
+std::string FormatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", v);
+  return text;
+}
 
 const ControllerOptions& Checked(const ControllerOptions& options) {
   std::string error;
@@ -18,23 +25,60 @@ const ControllerOptions& Checked(const ControllerOptions& options) {
 ControlSession::ControlSession(const ControllerOptions& options, BoardLink& link,
                                ControlTarget target)
     : controller_(Checked(options)), link_(link), target_(std::move(target)) {
-  if (target_.duty < -1.0 || target_.duty > 1.0) {
-    throw InputError("--pwm " + std::to_string(target_.duty) + ": duty must be in -1..1");
+  // Comparisons are false for NaN: test for the good range, not against the bad one.
+  if (!(target_.duty >= -1.0 && target_.duty <= 1.0)) {
+    throw InputError("--pwm " + FormatNumber(target_.duty) + ": duty must be in -1..1");
   }
-  if (target_.pressure_kpa < 0.0) {
-    throw InputError("--pressure-kpa " + std::to_string(target_.pressure_kpa) + ": must be >= 0");
+  if (!(target_.pressure_kpa >= 0.0 && target_.pressure_kpa <= kMaxBoardPressureLimitKpa)) {
+    throw InputError("--pressure-kpa " + FormatNumber(target_.pressure_kpa) +
+                     ": must be a number in 0.." + FormatNumber(kMaxBoardPressureLimitKpa));
+  }
+}
+
+ControlSession::~ControlSession() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  try {
+    link_.stop();
+  } catch (const std::exception&) {
+    // The link is already failing (that is likely why we are here); its error has been
+    // reported, and the board's watchdog vents when the commands stop.
   }
 }
 
 BoardInfo ControlSession::start() {
   const BoardInfo info = link_.handshake();
+  started_ = true;
+  stopped_ = false;
+  board_limit_kpa_ = info.pressure_limit_kpa;
   controller_.limit_max_kpa(info.pressure_limit_kpa);
-  if (target_.mode == ControlMode::kPressure && target_.pressure_kpa > info.pressure_limit_kpa) {
-    throw InputError("--pressure-kpa " + std::to_string(target_.pressure_kpa) +
-                     ": above the board's limit of " + std::to_string(info.pressure_limit_kpa) +
-                     " kPa");
+  const double max_kpa = controller_.options().max_kpa;
+  if (target_.mode == ControlMode::kPressure && target_.pressure_kpa > max_kpa) {
+    pressure_clamped_from_ = target_.pressure_kpa;
+    target_.pressure_kpa = max_kpa;
   }
   return info;
+}
+
+BoardState ControlSession::send_pressure(double setpoint_kpa) {
+  const ControllerOptions& c = controller_.options();
+  return link_.set_pressure_kpa(std::clamp(setpoint_kpa, c.min_kpa, c.max_kpa));
+}
+
+const BoardState& ControlSession::checked(const BoardState& state) {
+  if (state.pressure_kpa > board_limit_kpa_) {
+    stopped_ = true;
+    try {
+      link_.stop();
+    } catch (const std::exception&) {
+      // Reported below; the board's watchdog vents when the commands stop.
+    }
+    throw InputError(link_.port_name() + ": the board reports " +
+                     FormatNumber(state.pressure_kpa) + " kPa, above its own limit of " +
+                     FormatNumber(board_limit_kpa_) +
+                     " kPa (sensor or guard fault); sent STOP to vent, stopping");
+  }
+  return state;
 }
 
 ControlSample ControlSession::step(double time_s, std::optional<double> measured_deg) {
@@ -49,27 +93,30 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
       const ControllerOutput out = controller_.update(time_s, target_deg, measured_deg);
       sample.action = out.action;
       if (out.action == ControllerOutput::Action::kVent) {
-        sample.board = link_.stop();
+        sample.board = checked(link_.stop());
       } else {
         sample.setpoint_kpa = out.setpoint_kpa;
-        sample.board = link_.set_pressure_kpa(out.setpoint_kpa);
+        sample.board = checked(send_pressure(out.setpoint_kpa));
       }
       break;
     }
     case ControlMode::kPressure:
       sample.action = ControllerOutput::Action::kTrack;
       sample.setpoint_kpa = target_.pressure_kpa;
-      sample.board = link_.set_pressure_kpa(target_.pressure_kpa);
+      sample.board = checked(send_pressure(target_.pressure_kpa));
       break;
     case ControlMode::kDuty:
       sample.action = ControllerOutput::Action::kTrack;
       sample.duty_command = target_.duty;
-      sample.board = link_.set_duty(target_.duty);
+      sample.board = checked(link_.set_duty(target_.duty));
       break;
   }
   return sample;
 }
 
-BoardState ControlSession::stop() { return link_.stop(); }
+BoardState ControlSession::stop() {
+  stopped_ = true;  // Tried: the destructor does not try a second time.
+  return link_.stop();
+}
 
 }  // namespace softsight

@@ -1,9 +1,14 @@
 // The host side of the wire protocol (docs/protocol.md): handshake, commands, and the board's
 // answers, over any Transport. Every command waits for the answer with its sequence number;
-// rejected lines (garbage, truncated, bad checksum) and stale answers are counted and skipped.
+// rejected lines (garbage, truncated, bad CRC) and stale answers are counted and skipped. Each
+// try has a fixed deadline, reply_timeout_ms after the line went out, however much else the
+// board says meanwhile, so a command ends within (retries + 1) * reply_timeout_ms.
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "softsight/control/protocol.h"
@@ -13,11 +18,31 @@ namespace softsight {
 
 struct LinkOptions {
   int baud = 115200;          // Serial baud rate. Default 115200 (a 60-byte line takes ~5 ms).
-  int reply_timeout_ms = 100; // Wait for an answer this long before re-sending. Default 100 ms.
+  int reply_timeout_ms = 100; // Deadline of each try, from sending it. Default 100 ms.
   int retries = 2;            // Re-sends before giving up with an error. Default 2.
 
   bool Check(std::string* error) const;
 };
+
+// What the link takes from its surroundings: the clock and the user's stop request. Tests inject a
+// simulated clock; `softsight control` passes its Ctrl-C / SIGTERM flag.
+struct LinkEnvironment {
+  // Monotonic time in milliseconds. Empty: std::chrono::steady_clock.
+  std::function<int64_t()> now_ms;
+  // Polled while waiting for an answer (at least every kStopPollMs); true ends the wait with
+  // StopRequested. Never consulted by stop(), which must vent whatever happens. Empty: never.
+  std::function<bool()> stop_requested;
+};
+
+// Thrown by a wait for an answer that a stop request cut short: not an error of the link.
+class StopRequested : public std::runtime_error {
+ public:
+  StopRequested() : std::runtime_error("stop requested") {}
+};
+
+// The highest pressure limit a $HI may report, kPa: more is no soft actuator's limit but a wrong
+// or corrupted board configuration.
+constexpr double kMaxBoardPressureLimitKpa = 1000.0;
 
 // What the board said in its $HI answer.
 struct BoardInfo {
@@ -50,27 +75,41 @@ struct LinkStats {
 
 class BoardLink {
  public:
-  // `transport` must outlive the link.
-  BoardLink(Transport& transport, LinkOptions options = {});
+  // Longest single wait on the transport, so that a stop request is seen within this.
+  static constexpr int kStopPollMs = 20;
 
-  // Versioned handshake. Throws InputError naming the port when the board does not answer or
-  // speaks another protocol version.
+  // `transport` must outlive the link.
+  BoardLink(Transport& transport, LinkOptions options = {}, LinkEnvironment environment = {});
+
+  // Versioned handshake. Throws InputError naming the port when the board does not answer,
+  // speaks another protocol version, or reports a nonsensical limit (pressure limit <= 0 or above
+  // kMaxBoardPressureLimitKpa, loop rate or watchdog <= 0).
   BoardInfo handshake();
 
   BoardState set_pressure_kpa(double setpoint_kpa);
   BoardState set_duty(double duty);  // [-1, 1]; > 0 inflate, < 0 vent.
   BoardState read_state();
-  BoardState stop();                 // Vent to the safe state.
+  BoardState stop();                 // Vent to the safe state (ignores stop requests).
   BoardState heartbeat();
 
   const LinkStats& stats() const { return stats_; }
   const std::string& port_name() const { return transport_.name(); }
+  const LinkOptions& options() const { return options_; }
 
  private:
+  enum class Verdict { kAnswer, kStale, kRejected };
+  // Sends `line` up to retries + 1 times and returns the first line `classify` calls the answer;
+  // nothing when every try passed its deadline. Throws StopRequested when `honour_stop` and the
+  // user asked to stop.
+  std::optional<wire::Message> exchange(
+      const std::string& line, bool honour_stop,
+      const std::function<Verdict(const wire::Message&)>& classify);
   BoardState request(wire::MessageType type, int32_t value, const char* what);
+  int64_t now_ms() const;
 
   Transport& transport_;
   LinkOptions options_;
+  LinkEnvironment environment_;
   int32_t next_seq_ = 1;
   LinkStats stats_;
 };

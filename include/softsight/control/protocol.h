@@ -1,9 +1,10 @@
 // The wire protocol between the host and the pressure-control board (docs/protocol.md).
 //
 // One message per line, plain ASCII, readable in a terminal:
-//   $SETP 17 25000*4B\n
-// '$', a command word, space-separated decimal integer arguments, '*', two upper-case hex digits of
-// the XOR of every byte between '$' and '*', then '\n' ('\r' before it is ignored). Pressures are
+//   $SETP 17 25000*239F\n
+// '$', a command word, space-separated decimal integer arguments, '*', four upper-case hex digits
+// of the CRC-16/CCITT-FALSE of every byte between '$' and '*', then '\n' ('\r' before it is
+// ignored). Pressures are
 // gauge pressures in pascals, duties in per-mille, times in milliseconds: integers only, so the
 // board never formats or parses a float.
 //
@@ -17,7 +18,9 @@
 namespace softsight {
 namespace wire {
 
-const int32_t kProtocolVersion = 1;
+// 2: the check became a CRC-16 (version 1 had an 8-bit XOR, which two flips of the same bit in
+// two bytes pass).
+const int32_t kProtocolVersion = 2;
 // Longest line, from '$' to the checksum digits inclusive (without "\r\n").
 const size_t kMaxLineLength = 96;
 // Buffer size that holds any encoded line with its "\n" and a terminating NUL.
@@ -62,8 +65,8 @@ enum class DecodeStatus : uint8_t {
   kOk = 0,
   kEmpty,            // Only whitespace (not counted as an error by the receivers).
   kNoStart,          // Does not begin with '$' (garbage, or the tail of a truncated line).
-  kNoChecksum,       // No "*HH" at the end (truncated).
-  kBadChecksum,      // Checksum mismatch (corrupted, e.g. a flipped bit).
+  kNoChecksum,       // No "*HHHH" at the end (truncated).
+  kBadChecksum,      // CRC mismatch (corrupted: any 1, 2 or 3 flipped bits, any burst <= 16).
   kBadCharacter,     // A byte outside printable ASCII.
   kUnknownCommand,   // A command word this side does not know.
   kBadArguments,     // Wrong argument count, or an argument that is not a decimal integer.
@@ -83,10 +86,13 @@ const char* CommandWord(MessageType type);
 bool IsHostCommand(MessageType type);
 const char* DecodeStatusName(DecodeStatus status);
 
-// XOR of the bytes in [begin, end).
-uint8_t Checksum(const char* begin, const char* end);
+// CRC-16/CCITT-FALSE (polynomial 0x1021, initial value 0xFFFF, no reflection, no final XOR) of
+// the bytes in [begin, end); "123456789" gives 0x29B1. Its generator has the factor x + 1 and a
+// primitive factor of period 32767, so every error of 1, 2 or 3 bits and every burst of up to 16
+// bits in a line of up to 4095 bytes changes it.
+uint16_t Crc16(const char* begin, const char* end);
 
-// Encodes `message` as "$WORD a b c*HH\n" into `out` (NUL-terminated). Returns the length without
+// Encodes `message` as "$WORD a b c*HHHH\n" into `out` (NUL-terminated). Returns the length without
 // the NUL, or 0 when `capacity` is too small or the argument count is wrong.
 size_t EncodeMessage(const Message& message, char* out, size_t capacity);
 

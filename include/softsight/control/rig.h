@@ -73,13 +73,19 @@ class SimulatedRig {
   std::normal_distribution<double> noise_{0.0, 1.0};
 };
 
-// Serves a SimulatedRig on a new pseudo-terminal.
+// Serves a SimulatedRig on a new pseudo-terminal. Writes to the pty never block: answers wait in
+// a bounded queue (kMaxPendingBytes) while the host is not reading, and when that is full new
+// answers are dropped whole and counted, as a board's full serial buffer would lose them. So a
+// host that floods commands and never reads cannot stall the rig or its shutdown.
 class RigServer {
  public:
   // Opens the pseudo-terminal and starts answering. With `realtime`, a second thread advances the
   // rig with the wall clock. Throws InputError when no pseudo-terminal is available.
   explicit RigServer(SimulatedRig& rig, bool realtime = false);
   ~RigServer();
+
+  // About a hundred $STATE answers: far more than a host that reads ever leaves unread.
+  static constexpr size_t kMaxPendingBytes = 4096;
 
   // The device path for the host (/dev/pts/N).
   const std::string& port() const { return pty_.slave_path(); }
@@ -91,9 +97,15 @@ class RigServer {
   // rig itself keeps its state; its watchdog vents it as time advances.
   void disconnect();
   bool connected() const { return !port_closed_; }
+  // Answers dropped because the host did not read them and the queue was full.
+  uint64_t dropped_replies() const { return dropped_replies_; }
 
  private:
   void serve();
+  // Queues `bytes` (whole, or not at all when the queue is full); caller holds write_mutex_.
+  bool enqueue_locked(std::string_view bytes);
+  // Writes what the pty takes now, without blocking; caller holds write_mutex_.
+  void flush_locked();
   void run_clock();
   void stop_threads();
 
@@ -101,6 +113,8 @@ class RigServer {
   PseudoTerminal pty_;
   std::mutex write_mutex_;
   std::function<std::string(const std::string&)> filter_;
+  std::string pending_;  // Bytes for the host not yet taken by the pty (write_mutex_).
+  std::atomic<uint64_t> dropped_replies_{0};
   std::atomic<bool> port_closed_{false};
   std::atomic<bool> shutdown_{false};
   std::thread server_;

@@ -34,25 +34,49 @@ struct ControlSample {
   BoardState board;                      // The board's answer.
 };
 
+// Safety is structural: once start() has shaken hands, the session sends STOP when it ends,
+// however it ends (the end of the run, a board ERR, a failed link, a fault, any exception), unless
+// stop() already has. Every pressure command is clamped to the controller's max_kpa (itself at
+// most the board's limit), and every answer is checked against the board's limit.
 class ControlSession {
  public:
-  // `link` must outlive the session. Throws InputError when the options fail their Check().
+  // `link` must outlive the session. Throws InputError when the options or the target (NaN,
+  // infinite, out of range) are unusable.
   ControlSession(const ControllerOptions& options, BoardLink& link, ControlTarget target);
+  // Vents the actuator (STOP) if the session was started and not stopped; never throws.
+  ~ControlSession();
+  ControlSession(const ControlSession&) = delete;
+  ControlSession& operator=(const ControlSession&) = delete;
 
-  // Handshake; the controller's max_kpa is clamped to the board's limit. Throws InputError.
+  // Handshake; the controller's max_kpa is clamped to the board's limit, and so is an open-loop
+  // pressure target (see pressure_clamped_from()). Throws InputError.
   BoardInfo start();
-  // One frame at `time_s` (the frame's timestamp). Throws InputError when the link fails.
+  // One frame at `time_s` (the frame's timestamp). Throws InputError when the link fails, the
+  // board refuses a command, or the board reports a pressure above its limit (a fault: the
+  // session vents before throwing). Throws StopRequested when the user asked to stop mid-wait.
   ControlSample step(double time_s, std::optional<double> measured_deg);
   // Vents the actuator (end of run).
   BoardState stop();
 
+  // The open-loop pressure target as given, when start() lowered it to max_kpa.
+  std::optional<double> pressure_clamped_from() const { return pressure_clamped_from_; }
+  // The pressure the open-loop target sends (after the clamp).
+  double pressure_target_kpa() const { return target_.pressure_kpa; }
   const AngleController& controller() const { return controller_; }
 
  private:
+  BoardState send_pressure(double setpoint_kpa);
+  // Throws (after venting) when the board says its pressure is above its own limit.
+  const BoardState& checked(const BoardState& state);
+
   AngleController controller_;
   BoardLink& link_;
   ControlTarget target_;
   std::optional<double> start_time_s_;
+  std::optional<double> pressure_clamped_from_;
+  double board_limit_kpa_ = 0.0;
+  bool started_ = false;
+  bool stopped_ = false;
 };
 
 }  // namespace softsight

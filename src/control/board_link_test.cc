@@ -1,0 +1,369 @@
+// The host's side of the link against scripted boards, in simulated time: the link's clock is the
+// fake transport's, which jumps to the next line (or to the end of a wait) instead of sleeping. So
+// the deadlines are checked to the millisecond, and none of these tests waits for real.
+#include "softsight/control/board_link.h"
+
+#include <algorithm>
+#include <deque>
+#include <limits>
+#include <stdexcept>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "softsight/control/board.h"
+#include "softsight/control/session.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+std::string Encode(wire::MessageType type, std::initializer_list<int32_t> args) {
+  wire::Message m;
+  m.type = type;
+  for (int32_t a : args) m.args[m.argc++] = a;
+  char buffer[wire::kLineBufferSize];
+  return std::string(buffer, wire::EncodeMessage(m, buffer, sizeof(buffer)));
+}
+
+wire::Message Decode(const std::string& line) {
+  wire::Message m;
+  EXPECT_EQ(wire::DecodeLine(line.data(), line.size() - 1, &m), wire::DecodeStatus::kOk) << line;
+  return m;
+}
+
+// A board behind a Transport, in simulated milliseconds. By default the real board logic
+// (board.h) answers every line after `latency_ms`; `rewrite` may change or drop (return "") each
+// answer; `chatter_period_ms` > 0 adds a line of debug text that often, for ever.
+class FakeBoard : public Transport {
+ public:
+  FakeBoard() : board_(BoardConfig{}) {}
+
+  void write_line(std::string_view line) override {
+    written.emplace_back(line);
+    for (char c : line) {
+      const size_t n = board_.receive(c, static_cast<uint32_t>(now));
+      if (n == 0) continue;
+      std::string answer(board_.reply(), n);
+      if (rewrite) answer = rewrite(answer);
+      if (!answer.empty()) queue_.push_back({now + latency_ms, answer});
+    }
+  }
+
+  std::optional<std::string> read_line(int timeout_ms) override {
+    EXPECT_GT(timeout_ms, 0);
+    EXPECT_LE(timeout_ms, BoardLink::kStopPollMs);  // Short waits: a stop request is seen soon.
+    ++reads;
+    const int64_t until = now + timeout_ms;
+    int64_t next_chatter = -1;
+    if (chatter_period_ms > 0 && now < chatter_until_ms) {
+      next_chatter = (now / chatter_period_ms + 1) * chatter_period_ms;
+    }
+    if (!queue_.empty() && queue_.front().first <= until &&
+        (next_chatter < 0 || queue_.front().first <= next_chatter)) {
+      now = std::max(now, queue_.front().first);
+      std::string line = queue_.front().second;
+      queue_.pop_front();
+      line.pop_back();  // Transports return lines without '\n'.
+      return line;
+    }
+    if (next_chatter >= 0 && next_chatter <= until) {
+      now = next_chatter;
+      // Debug text and a stale answer, as a board printing its state at 20 Hz would.
+      std::string stale = Encode(wire::MessageType::kState, {0, 0, 1000, 0, 0, 33, 0});
+      stale.pop_back();
+      return (now / chatter_period_ms) % 2 == 0 ? std::string("debug: p=12.3 kPa") : stale;
+    }
+    now = until;
+    return std::nullopt;
+  }
+
+  const std::string& name() const override { return name_; }
+
+  // The command words the host sent, in order ("HELLO", "SETP", ...).
+  std::vector<std::string> words() const {
+    std::vector<std::string> out;
+    for (const std::string& line : written) {
+      wire::Message m;
+      if (wire::DecodeLine(line.data(), line.size() - 1, &m) == wire::DecodeStatus::kOk) {
+        out.push_back(wire::CommandWord(m.type));
+      }
+    }
+    return out;
+  }
+
+  int64_t now = 0;
+  int64_t latency_ms = 2;
+  int64_t chatter_period_ms = 0;
+  int64_t chatter_until_ms = 60000;  // Bounded, so that a link that would wait for ever fails.
+  std::function<std::string(const std::string&)> rewrite;
+  std::vector<std::string> written;
+  int reads = 0;
+
+ private:
+  Board board_;
+  std::deque<std::pair<int64_t, std::string>> queue_;
+  std::string name_ = "serial port /dev/fake0";
+};
+
+LinkEnvironment SimulatedClock(FakeBoard& board, std::function<bool()> stop = {}) {
+  LinkEnvironment env;
+  env.now_ms = [&board] { return board.now; };
+  env.stop_requested = std::move(stop);
+  return env;
+}
+
+TEST(BoardLink, AnswersArriveAndAreDecoded) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  const BoardInfo info = link.handshake();
+  EXPECT_EQ(info.protocol_version, wire::kProtocolVersion);
+  EXPECT_DOUBLE_EQ(info.pressure_limit_kpa, 50.0);
+  const BoardState state = link.set_pressure_kpa(20.0);
+  EXPECT_DOUBLE_EQ(state.setpoint_kpa, 20.0);
+  EXPECT_EQ(fake.now, 4);  // Two answers, 2 ms each.
+}
+
+TEST(BoardLink, AChatteringBoardCannotExtendTheReplyDeadline) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  link.handshake();
+  fake.chatter_period_ms = 50;  // 20 Hz of text, never the answer.
+  fake.rewrite = [](const std::string&) { return std::string(); };
+  const int64_t sent_ms = fake.now;
+  try {
+    link.heartbeat();
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("serial port /dev/fake0: no answer to PING after 3 tries"),
+              std::string::npos)
+        << e.what();
+  }
+  // Three tries, each ending exactly at its 100 ms deadline.
+  EXPECT_EQ(fake.now - sent_ms, 300);
+  EXPECT_EQ(link.stats().resends, 2u);
+  EXPECT_GE(link.stats().rejected_lines + link.stats().stale_answers, 5u);
+
+  // The handshake too.
+  BoardLink again(fake, LinkOptions{}, SimulatedClock(fake));
+  const int64_t hello_ms = fake.now;
+  EXPECT_THROW(again.handshake(), InputError);
+  EXPECT_EQ(fake.now - hello_ms, 300);
+}
+
+TEST(BoardLink, ALateAnswerWithinTheDeadlineIsTaken) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  link.handshake();
+  fake.chatter_period_ms = 30;
+  fake.latency_ms = 95;
+  EXPECT_NO_THROW(link.read_state());
+  EXPECT_EQ(link.stats().resends, 0u);
+  // Just late, without retries (a retry would take the late answer: it has the same seq).
+  LinkOptions no_retry;
+  no_retry.retries = 0;
+  BoardLink impatient(fake, no_retry, SimulatedClock(fake));
+  fake.latency_ms = 101;
+  const int64_t sent_ms = fake.now;
+  EXPECT_THROW(impatient.read_state(), InputError);
+  EXPECT_EQ(fake.now - sent_ms, 100);
+}
+
+TEST(BoardLink, AStopRequestEndsTheWaitButNotTheFinalStop) {
+  FakeBoard fake;
+  int64_t stop_at_ms = 1 << 30;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake, [&] { return fake.now >= stop_at_ms; }));
+  link.handshake();
+  fake.chatter_period_ms = 10;
+  fake.rewrite = [](const std::string&) { return std::string(); };  // Silent but chattering.
+  const int64_t sent_ms = fake.now;
+  stop_at_ms = sent_ms + 40;  // Ctrl-C 40 ms into the wait.
+  EXPECT_THROW(link.heartbeat(), StopRequested);
+  EXPECT_LE(fake.now - sent_ms, 40 + BoardLink::kStopPollMs);
+  // STOP goes out and is waited for (bounded) whatever the flag says.
+  fake.rewrite = nullptr;
+  fake.written.clear();
+  EXPECT_NO_THROW(link.stop());
+  EXPECT_EQ(fake.words(), std::vector<std::string>{"STOP"});
+  // And a stop request before the handshake ends it too.
+  BoardLink early(fake, LinkOptions{}, SimulatedClock(fake, [] { return true; }));
+  EXPECT_THROW(early.handshake(), StopRequested);
+}
+
+TEST(BoardLink, RefusesANonsensicalLimitAtTheHandshake) {
+  for (int32_t limit_pa : {0, -50000, 1000001, 2147483647}) {
+    FakeBoard fake;
+    fake.rewrite = [limit_pa](const std::string& answer) {
+      wire::Message m = Decode(answer);
+      if (m.type != wire::MessageType::kHelloReply) return answer;
+      return Encode(wire::MessageType::kHelloReply, {m.args[0], limit_pa, m.args[2], m.args[3]});
+    };
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    try {
+      link.handshake();
+      ADD_FAILURE() << "limit " << limit_pa << " Pa accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("serial port /dev/fake0: the board's handshake reports a nonsensical "
+                          "pressure limit"),
+                std::string::npos)
+          << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+  }
+}
+
+TEST(BoardLink, ABoardErrIsOneErrorNamingTheCommand) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  link.handshake();
+  try {
+    link.set_pressure_kpa(60.0);  // Above the board's 50 kPa: ERR 3.
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("refused SETP 60000: argument out of range"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// ---- The session: STOP on every way out, the host's pressure clamp, the board's limit. ----
+
+ControlTarget Pressure(double kpa) {
+  ControlTarget t;
+  t.mode = ControlMode::kPressure;
+  t.pressure_kpa = kpa;
+  return t;
+}
+
+TEST(ControlSession, ClampsThePressureTargetToMaxKpaAndSaysFromWhat) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  ControllerOptions options;
+  options.max_kpa = 45.0;
+  ControlSession session(options, link, Pressure(49.0));
+  session.start();
+  ASSERT_TRUE(session.pressure_clamped_from());
+  EXPECT_DOUBLE_EQ(*session.pressure_clamped_from(), 49.0);
+  const ControlSample sample = session.step(0.0, std::nullopt);
+  EXPECT_DOUBLE_EQ(*sample.setpoint_kpa, 45.0);
+  EXPECT_EQ(Decode(fake.written.back()).args[1], 45000);  // What went on the wire.
+  session.step(0.1, std::nullopt);
+  EXPECT_EQ(Decode(fake.written.back()).args[1], 45000);
+
+  // Within the limit: unchanged, nothing to say.
+  FakeBoard fake2;
+  BoardLink link2(fake2, LinkOptions{}, SimulatedClock(fake2));
+  ControlSession within(options, link2, Pressure(30.0));
+  within.start();
+  EXPECT_FALSE(within.pressure_clamped_from());
+  within.step(0.0, std::nullopt);
+  EXPECT_EQ(Decode(fake2.written.back()).args[1], 30000);
+}
+
+TEST(ControlSession, ABoardReportingMoreThanItsLimitIsAFaultThatVents) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+  session.start();
+  session.step(0.0, std::nullopt);
+  // The board now claims 80 kPa (its limit is 50).
+  fake.rewrite = [](const std::string& answer) {
+    wire::Message m = Decode(answer);
+    if (m.type != wire::MessageType::kState) return answer;
+    return Encode(wire::MessageType::kState,
+                  {m.args[0], m.args[1], 80000, m.args[3], m.args[4], m.args[5], m.args[6]});
+  };
+  try {
+    session.step(0.1, std::nullopt);
+    FAIL() << "expected a fault";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reports 80 kPa, above its own limit of 50 kPa"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(fake.words().back(), "STOP");
+}
+
+TEST(ControlSession, SendsStopOnEveryWayOut) {
+  // A board ERR mid-run.
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    {
+      ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+      session.start();
+      session.step(0.0, std::nullopt);
+      fake.rewrite = [](const std::string& answer) {
+        const wire::Message m = Decode(answer);
+        return m.type == wire::MessageType::kState && m.args[3] != 0
+                   ? Encode(wire::MessageType::kError, {m.args[0], wire::kErrRange})
+                   : answer;
+      };
+      EXPECT_THROW(session.step(0.1, std::nullopt), InputError);
+    }
+    EXPECT_EQ(fake.words().back(), "STOP");
+  }
+  // Any other exception between frames (a tracker's, a full disk's).
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    try {
+      ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+      session.start();
+      session.step(0.0, std::nullopt);
+      throw std::runtime_error("something else failed");
+    } catch (const std::runtime_error&) {
+    }
+    EXPECT_EQ(fake.words(), (std::vector<std::string>{"HELLO", "SETP", "STOP"}));
+  }
+  // A silent board: the STOP is sent (and waited for, bounded) after the link's error.
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    int64_t failed_ms = 0;
+    {
+      ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+      session.start();
+      fake.rewrite = [](const std::string&) { return std::string(); };
+      const int64_t sent_ms = fake.now;
+      EXPECT_THROW(session.step(0.0, std::nullopt), InputError);
+      EXPECT_EQ(fake.now - sent_ms, 300);
+      failed_ms = fake.now;
+    }
+    EXPECT_EQ(fake.words().back(), "STOP");
+    EXPECT_LE(fake.now - failed_ms, 300);  // Within 1 s of the reply deadline.
+  }
+  // A normal end: one STOP, not two.
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    {
+      ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+      session.start();
+      session.step(0.0, std::nullopt);
+      session.stop();
+    }
+    EXPECT_EQ(fake.words(), (std::vector<std::string>{"HELLO", "SETP", "STOP"}));
+  }
+}
+
+TEST(ControlSession, RefusesNonFiniteTargets) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double v : {nan, inf, -inf, -2.0, 1e9}) {
+    EXPECT_THROW(ControlSession(ControllerOptions{}, link, Pressure(v)), InputError) << v;
+    ControlTarget duty;
+    duty.mode = ControlMode::kDuty;
+    duty.duty = v;
+    EXPECT_THROW(ControlSession(ControllerOptions{}, link, duty), InputError) << v;
+  }
+  EXPECT_TRUE(fake.written.empty());  // Nothing was sent.
+}
+
+}  // namespace
+}  // namespace softsight
