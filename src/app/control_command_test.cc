@@ -223,22 +223,32 @@ TEST(ControlCommand, APressureAboveMaxKpaIsClampedAndSaidOnce) {
   }
 }
 
-// Starts `softsight rig --pty ...`; returns its pid and the pty path it printed.
-pid_t StartRig(const std::string& args, const std::string& stderr_file, std::string* port) {
+// Starts `softsight rig --pty ...`; returns its pid and the pty path it printed. Its stderr goes
+// to `stderr_file`, or with `stderr_pipe` to a pipe whose reading end it returns there.
+pid_t StartRig(const std::string& args, const std::string& stderr_file, std::string* port,
+               int* stderr_pipe = nullptr) {
   int out[2];
-  if (pipe(out) != 0) return -1;
+  int err_pipe[2] = {-1, -1};
+  if (pipe(out) != 0 || (stderr_pipe != nullptr && pipe(err_pipe) != 0)) return -1;
+  const std::string command = std::string("exec \"") + testing::SoftsightBinary() +
+                              "\" rig --pty " + args;
   const pid_t pid = fork();
   if (pid == 0) {
     dup2(out[1], STDOUT_FILENO);
-    const int err = open(stderr_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = stderr_pipe != nullptr
+                        ? err_pipe[1]
+                        : open(stderr_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(err, STDERR_FILENO);
     close(out[0]);
-    const std::string command = std::string("exec \"") + testing::SoftsightBinary() +
-                                "\" rig --pty " + args;
+    if (stderr_pipe != nullptr) close(err_pipe[0]);
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
   close(out[1]);
+  if (stderr_pipe != nullptr) {
+    close(err_pipe[1]);
+    *stderr_pipe = err_pipe[0];
+  }
   std::string line;
   char c;
   while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
@@ -248,14 +258,31 @@ pid_t StartRig(const std::string& args, const std::string& stderr_file, std::str
   return pid;
 }
 
+// Reads `fd` into `text` until it contains `until` (or, with "", until end of file); false when
+// nothing came for `timeout_ms`.
+bool ReadUntil(int fd, const std::string& until, std::string* text, int timeout_ms = 10000) {
+  while (until.empty() || text->find(until) == std::string::npos) {
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, timeout_ms) <= 0) return false;
+    char chunk[512];
+    const ssize_t n = read(fd, chunk, sizeof(chunk));
+    if (n <= 0) return until.empty();
+    text->append(chunk, static_cast<size_t>(n));
+  }
+  return true;
+}
+
 TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   TempDir dir;
   WriteTextFile(dir.file("rig.yaml"), kMarkers);
   std::string port;
   const std::string frames = dir.file("rig.png");
-  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 2 "
-                             "--duration-s 3",
-                             dir.file("rig.err"), &port);
+  // The cable is pulled 1.5 s after control's first command, however long control took to
+  // start; --duration-s only bounds the rig if the test fails.
+  int rig_stderr = -1;
+  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 1.5 "
+                             "--duration-s 30",
+                             "", &port, &rig_stderr);
   ASSERT_GT(rig, 0);
   ASSERT_THAT(port, HasSubstr("/dev/pts/"));
   const std::string command = std::string("\"") + testing::SoftsightBinary() +
@@ -263,6 +290,12 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
                               " --rig-frames " + frames + " --fps 20 --target-deg 120 --csv " +
                               dir.file("run.csv") + " --duration-s 10 2> " + dir.file("ctl.err");
   const int status = std::system(command.c_str());
+  // The rig saw the port go and its watchdog vent the actuator; then it ends on SIGTERM.
+  std::string rig_err;
+  EXPECT_TRUE(ReadUntil(rig_stderr, "board watchdog (vented)", &rig_err)) << rig_err;
+  kill(rig, SIGTERM);
+  ReadUntil(rig_stderr, "", &rig_err);
+  close(rig_stderr);
   int rig_status = 0;
   waitpid(rig, &rig_status, 0);
 
@@ -283,8 +316,6 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   for (size_t i = 1; i < lines.size(); ++i) {
     EXPECT_EQ(SplitCsv(lines[i] + ",x").size(), columns + 1) << "row " << i << ": " << lines[i];
   }
-  // The rig saw the port go and its watchdog vent the actuator.
-  const std::string rig_err = ReadTextFile(dir.file("rig.err"));
   EXPECT_THAT(rig_err, HasSubstr("port closed"));
   EXPECT_THAT(rig_err, HasSubstr("board watchdog (vented)"));
   EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 0) << rig_err;

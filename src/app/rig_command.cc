@@ -81,6 +81,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   bool last_limit = false;
   int frame_index = 1;
   RigCommandSummary summary;
+  std::optional<std::chrono::steady_clock::time_point> first_contact;
   {
     while (!stop.requested()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -95,8 +96,11 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
       }
       last_mode = s.mode;
       last_limit = limit;
-      if (options.disconnect_after_s && server.connected() &&
-          wall_s >= *options.disconnect_after_s) {
+      // The cable is pulled that long after the host's first command, however late it started.
+      if (!first_contact && server.contacted()) first_contact = std::chrono::steady_clock::now();
+      if (options.disconnect_after_s && server.connected() && first_contact &&
+          std::chrono::steady_clock::now() - *first_contact >=
+              std::chrono::duration<double>(*options.disconnect_after_s)) {
         server.disconnect();
         if (!options.quiet) {
           std::fprintf(stderr, "rig: t=%.3f s: port closed (cable pulled), rig keeps running\n",
@@ -146,8 +150,8 @@ CommandRunner SetupRigCommand(CLI::App& sub) {
   sub.add_option("--fps", o->fps, "Frame rate of --frames")->capture_default_str();
   sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds");
   sub.add_option("--disconnect-after-s", o->disconnect_after_s,
-                 "Close the port after this many seconds (a pulled cable) and keep running, to "
-                 "watch the watchdog vent");
+                 "Close the port this many seconds after the host's first command (a pulled "
+                 "cable) and keep running, to watch the watchdog vent");
   sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
   return [o] {
     RunRig(*o);

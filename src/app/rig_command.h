@@ -14,7 +14,8 @@ struct RigCommandOptions {
   double fps = 30.0;
   int supersample = 2;
   std::optional<double> duration_s;          // Default: until Ctrl-C / SIGTERM.
-  std::optional<double> disconnect_after_s;  // Close the port then (a pulled cable), keep running.
+  // Close the port this long after the host's first command (a pulled cable), keep running.
+  std::optional<double> disconnect_after_s;
   bool quiet = false;                        // No state-change lines on stderr.
 };
 

@@ -161,6 +161,7 @@ void RigServer::serve() {
     }
     const ssize_t n = ::read(pty_.master_fd(), buffer, sizeof(buffer));
     if (n <= 0) continue;
+    contacted_ = true;
     replies.clear();
     rig_.receive(std::string_view(buffer, static_cast<size_t>(n)), &replies);
     if (replies.empty()) continue;

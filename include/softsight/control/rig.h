@@ -97,6 +97,8 @@ class RigServer {
   // rig itself keeps its state; its watchdog vents it as time advances.
   void disconnect();
   bool connected() const { return !port_closed_; }
+  // Whether the host has sent anything yet.
+  bool contacted() const { return contacted_; }
   // Answers dropped because the host did not read them and the queue was full.
   uint64_t dropped_replies() const { return dropped_replies_; }
 
@@ -116,6 +118,7 @@ class RigServer {
   std::string pending_;  // Bytes for the host not yet taken by the pty (write_mutex_).
   std::atomic<uint64_t> dropped_replies_{0};
   std::atomic<bool> port_closed_{false};
+  std::atomic<bool> contacted_{false};
   std::atomic<bool> shutdown_{false};
   std::thread server_;
   std::thread clock_;
