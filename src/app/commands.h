@@ -21,5 +21,6 @@ CommandRunner SetupDemoCommand(CLI::App& sub);
 CommandRunner SetupCalibrateCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
+CommandRunner SetupConfigCommand(CLI::App& sub);
 
 }  // namespace softsight

@@ -37,6 +37,8 @@ const CommandEntry kCommands[] = {
      SetupRigCommand},
     {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",
      SetupPlotCommand},
+    {"config", "Print every config key with its default and range (--doc), or check a config",
+     SetupConfigCommand},
 };
 
 int Main(int argc, char** argv) {

@@ -8,7 +8,7 @@ namespace softsight {
 namespace {
 
 std::string Bound(double value) {
-  if (std::floor(value) == value && std::fabs(value) < 1e15) {
+  if (std::floor(value) == value && std::fabs(value) < 1e7) {
     return std::to_string(static_cast<int64_t>(value));
   }
   return FormatDouble(value);
@@ -172,13 +172,13 @@ std::string OptionRangeText(const OptionSpec& spec) {
   if (spec.kind == OptionKind::kStrings) {
     return spec.count > 0 ? std::to_string(spec.count) + " names" : "names";
   }
+  // The requirement without its verbs: "odd, 3..31", "0 (no limit) or 8..4096", "at least 1".
   std::string range = Requirement(spec);
-  for (const char* verb : {"lie within ", "be "}) {
-    const std::string v = verb;
-    if (range.rfind(v, 0) == 0) {
-      range = range.substr(v.size());
-      break;
-    }
+  for (const auto& [from, to] : {std::pair{"be odd and lie within ", "odd, "},
+                                 std::pair{"be odd and ", "odd, "}, std::pair{" or lie within ", " or "},
+                                 std::pair{"lie within ", ""}, std::pair{"be ", ""}}) {
+    const size_t at = range.find(from);
+    if (at != std::string::npos) range.replace(at, std::string(from).size(), to);
   }
   if (spec.count > 0) range = std::to_string(spec.count) + " values, each " + range;
   return range;

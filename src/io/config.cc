@@ -5,9 +5,12 @@
 #include <fstream>
 #include <set>
 
+#include "control/control_options.h"
+#include "geometry/measure_options.h"
 #include "io/config_sections.h"
 #include "io/control_config.h"
 #include "io/yaml_map.h"
+#include "track/track_options.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -125,6 +128,35 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   std::ofstream stream(file);
   stream << out.c_str() << "\n";
   if (!stream) throw InputError(file + ": cannot write config");
+}
+
+std::string DocumentConfig() {
+  std::string methods;
+  for (const std::string& m : TrackerMethods()) methods += (methods.empty() ? "" : " | ") + m;
+  std::string doc =
+      "# softsight tracking config: every key with its default, unit and range, generated from\n"
+      "# the option tables (softsight config --doc). Keys shown commented out are unset by\n"
+      "# default. examples/markers.yaml and examples/rig.yaml show them in use.\n"
+      "markers:                                  # one entry per marker\n"
+      "  - name: red                             # required: letters, digits, '_' or '-'; prefixes "
+      "its CSV columns\n"
+      "    method: colour                        # " + methods +
+      " (default: colour, or zncc with a template key)\n"
+      "    # ---- colour tracking\n";
+  doc += DescribeOptions(ColourParamsOptions(), 4);
+  doc += "    # ---- template matching (method sad, ssd or zncc)\n";
+  doc += DescribeOptions(TemplateParamsOptions(), 4);
+  doc += "# ---- measurements (triple and chain name markers above)\n";
+  doc += DescribeOptions(MeasureOptionsTable(), 0);
+  doc +=
+      "# plane: plane.yaml                        # instead of scale_mm_per_px: `softsight "
+      "calibrate --plane` output\n"
+      "# scale_from_points: {a: [x, y], b: [x, y], distance_mm: 50}   # px, px, mm: two points a "
+      "known distance apart\n"
+      "# camera: camera.yaml                       # lens model from `softsight calibrate`\n"
+      "control:                                   # closed loop (softsight control, rig)\n";
+  doc += DescribeOptions(ControlConfigTable(), 2);
+  return doc;
 }
 
 }  // namespace softsight

@@ -32,4 +32,9 @@ void WriteMeasureOptions(const MeasureOptions& measure, YAML::Emitter& out);
 // tracks); the session refuses it if it needs the measurements.
 bool CheckMeasureOptionsOfAFile(const MeasureOptions& measure, std::string* error);
 
+// config.cc: every key a tracking config can have, as commented YAML generated from the option
+// tables (`softsight config --doc`): each with its default, unit, range and one-line doc. It is a
+// valid config itself, reading back to the defaults.
+std::string DocumentConfig();
+
 }  // namespace softsight

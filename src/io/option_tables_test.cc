@@ -116,6 +116,33 @@ TEST(OptionTables, IntOverflowIsARangeError) {
               HasSubstr("markers[0].window: expected a whole number"));
 }
 
+TEST(OptionTables, GeneratedDocumentationIsAConfigThatReadsBackToTheDefaults) {
+  testing::TempDir dir;
+  const std::string file = dir.file("all_keys.yaml");
+  const std::string doc = DocumentConfig();
+  testing::WriteTextFile(file, doc);
+  const TrackingConfig config = LoadTrackingConfig(file);
+  ASSERT_EQ(config.markers.size(), 1u);
+  const ColourParams colour_defaults;
+  const TemplateParams template_defaults;
+  for (const auto& o : ColourParamsOptions()) {
+    EXPECT_EQ(o.get(config.markers[0].colour), o.get(colour_defaults)) << o.key;
+    EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;
+  }
+  for (const auto& o : TemplateParamsOptions()) {
+    EXPECT_EQ(o.get(config.markers[0].templ), o.get(template_defaults)) << o.key;
+    EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;
+  }
+  ASSERT_TRUE(config.control);
+  const ControlConfig control_defaults;
+  for (const auto& o : ControlConfigTable()) {
+    EXPECT_EQ(o.get(*config.control), o.get(control_defaults)) << o.key;
+  }
+  for (const auto& o : MeasureOptionsTable()) {
+    EXPECT_THAT(doc, HasSubstr(o.key + ":")) << o.key;
+  }
+}
+
 TEST(OptionTables, DescriptionListsEveryKeyWithItsDefault) {
   const std::string doc = DescribeOptions(ColourParamsOptions());
   EXPECT_THAT(doc, HasSubstr("blob:\n"));
