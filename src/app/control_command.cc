@@ -17,8 +17,10 @@
 #include "softsight/control/transport.h"
 #include "softsight/core/error.h"
 #include "softsight/io/config.h"
-#include "softsight/io/csv_writer.h"
+#include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/scene.h"
 
@@ -56,6 +58,131 @@ class RigFileSource : public FrameSource {
   double fps_;
   int64_t index_ = 0;
   std::chrono::steady_clock::time_point start_;
+};
+
+// The simulated rig's camera: each frame renders the rig's current bend, then the rig advances by
+// one frame period, in lock-step with the loop (simulated time: as fast as it can). Ends after
+// `duration_s`.
+class SimulatedRigSource : public FrameSource {
+ public:
+  SimulatedRigSource(SimulatedRig& rig, SyntheticScene& scene, double fps, double duration_s)
+      : rig_(rig), scene_(scene), fps_(fps),
+        frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1) {}
+  bool read(Frame& frame) override {
+    if (index_ >= frames_) return false;
+    if (index_ > 0) rig_.advance(1.0 / fps_);
+    truth_ = rig_.snapshot();
+    const double t = static_cast<double>(index_) / fps_;
+    scene_.render_at_bend(truth_->bend_deg, t, static_cast<int>(index_), frame.image);
+    frame.index = index_++;
+    frame.time_s = t;
+    return true;
+  }
+  std::string description() const override { return "simulated rig"; }
+  std::optional<int64_t> frame_count() const override { return frames_; }
+  std::optional<double> fps() const override { return fps_; }
+  // The rig's state when the last frame was rendered.
+  const std::optional<RigSnapshot>& truth() const { return truth_; }
+
+ private:
+  SimulatedRig& rig_;
+  SyntheticScene& scene_;
+  double fps_;
+  int64_t frames_;
+  int64_t index_ = 0;
+  std::optional<RigSnapshot> truth_;
+};
+
+// The controller as a sink: one step per frame with the measured angle. Its columns (by name)
+// read the step of the frame being written, so it must come before the CSV sink.
+class ControlSink : public FrameSink {
+ public:
+  // With `stop_at_duration`, done() turns true once `duration_s` of frame time has passed (a
+  // camera or the rig's frame file, which have no end of their own).
+  ControlSink(ControlSession& session, const BoardLink& link, double duration_s,
+              bool stop_at_duration)
+      : session_(session), link_(link), duration_s_(duration_s),
+        stop_at_duration_(stop_at_duration) {}
+
+  void consume(const Frame& frame, const FrameResult& result) override {
+    sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+    ++frames_;
+    summary_.duration_s = sample_.time_s;
+    summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
+    summary_.board_rejected = sample_.board.board_rejected;
+    if (sample_.measured_deg) ++summary_.measured;
+    if (sample_.measured_deg && sample_.target_deg) {
+      const double e = *sample_.measured_deg - *sample_.target_deg;
+      sum_sq_ += e * e;
+      ++errors_;
+      summary_.final_error_deg = e;
+    }
+    if (stop_at_duration_ && sample_.time_s >= duration_s_) done_ = true;
+  }
+
+  bool done() const { return done_; }
+
+  // The controller's CSV columns: target_deg, setpoint_kpa, board_pressure_kpa,
+  // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected.
+  std::vector<CsvColumn> columns() const {
+    const auto column = [this](const char* name, auto value) {
+      return NumberColumn(name, [this, value](const FrameResult&) -> std::optional<double> {
+        return value(sample_);
+      });
+    };
+    using S = const ControlSample&;
+    return {
+        column("target_deg", [](S s) { return s.target_deg; }),
+        column("setpoint_kpa", [](S s) { return s.setpoint_kpa; }),
+        column("board_pressure_kpa", [](S s) { return s.board.pressure_kpa; }),
+        column("board_setpoint_kpa", [](S s) { return s.board.setpoint_kpa; }),
+        column("duty", [](S s) { return s.board.duty; }),
+        column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
+        column("control_action",
+               [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
+        NumberColumn("link_rejected",
+                     [this](const FrameResult&) -> std::optional<double> {
+                       return static_cast<double>(link_.stats().rejected_lines);
+                     }),
+        column("board_rejected", [](S s) { return static_cast<double>(s.board.board_rejected); }),
+    };
+  }
+
+  // The figures so far (frames, errors, pressures); the link's counters are the caller's.
+  ControlSummary summary() const {
+    ControlSummary out = summary_;
+    out.frames = frames_;
+    if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
+    return out;
+  }
+
+ private:
+  ControlSession& session_;
+  const BoardLink& link_;
+  double duration_s_;
+  bool stop_at_duration_;
+  ControlSample sample_;
+  ControlSummary summary_;
+  int64_t frames_ = 0;
+  double sum_sq_ = 0.0;
+  int64_t errors_ = 0;
+  bool done_ = false;
+};
+
+// A simulated board with frames from elsewhere (--simulate --input): its clock follows the
+// frames' timestamps, as it would follow the wall clock on a bench.
+class RigClockSink : public FrameSink {
+ public:
+  explicit RigClockSink(SimulatedRig& rig) : rig_(rig) {}
+  void consume(const Frame& frame, const FrameResult& result) override {
+    (void)result;
+    if (previous_s_ && frame.time_s > *previous_s_) rig_.advance(frame.time_s - *previous_s_);
+    previous_s_ = frame.time_s;
+  }
+
+ private:
+  SimulatedRig& rig_;
+  std::optional<double> previous_s_;
 };
 
 std::string FormatNumber(double v) {
@@ -118,10 +245,11 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   ControlSummary& summary = summary_out != nullptr ? *summary_out : local;
   summary = ControlSummary{};
 
-  const int sources = (options.simulate ? 1 : 0) + (options.camera ? 1 : 0) +
-                      (options.rig_frames ? 1 : 0);
-  if (sources != 1) {
-    throw InputError("control: give exactly one frame source: --simulate, --camera or --rig-frames");
+  const int sources =
+      (options.camera ? 1 : 0) + (options.rig_frames ? 1 : 0) + (options.input ? 1 : 0);
+  if (sources > 1 || (sources == 0 && !options.simulate)) {
+    throw InputError("control: give one frame source: --camera, --rig-frames or --input (or "
+                     "none with --simulate, which renders the simulated rig)");
   }
   if (options.simulate == options.port.has_value()) {
     throw InputError("control: give --port DEVICE for a board, or --simulate (not both)");
@@ -158,69 +286,59 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
 
-  // Frames.
+  // Frames: a camera (newest frame wins), the rig's frame file, a video or image sequence, or
+  // the simulated rig rendered in lock-step.
   std::unique_ptr<FrameSource> source;
   std::unique_ptr<SyntheticScene> scene;
+  SimulatedRigSource* rendered = nullptr;
   if (options.camera) {
     FrameSourceSpec spec;
     spec.camera = options.camera;
-    source = OpenFrameSource(spec);
+    source = std::make_unique<NewestFrameSource>(OpenFrameSource(spec));
   } else if (options.rig_frames) {
     source = std::make_unique<RigFileSource>(*options.rig_frames, options.fps);
+  } else if (options.input) {
+    FrameSourceSpec spec;
+    spec.input = *options.input;
+    spec.sequence_fps = options.fps;
+    source = OpenFrameSource(spec);
   } else {
     SceneOptions scene_options;
     scene_options.fps = options.fps;
     RenderOptions render;
     render.supersample = options.sim_supersample;
     scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
+    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *scene, options.fps, duration_s);
+    rendered = rig_source.get();
+    source = std::move(rig_source);
   }
 
   TrackingSession tracking(tracking_config);
-  std::vector<std::string> names;
-  for (const MarkerSpec& spec : tracking_config.markers) names.push_back(spec.name);
-  // The controller's columns, by name, read from this frame's sample (and the rig's truth).
-  ControlSample sample;
-  std::optional<RigSnapshot> truth;
-  const auto sample_column = [&sample](const char* name, auto value) {
-    return NumberColumn(name, [&sample, value](const FrameResult&) -> std::optional<double> {
-      return value(sample);
-    });
-  };
-  std::vector<CsvColumn> extra = {
-      sample_column("target_deg", [](const ControlSample& s) { return s.target_deg; }),
-      sample_column("setpoint_kpa", [](const ControlSample& s) { return s.setpoint_kpa; }),
-      sample_column("board_pressure_kpa",
-                    [](const ControlSample& s) { return s.board.pressure_kpa; }),
-      sample_column("board_setpoint_kpa",
-                    [](const ControlSample& s) { return s.board.setpoint_kpa; }),
-      sample_column("duty", [](const ControlSample& s) { return s.board.duty; }),
-      sample_column("board_flags",
-                    [](const ControlSample& s) { return static_cast<double>(s.board.flags); }),
-      sample_column("control_action",
-                    [](const ControlSample& s) {
-                      return static_cast<double>(static_cast<int>(s.action));
-                    }),
-      NumberColumn("link_rejected",
-                   [&link](const FrameResult&) -> std::optional<double> {
-                     return static_cast<double>(link.stats().rejected_lines);
-                   }),
-      sample_column("board_rejected",
-                    [](const ControlSample& s) {
-                      return static_cast<double>(s.board.board_rejected);
-                    }),
-  };
-  if (options.simulate) {
-    extra.push_back(NumberColumn("rig_true_angle_deg", [&truth](const FrameResult&) {
+  ControlSink control(session, link, duration_s, /*stop_at_duration=*/rendered == nullptr);
+  std::vector<CsvColumn> extra = control.columns();
+  if (rendered != nullptr) {
+    extra.push_back(NumberColumn("rig_true_angle_deg", [rendered](const FrameResult&) {
+      const std::optional<RigSnapshot>& truth = rendered->truth();
       return truth ? std::optional<double>(truth->angle_deg) : std::nullopt;
     }));
-    extra.push_back(NumberColumn("rig_pressure_kpa", [&truth](const FrameResult&) {
+    extra.push_back(NumberColumn("rig_pressure_kpa", [rendered](const FrameResult&) {
+      const std::optional<RigSnapshot>& truth = rendered->truth();
       return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
     }));
   }
+  std::vector<std::string> names;
+  for (const MarkerSpec& spec : tracking_config.markers) names.push_back(spec.name);
   const MetricModel& metric = tracking_config.measure.metric;
-  CsvWriter csv(options.csv_file,
-                TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image,
-                                extra));
+  CsvSink csv(options.csv_file,
+              TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra));
+  std::optional<RigClockSink> rig_clock;
+  std::vector<FrameSink*> sinks;
+  if (rig && rendered == nullptr) {
+    rig_clock.emplace(*rig);
+    sinks.push_back(&*rig_clock);
+  }
+  sinks.push_back(&control);  // Before the CSV: its columns read this frame's step.
+  sinks.push_back(&csv);
 
   BoardInfo info;
   try {
@@ -253,63 +371,43 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  c.ff_kpa_per_deg, c.min_kpa, c.max_kpa, c.max_rate_kpa_per_s, c.hold_s);
   }
 
-  double sum_sq = 0.0;
-  int64_t errors = 0;
-  Frame frame;
-  try {
-    for (int64_t k = 0;; ++k) {
-      if (stop.requested()) {
-        summary.stop_reason = "interrupted";
-        break;
-      }
-      truth.reset();
-      if (scene) {
-        const double t = static_cast<double>(k) / options.fps;
-        if (t > duration_s + 1e-9) break;
-        if (k > 0) rig->advance(1.0 / options.fps);
-        truth = rig->snapshot();
-        scene->render_at_bend(truth->bend_deg, t, static_cast<int>(k), frame.image);
-        frame.index = k;
-        frame.time_s = t;
-      } else {
-        if (!source->read(frame)) {
-          summary.stop_reason = "end of input";
-          break;
-        }
-      }
-      const FrameResult& result = tracking.process(frame);
-      sample = session.step(frame.time_s, result.measurement.angle_deg);
-      csv.write(result);
-
-      ++summary.frames;
-      summary.duration_s = sample.time_s;
-      summary.max_pressure_kpa = std::max(summary.max_pressure_kpa, sample.board.pressure_kpa);
-      summary.board_rejected = sample.board.board_rejected;
-      if (sample.measured_deg) ++summary.measured;
-      if (sample.measured_deg && sample.target_deg) {
-        const double e = *sample.measured_deg - *sample.target_deg;
-        sum_sq += e * e;
-        ++errors;
-        summary.final_error_deg = e;
-      }
-      if (!scene && sample.time_s >= duration_s) break;
-    }
-    if (summary.stop_reason.empty()) summary.stop_reason = "duration reached";
-    session.stop();  // Vent at the end of the run.
-  } catch (const StopRequested&) {
-    // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
-    summary.stop_reason = "interrupted";
-    session.stop();
-  } catch (const std::exception&) {
-    // The session's destructor sends STOP on the way out.
-    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
+  RunOptions run;
+  run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
+  const auto collect = [&] {
+    summary = control.summary();
     summary.link_rejected = link.stats().rejected_lines;
     summary.resends = link.stats().resends;
+  };
+  RunSummary ran;
+  try {
+    ran = RunPipeline(*source, tracking, sinks, run);
+  } catch (const StopRequested&) {
+    // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
+    collect();
+    summary.stop_reason = "interrupted";
+    session.stop();
+    return summary;
+  } catch (const std::exception&) {
+    // The session's destructor sends STOP on the way out.
+    collect();
+    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
     throw;
   }
-  if (errors > 0) summary.rms_error_deg = std::sqrt(sum_sq / static_cast<double>(errors));
-  summary.link_rejected = link.stats().rejected_lines;
-  summary.resends = link.stats().resends;
+  collect();
+  switch (ran.stop_reason) {
+    case StopReason::kEndOfInput:
+      summary.stop_reason = rendered != nullptr ? "duration reached" : "end of input";
+      break;
+    case StopReason::kMaxFrames:
+    case StopReason::kStopRequested:
+      summary.stop_reason = control.done() ? "duration reached" : "interrupted";
+      break;
+    case StopReason::kError:
+      // The session's destructor sends STOP on the way out.
+      summary.stop_reason = "stopped by an error at frame " + std::to_string(ran.frames);
+      throw InputError(ran.error);
+  }
+  session.stop();  // Vent at the end of the run.
   return summary;
 }
 
@@ -360,6 +458,9 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
   sub.add_option("--camera", o->camera, "Camera index for the frames (live)");
   sub.add_option("--rig-frames", o->rig_frames,
                  "Read frames from the file `softsight rig --frames FILE` keeps rewriting");
+  sub.add_option("-i,--input", o->input,
+                 "Frames from a video or image sequence (a recorded run replayed through the "
+                 "loop; with --simulate the simulated board follows the frames' timestamps)");
   sub.add_option("-t,--target-deg", o->target_deg,
                  "Target angle at the middle marker, degrees (180 = straight)");
   sub.add_option("--profile", o->profile_file,

@@ -17,9 +17,12 @@ struct ControlOptions {
   // in-process simulated rig behind a real pseudo-terminal, advanced in lock-step with the frames.
   std::optional<std::string> port;
   bool simulate = false;
-  // Frames (not with simulate): a camera index, or a file the rig rewrites (`rig --frames`).
+  // Frames: a camera index, a file the rig rewrites (`rig --frames`), or a video / image
+  // sequence (replayed through the loop as fast as it decodes, its timestamps the loop's clock).
+  // None of them with `simulate`: the simulated rig is rendered.
   std::optional<int> camera;
   std::optional<std::string> rig_frames;
+  std::optional<std::string> input;
   // What to do (one of): target angle, profile file, open-loop pressure, open-loop duty.
   std::optional<double> target_deg;
   std::optional<std::string> profile_file;

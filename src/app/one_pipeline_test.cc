@@ -1,0 +1,117 @@
+// `track` and `control` share one pipeline: the same video through both gives the same tracking
+// columns, and each CSV's header and rows come from one column table.
+#include <algorithm>
+#include <map>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "app/control_command.h"
+#include "app/track_command.h"
+#include "core/test_util.h"
+#include "softsight/io/frame_writer.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+using testing::ReadLines;
+using testing::SplitCsv;
+using testing::TempDir;
+using testing::WriteTextFile;
+
+const char* kMarkers = R"(markers:
+  - name: red
+    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+  - name: green
+    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
+triple: [red, blue, green]
+scale_mm_per_px: 0.2
+)";
+
+// A CSV as columns by name; checks that every row has the header's field count.
+struct Csv {
+  std::vector<std::string> header;
+  std::map<std::string, std::vector<std::string>> columns;
+  size_t rows = 0;
+};
+
+Csv ReadCsv(const std::string& file) {
+  const std::vector<std::string> lines = ReadLines(file);
+  Csv csv;
+  EXPECT_FALSE(lines.empty()) << file;
+  if (lines.empty()) return csv;
+  csv.header = SplitCsv(lines[0]);
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = SplitCsv(lines[i]);
+    EXPECT_EQ(row.size(), csv.header.size()) << file << " row " << i;
+    for (size_t c = 0; c < std::min(row.size(), csv.header.size()); ++c) {
+      csv.columns[csv.header[c]].push_back(row[c]);
+    }
+    ++csv.rows;
+  }
+  return csv;
+}
+
+TEST(OnePipeline, TrackAndControlGiveTheSameTrackingColumnsForTheSameVideo) {
+  TempDir dir;
+  SceneOptions scene;
+  scene.frame_count = 12;
+  scene.max_bend_deg = 150;
+  SyntheticScene renderer(scene);
+  const std::string video = dir.file("clip.avi");
+  {
+    FrameWriter writer({video, "", scene.fps});
+    cv::Mat image;
+    for (int i = 0; i < scene.frame_count; ++i) {
+      renderer.render(i, image);
+      writer.write(image, i);
+    }
+  }
+  WriteTextFile(dir.file("markers.yaml"), kMarkers);
+
+  TrackOptions track;
+  track.config_file = dir.file("markers.yaml");
+  track.source.input = video;
+  track.csv_file = dir.file("track.csv");
+  track.quiet = true;
+  RunTrack(track);
+
+  ControlOptions control;
+  control.config_file = dir.file("markers.yaml");
+  control.simulate = true;  // A simulated board; the frames are the video's.
+  control.input = video;
+  control.target_deg = 120.0;
+  control.csv_file = dir.file("control.csv");
+  control.quiet = true;
+  const ControlSummary summary = RunControl(control);
+  EXPECT_EQ(summary.frames, 12);
+  EXPECT_EQ(summary.stop_reason, "end of input");
+
+  const Csv tracked = ReadCsv(track.csv_file);
+  const Csv controlled = ReadCsv(control.csv_file);
+  ASSERT_EQ(tracked.rows, 12u);
+  ASSERT_EQ(controlled.rows, 12u);
+  // The tracking columns come first, in the same order; control's own follow, by name.
+  ASSERT_GT(controlled.header.size(), tracked.header.size());
+  EXPECT_TRUE(std::equal(tracked.header.begin(), tracked.header.end() - 1,
+                         controlled.header.begin()));
+  EXPECT_EQ(controlled.header.back(), "proc_ms");
+  for (const char* name : {"target_deg", "setpoint_kpa", "board_pressure_kpa", "control_action"}) {
+    EXPECT_TRUE(controlled.columns.count(name)) << name;
+  }
+  EXPECT_EQ(controlled.columns.at("target_deg").front(), "120");
+  for (const std::string& name : tracked.header) {
+    if (name == "proc_ms") continue;  // A timing.
+    EXPECT_EQ(controlled.columns.at(name), tracked.columns.at(name)) << name;
+  }
+  // Every row names the video's frame.
+  for (size_t i = 0; i < tracked.rows; ++i) {
+    EXPECT_EQ(controlled.columns.at("frame")[i], std::to_string(i));
+  }
+}
+
+}  // namespace
+}  // namespace softsight
