@@ -275,6 +275,9 @@ HostileRun RunAgainst(Hostility hostility) {
 // it is waited for as long again at most; "within 1 s of the deadline" gets 1 s of slack more
 // for a loaded machine here (the exact figures are in simulated time in board_link_test.cc).
 void ExpectCleanEnd(const HostileRun& run, bool port_open, const std::string& why) {
+  std::printf("hostile board (%s): the program ended %.2f s after the board turned hostile\n",
+              ::testing::UnitTest::GetInstance()->current_test_info()->name(),
+              run.end_after_hostile_s);
   EXPECT_EQ(run.exit_code, 2) << run.err;
   EXPECT_LT(run.end_after_hostile_s, 0.3 + 1.0 + 1.0) << run.err;
   // One line on stderr, the error, naming the port and saying why.
@@ -363,6 +366,8 @@ TEST(HostileBoard, SigtermWhileTheBoardChattersStopsPromptlyAndVents) {
   const int code = WaitExit(pid, std::chrono::seconds(30));
   const double took_s = std::chrono::duration<double>(Clock::now() - sent).count();
   const std::string err = testing::ReadTextFile(dir.file("err.txt"));
+  std::printf("SIGTERM while the board chatters: the program ended %.2f s later, after STOP\n",
+              took_s);
   EXPECT_NE(code, -1) << "hung after SIGTERM: " << err;
   EXPECT_NE(code, 128 + SIGTERM) << "killed by the signal instead of ending cleanly";
   EXPECT_LT(took_s, 0.3 + 1.0 + 1.0) << err;

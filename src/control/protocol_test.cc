@@ -138,6 +138,34 @@ TEST(Protocol, RejectsEveryOneAndTwoBitError) {
   EXPECT_GT(xor_accepted, 0);  // The test can tell a weak check from a strong one.
 }
 
+TEST(Protocol, TheHostileTrialOf2000SetpLinesWithTwoRandomFlips) {
+  // The trial of issue 10: 2000 SETP lines with random arguments, two random bit flips each.
+  std::mt19937 rng(2000);
+  std::uniform_int_distribution<int32_t> seq(1, 999999), pa(0, 50000);
+  int accepted = 0, xor_accepted = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int32_t s = seq(rng), p = pa(rng);
+    const std::string line = Encode(MessageType::kSetPressure, {s, p});
+    const std::string v1 = XorLine(line.substr(1, line.size() - 7));
+    for (const std::string* l : {&line, &v1}) {
+      std::uniform_int_distribution<size_t> bit(0, (l->size() - 1) * 8 - 1);
+      const size_t a = bit(rng);
+      size_t b = bit(rng);
+      while (b == a) b = bit(rng);
+      if (l == &line) {
+        accepted += Accepted(Flipped(*l, {a, b}));
+      } else {
+        xor_accepted += AcceptedByXor(Flipped(*l, {a, b}));
+      }
+    }
+  }
+  std::printf("2000 SETP lines, two random bit flips each: %d accepted with the CRC, %d with the "
+              "version-1 XOR\n", accepted, xor_accepted);
+  RecordProperty("setp_2000_accepted", std::to_string(accepted));
+  RecordProperty("setp_2000_accepted_xor_v1", std::to_string(xor_accepted));
+  EXPECT_EQ(accepted, 0);
+}
+
 TEST(Protocol, RejectsRandomTwoAndThreeBitErrors) {
   std::mt19937 rng(12);
   const std::vector<std::string> lines = RealisticLines();
