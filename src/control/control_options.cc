@@ -63,7 +63,7 @@ OptionTable<LinkOptions> MakeLink() {
       IntOption<P>("reply_timeout_ms", &P::reply_timeout_ms)
           .Range(5, 10000)
           .Unit("ms")
-          .Doc("wait this long for an answer before re-sending"),
+          .Doc("deadline of each try, from sending it (other lines never extend it); then re-send"),
       IntOption<P>("retries", &P::retries).Range(0, 10).Doc("re-sends before giving up with an error"),
   };
 }
