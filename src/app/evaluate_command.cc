@@ -111,8 +111,8 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
       spec.templ.colour = run.mode == std::optional<std::string>("colour");
       spec.templ.template_frame = 0;
       spec.templ.rect = DraggedRect(*centre, scene.marker_radius_px);
-      spec.templ.centre_on_symmetry = options.centre_on_symmetry;
-      spec.templ.round_mask = options.round_mask;
+      if (options.rect_centre) spec.templ.report = TemplateReport::kRectCentre;
+      if (options.square_mask) spec.templ.round_mask = false;
     }
     config.markers.push_back(spec);
   }
@@ -193,8 +193,8 @@ std::string Conditions(const EvaluateOptions& options) {
        << noise.blur_sigma_px << " px, gain " << noise.gain_start << " -> " << noise.gain_end
        << ", seeds " << scene.seed << "/" << noise.seed
        << (options.occluders.empty() ? "" : ", with occluders")
-       << (options.centre_on_symmetry ? "; templates centred on symmetry" : "")
-       << (options.round_mask ? "; round template masks" : "") << ".";
+       << (options.rect_centre ? "; templates report the rectangle's centre" : "")
+       << (options.square_mask ? "; square template masks" : "") << ".";
   return text.str();
 }
 
@@ -363,11 +363,11 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
                  "Template matching modes, comma separated: gray,colour")
       ->delimiter(',')
       ->capture_default_str();
-  sub.add_flag("--centre-on-symmetry", options->centre_on_symmetry,
-               "Template trackers report the template's centre of symmetry (removes the dragged "
-               "rectangle's sub-pixel offset)");
-  sub.add_flag("--round-mask", options->round_mask,
-               "Template trackers match only the disc inscribed in the template square");
+  sub.add_flag("--rect-centre", options->rect_centre,
+               "Template trackers report the dragged rectangle's centre (the paper's position) "
+               "instead of the marker's centre of symmetry");
+  sub.add_flag("--square-mask", options->square_mask,
+               "Template trackers match the whole template square, not the disc inscribed in it");
   sub.add_option("--csv", options->csv_file, "Also write the table as CSV to this file");
   sub.add_option("--seed", options->scene.seed,
                  "Background texture and noise seed (as `softsight synth --seed`: same frames)")

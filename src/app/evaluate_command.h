@@ -29,12 +29,12 @@ struct EvaluateOptions {
   std::vector<std::string> methods = {"colour", "sad", "ssd", "zncc"};
   // Template matching modes: gray and/or colour (default both). The colour method has no mode.
   std::vector<std::string> modes = {"gray", "colour"};
-  // Template trackers report the template's centre of symmetry instead of the dragged
-  // rectangle's centre (TemplateParams::centre_on_symmetry). Default off, the library's default.
-  bool centre_on_symmetry = false;
-  // Template trackers match only the disc inscribed in the square (TemplateParams::round_mask),
-  // ignoring the corners where the background shows. Default off, the library's default.
-  bool round_mask = false;
+  // Template trackers report the dragged rectangle's centre (the paper's position) instead of the
+  // marker's centre of symmetry (TemplateParams::report). Default off, the library's default.
+  bool rect_centre = false;
+  // Template trackers match the whole square instead of the disc inscribed in it
+  // (TemplateParams::round_mask). Default off: the library matches the disc.
+  bool square_mask = false;
   std::optional<std::string> csv_file;  // The table as CSV as well.
   bool quiet = false;            // No progress line.
 

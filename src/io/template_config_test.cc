@@ -24,8 +24,10 @@ TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
       frame: 3
       rect: [205, 186, 25, 27]
       colour: true
-      round: true
-      centre_on_symmetry: true
+      round: false
+      report: rect_centre
+      ambiguity_margin: 0.05
+      scale_search: false
       min_zncc: 0.7
       max_sad: 12.5
       max_ssd: 18
@@ -48,8 +50,10 @@ TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
     ASSERT_TRUE(t.rect.has_value());
     EXPECT_EQ(*t.rect, cv::Rect(205, 186, 25, 27));
     EXPECT_TRUE(t.colour);
-    EXPECT_TRUE(t.round_mask);
-    EXPECT_TRUE(t.centre_on_symmetry);
+    EXPECT_FALSE(t.round_mask);
+    EXPECT_EQ(t.report, TemplateReport::kRectCentre);
+    EXPECT_DOUBLE_EQ(t.ambiguity_margin, 0.05);
+    EXPECT_FALSE(t.scale_search);
     EXPECT_DOUBLE_EQ(t.min_zncc, 0.7);
     EXPECT_DOUBLE_EQ(t.max_sad, 12.5);
     EXPECT_DOUBLE_EQ(t.max_ssd, 18);
@@ -106,6 +110,9 @@ TEST(TemplateConfig, ErrorsNameTheKey) {
               HasSubstr("colur"));
   EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 2, 30]}\n"),
               HasSubstr("template.rect: [1, 2, 2, 30]"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
+                      "report: middle}\n"),
+              HasSubstr("markers[0].template.report"));
 }
 
 }  // namespace

@@ -38,9 +38,14 @@ OptionTable<TemplateParams> MakeTable() {
       BoolOption<P>("template.contrast_gray", &P::contrast_gray)
           .Doc("gray: match BGR projected on the template's colour axis instead of luma"),
       BoolOption<P>("template.round", &P::round_mask)
-          .Doc("match only the ellipse inscribed in the rectangle"),
-      BoolOption<P>("template.centre_on_symmetry", &P::centre_on_symmetry)
-          .Doc("report the template's centre of symmetry (a disc's centre), not the rectangle's"),
+          .Doc("match only the ellipse inscribed in the rectangle (false: the whole rectangle)"),
+      EnumOption<P>("template.report", &P::report,
+                    std::vector<std::pair<std::string, TemplateReport>>{
+                        {"centre", TemplateReport::kCentre},
+                        {"symmetry", TemplateReport::kSymmetry},
+                        {"rect_centre", TemplateReport::kRectCentre}})
+          .Doc("point reported: the marker's centre (blob centroid, else centre of symmetry), "
+               "the centre of symmetry, or the rectangle's centre (the paper's)"),
       DoubleOption<P>("template.min_zncc", &P::min_zncc)
           .Range(-1, 1)
           .Doc("a best match below this ZNCC is not found (all methods)"),
@@ -54,6 +59,9 @@ OptionTable<TemplateParams> MakeTable() {
           .AtMost(255)
           .Unit("grey levels")
           .Doc("ssd: RMS difference per pixel and channel above this: not found"),
+      DoubleOption<P>("template.ambiguity_margin", &P::ambiguity_margin)
+          .Range(0, 2)
+          .Doc("a distinct second peak this close (ZNCC) to the best: ambiguous, not found (0: off)"),
       IntOption<P>("template.search_margin_px", &P::search_margin_px)
           .Range(1, 4096)
           .Unit("px")
@@ -66,12 +74,13 @@ OptionTable<TemplateParams> MakeTable() {
           .Range(1, 6)
           .Doc("coarse-to-fine levels for acquisition (1: full resolution only)"),
       DoubleOption<P>("template.update_rate", &P::update_rate)
-          .AtLeast(0)
-          .Below(1)
-          .Doc("slow template update per accepted match (0: fixed template)"),
+          .Range(0, 1)
+          .Doc("template update per verified match, towards the patch there (0: fixed template)"),
       DoubleOption<P>("template.drift_min_zncc", &P::drift_min_zncc)
           .Range(-1, 1)
-          .Doc("an updated template below this ZNCC with the original is discarded"),
+          .Doc("least ZNCC of the match with the first template at the current scale (drift guard)"),
+      BoolOption<P>("template.scale_search", &P::scale_search)
+          .Doc("follow the marker's size: the first template tried 5 % larger and smaller each frame"),
   };
 }
 

@@ -1,31 +1,53 @@
 // Template-matching tracking (paper section 2.2): SAD, SSD and ZNCC, gray or colour.
 //
-// One template per marker, cut from a rectangle on a reference frame (init's hint) or given as an
-// image. While tracking, only a window around the position predicted by constant velocity is
-// searched; at start and after a loss the tracker acquires coarse-to-fine over an image pyramid,
-// around the last known position (or over the whole frame). The integer best match is refined
-// to sub-pixel by a 1-D fit per axis on the score surface: a parabola for SSD and ZNCC (their
-// surfaces are quadratic near the peak), the equiangular "V" fit for SAD (its surface is |d|-like;
-// a parabola would pull the estimate halfway back to the integer position).
+// The contract. One template per marker, cut from a rectangle on a reference frame (init's hint)
+// or given as an image. update() reports the marker's position only when the match is verified;
+// otherwise Observation::NotFound says why:
+//   found      the best match passes the measure's threshold (min_zncc, and max_sad / max_ssd),
+//              no distinct second peak in the searched region comes within ambiguity_margin of
+//              it (ZNCC), and the matched patch is still consistent with the FIRST template at
+//              the current scale (ZNCC >= drift_min_zncc);
+//   ambiguous  two distinct places fit about equally (look-alike markers, e.g. white dots): the
+//              tracker never picks one of them;
+//   lost       nothing in the searched region fits;
+//   out_of_frame  the predicted window lies outside the image.
+// The reported position is the marker's centre, not the rectangle's: by default the template's
+// centre of point symmetry (a dot's centroid; found once, on the selected template), mapped into
+// the frame through the match with the first template at the current scale (report: centre
+// measures the blob's centroid in every frame instead). A dragged rectangle
+// is centred on the marker only to the nearest pixel; report: rect_centre gives the rectangle's
+// centre (the paper's position) instead.
 //
-// Reported position: the template's centre in the pixel-centre convention. For a template cut
-// from rect [x, y, w, h] that centre is (x + (w-1)/2, y + (h-1)/2), so it is the marker's
-// centroid exactly when the marker sits centred in the rectangle. A rectangle placed off-centre
-// by a fraction of a pixel carries that offset into every position as a constant bias
-// (centre_on_symmetry removes it for symmetric markers).
+// Markers that change shape (perspective, a marker approaching the camera to twice its size,
+// rotation) are followed by three things, each on by default:
+//   - template update: after each verified match the working template is blended towards the
+//     patch at the match (update_rate), so it follows slow changes of pose and lighting;
+//   - drift correction against the first template: the position is always measured with the first
+//     template (scaled), never with the updated one, so an updated template cannot carry the
+//     position away; an updated template that no longer resembles the first is discarded;
+//   - a scale search: the first template is kept on a ladder of scales (5 % apart); each frame the
+//     neighbouring rungs are tried and the best one becomes the scale (scale_search).
+// A round mask (round, default on) matches only the ellipse inscribed in the template, so the
+// background in the rectangle's corners, which turns with the body, does not count.
 //
-// Observation::score, by measure:
+// Search: while tracking, only a window around the position predicted by constant velocity is
+// searched; at start the window around the hint; after a loss the region grows frame by frame
+// around the last known position up to acquire_radius_px, coarse-to-fine over an image pyramid.
+// The integer best match is refined to sub-pixel by a 1-D fit per axis on the score surface: a
+// parabola for SSD and ZNCC (their surfaces are quadratic near the peak), the equiangular "V" fit
+// for SAD (its surface is |d|-like; a parabola would pull the estimate halfway back).
+//
+// Observation::score, by measure (of the match with the working template):
 //   zncc: the ZNCC itself, in [-1, 1], 1 = perfect;
 //   sad:  SAD / (N * C), the mean absolute difference per pixel and channel, in grey levels;
 //   ssd:  sqrt(SSD / (N * C)), the RMS difference per pixel and channel, in grey levels.
 // (N = template pixels, C = channels.) SAD and SSD scores are thus in the same unit.
 //
 // Gray or colour: gray matches one channel, by default the template's best-contrast projection
-// of BGR (contrast_gray), else luma. In gray the red, green and blue discs are all dark discs on
-// a light band, and ZNCC (which cancels gain and offset) cannot tell them apart; a whole-frame
-// search may find another marker. Acquisition therefore looks around the last known position
-// (acquire_radius_px), and colour matching is the choice when markers must be told apart on the
-// whole frame.
+// of BGR (contrast_gray), else luma; CV_8UC1 frames (a mono camera) are matched as they are. In
+// gray the red, green and blue discs are all dark discs on a light band, and ZNCC (which cancels
+// gain and offset) cannot tell them apart: a search that sees two of them reports ambiguous.
+// Colour matching is the choice when markers must be told apart by colour.
 #pragma once
 
 #include <memory>
@@ -42,6 +64,10 @@ class Tracker;
 
 enum class MatchMeasure { kSad, kSsd, kZncc };
 
+// The point a match reports: the marker's centre (the template's centre of symmetry, or its blob's
+// soft centroid measured in every frame), or the dragged rectangle's centre.
+enum class TemplateReport { kCentre, kSymmetry, kRectCentre };
+
 // The largest template (pixels x channels) the matching kernels' 32-bit sums take:
 // 255^2 * 33025 < 2^31. About 181 x 181 gray or 104 x 104 colour.
 inline constexpr int kMaxTemplateValues = 33025;
@@ -57,16 +83,21 @@ struct TemplateParams {
   cv::Mat image;
   std::string image_file;  // Where `image` was read from, so a saved config names it.
   // Match only the ellipse inscribed in the template rectangle (a disc for a square one), so the
-  // background in the rectangle's corners, which rotates with the body, is ignored. Measured on
-  // the rendered bending scene it changes the error by < 0.01 px (the disc edge dominates), and
-  // masked ZNCC needs a slower fused kernel, so it is off by default.
-  bool round_mask = false;
-  // Report the template's centre of point symmetry instead of its geometric centre. A dragged
-  // rectangle is centred on the marker only to the nearest pixel, so the geometric centre is off
-  // the marker's centroid by up to half a pixel per axis, in every frame; for a symmetric marker
-  // (a disc) the centre of symmetry is its centroid. Off by default (the documented contract is
-  // the rectangle's centre).
-  bool centre_on_symmetry = false;
+  // background in the rectangle's corners, which rotates with the body or is clutter behind a
+  // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a
+  // faster unmasked ZNCC kernel).
+  bool round_mask = true;
+  // Which point is reported (see the contract above). Default kSymmetry: the template's centre
+  // of point symmetry (a dot's or disc's centroid), carried by the match with the first template;
+  // a template without a clear one (self-match of the turned template below 0.5) reports its
+  // rectangle's centre. kCentre: when the selected template shows a blob (one compact region
+  // brighter or darker than what is around it, wholly inside the template), its soft centroid,
+  // measured again in every frame at the match (where it cannot be separated, the centre of
+  // symmetry). On the rendered bending scene the blob is the less accurate (0.12 vs 0.087 px
+  // RMS: the band's shading and ribs at the disc's rim enter its levels). kRectCentre: the
+  // rectangle's centre, (x + (w-1)/2, y + (h-1)/2), scaled with the marker: the marker's centroid
+  // only when the rectangle was centred on it (the paper's position).
+  TemplateReport report = TemplateReport::kSymmetry;
   // Gray mode only: the single channel matched is not luma but BGR projected on the template's
   // principal colour axis (largest colour variance in the template: the marker against what is
   // around it), weights of L1 norm 1 plus an offset, so values stay 0..255 grey levels and SAD/SSD
@@ -83,7 +114,7 @@ struct TemplateParams {
   // false: plain luma (the paper's gray).
   bool contrast_gray = true;
 
-  // ---- Loss detection: a best match worse than these is "not found" ----------------------------
+  // ---- Verification: a best match worse than these is "not found" ----------------------------
   // Default 0.8: the paper's "realistic match". Higher rejects more partly covered markers and
   // more frames under blur or lighting change. SAD and SSD matches must pass it too (one ZNCC at
   // the best placement, a shape check): grey-level closeness alone accepts smooth background
@@ -95,36 +126,50 @@ struct TemplateParams {
   double max_sad = 20.0;
   // SSD: largest RMS difference per pixel and channel (grey levels), default 25.
   double max_ssd = 25.0;
+  // A second peak of the searched region, at least half a template away from the best, whose
+  // ZNCC is within this of the best's makes the match ambiguous (not found): two look-alike
+  // markers in view are never guessed between. Default 0.1; 0 turns the check off. Larger
+  // refuses more (and needs the markers further apart).
+  double ambiguity_margin = 0.1;
 
-  // ---- Search
-  // ------------------------------------------------------------------------------------ While
-  // tracking, the window is the template grown by this margin on every side, centred on the
+  // ---- Search -------------------------------------------------------------------------------
+  // While tracking, the window is the template grown by this margin on every side, centred on the
   // constant-velocity prediction. It must exceed the largest change of velocity between two
   // frames (px/frame^2); the cost grows with its square. Default 8.
   int search_margin_px = 8;
-  // At start (with a hint) and after a loss, look this far around the last known position;
-  // 0 searches the whole frame. Small keeps look-alike markers (red and blue are nearly the same
-  // grey) from being taken for a hidden one; large re-finds a marker that moved far while hidden.
-  // Without a known position (template from a file, or after reset()) the whole frame is searched.
+  // After a loss the region searched around the last known position grows by search_margin_px
+  // per frame lost, up to this radius; 0 lets it grow to the whole frame. Small keeps look-alike
+  // markers from being taken for a hidden one (a look-alike in the region makes the search
+  // ambiguous at best); large re-finds a marker that moved far while hidden. Without a known
+  // position (template from a file, or after reset()) the whole frame is searched. Default 64.
   int acquire_radius_px = 64;
   // Acquisition pyramid: at most this many levels (1 = full resolution only). Fewer are used when
   // the template would shrink below 8 px at the coarsest level.
   int pyramid_levels = 3;
 
-  // ---- Slow template update (off by default)
-  // ------------------------------------------------------- After each accepted match, template =
-  // (1 - rate) * template + rate * matched patch (cut at the sub-pixel position). Follows slow
-  // changes of pose and lighting; 0 keeps the template fixed.
-  double update_rate = 0.0;
-  // Drift guard: an updated template whose ZNCC with the original falls below this is discarded
-  // and the original restored, so the template cannot wander onto the background.
-  double drift_min_zncc = 0.9;
+  // ---- Following shape changes (see the contract above) ----------------------------------------
+  // Template update: after each verified match, working template = (1 - rate) * working template
+  // + rate * the patch at the match (cut at the sub-pixel position, at the current scale). Follows
+  // perspective, rotation and lighting; 0 keeps the template fixed (the paper's). Default 0.5.
+  double update_rate = 0.5;
+  // Drift guard: the matched patch must have at least this ZNCC with the first template at the
+  // current scale, else the marker is not found; an updated template below it is discarded and
+  // the first template (scaled) restored. It bounds how far the appearance may wander: a disc
+  // seen at 50 degrees of tilt scores ~0.75 against its frontal template, a background patch
+  // rarely above 0.5. Default 0.6.
+  double drift_min_zncc = 0.6;
+  // Scale search: each frame the first template one rung (5 %) larger and smaller is tried at the
+  // match, and the better rung is kept when it fits better by a little (hysteresis), so the
+  // template follows a marker that approaches or recedes (0.4x .. 4x). Default true; false keeps
+  // the selected size.
+  bool scale_search = true;
 
   // Returns true when every field is usable; otherwise false with `error` naming the field.
   bool Check(std::string* error) const;
 };
 
-const char* MatchMeasureName(MatchMeasure measure);  // "sad", "ssd", "zncc"
+const char* MatchMeasureName(MatchMeasure measure);      // "sad", "ssd", "zncc"
+const char* TemplateReportName(TemplateReport report);  // "centre", "symmetry", "rect_centre"
 
 // Builds a template tracker (CreateTracker does this for the methods sad, ssd and zncc).
 // Throws InputError naming the field when `params` fail Check().
