@@ -63,6 +63,25 @@ bool AllowedInt(const OptionSpec& spec, int64_t value) {
   return Allowed(spec, static_cast<double>(value));
 }
 
+// A name from a file as a message shows it: on one line, printable, not too long.
+std::string Printable(const std::string& text) {
+  constexpr size_t kMaxShown = 60;
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < kMaxShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      static const char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  if (text.size() > kMaxShown) out += "...";
+  return out;
+}
+
 std::string NamesText(const std::vector<std::string>& names) {
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
@@ -91,7 +110,7 @@ std::string OptionValueText(const OptionValue& value) {
     std::string operator()(bool b) const { return b ? "true" : "false"; }
     std::string operator()(int64_t i) const { return std::to_string(i); }
     std::string operator()(double d) const { return FormatDouble(d); }
-    std::string operator()(const std::string& s) const { return s; }
+    std::string operator()(const std::string& s) const { return Printable(s); }
     std::string operator()(const std::vector<int64_t>& list) const {
       std::string text = "[";
       for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + std::to_string(list[i]);
@@ -104,7 +123,7 @@ std::string OptionValueText(const OptionValue& value) {
     }
     std::string operator()(const std::vector<std::string>& list) const {
       std::string text = "[";
-      for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + list[i];
+      for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + Printable(list[i]);
       return text + "]";
     }
   };
@@ -122,7 +141,11 @@ std::optional<std::string> OptionProblem(const OptionSpec& spec, const OptionVal
       for (const std::string& n : spec.names) {
         if (n == name) return std::nullopt;
       }
-      return "'" + name + "' is not one of: " + NamesText(spec.names);
+      std::string problem = "'";  // (literal + temporary trips GCC 12's -Wrestrict)
+      problem += Printable(name);
+      problem += "' is not one of: ";
+      problem += NamesText(spec.names);
+      return problem;
     }
     case OptionKind::kInt:
       if (AllowedInt(spec, std::get<int64_t>(value))) return std::nullopt;

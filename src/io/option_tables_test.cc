@@ -106,6 +106,14 @@ TEST(OptionTables, UnknownAndDuplicateNestedKeysAreRejected) {
               HasSubstr("markers[0].blob.min_area: key given twice"));
 }
 
+TEST(OptionTables, ABadNameIsShownOnOneLine) {
+  const std::string error = testing::ConfigErrorOf(
+      "markers:\n  - name: red\n    filter: {type: \"gau\\x01ss\\nian\"}\n");
+  EXPECT_THAT(error, HasSubstr("markers[0].filter.type: 'gau\\x01ss\\x0aian' is not one of: none, "
+                               "gaussian, median"));
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+}
+
 TEST(OptionTables, IntOverflowIsARangeError) {
   // Issue 10, item 6: this used to overflow a signed int inside the tracker.
   EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [205, 186, 25, "

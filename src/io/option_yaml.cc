@@ -6,12 +6,7 @@
 namespace softsight {
 namespace {
 
-std::string Shown(const YAML::Node& node) {
-  if (node.IsScalar()) return "'" + node.Scalar() + "'";
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  return "nothing";
-}
+std::string Shown(const YAML::Node& node) { return ShownInMessage(node); }  // one spelling
 
 bool DecodeInt(const YAML::Node& node, int64_t* value) {
   return node.IsScalar() && YAML::convert<int64_t>::decode(node, *value);

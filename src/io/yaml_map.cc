@@ -32,6 +32,8 @@ std::string Range(T min, T max) {
 
 }  // namespace
 
+std::string ShownInMessage(const YAML::Node& node) { return Shown(node); }
+
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
     : node_(node), file_(std::move(file)), path_(std::move(path)) {
   if (!node_.IsMap()) {

@@ -51,6 +51,9 @@ class YamlMap {
   mutable std::set<std::string> known_;
 };
 
+// How an error message shows a value from the file: 'text' for a scalar, "a list", "a mapping".
+std::string ShownInMessage(const YAML::Node& node);
+
 // A path written in a config file, relative to that file's folder unless absolute.
 std::string ResolveBesideFile(const std::string& config_file, const std::string& path);
 
