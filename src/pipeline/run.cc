@@ -18,26 +18,31 @@ bool NeedsColour(const TrackingConfig& config) {
 
 }  // namespace
 
-RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
-                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const TrackingConfig& config = session.config();
-  RunSummary summary;
-  summary.source = source.description();
+RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
+                    const RunOptions& options) {
   RunInfo info;
-  info.source = summary.source;
+  info.source = source.description();
   info.fps = source.fps();
   info.live = source.is_live();
   info.frame_count = source.frame_count();
   if (options.max_frames && (!info.frame_count || *options.max_frames < *info.frame_count)) {
     info.frame_count = options.max_frames;
   }
-  for (const MarkerSpec& spec : config.markers) {
-    info.marker_names.push_back(spec.name);
-    summary.markers.push_back({spec.name, 0});
-  }
+  const TrackingConfig& config = session.config();
+  for (const MarkerSpec& spec : config.markers) info.marker_names.push_back(spec.name);
   const MetricModel& metric = config.measure.metric;
   info.metric = metric.scale_mm_per_px.has_value() || metric.plane_mm_from_image.has_value();
+  return info;
+}
+
+RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
+                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const TrackingConfig& config = session.config();
+  RunSummary summary;
+  summary.source = source.description();
+  RunInfo info = DescribeRun(source, session, options);
+  for (const std::string& name : info.marker_names) summary.markers.push_back({name, 0});
 
   std::vector<double> proc_ms;
   if (info.frame_count) {

@@ -114,6 +114,12 @@ TEST(RunPipeline, VideoFileNeverDropsAFrameAndEveryRowCarriesTheSourceIndex) {
   EXPECT_EQ(sink.info.frame_size, options.size);
   EXPECT_EQ(sink.info.frame_count, 12);
   EXPECT_THAT(sink.info.marker_names, ::testing::ElementsAre("red", "blue", "green"));
+  // A sink joining late is told the same.
+  const RunInfo late = DescribeRun(*source, session);
+  EXPECT_EQ(late.marker_names, sink.info.marker_names);
+  EXPECT_EQ(late.frame_count, sink.info.frame_count);
+  EXPECT_EQ(late.source, sink.info.source);
+  EXPECT_EQ(late.metric, sink.info.metric);
 }
 
 TEST(RunPipeline, ImageSequenceKeepsItsFileIndicesAndRate) {

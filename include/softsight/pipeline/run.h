@@ -33,4 +33,9 @@ struct RunOptions {
 RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options = {});
 
+// What RunPipeline tells its sinks in begin() (frame_size left empty: the first frame's). For a
+// sink that joins a run late (a recording started in the live window), so it is told the same.
+RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
+                    const RunOptions& options = {});
+
 }  // namespace softsight
