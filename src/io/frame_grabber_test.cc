@@ -62,14 +62,19 @@ TEST(FrameGrabberTest, FileSourcesArePacedAtTheirFrameRate) {
   const auto start = SteadyClock::now();
   FrameGrabber grabber(std::make_unique<CountingSource>(6, 50.0), /*pace=*/true);
   GrabbedFrame g;
-  int64_t last = -1;
+  int64_t last = -1, taken = 0;
   while (!grabber.finished()) {
-    if (grabber.wait_take(g, std::chrono::milliseconds(50))) last = g.frame.index;
+    if (grabber.wait_take(g, std::chrono::milliseconds(50))) {
+      last = g.frame.index;
+      ++taken;
+    }
   }
   EXPECT_EQ(last, 5);
   // Frame 5 is due 100 ms after frame 0: pacing holds it back (a lower bound only).
   EXPECT_GE(SteadyClock::now() - start, std::chrono::milliseconds(100));
-  EXPECT_EQ(grabber.dropped_count(), 0);  // This consumer keeps up.
+  // Whether this consumer keeps up depends on the machine's load, so only the books must
+  // balance (a file that must never drop goes through PacedFrameSource instead).
+  EXPECT_EQ(grabber.dropped_count() + taken, 6);
 }
 
 TEST(FrameGrabberTest, SourceErrorReachesTheConsumerOnce) {
