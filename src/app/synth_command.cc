@@ -194,7 +194,7 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
                  "that tilts to 50 degrees and grows 1x to 2x (dot0..dot4)")
       ->capture_default_str();
   sub.add_option("-o,--out", options->out,
-                 "Video (.avi/.mkv: lossless FFV1; .mp4: lossy) or image pattern "
+                 "Video (.avi/.mkv: lossless HuffYUV; .mp4: lossy) or image pattern "
                  "(frames/%04d.png)")
       ->required();
   sub.add_option("--truth", options->truth_csv, "Ground-truth CSV (one row per frame)");

@@ -23,11 +23,11 @@ struct SynthOptions {
   RenderOptions render;
   std::vector<Occluder> occluders;
   // Output, chosen by its name:
-  //   *.avi, *.mkv   FFV1, lossless (what FFmpeg-based readers decode bit-exactly);
+  //   *.avi, *.mkv   HuffYUV, lossless (what FFmpeg-based readers decode bit-exactly);
   //   *.mp4          MPEG-4 part 2, lossy (for sharing, not for accuracy tests);
   //   a printf pattern such as frames/%04d.png: one image per frame (PNG is lossless).
   std::string out;
-  // Overrides the codec of a video: ffv1 (lossless), hfyu (HuffYUV, lossless, larger, faster),
+  // Overrides the codec of a video: hfyu (HuffYUV, lossless), ffv1 (lossless, smaller, slower),
   // mjpg (Motion JPEG, lossy), mp4v (lossy). Empty: chosen by the extension as above.
   std::string codec;
   std::optional<std::string> truth_csv;
@@ -38,7 +38,7 @@ struct SynthSummary {
   int64_t frames = 0;
   cv::Size size;
   std::string scene;        // "bending", "wedge1", "wedge4", "plate".
-  std::string format;       // "FFV1 video (lossless)", "PNG images", ...
+  std::string format;       // "HuffYUV video (lossless)", "PNG images", ...
   double render_ms_mean = 0.0;
   double wall_s = 0.0;
 };

@@ -116,7 +116,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_option("--annotated", options->annotated_file,
                  "Also write a video with the overlay drawn on each frame (.avi)");
   sub.add_option("--record", options->record_file,
-                 "Also write every processed frame as read (.avi/.mkv: lossless FFV1, or "
+                 "Also write every processed frame as read (.avi/.mkv: lossless HuffYUV, or "
                  "frames/%04d.png), e.g. to track a camera run again later");
   sub.add_option("--fps", options->source.sequence_fps,
                  "Frame rate of an image sequence, for its timestamps")

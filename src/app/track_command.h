@@ -23,7 +23,7 @@ struct TrackOptions {
   // Overrides every template marker's mode: true matches BGR, false gray (--colour / --gray).
   std::optional<bool> template_colour;
   std::optional<std::string> annotated_file; // Annotated video (overlay drawn on each frame).
-  // Raw recording: every processed frame as read (FFV1 .avi/.mkv, or an image pattern), so a
+  // Raw recording: every processed frame as read (lossless HuffYUV .avi/.mkv, or an image pattern), so a
   // camera run can be tracked again later and gives the same rows.
   std::optional<std::string> record_file;
   std::optional<int64_t> max_frames;

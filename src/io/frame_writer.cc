@@ -21,6 +21,21 @@ std::string Lower(std::string s) {
   return s;
 }
 
+// The lossless codec of softsight's own recordings (synth, demo, track --raw, the live raw
+// video): HuffYUV, chosen by measurement (src/io/frame_writer_benchmark.cc, VGA rendered scene,
+// one core, process CPU time, FFV1 beside it in the same run on a shared 2-core machine):
+//                         encode fps          decode fps          kB/frame
+//                         FFV1   HuffYUV      FFV1   HuffYUV      FFV1  HuffYUV
+//   clean render            60   623 (10.5x)      60   459 (7.7x)    196   285
+//   sensor noise sigma 4    61   486 (8.0x)     55   186 (3.4x)    510   673
+// Both read back bit-exact as BGR24 through OpenCV 4.6's FFmpeg backend. FFV1 cannot be made
+// faster on one core (its slices only help with threads); UtVideo, MagicYUV, FFVHuff and raw video
+// are faster still but OpenCV's writer feeds them YUV 4:2:0, so they are not lossless for BGR.
+// HuffYUV files are ~1.3-1.5x larger than FFV1. (One BGR->gray pass over the frame: 75 us CPU in
+// that run.) Older FFV1 recordings still read (FFmpeg
+// detects the codec from the file); `--codec ffv1` still writes FFV1 when size matters more.
+constexpr const char* kLosslessCodec = "hfyu";
+
 }  // namespace
 
 FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(options)) {
@@ -52,18 +67,18 @@ FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(option
   std::string codec = Lower(options_.codec);
   if (codec.empty()) {
     if (ext == ".avi" || ext == ".mkv") {
-      codec = "ffv1";
+      codec = kLosslessCodec;
     } else if (ext == ".mp4") {
       codec = "mp4v";
     } else {
       throw InputError(path + ": unknown video type '" + ext +
-                       "' (use .avi or .mkv for lossless FFV1, .mp4, or an image pattern such "
+                       "' (use .avi or .mkv for lossless HuffYUV, .mp4, or an image pattern such "
                        "as frames/%04d.png)");
     }
   }
   if (codec == "ffv1") {
     fourcc_ = cv::VideoWriter::fourcc('F', 'F', 'V', '1');
-    format_ = "FFV1 video (lossless)";
+    format_ = "FFV1 video (lossless, smaller, slower)";
   } else if (codec == "hfyu") {
     fourcc_ = cv::VideoWriter::fourcc('H', 'F', 'Y', 'U');
     format_ = "HuffYUV video (lossless)";

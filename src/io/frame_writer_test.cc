@@ -7,6 +7,8 @@
 
 #include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/sim/scene.h"
 
 namespace softsight {
 namespace {
@@ -30,25 +32,86 @@ std::string ErrorOf(const FrameWriterOptions& options) {
   return "";
 }
 
-TEST(FrameWriter, Ffv1VideoReadsBackBitExact) {
+// Rendered VGA frames of the bending scene: clean ones, and one with sensor noise (the hardest
+// content for a lossless coder; a lossy or YUV path shows up there first).
+std::vector<cv::Mat> RenderedFrames() {
+  SceneOptions scene;
+  scene.size = cv::Size(640, 480);
+  scene.frame_count = 4;
+  SyntheticScene clean(scene);
+  NoiseOptions noise;
+  noise.sigma = 6.0;
+  noise.seed = 11;
+  SyntheticScene noisy(scene, noise);
+  std::vector<cv::Mat> frames(4);
+  for (int i = 0; i < 3; ++i) clean.render(i, frames[i]);
+  noisy.render(3, frames[3]);
+  return frames;
+}
+
+// Every frame read back through the project's reader, each compared pixel for pixel.
+void ExpectReadsBackBitExact(const std::string& path, const std::vector<cv::Mat>& frames) {
+  FrameSourceSpec spec;
+  spec.input = path;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  Frame frame;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    ASSERT_TRUE(source->read(frame)) << path << ": frame " << i;
+    ASSERT_EQ(frame.image.size(), frames[i].size());
+    EXPECT_EQ(cv::norm(frame.image, frames[i], cv::NORM_INF), 0.0) << path << ": frame " << i;
+  }
+  EXPECT_FALSE(source->read(frame)) << path;
+}
+
+int FourccOf(const std::string& path) {
+  cv::VideoCapture video(path, cv::CAP_FFMPEG);
+  return static_cast<int>(video.get(cv::CAP_PROP_FOURCC));
+}
+
+TEST(FrameWriter, DefaultVideoIsHuffyuvAndReadsBackBitExact) {
   TempDir dir;
-  cv::setRNGSeed(3);
-  std::vector<cv::Mat> frames = {Pattern(1), Pattern(2), Pattern(3)};
-  {
-    FrameWriter writer({dir.file("raw.avi"), "", 25.0});
-    EXPECT_EQ(writer.format(), "FFV1 video (lossless)");
-    for (size_t i = 0; i < frames.size(); ++i) writer.write(frames[i], static_cast<int64_t>(i));
-    EXPECT_EQ(writer.written(), 3);
+  const std::vector<cv::Mat> frames = RenderedFrames();
+  ASSERT_GT(cv::norm(frames[3], frames[2], cv::NORM_L1), 0.0);
+  for (const char* name : {"raw.avi", "raw.mkv"}) {
+    const std::string path = dir.file(name);
+    {
+      FrameWriter writer({path, "", 25.0});
+      EXPECT_EQ(writer.format(), "HuffYUV video (lossless)");
+      for (size_t i = 0; i < frames.size(); ++i) writer.write(frames[i], static_cast<int64_t>(i));
+      EXPECT_EQ(writer.written(), 4);
+    }
+    EXPECT_EQ(FourccOf(path), cv::VideoWriter::fourcc('H', 'F', 'Y', 'U')) << name;
+    ExpectReadsBackBitExact(path, frames);
   }
   cv::VideoCapture video(dir.file("raw.avi"), cv::CAP_FFMPEG);
-  ASSERT_TRUE(video.isOpened());
   EXPECT_DOUBLE_EQ(video.get(cv::CAP_PROP_FPS), 25.0);
-  cv::Mat read;
-  for (const cv::Mat& frame : frames) {
-    ASSERT_TRUE(video.read(read));
-    EXPECT_EQ(cv::norm(read, frame, cv::NORM_INF), 0.0);
+}
+
+TEST(FrameWriter, Ffv1OnRequestReadsBackBitExact) {
+  TempDir dir;
+  cv::setRNGSeed(3);
+  const std::vector<cv::Mat> frames = {Pattern(1), Pattern(2), Pattern(3)};
+  {
+    FrameWriter writer({dir.file("raw.avi"), "ffv1", 25.0});
+    for (size_t i = 0; i < frames.size(); ++i) writer.write(frames[i], static_cast<int64_t>(i));
   }
-  EXPECT_FALSE(video.read(read));
+  EXPECT_EQ(FourccOf(dir.file("raw.avi")), cv::VideoWriter::fourcc('F', 'F', 'V', '1'));
+  ExpectReadsBackBitExact(dir.file("raw.avi"), frames);
+}
+
+// Recordings made before HuffYUV became the default (FFV1, written straight through
+// cv::VideoWriter as the old writers did) still read, bit-exact.
+TEST(FrameWriter, OldFfv1RecordingsStillRead) {
+  TempDir dir;
+  const std::vector<cv::Mat> frames = RenderedFrames();
+  const std::string path = dir.file("old.raw.avi");
+  {
+    cv::VideoWriter old(path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0,
+                        frames[0].size());
+    ASSERT_TRUE(old.isOpened());
+    for (const cv::Mat& frame : frames) old.write(frame);
+  }
+  ExpectReadsBackBitExact(path, frames);
 }
 
 TEST(FrameWriter, ImagePatternNamesEachFileByTheFrameIndex) {

@@ -12,10 +12,11 @@
 namespace softsight {
 
 struct FrameWriterOptions {
-  // A video (*.avi, *.mkv: FFV1 lossless by default; *.mp4: MPEG-4, lossy) or a printf pattern
+  // A video (*.avi, *.mkv: HuffYUV lossless by default; *.mp4: MPEG-4, lossy) or a printf pattern
   // with one integer field, frames/%04d.png (one image per frame, named by the frame's index).
   std::string path;
-  // Video codec: ffv1 (lossless), hfyu (HuffYUV, lossless, larger, faster), mjpg (Motion JPEG,
+  // Video codec: hfyu (HuffYUV, lossless, fast: the default), ffv1 (lossless, ~1.4x smaller,
+  // 8-10x slower to encode; older recordings), mjpg (Motion JPEG,
   // lossy, small: for videos people watch), mp4v (lossy). Empty: chosen by the extension.
   std::string codec;
   double fps = 30.0;  // The video's nominal rate (ignored for image patterns). > 0.
@@ -39,7 +40,7 @@ class FrameWriter {
   // Finishes the video (also done by the destructor).
   void close();
 
-  // "FFV1 video (lossless)", "PNG images (lossless)", ...
+  // "HuffYUV video (lossless)", "PNG images (lossless)", ...
   const std::string& format() const { return format_; }
   const std::string& path() const { return options_.path; }
   int64_t written() const { return written_; }
