@@ -137,6 +137,10 @@ TEST(Config, ShippedMarkerExamplesLoad) {
   EXPECT_EQ(config.markers.size(), 3u);
   EXPECT_EQ(config.measure.middle, "blue");
   EXPECT_TRUE(config.measure.metric.scale_mm_per_px.has_value());
+  const TrackingConfig templates = LoadTrackingConfig(dir + "markers_template.yaml");
+  ASSERT_EQ(templates.markers.size(), 5u);
+  EXPECT_EQ(templates.markers[0].templ.rect, cv::Rect(388, 367, 25, 25));
+  EXPECT_EQ(templates.markers[4].method, "zncc");
 }
 
 TEST(Config, ShippedRigExampleLoadsWithItsControlSection) {

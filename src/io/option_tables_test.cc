@@ -59,6 +59,8 @@ TEST(OptionTables, MeasureOptions) {
 TEST(OptionTables, TheExamplesMentionEveryKey) {
   EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
             std::vector<std::string>{});
+  EXPECT_EQ(testing::KeysMissingFrom(TemplateParamsOptions(), Example("markers_template.yaml")),
+            std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(MeasureOptionsTable(), Example("markers.yaml")),
             std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(ControlConfigTable(), Example("rig.yaml")),

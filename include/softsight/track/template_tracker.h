@@ -93,8 +93,9 @@ struct TemplateParams {
   // rectangle's centre. kCentre: when the selected template shows a blob (one compact region
   // brighter or darker than what is around it, wholly inside the template), its soft centroid,
   // measured again in every frame at the match (where it cannot be separated, the centre of
-  // symmetry). On the rendered bending scene the blob is the less accurate (0.12 vs 0.087 px
-  // RMS: the band's shading and ribs at the disc's rim enter its levels). kRectCentre: the
+  // symmetry). On the rendered bending scene (30 frames) the blob is the less accurate (0.125 vs
+  // 0.087 px RMS: the band's shading and ribs at the disc's rim enter its levels); on the rendered
+  // plate (white dots on a dark plate) it is the more accurate (0.001 vs 0.048 px). kRectCentre: the
   // rectangle's centre, (x + (w-1)/2, y + (h-1)/2), scaled with the marker: the marker's centroid
   // only when the rectangle was centred on it (the paper's position).
   TemplateReport report = TemplateReport::kSymmetry;
@@ -154,9 +155,9 @@ struct TemplateParams {
   double update_rate = 0.5;
   // Drift guard: the matched patch must have at least this ZNCC with the first template at the
   // current scale, else the marker is not found; an updated template below it is discarded and
-  // the first template (scaled) restored. It bounds how far the appearance may wander: a disc
-  // seen at 50 degrees of tilt scores ~0.75 against its frontal template, a background patch
-  // rarely above 0.5. Default 0.6.
+  // the first template (scaled) restored. It bounds how far the appearance may wander from the
+  // selection (a dot foreshortened by a tilt scores lower against its frontal template, but
+  // passes 0.6 on the rendered plate tilting to 50 degrees). Default 0.6.
   double drift_min_zncc = 0.6;
   // Scale search: each frame the first template one rung (5 %) larger and smaller is tried at the
   // match, and the better rung is kept when it fits better by a little (hysteresis), so the
