@@ -23,8 +23,8 @@ Option<ColourParams> HsvOption(const char* key, HsvRange ColourParams::*range, i
       .Count(2)
       .Range(0, max)
       .Doc(doc)
-      // With auto_colour the ranges are not used, so a saved config does not carry them.
-      .AppliesIf([](const ColourParams& p) { return !p.auto_bgr; });
+      // With auto_colour or gray the ranges are not used, so a saved config does not carry them.
+      .AppliesIf([](const ColourParams& p) { return !p.auto_bgr && !p.gray; });
 }
 
 OptionTable<ColourParams> MakeTable() {
@@ -52,7 +52,25 @@ OptionTable<ColourParams> MakeTable() {
           /*optional=*/true)
           .Count(3)
           .Range(0, 255)
-          .Doc("nominal [b, g, r] instead of hsv: Otsu's split on the colour distance (give roi)"),
+          .Doc("nominal [b, g, r] instead of hsv: threshold around it, candidates verified against it"),
+      CustomOption<P>(
+          "gray", OptionKind::kInts,
+          [](const P& p) -> std::optional<OptionValue> {
+            if (!p.gray) return std::nullopt;
+            return OptionValue(std::vector<int64_t>{p.gray->lo, p.gray->hi});
+          },
+          [](P& p, const std::optional<OptionValue>& v) {
+            if (!v) {
+              p.gray.reset();
+              return;
+            }
+            const auto& list = std::get<std::vector<int64_t>>(*v);
+            p.gray = HsvRange{static_cast<int>(list[0]), static_cast<int>(list[1])};
+          },
+          /*optional=*/true)
+          .Count(2)
+          .Range(0, 255)
+          .Doc("gray-level [lo, hi] instead of hsv: white or black dots, on gray or colour video"),
       EnumOption<P>("filter.type", &P::filter,
                     std::vector<std::pair<std::string, Filter>>{{"none", Filter::kNone},
                                                                 {"gaussian", Filter::kGaussian},
@@ -92,6 +110,17 @@ OptionTable<ColourParams> MakeTable() {
           .Range(1, 1e6)
           .Or(0, "no limit")
           .Doc("a blob above this multiple of the reference area is not the marker"),
+      EnumOption<P>("centroid", &P::centroid,
+                    std::vector<std::pair<std::string, ColourParams::Centroid>>{
+                        {"soft", ColourParams::Centroid::kSoft},
+                        {"binary", ColourParams::Centroid::kBinary}})
+          .Doc("soft: edge pixels weighted by membership (sub-pixel); binary: the paper's mask"),
+      DoubleOption<P>("ambiguity_margin", &P::ambiguity_margin)
+          .Range(0, 10)
+          .Doc("a runner-up within this misfit of the best makes the marker ambiguous (not found)"),
+      DoubleOption<P>("adapt_rate", &P::adapt_rate)
+          .Range(0, 1)
+          .Doc("share per frame by which the learned area, shape and colour follow the marker"),
       CustomOption<P>(
           "roi", OptionKind::kInts,
           [](const P& p) -> std::optional<OptionValue> {

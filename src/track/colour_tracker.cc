@@ -1,6 +1,7 @@
 #include "softsight/track/colour_tracker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -24,6 +25,50 @@ constexpr int kCoarseHueSlack = 8;
 constexpr int kMaxGrowRounds = 8;
 // Coarse candidate cells are grouped by tiles of this many cells a side.
 constexpr int kTile = 8;
+
+// ---- Soft centroid and colour statistics (ColourBlob) ----------------------------------------------
+// Pixels within this distance of the binary edge (inside or outside) are weighted by their
+// membership; deeper ones count 1, the core colour is their mean. 2 px holds an anti-aliased
+// edge blurred by a Gaussian of sigma ~1 px.
+constexpr int kSoftBand = 2;
+// The local background is the ring from kSoftBand + 1 to kRingOuter px outside the blob.
+constexpr int kRingOuter = 4;
+// Angular sectors of the ring (about the blob's centroid) that give each edge pixel its local
+// background.
+constexpr int kSectors = 16;
+// Memberships within this of 0 or 1 snap to it (the rest is stretched linearly to keep 0.5 at
+// 0.5): background texture and noise next to the marker then add no weight, while an edge,
+// whose pixels' coverages spread evenly over 0..1, keeps its total weight and its centre.
+constexpr double kMembershipDeadband = 0.12;
+// Noise floor (gray levels) in the contrast's denominator: perfectly flat synthetic colours
+// would otherwise make any difference infinitely significant.
+constexpr double kContrastNoiseFloor = 2.0;
+
+// ---- Verification (ColourTracker::judge) -----------------------------------------------------------
+// A candidate whose contrast is below this does not stand out from its surroundings.
+constexpr double kMinContrast = 2.0;
+// Without a learned model only compact blobs are accepted (a disc is 1, a 2:1 ellipse 0.8, a disc
+// seen at 50 degrees 0.91): elongated patches of the right colour are common on a bench.
+constexpr double kMinCircularityWithoutModel = 0.7;
+// Tolerances of the colour check against the learned (or nominal) core colour: the angle between
+// the BGR vectors (tint, insensitive to illumination gain) and the brightness ratio. A same-hue
+// blob at 60 % of the marker's brightness or 9 degrees off in tint is something else.
+constexpr double kChromaTolerance = 0.15;   // radians
+constexpr double kBrightnessTolerance = 1.6;
+// The learned shape: a candidate less circular than the model by this much is at its limit
+// (and never below min_circularity).
+constexpr double kShapeTolerance = 0.3;
+// Adaptation while tracking only from frames where the marker fits well: area within this ratio
+// of the reference and shape within kAdaptShape of it; the reference area stays within
+// kAdaptRange^-1 .. 4 times the first one.
+constexpr double kAdaptArea = 1.25;
+constexpr double kAdaptShape = 0.1;
+constexpr double kAdaptMinRange = 0.5;
+constexpr double kAdaptMaxRange = 4.0;
+
+// ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
+constexpr int kAutoHueTolerance = 12;        // hue units (2 degrees each)
+constexpr int kAutoGraySaturation = 40;      // below: the nominal colour is a gray level
 
 // A Mat header of `size` and `type` over `store`, which reallocates only when it is too small, so
 // frames of a steady size allocate nothing. The header is continuous and has no parent matrix,
@@ -53,12 +98,14 @@ bool SameBlob(const ColourBlob& a, const ColourBlob& b) {
   return a.bbox_px == b.bbox_px && a.area_px == b.area_px && a.centroid_px == b.centroid_px;
 }
 
-void CheckFrame(const cv::Mat& frame) {
-  if (frame.empty() || frame.type() != CV_8UC3) {
-    throw InputError("colour tracking needs 8-bit BGR colour frames, got " +
-                     (frame.empty() ? std::string("an empty frame")
-                                    : cv::typeToString(frame.type()) + " frames"));
-  }
+bool HueIsFull(const HsvRange& h) {
+  return (h.lo == 0 && h.hi == 179) || (h.lo > h.hi && h.lo == h.hi + 1);
+}
+
+double Norm(const cv::Vec3d& v, int channels) {
+  double sum = 0;
+  for (int c = 0; c < channels; ++c) sum += v[c] * v[c];
+  return std::sqrt(sum);
 }
 
 int MorphShape(ColourParams::Shape shape) {
@@ -107,7 +154,22 @@ bool ColourParams::Check(std::string* error) const {
         << "] needs a positive width and height";
     return Fail(error, why.str());
   }
+  if (gray && gray->lo > gray->hi) {
+    why << "gray: [" << gray->lo << ", " << gray->hi << "]: lower bound above upper bound";
+    return Fail(error, why.str());
+  }
+  if (gray && auto_bgr) return Fail(error, "gray: give either gray or auto_colour, not both");
   return true;
+}
+
+bool ColourParams::NeedsColour() const {
+  if (gray) return false;
+  if (auto_bgr) {
+    cv::Mat bgr(1, 1, CV_8UC3, cv::Scalar((*auto_bgr)[0], (*auto_bgr)[1], (*auto_bgr)[2])), hsv;
+    cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+    return hsv.at<cv::Vec3b>(0, 0)[1] >= kAutoGraySaturation;
+  }
+  return !(HueIsFull(h) && s.lo == 0);
 }
 
 HsvBox HsvBox::Make(HsvRange h, HsvRange s, HsvRange v) {
@@ -139,11 +201,61 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     kernel_ = cv::getStructuringElement(MorphShape(params_.morph_shape),
                                         cv::Size(params_.morph_size, params_.morph_size));
   }
-  // Opening then closing is four erosions/dilations, each reaching one radius further.
-  margin_px_ = filter_radius + 4 * morph_radius + 1;
-  fine_box_ = HsvBox::Make(params_.h, params_.s, params_.v);
-  coarse_box_ = CoarseBox(params_);
+  core_kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                           cv::Size(2 * kSoftBand + 1, 2 * kSoftBand + 1));
+  ring_kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                           cv::Size(2 * kRingOuter + 1, 2 * kRingOuter + 1));
+  // Opening then closing is four erosions/dilations, each reaching one radius further; the ring
+  // around a blob reaches kRingOuter beyond it. With this margin every pixel a blob inside the
+  // region depends on is exactly what a whole-frame pass would see.
+  margin_px_ = filter_radius + 4 * morph_radius + kRingOuter + 1;
+  HsvRange h = params_.h, s = params_.s, v = params_.v;
+  gray_ = params_.gray;
+  if (params_.auto_bgr) {
+    // The nominal colour gives the threshold and, until the marker's own colour is learned, the
+    // colour model: generous bounds, since verification rejects a wrong tint or brightness.
+    const cv::Vec3b c = *params_.auto_bgr;
+    cv::Mat bgr(1, 1, CV_8UC3, cv::Scalar(c[0], c[1], c[2])), hsv;
+    cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+    const cv::Vec3b n = hsv.at<cv::Vec3b>(0, 0);
+    if (n[1] < kAutoGraySaturation) {
+      cv::Mat level;
+      cv::cvtColor(bgr, level, cv::COLOR_BGR2GRAY);
+      const int l = level.at<uchar>(0, 0);
+      const int reach = std::max(40, l * 2 / 5);
+      gray_ = HsvRange{std::max(0, l - reach), std::min(255, l + reach)};
+      nominal_ = cv::Vec3d(l, 0, 0);
+    } else {
+      h = HsvRange{(n[0] - kAutoHueTolerance + 180) % 180, (n[0] + kAutoHueTolerance) % 180};
+      s = HsvRange{std::max(30, n[1] / 2), 255};
+      v = HsvRange{std::max(30, n[2] * 2 / 5), 255};
+      nominal_ = cv::Vec3d(c[0], c[1], c[2]);
+    }
+  }
+  if (gray_) {
+    coarse_gray_ = HsvRange{gray_->lo * 3 / 4, gray_->hi + (255 - gray_->hi) / 4};
+  } else {
+    ColourParams derived = params_;
+    derived.h = h;
+    derived.s = s;
+    derived.v = v;
+    fine_box_ = HsvBox::Make(h, s, v);
+    coarse_box_ = CoarseBox(derived);
+  }
   acquire_roi_ = params_.roi;
+}
+
+void ColourTracker::check_frame(const cv::Mat& frame) const {
+  if (frame.empty() || (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)) {
+    throw InputError("colour tracking needs 8-bit BGR or gray frames, got " +
+                     (frame.empty() ? std::string("an empty frame")
+                                    : cv::typeToString(frame.type()) + " frames"));
+  }
+  if (frame.type() == CV_8UC1 && params_.NeedsColour()) {
+    throw InputError("the frames are gray, but this colour marker's range needs colour (a gray "
+                     "level range `gray: [lo, hi]` or an HSV range of any hue from saturation 0 "
+                     "tracks white, gray or black markers)");
+  }
 }
 
 void ColourTracker::reset() {
@@ -154,7 +266,7 @@ void ColourTracker::reset() {
 }
 
 void ColourTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
-  CheckFrame(frame_bgr);
+  check_frame(frame_bgr);
   const cv::Rect frame_rect(cv::Point(0, 0), frame_bgr.size());
   if (hint.width <= 0 || hint.height <= 0) {
     throw InputError("colour marker rectangle [" + std::to_string(hint.x) + ", " +
@@ -168,80 +280,168 @@ void ColourTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
                      std::to_string(frame_rect.width) + "x" + std::to_string(frame_rect.height) +
                      " frame");
   }
-  // A new selection is a new calibration: learn area and threshold again, inside the hint.
+  // A new selection is a new calibration: learn the model again, inside the hint.
   params_.roi = hint & frame_rect;
   reset();
-  reference_area_px_.reset();
-  auto_threshold_.reset();
+  model_.reset();
   frame_size_ = frame_bgr.size();
   report(acquire(frame_bgr));
 }
 
 Observation ColourTracker::update(const cv::Mat& frame_bgr) {
-  CheckFrame(frame_bgr);
+  check_frame(frame_bgr);
   if (frame_bgr.size() != frame_size_) {
     if (!frame_size_.empty()) reset();
     frame_size_ = frame_bgr.size();
   }
-  std::optional<ColourBlob> blob;
+  candidates_.clear();
+  Choice choice;
   if (tracking_ && params_.window_px > 0) {
-    blob = track_in_windows(frame_bgr);
+    choice = track_in_windows(frame_bgr);
   } else if (tracking_) {
-    // Whole-frame tracking (window 0): the same choice as in a window, the nearest blob.
+    // Whole-frame tracking (window 0): the same choice as in a window, the nearest verified blob.
     const cv::Point2d predicted = *last_px_ + velocity_px_;
     find_blobs(frame_bgr, acquire_downsample(), &blobs_);
     last_search_px_ = cv::Rect(cv::Point(0, 0), frame_bgr.size());
     double best = std::numeric_limits<double>::infinity();
+    size_t chosen = 0;
     for (const ColourBlob& b : blobs_) {
+      const auto [verdict, misfit] = judge(b);
+      candidates_.push_back(candidate(b, verdict, misfit));
       const double d = cv::norm(b.centroid_px - predicted);
-      if (acceptable(b) && d < best) {
+      if (verdict == CandidateVerdict::kFits && d < best) {
         best = d;
-        blob = b;
+        choice.blob = b;
+        chosen = candidates_.size() - 1;
       }
     }
+    if (choice.blob) candidates_[chosen].verdict = CandidateVerdict::kChosen;
   }
-  if (!blob) blob = acquire(frame_bgr);
-  return report(blob);
+  if (!choice.blob) {
+    const bool was_tracking = tracking_;
+    const cv::Point2d predicted = last_px_.value_or(cv::Point2d()) + velocity_px_;
+    choice = acquire(frame_bgr);
+    if (!choice.blob && was_tracking && choice.status == MarkerStatus::kLost &&
+        !cv::Rect2d(-0.5, -0.5, frame_bgr.cols, frame_bgr.rows).contains(predicted)) {
+      choice.status = MarkerStatus::kOutOfFrame;
+    }
+  }
+  return report(choice);
 }
 
-Observation ColourTracker::report(const std::optional<ColourBlob>& blob) {
-  Observation obs;
-  if (!blob) {
+void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
+  if (!model_) {
+    model_ = ColourModel{blob.area_px, blob.area_px, blob.circularity, blob.core_colour};
+    return;
+  }
+  if (!tracking || params_.adapt_rate <= 0) return;
+  // Follow slow changes only: a marker growing in perspective, the light drifting. A sudden one
+  // (a partial cover, a reflection) is not learned.
+  ColourModel& m = *model_;
+  const double ratio = blob.area_px / m.area_px;
+  if (ratio > kAdaptArea || ratio < 1.0 / kAdaptArea) return;
+  if (blob.circularity < m.circularity - kAdaptShape) return;
+  const double r = params_.adapt_rate;
+  m.area_px = std::clamp(m.area_px + r * (blob.area_px - m.area_px),
+                         kAdaptMinRange * m.first_area_px, kAdaptMaxRange * m.first_area_px);
+  m.circularity += r * (blob.circularity - m.circularity);
+  if (blob.measured) m.colour += r * (blob.core_colour - m.colour);
+}
+
+Observation ColourTracker::report(const Choice& choice) {
+  if (!choice.blob) {
     tracking_ = false;
     velocity_px_ = cv::Point2d(0, 0);
-    return obs;
+    return Observation::NotFound(choice.status, choice.tied);
   }
-  if (!reference_area_px_) {
-    reference_area_px_ = blob->area_px;
-    reference_circularity_ = blob->circularity;
-  }
-  velocity_px_ = tracking_ ? blob->centroid_px - *last_px_ : cv::Point2d(0, 0);
-  last_px_ = blob->centroid_px;
+  const ColourBlob& blob = *choice.blob;
+  learn(blob, tracking_);
+  velocity_px_ = tracking_ ? blob.centroid_px - *last_px_ : cv::Point2d(0, 0);
+  last_px_ = blob.centroid_px;
   tracking_ = true;
   acquire_roi_.reset();
-  obs.position_px = blob->centroid_px;
-  obs.score = blob->area_px / *reference_area_px_;
+  Observation obs;
+  obs.position_px = blob.centroid_px;
+  obs.score = blob.area_px / model_->area_px;
   return obs;
 }
 
-bool ColourTracker::acceptable(const ColourBlob& b) const {
-  if (b.clipped || b.area_px < params_.min_area_px) return false;
-  if (params_.max_area_px > 0 && b.area_px > params_.max_area_px) return false;
-  if (b.circularity < params_.min_circularity) return false;
-  if (reference_area_px_) {
-    if (b.area_px < params_.min_area_fraction * *reference_area_px_) return false;
-    if (params_.max_area_factor > 0 && b.area_px > params_.max_area_factor * *reference_area_px_) {
-      return false;
-    }
-  }
-  return true;
+MarkerCandidate ColourTracker::candidate(const ColourBlob& b, CandidateVerdict verdict,
+                                         double misfit) const {
+  MarkerCandidate c;
+  c.position_px = b.clipped ? cv::Point2d(b.bbox_px.x + (b.bbox_px.width - 1) / 2.0,
+                                          b.bbox_px.y + (b.bbox_px.height - 1) / 2.0)
+                            : b.centroid_px;
+  c.area_px = b.area_px;
+  c.circularity = b.circularity;
+  c.misfit = misfit;
+  c.verdict = verdict;
+  return c;
 }
 
-std::optional<ColourBlob> ColourTracker::track_in_windows(const cv::Mat& frame) {
+std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (b.clipped) return {CandidateVerdict::kClipped, kInf};
+  if (b.area_px < params_.min_area_px || (params_.max_area_px > 0 && b.area_px > params_.max_area_px)) {
+    return {CandidateVerdict::kSize, kInf};
+  }
+  const double min_circularity =
+      model_ ? params_.min_circularity
+             : std::max(params_.min_circularity, kMinCircularityWithoutModel);
+  if (b.circularity < min_circularity || !b.measured) return {CandidateVerdict::kShape, kInf};
+  double misfit = 0;
+  // Shape: 0 as round as the model (a disc without one), 1 at the limit.
+  const double ref_circularity = model_ ? model_->circularity : 1.0;
+  const double shape_span =
+      std::max(0.05, std::min(kShapeTolerance, ref_circularity - min_circularity));
+  const double shape = std::max(0.0, ref_circularity - b.circularity) / shape_span;
+  if (shape > 1) return {CandidateVerdict::kShape, kInf};
+  misfit += shape;
+  // Size against the learned area: the configured fraction and factor are the limits.
+  if (model_) {
+    const double ratio = b.area_px / model_->area_px;
+    double size = 0;
+    if (ratio < 1 && params_.min_area_fraction > 0) {
+      if (ratio < params_.min_area_fraction) return {CandidateVerdict::kSize, kInf};
+      size = std::log(ratio) / std::log(params_.min_area_fraction);
+    } else if (ratio > 1 && params_.max_area_factor > 0) {
+      if (ratio > params_.max_area_factor) return {CandidateVerdict::kSize, kInf};
+      size = std::log(ratio) / std::log(params_.max_area_factor);
+    }
+    misfit += size;
+  }
+  // Contrast to its own surroundings.
+  if (!(b.contrast >= kMinContrast)) return {CandidateVerdict::kContrast, kInf};
+  misfit += kMinContrast / b.contrast;
+  // Colour against the learned core colour, or the nominal one.
+  const std::optional<cv::Vec3d> reference =
+      model_ ? std::optional<cv::Vec3d>(model_->colour) : nominal_;
+  if (reference) {
+    const int channels = gray_ ? 1 : 3;
+    const double ref_bright = Norm(*reference, channels);
+    const double bright = Norm(b.core_colour, channels);
+    double colour = 0;
+    if (ref_bright > 1 && bright > 1) {
+      colour = std::abs(std::log(bright / ref_bright)) / std::log(kBrightnessTolerance);
+      if (channels == 3) {
+        const double cosine = std::clamp(b.core_colour.dot(*reference) / (bright * ref_bright),
+                                         -1.0, 1.0);
+        colour = std::max(colour, std::acos(cosine) / kChromaTolerance);
+      }
+    } else if (std::abs(bright - ref_bright) > 8) {
+      colour = kInf;  // One of them black: compare levels directly.
+    }
+    if (colour > 1) return {CandidateVerdict::kColour, kInf};
+    misfit += colour;
+  }
+  return {CandidateVerdict::kFits, misfit};
+}
+
+ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
   const cv::Point2d predicted = *last_px_ + velocity_px_;
   // The window must hold the whole marker with room to move: at least two diameters.
-  const double ref_radius = std::sqrt(reference_area_px_.value_or(0.0) / CV_PI);
+  const double ref_radius = std::sqrt(model_ ? model_->area_px / CV_PI : 0.0);
   const int base = std::max(params_.window_px, static_cast<int>(std::ceil(4.0 * ref_radius)));
   for (int step = 0; step <= params_.widen_steps; ++step) {
     const int side = base << step;
@@ -253,14 +453,19 @@ std::optional<ColourBlob> ColourTracker::track_in_windows(const cv::Mat& frame) 
     blobs_.clear();
     analyse(frame, window, &blobs_);
     std::sort(blobs_.begin(), blobs_.end(), CentroidBefore);
+    candidates_.clear();
     const ColourBlob* best = nullptr;
+    size_t best_index = 0;
     double best_dist = std::numeric_limits<double>::infinity();
     for (const ColourBlob& b : blobs_) {
-      if (!acceptable(b)) continue;
+      const auto [verdict, misfit] = judge(b);
+      candidates_.push_back(candidate(b, verdict, misfit));
+      if (verdict != CandidateVerdict::kFits) continue;
       const double d = cv::norm(b.centroid_px - predicted);
       if (d < best_dist) {
         best_dist = d;
         best = &b;
+        best_index = candidates_.size() - 1;
       }
     }
     // A blob cut by the window's border may be the marker extending outside, and nearer than
@@ -269,20 +474,25 @@ std::optional<ColourBlob> ColourTracker::track_in_windows(const cv::Mat& frame) 
     for (const ColourBlob& b : blobs_) {
       if (b.clipped && DistanceToRect(predicted, b.bbox_px) < best_dist) nearer_clipped = true;
     }
-    if (best && !nearer_clipped) return *best;
+    if (best && !nearer_clipped) {
+      candidates_[best_index].verdict = CandidateVerdict::kChosen;
+      Choice choice;
+      choice.blob = *best;
+      choice.status = MarkerStatus::kFound;
+      return choice;
+    }
     if (window == frame_rect) break;
   }
-  return std::nullopt;
+  return Choice{};
 }
 
-std::optional<ColourBlob> ColourTracker::acquire(const cv::Mat& frame) {
+ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
   cv::Rect region = frame_rect;
   if (acquire_roi_) {
     region = *acquire_roi_ & frame_rect;
-    if (region.empty()) return std::nullopt;  // ROI outside this (smaller) frame.
+    if (region.empty()) return Choice{std::nullopt, MarkerStatus::kOutOfFrame, 0};
   }
-  if (params_.auto_bgr && !auto_threshold_) learn_auto_threshold(frame, region);
   last_search_px_ = region;
   blobs_.clear();
   const int factor = acquire_downsample();
@@ -293,39 +503,59 @@ std::optional<ColourBlob> ColourTracker::acquire(const cv::Mat& frame) {
   }
   std::sort(blobs_.begin(), blobs_.end(), CentroidBefore);
 
-  // Before the first acquisition the marker is the largest acceptable blob; afterwards the one
-  // whose area and shape match the marker's best, preferring the neighbourhood of the last
-  // known position.
+  // Every candidate is judged against the model (or, before one is learned, the configured
+  // ranges and a compact, contrasted shape); among those that fit, the best fit wins, with a
+  // preference for the neighbourhood of the last known position. A runner-up nearly as good
+  // makes the marker ambiguous: a coin toss between look-alikes is not a measurement.
   const double diagonal = std::hypot(frame.cols, frame.rows);
   const cv::Rect2d roi_area = acquire_roi_ ? cv::Rect2d(acquire_roi_->x - 0.5, acquire_roi_->y - 0.5,
                                                         acquire_roi_->width, acquire_roi_->height)
                                            : cv::Rect2d();
-  const ColourBlob* best = nullptr;
-  double best_cost = std::numeric_limits<double>::infinity();
+  candidates_.clear();
+  size_t best = 0;
+  double best_cost = std::numeric_limits<double>::infinity(), second_cost = best_cost;
   for (const ColourBlob& b : blobs_) {
-    if (!acceptable(b)) continue;
-    if (acquire_roi_ && !roi_area.contains(b.centroid_px)) continue;
-    double cost = -b.area_px;
-    if (reference_area_px_) {
-      cost = std::abs(std::log(b.area_px / *reference_area_px_)) +
-             std::abs(b.circularity - reference_circularity_);
-      if (last_px_) cost += cv::norm(b.centroid_px - *last_px_) / diagonal;
+    auto [verdict, misfit] = judge(b);
+    if (verdict == CandidateVerdict::kFits && acquire_roi_ && !roi_area.contains(b.centroid_px)) {
+      verdict = CandidateVerdict::kOutsideRoi;
     }
+    candidates_.push_back(candidate(b, verdict, misfit));
+    if (verdict != CandidateVerdict::kFits) continue;
+    double cost = misfit;
+    if (last_px_) cost += cv::norm(b.centroid_px - *last_px_) / diagonal;
+    const size_t index = candidates_.size() - 1;
     if (cost < best_cost) {
+      second_cost = best_cost;
+      best = index;
       best_cost = cost;
-      best = &b;
+    } else if (cost < second_cost) {
+      second_cost = cost;
     }
   }
-  if (!best) return std::nullopt;
-  return *best;
+  Choice choice;
+  if (!std::isfinite(best_cost)) return choice;  // kLost: nothing fits.
+  if (std::isfinite(second_cost) && second_cost - best_cost < params_.ambiguity_margin) {
+    choice.status = MarkerStatus::kAmbiguous;
+    for (size_t i = 0; i < candidates_.size(); ++i) {
+      if (candidates_[i].verdict != CandidateVerdict::kFits) continue;
+      double cost = candidates_[i].misfit;
+      if (last_px_) cost += cv::norm(blobs_[i].centroid_px - *last_px_) / diagonal;
+      if (cost - best_cost < params_.ambiguity_margin) ++choice.tied;
+    }
+    return choice;
+  }
+  candidates_[best].verdict = CandidateVerdict::kChosen;
+  choice.blob = blobs_[best];
+  choice.status = MarkerStatus::kFound;
+  return choice;
 }
 
 int ColourTracker::acquire_downsample() const {
   if (params_.acquire_downsample > 0) return params_.acquire_downsample;
   // The smallest blob that can count as the marker must hold sample points of the coarse grid
   // (spacing f): a disc of radius r >= f / sqrt(2) holds one, r >= f holds at least three.
-  const double min_area =
-      std::max(params_.min_area_px, params_.min_area_fraction * reference_area_px_.value_or(0.0));
+  const double min_area = std::max(params_.min_area_px,
+                                   params_.min_area_fraction * (model_ ? model_->area_px : 0.0));
   const double radius = std::sqrt(min_area / CV_PI);
   int factor = 1;
   while (factor < 8 && radius >= 2.0 * factor) factor *= 2;
@@ -334,10 +564,9 @@ int ColourTracker::acquire_downsample() const {
 
 void ColourTracker::find_blobs(const cv::Mat& frame_bgr, int downsample,
                                std::vector<ColourBlob>* blobs) {
-  CheckFrame(frame_bgr);
+  check_frame(frame_bgr);
   blobs->clear();
   const cv::Rect frame_rect(cv::Point(0, 0), frame_bgr.size());
-  if (params_.auto_bgr && !auto_threshold_) learn_auto_threshold(frame_bgr, frame_rect);
   if (downsample > 1) {
     coarse_to_fine(frame_bgr, frame_rect, downsample, blobs);
   } else {
@@ -346,43 +575,25 @@ void ColourTracker::find_blobs(const cv::Mat& frame_bgr, int downsample,
   std::sort(blobs->begin(), blobs->end(), CentroidBefore);
 }
 
-void ColourTracker::classify(const cv::Mat& src, const HsvBox& box, int distance_threshold,
-                             cv::Mat& mask) {
-  cv::Mat work = Scratch(hsv_store_, src.size(), CV_8UC3);
-  if (params_.auto_bgr) {
-    const cv::Vec3b c = *params_.auto_bgr;
-    cv::absdiff(src, cv::Scalar(c[0], c[1], c[2]), work);
-    // Mean absolute channel difference: a colour distance 0..255.
-    cv::transform(work, mask, cv::Matx13f(1.f / 3, 1.f / 3, 1.f / 3));
-    cv::threshold(mask, mask, distance_threshold, 255, cv::THRESH_BINARY_INV);
+cv::Mat ColourTracker::prepare(const cv::Mat& src, cv::Mat& store) {
+  const int channels = gray_ ? 1 : 3;
+  if (src.channels() == channels) return src;
+  cv::Mat converted = Scratch(store, src.size(), CV_MAKETYPE(CV_8U, channels));
+  cv::cvtColor(src, converted, channels == 1 ? cv::COLOR_BGR2GRAY : cv::COLOR_GRAY2BGR);
+  return converted;
+}
+
+void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask) {
+  if (gray_) {
+    const HsvRange& g = coarse ? *coarse_gray_ : *gray_;
+    cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
     return;
   }
+  const HsvBox& box = coarse ? coarse_box_ : fine_box_;
+  cv::Mat work = Scratch(hsv_store_, src.size(), CV_8UC3);
   cv::cvtColor(src, work, cv::COLOR_BGR2HSV);
   if (box.shift) cv::LUT(work, box.lut, work);
   cv::inRange(work, box.lower, box.upper, mask);
-}
-
-void ColourTracker::learn_auto_threshold(const cv::Mat& frame, const cv::Rect& region) {
-  // Otsu's two classes of minimal within-class variance, on the colour distance to the nominal
-  // colour, over the first acquisition's region (the ROI or hint if given: the marker is then a
-  // large share of the pixels, which is where Otsu's split is meaningful).
-  cv::Mat src = frame(region);
-  cv::Mat filtered = src;
-  if (params_.filter == ColourParams::Filter::kGaussian) {
-    filtered = Scratch(filtered_store_, region.size(), CV_8UC3);
-    cv::GaussianBlur(src, filtered, cv::Size(params_.filter_ksize, params_.filter_ksize), 0);
-  } else if (params_.filter == ColourParams::Filter::kMedian) {
-    filtered = Scratch(filtered_store_, region.size(), CV_8UC3);
-    cv::medianBlur(src, filtered, params_.filter_ksize);
-  }
-  cv::Mat work = Scratch(hsv_store_, region.size(), CV_8UC3);
-  cv::Mat distance = Scratch(mask_store_, region.size(), CV_8U);
-  const cv::Vec3b c = *params_.auto_bgr;
-  cv::absdiff(filtered, cv::Scalar(c[0], c[1], c[2]), work);
-  cv::transform(work, distance, cv::Matx13f(1.f / 3, 1.f / 3, 1.f / 3));
-  const double threshold =
-      cv::threshold(distance, distance, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
-  auto_threshold_ = static_cast<int>(threshold);
 }
 
 void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
@@ -408,22 +619,23 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
   const cv::Rect extended =
       cv::Rect(region.x - m, region.y - m, region.width + 2 * m, region.height + 2 * m) &
       frame_rect;
-  const cv::Mat src = frame(extended);
+  // A view into the frame (when it has the channels the classifier needs), so near the frame's
+  // edges the filter sees the same border as a whole-frame pass would.
+  const cv::Mat src = prepare(frame(extended), prepared_store_);
 
-  // 1. Filter. The source is a view into the frame, so near the frame's edges the filter sees
-  //    the same border as a whole-frame pass would.
+  // 1. Filter.
   cv::Mat filtered = src;
   if (params_.filter == ColourParams::Filter::kGaussian) {
-    filtered = Scratch(filtered_store_, extended.size(), CV_8UC3);
+    filtered = Scratch(filtered_store_, extended.size(), src.type());
     cv::GaussianBlur(src, filtered, cv::Size(params_.filter_ksize, params_.filter_ksize), 0);
   } else if (params_.filter == ColourParams::Filter::kMedian) {
-    filtered = Scratch(filtered_store_, extended.size(), CV_8UC3);
+    filtered = Scratch(filtered_store_, extended.size(), src.type());
     cv::medianBlur(src, filtered, params_.filter_ksize);
   }
 
   // 2. Binarise.
   cv::Mat mask = Scratch(mask_store_, extended.size(), CV_8U);
-  classify(filtered, fine_box_, auto_threshold_.value_or(0), mask);
+  classify(filtered, false, mask);
 
   // 3. Opening then closing, only where it can change anything: outside the bounding box of the
   //    marker-coloured pixels the mask is 0 and stays 0 (opening only removes, closing only fills
@@ -475,14 +687,154 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
       cv::Mat blob_mask = Scratch(blob_store_, box.size(), CV_8U);
       cv::compare(labels(box), i, blob_mask, cv::CMP_EQ);
       const cv::Moments mo = cv::moments(blob_mask, true);
-      blob.centroid_px = cv::Point2d(mo.m10 / mo.m00 + blob.bbox_px.x,
-                                     mo.m01 / mo.m00 + blob.bbox_px.y);
+      blob.binary_centroid_px = cv::Point2d(mo.m10 / mo.m00 + blob.bbox_px.x,
+                                            mo.m01 / mo.m00 + blob.bbox_px.y);
+      blob.centroid_px = blob.binary_centroid_px;
       // Polar moment of the pixels as unit squares (each adds 1/6 about its own centre).
       const double polar = mo.mu20 + mo.mu02 + mo.m00 / 6.0;
       blob.circularity = mo.m00 * mo.m00 / (2.0 * CV_PI * polar);
+      // 6. Colour statistics and the soft centroid, for blobs that may be the marker.
+      if (blob.circularity >= params_.min_circularity) {
+        measure(filtered, mask, labels, i, box, labelled.tl(), extended.tl(), &blob);
+      }
     }
     blobs->push_back(blob);
   }
+}
+
+void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const cv::Mat& labels,
+                            int label, const cv::Rect& box, cv::Point labelled_tl,
+                            cv::Point origin, ColourBlob* blob) {
+  // The blob's box in `filtered`, padded by the ring's reach.
+  const cv::Rect box_local = box + labelled_tl;
+  const cv::Rect padded =
+      cv::Rect(box_local.x - kRingOuter - 1, box_local.y - kRingOuter - 1,
+               box_local.width + 2 * kRingOuter + 2, box_local.height + 2 * kRingOuter + 2) &
+      cv::Rect(cv::Point(0, 0), filtered.size());
+  const cv::Size size = padded.size();
+  cv::Mat own = Scratch(blob_store_, size, CV_8U);
+  own.setTo(0);
+  cv::compare(labels(box), label, own(cv::Rect(box_local.tl() - padded.tl(), box.size())),
+              cv::CMP_EQ);
+  // near: within kSoftBand of the blob; core: kSoftBand inside it; reach: within kRingOuter.
+  cv::Mat near = Scratch(near_store_, size, CV_8U);
+  cv::Mat core = Scratch(core_store_, size, CV_8U);
+  cv::Mat reach = Scratch(ring_store_, size, CV_8U);
+  cv::dilate(own, near, core_kernel_, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::erode(own, core, core_kernel_);  // The frame's edge counts as inside (default border).
+  cv::dilate(own, reach, ring_kernel_, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  const cv::Mat pixels = filtered(padded);
+  const cv::Mat others = mask(padded);
+  const int channels = pixels.channels();
+
+  // The local background varies around a marker (the body's edge, texture): the ring is split
+  // into kSectors angular sectors about the blob's centroid, and an edge pixel's background is
+  // interpolated between the two sectors nearest its direction.
+  const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
+  auto sector_of = [&](int x, int y) {
+    const double u = (std::atan2(y - centre.y, x - centre.x) + CV_PI) / (2 * CV_PI) * kSectors;
+    return std::clamp(u, 0.0, kSectors - 1e-9);
+  };
+
+  // Pass 1: core colour, ring colour (overall and per sector).
+  const bool core_empty = cv::countNonZero(core) == 0;
+  const cv::Mat& inside = core_empty ? own : core;
+  cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
+  std::array<cv::Vec3d, kSectors> sector_sum{};
+  std::array<int, kSectors> sector_n{};
+  double core_n = 0, ring_n = 0;
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* in = inside.ptr<uchar>(y);
+    const uchar* nr = near.ptr<uchar>(y);
+    const uchar* rc = reach.ptr<uchar>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const uchar* c = p + x * channels;
+      if (in[x]) {
+        for (int k = 0; k < channels; ++k) {
+          core_sum[k] += c[k];
+          core_sq[k] += c[k] * c[k];
+        }
+        core_n += 1;
+      } else if (rc[x] && !nr[x] && !ot[x]) {
+        const int sector = static_cast<int>(sector_of(x, y));
+        for (int k = 0; k < channels; ++k) {
+          ring_sum[k] += c[k];
+          ring_sq[k] += c[k] * c[k];
+          sector_sum[sector][k] += c[k];
+        }
+        ++sector_n[sector];
+        ring_n += 1;
+      }
+    }
+  }
+  if (core_n < 1 || ring_n < 3) return;  // Crowded by other blobs: no local background.
+  double core_var = 0, ring_var = 0;
+  for (int k = 0; k < channels; ++k) {
+    blob->core_colour[k] = core_sum[k] / core_n;
+    blob->ring_colour[k] = ring_sum[k] / ring_n;
+    core_var += std::max(0.0, core_sq[k] / core_n - blob->core_colour[k] * blob->core_colour[k]);
+    ring_var += std::max(0.0, ring_sq[k] / ring_n - blob->ring_colour[k] * blob->ring_colour[k]);
+  }
+  blob->core_sigma = std::sqrt(core_var);
+  blob->ring_sigma = std::sqrt(ring_var);
+  const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
+  const double axis2 = axis.dot(axis);
+  blob->contrast = std::sqrt(axis2) / (blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  blob->measured = true;
+  if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
+
+  // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
+  // pixel's colour lies between its local background (0) and the core colour (1), on the line
+  // through them. Pixels of other blobs count 0.
+  std::array<cv::Vec3d, kSectors> sector_mean;
+  for (int i = 0; i < kSectors; ++i) {
+    sector_mean[i] = sector_n[i] >= 2 ? sector_sum[i] / sector_n[i] : blob->ring_colour;
+  }
+  const cv::Vec3d& f = blob->core_colour;
+  const double deadband_scale = 1.0 / (1.0 - 2.0 * kMembershipDeadband);
+  double sw = 0, sx = 0, sy = 0;
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* cr = core.ptr<uchar>(y);
+    const uchar* nr = near.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    double row_w = 0, row_x = 0;
+    for (int x = 0; x < size.width; ++x) {
+      if (!nr[x]) continue;
+      double w = 1.0;
+      if (!cr[x]) {
+        if (ot[x] && !ow[x]) continue;
+        const uchar* c = p + x * channels;
+        // Sector centres sit at i + 0.5.
+        const double u = sector_of(x, y) - 0.5;
+        const double lower = std::floor(u);
+        const double t = u - lower;
+        const int i0 = (static_cast<int>(lower) + kSectors) % kSectors;
+        const int i1 = (i0 + 1) % kSectors;
+        double num = 0, den = 0;
+        for (int k = 0; k < channels; ++k) {
+          const double g = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
+          const double d = f[k] - g;
+          num += (c[k] - g) * d;
+          den += d * d;
+        }
+        w = den > 1.0 ? std::clamp((num / den - kMembershipDeadband) * deadband_scale, 0.0, 1.0)
+                      : (ow[x] ? 1.0 : 0.0);
+      }
+      row_w += w;
+      row_x += w * x;
+    }
+    sw += row_w;
+    sx += row_x;
+    sy += row_w * y;
+  }
+  if (sw <= 0) return;
+  // Offsets added as one integer: the same blob in a window and in the whole frame gives the
+  // same bits.
+  blob->centroid_px = cv::Point2d(sx / sw + (padded.x + origin.x), sy / sw + (padded.y + origin.y));
 }
 
 void ColourTracker::complete_blobs(const cv::Mat& frame, cv::Rect region,
@@ -528,11 +880,11 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
   // frame, not a mix of marker and background. Columns beyond a multiple of the factor are
   // covered by the last cell's window below.
   const cv::Mat src = frame(cv::Rect(region.x, region.y, coarse_cols * factor, coarse_rows * factor));
-  cv::Mat coarse = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), CV_8UC3);
-  cv::resize(src, coarse, coarse.size(), 0, 0, cv::INTER_NEAREST_EXACT);
+  cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
+  cv::resize(src, sampled, sampled.size(), 0, 0, cv::INTER_NEAREST_EXACT);
+  const cv::Mat coarse = prepare(sampled, coarse_prepared_store_);
   cv::Mat mask = Scratch(coarse_mask_store_, coarse.size(), CV_8U);
-  const int threshold = std::min(255, auto_threshold_.value_or(0) * 5 / 4 + 4);
-  classify(coarse, coarse_box_, threshold, mask);
+  classify(coarse, true, mask);
   // Group the candidate cells by tiles of kTile x kTile cells, 8-connected tiles together:
   // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
   windows_.clear();

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -24,13 +25,25 @@
 
 namespace softsight {
 
-// One connected component of the marker mask, in frame coordinates.
+// One connected component of the marker mask, in frame coordinates. Centroid, circularity and
+// the colour statistics are set only for complete blobs (not clipped) of acceptable area, the
+// colour statistics only when the blob is compact enough to be a candidate (`measured`).
 struct ColourBlob {
-  cv::Point2d centroid_px;  // m10/m00, m01/m00 (only for complete blobs).
-  double area_px = 0;       // m00: pixel count.
-  double circularity = 0;   // See ColourParams::min_circularity (only for complete blobs).
+  cv::Point2d centroid_px;         // The reported one: soft or binary (ColourParams::centroid).
+  cv::Point2d binary_centroid_px;  // m10/m00, m01/m00 of the mask.
+  double area_px = 0;              // m00: pixel count.
+  double circularity = 0;          // See ColourParams::min_circularity.
   cv::Rect bbox_px;
-  bool clipped = false;     // Touches a region edge that is not a frame edge: incomplete.
+  bool clipped = false;            // Touches a region edge that is not a frame edge: incomplete.
+  bool measured = false;           // The colour statistics below are set.
+  // Mean colour (B, G, R, or the gray level in [0]) of the blob's core (2 px inside its edge, or
+  // the whole blob when that is empty) and of its surroundings (a ring 3-4 px outside, pixels of
+  // other blobs excluded), with their RMS spread (over channels).
+  cv::Vec3d core_colour, ring_colour;
+  double core_sigma = 0, ring_sigma = 0;
+  // |core - ring| / (core_sigma + ring_sigma + 2): how clearly the blob stands out from what
+  // surrounds it. A printed or painted marker scores far above a patch of background texture.
+  double contrast = 0;
 };
 
 // A hue/saturation/value box as one inRange call: a wrapping hue range is shifted by a lookup
@@ -43,6 +56,14 @@ struct HsvBox {
   static HsvBox Make(HsvRange h, HsvRange s, HsvRange v);
 };
 
+// What the tracker knows of its marker: learned at the first acquisition, adapted while tracking.
+struct ColourModel {
+  double area_px = 0;        // Reference area (Observation::score's denominator).
+  double first_area_px = 0;  // The area when learned: area_px stays within 1/2..4x of it.
+  double circularity = 1;
+  cv::Vec3d colour;          // Core colour.
+};
+
 class ColourTracker : public Tracker {
  public:
   // `params` must pass Check() (CreateTracker checks).
@@ -51,6 +72,7 @@ class ColourTracker : public Tracker {
   void init(const cv::Mat& frame_bgr, const cv::Rect& hint) override;
   Observation update(const cv::Mat& frame_bgr) override;
   void reset() override;
+  const std::vector<MarkerCandidate>& candidates() const override { return candidates_; }
 
   // ---- Internals exposed for tests and benchmarks ------------------------------------------------
   // Every complete blob of the frame, whole-frame search at full resolution or coarse-to-fine
@@ -58,8 +80,14 @@ class ColourTracker : public Tracker {
   void find_blobs(const cv::Mat& frame_bgr, int downsample, std::vector<ColourBlob>* blobs);
   // The factor the next whole-frame acquisition would use.
   int acquire_downsample() const;
-  std::optional<double> reference_area_px() const { return reference_area_px_; }
-  std::optional<int> auto_threshold() const { return auto_threshold_; }
+  std::optional<double> reference_area_px() const {
+    return model_ ? std::optional<double>(model_->area_px) : std::nullopt;
+  }
+  const std::optional<ColourModel>& model() const { return model_; }
+  // True when pixels are classified by gray level (`gray`, or a nominal gray `auto_bgr`).
+  bool gray_mode() const { return gray_.has_value(); }
+  // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit).
+  std::pair<CandidateVerdict, double> judge(const ColourBlob& blob) const;
   // Bounded side of the last region searched (for tests of the windowing).
   const cv::Rect& last_search_px() const { return last_search_px_; }
 
@@ -69,30 +97,45 @@ class ColourTracker : public Tracker {
   void analyse(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs);
   void analyse_region(const cv::Mat& frame, const cv::Rect& region,
                       std::vector<ColourBlob>* blobs);
-  // Marker mask of `src` (already filtered) into `mask`.
-  void classify(const cv::Mat& src, const HsvBox& box, int distance_threshold, cv::Mat& mask);
+  // `src` with the channels the classifier needs (1 in gray mode, else 3), converted into `store`
+  // when the frame has the other kind.
+  cv::Mat prepare(const cv::Mat& src, cv::Mat& store);
+  // Marker mask of `src` (prepared, filtered) into `mask`.
+  void classify(const cv::Mat& src, bool coarse, cv::Mat& mask);
+  // Colour statistics and soft centroid of label `label`, whose box in `labels` is `box`;
+  // `labelled_tl` is the labels' origin in `filtered` / `mask`, `origin` the latter's in the frame.
+  void measure(const cv::Mat& filtered, const cv::Mat& mask, const cv::Mat& labels, int label,
+               const cv::Rect& box, cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
   // Every complete blob of `region`: analyse, growing the region around clipped blobs.
   void complete_blobs(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs);
   // Coarse candidates -> full-resolution windows -> complete blobs.
   void coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
                       std::vector<ColourBlob>* blobs);
-  void learn_auto_threshold(const cv::Mat& frame, const cv::Rect& region);
 
-  bool acceptable(const ColourBlob& blob) const;
-  std::optional<ColourBlob> track_in_windows(const cv::Mat& frame);
-  std::optional<ColourBlob> acquire(const cv::Mat& frame);
-  Observation report(const std::optional<ColourBlob>& blob);
+  // The outcome of one search: the chosen blob, or why there is none.
+  struct Choice {
+    std::optional<ColourBlob> blob;
+    MarkerStatus status = MarkerStatus::kLost;
+    int tied = 0;  // With kAmbiguous: how many candidates fitted about equally.
+  };
+  void check_frame(const cv::Mat& frame) const;
+  Choice track_in_windows(const cv::Mat& frame);
+  Choice acquire(const cv::Mat& frame);
+  Observation report(const Choice& choice);
+  void learn(const ColourBlob& blob, bool tracking);
+  MarkerCandidate candidate(const ColourBlob& blob, CandidateVerdict verdict, double misfit) const;
 
   ColourParams params_;
   cv::Mat kernel_;          // Morphology structuring element.
   int margin_px_ = 0;       // Filter radius + 4 morphology radii (+1).
   HsvBox fine_box_, coarse_box_;
+  std::optional<HsvRange> gray_, coarse_gray_;  // Gray-level mode (`gray`, or a nominal gray).
+  std::optional<cv::Vec3d> nominal_;          // auto_bgr: the colour model until one is learned.
 
   // The marker, learned at acquisition.
-  std::optional<double> reference_area_px_;
-  double reference_circularity_ = 1.0;
-  std::optional<int> auto_threshold_;         // Otsu's distance threshold (auto_bgr mode).
+  std::optional<ColourModel> model_;
   std::optional<cv::Rect> acquire_roi_;       // Restricts acquisitions until the first success.
+  std::vector<MarkerCandidate> candidates_;   // Of the last search.
 
   // Motion.
   std::optional<cv::Point2d> last_px_;        // Last found position (kept to prefer on re-acquisition).
@@ -103,6 +146,8 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, hsv_store_, mask_store_, morph_store_, labels_store_, blob_store_;
+  cv::Mat prepared_store_, coarse_prepared_store_, near_store_, core_store_, ring_store_;
+  cv::Mat core_kernel_, ring_kernel_;         // Ellipses of radius kSoftBand and kRingOuter.
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat stats_, centroids_, coarse_stats_, coarse_centroids_;
   std::vector<ColourBlob> blobs_, pending_;

@@ -49,6 +49,25 @@ const Method kMethods[] = {
 
 }  // namespace
 
+const std::vector<MarkerCandidate>& Tracker::candidates() const {
+  static const std::vector<MarkerCandidate> kNone;
+  return kNone;
+}
+
+const char* CandidateVerdictName(CandidateVerdict verdict) {
+  switch (verdict) {
+    case CandidateVerdict::kChosen: return "chosen";
+    case CandidateVerdict::kFits: return "fits";
+    case CandidateVerdict::kClipped: return "clipped";
+    case CandidateVerdict::kSize: return "size";
+    case CandidateVerdict::kShape: return "shape";
+    case CandidateVerdict::kColour: return "colour";
+    case CandidateVerdict::kContrast: return "contrast";
+    case CandidateVerdict::kOutsideRoi: return "outside_roi";
+  }
+  return "fits";
+}
+
 std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec) {
   for (const Method& method : kMethods) {
     if (spec.method == method.name) return method.create(spec);

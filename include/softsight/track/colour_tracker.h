@@ -2,11 +2,16 @@
 // blobs -> centroid from moments, with region-of-interest tracking and honest loss detection.
 //
 // The tracker itself (ColourTracker, built by CreateTracker(spec) with method "colour") reports
-//   Observation::position_px = centroid (m10/m00, m01/m00) of the chosen blob's binary mask,
-//                              pixel-centre convention (x = column), sub-pixel;
-//   Observation::score       = blob area / reference area (the marker's area when it was
-//                              acquired): ~1 for a fully visible marker, lower when partly covered.
-// A blob whose area is below min_area_fraction of the reference area counts as not found.
+//   Observation::position_px = the chosen blob's centroid, pixel-centre convention (x = column),
+//                              sub-pixel: by default the soft centroid (edge pixels weighted by
+//                              how much of them is marker), or the paper's binary centroid
+//                              (m10/m00, m01/m00 of the blob's mask) with centroid = kBinary;
+//   Observation::score       = blob area / reference area (the marker's area as learned, updated
+//                              slowly while tracking): ~1 when fully visible, lower when covered.
+// "Found" means verified: a blob is reported only when it fits the marker's model (size, shape,
+// colour against its surroundings), learned when the marker is first acquired; before that only a
+// compact, contrasted blob that fits the configured ranges is accepted, and only when no other
+// candidate fits about as well (otherwise: not found, MarkerStatus::kAmbiguous).
 #pragma once
 
 #include <optional>
@@ -37,11 +42,15 @@ struct ColourParams {
   HsvRange h{0, 179};
   HsvRange s{0, 255};
   HsvRange v{0, 255};
-  // Automatic threshold: when set, h/s/v are ignored and pixels are split into marker and
-  // background by Otsu's criterion on their colour distance (mean absolute BGR difference) to
-  // this nominal colour. The threshold is learned once, on the first acquisition's region, and
-  // kept until init(): give `roi` (or init's hint) so the marker is a fair share of that region;
-  // on a whole frame the marker is too small a class for Otsu's split to be meaningful.
+  // Intensity markers (white or black dots): when set, h/s/v are ignored and a pixel is marker
+  // when its gray level (BGR->gray luma, or the frame itself when it is CV_8UC1) lies in this
+  // inclusive range 0..255. Works on gray and colour video alike.
+  std::optional<HsvRange> gray;
+  // Automatic colour: when set, h/s/v are ignored. The nominal colour (B, G, R) gives the
+  // threshold (hue within 12 of the nominal's, saturation and value at least half and
+  // 40 % of the nominal's) and is the colour model candidates are verified against
+  // until the marker's own colour is learned: a same-hue blob much darker or of another tint is
+  // not the marker. A nominal gray (B = G = R, or saturation below 40) tracks by gray level.
   std::optional<cv::Vec3b> auto_bgr;
 
   // ---- Morphology: opening (removes specks) then closing (fills holes) ----------------------------
@@ -63,11 +72,31 @@ struct ColourParams {
   // cable bundle); 0: no limit.
   double max_area_factor = 4.0;
 
+  // ---- Centroid ----------------------------------------------------------------------------------
+  // kSoft: pixels within 2 px of the blob's edge count by their membership, the projection of
+  // their colour on the line from the blob's local background colour (a ring 3-4 px outside) to
+  // its core colour, clamped to 0..1: anti-aliased and blurred edges then weigh what they cover.
+  // kBinary: the paper's centroid of the binary mask (exact for hard-edged, unblurred markers).
+  enum class Centroid { kSoft, kBinary };
+  Centroid centroid = Centroid::kSoft;
+
+  // ---- Verification ------------------------------------------------------------------------------
+  // Each candidate gets a misfit: 0 is a perfect fit, each criterion (area, shape, colour,
+  // contrast to its surroundings) reaching 1 at its limit; above 1 it is rejected. When the
+  // runner-up's misfit is within this margin of the best one's, the marker is ambiguous and not
+  // found. Larger refuses more often; 0 accepts the best even against a twin.
+  double ambiguity_margin = 0.2;
+  // While tracking, the learned area, shape and colour follow the marker by this fraction per
+  // frame (only from frames where it fits well: a sudden change is not learned), so a marker that
+  // grows to twice its size in perspective keeps fitting. The learned area stays within 1/2..4x
+  // of its first value. 0: keep the first model.
+  double adapt_rate = 0.05;
+
   // ---- Search ------------------------------------------------------------------------------------
   // Where the first acquisition looks (a dragged rectangle); the chosen blob's centroid lies in it.
-  // Without it the first acquisition takes the largest acceptable blob of the frame. Later
-  // re-acquisitions search the whole frame, preferring blobs near the last known position whose
-  // area and circularity match the reference.
+  // Without it the first acquisition searches the whole frame and accepts a blob only when it is
+  // the one candidate that fits (see above). Later re-acquisitions search the whole frame,
+  // preferring candidates that fit the learned model best, near the last known position.
   std::optional<cv::Rect> roi;
   // Side of the square window searched around the constant-velocity prediction while tracking;
   // at least 4 reference radii. Smaller is faster but needs widening sooner for fast markers.
@@ -85,6 +114,9 @@ struct ColourParams {
 
   // Returns true when every field is usable; otherwise false with `error` naming the field.
   bool Check(std::string* error) const;
+  // False when gray frames suffice: a gray-level range, a nominal gray, or an HSV range that takes
+  // any hue at zero saturation (white, gray and black markers).
+  bool NeedsColour() const;
 };
 
 }  // namespace softsight

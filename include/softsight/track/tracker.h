@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,30 @@
 #include "softsight/track/template_tracker.h"
 
 namespace softsight {
+
+// What a tracker made of one blob or match it considered in its last update(): the session's
+// joint checks and the live window's mask view read them.
+enum class CandidateVerdict : uint8_t {
+  kChosen,      // Reported as the marker.
+  kFits,        // Fits the marker's model, but another one was chosen (or tied: ambiguous).
+  kClipped,     // Cut by the searched region's border: its centroid is not the whole blob's.
+  kSize,        // Area outside the configured range or too far from the learned area.
+  kShape,       // Not compact enough, or unlike the learned shape.
+  kColour,      // Its colour is not the marker's (tint or brightness).
+  kContrast,    // Does not stand out from its surroundings (a patch of background texture).
+  kOutsideRoi,  // Outside the region the first acquisition is restricted to.
+};
+
+// "chosen", "fits", "clipped", "size", "shape", "colour", "contrast", "outside_roi".
+const char* CandidateVerdictName(CandidateVerdict verdict);
+
+struct MarkerCandidate {
+  cv::Point2d position_px;     // Centroid (complete blobs) or bounding-box centre (clipped ones).
+  double area_px = 0;
+  double circularity = 0;      // See ColourParams::min_circularity.
+  double misfit = 0;           // 0 perfect; above 1 rejected (see ColourParams::ambiguity_margin).
+  CandidateVerdict verdict = CandidateVerdict::kFits;
+};
 
 class Tracker {
  public:
@@ -33,6 +58,10 @@ class Tracker {
 
   // Forgets position and velocity; the next update() acquires on the full frame (or the ROI).
   virtual void reset() = 0;
+
+  // The candidates the last update() (or init()) weighed, with the verdict on each; empty for
+  // trackers that do not report them. Valid until the next update().
+  virtual const std::vector<MarkerCandidate>& candidates() const;
 };
 
 // Everything needed to build the tracker of one marker.
