@@ -9,9 +9,11 @@
 namespace softsight {
 namespace {
 
+// A marker whose colour range accepts gray pixels (a gray-level range, white or black dots) is
+// tracked on gray video as well; only the others make a gray video an error.
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
-    if (!IsTemplateMethod(spec.method) || spec.templ.colour) return true;
+    if (IsTemplateMethod(spec.method) ? spec.templ.colour : spec.colour.NeedsColour()) return true;
   }
   return false;
 }
@@ -82,7 +84,8 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
         if (needs_colour && IsGrayscale(frame.image)) {
           throw InputError(summary.source +
                            ": the video is grayscale, but colour tracking needs colour (use "
-                           "--method zncc, which matches in gray)");
+                           "--method zncc, which matches in gray, or a gray-level range "
+                           "`gray: [lo, hi]` for white or black markers)");
         }
         info.frame_size = frame.image.size();
         begin_sinks();
