@@ -102,6 +102,65 @@ bool HueIsFull(const HsvRange& h) {
   return (h.lo == 0 && h.hi == 179) || (h.lo > h.hi && h.lo == h.hi + 1);
 }
 
+// A pseudo-angle of (dx, dy) in [0, 4): monotonic in atan2 (one unit per quadrant), without a
+// transcendental function. 0 for (0, 0).
+double DiamondAngle(double dx, double dy) {
+  const double sum = std::abs(dx) + std::abs(dy);
+  if (sum == 0) return 0;
+  if (dy >= 0) return dx >= 0 ? dy / sum : 1 - dx / sum;
+  return dx < 0 ? 2 - dy / sum : 3 + dx / sum;
+}
+
+// Chamfer (3-4) distance to the edge of the nonzero pixels of `inside`, in thirds of a pixel,
+// into `distance` (CV_16U, same size): for an outside pixel, to the nearest inside one; for an
+// inside pixel, to the nearest outside one (pixels beyond the image count as inside, as erosion
+// by OpenCV's default border does).
+void ChamferToEdge(const cv::Mat& inside, cv::Mat& distance) {
+  constexpr int kFar = 0x3fff;
+  const int w = inside.cols, h = inside.rows;
+  distance.setTo(kFar);
+  // Two transforms in one map: a pixel's seeds are its neighbours of the other kind (one step
+  // away); through a neighbour of its own kind it inherits that one's distance plus the step.
+  auto relax = [](int& d, bool kind, const uchar* in, const uint16_t* dist, int x, int step) {
+    const int via = (in[x] != 0) == kind ? dist[x] + step : step;
+    d = std::min(d, via);
+  };
+  for (int y = 0; y < h; ++y) {
+    const uchar* in = inside.ptr<uchar>(y);
+    const uchar* in_up = y > 0 ? inside.ptr<uchar>(y - 1) : nullptr;
+    uint16_t* row = distance.ptr<uint16_t>(y);
+    const uint16_t* up = y > 0 ? distance.ptr<uint16_t>(y - 1) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      const bool kind = in[x] != 0;
+      int d = row[x];
+      if (x > 0) relax(d, kind, in, row, x - 1, 3);
+      if (up) {
+        if (x > 0) relax(d, kind, in_up, up, x - 1, 4);
+        relax(d, kind, in_up, up, x, 3);
+        if (x + 1 < w) relax(d, kind, in_up, up, x + 1, 4);
+      }
+      row[x] = static_cast<uint16_t>(d);
+    }
+  }
+  for (int y = h - 1; y >= 0; --y) {
+    const uchar* in = inside.ptr<uchar>(y);
+    const uchar* in_down = y + 1 < h ? inside.ptr<uchar>(y + 1) : nullptr;
+    uint16_t* row = distance.ptr<uint16_t>(y);
+    const uint16_t* down = y + 1 < h ? distance.ptr<uint16_t>(y + 1) : nullptr;
+    for (int x = w - 1; x >= 0; --x) {
+      const bool kind = in[x] != 0;
+      int d = row[x];
+      if (x + 1 < w) relax(d, kind, in, row, x + 1, 3);
+      if (down) {
+        if (x + 1 < w) relax(d, kind, in_down, down, x + 1, 4);
+        relax(d, kind, in_down, down, x, 3);
+        if (x > 0) relax(d, kind, in_down, down, x - 1, 4);
+      }
+      row[x] = static_cast<uint16_t>(d);
+    }
+  }
+}
+
 double Norm(const cv::Vec3d& v, int channels) {
   double sum = 0;
   for (int c = 0; c < channels; ++c) sum += v[c] * v[c];
@@ -201,10 +260,6 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     kernel_ = cv::getStructuringElement(MorphShape(params_.morph_shape),
                                         cv::Size(params_.morph_size, params_.morph_size));
   }
-  core_kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                           cv::Size(2 * kSoftBand + 1, 2 * kSoftBand + 1));
-  ring_kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                           cv::Size(2 * kRingOuter + 1, 2 * kRingOuter + 1));
   // Opening then closing is four erosions/dilations, each reaching one radius further; the ring
   // around a blob reaches kRingOuter beyond it. With this margin every pixel a blob inside the
   // region depends on is exactly what a whole-frame pass would see.
@@ -716,13 +771,11 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
   own.setTo(0);
   cv::compare(labels(box), label, own(cv::Rect(box_local.tl() - padded.tl(), box.size())),
               cv::CMP_EQ);
-  // near: within kSoftBand of the blob; core: kSoftBand inside it; reach: within kRingOuter.
-  cv::Mat near = Scratch(near_store_, size, CV_8U);
-  cv::Mat core = Scratch(core_store_, size, CV_8U);
-  cv::Mat reach = Scratch(ring_store_, size, CV_8U);
-  cv::dilate(own, near, core_kernel_, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  cv::erode(own, core, core_kernel_);  // The frame's edge counts as inside (default border).
-  cv::dilate(own, reach, ring_kernel_, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
+  // core = more than kSoftBand inside, reach = within kRingOuter outside.
+  cv::Mat distance = Scratch(distance_store_, size, CV_16U);
+  ChamferToEdge(own, distance);
+  constexpr int kNear = 3 * kSoftBand, kReach = 3 * kRingOuter;
   const cv::Mat pixels = filtered(padded);
   const cv::Mat others = mask(padded);
   const int channels = pixels.channels();
@@ -732,32 +785,38 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
   // interpolated between the two sectors nearest its direction.
   const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
   auto sector_of = [&](int x, int y) {
-    const double u = (std::atan2(y - centre.y, x - centre.x) + CV_PI) / (2 * CV_PI) * kSectors;
+    const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
     return std::clamp(u, 0.0, kSectors - 1e-9);
   };
 
+  // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
+  bool core_empty = true;
+  for (int y = 0; y < size.height && core_empty; ++y) {
+    const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* d = distance.ptr<uint16_t>(y);
+    for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] && d[x] > kNear);
+  }
+  const int core_depth = core_empty ? 0 : kNear;
+
   // Pass 1: core colour, ring colour (overall and per sector).
-  const bool core_empty = cv::countNonZero(core) == 0;
-  const cv::Mat& inside = core_empty ? own : core;
   cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
   std::array<cv::Vec3d, kSectors> sector_sum{};
   std::array<int, kSectors> sector_n{};
   double core_n = 0, ring_n = 0;
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
-    const uchar* in = inside.ptr<uchar>(y);
-    const uchar* nr = near.ptr<uchar>(y);
-    const uchar* rc = reach.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* d = distance.ptr<uint16_t>(y);
     const uchar* ot = others.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) {
       const uchar* c = p + x * channels;
-      if (in[x]) {
+      if (ow[x] && d[x] > core_depth) {
         for (int k = 0; k < channels; ++k) {
           core_sum[k] += c[k];
           core_sq[k] += c[k] * c[k];
         }
         core_n += 1;
-      } else if (rc[x] && !nr[x] && !ot[x]) {
+      } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
         for (int k = 0; k < channels; ++k) {
           ring_sum[k] += c[k];
@@ -797,15 +856,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
   double sw = 0, sx = 0, sy = 0;
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
-    const uchar* cr = core.ptr<uchar>(y);
-    const uchar* nr = near.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* dist = distance.ptr<uint16_t>(y);
     const uchar* ot = others.ptr<uchar>(y);
     double row_w = 0, row_x = 0;
     for (int x = 0; x < size.width; ++x) {
-      if (!nr[x]) continue;
+      if (!ow[x] && dist[x] > kNear) continue;  // Beyond the band.
       double w = 1.0;
-      if (!cr[x]) {
+      if (!(ow[x] && dist[x] > kNear)) {
         if (ot[x] && !ow[x]) continue;
         const uchar* c = p + x * channels;
         // Sector centres sit at i + 0.5.

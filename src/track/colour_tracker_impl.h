@@ -146,8 +146,7 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, hsv_store_, mask_store_, morph_store_, labels_store_, blob_store_;
-  cv::Mat prepared_store_, coarse_prepared_store_, near_store_, core_store_, ring_store_;
-  cv::Mat core_kernel_, ring_kernel_;         // Ellipses of radius kSoftBand and kRingOuter.
+  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat stats_, centroids_, coarse_stats_, coarse_centroids_;
   std::vector<ColourBlob> blobs_, pending_;
