@@ -92,23 +92,30 @@ bool MetricModel::Check(std::string* error) const {
   return true;
 }
 
+std::vector<std::string> MeasureOptions::inner_markers() const {
+  if (chain.size() < 3) return {};
+  return std::vector<std::string>(chain.begin() + 1, chain.end() - 1);
+}
+
 bool MeasureOptions::Check(std::string* error) const {
   std::string unused;
   if (error == nullptr) error = &unused;  // Check(nullptr) asks only whether it passes
   // Ranges are the table's (geometry/measure_options.cc); the rules across fields follow.
   if (const auto problem = CheckOptions(MeasureOptionsTable(), *this)) return Fail(error, *problem);
-  const std::pair<const char*, const std::string*> triple[] = {
-      {"base", &base}, {"middle", &middle}, {"tip", &tip}};
-  for (const auto& [field, name] : triple) {
-    if (name->empty()) {
-      *error = std::string("triple: the ") + field + " marker is not named";
+  if (has_triple()) {
+    const std::pair<const char*, const std::string*> triple[] = {
+        {"base", &base}, {"middle", &middle}, {"tip", &tip}};
+    for (const auto& [field, name] : triple) {
+      if (name->empty()) {
+        *error = std::string("triple: the ") + field + " marker is not named";
+        return false;
+      }
+    }
+    if (base == middle || middle == tip || base == tip) {
+      *error = "triple: base, middle and tip must be three different markers, got [" + base +
+               ", " + middle + ", " + tip + "]";
       return false;
     }
-  }
-  if (base == middle || middle == tip || base == tip) {
-    *error = "triple: base, middle and tip must be three different markers, got [" + base + ", " +
-             middle + ", " + tip + "]";
-    return false;
   }
   if (!chain.empty()) {
     if (chain.size() < 3) {
@@ -146,9 +153,27 @@ void Measurer::set_metric(const MetricModel& metric) {
 
 Measurement Measurer::measure(const std::vector<MarkerObservation>& markers) {
   Measurement out;
-  const cv::Point2d* base = Find(markers, options_.base);
-  const cv::Point2d* middle = Find(markers, options_.middle);
-  const cv::Point2d* tip = Find(markers, options_.tip);
+  measure(markers, out);
+  return out;
+}
+
+void Measurer::measure(const std::vector<MarkerObservation>& markers, Measurement& out) {
+  // Every value starts absent; the inner angles keep their storage.
+  std::vector<std::optional<double>> inner = std::move(out.inner_angle_deg);
+  out = Measurement();
+  out.inner_angle_deg = std::move(inner);
+  out.inner_angle_deg.assign(options_.chain.size() < 3 ? 0 : options_.chain.size() - 2,
+                             std::nullopt);
+  for (size_t k = 0; k < out.inner_angle_deg.size(); ++k) {
+    const cv::Point2d* before = Find(markers, options_.chain[k]);
+    const cv::Point2d* at = Find(markers, options_.chain[k + 1]);
+    const cv::Point2d* after = Find(markers, options_.chain[k + 2]);
+    if (before && at && after) out.inner_angle_deg[k] = AngleAtMiddleDeg(*before, *at, *after);
+  }
+  // Without a triple the names are empty and match no marker: the triple's values stay absent.
+  const cv::Point2d* base = options_.has_triple() ? Find(markers, options_.base) : nullptr;
+  const cv::Point2d* middle = options_.has_triple() ? Find(markers, options_.middle) : nullptr;
+  const cv::Point2d* tip = options_.has_triple() ? Find(markers, options_.tip) : nullptr;
   const MetricModel& metric = options_.metric;
   const std::optional<cv::Matx33d>& plane = metric.plane_mm_from_image;
   const double scale = metric.scale_mm_per_px.value_or(1.0);
@@ -228,7 +253,6 @@ Measurement Measurer::measure(const std::vector<MarkerObservation>& markers) {
     }
     if (plane && all_mapped) MeasureChain(chain_mm, &out.radius_mm, &out.arc_length_mm);
   }
-  return out;
 }
 
 }  // namespace softsight

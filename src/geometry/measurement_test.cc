@@ -278,6 +278,55 @@ TEST(MeasurerTest, ChainInThePlaneAgreesWithTheScaleModel) {
   EXPECT_THAT(by_plane.radius_mm, Optional(DoubleNear(12.0, 1e-8)));
 }
 
+TEST(MeasurerTest, ChainGivesTheAngleAtEveryInnerMarker) {
+  Measurer measurer(Chain());
+  EXPECT_EQ(measurer.options().inner_markers(),
+            (std::vector<std::string>{"c1", "blue", "c2"}));
+  // A zig-zag: right angles at c1 and c2 (computed by hand), 180 at the straight middle.
+  std::vector<MarkerObservation> markers = {Seen("red", 0, 0), Seen("c1", 10, 0),
+                                            Seen("blue", 10, 10), Seen("c2", 10, 20),
+                                            Seen("green", 0, 20)};
+  Measurement m = measurer.measure(markers);
+  ASSERT_EQ(m.inner_angle_deg.size(), 3u);
+  EXPECT_THAT(m.inner_angle_deg[0], Optional(DoubleNear(90.0, kTol)));
+  EXPECT_THAT(m.inner_angle_deg[1], Optional(DoubleNear(180.0, kTol)));
+  EXPECT_THAT(m.inner_angle_deg[2], Optional(DoubleNear(90.0, kTol)));
+  // A lost marker takes the angles it is part of with it: its own and its neighbours'.
+  markers[1] = Lost("c1");
+  measurer.measure(markers, m);
+  ASSERT_EQ(m.inner_angle_deg.size(), 3u);
+  EXPECT_EQ(m.inner_angle_deg[0], std::nullopt);
+  EXPECT_EQ(m.inner_angle_deg[1], std::nullopt);
+  EXPECT_THAT(m.inner_angle_deg[2], Optional(DoubleNear(90.0, kTol)));
+  EXPECT_TRUE(Measurer(Triple()).measure(markers).inner_angle_deg.empty());
+}
+
+TEST(MeasurerTest, WithoutATripleOnlyTheChainIsMeasured) {
+  MeasureOptions none;
+  std::string error;
+  EXPECT_TRUE(none.Check(&error)) << error;
+  Measurer positions_only(none);
+  const Measurement m = positions_only.measure({Seen("ball", 3, 4)});
+  EXPECT_EQ(m.angle_deg, std::nullopt);
+  EXPECT_EQ(m.chord_px, std::nullopt);
+  EXPECT_EQ(m.tip_disp_px, std::nullopt);
+  EXPECT_TRUE(m.inner_angle_deg.empty());
+
+  MeasureOptions chain_only = Chain();
+  chain_only.base.clear();
+  chain_only.middle.clear();
+  chain_only.tip.clear();
+  EXPECT_TRUE(chain_only.Check(&error)) << error;
+  Measurer chain(chain_only);
+  const Measurement c = chain.measure(ChainOnCircle({300, 200}, 80.0, 150.0, -90.0));
+  EXPECT_EQ(c.angle_deg, std::nullopt);
+  EXPECT_EQ(c.chord_px, std::nullopt);
+  EXPECT_THAT(c.radius_px, Optional(DoubleNear(80.0, 1e-8)));
+  ASSERT_EQ(c.inner_angle_deg.size(), 3u);
+  // Equally spaced on a circle, 60 degrees of arc apart: each inner angle is 180 - 60.
+  for (const auto& angle : c.inner_angle_deg) EXPECT_THAT(angle, Optional(DoubleNear(120.0, 1e-8)));
+}
+
 TEST(MeasureOptionsTest, CheckNamesTheBadField) {
   std::string error;
   EXPECT_TRUE(Triple().Check(&error)) << error;
@@ -287,6 +336,12 @@ TEST(MeasureOptionsTest, CheckNamesTheBadField) {
   o.middle.clear();
   EXPECT_FALSE(o.Check(&error));
   EXPECT_THAT(error, HasSubstr("middle"));
+
+  o = Triple();
+  o.base.clear();
+  o.middle.clear();
+  EXPECT_FALSE(o.Check(&error)) << "a triple names all three or none";
+  EXPECT_THAT(error, HasSubstr("triple: the base"));
 
   o = Triple();
   o.tip = "red";

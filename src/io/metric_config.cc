@@ -101,16 +101,8 @@ void ReadMeasureOptions(YamlMap& top, MeasureOptions* measure) {
 }
 
 bool CheckMeasureOptionsOfAFile(const MeasureOptions& measure, std::string* error) {
-  // Until one- and two-marker configs are allowed (issue 9), MeasureOptions::Check() asks for a
-  // triple; saying so is the session's business for a config that only tracks. Every other rule
-  // is checked here, with stand-in names no marker can have (they contain spaces).
-  MeasureOptions checked = measure;
-  if (checked.base.empty() && checked.middle.empty() && checked.tip.empty()) {
-    checked.base = "no base";
-    checked.middle = "no middle";
-    checked.tip = "no tip";
-  }
-  return checked.Check(error);
+  // A triple is optional (one or two markers only track), so the file's rules are Check()'s.
+  return measure.Check(error);
 }
 
 void WriteMeasureOptions(const MeasureOptions& measure, YAML::Emitter& out) {

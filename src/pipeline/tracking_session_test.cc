@@ -5,6 +5,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/scene.h"
@@ -36,10 +37,9 @@ struct Clip {
   std::vector<SceneTruth> truth;
 };
 
-Clip Render(int count) {
-  SceneOptions options;
+Clip Render(int count, SceneOptions options = {}) {
   options.frame_count = count;
-  options.max_bend_deg = 120;
+  if (options.markers.size() == 3) options.max_bend_deg = 120;
   SyntheticScene scene(options);
   Clip clip;
   for (int i = 0; i < count; ++i) {
@@ -184,6 +184,122 @@ TEST(TrackingSession, MeasurementPointIsTheUndistortedPointWithACameraModel) {
                     camera.distortion, projected);
   EXPECT_NEAR(projected[0].x, raw.x, 1e-3);
   EXPECT_NEAR(projected[0].y, raw.y, 1e-3);
+}
+
+// The angle at `at` between the rays to `a` and `b`, in degrees: the test's own eq. 7.
+double AngleDeg(cv::Point2d a, cv::Point2d at, cv::Point2d b) {
+  const cv::Point2d u = a - at, v = b - at;
+  return std::acos(u.dot(v) / (cv::norm(u) * cv::norm(v))) * 180.0 / CV_PI;
+}
+
+TEST(TrackingSession, OneMarkerConfigFileTracksAndHasNoMeasurements) {
+  testing::TempDir dir;
+  testing::WriteTextFile(dir.file("ball.yaml"),
+                         "markers:\n  - name: ball\n    hsv: {h: [100, 130], s: [80, 255], "
+                         "v: [40, 255]}\n");
+  const TrackingConfig config = LoadTrackingConfig(dir.file("ball.yaml"));
+  SceneOptions scene;
+  scene.markers = {{"ball", {220, 90, 40}, 0.7}};
+  const Clip clip = Render(4, scene);
+  TrackingSession session(config);
+  for (size_t i = 0; i < clip.frames.size(); ++i) {
+    const FrameResult& result = session.process(clip.frames[i]);
+    ASSERT_EQ(result.markers.size(), 1u);
+    ASSERT_TRUE(result.markers[0].observation.found()) << "frame " << i;
+    EXPECT_LT(cv::norm(*result.markers[0].observation.position_px -
+                       *clip.truth[i].markers[0].centroid_px),
+              0.2);
+    EXPECT_FALSE(result.measurement.angle_deg || result.measurement.chord_px ||
+                 result.measurement.tip_disp_px);
+    EXPECT_TRUE(result.measurement.inner_angle_deg.empty());
+  }
+}
+
+TEST(TrackingSession, TwoMarkersTrackWithoutATriple) {
+  SceneOptions scene;
+  scene.markers = {{"red", {40, 40, 220}, 0.2}, {"green", {60, 200, 60}, 0.9}};
+  scene.max_bend_deg = 90;
+  const Clip clip = Render(4, scene);
+  TrackingConfig config;
+  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("green", {45, 85})};
+  TrackingSession session(config);
+  for (size_t i = 0; i < clip.frames.size(); ++i) {
+    const FrameResult& result = session.process(clip.frames[i]);
+    for (size_t m = 0; m < 2; ++m) {
+      ASSERT_TRUE(result.markers[m].observation.found()) << "frame " << i;
+      EXPECT_LT(cv::norm(*result.markers[m].observation.position_px -
+                         *clip.truth[i].markers[m].centroid_px),
+                0.2);
+    }
+    EXPECT_FALSE(result.measurement.angle_deg.has_value());
+  }
+}
+
+// The paper's 4-segment actuator has a marker on each of its five hinges and ends.
+SceneOptions FiveMarkerChain() {
+  SceneOptions scene;
+  scene.markers = {{"red", {40, 40, 220}, 0.05},    {"yellow", {40, 210, 220}, 0.3},
+                   {"green", {60, 200, 60}, 0.5},   {"blue", {220, 90, 40}, 0.7},
+                   {"magenta", {200, 50, 200}, 0.95}};
+  scene.max_bend_deg = 200;
+  return scene;
+}
+
+TrackingConfig FiveMarkerConfig() {
+  TrackingConfig config;
+  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("yellow", {20, 35}),
+                    ColourMarker("green", {45, 85}), ColourMarker("blue", {100, 130}),
+                    ColourMarker("magenta", {140, 165})};
+  config.measure.base = "red";
+  config.measure.middle = "green";
+  config.measure.tip = "magenta";
+  config.measure.chain = {"red", "yellow", "green", "blue", "magenta"};
+  return config;
+}
+
+TEST(TrackingSession, FiveMarkerChainMeasuresTheAngleAtEveryInnerMarkerLikeTheTruth) {
+  const Clip clip = Render(8, FiveMarkerChain());
+  TrackingSession session(FiveMarkerConfig());
+  for (size_t i = 0; i < clip.frames.size(); ++i) {
+    const FrameResult& result = session.process(clip.frames[i]);
+    const std::vector<MarkerTruth>& truth = clip.truth[i].markers;
+    ASSERT_EQ(result.measurement.inner_angle_deg.size(), 3u);
+    for (size_t k = 0; k < 3; ++k) {
+      const double expected =
+          AngleDeg(*truth[k].centroid_px, *truth[k + 1].centroid_px, *truth[k + 2].centroid_px);
+      ASSERT_TRUE(result.measurement.inner_angle_deg[k].has_value()) << "frame " << i;
+      EXPECT_NEAR(*result.measurement.inner_angle_deg[k], expected, 0.3)
+          << "frame " << i << ", inner marker " << k;
+    }
+    ASSERT_TRUE(result.measurement.angle_deg.has_value());
+    EXPECT_NEAR(*result.measurement.angle_deg, *clip.truth[i].measurement.angle_deg, 0.3);
+  }
+  // The profile bends: the last frame's angles are well away from straight.
+  EXPECT_LT(*session.process(clip.frames.back()).measurement.inner_angle_deg[1], 170.0);
+}
+
+TEST(TrackingSession, ConfigErrorsOfTheTripleAndChainNameTheFileAndKey) {
+  testing::TempDir dir;
+  const std::string markers =
+      "markers:\n  - name: a\n  - name: b\n  - name: c\n";
+  auto error_of = [&](const std::string& text) {
+    testing::WriteTextFile(dir.file("m.yaml"), markers + text);
+    try {
+      TrackingSession session(LoadTrackingConfig(dir.file("m.yaml")));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of(""), "");
+  EXPECT_EQ(error_of("chain: [a, b, c]\n"), "");
+  for (const char* bad : {"triple: [a, b]\n", "triple: [a, b, a]\n",
+                                 "chain: [a, b, a]\n", "chain: [a, b]\n", "chain: [a, b, x]\n"}) {
+    const std::string error = error_of(bad);
+    const std::string key = std::string(bad).substr(0, std::string(bad).find(':'));
+    EXPECT_THAT(error, ::testing::HasSubstr(dir.file("m.yaml"))) << bad;
+    EXPECT_THAT(error, ::testing::HasSubstr(key)) << bad;
+  }
 }
 
 }  // namespace

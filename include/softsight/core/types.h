@@ -76,6 +76,11 @@ struct Measurement {
   std::optional<double> arc_length_px;    // Eq. 9 (major arc when d > R); = c when straight.
   std::optional<double> circumradius_px;  // Circle through the three points: a cross-check.
   std::optional<double> tip_disp_px;      // Bending distance: tip displacement from reference.
+  // With a chain of N >= 3 markers: the angle (eq. 7) at each inner marker chain[1] .. chain[N-2],
+  // in chain order, between its two neighbours along the chain (the paper's multi-segment
+  // actuators have one per hinge); absent where that marker or a neighbour is not found. Empty
+  // without a chain. CSV: angle_<name>_deg.
+  std::vector<std::optional<double>> inner_angle_deg;
 
   std::optional<double> chord_mm;
   std::optional<double> sagitta_mm;

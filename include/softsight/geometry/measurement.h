@@ -41,16 +41,25 @@ std::optional<cv::Point2d> MapToPlane(const cv::Matx33d& plane_from_image,
                                       const cv::Point2d& image_px);
 
 struct MeasureOptions {
-  std::string base, middle, tip;          // The triple, by marker name.
-  // Optional: every marker along the body in order, base to tip. With more than three, radius
-  // and arc length come from a least-squares (Taubin) circle fit through all found markers.
+  // The triple, by marker name: all three named (the paper's measurements), or all three empty
+  // (no triple: one or two markers, or a chain only; angle, chord, sagitta, ... stay absent).
+  std::string base, middle, tip;
+  // Optional: every marker along the body in order, base to tip. Gives the angle at every inner
+  // marker (Measurement::inner_angle_deg); with more than three, radius and arc length come from
+  // a least-squares (Taubin) circle fit through all found markers.
   std::vector<std::string> chain;
   // Reference for the bending distance; absent: the tip's position in the first frame where found.
   std::optional<cv::Point2d> tip_reference_px;
   MetricModel metric;
 
-  // base, middle and tip named and distinct; chain empty or at least 3 distinct names; the tip
-  // reference finite; the metric model valid. Unknown marker names are the config's business.
+  bool has_triple() const { return !base.empty() || !middle.empty() || !tip.empty(); }
+  // The chain's inner markers chain[1] .. chain[N-2], whose angles inner_angle_deg holds.
+  std::vector<std::string> inner_markers() const;
+
+  // No triple, or base, middle and tip all named and distinct; chain empty or at least 3
+  // distinct names; the tip reference finite; the metric model valid. On failure `error` starts
+  // with the config key at fault ("triple: ...", "chain: ..."). Unknown marker names are the
+  // config's business.
   bool Check(std::string* error) const;
 };
 
@@ -63,6 +72,9 @@ class Measurer {
   // Throws InputError when options.Check fails.
   explicit Measurer(MeasureOptions options);
   Measurement measure(const std::vector<MarkerObservation>& markers);
+  // The same into `out`, reusing its storage (no allocation per frame once inner_angle_deg has
+  // its size).
+  void measure(const std::vector<MarkerObservation>& markers, Measurement& out);
   // Next frame where the tip is found becomes the reference (or the configured point again).
   void reset_tip_reference();
   // A new metric model (e.g. a scale clicked live). The tip reference is kept: it is an image
