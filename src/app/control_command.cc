@@ -326,11 +326,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
     }));
   }
-  std::vector<std::string> names;
-  for (const MarkerSpec& spec : tracking_config.markers) names.push_back(spec.name);
-  const MetricModel& metric = tracking_config.measure.metric;
-  CsvSink csv(options.csv_file,
-              TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra));
+  CsvSink csv(options.csv_file, TrackingColumns(tracking_config, extra));
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
   if (rig && rendered == nullptr) {

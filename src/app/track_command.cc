@@ -49,11 +49,7 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   TrackingSession session(config);
 
   // Sinks in the order they see each frame; every output is opened (and checked) before the run.
-  std::vector<std::string> names;
-  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
-  const MetricModel& metric = config.measure.metric;
-  CsvSink csv(options.csv_file,
-              TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image));
+  CsvSink csv(options.csv_file, TrackingColumns(config));
   std::vector<FrameSink*> sinks = {&csv};
   std::optional<VideoSink> annotated;
   if (options.annotated_file) {

@@ -151,6 +151,37 @@ TEST(TrackCommand, AnnotatedVideoHasEveryFrameWithTheOverlayOnTheMarkers) {
 }
 
 // Every column but proc_ms (a timing) of a CSV, row by row.
+TEST(TrackCommand, OneMarkerConfigWritesItsPositionsAndStatusWithoutMeasurements) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 6);
+  testing::WriteTextFile(dir.file("one.yaml"), R"(markers:
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+)");
+  TrackOptions options;
+  options.config_file = dir.file("one.yaml");
+  options.source.input = clip.video;
+  options.csv_file = dir.file("out.csv");
+  options.quiet = true;
+  EXPECT_EQ(RunTrack(options).frames, 6);
+  const std::vector<std::string> lines = testing::ReadLines(options.csv_file);
+  ASSERT_EQ(lines.size(), 7u);
+  const std::vector<std::string> header = testing::SplitCsv(lines[0]);
+  auto column = [&](const std::string& name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(at, header.end()) << name;
+    return static_cast<size_t>(at - header.begin());
+  };
+  for (int i = 0; i < 6; ++i) {
+    const std::vector<std::string> row = testing::SplitCsv(lines[i + 1] + ",");
+    const cv::Point2d truth = *clip.truth[i].markers[1].centroid_px;
+    EXPECT_NEAR(std::stod(row[column("blue_x")]), truth.x, 0.2);
+    EXPECT_NEAR(std::stod(row[column("blue_y")]), truth.y, 0.2);
+    EXPECT_EQ(row[column("blue_status")], "found");
+    EXPECT_EQ(row[column("angle_deg")], "") << "no triple, no angle";
+  }
+}
+
 std::vector<std::vector<std::string>> TrackingRows(const std::string& csv) {
   std::vector<std::vector<std::string>> rows;
   for (const std::string& line : testing::ReadLines(csv)) {

@@ -442,11 +442,7 @@ void LiveController::toggle_recording() {
     }
     auto recording = std::make_unique<Recording>();
     recording->prefix = prefix;
-    std::vector<std::string> names;
-    for (const MarkerSpec& spec : config_.markers) names.push_back(spec.name);
-    const MetricModel& metric = config_.measure.metric;
-    recording->csv = std::make_unique<CsvWriter>(
-        prefix + ".csv", names, metric.scale_mm_per_px || metric.plane_mm_from_image);
+    recording->csv = std::make_unique<CsvWriter>(prefix + ".csv", TrackingColumns(config_));
     const double fps = options_.record_fps.value_or(fps_.value_or(30.0));
     recording->annotated.open(prefix + ".avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
                               frame_.size());

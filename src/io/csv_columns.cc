@@ -72,7 +72,8 @@ void CsvColumnTable::append_row(const FrameResult& result, std::string& row) con
 }
 
 CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
-                               const std::vector<CsvColumn>& extra) {
+                               const std::vector<CsvColumn>& extra,
+                               const std::vector<std::string>& inner_angle_markers) {
   CsvColumnTable table;
   table.add({"frame", [](const FrameResult& r, std::string& row) {
                row += std::to_string(r.frame_index);
@@ -97,6 +98,10 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
     table.add({name + "_score", [i](const FrameResult& r, std::string& row) {
                  AppendNumber(row, r.markers.at(i).observation.score, "%.4f");
                }});
+    // Why the marker has no position (or "found"): a word, never a number.
+    table.add({name + "_status", [i](const FrameResult& r, std::string& row) {
+                 row += MarkerStatusName(r.markers.at(i).observation.status());
+               }});
   }
   table.add(MeasurementColumn("angle_deg", &Measurement::angle_deg));
   table.add(MeasurementColumn("chord_px", &Measurement::chord_px));
@@ -104,6 +109,13 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
   table.add(MeasurementColumn("radius_px", &Measurement::radius_px));
   table.add(MeasurementColumn("arc_length_px", &Measurement::arc_length_px));
   table.add(MeasurementColumn("tip_disp_px", &Measurement::tip_disp_px));
+  for (size_t k = 0; k < inner_angle_markers.size(); ++k) {
+    table.add({"angle_" + inner_angle_markers[k] + "_deg",
+               [k](const FrameResult& r, std::string& row) {
+                 const auto& angles = r.measurement.inner_angle_deg;
+                 if (k < angles.size()) AppendNumber(row, angles[k], "%.4f");
+               }});
+  }
   if (metric) {
     table.add(MeasurementColumn("chord_mm", &Measurement::chord_mm));
     table.add(MeasurementColumn("sagitta_mm", &Measurement::sagitta_mm));
@@ -116,6 +128,14 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
                AppendNumber(row, r.proc_ms, "%.4f");
              }});
   return table;
+}
+
+CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<CsvColumn>& extra) {
+  std::vector<std::string> names;
+  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
+  const MetricModel& metric = config.measure.metric;
+  return TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra,
+                         config.measure.inner_markers());
 }
 
 }  // namespace softsight

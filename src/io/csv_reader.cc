@@ -30,6 +30,13 @@ std::vector<std::string> SplitFields(const std::string& line) {
   return fields;
 }
 
+// A marker's status column holds words ("found", "lost"): no number to read.
+bool IsTextColumn(const std::string& column) {
+  const std::string suffix = "_status";
+  return column.size() >= suffix.size() &&
+         column.compare(column.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 }  // namespace
 
 std::optional<size_t> CsvTable::find(const std::string& column) const {
@@ -62,7 +69,7 @@ CsvTable ReadCsvTable(const std::string& file) {
     }
     for (size_t c = 0; c < fields.size(); ++c) {
       std::optional<double> value;
-      if (!fields[c].empty()) {
+      if (!fields[c].empty() && !IsTextColumn(table.columns[c])) {
         char* end = nullptr;
         const double parsed = std::strtod(fields[c].c_str(), &end);
         if (end != fields[c].c_str() + fields[c].size()) {

@@ -33,8 +33,9 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
   TempDir dir;
   { CsvWriter csv(dir.file("a.csv"), {"red", "blue"}, /*metric=*/false); }
   EXPECT_EQ(testing::ReadLines(dir.file("a.csv")).at(0),
-            "frame,time_s,red_x,red_y,red_found,red_score,blue_x,blue_y,blue_found,blue_score,"
-            "angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,proc_ms");
+            "frame,time_s,red_x,red_y,red_found,red_score,red_status,blue_x,blue_y,blue_found,"
+            "blue_score,blue_status,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,"
+            "tip_disp_px,proc_ms");
   {
     CsvWriter csv(dir.file("b.csv"),
                   TrackingColumns({"red"}, /*metric=*/true,
@@ -43,7 +44,7 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
                                   })}));
   }
   EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).at(0),
-            "frame,time_s,red_x,red_y,red_found,red_score,angle_deg,chord_px,sagitta_px,"
+            "frame,time_s,red_x,red_y,red_found,red_score,red_status,angle_deg,chord_px,sagitta_px,"
             "radius_px,arc_length_px,tip_disp_px,chord_mm,sagitta_mm,radius_mm,arc_length_mm,"
             "tip_disp_mm,target_deg,proc_ms");
 }
@@ -56,8 +57,8 @@ TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
   const std::vector<std::string> lines = testing::ReadLines(dir.file("run.csv"));
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_THAT(testing::SplitCsv(lines[1]),
-              ElementsAre("7", "0.250000", "10.5000", "20.2500", "1", "0.9700", "", "", "0", "",
-                          "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
+              ElementsAre("7", "0.250000", "10.5000", "20.2500", "1", "0.9700", "found", "", "",
+                          "0", "", "lost", "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
                           "0.1250"));
 }
 
@@ -83,6 +84,49 @@ TEST(CsvColumnTable, HeaderAndRowsComeFromTheSameColumns) {
   EXPECT_EQ(header.back(), "proc_ms") << "extra columns go before proc_ms";
   EXPECT_EQ(*table.find("target_deg") + 1, *table.find("duty"));
   EXPECT_FALSE(table.find("chord_mm")) << "no _mm columns without a metric model";
+}
+
+TEST(CsvColumnTable, StatusColumnNamesWhyAMarkerHasNoPosition) {
+  const CsvColumnTable table = TrackingColumns({"red", "blue"}, /*metric=*/false);
+  FrameResult result = TwoMarkers(/*second_found=*/false);
+  std::string row;
+  const auto field = [&](const std::string& name) {
+    table.append_row(result, row);
+    return testing::SplitCsv(row + ",").at(*table.find(name));
+  };
+  EXPECT_EQ(field("red_status"), "found");
+  for (MarkerStatus status : {MarkerStatus::kLost, MarkerStatus::kAmbiguous,
+                              MarkerStatus::kImplausible, MarkerStatus::kCovered,
+                              MarkerStatus::kOutOfFrame, MarkerStatus::kNotStarted}) {
+    result.markers[1].observation = Observation::NotFound(status, 2);
+    EXPECT_EQ(field("blue_status"), MarkerStatusName(status));
+    EXPECT_EQ(field("blue_found"), "0");
+    EXPECT_EQ(field("blue_x"), "");
+  }
+  EXPECT_EQ(field("red_status"), "found");
+}
+
+TEST(CsvColumnTable, AChainHasAnAngleColumnPerInnerMarker) {
+  TrackingConfig config;
+  for (const char* name : {"a", "b", "c", "d"}) {
+    config.markers.emplace_back();
+    config.markers.back().name = name;
+  }
+  config.measure.chain = {"a", "c", "b", "d"};  // Body order, not config order.
+  const CsvColumnTable table = TrackingColumns(config);
+  ASSERT_TRUE(table.find("angle_c_deg") && table.find("angle_b_deg"));
+  EXPECT_EQ(*table.find("angle_c_deg") + 1, *table.find("angle_b_deg"));
+  EXPECT_FALSE(table.find("angle_a_deg") || table.find("angle_d_deg")) << "ends have no angle";
+  EXPECT_LT(*table.find("tip_disp_px"), *table.find("angle_c_deg"));
+  FrameResult result;
+  for (const char* name : {"a", "b", "c", "d"}) result.markers.push_back({name, Observation{}});
+  result.measurement.inner_angle_deg = {150.25, std::nullopt};
+  std::string row;
+  table.append_row(result, row);
+  const std::vector<std::string> fields = testing::SplitCsv(row + ",");
+  EXPECT_EQ(fields.at(*table.find("angle_c_deg")), "150.2500");
+  EXPECT_EQ(fields.at(*table.find("angle_b_deg")), "");
+  EXPECT_FALSE(TrackingColumns(TrackingConfig{}).find("angle_deg_deg"));
 }
 
 TEST(CsvColumnTable, InsertBeforeNamesItsAnchor) {

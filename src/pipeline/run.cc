@@ -95,6 +95,7 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
       for (size_t i = 0; i < result.markers.size(); ++i) {
         summary.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
       }
+      summary.statuses.add(result);
       summary.measured += result.measurement.angle_deg ? 1 : 0;
       proc_ms.push_back(result.proc_ms);
       for (FrameSink* sink : sinks) sink->consume(frame, result);

@@ -48,20 +48,25 @@ std::vector<std::string> MarkerStatusSummary::lines() const {
       const auto status = static_cast<MarkerStatus>(s);
       const PerStatus& per = marker.status[s];
       if (status == MarkerStatus::kFound || per.frames == 0) continue;
-      line += line.empty() ? marker.name + ": " : "; ";
-      line += std::string(MarkerStatusName(status)) + " in " + std::to_string(per.frames) +
-              (per.frames == 1 ? " frame: " : " frames: ");
+      // Appended piece by piece (GCC 12 misreads chained operator+ here as an overlap).
+      if (line.empty()) {
+        line.append(marker.name).append(": ");
+      } else {
+        line.append("; ");
+      }
+      line.append(MarkerStatusName(status)).append(" in ").append(std::to_string(per.frames));
+      line.append(per.frames == 1 ? " frame: " : " frames: ");
       for (size_t r = 0; r < per.listed.size(); ++r) {
         const Run& run = per.listed[r];
-        if (r > 0) line += ", ";
-        line += std::to_string(run.first);
-        if (run.last != run.first) line += "-" + std::to_string(run.last);
+        if (r > 0) line.append(", ");
+        line.append(std::to_string(run.first));
+        if (run.last != run.first) line.append("-").append(std::to_string(run.last));
         if (status == MarkerStatus::kAmbiguous && run.candidates > 1) {
-          line += " (" + std::to_string(run.candidates) + " candidates)";
+          line.append(" (").append(std::to_string(run.candidates)).append(" candidates)");
         }
       }
       const int64_t unlisted = per.runs - static_cast<int64_t>(per.listed.size());
-      if (unlisted > 0) line += " and " + std::to_string(unlisted) + " more";
+      if (unlisted > 0) line.append(" and ").append(std::to_string(unlisted)).append(" more");
     }
     if (!line.empty()) out.push_back(line);
   }

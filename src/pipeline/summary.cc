@@ -73,6 +73,9 @@ std::string RunSummary::FullReport() const {
                   100.0 * found_rate(i));
     out += line;
   }
+  const std::vector<std::string> not_found = statuses.lines();
+  if (!not_found.empty()) out += "not found:\n";
+  for (const std::string& status : not_found) out += "  " + status + "\n";
   std::snprintf(line, sizeof(line), "angle measured in %lld frames\n",
                 static_cast<long long>(measured));
   out += line;

@@ -2,8 +2,9 @@
 // that writes its field for a frame (the row), so header and rows cannot disagree, and callers
 // add columns by name (the controller's), never by position. The tracking columns are the stable
 // contract other programs rely on (README "CSV columns"):
-//   frame, time_s, per marker <name>_x, <name>_y, <name>_found, <name>_score,
+//   frame, time_s, per marker <name>_x, <name>_y, <name>_found, <name>_score, <name>_status,
 //   angle_deg, chord_px, sagitta_px, radius_px, arc_length_px, tip_disp_px,
+//   angle_<name>_deg per inner marker of the chain (none without a chain),
 //   chord_mm, sagitta_mm, radius_mm, arc_length_mm, tip_disp_mm (only with a metric model),
 //   any extra columns a caller adds (the controller's), proc_ms.
 // Undefined values are empty fields.
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "softsight/core/types.h"
+#include "softsight/io/config.h"
 
 namespace softsight {
 
@@ -51,9 +53,15 @@ class CsvColumnTable {
   std::vector<CsvColumn> columns_;
 };
 
-// The tracking columns above for these markers (in FrameResult::markers order), with the _mm
-// twins when `metric`, then `extra` (by name, before proc_ms), then proc_ms.
+// The tracking columns above for these markers (in FrameResult::markers order), an inner-angle
+// column per name of `inner_angle_markers` (Measurement::inner_angle_deg, in that order), the
+// _mm twins when `metric`, then `extra` (by name, before proc_ms), then proc_ms.
 CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
+                               const std::vector<CsvColumn>& extra = {},
+                               const std::vector<std::string>& inner_angle_markers = {});
+// The tracking columns of a run of `config`: its markers, its chain's inner angles, the _mm twins
+// when it has a metric model.
+CsvColumnTable TrackingColumns(const TrackingConfig& config,
                                const std::vector<CsvColumn>& extra = {});
 
 }  // namespace softsight

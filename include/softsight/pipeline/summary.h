@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "softsight/pipeline/status_summary.h"
+
 namespace softsight {
 
 enum class StopReason {
@@ -34,6 +36,7 @@ struct RunSummary {
   std::optional<int64_t> first_index;  // Source indices of the first and last processed frame.
   std::optional<int64_t> last_index;
   std::vector<MarkerRunSummary> markers;  // In config order.
+  MarkerStatusSummary statuses;        // Why and when each marker was not found.
   int64_t measured = 0;                // Frames with an angle.
   double proc_ms_median = 0.0;         // FrameResult::proc_ms over the processed frames.
   double proc_ms_p99 = 0.0;
@@ -48,7 +51,8 @@ struct RunSummary {
 
   // "300 frames (end of input), found: red 100.0 %, blue 99.7 %, green 100.0 %, 0.41 ms/frame"
   std::string BriefReport() const;
-  // Source, frames and drops, one line per marker, measured frames, timings, why it stopped.
+  // Source, frames and drops, one line per marker, why and when markers were not found
+  // (MarkerStatusSummary::lines), measured frames, timings, why it stopped.
   std::string FullReport() const;
 };
 
