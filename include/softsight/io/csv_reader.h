@@ -21,7 +21,7 @@ struct CsvTable {
 
 // Reads a comma-separated file with a header line. Throws InputError (one line naming the file,
 // line and column) when the file is missing or unreadable, a row has the wrong number of fields,
-// or a field is not a number (except in `<name>_status` columns, which hold words: read as absent).
+// or a field is not a number (except in `<name>_status` columns: words, read as absent).
 CsvTable ReadCsvTable(const std::string& file);
 
 }  // namespace softsight
