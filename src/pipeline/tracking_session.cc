@@ -2,18 +2,61 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <algorithm>
+
 #include "pipeline/coincident_markers.h"
+#include "pipeline/frame_change.h"
+#include "pipeline/marker_plausibility.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
+namespace {
+
+// About the marker's radius, from what the config says of its size: the unit of how far it may
+// move beyond its predicted position in one frame. A template or ROI rectangle is drawn around
+// the marker; the colour tracker's window is at least 4 marker radii (its documented minimum).
+double MarkerSizePx(const MarkerSpec& spec) {
+  double size = 0.0;
+  if (IsTemplateMethod(spec.method)) {
+    if (spec.templ.rect) size = 0.5 * std::max(spec.templ.rect->width, spec.templ.rect->height);
+    if (!spec.templ.image.empty()) size = 0.5 * std::max(spec.templ.image.cols, spec.templ.image.rows);
+  } else if (spec.colour.roi) {
+    size = 0.5 * std::max(spec.colour.roi->width, spec.colour.roi->height);
+  } else if (spec.colour.window_px > 0) {
+    size = 0.25 * spec.colour.window_px;
+  }
+  return std::clamp(size > 0.0 ? size : 16.0, 4.0, 64.0);
+}
+
+// The markers along one body, base to tip, by index: the chain, else the triple.
+std::vector<size_t> BodyOrder(const TrackingConfig& config) {
+  std::vector<std::string> names = config.measure.chain;
+  if (names.empty() && config.measure.has_triple()) {
+    names = {config.measure.base, config.measure.middle, config.measure.tip};
+  }
+  std::vector<size_t> body;
+  for (const std::string& name : names) {
+    for (size_t i = 0; i < config.markers.size(); ++i) {
+      if (config.markers[i].name == name) body.push_back(i);
+    }
+  }
+  return body.size() == names.size() ? body : std::vector<size_t>();
+}
+
+}  // namespace
+
 TrackingSession::TrackingSession(const TrackingConfig& config)
     : config_(config), measurer_(config.measure) {
+  std::vector<double> sizes;
   for (const MarkerSpec& spec : config_.markers) {
     trackers_.push_back(CreateTracker(spec));
     initialised_.push_back(false);
     previous_px_.emplace_back();
     result_.markers.push_back({spec.name, {}});
+    sizes.push_back(MarkerSizePx(spec));
   }
+  frame_change_ = std::make_unique<FrameChangeDetector>();
+  plausibility_ = std::make_unique<MarkerPlausibility>(sizes, BodyOrder(config_));
   if (config_.camera) {
     undistorter_.emplace(*config_.camera);
     undistorted_ = result_.markers;
@@ -42,16 +85,38 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     }
     // A template tracker without a template yet (none configured, or its reference frame is
     // still ahead) has nothing to look for: its marker is not found.
-    result_.markers[i].observation =
-        initialised_[i] ? trackers_[i]->update(frame.image)
-                       : Observation::NotFound(MarkerStatus::kNotStarted);
+    if (!initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
   }
-  // Two markers cannot be at one place: a report that jumped onto another marker (a look-alike
-  // re-acquired while its own marker is covered) is dropped, and its tracker searches afresh.
-  for (size_t i : FindCoincidentMarkers(result_.markers, previous_px_)) {
-    result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-    trackers_[i]->reset();
+  frame_change_->observe(frame.image);
+  if (frame_change_->whole_frame_changed()) {
+    // Nothing in this frame is believed, and the trackers do not see it: their windows, motion
+    // and learned models stay as they were in the last believable frame.
+    for (size_t i = 0; i < trackers_.size(); ++i) {
+      if (initialised_[i]) {
+        result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+      }
+    }
+  } else {
+    for (size_t i = 0; i < trackers_.size(); ++i) {
+      if (initialised_[i]) result_.markers[i].observation = trackers_[i]->update(frame.image);
+    }
+    // Two markers cannot be at one place: a report that jumped onto another marker (a
+    // look-alike re-acquired while its own marker is covered) is dropped, and its tracker
+    // searches afresh.
+    for (size_t i : FindCoincidentMarkers(result_.markers, previous_px_)) {
+      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+      trackers_[i]->reset();
+    }
+    // A position next to decoded garbage is whatever the garbage made of the marker.
+    for (size_t i = 0; i < result_.markers.size(); ++i) {
+      const Observation& o = result_.markers[i].observation;
+      if (o.found() && frame_change_->garbage_near(*o.position_px)) {
+        result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+        trackers_[i]->reset();
+      }
+    }
   }
+  for (size_t i : plausibility_->check(frame.index, result_.markers)) trackers_[i]->reset();
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
   }
@@ -70,9 +135,9 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
             undistorter_->undistort_point(*result_.markers[i].observation.position_px);
       }
     }
-    result_.measurement = measurer_.measure(undistorted_);
+    measurer_.measure(undistorted_, result_.measurement);
   } else {
-    result_.measurement = measurer_.measure(result_.markers);
+    measurer_.measure(result_.markers, result_.measurement);
   }
   result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
                     cv::getTickFrequency();
@@ -85,6 +150,7 @@ void TrackingSession::reselect(const std::string& marker, const cv::Mat& frame,
     if (config_.markers[i].name != marker) continue;
     trackers_[i]->init(frame, rect);
     initialised_[i] = true;
+    plausibility_->forget(i);  // A person said where it is: no history to contradict that.
     // Saved configs must reproduce what the mouse did.
     if (IsTemplateMethod(config_.markers[i].method)) {
       config_.markers[i].templ.rect = rect;
@@ -103,6 +169,7 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     trackers_[i] = CreateTracker(spec);
     config_.markers[i] = spec;
     initialised_[i] = false;
+    plausibility_->forget(i);
     return;
   }
   throw InputError("no marker named '" + spec.name + "'");

@@ -15,6 +15,9 @@
 
 namespace softsight {
 
+class FrameChangeDetector;
+class MarkerPlausibility;
+
 // FrameResult (one frame's observations + measurement) is a core value type: core/types.h.
 
 class TrackingSession {
@@ -24,7 +27,12 @@ class TrackingSession {
   ~TrackingSession();
 
   // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
-  // frame) trackers are initialised from the config's ROIs and template rectangles. With a camera
+  // frame) trackers are initialised from the config's ROIs and template rectangles. Only
+  // plausible reports are found (pipeline/marker_plausibility.h, pipeline/frame_change.h): in a
+  // frame that changed all at once (another video's frame, a flash) no marker is found and the
+  // trackers do not see it; a report next to decoded garbage, that jumps against the marker's
+  // motion, or that breaks the markers' arrangement along the body is kImplausible and its
+  // tracker searches afresh. With a camera
   // model, observations stay in recorded-image pixels (where the overlay draws them) and the
   // measurement uses their undistorted positions. Throws InputError when the frame size differs
   // from the calibrated one.
@@ -52,6 +60,8 @@ class TrackingSession {
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;
   std::vector<std::optional<cv::Point2d>> previous_px_;  // Last frame's positions.
+  std::unique_ptr<FrameChangeDetector> frame_change_;
+  std::unique_ptr<MarkerPlausibility> plausibility_;
   Measurer measurer_;
   std::optional<Undistorter> undistorter_;     // Present when the config names a camera file.
   std::vector<MarkerObservation> undistorted_; // Reused: what the measurer sees with a lens model.

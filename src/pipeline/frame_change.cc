@@ -1,0 +1,151 @@
+#include "pipeline/frame_change.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace softsight {
+namespace {
+
+// Samples per cell side: cells of 8 x 8 samples (32 px at VGA) hold a marker or two.
+constexpr int kSamplesPerCell = 8;
+// About this many samples across the image's shorter side, whatever its resolution.
+constexpr int kSamplesAcross = 120;
+// A garbage cell stays "garbage" for at most this many frames before it is taken as the scene
+// (a finely textured object may really have come into view).
+constexpr int kGarbageMemory = 10;
+// After this many changed frames in a row the footage itself changes that much (a moving
+// camera): the change becomes normal even when the frames do not look alike.
+constexpr int kLongestChangeRun = 10;
+
+}  // namespace
+
+void FrameChangeDetector::summarise(const cv::Mat& bgr, std::vector<Cell>& cells) {
+  cells.assign(static_cast<size_t>(cols_) * rows_, Cell());
+  std::vector<int>& counts = counts_;
+  counts.assign(cells.size(), 0);
+  const int half = step_ / 2;
+  for (int y = half; y < bgr.rows; y += step_) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    const cv::Vec3b* above = y - step_ >= 0 ? bgr.ptr<cv::Vec3b>(y - step_) : nullptr;
+    const int cy = std::min(y / cell_px_, rows_ - 1);
+    for (int x = half; x < bgr.cols; x += step_) {
+      const int cx = std::min(x / cell_px_, cols_ - 1);
+      Cell& cell = cells[static_cast<size_t>(cy) * cols_ + cx];
+      const cv::Vec3b p = row[x];
+      cell.b += p[0];
+      cell.g += p[1];
+      cell.r += p[2];
+      float texture = 0.0f;
+      int pairs = 0;
+      if (x - step_ >= 0) {
+        const cv::Vec3b q = row[x - step_];
+        texture += static_cast<float>(std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) +
+                                      std::abs(p[2] - q[2]));
+        ++pairs;
+      }
+      if (above != nullptr) {
+        const cv::Vec3b q = above[x];
+        texture += static_cast<float>(std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) +
+                                      std::abs(p[2] - q[2]));
+        ++pairs;
+      }
+      if (pairs > 0) cell.texture += texture / (3.0f * static_cast<float>(pairs));
+      ++counts[static_cast<size_t>(cy) * cols_ + cx];
+    }
+  }
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (counts[i] == 0) continue;
+    const float n = static_cast<float>(counts[i]);
+    cells[i].b /= n;
+    cells[i].g /= n;
+    cells[i].r /= n;
+    cells[i].texture /= n;
+  }
+}
+
+bool FrameChangeDetector::Changed(const Cell& now, const Cell& before) {
+  // 30 grey levels of mean colour over a whole cell: a marker moving a few pixels inside it
+  // changes the mean by less; the picture being replaced, by more.
+  const float colour = std::max({std::abs(now.b - before.b), std::abs(now.g - before.g),
+                                 std::abs(now.r - before.r)});
+  return colour > 30.0f || now.texture > 2.0f * before.texture + 10.0f ||
+         now.texture < 0.5f * before.texture - 10.0f;
+}
+
+bool FrameChangeDetector::Garbage(const Cell& now, const Cell& before) {
+  // Uniform random bytes differ by ~85 levels between neighbours; camera noise of sigma 10 by
+  // ~11, a marker's rim adds ~20 to its cell.
+  return now.texture > 45.0f && now.texture > 3.0f * before.texture + 30.0f;
+}
+
+double FrameChangeDetector::changed_between(const std::vector<Cell>& a,
+                                            const std::vector<Cell>& b) const {
+  int changed = 0;
+  for (size_t i = 0; i < a.size(); ++i) changed += Changed(a[i], b[i]) ? 1 : 0;
+  return a.empty() ? 0.0 : static_cast<double>(changed) / static_cast<double>(a.size());
+}
+
+void FrameChangeDetector::observe(const cv::Mat& bgr) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  if (bgr.size() != size_ || !has_normal_) {
+    size_ = bgr.size();
+    step_ = std::max(1, std::min(bgr.cols, bgr.rows) / kSamplesAcross);
+    cell_px_ = step_ * kSamplesPerCell;
+    cols_ = std::max(1, bgr.cols / cell_px_);
+    rows_ = std::max(1, bgr.rows / cell_px_);
+    summarise(bgr, now_);
+    normal_ = now_;
+    previous_ = now_;
+    garbage_.assign(now_.size(), 0);
+    has_normal_ = true;
+    whole_frame_changed_ = false;
+    changed_fraction_ = 0.0;
+    changed_run_ = 0;
+    return;
+  }
+  summarise(bgr, now_);
+  changed_fraction_ = changed_between(now_, normal_);
+  // Footage that changes a lot from frame to frame (a moving camera) raises the bar.
+  const double threshold = std::clamp(3.0 * usual_fraction_ + 0.15, 0.4, 0.95);
+  bool normal = true;
+  if (changed_fraction_ > threshold) {
+    // Frames that look alike (a change that stays) count towards accepting it.
+    const bool alike = changed_run_ > 0 && changed_between(now_, previous_) < 0.5 * threshold;
+    ++changed_run_;
+    alike_run_ = alike ? alike_run_ + 1 : 1;
+    normal = alike_run_ >= kFramesToAcceptAChange || changed_run_ >= kLongestChangeRun;
+    if (normal) {
+      usual_fraction_ = std::max(usual_fraction_, changed_fraction_ / 3.0);
+      changed_run_ = 0;
+      alike_run_ = 0;
+    }
+    whole_frame_changed_ = !normal;
+  } else {
+    whole_frame_changed_ = false;
+    changed_run_ = 0;
+    alike_run_ = 0;
+    usual_fraction_ = 0.95 * usual_fraction_ + 0.05 * changed_fraction_;
+  }
+  for (size_t i = 0; i < now_.size(); ++i) {
+    const bool garbage = Garbage(now_[i], normal_[i]) && garbage_[i] < kGarbageMemory;
+    garbage_[i] = garbage ? static_cast<unsigned char>(garbage_[i] + 1) : 0;
+    // The normal picture keeps what the garbage hides, so garbage that stays is still garbage.
+    if (normal && !garbage) normal_[i] = now_[i];
+  }
+  std::swap(previous_, now_);
+}
+
+bool FrameChangeDetector::garbage_near(const cv::Point2d& image_px) const {
+  if (!has_normal_ || !std::isfinite(image_px.x) || !std::isfinite(image_px.y)) return false;
+  const int cx = std::clamp(static_cast<int>(image_px.x / cell_px_), 0, cols_ - 1);
+  const int cy = std::clamp(static_cast<int>(image_px.y / cell_px_), 0, rows_ - 1);
+  for (int y = std::max(0, cy - 1); y <= std::min(rows_ - 1, cy + 1); ++y) {
+    for (int x = std::max(0, cx - 1); x <= std::min(cols_ - 1, cx + 1); ++x) {
+      if (garbage_[static_cast<size_t>(y) * cols_ + x] != 0) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace softsight

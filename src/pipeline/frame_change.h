@@ -1,0 +1,64 @@
+// Frames that no motion explains: a frame from another video, a block of decoded garbage, a
+// flash. Trackers answer such frames with confident positions (a blob of the right colour is
+// somewhere in any picture), so the session must know before it believes them.
+//
+// The frame is summarised on a coarse grid of cells (a sample every few pixels, so it costs a
+// small fraction of one BGR->gray pass): per cell the mean colour and the texture (mean absolute
+// difference of neighbouring samples). Each frame is compared with the last frame judged normal:
+//  - most cells changed at once (far more than the footage's usual frame-to-frame change): the
+//    whole frame changed. A change that persists (the light was switched on, the camera was
+//    bumped) becomes the new normal after a few frames.
+//  - a cell whose texture exploded (random bytes are ~85 grey levels between neighbours, camera
+//    images a few): decoded garbage there; markers in or next to it are not trusted.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace softsight {
+
+class FrameChangeDetector {
+ public:
+  // Frames in a row that must look alike (each compared with the one before) before a sudden
+  // change is accepted as the new normal.
+  static constexpr int kFramesToAcceptAChange = 3;
+
+  // Compares `bgr` (CV_8UC3) with the last normal frame; call once per frame, before the
+  // queries below. A frame of another size starts afresh (it is taken as normal).
+  void observe(const cv::Mat& bgr);
+
+  // The frame changed all at once: nothing found in it can be trusted.
+  bool whole_frame_changed() const { return whole_frame_changed_; }
+  // The neighbourhood of `image_px` holds garbage (texture far beyond what it had).
+  bool garbage_near(const cv::Point2d& image_px) const;
+
+  // Fraction of cells that changed against the last normal frame (for tests and tuning).
+  double changed_fraction() const { return changed_fraction_; }
+
+ private:
+  struct Cell {
+    float b = 0, g = 0, r = 0;  // Mean colour.
+    float texture = 0;          // Mean |difference| of horizontally and vertically adjacent samples.
+  };
+  void summarise(const cv::Mat& bgr, std::vector<Cell>& cells);
+  static bool Changed(const Cell& now, const Cell& before);
+  static bool Garbage(const Cell& now, const Cell& before);
+  double changed_between(const std::vector<Cell>& a, const std::vector<Cell>& b) const;
+
+  cv::Size size_;             // Of the frames summarised so far.
+  int step_ = 1;              // Sample spacing in pixels.
+  int cell_px_ = 1;           // Cell side in pixels (kSamplesPerCell * step_).
+  int cols_ = 0, rows_ = 0;   // Cells per row and column.
+  std::vector<Cell> now_, normal_, previous_;  // Reused: no allocation per frame.
+  std::vector<int> counts_;                    // Samples per cell (summarise's scratch).
+  std::vector<unsigned char> garbage_;         // Per cell: frames in a row it held garbage.
+  bool has_normal_ = false;
+  bool whole_frame_changed_ = false;
+  double changed_fraction_ = 0.0;
+  double usual_fraction_ = 0.0;  // Running mean of changed_fraction_ over normal frames.
+  int changed_run_ = 0;          // Consecutive frames that changed against the normal one.
+  int alike_run_ = 0;            // ... of which the last ones looked like each other.
+};
+
+}  // namespace softsight
