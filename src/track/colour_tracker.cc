@@ -58,10 +58,10 @@ constexpr double kBrightnessTolerance = 1.6;
 // The learned shape: a candidate less circular than the model by this much is at its limit
 // (and never below min_circularity).
 constexpr double kShapeTolerance = 0.3;
-// Adaptation while tracking only from frames where the marker fits well: area within this ratio
-// of the reference and shape within kAdaptShape of it; the reference area stays within
-// kAdaptRange^-1 .. 4 times the first one.
-constexpr double kAdaptArea = 1.25;
+// Adaptation while tracking only from frames where the marker's shape is within kAdaptShape of
+// the learned one (a partial cover changes it; growth and tilt change it slowly); the reference
+// area stays within kAdaptMinRange..kAdaptMaxRange times the first one. A jump in area is not
+// learned because it is not accepted (min_area_fraction, max_area_factor).
 constexpr double kAdaptShape = 0.1;
 constexpr double kAdaptMinRange = 0.5;
 constexpr double kAdaptMaxRange = 4.0;
@@ -393,8 +393,6 @@ void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
   // Follow slow changes only: a marker growing in perspective, the light drifting. A sudden one
   // (a partial cover, a reflection) is not learned.
   ColourModel& m = *model_;
-  const double ratio = blob.area_px / m.area_px;
-  if (ratio > kAdaptArea || ratio < 1.0 / kAdaptArea) return;
   if (blob.circularity < m.circularity - kAdaptShape) return;
   const double r = params_.adapt_rate;
   m.area_px = std::clamp(m.area_px + r * (blob.area_px - m.area_px),
