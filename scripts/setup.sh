@@ -13,6 +13,7 @@ PACKAGES=(
   libbenchmark-dev       # benchmarks
   xvfb xauth xdotool     # the live window's tests run under a virtual X server
   libx11-dev             # the live window checks the X display before opening a window
+  opencv-doc             # real sample images with known answers for the golden tests (chessboards, ...)
 )
 
 missing=()
