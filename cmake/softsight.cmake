@@ -45,3 +45,23 @@ function(softsight_add_benchmark name)
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} benchmark::benchmark benchmark::benchmark_main)
 endfunction()
+
+# softsight_check_public_headers()
+# A public header is a promise: a library user has include/ (and OpenCV) on the path, never src/.
+# Compiles every header in include/softsight/ on its own, in one translation unit per header, with
+# exactly that include path, so a public header that includes a private one (or forgets one of
+# its own includes) fails the build.
+function(softsight_check_public_headers)
+  file(GLOB_RECURSE headers CONFIGURE_DEPENDS RELATIVE ${PROJECT_SOURCE_DIR}/include
+       ${PROJECT_SOURCE_DIR}/include/softsight/*.h)
+  set(sources "")
+  foreach(header ${headers})
+    string(REPLACE "/" "__" name ${header})
+    set(source ${PROJECT_BINARY_DIR}/public_headers/${name}.cc)
+    file(CONFIGURE OUTPUT ${source} CONTENT "#include \"${header}\"\n")
+    list(APPEND sources ${source})
+  endforeach()
+  add_library(softsight_public_headers OBJECT ${sources})
+  target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include)
+  target_include_directories(softsight_public_headers SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
+endfunction()

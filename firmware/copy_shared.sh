@@ -6,10 +6,11 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
 dst="$here/softsight_board/src"
 mkdir -p "$dst"
-for f in include/softsight/control/protocol.h include/softsight/control/board.h \
+for f in include/softsight/control/board_config.h src/control/protocol.h src/control/board.h \
          src/control/protocol.cc src/control/board.cc; do
   name=$(basename "$f")
   case "$name" in *.cc) name="${name%.cc}.cpp" ;; esac
-  sed 's|#include "softsight/control/|#include "|' "$root/$f" > "$dst/$name"
+  sed -e 's|#include "softsight/control/|#include "|' -e 's|#include "control/|#include "|' \
+    "$root/$f" > "$dst/$name"
 done
 echo "shared code copied to $dst"

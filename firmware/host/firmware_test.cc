@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "shim_control.h"
-#include "softsight/control/protocol.h"
+#include "control/protocol.h"
 
 void setup();
 void loop();

@@ -1,6 +1,6 @@
 // softsight pressure-control board: the inner loop of the cascade (docs/control.md).
 //
-// Everything that decides anything lives in the shared code (softsight/control/board.h and
+// Everything that decides anything lives in the shared code (src/control/board.h and
 // protocol.h, unit-tested on the host): the serial protocol, the pressure loop, the pressure limit
 // guard and the watchdog. This sketch only binds it to pins and timers. It speaks protocol
 // version 2 (every line checked by a CRC-16, docs/protocol.md): after changing the shared code,

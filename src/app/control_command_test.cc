@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
-#include "softsight/control/protocol.h"
+#include "control/protocol.h"
 #include "softsight/core/error.h"
 #include "softsight/io/control_config.h"
 

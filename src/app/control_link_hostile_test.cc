@@ -28,8 +28,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/test_util.h"
-#include "softsight/control/board.h"
-#include "softsight/control/protocol.h"
+#include "control/board.h"
+#include "control/protocol.h"
 #include "softsight/control/transport.h"
 #include "softsight/sim/scene.h"
 

@@ -17,13 +17,13 @@
 namespace softsight {
 namespace {
 
-const char* ModeName(Board::Mode mode) {
+const char* ModeName(BoardMode mode) {
   switch (mode) {
-    case Board::Mode::kIdle: return "idle (vented)";
-    case Board::Mode::kPressure: return "pressure";
-    case Board::Mode::kDuty: return "duty";
-    case Board::Mode::kStopped: return "stopped (vented)";
-    case Board::Mode::kWatchdog: return "watchdog (vented)";
+    case BoardMode::kIdle: return "idle (vented)";
+    case BoardMode::kPressure: return "pressure";
+    case BoardMode::kDuty: return "duty";
+    case BoardMode::kStopped: return "stopped (vented)";
+    case BoardMode::kWatchdog: return "watchdog (vented)";
   }
   return "?";
 }
@@ -77,7 +77,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   auto next_frame = start;
   const auto frame_period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(1.0 / options.fps));
-  Board::Mode last_mode = Board::Mode::kIdle;
+  BoardMode last_mode = BoardMode::kIdle;
   bool last_limit = false;
   int frame_index = 1;
   RigCommandSummary summary;
@@ -88,7 +88,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
       const double wall_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const RigSnapshot s = rig.snapshot();
-      const bool limit = (s.flags & wire::kFlagLimit) != 0;
+      const bool limit = s.limit();
       if (!options.quiet && (s.mode != last_mode || limit != last_limit)) {
         std::fprintf(stderr, "rig: t=%.3f s: board %s%s, pressure %.2f kPa, angle %.1f deg\n",
                      s.time_s, ModeName(s.mode), limit ? ", limit guard venting" : "",

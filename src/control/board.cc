@@ -1,5 +1,5 @@
 // Shared with the firmware: plain C++11, no heap, C headers only (see board.h).
-#include "softsight/control/board.h"
+#include "control/board.h"
 
 namespace softsight {
 namespace {

@@ -5,10 +5,16 @@
 #include <cmath>
 #include <cstdio>
 
-#include "softsight/core/error.h"
 #include "control/control_options.h"
+#include "control/protocol.h"
+#include "softsight/core/error.h"
 
 namespace softsight {
+
+bool BoardState::vented() const { return (flags & wire::kFlagVented) != 0; }
+bool BoardState::watchdog() const { return (flags & wire::kFlagWatchdog) != 0; }
+bool BoardState::limit() const { return (flags & wire::kFlagLimit) != 0; }
+
 namespace {
 
 std::string Encode(const wire::Message& m) {

@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "softsight/control/board.h"
+#include "control/board.h"
 #include "softsight/control/session.h"
 #include "softsight/core/error.h"
 

@@ -1,11 +1,11 @@
-#include "softsight/control/board.h"
+#include "control/board.h"
 
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "softsight/control/plant.h"
-#include "softsight/control/protocol.h"
+#include "control/plant.h"
+#include "control/protocol.h"
 
 namespace softsight {
 namespace {

@@ -1,4 +1,4 @@
-#include "softsight/control/plant.h"
+#include "control/plant.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,5 +1,5 @@
 // Shared with the firmware: plain C++11, no heap, C headers only (see protocol.h).
-#include "softsight/control/protocol.h"
+#include "control/protocol.h"
 
 #include <string.h>
 

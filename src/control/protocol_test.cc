@@ -1,4 +1,4 @@
-#include "softsight/control/protocol.h"
+#include "control/protocol.h"
 
 #include <cctype>
 #include <cstring>

@@ -8,8 +8,13 @@
 #include <chrono>
 #include <cmath>
 
-#include "softsight/core/error.h"
+#include <random>
+
+#include "control/board.h"
 #include "control/control_options.h"
+#include "control/plant.h"
+#include "control/protocol.h"
+#include "softsight/core/error.h"
 
 namespace softsight {
 
@@ -39,50 +44,70 @@ const RigOptions& Checked(const RigOptions& options) {
 
 }  // namespace
 
-SimulatedRig::SimulatedRig(const RigOptions& options)
-    : options_(Checked(options)), board_(options.board), plant_(options.plant), rng_(options.seed) {}
+bool RigSnapshot::limit() const { return (flags & wire::kFlagLimit) != 0; }
 
-uint32_t SimulatedRig::now_ms_locked() const {
-  return static_cast<uint32_t>(tick_ * 1000 / options_.board.loop_hz);
-}
+struct SimulatedRig::Parts {
+  explicit Parts(const RigOptions& options)
+      : board(options.board), plant(options.plant), rng(options.seed) {}
+
+  uint32_t now_ms(const RigOptions& options) const {
+    return static_cast<uint32_t>(tick * 1000 / options.board.loop_hz);
+  }
+
+  Board board;
+  PneumaticPlant plant;
+  ValveOutputs drive;
+  int64_t tick = 0;
+  double peak_pressure_pa = 0.0;
+  std::mt19937_64 rng;
+  std::normal_distribution<double> noise{0.0, 1.0};
+};
+
+SimulatedRig::SimulatedRig(const RigOptions& options)
+    : options_(Checked(options)), parts_(std::make_unique<Parts>(options_)) {}
+
+SimulatedRig::~SimulatedRig() = default;
 
 void SimulatedRig::advance(double dt_s) {
   std::lock_guard<std::mutex> lock(mutex_);
+  Parts& p = *parts_;
   const double period_s = 1.0 / options_.board.loop_hz;
   const int64_t ticks = std::llround(dt_s / period_s);
   for (int64_t i = 0; i < ticks; ++i) {
     // The board samples the sensor and sets the valves once per period; the plant runs under
     // that drive until the next period.
     const double sensed_pa =
-        plant_.pressure_pa() + options_.sensor_noise_kpa * 1e3 * noise_(rng_);
-    drive_ = board_.update(now_ms_locked(), static_cast<int32_t>(std::lround(sensed_pa)));
-    plant_.step(period_s, drive_);
-    peak_pressure_pa_ = std::max(peak_pressure_pa_, plant_.pressure_pa());
-    ++tick_;
+        p.plant.pressure_pa() + options_.sensor_noise_kpa * 1e3 * p.noise(p.rng);
+    p.drive = p.board.update(p.now_ms(options_), static_cast<int32_t>(std::lround(sensed_pa)));
+    p.plant.step(period_s, p.drive);
+    p.peak_pressure_pa = std::max(p.peak_pressure_pa, p.plant.pressure_pa());
+    ++p.tick;
   }
 }
 
 void SimulatedRig::receive(std::string_view bytes, std::string* replies) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const uint32_t now = now_ms_locked();
+  Parts& p = *parts_;
+  const uint32_t now = p.now_ms(options_);
   for (char c : bytes) {
-    const size_t n = board_.receive(c, now);
-    if (n > 0) replies->append(board_.reply(), n);
+    const size_t n = p.board.receive(c, now);
+    if (n > 0) replies->append(p.board.reply(), n);
   }
 }
 
 RigSnapshot SimulatedRig::snapshot() const {
   std::lock_guard<std::mutex> lock(mutex_);
+  const Parts& p = *parts_;
   RigSnapshot s;
-  s.time_s = static_cast<double>(tick_) / options_.board.loop_hz;
-  s.pressure_kpa = plant_.pressure_pa() * 1e-3;
-  s.peak_pressure_kpa = peak_pressure_pa_ * 1e-3;
-  s.bend_deg = plant_.bend_deg();
+  s.time_s = static_cast<double>(p.tick) / options_.board.loop_hz;
+  s.pressure_kpa = p.plant.pressure_pa() * 1e-3;
+  s.peak_pressure_kpa = p.peak_pressure_pa * 1e-3;
+  s.bend_deg = p.plant.bend_deg();
   s.angle_deg = PaperAngleFromBend(s.bend_deg, options_.end_marker_span);
-  s.drive = drive_;
-  s.mode = board_.mode();
-  s.flags = board_.flags();
-  s.board_rejected = board_.rejected();
+  s.drive = p.drive;
+  s.mode = p.board.mode();
+  s.flags = p.board.flags();
+  s.board_rejected = p.board.rejected();
   return s;
 }
 

@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "control/protocol.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/session.h"
 #include "softsight/core/error.h"
@@ -201,11 +202,11 @@ TEST(ClosedLoop, PortDisappearsMidRunOneClearErrorAndTheWatchdogVents) {
   EXPECT_NE(error.find("disconnected"), std::string::npos) << error;
   const RigSnapshot before = h.rig().snapshot();
   EXPECT_GT(before.pressure_kpa, 15.0);
-  EXPECT_EQ(before.mode, Board::Mode::kPressure);
+  EXPECT_EQ(before.mode, BoardMode::kPressure);
   h.rig().advance(0.2);
-  EXPECT_EQ(h.rig().snapshot().mode, Board::Mode::kPressure);  // Not yet: 250 ms.
+  EXPECT_EQ(h.rig().snapshot().mode, BoardMode::kPressure);  // Not yet: 250 ms.
   h.rig().advance(0.1);
-  EXPECT_EQ(h.rig().snapshot().mode, Board::Mode::kWatchdog);
+  EXPECT_EQ(h.rig().snapshot().mode, BoardMode::kWatchdog);
   h.rig().advance(1.0);
   EXPECT_LT(h.rig().snapshot().pressure_kpa, 1.0);
 }
@@ -261,7 +262,7 @@ TEST(ClosedLoop, CorruptedCommandsAreRejectedByTheBoardAndNeverActedOn) {
   transport->write_line("\nrandom noise\n");
   EXPECT_FALSE(transport->read_line(50).has_value());  // Never answered.
   h.rig().advance(0.5);
-  EXPECT_EQ(h.rig().snapshot().mode, Board::Mode::kIdle);  // Never acted on.
+  EXPECT_EQ(h.rig().snapshot().mode, BoardMode::kIdle);  // Never acted on.
   EXPECT_LT(h.rig().snapshot().pressure_kpa, 0.5);
   EXPECT_EQ(h.rig().snapshot().board_rejected, 3u);
   const BoardState state = h.link().read_state();
@@ -270,7 +271,7 @@ TEST(ClosedLoop, CorruptedCommandsAreRejectedByTheBoardAndNeverActedOn) {
   // The genuine line is acted on.
   transport->write_line(line);
   ASSERT_TRUE(transport->read_line(200).has_value());
-  EXPECT_EQ(h.rig().snapshot().mode, Board::Mode::kPressure);
+  EXPECT_EQ(h.rig().snapshot().mode, BoardMode::kPressure);
 }
 
 TEST(ClosedLoop, PressureNeverExceedsTheLimitWhateverTheGains) {

@@ -11,10 +11,15 @@
 #include <stdexcept>
 #include <string>
 
-#include "softsight/control/protocol.h"
 #include "softsight/control/transport.h"
 
 namespace softsight {
+
+// The wire format itself is private to control (src/control/protocol.h, shared with the firmware).
+namespace wire {
+struct Message;
+enum class MessageType : uint8_t;
+}  // namespace wire
 
 struct LinkOptions {
   int baud = 115200;          // Serial baud rate. Default 115200 (a 60-byte line takes ~5 ms).
@@ -59,12 +64,12 @@ struct BoardState {
   double pressure_kpa = 0.0;    // Sensed chamber pressure (gauge).
   double setpoint_kpa = 0.0;    // Active pressure setpoint (0 unless in pressure mode).
   double duty = 0.0;            // Applied duty in [-1, 1]: > 0 inflating, < 0 venting.
-  uint16_t flags = 0;           // wire::StateFlag bits.
+  uint16_t flags = 0;           // The board's <flags> bits (docs/protocol.md).
   uint32_t board_rejected = 0;  // Lines the board has rejected since power-up/handshake.
 
-  bool vented() const { return (flags & wire::kFlagVented) != 0; }
-  bool watchdog() const { return (flags & wire::kFlagWatchdog) != 0; }
-  bool limit() const { return (flags & wire::kFlagLimit) != 0; }
+  bool vented() const;    // Outputs in the safe state (pump off, inflate closed, vent open).
+  bool watchdog() const;  // Vented because no valid command arrived in time.
+  bool limit() const;     // The pressure limit guard is overriding the outputs.
 };
 
 struct LinkStats {

@@ -1,5 +1,6 @@
-// The simulated rig: the board (board.h, the firmware's own logic) driving a pneumatic actuator
-// (plant.h), served on a pseudo-terminal so the host drives it exactly as a board on /dev/ttyACM0.
+// The simulated rig: the board (src/control/board.h, the firmware's own logic) driving a pneumatic
+// actuator (src/control/plant.h), served on a pseudo-terminal so the host drives it exactly as a
+// board on /dev/ttyACM0.
 //
 // Time is simulated: advance() runs the board's inner loop at its loop_hz and the plant between
 // periods. In lock-step use (tests, `softsight control --simulate`) the host advances the rig one
@@ -10,23 +11,38 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
-#include <random>
 #include <string>
 #include <string_view>
 #include <thread>
 
-#include "softsight/control/board.h"
-#include "softsight/control/plant.h"
+#include "softsight/control/board_config.h"
 #include "softsight/control/transport.h"
 
 namespace softsight {
+
+// The pneumatic actuator the rig simulates (src/control/plant.h gives the model).
+struct PlantOptions {
+  double chamber_volume_ml = 20.0;       // Chamber + tubing. Larger: slower pressure. Default 20 mL.
+  double pump_flow_l_per_min = 1.0;      // Free flow of the pump (standard L/min). Default 1.0.
+  double pump_stall_kpa = 120.0;         // Pressure at which the pump's flow drops to 0.
+  double vent_flow_l_per_min = 2.0;      // Vent valve flow at 10 kPa, fully open. Default 2.0.
+  double leak_l_per_min = 0.001;         // Leak at 10 kPa (linear). Default 0.001.
+  double bend_start_kpa = 3.0;           // Below this the actuator does not bend. Default 3 kPa.
+  double bend_deg_per_kpa = 6.0;         // Slope of the equilibrium bend. Default 6 deg/kPa.
+  double max_bend_deg = 300.0;           // Mechanical end stop of the bend. Default 300 deg.
+  double bend_lag_s = 0.15;              // Time constant of the bending response. Default 0.15 s.
+  double hysteresis_deg = 3.0;           // Width of the play operator. Default 3 deg.
+
+  bool Check(std::string* error) const;
+};
 
 struct RigOptions {
   BoardConfig board;
   PlantOptions plant;
   // Body fraction between the base and tip markers (the renderer's defaults sit at 0.1 and 0.9),
-  // which relates the bend to the paper's angle (PaperAngleFromBend).
+  // which relates the bend to the paper's angle (RigSnapshot::angle_deg).
   double end_marker_span = 0.8;
   double sensor_noise_kpa = 0.05;  // Pressure sensor noise, standard deviation. Default 0.05 kPa.
   uint64_t seed = 1;               // Sensor noise.
@@ -41,9 +57,12 @@ struct RigSnapshot {
   double bend_deg = 0.0;           // Total turning of the centre line (the renderer's bend_deg).
   double angle_deg = 180.0;        // The paper's angle at the middle marker.
   ValveOutputs drive;
-  Board::Mode mode = Board::Mode::kIdle;
-  uint16_t flags = 0;
+  BoardMode mode = BoardMode::kIdle;
+  uint16_t flags = 0;  // The board's <flags> (docs/protocol.md).
   uint32_t board_rejected = 0;
+
+  // The pressure limit guard is overriding the outputs (the limit flag).
+  bool limit() const;
 };
 
 // Thread-safe: the serial thread feeds bytes while the owner advances time.
@@ -51,6 +70,7 @@ class SimulatedRig {
  public:
   // Throws InputError naming the bad option.
   explicit SimulatedRig(const RigOptions& options);
+  ~SimulatedRig();
 
   // Advances simulated time by dt_s (rounded to whole inner-loop periods).
   void advance(double dt_s);
@@ -60,17 +80,11 @@ class SimulatedRig {
   const RigOptions& options() const { return options_; }
 
  private:
-  uint32_t now_ms_locked() const;
+  struct Parts;  // The board and the plant (private to control), the noise, the clock.
 
   RigOptions options_;
   mutable std::mutex mutex_;
-  Board board_;
-  PneumaticPlant plant_;
-  ValveOutputs drive_;
-  int64_t tick_ = 0;
-  double peak_pressure_pa_ = 0.0;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  std::unique_ptr<Parts> parts_;
 };
 
 // Serves a SimulatedRig on a new pseudo-terminal. Writes to the pty never block: answers wait in

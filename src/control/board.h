@@ -1,6 +1,8 @@
 // The board side of the cascade: the protocol endpoint, the inner pressure loop, the pressure
 // limit guard and the watchdog. The firmware sketch (firmware/softsight_board) and the simulated
-// rig (rig.h) run this same code; the sketch only binds it to pins and timers.
+// rig (softsight/control/rig.h) run this same code; the sketch only binds it to pins and timers.
+// Private to control: library users see the board through its settings and outputs
+// (softsight/control/board_config.h) and through the wire (BoardLink).
 //
 // Shared with the firmware: plain C++11, no heap, C headers only.
 #pragma once
@@ -8,42 +10,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "softsight/control/protocol.h"
+#include "control/protocol.h"
+#include "softsight/control/board_config.h"
 
 namespace softsight {
-
-// Valve and pump drive, each a PWM duty in [0, 1]. The default is the safe state: pump off, inflate
-// valve closed, vent (deflate) valve open.
-struct ValveOutputs {
-  float inflate = 0.0f;
-  float deflate = 1.0f;
-  float pump = 0.0f;
-};
-
-struct BoardConfig {
-  // Hard pressure limit, gauge Pa. The guard (below) keeps the chamber under it whatever the
-  // commands and gains. Default 50 kPa: typical for small silicone actuators.
-  int32_t pressure_limit_pa = 50000;
-  // The guard trips at limit - guard_margin_pa: one loop period of full inflation (plus sensor
-  // noise) must fit in the margin. Default 2 kPa (a 1 L/min pump into 20 mL rises ~0.2 kPa per
-  // 2 ms period).
-  int32_t guard_margin_pa = 2000;
-  // Hysteresis of the guard: it releases below trip - guard_release_pa. Default 3 kPa.
-  int32_t guard_release_pa = 3000;
-  // Inner loop rate (Hz). Default 500; >= 200 so the pressure loop is much faster than a camera.
-  uint16_t loop_hz = 500;
-  // No valid command for this long -> vent to the safe state. Default 250 ms.
-  uint16_t watchdog_ms = 250;
-  // Pressure loop gains: duty per kPa of error, and duty per kPa*s. Defaults suit ~20 mL chambers;
-  // higher kp is faster but chatters ON/OFF valves.
-  float kp_per_kpa = 0.25f;
-  float ki_per_kpa_s = 0.5f;
-  // |error| below this holds both valves closed (no chatter around the setpoint). Default 150 Pa.
-  int32_t deadband_pa = 150;
-};
-
-// Returns 0 when `config` is usable, else a static string naming the bad field.
-const char* CheckBoardConfig(const BoardConfig& config);
 
 // PI pressure loop with anti-windup: pressure error -> signed duty (> 0 inflate, < 0 vent).
 class PressureLoop {
@@ -65,7 +35,7 @@ class PressureLoop {
 
 class Board {
  public:
-  enum class Mode : uint8_t { kIdle, kPressure, kDuty, kStopped, kWatchdog };
+  using Mode = BoardMode;
 
   explicit Board(const BoardConfig& config);
 

@@ -7,28 +7,14 @@
 // Bending: the equilibrium bend grows linearly with pressure above `bend_start_kpa`; a play
 // (backlash) operator of width `hysteresis_deg` models the silicone's hysteresis, and a first-order
 // lag `bend_lag_s` its viscoelastic response.
+//
+// Private to control: the rig (softsight/control/rig.h) runs it; its options are RigOptions::plant.
 #pragma once
 
-#include <string>
-
-#include "softsight/control/board.h"
+#include "softsight/control/board_config.h"
+#include "softsight/control/rig.h"  // PlantOptions
 
 namespace softsight {
-
-struct PlantOptions {
-  double chamber_volume_ml = 20.0;       // Chamber + tubing. Larger: slower pressure. Default 20 mL.
-  double pump_flow_l_per_min = 1.0;      // Free flow of the pump (standard L/min). Default 1.0.
-  double pump_stall_kpa = 120.0;         // Pressure at which the pump's flow drops to 0.
-  double vent_flow_l_per_min = 2.0;      // Vent valve flow at 10 kPa, fully open. Default 2.0.
-  double leak_l_per_min = 0.001;         // Leak at 10 kPa (linear). Default 0.001.
-  double bend_start_kpa = 3.0;           // Below this the actuator does not bend. Default 3 kPa.
-  double bend_deg_per_kpa = 6.0;         // Slope of the equilibrium bend. Default 6 deg/kPa.
-  double max_bend_deg = 300.0;           // Mechanical end stop of the bend. Default 300 deg.
-  double bend_lag_s = 0.15;              // Time constant of the bending response. Default 0.15 s.
-  double hysteresis_deg = 3.0;           // Width of the play operator. Default 3 deg.
-
-  bool Check(std::string* error) const;
-};
 
 class PneumaticPlant {
  public:
