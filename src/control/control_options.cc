@@ -19,6 +19,10 @@ OptionTable<ControllerOptions> MakeController() {
           .Range(0, 1000)
           .Unit("kPa/(deg s)")
           .Doc("integral gain; removes the steady-state error, 0 disables it"),
+      DoubleOption<P>("integral_band_deg", &P::integral_band_deg)
+          .Range(0, 180)
+          .Unit("deg")
+          .Doc("the integral accumulates only while |error| is below this (0: always)"),
       DoubleOption<P>("kd_kpa_s_per_deg", &P::kd_kpa_s_per_deg)
           .Range(0, 100)
           .Unit("kPa s/deg")
@@ -35,6 +39,15 @@ OptionTable<ControllerOptions> MakeController() {
           .Range(0, 100)
           .Unit("kPa/deg")
           .Doc("feed-forward per degree of target bend (inverse static gain; 0: off)"),
+      DoubleOption<P>("hysteresis_kpa", &P::hysteresis_kpa)
+          .Range(0, 100)
+          .Unit("kPa")
+          .Doc("hysteresis compensation: +-half of it on the feed-forward by the target's "
+               "direction (0: off)"),
+      DoubleOption<P>("ff_lead_s", &P::ff_lead_s)
+          .Range(0, 10)
+          .Unit("s")
+          .Doc("dynamic feed-forward: lead of the target bend by its rate (0: off)"),
       DoubleOption<P>("min_kpa", &P::min_kpa)
           .Range(0, 1000)
           .Unit("kPa")
@@ -177,12 +190,50 @@ OptionTable<RigOptions> MakeRig() {
   return table;
 }
 
+OptionTable<ActuatorModel> MakeModel() {
+  using P = ActuatorModel;
+  const auto row = [](const char* key, double P::*field, double lo, double hi, const char* unit,
+                      const char* doc) -> Option<P> {
+    return DoubleOption<P>(key, field).Range(lo, hi).Unit(unit).Doc(doc);
+  };
+  return {
+      row("straight_deg", &P::straight_deg, 0, 180, "deg", "angle when vented (identified)"),
+      row("bend_start_kpa", &P::bend_start_kpa, 0, 1000, "kPa",
+          "static map: the angle starts to fall above this pressure"),
+      row("slope_deg_per_kpa", &P::slope_deg_per_kpa, 0, 1000, "deg/kPa",
+          "static map: angle change per kPa, mid line of the two branches (0: no model)"),
+      row("saturation_kpa", &P::saturation_kpa, 0, 1000, "kPa",
+          "static map: the angle stops falling above this (0: none seen)"),
+      row("hysteresis_deg", &P::hysteresis_deg, 0, 180, "deg",
+          "static map: width between the up and down branches"),
+      row("static_rms_deg", &P::static_rms_deg, 0, 180, "deg", "RMS residual of the static fit"),
+      row("pressure_lag_s", &P::pressure_lag_s, 0, 100, "s",
+          "inner loop setpoint -> sensed pressure: first-order lag"),
+      row("pressure_dead_time_s", &P::pressure_dead_time_s, 0, 100, "s",
+          "inner loop: dead time"),
+      row("pressure_rms_kpa", &P::pressure_rms_kpa, 0, 1000, "kPa",
+          "RMS residual of the inner-loop fit"),
+      row("lag_s", &P::lag_s, 0, 100, "s", "sensed pressure -> angle: first-order lag"),
+      row("dead_time_s", &P::dead_time_s, 0, 100, "s",
+          "sensed pressure -> angle: dead time (camera and tracker included)"),
+      row("dynamic_rms_deg", &P::dynamic_rms_deg, 0, 180, "deg",
+          "RMS residual of the bending dynamics fit"),
+      row("valid_min_kpa", &P::valid_min_kpa, 0, 1000, "kPa", "lowest pressure the fit covers"),
+      row("valid_max_kpa", &P::valid_max_kpa, 0, 1000, "kPa", "highest pressure the fit covers"),
+      row("valid_min_deg", &P::valid_min_deg, 0, 180, "deg", "smallest angle the fit covers"),
+      row("valid_max_deg", &P::valid_max_deg, 0, 180, "deg", "largest angle the fit covers"),
+      row("closed_loop_s", &P::closed_loop_s, 0, 100, "s",
+          "SIMC closed-loop time the controller's gains were computed with"),
+  };
+}
+
 OptionTable<ControlConfig> MakeControl() {
   using P = ControlConfig;
   OptionTable<P> table;
   AppendOptions(&table, "controller", &P::controller, ControllerOptionsTable());
   AppendOptions(&table, "link", &P::link, LinkOptionsTable());
   AppendOptions(&table, "rig", &P::rig, RigOptionsTable());
+  AppendOptions(&table, "model", &P::model, ModelOptionsTable());
   return table;
 }
 
@@ -206,6 +257,10 @@ const OptionTable<PlantOptions>& PlantOptionsTable() {
 }
 const OptionTable<RigOptions>& RigOptionsTable() {
   static const OptionTable<RigOptions> table = MakeRig();
+  return table;
+}
+const OptionTable<ActuatorModel>& ModelOptionsTable() {
+  static const OptionTable<ActuatorModel> table = MakeModel();
   return table;
 }
 const OptionTable<ControlConfig>& ControlConfigTable() {

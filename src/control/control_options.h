@@ -13,7 +13,8 @@ const OptionTable<LinkOptions>& LinkOptionsTable();
 const OptionTable<BoardConfig>& BoardConfigTable();  // in kPa where the board counts Pa
 const OptionTable<PlantOptions>& PlantOptionsTable();
 const OptionTable<RigOptions>& RigOptionsTable();    // with board.* and plant.*
-// controller.*, link.*, rig.*: the whole section.
+const OptionTable<ActuatorModel>& ModelOptionsTable();  // what `softsight identify` found
+// controller.*, link.*, rig.*, model.*: the whole section.
 const OptionTable<ControlConfig>& ControlConfigTable();
 
 }  // namespace softsight

@@ -41,14 +41,18 @@ void AngleController::reset() {
   last_time_s_.reset();
   loss_start_s_.reset();
   last_measured_deg_.reset();
+  last_target_deg_.reset();
+  reference_deg_.reset();
+  bend_direction_ = 1.0;
   integral_kpa_ = 0.0;
   derivative_deg_per_s_ = 0.0;
   setpoint_kpa_ = 0.0;
   vented_ = true;
 }
 
-ControllerOutput AngleController::update(double time_s, double target_deg,
+ControllerOutput AngleController::update(double time_s, double target_deg_in,
                                          std::optional<double> measured_deg) {
+  double target_deg = target_deg_in;  // Becomes the reference (below) when it is ramped.
   const double dt_s = last_time_s_ ? std::max(0.0, time_s - *last_time_s_) : 0.0;
   last_time_s_ = time_s;
   ControllerOutput out;
@@ -66,14 +70,25 @@ ControllerOutput AngleController::update(double time_s, double target_deg,
     vented_ = true;
     integral_kpa_ = 0.0;
     setpoint_kpa_ = 0.0;
+    reference_deg_.reset();
     out.action = ControllerOutput::Action::kVent;
     return out;
   }
 
   loss_start_s_.reset();
   vented_ = false;
+  out.error_deg = *measured_deg - target_deg;
+  // With a feed-forward the slew limit shapes the reference too: the loop follows a reference
+  // that moves towards the target at most as fast as the slew limit lets the feed-forward move
+  // (max_rate / ff deg/s), starting where the actuator is. So P and I act on the error from a
+  // reachable reference: a step gives no proportional kick beyond the ramp and no wind-up.
+  if (options_.ff_kpa_per_deg > 0.0 && options_.max_rate_kpa_per_s > 0.0) {
+    if (!reference_deg_) reference_deg_ = *measured_deg;
+    const double step = options_.max_rate_kpa_per_s / options_.ff_kpa_per_deg * dt_s;
+    reference_deg_ = std::clamp(target_deg, *reference_deg_ - step, *reference_deg_ + step);
+    target_deg = *reference_deg_;
+  }
   const double error_deg = *measured_deg - target_deg;
-  out.error_deg = error_deg;
 
   // Derivative on the measurement: bending (angle decreasing) reduces the setpoint's rise.
   if (last_measured_deg_ && dt_s > 0.0) {
@@ -87,8 +102,20 @@ ControllerOutput AngleController::update(double time_s, double target_deg,
   }
   last_measured_deg_ = measured_deg;
 
-  const double feedforward_kpa =
-      options_.bias_kpa + options_.ff_kpa_per_deg * (180.0 - target_deg);
+  // The target's last direction of motion (a smaller angle is more bend) selects the branch of
+  // the hysteresis the actuator is on.
+  if (last_target_deg_ && target_deg < *last_target_deg_) bend_direction_ = 1.0;
+  if (last_target_deg_ && target_deg > *last_target_deg_) bend_direction_ = -1.0;
+  // The target's rate, for the lead; none across a jump (or before a previous target).
+  double target_rate_deg_per_s = 0.0;
+  if (last_target_deg_ && dt_s > 0.0) {
+    target_rate_deg_per_s = (target_deg - *last_target_deg_) / dt_s;
+    if (std::abs(target_rate_deg_per_s) > kStepRateDegPerS) target_rate_deg_per_s = 0.0;
+  }
+  last_target_deg_ = target_deg;
+  const double led_bend_deg = 180.0 - target_deg - options_.ff_lead_s * target_rate_deg_per_s;
+  const double feedforward_kpa = options_.bias_kpa + options_.ff_kpa_per_deg * led_bend_deg +
+                                 0.5 * options_.hysteresis_kpa * bend_direction_;
   const double pd_kpa = feedforward_kpa + options_.kp_kpa_per_deg * error_deg -
                         options_.kd_kpa_s_per_deg * derivative_deg_per_s_;
   const double candidate_integral =
@@ -105,7 +132,9 @@ ControllerOutput AngleController::update(double time_s, double target_deg,
   // back by a limit in the direction the error pushes it.
   const bool pushing_up = error_deg > 0.0 && limited < wanted - 1e-9;
   const bool pushing_down = error_deg < 0.0 && limited > wanted + 1e-9;
-  if (!pushing_up && !pushing_down) {
+  const bool outside_band =
+      options_.integral_band_deg > 0.0 && std::abs(error_deg) >= options_.integral_band_deg;
+  if (!pushing_up && !pushing_down && !outside_band) {
     integral_kpa_ = candidate_integral;
   }
   // The integral alone never needs to exceed the output range.

@@ -114,6 +114,19 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
   return sample;
 }
 
+ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
+                                            std::optional<double> measured_deg) {
+  if (!start_time_s_) start_time_s_ = time_s;
+  ControlSample sample;
+  sample.time_s = time_s - *start_time_s_;
+  sample.measured_deg = measured_deg;
+  sample.action = ControllerOutput::Action::kTrack;
+  const ControllerOptions& c = controller_.options();
+  sample.setpoint_kpa = std::clamp(setpoint_kpa, c.min_kpa, c.max_kpa);
+  sample.board = checked(send_pressure(*sample.setpoint_kpa));
+  return sample;
+}
+
 BoardState ControlSession::stop() {
   stopped_ = true;  // Tried: the destructor does not try a second time.
   return link_.stop();

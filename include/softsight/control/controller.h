@@ -17,6 +17,10 @@ struct ControllerOptions {
   // Integral gain, kPa per (degree * s). Removes the steady-state error a pressure setpoint leaves
   // with P only; 0 disables it.
   double ki_kpa_per_deg_s = 1.3;
+  // The integral only accumulates while |error| is below this (integral separation): a large
+  // error is the feed-forward's and P's to remove, and integrating it only winds up (overshoot
+  // after a step the feed-forward already answers). Default 0: always.
+  double integral_band_deg = 0.0;
   // Derivative gain on the measurement (no kick on target steps), kPa * s / degree. Default 0: the
   // camera's angle is noisy.
   double kd_kpa_s_per_deg = 0.0;
@@ -28,10 +32,21 @@ struct ControllerOptions {
   // much less lag. Defaults 3 kPa and 0 (off).
   double bias_kpa = 3.0;
   double ff_kpa_per_deg = 0.0;
+  // Hysteresis compensation, the inverse of the actuator's play: the feed-forward adds half of
+  // this while the target last moved towards more bend and subtracts half once it moved back
+  // (the identified hysteresis width in kPa: model.hysteresis_deg / model.slope_deg_per_kpa).
+  // Default 0: off.
+  double hysteresis_kpa = 0.0;
+  // Dynamic feed-forward: the target bend is led by this many seconds of its rate of change (the
+  // inverse of the actuator's lags, to first order: the identified lags and dead times), so a
+  // moving target is not followed a lag behind. Jumps of the target (faster than
+  // kStepRateDegPerS) are steps, which no lead can anticipate: they get none. Default 0: off.
+  double ff_lead_s = 0.0;
   // Output limits, kPa. The board enforces its own hard limit as well; max_kpa is clamped to it.
   double min_kpa = 0.0;
   double max_kpa = 45.0;
   // Setpoint slew limit, kPa/s; 0 = unlimited. Default 60: protects the silicone on target steps.
+  // With a feed-forward it also ramps the reference the loop follows (max_rate / ff deg/s).
   double max_rate_kpa_per_s = 60.0;
   // Vision loss: keep the last setpoint (integral frozen) while the measurement has been missing
   // for at most this long (from the first frame without one), then vent. Default 0.5 s.
@@ -40,6 +55,9 @@ struct ControllerOptions {
   // Returns false and names the bad field in `error`.
   bool Check(std::string* error) const;
 };
+
+// A target moving faster than this between two frames has jumped (a step), deg/s.
+constexpr double kStepRateDegPerS = 300.0;
 
 struct ControllerOutput {
   enum class Action { kTrack, kHold, kVent };
@@ -68,6 +86,9 @@ class AngleController {
   std::optional<double> last_time_s_;
   std::optional<double> loss_start_s_;  // First frame of the current vision loss.
   std::optional<double> last_measured_deg_;
+  std::optional<double> last_target_deg_;
+  std::optional<double> reference_deg_;  // The ramped target (with a feed-forward).
+  double bend_direction_ = 1.0;  // +1: the target last moved towards more bend; -1: back.
   double integral_kpa_ = 0.0;
   double derivative_deg_per_s_ = 0.0;
   double setpoint_kpa_ = 0.0;

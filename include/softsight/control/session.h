@@ -55,6 +55,10 @@ class ControlSession {
   // board refuses a command, or the board reports a pressure above its limit (a fault: the
   // session vents before throwing). Throws StopRequested when the user asked to stop mid-wait.
   ControlSample step(double time_s, std::optional<double> measured_deg);
+  // One frame open loop at a pressure chosen for this frame (an identification experiment), with
+  // the same clamp to max_kpa and the same checks of the answer as step().
+  ControlSample step_pressure(double time_s, double setpoint_kpa,
+                              std::optional<double> measured_deg);
   // Vents the actuator (end of run).
   BoardState stop();
 

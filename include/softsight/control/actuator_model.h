@@ -1,0 +1,43 @@
+// What `softsight identify` learned about an actuator: the `control: model:` section of a config.
+// Angles are the paper's angle at the middle marker (180 deg straight, smaller = more bent);
+// pressures are gauge kPa. All zero (the default) means "not identified": nothing is written.
+#pragma once
+
+#include <string>
+
+namespace softsight {
+
+struct ActuatorModel {
+  // Static map, pressure -> angle, from the steps up and down. Below bend_start_kpa the angle
+  // stays at straight_deg; above it falls by slope_deg_per_kpa per kPa (the mean of the up and
+  // down branches, which lie hysteresis_deg apart) until saturation_kpa, where it stops
+  // (saturation_kpa 0: no saturation seen within the tested range).
+  double straight_deg = 0.0;
+  double bend_start_kpa = 0.0;
+  double slope_deg_per_kpa = 0.0;
+  double saturation_kpa = 0.0;
+  double hysteresis_deg = 0.0;
+  double static_rms_deg = 0.0;   // RMS residual of the static fit.
+  // Inner loop, pressure setpoint -> sensed pressure: first-order lag plus dead time.
+  double pressure_lag_s = 0.0;
+  double pressure_dead_time_s = 0.0;
+  double pressure_rms_kpa = 0.0;  // RMS residual of that fit.
+  // Bending, sensed pressure -> angle: the static map (with its hysteresis) through a first-order
+  // lag plus dead time (the camera's and the tracker's delay are in the dead time).
+  double lag_s = 0.0;
+  double dead_time_s = 0.0;
+  double dynamic_rms_deg = 0.0;  // RMS residual of that fit.
+  // The ranges the experiment covered: the model is valid within them only.
+  double valid_min_kpa = 0.0;
+  double valid_max_kpa = 0.0;
+  double valid_min_deg = 0.0;
+  double valid_max_deg = 0.0;
+  // The tuning rule's closed-loop time constant (SIMC's tau_c) the gains were computed with.
+  double closed_loop_s = 0.0;
+
+  bool identified() const { return slope_deg_per_kpa > 0.0; }
+  // Returns false and names the bad field.
+  bool Check(std::string* error) const;
+};
+
+}  // namespace softsight

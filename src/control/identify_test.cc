@@ -1,0 +1,300 @@
+// Identification and tuning on simulated actuators, in-process and in simulated time: the rig
+// (the board's own code and the pneumatic plant) behind DirectRigTransport, the "camera" its true
+// angle plus noise. Each plant: the experiment, the fitted model against the plant's truth, then
+// the loop with the gains from the model (a step from straight to 120 deg, a 0.25 Hz sine).
+#include "control/identify.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "control/rig_test_util.h"
+#include "control/step_metrics.h"
+#include "softsight/control/board_link.h"
+#include "softsight/control/rig.h"
+#include "softsight/control/session.h"
+
+namespace softsight {
+namespace {
+
+constexpr double kFps = 30.0;
+
+struct PlantCase {
+  const char* name;
+  double bend_deg_per_kpa;
+  double chamber_ml;
+  double lag_s;
+  double hysteresis_deg;
+  uint64_t seed;
+  double limit_kpa = 50.0;  // A weak actuator needs a higher pressure for the same bend.
+  double pump_l_per_min = 1.0;
+};
+
+RigOptions RigFor(const PlantCase& c) {
+  RigOptions rig;
+  rig.plant.bend_deg_per_kpa = c.bend_deg_per_kpa;
+  rig.plant.chamber_volume_ml = c.chamber_ml;
+  rig.plant.bend_lag_s = c.lag_s;
+  rig.plant.hysteresis_deg = c.hysteresis_deg;
+  rig.plant.pump_flow_l_per_min = c.pump_l_per_min;
+  rig.board.pressure_limit_pa = static_cast<int32_t>(c.limit_kpa * 1000);
+  rig.seed = c.seed;
+  return rig;
+}
+
+ControllerOptions ControllerFor(const PlantCase& c) {
+  ControllerOptions o;
+  o.max_kpa = c.limit_kpa - 5.0;
+  return o;
+}
+
+// The rig, the link and a camera that sees the true angle plus 0.15 deg of noise (when `visible`).
+class Bench {
+ public:
+  explicit Bench(const RigOptions& rig, uint64_t seed = 1)
+      : rig_(rig), transport_(rig_), link_(transport_, LinkOptions{}, transport_.environment()),
+        rng_(seed) {}
+
+  std::optional<double> camera(double t) {
+    const double noise = noise_(rng_);
+    if (visible && !visible(t)) return std::nullopt;
+    return frozen_angle.value_or(rig_.snapshot().angle_deg) + noise;
+  }
+
+  // Runs the experiment to its end; the session vents (STOP) when it ends, however it ends.
+  IdentificationExperiment identify(const ControllerOptions& controller,
+                                    const IdentifyOptions& options = {},
+                                    std::function<void(int)> before_frame = {}) {
+    ControlTarget target;
+    target.mode = ControlMode::kPressure;
+    ControlSession session(controller, link_, target);
+    const BoardInfo info = session.start();
+    IdentificationExperiment experiment(
+        options, IdentificationCeiling(session.controller().options(), info.pressure_limit_kpa));
+    for (int k = 0; !experiment.done(); ++k) {
+      if (k > 0) rig_.advance(1.0 / kFps);
+      if (before_frame) before_frame(k);
+      const double t = k / kFps;
+      const ControlSample s = StepIdentification(experiment, session, t, camera(t));
+      max_setpoint_kpa = std::max(max_setpoint_kpa, s.setpoint_kpa.value_or(0.0));
+      if (k > 100000) throw std::runtime_error("the experiment does not end");
+    }
+    session.stop();
+    return experiment;
+  }
+
+  // The closed loop; returns the true angle against the target at every frame.
+  std::vector<TrackingPoint> control(const ControllerOptions& controller, const TargetProfile& p,
+                                     double seconds) {
+    ControlTarget target;
+    target.profile = p;
+    ControlSession session(controller, link_, target);
+    session.start();
+    std::vector<TrackingPoint> out;
+    for (int k = 0; k <= std::lround(seconds * kFps); ++k) {
+      if (k > 0) rig_.advance(1.0 / kFps);
+      const double t = k / kFps;
+      const double truth = rig_.snapshot().angle_deg;
+      const ControlSample s = session.step(t, camera(t));
+      out.push_back({s.time_s, *s.target_deg, truth});
+      if (std::getenv("IDENTIFY_TRACE")) {
+        std::printf("trace %.3f %.2f %.2f %.2f %.2f %.2f\n", s.time_s, *s.target_deg, truth,
+                    s.setpoint_kpa.value_or(-1), s.board.pressure_kpa,
+                    session.controller().integral_kpa());
+      }
+    }
+    session.stop();
+    return out;
+  }
+
+  SimulatedRig& rig() { return rig_; }
+  testing::DirectRigTransport& transport() { return transport_; }
+  std::function<bool(double)> visible;
+  std::optional<double> frozen_angle;  // A camera that does not see the actuator move.
+  double max_setpoint_kpa = 0.0;
+
+ private:
+  SimulatedRig rig_;
+  testing::DirectRigTransport transport_;
+  BoardLink link_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> noise_{0.0, 0.15};
+};
+
+class Plants : public ::testing::TestWithParam<PlantCase> {};
+
+// Identifies the plant; the model and the gains from it, for the plant's tests.
+struct Identified {
+  ActuatorModel model;
+  ControllerOptions tuned;
+  double max_setpoint_kpa = 0.0;
+  RigSnapshot after;  // The rig when the experiment ended.
+};
+
+Identified IdentifyPlant(const PlantCase& c, Bench& bench) {
+  Identified out;
+  const ControllerOptions base = ControllerFor(c);
+  const IdentificationExperiment experiment = bench.identify(base);
+  out.model = FitActuatorModel(experiment);
+  if (std::getenv("IDENTIFY_TRACE")) {
+    for (const StaticPoint& p : experiment.static_points()) {
+      std::printf("static %s %.2f kPa %.2f deg\n", p.up ? "up" : "down", p.pressure_kpa,
+                  p.angle_deg);
+    }
+  }
+  out.tuned = TuneController(&out.model, base, 1.0 / kFps);
+  out.max_setpoint_kpa = bench.max_setpoint_kpa;
+  out.after = bench.rig().snapshot();
+  return out;
+}
+
+TEST_P(Plants, IdentificationRecoversTheStaticSlopeAndTheLag) {
+  const PlantCase& c = GetParam();
+  const RigOptions rig = RigFor(c);
+  Bench bench(rig, c.seed);
+  const Identified id = IdentifyPlant(c, bench);
+  const ActuatorModel& model = id.model;
+  // The truth: the angle at the middle marker falls by span/2 per degree of bend.
+  const double true_slope = 0.5 * rig.end_marker_span * c.bend_deg_per_kpa;
+  const double true_hysteresis = 0.5 * rig.end_marker_span * c.hysteresis_deg;
+  const double slope_error = model.slope_deg_per_kpa / true_slope - 1.0;
+  const double lag_error = model.lag_s / c.lag_s - 1.0;
+  std::printf(
+      "plant %-10s bend %4.1f deg/kPa, %2.0f ml, lag %.2f s, hysteresis %.0f deg: slope %.3f "
+      "deg/kPa (true %.3f, %+.1f %%), lag %.3f s (%+.0f %%), dead time %.3f s, pressure lag "
+      "%.3f s, hysteresis %.2f deg (true %.2f), bend start %.2f kPa (true %.2f), residuals "
+      "%.2f / %.2f deg, saturation %.1f kPa\n",
+      c.name, c.bend_deg_per_kpa, c.chamber_ml, c.lag_s, c.hysteresis_deg,
+      model.slope_deg_per_kpa, true_slope, 100 * slope_error, model.lag_s, 100 * lag_error,
+      model.dead_time_s, model.pressure_lag_s, model.hysteresis_deg, true_hysteresis,
+      model.bend_start_kpa, rig.plant.bend_start_kpa, model.static_rms_deg,
+      model.dynamic_rms_deg, model.saturation_kpa);
+  EXPECT_LT(std::abs(slope_error), 0.10);
+  EXPECT_LT(std::abs(lag_error), 0.30);
+  EXPECT_NEAR(model.bend_start_kpa, rig.plant.bend_start_kpa, 1.0);
+  EXPECT_NEAR(model.hysteresis_deg, true_hysteresis, 1.0);
+  EXPECT_NEAR(model.straight_deg, 180.0, 0.5);
+  // Saturation where the bend reaches the end stop within the tested range (on the up branch,
+  // the stop less half the play), else none.
+  const double stop_kpa = rig.plant.bend_start_kpa +
+                          (rig.plant.max_bend_deg + 0.5 * c.hysteresis_deg) / c.bend_deg_per_kpa;
+  if (stop_kpa < model.valid_max_kpa) {
+    EXPECT_NEAR(model.saturation_kpa, stop_kpa, 1.0);
+  } else {
+    EXPECT_EQ(model.saturation_kpa, 0.0);
+  }
+  EXPECT_LT(model.static_rms_deg, 1.0);
+  EXPECT_LT(model.dynamic_rms_deg, 1.5);
+  EXPECT_GT(model.valid_max_kpa, 0.8 * IdentificationCeiling(ControllerFor(c), c.limit_kpa));
+  // Never above the ceiling, the true pressure never above the board's limit, vented at the end.
+  EXPECT_LE(id.max_setpoint_kpa, IdentificationCeiling(ControllerFor(c), c.limit_kpa) + 1e-9);
+  EXPECT_LE(id.after.peak_pressure_kpa, c.limit_kpa);
+  EXPECT_EQ(id.after.mode, BoardMode::kStopped);
+  // The gains by the documented rule.
+  EXPECT_NEAR(id.tuned.ff_kpa_per_deg, 1.0 / model.slope_deg_per_kpa, 1e-12);
+  EXPECT_GT(id.tuned.kp_kpa_per_deg, 0.0);
+  EXPECT_GT(id.tuned.ki_kpa_per_deg_s, 0.0);
+  EXPECT_GE(model.closed_loop_s, 0.15);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Identify, Plants,
+    ::testing::Values(PlantCase{"shipped", 6.0, 20, 0.15, 3.0, 1},
+                      PlantCase{"weak_fast", 3.0, 10, 0.05, 1.0, 2, 70.0},
+                      PlantCase{"stiff_slow", 10.0, 60, 0.40, 6.0, 3},
+                      PlantCase{"stiff_fast", 10.0, 10, 0.05, 6.0, 4},
+                      PlantCase{"weak_slow", 3.0, 30, 0.40, 3.0, 5, 70.0},
+                      PlantCase{"big_laggy", 6.0, 55, 0.40, 6.0, 6},
+                      PlantCase{"mid", 4.5, 40, 0.10, 1.0, 7},
+                      PlantCase{"big_stiff", 8.0, 50, 0.25, 4.0, 8}),
+    [](const ::testing::TestParamInfo<PlantCase>& info) { return std::string(info.param.name); });
+
+PlantCase Shipped() { return PlantCase{"shipped", 6.0, 20, 0.15, 3.0, 1}; }
+
+// Runs the experiment expecting it to stop with an error; returns the error.
+template <typename Error>
+std::string ExpectAbort(Bench& bench, const ControllerOptions& controller,
+                        std::function<void(int)> before_frame = {}) {
+  try {
+    bench.identify(controller, IdentifyOptions{}, std::move(before_frame));
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "the experiment did not stop";
+  return "";
+}
+
+TEST(Identify, MarkersHiddenMidExperimentAbortsAndVents) {
+  Bench bench(RigFor(Shipped()));
+  bench.visible = [](double t) { return t < 6.0; };  // Hidden during the steps up.
+  const std::string error = ExpectAbort<IdentifyAbort>(bench, ControllerFor(Shipped()));
+  EXPECT_NE(error.find("identify: markers lost for 0.33 s at 6.33 s ("), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos);  // One line.
+  // The session sent STOP on the way out: the board vents at once.
+  const RigSnapshot at_abort = bench.rig().snapshot();
+  EXPECT_EQ(at_abort.mode, BoardMode::kStopped);
+  EXPECT_GT(at_abort.pressure_kpa, 5.0);  // It was inflated when the markers went.
+  bench.rig().advance(1.0);
+  EXPECT_LT(bench.rig().snapshot().pressure_kpa, 0.5);
+}
+
+TEST(Identify, PortDisappearingMidExperimentIsOneErrorAndTheWatchdogVents) {
+  Bench bench(RigFor(Shipped()));
+  const std::string error = ExpectAbort<InputError>(bench, ControllerFor(Shipped()), [&](int k) {
+    if (k == 200) bench.transport().disconnect();
+  });
+  EXPECT_NE(error.find("disconnected"), std::string::npos) << error;
+  const RigSnapshot at_abort = bench.rig().snapshot();
+  EXPECT_EQ(at_abort.mode, BoardMode::kPressure);  // No STOP could reach it.
+  EXPECT_GT(at_abort.pressure_kpa, 5.0);
+  bench.rig().advance(0.3);  // The board's watchdog: 250 ms without a command.
+  EXPECT_EQ(bench.rig().snapshot().mode, BoardMode::kWatchdog);
+  bench.rig().advance(1.0);
+  EXPECT_LT(bench.rig().snapshot().pressure_kpa, 0.5);
+}
+
+TEST(Identify, AnAngleThatDoesNotRespondAbortsAtHalfTheCeiling) {
+  Bench bench(RigFor(Shipped()));
+  bench.frozen_angle = 178.0;  // The camera watches something else.
+  const std::string error = ExpectAbort<IdentifyAbort>(bench, ControllerFor(Shipped()));
+  EXPECT_NE(error.find("identify: the angle does not respond"), std::string::npos) << error;
+  const double ceiling = IdentificationCeiling(ControllerFor(Shipped()), 50.0);
+  EXPECT_LE(bench.max_setpoint_kpa, 0.5 * ceiling + 1e-9);
+  EXPECT_EQ(bench.rig().snapshot().mode, BoardMode::kStopped);
+}
+
+TEST(Identify, TheCeilingStaysBelowTheBoardsLimit) {
+  // max_kpa 45 against a board limited to 30 kPa: 26 kPa, 4 below the limit.
+  PlantCase c = Shipped();
+  c.limit_kpa = 30.0;
+  Bench bench(RigFor(c));
+  ControllerOptions controller;
+  controller.max_kpa = 45.0;
+  bench.identify(controller);
+  EXPECT_DOUBLE_EQ(bench.max_setpoint_kpa, 26.0);
+  EXPECT_LT(bench.rig().snapshot().peak_pressure_kpa, 30.0);
+  EXPECT_EQ(bench.rig().snapshot().mode, BoardMode::kStopped);
+}
+
+TEST(Identify, ASensedPressureAboveTheCeilingAborts) {
+  IdentificationExperiment experiment(IdentifyOptions{}, 20.0);
+  experiment.next(0.0, 180.0);
+  experiment.answered(21.9);  // Within the 2 kPa margin.
+  experiment.next(0.1, 180.0);
+  try {
+    experiment.answered(22.5);
+    ADD_FAILURE() << "not refused";
+  } catch (const IdentifyAbort& e) {
+    EXPECT_STREQ(e.what(),
+                 "identify: the sensed pressure 22.5 kPa is above the experiment's ceiling of 20 "
+                 "kPa; vented");
+  }
+  EXPECT_THROW(IdentificationExperiment(IdentifyOptions{}, 0.0), InputError);
+}
+
+}  // namespace
+}  // namespace softsight
