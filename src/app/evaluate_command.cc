@@ -26,7 +26,6 @@
 namespace softsight {
 namespace {
 
-const std::vector<std::string> kMethods = {"colour", "sad", "ssd", "zncc"};
 const std::vector<std::string> kModes = {"gray", "colour"};
 
 // Side of the dragged template square, in marker radii.
@@ -53,12 +52,6 @@ void CheckNames(const std::vector<std::string>& names, const std::vector<std::st
       throw InputError(option + ": '" + names[i] + "' is given twice");
     }
   }
-}
-
-MatchMeasure MeasureNamed(const std::string& method) {
-  if (method == "sad") return MatchMeasure::kSad;
-  if (method == "ssd") return MatchMeasure::kSsd;
-  return MatchMeasure::kZncc;
 }
 
 std::string FormatNumber(double value, int decimals) {
@@ -95,7 +88,7 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
     MarkerSpec spec;
     spec.name = scene.markers[i].name;
     spec.method = run.method;
-    if (run.method == "colour") {
+    if (!IsTemplateMethod(run.method)) {
       spec.colour = ThresholdsFor(scene.markers[i].bgr);
       if (options.noise.sigma > 0) {
         spec.colour.filter = ColourParams::Filter::kGaussian;
@@ -107,7 +100,6 @@ TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
         throw InputError("marker '" + spec.name +
                          "' is hidden on frame 0: no template can be dragged around it");
       }
-      spec.templ.measure = MeasureNamed(run.method);
       spec.templ.colour = run.mode == std::optional<std::string>("colour");
       spec.templ.template_frame = 0;
       spec.templ.rect = DraggedRect(*centre, scene.marker_radius_px);
@@ -207,7 +199,7 @@ void EvaluateOptions::Check() const {
     throw InputError("--frames must be at least 1, got " + std::to_string(scene.frame_count));
   }
   if (methods.empty()) throw InputError("--methods: no method given");
-  CheckNames(methods, kMethods, "--methods");
+  CheckNames(methods, TrackerMethods(), "--methods");
   CheckNames(modes, kModes, "--modes");
   const bool templates = std::any_of(methods.begin(), methods.end(), IsTemplateMethod);
   if (templates && modes.empty()) {
@@ -246,7 +238,7 @@ EvaluateReport RunEvaluate(const EvaluateOptions& options) {
   options.Check();
   std::vector<Run> runs;
   for (const std::string& method : options.methods) {
-    if (method == "colour") {
+    if (!IsTemplateMethod(method)) {
       runs.push_back({method, std::nullopt});
     } else {
       for (const std::string& mode : options.modes) runs.push_back({method, mode});
@@ -356,7 +348,8 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--gain-ramp", *gain_ramp,
                  "Illumination gain START,END, ramping linearly over the sequence (e.g. 0.6,1.4)");
-  sub.add_option("--methods", options->methods, "Methods, comma separated: colour,sad,ssd,zncc")
+  sub.add_option("--methods", options->methods,
+                 "Methods, comma separated: " + JoinNames(TrackerMethods()))
       ->delimiter(',')
       ->capture_default_str();
   sub.add_option("--modes", options->modes,

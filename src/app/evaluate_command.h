@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "softsight/sim/scene.h"
+#include "softsight/track/tracker.h"
 
 namespace softsight {
 
@@ -25,8 +26,8 @@ struct EvaluateOptions {
   NoiseOptions noise;            // Sensor noise, blur, gain ramp, noise seed.
                                  // (The command line sets noise.seed = scene.seed, as synth does.)
   std::vector<Occluder> occluders;  // Covers drawn over the scene (tests; not on the command line).
-  // Methods to compare: any of colour, sad, ssd, zncc (default all, in this order).
-  std::vector<std::string> methods = {"colour", "sad", "ssd", "zncc"};
+  // Methods to compare: any of TrackerMethods() (default all, in the registry's order).
+  std::vector<std::string> methods = TrackerMethods();
   // Template matching modes: gray and/or colour (default both). The colour method has no mode.
   std::vector<std::string> modes = {"gray", "colour"};
   // Template trackers report the dragged rectangle's centre (the paper's position) instead of the

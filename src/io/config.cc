@@ -28,7 +28,7 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   }
   const bool has_template = marker.has("template");
   const std::vector<std::string> methods = TrackerMethods();
-  spec.method = marker.choice("method", methods).value_or(has_template ? "zncc" : "colour");
+  spec.method = marker.choice("method", methods).value_or(DefaultTrackerMethod(has_template));
   if (method_override) spec.method = *method_override;
   ReadColourParams(marker, &spec.colour);
   ReadTemplateParams(marker, &spec.templ);

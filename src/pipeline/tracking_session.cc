@@ -70,21 +70,9 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   result_.frame_index = frame.index;
   result_.time_s = frame.time_s;
   for (size_t i = 0; i < trackers_.size(); ++i) {
-    const MarkerSpec& spec = config_.markers[i];
-    if (!initialised_[i]) {
-      if (!IsTemplateMethod(spec.method)) {
-        if (spec.colour.roi) trackers_[i]->init(frame.image, *spec.colour.roi);
-        initialised_[i] = true;
-      } else if (!spec.templ.image.empty()) {
-        trackers_[i]->init(frame.image, cv::Rect());
-        initialised_[i] = true;
-      } else if (spec.templ.rect && frame.index >= spec.templ.template_frame) {
-        trackers_[i]->init(frame.image, *spec.templ.rect);
-        initialised_[i] = true;
-      }
-    }
-    // A template tracker without a template yet (none configured, or its reference frame is
-    // still ahead) has nothing to look for: its marker is not found.
+    // Each tracker knows from its parameters when and how it can start. One that cannot yet (a
+    // template not selected, or its reference frame still ahead) has nothing to look for.
+    if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
     if (!initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
   }
   frame_change_->observe(frame.image);

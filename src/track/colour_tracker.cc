@@ -320,6 +320,13 @@ void ColourTracker::reset() {
   acquire_roi_ = params_.roi;
 }
 
+bool ColourTracker::start(const Frame& frame) {
+  // Without a roi there is nothing to learn before the first update: it acquires on the whole
+  // frame.
+  if (params_.roi) init(frame.image, *params_.roi);
+  return true;
+}
+
 void ColourTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
   check_frame(frame_bgr);
   const cv::Rect frame_rect(cv::Point(0, 0), frame_bgr.size());

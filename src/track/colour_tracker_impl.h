@@ -70,6 +70,7 @@ class ColourTracker : public Tracker {
   explicit ColourTracker(const ColourParams& params);
 
   void init(const cv::Mat& frame_bgr, const cv::Rect& hint) override;
+  bool start(const Frame& frame) override;
   Observation update(const cv::Mat& frame_bgr) override;
   void reset() override;
   const std::vector<MarkerCandidate>& candidates() const override { return candidates_; }

@@ -9,6 +9,7 @@
 
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -207,9 +208,19 @@ const Scene& TheScene() {
   return scene;
 }
 
-const char* const kMethodNames[] = {"sad", "ssd", "zncc"};
+// The template methods of the registry, in its order (sad, ssd, zncc: the benchmarks' argument).
+const std::vector<std::string>& TemplateMethods() {
+  static const std::vector<std::string> methods = [] {
+    std::vector<std::string> names;
+    for (const std::string& name : TrackerMethods()) {
+      if (IsTemplateMethod(name)) names.push_back(name);
+    }
+    return names;
+  }();
+  return methods;
+}
 
-std::vector<std::unique_ptr<Tracker>> MakeTrackers(const char* method, bool colour) {
+std::vector<std::unique_ptr<Tracker>> MakeTrackers(const std::string& method, bool colour) {
   const Scene& scene = TheScene();
   std::vector<std::unique_ptr<Tracker>> trackers;
   for (const cv::Rect& rect : scene.rects) {
@@ -226,7 +237,7 @@ std::vector<std::unique_ptr<Tracker>> MakeTrackers(const char* method, bool colo
 // Per frame: all three markers tracked in their windows (the steady state).
 void BM_TrackWindowed(benchmark::State& state) {
   const Scene& scene = TheScene();
-  const char* method = kMethodNames[state.range(0)];
+  const std::string& method = TemplateMethods()[static_cast<size_t>(state.range(0))];
   const bool colour = state.range(1) != 0;
   std::string label = method;
   label += colour ? " colour" : " gray";
@@ -245,7 +256,7 @@ BENCHMARK(BM_TrackWindowed)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::k
 // Per frame: every marker acquired on the whole frame (no known position), coarse to fine.
 void BM_AcquireWholeFrame(benchmark::State& state) {
   const Scene& scene = TheScene();
-  const char* method = kMethodNames[state.range(0)];
+  const std::string& method = TemplateMethods()[static_cast<size_t>(state.range(0))];
   const bool colour = state.range(1) != 0;
   std::string label = method;
   label += colour ? " colour, 3 markers" : " gray, 3 markers";

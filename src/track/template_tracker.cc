@@ -14,15 +14,6 @@
 
 namespace softsight {
 
-const char* MatchMeasureName(MatchMeasure measure) {
-  switch (measure) {
-    case MatchMeasure::kSad: return "sad";
-    case MatchMeasure::kSsd: return "ssd";
-    case MatchMeasure::kZncc: return "zncc";
-  }
-  return "?";
-}
-
 const char* TemplateReportName(TemplateReport report) {
   switch (report) {
     case TemplateReport::kCentre: return "centre";
@@ -409,6 +400,7 @@ class TemplateTracker final : public Tracker {
   }
 
   void init(const cv::Mat& frame_bgr, const cv::Rect& hint) override;
+  bool start(const Frame& frame) override;
   Observation update(const cv::Mat& frame_bgr) override;
   void reset() override {
     tracking_ = false;
@@ -607,6 +599,18 @@ void TemplateTracker::RestoreWorkingTemplate() {
   working_mask_ = rung.mask().empty() ? cv::Mat() : rung.mask().clone();
   rung.image().convertTo(working_f_, CV_32F);
   coarse_.clear();
+}
+
+bool TemplateTracker::start(const Frame& frame) {
+  if (!params_.image.empty()) {
+    init(frame.image, cv::Rect());  // The template is given: the first update searches for it.
+    return true;
+  }
+  if (params_.rect && frame.index >= params_.template_frame) {
+    init(frame.image, *params_.rect);  // Cut from this frame, where the config says it is.
+    return true;
+  }
+  return false;
 }
 
 void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {

@@ -472,9 +472,6 @@ TEST(TemplateTrackerTest, MethodsAreRegistered) {
   for (const char* method : kMethods) {
     EXPECT_NE(std::find(methods.begin(), methods.end(), method), methods.end()) << method;
   }
-  EXPECT_STREQ(MatchMeasureName(MatchMeasure::kSad), "sad");
-  EXPECT_STREQ(MatchMeasureName(MatchMeasure::kSsd), "ssd");
-  EXPECT_STREQ(MatchMeasureName(MatchMeasure::kZncc), "zncc");
 }
 
 // The README's minimal config, a rectangle dragged around each marker and nothing else, reports

@@ -78,6 +78,8 @@ std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec) {
                    list + ")");
 }
 
+const char* DefaultTrackerMethod(bool has_template) { return has_template ? "zncc" : "colour"; }
+
 bool IsTemplateMethod(const std::string& method) {
   for (const Method& m : kMethods) {
     if (method == m.name) return m.uses_template;

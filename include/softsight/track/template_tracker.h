@@ -169,7 +169,6 @@ struct TemplateParams {
   bool Check(std::string* error) const;
 };
 
-const char* MatchMeasureName(MatchMeasure measure);      // "sad", "ssd", "zncc"
 const char* TemplateReportName(TemplateReport report);  // "centre", "symmetry", "rect_centre"
 
 // Builds a template tracker (CreateTracker does this for the methods sad, ssd and zncc).

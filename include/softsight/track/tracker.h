@@ -52,6 +52,13 @@ class Tracker {
   // cannot be used (empty, or outside the frame).
   virtual void init(const cv::Mat& frame_bgr, const cv::Rect& hint) = 0;
 
+  // Starts the tracker from what its parameters say, on the first frame where it can: a colour
+  // tracker at once (restricted to its roi when one is set); a template tracker from its template
+  // image, or from its rect once frame.index reaches its template frame. Returns false while it
+  // cannot start (no template yet, or the template's frame is still ahead): its marker is then not
+  // started, and the caller asks again with the next frame. Throws InputError as init() does.
+  virtual bool start(const Frame& frame) = 0;
+
   // Finds the marker in the next frame (CV_8UC3 BGR). found() == false is a normal result; a
   // tracker never reports a stale or predicted position.
   virtual Observation update(const cv::Mat& frame_bgr) = 0;
@@ -64,10 +71,14 @@ class Tracker {
   virtual const std::vector<MarkerCandidate>& candidates() const;
 };
 
+// The method of a marker whose config names none: template matching (zncc) when it has a
+// template, else colour.
+const char* DefaultTrackerMethod(bool has_template);
+
 // Everything needed to build the tracker of one marker.
 struct MarkerSpec {
   std::string name;                   // Unique; prefixes the marker's CSV columns.
-  std::string method = "colour";      // A name from TrackerMethods(): colour, sad, ssd, zncc.
+  std::string method = DefaultTrackerMethod(false);  // A name from TrackerMethods().
   ColourParams colour;                // Used by the colour method.
   TemplateParams templ;               // Used by the template methods.
 };
