@@ -14,6 +14,7 @@ using CommandRunner = std::function<int()>;
 
 CommandRunner SetupTrackCommand(CLI::App& sub);
 CommandRunner SetupControlCommand(CLI::App& sub);
+CommandRunner SetupIdentifyCommand(CLI::App& sub);
 CommandRunner SetupRigCommand(CLI::App& sub);
 CommandRunner SetupSynthCommand(CLI::App& sub);
 CommandRunner SetupEvaluateCommand(CLI::App& sub);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -104,8 +105,18 @@ class ControlSink : public FrameSink {
       : session_(session), link_(link), duration_s_(duration_s),
         stop_at_duration_(stop_at_duration) {}
 
+  // From then on each frame runs this experiment (open loop) instead of the closed loop, until
+  // it is done.
+  void identify(IdentificationExperiment* experiment) { experiment_ = experiment; }
+
   void consume(const Frame& frame, const FrameResult& result) override {
-    sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+    if (experiment_ != nullptr) {
+      sample_ = StepIdentification(*experiment_, session_, frame.time_s,
+                                   result.measurement.angle_deg);
+      if (experiment_->done()) done_ = true;
+    } else {
+      sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+    }
     ++frames_;
     summary_.duration_s = sample_.time_s;
     summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
@@ -117,6 +128,7 @@ class ControlSink : public FrameSink {
       ++errors_;
       summary_.final_error_deg = e;
     }
+    if (sample_.target_deg) collect_step_point(*sample_.target_deg);
     if (stop_at_duration_ && sample_.time_s >= duration_s_) done_ = true;
   }
 
@@ -153,6 +165,10 @@ class ControlSink : public FrameSink {
     ControlSummary out = summary_;
     out.frames = frames_;
     if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
+    if (!step_points_.empty()) {
+      out.metrics = ComputeStepMetrics(step_points_);
+      out.metrics.rms_error_deg = out.rms_error_deg;  // Over the whole run, not the last step.
+    }
     return out;
   }
 
@@ -161,6 +177,24 @@ class ControlSink : public FrameSink {
   const BoardLink& link_;
   double duration_s_;
   bool stop_at_duration_;
+  // The frames since the target last jumped (with the one before the jump), for the step
+  // figures, at most kMaxStepPoints of them (an hour at 30 fps): a longer hold keeps its first
+  // hour, which is where a step settles.
+  static constexpr size_t kMaxStepPoints = 108000;
+  void collect_step_point(double target_deg) {
+    const TrackingPoint point{sample_.time_s, target_deg, sample_.measured_deg};
+    const StepMetricsOptions defaults;
+    if (!step_points_.empty() &&
+        std::abs(target_deg - step_points_.back().target_deg) > defaults.step_threshold_deg) {
+      const TrackingPoint before = step_points_.back();
+      step_points_.clear();
+      step_points_.push_back(before);
+    }
+    if (step_points_.size() < kMaxStepPoints) step_points_.push_back(point);
+  }
+
+  IdentificationExperiment* experiment_ = nullptr;
+  std::vector<TrackingPoint> step_points_;
   ControlSample sample_;
   ControlSummary summary_;
   int64_t frames_ = 0;
@@ -189,6 +223,16 @@ std::string FormatNumber(double v) {
   char text[32];
   std::snprintf(text, sizeof(text), "%g", v);
   return text;
+}
+
+// The longest identification experiment: far more than the steps and the PRBS take.
+constexpr double kMaxIdentifyS = 600.0;
+
+void WriteTextFileOrThrow(const std::string& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) throw InputError(file + ": cannot write it");
 }
 
 // The one check of every number from the command line: finite and in [lo, hi] (or (lo, hi] with
@@ -255,15 +299,31 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     throw InputError("control: give --port DEVICE for a board, or --simulate (not both)");
   }
   CheckOptions(options);
-  const ControlTarget target = MakeTarget(options);
+  // Identification: open loop at the experiment's pressures (the target is only the session's
+  // starting point), for as long as the experiment takes (bounded by --duration-s).
+  ControlTarget target;
+  if (options.identify) {
+    if (options.target_deg || options.profile_file || options.pressure_kpa || options.pwm) {
+      throw InputError("identify: no target option (--target-deg, --profile, --pressure-kpa, "
+                       "--pwm): the experiment chooses the pressures");
+    }
+    target.mode = ControlMode::kPressure;
+  } else {
+    target = MakeTarget(options);
+  }
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
   // LoadTrackingConfig has read and checked the `control:` section; defaults without one.
-  const ControlConfig config = tracking_config.control.value_or(ControlConfig{});
-  const double duration_s =
-      options.duration_s.value_or(target.mode == ControlMode::kAngle &&
-                                          target.profile.duration_s() > 0.0
-                                      ? target.profile.duration_s() + 2.0
-                                      : 10.0);
+  ControlConfig config = tracking_config.control.value_or(ControlConfig{});
+  if (options.controller) {
+    std::string problem;
+    if (!options.controller->Check(&problem)) throw InputError("control.controller: " + problem);
+    config.controller = *options.controller;
+  }
+  const double duration_s = options.duration_s.value_or(
+      options.identify ? kMaxIdentifyS
+      : target.mode == ControlMode::kAngle && target.profile.duration_s() > 0.0
+          ? target.profile.duration_s() + 2.0
+          : 10.0);
 
   // The board: a device, or the simulated rig behind a real pseudo-terminal.
   std::unique_ptr<SimulatedRig> rig;
@@ -314,8 +374,17 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
 
   TrackingSession tracking(tracking_config);
-  ControlSink control(session, link, duration_s, /*stop_at_duration=*/rendered == nullptr);
+  ControlSink control(session, link, duration_s,
+                      /*stop_at_duration=*/rendered == nullptr || options.identify);
   std::vector<CsvColumn> extra = control.columns();
+  std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
+  if (options.identify) {
+    extra.push_back(NumberColumn("identify_phase", [&experiment](const FrameResult&) {
+      return experiment && !experiment->samples().empty()
+                 ? std::optional<double>(experiment->samples().back().phase)
+                 : std::nullopt;
+    }));
+  }
   if (rendered != nullptr) {
     extra.push_back(NumberColumn("rig_true_angle_deg", [rendered](const FrameResult&) {
       const std::optional<RigSnapshot>& truth = rendered->truth();
@@ -326,7 +395,11 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
     }));
   }
-  CsvSink csv(options.csv_file, TrackingColumns(tracking_config, extra));
+  // The CSV is optional for an identification run (`softsight identify` without --csv).
+  std::optional<CsvSink> csv;
+  if (!options.csv_file.empty() || !options.identify) {
+    csv.emplace(options.csv_file, TrackingColumns(tracking_config, extra));
+  }
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
   if (rig && rendered == nullptr) {
@@ -334,7 +407,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     sinks.push_back(&*rig_clock);
   }
   sinks.push_back(&control);  // Before the CSV: its columns read this frame's step.
-  sinks.push_back(&csv);
+  if (csv) sinks.push_back(&*csv);
 
   BoardInfo info;
   try {
@@ -352,6 +425,20 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  FormatNumber(session.controller().options().max_kpa).c_str(),
                  FormatNumber(session.pressure_target_kpa()).c_str());
   }
+  if (options.identify) {
+    experiment.emplace(options.identify_options,
+                       IdentificationCeiling(session.controller().options(),
+                                             info.pressure_limit_kpa));
+    control.identify(&*experiment);
+    if (!options.quiet) {
+      std::fprintf(stderr,
+                   "identify: steps of %.3g kPa up to %.3g kPa and back, then a PRBS around a "
+                   "working point; vents and stops on lost markers, no response or a pressure "
+                   "above the ceiling\n",
+                   experiment->ceiling_kpa() / options.identify_options.levels,
+                   experiment->ceiling_kpa());
+    }
+  }
   if (!options.quiet) {
     std::fprintf(stderr,
                  "control: %s: board protocol %d, pressure limit %.1f kPa, inner loop %d Hz, "
@@ -359,12 +446,15 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  transport->name().c_str(), info.protocol_version, info.pressure_limit_kpa,
                  info.loop_hz, info.watchdog_ms);
     const ControllerOptions& c = session.controller().options();
-    std::fprintf(stderr,
-                 "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
-                 "bias %.3g kPa, ff %.3g kPa/deg, output %.3g..%.3g kPa, slew %.3g kPa/s, "
-                 "hold %.3g s\n",
-                 c.kp_kpa_per_deg, c.ki_kpa_per_deg_s, c.kd_kpa_s_per_deg, c.bias_kpa,
-                 c.ff_kpa_per_deg, c.min_kpa, c.max_kpa, c.max_rate_kpa_per_s, c.hold_s);
+    if (!options.identify) {  // The experiment runs open loop: the gains play no part.
+      std::fprintf(stderr,
+                   "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
+                   "bias %.3g kPa, ff %.3g kPa/deg, hysteresis %.3g kPa, lead %.3g s, output "
+                   "%.3g..%.3g kPa, slew %.3g kPa/s, hold %.3g s\n",
+                   c.kp_kpa_per_deg, c.ki_kpa_per_deg_s, c.kd_kpa_s_per_deg, c.bias_kpa,
+                   c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.min_kpa, c.max_kpa,
+                   c.max_rate_kpa_per_s, c.hold_s);
+    }
   }
 
   RunOptions run;
@@ -390,6 +480,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     throw;
   }
   collect();
+  if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
+    session.stop();
+    throw IdentifyAbort("identify: the experiment did not finish (" +
+                        std::string(stop.requested() ? "interrupted" : "the frames ran out") +
+                        " at " + FormatNumber(summary.duration_s) + " s); vented");
+  }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
       summary.stop_reason = rendered != nullptr ? "duration reached" : "end of input";
@@ -404,6 +500,20 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       throw InputError(ran.error);
   }
   session.stop();  // Vent at the end of the run.
+  if (experiment) {
+    IdentifyOutcome outcome;
+    outcome.model = FitActuatorModel(*experiment);
+    const std::vector<IdentifySample>& samples = experiment->samples();
+    const double frame_period_s = (samples.back().time_s - samples.front().time_s) /
+                                  static_cast<double>(std::max<size_t>(1, samples.size() - 1));
+    outcome.tuned = TuneController(&outcome.model, config.controller, frame_period_s,
+                                   options.identify_options.closed_loop_s);
+    outcome.samples = experiment->samples();
+    summary.identified = std::move(outcome);
+  }
+  if (!options.metrics_csv_file.empty()) {
+    WriteTextFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.metrics));
+  }
   return summary;
 }
 
@@ -419,6 +529,7 @@ std::string FormatControlSummary(const ControlSummary& s) {
                   *s.rms_error_deg, s.final_error_deg.value_or(0.0));
     out << line;
   }
+  if (s.metrics.step_to_deg) out << FormatStepMetrics(s.metrics) << "\n";
   std::snprintf(line, sizeof(line),
                 "max board pressure %.2f kPa; link: %llu rejected lines from the board, %llu "
                 "resends; board rejected %u lines\n",
@@ -426,6 +537,42 @@ std::string FormatControlSummary(const ControlSummary& s) {
                 static_cast<unsigned long long>(s.resends), s.board_rejected);
   out << line;
   return out.str();
+}
+
+std::string IdentifyCsvBeside(const std::string& csv_file) {
+  const size_t dot = csv_file.rfind('.');
+  const size_t slash = csv_file.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+    return csv_file + "_identify.csv";
+  }
+  return csv_file.substr(0, dot) + "_identify" + csv_file.substr(dot);
+}
+
+std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
+  const ActuatorModel& m = found.model;
+  const ControllerOptions& c = found.tuned;
+  char saturation[32] = "none seen";
+  if (m.saturation_kpa > 0.0) {
+    std::snprintf(saturation, sizeof(saturation), "%.2f kPa", m.saturation_kpa);
+  }
+  char text[1024];
+  std::snprintf(
+      text, sizeof(text),
+      "identify: static map: straight %.1f deg, bend start %.2f kPa, slope %.3f deg/kPa, "
+      "saturation %s, hysteresis %.2f deg (RMS residual %.2f deg), valid %.1f..%.1f kPa, "
+      "%.1f..%.1f deg\n"
+      "identify: dynamics: pressure lag %.3f s + dead time %.3f s (RMS %.2f kPa); bending lag "
+      "%.3f s + dead time %.3f s (RMS %.2f deg)\n"
+      "identify: gains (SIMC, closed-loop time %.3f s): kp %.3f kPa/deg, ki %.3f kPa/(deg s), "
+      "bias %.2f kPa, ff %.4f kPa/deg, hysteresis %.2f kPa, lead %.3f s, integral band %.1f "
+      "deg\n",
+      m.straight_deg, m.bend_start_kpa, m.slope_deg_per_kpa,
+      saturation,
+      m.hysteresis_deg, m.static_rms_deg, m.valid_min_kpa, m.valid_max_kpa, m.valid_min_deg,
+      m.valid_max_deg, m.pressure_lag_s, m.pressure_dead_time_s, m.pressure_rms_kpa, m.lag_s,
+      m.dead_time_s, m.dynamic_rms_deg, m.closed_loop_s, c.kp_kpa_per_deg, c.ki_kpa_per_deg_s,
+      c.bias_kpa, c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.integral_band_deg);
+  return text;
 }
 
 CommandRunner SetupControlCommand(CLI::App& sub) {
@@ -470,9 +617,38 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                  "Run length in seconds (default: the profile's length + 2 s, else 10 s)");
   sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")
       ->capture_default_str();
+  sub.add_option("--metrics-csv", o->metrics_csv_file,
+                 "Write the step-response figures (rise, settling +-1/+-2 deg, overshoot, "
+                 "steady-state error, RMS error) as a two-line CSV");
+  auto auto_tune = std::make_shared<bool>(false);
+  auto closed_loop_s = std::make_shared<std::optional<double>>();
+  sub.add_flag("--auto-tune", *auto_tune,
+               "Identify the actuator first (`softsight identify`: steps and a PRBS, its CSV "
+               "beside --csv as *_identify.csv), then run the loop with the gains it found");
+  sub.add_option("--closed-loop-s", *closed_loop_s,
+                 "With --auto-tune: the SIMC closed-loop time (default max(dead time, 0.15 s))");
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
-  return [o] {
-    const ControlSummary summary = RunControl(*o);
+  return [o, auto_tune, closed_loop_s] {
+    ControlOptions run = *o;
+    if (*auto_tune) {
+      ControlOptions identify = *o;
+      identify.identify = true;
+      identify.target_deg.reset();
+      identify.profile_file.reset();
+      identify.pressure_kpa.reset();
+      identify.pwm.reset();
+      identify.duration_s.reset();
+      identify.metrics_csv_file.clear();
+      identify.identify_options.closed_loop_s = *closed_loop_s;
+      identify.csv_file = IdentifyCsvBeside(o->csv_file);
+      const ControlSummary found = RunControl(identify);
+      if (!found.identified) throw InputError("control --auto-tune: the identification stopped");
+      if (!o->quiet) std::cerr << FormatIdentifyOutcome(*found.identified);
+      run.controller = found.identified->tuned;
+    } else if (closed_loop_s->has_value()) {
+      throw InputError("control: --closed-loop-s needs --auto-tune");
+    }
+    const ControlSummary summary = RunControl(run);
     if (!o->quiet) std::cerr << FormatControlSummary(summary);
     return 0;
   };

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "control/identify.h"
+#include "control/step_metrics.h"
 #include "softsight/control/session.h"
 
 namespace softsight {
@@ -33,6 +35,21 @@ struct ControlOptions {
   double fps = 30.0;                    // Frame rate of simulate / rig_frames.
   int sim_supersample = 2;              // Renderer supersampling in simulate (speed vs fidelity).
   bool quiet = false;
+  // Identification instead of a target (`softsight identify`, `control --auto-tune`): the
+  // experiment of control/identify.h runs open loop until it is done, then the model is fitted
+  // and gains computed (ControlSummary::identified). No target option then.
+  bool identify = false;
+  IdentifyOptions identify_options;
+  // Replaces the config's control.controller (the gains `--auto-tune` found).
+  std::optional<ControllerOptions> controller;
+  std::string metrics_csv_file;         // The step-response figures (StepMetricsCsv), if given.
+};
+
+// What an identification run found.
+struct IdentifyOutcome {
+  ActuatorModel model;
+  ControllerOptions tuned;                 // The config's controller with the gains from the model.
+  std::vector<IdentifySample> samples;     // Every frame of the experiment.
 };
 
 struct ControlSummary {
@@ -46,11 +63,19 @@ struct ControlSummary {
   uint32_t board_rejected = 0;          // Lines from the host the board rejected.
   uint64_t resends = 0;
   std::string stop_reason;
+  // Angle mode: rise and settling time, overshoot and steady-state error of the last step to a
+  // constant target, RMS error over the run (control/step_metrics.h).
+  StepMetrics metrics;
+  std::optional<IdentifyOutcome> identified;
 };
 
 // Runs the loop. Throws InputError for bad input or a failed link (e.g. the port disappears);
 // every CSV row written before stays intact. `summary_out` receives the summary even then.
 ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary_out = nullptr);
 std::string FormatControlSummary(const ControlSummary& summary);
+// Three lines: the static map, the dynamics, the gains.
+std::string FormatIdentifyOutcome(const IdentifyOutcome& found);
+// "run.csv" -> "run_identify.csv": where `control --auto-tune` writes the identification run.
+std::string IdentifyCsvBeside(const std::string& csv_file);
 
 }  // namespace softsight

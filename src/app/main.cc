@@ -33,6 +33,8 @@ const CommandEntry kCommands[] = {
      SetupLiveCommand},
     {"control", "Close the loop: bend the actuator to a target angle over the serial link",
      SetupControlCommand},
+    {"identify", "Identify the actuator (steps, PRBS) and write a config with gains from the model",
+     SetupIdentifyCommand},
     {"rig", "Simulated pressure-control board + actuator on a pseudo-terminal (no hardware)",
      SetupRigCommand},
     {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",

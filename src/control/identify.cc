@@ -466,6 +466,19 @@ std::vector<double> PredictAngles(const ActuatorModel& m, const std::vector<Iden
   return out;
 }
 
+std::vector<double> PredictPressures(const ActuatorModel& m,
+                                     const std::vector<IdentifySample>& s) {
+  std::vector<double> t, u;
+  for (const IdentifySample& x : s) {
+    t.push_back(x.time_s);
+    u.push_back(x.setpoint_kpa);
+  }
+  if (t.empty()) return {};
+  const double p0 = std::isfinite(s.front().pressure_kpa) ? s.front().pressure_kpa : 0.0;
+  return SimulateLag(t, p0, std::max(1e-3, m.pressure_lag_s), m.pressure_dead_time_s,
+                     [&](double time) { return HeldAt(t, u, time); });
+}
+
 ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
   if (!experiment.straight_deg()) throw IdentifyAbort("identify: the experiment did not finish");
   ActuatorModel m = FitStaticMap(experiment.static_points(), *experiment.straight_deg());

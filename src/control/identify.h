@@ -133,6 +133,9 @@ ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment);
 // uses): for plots of data against model. `samples` as recorded; returns one angle per sample.
 std::vector<double> PredictAngles(const ActuatorModel& model,
                                   const std::vector<IdentifySample>& samples);
+// The inner loop's model: the sensed pressure it predicts from the setpoints sent.
+std::vector<double> PredictPressures(const ActuatorModel& model,
+                                     const std::vector<IdentifySample>& samples);
 
 // The highest setpoint the experiment sends: the controller's max_kpa, at most 90 % of the
 // board's limit and 4 kPa below it (so neither the abort margin nor the board's guard is reached).

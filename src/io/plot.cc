@@ -113,10 +113,14 @@ std::vector<PlotPanel> ChoosePanels(const CsvTable& table) {
   std::vector<PlotPanel> panels;
   const auto angle = table.find("angle_deg");
   const auto target = table.find("target_deg");
+  const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
   if (angle || target) {
     PlotPanel panel = MakePanel("angle [deg]");
     if (target) panel.series.push_back({"target", *target, kTarget});
-    if (angle) panel.series.push_back({target ? "measured" : "angle", *angle, kMeasured});
+    if (model) panel.series.push_back({"model", *model, kTarget});
+    if (angle) {
+      panel.series.push_back({target || model ? "measured" : "angle", *angle, kMeasured});
+    }
     panels.push_back(panel);
   }
   // Millimetres when the CSV has them (a metric model was configured), pixels otherwise.

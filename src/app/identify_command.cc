@@ -1,0 +1,145 @@
+#include "app/identify_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "app/commands.h"
+#include "softsight/core/error.h"
+#include "softsight/io/config.h"
+
+namespace softsight {
+namespace {
+
+// Whether two paths name the same file (also through links, `./`, `..`), whether or not the
+// second exists yet.
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec)) return true;
+  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+}
+
+void WriteOrThrow(const std::string& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) throw InputError(file + ": cannot write it");
+}
+
+}  // namespace
+
+std::string ModelCsv(const IdentifyOutcome& found) {
+  const std::vector<double> angles = PredictAngles(found.model, found.samples);
+  const std::vector<double> pressures = PredictPressures(found.model, found.samples);
+  std::string out =
+      "time_s,identify_phase,setpoint_kpa,board_pressure_kpa,model_pressure_kpa,angle_deg,"
+      "model_angle_deg\n";
+  char line[256];
+  for (size_t k = 0; k < found.samples.size(); ++k) {
+    const IdentifySample& s = found.samples[k];
+    char angle[32] = "";
+    if (s.angle_deg) std::snprintf(angle, sizeof(angle), "%.3f", *s.angle_deg);
+    char pressure[32] = "";
+    if (std::isfinite(s.pressure_kpa)) std::snprintf(pressure, sizeof(pressure), "%.3f", s.pressure_kpa);
+    std::snprintf(line, sizeof(line), "%.4f,%d,%.3f,%s,%.3f,%s,%.3f\n", s.time_s, s.phase,
+                  s.setpoint_kpa, pressure, pressures[k], angle, angles[k]);
+    out += line;
+  }
+  return out;
+}
+
+IdentifyOutcome RunIdentify(const IdentifyCommandOptions& options) {
+  if (options.output_file.empty()) throw InputError("identify: give the config to write (-o)");
+  if (SameFile(options.config_file, options.output_file)) {
+    throw InputError("identify: -o " + options.output_file +
+                     " is the input config; the input is never overwritten: give a new file");
+  }
+  // The input as it is, read (and checked) before the actuator moves.
+  TrackingConfig config = LoadTrackingConfig(options.config_file);
+
+  ControlOptions run;
+  run.config_file = options.config_file;
+  run.simulate = options.simulate;
+  run.port = options.port;
+  run.camera = options.camera;
+  run.rig_frames = options.rig_frames;
+  run.csv_file = options.csv_file;
+  run.fps = options.fps;
+  run.sim_supersample = options.sim_supersample;
+  run.duration_s = options.max_s;
+  run.quiet = options.quiet;
+  run.identify = true;
+  run.identify_options.closed_loop_s = options.closed_loop_s;
+  ControlSummary summary = RunControl(run);
+  if (!summary.identified) {
+    throw IdentifyAbort("identify: the experiment stopped (" + summary.stop_reason +
+                        "); vented, nothing written");
+  }
+  IdentifyOutcome found = std::move(*summary.identified);
+
+  if (!config.control) config.control.emplace();
+  config.control->controller = found.tuned;
+  config.control->model = found.model;
+  std::string problem;
+  if (!config.control->Check(&problem)) {
+    throw InputError("identify: the gains found are outside the allowed ranges (control." +
+                     problem + "); nothing written");
+  }
+  if (!options.model_csv_file.empty()) WriteOrThrow(options.model_csv_file, ModelCsv(found));
+  SaveTrackingConfig(config, options.output_file);
+  return found;
+}
+
+CommandRunner SetupIdentifyCommand(CLI::App& sub) {
+  auto o = std::make_shared<IdentifyCommandOptions>();
+  sub.description(
+      "Identify the actuator and tune the loop: a safe automatic experiment within the\n"
+      "configured pressure limits (pressure steps up and down, then a PRBS around a working\n"
+      "point), open loop, the camera measuring the angle. Fits the static map (bend start,\n"
+      "slope, saturation, hysteresis) and the dynamics (inner pressure loop and bending: lag +\n"
+      "dead time), computes the outer-loop gains (SIMC PI, feed-forward from the static map,\n"
+      "hysteresis compensation) and writes them with a `control: model:` section into a new\n"
+      "config. Vents and stops with one error line when the markers are lost, the angle does\n"
+      "not respond or the pressure goes above the ceiling. See docs/control.md.\n"
+      "Examples:\n"
+      "  softsight identify --config examples/rig.yaml --simulate -o tuned.yaml --csv ident.csv\n"
+      "  softsight identify --config rig.yaml --port /dev/ttyACM0 --camera 0 -o tuned.yaml");
+  sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), read only")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub.add_option("-o,--output", o->output_file,
+                 "The config to write (the input's with the gains and model:); not the input")
+      ->required();
+  sub.add_option("-p,--port", o->port, "Serial device of the board (/dev/ttyACM0, /dev/pts/N)");
+  sub.add_flag("--simulate", o->simulate,
+               "The in-process simulated rig, its frames rendered and tracked (simulated time)");
+  sub.add_option("--camera", o->camera, "Camera index for the frames (live)");
+  sub.add_option("--rig-frames", o->rig_frames,
+                 "Frames from the file `softsight rig --frames FILE` keeps rewriting");
+  sub.add_option("--csv", o->csv_file, "Every frame of the experiment (tracking and board)");
+  sub.add_option("--model-csv", o->model_csv_file,
+                 "Measured against the fitted model per frame, for `softsight plot`");
+  sub.add_option("--closed-loop-s", o->closed_loop_s,
+                 "SIMC closed-loop time constant (default max(dead time, 0.15 s)); larger: "
+                 "gentler gains");
+  sub.add_option("--max-s", o->max_s, "Longest the experiment may take (default 600 s)");
+  sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")->capture_default_str();
+  sub.add_flag("-q,--quiet", o->quiet, "Only errors");
+  return [o] {
+    if (o->closed_loop_s && !(*o->closed_loop_s > 0.0 && *o->closed_loop_s <= 100.0)) {
+      throw InputError("--closed-loop-s " + std::to_string(*o->closed_loop_s) +
+                       ": must be a number in (0, 100]");
+    }
+    const IdentifyOutcome found = RunIdentify(*o);
+    if (!o->quiet) {
+      std::cerr << FormatIdentifyOutcome(found);
+      std::cerr << "identify: wrote " << o->output_file << "\n";
+    }
+    return 0;
+  };
+}
+
+}  // namespace softsight

@@ -1,0 +1,37 @@
+// `softsight identify`: a safe automatic experiment on the actuator (control/identify.h), the
+// model fitted to it, gains from the model, all saved into a new config (never the input one).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "app/control_command.h"
+
+namespace softsight {
+
+struct IdentifyCommandOptions {
+  std::string config_file;    // Markers + `control:` section, read only.
+  std::string output_file;    // The config to write: the input's, plus model: and the gains.
+  bool simulate = false;      // The in-process simulated rig, rendered and tracked.
+  std::optional<std::string> port;
+  std::optional<int> camera;
+  std::optional<std::string> rig_frames;
+  std::string csv_file;       // Every frame of the experiment (optional).
+  std::string model_csv_file; // Measured against the fitted model, per frame (optional).
+  double fps = 30.0;          // Of --simulate and --rig-frames.
+  int sim_supersample = 2;
+  std::optional<double> closed_loop_s;  // SIMC tau_c.
+  std::optional<double> max_s;          // Bound on the experiment's length (default 600 s).
+  bool quiet = false;
+};
+
+// Runs the experiment, fits, tunes and writes output_file (only when everything succeeded).
+// Throws InputError (IdentifyAbort for an experiment stopped for safety) after venting; the
+// output is then not written. Refuses an output that is the input.
+IdentifyOutcome RunIdentify(const IdentifyCommandOptions& options);
+
+// The model CSV: time_s, identify_phase, setpoint_kpa, board_pressure_kpa, model_pressure_kpa,
+// angle_deg, model_angle_deg (softsight plot draws measured against model).
+std::string ModelCsv(const IdentifyOutcome& found);
+
+}  // namespace softsight

@@ -1,0 +1,166 @@
+// `softsight identify` and `control --auto-tune` end to end on the simulated rig: rendered frames
+// through the tracker, the board over a real pseudo-terminal, simulated time.
+#include "app/identify_command.h"
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/io/config.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::ReadLines;
+using testing::ReadTextFile;
+using testing::SplitCsv;
+using testing::TempDir;
+using testing::WriteTextFile;
+
+std::string Example() { return testing::SourceDir() + "/examples/rig.yaml"; }
+
+TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTheInput) {
+  TempDir dir;
+  const std::string input = dir.file("rig.yaml");
+  WriteTextFile(input, ReadTextFile(Example()));
+  IdentifyCommandOptions o;
+  o.config_file = input;
+  o.output_file = dir.file("tuned.yaml");
+  o.simulate = true;
+  o.sim_supersample = 1;
+  o.csv_file = dir.file("ident.csv");
+  o.model_csv_file = dir.file("model.csv");
+  o.quiet = true;
+  const IdentifyOutcome found = RunIdentify(o);
+  EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));  // Never touched.
+
+  // The example's plant: 6 deg of bend per kPa, 0.4 deg of angle per degree of bend; lag 0.15 s.
+  EXPECT_NEAR(found.model.slope_deg_per_kpa, 2.4, 0.24);
+  EXPECT_NEAR(found.model.lag_s, 0.15, 0.045);
+  EXPECT_NEAR(found.model.bend_start_kpa, 3.0, 1.0);
+  // The renderer's end stop (240 deg of bend, angle 84 deg) is a saturation the camera sees.
+  EXPECT_NEAR(found.model.saturation_kpa, 3.0 + (240 + 1.5) / 6.0, 1.5);
+
+  const TrackingConfig tuned = LoadTrackingConfig(o.output_file);
+  ASSERT_TRUE(tuned.control);
+  EXPECT_DOUBLE_EQ(tuned.control->model.slope_deg_per_kpa, found.model.slope_deg_per_kpa);
+  EXPECT_DOUBLE_EQ(tuned.control->controller.kp_kpa_per_deg, found.tuned.kp_kpa_per_deg);
+  EXPECT_NEAR(tuned.control->controller.ff_kpa_per_deg, 1.0 / found.model.slope_deg_per_kpa,
+              1e-12);
+  EXPECT_EQ(tuned.markers.size(), 3u);
+  EXPECT_EQ(tuned.control->rig.plant.chamber_volume_ml, 20.0);  // The rest is the input's.
+
+  // The run's CSV and the model's, which `softsight plot` draws.
+  const std::vector<std::string> rows = ReadLines(o.csv_file);
+  EXPECT_EQ(rows.size(), found.samples.size() + 1);
+  EXPECT_THAT(rows[0], HasSubstr("identify_phase"));
+  const std::vector<std::string> model = ReadLines(o.model_csv_file);
+  ASSERT_EQ(model.size(), found.samples.size() + 1);
+  EXPECT_EQ(model[0], "time_s,identify_phase,setpoint_kpa,board_pressure_kpa,model_pressure_kpa,"
+                      "angle_deg,model_angle_deg");
+  const std::string plot = std::string("\"") + testing::SoftsightBinary() + "\" plot " +
+                           o.model_csv_file + " -o " + dir.file("model.png") + " > /dev/null";
+  EXPECT_EQ(std::system(plot.c_str()), 0);
+}
+
+TEST(IdentifyCommand, RefusesToOverwriteTheInputConfig) {
+  TempDir dir;
+  const std::string input = dir.file("rig.yaml");
+  WriteTextFile(input, ReadTextFile(Example()));
+  IdentifyCommandOptions o;
+  o.config_file = input;
+  o.simulate = true;
+  const std::string up = (dir.path() / ".." / dir.path().filename() / "rig.yaml").string();
+  for (const std::string& same : {input, dir.file("./rig.yaml"), up}) {
+    o.output_file = same;
+    try {
+      RunIdentify(o);
+      ADD_FAILURE() << same;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("is the input config; the input is never overwritten"));
+    }
+  }
+  EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));
+  // Through the program: one line, exit code 2.
+  const std::string command = std::string("\"") + testing::SoftsightBinary() +
+                              "\" identify --config " + input + " --simulate -o " + input +
+                              " 2> " + dir.file("err.txt");
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(ReadLines(dir.file("err.txt")).size(), 1u) << ReadTextFile(dir.file("err.txt"));
+}
+
+TEST(IdentifyCommand, MarkersThatAreNeverSeenStopItVentedWithOneErrorAndNoConfig) {
+  TempDir dir;
+  // Markers of colours the scene does not have: nothing is found.
+  WriteTextFile(dir.file("rig.yaml"), R"(markers:
+  - name: a
+    hsv: {h: [140, 150], s: [250, 255], v: [250, 255]}
+  - name: b
+    hsv: {h: [150, 160], s: [250, 255], v: [250, 255]}
+  - name: c
+    hsv: {h: [160, 165], s: [250, 255], v: [250, 255]}
+triple: [a, b, c]
+)");
+  const std::string command = std::string("\"") + testing::SoftsightBinary() +
+                              "\" identify --config " + dir.file("rig.yaml") + " --simulate -o " +
+                              dir.file("tuned.yaml") + " --csv " + dir.file("ident.csv") +
+                              " 2> " + dir.file("err.txt");
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::vector<std::string> err = ReadLines(dir.file("err.txt"));
+  int errors = 0;
+  for (const std::string& line : err) errors += line.find("error") != std::string::npos;
+  EXPECT_EQ(errors, 1) << ReadTextFile(dir.file("err.txt"));
+  EXPECT_THAT(ReadTextFile(dir.file("err.txt")), HasSubstr("identify: markers lost for 0.30 s at 0.30 s"));
+  EXPECT_FALSE(std::ifstream(dir.file("tuned.yaml")).good());
+}
+
+TEST(ControlCommand, AutoTuneIdentifiesThenRunsTheLoopWithTheGainsFound) {
+  TempDir dir;
+  ControlOptions o;
+  o.config_file = Example();
+  o.simulate = true;
+  o.sim_supersample = 1;
+  o.target_deg = 120.0;
+  o.duration_s = 4.0;
+  o.csv_file = dir.file("run.csv");
+  o.metrics_csv_file = dir.file("metrics.csv");
+  o.quiet = true;
+  // What `control --auto-tune` does: the identification (its CSV beside the run's), then the loop.
+  ControlOptions identify = o;
+  identify.identify = true;
+  identify.target_deg.reset();
+  identify.duration_s.reset();
+  identify.metrics_csv_file.clear();
+  identify.csv_file = IdentifyCsvBeside(o.csv_file);
+  EXPECT_EQ(identify.csv_file, dir.file("run_identify.csv"));
+  const ControlSummary found = RunControl(identify);
+  ASSERT_TRUE(found.identified);
+  o.controller = found.identified->tuned;
+  const ControlSummary run = RunControl(o);
+  // The tracked angle: 180 -> 120 deg settles within +-1 deg in under 2 s, overshoot under 5 %.
+  ASSERT_TRUE(run.metrics.settling_1deg_s) << FormatStepMetrics(run.metrics);
+  EXPECT_LT(*run.metrics.settling_1deg_s, 2.0) << FormatStepMetrics(run.metrics);
+  EXPECT_LT(*run.metrics.overshoot_percent, 5.0) << FormatStepMetrics(run.metrics);
+  EXPECT_THAT(FormatControlSummary(run), HasSubstr("settling +-1 deg"));
+  const std::vector<std::string> metrics = ReadLines(o.metrics_csv_file);
+  ASSERT_EQ(metrics.size(), 2u);
+  EXPECT_EQ(metrics[0], "step_time_s,step_from_deg,step_to_deg,rise_time_s,settling_1deg_s,"
+                        "settling_2deg_s,overshoot_percent,steady_state_error_deg,rms_error_deg");
+  EXPECT_EQ(SplitCsv(metrics[1]).size(), 9u);
+  EXPECT_GT(ReadLines(identify.csv_file).size(), 300u);
+}
+
+}  // namespace
+}  // namespace softsight
