@@ -13,6 +13,7 @@
 #include "softsight/gui/live_window.h"
 #include "softsight/io/config.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/io/paced_source.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {
@@ -64,10 +65,17 @@ int RunLive(const LiveArgs& args) {
   LiveController controller(config, options);
   std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
             << " markers; press h in the window for help\n";
-  FrameGrabber grabber(std::move(source), !args.no_pace);
+  // Pacing belongs to the source: a camera keeps only its newest frame (drops are counted and
+  // shown); a file or image sequence plays every frame at its own rate and pauses with the
+  // window (or, with --no-pace, as fast as it decodes).
+  if (source->is_live()) {
+    source = std::make_unique<NewestFrameSource>(std::move(source));
+  } else if (!args.no_pace) {
+    source = std::make_unique<PacedFrameSource>(std::move(source));
+  }
   LiveWindowOptions window;
   window.trackbars = !args.no_trackbars;
-  const int code = RunLiveWindow(controller, grabber, window);
+  const int code = RunLiveWindow(controller, *source, window);
   if (!controller.last_recording().empty()) {
     std::cerr << "softsight live: last recording " << controller.last_recording() << ".*\n";
   }

@@ -4,12 +4,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
-#include "softsight/io/csv_writer.h"
+#include "softsight/pipeline/sinks.h"
 
 namespace softsight {
 namespace {
@@ -42,15 +43,13 @@ std::string RangeText(const HsvRange& r) {
 
 }  // namespace
 
-// The files of one recording. The raw video is lossless (FFV1) so that `softsight track` with
-// the saved config sees exactly the pixels the live session saw.
+// The files of one recording, as the pipeline's sinks: the CSV, the raw video (lossless FFV1, so
+// that `softsight track` with the saved config sees exactly the pixels the live session saw) and
+// the annotated video. Every processed frame goes to every sink.
 struct LiveController::Recording {
   std::string prefix;
-  std::unique_ptr<CsvWriter> csv;
-  cv::VideoWriter annotated, raw;
+  std::vector<std::unique_ptr<FrameSink>> sinks;
   int64_t frames = 0;
-  int64_t first_index = 0;
-  double first_time_s = 0.0;
 };
 
 bool LiveOptions::Check(std::string* error) const {
@@ -79,19 +78,23 @@ bool LiveOptions::Check(std::string* error) const {
 }
 
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options)
-    : config_(config), options_(std::move(options)), chart_(options_.chart) {
+    : options_(std::move(options)), chart_(options_.chart) {
   std::string error;
   if (!options_.Check(&error)) throw InputError("live options: " + error);
-  if (config_.markers.empty()) throw InputError(config_.source_file + ": no markers to track");
-  options_.overlay.base = config_.measure.base;
-  options_.overlay.middle = config_.measure.middle;
-  options_.overlay.tip = config_.measure.tip;
-  session_ = std::make_unique<TrackingSession>(config_);
+  if (config.markers.empty()) throw InputError(config.source_file + ": no markers to track");
+  options_.overlay.base = config.measure.base;
+  options_.overlay.middle = config.measure.middle;
+  options_.overlay.tip = config.measure.tip;
+  // The session holds the only copy of the config: every live edit goes through it, and `s`
+  // and recordings save what it holds.
+  session_ = std::make_unique<TrackingSession>(config);
   frame_times_.reserve(kFpsWindow);
   say("press h for help");
 }
 
 LiveController::~LiveController() = default;
+
+const TrackingConfig& LiveController::config() const { return session_->config(); }
 
 void LiveController::say(const std::string& message) {
   message_ = message;
@@ -104,6 +107,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   frame.image.copyTo(frame_);
   frame_index_ = frame.index;
   ended_ = false;
+  frame_time_s_ = frame.time_s;
   const FrameResult& result = session_->process(frame);
   chart_.add(result);
 
@@ -121,7 +125,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
     const double span_s = std::chrono::duration<double>(now - oldest).count();
     if (span_s > 0) fps_ = (frame_times_.size() - 1) / span_s;
   }
-  record_frame(result);
+  record_frame(frame, result);
   // Latency: from capture to the annotated (and recorded) result, as the window is about to show
   // it. The overlay shows the smoothed value up to the previous frame.
   const double latency =
@@ -133,11 +137,14 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
 void LiveController::redraw_annotated() {
   if (frame_.empty()) return;
   frame_.copyTo(annotated_);
-  if (!last_result_) return;
+  if (last_result_) draw_overlay(annotated_, *last_result_);
+}
+
+void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) const {
   OverlayStatus status;
   status.fps = fps_;
   status.latency_ms = latency_ms_;
-  DrawOverlay(annotated_, *last_result_, options_.overlay, status);
+  DrawOverlay(image, result, options_.overlay, status);
 }
 
 void LiveController::on_end_of_input() {
@@ -155,7 +162,7 @@ std::optional<cv::Point2d> LiveController::position_of(int marker) const {
 std::optional<int> LiveController::marker_at(const cv::Point2d& p, double max_distance) const {
   std::optional<int> best;
   double best_distance = max_distance;
-  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
+  for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
     const auto position = position_of(i);
     if (!position) continue;
     const double d = std::hypot(position->x - p.x, position->y - p.y);
@@ -174,21 +181,20 @@ cv::Rect LiveController::box_around(const cv::Point2d& p) const {
 }
 
 void LiveController::select_marker(int index) {
-  if (index < 0 || index >= static_cast<int>(config_.markers.size())) {
+  if (index < 0 || index >= static_cast<int>(config().markers.size())) {
     say("no marker " + std::to_string(index + 1) + " (the config has " +
-        std::to_string(config_.markers.size()) + ")");
+        std::to_string(config().markers.size()) + ")");
     return;
   }
   active_ = index;
   ++hsv_revision_;
-  say("active marker: " + config_.markers[index].name);
+  say("active marker: " + config().markers[index].name);
 }
 
 void LiveController::apply_spec(int marker, const MarkerSpec& spec,
                                 const std::optional<cv::Rect>& hint) {
   try {
     session_->respec(spec);
-    config_.markers[marker] = spec;
     if (hint && !hint->empty() && !frame_.empty()) session_->reselect(spec.name, frame_, *hint);
   } catch (const InputError& e) {
     // A live edit that cannot be used is reported on screen; the session keeps running.
@@ -204,11 +210,11 @@ void LiveController::click(const cv::Point2d& p) {
   std::string why;
   const auto pick = PickHsvRange(frame_, p, options_.picker, &why);
   if (!pick) {
-    say("colour pick for " + config_.markers[marker].name + ": " + why);
+    say("colour pick for " + config().markers[marker].name + ": " + why);
     return;
   }
   active_ = marker;
-  MarkerSpec spec = config_.markers[marker];
+  MarkerSpec spec = config().markers[marker];
   spec.colour.h = pick->h;
   spec.colour.s = pick->s;
   spec.colour.v = pick->v;
@@ -232,7 +238,7 @@ void LiveController::drag(const cv::Rect& dragged) {
   // The marker inside the box, if exactly one is; else the active marker.
   std::optional<int> inside;
   int count = 0;
-  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
+  for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
     const auto position = position_of(i);
     if (position && rect.contains(cv::Point(cvRound(position->x), cvRound(position->y)))) {
       inside = i;
@@ -240,20 +246,14 @@ void LiveController::drag(const cv::Rect& dragged) {
     }
   }
   const int marker = count == 1 ? *inside : active_;
-  MarkerSpec& spec = config_.markers[marker];
+  const MarkerSpec& spec = config().markers[marker];
   try {
+    // The session remembers the selection in its config (the template's pixels, or the colour
+    // search box), so that `s` saves it.
     session_->reselect(spec.name, frame_, rect);
   } catch (const InputError& e) {
     say(e.what());
     return;
-  }
-  // Remember the selection in the config, so that `s` saves it.
-  if (IsTemplateMethod(spec.method)) {
-    spec.templ.rect = rect;
-    spec.templ.template_frame = static_cast<int>(frame_index_);
-    spec.templ.image = frame_(rect).clone();
-  } else {
-    spec.colour.roi = rect;
   }
   if (active_ != marker) ++hsv_revision_;
   active_ = marker;
@@ -263,23 +263,17 @@ void LiveController::drag(const cv::Rect& dragged) {
 
 void LiveController::switch_method() {
   const std::vector<std::string> methods = TrackerMethods();
-  const auto current = std::find(methods.begin(), methods.end(), config_.markers[active_].method);
+  const auto current = std::find(methods.begin(), methods.end(), config().markers[active_].method);
   const std::string next =
       current == methods.end() || current + 1 == methods.end() ? methods.front() : *(current + 1);
-  for (int i = 0; i < static_cast<int>(config_.markers.size()); ++i) {
-    MarkerSpec spec = config_.markers[i];
+  for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
+    MarkerSpec spec = config().markers[i];
     spec.method = next;
     std::optional<cv::Rect> hint;
     if (const auto position = position_of(i); position && !frame_.empty()) {
       hint = box_around(*position);
-      if (IsTemplateMethod(next)) {
-        // A new template from the frame on screen, where the marker is now.
-        spec.templ.rect = *hint;
-        spec.templ.template_frame = static_cast<int>(frame_index_);
-        spec.templ.image = frame_(*hint).clone();
-      } else {
-        spec.colour.roi = *hint;
-      }
+      // The hint cuts a new template from the frame on screen, where the marker is now (the
+      // session keeps its pixels for `s`), or is the colour tracker's first search box.
     }
     apply_spec(i, spec, hint);
   }
@@ -289,7 +283,7 @@ void LiveController::switch_method() {
 void LiveController::set_hsv(int trackbar, int value) {
   if (trackbar < 0 || trackbar >= static_cast<int>(kHsvTrackbars.size())) return;
   value = std::clamp(value, 0, kHsvTrackbars[trackbar].max);
-  MarkerSpec spec = config_.markers[active_];
+  MarkerSpec spec = config().markers[active_];
   HsvRange* ranges[3] = {&spec.colour.h, &spec.colour.s, &spec.colour.v};
   int& field = trackbar % 2 == 0 ? ranges[trackbar / 2]->lo : ranges[trackbar / 2]->hi;
   if (field == value) return;  // The adapter moving its own trackbar: nothing changed.
@@ -301,15 +295,40 @@ void LiveController::set_hsv(int trackbar, int value) {
 }
 
 std::array<int, 6> LiveController::active_hsv() const {
-  const ColourParams& c = config_.markers[active_].colour;
+  const ColourParams& c = config().markers[active_].colour;
   return {c.h.lo, c.h.hi, c.s.lo, c.s.hi, c.v.lo, c.v.hi};
 }
+
+namespace {
+
+// A template held as pixels (cut live, or read from a file) is written as an image beside the
+// config, `<config without extension>.<marker>.png`, and the config names it (`template: {file:
+// ...}`): a rectangle on frame 0 would cut the wrong pixels (the marker has moved since). Writes
+// the images and returns the config to save.
+TrackingConfig WithTemplateImages(const TrackingConfig& config, const std::string& path) {
+  TrackingConfig saved = config;
+  const std::filesystem::path file(path);
+  for (MarkerSpec& spec : saved.markers) {
+    if (!IsTemplateMethod(spec.method) || spec.templ.image.empty()) continue;
+    const std::string name = file.stem().string() + "." + spec.name + ".png";
+    const std::string image_path = (file.parent_path() / name).string();
+    if (!cv::imwrite(image_path, spec.templ.image)) {
+      throw InputError(image_path + ": cannot write the template image");
+    }
+    spec.templ.image_file = name;  // Relative to the config, as the reader resolves it.
+    spec.templ.rect.reset();
+    spec.templ.template_frame = 0;
+  }
+  return saved;
+}
+
+}  // namespace
 
 void LiveController::save_config() {
   const std::string path =
       options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
   try {
-    SaveTrackingConfig(config_, path);
+    SaveTrackingConfig(WithTemplateImages(config(), path), path);
     say("saved " + path);
   } catch (const InputError& e) {
     say(e.what());
@@ -364,6 +383,7 @@ void LiveController::scale_point(const cv::Point2d& p) {
     return;
   }
   MetricModel metric;
+  const bool replaces_plane = config().measure.metric.plane_mm_from_image.has_value();
   try {
     metric.scale_mm_per_px = ScaleFromTwoPoints(a, b, distance_mm, "scale points");
     metric.scale_points = MetricModel::ScalePoints{a, b, distance_mm};
@@ -373,16 +393,15 @@ void LiveController::scale_point(const cv::Point2d& p) {
     say(std::string(e.what()) + "; click the first point again");
     return;
   }
-  const bool replaced_plane = config_.measure.metric.plane_mm_from_image.has_value();
-  config_.measure.metric = metric;
+  const bool replaced_plane = replaces_plane;
   scale_mode_ = false;
   scale_clicks_.clear();
   pointer_.reset();
   // Measure the frame on screen again, so the mm values appear now, also while paused. The
   // strip chart restarts in mm: its px history cannot share the new axis.
   if (!frame_.empty()) {
-    record_frame(session_->process(
-        Frame{frame_, frame_index_, last_result_ ? last_result_->time_s : 0.0}));
+    const Frame again{frame_, frame_index_, frame_time_s_};
+    record_frame(again, session_->process(again));
     chart_.clear();
     chart_.add(*last_result_);
   }
@@ -406,6 +425,9 @@ void LiveController::toggle_recording() {
   if (recording_) {
     const int64_t frames = recording_->frames;
     last_recording_ = recording_->prefix;
+    RunSummary summary;
+    summary.frames = frames;
+    for (auto& sink : recording_->sinks) sink->end(summary);
     recording_.reset();  // Closes the CSV and both videos.
     say("recorded " + std::to_string(frames) + " frames to " + last_recording_ + ".*");
     return;
@@ -427,7 +449,8 @@ void LiveController::toggle_recording() {
     // screen as its frame 0, every tracker is rebuilt from the saved config exactly as `track`
     // builds it (a search box, or a template cut on frame 0, around where each marker is now),
     // and the bending-distance reference restarts at that frame.
-    TrackingConfig snapshot = config_;
+    TrackingConfig snapshot = config();
+    snapshot.recording.reset();
     for (int i = 0; i < static_cast<int>(snapshot.markers.size()); ++i) {
       MarkerSpec& spec = snapshot.markers[i];
       const auto position = position_of(i);
@@ -442,25 +465,29 @@ void LiveController::toggle_recording() {
     }
     auto recording = std::make_unique<Recording>();
     recording->prefix = prefix;
-    recording->csv = std::make_unique<CsvWriter>(prefix + ".csv", TrackingColumns(config_));
-    const double fps = options_.record_fps.value_or(fps_.value_or(30.0));
-    recording->annotated.open(prefix + ".avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                              frame_.size());
-    recording->raw.open(prefix + ".raw.avi", cv::VideoWriter::fourcc('F', 'F', 'V', '1'), fps,
-                        frame_.size());
-    if (!recording->annotated.isOpened() || !recording->raw.isOpened()) {
-      throw InputError(prefix + ".avi: cannot open a video writer (FFmpeg with MJPG and FFV1)");
-    }
+    RunInfo info;
+    info.frame_size = frame_.size();
+    info.fps = options_.record_fps.value_or(fps_.value_or(30.0));
+    for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
+    const MetricModel& metric = snapshot.measure.metric;
+    info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
+    recording->sinks.push_back(
+        std::make_unique<CsvSink>(prefix + ".csv", TrackingColumns(snapshot)));
+    recording->sinks.push_back(std::make_unique<VideoSink>(prefix + ".raw.avi", "ffv1", info.fps));
+    recording->sinks.push_back(std::make_unique<VideoSink>(
+        prefix + ".avi", "mjpg", info.fps,
+        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); }));
+    for (auto& sink : recording->sinks) sink->begin(info);
+    // The raw video's frame 0 is this source frame: its config says so (`recording:`), so that
+    // `track` on it numbers and times the rows as the source did, like the live CSV.
+    snapshot.recording = RecordingOrigin{frame_index_, frame_time_s_};
     SaveTrackingConfig(snapshot, prefix + ".yaml");
 
     for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
     session_->reset_tip_reference();
-    config_ = snapshot;
-    recording->first_index = frame_index_;
-    recording->first_time_s = last_result_ ? last_result_->time_s : 0.0;
     recording_ = std::move(recording);
-    Frame again{frame_.clone(), frame_index_, recording_->first_time_s};
-    record_frame(session_->process(again));
+    const Frame again{frame_.clone(), frame_index_, frame_time_s_};
+    record_frame(again, session_->process(again));
     ++hsv_revision_;
     say("recording to " + prefix + ".*");
   } catch (const InputError& e) {
@@ -469,17 +496,20 @@ void LiveController::toggle_recording() {
   }
 }
 
-void LiveController::record_frame(const FrameResult& result) {
+void LiveController::record_frame(const Frame& frame, const FrameResult& result) {
   last_result_ = result;
   redraw_annotated();
   if (!recording_) return;
-  // Rows and frames count from the start of the recording, like the raw video they describe.
-  FrameResult row = result;
-  row.frame_index -= recording_->first_index;
-  row.time_s -= recording_->first_time_s;
-  recording_->csv->write(row);
-  recording_->annotated.write(annotated_);
-  recording_->raw.write(frame_);
+  // Rows carry the source's frame index and timestamp, as every CSV does.
+  try {
+    for (auto& sink : recording_->sinks) sink->consume(frame, result);
+  } catch (const InputError& e) {
+    // A full disk: stop recording (what is written stays), keep the window running.
+    ++recording_->frames;
+    toggle_recording();
+    say(e.what());
+    return;
+  }
   ++recording_->frames;
 }
 
@@ -585,9 +615,10 @@ const cv::Mat& LiveController::canvas() {
   if (recording_) state += "REC " + recording_->prefix + "  ";
   if (paused_) state += "PAUSED  ";
   if (ended_) state += "END  ";
+  if (dropped_ > 0) state += "dropped " + std::to_string(dropped_) + "  ";
   state +=
-      "active: " + config_.markers[active_].name + " (" + config_.markers[active_].method + ")";
-  if (const auto& scale = config_.measure.metric.scale_mm_per_px) {
+      "active: " + config().markers[active_].name + " (" + config().markers[active_].method + ")";
+  if (const auto& scale = config().measure.metric.scale_mm_per_px) {
     state += "  " + Number(*scale, 4) + " mm/px";
   }
   lines.push_back(state);

@@ -9,6 +9,13 @@
 #include <opencv2/videoio.hpp>
 
 #include "softsight/core/error.h"
+#include "softsight/gui/live_feed.h"
+#include "softsight/io/csv_columns.h"
+#include "softsight/io/frame_writer.h"
+#include "softsight/io/paced_source.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sinks.h"
+#include <fstream>
 #include "softsight/io/config.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/scene.h"
@@ -278,11 +285,14 @@ TEST_F(LiveControllerTest, RecordingIsReproducedByTrackingTheRawVideoWithItsConf
     EXPECT_TRUE(fs::exists(prefix + ext)) << ext;
   }
 
-  // 7 rows: the frame on screen when recording started (2), then frames 3..8, numbered from 0.
+  // 7 rows: the frame on screen when recording started (2), then frames 3..8, numbered as the
+  // source numbers them.
   const CsvTable table = ReadCsvTable(prefix + ".csv");
   ASSERT_EQ(table.row_count(), 7u);
-  EXPECT_EQ(*table.values[*table.find("frame")][0], 0);
-  EXPECT_EQ(*table.values[*table.find("frame")][6], 6);
+  EXPECT_EQ(*table.values[*table.find("frame")][0], 2);
+  EXPECT_EQ(*table.values[*table.find("frame")][6], 8);
+  ASSERT_TRUE(LoadTrackingConfig(prefix + ".yaml").recording);
+  EXPECT_EQ(LoadTrackingConfig(prefix + ".yaml").recording->first_frame, 2);
   EXPECT_EQ(*table.values[*table.find("tip_disp_px")][0], 0.0);  // Reference restarts.
 
   // `softsight track` on the raw video with the saved config gives the same rows.
@@ -469,6 +479,172 @@ TEST_F(LiveControllerTest, BadOptionsOrConfigAreInputErrors) {
   EXPECT_THROW(LiveController(SceneConfig(), options), InputError);
   TrackingConfig empty;
   EXPECT_THROW(LiveController(empty, Options()), InputError);
+}
+
+}  // namespace
+}  // namespace softsight
+
+namespace softsight {
+namespace {
+
+// The lines of a CSV without the last column (proc_ms, a timing that differs from run to run).
+std::vector<std::string> RowsWithoutTiming(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(line.substr(0, line.rfind(',')));
+  return rows;
+}
+
+// `softsight track --config <config> --input <video> --csv <csv>`, through the same pipeline.
+void Track(const std::string& config_file, const std::string& video, const std::string& csv) {
+  const TrackingConfig config = LoadTrackingConfig(config_file);
+  FrameSourceSpec spec;
+  spec.input = video;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  TrackingSession session(config);
+  std::vector<std::string> names;
+  for (const MarkerSpec& m : config.markers) names.push_back(m.name);
+  CsvSink sink(csv, TrackingColumns(names, false));
+  const RunSummary summary = RunPipeline(*source, session, {&sink});
+  ASSERT_TRUE(summary.error.empty()) << summary.error;
+}
+
+// A fake clock for PacedFrameSource: waiting moves the time forward at once, so the test never
+// sleeps and a loaded machine cannot change what it sees.
+struct FakeClock {
+  PacedFrameSource::Clock::time_point now{};
+  std::vector<PacedFrameSource::Clock::time_point> waits;  // Every sleep_until target.
+  PacingClock timing() {
+    PacingClock timing;
+    timing.now = [this] { return now; };
+    timing.sleep_until = [this](PacedFrameSource::Clock::time_point t) {
+      waits.push_back(t);
+      if (t > now) now = t;
+    };
+    return timing;
+  }
+};
+
+class LiveFileTest : public LiveControllerTest {
+ protected:
+  // The rendered scene as a lossless 30 fps video, the file a person would play in `live`.
+  std::string WriteVideo(int frames) {
+    const std::string path = (dir_ / "scene.avi").string();
+    FrameWriterOptions options;
+    options.path = path;
+    options.fps = 30.0;
+    FrameWriter writer(options);
+    cv::Mat image;
+    for (int i = 0; i < frames; ++i) {
+      scene_->render(i, image);
+      writer.write(image, i);
+    }
+    writer.close();
+    return path;
+  }
+  std::unique_ptr<PacedFrameSource> PlayFile(const std::string& path, FakeClock& clock) {
+    FrameSourceSpec spec;
+    spec.input = path;
+    return std::make_unique<PacedFrameSource>(OpenFrameSource(spec), clock.timing());
+  }
+};
+
+TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrackReproduces) {
+  const std::string video = WriteVideo(24);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveOptions options = Options();
+  options.record_fps = 30.0;  // What the command takes from the source.
+  LiveController live(SceneConfig(), options);
+  LiveFeed feed(*source);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(feed.step(live));
+  EXPECT_EQ(live.last_result()->frame_index, 6);
+
+  // Pause: no frame is read however long it lasts, and the source's clock stops.
+  live.on_event(UiEvent::Key(' '));
+  ASSERT_TRUE(live.paused());
+  for (int i = 0; i < 5; ++i) EXPECT_FALSE(feed.step(live));
+  EXPECT_TRUE(source->paused());
+  const auto paused_at = clock.now;
+  clock.now += std::chrono::seconds(14);  // A long pause (418 frames at 30 fps).
+  live.on_event(UiEvent::Key(' '));
+  ASSERT_TRUE(feed.step(live));
+  // Resume: the next frame, one frame period after the resume (no jump, no burst).
+  EXPECT_EQ(live.last_result()->frame_index, 7);
+  EXPECT_FALSE(source->paused());
+  ASSERT_FALSE(clock.waits.empty());
+  EXPECT_GT(clock.waits.back(), paused_at + std::chrono::seconds(14));
+  EXPECT_LE(clock.waits.back(), paused_at + std::chrono::seconds(14) + std::chrono::milliseconds(34));
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_FALSE(live.recording());
+  EXPECT_EQ(source->dropped_frames(), 0);
+
+  // The CSV: consecutive frames 2..12, the source's own indices and timestamps.
+  const std::string prefix = live.last_recording();
+  const CsvTable table = ReadCsvTable(prefix + ".csv");
+  ASSERT_EQ(table.row_count(), 11u);
+  for (size_t row = 0; row < table.row_count(); ++row) {
+    EXPECT_EQ(*table.values[*table.find("frame")][row], 2.0 + row);
+    EXPECT_NEAR(*table.values[*table.find("time_s")][row], (2.0 + row) / 30.0, 1e-6);
+  }
+
+  // Re-tracking the raw recording with its saved config gives the same rows, frame and time_s
+  // included (the config's `recording:` key says where the raw video starts).
+  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+  const std::vector<std::string> live_rows = RowsWithoutTiming(prefix + ".csv");
+  const std::vector<std::string> again = RowsWithoutTiming((dir_ / "again.csv").string());
+  ASSERT_EQ(live_rows.size(), 12u);  // Header and 11 rows.
+  EXPECT_EQ(again, live_rows);
+}
+
+TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfterTheReselection) {
+  const std::string video = WriteVideo(30);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source);
+  for (int i = 0; i < 8; ++i) ASSERT_TRUE(feed.step(live));
+  // `m` three times: colour -> sad -> ssd -> zncc, templates cut where the markers are on frame
+  // 7; then a drag re-cuts blue's template on frame 12.
+  for (int i = 0; i < 3; ++i) live.on_event(UiEvent::Key('m'));
+  ASSERT_EQ(live.config().markers[0].method, "zncc");
+  std::vector<FrameResult> shown;
+  while (feed.step(live)) {
+    shown.push_back(*live.last_result());
+    if (live.last_result()->frame_index == 12) {
+      const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+      Drag(live, blue - cv::Point2d(11, 11), blue + cv::Point2d(11, 11));
+      ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
+    }
+  }
+  live.on_event(UiEvent::Key('s'));
+  const std::string saved = (dir_ / "saved.yaml").string();
+  ASSERT_NE(live.message().find("saved"), std::string::npos) << live.message();
+  for (const char* marker : {"red", "blue", "green"}) {
+    EXPECT_TRUE(fs::exists(dir_ / ("saved." + std::string(marker) + ".png"))) << marker;
+  }
+
+  Track(saved, video, (dir_ / "tracked.csv").string());
+  const CsvTable table = ReadCsvTable((dir_ / "tracked.csv").string());
+  ASSERT_EQ(table.row_count(), 30u);
+  ASSERT_EQ(shown.size(), 22u);  // Frames 8..29.
+  for (const FrameResult& result : shown) {
+    const size_t row = static_cast<size_t>(result.frame_index);
+    // Blue's saved template is the one dragged on frame 12: the same from frame 13 on.
+    for (const MarkerObservation& m : result.markers) {
+      if (m.name == "blue" && result.frame_index <= 12) continue;
+      ASSERT_TRUE(m.observation.found()) << m.name << " frame " << row;
+      const auto x = table.values[*table.find(m.name + "_x")][row];
+      const auto y = table.values[*table.find(m.name + "_y")][row];
+      ASSERT_TRUE(x && y) << m.name << " not found by track in frame " << row;
+      EXPECT_NEAR(*x, m.observation.position_px->x, 1e-3) << m.name << " frame " << row;
+      EXPECT_NEAR(*y, m.observation.position_px->y, 1e-3) << m.name << " frame " << row;
+    }
+  }
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <iostream>
 #include <opencv2/highgui.hpp>
 
+#include "softsight/gui/live_feed.h"
+
 namespace softsight {
 namespace {
 
@@ -62,7 +64,7 @@ bool HaveDisplay(std::string* why) {
   return true;
 }
 
-int RunLiveWindow(LiveController& controller, FrameGrabber& grabber,
+int RunLiveWindow(LiveController& controller, FrameSource& source,
                   const LiveWindowOptions& options) {
   const std::string& title = options.title;
   // GUI_NORMAL: no toolbar or status bar, so image pixels are canvas pixels.
@@ -82,18 +84,13 @@ int RunLiveWindow(LiveController& controller, FrameGrabber& grabber,
     shown_revision = controller.hsv_revision();
   }
 
-  bool end_shown = false, end_announced = false;
-  GrabbedFrame grabbed;
+  bool end_announced = false;
+  LiveFeed feed(source);
   while (!controller.quit_requested()) {
-    bool got = false;
-    if (!controller.paused()) {
-      got = grabber.take(grabbed);
-      if (got) controller.on_frame(grabbed.frame, grabbed.captured);
-    }
-    if (!got && !end_shown && grabber.finished()) {
-      controller.on_end_of_input();
-      end_shown = true;
-    }
+    // A paced file waits in read() until its frame is due (at most one frame period); a camera
+    // returns its newest frame.
+    const bool got = feed.step(controller);
+    const bool end_shown = feed.ended();
     cv::imshow(title, controller.canvas());
     const int key = cv::waitKeyEx(got ? 1 : 15);
     if (end_shown && !end_announced) {

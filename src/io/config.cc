@@ -98,6 +98,14 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
     config.control.emplace();
     ReadControlConfig(control, &*config.control);
   }
+  if (top.has("recording")) {
+    YamlMap recording = top.map("recording");
+    RecordingOrigin origin;
+    origin.first_frame = recording.integer("first_frame", 0, 1 << 30).value_or(0);
+    origin.first_time_s = recording.number("first_time_s", 0.0, 1e9).value_or(0.0);
+    recording.finish();
+    config.recording = origin;
+  }
   top.finish();
   return config;
 }
@@ -118,6 +126,13 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
+  if (config.recording) {
+    out << YAML::Key << "recording" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "first_frame" << YAML::Value << config.recording->first_frame;
+    out << YAML::Key << "first_time_s" << YAML::Value << YAML::Precision(17)
+        << config.recording->first_time_s;
+    out << YAML::EndMap;
+  }
   if (config.control) {
     out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;
     WriteControlConfig(*config.control, out);

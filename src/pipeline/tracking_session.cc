@@ -67,8 +67,13 @@ TrackingSession::~TrackingSession() = default;
 
 const FrameResult& TrackingSession::process(const Frame& frame) {
   const int64_t start = cv::getTickCount();
+  // A live recording's raw video names the live source's frames (config.recording).
   result_.frame_index = frame.index;
   result_.time_s = frame.time_s;
+  if (config_.recording) {
+    result_.frame_index += config_.recording->first_frame;
+    result_.time_s += config_.recording->first_time_s;
+  }
   for (size_t i = 0; i < trackers_.size(); ++i) {
     // Each tracker knows from its parameters when and how it can start. One that cannot yet (a
     // template not selected, or its reference frame still ahead) has nothing to look for.
@@ -139,10 +144,14 @@ void TrackingSession::reselect(const std::string& marker, const cv::Mat& frame,
     trackers_[i]->init(frame, rect);
     initialised_[i] = true;
     plausibility_->forget(i);  // A person said where it is: no history to contradict that.
-    // Saved configs must reproduce what the mouse did.
+    // Saved configs must reproduce what the mouse did: the template's own pixels (a rectangle
+    // on the config's template frame would cut whatever is there, not this marker), which a
+    // saved config writes as an image file beside itself.
     if (IsTemplateMethod(config_.markers[i].method)) {
-      config_.markers[i].templ.rect = rect;
-      config_.markers[i].templ.image.release();
+      TemplateParams& templ = config_.markers[i].templ;
+      templ.rect = rect;
+      templ.image = frame(rect & cv::Rect(0, 0, frame.cols, frame.rows)).clone();
+      templ.image_file.clear();
     } else {
       config_.markers[i].colour.roi = rect;
     }

@@ -109,8 +109,15 @@ class LiveController {
   // Scale mode (`c`): the next left clicks are the two scale points.
   bool scale_mode() const { return scale_mode_; }
   int active_marker() const { return active_; }
-  // The config as edited live (what `s` saves).
-  const TrackingConfig& config() const { return config_; }
+  // The config as edited live (what `s` saves): the session's, the only copy.
+  const TrackingConfig& config() const;
+  // Frames the source dropped so far (a camera, newest frame wins; files never drop): shown in
+  // the status line.
+  void set_dropped_frames(int64_t dropped) {
+    if (dropped != dropped_) dirty_ = true;
+    dropped_ = dropped;
+  }
+  int64_t dropped_frames() const { return dropped_; }
   const std::optional<FrameResult>& last_result() const { return last_result_; }
   const std::string& message() const { return message_; }
   std::optional<double> latency_ms() const { return latency_ms_; }
@@ -142,15 +149,17 @@ class LiveController {
   cv::Rect box_around(const cv::Point2d& p) const;
   void apply_spec(int marker, const MarkerSpec& spec, const std::optional<cv::Rect>& hint);
   void redraw_annotated();
-  void record_frame(const FrameResult& result);
+  void draw_overlay(cv::Mat& image, const FrameResult& result) const;
+  void record_frame(const Frame& frame, const FrameResult& result);
   void say(const std::string& message);
 
-  TrackingConfig config_;
   LiveOptions options_;
   std::unique_ptr<TrackingSession> session_;
   StripChart chart_;
   cv::Mat frame_;  // The frame on screen, as captured.
   int64_t frame_index_ = -1;
+  double frame_time_s_ = 0.0;  // The source's timestamp of frame_.
+  int64_t dropped_ = 0;
   cv::Mat annotated_;  // frame_ + overlay (what annotated video records).
   cv::Mat canvas_;
   bool dirty_ = true;

@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_controller.h"
+#include "softsight/io/frame_source.h"
 
 namespace softsight {
 
@@ -20,9 +20,10 @@ struct LiveWindowOptions {
 };
 
 // Runs the window until the controller asks to quit or the window is closed. Frames come from
-// `grabber` (newest wins). Prints "end of input" on stdout once the last frame of a file source
+// `source` through a LiveFeed: a PacedFrameSource for a file (every frame, at its rate, paused
+// with the window), a NewestFrameSource for a camera (stale frames dropped and counted). Prints "end of input" on stdout once the last frame of a file source
 // is on screen. Returns the exit code (0).
-int RunLiveWindow(LiveController& controller, FrameGrabber& grabber,
+int RunLiveWindow(LiveController& controller, FrameSource& source,
                   const LiveWindowOptions& options = {});
 
 }  // namespace softsight

@@ -14,6 +14,15 @@
 
 namespace softsight {
 
+// Where frame 0 of the input sits in the source it was cut from: a live recording's raw video
+// starts at a later source frame, and its saved config (the `recording:` key) says which, so
+// `softsight track` on it numbers and times rows as the live CSV did (frame + first_frame,
+// time_s + first_time_s).
+struct RecordingOrigin {
+  int64_t first_frame = 0;    // Source frame index of the input's frame 0.
+  double first_time_s = 0.0;  // Source timestamp of the input's frame 0, seconds.
+};
+
 struct TrackingConfig {
   std::vector<MarkerSpec> markers;
   MeasureOptions measure;              // Triple, chain, tip reference, metric model.
@@ -23,6 +32,7 @@ struct TrackingConfig {
   std::optional<CameraIntrinsics> camera;
   // The `control:` section (gains, limits, rig), when the file has one: `softsight control`.
   std::optional<ControlConfig> control;
+  std::optional<RecordingOrigin> recording;  // Written by live recordings only.
   std::string source_file;             // Where this config was read from ("" if built in code).
 };
 
