@@ -10,7 +10,8 @@
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
-#include "softsight/pipeline/sinks.h"
+#include "gui/live_recording.h"
+#include "gui/live_view.h"
 
 namespace softsight {
 namespace {
@@ -42,15 +43,6 @@ std::string RangeText(const HsvRange& r) {
 }
 
 }  // namespace
-
-// The files of one recording, as the pipeline's sinks: the CSV, the raw video (lossless FFV1, so
-// that `softsight track` with the saved config sees exactly the pixels the live session saw) and
-// the annotated video. Every processed frame goes to every sink.
-struct LiveController::Recording {
-  std::string prefix;
-  std::vector<std::unique_ptr<FrameSink>> sinks;
-  int64_t frames = 0;
-};
 
 bool LiveOptions::Check(std::string* error) const {
   if (select_box_px < 4 || select_box_px > 1000) {
@@ -423,11 +415,8 @@ void LiveController::draw_scale_points(cv::Mat& top) const {
 
 void LiveController::toggle_recording() {
   if (recording_) {
-    const int64_t frames = recording_->frames;
-    last_recording_ = recording_->prefix;
-    RunSummary summary;
-    summary.frames = frames;
-    for (auto& sink : recording_->sinks) sink->end(summary);
+    const int64_t frames = recording_->frames();
+    last_recording_ = recording_->prefix();
     recording_.reset();  // Closes the CSV and both videos.
     say("recorded " + std::to_string(frames) + " frames to " + last_recording_ + ".*");
     return;
@@ -435,13 +424,6 @@ void LiveController::toggle_recording() {
   if (frame_.empty()) {
     say("nothing to record yet");
     return;
-  }
-  std::string prefix;
-  for (int n = 1; n < 1000; ++n) {
-    char name[16];
-    std::snprintf(name, sizeof(name), "-%03d", n);
-    prefix = options_.record_prefix + name;
-    if (!std::filesystem::exists(prefix + ".csv")) break;
   }
   try {
     // The recording must be reproducible: `softsight track --config <prefix>.yaml --input
@@ -463,25 +445,17 @@ void LiveController::toggle_recording() {
         spec.templ.image = cv::Mat();
       }
     }
-    auto recording = std::make_unique<Recording>();
-    recording->prefix = prefix;
     RunInfo info;
     info.frame_size = frame_.size();
     info.fps = options_.record_fps.value_or(fps_.value_or(30.0));
     for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
     const MetricModel& metric = snapshot.measure.metric;
     info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
-    recording->sinks.push_back(
-        std::make_unique<CsvSink>(prefix + ".csv", TrackingColumns(snapshot)));
-    recording->sinks.push_back(std::make_unique<VideoSink>(prefix + ".raw.avi", "ffv1", info.fps));
-    recording->sinks.push_back(std::make_unique<VideoSink>(
-        prefix + ".avi", "mjpg", info.fps,
-        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); }));
-    for (auto& sink : recording->sinks) sink->begin(info);
     // The raw video's frame 0 is this source frame: its config says so (`recording:`), so that
     // `track` on it numbers and times the rows as the source did, like the live CSV.
-    snapshot.recording = RecordingOrigin{frame_index_, frame_time_s_};
-    SaveTrackingConfig(snapshot, prefix + ".yaml");
+    auto recording = std::make_unique<LiveRecording>(
+        options_.record_prefix, snapshot, info, RecordingOrigin{frame_index_, frame_time_s_},
+        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); });
 
     for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
     session_->reset_tip_reference();
@@ -489,7 +463,7 @@ void LiveController::toggle_recording() {
     const Frame again{frame_.clone(), frame_index_, frame_time_s_};
     record_frame(again, session_->process(again));
     ++hsv_revision_;
-    say("recording to " + prefix + ".*");
+    say("recording to " + recording_->prefix() + ".*");
   } catch (const InputError& e) {
     recording_.reset();
     say(e.what());
@@ -502,15 +476,12 @@ void LiveController::record_frame(const Frame& frame, const FrameResult& result)
   if (!recording_) return;
   // Rows carry the source's frame index and timestamp, as every CSV does.
   try {
-    for (auto& sink : recording_->sinks) sink->consume(frame, result);
+    recording_->consume(frame, result);
   } catch (const InputError& e) {
     // A full disk: stop recording (what is written stays), keep the window running.
-    ++recording_->frames;
     toggle_recording();
     say(e.what());
-    return;
   }
-  ++recording_->frames;
 }
 
 void LiveController::on_event(const UiEvent& event) {
@@ -609,10 +580,9 @@ const cv::Mat& LiveController::canvas() {
     // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
     annotated_.copyTo(top);
   }
-  const double scale = std::max(0.4, image_size.width / 640.0 * 0.5);
   std::vector<std::string> lines;
   std::string state;
-  if (recording_) state += "REC " + recording_->prefix + "  ";
+  if (recording_) state += "REC " + recording_->prefix() + "  ";
   if (paused_) state += "PAUSED  ";
   if (ended_) state += "END  ";
   if (dropped_ > 0) state += "dropped " + std::to_string(dropped_) + "  ";
@@ -625,55 +595,14 @@ const cv::Mat& LiveController::canvas() {
   if (!message_.empty()) lines.push_back(message_);
   // The hint stays while picking, whatever other keys say meanwhile.
   if (scale_mode_ && message_ != scale_hint()) lines.push_back(scale_hint());
-  int y = image_size.height - 10 - 22 * static_cast<int>(lines.size() - 1);
-  for (const std::string& text : lines) {
-    cv::putText(top, text, {8, y}, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-    cv::putText(
-        top, text, {8, y}, kFont, scale,
-        recording_ && &text == &lines.front() ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255),
-        1, cv::LINE_AA);
-    y += 22;
-  }
+  DrawStatusLines(top, lines, recording_ != nullptr);
   if (scale_mode_) {
     draw_scale_points(top);
   } else if (press_ && pointer_) {
     cv::rectangle(top, cv::Point(cvRound(press_->x), cvRound(press_->y)),
                   cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kDragColour, 1);
   }
-  if (help_) {
-    // The key list, scaled down until it fits the image, centred on a darkened block.
-    std::vector<std::string> help;
-    for (const LiveKey& k : kLiveKeys) {
-      std::string text = k.key == ' ' ? "space  "
-                         : k.key != 0 ? std::string(1, char(k.key)) + "  "
-                                      : "";
-      help.push_back(text + k.what);
-    }
-    double help_scale = 0.5;
-    int baseline = 0, width = 0;
-    for (const std::string& text : help) {
-      width = std::max(width, cv::getTextSize(text, kFont, help_scale, 1, &baseline).width);
-    }
-    const int line_height_at_scale = 24;
-    const double fit =
-        std::min((image_size.width - 24.0) / width,
-                 (image_size.height - 16.0) / (line_height_at_scale * (help.size() + 0.5)));
-    if (fit < 1.0) help_scale *= fit;
-    const int line_height = std::max(8, cvRound(line_height_at_scale * help_scale / 0.5));
-    const int block_w = cvRound(width * help_scale / 0.5) + 20;
-    const int block_h = line_height * static_cast<int>(help.size()) + line_height / 2;
-    const cv::Rect block = cv::Rect((image_size.width - block_w) / 2,
-                                    (image_size.height - block_h) / 2, block_w, block_h) &
-                           cv::Rect(0, 0, image_size.width, image_size.height);
-    cv::Mat shade = top(block);
-    shade.convertTo(shade, -1, 0.25, 0);
-    int line_y = block.y + line_height;
-    for (const std::string& text : help) {
-      cv::putText(top, text, {block.x + 10, line_y}, kFont, help_scale, cv::Scalar(255, 255, 255),
-                  1, cv::LINE_AA);
-      line_y += line_height;
-    }
-  }
+  if (help_) DrawLiveHelp(top);
   cv::Mat bottom =
       canvas_(cv::Rect(0, image_size.height, image_size.width, options_.chart.height_px));
   chart_.draw(bottom);

@@ -23,6 +23,7 @@
 
 #include "softsight/gui/overlay.h"
 #include "softsight/io/config.h"
+#include "softsight/io/csv_reader.h"
 #include "softsight/sim/scene.h"
 
 extern char** environ;
@@ -336,6 +337,86 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
 
   ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &xdotool_output), 0) << xdotool_output;
   EXPECT_EQ(WaitExit(live, 20s), 0);
+}
+
+// The lines of a CSV without its last column (proc_ms, a timing).
+std::vector<std::string> CsvRowsWithoutTiming(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(line.substr(0, line.rfind(',')));
+  return rows;
+}
+
+TEST_F(LiveWindowTest, RecordingAPausedVideoKeepsTheSourcesFramesAndTrackReproducesIt) {
+  // A 3 s rendered video at 30 fps, played by the real window.
+  SceneOptions scene;
+  scene.size = cv::Size(320, 240);
+  scene.length_px = 160;
+  scene.width_px = 24;
+  scene.marker_radius_px = 8;
+  scene.frame_count = 90;
+  scene.max_bend_deg = 90;
+  SyntheticScene renderer(scene);
+  const std::string video = (dir_ / "scene.avi").string();
+  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
+  ASSERT_TRUE(writer.isOpened());
+  cv::Mat image;
+  for (int i = 0; i < scene.frame_count; ++i) {
+    renderer.render(i, image);
+    writer.write(image);
+  }
+  writer.release();
+  const std::string config = (dir_ / "markers.yaml").string();
+  std::ofstream(config) << "markers:\n"
+                           "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
+                           "  - name: blue\n    hsv: {h: [95, 125], s: [80, 255], v: [40, 255]}\n"
+                           "  - name: green\n    hsv: {h: [45, 75], s: [80, 255], v: [40, 255]}\n"
+                           "triple: [red, blue, green]\n";
+  const std::string display = StartXvfb();
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  live_ = Spawn({binary_, "live", "--input", video, "--config", config, "--no-trackbars",
+                 "--record-prefix", (dir_ / "rec").string()},
+                {"DISPLAY=" + display}, true);
+  ASSERT_GT(live_.pid, 0);
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  std::string out;
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--name", "softsight live", "windowfocus",
+                        "--sync"},
+                       env, &out),
+            0)
+      << out;
+  // Record, pause, resume, stop. How many frames fall between the keys depends on the machine;
+  // what is checked below holds for any number (the window reads keys only after a frame is on
+  // screen, so `r` always has a frame to start with).
+  ASSERT_EQ(RunProcess({"xdotool", "key", "r", "sleep", "0.3", "key", "space", "sleep", "0.5",
+                        "key", "space", "sleep", "0.3", "key", "r"},
+                       env, &out),
+            0)
+      << out;
+  std::string output;
+  ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
+  ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;
+  EXPECT_EQ(WaitExit(live_, 20s), 0);
+
+  // Every row is a source frame: consecutive indices, the file's timestamps.
+  const std::string prefix = (dir_ / "rec-001").string();
+  std::vector<std::string> rows = CsvRowsWithoutTiming(prefix + ".csv");
+  ASSERT_GE(rows.size(), 2u) << "no recording: " << output;
+  const CsvTable table = ReadCsvTable(prefix + ".csv");
+  const size_t frame = *table.find("frame"), time = *table.find("time_s");
+  const double first = *table.values[frame][0];
+  for (size_t row = 0; row < table.row_count(); ++row) {
+    EXPECT_EQ(*table.values[frame][row], first + row) << "row " << row;
+    EXPECT_NEAR(*table.values[time][row], (first + row) / 30.0, 1e-6) << "row " << row;
+  }
+  // `softsight track` on the raw recording with the saved config: the same rows.
+  const std::string again = (dir_ / "again.csv").string();
+  ASSERT_EQ(RunProcess({binary_, "track", "--config", prefix + ".yaml", "--input",
+                        prefix + ".raw.avi", "--csv", again},
+                       {}, &out),
+            0)
+      << out;
+  EXPECT_EQ(CsvRowsWithoutTiming(again), rows);
 }
 
 TEST_F(LiveWindowTest, WithoutADisplayOneErrorSuggestsTrack) {

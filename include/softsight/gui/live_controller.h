@@ -23,6 +23,8 @@
 
 namespace softsight {
 
+class LiveRecording;  // gui/live_recording.h: the files of one recording.
+
 struct UiEvent {
   enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
   Type type = Type::kKey;
@@ -130,7 +132,6 @@ class LiveController {
   const std::string& last_recording() const { return last_recording_; }
 
  private:
-  struct Recording;
 
   void click(const cv::Point2d& p);
   void drag(const cv::Rect& rect);
@@ -175,7 +176,7 @@ class LiveController {
   bool scale_mode_ = false;
   std::vector<cv::Point2d> scale_clicks_;  // Scale mode: the points so far, image pixels.
   std::string message_;
-  std::unique_ptr<Recording> recording_;
+  std::unique_ptr<LiveRecording> recording_;
   std::string last_recording_;
 };
 

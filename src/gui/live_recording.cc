@@ -1,0 +1,51 @@
+#include "gui/live_recording.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "softsight/core/error.h"
+#include "softsight/io/csv_columns.h"
+
+namespace softsight {
+namespace {
+
+constexpr int kMaxRecordings = 999;
+
+std::string FreePrefix(const std::string& base) {
+  for (int n = 1; n <= kMaxRecordings; ++n) {
+    char number[16];
+    std::snprintf(number, sizeof(number), "-%03d", n);
+    const std::string prefix = base + number;
+    if (!std::filesystem::exists(prefix + ".csv")) return prefix;
+  }
+  throw InputError(base + "-*.csv: all " + std::to_string(kMaxRecordings) +
+                   " recording numbers are taken; choose another --record-prefix");
+}
+
+}  // namespace
+
+LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& config,
+                             const RunInfo& info, const RecordingOrigin& origin, FrameDrawer draw)
+    : prefix_(FreePrefix(base)) {
+  sinks_.push_back(
+      std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config)));
+  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".raw.avi", "ffv1", info.fps));
+  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw)));
+  for (auto& sink : sinks_) sink->begin(info);
+  TrackingConfig saved = config;
+  saved.recording = origin;
+  SaveTrackingConfig(saved, prefix_ + ".yaml");
+}
+
+LiveRecording::~LiveRecording() {
+  RunSummary summary;
+  summary.frames = frames_;
+  for (auto& sink : sinks_) sink->end(summary);
+}
+
+void LiveRecording::consume(const Frame& frame, const FrameResult& result) {
+  for (auto& sink : sinks_) sink->consume(frame, result);
+  ++frames_;
+}
+
+}  // namespace softsight

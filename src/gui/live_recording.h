@@ -1,0 +1,41 @@
+// One recording of the live window: its files are the pipeline's sinks (the CSV, the raw
+// lossless video, the annotated video) plus the config that reproduces it, so `softsight track
+// --config <prefix>.yaml --input <prefix>.raw.avi` gives the same rows. Internal to gui.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "softsight/io/config.h"
+#include "softsight/pipeline/sink.h"
+#include "softsight/pipeline/sinks.h"
+
+namespace softsight {
+
+class LiveRecording {
+ public:
+  // Opens <base>-NNN.csv, .raw.avi, .avi and writes .yaml, with the first NNN whose CSV does not
+  // exist (nothing is overwritten). `config` is what the session runs from this frame on;
+  // `origin` the source frame and time of the recording's first frame, saved with the config
+  // (its `recording:` key) so that re-tracking the raw video names the source's frames.
+  // `draw` draws the overlay of the annotated video. Throws InputError (unwritable folder, no
+  // free number, no codec) with nothing left open.
+  LiveRecording(const std::string& base, const TrackingConfig& config, const RunInfo& info,
+                const RecordingOrigin& origin, FrameDrawer draw);
+  ~LiveRecording();  // Closes every file (end() of each sink).
+
+  // Every processed frame, in order. Throws InputError (a full disk).
+  void consume(const Frame& frame, const FrameResult& result);
+
+  const std::string& prefix() const { return prefix_; }
+  int64_t frames() const { return frames_; }
+
+ private:
+  std::string prefix_;
+  std::vector<std::unique_ptr<FrameSink>> sinks_;
+  int64_t frames_ = 0;
+};
+
+}  // namespace softsight
