@@ -29,7 +29,7 @@ LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& conf
     : prefix_(FreePrefix(base)) {
   sinks_.push_back(
       std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config)));
-  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".raw.avi", "ffv1", info.fps));
+  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps));
   sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw)));
   for (auto& sink : sinks_) sink->begin(info);
   TrackingConfig saved = config;
