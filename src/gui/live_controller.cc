@@ -90,6 +90,7 @@ const TrackingConfig& LiveController::config() const { return session_->config()
 
 void LiveController::say(const std::string& message) {
   message_ = message;
+  ++message_count_;
   dirty_ = true;
 }
 
@@ -187,7 +188,9 @@ void LiveController::apply_spec(int marker, const MarkerSpec& spec,
                                 const std::optional<cv::Rect>& hint) {
   try {
     session_->respec(spec);
-    if (hint && !hint->empty() && !frame_.empty()) session_->reselect(spec.name, frame_, *hint);
+    if (hint && !hint->empty() && !frame_.empty()) {
+      show(session_->reselect(spec.name, on_screen(), *hint));
+    }
   } catch (const InputError& e) {
     // A live edit that cannot be used is reported on screen; the session keeps running.
     say(e.what());
@@ -242,7 +245,7 @@ void LiveController::drag(const cv::Rect& dragged) {
   try {
     // The session remembers the selection in its config (the template's pixels, or the colour
     // search box), so that `s` saves it.
-    session_->reselect(spec.name, frame_, rect);
+    show(session_->reselect(spec.name, on_screen(), rect));
   } catch (const InputError& e) {
     say(e.what());
     return;
@@ -307,9 +310,9 @@ TrackingConfig WithTemplateImages(const TrackingConfig& config, const std::strin
     if (!cv::imwrite(image_path, spec.templ.image)) {
       throw InputError(image_path + ": cannot write the template image");
     }
-    spec.templ.image_file = name;  // Relative to the config, as the reader resolves it.
-    spec.templ.rect.reset();
-    spec.templ.template_frame = 0;
+    // Relative to the config, as the reader resolves it. A template selected live keeps its rect
+    // and frame: `track` starts it there and then, as the selection did.
+    spec.templ.image_file = name;
   }
   return saved;
 }
@@ -443,6 +446,7 @@ void LiveController::toggle_recording() {
         spec.templ.rect = box;
         spec.templ.template_frame = 0;
         spec.templ.image = cv::Mat();
+        spec.templ.image_file.clear();
       }
     }
     RunInfo info;
@@ -470,9 +474,16 @@ void LiveController::toggle_recording() {
   }
 }
 
-void LiveController::record_frame(const Frame& frame, const FrameResult& result) {
+Frame LiveController::on_screen() const { return Frame{frame_, frame_index_, frame_time_s_}; }
+
+void LiveController::show(const FrameResult& result) {
   last_result_ = result;
   redraw_annotated();
+  dirty_ = true;
+}
+
+void LiveController::record_frame(const Frame& frame, const FrameResult& result) {
+  show(result);
   if (!recording_) return;
   // Rows carry the source's frame index and timestamp, as every CSV does.
   try {

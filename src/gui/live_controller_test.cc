@@ -609,13 +609,19 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
   LiveFeed feed(*source);
   for (int i = 0; i < 8; ++i) ASSERT_TRUE(feed.step(live));
   // `m` three times: colour -> sad -> ssd -> zncc, templates cut where the markers are on frame
-  // 7. (A template dragged later, on frame 12, is not yet reproduced by track since the template
-  // tracker's drift check against its first template: left for a follow-up.)
+  // 7; then a drag re-cuts blue's template on frame 12, off-centre (a person's box is never
+  // centred to the pixel).
   for (int i = 0; i < 3; ++i) live.on_event(UiEvent::Key('m'));
   ASSERT_EQ(live.config().markers[0].method, "zncc");
-  std::vector<FrameResult> shown;
+  std::vector<FrameResult> shown = {*live.last_result()};  // Frame 7 with the new templates.
   while (feed.step(live)) {
     shown.push_back(*live.last_result());
+    if (live.last_result()->frame_index == 12) {
+      const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+      Drag(live, blue - cv::Point2d(10, 12), blue + cv::Point2d(13, 10));
+      ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
+      shown.back() = *live.last_result();  // Frame 12 as shown after the drag.
+    }
   }
   live.on_event(UiEvent::Key('s'));
   const std::string saved = (dir_ / "saved.yaml").string();
@@ -623,14 +629,24 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
   for (const char* marker : {"red", "blue", "green"}) {
     EXPECT_TRUE(fs::exists(dir_ / ("saved." + std::string(marker) + ".png"))) << marker;
   }
+  const TrackingConfig reloaded = LoadTrackingConfig(saved);
+  EXPECT_EQ(reloaded.markers[0].templ.template_frame, 7);
+  EXPECT_EQ(reloaded.markers[1].templ.template_frame, 12);
+  EXPECT_EQ(reloaded.markers[1].templ.rect->size(), cv::Size(23, 22));
 
   Track(saved, video, (dir_ / "tracked.csv").string());
   const CsvTable table = ReadCsvTable((dir_ / "tracked.csv").string());
   ASSERT_EQ(table.row_count(), 30u);
-  ASSERT_EQ(shown.size(), 22u);  // Frames 8..29.
+  ASSERT_EQ(shown.size(), 23u);  // Frames 7..29.
   for (const FrameResult& result : shown) {
     const size_t row = static_cast<size_t>(result.frame_index);
+    // Blue's saved template is the one dragged on frame 12: track starts it there (not found
+    // before), and from there on it is where live had it.
     for (const MarkerObservation& m : result.markers) {
+      if (m.name == "blue" && result.frame_index < 12) {
+        EXPECT_FALSE(table.values[*table.find("blue_x")][row]) << "frame " << row;
+        continue;
+      }
       ASSERT_TRUE(m.observation.found()) << m.name << " frame " << row;
       const auto x = table.values[*table.find(m.name + "_x")][row];
       const auto y = table.values[*table.find(m.name + "_y")][row];

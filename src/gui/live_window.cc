@@ -85,6 +85,7 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
   }
 
   bool end_announced = false;
+  int64_t logged_messages = controller.message_count();
   LiveFeed feed(source);
   while (!controller.quit_requested()) {
     // A paced file waits in read() until its frame is due (at most one frame period); a camera
@@ -102,6 +103,12 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
     if (key >= 0) {
       const int code = key & 0xFFFF;
       if (code < 0x100) controller.on_event(UiEvent::Key(code));
+    }
+    if (controller.message_count() != logged_messages) {
+      // What the window said (recording started, paused, saved ...) also goes to stdout, one
+      // line each, for the terminal's scrollback and for scripts that drive the window.
+      std::cout << "live: " << controller.message() << std::endl;
+      logged_messages = controller.message_count();
     }
     if (options.trackbars && controller.hsv_revision() != shown_revision) {
       const std::array<int, 6> hsv = controller.active_hsv();

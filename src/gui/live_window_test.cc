@@ -303,8 +303,8 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   // Keys through the real window: h shows the help over the image, q quits cleanly.
   std::string xdotool_output;
   const std::vector<std::string> env = {"DISPLAY=" + display};
-  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--name", "softsight live", "windowfocus",
-                        "--sync"},
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
+                        "windowfocus", "--sync"},
                        env, &xdotool_output),
             0)
       << xdotool_output;
@@ -380,20 +380,24 @@ TEST_F(LiveWindowTest, RecordingAPausedVideoKeepsTheSourcesFramesAndTrackReprodu
   ASSERT_GT(live_.pid, 0);
   const std::vector<std::string> env = {"DISPLAY=" + display};
   std::string out;
-  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--name", "softsight live", "windowfocus",
-                        "--sync"},
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
+                        "windowfocus", "--sync"},
                        env, &out),
             0)
       << out;
-  // Record, pause, resume, stop. How many frames fall between the keys depends on the machine;
-  // what is checked below holds for any number (the window reads keys only after a frame is on
-  // screen, so `r` always has a frame to start with).
-  ASSERT_EQ(RunProcess({"xdotool", "key", "r", "sleep", "0.3", "key", "space", "sleep", "0.5",
-                        "key", "space", "sleep", "0.3", "key", "r"},
-                       env, &out),
-            0)
-      << out;
+  // Record, pause, resume, stop: each key once the window has said it handled the one before
+  // (its messages on stdout), so no key waits on a clock. How many frames fall between the keys
+  // depends on the machine; what is checked below holds for any number (the window reads keys
+  // only after a frame is on screen, so `r` always has a frame to start with).
   std::string output;
+  for (const auto& [key, said] : std::vector<std::pair<std::string, std::string>>{
+           {"r", "live: recording to "},
+           {"space", "live: paused"},
+           {"space", "live: running"},
+           {"r", "live: recorded "}}) {
+    ASSERT_EQ(RunProcess({"xdotool", "key", key}, env, &out), 0) << out;
+    ASSERT_TRUE(WaitForOutput(live_, said, 60s, &output)) << key << ": " << output;
+  }
   ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
   ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;
   EXPECT_EQ(WaitExit(live_, 20s), 0);

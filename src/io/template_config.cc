@@ -13,8 +13,11 @@
 //         min_zncc: 0.8            # below: not found (all methods; SAD/SSD: shape check)
 //         ...
 //
-// `rect` and `file` are exclusive; with neither, the template is selected live (softsight's
-// window) or the marker is not found.
+// With only `rect` the template is cut from frame `frame`; with only `file` it is the image and
+// the first frame is searched whole. With both (what the live window's `s` saves for a template
+// selected live) the image is the template and `rect` (the image's size) is where it was
+// selected on frame `frame`: tracking starts there on that frame, as it did live. With neither,
+// the template is selected live (softsight's window) or the marker is not found.
 #include <opencv2/imgcodecs.hpp>
 
 #include "io/config_sections.h"

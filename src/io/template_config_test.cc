@@ -97,6 +97,34 @@ TEST(TemplateConfig, ImageFileIsRelativeToTheConfig) {
   EXPECT_FALSE(t.rect.has_value());
 }
 
+TEST(TemplateConfig, ImageWithRectIsWhereItWasSelectedAndMustBeItsSize) {
+  // What the live window saves for a template selected live: the image, and where and on which
+  // frame it was cut.
+  TempDir dir;
+  const cv::Mat image(21, 23, CV_8UC3, cv::Scalar(30, 60, 90));
+  ASSERT_TRUE(cv::imwrite(dir.file("marker.png"), image));
+  testing::WriteTextFile(dir.file("markers.yaml"),
+                         "markers:\n  - name: red\n    method: zncc\n"
+                         "    template: {file: marker.png, frame: 12, rect: [40, 50, 23, 21]}\n");
+  const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+  const TemplateParams& t = config.markers[0].templ;
+  EXPECT_EQ(t.image.size(), image.size());
+  EXPECT_EQ(t.rect, cv::Rect(40, 50, 23, 21));
+  EXPECT_EQ(t.template_frame, 12);
+  EXPECT_NO_THROW(CreateTracker(config.markers[0]));
+
+  testing::WriteTextFile(dir.file("wrong.yaml"),
+                         "markers:\n  - name: red\n    method: zncc\n"
+                         "    template: {file: marker.png, rect: [40, 50, 25, 25]}\n");
+  try {
+    LoadTrackingConfig(dir.file("wrong.yaml"));
+    ADD_FAILURE() << "a rect of another size than the image was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("template.rect: [40, 50, 25, 25] is not the size of the image "
+                                    "'marker.png' (23x21 px)"));
+  }
+}
+
 TEST(TemplateConfig, ErrorsNameTheKey) {
   EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {file: nothere.png}\n"),
               HasSubstr("markers[0].template.file: cannot read image"));

@@ -113,6 +113,13 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
   }
+  measure(frame);
+  result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
+                    cv::getTickFrequency();
+  return result_;
+}
+
+void TrackingSession::measure(const Frame& frame) {
   if (undistorter_) {
     if (frame.image.size() != undistorter_->camera().image_size) {
       const cv::Size calibrated = undistorter_->camera().image_size;
@@ -132,30 +139,40 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   } else {
     measurer_.measure(result_.markers, result_.measurement);
   }
-  result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
-                    cv::getTickFrequency();
-  return result_;
 }
 
-void TrackingSession::reselect(const std::string& marker, const cv::Mat& frame,
-                               const cv::Rect& rect) {
+const FrameResult& TrackingSession::reselect(const std::string& marker, const Frame& frame,
+                                             const cv::Rect& rect) {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (config_.markers[i].name != marker) continue;
-    trackers_[i]->init(frame, rect);
+    trackers_[i]->init(frame.image, rect);
     initialised_[i] = true;
     plausibility_->forget(i);  // A person said where it is: no history to contradict that.
     // Saved configs must reproduce what the mouse did: the template's own pixels (a rectangle
     // on the config's template frame would cut whatever is there, not this marker), which a
-    // saved config writes as an image file beside itself.
+    // saved config writes as an image file beside itself, with where and on which frame it was
+    // selected, so that `track` starts it there and then, as here.
     if (IsTemplateMethod(config_.markers[i].method)) {
       TemplateParams& templ = config_.markers[i].templ;
       templ.rect = rect;
-      templ.image = frame(rect & cv::Rect(0, 0, frame.cols, frame.rows)).clone();
+      templ.template_frame = static_cast<int>(std::max<int64_t>(0, frame.index));
+      templ.image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
       templ.image_file.clear();
     } else {
       config_.markers[i].colour.roi = rect;
     }
-    return;
+    // The selection's frame is tracked by the new tracker at once, as `track` tracks a template's
+    // reference frame: the window shows the new result now, and the tracker has seen the frames
+    // it would have seen in `track`. The other markers already saw this frame; the joint checks
+    // are not repeated (the person chose this place).
+    if (frame_change_->whole_frame_changed()) {
+      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+    } else {
+      result_.markers[i].observation = trackers_[i]->update(frame.image);
+    }
+    previous_px_[i] = result_.markers[i].observation.position_px;
+    measure(frame);
+    return result_;
   }
   throw InputError("no marker named '" + marker + "'");
 }

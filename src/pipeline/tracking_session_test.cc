@@ -96,9 +96,10 @@ TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
 TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
   const Clip clip = Render(1);
   TrackingSession session(SceneConfig());
-  session.reselect("blue", clip.frames[0].image, cv::Rect(10, 20, 30, 40));
+  session.process(clip.frames[0]);
+  session.reselect("blue", clip.frames[0], cv::Rect(10, 20, 30, 40));
   EXPECT_EQ(session.config().markers[1].colour.roi, cv::Rect(10, 20, 30, 40));
-  EXPECT_THROW(session.reselect("yellow", clip.frames[0].image, cv::Rect(0, 0, 5, 5)),
+  EXPECT_THROW(session.reselect("yellow", clip.frames[0], cv::Rect(0, 0, 5, 5)),
                InputError);
 }
 

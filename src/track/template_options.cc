@@ -9,7 +9,7 @@ OptionTable<TemplateParams> MakeTable() {
   return {
       IntOption<P>("template.frame", &P::template_frame)
           .Range(0, 1e9)
-          .Doc("reference frame the rectangle is cut from"),
+          .Doc("reference frame: where rect is cut (or, with file, where tracking starts)"),
       CustomOption<P>(
           "template.rect", OptionKind::kInts,
           [](const P& p) -> std::optional<OptionValue> {
@@ -30,9 +30,9 @@ OptionTable<TemplateParams> MakeTable() {
           .Count(4)
           .Range(0, 65535)
           .Unit("px")
-          .Doc("[x, y, w, h] on the reference frame (what the mouse drags); or file"),
+          .Doc("[x, y, w, h] on the reference frame (what the mouse drags; with file: where it was)"),
       StringOption<P>("template.file", &P::image_file)
-          .Doc("template image instead of rect, relative to the config file"),
+          .Doc("template image, relative to the config file (with rect: selected there live)"),
       BoolOption<P>("template.colour", &P::colour)
           .Doc("match BGR, not gray (3x the work; tells look-alike markers apart)"),
       BoolOption<P>("template.contrast_gray", &P::contrast_gray)

@@ -602,8 +602,14 @@ void TemplateTracker::RestoreWorkingTemplate() {
 }
 
 bool TemplateTracker::start(const Frame& frame) {
-  if (!params_.image.empty()) {
+  if (!params_.image.empty() && !params_.rect) {
     init(frame.image, cv::Rect());  // The template is given: the first update searches for it.
+    return true;
+  }
+  if (!params_.image.empty() && frame.index >= params_.template_frame) {
+    // An image selected at rect on its frame (a template reselected live and saved): tracking
+    // starts there, then, as it did live.
+    init(frame.image, cv::Rect());
     return true;
   }
   if (params_.rect && frame.index >= params_.template_frame) {
@@ -667,8 +673,15 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
       projection_ = previous;
       throw;
     }
-    last_centre_.reset();  // Position unknown: the first update searches the whole frame.
-    tracking_ = false;
+    if (params_.rect) {
+      // The image was selected at `rect` on the reference frame (a template reselected live and
+      // saved): the tracker starts there, as it did when the selection was made.
+      last_centre_ = cv::Point2d(params_.rect->x, params_.rect->y) + HalfSize(params_.rect->size());
+      tracking_ = true;
+    } else {
+      last_centre_.reset();  // Position unknown: the first update searches the whole frame.
+      tracking_ = false;
+    }
     scan_pending_ = true;
   }
   velocity_px_ = {0, 0};
@@ -1074,8 +1087,12 @@ bool TemplateParams::Check(std::string* error) const {
   if (const auto problem = CheckOptions(TemplateParamsOptions(), *this)) {
     return Fail(error, *problem);
   }
-  if (rect && !image_file.empty()) {
-    return Fail(error, "template.file: give either rect or file, not both");
+  if (rect && !image.empty() && rect->size() != image.size()) {
+    // With an image, rect says where it was selected: the image's own size.
+    const std::string named = image_file.empty() ? std::string() : " '" + image_file + "'";
+    return Fail(error, "template.rect: " + RectText(*rect) + " is not the size of the image" +
+                           named + " (" + std::to_string(image.cols) + "x" +
+                           std::to_string(image.rows) + " px)");
   }
   const int cn = colour ? 3 : 1;
   if (rect) {

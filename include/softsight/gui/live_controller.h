@@ -121,7 +121,10 @@ class LiveController {
   }
   int64_t dropped_frames() const { return dropped_; }
   const std::optional<FrameResult>& last_result() const { return last_result_; }
+  // The last message on screen, and how many have been said so far (the same text said twice
+  // counts twice), so the window can log each one once.
   const std::string& message() const { return message_; }
+  int64_t message_count() const { return message_count_; }
   std::optional<double> latency_ms() const { return latency_ms_; }
   std::optional<double> fps() const { return fps_; }
   // The active marker's ranges in kHsvTrackbars order, and a counter that changes whenever they
@@ -152,6 +155,10 @@ class LiveController {
   void redraw_annotated();
   void draw_overlay(cv::Mat& image, const FrameResult& result) const;
   void record_frame(const Frame& frame, const FrameResult& result);
+  // The frame on screen, as the session saw it (no copy of the pixels).
+  Frame on_screen() const;
+  // A new result for the frame on screen (a reselection): shown, not recorded again.
+  void show(const FrameResult& result);
   void say(const std::string& message);
 
   LiveOptions options_;
@@ -176,6 +183,7 @@ class LiveController {
   bool scale_mode_ = false;
   std::vector<cv::Point2d> scale_clicks_;  // Scale mode: the points so far, image pixels.
   std::string message_;
+  int64_t message_count_ = 0;
   std::unique_ptr<LiveRecording> recording_;
   std::string last_recording_;
 };

@@ -21,8 +21,10 @@ struct LiveWindowOptions {
 
 // Runs the window until the controller asks to quit or the window is closed. Frames come from
 // `source` through a LiveFeed: a PacedFrameSource for a file (every frame, at its rate, paused
-// with the window), a NewestFrameSource for a camera (stale frames dropped and counted). Prints "end of input" on stdout once the last frame of a file source
-// is on screen. Returns the exit code (0).
+// with the window), a NewestFrameSource for a camera (stale frames dropped and counted). On
+// stdout: each message the window shows, as "live: <message>" (after the key or click that caused
+// it has been handled), and "end of input" once the last frame of a file source is on screen.
+// Returns the exit code (0).
 int RunLiveWindow(LiveController& controller, FrameSource& source,
                   const LiveWindowOptions& options = {});
 

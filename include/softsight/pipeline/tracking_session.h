@@ -38,9 +38,13 @@ class TrackingSession {
   // from the calibrated one.
   const FrameResult& process(const Frame& frame);
 
-  // Live recalibration: the marker is inside `rect` on `frame` (re-cuts a template, or restricts
-  // the colour tracker's next acquisition). Throws InputError for an unknown marker.
-  void reselect(const std::string& marker, const cv::Mat& frame, const cv::Rect& rect);
+  // Live recalibration: the marker is inside `rect` on `frame`, the frame process() saw last
+  // (re-cuts a template, or restricts the colour tracker's acquisition). The new tracker tracks
+  // that frame at once; returns the frame's result with it. config() records the selection so a
+  // saved config reproduces it: a template's pixels, rect and frame index (tracking starts there
+  // and then), a colour marker's search box. Throws InputError for an unknown marker or a
+  // rectangle the tracker cannot use.
+  const FrameResult& reselect(const std::string& marker, const Frame& frame, const cv::Rect& rect);
   // Replace a marker's spec (new HSV ranges or method) and rebuild its tracker.
   void respec(const MarkerSpec& spec);
   void reset_tip_reference();
@@ -56,6 +60,7 @@ class TrackingSession {
   const TrackingConfig& config() const { return config_; }
 
  private:
+  void measure(const Frame& frame);  // result_.measurement from result_.markers.
   TrackingConfig config_;
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;

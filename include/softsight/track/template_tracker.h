@@ -78,6 +78,9 @@ struct TemplateParams {
   // Where the template comes from: a rectangle on a reference frame, or an image file (loaded by
   // the caller into `image`, BGR or gray). When `image` is empty the tracker takes it from init()'s
   // hint. A non-empty hint always wins (that is how a person re-selects a template at run time).
+  // With both `image` and `rect` (a template selected live and saved), the image is the template
+  // and `rect`, its size, is where it was selected on `template_frame`: init() without a hint
+  // starts tracking there, exactly as the selection did, instead of searching the whole frame.
   int template_frame = 0;
   std::optional<cv::Rect> rect;
   cv::Mat image;
