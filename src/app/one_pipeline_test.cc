@@ -1,5 +1,5 @@
-// `track` and `control` share one pipeline: the same video through both gives the same tracking
-// columns, and each CSV's header and rows come from one column table.
+// `track`, `live` and `control` share one pipeline: the same video through each gives the same
+// tracking columns, and each CSV's header and rows come from one column table.
 #include <algorithm>
 #include <map>
 
@@ -9,6 +9,11 @@
 #include "app/control_command.h"
 #include "app/track_command.h"
 #include "core/test_util.h"
+#include "gui/live_feed.h"
+#include "softsight/gui/live_controller.h"
+#include "softsight/io/config.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/sim/scene.h"
 
@@ -55,7 +60,7 @@ Csv ReadCsv(const std::string& file) {
   return csv;
 }
 
-TEST(OnePipeline, TrackAndControlGiveTheSameTrackingColumnsForTheSameVideo) {
+TEST(OnePipeline, TrackLiveAndControlGiveTheSameTrackingColumnsForTheSameVideo) {
   TempDir dir;
   SceneOptions scene;
   scene.frame_count = 12;
@@ -90,8 +95,36 @@ TEST(OnePipeline, TrackAndControlGiveTheSameTrackingColumnsForTheSameVideo) {
   EXPECT_EQ(summary.frames, 12);
   EXPECT_EQ(summary.stop_reason, "end of input");
 
+  // `live --no-pace`: the window's controller fed by the unpaced file, each frame's result as
+  // the window shows it written through the same column table.
+  {
+    const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
+    LiveOptions options;
+    options.record_prefix = dir.file("rec");
+    options.save_config_path = dir.file("saved.yaml");
+    LiveController live(config, options);
+    FrameSourceSpec spec;
+    spec.input = video;
+    std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+    LiveFeed feed(*source);
+    CsvSink csv(dir.file("live.csv"), TrackingColumns(config));
+    Frame frame;
+    while (feed.step(live)) {
+      frame.index = live.last_result()->frame_index;
+      csv.consume(frame, *live.last_result());
+    }
+    EXPECT_TRUE(feed.ended());
+  }
+
   const Csv tracked = ReadCsv(track.csv_file);
+  const Csv lived = ReadCsv(dir.file("live.csv"));
   const Csv controlled = ReadCsv(control.csv_file);
+  ASSERT_EQ(lived.rows, 12u);
+  EXPECT_EQ(lived.header, tracked.header);
+  for (const std::string& name : tracked.header) {
+    if (name == "proc_ms") continue;  // A timing.
+    EXPECT_EQ(lived.columns.at(name), tracked.columns.at(name)) << name;
+  }
   ASSERT_EQ(tracked.rows, 12u);
   ASSERT_EQ(controlled.rows, 12u);
   // The tracking columns come first, in the same order; control's own follow, by name.

@@ -9,7 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "softsight/core/error.h"
-#include "softsight/gui/live_feed.h"
+#include "gui/live_feed.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/paced_source.h"
@@ -655,6 +655,50 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
       EXPECT_NEAR(*y, m.observation.position_px->y, 1e-3) << m.name << " frame " << row;
     }
   }
+}
+
+// The positions `track` finds in `csv` for every marker of `shown` from frame `from` on equal
+// the window's, to 1e-3 px, found flags included.
+void ExpectTrackShowsTheSame(const std::string& csv, const std::vector<FrameResult>& shown,
+                             int64_t from) {
+  const CsvTable table = ReadCsvTable(csv);
+  int compared = 0;
+  for (const FrameResult& result : shown) {
+    if (result.frame_index < from) continue;
+    const size_t row = static_cast<size_t>(result.frame_index);
+    ASSERT_LT(row, table.row_count());
+    for (const MarkerObservation& m : result.markers) {
+      const auto x = table.values[*table.find(m.name + "_x")][row];
+      const auto y = table.values[*table.find(m.name + "_y")][row];
+      ASSERT_EQ(x.has_value(), m.observation.found()) << m.name << " frame " << row;
+      if (!x) continue;
+      EXPECT_NEAR(*x, m.observation.position_px->x, 1e-3) << m.name << " frame " << row;
+      EXPECT_NEAR(*y, m.observation.position_px->y, 1e-3) << m.name << " frame " << row;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 0);
+}
+
+TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem) {
+  const std::string video = WriteVideo(24);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source);
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(feed.step(live));
+  // Blue active, its hue range moved with the trackbars on frame 5.
+  live.on_event(UiEvent::Key('2'));
+  live.on_event(UiEvent::Trackbar(0, 92));
+  live.on_event(UiEvent::Trackbar(1, 128));
+  std::vector<FrameResult> shown;
+  while (feed.step(live)) shown.push_back(*live.last_result());
+  live.on_event(UiEvent::Key('s'));
+  const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
+  EXPECT_EQ(saved.markers[1].colour.h.lo, 92);
+  EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
+  Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
+  ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
 }
 
 }  // namespace

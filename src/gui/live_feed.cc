@@ -1,4 +1,4 @@
-#include "softsight/gui/live_feed.h"
+#include "gui/live_feed.h"
 
 namespace softsight {
 

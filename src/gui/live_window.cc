@@ -6,7 +6,7 @@
 #include <iostream>
 #include <opencv2/highgui.hpp>
 
-#include "softsight/gui/live_feed.h"
+#include "gui/live_feed.h"
 
 namespace softsight {
 namespace {

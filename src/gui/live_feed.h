@@ -1,8 +1,9 @@
-// Feeds the live controller from a frame source, one frame per step, and couples the source's
-// pacing to the window's pause: while the controller is paused no frame is read and a paced file
-// (PacedFrameSource) stops its clock, so the video neither runs on behind the still frame nor
-// jumps ahead on resume. A file never drops a frame; a camera (NewestFrameSource) drops stale
-// ones and the controller shows how many. Window-free, so tests drive it with a fake clock.
+// Internal to gui (and the tests). Feeds the live controller from a frame source, one frame per
+// step, and couples the source's pacing to the window's pause: while the controller is paused no
+// frame is read and a paced file (PacedFrameSource) stops its clock, so the video neither runs
+// on behind the still frame nor jumps ahead on resume. A file never drops a frame; a camera
+// (NewestFrameSource) drops stale ones and the controller shows how many. Window-free, so tests
+// drive it with a fake clock.
 #pragma once
 
 #include <cstdint>
