@@ -10,6 +10,7 @@
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
+#include "gui/live_pointer.h"
 #include "gui/live_recording.h"
 #include "gui/live_view.h"
 
@@ -70,7 +71,7 @@ bool LiveOptions::Check(std::string* error) const {
 }
 
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options)
-    : options_(std::move(options)), chart_(options_.chart) {
+    : options_(std::move(options)), chart_(options_.chart), pointer_(std::make_unique<LivePointer>(options_.click_slop_px)) {
   std::string error;
   if (!options_.Check(&error)) throw InputError("live options: " + error);
   if (config.markers.empty()) throw InputError(config.source_file + ": no markers to track");
@@ -355,7 +356,7 @@ void LiveController::start_scale() {
 void LiveController::cancel_scale() {
   scale_mode_ = false;
   scale_clicks_.clear();
-  pointer_.reset();
+  pointer_->forget_pointer();
   say("scale: cancelled, unchanged");
 }
 
@@ -391,7 +392,7 @@ void LiveController::scale_point(const cv::Point2d& p) {
   const bool replaced_plane = replaces_plane;
   scale_mode_ = false;
   scale_clicks_.clear();
-  pointer_.reset();
+  pointer_->forget_pointer();
   // Measure the frame on screen again, so the mm values appear now, also while paused. The
   // strip chart restarts in mm: its px history cannot share the new axis.
   if (!frame_.empty()) {
@@ -410,9 +411,9 @@ void LiveController::draw_scale_points(cv::Mat& top) const {
     cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS, 15,
                    1, cv::LINE_AA);
   }
-  if (scale_clicks_.size() == 1 && pointer_) {
+  if (const auto& pointer = pointer_->pointer(); scale_clicks_.size() == 1 && pointer) {
     cv::line(top, cv::Point(cvRound(scale_clicks_[0].x), cvRound(scale_clicks_[0].y)),
-             cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kScaleColour, 1, cv::LINE_AA);
+             cv::Point(cvRound(pointer->x), cvRound(pointer->y)), kScaleColour, 1, cv::LINE_AA);
   }
 }
 
@@ -501,33 +502,23 @@ void LiveController::on_event(const UiEvent& event) {
                         event.position_px.x < frame_.cols && event.position_px.y < frame_.rows;
   switch (event.type) {
     case Type::kMouseDown:
-      if (in_image) press_ = pointer_ = event.position_px;
+      if (pointer_->down(event.position_px, in_image)) dirty_ = true;
       break;
     case Type::kMouseMove:
       // In scale mode the pointer is followed without a button too: the line to the first point.
-      if (press_ || scale_mode_) {
-        pointer_ = event.position_px;
-        dirty_ = true;
-      }
+      if (pointer_->move(event.position_px, scale_mode_)) dirty_ = true;
       break;
     case Type::kMouseUp: {
-      if (!press_) break;
-      const cv::Point2d start = *press_;
-      press_.reset();
-      pointer_.reset();
+      const PointerGesture gesture = pointer_->up(event.position_px, in_image);
+      if (gesture.kind == PointerGesture::Kind::kNone) break;
       dirty_ = true;
-      const cv::Point2d end = event.position_px;
       if (scale_mode_) {
         // Where the button is released, so a person can press, aim and let go.
-        scale_point(in_image ? end : start);
-        break;
-      }
-      if (std::hypot(end.x - start.x, end.y - start.y) <= options_.click_slop_px) {
-        click(start);
+        scale_point(gesture.release);
+      } else if (gesture.kind == PointerGesture::Kind::kClick) {
+        click(gesture.press);
       } else {
-        const cv::Point a(cvRound(std::min(start.x, end.x)), cvRound(std::min(start.y, end.y)));
-        const cv::Point b(cvRound(std::max(start.x, end.x)), cvRound(std::max(start.y, end.y)));
-        drag(cv::Rect(a, b));
+        drag(gesture.box);
       }
       break;
     }
@@ -609,9 +600,11 @@ const cv::Mat& LiveController::canvas() {
   DrawStatusLines(top, lines, recording_ != nullptr);
   if (scale_mode_) {
     draw_scale_points(top);
-  } else if (press_ && pointer_) {
-    cv::rectangle(top, cv::Point(cvRound(press_->x), cvRound(press_->y)),
-                  cv::Point(cvRound(pointer_->x), cvRound(pointer_->y)), kDragColour, 1);
+  } else if (pointer_->press() && pointer_->pointer()) {
+    const cv::Point2d& a = *pointer_->press();
+    const cv::Point2d& b = *pointer_->pointer();
+    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+                  kDragColour, 1);
   }
   if (help_) DrawLiveHelp(top);
   cv::Mat bottom =

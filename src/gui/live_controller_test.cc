@@ -10,6 +10,7 @@
 
 #include "softsight/core/error.h"
 #include "gui/live_feed.h"
+#include "gui/live_pointer.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/paced_source.h"
@@ -699,6 +700,29 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
+}
+
+TEST(LivePointer, ClicksWithinTheSlopDragsBeyondItAndNothingWithoutAPressInTheImage) {
+  LivePointer pointer(4);
+  EXPECT_EQ(pointer.up({10, 10}, true).kind, PointerGesture::Kind::kNone);  // No press.
+  EXPECT_FALSE(pointer.down({10, 10}, false));  // Outside the image: no gesture starts.
+  EXPECT_EQ(pointer.up({10, 10}, true).kind, PointerGesture::Kind::kNone);
+  ASSERT_TRUE(pointer.down({10, 10}, true));
+  EXPECT_TRUE(pointer.move({12, 11}, false));
+  EXPECT_EQ(*pointer.pointer(), cv::Point2d(12, 11));
+  const PointerGesture click = pointer.up({13, 10}, true);
+  EXPECT_EQ(click.kind, PointerGesture::Kind::kClick);
+  EXPECT_EQ(click.press, cv::Point2d(10, 10));
+  EXPECT_FALSE(pointer.press() || pointer.pointer());
+  ASSERT_TRUE(pointer.down({30.4, 40.6}, true));
+  const PointerGesture drag = pointer.up({10.2, 20.5}, true);
+  EXPECT_EQ(drag.kind, PointerGesture::Kind::kDrag);
+  EXPECT_EQ(drag.box, cv::Rect(cv::Point(10, 20), cv::Point(30, 41)));
+  // Released outside the image: the release point is the press (scale mode takes it).
+  ASSERT_TRUE(pointer.down({5, 5}, true));
+  EXPECT_EQ(pointer.up({-50, 5}, false).release, cv::Point2d(5, 5));
+  EXPECT_FALSE(pointer.move({7, 7}, false));  // No button: not followed ...
+  EXPECT_TRUE(pointer.move({7, 7}, true));    // ... unless asked (scale mode).
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 namespace softsight {
 
 class LiveRecording;  // gui/live_recording.h: the files of one recording.
+class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
 
 struct UiEvent {
   enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
@@ -179,7 +180,7 @@ class LiveController {
   bool paused_ = false, help_ = false, quit_ = false, ended_ = false;
   int active_ = 0;
   int hsv_revision_ = 0;
-  std::optional<cv::Point2d> press_, pointer_;
+  std::unique_ptr<LivePointer> pointer_;
   bool scale_mode_ = false;
   std::vector<cv::Point2d> scale_clicks_;  // Scale mode: the points so far, image pixels.
   std::string message_;
