@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -295,36 +293,11 @@ std::array<int, 6> LiveController::active_hsv() const {
   return {c.h.lo, c.h.hi, c.s.lo, c.s.hi, c.v.lo, c.v.hi};
 }
 
-namespace {
-
-// A template held as pixels (cut live, or read from a file) is written as an image beside the
-// config, `<config without extension>.<marker>.png`, and the config names it (`template: {file:
-// ...}`): a rectangle on frame 0 would cut the wrong pixels (the marker has moved since). Writes
-// the images and returns the config to save.
-TrackingConfig WithTemplateImages(const TrackingConfig& config, const std::string& path) {
-  TrackingConfig saved = config;
-  const std::filesystem::path file(path);
-  for (MarkerSpec& spec : saved.markers) {
-    if (!IsTemplateMethod(spec.method) || spec.templ.image.empty()) continue;
-    const std::string name = file.stem().string() + "." + spec.name + ".png";
-    const std::string image_path = (file.parent_path() / name).string();
-    if (!cv::imwrite(image_path, spec.templ.image)) {
-      throw InputError(image_path + ": cannot write the template image");
-    }
-    // Relative to the config, as the reader resolves it. A template selected live keeps its rect
-    // and frame: `track` starts it there and then, as the selection did.
-    spec.templ.image_file = name;
-  }
-  return saved;
-}
-
-}  // namespace
-
 void LiveController::save_config() {
   const std::string path =
       options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
   try {
-    SaveTrackingConfig(WithTemplateImages(config(), path), path);
+    SaveLiveConfig(config(), path);
     say("saved " + path);
   } catch (const InputError& e) {
     say(e.what());

@@ -1,3 +1,5 @@
+// The files the live window writes: a recording, and the saved config. Internal to gui.
+//
 // One recording of the live window: its files are the pipeline's sinks (the CSV, the raw
 // lossless video, the annotated video) plus the config that reproduces it, so `softsight track
 // --config <prefix>.yaml --input <prefix>.raw.avi` gives the same rows. Internal to gui.
@@ -37,5 +39,10 @@ class LiveRecording {
   std::vector<std::unique_ptr<FrameSink>> sinks_;
   int64_t frames_ = 0;
 };
+
+// Writes `config` (what the window runs) to `path` for `softsight track`: templates held as pixels
+// (selected live, or read from a file) go beside it as `<path stem>.<marker>.png`, named by the
+// config with the rect and frame they were selected on. Throws InputError naming the file.
+void SaveLiveConfig(const TrackingConfig& config, const std::string& path);
 
 }  // namespace softsight
