@@ -5,9 +5,9 @@
 #include <string>
 
 #include "app/commands.h"
-#include "io/config_sections.h"
+#include "config/config_sections.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight {
 

@@ -17,7 +17,7 @@
 #include "softsight/control/rig.h"
 #include "softsight/control/transport.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/run.h"

@@ -19,7 +19,7 @@
 #include "core/test_util.h"
 #include "control/protocol.h"
 #include "softsight/core/error.h"
-#include "softsight/io/control_config.h"
+#include "softsight/config/control_config.h"
 
 namespace softsight {
 namespace {

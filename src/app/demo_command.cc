@@ -12,7 +12,7 @@
 #include "app/track_command.h"
 #include "app/truth_sink.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/plot.h"
 
 namespace softsight {

@@ -18,7 +18,7 @@
 #include "app/scene_config.h"
 #include "app/truth_sink.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/builtin_scenes.h"

@@ -9,7 +9,7 @@
 
 #include "app/commands.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight {
 namespace {

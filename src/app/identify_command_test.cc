@@ -13,7 +13,7 @@
 
 #include "core/test_util.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight {
 namespace {

@@ -11,7 +11,7 @@
 #include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_controller.h"
 #include "softsight/gui/live_window.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/paced_source.h"
 #include "softsight/track/tracker.h"

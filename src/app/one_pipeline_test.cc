@@ -11,7 +11,7 @@
 #include "core/test_util.h"
 #include "gui/live_feed.h"
 #include "softsight/gui/live_controller.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/io/frame_writer.h"

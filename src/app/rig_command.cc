@@ -11,7 +11,7 @@
 #include "app/stop_request.h"
 #include "softsight/control/rig.h"
 #include "softsight/core/error.h"
-#include "softsight/io/control_config.h"
+#include "softsight/config/control_config.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "softsight/core/types.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/summary.h"

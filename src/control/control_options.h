@@ -1,6 +1,6 @@
 // The option tables of the `control:` section (core/option_table.h): every key of the controller,
 // the link and the simulated rig, with its unit, range and doc. The structs' Check() functions run
-// them; the config reader and writer (io/control_config.cc) iterate them.
+// them; the config reader and writer (config/control_config.cc) iterate them.
 #pragma once
 
 #include "core/option_table.h"

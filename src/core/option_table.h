@@ -1,7 +1,7 @@
 // Each setting registered once: a table per options struct names every field's key, kind, unit,
 // allowed range and one-line doc. From that table come
 //   - the struct's Check() (CheckOptions below, plus the few cross-field rules it cannot express),
-//   - the YAML reader and writer (io/option_yaml.h iterates the table),
+//   - the YAML reader and writer (config/option_yaml.h iterates the table),
 //   - the documentation of the example configs (DescribeOptions, checked against examples/).
 // The default is the default-constructed struct's value, so it is written once too: in the struct.
 // The same problem text serves Check() and the YAML reader:

@@ -17,7 +17,7 @@
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include <fstream>
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/scene.h"
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/sinks.h"
 

@@ -22,7 +22,7 @@
 #include <thread>
 
 #include "softsight/gui/overlay.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/io/csv_reader.h"
 #include "softsight/sim/scene.h"
 

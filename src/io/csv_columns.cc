@@ -130,12 +130,4 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
   return table;
 }
 
-CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<CsvColumn>& extra) {
-  std::vector<std::string> names;
-  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
-  const MetricModel& metric = config.measure.metric;
-  return TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra,
-                         config.measure.inner_markers());
-}
-
 }  // namespace softsight

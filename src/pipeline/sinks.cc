@@ -1,8 +1,18 @@
 #include "softsight/pipeline/sinks.h"
 
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace softsight {
+
+CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<CsvColumn>& extra) {
+  std::vector<std::string> names;
+  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
+  const MetricModel& metric = config.measure.metric;
+  return TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra,
+                         config.measure.inner_markers());
+}
 
 CsvSink::CsvSink(const std::string& path, CsvColumnTable columns)
     : writer_(path, std::move(columns)) {}

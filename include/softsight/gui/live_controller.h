@@ -18,7 +18,7 @@
 #include "softsight/io/frame_grabber.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/gui/strip_chart.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {

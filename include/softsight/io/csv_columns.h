@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "softsight/core/types.h"
-#include "softsight/io/config.h"
 
 namespace softsight {
 
@@ -59,9 +58,6 @@ class CsvColumnTable {
 CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
                                const std::vector<CsvColumn>& extra = {},
                                const std::vector<std::string>& inner_angle_markers = {});
-// The tracking columns of a run of `config`: its markers, its chain's inner angles, the _mm twins
-// when it has a metric model.
-CsvColumnTable TrackingColumns(const TrackingConfig& config,
-                               const std::vector<CsvColumn>& extra = {});
+// (The columns of a run of a TrackingConfig: TrackingColumns(config) in pipeline/sinks.h.)
 
 }  // namespace softsight

@@ -9,12 +9,18 @@
 #include <string>
 #include <vector>
 
+#include "softsight/config/config.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/pipeline/sink.h"
 
 namespace softsight {
+
+// The tracking columns of a run of `config` (io/csv_columns.h): its markers, its chain's inner
+// angles, the _mm twins when it has a metric model, then `extra` before proc_ms.
+CsvColumnTable TrackingColumns(const TrackingConfig& config,
+                               const std::vector<CsvColumn>& extra = {});
 
 // One CSV row per processed frame, with the columns of `columns` (TrackingColumns for the
 // session's markers, plus the caller's extra columns by name). The file and its header are

@@ -10,7 +10,7 @@
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/types.h"
 #include "softsight/geometry/measurement.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {

@@ -1,4 +1,4 @@
-#include "io/option_yaml.h"
+#include "config/option_yaml.h"
 
 #include <cmath>
 #include <cstdint>

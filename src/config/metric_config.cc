@@ -10,8 +10,8 @@
 #include <string>
 
 #include "geometry/measure_options.h"
-#include "io/config_sections.h"
-#include "io/option_yaml.h"
+#include "config/config_sections.h"
+#include "config/option_yaml.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 

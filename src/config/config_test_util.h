@@ -1,11 +1,11 @@
-// Test helper shared by the config tests of the io module.
+// Test helper shared by the config module's tests.
 #pragma once
 
 #include <string>
 
 #include "core/test_util.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight::testing {
 

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "io/config_sections.h"
-#include "io/yaml_map.h"
+#include "config/config_sections.h"
+#include "config/yaml_map.h"
 #include "softsight/core/error.h"
 
 namespace softsight {

@@ -1,9 +1,9 @@
-#include "io/control_config.h"
+#include "softsight/config/control_config.h"
 
+#include "config/config_sections.h"
+#include "config/option_yaml.h"
 #include "control/control_options.h"
-#include "io/option_yaml.h"
 #include "softsight/core/error.h"
-#include "softsight/io/control_config.h"
 
 namespace softsight {
 

@@ -9,7 +9,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/option_table.h"
-#include "io/yaml_map.h"
+#include "config/yaml_map.h"
 
 namespace softsight {
 

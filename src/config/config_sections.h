@@ -5,7 +5,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "io/yaml_map.h"
+#include "config/yaml_map.h"
+#include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/template_tracker.h"
@@ -31,6 +32,13 @@ void WriteMeasureOptions(const MeasureOptions& measure, YAML::Emitter& out);
 // MeasureOptions::Check() for what a file may give: no triple is allowed (a config that only
 // tracks); the session refuses it if it needs the measurements.
 bool CheckMeasureOptionsOfAFile(const MeasureOptions& measure, std::string* error);
+
+// control_config.cc: the `control:` section (examples/rig.yaml documents every key). Read consumes
+// the keys of the `control:` mapping into `config` (defaults stay where a key is absent), finishes
+// the mapping (unknown keys are errors) and checks the result; Write emits the keys that differ
+// from the defaults.
+void ReadControlConfig(YamlMap& control, ControlConfig* config);
+void WriteControlConfig(const ControlConfig& config, YAML::Emitter& out);
 
 // config.cc: every key a tracking config can have, as commented YAML generated from the option
 // tables (`softsight config --doc`): each with its default, unit, range and one-line doc. It is a

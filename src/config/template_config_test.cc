@@ -5,9 +5,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/test_util.h"
-#include "io/config_test_util.h"
+#include "config/config_test_util.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight {
 namespace {

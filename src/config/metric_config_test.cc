@@ -6,7 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "io/config_sections.h"
+#include "config/config_sections.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 

@@ -1,4 +1,4 @@
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 #include <algorithm>
 #include <cctype>
@@ -7,9 +7,8 @@
 
 #include "control/control_options.h"
 #include "geometry/measure_options.h"
-#include "io/config_sections.h"
-#include "io/control_config.h"
-#include "io/yaml_map.h"
+#include "config/config_sections.h"
+#include "config/yaml_map.h"
 #include "track/track_options.h"
 #include "softsight/core/error.h"
 

@@ -20,8 +20,8 @@
 // the template is selected live (softsight's window) or the marker is not found.
 #include <opencv2/imgcodecs.hpp>
 
-#include "io/config_sections.h"
-#include "io/option_yaml.h"
+#include "config/config_sections.h"
+#include "config/option_yaml.h"
 #include "track/track_options.h"
 
 namespace softsight {

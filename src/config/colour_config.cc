@@ -15,8 +15,8 @@
 //   window: 64
 //   widen_steps: 2
 //   acquire_downsample: 0
-#include "io/config_sections.h"
-#include "io/option_yaml.h"
+#include "config/config_sections.h"
+#include "config/option_yaml.h"
 #include "track/track_options.h"
 
 namespace softsight {

@@ -1,4 +1,4 @@
-#include "io/yaml_map.h"
+#include "config/yaml_map.h"
 
 #include <cmath>
 #include <filesystem>

@@ -5,10 +5,9 @@
 
 #include "control/control_options.h"
 #include "geometry/measure_options.h"
-#include "io/config_sections.h"
-#include "io/control_config.h"
-#include "io/config_test_util.h"
-#include "io/option_table_test_util.h"
+#include "config/config_sections.h"
+#include "config/config_test_util.h"
+#include "config/option_table_test_util.h"
 #include "track/track_options.h"
 
 namespace softsight {

@@ -1,10 +1,10 @@
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
-#include "io/config_test_util.h"
+#include "config/config_test_util.h"
 #include "softsight/core/error.h"
 
 namespace softsight {

@@ -18,8 +18,8 @@
 
 #include "core/option_table.h"
 #include "core/test_util.h"
-#include "io/option_yaml.h"
-#include "io/yaml_map.h"
+#include "config/option_yaml.h"
+#include "config/yaml_map.h"
 #include "softsight/core/error.h"
 
 namespace softsight::testing {
