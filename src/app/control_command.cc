@@ -626,7 +626,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                "Identify the actuator first (`softsight identify`: steps and a PRBS, its CSV "
                "beside --csv as *_identify.csv), then run the loop with the gains it found");
   sub.add_option("--closed-loop-s", *closed_loop_s,
-                 "With --auto-tune: the SIMC closed-loop time (default max(dead time, 0.15 s))");
+                 "With --auto-tune: the SIMC closed-loop time (default max(dead time, 3 camera periods))");
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
   return [o, auto_tune, closed_loop_s] {
     ControlOptions run = *o;

@@ -123,7 +123,7 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   sub.add_option("--model-csv", o->model_csv_file,
                  "Measured against the fitted model per frame, for `softsight plot`");
   sub.add_option("--closed-loop-s", o->closed_loop_s,
-                 "SIMC closed-loop time constant (default max(dead time, 0.15 s)); larger: "
+                 "SIMC closed-loop time constant (default max(dead time, 3 camera periods)); larger: "
                  "gentler gains");
   sub.add_option("--max-s", o->max_s, "Longest the experiment may take (default 600 s)");
   sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")->capture_default_str();

@@ -48,6 +48,10 @@ OptionTable<ControllerOptions> MakeController() {
           .Range(0, 10)
           .Unit("s")
           .Doc("dynamic feed-forward: lead of the target bend by its rate (0: off)"),
+      DoubleOption<P>("ff_lead2_s2", &P::ff_lead2_s2)
+          .Range(0, 100)
+          .Unit("s^2")
+          .Doc("dynamic feed-forward, second order: the target bend's acceleration times this"),
       DoubleOption<P>("min_kpa", &P::min_kpa)
           .Range(0, 1000)
           .Unit("kPa")

@@ -42,6 +42,8 @@ void AngleController::reset() {
   loss_start_s_.reset();
   last_measured_deg_.reset();
   last_target_deg_.reset();
+  last_target_rate_.reset();
+  last_input_deg_.reset();
   reference_deg_.reset();
   bend_direction_ = 1.0;
   integral_kpa_ = 0.0;
@@ -107,13 +109,21 @@ ControllerOutput AngleController::update(double time_s, double target_deg_in,
   if (last_target_deg_ && target_deg < *last_target_deg_) bend_direction_ = 1.0;
   if (last_target_deg_ && target_deg > *last_target_deg_) bend_direction_ = -1.0;
   // The target's rate, for the lead; none across a jump (or before a previous target).
-  double target_rate_deg_per_s = 0.0;
-  if (last_target_deg_ && dt_s > 0.0) {
-    target_rate_deg_per_s = (target_deg - *last_target_deg_) / dt_s;
-    if (std::abs(target_rate_deg_per_s) > kStepRateDegPerS) target_rate_deg_per_s = 0.0;
+  std::optional<double> target_rate_deg_per_s;
+  if (last_input_deg_ && dt_s > 0.0) {
+    target_rate_deg_per_s = (target_deg_in - *last_input_deg_) / dt_s;
+    if (std::abs(*target_rate_deg_per_s) > kStepRateDegPerS) target_rate_deg_per_s.reset();
+  }
+  double target_accel_deg_per_s2 = 0.0;
+  if (target_rate_deg_per_s && last_target_rate_ && dt_s > 0.0) {
+    target_accel_deg_per_s2 = (*target_rate_deg_per_s - *last_target_rate_) / dt_s;
   }
   last_target_deg_ = target_deg;
-  const double led_bend_deg = 180.0 - target_deg - options_.ff_lead_s * target_rate_deg_per_s;
+  last_input_deg_ = target_deg_in;
+  last_target_rate_ = target_rate_deg_per_s;
+  const double led_bend_deg = 180.0 - target_deg -
+                              options_.ff_lead_s * target_rate_deg_per_s.value_or(0.0) -
+                              options_.ff_lead2_s2 * target_accel_deg_per_s2;
   const double feedforward_kpa = options_.bias_kpa + options_.ff_kpa_per_deg * led_bend_deg +
                                  0.5 * options_.hysteresis_kpa * bend_direction_;
   const double pd_kpa = feedforward_kpa + options_.kp_kpa_per_deg * error_deg -

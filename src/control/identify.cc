@@ -561,7 +561,7 @@ ControlSample StepIdentification(IdentificationExperiment& experiment, ControlSe
 
 // Integral separation of the tuned controller: errors beyond this are left to the feed-forward
 // and P (see ControllerOptions::integral_band_deg).
-constexpr double kIntegralBandDeg = 5.0;
+constexpr double kIntegralBandDeg = 3.0;
 
 ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& base,
                                  double frame_period_s, std::optional<double> closed_loop_s) {
@@ -573,7 +573,12 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
   const double tau = std::max(1e-3, tau1 + 0.5 * tau2);
   const double theta =
       m.dead_time_s + m.pressure_dead_time_s + 0.5 * tau2 + 0.5 * frame_period_s;
-  const double tau_c = closed_loop_s.value_or(std::max(theta, 0.15));
+  // Tight control (SIMC's tau_c = theta) on the measured dead times (not the share of the smaller
+  // lag the half rule moves into theta), but no faster than three camera periods: the loop sees
+  // the actuator only once per frame.
+  const double measured_dead_s =
+      m.dead_time_s + m.pressure_dead_time_s + 0.5 * frame_period_s;
+  const double tau_c = closed_loop_s.value_or(std::max(measured_dead_s, 3.0 * frame_period_s));
   model->closed_loop_s = tau_c;
   ControllerOptions c = base;
   c.kp_kpa_per_deg = std::clamp(tau / (k * (tau_c + theta)), 0.0, 100.0);
@@ -586,7 +591,9 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
   c.integral_band_deg = kIntegralBandDeg;
   c.ff_kpa_per_deg = std::min(100.0, 1.0 / k);
   c.hysteresis_kpa = std::min(100.0, m.hysteresis_deg / k);
+  // The inverse of the two lags (1 + tau1 s)(1 + tau2 s) and, to first order, of the dead times.
   c.ff_lead_s = std::min(10.0, m.lag_s + m.pressure_lag_s + m.dead_time_s + m.pressure_dead_time_s);
+  c.ff_lead2_s2 = std::min(100.0, m.lag_s * m.pressure_lag_s);
   return c;
 }
 

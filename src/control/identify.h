@@ -23,10 +23,13 @@
 //   the two lags by the half rule: tau = tau1 + tau2 / 2, theta = theta_p + theta_b + tau2 / 2
 //     + half a camera period (the controller acts once per frame);
 //   kp = tau / (K (tau_c + theta)),  ki = kp / min(tau, 4 (tau_c + theta)),
-// with tau_c the chosen closed-loop time (default: max(theta, 0.15 s)), K the static slope; the
-// feed-forward from the static map (bias_kpa = bend start, ff_kpa_per_deg = 1 / K) and the
-// hysteresis compensation (hysteresis_kpa = hysteresis width / K) do most of the work, the PI
-// removes what the model misses.
+// with tau_c the chosen closed-loop time (default: the measured dead times plus half a camera
+// period, at least three camera periods), K the static slope; the
+// feed-forward from the static map (bias_kpa = bend start, ff_kpa_per_deg = 1 / K), its lead
+// (ff_lead_s = the lags and dead times, ff_lead2_s2 = the product of the two lags: the inverse of
+// both) and the hysteresis compensation (hysteresis_kpa = hysteresis width / K) do most of the
+// work; the PI removes what the model misses, integrating only within 3 deg of the reference
+// (integral_band_deg), so it does not wind up on the transient the feed-forward answers.
 #pragma once
 
 #include <optional>
@@ -52,7 +55,7 @@ struct IdentifyOptions {
   double lost_s = 0.3;              // Markers missing this long: abort.
   double min_response_deg = 3.0;    // Less angle change than this at half the ceiling: abort.
   double over_ceiling_kpa = 2.0;    // Sensed pressure this far above the ceiling: abort.
-  std::optional<double> closed_loop_s;  // SIMC tau_c; default max(theta, 0.15 s).
+  std::optional<double> closed_loop_s;  // SIMC tau_c; default max(dead times, 3 camera periods).
 };
 
 // Why the experiment stopped early: one line, for the user.

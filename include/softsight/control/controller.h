@@ -42,6 +42,9 @@ struct ControllerOptions {
   // moving target is not followed a lag behind. Jumps of the target (faster than
   // kStepRateDegPerS) are steps, which no lead can anticipate: they get none. Default 0: off.
   double ff_lead_s = 0.0;
+  // Its second-order term: the target bend's acceleration times this (the product of the two
+  // identified lags, so that lead and this invert both exactly). Default 0: off.
+  double ff_lead2_s2 = 0.0;
   // Output limits, kPa. The board enforces its own hard limit as well; max_kpa is clamped to it.
   double min_kpa = 0.0;
   double max_kpa = 45.0;
@@ -88,6 +91,8 @@ class AngleController {
   std::optional<double> last_measured_deg_;
   std::optional<double> last_target_deg_;
   std::optional<double> reference_deg_;  // The ramped target (with a feed-forward).
+  std::optional<double> last_target_rate_;  // For the second-order lead.
+  std::optional<double> last_input_deg_;    // The target as given (not ramped), for the lead.
   double bend_direction_ = 1.0;  // +1: the target last moved towards more bend; -1: back.
   double integral_kpa_ = 0.0;
   double derivative_deg_per_s_ = 0.0;
