@@ -50,6 +50,11 @@ constexpr double kMinContrast = 2.0;
 // Without a learned model only compact blobs are accepted (a disc is 1, a 2:1 ellipse 0.8, a disc
 // seen at 50 degrees 0.91): elongated patches of the right colour are common on a bench.
 constexpr double kMinCircularityWithoutModel = 0.7;
+// A whole-frame first acquisition (no learned model, no roi) accepts only a blob with at least
+// this many pixels of its own colour (deeper than the soft band inside its edge): the colour of a
+// smaller blob is a mixture with its surroundings, and such specks are everywhere in real footage
+// (the yellow rim of a highlight on an orange object, a glint on a blue one).
+constexpr int kMinCorePxWithoutModel = 9;
 // Tolerances of the colour check against the learned (or nominal) core colour: the angle between
 // the BGR vectors (tint, insensitive to illumination gain) and the brightness ratio. A same-hue
 // blob at 60 % of the marker's brightness or 9 degrees off in tint is something else.
@@ -449,6 +454,9 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b) co
       model_ ? params_.min_circularity
              : std::max(params_.min_circularity, kMinCircularityWithoutModel);
   if (b.circularity < min_circularity || !b.measured) return {CandidateVerdict::kShape, kInf};
+  if (!model_ && !acquire_roi_ && b.core_px < kMinCorePxWithoutModel) {
+    return {CandidateVerdict::kSize, kInf};
+  }
   double misfit = 0;
   // Shape: 0 as round as the model (a disc without one), 1 at the limit.
   const double ref_circularity = model_ ? model_->circularity : 1.0;
@@ -594,13 +602,18 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   }
   Choice choice;
   if (!std::isfinite(best_cost)) return choice;  // kLost: nothing fits.
-  if (std::isfinite(second_cost) && second_cost - best_cost < params_.ambiguity_margin) {
+  // Before a model is learned, the misfit knows only the configured ranges and a compact,
+  // contrasted shape: it cannot tell a marker from a look-alike (a glint, a dot of the bench), so
+  // a whole-frame first acquisition needs the one candidate that fits at all.
+  const double margin = !model_ && !acquire_roi_ ? std::numeric_limits<double>::infinity()
+                                                 : params_.ambiguity_margin;
+  if (std::isfinite(second_cost) && second_cost - best_cost < margin) {
     choice.status = MarkerStatus::kAmbiguous;
     for (size_t i = 0; i < candidates_.size(); ++i) {
       if (candidates_[i].verdict != CandidateVerdict::kFits) continue;
       double cost = candidates_[i].misfit;
       if (last_px_) cost += cv::norm(blobs_[i].centroid_px - *last_px_) / diagonal;
-      if (cost - best_cost < params_.ambiguity_margin) ++choice.tied;
+      if (cost - best_cost < margin) ++choice.tied;
     }
     return choice;
   }
@@ -802,6 +815,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
     for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] && d[x] > kNear);
   }
   const int core_depth = core_empty ? 0 : kNear;
+  const bool pure_core = !core_empty;
 
   // Pass 1: core colour, ring colour (overall and per sector).
   cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
@@ -841,6 +855,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
     core_var += std::max(0.0, core_sq[k] / core_n - blob->core_colour[k] * blob->core_colour[k]);
     ring_var += std::max(0.0, ring_sq[k] / ring_n - blob->ring_colour[k] * blob->ring_colour[k]);
   }
+  blob->core_px = pure_core ? static_cast<int>(core_n) : 0;
   blob->core_sigma = std::sqrt(core_var);
   blob->ring_sigma = std::sqrt(ring_var);
   const cv::Vec3d axis = blob->core_colour - blob->ring_colour;

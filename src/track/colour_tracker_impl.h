@@ -40,6 +40,9 @@ struct ColourBlob {
   // the whole blob when that is empty) and of its surroundings (a ring 3-4 px outside, pixels of
   // other blobs excluded), with their RMS spread (over channels).
   cv::Vec3d core_colour, ring_colour;
+  // Pixels deeper than the soft band inside the edge: of the marker's own colour, not mixed with
+  // the background. 0 for a blob too small to have any (its colour is then the whole blob's).
+  int core_px = 0;
   double core_sigma = 0, ring_sigma = 0;
   // |core - ring| / (core_sigma + ring_sigma + 2): how clearly the blob stands out from what
   // surrounds it. A printed or painted marker scores far above a patch of background texture.

@@ -84,7 +84,9 @@ struct ColourParams {
   // Each candidate gets a misfit: 0 is a perfect fit, each criterion (area, shape, colour,
   // contrast to its surroundings) reaching 1 at its limit; above 1 it is rejected. When the
   // runner-up's misfit is within this margin of the best one's, the marker is ambiguous and not
-  // found. Larger refuses more often; 0 accepts the best even against a twin.
+  // found. Larger refuses more often; 0 accepts the best even against a twin. (A whole-frame first
+  // acquisition, with no model learned and no roi, needs the one candidate that fits at all, with
+  // at least 9 pixels of its own colour: see roi.)
   double ambiguity_margin = 0.2;
   // While tracking, the learned area, shape and colour follow the marker by this fraction per
   // frame (only from frames where it fits well: a sudden change is not learned), so a marker that
@@ -95,7 +97,9 @@ struct ColourParams {
   // ---- Search ------------------------------------------------------------------------------------
   // Where the first acquisition looks (a dragged rectangle); the chosen blob's centroid lies in it.
   // Without it the first acquisition searches the whole frame and accepts a blob only when it is
-  // the one candidate that fits (see above). Later re-acquisitions search the whole frame,
+  // the one candidate that fits, and has a core of its own colour (at least 9 pixels deeper than
+  // 2 px inside its edge: a speck's colour is a mix with its surroundings, and real footage is
+  // full of glints and highlight rims). Later re-acquisitions search the whole frame,
   // preferring candidates that fit the learned model best, near the last known position.
   std::optional<cv::Rect> roi;
   // Side of the square window searched around the constant-velocity prediction while tracking;
