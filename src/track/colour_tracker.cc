@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -123,46 +124,81 @@ double DiamondAngle(double dx, double dy) {
 void ChamferToEdge(const cv::Mat& inside, cv::Mat& distance) {
   constexpr int kFar = 0x3fff;
   const int w = inside.cols, h = inside.rows;
-  distance.setTo(kFar);
   // Two transforms in one map: a pixel's seeds are its neighbours of the other kind (one step
   // away); through a neighbour of its own kind it inherits that one's distance plus the step.
-  auto relax = [](int& d, bool kind, const uchar* in, const uint16_t* dist, int x, int step) {
-    const int via = (in[x] != 0) == kind ? dist[x] + step : step;
-    d = std::min(d, via);
+  // `inside` holds 0 or 255, so a pixel's kind is its low bit; `same` is all ones when the
+  // neighbour's kind is the pixel's, and masks in the neighbour's distance.
+  auto relax = [](int d, int k, const uchar* in, const uint16_t* dist, int x, int step) {
+    const int same = ((in[x] & 1) ^ k) - 1;
+    return std::min(d, step + (dist[x] & same));
+  };
+  auto forward = [&](const uchar* in, const uchar* in_up, uint16_t* row, const uint16_t* up,
+                     int x) {
+    const int k = in[x] & 1;
+    int d = kFar;
+    if (x > 0) d = relax(d, k, in, row, x - 1, 3);
+    if (up) {
+      if (x > 0) d = relax(d, k, in_up, up, x - 1, 4);
+      d = relax(d, k, in_up, up, x, 3);
+      if (x + 1 < w) d = relax(d, k, in_up, up, x + 1, 4);
+    }
+    row[x] = static_cast<uint16_t>(d);
+  };
+  auto backward = [&](const uchar* in, const uchar* in_down, uint16_t* row, const uint16_t* down,
+                      int x) {
+    const int k = in[x] & 1;
+    int d = row[x];
+    if (x + 1 < w) d = relax(d, k, in, row, x + 1, 3);
+    if (down) {
+      if (x + 1 < w) d = relax(d, k, in_down, down, x + 1, 4);
+      d = relax(d, k, in_down, down, x, 3);
+      if (x > 0) d = relax(d, k, in_down, down, x - 1, 4);
+    }
+    row[x] = static_cast<uint16_t>(d);
   };
   for (int y = 0; y < h; ++y) {
     const uchar* in = inside.ptr<uchar>(y);
-    const uchar* in_up = y > 0 ? inside.ptr<uchar>(y - 1) : nullptr;
     uint16_t* row = distance.ptr<uint16_t>(y);
-    const uint16_t* up = y > 0 ? distance.ptr<uint16_t>(y - 1) : nullptr;
-    for (int x = 0; x < w; ++x) {
-      const bool kind = in[x] != 0;
-      int d = row[x];
-      if (x > 0) relax(d, kind, in, row, x - 1, 3);
-      if (up) {
-        if (x > 0) relax(d, kind, in_up, up, x - 1, 4);
-        relax(d, kind, in_up, up, x, 3);
-        if (x + 1 < w) relax(d, kind, in_up, up, x + 1, 4);
-      }
+    if (y == 0 || w < 3) {
+      const uchar* in_up = y > 0 ? inside.ptr<uchar>(y - 1) : nullptr;
+      const uint16_t* up = y > 0 ? distance.ptr<uint16_t>(y - 1) : nullptr;
+      for (int x = 0; x < w; ++x) forward(in, in_up, row, up, x);
+      continue;
+    }
+    const uchar* in_up = inside.ptr<uchar>(y - 1);
+    const uint16_t* up = distance.ptr<uint16_t>(y - 1);
+    forward(in, in_up, row, up, 0);
+    for (int x = 1; x + 1 < w; ++x) {  // Every neighbour exists: no bounds tests.
+      const int k = in[x] & 1;
+      int d = relax(kFar, k, in, row, x - 1, 3);
+      d = relax(d, k, in_up, up, x - 1, 4);
+      d = relax(d, k, in_up, up, x, 3);
+      d = relax(d, k, in_up, up, x + 1, 4);
       row[x] = static_cast<uint16_t>(d);
     }
+    forward(in, in_up, row, up, w - 1);
   }
   for (int y = h - 1; y >= 0; --y) {
     const uchar* in = inside.ptr<uchar>(y);
-    const uchar* in_down = y + 1 < h ? inside.ptr<uchar>(y + 1) : nullptr;
     uint16_t* row = distance.ptr<uint16_t>(y);
-    const uint16_t* down = y + 1 < h ? distance.ptr<uint16_t>(y + 1) : nullptr;
-    for (int x = w - 1; x >= 0; --x) {
-      const bool kind = in[x] != 0;
-      int d = row[x];
-      if (x + 1 < w) relax(d, kind, in, row, x + 1, 3);
-      if (down) {
-        if (x + 1 < w) relax(d, kind, in_down, down, x + 1, 4);
-        relax(d, kind, in_down, down, x, 3);
-        if (x > 0) relax(d, kind, in_down, down, x - 1, 4);
-      }
+    if (y == h - 1 || w < 3) {
+      const uchar* in_down = y + 1 < h ? inside.ptr<uchar>(y + 1) : nullptr;
+      const uint16_t* down = y + 1 < h ? distance.ptr<uint16_t>(y + 1) : nullptr;
+      for (int x = w - 1; x >= 0; --x) backward(in, in_down, row, down, x);
+      continue;
+    }
+    const uchar* in_down = inside.ptr<uchar>(y + 1);
+    const uint16_t* down = distance.ptr<uint16_t>(y + 1);
+    backward(in, in_down, row, down, w - 1);
+    for (int x = w - 2; x >= 1; --x) {
+      const int k = in[x] & 1;
+      int d = relax(row[x], k, in, row, x + 1, 3);
+      d = relax(d, k, in_down, down, x + 1, 4);
+      d = relax(d, k, in_down, down, x, 3);
+      d = relax(d, k, in_down, down, x - 1, 4);
       row[x] = static_cast<uint16_t>(d);
     }
+    backward(in, in_down, row, down, 0);
   }
 }
 
@@ -181,8 +217,8 @@ int MorphShape(ColourParams::Shape shape) {
   return cv::MORPH_ELLIPSE;
 }
 
-// The coarse test: hue widened by kCoarseHueSlack each side, lower S and V bounds lowered by a
-// quarter and the upper ones raised a quarter of the way to 255.
+// The coarse test with a pre-filter: hue widened by kCoarseHueSlack each side, lower S and V
+// bounds lowered by a quarter and the upper ones raised a quarter of the way to 255.
 HsvBox CoarseBox(const ColourParams& p) {
   const int span = p.h.lo <= p.h.hi ? p.h.hi - p.h.lo : p.h.hi + 180 - p.h.lo;
   HsvRange h{0, 179};
@@ -236,26 +272,6 @@ bool ColourParams::NeedsColour() const {
   return !(HueIsFull(h) && s.lo == 0);
 }
 
-HsvBox HsvBox::Make(HsvRange h, HsvRange s, HsvRange v) {
-  HsvBox box;
-  if (h.lo <= h.hi) {
-    box.lower = cv::Scalar(h.lo, s.lo, v.lo);
-    box.upper = cv::Scalar(h.hi, s.hi, v.hi);
-    return box;
-  }
-  // Wrapping hue (red: 170..10): rotate hue so the range starts at 0, one inRange then tests it.
-  box.shift = true;
-  box.lut.create(1, 256, CV_8UC3);
-  for (int i = 0; i < 256; ++i) {
-    const int hue = i < 180 ? (i - h.lo + 180) % 180 : 255;  // 8-bit hue never exceeds 179.
-    box.lut.at<cv::Vec3b>(0, i) = cv::Vec3b(static_cast<uchar>(hue), static_cast<uchar>(i),
-                                            static_cast<uchar>(i));
-  }
-  box.lower = cv::Scalar(0, s.lo, v.lo);
-  box.upper = cv::Scalar(h.hi + 180 - h.lo, s.hi, v.hi);
-  return box;
-}
-
 ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
   CV_Assert(params_.Check(nullptr));
   const int filter_radius = params_.filter == ColourParams::Filter::kNone ? 0
@@ -264,6 +280,11 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
   if (params_.morph_size > 1) {
     kernel_ = cv::getStructuringElement(MorphShape(params_.morph_shape),
                                         cv::Size(params_.morph_size, params_.morph_size));
+    if (params_.morph_size == 3) {
+      morph_square_ = cv::countNonZero(kernel_) == 9;
+      morph_cross_ = cv::countNonZero(kernel_ != cv::getStructuringElement(
+                                                     cv::MORPH_CROSS, cv::Size(3, 3))) == 0;
+    }
   }
   // Opening then closing is four erosions/dilations, each reaching one radius further; the ring
   // around a blob reaches kRingOuter beyond it. With this margin every pixel a blob inside the
@@ -292,15 +313,19 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
       nominal_ = cv::Vec3d(c[0], c[1], c[2]);
     }
   }
+  // The coarse test sees single unfiltered pixels. Without a pre-filter those are exactly what
+  // the fine test sees, so it is the fine test; a filter moves colours, and the coarse test is
+  // then widened so that a marker whose filtered pixels pass is not missed.
+  const bool filtered = params_.filter != ColourParams::Filter::kNone;
   if (gray_) {
-    coarse_gray_ = HsvRange{gray_->lo * 3 / 4, gray_->hi + (255 - gray_->hi) / 4};
+    coarse_gray_ = filtered ? HsvRange{gray_->lo * 3 / 4, gray_->hi + (255 - gray_->hi) / 4} : *gray_;
   } else {
     ColourParams derived = params_;
     derived.h = h;
     derived.s = s;
     derived.v = v;
-    fine_box_ = HsvBox::Make(h, s, v);
-    coarse_box_ = CoarseBox(derived);
+    fine_hsv_ = HsvClassifier(HsvBox::Make(h, s, v));
+    coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
   }
   acquire_roi_ = params_.roi;
 }
@@ -623,13 +648,17 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   return choice;
 }
 
+double ColourTracker::min_blob_radius_px() const {
+  const double min_area = std::max(params_.min_area_px,
+                                   params_.min_area_fraction * (model_ ? model_->area_px : 0.0));
+  return std::sqrt(min_area / CV_PI);
+}
+
 int ColourTracker::acquire_downsample() const {
   if (params_.acquire_downsample > 0) return params_.acquire_downsample;
   // The smallest blob that can count as the marker must hold sample points of the coarse grid
   // (spacing f): a disc of radius r >= f / sqrt(2) holds one, r >= f holds at least three.
-  const double min_area = std::max(params_.min_area_px,
-                                   params_.min_area_fraction * (model_ ? model_->area_px : 0.0));
-  const double radius = std::sqrt(min_area / CV_PI);
+  const double radius = min_blob_radius_px();
   int factor = 1;
   while (factor < 8 && radius >= 2.0 * factor) factor *= 2;
   return factor;
@@ -662,11 +691,8 @@ void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask) {
     cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
     return;
   }
-  const HsvBox& box = coarse ? coarse_box_ : fine_box_;
-  cv::Mat work = Scratch(hsv_store_, src.size(), CV_8UC3);
-  cv::cvtColor(src, work, cv::COLOR_BGR2HSV);
-  if (box.shift) cv::LUT(work, box.lut, work);
-  cv::inRange(work, box.lower, box.upper, mask);
+  // One pass, bit-exact with cvtColor(BGR2HSV) + inRange (track/colour_kernels.h).
+  (coarse ? coarse_hsv_ : fine_hsv_).Classify(src, mask);
 }
 
 void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
@@ -715,17 +741,23 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
   //    between pixels), so morphology and labelling work on that box plus the reach of the four
   //    passes. Beyond the box the parent mask holds zeros, exactly what a whole pass would read.
   const cv::Rect extended_local(cv::Point(0, 0), extended.size());
-  cv::Rect active = cv::boundingRect(mask);
+  cv::Rect active = NonZeroBounds(mask);
   if (active.empty()) return;
   if (!kernel_.empty()) {
     const int reach = 4 * (params_.morph_size / 2) + 1;
     active = cv::Rect(active.x - reach, active.y - reach, active.width + 2 * reach,
                       active.height + 2 * reach) &
              extended_local;
-    cv::Mat opened = Scratch(morph_store_, active.size(), CV_8U);
-    cv::morphologyEx(mask(active), opened, cv::MORPH_OPEN, kernel_);
     cv::Mat cleaned = mask(active);
-    cv::morphologyEx(opened, cleaned, cv::MORPH_CLOSE, kernel_);
+    if (morph_cross_ || morph_square_) {
+      // The reach padding keeps `active`'s border rows zero, so reading the outside as the
+      // border (the kernel) equals reading the parent's zeros (morphologyEx on the view).
+      OpenClose3x3(cleaned, morph_cross_, morph_store_);
+    } else {
+      cv::Mat opened = Scratch(morph_store_, active.size(), CV_8U);
+      cv::morphologyEx(cleaned, opened, cv::MORPH_OPEN, kernel_);
+      cv::morphologyEx(opened, cleaned, cv::MORPH_CLOSE, kernel_);
+    }
   }
 
   // 4. Blobs of the region proper (the margin only fed the filters); the region is 0 outside
@@ -734,20 +766,18 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
   const cv::Rect labelled = active & inner_local;
   if (labelled.empty()) return;
   const cv::Point offset = labelled.tl() - inner_local.tl();  // Of `labelled` in the region.
-  cv::Mat labels = Scratch(labels_store_, labelled.size(), CV_32S);
-  const int count =
-      cv::connectedComponentsWithStats(mask(labelled), labels, stats_, centroids_, 8, CV_32S);
+  labeller_.Label(mask(labelled));
   const bool open_left = region.x > 0;
   const bool open_top = region.y > 0;
   const bool open_right = region.x + region.width < frame.cols;
   const bool open_bottom = region.y + region.height < frame.rows;
-  for (int i = 1; i < count; ++i) {
-    const int* s = stats_.ptr<int>(i);
-    const cv::Rect box(s[cv::CC_STAT_LEFT], s[cv::CC_STAT_TOP], s[cv::CC_STAT_WIDTH],
-                       s[cv::CC_STAT_HEIGHT]);
+  const std::vector<RunLabeller::Component>& components = labeller_.components();
+  for (size_t i = 0; i < components.size(); ++i) {
+    const RunLabeller::Component& comp = components[i];
+    const cv::Rect& box = comp.box;
     const cv::Rect in_region = box + offset;
     ColourBlob blob;
-    blob.area_px = s[cv::CC_STAT_AREA];
+    blob.area_px = comp.area;
     blob.clipped = (open_left && in_region.x == 0) || (open_top && in_region.y == 0) ||
                    (open_right && in_region.x + in_region.width == region.width) ||
                    (open_bottom && in_region.y + in_region.height == region.height);
@@ -755,29 +785,30 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
     if (!blob.clipped) {
       if (blob.area_px < params_.min_area_px) continue;
       if (params_.max_area_px > 0 && blob.area_px > params_.max_area_px) continue;
-      // 5. Centroid from the binary moments of this blob alone (another blob may share its
-      //    bounding box), then the exact integer offset of the box in the frame.
-      cv::Mat blob_mask = Scratch(blob_store_, box.size(), CV_8U);
-      cv::compare(labels(box), i, blob_mask, cv::CMP_EQ);
-      const cv::Moments mo = cv::moments(blob_mask, true);
-      blob.binary_centroid_px = cv::Point2d(mo.m10 / mo.m00 + blob.bbox_px.x,
-                                            mo.m01 / mo.m00 + blob.bbox_px.y);
+      // 5. Centroid from the binary moments of this blob alone (exact integer sums relative to
+      //    its box, as cv::moments of its own pixels), then the box's integer offset in the frame.
+      const double m00 = comp.area, inv_m00 = 1.0 / m00;
+      const double cx = static_cast<double>(comp.m10) * inv_m00;
+      const double cy = static_cast<double>(comp.m01) * inv_m00;
+      blob.binary_centroid_px = cv::Point2d(cx + blob.bbox_px.x, cy + blob.bbox_px.y);
       blob.centroid_px = blob.binary_centroid_px;
       // Polar moment of the pixels as unit squares (each adds 1/6 about its own centre).
-      const double polar = mo.mu20 + mo.mu02 + mo.m00 / 6.0;
-      blob.circularity = mo.m00 * mo.m00 / (2.0 * CV_PI * polar);
+      const double mu20 = static_cast<double>(comp.m20) - static_cast<double>(comp.m10) * cx;
+      const double mu02 = static_cast<double>(comp.m02) - static_cast<double>(comp.m01) * cy;
+      const double polar = mu20 + mu02 + m00 / 6.0;
+      blob.circularity = m00 * m00 / (2.0 * CV_PI * polar);
       // 6. Colour statistics and the soft centroid, for blobs that may be the marker.
       if (blob.circularity >= params_.min_circularity) {
-        measure(filtered, mask, labels, i, box, labelled.tl(), extended.tl(), &blob);
+        measure(filtered, mask, static_cast<int>(i), box, labelled.tl(), extended.tl(), &blob);
       }
     }
     blobs->push_back(blob);
   }
 }
 
-void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const cv::Mat& labels,
-                            int label, const cv::Rect& box, cv::Point labelled_tl,
-                            cv::Point origin, ColourBlob* blob) {
+void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int component,
+                            const cv::Rect& box, cv::Point labelled_tl, cv::Point origin,
+                            ColourBlob* blob) {
   // The blob's box in `filtered`, padded by the ring's reach.
   const cv::Rect box_local = box + labelled_tl;
   const cv::Rect padded =
@@ -786,9 +817,10 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, const 
       cv::Rect(cv::Point(0, 0), filtered.size());
   const cv::Size size = padded.size();
   cv::Mat own = Scratch(blob_store_, size, CV_8U);
-  own.setTo(0);
-  cv::compare(labels(box), label, own(cv::Rect(box_local.tl() - padded.tl(), box.size())),
-              cv::CMP_EQ);
+  for (int y = 0; y < size.height; ++y) {
+    std::memset(own.ptr<uchar>(y), 0, static_cast<size_t>(size.width));
+  }
+  labeller_.Draw(component, own, padded.tl() - labelled_tl);
   // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
   // core = more than kSoftBand inside, reach = within kRingOuter outside.
   cv::Mat distance = Scratch(distance_store_, size, CV_16U);
@@ -959,7 +991,22 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
   // covered by the last cell's window below.
   const cv::Mat src = frame(cv::Rect(region.x, region.y, coarse_cols * factor, coarse_rows * factor));
   cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
-  cv::resize(src, sampled, sampled.size(), 0, 0, cv::INTER_NEAREST_EXACT);
+  // The pixel cv::resize's INTER_NEAREST_EXACT takes, (i + 1/2) * factor, copied directly.
+  const int channels = src.channels(), half = factor / 2;
+  for (int y = 0; y < coarse_rows; ++y) {
+    const uchar* in = src.ptr<uchar>(y * factor + half) + half * channels;
+    uchar* out = sampled.ptr<uchar>(y);
+    const int step = factor * channels;
+    if (channels == 3) {
+      for (int x = 0; x < coarse_cols; ++x, in += step, out += 3) {
+        out[0] = in[0];
+        out[1] = in[1];
+        out[2] = in[2];
+      }
+    } else {
+      for (int x = 0; x < coarse_cols; ++x, in += step) out[x] = in[0];
+    }
+  }
   const cv::Mat coarse = prepare(sampled, coarse_prepared_store_);
   cv::Mat mask = Scratch(coarse_mask_store_, coarse.size(), CV_8U);
   classify(coarse, true, mask);
@@ -967,6 +1014,20 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
   // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
   windows_.clear();
   cv::findNonZero(mask, points_);
+  // A blob that can be the marker has radius >= factor (as acquire_downsample chooses it), so it
+  // holds at least two 8-adjacent sample points: a lone lit sample is a speck of background texture.
+  if (min_blob_radius_px() >= factor) {
+    auto alone = [&](const cv::Point& p) {
+      for (int y = std::max(0, p.y - 1); y <= std::min(mask.rows - 1, p.y + 1); ++y) {
+        const uchar* row = mask.ptr<uchar>(y);
+        for (int x = std::max(0, p.x - 1); x <= std::min(mask.cols - 1, p.x + 1); ++x) {
+          if ((x != p.x || y != p.y) && row[x]) return false;
+        }
+      }
+      return true;
+    };
+    points_.erase(std::remove_if(points_.begin(), points_.end(), alone), points_.end());
+  }
   if (points_.empty()) return;
   const cv::Size grid((coarse_cols + kTile - 1) / kTile, (coarse_rows + kTile - 1) / kTile);
   cv::Mat tiles = Scratch(tiles_store_, grid, CV_8U);

@@ -22,6 +22,7 @@
 #include "softsight/core/types.h"
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/tracker.h"
+#include "track/colour_kernels.h"
 
 namespace softsight {
 
@@ -49,16 +50,6 @@ struct ColourBlob {
   double contrast = 0;
 };
 
-// A hue/saturation/value box as one inRange call: a wrapping hue range is shifted by a lookup
-// table so that it becomes one ordinary range.
-struct HsvBox {
-  bool shift = false;       // Apply `lut` (hue - lo mod 180) before inRange.
-  cv::Mat lut;              // 1x256 CV_8UC3.
-  cv::Scalar lower, upper;
-
-  static HsvBox Make(HsvRange h, HsvRange s, HsvRange v);
-};
-
 // What the tracker knows of its marker: learned at the first acquisition, adapted while tracking.
 struct ColourModel {
   double area_px = 0;        // Reference area (Observation::score's denominator).
@@ -84,6 +75,8 @@ class ColourTracker : public Tracker {
   void find_blobs(const cv::Mat& frame_bgr, int downsample, std::vector<ColourBlob>* blobs);
   // The factor the next whole-frame acquisition would use.
   int acquire_downsample() const;
+  // Radius of the smallest blob that can count as the marker (a disc of the least acceptable area).
+  double min_blob_radius_px() const;
   std::optional<double> reference_area_px() const {
     return model_ ? std::optional<double>(model_->area_px) : std::nullopt;
   }
@@ -106,10 +99,11 @@ class ColourTracker : public Tracker {
   cv::Mat prepare(const cv::Mat& src, cv::Mat& store);
   // Marker mask of `src` (prepared, filtered) into `mask`.
   void classify(const cv::Mat& src, bool coarse, cv::Mat& mask);
-  // Colour statistics and soft centroid of label `label`, whose box in `labels` is `box`;
-  // `labelled_tl` is the labels' origin in `filtered` / `mask`, `origin` the latter's in the frame.
-  void measure(const cv::Mat& filtered, const cv::Mat& mask, const cv::Mat& labels, int label,
-               const cv::Rect& box, cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
+  // Colour statistics and soft centroid of the labeller's `component`, whose box in the labelled
+  // mask is `box`; `labelled_tl` is that mask's origin in `filtered` / `mask`, `origin` the
+  // latter's in the frame.
+  void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
+               cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
   // Every complete blob of `region`: analyse, growing the region around clipped blobs.
   void complete_blobs(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs);
   // Coarse candidates -> full-resolution windows -> complete blobs.
@@ -132,7 +126,8 @@ class ColourTracker : public Tracker {
   ColourParams params_;
   cv::Mat kernel_;          // Morphology structuring element.
   int margin_px_ = 0;       // Filter radius + 4 morphology radii (+1).
-  HsvBox fine_box_, coarse_box_;
+  HsvClassifier fine_hsv_, coarse_hsv_;  // The marker test, and the lenient coarse one.
+  bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
   std::optional<HsvRange> gray_, coarse_gray_;  // Gray-level mode (`gray`, or a nominal gray).
   std::optional<cv::Vec3d> nominal_;          // auto_bgr: the colour model until one is learned.
 
@@ -149,10 +144,11 @@ class ColourTracker : public Tracker {
   cv::Rect last_search_px_;
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
-  cv::Mat filtered_store_, hsv_store_, mask_store_, morph_store_, labels_store_, blob_store_;
+  cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
   cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
-  cv::Mat stats_, centroids_, coarse_stats_, coarse_centroids_;
+  cv::Mat coarse_stats_, coarse_centroids_;
+  RunLabeller labeller_;
   std::vector<ColourBlob> blobs_, pending_;
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;

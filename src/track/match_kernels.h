@@ -1,6 +1,6 @@
 // Template-matching kernels: SAD, SSD and ZNCC score maps, each with a vector implementation
 // (OpenCV universal intrinsics, 128-bit: SSE2 on any x86-64, NEON on ARM) and a slow, obviously
-// correct scalar reference beside it. This file pair is the only place in softsight with SIMD.
+// correct scalar reference beside it. This file pair and colour_kernels are softsight's SIMD.
 //
 // Every kernel computes, for each placement (x, y) of the w x h template fully inside the image,
 // one score over all w*h pixels and all channels, into a (W - w + 1) x (H - h + 1) map:

@@ -1,0 +1,503 @@
+#include "track/colour_kernels.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+// OpenCV's RGB2HSV_b tables (imgproc/src/color_hsv.simd.hpp): hsv_shift 12, 8-bit hue 0..179.
+constexpr int kHsvShift = 12;
+struct HsvTables {
+  int sdiv[256];
+  int hdiv[256];
+  HsvTables() {
+    sdiv[0] = hdiv[0] = 0;
+    for (int i = 1; i < 256; ++i) {
+      sdiv[i] = cv::saturate_cast<int>((255 << kHsvShift) / (1. * i));
+      hdiv[i] = cv::saturate_cast<int>((180 << kHsvShift) / (6. * i));
+    }
+  }
+};
+const HsvTables& Tables() {
+  static const HsvTables tables;
+  return tables;
+}
+
+// The hue numerator N' = N + diff of OpenCV's formula hue = N * 30 / diff (N = g - b when the
+// maximum is red, b - r + 2 diff when green, r - g + 4 diff when blue), shifted so it is >= 0.
+inline int ShiftedNumerator(int b, int g, int r, int v, int diff) {
+  if (v == r) return g - b + diff;
+  if (v == g) return b - r + 3 * diff;
+  return r - g + 5 * diff;
+}
+
+}  // namespace
+
+bool HsvBox::ContainsHue(int hue) const {
+  return h.lo <= h.hi ? hue >= h.lo && hue <= h.hi : hue >= h.lo || hue <= h.hi;
+}
+
+cv::Vec3b BgrToHsvExact(uchar b, uchar g, uchar r) {
+  const HsvTables& t = Tables();
+  const int v = std::max({b, g, r});
+  const int vmin = std::min({b, g, r});
+  const int diff = v - vmin;
+  const int vr = v == r ? -1 : 0;
+  const int vg = v == g ? -1 : 0;
+  const int s = (diff * t.sdiv[v] + (1 << (kHsvShift - 1))) >> kHsvShift;
+  int h = (vr & (g - b)) + (~vr & ((vg & (b - r + 2 * diff)) + ((~vg) & (r - g + 4 * diff))));
+  h = (h * t.hdiv[diff] + (1 << (kHsvShift - 1))) >> kHsvShift;
+  h += h < 0 ? 180 : 0;
+  return cv::Vec3b(cv::saturate_cast<uchar>(h), static_cast<uchar>(s), static_cast<uchar>(v));
+}
+
+HsvClassifier::HsvClassifier(const HsvBox& box) : box_(box) {
+  full_hue_ = (box.h.lo == 0 && box.h.hi >= 179) || (box.h.lo > box.h.hi && box.h.lo <= box.h.hi + 1);
+  gray_in_ = box.ContainsHue(0) && box.s.lo == 0;
+  if (full_hue_) return;
+  // Rounded hue u in 0..179 comes from the unrounded t in [-30, 150): u = round(t), plus 180 when
+  // negative. So u in [a, b] is t in [a, min(b, 149)] and t in [max(a, 150) - 180, b - 180].
+  std::array<std::pair<int, int>, 4> parts;
+  int n = 0;
+  auto add = [&](int a, int b) {
+    if (a <= 149) parts[n++] = {a, std::min(b, 149)};
+    if (b >= 150) parts[n++] = {std::max(a, 150) - 180, b - 180};
+  };
+  if (box.h.lo <= box.h.hi) {
+    add(box.h.lo, std::min(box.h.hi, 179));
+  } else {
+    add(box.h.lo, 179);
+    add(0, box.h.hi);
+  }
+  for (int i = 1; i < n; ++i) {  // Insertion sort by start (at most four parts).
+    for (int j = i; j > 0 && parts[j].first < parts[j - 1].first; --j) std::swap(parts[j], parts[j - 1]);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (intervals_ > 0 && parts[i].first <= t_hi_[intervals_ - 1] + 1) {
+      t_hi_[intervals_ - 1] = std::max(t_hi_[intervals_ - 1], parts[i].second);
+    } else {
+      t_lo_[intervals_] = parts[i].first;
+      t_hi_[intervals_] = parts[i].second;
+      ++intervals_;
+    }
+  }
+}
+
+void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
+  CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uchar* p = bgr.ptr<uchar>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < bgr.cols; ++x, p += 3) {
+      const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+      m[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+    }
+  }
+}
+
+void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
+  CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
+  for (int y = 0; y < bgr.rows; ++y) ClassifyRow(bgr.ptr<uchar>(y), mask.ptr<uchar>(y), bgr.cols);
+}
+
+// The vector path decides each pixel from exact integer inequalities where they are conclusive,
+// and leaves the rest (within one hue unit or one saturation unit of a boundary, where OpenCV's
+// rounding through its division tables decides) to the exact scalar formula:
+//  - saturation: OpenCV's S is floor(255 diff / v + e + 1/2) with |e| <= 0.031, so
+//    255 diff >= lo v gives S >= lo, 255 diff <= (lo - 1) v gives S < lo (likewise for hi);
+//  - hue: OpenCV's H is floor(t + e + 1/2), t = 30 N / diff, |e| <= 0.16, so t in [A, B] (an
+//    interval of integers) is in, and t <= A - 1 or t >= B + 1 for every interval is out.
+// All products stay below 2^16: 30 N' <= 30 * 6 * 255, 255 diff, (B + 31) diff <= 180 * 255.
+void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
+  int x = 0;
+#if CV_SIMD128
+  using namespace cv;
+  const v_uint8x16 v_lo = v_setall_u8(static_cast<uchar>(box_.v.lo));
+  const v_uint8x16 v_hi = v_setall_u8(static_cast<uchar>(box_.v.hi));
+  const v_uint16x8 s_lo = v_setall_u16(static_cast<ushort>(box_.s.lo));
+  const v_uint16x8 s_lo1 = v_setall_u16(static_cast<ushort>(std::max(0, box_.s.lo - 1)));
+  const v_uint16x8 s_hi = v_setall_u16(static_cast<ushort>(box_.s.hi));
+  const v_uint16x8 s_hi1 = v_setall_u16(static_cast<ushort>(box_.s.hi + 1));
+  const v_uint16x8 k255 = v_setall_u16(255), k30 = v_setall_u16(30), k3 = v_setall_u16(3),
+                   k5 = v_setall_u16(5);
+  const v_uint16x8 all16 = v_setall_u16(0xffff), none16 = v_setzero_u16();
+  const bool s_lo_can_fail = box_.s.lo > 0, s_hi_can_fail = box_.s.hi < 255;
+  std::array<v_uint16x8, 3> in_a, in_b, near_a, near_b;
+  std::array<bool, 3> near_a_any{};
+  for (int i = 0; i < intervals_; ++i) {
+    in_a[i] = v_setall_u16(static_cast<ushort>(t_lo_[i] + 30));
+    in_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 30));
+    near_a_any[i] = t_lo_[i] + 29 < 0;  // No t lies below: the lower side never excludes.
+    near_a[i] = v_setall_u16(static_cast<ushort>(std::max(0, t_lo_[i] + 29)));
+    near_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 31));
+  }
+  const v_uint8x16 gray_in = gray_in_ ? v_setall_u8(0xff) : v_setzero_u8();
+  alignas(16) uchar undecided[16];
+
+  // In / out decisions for 8 pixels (16-bit lanes).
+  auto decide = [&](const v_uint16x8& b, const v_uint16x8& g, const v_uint16x8& r,
+                    const v_uint16x8& v, const v_uint16x8& d, v_uint16x8& in, v_uint16x8& out) {
+    in = all16;
+    out = none16;
+    const v_uint16x8 s255 = v_mul_wrap(d, k255);
+    if (s_lo_can_fail) {
+      in &= s255 >= v_mul_wrap(s_lo, v);
+      out |= s255 <= v_mul_wrap(s_lo1, v);
+    }
+    if (s_hi_can_fail) {
+      in &= s255 <= v_mul_wrap(s_hi, v);
+      out |= s255 >= v_mul_wrap(s_hi1, v);
+    }
+    if (full_hue_) return;
+    const v_uint16x8 is_r = v == r, is_g = (v == g) & ~is_r;
+    const v_uint16x8 n_r = v_sub_wrap(v_add_wrap(g, d), b);
+    const v_uint16x8 n_g = v_sub_wrap(v_add_wrap(b, v_mul_wrap(d, k3)), r);
+    const v_uint16x8 n_b = v_sub_wrap(v_add_wrap(r, v_mul_wrap(d, k5)), g);
+    const v_uint16x8 t30 = v_mul_wrap(v_select(is_r, n_r, v_select(is_g, n_g, n_b)), k30);
+    v_uint16x8 hue_in = none16, hue_near = none16;
+    for (int i = 0; i < intervals_; ++i) {
+      const v_uint16x8 below_b = t30 <= v_mul_wrap(in_b[i], d);
+      hue_in |= (t30 >= v_mul_wrap(in_a[i], d)) & below_b;
+      const v_uint16x8 above_near_a =
+          near_a_any[i] ? all16 : (t30 > v_mul_wrap(near_a[i], d));
+      hue_near |= above_near_a & (t30 < v_mul_wrap(near_b[i], d));
+    }
+    in &= hue_in;
+    out |= ~hue_near;
+  };
+
+  for (; x + 16 <= n; x += 16) {
+    v_uint8x16 b8, g8, r8;
+    v_load_deinterleave(bgr + 3 * x, b8, g8, r8);
+    const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
+    const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
+    const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
+    v_uint16x8 vv0, vv1, d0, d1;
+    v_expand(v8, vv0, vv1);
+    v_expand(d8, d0, d1);
+    // Most pixels of a scene are far from the marker's value or saturation: when all 16 are out
+    // on those alone (exact, as above), the hue is not needed.
+    if (s_lo_can_fail && !v_check_any(v_ok & v_pack(v_mul_wrap(d0, k255) > v_mul_wrap(s_lo1, vv0),
+                                                    v_mul_wrap(d1, k255) > v_mul_wrap(s_lo1, vv1)))) {
+      v_store(mask + x, v_setzero_u8());
+      continue;
+    }
+    v_uint16x8 b0, b1, g0, g1, r0, r1;
+    v_expand(b8, b0, b1);
+    v_expand(g8, g0, g1);
+    v_expand(r8, r0, r1);
+    v_uint16x8 in0, in1, out0, out1;
+    decide(b0, g0, r0, vv0, d0, in0, out0);
+    decide(b1, g1, r1, vv1, d1, in1, out1);
+    v_uint8x16 in = v_pack(in0, in1) & v_ok;
+    v_uint8x16 out = v_pack(out0, out1) | ~v_ok;
+    // max == min: hue 0 and saturation 0 exactly.
+    const v_uint8x16 flat = d8 == v_setzero_u8();
+    in = v_select(flat, gray_in & v_ok, in);
+    out = v_select(flat, ~in, out);
+    v_store(mask + x, in);
+    const v_uint8x16 open = ~(in | out);
+    if (v_check_any(open)) {
+      v_store_aligned(undecided, open);
+      for (int k = 0; k < 16; ++k) {
+        if (!undecided[k]) continue;
+        const uchar* p = bgr + 3 * (x + k);
+        const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+        mask[x + k] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+      }
+    }
+  }
+#endif
+  for (; x < n; ++x) {
+    const uchar* p = bgr + 3 * x;
+    const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+    mask[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+  }
+}
+
+void ClassifyHsvOpenCv(const cv::Mat& bgr, const HsvBox& box, cv::Mat& mask) {
+  cv::Mat hsv;
+  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+  if (box.h.lo <= box.h.hi) {
+    cv::inRange(hsv, cv::Scalar(box.h.lo, box.s.lo, box.v.lo),
+                cv::Scalar(box.h.hi, box.s.hi, box.v.hi), mask);
+    return;
+  }
+  // Wrapping hue: rotate it so the range starts at 0, then one inRange.
+  cv::Mat lut(1, 256, CV_8UC3);
+  for (int i = 0; i < 256; ++i) {
+    const int hue = i < 180 ? (i - box.h.lo + 180) % 180 : 255;
+    lut.at<cv::Vec3b>(0, i) = cv::Vec3b(static_cast<uchar>(hue), static_cast<uchar>(i),
+                                        static_cast<uchar>(i));
+  }
+  cv::LUT(hsv, lut, hsv);
+  cv::inRange(hsv, cv::Scalar(0, box.s.lo, box.v.lo),
+              cv::Scalar(box.h.hi + 180 - box.h.lo, box.s.hi, box.v.hi), mask);
+}
+
+namespace {
+
+// One 3x3 erosion (min) or dilation (max) of the padded plane `src` into the inside of the padded
+// plane `dst` (both with one row and column of border all round; the border of `src` set).
+void Morph3x3Pass(const cv::Mat& src, cv::Mat& dst, bool cross, bool erode) {
+  const int w = dst.cols - 2, h = dst.rows - 2;
+  for (int y = 0; y < h; ++y) {
+    const uchar* up = src.ptr<uchar>(y) + 1;
+    const uchar* mid = src.ptr<uchar>(y + 1) + 1;
+    const uchar* down = src.ptr<uchar>(y + 2) + 1;
+    uchar* out = dst.ptr<uchar>(y + 1) + 1;
+    int x = 0;
+#if CV_SIMD128
+    for (; x + 16 <= w; x += 16) {
+      using namespace cv;
+      const v_uint8x16 c = v_load(mid + x), l = v_load(mid + x - 1), r = v_load(mid + x + 1);
+      const v_uint8x16 u = v_load(up + x), d = v_load(down + x);
+      v_uint8x16 m;
+      if (erode) {
+        m = v_min(v_min(c, v_min(l, r)), v_min(u, d));
+        if (!cross) {
+          m = v_min(m, v_min(v_min(v_load(up + x - 1), v_load(up + x + 1)),
+                             v_min(v_load(down + x - 1), v_load(down + x + 1))));
+        }
+      } else {
+        m = v_max(v_max(c, v_max(l, r)), v_max(u, d));
+        if (!cross) {
+          m = v_max(m, v_max(v_max(v_load(up + x - 1), v_load(up + x + 1)),
+                             v_max(v_load(down + x - 1), v_load(down + x + 1))));
+        }
+      }
+      v_store(out + x, m);
+    }
+#endif
+    for (; x < w; ++x) {
+      uchar m = mid[x];
+      const uchar n[4] = {mid[x - 1], mid[x + 1], up[x], down[x]};
+      const uchar diag[4] = {up[x - 1], up[x + 1], down[x - 1], down[x + 1]};
+      for (uchar v : n) m = erode ? std::min(m, v) : std::max(m, v);
+      if (!cross) {
+        for (uchar v : diag) m = erode ? std::min(m, v) : std::max(m, v);
+      }
+      out[x] = m;
+    }
+  }
+}
+
+void SetBorder(cv::Mat& padded, int w, int h, uchar value) {
+  std::memset(padded.ptr<uchar>(0), value, static_cast<size_t>(w + 2));
+  std::memset(padded.ptr<uchar>(h + 1), value, static_cast<size_t>(w + 2));
+  for (int y = 1; y <= h; ++y) {
+    uchar* row = padded.ptr<uchar>(y);
+    row[0] = value;
+    row[w + 1] = value;
+  }
+}
+
+}  // namespace
+
+void OpenClose3x3(cv::Mat& mask, bool cross, cv::Mat& scratch) {
+  CV_Assert(mask.type() == CV_8UC1);
+  const int w = mask.cols, h = mask.rows;
+  if (w == 0 || h == 0) return;
+  // Two padded planes in one buffer: rows of w + 2 border bytes + 16 bytes of slack, so the vector
+  // loop's loads stay inside the buffer.
+  const int stride = w + 2 + 16;
+  const int rows = h + 2;
+  const size_t bytes = static_cast<size_t>(stride) * rows * 2;
+  if (scratch.empty() || scratch.total() * scratch.elemSize() < bytes) {
+    scratch.create(1, static_cast<int>(bytes), CV_8U);
+  }
+  cv::Mat a(rows, w + 2, CV_8U, scratch.data, static_cast<size_t>(stride));
+  cv::Mat b(rows, w + 2, CV_8U, scratch.data + static_cast<size_t>(stride) * rows,
+            static_cast<size_t>(stride));
+  const cv::Rect inner(1, 1, w, h);
+  mask.copyTo(a(inner));
+  // Opening: erode (outside counts as 255), dilate (outside 0); closing: dilate, erode.
+  SetBorder(a, w, h, 255);
+  Morph3x3Pass(a, b, cross, true);
+  SetBorder(b, w, h, 0);
+  Morph3x3Pass(b, a, cross, false);
+  SetBorder(a, w, h, 0);
+  Morph3x3Pass(a, b, cross, false);
+  SetBorder(b, w, h, 255);
+  Morph3x3Pass(b, a, cross, true);
+  a(inner).copyTo(mask);
+}
+
+void OpenClose3x3Reference(cv::Mat& mask, bool cross) {
+  const cv::Mat kernel =
+      cv::getStructuringElement(cross ? cv::MORPH_CROSS : cv::MORPH_RECT, cv::Size(3, 3));
+  cv::Mat isolated = mask.clone(), opened, closed;
+  cv::morphologyEx(isolated, opened, cv::MORPH_OPEN, kernel);
+  cv::morphologyEx(opened, closed, cv::MORPH_CLOSE, kernel);
+  closed.copyTo(mask);
+}
+
+cv::Rect NonZeroBounds(const cv::Mat& mask) {
+  CV_Assert(mask.type() == CV_8UC1);
+  int top = -1, bottom = -1, left = mask.cols, right = -1;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uchar* row = mask.ptr<uchar>(y);
+    int x = 0;
+    // First nonzero column of the row, then the last one (only beyond the extent known so far).
+#if CV_SIMD128
+    while (x + 16 <= mask.cols && !cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) {
+      x += 16;
+    }
+#endif
+    while (x < mask.cols && !row[x]) ++x;
+    if (x == mask.cols) continue;
+    left = std::min(left, x);
+    if (top < 0) top = y;
+    bottom = y;
+    int last = mask.cols - 1;
+#if CV_SIMD128
+    while (last - 15 > right && last - 15 >= x &&
+           !cv::v_check_any(cv::v_load(row + last - 15) != cv::v_setzero_u8())) {
+      last -= 16;
+    }
+#endif
+    while (last > right && !row[last]) --last;
+    right = std::max(right, last);
+  }
+  if (top < 0) return cv::Rect();
+  return cv::Rect(left, top, right - left + 1, bottom - top + 1);
+}
+
+int RunLabeller::Find(int i) {
+  while (parent_[static_cast<size_t>(i)] != i) {
+    parent_[static_cast<size_t>(i)] = parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])];
+    i = parent_[static_cast<size_t>(i)];
+  }
+  return i;
+}
+
+void RunLabeller::Label(const cv::Mat& mask) {
+  CV_Assert(mask.type() == CV_8UC1);
+  runs_.clear();
+  parent_.clear();
+  components_.clear();
+  const int w = mask.cols;
+  size_t prev_begin = 0, prev_end = 0;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uchar* row = mask.ptr<uchar>(y);
+    const size_t begin = runs_.size();
+    int x = 0;
+    int start = -1;  // Start of the run being read, or -1.
+    while (x < w) {
+#if CV_SIMD128
+      // Skip 16 pixels at a time while outside a run and they are all 0.
+      if (start < 0) {
+        while (x + 16 <= w && !cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) x += 16;
+        if (x >= w) break;
+      }
+#endif
+      if (row[x]) {
+        if (start < 0) start = x;
+      } else if (start >= 0) {
+        runs_.push_back({y, start, x});
+        start = -1;
+      }
+      ++x;
+    }
+    if (start >= 0) runs_.push_back({y, start, w});
+    // Union with the runs of the row above that touch (8-connected: columns overlap or meet
+    // diagonally). Both lists are sorted by x0.
+    size_t p = prev_begin;
+    for (size_t r = begin; r < runs_.size(); ++r) {
+      parent_.push_back(static_cast<int>(r));
+      const Run& run = runs_[r];
+      while (p < prev_end && runs_[p].x1 < run.x0) ++p;  // Ends before the diagonal.
+      for (size_t q = p; q < prev_end && runs_[q].x0 <= run.x1; ++q) {
+        const int a = Find(static_cast<int>(r)), b = Find(static_cast<int>(q));
+        if (a != b) parent_[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+      }
+    }
+    prev_begin = begin;
+    prev_end = runs_.size();
+  }
+  // Components in order of their first run (= raster order of their first pixel): roots are the
+  // smallest run index of their set.
+  const size_t n = runs_.size();
+  run_component_.assign(n, -1);
+  for (size_t r = 0; r < n; ++r) {
+    const int root = Find(static_cast<int>(r));
+    if (root == static_cast<int>(r)) {
+      run_component_[r] = static_cast<int>(components_.size());
+      components_.emplace_back();
+    } else {
+      run_component_[r] = run_component_[static_cast<size_t>(root)];
+    }
+  }
+  // Boxes first (moments are taken relative to them), then runs grouped by component.
+  count_.assign(components_.size(), 0);
+  for (size_t r = 0; r < n; ++r) {
+    const Run& run = runs_[r];
+    const size_t c = static_cast<size_t>(run_component_[r]);
+    Component& comp = components_[c];
+    const cv::Rect rect(run.x0, run.y, run.x1 - run.x0, 1);
+    comp.box = count_[c] == 0 ? rect : (comp.box | rect);
+    ++count_[c];
+  }
+  int offset = 0;
+  for (size_t c = 0; c < components_.size(); ++c) {
+    components_[c].first_run = offset;
+    components_[c].run_count = 0;
+    offset += count_[c];
+  }
+  sorted_.resize(n);
+  for (size_t r = 0; r < n; ++r) {
+    const Run& run = runs_[r];
+    Component& comp = components_[static_cast<size_t>(run_component_[r])];
+    sorted_[static_cast<size_t>(comp.first_run + comp.run_count++)] = run;
+    // Sums over x in [a, b) and their squares, exact in 64 bits.
+    const int64_t a = run.x0 - comp.box.x, b = run.x1 - comp.box.x, len = b - a;
+    const int64_t yy = run.y - comp.box.y;
+    auto sum_sq = [](int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 0^2 + .. + k^2
+    comp.area += static_cast<int>(len);
+    comp.m10 += (a + b - 1) * len / 2;
+    comp.m20 += sum_sq(b - 1) - (a > 0 ? sum_sq(a - 1) : 0);
+    comp.m01 += yy * len;
+    comp.m02 += yy * yy * len;
+  }
+}
+
+void RunLabeller::Draw(int i, cv::Mat& out, cv::Point origin) const {
+  const Component& comp = components_[static_cast<size_t>(i)];
+  for (int k = 0; k < comp.run_count; ++k) {
+    const Run& run = sorted_[static_cast<size_t>(comp.first_run + k)];
+    const int y = run.y - origin.y;
+    if (y < 0 || y >= out.rows) continue;
+    const int x0 = std::max(0, run.x0 - origin.x), x1 = std::min(out.cols, run.x1 - origin.x);
+    if (x1 > x0) std::memset(out.ptr<uchar>(y) + x0, 255, static_cast<size_t>(x1 - x0));
+  }
+}
+
+std::vector<RunLabeller::Component> LabelReference(const cv::Mat& mask) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<RunLabeller::Component> out(static_cast<size_t>(std::max(0, count - 1)));
+  for (int i = 1; i < count; ++i) {
+    RunLabeller::Component& c = out[static_cast<size_t>(i - 1)];
+    const int* s = stats.ptr<int>(i);
+    c.box = cv::Rect(s[cv::CC_STAT_LEFT], s[cv::CC_STAT_TOP], s[cv::CC_STAT_WIDTH],
+                     s[cv::CC_STAT_HEIGHT]);
+    c.area = s[cv::CC_STAT_AREA];
+    for (int y = 0; y < c.box.height; ++y) {
+      const int* l = labels.ptr<int>(c.box.y + y) + c.box.x;
+      for (int x = 0; x < c.box.width; ++x) {
+        if (l[x] != i) continue;
+        c.m10 += x;
+        c.m01 += y;
+        c.m20 += static_cast<int64_t>(x) * x;
+        c.m02 += static_cast<int64_t>(y) * y;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace softsight

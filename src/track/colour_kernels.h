@@ -1,0 +1,114 @@
+// Colour-tracking kernels: the per-pixel marker test of the colour tracker (is this BGR pixel in
+// the marker's HSV box?) and 3x3 binary morphology, each with a vector implementation (OpenCV
+// universal intrinsics, 128-bit: SSE2 on any x86-64, NEON on ARM) and a scalar reference beside
+// it that is obviously what OpenCV computes (cv::cvtColor + cv::inRange, cv::morphologyEx); tests
+// check that they agree bit for bit (the HSV test over all 2^24 colours).
+//
+// Why: on the tracker's small windows OpenCV's 8-bit BGR->HSV conversion runs scalar (~36
+// instructions a pixel), a wrapping hue needs a 3-channel LUT and inRange another pass, and each
+// morphologyEx call builds a filter engine: together 5-10x the work of the whole rest of a frame.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/track/colour_tracker.h"
+
+namespace softsight {
+
+// A box in OpenCV's 8-bit HSV (H 0..179, S and V 0..255): every range inclusive; a hue range with
+// lo > hi wraps around 0 ({170, 10}: 170..179 and 0..10).
+struct HsvBox {
+  HsvRange h{0, 179}, s{0, 255}, v{0, 255};
+
+  static HsvBox Make(HsvRange h, HsvRange s, HsvRange v) { return HsvBox{h, s, v}; }
+  bool ContainsHue(int hue) const;
+  bool Contains(int hue, int sat, int val) const {
+    return ContainsHue(hue) && sat >= s.lo && sat <= s.hi && val >= v.lo && val <= v.hi;
+  }
+};
+
+// OpenCV's 8-bit BGR->HSV of one pixel, bit-exact with cv::cvtColor(COLOR_BGR2HSV) (its integer
+// formula with the same division tables).
+cv::Vec3b BgrToHsvExact(uchar b, uchar g, uchar r);
+
+// The box prepared for the vector kernel: its hue ranges as intervals of the unrounded hue.
+class HsvClassifier {
+ public:
+  HsvClassifier() : HsvClassifier(HsvBox{}) {}
+  explicit HsvClassifier(const HsvBox& box);
+  const HsvBox& box() const { return box_; }
+
+  // mask = 255 where the BGR pixel of `bgr` (CV_8UC3) is in the box, else 0; `mask` is CV_8UC1 of
+  // the same size (allocated by the caller: no allocation here). Any strides (ROI views).
+  void Classify(const cv::Mat& bgr, cv::Mat& mask) const;
+  // The scalar reference: BgrToHsvExact and Contains, pixel by pixel.
+  void ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const;
+
+ private:
+  void ClassifyRow(const uchar* bgr, uchar* mask, int n) const;
+
+  HsvBox box_;
+  bool full_hue_ = false;
+  // Hue intervals [lo, hi] of the unrounded hue t = 30 N / diff in [-30, 150) (OpenCV rounds t,
+  // and adds 180 when negative), merged; at most three.
+  int intervals_ = 0;
+  std::array<int, 3> t_lo_{}, t_hi_{};
+  bool gray_in_ = false;  // Whether a pixel with max == min (hue 0, saturation 0) is in (given V).
+};
+
+// The OpenCV route the classifier replaces, for tests and benchmarks: cvtColor to HSV, a hue LUT
+// for a wrapping range, inRange. `mask` is allocated when needed.
+void ClassifyHsvOpenCv(const cv::Mat& bgr, const HsvBox& box, cv::Mat& mask);
+
+// Opening then closing of a binary mask (0 / 255) by a 3x3 element, `cross` (MORPH_CROSS, which is
+// also what getStructuringElement gives for a 3x3 MORPH_ELLIPSE) or a full 3x3 square, with
+// cv::morphologyEx's default border (beyond the image: 255 for erosion, 0 for dilation). In place
+// on `mask` (CV_8UC1, any strides); `scratch` is reused storage. Equals two cv::morphologyEx calls.
+void OpenClose3x3(cv::Mat& mask, bool cross, cv::Mat& scratch);
+void OpenClose3x3Reference(cv::Mat& mask, bool cross);
+
+// The bounding box of the nonzero pixels of `mask` (CV_8UC1, any strides), empty when there are
+// none, reading 16 pixels at a time (the tracker's replacement for cv::boundingRect(mask)).
+cv::Rect NonZeroBounds(const cv::Mat& mask);
+
+// 8-connected components of a binary mask (nonzero = in) from its runs: rows are scanned 16
+// bytes at a time, so the cost is the mask's area / 16 plus its runs, where
+// cv::connectedComponentsWithStats visits every pixel (which dominated whole-frame searches of
+// textured scenes). Exact integer area, bounding box and moments per component; reused storage,
+// no allocation once warm.
+class RunLabeller {
+ public:
+  struct Run {
+    int y, x0, x1;  // Row and columns [x0, x1) in the mask.
+  };
+  struct Component {
+    int area = 0;
+    cv::Rect box;                      // In the mask.
+    int64_t m10 = 0, m01 = 0;          // Sums of x and y, relative to box.tl().
+    int64_t m20 = 0, m02 = 0;          // Sums of x^2 and y^2, relative to box.tl().
+    int first_run = 0, run_count = 0;  // Its runs: runs()[first_run .. first_run + run_count).
+  };
+
+  // Labels `mask` (CV_8UC1, any strides). Components are in raster order of their first pixel.
+  void Label(const cv::Mat& mask);
+  const std::vector<Component>& components() const { return components_; }
+  const std::vector<Run>& runs() const { return sorted_; }
+  // Sets the pixels of component `i` to 255 in `out`, whose origin is `origin` in the mask (only
+  // the part inside `out` is drawn).
+  void Draw(int i, cv::Mat& out, cv::Point origin) const;
+
+ private:
+  int Find(int i);
+  std::vector<Run> runs_, sorted_;
+  std::vector<int> parent_, run_component_, count_;
+  std::vector<Component> components_;
+};
+
+// The reference: the same components from cv::connectedComponentsWithStats and per-label moments.
+std::vector<RunLabeller::Component> LabelReference(const cv::Mat& mask);
+
+}  // namespace softsight

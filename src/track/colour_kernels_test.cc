@@ -1,0 +1,184 @@
+// The colour kernels against their references: every one of the 2^24 BGR colours for the HSV
+// test (vector kernel, scalar reference and OpenCV's cvtColor + inRange all agree), random masks
+// and strided views for the morphology.
+#include "track/colour_kernels.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+// All colours with blue = `b`: a 256x256 image, green down the rows, red along the columns.
+cv::Mat ColoursWithBlue(int b) {
+  cv::Mat image(256, 256, CV_8UC3);
+  for (int g = 0; g < 256; ++g) {
+    cv::Vec3b* row = image.ptr<cv::Vec3b>(g);
+    for (int r = 0; r < 256; ++r) row[r] = cv::Vec3b(static_cast<uchar>(b), static_cast<uchar>(g),
+                                                      static_cast<uchar>(r));
+  }
+  return image;
+}
+
+std::string Name(const HsvBox& box) {
+  return "h [" + std::to_string(box.h.lo) + ", " + std::to_string(box.h.hi) + "] s [" +
+         std::to_string(box.s.lo) + ", " + std::to_string(box.s.hi) + "] v [" +
+         std::to_string(box.v.lo) + ", " + std::to_string(box.v.hi) + "]";
+}
+
+TEST(ColourKernels, ExactHsvIsOpenCvsForEveryColour) {
+  cv::Mat hsv;
+  for (int b = 0; b < 256; ++b) {
+    const cv::Mat image = ColoursWithBlue(b);
+    cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);
+    int mismatches = 0;
+    for (int g = 0; g < 256; ++g) {
+      for (int r = 0; r < 256; ++r) {
+        mismatches += BgrToHsvExact(static_cast<uchar>(b), static_cast<uchar>(g),
+                                    static_cast<uchar>(r)) != hsv.at<cv::Vec3b>(g, r);
+      }
+    }
+    ASSERT_EQ(mismatches, 0) << "blue " << b;
+  }
+}
+
+TEST(ColourKernels, VectorHsvTestIsOpenCvsForEveryColour) {
+  const HsvBox boxes[] = {
+      {{170, 10}, {80, 255}, {40, 255}},   // red, wrapping
+      {{45, 85}, {80, 255}, {40, 255}},    // green
+      {{100, 130}, {104, 255}, {88, 255}}, // blue, auto_colour-like
+      {{0, 179}, {0, 40}, {200, 255}},     // white: any hue
+      {{160, 155}, {1, 254}, {1, 254}},    // almost every hue, wrapping across 150
+      {{140, 165}, {30, 200}, {10, 250}},  // across the hue 150 seam
+      {{0, 0}, {0, 0}, {0, 255}},          // hue 0 only, gray pixels
+  };
+  cv::Mat fast(256, 256, CV_8U), reference;
+  for (const HsvBox& box : boxes) {
+    const HsvClassifier classifier(box);
+    int mismatches = 0;
+    for (int b = 0; b < 256; ++b) {
+      const cv::Mat image = ColoursWithBlue(b);
+      classifier.Classify(image, fast);
+      ClassifyHsvOpenCv(image, box, reference);
+      mismatches += cv::countNonZero(fast != reference);
+    }
+    EXPECT_EQ(mismatches, 0) << Name(box);
+  }
+}
+
+TEST(ColourKernels, ScalarReferenceAndStridedViews) {
+  cv::RNG rng(7);
+  cv::Mat big(61, 203, CV_8UC3);
+  rng.fill(big, cv::RNG::UNIFORM, 0, 256);
+  // Saturated, hue-rich pixels too, not only the gray-ish mean of uniform noise.
+  for (int y = 0; y < big.rows; y += 2) {
+    for (int x = 0; x < big.cols; ++x) big.at<cv::Vec3b>(y, x)[x % 3] = 255;
+  }
+  const HsvBox box{{170, 10}, {60, 255}, {40, 255}};
+  const HsvClassifier classifier(box);
+  for (const cv::Rect& r : {cv::Rect(0, 0, 203, 61), cv::Rect(3, 5, 37, 11), cv::Rect(1, 1, 15, 3),
+                            cv::Rect(190, 50, 13, 11)}) {
+    const cv::Mat view = big(r);
+    cv::Mat fast(view.size(), CV_8U), scalar(view.size(), CV_8U), reference;
+    classifier.Classify(view, fast);
+    classifier.ClassifyScalar(view, scalar);
+    ClassifyHsvOpenCv(view, box, reference);
+    EXPECT_EQ(cv::countNonZero(fast != reference), 0) << r;
+    EXPECT_EQ(cv::countNonZero(scalar != reference), 0) << r;
+  }
+}
+
+TEST(ColourKernels, OpenClose3x3IsMorphologyEx) {
+  cv::RNG rng(11);
+  cv::Mat scratch;
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(1, 9), cv::Size(9, 1), cv::Size(17, 5),
+                              cv::Size(16, 16), cv::Size(64, 48), cv::Size(83, 29)}) {
+    for (const double density : {0.1, 0.5, 0.9}) {
+      for (const bool cross : {true, false}) {
+        cv::Mat noise(size, CV_32F), mask;
+        rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+        mask = noise < density;
+        cv::Mat fast = mask.clone(), reference = mask.clone();
+        OpenClose3x3(fast, cross, scratch);
+        OpenClose3x3Reference(reference, cross);
+        EXPECT_EQ(cv::countNonZero(fast != reference), 0)
+            << size << " density " << density << " cross " << cross;
+        // On a view into a larger mask: the view's outside counts as the border, its parent's
+        // pixels around it are neither read nor written.
+        cv::Mat parent(size.height + 4, size.width + 4, CV_8U, cv::Scalar(255));
+        const cv::Rect inner(2, 2, size.width, size.height);
+        mask.copyTo(parent(inner));
+        cv::Mat view = parent(inner);
+        OpenClose3x3(view, cross, scratch);
+        EXPECT_EQ(cv::countNonZero(parent(inner) != reference), 0) << size << " view";
+        EXPECT_EQ(cv::countNonZero(parent == 255), cv::countNonZero(reference) + parent.total() -
+                                                       static_cast<size_t>(size.area()))
+            << size << " view: parent untouched";
+      }
+    }
+  }
+  // The 3x3 ellipse is the cross.
+  EXPECT_EQ(cv::countNonZero(cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)) !=
+                             cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3))),
+            0);
+}
+
+TEST(ColourKernels, NonZeroBoundsIsTheBoxOfTheNonzeroPixels) {
+  cv::RNG rng(9);
+  for (int trial = 0; trial < 300; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 70), 1 + rng.uniform(0, 30));
+    cv::Mat parent(size.height + 2, size.width + 5, CV_8U, cv::Scalar(255));
+    cv::Mat mask = parent(cv::Rect(2, 1, size.width, size.height));
+    mask.setTo(0);
+    const int dots = rng.uniform(0, 4);
+    for (int i = 0; i < dots; ++i) {
+      mask.at<uchar>(rng.uniform(0, size.height), rng.uniform(0, size.width)) = 255;
+    }
+    // The box of the nonzero points themselves.
+    std::vector<cv::Point> points;
+    cv::findNonZero(mask, points);
+    const cv::Rect expected = points.empty() ? cv::Rect() : cv::boundingRect(points);
+    EXPECT_EQ(NonZeroBounds(mask), expected) << size << " dots " << dots;
+  }
+}
+
+TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
+  cv::RNG rng(5);
+  RunLabeller labeller;
+  auto key = [](const RunLabeller::Component& c) {
+    return std::vector<int64_t>{c.box.y, c.box.x, c.box.width, c.box.height, c.area,
+                                c.m10,   c.m01,   c.m20,       c.m02};
+  };
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(40, 1), cv::Size(1, 40), cv::Size(33, 17),
+                              cv::Size(64, 64), cv::Size(200, 90)}) {
+    for (const double density : {0.05, 0.3, 0.6, 0.95}) {
+      cv::Mat noise(size, CV_32F);
+      rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::Mat parent(size.height + 2, size.width + 6, CV_8U, cv::Scalar(255));
+      cv::Mat mask = parent(cv::Rect(3, 1, size.width, size.height));  // A strided view.
+      cv::Mat(noise < density).copyTo(mask);
+      labeller.Label(mask);
+      std::vector<RunLabeller::Component> reference = LabelReference(mask);
+      std::vector<std::vector<int64_t>> ours, theirs;
+      for (const auto& c : labeller.components()) ours.push_back(key(c));
+      for (const auto& c : reference) theirs.push_back(key(c));
+      std::sort(ours.begin(), ours.end());
+      std::sort(theirs.begin(), theirs.end());
+      EXPECT_EQ(ours, theirs) << size << " density " << density;
+      // Drawing every component gives back the mask.
+      cv::Mat drawn(mask.size(), CV_8U, cv::Scalar(0));
+      for (size_t i = 0; i < labeller.components().size(); ++i) {
+        labeller.Draw(static_cast<int>(i), drawn, cv::Point(0, 0));
+      }
+      EXPECT_EQ(cv::countNonZero(drawn != mask), 0) << size << " density " << density;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace softsight
