@@ -6,6 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev          # image processing, video I/O, calibration, GUI (OpenCV 4.6)
+  libavutil-dev          # FFmpeg's log (OpenCV decodes with FFmpeg): which frames a decoder found damaged
   libyaml-cpp-dev        # configuration files
   libcli11-dev           # command-line parsing
   libserial-dev          # serial link to the pneumatic board
@@ -14,6 +15,7 @@ PACKAGES=(
   xvfb xauth xdotool     # the live window's tests run under a virtual X server
   libx11-dev             # the live window checks the X display before opening a window
   opencv-doc             # real sample images with known answers for the golden tests (chessboards, ...)
+  clang libfuzzer-14-dev # fuzz targets (scripts/fuzz.sh): clang's libFuzzer with ASan + UBSan
 )
 
 missing=()

@@ -12,6 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "app/commands.h"
+#include "io/sequence_pattern.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 
@@ -37,11 +38,6 @@ cv::Mat ReadImage(const std::string& file) {
   return image;
 }
 
-std::string Formatted(const std::string& pattern, int index) {
-  std::vector<char> buffer(pattern.size() + 32);
-  std::snprintf(buffer.data(), buffer.size(), pattern.c_str(), index);
-  return buffer.data();
-}
 
 // Every view in `input`: a folder (its image files in name order), a printf pattern (from index
 // 0 or 1 up to the first gap) or a video (every `step`-th frame).
@@ -57,7 +53,12 @@ void ForEachView(const std::string& input, int step, const ViewCallback& callbac
     for (const fs::path& file : files) callback(file.filename().string(), ReadImage(file.string()));
     return;
   }
-  if (input.find('%') != std::string::npos) {
+  if (input.find('%') != std::string::npos && !fs::exists(input, error)) {
+    // Parsed, never handed to printf: "%s" in the user's text must not be a format.
+    const SequencePattern pattern = ParseSequencePattern(input);
+    const auto Formatted = [&pattern](const std::string&, int index) {
+      return pattern.Format(index);
+    };
     int index = fs::exists(Formatted(input, 0)) ? 0 : 1;
     if (!fs::exists(Formatted(input, index))) {
       throw InputError("--input " + input + ": no file matches the pattern (tried " +

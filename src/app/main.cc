@@ -1,12 +1,18 @@
 // softsight: measure soft robots with a camera. See README.md.
+#include <csignal>
+#include <exception>
 #include <iostream>
 #include <map>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
+#include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/stop_request.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -45,6 +51,9 @@ const CommandEntry kCommands[] = {
 
 int Main(int argc, char** argv) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_WARNING);
+  // A file-size limit (ulimit -f) must surface as a failed write() with EFBIG, which the CSV
+  // writer reports after cutting the file back to its last complete row, not kill the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "softsight measures soft robots with a camera: it finds coloured markers on an actuator,\n"
       "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
@@ -56,20 +65,36 @@ int Main(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.summary);
     runners[sub] = entry.setup(*sub);
   }
+  RequireFiniteNumbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : kInputErrorExitCode;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
+    // One line like every other error, naming the command it was for.
+    const std::vector<CLI::App*> parsed = app.get_subcommands();
+    const std::string command =
+        parsed.empty() ? "softsight" : "softsight " + parsed.front()->get_name();
+    std::cerr << command << ": error: " << EscapeForMessage(e.what()) << " (see " << command
+              << " --help)\n";
+    return kInputErrorExitCode;
   }
   const CLI::App* chosen = app.get_subcommands().front();
+  // Messages may quote the user's bytes (a config's text, a file name): one escaped line each.
   try {
-    return runners.at(chosen)();
+    // A run a signal stopped has printed its summary; its exit code says it was interrupted.
+    return ExitCodeAfterStop(runners.at(chosen)());
   } catch (const InputError& e) {
-    std::cerr << "softsight " << chosen->get_name() << ": error: " << e.what() << "\n";
+    std::cerr << "softsight " << chosen->get_name() << ": error: " << EscapeForMessage(e.what())
+              << "\n";
     return kInputErrorExitCode;
   } catch (const cv::Exception& e) {
-    std::cerr << "softsight " << chosen->get_name() << ": OpenCV error: " << e.what() << "\n";
+    std::cerr << "softsight " << chosen->get_name()
+              << ": OpenCV error: " << EscapeForMessage(e.what()) << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    // A bug, not the user's fault, but still one line and an exit code rather than an abort.
+    std::cerr << "softsight " << chosen->get_name()
+              << ": internal error: " << EscapeForMessage(e.what()) << "\n";
     return 1;
   }
 }

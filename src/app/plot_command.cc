@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "app/cli_checks.h"
 #include "app/commands.h"
 #include "softsight/io/plot.h"
 
@@ -32,6 +33,7 @@ CommandRunner SetupPlotCommand(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--title", args->options.title, "Figure title (default: the CSV's file name)");
   return [args] {
+    CheckOutputsAreNotInputs({{"--out", args->out}}, {{"the CSV", args->csv}});
     WritePlot(args->csv, args->out, args->options);
     std::cout << "wrote " << args->out << "\n";
     return 0;

@@ -3,16 +3,20 @@
 namespace softsight {
 namespace {
 
-// Only a lock-free atomic may be touched from a signal handler.
-std::atomic<bool> g_stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
+// Only lock-free atomics may be touched from a signal handler.
+std::atomic<int> g_stop_signal{0};       // This StopRequest's signal.
+std::atomic<int> g_last_stop_signal{0};  // Any StopRequest's, for the exit code.
+static_assert(std::atomic<int>::is_always_lock_free);
 
-extern "C" void OnStopSignal(int) { g_stop_requested = true; }
+extern "C" void OnStopSignal(int signal) {
+  g_stop_signal = signal;
+  g_last_stop_signal = signal;
+}
 
 }  // namespace
 
 StopRequest::StopRequest() {
-  g_stop_requested = false;
+  g_stop_signal = 0;
   previous_int_ = std::signal(SIGINT, OnStopSignal);
   previous_term_ = std::signal(SIGTERM, OnStopSignal);
 }
@@ -22,6 +26,21 @@ StopRequest::~StopRequest() {
   std::signal(SIGTERM, previous_term_);
 }
 
-bool StopRequest::requested() const { return g_stop_requested; }
+bool StopRequest::requested() const { return g_stop_signal != 0; }
+
+int StopRequest::signal() const { return g_stop_signal; }
+
+std::string StopSignalReason(int signal) {
+  if (signal == SIGINT) return "stopped by Ctrl-C (SIGINT)";
+  if (signal == SIGTERM) return "stopped by SIGTERM";
+  return "stopped by signal " + std::to_string(signal);
+}
+
+int LastStopSignal() { return g_last_stop_signal; }
+
+int ExitCodeAfterStop(int code) {
+  const int signal = g_last_stop_signal;
+  return signal != 0 ? 128 + signal : code;
+}
 
 }  // namespace softsight

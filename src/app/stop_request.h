@@ -1,9 +1,12 @@
 // Ctrl-C (SIGINT) and SIGTERM as a polite request: long-running commands poll it between frames,
 // then finish their files, vent the actuator and print their summary instead of dying mid-write.
+// The process then exits 128 + the signal's number (130 for SIGINT, 143 for SIGTERM), as a shell
+// reports a process killed by it, so a script can tell an interrupted run from a complete one.
 #pragma once
 
 #include <atomic>
 #include <csignal>
+#include <string>
 
 namespace softsight {
 
@@ -17,11 +20,23 @@ class StopRequest {
   StopRequest& operator=(const StopRequest&) = delete;
 
   bool requested() const;
+  // The signal that asked to stop (SIGINT or SIGTERM), 0 while none has.
+  int signal() const;
 
  private:
   using Handler = void (*)(int);
   Handler previous_int_;
   Handler previous_term_;
 };
+
+// For a summary: "stopped by Ctrl-C (SIGINT)", "stopped by SIGTERM".
+std::string StopSignalReason(int signal);
+
+// The signal that stopped a command during this process (0: none), kept after the StopRequest
+// is gone so main() can turn it into the exit code after the summary is printed.
+int LastStopSignal();
+
+// 128 + signal for a run a signal stopped, else `code`.
+int ExitCodeAfterStop(int code);
 
 }  // namespace softsight

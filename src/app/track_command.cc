@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/stop_request.h"
@@ -29,6 +30,20 @@ void CheckRunnable(const TrackingConfig& config, const TrackOptions& options) {
   }
 }
 
+// Before any output is opened: none of them may be a file this run reads, nor another output.
+void CheckOutputs(const TrackOptions& options, const TrackingConfig& config,
+                  const FrameSource& source) {
+  std::vector<PathRole> outputs{{"--csv", options.csv_file}};
+  if (options.annotated_file) outputs.push_back({"--annotated", *options.annotated_file});
+  if (options.record_file) outputs.push_back({"--record", *options.record_file});
+  std::vector<PathRole> inputs;
+  for (size_t i = 0; i < config.files_read.size(); ++i) {
+    inputs.push_back({i == 0 ? "the config" : "a file the config names:", config.files_read[i]});
+  }
+  for (const std::string& file : source.files()) inputs.push_back({"--input", file});
+  CheckOutputsAreNotInputs(outputs, inputs);
+}
+
 }  // namespace
 
 RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
@@ -42,7 +57,11 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
     for (MarkerSpec& spec : config.markers) spec.templ.colour = *options.template_colour;
   }
   CheckRunnable(config, options);
+  if (options.max_frames && *options.max_frames < 0) {
+    throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
+  }
   std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
+  CheckOutputs(options, config, *source);
   // A camera is read in its own thread, newest frame wins (drops are counted in the summary);
   // a file or image sequence is read frame by frame and never drops one.
   if (source->is_live()) source = std::make_unique<NewestFrameSource>(std::move(source));
@@ -75,6 +94,9 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
   summary = RunPipeline(*source, session, sinks, run);
+  if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {
+    summary.stop_detail = StopSignalReason(stop.signal());
+  }
   if (!summary.ok()) throw InputError(summary.error);
   return summary;
 }
@@ -116,8 +138,10 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
                  "frames/%04d.png), e.g. to track a camera run again later");
   sub.add_option("--fps", options->source.sequence_fps,
                  "Frame rate of an image sequence, for its timestamps")
-      ->capture_default_str();
-  sub.add_option("--max-frames", options->max_frames, "Stop after this many frames");
+      ->capture_default_str()
+      ->check(NumberIn(1e-3, 1e6));
+  sub.add_option("--max-frames", options->max_frames, "Stop after this many frames")
+      ->check(NumberIn(0, 1e15));
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   return [options] {
     RunSummary summary;

@@ -6,10 +6,13 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <random>
 #include <fstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -290,8 +293,8 @@ TEST(TrackCommand, CtrlCStopsWithASummaryAndEveryRowComplete) {
   int status = 0;
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
-  EXPECT_EQ(WEXITSTATUS(status), 0);
-  EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stop requested"));
+  EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT: an interrupted run is not a complete one";
+  EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stopped by Ctrl-C"));
   const std::vector<std::string> lines = testing::ReadLines(csv);
   ASSERT_GE(lines.size(), 6u);
   ASSERT_LT(lines.size(), 301u) << "the run ended before the interrupt arrived";
@@ -312,6 +315,172 @@ TEST(TrackCommand, TemplateMethodWithoutTemplateIsRefused) {
   options.method = "zncc";
   options.quiet = true;
   EXPECT_THROW(RunTrack(options), InputError);
+}
+
+TEST(TrackCommand, SigtermStopsWithItsOwnReasonAndExitCode) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  const std::string csv = dir.file("out.csv");
+  const std::string command = "exec " + testing::SoftsightBinary() + " track -c " +
+                              dir.file("markers.yaml") + " -i synth:bending -o " + csv + " 2> " +
+                              dir.file("stderr.txt");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  for (int wait_ms = 0; wait_ms < 20000 && testing::ReadLines(csv).size() < 4; wait_ms += 5) {
+    usleep(5000);
+  }
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
+  EXPECT_EQ(WEXITSTATUS(status), 143);
+  const std::string text = testing::ReadTextFile(dir.file("stderr.txt"));
+  EXPECT_THAT(text, HasSubstr("stopped by SIGTERM"));
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("Ctrl-C")));
+  EXPECT_THAT(text, HasSubstr("frames:")) << "the summary comes before the exit";
+}
+
+// Runs `track` with `args` on a two-frame rendered clip and a valid config.
+class TrackRefuses : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    clip_ = RenderClip(dir_, 2);
+    testing::WriteTextFile(config(), kConfig);
+  }
+  std::string config() const { return dir_.file("markers.yaml"); }
+  ProgramRun Track(const std::string& args) {
+    return RunBinary("track -q -c " + config() + " " + args, dir_);
+  }
+  // One error line naming `what`, exit code 2.
+  void ExpectOneError(const ProgramRun& run, const std::string& what) {
+    EXPECT_EQ(run.exit_code, 2) << run.stderr_text;
+    EXPECT_THAT(run.stderr_text, HasSubstr(what));
+    EXPECT_EQ(std::count(run.stderr_text.begin(), run.stderr_text.end(), '\n'), 1)
+        << "one error line, got: " << run.stderr_text;
+  }
+  TempDir dir_;
+  RenderedClip clip_;
+};
+
+TEST_F(TrackRefuses, PatternThatIsNotOneNumber) {
+  std::filesystem::create_directories(dir_.file("frames"));
+  for (const std::string pattern : {"frames/%s.png", "frames/%n.png", "frames/%d%d.png"}) {
+    ExpectOneError(Track("-i '" + dir_.file(pattern) + "' -o " + dir_.file("o.csv")), pattern);
+  }
+}
+
+TEST_F(TrackRefuses, NegativeMaxFrames) {
+  ExpectOneError(Track("-i " + clip_.video + " -o " + dir_.file("o.csv") + " --max-frames -1"),
+                 "--max-frames");
+}
+
+TEST_F(TrackRefuses, FpsThatIsNotAPositiveFiniteNumber) {
+  std::filesystem::create_directories(dir_.file("frames"));
+  cv::imwrite(dir_.file("frames/0.png"), cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30)));
+  for (const std::string fps : {"inf", "-inf", "nan", "0", "-1", "1e400"}) {
+    ExpectOneError(Track("-i " + dir_.file("frames") + " -o " + dir_.file("o.csv") + " --fps " + fps),
+                   "--fps");
+  }
+}
+
+TEST_F(TrackRefuses, OutputThatIsAnInputAndLeavesItUntouched) {
+  const std::string video_before = testing::ReadTextFile(clip_.video);
+  const std::string config_before = testing::ReadTextFile(config());
+  ExpectOneError(Track("-i " + clip_.video + " -o " + clip_.video), "refusing to overwrite");
+  ExpectOneError(Track("-i " + clip_.video + " -o " + config()), "refusing to overwrite");
+  // The same file by another spelling, and by a hard link.
+  std::filesystem::create_hard_link(clip_.video, dir_.file("link.avi"));
+  ExpectOneError(Track("-i " + clip_.video + " -o " + dir_.path().string() + "/./link.avi"),
+                 "refusing to overwrite");
+  ExpectOneError(Track("-i " + clip_.video + " -o " + dir_.file("o.csv") + " --annotated " +
+                       clip_.video),
+                 "refusing to overwrite");
+  EXPECT_EQ(testing::ReadTextFile(clip_.video), video_before);
+  EXPECT_EQ(testing::ReadTextFile(config()), config_before);
+
+  // A frame of the input sequence.
+  std::filesystem::create_directories(dir_.file("frames"));
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite(dir_.file("frames/f" + std::to_string(i) + ".png"),
+                cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30)));
+  }
+  const std::string frame_before = testing::ReadTextFile(dir_.file("frames/f1.png"));
+  ExpectOneError(Track("-i " + dir_.file("frames") + " -o " + dir_.file("frames/f1.png")),
+                 "f1.png");
+  ExpectOneError(Track("-i '" + dir_.file("frames/f%d.png") + "' -o " +
+                       dir_.file("frames/f2.png")),
+                 "f2.png");
+  EXPECT_EQ(testing::ReadTextFile(dir_.file("frames/f1.png")), frame_before);
+
+  // A file the config names (the camera model).
+  testing::WriteTextFile(dir_.file("camera.yaml"),
+                         "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+                         "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                         "   data: [500., 0., 320., 0., 500., 240., 0., 0., 1.]\n"
+                         "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n"
+                         "   dt: d\n   data: [0., 0., 0., 0., 0.]\n");
+  testing::WriteTextFile(dir_.file("with_camera.yaml"), std::string(kConfig) + "camera: camera.yaml\n");
+  const std::string camera_before = testing::ReadTextFile(dir_.file("camera.yaml"));
+  const ProgramRun run = RunBinary("track -q -c " + dir_.file("with_camera.yaml") + " -i " +
+                                       clip_.video + " -o " + dir_.file("camera.yaml"),
+                                   dir_);
+  ExpectOneError(run, "camera.yaml");
+  EXPECT_EQ(testing::ReadTextFile(dir_.file("camera.yaml")), camera_before);
+}
+
+TEST_F(TrackRefuses, OutputOnAFullDevice) {
+  ExpectOneError(Track("-i " + clip_.video + " -o /dev/full --max-frames 0"), "/dev/full");
+}
+
+TEST_F(TrackRefuses, ConfigWithRandomBytesOrAComplexKeyInOneEscapedLine) {
+  std::mt19937 random(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::string bytes(200, '\0');
+    for (char& c : bytes) c = static_cast<char>(random() & 0xFF);
+    testing::WriteTextFile(dir_.file("random.yaml"), bytes);
+    const ProgramRun run = RunBinary(
+        "track -q -c " + dir_.file("random.yaml") + " -i " + clip_.video + " -o " + dir_.file("o.csv"),
+        dir_);
+    ExpectOneError(run, "random.yaml");
+    for (char c : run.stderr_text.substr(0, run.stderr_text.size() - 1)) {
+      ASSERT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << "raw control character";
+    }
+  }
+  testing::WriteTextFile(dir_.file("key.yaml"), std::string(kConfig) + "? [a, b]\n: 1\n");
+  ExpectOneError(RunBinary("track -q -c " + dir_.file("key.yaml") + " -i " + clip_.video + " -o " +
+                               dir_.file("o.csv"),
+                           dir_),
+                 "key.yaml:10:");
+}
+
+TEST(TrackCommand, SequenceWithAGapNumbersRowsByFileAndSaysSoInTheSummary) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  SceneOptions scene;
+  scene.frame_count = 6;
+  SyntheticScene renderer(scene);
+  cv::Mat image;
+  std::filesystem::create_directories(dir.file("frames"));
+  for (int i : {0, 1, 2, 4, 5}) {  // File 3 is missing.
+    renderer.render(i, image);
+    char name[32];
+    std::snprintf(name, sizeof(name), "frames/%04d.png", i);
+    cv::imwrite(dir.file(name), image);
+  }
+  const ProgramRun run = RunBinary("track -c " + dir.file("markers.yaml") + " -i '" +
+                                       dir.file("frames/%04d.png") + "' -o " + dir.file("o.csv"),
+                                   dir);
+  EXPECT_EQ(run.exit_code, 0) << run.stderr_text;
+  EXPECT_THAT(run.stderr_text, HasSubstr("1 file number missing (first: 3)"));
+  const std::vector<std::string> lines = testing::ReadLines(dir.file("o.csv"));
+  ASSERT_EQ(lines.size(), 6u);
+  std::vector<std::string> frames;
+  for (size_t i = 1; i < lines.size(); ++i) frames.push_back(testing::SplitCsv(lines[i])[0]);
+  EXPECT_THAT(frames, ::testing::ElementsAre("0", "1", "2", "4", "5"));
 }
 
 }  // namespace

@@ -32,8 +32,10 @@ const cv::TermCriteria kUndistortCriteria(cv::TermCriteria::COUNT + cv::TermCrit
 cv::FileStorage OpenForReading(const std::string& file) {
   // Checked first: FileStorage would also log its own error line for a missing file.
   std::error_code ignored;
-  if (!std::filesystem::is_regular_file(file, ignored)) {
-    throw InputError(file + ": cannot open (no such file)");
+  const std::filesystem::file_status status = std::filesystem::status(file, ignored);
+  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot open (no such file)");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(file + ": not a regular file (expected an OpenCV YAML/XML file)");
   }
   cv::FileStorage fs;
   try {

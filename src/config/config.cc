@@ -42,7 +42,9 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
 
 }  // namespace
 
-TrackingConfig LoadTrackingConfig(const std::string& file,
+namespace {
+
+TrackingConfig ReadTrackingConfig(const std::string& file,
                                   const std::optional<std::string>& method_override) {
   if (method_override) {
     const std::vector<std::string> methods = TrackerMethods();
@@ -84,8 +86,16 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
     check_names("triple", {config.measure.base, config.measure.middle, config.measure.tip});
   }
   check_names("chain", config.measure.chain);
+  config.files_read.push_back(file);
+  if (const auto plane = top.string("plane")) config.files_read.push_back(ResolveBesideFile(file, *plane));
+  for (const MarkerSpec& spec : config.markers) {
+    if (!spec.templ.image_file.empty()) {
+      config.files_read.push_back(ResolveBesideFile(file, spec.templ.image_file));
+    }
+  }
   if (const auto camera = top.string("camera")) {
     config.camera_file = *camera;
+    config.files_read.push_back(ResolveBesideFile(file, *camera));
     try {
       config.camera = LoadCameraIntrinsics(ResolveBesideFile(file, *camera));
     } catch (const InputError& e) {
@@ -107,6 +117,17 @@ TrackingConfig LoadTrackingConfig(const std::string& file,
   }
   top.finish();
   return config;
+}
+
+}  // namespace
+
+TrackingConfig LoadTrackingConfig(const std::string& file,
+                                  const std::optional<std::string>& method_override) {
+  try {
+    return ReadTrackingConfig(file, method_override);
+  } catch (const YAML::Exception& e) {
+    RethrowYamlError(file, e);
+  }
 }
 
 void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {

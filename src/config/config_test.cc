@@ -1,5 +1,7 @@
 #include "softsight/config/config.h"
 
+#include <random>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -160,6 +162,56 @@ TEST(Config, MissingFileIsNamed) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("/no/such/markers.yaml"));
+  }
+}
+
+TEST(Config, NonScalarKeyIsOneErrorNamingFileAndLine) {
+  // A complex key (`? [a, b]`) at the top level and inside a marker: yaml-cpp would throw
+  // TypedBadConversion when the key is read as a name.
+  std::string message = testing::ConfigErrorOf(std::string(kValid) + "? [a, b]\n: 1\n");
+  EXPECT_THAT(message, HasSubstr("markers.yaml:11:"));
+  EXPECT_THAT(message, HasSubstr("a key must be a plain name"));
+  message = testing::ConfigErrorOf(
+      "markers:\n  - name: red\n    ? {x: 1}\n    : 2\n    hsv: {h: [0, 10]}\n");
+  EXPECT_THAT(message, HasSubstr("markers.yaml:3:"));
+  EXPECT_THAT(message, HasSubstr("markers[0]"));
+}
+
+TEST(Config, DeeplyNestedYamlSaysSo) {
+  const std::string message = testing::ConfigErrorOf(std::string(5000, '['));
+  EXPECT_THAT(message, HasSubstr("markers.yaml"));
+  EXPECT_THAT(message, HasSubstr("nested too deeply"));
+}
+
+TEST(Config, RandomBytesGiveOneEscapedLine) {
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bytes(300, '\0');
+    for (char& c : bytes) c = static_cast<char>(random() & 0xFF);
+    const std::string message = testing::ConfigErrorOf(bytes);
+    ASSERT_FALSE(message.empty()) << "random bytes were accepted as a config";
+    EXPECT_THAT(message, HasSubstr("markers.yaml"));
+    for (char c : message) {
+      ASSERT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+          << "raw control character in: " << EscapeForMessage(message);
+    }
+  }
+}
+
+TEST(Config, DeviceInsteadOfAFileIsRefusedWithoutReadingIt) {
+  try {
+    LoadTrackingConfig("/dev/zero");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/dev/zero: not a regular file"));
+  }
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), std::string(kValid) + "camera: /dev/zero\n");
+  try {
+    LoadTrackingConfig(dir.file("markers.yaml"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("not a regular file"));
   }
 }
 

@@ -20,15 +20,19 @@ void WriteControlConfig(const ControlConfig& config, YAML::Emitter& out) {
 }
 
 ControlConfig LoadControlConfig(const std::string& file) {
-  const YAML::Node root = LoadYamlFile(file);
-  ControlConfig config;
-  if (!root.IsDefined() || root.IsNull()) return config;
-  YamlMap top(root, file, "");
-  if (top.has("control")) {
-    YamlMap control = top.map("control");
-    ReadControlConfig(control, &config);
+  try {
+    const YAML::Node root = LoadYamlFile(file);
+    ControlConfig config;
+    if (!root.IsDefined() || root.IsNull()) return config;
+    YamlMap top(root, file, "");
+    if (top.has("control")) {
+      YamlMap control = top.map("control");
+      ReadControlConfig(control, &config);
+    }
+    return config;
+  } catch (const YAML::Exception& e) {
+    RethrowYamlError(file, e);
   }
-  return config;
 }
 
 }  // namespace softsight

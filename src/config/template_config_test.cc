@@ -143,5 +143,18 @@ TEST(TemplateConfig, ErrorsNameTheKey) {
               HasSubstr("markers[0].template.report"));
 }
 
+TEST(TemplateConfig, IntegersPastAnyImageSizeAreRefused) {
+  // 2147483647 once overflowed a signed int in the tracker's search window (UBSan).
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [205, 186, 25, "
+                                     "25], acquire_radius_px: 2147483647}\n"),
+              HasSubstr("template.acquire_radius_px"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [2147483600, "
+                                     "186, 25, 25]}\n"),
+              HasSubstr("template.rect"));
+  EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {frame: 2147483647, "
+                                     "rect: [205, 186, 25, 25]}\n"),
+              HasSubstr("template.frame"));
+}
+
 }  // namespace
 }  // namespace softsight

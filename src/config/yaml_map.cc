@@ -4,6 +4,10 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <cerrno>
+#include <cstring>
+
+#include <yaml-cpp/depthguard.h>  // YAML::DeepRecursion
 
 #include "softsight/core/error.h"
 
@@ -17,7 +21,7 @@ std::string LineOf(const YAML::Node& node) {
 }
 
 std::string Shown(const YAML::Node& node) {
-  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  if (node.IsScalar()) return "'" + EscapeForMessage(node.Scalar(), 60) + "'";
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a mapping";
   return "nothing";
@@ -43,6 +47,10 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
   // YAML parsers keep one of two equal keys silently; a config with both is a mistake.
   std::set<std::string> seen;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
+    if (!it->first.IsScalar()) {
+      throw InputError(file_ + ":" + LineOf(it->first) + " " + (path_.empty() ? "top level" : path_) +
+                       ": a key must be a plain name, got " + Shown(it->first) + " as a key");
+    }
     const std::string key = it->first.Scalar();
     if (!seen.insert(key).second) {
       throw InputError(file_ + ":" + LineOf(it->first) + " " + key_path(key) +
@@ -203,7 +211,7 @@ std::optional<std::vector<std::string>> YamlMap::strings(const std::string& key)
 
 void YamlMap::finish() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const std::string key = it->first.as<std::string>();
+    const std::string key = it->first.Scalar();  // Checked scalar by the constructor.
     if (known_.count(key) == 0) {
       throw InputError(file_ + ":" + LineOf(it->first) + " " + key_path(key) +
                        ": unknown key (check the spelling; examples/markers.yaml lists every key)");
@@ -218,13 +226,33 @@ std::string ResolveBesideFile(const std::string& config_file, const std::string&
 }
 
 YAML::Node LoadYamlFile(const std::string& file) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status)) {
+    throw InputError(file + ": cannot open config file (no such file)");
+  }
+  // A device or FIFO (/dev/zero, /dev/stdin) would be read for ever.
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(file + ": not a regular file (a config is a YAML text file)");
+  }
   std::ifstream in(file);
-  if (!in) throw InputError(file + ": cannot open config file (does it exist?)");
+  if (!in) throw InputError(file + ": cannot open config file (" + std::strerror(errno) + ")");
   try {
     return YAML::Load(in);
+  } catch (const YAML::DeepRecursion& e) {
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) +
+                     ": invalid YAML: nested too deeply (lists or mappings inside each other "
+                     "hundreds of levels deep)");
   } catch (const YAML::Exception& e) {
-    throw InputError(file + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+    throw InputError(file + ":" + std::to_string(e.mark.line + 1) +
+                     ": invalid YAML: " + EscapeForMessage(e.msg, 120));
   }
+}
+
+void RethrowYamlError(const std::string& file, const YAML::Exception& e) {
+  const std::string line = e.mark.line >= 0 ? std::to_string(e.mark.line + 1) + ":" : "";
+  throw InputError(file + ":" + line + " cannot read this config (" +
+                   EscapeForMessage(e.msg, 120) + ")");
 }
 
 }  // namespace softsight

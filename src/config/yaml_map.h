@@ -60,4 +60,8 @@ std::string ResolveBesideFile(const std::string& config_file, const std::string&
 // Loads a YAML file; throws InputError naming the file (and line) when it is missing or invalid.
 YAML::Node LoadYamlFile(const std::string& file);
 
+// The reader boundary: a yaml-cpp exception that escaped the checks above (a conversion of an
+// unexpected node, say) becomes one InputError line naming the file and line, never an abort.
+[[noreturn]] void RethrowYamlError(const std::string& file, const YAML::Exception& e);
+
 }  // namespace softsight

@@ -136,6 +136,11 @@ class SerialTransport : public Transport {
  public:
   SerialTransport(const std::string& port, int baud) : name_("serial port " + port) {
     const LibSerial::BaudRate rate = ToBaudRate(baud, port);
+    // LibSerial reports a missing device as "Bad file descriptor": say what is wrong instead.
+    if (::access(port.c_str(), F_OK) != 0) {
+      throw InputError(name_ + ": cannot open (" + std::strerror(errno) +
+                       "); is the board plugged in? try `ls /dev/ttyACM* /dev/ttyUSB*`");
+    }
     try {
       port_->Open(port);
       port_->SetBaudRate(rate);

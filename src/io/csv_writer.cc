@@ -1,5 +1,8 @@
 #include "softsight/io/csv_writer.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 
@@ -9,12 +12,17 @@ namespace softsight {
 
 CsvWriter::CsvWriter(const std::string& path, CsvColumnTable columns)
     : path_(path), columns_(std::move(columns)) {
-  file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0) {
     throw InputError(path + ": cannot write CSV (" + std::strerror(errno) + ")");
   }
   row_ = columns_.header();
-  put(std::nullopt);
+  try {
+    put(std::nullopt);
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& marker_names,
@@ -22,7 +30,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& ma
     : CsvWriter(path, TrackingColumns(marker_names, metric)) {}
 
 CsvWriter::~CsvWriter() {
-  if (file_ != nullptr) std::fclose(file_);
+  if (fd_ >= 0) ::close(fd_);
 }
 
 void CsvWriter::write(const FrameResult& result) {
@@ -31,15 +39,35 @@ void CsvWriter::write(const FrameResult& result) {
 }
 
 void CsvWriter::put(std::optional<int64_t> frame_index) {
-  // One write of the whole line with its newline, flushed at once: rows reach the disk whole.
+  // One write() of the whole line with its newline. When it fails (disk full, a file-size limit
+  // with SIGXFSZ ignored, an I/O error) or writes only part of the line, the file is cut back to
+  // the last complete row, so a reader never sees half a row.
   row_ += '\n';
-  if (std::fwrite(row_.data(), 1, row_.size(), file_) != row_.size() ||
-      std::fflush(file_) != 0) {
-    const std::string what =
-        frame_index ? "frame " + std::to_string(*frame_index) : std::string("the header");
-    throw InputError(path_ + ": writing " + what + " failed (" + std::strerror(errno) +
-                     "); rows before it are intact");
+  size_t written = 0;
+  int error = 0;
+  while (written < row_.size()) {
+    const ssize_t n = ::write(fd_, row_.data() + written, row_.size() - written);
+    if (n > 0) {
+      written += static_cast<size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      error = n < 0 ? errno : ENOSPC;
+      break;
+    }
   }
+  if (error == 0) {
+    committed_bytes_ += static_cast<off_t>(row_.size());
+    return;
+  }
+  if (written > 0) {
+    // Best effort: a device such as /dev/full cannot be truncated, and has no rows to keep.
+    [[maybe_unused]] const int ignored = ::ftruncate(fd_, committed_bytes_);
+  }
+  const std::string what =
+      frame_index ? "frame " + std::to_string(*frame_index) : std::string("the header");
+  throw InputError(path_ + ": writing " + what + " failed (" + std::strerror(error) + ")" +
+                   (frame_index ? "; the rows before it are intact" : ""));
 }
 
 }  // namespace softsight

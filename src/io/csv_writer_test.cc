@@ -1,5 +1,11 @@
 #include "softsight/io/csv_writer.h"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -117,6 +123,46 @@ TEST(CsvColumnTable, InsertBeforeNamesItsAnchor) {
 
 TEST(CsvWriter, UnwritablePathIsAnInputError) {
   EXPECT_THROW(CsvWriter("/nonexistent-folder/run.csv", {"red"}, false), InputError);
+}
+
+TEST(CsvWriter, FullDeviceFailsAtTheHeader) {
+  EXPECT_THROW(CsvWriter("/dev/full", {"red"}, false), InputError);
+}
+
+// A file-size limit in the middle of a row (ulimit -f): the file must end with the last complete
+// row. Run in a child process, which alone gets the limit.
+TEST(CsvWriter, FileSizeLimitLeavesOnlyCompleteRows) {
+  TempDir dir;
+  const std::string path = dir.file("out.csv");
+  constexpr rlim_t kLimitBytes = 1000;  // Not a multiple of the row length.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);  // As main() does: the write fails with EFBIG instead.
+    const rlimit limit{kLimitBytes, kLimitBytes};
+    if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(3);
+    try {
+      CsvWriter csv(path, {"red", "blue"}, true);
+      for (int i = 0; i < 1000; ++i) csv.write(TwoMarkers(i % 2 == 0));
+    } catch (const InputError& e) {
+      _exit(std::string(e.what()).find("intact") != std::string::npos ? 0 : 4);
+    }
+    _exit(5);  // The limit never struck.
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  const std::string text = testing::ReadTextFile(path);
+  ASSERT_FALSE(text.empty());
+  EXPECT_LE(text.size(), kLimitBytes);
+  EXPECT_EQ(text.back(), '\n') << "the file ends in a partial row";
+  const std::vector<std::string> lines = testing::ReadLines(path);
+  ASSERT_GE(lines.size(), 3u);
+  const size_t columns = testing::SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << "row " << i;
+  }
 }
 
 }  // namespace

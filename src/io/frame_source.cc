@@ -1,6 +1,8 @@
 #include "softsight/io/frame_source.h"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +13,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "io/decoder_log.h"
+#include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/builtin_scenes.h"
 
@@ -33,10 +37,19 @@ void ToBgr(const cv::Mat& decoded, cv::Mat& bgr) {
   }
 }
 
+// A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
+// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) is damaged: it gets
+//   no row (its garbage would be measured as if it were real), later frames keep their numbers,
+//   and the end of the run reports how many there were;
+// - a file cut short: the last frame decoded before the cut may be half a frame or a stale copy
+//   of an earlier one (FFmpeg's frame threads hand back an old buffer when the last packet is
+//   cut), so frames are read one ahead, and when the stream ends short of the header's frame
+//   count that last frame is dropped with the error.
 class VideoFileSource : public FrameSource {
  public:
   explicit VideoFileSource(const std::string& path) : path_(path) {
     if (!fs::exists(path)) throw InputError(path + ": no such video file");
+    CaptureDecoderErrors();
     if (!capture_.open(path, cv::CAP_FFMPEG) || !capture_.isOpened()) {
       throw InputError(path + ": cannot open as a video (unsupported, truncated or corrupt file)");
     }
@@ -47,49 +60,117 @@ class VideoFileSource : public FrameSource {
   }
 
   bool read(Frame& frame) override {
-    if (!capture_.read(decoded_) || decoded_.empty()) {
-      // Tell "the stream ended" from "a frame failed to decode": a decoder that can still grab a
-      // later frame skipped a broken one, and a header promising more frames means truncation.
-      bool later_frame_decodes = false;
-      for (int attempt = 0; attempt < 3 && !later_frame_decodes; ++attempt) {
-        later_frame_decodes = capture_.grab();
-      }
-      if (later_frame_decodes) {
-        throw InputError(path_ + ": frame " + std::to_string(next_index_) +
-                         " failed to decode (corrupt video)");
-      }
-      // FFmpeg skips a frame it cannot decode without saying so; the header's frame count is the
-      // only witness, so a shortfall is reported (at the end: the rows before stay valid).
-      if (frame_count_ && next_index_ < *frame_count_) {
-        throw InputError(path_ + ": only " + std::to_string(next_index_) + " of the " +
-                         std::to_string(*frame_count_) +
-                         " frames its header lists could be decoded (truncated or corrupt file; "
-                         "rows after the damage may be misnumbered)");
-      }
+    if (!started_) {
+      started_ = true;
+      have_current_ = decode(current_);
+    }
+    if (pending_error_) throw InputError(*pending_error_);
+    if (!have_current_) {
+      report_end();
       return false;
     }
-    ToBgr(decoded_, frame.image);
-    frame.index = next_index_++;
-    const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
-    // Container timestamps when the demuxer has them; the nominal rate otherwise.
-    frame.time_s = (pos_ms > 0 || frame.index == 0) ? pos_ms / 1000.0
-                                                    : frame.index / fps_.value_or(30.0);
-    if (frame.index > 0 && frame.time_s <= last_time_s_) {
-      frame.time_s = frame.index / fps_.value_or(30.0);
+    try {
+      have_next_ = decode(next_);
+    } catch (const InputError& e) {
+      // A broken frame further on: this one is good and still gets its row; the error comes next.
+      pending_error_ = e.what();
+      have_next_ = false;
+      return emit(frame);
     }
-    last_time_s_ = frame.time_s;
-    return true;
+    if (!have_next_ && frame_count_ && decoded_ < *frame_count_) {
+      // Truncated: `current_` was decoded from the last, cut packet.
+      throw InputError(path_ + ": only " + std::to_string(decoded_) + " of the " +
+                       std::to_string(*frame_count_) +
+                       " frames its header lists could be decoded (truncated or corrupt file); "
+                       "frame " + std::to_string(current_.index) +
+                       ", the last one before the damage, is left out" + damage_summary("; also"));
+    }
+    return emit(frame);
   }
 
   std::string description() const override { return "video " + path_; }
+  std::vector<std::string> files() const override { return {path_}; }
   std::optional<int64_t> frame_count() const override { return frame_count_; }
   std::optional<double> fps() const override { return fps_; }
 
  private:
+  struct Decoded {
+    cv::Mat image;
+    int64_t index = 0;
+    double time_s = 0.0;
+  };
+
+  bool emit(Frame& frame) {
+    ToBgr(current_.image, frame.image);
+    frame.index = current_.index;
+    frame.time_s = current_.time_s;
+    std::swap(current_, next_);
+    have_current_ = have_next_;
+    return true;
+  }
+
+  // Decodes the next undamaged frame into `out`; false at the end of the stream.
+  bool decode(Decoded& out) {
+    while (true) {
+      const uint64_t errors_before = DecoderErrorCount();
+      if (!capture_.read(out.image) || out.image.empty()) {
+        // Tell "the stream ended" from "a frame failed to decode": a decoder that can still grab
+        // a later frame skipped a broken one.
+        bool later_frame_decodes = false;
+        for (int attempt = 0; attempt < 3 && !later_frame_decodes; ++attempt) {
+          later_frame_decodes = capture_.grab();
+        }
+        if (later_frame_decodes) {
+          throw InputError(path_ + ": frame " + std::to_string(next_index_) +
+                           " failed to decode (corrupt video)" + damage_summary("; also"));
+        }
+        return false;
+      }
+      ++decoded_;
+      const int64_t index = next_index_++;
+      if (DecoderErrorCount() != errors_before) {
+        if (damaged_ == 0) first_damaged_ = index;
+        ++damaged_;
+        continue;
+      }
+      out.index = index;
+      const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      // Container timestamps when the demuxer has them; the nominal rate otherwise.
+      out.time_s = (pos_ms > 0 || index == 0) ? pos_ms / 1000.0 : index / fps_.value_or(30.0);
+      if (index > 0 && out.time_s <= last_time_s_) out.time_s = index / fps_.value_or(30.0);
+      last_time_s_ = out.time_s;
+      return true;
+    }
+  }
+
+  // "<lead> 3 damaged frames left out (first: frame 16, decoder: mjpeg: ...)", or "".
+  std::string damage_summary(const std::string& lead) const {
+    if (damaged_ == 0) return "";
+    return lead + " " + std::to_string(damaged_) + " frame" + (damaged_ == 1 ? "" : "s") +
+           " the decoder found damaged " + (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
+           std::to_string(first_damaged_) + ", decoder: " + LastDecoderError() + ")";
+  }
+
+  // At the end of the stream: damage and a shortfall are errors, reported after every good row.
+  void report_end() const {
+    if (frame_count_ && decoded_ < *frame_count_) {
+      throw InputError(path_ + ": only " + std::to_string(decoded_) + " of the " +
+                       std::to_string(*frame_count_) +
+                       " frames its header lists could be decoded (truncated or corrupt file)" +
+                       damage_summary(";"));
+    }
+    if (damaged_ > 0) throw InputError(path_ + ":" + damage_summary(""));
+  }
+
   std::string path_;
   cv::VideoCapture capture_;
-  cv::Mat decoded_;
-  int64_t next_index_ = 0;
+  Decoded current_, next_;  // One frame ahead (see the class comment); swapped, never copied.
+  bool started_ = false, have_current_ = false, have_next_ = false;
+  std::optional<std::string> pending_error_;  // Thrown by the read after the frame before it.
+  int64_t next_index_ = 0;  // Index of the next frame the decoder returns.
+  int64_t decoded_ = 0;     // Frames the decoder returned, damaged ones included.
+  int64_t damaged_ = 0;
+  int64_t first_damaged_ = 0;
   double last_time_s_ = -1.0;
   std::optional<int64_t> frame_count_;
   std::optional<double> fps_;
@@ -104,22 +185,52 @@ bool IsImageFile(const fs::path& path) {
                      [&](const char* e) { return ext == e; });
 }
 
+// One file of an image sequence and the frame number its rows carry.
+struct SequenceFile {
+  int64_t index;
+  std::string path;
+};
+
+// A gap in the numbering is not silent: rows keep the files' numbers (so frame 7 is still the
+// seventh file's number after a missing one), and the source says which numbers were missing.
+std::optional<std::string> DescribeGaps(const std::vector<SequenceFile>& files) {
+  int64_t missing = 0;
+  std::string first_gap;
+  for (size_t i = 1; i < files.size(); ++i) {
+    const int64_t gap = files[i].index - files[i - 1].index - 1;
+    if (gap <= 0) continue;
+    if (missing == 0) {
+      first_gap = gap == 1 ? std::to_string(files[i - 1].index + 1)
+                           : std::to_string(files[i - 1].index + 1) + ".." +
+                                 std::to_string(files[i].index - 1);
+    }
+    missing += gap;
+  }
+  if (missing == 0) return std::nullopt;
+  return "the numbering has gaps: " + std::to_string(missing) + " file number" +
+         (missing == 1 ? "" : "s") + " missing (first: " + first_gap +
+         "); rows keep each file's number in `frame`";
+}
+
 class ImageSequenceSource : public FrameSource {
  public:
-  ImageSequenceSource(std::vector<std::string> files, std::string description, double fps)
-      : files_(std::move(files)), description_(std::move(description)), fps_(fps) {}
+  ImageSequenceSource(std::vector<SequenceFile> files, std::string description, double fps)
+      : files_(std::move(files)), description_(std::move(description)), fps_(fps),
+        gaps_(DescribeGaps(files_)) {}
 
   bool read(Frame& frame) override {
-    if (next_index_ >= static_cast<int64_t>(files_.size())) return false;
-    const std::string& file = files_[next_index_];
-    decoded_ = cv::imread(file, cv::IMREAD_UNCHANGED);
+    if (next_ >= files_.size()) return false;
+    const SequenceFile& file = files_[next_];
+    decoded_ = cv::imread(file.path, cv::IMREAD_UNCHANGED);
     if (decoded_.empty()) {
-      throw InputError(file + ": frame " + std::to_string(next_index_) +
+      throw InputError(file.path + ": frame " + std::to_string(file.index) +
                        " cannot be read as an image (corrupt or not an image)");
     }
     ToBgr(decoded_, frame.image);
-    frame.index = next_index_++;
-    frame.time_s = frame.index / fps_;
+    frame.index = file.index;
+    // Time counts from the first file, at the nominal rate, so gaps keep their duration.
+    frame.time_s = static_cast<double>(file.index - files_.front().index) / fps_;
+    ++next_;
     return true;
   }
 
@@ -128,42 +239,82 @@ class ImageSequenceSource : public FrameSource {
     return static_cast<int64_t>(files_.size());
   }
   std::optional<double> fps() const override { return fps_; }
+  std::optional<std::string> note() const override { return gaps_; }
+  std::vector<std::string> files() const override {
+    std::vector<std::string> paths;
+    for (const SequenceFile& file : files_) paths.push_back(file.path);
+    return paths;
+  }
 
  private:
-  std::vector<std::string> files_;
+  std::vector<SequenceFile> files_;
   std::string description_;
   double fps_;
+  std::optional<std::string> gaps_;
   cv::Mat decoded_;
-  int64_t next_index_ = 0;
+  size_t next_ = 0;
 };
 
+// A folder's files in name order. When every name is one prefix + a number + one suffix
+// (shot_0001.png ...), rows carry that number (a missing file is a gap, not a renumbering);
+// otherwise they are numbered 0, 1, 2 ... in name order.
 std::unique_ptr<FrameSource> OpenFolder(const std::string& folder, double fps) {
-  std::vector<std::string> files;
+  std::vector<std::string> names;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
-    if (entry.is_regular_file() && IsImageFile(entry.path())) files.push_back(entry.path().string());
+    if (entry.is_regular_file() && IsImageFile(entry.path())) {
+      names.push_back(entry.path().filename().string());
+    }
   }
-  if (files.empty()) throw InputError(folder + ": folder holds no image files");
-  std::sort(files.begin(), files.end());
+  if (names.empty()) throw InputError(folder + ": folder holds no image files");
+  std::sort(names.begin(), names.end());
+  // The number is the last run of digits of the first name; the rest must match in every name.
+  std::optional<SequencePattern> numbering;
+  const std::string& first = names.front();
+  const size_t digits_end = first.find_last_of("0123456789");
+  if (digits_end != std::string::npos) {
+    size_t digits_start = digits_end;
+    while (digits_start > 0 && std::isdigit(static_cast<unsigned char>(first[digits_start - 1]))) {
+      --digits_start;
+    }
+    const size_t digit_count = digits_end + 1 - digits_start;
+    SequencePattern padded{first.substr(0, digits_start), first.substr(digits_end + 1),
+                           static_cast<int>(digit_count)};
+    SequencePattern plain{padded.prefix, padded.suffix, 0};
+    for (const SequencePattern& candidate : {padded, plain}) {
+      if (std::all_of(names.begin(), names.end(),
+                      [&](const std::string& n) { return candidate.Match(n).has_value(); })) {
+        numbering = candidate;
+        break;
+      }
+    }
+  }
+  std::vector<SequenceFile> files;
+  for (size_t i = 0; i < names.size(); ++i) {
+    files.push_back({numbering ? *numbering->Match(names[i]) : static_cast<int64_t>(i),
+                     (fs::path(folder) / names[i]).string()});
+  }
+  std::sort(files.begin(), files.end(),
+            [](const SequenceFile& a, const SequenceFile& b) { return a.index < b.index; });
   return std::make_unique<ImageSequenceSource>(std::move(files), "images " + folder, fps);
 }
 
-std::string FormatIndex(const std::string& pattern, int index) {
-  std::vector<char> name(pattern.size() + 32);
-  std::snprintf(name.data(), name.size(), pattern.c_str(), index);
-  return name.data();
-}
-
+// Every file the pattern names, in number order, wherever the numbering starts or has gaps.
 std::unique_ptr<FrameSource> OpenPattern(const std::string& pattern, double fps) {
-  // Sequences start at 0 or 1 and end at the first missing index.
-  int start = 0;
-  if (!fs::exists(FormatIndex(pattern, start))) start = 1;
-  std::vector<std::string> files;
-  for (int index = start; fs::exists(FormatIndex(pattern, index)); ++index) {
-    files.push_back(FormatIndex(pattern, index));
+  const SequencePattern parsed = ParseSequencePattern(pattern);
+  const size_t slash = parsed.prefix.find_last_of('/');
+  const std::string folder = slash == std::string::npos ? "." : parsed.prefix.substr(0, slash + 1);
+  const SequencePattern names{slash == std::string::npos ? parsed.prefix
+                                                         : parsed.prefix.substr(slash + 1),
+                              parsed.suffix, parsed.width};
+  std::vector<SequenceFile> files;
+  std::error_code error;
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    const std::optional<int64_t> index = names.Match(it->path().filename().string());
+    if (index && it->is_regular_file()) files.push_back({*index, parsed.Format(*index)});
   }
-  if (files.empty()) {
-    throw InputError(pattern + ": no image matches this pattern (tried indices 0 and 1)");
-  }
+  if (files.empty()) throw InputError(pattern + ": no file matches this pattern");
+  std::sort(files.begin(), files.end(),
+            [](const SequenceFile& a, const SequenceFile& b) { return a.index < b.index; });
   return std::make_unique<ImageSequenceSource>(std::move(files), "images " + pattern, fps);
 }
 
@@ -250,18 +401,23 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
   if (input.empty()) {
     throw InputError("no input given (use --input VIDEO|FOLDER|PATTERN or --camera N)");
   }
-  if (!(spec.sequence_fps > 0)) throw InputError("--fps must be positive");
+  if (!(std::isfinite(spec.sequence_fps) && spec.sequence_fps > 0)) {
+    throw InputError("--fps " + std::to_string(spec.sequence_fps) + ": must be a positive number");
+  }
   if (input.rfind(kSyntheticPrefix, 0) == 0) {
     const BuiltinSceneOptions scene =
         ParseBuiltinScene(input.substr(std::string(kSyntheticPrefix).size()));
     return std::visit([](const auto& o) { return OpenSyntheticSource(o, NoiseOptions{}); }, scene);
   }
-  if (input.find('%') != std::string::npos) return OpenPattern(input, spec.sequence_fps);
   if (fs::is_directory(input)) return OpenFolder(input, spec.sequence_fps);
-  if (!fs::exists(input)) throw InputError(input + ": no such file or folder");
+  // A file whose name holds a '%' is still that file; otherwise '%' makes a numbered pattern.
+  if (!fs::exists(input)) {
+    if (input.find('%') != std::string::npos) return OpenPattern(input, spec.sequence_fps);
+    throw InputError(input + ": no such file or folder");
+  }
   if (IsImageFile(input)) {
-    return std::make_unique<ImageSequenceSource>(std::vector<std::string>{input}, "image " + input,
-                                                 spec.sequence_fps);
+    return std::make_unique<ImageSequenceSource>(std::vector<SequenceFile>{{0, input}},
+                                                 "image " + input, spec.sequence_fps);
   }
   return std::make_unique<VideoFileSource>(input);
 }

@@ -1,6 +1,8 @@
 #include "softsight/io/frame_source.h"
 
 #include <fstream>
+#include <random>
+#include <set>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -9,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/test_util.h"
+#include "io/decoder_log.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/plate_scene.h"
 
@@ -92,6 +95,129 @@ TEST(VideoFileSource, FrameThatFailsToDecodeIsAnError) {
   EXPECT_THROW(ReadAll(*source), InputError);
 }
 
+// Frames that differ from each other everywhere a little and in one place a lot: a textured
+// background and a disc moving 6 px per frame.
+std::vector<cv::Mat> DistinctFrames(int count) {
+  cv::RNG rng(1);
+  cv::Mat background(240, 320, CV_8UC3);
+  rng.fill(background, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(background, background, {0, 0}, 3);
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < count; ++i) {
+    frames.push_back(background.clone());
+    cv::circle(frames.back(), {20 + 6 * i, 120}, 15, {0, 0, 255}, -1);
+  }
+  return frames;
+}
+
+std::string WriteFrames(const std::string& path, const char* fourcc,
+                        const std::vector<cv::Mat>& frames) {
+  cv::VideoWriter writer(path, cv::CAP_FFMPEG,
+                         cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), 30.0,
+                         frames.front().size());
+  EXPECT_TRUE(writer.isOpened());
+  for (const cv::Mat& frame : frames) writer << frame;
+  return path;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+void WriteBytes(const std::string& path, const std::string& data) {
+  std::ofstream(path, std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
+}
+
+// The original frame `image` is closest to.
+int ClosestOriginal(const cv::Mat& image, const std::vector<cv::Mat>& originals, double* distance) {
+  int best = -1;
+  *distance = 1e300;
+  for (size_t j = 0; j < originals.size(); ++j) {
+    const double d = cv::norm(image, originals[j], cv::NORM_L1) / static_cast<double>(image.total());
+    if (d < *distance) *distance = d, best = static_cast<int>(j);
+  }
+  return best;
+}
+
+// Cut short at many places: every frame returned is the frame its index names (never a stale
+// copy of an earlier one, never half decoded), and the end is an error.
+TEST(VideoFileSource, TruncatedVideoReturnsOnlyWholeFramesOfTheRightIndex) {
+  TempDir dir;
+  const std::vector<cv::Mat> originals = DistinctFrames(40);
+  for (const char* codec : {"FFV1", "MJPG"}) {
+    const std::string full = ReadBytes(WriteFrames(dir.file("full.avi"), codec, originals));
+    for (double cut = 0.20; cut < 0.70; cut += 0.02) {
+      const std::string path = dir.file("cut.avi");
+      WriteBytes(path, full.substr(0, static_cast<size_t>(cut * full.size())));
+      auto source = OpenFrameSource({path, {}, 30.0});
+      Frame frame;
+      int read = 0;
+      try {
+        while (source->read(frame)) {
+          double distance = 0;
+          ASSERT_EQ(ClosestOriginal(frame.image, originals, &distance), frame.index)
+              << codec << " cut at " << cut << ": frame " << frame.index << " shows another frame";
+          // FFV1 is lossless; MJPG at OpenCV's quality stays within a few grey levels.
+          ASSERT_LE(distance, std::string(codec) == "FFV1" ? 0.0 : 2.0 * 3)
+              << codec << " cut at " << cut << ": frame " << frame.index << " is damaged";
+          ASSERT_EQ(frame.index, read++);
+        }
+        ADD_FAILURE() << codec << " cut at " << cut << ": the truncation was not reported";
+      } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("truncated")) << e.what();
+      }
+      EXPECT_GT(read, 3) << codec << " cut at " << cut;
+    }
+  }
+}
+
+// Bits flipped in an MJPG video: the frames whose decoding FFmpeg logged an error for get no
+// frame (no row), the others keep their indices, and the end of the stream reports the count.
+TEST(VideoFileSource, FramesTheDecoderFoundDamagedAreLeftOutAndReported) {
+  TempDir dir;
+  const std::vector<cv::Mat> originals = DistinctFrames(40);
+  std::string data = ReadBytes(WriteFrames(dir.file("clip.avi"), "MJPG", originals));
+  std::mt19937 random(5);
+  for (int flip = 0; flip < 20; ++flip) {
+    const size_t at = data.size() * 4 / 10 + random() % (data.size() / 5);
+    data[at] = static_cast<char>(data[at] ^ (1 << (random() % 8)));
+  }
+  const std::string path = dir.file("flipped.avi");
+  WriteBytes(path, data);
+
+  // Which frames the decoder itself complains about, read with OpenCV directly.
+  CaptureDecoderErrors();
+  std::set<int64_t> damaged;
+  {
+    cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+    cv::Mat image;
+    for (int64_t i = 0;; ++i) {
+      const uint64_t before = DecoderErrorCount();
+      if (!capture.read(image)) break;
+      if (DecoderErrorCount() != before) damaged.insert(i);
+    }
+  }
+  ASSERT_FALSE(damaged.empty()) << "these flips no longer upset the decoder: choose others";
+
+  auto source = OpenFrameSource({path, {}, 30.0});
+  Frame frame;
+  std::vector<int64_t> indices;
+  try {
+    while (source->read(frame)) indices.push_back(frame.index);
+    FAIL() << "the damaged frames were not reported";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(std::to_string(damaged.size()) + " frame"));
+    EXPECT_THAT(e.what(), HasSubstr("damaged"));
+    EXPECT_THAT(e.what(), HasSubstr("first: frame " + std::to_string(*damaged.begin())));
+  }
+  std::vector<int64_t> expected;
+  for (int64_t i = 0; i < 40; ++i) {
+    if (damaged.count(i) == 0) expected.push_back(i);
+  }
+  EXPECT_EQ(indices, expected);
+}
+
 TEST(VideoFileSource, MissingOrNonVideoFileIsAnError) {
   TempDir dir;
   try {
@@ -133,9 +259,62 @@ TEST(ImageSequenceSource, PrintfPatternStartingAtOne) {
   EXPECT_EQ(ReadAll(*source), 3);
 }
 
+TEST(ImageSequenceSource, PatternWithAGapKeepsEachFilesNumberAndSaysSo) {
+  TempDir dir;
+  for (int i : {1, 2, 3, 4, 8, 9}) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "f%03d.png", i);
+    cv::imwrite(dir.file(name), MakeFrame(i));
+  }
+  auto source = OpenFrameSource({dir.file("f%03d.png"), {}, 10.0});
+  EXPECT_EQ(source->frame_count(), 6);
+  ASSERT_TRUE(source->note().has_value());
+  EXPECT_THAT(*source->note(), HasSubstr("3 file numbers missing (first: 5..7)"));
+  Frame frame;
+  for (int i : {1, 2, 3, 4, 8, 9}) {
+    ASSERT_TRUE(source->read(frame));
+    EXPECT_EQ(frame.index, i);
+    EXPECT_NEAR(frame.time_s, (i - 1) / 10.0, 1e-12);
+    EXPECT_EQ(frame.image.at<cv::Vec3b>(60, 30 + 3 * i), cv::Vec3b(0, 0, 255)) << "file " << i;
+  }
+  EXPECT_FALSE(source->read(frame));
+}
+
+TEST(ImageSequenceSource, FolderWithAGapIsNumberedByTheFileNames) {
+  TempDir dir;
+  for (int i : {0, 1, 2, 5, 6, 10}) {
+    cv::imwrite(dir.file("shot_" + std::to_string(i) + ".png"), MakeFrame(i));
+  }
+  auto source = OpenFrameSource({dir.path().string(), {}, 30.0});
+  ASSERT_TRUE(source->note().has_value());
+  EXPECT_THAT(*source->note(), HasSubstr("5 file numbers missing (first: 3..4)"));
+  Frame frame;
+  for (int i : {0, 1, 2, 5, 6, 10}) {  // Number order, not name order (shot_10 < shot_2).
+    ASSERT_TRUE(source->read(frame));
+    EXPECT_EQ(frame.index, i);
+    EXPECT_EQ(frame.image.at<cv::Vec3b>(60, 30 + 3 * i), cv::Vec3b(0, 0, 255)) << "file " << i;
+  }
+  EXPECT_FALSE(source->read(frame));
+}
+
+TEST(ImageSequenceSource, PatternWithAnythingButOneNumberIsRefusedNotFormatted) {
+  TempDir dir;
+  cv::imwrite(dir.file("0.png"), MakeFrame(0));
+  for (const char* bad : {"%s.png", "%n.png", "%d%d.png", "%5d.png"}) {
+    try {
+      OpenFrameSource({dir.file(bad), {}, 30.0});
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(bad));
+    }
+  }
+}
+
 TEST(ImageSequenceSource, CorruptImageMidSequenceNamesFileAndFrame) {
   TempDir dir;
-  for (int i = 0; i < 4; ++i) cv::imwrite(dir.file("f" + std::to_string(i) + ".png"), MakeFrame(i));
+  for (int i = 0; i < 4; ++i) {
+    cv::imwrite(dir.file(std::string("f").append(std::to_string(i)).append(".png")), MakeFrame(i));
+  }
   testing::WriteTextFile(dir.file("f2.png"), "garbage");
   auto source = OpenFrameSource({dir.path().string(), {}, 30.0});
   Frame frame;

@@ -59,6 +59,7 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
 
   const auto finish = [&] {
     summary.dropped = source.dropped_frames();
+    if (const std::optional<std::string> note = source.note()) summary.notes.push_back(*note);
     SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
     summary.wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

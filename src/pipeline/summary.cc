@@ -59,7 +59,7 @@ std::string RunSummary::FullReport() const {
   char line[256];
   std::snprintf(line, sizeof(line), "frames: %lld from %s in %.2f s (%s)\n",
                 static_cast<long long>(frames), source.c_str(), wall_s,
-                StopReasonName(stop_reason));
+                stop_detail.empty() ? StopReasonName(stop_reason) : stop_detail.c_str());
   out += line;
   if (first_index && last_index) {
     std::snprintf(line, sizeof(line), "source frames %lld..%lld, %lld dropped by the source\n",
@@ -82,6 +82,7 @@ std::string RunSummary::FullReport() const {
   std::snprintf(line, sizeof(line), "processing per frame: median %.3f ms, p99 %.3f ms\n",
                 proc_ms_median, proc_ms_p99);
   out += line;
+  for (const std::string& note : notes) out += "note: " + note + "\n";
   if (stop_reason == StopReason::kError) out += "stopped by: " + error + "\n";
   return out;
 }

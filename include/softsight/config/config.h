@@ -34,6 +34,9 @@ struct TrackingConfig {
   std::optional<ControlConfig> control;
   std::optional<RecordingOrigin> recording;  // Written by live recordings only.
   std::string source_file;             // Where this config was read from ("" if built in code).
+  // Every file reading this config opened: the config itself, then the camera, plane and
+  // template image files it names (resolved), so no output may overwrite one of them.
+  std::vector<std::string> files_read;
 };
 
 // Reads and checks a config file. `method_override` (from --method) replaces every marker's

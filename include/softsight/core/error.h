@@ -9,6 +9,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace softsight {
 
@@ -18,5 +19,10 @@ class InputError : public std::runtime_error {
  public:
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
+
+// `text` made safe for a one-line message: control characters, DEL and bytes that are not valid
+// UTF-8 become \xNN (a newline \n), so a random-bytes config or file name cannot break the line
+// or the terminal. Texts longer than `max_bytes` are cut and end in "...".
+std::string EscapeForMessage(std::string_view text, size_t max_bytes = 400);
 
 }  // namespace softsight

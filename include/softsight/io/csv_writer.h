@@ -1,10 +1,12 @@
 // Per-frame results as CSV, one row per frame from a CsvColumnTable (csv_columns.h documents the
-// columns). Every row is written whole and flushed as it is written, so a run that stops early
-// (Ctrl-C, a crash, an error) leaves every row written so far intact.
+// columns). Every row goes to the file in one write() as it is produced, so a run that stops
+// early (Ctrl-C, a crash, an error) leaves every row written so far intact; a failed write (disk
+// full, a file-size limit) cuts the file back to its last complete row and throws InputError.
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstdint>
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,12 +33,13 @@ class CsvWriter {
   const CsvColumnTable& columns() const { return columns_; }
 
  private:
-  // Writes row_ (plus the newline) and flushes; frame_index names the row in the error.
+  // Writes row_ (plus the newline); frame_index names the row in the error.
   void put(std::optional<int64_t> frame_index);
 
   std::string path_;
   CsvColumnTable columns_;
-  std::FILE* file_ = nullptr;
+  int fd_ = -1;
+  off_t committed_bytes_ = 0;  // File size after the last complete row.
   std::string row_;  // Reused buffer: no allocation per row once it has grown.
 };
 

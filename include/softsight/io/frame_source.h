@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "softsight/core/types.h"
 
@@ -35,6 +36,13 @@ class FrameSource {
   // Frames the source skipped so far because its reader was slower than it (newest frame wins,
   // see NewestFrameSource). Files, image sequences and rendered scenes never drop: always 0.
   virtual int64_t dropped_frames() const { return 0; }
+  // Something the run's summary should say about the input, e.g. gaps in an image sequence's
+  // numbering ("the numbering has gaps: 3 file numbers missing (first: 5..7) ...").
+  virtual std::optional<std::string> note() const { return std::nullopt; }
+
+  // The files this source reads (a video; every file of an image sequence); none for cameras
+  // and synthetic scenes. Outputs are checked against them before anything is written.
+  virtual std::vector<std::string> files() const { return {}; }
 };
 
 }  // namespace softsight
@@ -51,8 +59,9 @@ struct NoiseOptions;
 inline constexpr const char* kSyntheticPrefix = "synth:";
 
 struct FrameSourceSpec {
-  // A video file (anything FFmpeg reads), a folder of images (sorted by name), a printf
-  // pattern such as "frames/%04d.png", or a synthetic scene ("synth:bending").
+  // A video file (anything FFmpeg reads), a folder of images (sorted by name), a numbered
+  // pattern such as "frames/%04d.png" (one %d or %0Nd; rows carry each file's number), or a
+  // synthetic scene ("synth:bending").
   std::string input;
   std::optional<int> camera;           // V4L2 camera index (live).
   // Frame rate for image sequences, whose files carry no timestamps (frames per second).

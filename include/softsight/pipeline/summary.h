@@ -42,7 +42,11 @@ struct RunSummary {
   double proc_ms_p99 = 0.0;
   double wall_s = 0.0;                 // Whole run, reading and sinks included.
   StopReason stop_reason = StopReason::kEndOfInput;
+  // With kStopRequested, who asked, when the caller knows: "stopped by SIGTERM".
+  std::string stop_detail;
   std::string error;                   // With kError: the InputError's message.
+  // What the source says about its input (FrameSource::note), e.g. gaps in a sequence.
+  std::vector<std::string> notes;
 
   // Fraction of processed frames in which marker `i` was found (0 without frames).
   double found_rate(size_t i) const;

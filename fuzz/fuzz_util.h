@@ -1,0 +1,30 @@
+// Shared by the fuzz targets: the readers under test take file names, so each input is written
+// to one scratch file per process first.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace softsight::fuzz {
+
+// A scratch file `name` in a folder made once per process (removed by the OS's tmp cleaning;
+// a fuzz run makes one folder).
+inline std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_t size) {
+  static const std::string folder = [] {
+    std::string pattern = "/tmp/softsight_fuzz_XXXXXX";
+    if (mkdtemp(pattern.data()) == nullptr) std::abort();
+    return pattern;
+  }();
+  const std::string path = folder + "/" + name;
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) std::abort();
+  if (size > 0 && std::fwrite(data, 1, size, file) != size) std::abort();
+  std::fclose(file);
+  return path;
+}
+
+}  // namespace softsight::fuzz

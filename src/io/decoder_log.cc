@@ -1,0 +1,53 @@
+#include "io/decoder_log.h"
+
+#include <atomic>
+#include <cstdarg>
+#include <cstdio>
+#include <mutex>
+
+extern "C" {
+#include <libavutil/log.h>
+}
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+std::atomic<uint64_t> g_error_count{0};
+std::mutex g_last_error_mutex;
+std::string g_last_error;
+
+extern "C" void OnDecoderLog(void* context, int level, const char* format, va_list args) {
+  if (level > AV_LOG_ERROR) return;
+  char text[256];
+  std::vsnprintf(text, sizeof(text), format, args);
+  std::string message = text;
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  // The component ("mjpeg", "ffv1") that logged it, as FFmpeg's own log line names it.
+  AVClass* const* av_class = static_cast<AVClass* const*>(context);
+  if (av_class != nullptr && *av_class != nullptr) {
+    message = std::string((*av_class)->item_name(context)) + ": " + message;
+  }
+  {
+    std::lock_guard<std::mutex> lock(g_last_error_mutex);
+    g_last_error = EscapeForMessage(message, 160);
+  }
+  g_error_count.fetch_add(1);
+}
+
+}  // namespace
+
+void CaptureDecoderErrors() {
+  static std::once_flag installed;
+  std::call_once(installed, [] { av_log_set_callback(OnDecoderLog); });
+}
+
+uint64_t DecoderErrorCount() { return g_error_count.load(); }
+
+std::string LastDecoderError() {
+  std::lock_guard<std::mutex> lock(g_last_error_mutex);
+  return g_last_error;
+}
+
+}  // namespace softsight
