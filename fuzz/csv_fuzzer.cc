@@ -5,6 +5,7 @@
 
 #include "fuzz_util.h"
 #include "softsight/core/error.h"
+#include "softsight/io/csv_reader.h"
 #include "softsight/io/plot.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
