@@ -14,7 +14,8 @@ namespace softsight {
 CLI::Validator NumberIn(double min, double max);
 
 // Adds the finiteness check to every numeric option of `app` and its subcommands, so no command
-// can forget it: `--fps inf`, `--noise nan` are refused with one line naming the option.
+// can forget it: `--fps inf`, `--noise nan` are refused with one line naming the option. main()
+// applies it to every command but control and rig, whose options' Check() does the same.
 void RequireFiniteNumbers(CLI::App& app);
 
 struct PathRole {

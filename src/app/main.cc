@@ -12,7 +12,6 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
-#include "app/stop_request.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -64,8 +63,10 @@ int Main(int argc, char** argv) {
   for (const CommandEntry& entry : kCommands) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.summary);
     runners[sub] = entry.setup(*sub);
+    // control and rig check every number in their own options' Check(), with their messages.
+    const std::string name = entry.name;
+    if (name != "control" && name != "rig") RequireFiniteNumbers(*sub);
   }
-  RequireFiniteNumbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -81,8 +82,7 @@ int Main(int argc, char** argv) {
   const CLI::App* chosen = app.get_subcommands().front();
   // Messages may quote the user's bytes (a config's text, a file name): one escaped line each.
   try {
-    // A run a signal stopped has printed its summary; its exit code says it was interrupted.
-    return ExitCodeAfterStop(runners.at(chosen)());
+    return runners.at(chosen)();
   } catch (const InputError& e) {
     std::cerr << "softsight " << chosen->get_name() << ": error: " << EscapeForMessage(e.what())
               << "\n";

@@ -1,6 +1,6 @@
 // Ctrl-C (SIGINT) and SIGTERM as a polite request: long-running commands poll it between frames,
 // then finish their files, vent the actuator and print their summary instead of dying mid-write.
-// The process then exits 128 + the signal's number (130 for SIGINT, 143 for SIGTERM), as a shell
+// `track` then exits 128 + the signal's number (130 for SIGINT, 143 for SIGTERM), as a shell
 // reports a process killed by it, so a script can tell an interrupted run from a complete one.
 #pragma once
 
@@ -33,7 +33,7 @@ class StopRequest {
 std::string StopSignalReason(int signal);
 
 // The signal that stopped a command during this process (0: none), kept after the StopRequest
-// is gone so main() can turn it into the exit code after the summary is printed.
+// is gone so a command can turn it into its exit code after the summary is printed.
 int LastStopSignal();
 
 // 128 + signal for a run a signal stopped, else `code`.

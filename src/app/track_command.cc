@@ -153,7 +153,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       throw;
     }
     if (!options->quiet) std::cerr << summary.FullReport() << "CSV: " << options->csv_file << "\n";
-    return 0;
+    // A run a signal stopped has printed its summary; its exit code says it was interrupted.
+    return ExitCodeAfterStop(0);
   };
 }
 
