@@ -9,12 +9,12 @@ scripts/setup.sh
 source scripts/sanitizer/env.sh
 GENERATOR=()
 command -v ninja >/dev/null && GENERATOR=(-G Ninja)
-WERROR=OFF
-if [ "${CI:-}" = "true" ]; then WERROR=ON; fi
-# -O1: sanitizer reports keep their line numbers, and the suite stays fast enough.
+# -O1: sanitizer reports keep their line numbers, and the suite stays fast enough. No -Werror:
+# GCC's flow warnings (-Wmaybe-uninitialized) misfire on sanitizer-instrumented code; the plain
+# build (scripts/test.sh) is the one that holds warnings at zero.
 cmake -S . -B build-sanitize "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DSOFTSIGHT_SANITIZE=ON \
-  -DSOFTSIGHT_BUILD_BENCHMARKS=OFF -DSOFTSIGHT_WERROR="$WERROR" "$@"
+  -DSOFTSIGHT_BUILD_BENCHMARKS=OFF -DSOFTSIGHT_WERROR=OFF "$@"
 cmake --build build-sanitize --parallel "$(nproc)"
 cd build-sanitize
 ctest --output-on-failure --parallel "$(nproc)" --timeout 480

@@ -215,5 +215,13 @@ TEST(Config, DeviceInsteadOfAFileIsRefusedWithoutReadingIt) {
   }
 }
 
+TEST(Config, UnknownKeySpanningLinesIsQuotedOnOneLine) {
+  // Found by the config fuzzer: a quoted key running over several lines came back raw.
+  const std::string message =
+      testing::ConfigErrorOf("markers:\n  - name: red\n    'hsv: {h: [0, 10]}\n  - x\n\nkey': 1\n");
+  ASSERT_FALSE(message.empty());
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
 }  // namespace
 }  // namespace softsight

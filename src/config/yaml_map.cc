@@ -60,7 +60,8 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
 }
 
 std::string YamlMap::key_path(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
+  // Keys in messages may come from the file (an unknown or repeated key): one escaped line.
+  return EscapeForMessage(path_.empty() ? key : path_ + "." + key, 120);
 }
 
 // The line of the deepest part of the dotted `key` that `node` has ("" when none).
