@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "softsight/control/board.h"
-#include "softsight/control/protocol.h"
+#include "control/board.h"
+#include "control/protocol.h"
 
 namespace {
 
