@@ -5,7 +5,7 @@
 
 #include "fuzz_util.h"
 #include "softsight/core/error.h"
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = softsight::fuzz::WriteScratchFile("markers.yaml", data, size);
