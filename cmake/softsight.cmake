@@ -12,6 +12,14 @@ function(softsight_add_library module)
     PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS})
   add_library(softsight::${module} ALIAS ${target})
+  if(SOFTSIGHT_BUILD_PYTHON)
+    # The Python module is a shared object that links these static libraries: their code must be
+    # position independent. -fno-semantic-interposition keeps GCC inlining calls between the
+    # library's own functions (which plain -fPIC would forbid), so the programs stay as fast.
+    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    target_compile_options(${target} PRIVATE
+      $<$<CXX_COMPILER_ID:GNU>:-fno-semantic-interposition>)
+  endif()
 endfunction()
 
 # softsight_add_test(<module> SOURCES ... DEPS ...)

@@ -16,6 +16,7 @@ PACKAGES=(
   libx11-dev             # the live window checks the X display before opening a window
   opencv-doc             # real sample images with known answers for the golden tests (chessboards, ...)
   clang libfuzzer-14-dev # fuzz targets (scripts/fuzz.sh): clang's libFuzzer with ASan + UBSan
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-opencv  # the Python package (python/), its tests and Dask batch runs
 )
 
 missing=()

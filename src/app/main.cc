@@ -13,6 +13,7 @@
 #include "app/cli_checks.h"
 #include "app/commands.h"
 #include "softsight/core/error.h"
+#include "softsight/version.h"
 
 namespace softsight {
 namespace {
@@ -58,7 +59,7 @@ int Main(int argc, char** argv) {
       "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
       "close the control loop over a serial link. Run `softsight <command> --help` for details."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "softsight 0.1.0");
+  app.set_version_flag("--version", std::string("softsight ") + kVersion);
   std::map<const CLI::App*, CommandRunner> runners;
   for (const CommandEntry& entry : kCommands) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.summary);

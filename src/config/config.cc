@@ -40,12 +40,7 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   return spec;
 }
 
-}  // namespace
-
-namespace {
-
-TrackingConfig ReadTrackingConfig(const std::string& file,
-                                  const std::optional<std::string>& method_override) {
+void CheckMethodOverride(const std::optional<std::string>& method_override) {
   if (method_override) {
     const std::vector<std::string> methods = TrackerMethods();
     if (std::find(methods.begin(), methods.end(), *method_override) == methods.end()) {
@@ -54,7 +49,11 @@ TrackingConfig ReadTrackingConfig(const std::string& file,
       throw InputError("--method " + *method_override + ": unknown method (choose " + list + ")");
     }
   }
-  const YAML::Node root = LoadYamlFile(file);
+}
+
+TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string& file,
+                                      const std::optional<std::string>& method_override) {
+  CheckMethodOverride(method_override);
   if (!root.IsDefined() || root.IsNull()) throw InputError(file + ": config file is empty");
   YamlMap top(root, file, "");
   TrackingConfig config;
@@ -123,8 +122,14 @@ TrackingConfig ReadTrackingConfig(const std::string& file,
 
 TrackingConfig LoadTrackingConfig(const std::string& file,
                                   const std::optional<std::string>& method_override) {
+  CheckMethodOverride(method_override);  // Before the file: a bad --method is named first.
+  return ReadTrackingConfig(LoadYamlFile(file), file, method_override);
+}
+
+TrackingConfig ReadTrackingConfig(const YAML::Node& root, const std::string& file,
+                                  const std::optional<std::string>& method_override) {
   try {
-    return ReadTrackingConfig(file, method_override);
+    return ReadTrackingConfigNode(root, file, method_override);
   } catch (const YAML::Exception& e) {
     RethrowYamlError(file, e);
   }

@@ -12,6 +12,10 @@
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
 
+namespace YAML {
+class Node;
+}
+
 namespace softsight {
 
 // Where frame 0 of the input sits in the source it was cut from: a live recording's raw video
@@ -42,6 +46,13 @@ struct TrackingConfig {
 // Reads and checks a config file. `method_override` (from --method) replaces every marker's
 // method. Throws InputError naming file, line and key.
 TrackingConfig LoadTrackingConfig(const std::string& file,
+                                  const std::optional<std::string>& method_override = {});
+
+// The same from a YAML document already in memory (e.g. built from a Python dict): the same keys,
+// checks and messages, with `file` standing for the file name in them ("file:line: key: ..."; a
+// node built in code has no lines: "file: key: ..."), and relative paths (camera, template and
+// plane files) resolved beside `file` (from the working directory when it names no folder).
+TrackingConfig ReadTrackingConfig(const YAML::Node& root, const std::string& file,
                                   const std::optional<std::string>& method_override = {});
 
 // Writes `config` back as YAML that LoadTrackingConfig reads to the same values.

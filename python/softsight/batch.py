@@ -1,0 +1,1 @@
+"""Many inputs on a Dask cluster: ``track_many``."""

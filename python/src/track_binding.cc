@@ -1,0 +1,233 @@
+// softsight.track: a whole run (a video, an image sequence or a built-in scene) through the same
+// RunPipeline and CSV column table as `softsight track`, its columns returned as numpy arrays.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <set>
+
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "softsight/core/error.h"
+#include "softsight/io/csv_columns.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sinks.h"
+#include "softsight/pipeline/tracking_session.h"
+
+namespace softsight::python {
+namespace {
+
+// Keeps every CSV row as `softsight track` writes it (the same column table), so the arrays hold
+// exactly the file's values: one text buffer and where each row ends (no allocation per frame
+// once the buffer has grown).
+class RowSink : public FrameSink {
+ public:
+  explicit RowSink(const CsvColumnTable& columns) : columns_(columns) {}
+  void consume(const Frame&, const FrameResult& result) override {
+    columns_.append_row(result, row_);
+    text_ += row_;
+    text_ += '\n';
+    ends_.push_back(text_.size());
+  }
+
+  size_t rows() const { return ends_.size(); }
+  // The fields of row `r` (each a pointer into the buffer and a length).
+  void fields(size_t r, std::vector<std::pair<const char*, size_t>>& out) const {
+    out.clear();
+    const size_t begin = r == 0 ? 0 : ends_[r - 1];
+    const size_t end = ends_[r] - 1;  // Without the newline.
+    size_t start = begin;
+    for (size_t i = begin; i <= end; ++i) {
+      if (i == end || text_[i] == ',') {
+        out.emplace_back(text_.data() + start, i - start);
+        start = i + 1;
+      }
+    }
+  }
+
+ private:
+  const CsvColumnTable& columns_;
+  std::string row_, text_;
+  std::vector<size_t> ends_;
+};
+
+// "track: 120 / 300 frames" on stderr, a few times a second (progress=True).
+class ProgressLine : public FrameSink {
+ public:
+  void begin(const RunInfo& info) override { total_ = info.frame_count; }
+  void consume(const Frame&, const FrameResult&) override {
+    ++frames_;
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_) return;
+    next_ = now + std::chrono::milliseconds(250);
+    print();
+  }
+  void end(const RunSummary&) override {
+    print();
+    std::fputc('\n', stderr);
+  }
+
+ private:
+  void print() const {
+    if (total_) {
+      std::fprintf(stderr, "\rtrack: %lld / %lld frames", static_cast<long long>(frames_),
+                   static_cast<long long>(*total_));
+    } else {
+      std::fprintf(stderr, "\rtrack: %lld frames", static_cast<long long>(frames_));
+    }
+    std::fflush(stderr);
+  }
+  std::optional<int64_t> total_;
+  int64_t frames_ = 0;
+  std::chrono::steady_clock::time_point next_{};
+};
+
+enum class Kind { kInt, kBool, kText, kNumber };
+
+// The numpy type of each CSV column: frame an int64, <marker>_found a bool, <marker>_status a
+// string, every other column a float64 (NaN for an empty field).
+Kind ColumnKind(const std::string& name, const std::set<std::string>& found,
+                const std::set<std::string>& status) {
+  if (name == "frame") return Kind::kInt;
+  if (found.count(name)) return Kind::kBool;
+  if (status.count(name)) return Kind::kText;
+  return Kind::kNumber;
+}
+
+py::dict Columns(const RowSink& rows, const CsvColumnTable& table, const TrackingConfig& config) {
+  std::set<std::string> found, status;
+  for (const MarkerSpec& spec : config.markers) {
+    found.insert(spec.name + "_found");
+    status.insert(spec.name + "_status");
+  }
+  const size_t n = rows.rows();
+  std::vector<std::pair<const char*, size_t>> fields;
+  std::vector<Kind> kinds;
+  std::vector<py::array> arrays;
+  std::vector<py::list> texts;
+  for (size_t c = 0; c < table.size(); ++c) {
+    kinds.push_back(ColumnKind(table.column(c).name, found, status));
+    switch (kinds.back()) {
+      case Kind::kInt: arrays.push_back(py::array_t<int64_t>(n)); break;
+      case Kind::kBool: arrays.push_back(py::array_t<bool>(n)); break;
+      case Kind::kNumber: arrays.push_back(py::array_t<double>(n)); break;
+      case Kind::kText: arrays.emplace_back(); break;
+    }
+    texts.emplace_back(kinds.back() == Kind::kText ? py::list(n) : py::list());
+  }
+  std::string field;
+  for (size_t r = 0; r < n; ++r) {
+    rows.fields(r, fields);
+    CV_Assert(fields.size() == table.size());
+    for (size_t c = 0; c < fields.size(); ++c) {
+      field.assign(fields[c].first, fields[c].second);
+      switch (kinds[c]) {
+        case Kind::kInt:
+          static_cast<int64_t*>(arrays[c].mutable_data())[r] = std::strtoll(field.c_str(), nullptr, 10);
+          break;
+        case Kind::kBool:
+          static_cast<bool*>(arrays[c].mutable_data())[r] = field == "1";
+          break;
+        case Kind::kNumber:
+          static_cast<double*>(arrays[c].mutable_data())[r] =
+              field.empty() ? std::numeric_limits<double>::quiet_NaN()
+                            : std::strtod(field.c_str(), nullptr);
+          break;
+        case Kind::kText:
+          texts[c][r] = py::str(field);
+          break;
+      }
+    }
+  }
+  py::module_ np = py::module_::import("numpy");
+  py::dict out;
+  for (size_t c = 0; c < table.size(); ++c) {
+    py::str name(table.column(c).name);
+    if (kinds[c] == Kind::kText) {
+      out[name] = np.attr("array")(texts[c], py::arg("dtype") = "U");
+    } else {
+      out[name] = arrays[c];
+    }
+  }
+  return out;
+}
+
+py::dict SummaryDict(const RunSummary& s) {
+  py::dict out;
+  out["source"] = s.source;
+  out["frames"] = s.frames;
+  out["dropped"] = s.dropped;
+  out["first_index"] = s.first_index ? py::object(py::int_(*s.first_index)) : py::none();
+  out["last_index"] = s.last_index ? py::object(py::int_(*s.last_index)) : py::none();
+  py::dict found;
+  for (size_t i = 0; i < s.markers.size(); ++i) found[py::str(s.markers[i].name)] = s.found_rate(i);
+  out["found_rate"] = found;
+  out["measured"] = s.measured;
+  out["proc_ms_median"] = s.proc_ms_median;
+  out["proc_ms_p99"] = s.proc_ms_p99;
+  out["wall_s"] = s.wall_s;
+  out["stop_reason"] = StopReasonName(s.stop_reason);
+  out["error"] = s.ok() ? py::object(py::none()) : py::object(py::str(s.error));
+  out["report"] = s.FullReport();
+  return out;
+}
+
+// Returns (columns, summary); an InputError before the run (config, input, CSV path) is raised,
+// one during it ends the run and is the summary's "error" (the caller raises it with the rows
+// so far, as the CLI keeps the rows it wrote).
+py::tuple Track(const py::object& input, const py::object& config_source,
+                std::optional<int64_t> max_frames, bool progress,
+                const std::optional<std::string>& csv, double fps,
+                const std::optional<std::string>& method) {
+  if (max_frames && *max_frames < 0) {
+    throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
+  }
+  const TrackingConfig config = ResolveConfig(config_source, method);
+  FrameSourceSpec spec;
+  spec.input = py::str(py::module_::import("os").attr("fspath")(input));
+  spec.sequence_fps = fps;
+  RunSummary summary;
+  const CsvColumnTable table = TrackingColumns(config);
+  RowSink rows(table);
+  bool interrupted = false;
+  {
+    py::gil_scoped_release release;
+    std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+    TrackingSession session(config);
+    std::optional<CsvSink> file;
+    std::vector<FrameSink*> sinks = {&rows};
+    if (csv) {
+      file.emplace(*csv, TrackingColumns(config));
+      sinks.push_back(&*file);
+    }
+    ProgressLine line;
+    if (progress) sinks.push_back(&line);
+    RunOptions run;
+    run.max_frames = max_frames;
+    // Ctrl-C in the interpreter's main thread ends the run (checked a few times a second).
+    auto next_check = std::chrono::steady_clock::now();
+    run.stop_requested = [&] {
+      const auto now = std::chrono::steady_clock::now();
+      if (now < next_check) return false;
+      next_check = now + std::chrono::milliseconds(200);
+      py::gil_scoped_acquire gil;
+      interrupted = PyErr_CheckSignals() != 0;
+      return interrupted;
+    };
+    summary = RunPipeline(*source, session, sinks, run);
+  }
+  if (interrupted) throw py::error_already_set();
+  return py::make_tuple(Columns(rows, table, config), SummaryDict(summary));
+}
+
+}  // namespace
+
+void BindTrack(py::module_& m) {
+  m.def("_track", &Track, py::arg("input"), py::arg("config"), py::arg("max_frames"),
+        py::arg("progress"), py::arg("csv"), py::arg("fps"), py::arg("method"),
+        "softsight.track without the table: (columns dict, summary dict).");
+}
+
+}  // namespace softsight::python

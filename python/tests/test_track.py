@@ -1,0 +1,99 @@
+"""softsight.track on a rendered video gives exactly the CLI's CSV values."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+import softsight
+from conftest import cli_error, read_csv, run_cli
+
+
+def as_text(column: np.ndarray, name: str) -> list:
+    """An array back in the CSV's text, to compare field by field."""
+    if column.dtype == np.bool_:
+        return ["1" if v else "0" for v in column]
+    if column.dtype.kind == "U":
+        return [str(v) for v in column]
+    if column.dtype == np.int64:
+        return [str(v) for v in column]
+    fmt = "%.6f" if name == "time_s" else "%.4f"
+    return ["" if math.isnan(v) else fmt % v for v in column]
+
+
+def test_track_gives_exactly_the_cli_csv(bending_video, markers_yaml, tmp_path):
+    out = tmp_path / "cli.csv"
+    run_cli("track", "-c", str(markers_yaml), "-i", str(bending_video), "-o", str(out), "-q")
+    expected = read_csv(out)
+    table = softsight.track(bending_video, markers_yaml, csv=tmp_path / "py.csv")
+    assert list(table) == list(expected)  # Same columns, same order.
+    assert table.rows == 24
+    for name, column in table.items():
+        assert len(column) == 24
+        if name == "proc_ms":
+            assert column.dtype == np.float64 and np.all(column > 0)
+            continue
+        assert as_text(column, name) == expected[name], name
+        # The arrays hold the file's numbers exactly (not re-rounded values).
+        if column.dtype == np.float64:
+            parsed = np.array([float(v) if v else np.nan for v in expected[name]])
+            np.testing.assert_array_equal(column, parsed)
+    assert table["frame"].dtype == np.int64 and table["red_found"].dtype == np.bool_
+    assert table["blue_status"][0] == "found" and table["red_found"].all()
+    # csv= writes the CLI's file (apart from the timing column).
+    written = read_csv(tmp_path / "py.csv")
+    del written["proc_ms"], expected["proc_ms"]
+    assert written == expected
+    summary = table.summary
+    assert summary["frames"] == 24 and summary["stop_reason"] == "end of input"
+    assert summary["found_rate"] == {"red": 1.0, "blue": 1.0, "green": 1.0}
+    assert summary["error"] is None
+
+
+def test_track_a_builtin_scene_with_max_frames(markers_yaml, tmp_path):
+    out = tmp_path / "cli.csv"
+    run_cli("track", "-c", str(markers_yaml), "-i", "synth:bending", "--max-frames", "5",
+            "-o", str(out), "-q")
+    expected = read_csv(out)
+    table = softsight.track("synth:bending", markers_yaml, max_frames=5)
+    assert table.rows == 5 and table.summary["stop_reason"] == "max frames reached"
+    for name in expected:
+        if name != "proc_ms":
+            assert as_text(table[name], name) == expected[name], name
+
+
+def test_a_missing_input_gives_the_cli_message(markers_yaml, tmp_path):
+    missing = tmp_path / "missing.avi"
+    expected = cli_error("track", "-c", str(markers_yaml), "-i", str(missing), "-o",
+                         str(tmp_path / "x.csv"))
+    with pytest.raises(softsight.InputError) as error:
+        softsight.track(missing, markers_yaml)
+    assert str(error.value) == expected and str(missing) in expected
+
+
+def test_a_corrupt_video_fails_with_the_rows_before(bending_video, markers_yaml, tmp_path):
+    data = bending_video.read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) * 2 // 3])  # Ends mid-stream.
+    expected = cli_error("track", "-c", str(markers_yaml), "-i", str(cut), "-o",
+                         str(tmp_path / "x.csv"))
+    with pytest.raises(softsight.InputError) as error:
+        softsight.track(cut, markers_yaml)
+    assert str(error.value) == expected
+    assert 0 < error.value.table.rows < 24
+
+
+def test_to_pandas_without_pandas_raises_a_clear_import_error(monkeypatch):
+    table = softsight.Table({"frame": np.arange(3)})
+    monkeypatch.setitem(sys.modules, "pandas", None)  # As if pandas were not installed.
+    with pytest.raises(ImportError, match="to_pandas\\(\\) needs pandas, which is not installed"):
+        table.to_pandas()
+
+
+def test_to_pandas_with_pandas():
+    pandas = pytest.importorskip("pandas")
+    frame = softsight.Table({"frame": np.arange(3), "angle_deg": np.array([180.0, np.nan, 90.0])}).to_pandas()
+    assert isinstance(frame, pandas.DataFrame) and list(frame.columns) == ["frame", "angle_deg"]
