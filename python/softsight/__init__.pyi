@@ -108,8 +108,13 @@ class Session:
     def next_index(self) -> int: ...
     def reset_tip_reference(self) -> None: ...
     def reselect(
-        self, marker: str, frame: npt.NDArray[np.uint8], rect: Tuple[int, int, int, int]
-    ) -> None: ...
+        self,
+        marker: str,
+        frame: npt.NDArray[np.uint8],
+        rect: Tuple[int, int, int, int],
+        time_s: float = 0.0,
+        index: Optional[int] = None,
+    ) -> FrameResult: ...
 
 class Table(Dict[str, np.ndarray]):
     """A run's columns as numpy arrays, in the CSV's order."""

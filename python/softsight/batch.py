@@ -1,1 +1,152 @@
-"""Many inputs on a Dask cluster: ``track_many``."""
+"""Many inputs on a Dask cluster: ``track_many``.
+
+Each input is one task running ``softsight.track`` on a worker (the GIL is released while it
+tracks), writing its own CSV; the caller gets a summary table with one row per input. A failing
+input (missing, corrupt, a frame that does not decode) is a row with ``ok`` False and the CLI's
+error message; the others carry on. Needs Dask (Debian: python3-dask, python3-distributed).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import InputError, load_config, track
+from ._table import Table
+
+__all__ = ["track_many"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _csv_names(paths: Sequence[str], out_dir: Path) -> List[str]:
+    """One CSV per input, named after it; inputs with the same name get -1, -2, ... suffixes."""
+    taken: Dict[str, int] = {}
+    names = []
+    for path in paths:
+        stem = Path(path).stem if not path.startswith("synth:") else path.replace(":", "_")
+        stem = stem.replace("%", "") or "input"
+        n = taken.get(stem, 0)
+        taken[stem] = n + 1
+        names.append(str(out_dir / (f"{stem}.csv" if n == 0 else f"{stem}-{n}.csv")))
+    return names
+
+
+def _track_one(path: str, config, csv: str, max_frames: Optional[int], fps: float,
+               method: Optional[str]) -> Dict[str, Any]:
+    """One input, on a worker: its summary row (never raises for bad input)."""
+    try:
+        from distributed import get_worker
+
+        worker = get_worker().address
+    except (ImportError, ValueError):
+        worker = ""
+    row: Dict[str, Any] = {"input": path, "csv": csv, "worker": worker}
+    try:
+        table = track(path, config, max_frames, csv=csv, fps=fps, method=method)
+        row.update(ok=True, error="", summary=table.summary)
+    except InputError as error:
+        table = getattr(error, "table", None)
+        row.update(ok=False, error=str(error), summary=None if table is None else table.summary)
+    return row
+
+
+def _failed(path: str, csv: str, error: BaseException) -> Dict[str, Any]:
+    """The row of an input whose task itself failed (a worker lost, a timeout)."""
+    text = str(error) or type(error).__name__
+    return {"input": path, "csv": csv, "worker": "", "ok": False,
+            "error": f"{type(error).__name__}: {text}", "summary": None}
+
+
+def _summary_table(rows: List[Dict[str, Any]], markers: List[str]) -> Table:
+    def summary(row, key, default):
+        s = row["summary"]
+        return default if s is None or s.get(key) is None else s[key]
+
+    columns: Dict[str, np.ndarray] = {
+        "input": np.array([r["input"] for r in rows], dtype="U"),
+        "csv": np.array([r["csv"] for r in rows], dtype="U"),
+        "ok": np.array([r["ok"] for r in rows], dtype=bool),
+        "frames": np.array([summary(r, "frames", 0) for r in rows], dtype=np.int64),
+        "stop_reason": np.array([summary(r, "stop_reason", "error") for r in rows], dtype="U"),
+        "error": np.array([r["error"] for r in rows], dtype="U"),
+    }
+    for name in markers:
+        columns[f"found_{name}"] = np.array(
+            [summary(r, "found_rate", {}).get(name, np.nan) for r in rows], dtype=np.float64)
+    columns["measured"] = np.array([summary(r, "measured", 0) for r in rows], dtype=np.int64)
+    for key in ("proc_ms_median", "proc_ms_p99", "wall_s"):
+        columns[key] = np.array([summary(r, key, np.nan) for r in rows], dtype=np.float64)
+    columns["worker"] = np.array([r["worker"] for r in rows], dtype="U")
+    return Table(columns)
+
+
+def track_many(
+    paths: Sequence[PathLike],
+    config,
+    client=None,
+    out_dir: PathLike = ".",
+    *,
+    max_frames: Optional[int] = None,
+    fps: float = 30.0,
+    method: Optional[str] = None,
+    n_workers: int = 2,
+    processes: bool = False,
+    timeout_s: Optional[float] = None,
+) -> Table:
+    """Tracks every input of ``paths`` on a Dask cluster; one CSV per input in ``out_dir``.
+
+    ``config`` is a Config, a YAML path or a dict, checked here first (a bad config raises
+    InputError before anything runs; workers reload it from its path or dict, so a path must be
+    readable on the workers, as the inputs must). ``client`` is a ``distributed.Client``, a
+    scheduler address ("tcp://host:8786"), or None for a LocalCluster of ``n_workers`` workers
+    (threads in this process unless ``processes``; closed again at the end). ``max_frames``,
+    ``fps`` and ``method`` are ``track``'s. ``timeout_s`` bounds the wait for each input.
+
+    Returns a Table (``to_pandas()`` for a DataFrame) with one row per input, in order: input,
+    csv, ok, frames, stop_reason, error (the CLI's one-line message; "" when ok), found_<marker>
+    (found rate), measured, proc_ms_median, proc_ms_p99, wall_s, worker. An input that fails
+    is a row with ok False; the others run on. Each CSV holds the rows ``softsight track``
+    writes (a failed input's CSV keeps the rows before its error).
+    """
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as error:
+        raise ImportError(
+            "softsight.batch.track_many needs Dask's distributed scheduler (Debian: apt install "
+            "python3-dask python3-distributed; or pip install 'dask[distributed]')"
+        ) from error
+    checked = load_config(config, method=method)  # A bad config fails here, once.
+    inputs = [os.fspath(p) for p in paths]
+    out = Path(os.fspath(out_dir))
+    out.mkdir(parents=True, exist_ok=True)
+    csvs = _csv_names(inputs, out)
+
+    own_cluster = own_client = None
+    if client is None:
+        own_cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=processes,
+                                   dashboard_address=None)
+        client = own_client = Client(own_cluster)
+    elif isinstance(client, str):
+        client = own_client = Client(client)
+    try:
+        futures = [
+            client.submit(_track_one, path, checked, csv, max_frames, fps, None, pure=False)
+            for path, csv in zip(inputs, csvs)
+        ]
+        rows = []
+        for path, csv, future in zip(inputs, csvs, futures):
+            try:
+                rows.append(future.result(timeout=timeout_s))
+            except Exception as error:  # A lost worker, a timeout: this input failed.
+                future.cancel()
+                rows.append(_failed(path, csv, error))
+    finally:
+        if own_client is not None:
+            own_client.close()
+        if own_cluster is not None:
+            own_cluster.close()
+    return _summary_table(rows, checked.marker_names)

@@ -1,5 +1,6 @@
 // softsight.Session: frames from the caller's own code (numpy arrays) through a TrackingSession.
 #include <atomic>
+#include <chrono>
 #include <mutex>
 
 #include <opencv2/imgproc.hpp>
@@ -51,6 +52,25 @@ class PySession {
     const FrameResult& result = session_.process(frame);
     next_index_ = frame_index + 1;
     return result;  // A copy: the session reuses its own for the next frame.
+  }
+
+  // The benchmark's reference: `calls` frames through TrackingSession::process alone, timed in
+  // C++ (the same header, indices and lock as process(); no Python in the loop). Seconds.
+  double time_cpp_process(const py::array& image, int calls) {
+    py::object copy;
+    const cv::Mat pixels = ImageHeader(image, "frame", &copy);
+    if (pixels.channels() != 3) throw InputError("frame: the benchmark takes BGR frames");
+    py::gil_scoped_release release;
+    Frame frame;
+    frame.image = pixels;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < calls; ++i) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      frame.index = next_index_;
+      session_.process(frame);
+      next_index_ = frame.index + 1;
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   TrackingSession& session() { return session_; }
@@ -241,23 +261,33 @@ first frame's.)doc")
       .def(
           "reselect",
           [](PySession& s, const std::string& marker, const py::array& frame,
-             const std::vector<int>& rect) {
+             const std::vector<int>& rect, double time_s,
+             std::optional<int64_t> index) -> FrameResult {
             if (rect.size() != 4) throw py::value_error("rect: expected (x, y, width, height)");
             py::object copy;
             const cv::Mat pixels = ImageHeader(frame, "reselect frame", &copy);
-            cv::Mat bgr = pixels;
-            if (pixels.channels() == 1) cv::cvtColor(pixels, bgr, cv::COLOR_GRAY2BGR);
+            Frame f;
+            f.image = pixels;
+            if (pixels.channels() == 1) cv::cvtColor(pixels, f.image, cv::COLOR_GRAY2BGR);
+            f.time_s = time_s;
+            py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(s.mutex());
-            s.session().reselect(marker, bgr, cv::Rect(rect[0], rect[1], rect[2], rect[3]));
+            f.index = index.value_or(std::max<int64_t>(0, s.next_index() - 1));
+            return s.session().reselect(marker, f, cv::Rect(rect[0], rect[1], rect[2], rect[3]));
+            // (A copy, made under the lock: the session reuses its result.)
           },
-          py::arg("marker"), py::arg("frame"), py::arg("rect"),
-          "The marker is inside rect (x, y, width, height) on frame: re-cuts its template, or "
-          "restricts its colour tracker's next acquisition (the live window's mouse "
-          "recalibration).")
+          py::arg("marker"), py::arg("frame"), py::arg("rect"), py::arg("time_s") = 0.0,
+          py::arg("index") = py::none(),
+          "The marker is inside rect (x, y, width, height) on `frame` (default index: the last "
+          "processed frame's): re-cuts its template or restricts its colour tracker's next "
+          "acquisition (the live window's mouse recalibration). Returns that frame's result.")
       // For the binding's own tests: where the pixels the library last read were, and whether
       // the GIL was released while it read them.
       .def_property_readonly("_last_frame_address", &PySession::last_frame_address)
-      .def_property_readonly("_last_call_released_gil", &PySession::last_call_released_gil);
+      .def_property_readonly("_last_call_released_gil", &PySession::last_call_released_gil)
+      .def("_time_cpp_process", &PySession::time_cpp_process, py::arg("frame"), py::arg("calls"),
+           "For the overhead benchmark (python/bench): seconds for `calls` frames through the C++ "
+           "TrackingSession::process alone.");
 
   m.def(
       "_image_header",

@@ -1,0 +1,34 @@
+"""`cmake --install` puts the package into the interpreter's site-packages: installed into a
+staging folder (DESTDIR), it imports from there alone, with its version and licence metadata."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+CMAKE = os.environ.get("SOFTSIGHT_CMAKE")
+BUILD_DIR = os.environ.get("SOFTSIGHT_BUILD_DIR")
+INSTALL_DIR = os.environ.get("SOFTSIGHT_PYTHON_INSTALL_DIR")
+
+
+@pytest.mark.skipif(not (CMAKE and BUILD_DIR and INSTALL_DIR), reason="run by ctest (python.test_install)")
+def test_cmake_install_puts_an_importable_package_into_site_packages(tmp_path):
+    env = dict(os.environ, DESTDIR=str(tmp_path))
+    subprocess.run([CMAKE, "--install", BUILD_DIR, "--component", "python"], env=env, check=True,
+                   capture_output=True, timeout=60)
+    site = Path(str(tmp_path) + INSTALL_DIR)
+    assert (site / "softsight" / "__init__.py").exists()
+    assert (site / "softsight" / "__init__.pyi").exists() and (site / "softsight" / "py.typed").exists()
+    code = ("import softsight, importlib.metadata as m; print(softsight.__file__); "
+            "print(softsight.__version__, m.version('softsight'), m.metadata('softsight')['License'])")
+    clean = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    out = subprocess.run([sys.executable, "-c", code], env=dict(clean, PYTHONPATH=str(site)),
+                         cwd=tmp_path, check=True, capture_output=True, text=True, timeout=60)
+    where, versions = out.stdout.splitlines()
+    assert where.startswith(str(site))
+    version, meta_version, licence = versions.split()
+    assert version == meta_version and licence == "Apache-2.0"
