@@ -10,7 +10,7 @@
 #include <pybind11/pybind11.h>
 #include <yaml-cpp/yaml.h>
 
-#include "softsight/io/config.h"
+#include "softsight/config/config.h"
 
 namespace softsight::python {
 

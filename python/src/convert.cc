@@ -7,6 +7,7 @@
 #include "bindings.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/pipeline/sinks.h"
 
 namespace softsight::python {
 namespace {

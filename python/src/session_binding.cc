@@ -9,6 +9,7 @@
 #include "bindings.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight::python {
