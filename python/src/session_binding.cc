@@ -99,8 +99,16 @@ const MarkerObservation& FindMarker(const FrameResult& r, const std::string& nam
   throw py::key_error("no marker named '" + name + "'");
 }
 
-py::dict MeasurementDict(const FrameResult& r) {
-  const Measurement& m = r.measurement;
+template <typename Class>
+void MeasurementProperty(Class& c, const char* name, std::optional<double> Measurement::*member,
+                         const char* doc) {
+  c.def_property_readonly(
+      name, [member](const FrameResult& r) { return Optional(r.measurement.*member); }, doc);
+}
+
+}  // namespace
+
+py::dict MeasurementDict(const Measurement& m) {
   py::dict out;
   out["angle_deg"] = Optional(m.angle_deg);
   out["chord_px"] = Optional(m.chord_px);
@@ -116,15 +124,6 @@ py::dict MeasurementDict(const FrameResult& r) {
   out["tip_disp_mm"] = Optional(m.tip_disp_mm);
   return out;
 }
-
-template <typename Class>
-void MeasurementProperty(Class& c, const char* name, std::optional<double> Measurement::*member,
-                         const char* doc) {
-  c.def_property_readonly(
-      name, [member](const FrameResult& r) { return Optional(r.measurement.*member); }, doc);
-}
-
-}  // namespace
 
 void BindSession(py::module_& m) {
   py::class_<MarkerObservation>(m, "Marker", R"doc(
@@ -179,7 +178,7 @@ missing, no radius when straight, no _mm values without a scale).)doc");
       .def_readonly("markers", &FrameResult::markers, "Every marker, in config order.")
       .def("__getitem__", &FindMarker, py::arg("name"), py::return_value_policy::reference_internal,
            "The marker named `name` (KeyError when there is none).")
-      .def_property_readonly("measurement", &MeasurementDict,
+      .def_property_readonly("measurement", [](const FrameResult& r) { return MeasurementDict(r.measurement); },
                              "Every measurement by name (None where absent).")
       .def_property_readonly(
           "inner_angle_deg",

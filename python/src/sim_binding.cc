@@ -21,14 +21,7 @@ py::dict TruthDict(const SceneTruth& t) {
     one["visible_fraction"] = m.visible_fraction;
     markers[py::str(m.name)] = one;
   }
-  const Measurement& r = t.measurement;
-  py::dict measurement;
-  measurement["angle_deg"] = Optional(r.angle_deg);
-  measurement["chord_px"] = Optional(r.chord_px);
-  measurement["sagitta_px"] = Optional(r.sagitta_px);
-  measurement["radius_px"] = Optional(r.radius_px);
-  measurement["arc_length_px"] = Optional(r.arc_length_px);
-  measurement["tip_disp_px"] = Optional(r.tip_disp_px);
+  const py::dict measurement = MeasurementDict(t.measurement);
   py::dict out;
   out["frame"] = t.frame_index;
   out["time_s"] = t.time_s;
