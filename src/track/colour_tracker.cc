@@ -387,6 +387,7 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
     frame_size_ = frame_bgr.size();
   }
   candidates_.clear();
+  partly_seen_ = false;
   Choice choice;
   if (tracking_ && params_.window_px > 0) {
     choice = track_in_windows(frame_bgr);
@@ -413,9 +414,12 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
     const bool was_tracking = tracking_;
     const cv::Point2d predicted = last_px_.value_or(cv::Point2d()) + velocity_px_;
     choice = acquire(frame_bgr);
-    if (!choice.blob && was_tracking && choice.status == MarkerStatus::kLost &&
-        !cv::Rect2d(-0.5, -0.5, frame_bgr.cols, frame_bgr.rows).contains(predicted)) {
-      choice.status = MarkerStatus::kOutOfFrame;
+    if (!choice.blob && was_tracking && choice.status == MarkerStatus::kLost) {
+      if (!cv::Rect2d(-0.5, -0.5, frame_bgr.cols, frame_bgr.rows).contains(predicted)) {
+        choice.status = MarkerStatus::kOutOfFrame;
+      } else if (partly_seen_) {
+        choice.status = MarkerStatus::kCovered;
+      }
     }
   }
   return report(choice);
@@ -553,6 +557,13 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     for (const ColourBlob& b : blobs_) {
       const auto [verdict, misfit] = judge(b);
       candidates_.push_back(candidate(b, verdict, misfit));
+      // What is left of a covered marker: of its colour, smaller than it (often a sliver, so of
+      // any shape), and within its own radius (plus one frame's motion) of where it should be.
+      if ((verdict == CandidateVerdict::kSize || verdict == CandidateVerdict::kShape) && model_ &&
+          b.area_px < model_->area_px &&
+          cv::norm(b.centroid_px - predicted) <= ref_radius + cv::norm(velocity_px_) + 1.0) {
+        partly_seen_ = true;
+      }
       if (verdict != CandidateVerdict::kFits) continue;
       const double d = cv::norm(b.centroid_px - predicted);
       if (d < best_dist) {

@@ -140,6 +140,9 @@ class ColourTracker : public Tracker {
   std::optional<cv::Point2d> last_px_;        // Last found position (kept to prefer on re-acquisition).
   cv::Point2d velocity_px_{0, 0};             // Per frame; 0 after a (re-)acquisition.
   bool tracking_ = false;                     // Found in the previous frame.
+  // The last windowed search saw a blob of the marker's colour where the marker was expected,
+  // too small to be measured: the marker is covered rather than gone.
+  bool partly_seen_ = false;
   cv::Size frame_size_;
   cv::Rect last_search_px_;
 

@@ -204,6 +204,11 @@ TEST(ColourTracker, MostlyCoveredMarkerIsNotFound) {
   const Observation hidden = tracker.update(covered);
   EXPECT_FALSE(hidden.found());
   EXPECT_FALSE(hidden.score);
+  // What is left of it is seen where it was: covered, not lost.
+  EXPECT_EQ(hidden.not_found_reason, MarkerStatus::kCovered);
+  // Wholly hidden (nothing of its colour left near it) is lost, not covered.
+  ASSERT_TRUE(tracker.update(image).found());
+  EXPECT_EQ(tracker.update(Background()).not_found_reason, MarkerStatus::kLost);
 
   // Half covered: found, at the centroid of what is visible, with score ~0.5.
   cv::Mat half = image.clone();
