@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "gui/seekable_source.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_controller.h"
@@ -54,6 +55,15 @@ int RunLive(const LiveArgs& args) {
   spec.camera = args.camera;
   spec.input = args.input;
   std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  SeekableSource* seekable = nullptr;
+  if (!source->is_live()) {
+    // The transport keys (step, seek, loop) read the file again from its start when they go
+    // back further than the frames kept in memory.
+    auto playable = std::make_unique<SeekableSource>(std::move(source),
+                                                     [spec] { return OpenFrameSource(spec); });
+    seekable = playable.get();
+    source = std::move(playable);
+  }
 
   LiveOptions options;
   options.save_config_path =
@@ -75,7 +85,7 @@ int RunLive(const LiveArgs& args) {
   }
   LiveWindowOptions window;
   window.trackbars = !args.no_trackbars;
-  const int code = RunLiveWindow(controller, *source, window);
+  const int code = RunLiveWindow(controller, *source, window, seekable);
   if (!controller.last_recording().empty()) {
     std::cerr << "softsight live: last recording " << controller.last_recording() << ".*\n";
   }
@@ -96,6 +106,9 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "to pick its HSV ranges from the pixels around the click (keys 1..9 choose which marker).\n"
       "Trackbars adjust the active marker's ranges. Keys: h help, space pause, r record, s save\n"
       "config, b reset the bending-distance reference, m switch method, c mm scale, q quit.\n"
+      "Playback of a file or image sequence: . / , one frame forward / back, ] / [ (Right / Left)\n"
+      "+-1 s, < / > (Home / End) first / last frame, l loop, 0 restart; at the end the last frame\n"
+      "stays and every key works. Rows keep the source's frame numbers after a seek.\n"
       "Scale: with --scale-distance-mm D, press c and click two points D mm apart (e.g. the ends\n"
       "of a ruler in the actuator's plane); the mm values appear at once and `s` saves the points\n"
       "as scale_from_points, so `softsight track` with the saved config gives the same mm.\n"

@@ -93,15 +93,29 @@ void LiveController::say(const std::string& message) {
   dirty_ = true;
 }
 
-void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captured) {
-  if (paused_) return;
+void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captured,
+                              FrameOrder order) {
+  if (paused_ && order == FrameOrder::kNext) return;
   CV_Assert(frame.image.type() == CV_8UC3);
+  if (order == FrameOrder::kJump) {
+    if (recording_) {
+      toggle_recording();
+      say(message_ + " (stopped: the playback jumped)");
+    }
+    session_->jump();
+    chart_.clear();  // Its time axis cannot run backwards.
+  }
   frame.image.copyTo(frame_);
   frame_index_ = frame.index;
   ended_ = false;
   frame_time_s_ = frame.time_s;
   const FrameResult& result = session_->process(frame);
   chart_.add(result);
+  if (order != FrameOrder::kNext) {
+    // A frame the user stepped or seeked to: no figure of the playing rate.
+    record_frame(frame, result);
+    return;
+  }
 
   // Frame rate over the last frames that produced a result, latency from capture to result.
   const SteadyClock::time_point now = SteadyClock::now();
@@ -141,7 +155,34 @@ void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) con
 
 void LiveController::on_end_of_input() {
   ended_ = true;
-  say("end of input: the last frame stays; q quits");
+  say("end of input: the last frame stays; space plays from the start, q quits");
+}
+
+std::optional<PlaybackRequest> LiveController::take_playback_request() {
+  std::optional<PlaybackRequest> request;
+  request.swap(playback_request_);
+  return request;
+}
+
+void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds) {
+  if (recording_ && kind != PlaybackRequest::Kind::kStepForward) {
+    // The recording's raw video must be re-trackable: its frames follow each other.
+    say("stop the recording first (r): a recording holds consecutive frames");
+    return;
+  }
+  if (kind == PlaybackRequest::Kind::kStepForward || kind == PlaybackRequest::Kind::kStepBack) {
+    paused_ = true;
+  }
+  playback_request_ = PlaybackRequest{kind, seconds};
+  dirty_ = true;
+}
+
+void LiveController::restart() {
+  if (recording_) toggle_recording();
+  request_playback(PlaybackRequest::Kind::kStart);
+  session_->reset_tip_reference();
+  paused_ = false;
+  say("restart: from the first frame, trackers afresh");
 }
 
 std::optional<cv::Point2d> LiveController::position_of(int marker) const {
@@ -506,8 +547,43 @@ void LiveController::on_event(const UiEvent& event) {
           break;
         case ' ':
         case 'p':
+          if (ended_ && !loop_) {
+            request_playback(PlaybackRequest::Kind::kStart);
+            paused_ = false;
+            say("playing from the first frame");
+            break;
+          }
           paused_ = !paused_;
           say(paused_ ? "paused" : "running");
+          break;
+        case '.':
+          request_playback(PlaybackRequest::Kind::kStepForward);
+          break;
+        case ',':
+          request_playback(PlaybackRequest::Kind::kStepBack);
+          break;
+        case ']':
+        case kKeyRight:
+          request_playback(PlaybackRequest::Kind::kSeekSeconds, 1.0);
+          break;
+        case '[':
+        case kKeyLeft:
+          request_playback(PlaybackRequest::Kind::kSeekSeconds, -1.0);
+          break;
+        case '<':
+        case kKeyHome:
+          request_playback(PlaybackRequest::Kind::kStart);
+          break;
+        case '>':
+        case kKeyEnd:
+          request_playback(PlaybackRequest::Kind::kEnd);
+          break;
+        case 'l':
+          loop_ = !loop_;
+          say(loop_ ? "loop on" : "loop off");
+          break;
+        case '0':
+          restart();
           break;
         case 'r':
           toggle_recording();
@@ -560,6 +636,7 @@ const cv::Mat& LiveController::canvas() {
   if (recording_) state += "REC " + recording_->prefix() + "  ";
   if (paused_) state += "PAUSED  ";
   if (ended_) state += "END  ";
+  if (loop_) state += "LOOP  ";
   if (dropped_ > 0) state += "dropped " + std::to_string(dropped_) + "  ";
   state +=
       "active: " + config().markers[active_].name + " (" + config().markers[active_].method + ")";

@@ -11,6 +11,7 @@
 #include "softsight/core/error.h"
 #include "gui/live_feed.h"
 #include "gui/live_pointer.h"
+#include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/paced_source.h"
@@ -46,6 +47,27 @@ TrackingConfig SceneConfig() {
   config.measure.tip = "green";
   config.source_file = "test config";
   return config;
+}
+
+// How many of 24 points on a circle of the overlay's ring radius around `centre` are the ring's
+// yellow (in canvas pixels = image pixels).
+int RingPoints(const cv::Mat& canvas, const cv::Point2d& centre, double radius = 12) {
+  int ring = 0;
+  for (int deg = 0; deg < 360; deg += 15) {
+    const cv::Point p(cvRound(centre.x + radius * std::cos(deg * CV_PI / 180)),
+                      cvRound(centre.y + radius * std::sin(deg * CV_PI / 180)));
+    bool yellow = false;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const cv::Point q = p + cv::Point(dx, dy);
+        if (q.x < 0 || q.y < 0 || q.x >= canvas.cols || q.y >= canvas.rows) continue;
+        const cv::Vec3b px = canvas.at<cv::Vec3b>(q);
+        yellow |= px[0] < 80 && px[1] > 200 && px[2] > 200;
+      }
+    }
+    ring += yellow;
+  }
+  return ring;
 }
 
 class LiveControllerTest : public ::testing::Test {
@@ -118,20 +140,7 @@ TEST_F(LiveControllerTest, TracksAndShowsTheOverlayAboveTheStripChart) {
   EXPECT_EQ(canvas.size(), cv::Size(320, 240 + StripChartOptions{}.height_px));
   for (const MarkerTruth& marker : truth.markers) {
     // The overlay's ring around each marker, in canvas coordinates (= image coordinates).
-    int ring = 0;
-    for (int deg = 0; deg < 360; deg += 15) {
-      const cv::Point p(cvRound(marker.centroid_px->x + 12 * std::cos(deg * CV_PI / 180)),
-                        cvRound(marker.centroid_px->y + 12 * std::sin(deg * CV_PI / 180)));
-      bool yellow = false;
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const cv::Vec3b px = canvas.at<cv::Vec3b>(p + cv::Point(dx, dy));
-          yellow |= px[0] < 80 && px[1] > 200 && px[2] > 200;
-        }
-      }
-      ring += yellow;
-    }
-    EXPECT_GE(ring, 20) << marker.name;
+    EXPECT_GE(RingPoints(canvas, *marker.centroid_px), 20) << marker.name;
   }
   ASSERT_TRUE(live.latency_ms());
   EXPECT_GE(*live.latency_ms(), 0.0);
@@ -700,6 +709,168 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
+}
+
+class LivePlaybackTest : public LiveFileTest {
+ protected:
+  // The file as `live` plays it: seekable under the pacing, with a ring of only 8 frames so
+  // that going back further reopens the file (both ways of reaching a frame are exercised).
+  void Play(const std::string& video) {
+    FrameSourceSpec spec;
+    spec.input = video;
+    auto seekable = std::make_unique<SeekableSource>(
+        OpenFrameSource(spec), [spec] { return OpenFrameSource(spec); }, 8 * 320 * 240 * 3);
+    seekable_ = seekable.get();
+    source_ = std::make_unique<PacedFrameSource>(std::move(seekable), clock_.timing());
+  }
+  // The frame on screen is source frame `index`: the row names it, the markers are found at
+  // its rendered truth, and the overlay's rings are drawn there.
+  void ExpectShowing(LiveController& live, int index) {
+    ASSERT_TRUE(live.last_result());
+    EXPECT_EQ(live.last_result()->frame_index, index);
+    EXPECT_NEAR(live.last_result()->time_s, index / 30.0, 1e-6);
+    cv::Mat image;
+    const SceneTruth truth = scene_->render(index, image);
+    for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 0.3);
+    const cv::Mat canvas = live.canvas().clone();
+    for (const MarkerTruth& marker : truth.markers) {
+      EXPECT_GE(RingPoints(canvas, *marker.centroid_px), 20) << marker.name << " frame " << index;
+    }
+  }
+  static void Key(LiveController& live, int key) { live.on_event(UiEvent::Key(key)); }
+
+  FakeClock clock_;
+  SeekableSource* seekable_ = nullptr;
+  std::unique_ptr<PacedFrameSource> source_;
+};
+
+TEST_F(LivePlaybackTest, StepSeekStartEndLandOnTheSourcesFramesWithTheOverlayOnTheirTruth) {
+  const std::string video = WriteVideo(40);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 4);
+
+  Key(live, '.');  // Step forward: pauses, shows the next frame.
+  ASSERT_TRUE(feed.step(live));
+  EXPECT_TRUE(live.paused());
+  ExpectShowing(live, 5);
+  EXPECT_FALSE(feed.step(live));  // Paused: nothing more.
+  Key(live, ',');
+  ASSERT_TRUE(feed.step(live));
+  Key(live, ',');
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 3);
+  Key(live, ']');  // +1 s = 30 frames.
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 33);
+  const int64_t decoded = seekable_->frames_decoded();
+  Key(live, kKeyLeft);  // -1 s: frame 3 is no longer in the ring, the file is read again.
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 3);
+  EXPECT_GT(seekable_->frames_decoded(), decoded);
+  Key(live, '>');
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 39);
+  EXPECT_FALSE(live.ended());
+  Key(live, '.');  // Past the last frame: END, the last frame stays.
+  EXPECT_FALSE(feed.step(live));
+  EXPECT_TRUE(live.ended());
+  ExpectShowing(live, 39);
+  // At END every control still works.
+  Key(live, ',');
+  ASSERT_TRUE(feed.step(live));
+  EXPECT_FALSE(live.ended());
+  ExpectShowing(live, 38);
+  Key(live, ']');  // Past the end: the last frame.
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 39);
+  Key(live, kKeyHome);
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 0);
+  Key(live, '[');  // Before the start: the first frame.
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 0);
+  Key(live, ',');
+  EXPECT_FALSE(feed.step(live));
+  EXPECT_EQ(live.message(), "at the first frame");
+}
+
+TEST_F(LivePlaybackTest, PlayingOnAfterASeekKeepsTheFilesRateAndEndKeepsEveryKeyWorking) {
+  const std::string video = WriteVideo(12);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  // +1 s while playing, past the end of this 0.4 s clip: the last frame at once, no wait for
+  // the old schedule, then END.
+  const auto before = clock_.now;
+  Key(live, ']');
+  ASSERT_TRUE(feed.step(live));
+  EXPECT_EQ(clock_.now, before);
+  ExpectShowing(live, 11);
+  EXPECT_FALSE(feed.step(live));
+  EXPECT_TRUE(live.ended());
+  EXPECT_TRUE(feed.ended());
+  // Space at END plays from the start; the next frame comes one frame period after it.
+  Key(live, ' ');
+  EXPECT_FALSE(live.paused());
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 0);
+  const auto at_start = clock_.now;
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 1);
+  EXPECT_GE(clock_.now - at_start, std::chrono::milliseconds(33));
+  EXPECT_LE(clock_.now - at_start, std::chrono::milliseconds(34));
+}
+
+TEST_F(LivePlaybackTest, LoopWrapsToTheFirstFrameAndRestartStartsTheTrackersAfresh) {
+  const std::string video = WriteVideo(10);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  Key(live, 'l');
+  EXPECT_TRUE(live.loop());
+  std::vector<int64_t> frames;
+  for (int i = 0; i < 25; ++i) {
+    ASSERT_TRUE(feed.step(live));
+    frames.push_back(live.last_result()->frame_index);
+  }
+  for (int i = 0; i < 25; ++i) EXPECT_EQ(frames[i], i % 10) << i;
+  ExpectShowing(live, 4);
+  // A recording stops at the wrap: its raw video must hold consecutive frames.
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  Key(live, 'r');
+  ASSERT_TRUE(live.recording());
+  Key(live, '[');  // Refused while recording.
+  EXPECT_NE(live.message().find("stop the recording first"), std::string::npos);
+  while (live.last_result()->frame_index != 0) ASSERT_TRUE(feed.step(live));
+  EXPECT_FALSE(live.recording());
+  const CsvTable table = ReadCsvTable(live.last_recording() + ".csv");
+  ASSERT_EQ(table.row_count(), 3u);  // Frames 7, 8, 9.
+  EXPECT_EQ(*table.values[*table.find("frame")][0], 7.0);
+
+  Key(live, 'l');  // Loop off: the clip ends.
+  while (feed.step(live)) {
+  }
+  EXPECT_TRUE(live.ended());
+  Key(live, '0');  // Restart: from frame 0, playing.
+  ASSERT_TRUE(feed.step(live));
+  EXPECT_FALSE(live.paused());
+  ExpectShowing(live, 0);
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 1);
+}
+
+TEST_F(LiveControllerTest, ACameraAnswersTransportKeysWithAMessage) {
+  LiveController live(SceneConfig(), Options());
+  auto source = OpenSyntheticSource(SceneOptions{}, NoiseOptions{});
+  LiveFeed feed(*source);  // No seekable source: played as it comes, like a camera.
+  ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key(','));
+  EXPECT_FALSE(feed.step(live));
+  EXPECT_NE(live.message().find("no stepping or seeking"), std::string::npos);
 }
 
 TEST(LivePointer, ClicksWithinTheSlopDragsBeyondItAndNothingWithoutAPressInTheImage) {

@@ -65,7 +65,7 @@ bool HaveDisplay(std::string* why) {
 }
 
 int RunLiveWindow(LiveController& controller, FrameSource& source,
-                  const LiveWindowOptions& options) {
+                  const LiveWindowOptions& options, SeekableSource* seekable) {
   const std::string& title = options.title;
   // GUI_NORMAL: no toolbar or status bar, so image pixels are canvas pixels.
   cv::namedWindow(title, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
@@ -86,7 +86,7 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
 
   bool end_announced = false;
   int64_t logged_messages = controller.message_count();
-  LiveFeed feed(source);
+  LiveFeed feed(source, seekable);
   while (!controller.quit_requested()) {
     // A paced file waits in read() until its frame is due (at most one frame period); a camera
     // returns its newest frame.
@@ -94,6 +94,7 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
     const bool end_shown = feed.ended();
     cv::imshow(title, controller.canvas());
     const int key = cv::waitKeyEx(got ? 1 : 15);
+    if (!end_shown) end_announced = false;  // Stepped back from the end: announce the next.
     if (end_shown && !end_announced) {
       // The last frame has been shown and the window has processed its events: tell whoever
       // watches stdout (scripts, the test under Xvfb) that the picture is final.
@@ -102,7 +103,10 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
     }
     if (key >= 0) {
       const int code = key & 0xFFFF;
-      if (code < 0x100) controller.on_event(UiEvent::Key(code));
+      if (code < 0x100 || code == kKeyLeft || code == kKeyRight || code == kKeyHome ||
+          code == kKeyEnd) {
+        controller.on_event(UiEvent::Key(code));
+      }
     }
     if (controller.message_count() != logged_messages) {
       // What the window said (recording started, paused, saved ...) also goes to stdout, one

@@ -10,6 +10,12 @@ namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kShift = 4;  // Sub-pixel drawing: coordinates in 1/16 px.
+// A radius of this many arc lengths or more reads "straight". The arc then turns by less than
+// 1/25 rad (2.3 deg) and its sagitta is under 1/200 of its length (s = L^2 / 8R): 0.5 px on a
+// 100 px actuator, only a few times the centroid noise (0.03-0.1 px). The radius's digits would
+// be mostly that noise (a 0.06 px sagitta error is 12 % of R there), growing without bound as
+// the actuator straightens ("84178 px"). The CSV keeps the number; this is what the eye reads.
+constexpr double kStraightRadiusPerArcLength = 25.0;
 
 cv::Point Fixed(const cv::Point2d& p) {
   return {cvRound(p.x * (1 << kShift)), cvRound(p.y * (1 << kShift))};
@@ -47,6 +53,11 @@ void OutlinedText(cv::Mat& image, const std::string& text, cv::Point origin, dou
 }
 
 }  // namespace
+
+bool ReadsStraight(const Measurement& m) {
+  return m.radius_px && m.arc_length_px &&
+         *m.radius_px >= kStraightRadiusPerArcLength * *m.arc_length_px;
+}
 
 bool OverlayOptions::Check(std::string* error) const {
   if (marker_ring_px < 2 || marker_ring_px > 200) {
@@ -118,13 +129,19 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
   if (options.show_measurements) {
     std::vector<std::pair<std::string, cv::Scalar>> lines;
     char buffer[96];
+    // Which frame this is, as the source numbers and times it (also in annotated video).
+    std::snprintf(buffer, sizeof(buffer), "frame %lld  %.3f s",
+                  static_cast<long long>(result.frame_index), result.time_s);
+    lines.emplace_back(buffer, overlay_colour::kText);
     if (m.angle_deg) {
       std::snprintf(buffer, sizeof(buffer), "angle %.1f deg", *m.angle_deg);
       lines.emplace_back(buffer, overlay_colour::kText);
     } else {
       lines.emplace_back("angle --", overlay_colour::kText);
     }
-    lines.emplace_back(Value("radius ", m.radius_mm, m.radius_px), overlay_colour::kText);
+    lines.emplace_back(ReadsStraight(m) ? std::string("radius straight")
+                                        : Value("radius ", m.radius_mm, m.radius_px),
+                       overlay_colour::kText);
     lines.emplace_back(Value("arc length ", m.arc_length_mm, m.arc_length_px),
                        overlay_colour::kText);
     lines.emplace_back(Value("bending dist ", m.tip_disp_mm, m.tip_disp_px), overlay_colour::kText);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "softsight/gui/strip_chart.h"
 
@@ -191,6 +192,35 @@ TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
   restart.time_s = 0.0;
   chart.add(restart);
   EXPECT_EQ(chart.size(), 1u);
+}
+
+TEST(DrawOverlayTest, TheTextNamesTheFrameAndItsTime) {
+  // Two frames with identical measurements: only the frame line differs, in the text block.
+  cv::Mat a(320, 320, CV_8UC3, cv::Scalar(90, 90, 90)), b = a.clone();
+  FrameResult result = ThreeMarkers(true);
+  DrawOverlay(a, result, Triple());
+  result.frame_index = 8;
+  result.time_s = 8 / 30.0;
+  DrawOverlay(b, result, Triple());
+  cv::Mat differs;
+  cv::absdiff(a, b, differs);
+  cv::cvtColor(differs, differs, cv::COLOR_BGR2GRAY);
+  const cv::Rect where = cv::boundingRect(differs > 0);
+  ASSERT_FALSE(where.empty());
+  EXPECT_LT(where.y + where.height, 40);  // The first line of the text block.
+}
+
+TEST(DrawOverlayTest, ARadiusOfManyArcLengthsReadsStraight) {
+  Measurement m;
+  m.arc_length_px = 200.0;
+  m.radius_px = 84178.0;  // What a nearly straight actuator gave.
+  EXPECT_TRUE(ReadsStraight(m));
+  m.radius_px = 25.0 * 200.0;
+  EXPECT_TRUE(ReadsStraight(m));
+  m.radius_px = 24.0 * 200.0;  // Bent by 2.4 deg: a radius worth showing.
+  EXPECT_FALSE(ReadsStraight(m));
+  m.radius_px.reset();
+  EXPECT_FALSE(ReadsStraight(m));
 }
 
 }  // namespace

@@ -191,6 +191,15 @@ void TrackingSession::respec(const MarkerSpec& spec) {
 
 void TrackingSession::reset_tip_reference() { measurer_.reset_tip_reference(); }
 
+void TrackingSession::jump() {
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    if (initialised_[i]) trackers_[i]->reset();
+    plausibility_->forget(i);
+    previous_px_[i].reset();
+  }
+  frame_change_ = std::make_unique<FrameChangeDetector>();
+}
+
 void TrackingSession::set_metric(const MetricModel& metric) {
   measurer_.set_metric(metric);  // Checks first: throws before anything changes.
   config_.measure.metric = metric;

@@ -51,19 +51,43 @@ struct LiveKey {
   int key;
   const char* what;
 };
-// The keys, as the on-screen help (`h`) lists them.
-inline constexpr std::array<LiveKey, 10> kLiveKeys = {{
-    {'h', "show / hide this help"},
-    {' ', "pause / resume"},
-    {'r', "start / stop recording (CSV, annotated + raw video, config)"},
+// Keys beyond ASCII, as the window adapter passes them (X keysyms of the arrow, Home and End
+// keys); each has an ASCII twin in kLiveKeys for keyboards and scripts without them.
+inline constexpr int kKeyLeft = 0xFF51, kKeyRight = 0xFF53, kKeyHome = 0xFF50, kKeyEnd = 0xFF57;
+// The keys, as the on-screen help (`h`) lists them (key 0: a line about the mouse).
+inline constexpr std::array<LiveKey, 17> kLiveKeys = {{
+    {'h', "help on / off"},
+    {' ', "pause / resume (at the end: play from the start)"},
+    {'.', "step 1 frame forward (pauses)"},
+    {',', "step 1 frame back (pauses)"},
+    {']', "+1 s (also Right)"},
+    {'[', "-1 s (also Left)"},
+    {'<', "first frame (also Home)"},
+    {'>', "last frame (also End)"},
+    {'l', "loop on / off"},
+    {'0', "restart: first frame, trackers afresh, playing"},
+    {'r', "record on / off (CSV, videos, config)"},
     {'s', "save the config"},
     {'b', "reset the bending-distance reference"},
     {'m', "switch method (colour, sad, ssd, zncc)"},
-    {'c', "mm scale: click two points --scale-distance-mm apart (Esc cancels)"},
-    {'1', "1..9: choose the active marker (trackbars, clicks)"},
-    {'q', "quit (also Esc)"},
-    {0, "mouse: drag a box over a marker to reselect it, click it to pick its colour"},
+    {'c', "mm scale: click 2 points (Esc cancels)"},
+    {'1', "1..9 active marker;  q / Esc quit"},
+    {0, "drag a box: reselect; click: pick colour"},
 }};
+
+// What a transport key asks of the source; LiveFeed carries it out (a camera cannot).
+struct PlaybackRequest {
+  enum class Kind { kStepForward, kStepBack, kSeekSeconds, kStart, kEnd };
+  Kind kind = Kind::kStepForward;
+  double seconds = 0.0;  // kSeekSeconds: how far, negative backwards.
+};
+
+// How a frame handed to the controller relates to the one before it.
+enum class FrameOrder {
+  kNext,  // The source's next frame, as it plays (ignored while paused).
+  kStep,  // The next frame, stepped to with `.`: shown also while paused.
+  kJump,  // Not the next frame (seek, step back, loop, restart): trackers search afresh.
+};
 
 struct LiveOptions {
   // Where `s` writes the config. Default: empty, which makes the command choose
@@ -96,17 +120,26 @@ class LiveController {
   LiveController(const TrackingConfig& config, LiveOptions options);
   ~LiveController();
 
-  // A new frame (ignored while paused). Tracks, measures, records, redraws.
-  void on_frame(const Frame& frame, SteadyClock::time_point captured);
+  // A new frame (kNext: ignored while paused). Tracks, measures, records, redraws. A jump stops
+  // a running recording first (a recording holds consecutive frames) and clears the strip chart.
+  void on_frame(const Frame& frame, SteadyClock::time_point captured,
+                FrameOrder order = FrameOrder::kNext);
   void on_event(const UiEvent& event);
-  // The source has ended: the last frame stays on screen until the user quits.
+  // The source has ended: the last frame stays on screen, and every key still works.
   void on_end_of_input();
+  // The transport request of the last key, taken by the feed (once).
+  std::optional<PlaybackRequest> take_playback_request();
+  // A message from outside (the feed: "a camera cannot seek"), shown like the controller's own.
+  void report(const std::string& message) { say(message); }
 
   // The image to show: the annotated frame with the UI on top, the strip chart under it.
   const cv::Mat& canvas();
 
   bool quit_requested() const { return quit_; }
   bool paused() const { return paused_; }
+  bool ended() const { return ended_; }
+  // Loop (`l`): at the end, play on from the first frame.
+  bool loop() const { return loop_; }
   bool recording() const { return recording_ != nullptr; }
   bool help_shown() const { return help_; }
   // Scale mode (`c`): the next left clicks are the two scale points.
@@ -149,6 +182,9 @@ class LiveController {
   std::string scale_hint() const;
   void draw_scale_points(cv::Mat& top) const;
   void select_marker(int index);
+  // A transport key: refused while recording (except a step forward), else queued for the feed.
+  void request_playback(PlaybackRequest::Kind kind, double seconds = 0.0);
+  void restart();
   std::optional<int> marker_at(const cv::Point2d& p, double max_distance) const;
   std::optional<cv::Point2d> position_of(int marker) const;
   cv::Rect box_around(const cv::Point2d& p) const;
@@ -177,7 +213,8 @@ class LiveController {
   std::vector<SteadyClock::time_point> frame_times_;  // Ring of recent result times, for fps.
   size_t frame_times_next_ = 0;
 
-  bool paused_ = false, help_ = false, quit_ = false, ended_ = false;
+  bool paused_ = false, help_ = false, quit_ = false, ended_ = false, loop_ = false;
+  std::optional<PlaybackRequest> playback_request_;
   int active_ = 0;
   int hsv_revision_ = 0;
   std::unique_ptr<LivePointer> pointer_;

@@ -10,6 +10,8 @@
 
 namespace softsight {
 
+class SeekableSource;  // gui/seekable_source.h: a file the transport keys can seek in.
+
 // True when a window can be opened (an X display answers, or a Wayland socket is named);
 // otherwise false with `why` saying what is missing.
 bool HaveDisplay(std::string* why);
@@ -24,8 +26,10 @@ struct LiveWindowOptions {
 // with the window), a NewestFrameSource for a camera (stale frames dropped and counted). On
 // stdout: each message the window shows, as "live: <message>" (after the key or click that caused
 // it has been handled), and "end of input" once the last frame of a file source is on screen.
+// `seekable`: the source under `source`'s pacing when it is a file, image sequence or rendered
+// scene (the transport keys step and seek in it); null for a camera.
 // Returns the exit code (0).
 int RunLiveWindow(LiveController& controller, FrameSource& source,
-                  const LiveWindowOptions& options = {});
+                  const LiveWindowOptions& options = {}, SeekableSource* seekable = nullptr);
 
 }  // namespace softsight

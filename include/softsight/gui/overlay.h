@@ -48,6 +48,10 @@ struct OverlayStatus {
   std::vector<std::string> notes;    // Extra lines (e.g. "REC live-001", "PAUSED").
 };
 
+// True when the radius is too large against the arc length to be told from a straight
+// actuator's (radius >= 25 arc lengths: see overlay.cc); the overlay then reads "straight".
+bool ReadsStraight(const Measurement& m);
+
 // Draws the overlay for `result` onto `frame_bgr` (CV_8UC3) in place.
 void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOptions& options,
                  const OverlayStatus& status = {});

@@ -48,6 +48,11 @@ class TrackingSession {
   // Replace a marker's spec (new HSV ranges or method) and rebuild its tracker.
   void respec(const MarkerSpec& spec);
   void reset_tip_reference();
+  // The next frame does not follow the last one (the live window seeked, stepped back or looped):
+  // every tracker searches afresh and the motion and whole-frame-change checks start over, so a
+  // jump is neither believed as motion nor taken for a foreign frame. The learned arrangement of
+  // the body and the bending-distance reference stay.
+  void jump();
   // Live calibration: a new metric model (e.g. a scale from two clicked points) for the next
   // measurements and in config(). The bending-distance reference is kept (it is an image point,
   // whatever the model), so tip_disp_px continues and tip_disp_mm is that distance in the new
