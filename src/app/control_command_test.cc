@@ -277,10 +277,10 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   WriteTextFile(dir.file("rig.yaml"), kMarkers);
   std::string port;
   const std::string frames = dir.file("rig.png");
-  // The cable is pulled 1.5 s after control's first command, however long control took to
-  // start; --duration-s only bounds the rig if the test fails.
+  // The cable is pulled after the rig's 40th answer: the handshake and a dozen or more frames'
+  // exchanges, however loaded the machine; --duration-s only bounds the rig if the test fails.
   int rig_stderr = -1;
-  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-s 1.5 "
+  const pid_t rig = StartRig("--frames " + frames + " --fps 20 --disconnect-after-replies 40 "
                              "--duration-s 30",
                              "", &port, &rig_stderr);
   ASSERT_GT(rig, 0);

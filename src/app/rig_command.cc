@@ -53,6 +53,10 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
     throw InputError("--disconnect-after-s " + std::to_string(*options.disconnect_after_s) +
                      ": must be a number in [0, 1e6]");
   }
+  if (options.disconnect_after_replies && *options.disconnect_after_replies < 1) {
+    throw InputError("--disconnect-after-replies " +
+                     std::to_string(*options.disconnect_after_replies) + ": must be at least 1");
+  }
   const ControlConfig config =
       options.config_file ? LoadControlConfig(*options.config_file) : ControlConfig{};
   SimulatedRig rig(config.rig);
@@ -98,9 +102,14 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
       last_limit = limit;
       // The cable is pulled that long after the host's first command, however late it started.
       if (!first_contact && server.contacted()) first_contact = std::chrono::steady_clock::now();
-      if (options.disconnect_after_s && server.connected() && first_contact &&
+      const bool pull_by_time =
+          options.disconnect_after_s && first_contact &&
           std::chrono::steady_clock::now() - *first_contact >=
-              std::chrono::duration<double>(*options.disconnect_after_s)) {
+              std::chrono::duration<double>(*options.disconnect_after_s);
+      const bool pull_by_count =
+          options.disconnect_after_replies &&
+          server.replies() >= static_cast<uint64_t>(*options.disconnect_after_replies);
+      if (server.connected() && (pull_by_time || pull_by_count)) {
         server.disconnect();
         if (!options.quiet) {
           std::fprintf(stderr, "rig: t=%.3f s: port closed (cable pulled), rig keeps running\n",
@@ -152,6 +161,9 @@ CommandRunner SetupRigCommand(CLI::App& sub) {
   sub.add_option("--disconnect-after-s", o->disconnect_after_s,
                  "Close the port this many seconds after the host's first command (a pulled "
                  "cable) and keep running, to watch the watchdog vent");
+  sub.add_option("--disconnect-after-replies", o->disconnect_after_replies,
+                 "Close the port once this many answer lines have been sent, and keep running "
+                 "(the same pulled cable, at a point that does not depend on timing)");
   sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
   return [o] {
     RunRig(*o);

@@ -16,6 +16,8 @@ struct RigCommandOptions {
   std::optional<double> duration_s;          // Default: until Ctrl-C / SIGTERM.
   // Close the port this long after the host's first command (a pulled cable), keep running.
   std::optional<double> disconnect_after_s;
+  // Or once this many answer lines have been sent (reproducible whatever the machine's load).
+  std::optional<int64_t> disconnect_after_replies;
   bool quiet = false;                        // No state-change lines on stderr.
 };
 

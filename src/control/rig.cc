@@ -197,7 +197,11 @@ void RigServer::serve() {
       std::string line = replies.substr(start, end == std::string::npos ? end : end - start + 1);
       start = end == std::string::npos ? replies.size() : end + 1;
       if (filter_) line = filter_(line);
-      if (!enqueue_locked(line)) ++dropped_replies_;
+      if (!enqueue_locked(line)) {
+        ++dropped_replies_;
+      } else if (!line.empty()) {
+        ++replies_;
+      }
     }
     flush_locked();
   }

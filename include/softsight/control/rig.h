@@ -115,6 +115,8 @@ class RigServer {
   bool contacted() const { return contacted_; }
   // Answers dropped because the host did not read them and the queue was full.
   uint64_t dropped_replies() const { return dropped_replies_; }
+  // Answer lines queued for the host so far (a count tests and `rig` can wait on, unlike time).
+  uint64_t replies() const { return replies_; }
 
  private:
   void serve();
@@ -131,6 +133,7 @@ class RigServer {
   std::function<std::string(const std::string&)> filter_;
   std::string pending_;  // Bytes for the host not yet taken by the pty (write_mutex_).
   std::atomic<uint64_t> dropped_replies_{0};
+  std::atomic<uint64_t> replies_{0};
   std::atomic<bool> port_closed_{false};
   std::atomic<bool> contacted_{false};
   std::atomic<bool> shutdown_{false};
