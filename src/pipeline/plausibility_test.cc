@@ -8,6 +8,7 @@
 
 #include "pipeline/frame_change.h"
 #include "pipeline/marker_plausibility.h"
+#include "pipeline/scene_config_test_util.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/corruption.h"
 #include "softsight/sim/scene.h"
@@ -15,24 +16,7 @@
 namespace softsight {
 namespace {
 
-MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
-  MarkerSpec spec;
-  spec.name = name;
-  spec.colour.h = hue;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
-  return spec;
-}
-
-TrackingConfig ThreeMarkers() {
-  TrackingConfig config;
-  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
-                    ColourMarker("green", {45, 85})};
-  config.measure.base = "red";
-  config.measure.middle = "blue";
-  config.measure.tip = "green";
-  return config;
-}
+using testing::ThreeMarkerSceneConfig;
 
 // Frames a tracker reported found more than 3 px from the truth, and frames with a marker not
 // found while fully visible in an intact frame.
@@ -96,7 +80,7 @@ TEST(Plausibility, CorruptedFramesNeverYieldAPositionMoreThan3PxOff) {
       {60, CorruptionKind::kShiftedBand, -1},  {61, CorruptionKind::kShiftedBand, -1},
       {68, CorruptionKind::kGarbageBlock, 0},
   };
-  TrackingSession session(ThreeMarkers());
+  TrackingSession session(ThreeMarkerSceneConfig());
   Tally tally;
   int statuses_named = 0, corrupt_marker_frames = 0;
   cv::Mat image;
@@ -135,7 +119,7 @@ TEST(Plausibility, CorruptedFramesNeverYieldAPositionMoreThan3PxOff) {
 TEST(Plausibility, AWholeFrameChangeIsNotBelievedAndAChangeThatStaysBecomesNormal) {
   SyntheticScene scene = Scene(300);
   cv::Mat image;
-  TrackingSession session(ThreeMarkers());
+  TrackingSession session(ThreeMarkerSceneConfig());
   for (int i = 0; i < 5; ++i) {
     scene.render(i, image);
     session.process(Frame{image, i, i / 30.0});
@@ -170,7 +154,7 @@ TEST(Plausibility, AJumpOntoALookAlikeIsImplausibleAndTheMarkerIsFoundAgainAfter
   options.frame_count = 300;
   options.max_bend_deg = 240;
   SyntheticScene scene(options);
-  TrackingSession session(ThreeMarkers());
+  TrackingSession session(ThreeMarkerSceneConfig());
   cv::Mat image;
   int implausible = 0, wrong = 0;
   for (int i = 0; i < 30; ++i) {
@@ -205,7 +189,7 @@ TEST(Plausibility, AJumpOntoALookAlikeIsImplausibleAndTheMarkerIsFoundAgainAfter
 TEST(Plausibility, FastLegitimateMotionIsFoundInEveryFrame) {
   // The whole 240-degree sweep in 24 frames: the tip moves up to ~35 px per frame and turns.
   SyntheticScene scene = Scene(24, 240);
-  TrackingSession session(ThreeMarkers());
+  TrackingSession session(ThreeMarkerSceneConfig());
   cv::Mat image;
   double worst_step = 0.0;
   std::optional<cv::Point2d> last_tip;
@@ -245,7 +229,7 @@ TEST(Plausibility, OcclusionThenReacquisitionWhereTheMarkerHasMovedTo) {
     cover = r;
   }
   SyntheticScene scene(options, {}, {}, {Occluder{cover, first, last}});
-  TrackingSession session(ThreeMarkers());
+  TrackingSession session(ThreeMarkerSceneConfig());
   const double moved = cv::norm(*truth[last + 1].markers[2].centroid_px -
                                 *truth[first - 1].markers[2].centroid_px);
   EXPECT_GT(moved, 40.0) << "the marker must re-appear far from where it was lost";

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
+#include "pipeline/scene_config_test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/pipeline/sinks.h"
@@ -14,27 +15,10 @@
 namespace softsight {
 namespace {
 
+using testing::ThreeMarkerSceneConfig;
+
 using ::testing::HasSubstr;
 using testing::TempDir;
-
-MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
-  MarkerSpec spec;
-  spec.name = name;
-  spec.colour.h = hue;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
-  return spec;
-}
-
-TrackingConfig SceneConfig() {
-  TrackingConfig config;
-  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
-                    ColourMarker("green", {45, 85})};
-  config.measure.base = "red";
-  config.measure.middle = "blue";
-  config.measure.tip = "green";
-  return config;
-}
 
 SceneOptions SmallScene(int frames) {
   SceneOptions scene;
@@ -94,7 +78,7 @@ TEST(RunPipeline, VideoFileNeverDropsAFrameAndEveryRowCarriesTheSourceIndex) {
   FrameSourceSpec spec;
   spec.input = dir.file("clip.avi");
   std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   const RunSummary summary = RunPipeline(*source, session, {&sink});
 
@@ -138,7 +122,7 @@ TEST(RunPipeline, ImageSequenceKeepsItsFileIndicesAndRate) {
   spec.input = dir.file("f%03d.png");
   spec.sequence_fps = 10.0;
   std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   const RunSummary summary = RunPipeline(*source, session, {&sink});
   EXPECT_EQ(summary.frames, 5);
@@ -198,7 +182,7 @@ TEST(RunPipeline, FoundCountsMatchTheRenderersTruth) {
     size_t next_ = 0;
   } source(frames);
 
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   const RunSummary summary = RunPipeline(source, session, {&sink});
   ASSERT_EQ(summary.frames, 14);
@@ -223,7 +207,7 @@ TEST(RunPipeline, FoundCountsMatchTheRenderersTruth) {
 
 TEST(RunPipeline, StopRequestEndsCleanlyWithASummary) {
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   RunOptions options;
   options.stop_requested = [&sink] { return sink.indices.size() >= 3; };
@@ -239,7 +223,7 @@ TEST(RunPipeline, StopRequestEndsCleanlyWithASummary) {
 
 TEST(RunPipeline, MaxFramesAndTheKnownCountReachTheSinks) {
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   RunOptions options;
   options.max_frames = 4;
@@ -251,7 +235,7 @@ TEST(RunPipeline, MaxFramesAndTheKnownCountReachTheSinks) {
 
 TEST(RunPipeline, AnErrorInASinkEndsTheRunWithItsMessage) {
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink first, failing;
   failing.fail_at = 3;
   const RunSummary summary = RunPipeline(*source, session, {&first, &failing});
@@ -265,7 +249,7 @@ TEST(RunPipeline, AnErrorInASinkEndsTheRunWithItsMessage) {
 
 TEST(RunPipeline, ARunOfNoFramesStillBeginsAndEndsEverySink) {
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(5), NoiseOptions{});
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   RunOptions options;
   options.max_frames = 0;
@@ -292,7 +276,7 @@ TEST(RunPipeline, GrayFramesForColourTrackingAreAnErrorNamingTheSource) {
    private:
     int64_t index_ = 0;
   } source;
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   RecordingSink sink;
   const RunSummary summary = RunPipeline(source, session, {&sink});
   EXPECT_EQ(summary.stop_reason, StopReason::kError);
@@ -304,7 +288,7 @@ TEST(RunPipeline, GrayFramesForColourTrackingAreAnErrorNamingTheSource) {
 TEST(CsvSink, WritesOneCompleteRowPerFrameWithTheSourceIndex) {
   TempDir dir;
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(6), NoiseOptions{});
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   CsvSink csv(dir.file("run.csv"), TrackingColumns({"red", "blue", "green"}, false));
   const RunSummary summary = RunPipeline(*source, session, {&csv});
   ASSERT_EQ(summary.frames, 6);

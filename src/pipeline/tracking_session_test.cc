@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/test_util.h"
+#include "pipeline/scene_config_test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/scene.h"
@@ -13,24 +14,8 @@
 namespace softsight {
 namespace {
 
-MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
-  MarkerSpec spec;
-  spec.name = name;
-  spec.colour.h = hue;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
-  return spec;
-}
-
-TrackingConfig SceneConfig() {
-  TrackingConfig config;
-  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
-                    ColourMarker("green", {45, 85})};
-  config.measure.base = "red";
-  config.measure.middle = "blue";
-  config.measure.tip = "green";
-  return config;
-}
+using testing::ColourMarker;
+using testing::ThreeMarkerSceneConfig;
 
 struct Clip {
   std::vector<Frame> frames;
@@ -58,7 +43,7 @@ Clip Render(int count, SceneOptions options = {}, int stretch = 10) {
 
 TEST(TrackingSession, TracksEveryMarkerAndMeasuresLikeTheTruth) {
   const Clip clip = Render(6);
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   for (size_t i = 0; i < clip.frames.size(); ++i) {
     const FrameResult& result = session.process(clip.frames[i]);
     EXPECT_EQ(result.frame_index, static_cast<int64_t>(i));
@@ -79,7 +64,7 @@ TEST(TrackingSession, TracksEveryMarkerAndMeasuresLikeTheTruth) {
 
 TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
   const Clip clip = Render(5);
-  TrackingConfig config = SceneConfig();
+  TrackingConfig config = ThreeMarkerSceneConfig();
   const cv::Point2d blue = *clip.truth[2].markers[1].centroid_px;
   config.markers[1].method = "zncc";
   config.markers[1].templ.template_frame = 2;
@@ -95,7 +80,7 @@ TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
 
 TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
   const Clip clip = Render(1);
-  TrackingSession session(SceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   session.process(clip.frames[0]);
   session.reselect("blue", clip.frames[0], cv::Rect(10, 20, 30, 40));
   EXPECT_EQ(session.config().markers[1].colour.roi, cv::Rect(10, 20, 30, 40));
@@ -105,13 +90,13 @@ TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
 
 TEST(TrackingSession, CameraModelMeasuresUndistortedPositionsButReportsRecordedOnes) {
   const Clip clip = Render(1);
-  TrackingConfig config = SceneConfig();
+  TrackingConfig config = ThreeMarkerSceneConfig();
   CameraIntrinsics camera;
   camera.image_size = clip.frames[0].image.size();
   camera.camera_matrix = cv::Matx33d(500, 0, 320, 0, 500, 240, 0, 0, 1);
   camera.distortion = {-0.3, 0.1, 0, 0, 0};
   config.camera = camera;
-  TrackingSession plain(SceneConfig());
+  TrackingSession plain(ThreeMarkerSceneConfig());
   TrackingSession corrected(config);
   const FrameResult raw = plain.process(clip.frames[0]);
   const FrameResult& result = corrected.process(clip.frames[0]);
@@ -137,8 +122,8 @@ TEST(TrackingSession, CameraModelMeasuresUndistortedPositionsButReportsRecordedO
 
 TEST(TrackingSession, SetMetricAppliesToTheNextFrameAndKeepsTheBendingReference) {
   const Clip clip = Render(4);
-  TrackingSession plain(SceneConfig());
-  TrackingSession session(SceneConfig());
+  TrackingSession plain(ThreeMarkerSceneConfig());
+  TrackingSession session(ThreeMarkerSceneConfig());
   for (int i = 0; i < 2; ++i) {
     plain.process(clip.frames[i]);
     EXPECT_FALSE(session.process(clip.frames[i]).measurement.chord_mm.has_value());
@@ -172,7 +157,7 @@ TEST(TrackingSession, SetMetricAppliesToTheNextFrameAndKeepsTheBendingReference)
 }
 
 TEST(TrackingSession, MeasurementPointIsTheUndistortedPointWithACameraModel) {
-  TrackingConfig config = SceneConfig();
+  TrackingConfig config = ThreeMarkerSceneConfig();
   EXPECT_EQ(TrackingSession(config).measurement_point({12.5, 300.25}), cv::Point2d(12.5, 300.25));
   CameraIntrinsics camera;
   camera.image_size = {640, 480};

@@ -1,0 +1,33 @@
+// The marker config a person would write for the renderer's default bending scene (red, blue and
+// green markers, base to tip), shared by the pipeline's tests (test code only).
+#pragma once
+
+#include <string>
+
+#include "softsight/config/config.h"
+
+namespace softsight::testing {
+
+// A colour marker: `hue` (OpenCV 0..179, wrapping when lo > hi), any strong saturation (>= 80)
+// and brightness (>= 40).
+inline MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
+  MarkerSpec spec;
+  spec.name = name;
+  spec.colour.h = hue;
+  spec.colour.s = {80, 255};
+  spec.colour.v = {40, 255};
+  return spec;
+}
+
+// Red, blue and green, measured as the paper's base, middle and tip.
+inline TrackingConfig ThreeMarkerSceneConfig() {
+  TrackingConfig config;
+  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {100, 130}),
+                    ColourMarker("green", {45, 85})};
+  config.measure.base = "red";
+  config.measure.middle = "blue";
+  config.measure.tip = "green";
+  return config;
+}
+
+}  // namespace softsight::testing
