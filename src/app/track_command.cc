@@ -12,6 +12,7 @@
 #include "softsight/core/error.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/io/frame_grabber.h"
+#include "softsight/io/read_ahead_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -63,8 +64,13 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
   CheckOutputs(options, config, *source);
   // A camera is read in its own thread, newest frame wins (drops are counted in the summary);
-  // a file or image sequence is read frame by frame and never drops one.
-  if (source->is_live()) source = std::make_unique<NewestFrameSource>(std::move(source));
+  // a file, image sequence or rendered scene is decoded on its own thread a few frames ahead,
+  // so decoding overlaps tracking, and never drops one.
+  if (source->is_live()) {
+    source = std::make_unique<NewestFrameSource>(std::move(source));
+  } else {
+    source = std::make_unique<ReadAheadSource>(std::move(source));
+  }
   TrackingSession session(config);
 
   // Sinks in the order they see each frame; every output is opened (and checked) before the run.
