@@ -23,15 +23,19 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _csv_names(paths: Sequence[str], out_dir: Path) -> List[str]:
-    """One CSV per input, named after it; inputs with the same name get -1, -2, ... suffixes."""
-    taken: Dict[str, int] = {}
+    """One CSV per input, named after it; a name already taken gets -1, -2, ... (as the CLI's
+    ``softsight track -i A -i B -o FOLDER/`` names them: app/track_many.h)."""
+    taken: set = set()
     names = []
     for path in paths:
         stem = Path(path).stem if not path.startswith("synth:") else path.replace(":", "_")
         stem = stem.replace("%", "") or "input"
-        n = taken.get(stem, 0)
-        taken[stem] = n + 1
-        names.append(str(out_dir / (f"{stem}.csv" if n == 0 else f"{stem}-{n}.csv")))
+        name, n = f"{stem}.csv", 0
+        while name in taken:
+            n += 1
+            name = f"{stem}-{n}.csv"
+        taken.add(name)
+        names.append(str(out_dir / name))
     return names
 
 

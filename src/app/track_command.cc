@@ -1,6 +1,8 @@
 #include "app/track_command.h"
 
+#include <filesystem>
 #include <iostream>
+#include <thread>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -9,6 +11,7 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/stop_request.h"
+#include "app/track_many.h"
 #include "softsight/core/error.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/io/frame_grabber.h"
@@ -45,14 +48,19 @@ void CheckOutputs(const TrackOptions& options, const TrackingConfig& config,
   CheckOutputsAreNotInputs(outputs, inputs);
 }
 
+// `-o` names a folder: an existing one, or a path ending in '/'.
+bool IsOutputFolder(const std::string& path) {
+  return !path.empty() && (path.back() == '/' || std::filesystem::is_directory(path));
+}
+
+int DefaultJobs() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return cores == 0 ? 1 : static_cast<int>(cores);
+}
+
 }  // namespace
 
-RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
-                    const std::vector<FrameSink*>& more_sinks) {
-  RunSummary local;
-  RunSummary& summary = summary_out != nullptr ? *summary_out : local;
-  summary = RunSummary{};
-
+TrackingConfig LoadTrackConfig(const TrackOptions& options) {
   TrackingConfig config = LoadTrackingConfig(options.config_file, options.method);
   if (options.template_colour) {
     for (MarkerSpec& spec : config.markers) spec.templ.colour = *options.template_colour;
@@ -61,6 +69,16 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   if (options.max_frames && *options.max_frames < 0) {
     throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
   }
+  return config;
+}
+
+RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
+                    const std::vector<FrameSink*>& more_sinks) {
+  RunSummary local;
+  RunSummary& summary = summary_out != nullptr ? *summary_out : local;
+  summary = RunSummary{};
+
+  const TrackingConfig config = LoadTrackConfig(options);
   std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
   CheckOutputs(options, config, *source);
   // A camera is read in its own thread, newest frame wins (drops are counted in the summary);
@@ -92,7 +110,7 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
     sinks.push_back(&*recording);
   }
   sinks.insert(sinks.end(), more_sinks.begin(), more_sinks.end());
-  ProgressSink progress("track", !options.quiet);
+  ProgressSink progress("track", !options.quiet && !options.brief);
   sinks.push_back(&progress);
 
   const StopRequest stop;  // Ctrl-C ends a camera run (or a long file) with its summary.
@@ -109,24 +127,35 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
 
 CommandRunner SetupTrackCommand(CLI::App& sub) {
   auto options = std::make_shared<TrackOptions>();
+  // Several inputs (or an output folder) run as a batch: one CSV per input (track_many.h).
+  auto inputs = std::make_shared<std::vector<std::string>>();
+  auto jobs = std::make_shared<int>(DefaultJobs());
   sub.description(
       "Track the markers of a config in a video (or image sequence) and write one CSV row per\n"
       "frame: every marker's centroid, the bending angle, chord, sagitta, radius of curvature,\n"
       "arc length and bending distance (in mm too when the config gives a scale).\n"
       "Examples:\n"
       "  softsight track --config examples/markers.yaml --input run.avi --csv run.csv\n"
-      "  softsight track --config markers.yaml --camera 0 --csv bench.csv   (Ctrl-C stops)");
+      "  softsight track --config markers.yaml --camera 0 --csv bench.csv   (Ctrl-C stops)\n"
+      "  softsight track -c markers.yaml -i a.avi -i b.avi -i c.avi -o results/ --jobs 2");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
-  CLI::Option* input = sub.add_option("-i,--input", options->source.input,
+  CLI::Option* input = sub.add_option("-i,--input", *inputs,
                  "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
-                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, synth:plate")
-      ;
+                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
+                 "synth:plate. Repeat it for several inputs (with -o FOLDER/)");
   sub.add_option("--camera", options->source.camera,
                  "Camera index (V4L2) instead of --input: tracks until Ctrl-C or --max-frames")
       ->excludes(input);
-  sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
+  sub.add_option("-o,--csv", options->csv_file,
+                 "Where to write the per-frame CSV; a folder (an existing one, or a path ending "
+                 "in /) gets one CSV per input, named after it (run.avi -> FOLDER/run.csv)")
+      ->required();
+  sub.add_option("-j,--jobs", *jobs,
+                 "With several inputs: how many are tracked at the same time (default: the "
+                 "number of cores)")
+      ->check(CLI::Range(1, 1024));
   sub.add_option("-m,--method", options->method,
                  "Use this method for every marker: colour, sad, ssd or zncc");
   CLI::Option* gray = sub.add_flag_function(
@@ -149,16 +178,38 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_option("--max-frames", options->max_frames, "Stop after this many frames")
       ->check(NumberIn(0, 1e15));
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
-  return [options] {
+  sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
+  return [options, inputs, jobs] {
+    const bool to_folder = IsOutputFolder(options->csv_file);
+    if (inputs->size() > 1 || to_folder) {
+      if (!to_folder) {
+        throw InputError("-o " + options->csv_file + ": with several inputs, give an output "
+                         "folder (one CSV per input), e.g. -o results/");
+      }
+      TrackManyOptions many;
+      many.common = *options;
+      many.inputs = *inputs;
+      many.out_dir = options->csv_file;
+      many.jobs = *jobs;
+      return RunTrackMany(many, std::cerr);
+    }
+    if (!inputs->empty()) options->source.input = inputs->front();
     RunSummary summary;
     try {
       RunTrack(*options, &summary);
     } catch (const InputError&) {
       // The error itself is reported once, by main().
-      if (!options->quiet && summary.frames > 0) std::cerr << summary.FullReport();
+      if (options->brief && summary.frames > 0) std::cerr << summary.BriefReport() << "\n";
+      if (!options->quiet && !options->brief && summary.frames > 0) {
+        std::cerr << summary.FullReport();
+      }
       throw;
     }
-    if (!options->quiet) std::cerr << summary.FullReport() << "CSV: " << options->csv_file << "\n";
+    if (options->brief) {
+      std::cerr << summary.BriefReport() << "\n";
+    } else if (!options->quiet) {
+      std::cerr << summary.FullReport() << "CSV: " << options->csv_file << "\n";
+    }
     // A run a signal stopped has printed its summary; its exit code says it was interrupted.
     return ExitCodeAfterStop(0);
   };

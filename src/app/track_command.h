@@ -28,7 +28,12 @@ struct TrackOptions {
   std::optional<std::string> record_file;
   std::optional<int64_t> max_frames;
   bool quiet = false;                        // No progress bar, no summary.
+  bool brief = false;                        // No progress bar, a one-line summary.
 };
+
+// The run's config, checked as RunTrack checks it (also what every input of a multi-input run
+// shares). Throws InputError naming the file and key.
+TrackingConfig LoadTrackConfig(const TrackOptions& options);
 
 // Runs the whole job through RunPipeline. Throws InputError for bad input, before the run
 // (config, source, outputs) or from it (a corrupt frame, a full disk; every CSV row written
