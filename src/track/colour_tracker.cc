@@ -73,6 +73,13 @@ constexpr double kAdaptMinRange = 0.5;
 constexpr double kAdaptMaxRange = 4.0;
 
 // ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
+// A marker lost this many frames in a row, with exactly one candidate near where it was last
+// seen that fits it in everything but brightness (same chroma, size, shape, contrast), is taken
+// to be under a new light and its colour relearned. Half a second at 30 fps: a passing shadow or a
+// hand does not relearn anything.
+constexpr int kRelearnAfterFrames = 15;
+// How near, in learned radii (plus one per frame lost): it may have moved while it was lost.
+constexpr double kRelearnRadii = 6.0;
 constexpr int kAutoHueTolerance = 12;        // hue units (2 degrees each)
 constexpr int kAutoGraySaturation = 40;      // below: the nominal colour is a gray level
 
@@ -421,6 +428,11 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
         choice.status = MarkerStatus::kCovered;
       }
     }
+    if (!choice.blob && choice.status != MarkerStatus::kAmbiguous && last_seen_px_ &&
+        lost_frames_ + 1 >= kRelearnAfterFrames) {
+      const Choice relearned = relearn(*last_seen_px_);
+      if (relearned.blob || relearned.status == MarkerStatus::kAmbiguous) choice = relearned;
+    }
   }
   return report(choice);
 }
@@ -446,10 +458,13 @@ Observation ColourTracker::report(const Choice& choice) {
   if (!choice.blob) {
     tracking_ = false;
     velocity_px_ = cv::Point2d(0, 0);
+    ++lost_frames_;
     return Observation::NotFound(choice.status, choice.tied);
   }
   const ColourBlob& blob = *choice.blob;
   learn(blob, tracking_);
+  lost_frames_ = 0;
+  last_seen_px_ = blob.centroid_px;
   velocity_px_ = tracking_ ? blob.centroid_px - *last_px_ : cv::Point2d(0, 0);
   last_px_ = blob.centroid_px;
   tracking_ = true;
@@ -473,7 +488,8 @@ MarkerCandidate ColourTracker::candidate(const ColourBlob& b, CandidateVerdict v
   return c;
 }
 
-std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b) const {
+std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
+                                                         bool any_brightness) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   if (b.clipped) return {CandidateVerdict::kClipped, kInf};
   if (b.area_px < params_.min_area_px || (params_.max_area_px > 0 && b.area_px > params_.max_area_px)) {
@@ -519,7 +535,9 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b) co
     const double bright = Norm(b.core_colour, channels);
     double colour = 0;
     if (ref_bright > 1 && bright > 1) {
-      colour = std::abs(std::log(bright / ref_bright)) / std::log(kBrightnessTolerance);
+      if (!any_brightness) {
+        colour = std::abs(std::log(bright / ref_bright)) / std::log(kBrightnessTolerance);
+      }
       if (channels == 3) {
         const double cosine = std::clamp(b.core_colour.dot(*reference) / (bright * ref_bright),
                                          -1.0, 1.0);
@@ -656,6 +674,41 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   candidates_[best].verdict = CandidateVerdict::kChosen;
   choice.blob = blobs_[best];
   choice.status = MarkerStatus::kFound;
+  return choice;
+}
+
+ColourTracker::Choice ColourTracker::relearn(const cv::Point2d& last_seen) {
+  // Chroma is what tells the marker from a darker or brighter look-alike here, so a gray-level
+  // marker (brightness is all it has) is never relearned.
+  Choice choice;
+  if (!model_ || gray_) return choice;
+  // Anywhere in the searched region, every candidate that fits in all but brightness counts: the
+  // one relearned must be the only one.
+  std::optional<size_t> only;
+  int fitting = 0;
+  for (size_t i = 0; i < candidates_.size() && i < blobs_.size(); ++i) {
+    const CandidateVerdict verdict = candidates_[i].verdict;
+    if (verdict == CandidateVerdict::kFits ||
+        (verdict == CandidateVerdict::kColour &&
+         judge(blobs_[i], true).first == CandidateVerdict::kFits)) {
+      ++fitting;
+      only = i;
+    }
+  }
+  if (fitting > 1) {
+    choice.status = MarkerStatus::kAmbiguous;
+    choice.tied = fitting;
+    return choice;
+  }
+  // And near where the marker was last seen: a few of its radii, and one more for every frame it
+  // has been lost (a marker moving a radius a frame is fast).
+  const double reach =
+      (kRelearnRadii + lost_frames_) * std::sqrt(model_->area_px / CV_PI);
+  if (!only || cv::norm(blobs_[*only].centroid_px - last_seen) > reach) return choice;
+  candidates_[*only].verdict = CandidateVerdict::kChosen;
+  choice.blob = blobs_[*only];
+  choice.status = MarkerStatus::kFound;
+  model_->colour = choice.blob->core_colour;  // The new light's colour, learned afresh.
   return choice;
 }
 

@@ -83,8 +83,10 @@ class ColourTracker : public Tracker {
   const std::optional<ColourModel>& model() const { return model_; }
   // True when pixels are classified by gray level (`gray`, or a nominal gray `auto_bgr`).
   bool gray_mode() const { return gray_.has_value(); }
-  // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit).
-  std::pair<CandidateVerdict, double> judge(const ColourBlob& blob) const;
+  // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit). With
+  // `any_brightness` the learned colour's brightness is not held against it (its chroma is).
+  std::pair<CandidateVerdict, double> judge(const ColourBlob& blob,
+                                            bool any_brightness = false) const;
   // Bounded side of the last region searched (for tests of the windowing).
   const cv::Rect& last_search_px() const { return last_search_px_; }
 
@@ -119,6 +121,9 @@ class ColourTracker : public Tracker {
   void check_frame(const cv::Mat& frame) const;
   Choice track_in_windows(const cv::Mat& frame);
   Choice acquire(const cv::Mat& frame);
+  // After a lasting change of the light: the one blob near where the marker was last seen that
+  // fits everything but the learned brightness, if there is exactly one.
+  Choice relearn(const cv::Point2d& last_seen);
   Observation report(const Choice& choice);
   void learn(const ColourBlob& blob, bool tracking);
   MarkerCandidate candidate(const ColourBlob& blob, CandidateVerdict verdict, double misfit) const;
@@ -143,6 +148,10 @@ class ColourTracker : public Tracker {
   // The last windowed search saw a blob of the marker's colour where the marker was expected,
   // too small to be measured: the marker is covered rather than gone.
   bool partly_seen_ = false;
+  // Frames since the marker was last found, and where that was (kept through reset(): the
+  // relearning below looks there).
+  int lost_frames_ = 0;
+  std::optional<cv::Point2d> last_seen_px_;
   cv::Size frame_size_;
   cv::Rect last_search_px_;
 

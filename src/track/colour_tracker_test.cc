@@ -529,6 +529,59 @@ TEST(ColourTrackerScene, OccludedMarkerIsNotFoundAndReacquired) {
   EXPECT_LE(run.rms_px, 0.1);
 }
 
+TEST(ColourTrackerScene, LastingChangeOfTheLightIsRelearned) {
+  // The light halves at frame 20 and stays so (a lamp switched off): beyond the learned colour's
+  // brightness tolerance, so each marker is lost, then relearned where it was, with the same
+  // chroma, size and shape, and never reported anywhere else.
+  SyntheticScene bright(BendingScene(80));
+  NoiseOptions dim_light;
+  dim_light.gain_start = dim_light.gain_end = 0.45;
+  SyntheticScene dim(BendingScene(80), dim_light);
+  std::vector<std::unique_ptr<ColourTracker>> trackers;
+  for (const ColourParams& p : SceneParams()) trackers.push_back(std::make_unique<ColourTracker>(p));
+  cv::Mat image;
+  int wrong = 0, missed_late = 0, found_dim = 0;
+  for (int f = 0; f < 80; ++f) {
+    const SceneTruth truth = (f < 20 ? bright : dim).render(f, image);
+    for (size_t m = 0; m < trackers.size(); ++m) {
+      const Observation obs = trackers[m]->update(image);
+      if (obs.found() && cv::norm(*obs.position_px - *truth.markers[m].centroid_px) > 0.5) ++wrong;
+      if (f >= 20 && obs.found()) ++found_dim;
+      if (f >= 50 && !obs.found()) ++missed_late;
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(found_dim, 0);
+  EXPECT_EQ(missed_late, 0);  // Relearned within the first 30 frames of the new light.
+}
+
+TEST(ColourTracker, RelearningRefusesTwoLookAlikes) {
+  ColourTracker tracker(RedParams());
+  cv::Mat image = Background();
+  PaintDisc(image, {150.5, 120.5}, 10, kRed);
+  ASSERT_TRUE(tracker.update(image).found());
+  // Darker by half (beyond the brightness tolerance), with a second disc of that new colour
+  // beside it: either may be the marker, so neither is relearned, however long it lasts.
+  const cv::Vec3b dark(kRed[0] / 2, kRed[1] / 2, kRed[2] / 2);
+  cv::Mat dimmed = Background();
+  PaintDisc(dimmed, {150.5, 120.5}, 10, dark);
+  PaintDisc(dimmed, {185.5, 120.5}, 10, dark);
+  for (int f = 0; f < 60; ++f) EXPECT_FALSE(tracker.update(dimmed).found()) << "frame " << f;
+  // The same change with the marker alone is relearned.
+  cv::Mat alone = Background();
+  const cv::Point2d truth = PaintDisc(alone, {150.5, 120.5}, 10, dark);
+  bool found = false;
+  for (int f = 0; f < 60 && !found; ++f) {
+    const Observation obs = tracker.update(alone);
+    if (obs.found()) {
+      found = true;
+      EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+      EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9);
+    }
+  }
+  EXPECT_TRUE(found);
+}
+
 TEST(ColourTrackerScene, WindowedEqualsWholeFrameAndCoarseEqualsFullResolution) {
   // Binary centroid: bit-identical (same pixels, same moments, same integer offsets). Soft
   // centroid: within 1e-3 px, because OpenCV's 8-bit Gaussian filter may round a pixel of a view
