@@ -23,5 +23,7 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
 CommandRunner SetupConfigCommand(CLI::App& sub);
+CommandRunner SetupInitCommand(CLI::App& sub);
+CommandRunner SetupPickCommand(CLI::App& sub);
 
 }  // namespace softsight

@@ -145,6 +145,40 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   return PickHsvFromSamples(samples, options, why_not);
 }
 
+std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point2d click_px,
+                                                   const HsvPickOptions& options,
+                                                   int box_side_px, std::string* why_not) {
+  const auto ranges = PickHsvRange(bgr, click_px, options, why_not);
+  if (!ranges) return std::nullopt;
+  MarkerColourPick pick;
+  pick.ranges = *ranges;
+  const int side = std::max(1, box_side_px);
+  pick.roi = cv::Rect(cvRound(click_px.x) - side / 2, cvRound(click_px.y) - side / 2, side, side) &
+             cv::Rect(0, 0, bgr.cols, bgr.rows);
+  return pick;
+}
+
+void ApplyColourPick(const MarkerColourPick& pick, ColourParams* colour) {
+  colour->h = pick.ranges.h;
+  colour->s = pick.ranges.s;
+  colour->v = pick.ranges.v;
+  colour->auto_bgr.reset();
+  colour->gray.reset();
+  colour->roi = pick.roi;
+}
+
+const char* HueName(int hue) {
+  hue = WrapHue(hue);
+  if (hue < 9 || hue >= 170) return "red";
+  if (hue < 20) return "orange";
+  if (hue < 35) return "yellow";
+  if (hue < 78) return "green";
+  if (hue < 96) return "cyan";
+  if (hue < 131) return "blue";
+  if (hue < 151) return "purple";
+  return "magenta";
+}
+
 bool HsvInRange(const cv::Vec3b& hsv, const HsvRange& h, const HsvRange& s, const HsvRange& v) {
   const bool hue_ok =
       h.lo <= h.hi ? (hsv[0] >= h.lo && hsv[0] <= h.hi) : (hsv[0] >= h.lo || hsv[0] <= h.hi);

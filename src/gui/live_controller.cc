@@ -243,25 +243,23 @@ void LiveController::click(const cv::Point2d& p) {
   if (frame_.empty()) return;
   const int marker = marker_at(p, 2.0 * options_.overlay.marker_ring_px).value_or(active_);
   std::string why;
-  const auto pick = PickHsvRange(frame_, p, options_.picker, &why);
+  // The one colour pick `softsight pick` shares: ranges from the pixels around the click, and
+  // the search box around it.
+  const auto pick = PickMarkerColourAt(frame_, p, options_.picker, options_.select_box_px, &why);
   if (!pick) {
     say("colour pick for " + config().markers[marker].name + ": " + why);
     return;
   }
   active_ = marker;
   MarkerSpec spec = config().markers[marker];
-  spec.colour.h = pick->h;
-  spec.colour.s = pick->s;
-  spec.colour.v = pick->v;
-  spec.colour.auto_bgr.reset();
-  const cv::Rect box = box_around(p);
-  spec.colour.roi = box;
+  ApplyColourPick(*pick, &spec.colour);
+  const cv::Rect box = pick->roi;
   // The colour tracker looks for the marker around the click first; a template tracker keeps
   // its template (the ranges are stored for the colour method).
   apply_spec(marker, spec, IsTemplateMethod(spec.method) ? std::nullopt : std::optional(box));
   ++hsv_revision_;
-  say(spec.name + ": h " + RangeText(pick->h) + " s " + RangeText(pick->s) + " v " +
-      RangeText(pick->v) + (IsTemplateMethod(spec.method) ? " (used by the colour method)" : ""));
+  say(spec.name + ": h " + RangeText(pick->ranges.h) + " s " + RangeText(pick->ranges.s) +
+      " v " + RangeText(pick->ranges.v) + (IsTemplateMethod(spec.method) ? " (used by the colour method)" : ""));
 }
 
 void LiveController::drag(const cv::Rect& dragged) {

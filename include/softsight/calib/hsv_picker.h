@@ -54,6 +54,28 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
                                     const HsvPickOptions& options, std::string* why_not = nullptr);
 
+// What a click on a marker in `live` gives, and `softsight pick` reproduces: the ranges picked
+// from the pixels around the click (PickHsvRange) and the square search box of `box_side_px`
+// centred on the clicked pixel (clipped to the image), where the colour tracker looks for the
+// marker first.
+struct MarkerColourPick {
+  HsvPick ranges;
+  cv::Rect roi;
+};
+
+std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point2d click_px,
+                                                   const HsvPickOptions& options,
+                                                   int box_side_px,
+                                                   std::string* why_not = nullptr);
+
+// Makes `colour` track the picked colour: its h, s, v ranges and roi become the pick's, and an
+// automatic colour or gray-level range it had is dropped (the pick replaces them).
+void ApplyColourPick(const MarkerColourPick& pick, ColourParams* colour);
+
+// A colour name for an 8-bit hue (0..179): red, orange, yellow, green, cyan, blue, purple,
+// magenta. Used to name the markers `init` and `pick` write.
+const char* HueName(int hue);
+
 // True when an 8-bit HSV pixel lies inside the three ranges (hue wrap included). The reference the
 // tests and the live window's preview use; the colour tracker has its own vectorised threshold.
 bool HsvInRange(const cv::Vec3b& hsv, const HsvRange& h, const HsvRange& s, const HsvRange& v);

@@ -1,0 +1,293 @@
+// `softsight init` and `softsight pick` on rendered scenes with exact truth: init's config tracks
+// as well as a hand-written one, in body order; a scene without markers or with look-alikes is
+// refused; pick gives exactly what a click in live gives.
+#include "app/init_command.h"
+
+#include <cmath>
+#include <iostream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "app/scene_config.h"
+#include "app/track_command.h"
+#include "app/truth_sink.h"
+#include "core/test_util.h"
+#include "softsight/core/error.h"
+#include "softsight/gui/live_controller.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::TempDir;
+
+struct Clip {
+  std::string video;
+  SceneOptions scene;
+  std::vector<SceneTruth> truth;
+};
+
+// A bending actuator on the textured bench (blotchy patches, tape, a cable; no look-alike
+// distractors), rendered into a lossless video.
+Clip RenderBenchClip(const TempDir& dir, std::vector<SceneMarker> markers, int frames,
+                     uint64_t seed) {
+  Clip clip;
+  clip.scene.frame_count = frames;
+  clip.scene.max_bend_deg = 150;
+  clip.scene.background = BackgroundKind::kBench;
+  clip.scene.seed = seed;
+  clip.scene.markers = std::move(markers);
+  NoiseOptions noise;
+  noise.sigma = 2;
+  SyntheticScene renderer(clip.scene, noise);
+  clip.video = dir.file("clip.avi");
+  cv::VideoWriter writer(clip.video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'),
+                         clip.scene.fps, clip.scene.size, true);
+  EXPECT_TRUE(writer.isOpened());
+  cv::Mat image;
+  for (int i = 0; i < frames; ++i) {
+    clip.truth.push_back(renderer.render(i, image));
+    writer << image;
+  }
+  return clip;
+}
+
+TruthScore Track(const std::string& config_file, const Clip& clip, const TempDir& dir) {
+  TrackOptions options;
+  options.config_file = config_file;
+  options.source.input = clip.video;
+  options.csv_file = dir.file("track.csv");
+  options.quiet = true;
+  TruthScoreSink truth(clip.truth, clip.scene.markers.size());
+  RunTrack(options, nullptr, {&truth});
+  return truth.score();
+}
+
+// What a person would write: thresholds around each marker's hue, the scene's triple or chain.
+std::string WriteHandConfig(const Clip& clip, const TempDir& dir) {
+  TrackingConfig config;
+  for (const SceneMarker& m : clip.scene.markers) {
+    MarkerSpec spec;
+    spec.name = m.name;
+    spec.colour = ThresholdsFor(m.bgr);
+    config.markers.push_back(spec);
+  }
+  config.measure = SceneMeasureOptions(clip.scene);
+  const std::string file = dir.file("hand.yaml");
+  SaveTrackingConfig(config, file);
+  return file;
+}
+
+void ExpectInitTracksLikeHandConfig(const std::vector<SceneMarker>& markers, uint64_t seed) {
+  TempDir dir;
+  const Clip clip = RenderBenchClip(dir, markers, 30, seed);
+  InitOptions init;
+  init.source.input = clip.video;
+  init.config_out = dir.file("init.yaml");
+  InitResult result;
+  try {
+    result = RunInit(init);
+  } catch (const InputError& e) {
+    const cv::Mat frame = ReadFrameAt(init.source, 0).image;
+    const MarkerFinding f = FindMarkers(frame);
+    for (const FoundMarker& m : f.markers) ADD_FAILURE() << m.spec.name << " " << m.position_px;
+    FAIL() << e.what();
+  }
+  ASSERT_TRUE(result.finding.ok()) << result.finding.problem;
+  EXPECT_TRUE(cv::imread(result.picture_file).data != nullptr) << "the picture is written";
+
+  // Body order: the i-th marker of init's config is the scene's i-th marker (base first), where
+  // the truth puts it on frame 0.
+  const TrackingConfig config = LoadTrackingConfig(init.config_out);
+  ASSERT_EQ(config.markers.size(), markers.size());
+  for (size_t i = 0; i < markers.size(); ++i) {
+    ASSERT_TRUE(clip.truth[0].markers[i].centroid_px);
+    EXPECT_LT(cv::norm(result.finding.markers[i].position_px - *clip.truth[0].markers[i].centroid_px),
+              0.5)
+        << "marker " << i << " (" << config.markers[i].name << ") is the scene's "
+        << markers[i].name;
+  }
+  const MeasureOptions expected = SceneMeasureOptions(clip.scene);
+  EXPECT_EQ(config.measure.chain.size(), expected.chain.size());
+  EXPECT_EQ(config.measure.base, config.markers.front().name);
+  EXPECT_EQ(config.measure.tip, config.markers.back().name);
+
+  const TruthScore by_init = Track(init.config_out, clip, dir);
+  const TruthScore by_hand = Track(WriteHandConfig(clip, dir), clip, dir);
+  std::cout << markers.size() << " markers: centroid RMS init " << *by_init.centroid_rms_px
+            << " px (max " << *by_init.centroid_max_px << "), hand " << *by_hand.centroid_rms_px
+            << " px; angle RMS init " << *by_init.angle_rms_deg << " deg, hand "
+            << *by_hand.angle_rms_deg << " deg; misses " << by_init.misses << " of "
+            << by_init.visible << "\n";
+  EXPECT_EQ(by_init.misses, 0);
+  EXPECT_EQ(by_init.false_reports, 0);
+  EXPECT_EQ(by_init.visible, by_hand.visible);
+  ASSERT_TRUE(by_init.centroid_rms_px && by_hand.centroid_rms_px && by_init.angle_rms_deg);
+  // Within the accuracy of the hand-written config.
+  EXPECT_LE(*by_init.centroid_rms_px, std::max(1.2 * *by_hand.centroid_rms_px, 0.1))
+      << "init " << *by_init.centroid_rms_px << " px, hand " << *by_hand.centroid_rms_px << " px";
+  EXPECT_LT(*by_init.centroid_max_px, 0.5);
+  EXPECT_LE(*by_init.angle_rms_deg, std::max(1.2 * *by_hand.angle_rms_deg, 0.1));
+}
+
+TEST(InitCommand, ThreeMarkersOnATexturedBenchTrackLikeAHandWrittenConfig) {
+  ExpectInitTracksLikeHandConfig({{"red", {40, 40, 220}, 0.1},
+                                  {"blue", {220, 90, 40}, 0.5},
+                                  {"green", {60, 200, 60}, 0.9}},
+                                 3);
+}
+
+TEST(InitCommand, FiveMarkersOfDistinctHuesTrackLikeAHandWrittenConfigInBodyOrder) {
+  ExpectInitTracksLikeHandConfig({{"orange", {20, 130, 240}, 0.1},
+                                  {"magenta", {200, 40, 220}, 0.3},
+                                  {"yellow", {30, 220, 230}, 0.5},
+                                  {"blue", {220, 90, 40}, 0.7},
+                                  {"green", {60, 200, 60}, 0.9}},
+                                 11);
+}
+
+TEST(InitCommand, ASceneWithoutMarkersIsRefusedAndNoConfigIsWritten) {
+  TempDir dir;
+  const Clip clip = RenderBenchClip(dir, {}, 2, 5);
+  InitOptions init;
+  init.source.input = clip.video;
+  init.config_out = dir.file("init.yaml");
+  try {
+    RunInit(init);
+    FAIL() << "a scene without markers gave a config";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("no markers"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(init.config_out));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("init.png"))) << "the picture says what was rejected";
+  // The program: one line, exit 2.
+  const std::string command = testing::SoftsightBinary() + " init --input " + clip.video + " -o " +
+                              dir.file("cli.yaml") + " 2> " + dir.file("err.txt");
+  const int status = std::system(command.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_THAT(testing::ReadTextFile(dir.file("err.txt")), HasSubstr("no markers"));
+}
+
+TEST(InitCommand, LookAlikesOfAMarkerColourAreRefusedNotGuessed) {
+  // The bench with a larger, a darker and half- and twice-sized blob of every marker colour:
+  // init cannot tell which red disc is the marker and must say so.
+  TempDir dir;
+  SceneOptions scene;
+  scene.frame_count = 1;
+  scene.background = BackgroundKind::kBench;
+  scene.distractors = MakeMarkerDistractors(scene, 1);
+  SyntheticScene renderer(scene);
+  cv::Mat image;
+  renderer.render(0, image);
+  cv::imwrite(dir.file("f0.png"), image);
+  InitOptions init;
+  init.source.input = dir.file("f%01d.png");
+  init.config_out = dir.file("init.yaml");
+  try {
+    RunInit(init);
+    FAIL() << "look-alikes gave a config";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("init will not guess"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(init.config_out));
+
+  // Restricted to the actuator's area, the same frame gives the three markers.
+  init.finder.search_px = cv::Rect(180, 50, 80, 300);
+  init.finder.expected_count = 3;
+  init.finder.base_near_px = cv::Point2d(220, 470);  // One frame shows no motion: say where.
+  const InitResult result = RunInit(init);
+  ASSERT_TRUE(result.finding.ok()) << result.finding.problem;
+  const SceneTruth truth = renderer.render(0, image);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_LT(cv::norm(result.finding.markers[i].position_px - *truth.markers[i].centroid_px), 0.5);
+  }
+}
+
+TEST(InitCommand, WhiteDotsOnGrayVideoGetAGrayRangeAndARoiEach) {
+  TempDir dir;
+  InitOptions init;
+  init.source.input = "synth:plate";
+  init.config_out = dir.file("plate.yaml");
+  const InitResult result = RunInit(init);
+  ASSERT_TRUE(result.finding.ok()) << result.finding.problem;
+  EXPECT_TRUE(result.finding.intensity);
+  ASSERT_EQ(result.config.markers.size(), 5u);
+  for (const MarkerSpec& m : result.config.markers) {
+    EXPECT_TRUE(m.colour.gray && m.colour.roi) << m.name;
+  }
+  EXPECT_EQ(result.config.measure.chain.size(), 5u);
+  // Identical dots need their rois, which track applies on the first frame: another frame is
+  // refused rather than written with rois that would be wrong there.
+  init.frame = 10;
+  EXPECT_THROW(RunInit(init), InputError);
+}
+
+TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
+  TempDir dir;
+  SceneOptions scene;
+  scene.frame_count = 3;
+  scene.background = BackgroundKind::kBench;
+  SyntheticScene renderer(scene);
+  cv::Mat image;
+  const SceneTruth truth = renderer.render(2, image);
+  cv::imwrite(dir.file("f0.png"), image);  // A one-frame sequence holding scene frame 2.
+  // Clicks off the centre (as a hand clicks), on every marker.
+  std::vector<cv::Point2d> clicks;
+  for (const MarkerTruth& m : truth.markers) clicks.push_back(*m.centroid_px + cv::Point2d(1.6, -2.3));
+
+  PickOptions pick;
+  pick.source.input = dir.file("f%01d.png");
+  pick.at_px = clicks;
+  pick.config_out = dir.file("pick.yaml");
+  const TrackingConfig picked = RunPick(pick);
+  ASSERT_EQ(picked.markers.size(), 3u);
+  EXPECT_EQ(picked.measure.base, picked.markers[0].name);
+  EXPECT_EQ(picked.markers[0].name, "red");
+  EXPECT_EQ(picked.markers[1].name, "blue");
+  EXPECT_EQ(picked.markers[2].name, "green");
+
+  // The live window on the same frame, clicked at the same pixels.
+  TrackingConfig start;
+  for (const SceneMarker& m : scene.markers) {
+    MarkerSpec spec;
+    spec.name = m.name;
+    spec.colour = ThresholdsFor(m.bgr);
+    start.markers.push_back(spec);
+  }
+  start.measure = SceneMeasureOptions(scene);
+  LiveController live(start, LiveOptions{});
+  Frame frame;
+  frame.image = image;
+  live.on_frame(frame, SteadyClock::now());
+  for (size_t i = 0; i < clicks.size(); ++i) {
+    live.on_event(UiEvent::Key('1' + static_cast<int>(i)));
+    live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseDown, clicks[i].x, clicks[i].y));
+    live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseUp, clicks[i].x, clicks[i].y));
+    const ColourParams& a = picked.markers[i].colour;
+    const ColourParams& b = live.config().markers[i].colour;
+    EXPECT_EQ(a.h.lo, b.h.lo);
+    EXPECT_EQ(a.h.hi, b.h.hi);
+    EXPECT_EQ(a.s.lo, b.s.lo);
+    EXPECT_EQ(a.s.hi, b.s.hi);
+    EXPECT_EQ(a.v.lo, b.v.lo);
+    EXPECT_EQ(a.v.hi, b.v.hi);
+    ASSERT_TRUE(a.roi && b.roi);
+    EXPECT_EQ(*a.roi, *b.roi);
+  }
+
+  // A point on the background is one error naming the point.
+  pick.at_px = {cv::Point2d(-50, 5)};
+  try {
+    RunPick(pick);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--at -50,5"));
+  }
+}
+
+}  // namespace
+}  // namespace softsight

@@ -1,0 +1,637 @@
+// Finding, verifying and ordering the markers of one frame: see marker_finder.h.
+#include "softsight/calib/marker_finder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+// Hue bands of the candidate search: centres every kHueStep, reaching kHueReach either side, so
+// any marker whose hues spread over less than 2 * kHueReach - kHueStep lies wholly in one band.
+constexpr int kHueStep = 10;
+constexpr int kHueReach = 12;
+// Gray-level bands of the candidate search on gray frames: bright dots at or above, dark dots at
+// or below these levels.
+constexpr int kBrightLevels[] = {230, 200, 170, 140, 110};
+constexpr int kDarkLevels[] = {25, 50, 80};
+// Candidates from different bands closer than this (in marker radii, at least 2 px) are one blob.
+constexpr double kSameBlobRadii = 0.5;
+// Rejected blobs smaller than this are not drawn or listed (texture specks are many).
+constexpr double kListedRejectAreaPx = 20.0;
+constexpr size_t kMaxListedRejects = 40;
+// Markers of one body have about one size: a blob this many times another's area is not one of them.
+constexpr double kMaxAreaRatio = 6.0;
+// The verifying tracker must find the candidate within this many radii (and 1 px) of where the
+// search found it: the same blob, measured with the marker's own ranges.
+constexpr double kVerifyRadii = 0.25;
+// A second body order within this fraction of the shortest path's length makes the order ambiguous.
+constexpr double kOrderAmbiguity = 0.10;
+// A marker's edge fades (80 % -> 20 %) within at most this many pixels, or this many radii for
+// large markers (see EdgeWidthPx). A sharp rendered marker measures 0.75-1 px; a Gaussian blur
+// adds 1.7 sigmas, so markers defocused up to sigma ~1 px (more for large ones) pass, while the
+// stains of a textured bench (3.5-4 px measured on the renderer's bench) do not.
+constexpr double kMaxEdgeWidthPx = 2.5;
+constexpr double kMaxEdgeWidthRadii = 0.15;
+// Paths through at most this many markers are searched exhaustively.
+constexpr size_t kExactOrderMax = 8;
+
+struct Candidate {
+  cv::Point2d position_px;
+  double area_px = 0;
+  std::optional<HsvRange> band_gray;  // Gray-level band that found it (gray frames).
+};
+
+double RadiusOf(double area_px) { return std::sqrt(std::max(area_px, 0.0) / CV_PI); }
+
+std::string Point(const cv::Point2d& p) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "(%.1f, %.1f)", p.x, p.y);
+  return text;
+}
+
+bool IsGrayFrame(const cv::Mat& frame) {
+  if (frame.channels() == 1) return true;
+  for (int y = 0; y < frame.rows; ++y) {
+    const cv::Vec3b* row = frame.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < frame.cols; ++x) {
+      if (row[x][0] != row[x][1] || row[x][1] != row[x][2]) return false;
+    }
+  }
+  return true;
+}
+
+// One probe of the colour tracker's whole-frame first acquisition with `colour`: what it weighed.
+std::vector<MarkerCandidate> Probe(const cv::Mat& frame, const ColourParams& colour) {
+  MarkerSpec spec;
+  spec.name = "probe";
+  spec.method = "colour";
+  spec.colour = colour;
+  const auto tracker = CreateTracker(spec);
+  Frame f;
+  f.image = frame;
+  tracker->start(f);
+  tracker->update(frame);
+  return tracker->candidates();
+}
+
+const char* RejectReason(CandidateVerdict verdict) {
+  switch (verdict) {
+    case CandidateVerdict::kSize:
+      return "size";
+    case CandidateVerdict::kShape:
+      return "shape (not compact)";
+    case CandidateVerdict::kColour:
+      return "colour";
+    case CandidateVerdict::kContrast:
+      return "contrast (background)";
+    default:
+      return CandidateVerdictName(verdict);
+  }
+}
+
+// Adds `c` to `list` unless a blob there already is the same one; keeps the larger.
+void Merge(std::vector<Candidate>* list, const Candidate& c) {
+  for (Candidate& other : *list) {
+    const double near = std::max(2.0, kSameBlobRadii * RadiusOf(std::max(c.area_px, other.area_px)));
+    if (cv::norm(other.position_px - c.position_px) < near) {
+      if (c.area_px > other.area_px) other = c;
+      return;
+    }
+  }
+  list->push_back(c);
+}
+
+double Median(std::vector<int> values) {
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// The gray range of a dot: from the level halfway between its core (the disc of 0.6 radii) and
+// its surroundings (the ring 2..4 px outside it) to white (a bright dot) or black (a dark one).
+std::optional<HsvRange> DotRange(const cv::Mat& gray, const cv::Point2d& centre, double radius) {
+  std::vector<int> core, ring;
+  const double core_r = std::max(1.0, 0.6 * radius);
+  const double ring_in = radius + 2, ring_out = radius + 4;
+  const int reach = static_cast<int>(std::ceil(ring_out));
+  for (int y = cvRound(centre.y) - reach; y <= cvRound(centre.y) + reach; ++y) {
+    if (y < 0 || y >= gray.rows) continue;
+    for (int x = cvRound(centre.x) - reach; x <= cvRound(centre.x) + reach; ++x) {
+      if (x < 0 || x >= gray.cols) continue;
+      const double d = std::hypot(x - centre.x, y - centre.y);
+      if (d <= core_r) core.push_back(gray.at<uchar>(y, x));
+      if (d >= ring_in && d <= ring_out) ring.push_back(gray.at<uchar>(y, x));
+    }
+  }
+  if (core.empty() || ring.empty()) return std::nullopt;
+  const double c = Median(core), r = Median(ring);
+  if (std::abs(c - r) < 20) return std::nullopt;  // Not a dot that stands out.
+  const double middle = 0.5 * (c + r);
+  if (c > r) return HsvRange{static_cast<int>(std::ceil(middle)), 255};
+  return HsvRange{0, static_cast<int>(std::floor(middle))};
+}
+
+// How sharply a blob's colour gives way to its surroundings: along rays from its centre, the
+// distance over which the colour goes from 80 % to 20 % of the way between its core (the disc of
+// half its radius) and its surroundings (the ring 3..5 px outside it), in pixels (median over
+// the rays). A printed or painted marker's edge takes 1-3 px (anti-aliasing, a little blur); a
+// patch of stain or shading on a bench fades over many. Absent when the core and the ring have
+// the same colour.
+std::optional<double> EdgeWidthPx(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
+  constexpr int kRays = 16;
+  auto sample = [&](double x, double y, cv::Vec3d* out) {
+    if (x < 0 || y < 0 || x > bgr.cols - 1.001 || y > bgr.rows - 1.001) return false;
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    const double fx = x - x0, fy = y - y0;
+    const cv::Vec3b& a = bgr.at<cv::Vec3b>(y0, x0);
+    const cv::Vec3b& b = bgr.at<cv::Vec3b>(y0, x0 + 1);
+    const cv::Vec3b& c = bgr.at<cv::Vec3b>(y0 + 1, x0);
+    const cv::Vec3b& d = bgr.at<cv::Vec3b>(y0 + 1, x0 + 1);
+    for (int k = 0; k < 3; ++k) {
+      (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
+    }
+    return true;
+  };
+  const double inner = 0.5 * radius, ring_in = radius + 3, ring_out = radius + 5;
+  cv::Vec3d core(0, 0, 0), ring(0, 0, 0);
+  int core_n = 0, ring_n = 0;
+  for (int k = 0; k < kRays; ++k) {
+    const double a = 2 * CV_PI * k / kRays;
+    const cv::Point2d dir(std::cos(a), std::sin(a));
+    cv::Vec3d p;
+    for (double d = 0; d <= inner; d += 0.5) {
+      if (sample(centre.x + d * dir.x, centre.y + d * dir.y, &p)) {
+        core += p;
+        ++core_n;
+      }
+    }
+    for (double d = ring_in; d <= ring_out; d += 0.5) {
+      if (sample(centre.x + d * dir.x, centre.y + d * dir.y, &p)) {
+        ring += p;
+        ++ring_n;
+      }
+    }
+  }
+  if (core_n == 0 || ring_n == 0) return std::nullopt;
+  core /= core_n;
+  ring /= ring_n;
+  const cv::Vec3d span = core - ring;
+  const double span2 = span.dot(span);
+  if (span2 < 15.0 * 15.0) return std::nullopt;
+  std::vector<double> widths;
+  for (int k = 0; k < kRays; ++k) {
+    const double a = 2 * CV_PI * k / kRays;
+    const cv::Point2d dir(std::cos(a), std::sin(a));
+    std::optional<double> d80, d20;
+    cv::Vec3d p;
+    for (double d = inner; d <= ring_out; d += 0.25) {
+      if (!sample(centre.x + d * dir.x, centre.y + d * dir.y, &p)) break;
+      const double m = (p - ring).dot(span) / span2;
+      if (!d80 && m < 0.8) d80 = d;
+      if (!d20 && m < 0.2) {
+        d20 = d;
+        break;
+      }
+    }
+    if (d80 && d20) widths.push_back(*d20 - *d80);
+    else widths.push_back(ring_out - inner);  // Never fades within reach: as wide as can be.
+  }
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+  return widths[widths.size() / 2];
+}
+
+int HueOf(const HsvRange& h) {
+  if (h.lo <= h.hi) return (h.lo + h.hi) / 2;
+  return ((h.lo + h.hi + 180) / 2) % 180;  // Wrapped through 0.
+}
+
+double PathLength(const std::vector<cv::Point2d>& points, const std::vector<size_t>& order) {
+  double length = 0;
+  for (size_t i = 1; i < order.size(); ++i) length += cv::norm(points[order[i]] - points[order[i - 1]]);
+  return length;
+}
+
+double BorderDistance(const cv::Point2d& p, cv::Size size) {
+  return std::min({p.x, p.y, size.width - 1 - p.x, size.height - 1 - p.y});
+}
+
+// The triple (and, beyond three, the chain) of markers in body order, as SceneMeasureOptions.
+MeasureOptions BodyMeasure(const std::vector<FoundMarker>& markers) {
+  MeasureOptions measure;
+  const size_t n = markers.size();
+  if (n < 3) return measure;
+  measure.base = markers.front().spec.name;
+  measure.middle = markers[n / 2].spec.name;
+  measure.tip = markers.back().spec.name;
+  if (n > 3) {
+    for (const FoundMarker& m : markers) measure.chain.push_back(m.spec.name);
+  }
+  return measure;
+}
+
+}  // namespace
+
+void ReverseBodyOrder(MarkerFinding* finding) {
+  std::reverse(finding->markers.begin(), finding->markers.end());
+  if (finding->intensity) {
+    for (size_t k = 0; k < finding->markers.size(); ++k) {
+      finding->markers[k].spec.name = "dot" + std::to_string(k);
+    }
+  }
+  finding->measure = BodyMeasure(finding->markers);
+}
+
+void MarkerFinderOptions::Check() const {
+  if (search_px && (search_px->width <= 0 || search_px->height <= 0)) {
+    throw InputError("search region: width and height must be positive");
+  }
+  if (expected_count && (*expected_count < 1 || *expected_count > 64)) {
+    throw InputError("marker count must be in 1..64, got " + std::to_string(*expected_count));
+  }
+  if (min_saturation < 1 || min_saturation > 255) {
+    throw InputError("min_saturation must be in 1..255, got " + std::to_string(min_saturation));
+  }
+  if (min_value < 0 || min_value > 255) {
+    throw InputError("min_value must be in 0..255, got " + std::to_string(min_value));
+  }
+  if (!(min_area_px >= 1)) throw InputError("min_area_px must be at least 1");
+  if (!(max_area_fraction > 0 && max_area_fraction <= 1)) {
+    throw InputError("max_area_fraction must be in (0, 1]");
+  }
+  if (roi_side_px < 3) throw InputError("roi side must be at least 3 px");
+  std::string error;
+  if (!picker.Check(&error)) throw InputError("picker: " + error);
+}
+
+std::vector<size_t> OrderAlongBody(const std::vector<cv::Point2d>& points, cv::Size image_size,
+                                   const std::optional<cv::Point2d>& base_near_px,
+                                   bool* ambiguous) {
+  const size_t n = points.size();
+  std::vector<size_t> best(n);
+  std::iota(best.begin(), best.end(), 0);
+  if (ambiguous != nullptr) *ambiguous = false;
+  if (n <= 2) {
+    // Nothing to order but the direction.
+  } else if (n <= kExactOrderMax) {
+    std::vector<size_t> order = best;
+    double best_length = std::numeric_limits<double>::infinity();
+    double second_length = best_length;
+    do {
+      if (order.front() > order.back()) continue;  // Each path once, not also reversed.
+      const double length = PathLength(points, order);
+      if (length < best_length) {
+        second_length = best_length;
+        best_length = length;
+        best = order;
+      } else if (length < second_length) {
+        second_length = length;
+      }
+    } while (std::next_permutation(order.begin(), order.end()));
+    if (ambiguous != nullptr) {
+      *ambiguous = second_length < (1 + kOrderAmbiguity) * best_length;
+    }
+  } else {
+    double best_length = std::numeric_limits<double>::infinity();
+    for (size_t start = 0; start < n; ++start) {
+      std::vector<size_t> order{start};
+      std::vector<bool> used(n, false);
+      used[start] = true;
+      while (order.size() < n) {
+        size_t next = 0;
+        double nearest = std::numeric_limits<double>::infinity();
+        for (size_t j = 0; j < n; ++j) {
+          const double d = cv::norm(points[j] - points[order.back()]);
+          if (!used[j] && d < nearest) {
+            nearest = d;
+            next = j;
+          }
+        }
+        used[next] = true;
+        order.push_back(next);
+      }
+      const double length = PathLength(points, order);
+      if (length < best_length) {
+        best_length = length;
+        best = order;
+      }
+    }
+  }
+  if (n >= 2) {
+    const cv::Point2d& first = points[best.front()];
+    const cv::Point2d& last = points[best.back()];
+    const bool reverse = base_near_px
+                             ? cv::norm(last - *base_near_px) < cv::norm(first - *base_near_px)
+                             : BorderDistance(last, image_size) < BorderDistance(first, image_size);
+    if (reverse) std::reverse(best.begin(), best.end());
+  }
+  return best;
+}
+
+MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& options) {
+  options.Check();
+  if (input.empty() || input.depth() != CV_8U || (input.channels() != 1 && input.channels() != 3)) {
+    throw InputError("init needs an 8-bit BGR or gray frame");
+  }
+  cv::Mat frame = input;
+  if (input.channels() == 1) cv::cvtColor(input, frame, cv::COLOR_GRAY2BGR);
+  MarkerFinding finding;
+  finding.intensity = IsGrayFrame(frame);
+  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
+  const cv::Rect search = options.search_px ? (*options.search_px & frame_rect) : frame_rect;
+  if (search.empty()) throw InputError("the search region lies outside the frame");
+  const cv::Rect2d search_area(search.x - 0.5, search.y - 0.5, search.width, search.height);
+
+  // ---- 1. Candidates: the colour tracker's own verdicts, band by band ----------------------------
+  ColourParams probe;
+  probe.min_area_px = options.min_area_px;
+  probe.max_area_px = std::max(options.min_area_px + 1,
+                               options.max_area_fraction * frame_rect.area());
+  std::vector<ColourParams> bands;
+  if (finding.intensity) {
+    for (int level : kBrightLevels) {
+      probe.gray = HsvRange{level, 255};
+      bands.push_back(probe);
+    }
+    for (int level : kDarkLevels) {
+      probe.gray = HsvRange{0, level};
+      bands.push_back(probe);
+    }
+  } else {
+    probe.s = {options.min_saturation, 255};
+    probe.v = {options.min_value, 255};
+    for (int centre = 0; centre < 180; centre += kHueStep) {
+      probe.h = {(centre + 180 - kHueReach) % 180, (centre + kHueReach) % 180};
+      bands.push_back(probe);
+    }
+  }
+  std::vector<Candidate> fitting;
+  std::vector<std::pair<Candidate, std::string>> rejects;
+  for (const ColourParams& band : bands) {
+    for (const MarkerCandidate& c : Probe(frame, band)) {
+      if (!search_area.contains(c.position_px)) continue;
+      Candidate candidate{c.position_px, c.area_px, band.gray};
+      if (c.verdict == CandidateVerdict::kFits || c.verdict == CandidateVerdict::kChosen) {
+        Merge(&fitting, candidate);
+      } else if (c.area_px >= kListedRejectAreaPx) {
+        rejects.emplace_back(candidate, RejectReason(c.verdict));
+      }
+    }
+  }
+  // A blob that fitted in one band is not also a reject from another (its partial hue there).
+  std::vector<Candidate> listed;
+  for (const auto& [candidate, why] : rejects) {
+    bool known = false;
+    for (const Candidate& f : fitting) {
+      if (cv::norm(f.position_px - candidate.position_px) < std::max(2.0, RadiusOf(f.area_px))) {
+        known = true;
+      }
+    }
+    const size_t before = listed.size();
+    if (!known) Merge(&listed, candidate);
+    if (listed.size() > before) {
+      finding.rejected.push_back({candidate.position_px, RadiusOf(candidate.area_px), why});
+    }
+  }
+
+  // ---- 2 + 3. Each candidate's own ranges, verified by a tracker built from them ---------------------
+  struct Verified {
+    FoundMarker marker;
+    int hue = 0;
+  };
+  std::vector<Verified> verified;
+  std::vector<std::string> look_alikes;
+  for (size_t i = 0; i < fitting.size(); ++i) {
+    const Candidate& c = fitting[i];
+    const double radius = RadiusOf(c.area_px);
+    auto reject = [&](const std::string& why) {
+      finding.rejected.push_back({c.position_px, radius, why});
+    };
+    // The roi: the click box, at least four radii, excluding every other candidate's centre.
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < fitting.size(); ++j) {
+      if (j != i) nearest = std::min(nearest, cv::norm(fitting[j].position_px - c.position_px));
+    }
+    int side = std::max(options.roi_side_px, static_cast<int>(std::ceil(4 * radius)));
+    if (std::isfinite(nearest)) side = std::min(side, static_cast<int>(std::floor(1.3 * nearest)));
+    side = std::max(side, static_cast<int>(std::ceil(2 * radius)) + 3);
+
+    if (BorderDistance(c.position_px, frame.size()) < radius + 2) {
+      reject("cut by the frame border");
+      continue;
+    }
+    const std::optional<double> edge = EdgeWidthPx(frame, c.position_px, radius);
+    if (!edge || *edge > std::max(kMaxEdgeWidthPx, kMaxEdgeWidthRadii * radius)) {
+      char why[96];
+      std::snprintf(why, sizeof(why), "soft edge (fades over %.1f px: a stain or shadow)",
+                    edge.value_or(0.0));
+      reject(edge ? why : "no edge (same colour around it)");
+      continue;
+    }
+    MarkerSpec spec;
+    spec.method = "colour";
+    int hue = 0;
+    if (finding.intensity) {
+      cv::Mat gray;
+      cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+      const auto range = DotRange(gray, c.position_px, radius);
+      if (!range) {
+        reject("contrast (no clear level between the dot and its surroundings)");
+        continue;
+      }
+      spec.colour.gray = *range;
+      spec.colour.roi = cv::Rect(cvRound(c.position_px.x) - side / 2,
+                                 cvRound(c.position_px.y) - side / 2, side, side) & frame_rect;
+    } else {
+      HsvPickOptions picker = options.picker;
+      picker.radius_px = std::clamp(static_cast<int>(std::floor(0.6 * radius)), 1,
+                                    options.picker.radius_px);
+      std::string why;
+      const auto pick = PickMarkerColourAt(frame, c.position_px, picker, side, &why);
+      if (!pick) {
+        reject("colour pick: " + why);
+        continue;
+      }
+      ApplyColourPick(*pick, &spec.colour);
+      hue = HueOf(pick->ranges.h);
+    }
+    const double tolerance = std::max(1.0, kVerifyRadii * radius);
+    auto verify = [&](bool with_roi, Observation* observation) {
+      MarkerSpec probe_spec = spec;
+      probe_spec.name = "verify";
+      if (!with_roi) probe_spec.colour.roi.reset();
+      const auto tracker = CreateTracker(probe_spec);
+      Frame f;
+      f.image = frame;
+      tracker->start(f);
+      *observation = tracker->update(frame);
+      return observation->found() && cv::norm(*observation->position_px - c.position_px) <= tolerance;
+    };
+    Observation alone;
+    bool ok = verify(false, &alone);
+    const bool needs_roi = finding.intensity || options.search_px.has_value();
+    if (!ok && needs_roi && (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
+      // Identical dots, or look-alikes outside the search region: told apart by a roi each.
+      Observation inside;
+      ok = verify(true, &inside);
+      if (!ok) {
+        reject(std::string("not verified in its roi (") + MarkerStatusName(inside.status()) + ")");
+        continue;
+      }
+      alone = inside;
+    } else if (!ok) {
+      if (alone.status() == MarkerStatus::kAmbiguous) {
+        const std::string what = finding.intensity ? "dot" : HueName(hue);
+        if (std::find(look_alikes.begin(), look_alikes.end(), what) == look_alikes.end()) {
+          look_alikes.push_back(what);
+        }
+        reject("ambiguous: " + std::to_string(std::max(2, alone.candidates)) +
+               " look-alikes of its colour");
+      } else if (alone.found()) {
+        reject("its own ranges find another blob first, at " + Point(*alone.position_px));
+      } else {
+        reject(std::string("not found again with its own ranges (") +
+               MarkerStatusName(alone.status()) + ")");
+      }
+      continue;
+    }
+    Verified v;
+    v.marker.spec = spec;
+    v.marker.position_px = *alone.position_px;
+    v.marker.radius_px = radius;
+    v.hue = hue;
+    verified.push_back(v);
+  }
+  // Only blobs of about a marker's size are worth showing: texture specks are many.
+  if (!verified.empty()) {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (const Verified& v : verified) smallest = std::min(smallest, v.marker.radius_px);
+    finding.rejected.erase(std::remove_if(finding.rejected.begin(), finding.rejected.end(),
+                                          [&](const RejectedCandidate& r) {
+                                            return r.radius_px < 0.5 * smallest;
+                                          }),
+                           finding.rejected.end());
+  }
+  std::sort(finding.rejected.begin(), finding.rejected.end(),
+            [](const RejectedCandidate& a, const RejectedCandidate& b) {
+              return a.radius_px > b.radius_px;
+            });
+  if (finding.rejected.size() > kMaxListedRejects) finding.rejected.resize(kMaxListedRejects);
+
+  // ---- 4. Body order, names, measurement ---------------------------------------------------------
+  std::vector<cv::Point2d> positions;
+  for (const Verified& v : verified) positions.push_back(v.marker.position_px);
+  bool order_ambiguous = false;
+  const std::vector<size_t> order =
+      OrderAlongBody(positions, frame.size(), options.base_near_px, &order_ambiguous);
+  for (size_t k = 0; k < order.size(); ++k) {
+    Verified& v = verified[order[k]];
+    std::string name = finding.intensity ? "dot" + std::to_string(k) : HueName(v.hue);
+    if (!finding.intensity) {
+      int same = 0;
+      for (const FoundMarker& m : finding.markers) {
+        if (m.spec.name == name || m.spec.name.rfind(name + "_", 0) == 0) ++same;
+      }
+      if (same > 0) name += "_" + std::to_string(same + 1);
+    }
+    v.marker.spec.name = name;
+    if (!options.write_roi && !finding.intensity && !options.search_px) {
+      v.marker.spec.colour.roi.reset();
+    }
+    finding.markers.push_back(v.marker);
+  }
+  const size_t n = finding.markers.size();
+  finding.measure = BodyMeasure(finding.markers);
+  if (n >= 2) {
+    finding.notes.push_back(
+        "base: " + finding.markers.front().spec.name +
+        (options.base_near_px ? " (the end nearest the given point)"
+                              : " (the end nearer the image border; --base X,Y chooses)"));
+  }
+
+  double min_radius = std::numeric_limits<double>::infinity(), max_radius = 0;
+  for (const FoundMarker& m : finding.markers) {
+    min_radius = std::min(min_radius, m.radius_px);
+    max_radius = std::max(max_radius, m.radius_px);
+  }
+  const std::string rejected_count = std::to_string(finding.rejected.size());
+  if (!look_alikes.empty()) {
+    std::string text;
+    for (const std::string& l : look_alikes) text += (text.empty() ? "" : "; ") + l;
+    finding.problem = "several blobs fit each of these colours alike, and init will not guess "
+                      "which is the marker: " + text + " (restrict the search to the actuator with --roi X,Y,W,H, or pick the "
+                      "markers with `softsight pick`)";
+  } else if (n == 0) {
+    finding.problem = std::string("no markers: no compact ") +
+                      (finding.intensity ? "white or black dot" : "saturated blob") +
+                      " stands out from its surroundings (" + rejected_count +
+                      " blobs rejected, see the picture)";
+  } else if (options.expected_count && static_cast<int>(n) != *options.expected_count) {
+    finding.problem = "found " + std::to_string(n) + " markers, expected " +
+                      std::to_string(*options.expected_count) + " (see the picture)";
+  } else if (n >= 2 && max_radius * max_radius > kMaxAreaRatio * min_radius * min_radius) {
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "the blobs found differ too much in size to be the markers of one body (radius "
+                  "%.1f to %.1f px): restrict the search with --roi X,Y,W,H",
+                  min_radius, max_radius);
+    finding.problem = text;
+  } else if (order_ambiguous) {
+    finding.problem = "the order along the body is ambiguous (two paths through the markers are "
+                      "about as short): choose a frame where the actuator is less bent (--frame)";
+  } else if (!options.write_roi && (finding.intensity || options.search_px)) {
+    finding.problem = std::string(finding.intensity ? "identical dots" : "markers found in a search "
+                                                                       "region") +
+                      " need a roi each, which `track` applies on the input's first frame: use "
+                      "the first frame (--frame 0)";
+  }
+  return finding;
+}
+
+cv::Mat DrawMarkerFinding(const cv::Mat& input, const MarkerFinding& finding) {
+  cv::Mat image;
+  if (input.channels() == 1) {
+    cv::cvtColor(input, image, cv::COLOR_GRAY2BGR);
+  } else {
+    image = input.clone();
+  }
+  const cv::Scalar ok_colour(60, 230, 60), reject_colour(40, 40, 255), roi_colour(0, 220, 255);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  for (const RejectedCandidate& r : finding.rejected) {
+    const cv::Point p(cvRound(r.position_px.x), cvRound(r.position_px.y));
+    const int s = std::max(3, cvRound(r.radius_px * 0.7));
+    cv::line(image, p + cv::Point(-s, -s), p + cv::Point(s, s), reject_colour, 1, cv::LINE_AA);
+    cv::line(image, p + cv::Point(-s, s), p + cv::Point(s, -s), reject_colour, 1, cv::LINE_AA);
+    cv::putText(image, r.why, p + cv::Point(s + 2, 4), font, 0.33, reject_colour, 1, cv::LINE_AA);
+  }
+  for (size_t i = 1; i < finding.markers.size(); ++i) {
+    cv::line(image, finding.markers[i - 1].position_px, finding.markers[i].position_px, ok_colour,
+             1, cv::LINE_AA);
+  }
+  for (size_t i = 0; i < finding.markers.size(); ++i) {
+    const FoundMarker& m = finding.markers[i];
+    if (m.spec.colour.roi) cv::rectangle(image, *m.spec.colour.roi, roi_colour, 1);
+    const cv::Point p(cvRound(m.position_px.x), cvRound(m.position_px.y));
+    cv::circle(image, p, cvRound(m.radius_px) + 3, ok_colour, 2, cv::LINE_AA);
+    cv::putText(image, std::to_string(i + 1) + " " + m.spec.name,
+                p + cv::Point(cvRound(m.radius_px) + 6, -4), font, 0.45, ok_colour, 1,
+                cv::LINE_AA);
+  }
+  std::string headline = finding.ok() ? std::to_string(finding.markers.size()) +
+                                            " markers, base to tip in order"
+                                      : finding.problem;
+  if (headline.size() > 110) headline = headline.substr(0, 107) + "...";
+  cv::putText(image, headline, cv::Point(8, 18), font, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(image, headline, cv::Point(8, 18), font, 0.45,
+              finding.ok() ? ok_colour : reject_colour, 1, cv::LINE_AA);
+  return image;
+}
+
+}  // namespace softsight
