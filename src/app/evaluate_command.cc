@@ -10,16 +10,20 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
+#include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/scene_config.h"
 #include "app/truth_sink.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/io/csv_reader.h"
 #include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/builtin_scenes.h"
 
@@ -80,38 +84,6 @@ cv::Rect DraggedRect(const cv::Point2d& centre_px, double radius_px) {
   return cv::Rect(cx - side / 2, cy - side / 2, side, side);
 }
 
-TrackingConfig ConfigForRun(const Run& run, const EvaluateOptions& options,
-                            const SceneTruth& first) {
-  TrackingConfig config;
-  const SceneOptions& scene = options.scene;
-  for (size_t i = 0; i < scene.markers.size(); ++i) {
-    MarkerSpec spec;
-    spec.name = scene.markers[i].name;
-    spec.method = run.method;
-    if (!IsTemplateMethod(run.method)) {
-      spec.colour = ThresholdsFor(scene.markers[i].bgr);
-      if (options.noise.sigma > 0) {
-        spec.colour.filter = ColourParams::Filter::kGaussian;
-        spec.colour.filter_ksize = 5;
-      }
-    } else {
-      const std::optional<cv::Point2d>& centre = first.markers[i].centroid_px;
-      if (!centre || first.markers[i].visible_fraction < kMustFindVisibleFraction) {
-        throw InputError("marker '" + spec.name +
-                         "' is hidden on frame 0: no template can be dragged around it");
-      }
-      spec.templ.colour = run.mode == std::optional<std::string>("colour");
-      spec.templ.template_frame = 0;
-      spec.templ.rect = DraggedRect(*centre, scene.marker_radius_px);
-      if (options.rect_centre) spec.templ.report = TemplateReport::kRectCentre;
-      if (options.square_mask) spec.templ.round_mask = false;
-    }
-    config.markers.push_back(spec);
-  }
-  config.measure = SceneMeasureOptions(scene);
-  return config;
-}
-
 // The rendered frames as a source: from memory when they fit, else rendered again (rendering is
 // deterministic, noise included, so every method sees the same frames).
 class RenderedFrames : public FrameSource {
@@ -166,6 +138,8 @@ MethodResult ResultOf(const Run& run, const TruthScore& score, const RunSummary&
   out.false_reports = score.false_reports;
   out.centroid_rms_px = score.centroid_rms_px;
   out.centroid_max_px = score.centroid_max_px;
+  out.centroid_p95_px = score.centroid_p95_px;
+  out.wrong_finds = score.wrong_finds;
   out.precision_rms_px = score.precision_rms_px;
   out.precision_max_px = score.precision_max_px;
   out.angle_rms_deg = score.angle_rms_deg;
@@ -191,6 +165,39 @@ std::string Conditions(const EvaluateOptions& options) {
 }
 
 }  // namespace
+
+TrackingConfig EvaluateMethodConfig(const std::string& method,
+                                    const std::optional<std::string>& mode,
+                                    const EvaluateOptions& options, const SceneTruth& first) {
+  TrackingConfig config;
+  const SceneOptions& scene = options.scene;
+  for (size_t i = 0; i < scene.markers.size(); ++i) {
+    MarkerSpec spec;
+    spec.name = scene.markers[i].name;
+    spec.method = method;
+    if (!IsTemplateMethod(method)) {
+      spec.colour = ThresholdsFor(scene.markers[i].bgr);
+      if (options.noise.sigma > 0) {
+        spec.colour.filter = ColourParams::Filter::kGaussian;
+        spec.colour.filter_ksize = 5;
+      }
+    } else {
+      const std::optional<cv::Point2d>& centre = first.markers[i].centroid_px;
+      if (!centre || first.markers[i].visible_fraction < kMustFindVisibleFraction) {
+        throw InputError("marker '" + spec.name +
+                         "' is hidden on frame 0: no template can be dragged around it");
+      }
+      spec.templ.colour = mode == std::optional<std::string>("colour");
+      spec.templ.template_frame = 0;
+      spec.templ.rect = DraggedRect(*centre, scene.marker_radius_px);
+      if (options.rect_centre) spec.templ.report = TemplateReport::kRectCentre;
+      if (options.square_mask) spec.templ.round_mask = false;
+    }
+    config.markers.push_back(spec);
+  }
+  config.measure = SceneMeasureOptions(scene);
+  return config;
+}
 
 std::string MethodResult::label() const { return mode ? method + " " + *mode : method; }
 
@@ -272,7 +279,7 @@ EvaluateReport RunEvaluate(const EvaluateOptions& options) {
   report.conditions = Conditions(options);
   report.frames = frames;
   for (const Run& run : runs) {
-    TrackingSession session(ConfigForRun(run, options, truths.front()));
+    TrackingSession session(EvaluateMethodConfig(run.method, run.mode, options, truths.front()));
     RenderedFrames source(scene, truths, images);
     TruthScoreSink score(truths, options.scene.markers.size());
     SharedProgress shared(progress, done);
@@ -288,21 +295,22 @@ EvaluateReport RunEvaluate(const EvaluateOptions& options) {
 std::string FormatEvaluateMarkdown(const EvaluateReport& report) {
   std::ostringstream out;
   out << report.conditions << "\n\n"
-      << "| method | centroid RMS (px) | centroid max (px) | precision RMS (px) | "
-         "precision max (px) | misses / visible | false / hidden | angle RMS (deg) | "
-         "median (ms) | p99 (ms) |\n"
-      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+      << "| method | centroid RMS (px) | centroid p95 (px) | centroid max (px) | "
+         "precision RMS (px) | precision max (px) | misses / visible | wrong (> 3 px) | "
+         "false / hidden | angle RMS (deg) | median (ms) | p99 (ms) |\n"
+      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
   for (const MethodResult& m : report.methods) {
     out << "| " << m.label() << " | " << FormatOptional(m.centroid_rms_px, 3) << " | "
-        << FormatOptional(m.centroid_max_px, 3) << " | " << FormatOptional(m.precision_rms_px, 3)
-        << " | " << FormatOptional(m.precision_max_px, 3) << " | " << m.misses << " / "
-        << m.visible << " | " << m.false_reports << " / " << m.hidden << " | "
+        << FormatOptional(m.centroid_p95_px, 3) << " | " << FormatOptional(m.centroid_max_px, 3)
+        << " | " << FormatOptional(m.precision_rms_px, 3) << " | "
+        << FormatOptional(m.precision_max_px, 3) << " | " << m.misses << " / " << m.visible
+        << " | " << m.wrong_finds << " | " << m.false_reports << " / " << m.hidden << " | "
         << FormatOptional(m.angle_rms_deg, 3) << " | " << FormatNumber(m.proc_ms_median, 3)
         << " | " << FormatNumber(m.proc_ms_p99, 3) << " |\n";
   }
   out << "\nCentroid: |tracked - true| over found, visible (>= 50%) marker-frames. Precision: the "
          "same after removing each marker's constant offset measured on its first found frame "
-         "(frame 0). Times: tracking + measurement of all markers per frame.\n";
+         "(frame 0). Wrong: found farther than 3 px from the truth. Times: tracking + measurement of all markers per frame.\n";
   return out.str();
 }
 
@@ -311,7 +319,7 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
   if (!out) throw InputError(file + ": cannot write the CSV (check the folder and permissions)");
   out << "method,mode,frames,visible,found,misses,hidden,false_reports,centroid_rms_px,"
          "centroid_max_px,precision_rms_px,precision_max_px,angle_rms_deg,angle_frames,"
-         "proc_ms_median,proc_ms_p99\n";
+         "proc_ms_median,proc_ms_p99,centroid_p95_px,wrong_finds\n";
   const auto field = [](const std::optional<double>& value) {
     return value ? FormatNumber(*value, 6) : std::string();
   };
@@ -321,16 +329,177 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
         << "," << field(m.centroid_rms_px) << "," << field(m.centroid_max_px) << ","
         << field(m.precision_rms_px) << "," << field(m.precision_max_px) << ","
         << field(m.angle_rms_deg) << "," << m.angle_frames << ","
-        << FormatNumber(m.proc_ms_median, 6) << "," << FormatNumber(m.proc_ms_p99, 6) << "\n";
+        << FormatNumber(m.proc_ms_median, 6) << "," << FormatNumber(m.proc_ms_p99, 6) << ","
+        << field(m.centroid_p95_px) << "," << m.wrong_finds << "\n";
   }
   out.flush();
   if (!out) throw InputError(file + ": writing the CSV failed (disk full?)");
+}
+
+namespace {
+
+// The truth of a user's recording by source frame index, for the markers it shares with the
+// config (in config order).
+struct TruthTable {
+  std::vector<size_t> config_index;        // Of each scored marker, in the config.
+  std::vector<std::string> names;          // The scored markers.
+  std::vector<std::string> unmatched;      // Config markers the truth has no columns for.
+  std::map<int64_t, SceneTruth> by_frame;
+};
+
+TruthTable ReadTruthTable(const std::string& file, const TrackingConfig& config) {
+  const CsvTable table = ReadCsvTable(file);
+  const auto frame_column = table.find("frame");
+  if (!frame_column) {
+    throw InputError(file + ": no 'frame' column (the truth needs frame, and <name>_x, <name>_y "
+                     "per marker)");
+  }
+  struct Columns {
+    size_t x, y;
+    std::optional<size_t> visible;
+  };
+  TruthTable truth;
+  std::vector<Columns> columns;
+  for (size_t i = 0; i < config.markers.size(); ++i) {
+    const std::string& name = config.markers[i].name;
+    const auto x = table.find(name + "_x"), y = table.find(name + "_y");
+    if (!x || !y) {
+      truth.unmatched.push_back(name);
+      continue;
+    }
+    truth.config_index.push_back(i);
+    truth.names.push_back(name);
+    columns.push_back({*x, *y, table.find(name + "_visible")});
+  }
+  if (truth.names.empty()) {
+    std::string have;
+    for (const std::string& c : table.columns) {
+      if (c.size() > 2 && c.compare(c.size() - 2, 2, "_x") == 0) {
+        have += (have.empty() ? "" : ", ") + c.substr(0, c.size() - 2);
+      }
+    }
+    throw InputError(file + ": no marker of the config has <name>_x and <name>_y columns here (the "
+                     "truth has: " + (have.empty() ? std::string("none") : have) + ")");
+  }
+  const auto angle_column = table.find("angle_deg");
+  const auto time_column = table.find("time_s");
+  for (size_t row = 0; row < table.row_count(); ++row) {
+    const std::optional<double>& frame = table.values[*frame_column][row];
+    if (!frame || *frame < 0 || *frame != std::floor(*frame)) {
+      throw InputError(file + ": line " + std::to_string(row + 2) +
+                       ": 'frame' must be a frame index (0, 1, 2, ...)");
+    }
+    SceneTruth t;
+    t.frame_index = static_cast<int64_t>(*frame);
+    if (time_column) t.time_s = table.values[*time_column][row].value_or(0.0);
+    for (size_t k = 0; k < columns.size(); ++k) {
+      MarkerTruth m;
+      m.name = truth.names[k];
+      const auto& x = table.values[columns[k].x][row];
+      const auto& y = table.values[columns[k].y][row];
+      if (x && y) m.centroid_px = cv::Point2d(*x, *y);
+      m.visible_fraction = m.centroid_px ? 1.0 : 0.0;
+      if (columns[k].visible) {
+        const auto& v = table.values[*columns[k].visible][row];
+        if (v && (*v < 0 || *v > 1)) {
+          throw InputError(file + ": line " + std::to_string(row + 2) + ": " + m.name +
+                           "_visible must lie within 0..1");
+        }
+        if (v && m.centroid_px) m.visible_fraction = *v;
+      }
+      t.markers.push_back(m);
+    }
+    if (angle_column) t.measurement.angle_deg = table.values[*angle_column][row];
+    if (!truth.by_frame.emplace(t.frame_index, std::move(t)).second) {
+      throw InputError(file + ": line " + std::to_string(row + 2) + ": frame " +
+                       std::to_string(static_cast<long long>(*frame)) + " is given twice");
+    }
+  }
+  if (truth.by_frame.empty()) throw InputError(file + ": no rows");
+  return truth;
+}
+
+// Scores each processed frame that has a truth row, with the scored markers only.
+class TruthTableSink : public FrameSink {
+ public:
+  explicit TruthTableSink(const TruthTable& truth) : truth_(truth), scorer_(truth.names.size()) {}
+  void consume(const Frame& frame, const FrameResult& result) override {
+    const auto it = truth_.by_frame.find(frame.index);
+    if (it == truth_.by_frame.end()) {
+      ++unscored_;
+      return;
+    }
+    scored_.frame_index = result.frame_index;
+    scored_.time_s = result.time_s;
+    scored_.measurement = result.measurement;
+    scored_.markers.resize(truth_.config_index.size());
+    for (size_t k = 0; k < truth_.config_index.size(); ++k) {
+      scored_.markers[k] = result.markers[truth_.config_index[k]];
+    }
+    scorer_.add(it->second, scored_);
+  }
+  TruthScore score() const { return scorer_.score(); }
+  int64_t unscored() const { return unscored_; }
+
+ private:
+  const TruthTable& truth_;
+  TruthScorer scorer_;
+  FrameResult scored_;
+  int64_t unscored_ = 0;
+};
+
+std::string BaseName(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+}  // namespace
+
+EvaluateReport RunVideoEvaluate(const VideoEvaluateOptions& options) {
+  const TrackingConfig config = LoadTrackingConfig(options.config_file);
+  const TruthTable truth = ReadTruthTable(options.truth_csv, config);
+  if (options.csv_file) {
+    std::vector<PathRole> inputs = {{"--truth", options.truth_csv}, {"--config", options.config_file}};
+    if (options.source.input.rfind(kSyntheticPrefix, 0) != 0) {
+      inputs.push_back({"--input", options.source.input});
+    }
+    CheckOutputsAreNotInputs({{"--csv", *options.csv_file}}, inputs);
+  }
+  std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
+  if (source->is_live()) throw InputError("evaluate --input needs a recording, not a camera");
+  TrackingSession session(config);
+  TruthTableSink score(truth);
+  ProgressSink progress("evaluate", !options.quiet);
+  const RunSummary summary = RunPipeline(*source, session, {&score, &progress});
+  if (!summary.ok()) throw InputError(summary.error);
+  if (summary.frames == score.unscored()) {
+    throw InputError(options.truth_csv + ": none of its frame numbers is a frame of " +
+                     source->description() + " (" + std::to_string(summary.frames) +
+                     " frames; `frame` is the source's frame index, as in track's CSV)");
+  }
+  Run run;
+  run.method = BaseName(options.config_file);
+  EvaluateReport report;
+  report.frames = summary.frames - score.unscored();
+  report.methods.push_back(ResultOf(run, score.score(), summary));
+  std::ostringstream conditions;
+  conditions << source->description() << ": " << summary.frames << " frames, "
+             << report.frames << " of them scored against " << options.truth_csv
+             << "; markers matched by name: " << JoinNames(truth.names);
+  if (!truth.unmatched.empty()) {
+    conditions << "; not in the truth (not scored): " << JoinNames(truth.unmatched);
+  }
+  conditions << ".";
+  report.conditions = conditions.str();
+  if (options.csv_file) WriteEvaluateCsv(report, *options.csv_file);
+  return report;
 }
 
 CommandRunner SetupEvaluateCommand(CLI::App& sub) {
   auto options = std::make_shared<EvaluateOptions>();
   auto scene_name = std::make_shared<std::string>("bending");
   auto gain_ramp = std::make_shared<std::string>();
+  auto video = std::make_shared<VideoEvaluateOptions>();
   sub.description(
       "Compare the tracking methods on a rendered scene with exact ground truth: the colour\n"
       "tracker and the SAD, SSD and ZNCC template trackers (gray and colour) run over the same\n"
@@ -338,7 +507,14 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
       "dragged around each marker on frame 0). Prints a Markdown table: centroid error (absolute,\n"
       "and with the template's constant placement offset removed), misses, false reports, angle\n"
       "error and time per frame. No video file is written. See docs/evaluation.md.\n"
-      "Example: softsight evaluate --noise 5 --csv noise5.csv");
+      "With --input, --truth and --config it scores your own recording instead: the config's\n"
+      "markers against the truth CSV's (matched by name: <name>_x, <name>_y and optionally\n"
+      "<name>_visible per frame number), with the same figures (RMS, p95, max, misses, wrong\n"
+      "finds farther than 3 px, false reports while hidden).\n"
+      "Examples:\n"
+      "  softsight evaluate --noise 5 --csv noise5.csv\n"
+      "  softsight synth --frames 100 --out run.avi --truth truth.csv\n"
+      "  softsight evaluate --input run.avi --truth truth.csv --config markers.yaml");
   sub.add_option("--scene", *scene_name, "bending, wedge1, wedge4 or bench (textured, with look-alike blobs)")->capture_default_str();
   sub.add_option("--frames", options->scene.frame_count, "Frames to render and track")
       ->capture_default_str();
@@ -366,7 +542,35 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
                  "Background texture and noise seed (as `softsight synth --seed`: same frames)")
       ->capture_default_str();
   sub.add_flag("-q,--quiet", options->quiet, "No progress line");
-  return [options, scene_name, gain_ramp] {
+  sub.add_option("-i,--input", video->source.input,
+                 "Your recording (video, image sequence or synth:NAME) to score instead of the "
+                 "built-in comparison; needs --truth and --config");
+  sub.add_option("--truth", video->truth_csv,
+                 "With --input: the truth CSV (frame, <name>_x, <name>_y[, <name>_visible]; "
+                 "`softsight synth --truth` writes one)");
+  sub.add_option("-c,--config", video->config_file, "With --input: the marker config to score");
+  sub.add_option("--fps", video->source.sequence_fps, "With --input: an image sequence's frame rate")
+      ->capture_default_str();
+  return [options, scene_name, gain_ramp, video, &sub] {
+    if (!video->source.input.empty() || !video->truth_csv.empty() || !video->config_file.empty()) {
+      if (video->source.input.empty() || video->truth_csv.empty() || video->config_file.empty()) {
+        throw InputError("scoring a recording needs all three of --input VIDEO, --truth TRUTH.csv "
+                         "and --config CFG");
+      }
+      for (const char* builtin : {"--scene", "--frames", "--noise", "--blur", "--gain-ramp",
+                                  "--methods", "--modes", "--rect-centre", "--square-mask",
+                                  "--seed"}) {
+        if (sub.count(builtin) > 0) {
+          throw InputError(std::string(builtin) +
+                           " sets up the built-in comparison; it does not apply to --input");
+        }
+      }
+      VideoEvaluateOptions run = *video;
+      run.csv_file = options->csv_file;
+      run.quiet = options->quiet;
+      std::cout << FormatEvaluateMarkdown(RunVideoEvaluate(run));
+      return 0;
+    }
     EvaluateOptions run = *options;
     SetActuatorScene(*scene_name, &run.scene);
     run.noise.seed = run.scene.seed;  // As `softsight synth` does, so both render the same frames.

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "softsight/config/config.h"
+#include "softsight/io/frame_source.h"
 #include "softsight/sim/scene.h"
 #include "softsight/track/tracker.h"
 
@@ -59,6 +61,8 @@ struct MethodResult {
   // none was found.
   std::optional<double> centroid_rms_px;
   std::optional<double> centroid_max_px;
+  std::optional<double> centroid_p95_px;  // 95th percentile of the same errors.
+  int64_t wrong_finds = 0;          // Found farther than kWrongFindPx (3 px) from the truth.
   // Precision: the same error after subtracting, per marker, the constant offset (tracked - true)
   // measured on the first frame where the marker was found and visible (frame 0 normally): what
   // remains once the half-pixel placement of a dragged template is taken out.
@@ -82,6 +86,31 @@ struct EvaluateReport {
 
 // Renders the scene and evaluates every requested method. Throws InputError for bad options.
 EvaluateReport RunEvaluate(const EvaluateOptions& options);
+
+// The config the built-in comparison gives `method` (and, for templates, `mode`) on the scene of
+// `options`, whose frame 0 has the truth `first`: what `evaluate --input` is compared with.
+TrackingConfig EvaluateMethodConfig(const std::string& method,
+                                    const std::optional<std::string>& mode,
+                                    const EvaluateOptions& options, const SceneTruth& first);
+
+// A user's own recording against its own truth: `evaluate --input VIDEO --truth TRUTH.csv
+// --config CFG`.
+struct VideoEvaluateOptions {
+  FrameSourceSpec source;
+  std::string truth_csv;   // synth's truth CSV, or any CSV with frame and <name>_x, <name>_y.
+  std::string config_file;
+  std::optional<std::string> csv_file;  // The table as CSV as well.
+  bool quiet = false;
+};
+
+// The truth CSV: a `frame` column (the source's frame index, as in track's CSV); per marker
+// <name>_x, <name>_y (empty: hidden) and optionally <name>_visible (the visible fraction 0..1;
+// absent: 1 where x and y are given, else 0); optionally angle_deg. Config markers are matched
+// to the truth's by name; markers the truth does not have are not scored (the report's
+// conditions say which). Frames without a truth row are not scored. The one scorer as the
+// built-in path (sim/truth_score.h), so a rendered video with synth's truth gives the built-in
+// figures. Throws InputError naming the file and column.
+EvaluateReport RunVideoEvaluate(const VideoEvaluateOptions& options);
 
 // The report as a Markdown table, ready to paste in the README (with the conditions above it).
 std::string FormatEvaluateMarkdown(const EvaluateReport& report);

@@ -7,8 +7,11 @@
 #include <fstream>
 #include <string>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "app/synth_command.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/scene.h"
 
@@ -172,6 +175,129 @@ TEST(EvaluateTest, BadOptionsAreOneLineInputErrors) {
   ParseGainRamp("0.6,1.4", &noise);
   EXPECT_DOUBLE_EQ(noise.gain_start, 0.6);
   EXPECT_DOUBLE_EQ(noise.gain_end, 1.4);
+}
+
+// The built-in comparison and `evaluate --input --truth --config` on the same frames: a rendered
+// video (lossless) with synth's truth CSV, and the config the built-in path gives the method.
+void ExpectVideoScoreEqualsBuiltIn(const std::string& method,
+                                   const std::optional<std::string>& mode) {
+  testing::TempDir dir;
+  EvaluateOptions builtin = SmallScene();
+  builtin.scene.frame_count = 20;
+  builtin.noise.sigma = 3;
+  builtin.noise.seed = builtin.scene.seed;  // As the command line (and synth) do.
+  builtin.methods = {method};
+  if (mode) builtin.modes = {*mode};
+  const EvaluateReport expected = RunEvaluate(builtin);
+  ASSERT_EQ(expected.methods.size(), 1u);
+
+  SynthOptions synth;
+  synth.scene = builtin.scene;
+  synth.noise = builtin.noise;
+  synth.out = dir.file("run.avi");
+  synth.truth_csv = dir.file("truth.csv");
+  synth.quiet = true;
+  std::vector<SceneTruth> truths;
+  RunSynth(synth, &truths);
+  SaveTrackingConfig(EvaluateMethodConfig(method, mode, builtin, truths.front()),
+                     dir.file("config.yaml"));
+
+  VideoEvaluateOptions video;
+  video.source.input = synth.out;
+  video.truth_csv = *synth.truth_csv;
+  video.config_file = dir.file("config.yaml");
+  video.quiet = true;
+  const EvaluateReport got = RunVideoEvaluate(video);
+  ASSERT_EQ(got.methods.size(), 1u);
+  const MethodResult& a = expected.methods[0];
+  const MethodResult& b = got.methods[0];
+  EXPECT_EQ(got.frames, expected.frames);
+  EXPECT_EQ(b.visible, a.visible);
+  EXPECT_EQ(b.found_visible, a.found_visible);
+  EXPECT_EQ(b.misses, a.misses);
+  EXPECT_EQ(b.hidden, a.hidden);
+  EXPECT_EQ(b.false_reports, a.false_reports);
+  EXPECT_EQ(b.wrong_finds, a.wrong_finds);
+  EXPECT_EQ(b.angle_frames, a.angle_frames);
+  // The truth CSV holds 6 decimals.
+  const auto near = [](const std::optional<double>& x, const std::optional<double>& y,
+                       const char* what) {
+    ASSERT_EQ(x.has_value(), y.has_value()) << what;
+    if (x) {
+      EXPECT_NEAR(*x, *y, 1e-5) << what;
+    }
+  };
+  near(b.centroid_rms_px, a.centroid_rms_px, "centroid RMS");
+  near(b.centroid_p95_px, a.centroid_p95_px, "centroid p95");
+  near(b.centroid_max_px, a.centroid_max_px, "centroid max");
+  near(b.precision_rms_px, a.precision_rms_px, "precision RMS");
+  near(b.angle_rms_deg, a.angle_rms_deg, "angle RMS");
+  ASSERT_TRUE(a.centroid_rms_px);
+  EXPECT_GT(a.visible, 0);
+}
+
+TEST(EvaluateVideo, ColourOnARenderedVideoGivesTheBuiltInFigures) {
+  ExpectVideoScoreEqualsBuiltIn("colour", std::nullopt);
+}
+
+TEST(EvaluateVideo, ZnccOnARenderedVideoGivesTheBuiltInFigures) {
+  ExpectVideoScoreEqualsBuiltIn("zncc", std::string("gray"));
+}
+
+TEST(EvaluateVideo, MarkersAreMatchedByNameAndWrongFindsCounted) {
+  testing::TempDir dir;
+  SynthOptions synth;
+  synth.scene = SmallScene().scene;
+  synth.scene.frame_count = 5;
+  synth.out = dir.file("run.avi");
+  synth.quiet = true;
+  std::vector<SceneTruth> truths;
+  RunSynth(synth, &truths);
+  // A hand-made truth: only red and green, in another column order, green 5 px off in frame 2,
+  // red hidden (empty) in frame 3, and no row for frame 4.
+  std::ofstream truth(dir.file("truth.csv"));
+  truth << "green_y,green_x,frame,red_x,red_y\n";
+  for (int i = 0; i < 4; ++i) {
+    const cv::Point2d r = *truths[i].markers[0].centroid_px, g = *truths[i].markers[2].centroid_px;
+    truth << (g.y + (i == 2 ? 5.0 : 0.0)) << "," << g.x << "," << i << ",";
+    if (i == 3) {
+      truth << ",\n";
+    } else {
+      truth << r.x << "," << r.y << "\n";
+    }
+  }
+  truth.close();
+  TrackingConfig config;
+  for (const SceneMarker& m : synth.scene.markers) {
+    MarkerSpec spec;
+    spec.name = m.name;
+    spec.colour = EvaluateMethodConfig("colour", std::nullopt, SmallScene(), truths[0])
+                      .markers[config.markers.size()]
+                      .colour;
+    config.markers.push_back(spec);
+  }
+  SaveTrackingConfig(config, dir.file("config.yaml"));
+  VideoEvaluateOptions video;
+  video.source.input = synth.out;
+  video.truth_csv = dir.file("truth.csv");
+  video.config_file = dir.file("config.yaml");
+  video.quiet = true;
+  const EvaluateReport report = RunVideoEvaluate(video);
+  EXPECT_EQ(report.frames, 4);
+  const MethodResult& m = report.methods.at(0);
+  EXPECT_EQ(m.visible, 7);          // red in frames 0-2, green in 0-3.
+  EXPECT_EQ(m.hidden, 1);           // red in frame 3, by the truth ...
+  EXPECT_EQ(m.false_reports, 1);    // ... but it is there and found.
+  EXPECT_EQ(m.wrong_finds, 1);      // green in frame 2.
+  EXPECT_THAT(report.conditions, ::testing::HasSubstr("not in the truth (not scored): blue"));
+
+  // A truth without any of the config's markers, or without frame numbers: one error each.
+  testing::WriteTextFile(dir.file("bad.csv"), "frame,tip_x,tip_y\n0,1,2\n");
+  video.truth_csv = dir.file("bad.csv");
+  EXPECT_THROW(RunVideoEvaluate(video), InputError);
+  testing::WriteTextFile(dir.file("bad2.csv"), "red_x,red_y\n1,2\n");
+  video.truth_csv = dir.file("bad2.csv");
+  EXPECT_THROW(RunVideoEvaluate(video), InputError);
 }
 
 }  // namespace

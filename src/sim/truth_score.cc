@@ -44,6 +44,8 @@ void TruthScorer::add(const SceneTruth& truth, const FrameResult& result) {
         const cv::Point2d residual = error - *offsets_[i];
         const double precise = std::hypot(residual.x, residual.y);
         squared_ += absolute * absolute;
+        errors_.push_back(absolute);
+        if (absolute > kWrongFindPx) ++counts_.wrong_finds;
         precise_squared_ += precise * precise;
         max_ = std::max(max_, absolute);
         precise_max_ = std::max(precise_max_, precise);
@@ -67,6 +69,10 @@ TruthScore TruthScorer::score() const {
     const double n = static_cast<double>(score.found_visible);
     score.centroid_rms_px = std::sqrt(squared_ / n);
     score.centroid_max_px = max_;
+    std::vector<double> sorted = errors_;
+    const size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(sorted.size())));
+    std::nth_element(sorted.begin(), sorted.begin() + (rank - 1), sorted.end());
+    score.centroid_p95_px = sorted[rank - 1];
     score.precision_rms_px = std::sqrt(precise_squared_ / n);
     score.precision_max_px = precise_max_;
   }

@@ -50,9 +50,25 @@ TEST(TruthScorer, CountsAndErrorsOverFrames) {
   EXPECT_EQ(score.false_reports, 1);
   EXPECT_DOUBLE_EQ(*score.centroid_rms_px, 5.0);
   EXPECT_DOUBLE_EQ(*score.centroid_max_px, 5.0);
+  EXPECT_DOUBLE_EQ(*score.centroid_p95_px, 5.0);
+  EXPECT_EQ(score.wrong_finds, 2) << "5 px off is farther than kWrongFindPx";
   EXPECT_DOUBLE_EQ(*score.precision_rms_px, 0.0) << "a constant offset is not imprecision";
   EXPECT_EQ(score.angle_frames, 1);
   EXPECT_DOUBLE_EQ(*score.angle_rms_deg, 1.0);
+}
+
+TEST(TruthScorer, P95IsTheNearestRankOfTheHitErrors) {
+  TruthScorer scorer(1);
+  SceneTruth truth;
+  truth.markers = {Truth(0, 0, 1.0)};
+  FrameResult result;
+  for (int i = 1; i <= 40; ++i) {  // Errors 0.1, 0.2, ... 4.0 px.
+    result.markers = {{"a", Found(0.1 * i, 0)}};
+    scorer.add(truth, result);
+  }
+  const TruthScore score = scorer.score();
+  EXPECT_NEAR(*score.centroid_p95_px, 3.8, 1e-9);  // The 38th of 40.
+  EXPECT_EQ(score.wrong_finds, 10);                 // 3.1 .. 4.0 px.
 }
 
 TEST(TruthScorer, NothingFoundLeavesTheErrorsAbsent) {

@@ -19,6 +19,9 @@
 namespace softsight {
 
 inline constexpr double kMustFindVisibleFraction = 0.5;
+// A hit farther than this from the truth is a wrong find: the marker was reported found, but not
+// where it is (the worst defect a tracker can have).
+inline constexpr double kWrongFindPx = 3.0;
 
 enum class TruthVerdict {
   kHit,          // Visible enough and found (its error counts).
@@ -40,6 +43,8 @@ struct TruthScore {
   // |tracked - true centroid| over the hits; absent without hits.
   std::optional<double> centroid_rms_px;
   std::optional<double> centroid_max_px;
+  std::optional<double> centroid_p95_px;  // 95th percentile (nearest rank) of the same errors.
+  int64_t wrong_finds = 0;                // Hits farther than kWrongFindPx from the truth.
   // The same after subtracting, per marker, the constant offset (tracked - true) of its first
   // hit: what remains once the half-pixel placement of a dragged template is taken out.
   std::optional<double> precision_rms_px;
@@ -62,6 +67,7 @@ class TruthScorer {
  private:
   TruthScore counts_;
   std::vector<std::optional<cv::Point2d>> offsets_;  // Per marker: tracked - true, first hit.
+  std::vector<double> errors_;                       // |tracked - true| of every hit, for p95.
   double squared_ = 0, precise_squared_ = 0, max_ = 0, precise_max_ = 0;
   double angle_squared_ = 0, angle_max_ = 0;
 };
