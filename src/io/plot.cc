@@ -84,15 +84,16 @@ struct Range {
 };
 
 // Rows where both time and value are present, split into unbroken runs.
-std::vector<std::vector<cv::Point2d>> Runs(const CsvTable& table, size_t time_column,
+std::vector<std::vector<cv::Point2d>> Runs(const PlotData& data, const PlotLayout& layout,
                                            const PlotPanel& panel, const PlotSeries& series) {
   std::vector<std::vector<cv::Point2d>> runs;
   std::vector<cv::Point2d> run;
-  const auto& t = table.values[time_column];
-  const auto& v = table.values[series.column];
+  const CsvTable& table = data.table(series.table);
+  const auto& t = table.values[layout.time_columns[series.table]];
   for (size_t row = 0; row < table.row_count(); ++row) {
-    if (t[row] && v[row]) {
-      run.push_back(panel.to_pixel(*t[row], *v[row]));
+    const std::optional<double> v = PlotSeriesValue(table, series, row);
+    if (t[row] && v) {
+      run.push_back(panel.to_pixel(*t[row], *v));
     } else if (!run.empty()) {
       runs.push_back(std::move(run));
       run.clear();
@@ -102,61 +103,187 @@ std::vector<std::vector<cv::Point2d>> Runs(const CsvTable& table, size_t time_co
   return runs;
 }
 
+PlotSeries Series(std::string label, size_t column, const cv::Scalar& bgr, size_t table) {
+  PlotSeries series;
+  series.label = std::move(label);
+  series.column = column;
+  series.bgr = bgr;
+  series.table = table;
+  return series;
+}
+
 PlotPanel MakePanel(std::string y_label) {
   PlotPanel panel;
   panel.y_label = std::move(y_label);
   return panel;
 }
 
-// The panels the table supports, in Figure 4's order, then the controller's.
-std::vector<PlotPanel> ChoosePanels(const CsvTable& table) {
-  std::vector<PlotPanel> panels;
-  const auto angle = table.find("angle_deg");
-  const auto target = table.find("target_deg");
-  const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
-  if (angle || target) {
+const char* const kPanelKinds[] = {"angle", "bending", "arc", "radius", "xy", "control"};
+const char* const kDefaultPanels[] = {"angle", "bending", "arc", "control"};
+// The live overlay's "straight" (gui/overlay.h, ReadsStraight): a radius of this many arc lengths
+// or more is mostly centroid noise and grows without bound as the actuator straightens, so the
+// radius panel leaves it out (a gap) rather than let it set the axis.
+constexpr double kStraightRadiusPerArcLength = 25.0;
+// One colour per run when several are overlaid; the truth is black.
+const cv::Scalar kRunColours[] = {kMeasured, kTarget, kBending, kArc, {0, 159, 230}, {233, 180, 86}};
+
+// How the series of table `t` are labelled and coloured: a single run keeps the names of the
+// quantities ("measured", "target"); overlaid runs are told apart by their file names.
+struct Legend {
+  const PlotData& data;
+  std::vector<std::string> names;  // Per table.
+  bool single() const { return data.table_count() == 1; }
+  bool is_truth(size_t t) const { return t >= data.runs.size(); }
+  std::string label(size_t t, const std::string& quantity) const {
+    if (single()) return quantity;
+    if (is_truth(t)) return quantity.empty() ? "truth" : "truth " + quantity;
+    return quantity.empty() ? names[t] : names[t] + " " + quantity;
+  }
+  cv::Scalar colour(size_t t, const cv::Scalar& single_colour) const {
+    if (single()) return single_colour;
+    if (is_truth(t)) return kBlack;
+    return kRunColours[t % std::size(kRunColours)];
+  }
+};
+
+std::string Stem(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const size_t dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name.erase(dot);
+  return name;
+}
+
+// A panel of one quantity: the column `stem`_mm when the first run has it (a metric model was
+// configured), else `stem`_px, from every table that has it.
+void AddLengthPanel(const PlotData& data, const Legend& legend, const std::string& stem,
+                    const std::string& label, const cv::Scalar& colour,
+                    std::vector<PlotPanel>* panels) {
+  const bool mm = data.runs.front().find(stem + "_mm").has_value();
+  const std::string column = stem + (mm ? "_mm" : "_px");
+  PlotPanel panel = MakePanel(WithUnit(label, mm ? "mm" : "px"));
+  panel.unit = mm ? "mm" : "px";
+  for (size_t t = 0; t < data.table_count(); ++t) {
+    const auto c = data.table(t).find(column);
+    if (!c) continue;
+    PlotSeries series = Series(legend.label(t, legend.single() ? label : ""), *c,
+                               legend.colour(t, colour), t);
+    if (stem == "radius") {
+      series.cap_column = data.table(t).find(std::string("arc_length") + (mm ? "_mm" : "_px"));
+      series.cap_factor = kStraightRadiusPerArcLength;
+    }
+    panel.series.push_back(series);
+  }
+  if (!panel.series.empty()) panels->push_back(panel);
+}
+
+// The panels of `kind`, appended to `panels`.
+void AddPanels(const std::string& kind, const PlotData& data, const Legend& legend,
+               std::vector<PlotPanel>* panels) {
+  const CsvTable& first = data.runs.front();
+  if (kind == "angle") {
     PlotPanel panel = MakePanel("angle [deg]");
-    if (target) panel.series.push_back({"target", *target, kTarget});
-    if (model) panel.series.push_back({"model", *model, kTarget});
-    if (angle) {
-      panel.series.push_back({target || model ? "measured" : "angle", *angle, kMeasured});
+    panel.unit = "deg";
+    for (size_t t = 0; t < data.table_count(); ++t) {
+      const CsvTable& table = data.table(t);
+      const auto angle = table.find("angle_deg");
+      const auto target = table.find("target_deg");
+      const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
+      if (target) panel.series.push_back(Series(legend.label(t, "target"), *target, kTarget, t));
+      if (model) panel.series.push_back(Series(legend.label(t, "model"), *model, kTarget, t));
+      if (angle) {
+        const std::string quantity = legend.single() ? (target || model ? "measured" : "angle") : "";
+        panel.series.push_back(Series(legend.label(t, quantity), *angle, legend.colour(t, kMeasured), t));
+      }
     }
-    panels.push_back(panel);
+    if (!panel.series.empty()) panels->push_back(panel);
+  } else if (kind == "bending") {
+    AddLengthPanel(data, legend, "tip_disp", "bending distance", kBending, panels);
+  } else if (kind == "arc") {
+    AddLengthPanel(data, legend, "arc_length", "arc length", kArc, panels);
+  } else if (kind == "radius") {
+    // Empty fields (a straight actuator has no radius) are gaps, as everywhere.
+    AddLengthPanel(data, legend, "radius", "radius of curvature", kMeasured, panels);
+  } else if (kind == "xy") {
+    // The markers of the first run, in its column order: one panel for x, one for y each.
+    for (const std::string& column : first.columns) {
+      if (column.size() < 3 || column.compare(column.size() - 2, 2, "_x") != 0) continue;
+      const std::string name = column.substr(0, column.size() - 2);
+      if (!first.find(name + "_y")) continue;
+      for (const char* axis : {"_x", "_y"}) {
+        PlotPanel panel = MakePanel(name + " " + (axis + 1) + " [px]");
+        panel.unit = "px";
+        for (size_t t = 0; t < data.table_count(); ++t) {
+          const auto c = data.table(t).find(name + axis);
+          if (c) panel.series.push_back(Series(legend.label(t, legend.single() ? name + " " + (axis + 1) : ""),
+                                         *c, legend.colour(t, kMeasured), t));
+        }
+        panels->push_back(panel);
+      }
+    }
+  } else if (kind == "control") {
+    // Controller columns: every pressure (a name with "pressure" or a pressure unit, such as
+    // `softsight control`'s setpoint_kpa and board_pressure_kpa) in one panel, every duty*
+    // column in another.
+    const auto is_pressure = [](const std::string& column) {
+      const std::string unit = UnitOf(column);
+      return column.find("pressure") != std::string::npos || unit == "kPa" || unit == "Pa" ||
+             unit == "mbar" || unit == "bar" || unit == "psi";
+    };
+    const auto is_duty = [](const std::string& column) { return StartsWith(column, "duty"); };
+    const std::pair<const char*, bool (*)(const std::string&)> kControllerPanels[] = {
+        {"pressure", +is_pressure}, {"duty", +is_duty}};
+    for (const auto& [label, belongs] : kControllerPanels) {
+      PlotPanel panel;
+      std::string unit;
+      for (size_t t = 0; t < data.runs.size(); ++t) {
+        const CsvTable& table = data.runs[t];
+        for (size_t c = 0; c < table.columns.size(); ++c) {
+          if (!belongs(table.columns[c])) continue;
+          if (panel.series.empty()) unit = UnitOf(table.columns[c]);
+          const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
+          panel.series.push_back(Series(legend.label(t, table.columns[c]), c, colour, t));
+        }
+      }
+      if (!panel.series.empty()) {
+        panel.y_label = WithUnit(label, unit);
+        panel.unit = unit;
+        panels->push_back(panel);
+      }
+    }
   }
-  // Millimetres when the CSV has them (a metric model was configured), pixels otherwise.
-  for (const auto& [stem, label, colour] : {std::tuple{"tip_disp", "bending distance", kBending},
-                                            std::tuple{"arc_length", "arc length", kArc}}) {
-    const auto mm = table.find(std::string(stem) + "_mm");
-    const auto px = table.find(std::string(stem) + "_px");
-    if (mm || px) {
-      PlotPanel panel = MakePanel(WithUnit(label, mm ? "mm" : "px"));
-      panel.series.push_back({label, mm ? *mm : *px, colour});
-      panels.push_back(panel);
+}
+
+// The panels asked for (or the default ones the tables support), top to bottom.
+std::vector<PlotPanel> ChoosePanels(const PlotData& data, const PlotOptions& options) {
+  Legend legend{data, {}};
+  for (size_t t = 0; t < data.table_count(); ++t) legend.names.push_back(Stem(data.table(t).source));
+  for (size_t t = 0; t < data.runs.size(); ++t) {
+    for (size_t u = 0; u < t; ++u) {
+      if (legend.names[t] == legend.names[u]) legend.names[t] = data.runs[t].source;  // Same stem.
     }
   }
-  // Controller columns: every pressure (a name with "pressure" or a pressure unit, such as
-  // `softsight control`'s setpoint_kpa and board_pressure_kpa) in one panel, every duty* column
-  // in another.
-  const auto is_pressure = [](const std::string& column) {
-    const std::string unit = UnitOf(column);
-    return column.find("pressure") != std::string::npos || unit == "kPa" || unit == "Pa" ||
-           unit == "mbar" || unit == "bar" || unit == "psi";
-  };
-  const auto is_duty = [](const std::string& column) { return StartsWith(column, "duty"); };
-  const std::pair<const char*, bool (*)(const std::string&)> kControllerPanels[] = {
-      {"pressure", +is_pressure}, {"duty", +is_duty}};
-  for (const auto& [label, belongs] : kControllerPanels) {
-    PlotPanel panel;
-    std::string unit;
-    for (size_t c = 0; c < table.columns.size(); ++c) {
-      if (!belongs(table.columns[c])) continue;
-      if (panel.series.empty()) unit = UnitOf(table.columns[c]);
-      const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
-      panel.series.push_back({table.columns[c], c, colour});
+  std::vector<PlotPanel> panels;
+  if (options.panels.empty()) {
+    for (const char* kind : kDefaultPanels) AddPanels(kind, data, legend, &panels);
+    return panels;
+  }
+  for (const std::string& kind : options.panels) {
+    if (std::find(std::begin(kPanelKinds), std::end(kPanelKinds), kind) == std::end(kPanelKinds)) {
+      throw InputError("--panels: unknown panel '" + kind + "' (choose " + PlotPanelNames() + ")");
     }
-    if (!panel.series.empty()) {
-      panel.y_label = WithUnit(label, unit);
-      panels.push_back(panel);
+    const size_t before = panels.size();
+    AddPanels(kind, data, legend, &panels);
+    if (panels.size() == before) {
+      throw InputError("--panels " + kind + ": " + data.runs.front().source +
+                       " has no column for it (" +
+                       (kind == "xy" ? std::string("<name>_x and <name>_y")
+                        : kind == "radius" ? std::string("radius_px")
+                        : kind == "angle" ? std::string("angle_deg")
+                        : kind == "bending" ? std::string("tip_disp_px")
+                        : kind == "arc" ? std::string("arc_length_px")
+                                        : std::string("pressure or duty columns")) +
+                       ")");
     }
   }
   return panels;
@@ -255,33 +382,58 @@ std::string FormatTick(double value, double step) {
   return text;
 }
 
+std::optional<double> PlotSeriesValue(const CsvTable& table, const PlotSeries& series, size_t row) {
+  const std::optional<double>& v = table.values[series.column][row];
+  if (!v || !series.cap_column) return v;
+  const std::optional<double>& cap = table.values[*series.cap_column][row];
+  if (cap && *v >= series.cap_factor * *cap) return std::nullopt;
+  return v;
+}
+
+const char* PlotPanelNames() { return "angle, bending, arc, radius, xy, control"; }
+
 PlotLayout ComputePlotLayout(const CsvTable& table, const PlotOptions& options) {
+  return ComputePlotLayout(PlotData{{table}, std::nullopt}, options);
+}
+
+PlotLayout ComputePlotLayout(const PlotData& data, const PlotOptions& options) {
   std::string error;
   if (!options.Check(&error)) throw InputError("plot options: " + error);
-  const auto time_column = table.find("time_s");
-  if (!time_column) throw InputError(table.source + ": no time_s column to plot against");
-  if (table.row_count() == 0) throw InputError(table.source + ": no rows to plot");
-
+  if (data.runs.empty()) throw InputError("plot: no CSV to plot");
   PlotLayout layout;
-  layout.time_column = *time_column;
-  layout.panels = ChoosePanels(table);
+  Range time;
+  for (size_t t = 0; t < data.table_count(); ++t) {
+    const CsvTable& table = data.table(t);
+    const auto time_column = table.find("time_s");
+    if (!time_column) throw InputError(table.source + ": no time_s column to plot against");
+    if (table.row_count() == 0) throw InputError(table.source + ": no rows to plot");
+    layout.time_columns.push_back(*time_column);
+    bool any = false;
+    for (const auto& value : table.values[*time_column]) {
+      if (value) {
+        time.add(*value);
+        any = true;
+      }
+    }
+    if (!any) throw InputError(table.source + ": every time_s value is empty");
+  }
+  layout.time_column = layout.time_columns.front();
+  layout.panels = ChoosePanels(data, options);
   if (layout.panels.empty()) {
-    throw InputError(table.source +
+    throw InputError(data.runs.front().source +
                      ": nothing to plot (no angle_deg, tip_disp_*, arc_length_*, target_deg, "
                      "pressure* or duty* column)");
   }
   if (options.title.empty()) {
-    const size_t slash = table.source.find_last_of('/');
-    layout.title = slash == std::string::npos ? table.source : table.source.substr(slash + 1);
+    for (const CsvTable& run : data.runs) {
+      const size_t slash = run.source.find_last_of('/');
+      layout.title += (layout.title.empty() ? "" : ", ") +
+                      (slash == std::string::npos ? run.source : run.source.substr(slash + 1));
+    }
+    if (data.truth) layout.title += " vs truth";
   } else {
     layout.title = options.title;
   }
-
-  Range time;
-  for (const auto& t : table.values[*time_column]) {
-    if (t) time.add(*t);
-  }
-  if (time.empty()) throw InputError(table.source + ": every time_s value is empty");
   if (time.hi - time.lo < 1e-9) {  // One instant: centre it in a one-second axis.
     time.lo -= 0.5;
     time.hi += 0.5;
@@ -302,15 +454,27 @@ PlotLayout ComputePlotLayout(const CsvTable& table, const PlotOptions& options) 
 
     Range values;
     for (const PlotSeries& series : panel.series) {
+      const CsvTable& table = data.table(series.table);
+      const auto& t = table.values[layout.time_columns[series.table]];
       for (size_t row = 0; row < table.row_count(); ++row) {
-        const auto& v = table.values[series.column][row];
-        if (v && table.values[*time_column][row]) values.add(*v);
+        const std::optional<double> v = PlotSeriesValue(table, series, row);
+        if (v && t[row]) values.add(*v);
       }
     }
     panel.has_data = !values.empty();
+    // The smallest span the axis may have: below it, the curve would show the tracker's noise
+    // as if it were motion (a steady arc length jittering by 0.1 px over the whole panel).
+    const double min_span = panel.unit == "px"    ? options.min_span_px
+                            : panel.unit == "deg" ? options.min_span_deg
+                            : panel.unit == "mm"  ? options.min_span_mm
+                                                  : 0.0;
     if (!panel.has_data) {
       values.lo = 0.0;
       values.hi = 1.0;
+    } else if (values.hi - values.lo < min_span) {
+      const double centre = 0.5 * (values.lo + values.hi);
+      values.lo = centre - 0.5 * min_span;
+      values.hi = centre + 0.5 * min_span;
     } else if (values.hi - values.lo < 1e-9) {
       const double pad = std::max(1.0, std::abs(values.lo) * 0.05);
       values.lo -= pad;
@@ -327,6 +491,14 @@ PlotLayout ComputePlotLayout(const CsvTable& table, const PlotOptions& options) 
 }
 
 cv::Mat RenderPlotImage(const CsvTable& table, const PlotLayout& layout) {
+  return RenderPlotImage(PlotData{{table}, std::nullopt}, layout);
+}
+
+std::string RenderPlotSvg(const CsvTable& table, const PlotLayout& layout) {
+  return RenderPlotSvg(PlotData{{table}, std::nullopt}, layout);
+}
+
+cv::Mat RenderPlotImage(const PlotData& data, const PlotLayout& layout) {
   cv::Mat image(layout.size, CV_8UC3, kWhite);
   Text(image, layout.title, {layout.size.width / 2, kTitleHeight / 2}, 0.5, 0.6, 1);
   for (size_t p = 0; p < layout.panels.size(); ++p) {
@@ -370,7 +542,7 @@ cv::Mat RenderPlotImage(const CsvTable& table, const PlotLayout& layout) {
     cv::Mat area = image(r);
     constexpr int kShift = 4;
     for (const PlotSeries& series : panel.series) {
-      for (const auto& run : Runs(table, layout.time_column, panel, series)) {
+      for (const auto& run : Runs(data, layout, panel, series)) {
         std::vector<cv::Point> points;
         points.reserve(run.size());
         for (const cv::Point2d& p : run) {
@@ -392,7 +564,7 @@ cv::Mat RenderPlotImage(const CsvTable& table, const PlotLayout& layout) {
   return image;
 }
 
-std::string RenderPlotSvg(const CsvTable& table, const PlotLayout& layout) {
+std::string RenderPlotSvg(const PlotData& data, const PlotLayout& layout) {
   std::ostringstream svg;
   const int w = layout.size.width, h = layout.size.height;
   svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -442,7 +614,7 @@ std::string RenderPlotSvg(const CsvTable& table, const PlotLayout& layout) {
     }
     for (const PlotSeries& series : panel.series) {
       const std::string colour = SvgColour(series.bgr);
-      for (const auto& run : Runs(table, layout.time_column, panel, series)) {
+      for (const auto& run : Runs(data, layout, panel, series)) {
         if (run.size() == 1) {
           svg << "<circle cx=\"" << Num(run[0].x) << "\" cy=\"" << Num(run[0].y)
               << "\" r=\"3\" fill=\"" << colour << "\"/>\n";
@@ -469,8 +641,16 @@ std::string RenderPlotSvg(const CsvTable& table, const PlotLayout& layout) {
 
 void WritePlot(const std::string& csv_file, const std::string& out_file,
                const PlotOptions& options) {
-  const CsvTable table = ReadCsvTable(csv_file);
-  const PlotLayout layout = ComputePlotLayout(table, options);
+  WritePlot(std::vector<std::string>{csv_file}, std::nullopt, out_file, options);
+}
+
+void WritePlot(const std::vector<std::string>& csv_files,
+               const std::optional<std::string>& truth_file, const std::string& out_file,
+               const PlotOptions& options) {
+  PlotData data;
+  for (const std::string& file : csv_files) data.runs.push_back(ReadCsvTable(file));
+  if (truth_file) data.truth = ReadCsvTable(*truth_file);
+  const PlotLayout layout = ComputePlotLayout(data, options);
   std::string extension;
   const size_t dot = out_file.find_last_of('.');
   if (dot != std::string::npos && out_file.find('/', dot) == std::string::npos) {
@@ -480,7 +660,7 @@ void WritePlot(const std::string& csv_file, const std::string& out_file,
   }
   if (extension == "svg") {
     std::ofstream out(out_file);
-    out << RenderPlotSvg(table, layout);
+    out << RenderPlotSvg(data, layout);
     out.close();
     if (!out) throw InputError(out_file + ": cannot write SVG (" + std::strerror(errno) + ")");
     return;
@@ -491,7 +671,7 @@ void WritePlot(const std::string& csv_file, const std::string& out_file,
   }
   bool written = false;
   try {
-    written = cv::imwrite(out_file, RenderPlotImage(table, layout));
+    written = cv::imwrite(out_file, RenderPlotImage(data, layout));
   } catch (const cv::Exception&) {
     written = false;
   }
