@@ -123,6 +123,70 @@ TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
   EXPECT_GT(std::stod(last[pressure]), 20.0);
 }
 
+// The summary's step figures (rise, settling +-1 / +-2 deg, overshoot, steady-state error, RMS
+// error) are those of the run's own angle: recomputed from the CSV they agree, they are printed,
+// and --metrics-csv writes them.
+TEST(ControlCommand, SimulatedStepSummaryGivesRiseSettlingOvershootSteadyStateAndRms) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  ControlOptions options;
+  options.config_file = dir.file("rig.yaml");
+  options.simulate = true;
+  options.target_deg = 120.0;
+  options.duration_s = 4.0;
+  options.csv_file = dir.file("run.csv");
+  options.metrics_csv_file = dir.file("metrics.csv");
+  options.quiet = true;
+  const ControlSummary summary = RunControl(options);
+  const StepMetrics& m = summary.metrics;
+  ASSERT_TRUE(m.rise_time_s && m.settling_1deg_s && m.settling_2deg_s && m.overshoot_percent &&
+              m.steady_state_error_deg && m.rms_error_deg)
+      << FormatStepMetrics(m);
+  std::printf("simulated step 180 -> 120 deg: %s\n", FormatStepMetrics(m).c_str());
+  // A step from straight: rises, settles within +-2 deg no later than within +-1 deg, under 3 s.
+  EXPECT_NEAR(*m.step_to_deg, 120.0, 1e-9);
+  EXPECT_GT(*m.step_from_deg, 170.0);
+  EXPECT_GT(*m.rise_time_s, 0.0);
+  EXPECT_LE(*m.settling_2deg_s, *m.settling_1deg_s);
+  EXPECT_LT(*m.settling_1deg_s, 3.0);
+  EXPECT_LT(*m.overshoot_percent, 10.0);
+  EXPECT_LT(std::abs(*m.steady_state_error_deg), 1.0);
+
+  // The same figures from the CSV's columns.
+  const std::vector<std::string> lines = ReadLines(options.csv_file);
+  const std::vector<std::string> header = SplitCsv(lines[0]);
+  auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const size_t time = column("time_s"), angle = column("angle_deg"), target = column("target_deg");
+  std::vector<TrackingPoint> points;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = SplitCsv(lines[i]);
+    TrackingPoint p;
+    p.time_s = std::stod(row[time]);
+    p.target_deg = std::stod(row[target]);
+    if (!row[angle].empty()) p.measured_deg = std::stod(row[angle]);
+    points.push_back(p);
+  }
+  const StepMetrics again = ComputeStepMetrics(points);
+  // The CSV's numbers are rounded: figures agree to the CSV's precision (times to a frame).
+  EXPECT_NEAR(*again.rise_time_s, *m.rise_time_s, 1e-3);
+  EXPECT_NEAR(*again.settling_1deg_s, *m.settling_1deg_s, 1.0 / 30);
+  EXPECT_NEAR(*again.settling_2deg_s, *m.settling_2deg_s, 1.0 / 30);
+  EXPECT_NEAR(*again.overshoot_percent, *m.overshoot_percent, 1e-2);
+  EXPECT_NEAR(*again.steady_state_error_deg, *m.steady_state_error_deg, 1e-3);
+  EXPECT_NEAR(*again.rms_error_deg, *m.rms_error_deg, 1e-3);
+
+  const std::string printed = FormatControlSummary(summary);
+  for (const char* figure : {"rise (10-90 %)", "settling +-1 deg", "+-2 deg", "overshoot",
+                             "steady-state error", "RMS error"}) {
+    EXPECT_NE(printed.find(figure), std::string::npos) << figure << " in\n" << printed;
+  }
+  const std::vector<std::string> metrics = ReadLines(options.metrics_csv_file);
+  ASSERT_EQ(metrics.size(), 2u);
+  EXPECT_EQ(metrics[0].rfind("step_time_s,", 0), 0u);
+}
+
 TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
   ControlOptions options;
   options.config_file = Example();
