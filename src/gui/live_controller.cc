@@ -8,6 +8,7 @@
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
+#include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/live_recording.h"
 #include "gui/live_view.h"
@@ -112,8 +113,10 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   const FrameResult& result = session_->process(frame);
   chart_.add(result);
   if (order != FrameOrder::kNext) {
-    // A frame the user stepped or seeked to: no figure of the playing rate.
+    // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
+    // (stdout too, for the terminal and for scripts driving the window).
     record_frame(frame, result);
+    say("frame " + std::to_string(frame.index) + " (" + Number(frame.time_s, 3) + " s)");
     return;
   }
 
@@ -418,14 +421,16 @@ void LiveController::scale_point(const cv::Point2d& p) {
       (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
 }
 
-void LiveController::draw_scale_points(cv::Mat& top) const {
-  for (const cv::Point2d& p : scale_clicks_) {
+void LiveController::draw_scale_points(cv::Mat& top, const LiveLayout& view) const {
+  for (const cv::Point2d& clicked : scale_clicks_) {
+    const cv::Point2d p = view.to_view(clicked);
     cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS, 15,
                    1, cv::LINE_AA);
   }
   if (const auto& pointer = pointer_->pointer(); scale_clicks_.size() == 1 && pointer) {
-    cv::line(top, cv::Point(cvRound(scale_clicks_[0].x), cvRound(scale_clicks_[0].y)),
-             cv::Point(cvRound(pointer->x), cvRound(pointer->y)), kScaleColour, 1, cv::LINE_AA);
+    const cv::Point2d a = view.to_view(scale_clicks_[0]), b = view.to_view(*pointer);
+    cv::line(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+             kScaleColour, 1, cv::LINE_AA);
   }
 }
 
@@ -508,20 +513,44 @@ void LiveController::record_frame(const Frame& frame, const FrameResult& result)
   }
 }
 
+void LiveController::set_screen(cv::Size screen_px) {
+  max_canvas_ = screen_px.area() > 0 ? MaxCanvasForScreen(screen_px) : cv::Size();
+  dirty_ = true;
+}
+
+LiveLayout LiveController::layout() const {
+  const cv::Size image_size = frame_.empty() ? cv::Size(640, 480) : frame_.size();
+  const int help_width = help_ ? HelpPanelWidth() : 0;
+  return ComputeLiveLayout(image_size, options_.chart.height_px, help_width, max_canvas_);
+}
+
+cv::Point2d LiveController::to_view(const cv::Point2d& image_px) const {
+  return layout().to_view(image_px);
+}
+
+cv::Point2d LiveController::to_image(const cv::Point2d& view_px) const {
+  return layout().to_image(view_px);
+}
+
 void LiveController::on_event(const UiEvent& event) {
   using Type = UiEvent::Type;
-  const bool in_image = event.position_px.x >= 0 && event.position_px.y >= 0 &&
-                        event.position_px.x < frame_.cols && event.position_px.y < frame_.rows;
+  // The pointer works in image pixels: the canvas may show the image scaled down.
+  const LiveLayout view = layout();
+  const cv::Point2d at = view.to_image(event.position_px);
+  const bool in_image = view.image.contains(cv::Point(cvFloor(event.position_px.x),
+                                                      cvFloor(event.position_px.y))) &&
+                        at.x >= -0.5 && at.y >= -0.5 && at.x < frame_.cols - 0.5 &&
+                        at.y < frame_.rows - 0.5;
   switch (event.type) {
     case Type::kMouseDown:
-      if (pointer_->down(event.position_px, in_image)) dirty_ = true;
+      if (pointer_->down(at, in_image)) dirty_ = true;
       break;
     case Type::kMouseMove:
       // In scale mode the pointer is followed without a button too: the line to the first point.
-      if (pointer_->move(event.position_px, scale_mode_)) dirty_ = true;
+      if (pointer_->move(at, scale_mode_)) dirty_ = true;
       break;
     case Type::kMouseUp: {
-      const PointerGesture gesture = pointer_->up(event.position_px, in_image);
+      const PointerGesture gesture = pointer_->up(at, in_image);
       if (gesture.kind == PointerGesture::Kind::kNone) break;
       dirty_ = true;
       if (scale_mode_) {
@@ -618,16 +647,18 @@ void LiveController::on_event(const UiEvent& event) {
 
 const cv::Mat& LiveController::canvas() {
   if (!dirty_ && !canvas_.empty()) return canvas_;
-  const cv::Size image_size = frame_.empty() ? cv::Size(640, 480) : frame_.size();
-  canvas_.create(image_size.height + options_.chart.height_px, image_size.width, CV_8UC3);
-  cv::Mat top = canvas_(cv::Rect(0, 0, image_size.width, image_size.height));
+  const LiveLayout view = layout();
+  canvas_.create(view.canvas, CV_8UC3);
+  cv::Mat top = canvas_(view.image);
   if (annotated_.empty()) {
     top.setTo(cv::Scalar(0, 0, 0));
     cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
                 cv::LINE_AA);
-  } else {
+  } else if (view.image.size() == annotated_.size()) {
     // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
     annotated_.copyTo(top);
+  } else {
+    cv::resize(annotated_, top, view.image.size(), 0, 0, cv::INTER_AREA);
   }
   std::vector<std::string> lines;
   std::string state;
@@ -641,23 +672,28 @@ const cv::Mat& LiveController::canvas() {
   if (const auto& scale = config().measure.metric.scale_mm_per_px) {
     state += "  " + Number(*scale, 4) + " mm/px";
   }
+  if (view.image.size() != view.image_px) {
+    state += "  view " + std::to_string(cvRound(100 * view.scale_x())) + "%";
+  }
   lines.push_back(state);
   if (!message_.empty()) lines.push_back(message_);
   // The hint stays while picking, whatever other keys say meanwhile.
   if (scale_mode_ && message_ != scale_hint()) lines.push_back(scale_hint());
   DrawStatusLines(top, lines, recording_ != nullptr);
   if (scale_mode_) {
-    draw_scale_points(top);
+    draw_scale_points(top, view);
   } else if (pointer_->press() && pointer_->pointer()) {
-    const cv::Point2d& a = *pointer_->press();
-    const cv::Point2d& b = *pointer_->pointer();
+    const cv::Point2d a = view.to_view(*pointer_->press());
+    const cv::Point2d b = view.to_view(*pointer_->pointer());
     cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
                   kDragColour, 1);
   }
-  if (help_) DrawLiveHelp(top);
-  cv::Mat bottom =
-      canvas_(cv::Rect(0, image_size.height, image_size.width, options_.chart.height_px));
+  cv::Mat bottom = canvas_(view.chart);
   chart_.draw(bottom);
+  if (!view.help.empty()) {
+    cv::Mat panel = canvas_(view.help);
+    DrawHelpPanel(panel);
+  }
   dirty_ = false;
   return canvas_;
 }

@@ -6,10 +6,12 @@
 
 #include <filesystem>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "softsight/core/error.h"
 #include "gui/live_feed.h"
+#include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
@@ -233,7 +235,19 @@ TEST_F(LiveControllerTest, KeysPauseHelpSelectAndQuit) {
   const cv::Mat without_help = live.canvas().clone();
   live.on_event(UiEvent::Key('h'));
   EXPECT_TRUE(live.help_shown());
-  EXPECT_GT(cv::norm(live.canvas(), without_help, cv::NORM_L1), 0);  // The help is drawn.
+  // The help is a panel beside the image and chart: the image (and every marker on it) stays
+  // as it was, the panel holds text.
+  const cv::Mat& with_help = live.canvas();
+  ASSERT_EQ(with_help.rows, without_help.rows);
+  ASSERT_GT(with_help.cols, without_help.cols + 150);
+  EXPECT_EQ(cv::norm(with_help(cv::Rect(0, 0, 320, 240)), without_help(cv::Rect(0, 0, 320, 240)),
+                     cv::NORM_L1),
+            0);
+  cv::Mat panel_gray;
+  cv::cvtColor(with_help(cv::Rect(without_help.cols, 0, with_help.cols - without_help.cols,
+                                  with_help.rows)),
+               panel_gray, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(panel_gray > 200), 300);  // The key list's text.
 
   live.on_event(UiEvent::Key('9'));
   EXPECT_EQ(live.active_marker(), 0);
@@ -709,6 +723,88 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
+}
+
+TEST(LiveLayout, AFrameFitsTheScreenAndCanvasPixelsMapBackToImagePixels) {
+  // 1280x720 with the 180 px chart and the help panel on a 1366x768 laptop screen.
+  const cv::Size screen(1366, 768);
+  const cv::Size max_canvas = MaxCanvasForScreen(screen);
+  for (const bool help : {false, true}) {
+    const LiveLayout layout = ComputeLiveLayout({1280, 720}, 180, help ? 300 : 0, max_canvas);
+    EXPECT_LE(layout.canvas.width, screen.width - kScreenMarginWidthPx);
+    EXPECT_LE(layout.canvas.height, screen.height - kScreenMarginHeightPx);
+    EXPECT_LT(layout.scale_x(), 1.0);
+    EXPECT_NEAR(layout.scale_x(), layout.scale_y(), 0.01);  // Not distorted.
+    EXPECT_EQ(layout.chart.y, layout.image.height);
+    EXPECT_EQ(layout.help.empty(), !help);
+    // A canvas pixel's centre maps to the image point it shows, and back.
+    for (const cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(1279, 719), cv::Point2d(640.25, 77.5)}) {
+      const cv::Point2d back = layout.to_image(layout.to_view(p));
+      EXPECT_NEAR(back.x, p.x, 1e-9);
+      EXPECT_NEAR(back.y, p.y, 1e-9);
+    }
+    EXPECT_NEAR(layout.to_image({-0.5, -0.5}).x, -0.5, 1e-9);  // The image's corner.
+  }
+  // A small frame is never enlarged.
+  const LiveLayout small = ComputeLiveLayout({320, 240}, 180, 0, max_canvas);
+  EXPECT_EQ(small.image, cv::Rect(0, 0, 320, 240));
+  EXPECT_EQ(small.canvas, cv::Size(320, 420));
+}
+
+TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRightPixels) {
+  SceneOptions options;
+  options.size = cv::Size(1280, 720);
+  options.length_px = 480;
+  options.width_px = 60;
+  options.marker_radius_px = 18;
+  options.frame_count = 10;
+  SyntheticScene scene(options);
+  LiveOptions live_options;
+  live_options.save_config_path = (fs::temp_directory_path() / "softsight_fit_test.yaml").string();
+  LiveController live(SceneConfig(), live_options);
+  live.set_screen({1366, 768});
+  Frame frame;
+  SceneTruth truth;
+  for (int i = 0; i < 3; ++i) {
+    truth = scene.render(i, frame.image);
+    frame.index = i;
+    frame.time_s = truth.time_s;
+    live.on_frame(frame, SteadyClock::now());
+  }
+  for (const bool help : {false, true}) {
+    if (help) live.on_event(UiEvent::Key('h'));
+    const cv::Mat& canvas = live.canvas();
+    EXPECT_LE(canvas.cols, 1366 - kScreenMarginWidthPx) << "help " << help;
+    EXPECT_LE(canvas.rows, 768 - kScreenMarginHeightPx) << "help " << help;
+    // The rings are drawn where the found markers are, in canvas pixels (red and blue at least:
+    // this scene's green is darker than the test config's range).
+    ASSERT_TRUE(live.last_result()->markers[0].observation.found());
+    ASSERT_TRUE(live.last_result()->markers[1].observation.found());
+    for (const MarkerTruth& marker : truth.markers) {
+      if (!live.last_result()->markers[&marker - &truth.markers[0]].observation.found()) continue;
+      const cv::Point2d at = live.to_view(*marker.centroid_px);
+      EXPECT_LT(at.x, 1280 * 0.8);  // Scaled down.
+      EXPECT_GE(RingPoints(canvas, at, 12 * (at.x / marker.centroid_px->x)), 18) << marker.name;
+    }
+  }
+  // A click at blue's place on the scaled canvas: blue's colour is picked around the image pixel
+  // under the pointer (the search box is centred there, within a pixel).
+  const cv::Point2d blue = *truth.markers[1].centroid_px;
+  const cv::Point2d on_canvas = live.to_view(blue);
+  live.on_event(UiEvent::Mouse(Type::kMouseDown, std::round(on_canvas.x), std::round(on_canvas.y)));
+  live.on_event(UiEvent::Mouse(Type::kMouseUp, std::round(on_canvas.x), std::round(on_canvas.y)));
+  EXPECT_EQ(live.active_marker(), 1);
+  const MarkerSpec& spec = live.config().markers[1];
+  ASSERT_TRUE(spec.colour.roi) << live.message();
+  const cv::Point2d centre(spec.colour.roi->x + spec.colour.roi->width / 2.0,
+                           spec.colour.roi->y + spec.colour.roi->height / 2.0);
+  // Rounding the click to a canvas pixel moves it by up to half a canvas pixel, and the box is
+  // cut around the nearest image pixel.
+  const double scale = live.to_view({1, 0}).x - live.to_view({0, 0}).x;
+  EXPECT_NEAR(centre.x, blue.x, 0.5 / scale + 1.0) << live.message();
+  EXPECT_NEAR(centre.y, blue.y, 0.5 / scale + 1.0);
+  EXPECT_LT(spec.colour.h.lo, 107);  // Blue's hue, about 107.
+  EXPECT_GT(spec.colour.h.hi, 107);
 }
 
 class LivePlaybackTest : public LiveFileTest {

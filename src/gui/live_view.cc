@@ -23,39 +23,50 @@ void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool f
   }
 }
 
-void DrawLiveHelp(cv::Mat& top) {
-  const cv::Size image_size = top.size();
-  // The key list, scaled down until it fits the image, centred on a darkened block.
-  std::vector<std::string> help;
+namespace {
+
+constexpr double kHelpScale = 0.42;
+constexpr int kHelpLine = 17;    // px between lines at kHelpScale.
+constexpr int kHelpKeyColumn = 58;  // px for the key names at kHelpScale.
+constexpr int kHelpMargin = 8;
+
+std::string KeyName(int key) {
+  switch (key) {
+    case 0:
+      return "mouse";
+    case ' ':
+      return "space";
+    default:
+      return std::string(1, static_cast<char>(key));
+  }
+}
+
+}  // namespace
+
+int HelpPanelWidth() {
+  int width = 0, baseline = 0;
   for (const LiveKey& k : kLiveKeys) {
-    std::string text = k.key == ' ' ? "space  "
-                       : k.key != 0 ? std::string(1, char(k.key)) + "  "
-                                    : "";
-    help.push_back(text + k.what);
+    width = std::max(width, cv::getTextSize(k.what, kFont, kHelpScale, 1, &baseline).width);
   }
-  double help_scale = 0.5;
-  int baseline = 0, width = 0;
-  for (const std::string& text : help) {
-    width = std::max(width, cv::getTextSize(text, kFont, help_scale, 1, &baseline).width);
-  }
-  const int line_height_at_scale = 24;
-  const double fit =
-      std::min((image_size.width - 24.0) / width,
-               (image_size.height - 16.0) / (line_height_at_scale * (help.size() + 0.5)));
-  if (fit < 1.0) help_scale *= fit;
-  const int line_height = std::max(8, cvRound(line_height_at_scale * help_scale / 0.5));
-  const int block_w = cvRound(width * help_scale / 0.5) + 20;
-  const int block_h = line_height * static_cast<int>(help.size()) + line_height / 2;
-  const cv::Rect block = cv::Rect((image_size.width - block_w) / 2,
-                                  (image_size.height - block_h) / 2, block_w, block_h) &
-                         cv::Rect(0, 0, image_size.width, image_size.height);
-  cv::Mat shade = top(block);
-  shade.convertTo(shade, -1, 0.25, 0);
-  int line_y = block.y + line_height;
-  for (const std::string& text : help) {
-    cv::putText(top, text, {block.x + 10, line_y}, kFont, help_scale, cv::Scalar(255, 255, 255),
+  return 2 * kHelpMargin + kHelpKeyColumn + width;
+}
+
+void DrawHelpPanel(cv::Mat& panel) {
+  panel.setTo(cv::Scalar(24, 24, 24));
+  const int lines = static_cast<int>(kLiveKeys.size()) + 1;
+  // Shrink the text when the panel is lower than the list (a small frame on a small screen).
+  const double fit = std::min(1.0, (panel.rows - 2.0 * kHelpMargin) / (kHelpLine * lines));
+  const double scale = kHelpScale * fit;
+  const int line = std::max(6, cvRound(kHelpLine * fit));
+  int y = kHelpMargin + line;
+  cv::putText(panel, "keys (h hides)", {kHelpMargin, y}, kFont, scale, cv::Scalar(120, 220, 255), 1,
+              cv::LINE_AA);
+  for (const LiveKey& k : kLiveKeys) {
+    y += line;
+    cv::putText(panel, KeyName(k.key), {kHelpMargin, y}, kFont, scale, cv::Scalar(120, 220, 255),
                 1, cv::LINE_AA);
-    line_y += line_height;
+    cv::putText(panel, k.what, {kHelpMargin + cvRound(kHelpKeyColumn * fit), y}, kFont, scale,
+                cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
   }
 }
 

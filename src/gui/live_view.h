@@ -12,7 +12,9 @@ namespace softsight {
 // (recording).
 void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red);
 
-// The key list (kLiveKeys), scaled down until it fits the image, centred on a darkened block.
-void DrawLiveHelp(cv::Mat& top);
+// The key list (kLiveKeys) as a compact panel beside the image (never over it, so no marker is
+// hidden): the width it needs, and the drawing into `panel` (text shrinks if it is too low).
+int HelpPanelWidth();
+void DrawHelpPanel(cv::Mat& panel);
 
 }  // namespace softsight

@@ -64,22 +64,39 @@ bool HaveDisplay(std::string* why) {
   return true;
 }
 
+// The default screen's size in pixels, when an X server answers (XWayland too).
+cv::Size ScreenSize() {
+  Display* connection = XOpenDisplay(nullptr);
+  if (connection == nullptr) return {};
+  const int screen = DefaultScreen(connection);
+  const cv::Size size(DisplayWidth(connection, screen), DisplayHeight(connection, screen));
+  XCloseDisplay(connection);
+  return size;
+}
+
 int RunLiveWindow(LiveController& controller, FrameSource& source,
                   const LiveWindowOptions& options, SeekableSource* seekable) {
   const std::string& title = options.title;
+  // The canvas is scaled to the screen (a 720p frame with its chart is taller than a laptop's
+  // screen); mouse positions come back in canvas pixels and the controller maps them.
+  controller.set_screen(options.screen_px.area() > 0 ? options.screen_px : ScreenSize());
   // GUI_NORMAL: no toolbar or status bar, so image pixels are canvas pixels.
   cv::namedWindow(title, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
   CallbackContext mouse{&controller};
   cv::setMouseCallback(title, OnMouse, &mouse);
   std::array<TrackbarContext, kHsvTrackbars.size()> trackbars;
   int shown_revision = -1;
+  // The trackbars have a window of their own: in the image's window they would take six rows
+  // of the screen's height from the image.
+  const std::string sliders = options.trackbar_title;
   if (options.trackbars) {
+    cv::namedWindow(sliders, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
     const std::array<int, 6> hsv = controller.active_hsv();
     for (size_t i = 0; i < kHsvTrackbars.size(); ++i) {
       trackbars[i] = {&controller, static_cast<int>(i)};
-      cv::createTrackbar(kHsvTrackbars[i].name, title, nullptr, kHsvTrackbars[i].max, OnTrackbar,
+      cv::createTrackbar(kHsvTrackbars[i].name, sliders, nullptr, kHsvTrackbars[i].max, OnTrackbar,
                          &trackbars[i]);
-      cv::setTrackbarPos(kHsvTrackbars[i].name, title, hsv[i]);
+      cv::setTrackbarPos(kHsvTrackbars[i].name, sliders, hsv[i]);
     }
     shown_revision = controller.hsv_revision();
   }
@@ -117,13 +134,14 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
     if (options.trackbars && controller.hsv_revision() != shown_revision) {
       const std::array<int, 6> hsv = controller.active_hsv();
       for (size_t i = 0; i < kHsvTrackbars.size(); ++i) {
-        cv::setTrackbarPos(kHsvTrackbars[i].name, title, hsv[i]);
+        cv::setTrackbarPos(kHsvTrackbars[i].name, sliders, hsv[i]);
       }
       shown_revision = controller.hsv_revision();
     }
     if (cv::getWindowProperty(title, cv::WND_PROP_VISIBLE) < 1) break;  // Closed by the user.
   }
   cv::destroyWindow(title);
+  if (options.trackbars) cv::destroyWindow(sliders);
   cv::waitKey(1);
   return 0;
 }

@@ -194,6 +194,32 @@ TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
   EXPECT_EQ(chart.size(), 1u);
 }
 
+TEST(StripChartTest, ValueLabelsAreNotClippedWhateverTheirWidth) {
+  // Wide labels: a five-digit arc length, a negative bending distance, angles near 180.
+  StripChart chart(StripChartOptions{.window_s = 10.0, .height_px = 150});
+  for (int i = 0; i < 50; ++i) {
+    FrameResult result;
+    result.time_s = i * 0.1;
+    result.measurement.angle_deg = 179.0 + 0.02 * i;
+    result.measurement.tip_disp_px = -1234.5 - 20.0 * i;
+    result.measurement.arc_length_px = 12345.0 + 3.0 * i;
+    chart.add(result);
+  }
+  cv::Mat area(150, 480, CV_8UC3);
+  chart.draw(area);
+  for (int lane = 0; lane < 3; ++lane) {
+    const StripChart::Lane& l = chart.lane(lane);
+    ASSERT_GE(l.tick_labels.size(), 1u) << l.label;
+    for (const cv::Rect& text : l.tick_labels) {
+      EXPECT_GE(text.x, 0) << l.label;
+      EXPECT_LE(text.x + text.width, l.rect.x) << l.label;  // Left of the lane, not under it.
+      EXPECT_GE(text.y, l.rect.y - 3) << l.label;           // Within its lane's rows.
+      EXPECT_LE(text.y + text.height, l.rect.y + l.rect.height + 3) << l.label;
+      EXPECT_LE(text.y + text.height, area.rows);
+    }
+  }
+}
+
 TEST(DrawOverlayTest, TheTextNamesTheFrameAndItsTime) {
   // Two frames with identical measurements: only the frame line differs, in the text block.
   cv::Mat a(320, 320, CV_8UC3, cv::Scalar(90, 90, 90)), b = a.clone();

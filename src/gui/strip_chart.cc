@@ -14,7 +14,8 @@ namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.4;
-constexpr int kLeft = 56;  // Room for value labels.
+constexpr int kLeft = 40;      // The least room for value labels; more when they are wider.
+constexpr int kLabelPad = 4;  // Between a value label and the lane, and the chart's edge.
 constexpr int kRight = 8;
 constexpr int kShift = 4;
 const cv::Scalar kBackground(32, 32, 32);
@@ -71,14 +72,16 @@ void StripChart::draw(cv::Mat& area) const {
   const std::string names[3] = {"angle [deg]", std::string("bending dist [") + unit + "]",
                                 std::string("arc length [") + unit + "]"};
   const int lane_height = area.rows / 3;
-  x_left_ = kLeft;
-  x_width_ = std::max(1, area.cols - kLeft - kRight);
   t_right_ = samples_.empty() ? 0.0 : samples_.back().time_s;
 
-  std::vector<cv::Point> run;
+  // The value ranges and tick labels of all lanes first: the left margin is as wide as the
+  // widest label (a 5-digit arc length or a negative distance is not cut off).
+  std::vector<double> ticks[3];
+  std::vector<std::string> tick_text[3];
+  int label_width = 0, baseline = 0;
+  const int text_height = cv::getTextSize("0", kFont, kFontScale, 1, &baseline).height;
   for (int i = 0; i < 3; ++i) {
     Lane& lane = lanes_[i];
-    lane.rect = cv::Rect(kLeft, i * lane_height + 3, static_cast<int>(x_width_), lane_height - 6);
     lane.label = names[i];
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Sample& s : samples_) {
@@ -103,16 +106,38 @@ void StripChart::draw(cv::Mat& area) const {
     }
     lane.y_min = lo;
     lane.y_max = hi;
+    ticks[i] = NiceTicks(lo, hi, 3);
+    const double step = ticks[i].size() > 1 ? ticks[i][1] - ticks[i][0] : 1.0;
+    for (double v : ticks[i]) {
+      tick_text[i].push_back(FormatTick(v, step));
+      label_width = std::max(
+          label_width, cv::getTextSize(tick_text[i].back(), kFont, kFontScale, 1, &baseline).width);
+    }
+  }
+  const int left = std::clamp(label_width + 2 * kLabelPad, kLeft, std::max(kLeft, area.cols / 3));
+  x_left_ = left;
+  x_width_ = std::max(1, area.cols - left - kRight);
+
+  std::vector<cv::Point> run;
+  for (int i = 0; i < 3; ++i) {
+    Lane& lane = lanes_[i];
+    lane.rect = cv::Rect(left, i * lane_height + 3, static_cast<int>(x_width_), lane_height - 6);
+    const double lo = lane.y_min, hi = lane.y_max;
     const cv::Rect& r = lane.rect;
     auto y_of = [&](double v) { return r.y + (hi - v) / (hi - lo) * (r.height - 1); };
 
     cv::rectangle(area, r, kGridColour, 1);
-    const std::vector<double> ticks = NiceTicks(lo, hi, 3);
-    const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
-    for (double v : ticks) {
-      const int y = cvRound(y_of(v));
+    lane.tick_labels.clear();
+    for (size_t k = 0; k < ticks[i].size(); ++k) {
+      const int y = cvRound(y_of(ticks[i][k]));
       cv::line(area, {r.x, y}, {r.x + r.width - 1, y}, kGridColour, 1);
-      cv::putText(area, FormatTick(v, step), {4, y + 4}, kFont, kFontScale, kLabel, 1, cv::LINE_AA);
+      // Centred on its grid line, but kept inside the lane (a tick at the lane's edge).
+      const int text_y = std::clamp(y + text_height / 2, r.y + text_height, r.y + r.height - 1);
+      const int width = cv::getTextSize(tick_text[i][k], kFont, kFontScale, 1, &baseline).width;
+      const int text_x = left - kLabelPad - width;  // Right-aligned against the lane.
+      cv::putText(area, tick_text[i][k], {text_x, text_y}, kFont, kFontScale, kLabel, 1,
+                  cv::LINE_AA);
+      lane.tick_labels.emplace_back(text_x, text_y - text_height, width, text_height + baseline);
     }
     // Current value in the lane's label, so the chart reads without the overlay.
     std::string label = names[i];

@@ -25,11 +25,12 @@ namespace softsight {
 
 class LiveRecording;  // gui/live_recording.h: the files of one recording.
 class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
+struct LiveLayout;    // gui/live_layout.h: where the image, chart and help go on the canvas.
 
 struct UiEvent {
   enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
   Type type = Type::kKey;
-  cv::Point2d position_px;  // Mouse events: canvas pixel (the image occupies the top rows).
+  cv::Point2d position_px;  // Mouse events: canvas pixel (the scaled image is top left).
   int key = 0;              // kKey: the character ('q', ' ', '1') or 27 for Escape.
   int trackbar = 0;         // kTrackbar: index into kHsvTrackbars.
   int value = 0;            // kTrackbar: new position.
@@ -132,8 +133,15 @@ class LiveController {
   // A message from outside (the feed: "a camera cannot seek"), shown like the controller's own.
   void report(const std::string& message) { say(message); }
 
-  // The image to show: the annotated frame with the UI on top, the strip chart under it.
+  // The image to show: the annotated frame (scaled down to fit the screen) with the UI on top,
+  // the strip chart under it, the help panel (`h`) to the right. Mouse events are in its pixels.
   const cv::Mat& canvas();
+  // The screen the window is on: the canvas is scaled to fit it (never up); mouse positions are
+  // mapped back to image pixels. Default: no screen known, nothing scaled.
+  void set_screen(cv::Size screen_px);
+  // The canvas position of an image point, and back (the mapping canvas() and mouse events use).
+  cv::Point2d to_view(const cv::Point2d& image_px) const;
+  cv::Point2d to_image(const cv::Point2d& view_px) const;
 
   bool quit_requested() const { return quit_; }
   bool paused() const { return paused_; }
@@ -180,7 +188,8 @@ class LiveController {
   void cancel_scale();
   void scale_point(const cv::Point2d& p);
   std::string scale_hint() const;
-  void draw_scale_points(cv::Mat& top) const;
+  void draw_scale_points(cv::Mat& top, const LiveLayout& view) const;
+  LiveLayout layout() const;
   void select_marker(int index);
   // A transport key: refused while recording (except a step forward), else queued for the feed.
   void request_playback(PlaybackRequest::Kind kind, double seconds = 0.0);
@@ -207,6 +216,7 @@ class LiveController {
   int64_t dropped_ = 0;
   cv::Mat annotated_;  // frame_ + overlay (what annotated video records).
   cv::Mat canvas_;
+  cv::Size max_canvas_;  // Empty: no screen known.
   bool dirty_ = true;
   std::optional<FrameResult> last_result_;
   std::optional<double> latency_ms_, fps_;

@@ -3,6 +3,7 @@
 // and images out.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 
 #include "softsight/gui/live_controller.h"
@@ -18,7 +19,10 @@ bool HaveDisplay(std::string* why);
 
 struct LiveWindowOptions {
   std::string title = "softsight live";
-  bool trackbars = true;  // The six HSV trackbars of the active marker.
+  bool trackbars = true;  // The six HSV trackbars of the active marker, in a window of their own.
+  std::string trackbar_title = "HSV ranges (softsight)";
+  // The screen the window must fit (the canvas is scaled down to it); empty: the X screen's.
+  cv::Size screen_px;
 };
 
 // Runs the window until the controller asks to quit or the window is closed. Frames come from

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "softsight/pipeline/tracking_session.h"
 
@@ -35,6 +36,7 @@ class StripChart {
     cv::Rect rect;
     double y_min = 0, y_max = 1;
     std::string label;
+    std::vector<cv::Rect> tick_labels;  // Where each value label's text went.
   };
   const Lane& lane(int i) const { return lanes_[i]; }
   // Horizontal pixel of time `time_s` in the last draw() (the newest sample at the right edge).
