@@ -413,7 +413,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   try {
     info = session.start();
   } catch (const StopRequested&) {
-    summary.stop_reason = "interrupted";
+    summary.stop_reason = StopSignalReason(stop.signal());
     return summary;
   }
   if (const std::optional<double> asked = session.pressure_clamped_from()) {
@@ -470,7 +470,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
     collect();
-    summary.stop_reason = "interrupted";
+    summary.stop_reason = StopSignalReason(stop.signal());
     session.stop();
     return summary;
   } catch (const std::exception&) {
@@ -492,7 +492,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       break;
     case StopReason::kMaxFrames:
     case StopReason::kStopRequested:
-      summary.stop_reason = control.done() ? "duration reached" : "interrupted";
+      summary.stop_reason =
+          control.done() ? "duration reached" : StopSignalReason(stop.signal());
       break;
     case StopReason::kError:
       // The session's destructor sends STOP on the way out.
@@ -650,7 +651,9 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
     }
     const ControlSummary summary = RunControl(run);
     if (!o->quiet) std::cerr << FormatControlSummary(summary);
-    return 0;
+    // 130 / 143 after Ctrl-C / SIGTERM (the actuator vented, the summary printed): a script
+    // can tell an interrupted run from a complete one.
+    return ExitCodeAfterStop(0);
   };
 }
 

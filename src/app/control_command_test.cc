@@ -382,7 +382,41 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   }
   EXPECT_THAT(rig_err, HasSubstr("port closed"));
   EXPECT_THAT(rig_err, HasSubstr("board watchdog (vented)"));
-  EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 0) << rig_err;
+  EXPECT_THAT(rig_err, HasSubstr("rig: stopped by SIGTERM after"));
+  // After its summary: 128 + SIGTERM, as for a process the signal killed.
+  EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 143) << rig_err;
+}
+
+TEST(ControlCommand, CtrlCVentsPrintsTheSummaryAndExits130) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  const std::string csv = dir.file("run.csv");
+  const std::string command = std::string("exec \"") + testing::SoftsightBinary() +
+                              "\" control --config " + dir.file("rig.yaml") +
+                              " --simulate --target-deg 120 --duration-s 600 --csv " + csv +
+                              " 2> " + dir.file("ctl.err");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Interrupt once a few rows are on disk (the handler is installed before the first row).
+  for (int wait_ms = 0; wait_ms < 30000 && ReadLines(csv).size() < 4; wait_ms += 5) usleep(5000);
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string err = ReadTextFile(dir.file("ctl.err"));
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT, after the summary: " << err;
+  EXPECT_THAT(err, HasSubstr("(stopped by Ctrl-C (SIGINT))"));
+  EXPECT_THAT(err, HasSubstr("max board pressure")) << "the summary comes before the exit";
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_GE(lines.size(), 4u);
+  const size_t columns = SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(SplitCsv(lines[i] + ",x").size(), columns + 1) << "row " << i << ": " << lines[i];
+  }
 }
 
 TEST(RigCommand, SigtermEndsItWhileAHostFloodsAndNeverReads) {
@@ -422,7 +456,7 @@ TEST(RigCommand, SigtermEndsItWhileAHostFloodsAndNeverReads) {
   waitpid(rig, &status, 0);
   close(fd);
   EXPECT_TRUE(ended) << "the rig ignored SIGTERM while its answers were not read";
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << ReadTextFile(dir.file("rig.err"));
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 143) << ReadTextFile(dir.file("rig.err"));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include <opencv2/imgcodecs.hpp>
@@ -130,11 +131,13 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   summary.board_rejected = s.board_rejected;
   summary.final_mode = ModeName(s.mode);
   if (!options.quiet) {
+    const std::string why =
+        stop.requested() ? StopSignalReason(stop.signal()) : "stopped (--duration-s)";
     std::fprintf(stderr,
-                 "rig: stopped after %.2f s; board %s, pressure %.2f kPa (peak %.2f), %u lines "
+                 "rig: %s after %.2f s; board %s, pressure %.2f kPa (peak %.2f), %u lines "
                  "rejected\n",
-                 s.time_s, summary.final_mode.c_str(), s.pressure_kpa, s.peak_pressure_kpa,
-                 s.board_rejected);
+                 why.c_str(), s.time_s, summary.final_mode.c_str(), s.pressure_kpa,
+                 s.peak_pressure_kpa, s.board_rejected);
   }
   return summary;
 }
@@ -167,7 +170,7 @@ CommandRunner SetupRigCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
   return [o] {
     RunRig(*o);
-    return 0;
+    return ExitCodeAfterStop(0);  // 130 / 143 when Ctrl-C / SIGTERM ended it.
   };
 }
 

@@ -1,7 +1,8 @@
 // Ctrl-C (SIGINT) and SIGTERM as a polite request: long-running commands poll it between frames,
 // then finish their files, vent the actuator and print their summary instead of dying mid-write.
-// `track` then exits 128 + the signal's number (130 for SIGINT, 143 for SIGTERM), as a shell
-// reports a process killed by it, so a script can tell an interrupted run from a complete one.
+// `track`, `control` and `rig` then exit 128 + the signal's number (130 for SIGINT, 143 for
+// SIGTERM), as a shell reports a process killed by it, so a script can tell an interrupted run
+// from a complete one.
 #pragma once
 
 #include <atomic>

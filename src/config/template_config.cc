@@ -18,6 +18,9 @@
 // selected live) the image is the template and `rect` (the image's size) is where it was
 // selected on frame `frame`: tracking starts there on that frame, as it did live. With neither,
 // the template is selected live (softsight's window) or the marker is not found.
+#include <filesystem>
+#include <system_error>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "config/config_sections.h"
@@ -33,6 +36,13 @@ void ReadTemplateParams(YamlMap& marker, TemplateParams* params) {
   if (!params->Check(&problem)) FailAtKey(marker, problem);  // before the image is read
   if (params->image_file != file_before && !params->image_file.empty()) {
     const std::string path = ResolveBesideFile(marker.file(), params->image_file);
+    // A FIFO or device (/dev/stdin) would block imread for ever; a folder is no image either.
+    std::error_code ignored;
+    const std::filesystem::file_status status = std::filesystem::status(path, ignored);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+      marker.fail("template.file", "'" + path + "' is not a regular file (a template is an "
+                  "image file such as blue.png)");
+    }
     params->image = cv::imread(path, cv::IMREAD_COLOR);
     if (params->image.empty()) {
       marker.fail("template.file", "cannot read image '" + path + "' (missing, or not an image)");

@@ -1,5 +1,10 @@
 // The `template:` section of a marker: every key read, written back and read again to the same
 // values; template images relative to the config file; errors naming the key.
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <string>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -141,6 +146,21 @@ TEST(TemplateConfig, ErrorsNameTheKey) {
   EXPECT_THAT(testing::ConfigErrorOf("markers:\n  - name: red\n    template: {rect: [1, 2, 30, 30], "
                       "report: middle}\n"),
               HasSubstr("markers[0].template.report"));
+}
+
+// imread on a FIFO or /dev/stdin would wait for ever for a writer: refused before it is opened.
+TEST(TemplateConfig, ATemplateFileThatIsNoRegularFileIsRefusedWithoutReadingIt) {
+  TempDir dir;
+  ASSERT_EQ(mkfifo(dir.file("fifo.png").c_str(), 0600), 0);
+  std::filesystem::create_directory(dir.file("folder.png"));
+  for (const std::string& file :
+       {dir.file("fifo.png"), dir.file("folder.png"), std::string("/dev/null")}) {
+    const std::string message = testing::ConfigErrorOf(
+        "markers:\n  - name: red\n    template: {file: " + file + "}\n");
+    EXPECT_THAT(message, HasSubstr("markers[0].template.file: '" + file +
+                                   "' is not a regular file"));
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
 }
 
 TEST(TemplateConfig, IntegersPastAnyImageSizeAreRefused) {

@@ -2,13 +2,12 @@
 
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <regex>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -51,12 +50,8 @@ FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(option
   }
   const std::string ext = Lower(fs::path(path).extension().string());
   if (path.find('%') != std::string::npos) {
-    // Exactly one integer conversion, so snprintf with the frame index is safe.
-    static const std::regex kPattern(R"([^%]*%0?[0-9]*d[^%]*)");
-    if (!std::regex_match(path, kPattern)) {
-      throw InputError(path + ": an image pattern needs exactly one %d-style field, e.g. "
-                       "frames/%04d.png");
-    }
+    // Parsed, never handed to printf: the user's text is not a format string.
+    pattern_ = std::make_shared<const SequencePattern>(ParseSequencePattern(path));
     if (!cv::haveImageWriter("x" + ext)) {
       throw InputError(path + ": no image writer for '" + ext + "' (use .png)");
     }
@@ -119,17 +114,14 @@ void FrameWriter::write(const cv::Mat& image_bgr, int64_t index) {
     ++written_;
     return;
   }
-  name_.resize(options_.path.size() + 32);
-  std::snprintf(name_.data(), name_.size(), options_.path.c_str(), static_cast<int>(index));
+  const std::string name = pattern_->Format(index);
   bool ok = false;
   try {
-    ok = cv::imwrite(name_.c_str(), image_bgr);
+    ok = cv::imwrite(name, image_bgr);
   } catch (const cv::Exception&) {
     ok = false;
   }
-  if (!ok) {
-    throw InputError(std::string(name_.c_str()) + ": cannot write frame " + std::to_string(index));
-  }
+  if (!ok) throw InputError(name + ": cannot write frame " + std::to_string(index));
   ++written_;
 }
 

@@ -126,12 +126,29 @@ TEST(FrameWriter, ImagePatternNamesEachFileByTheFrameIndex) {
   EXPECT_EQ(cv::norm(read, frame, cv::NORM_INF), 0.0);
 }
 
+// The pattern is parsed, never handed to printf as a format: what printf would misread is
+// refused, and "%%" is a literal percent sign.
+TEST(FrameWriter, ImagePatternIsNeverAPrintfFormat) {
+  TempDir dir;
+  for (const char* bad : {"f%s.png", "f%n.png", "f%099d.png", "f%5d.png", "f%x.png", "f%ld.png"}) {
+    EXPECT_THAT(ErrorOf({dir.file(bad), "", 30.0}), HasSubstr(bad));
+  }
+  const cv::Mat frame = Pattern(3);
+  {
+    FrameWriter writer({dir.file("run_100%%_%03d.png"), "", 30.0});
+    writer.write(frame, 7);
+  }
+  const cv::Mat read = cv::imread(dir.file("run_100%_007.png"), cv::IMREAD_COLOR);
+  ASSERT_FALSE(read.empty()) << "\"%%\" is a literal percent sign";
+  EXPECT_EQ(cv::norm(read, frame, cv::NORM_INF), 0.0);
+}
+
 TEST(FrameWriter, BadOutputsAreRefusedBeforeAnyFrame) {
   TempDir dir;
   EXPECT_THAT(ErrorOf({dir.file("none/raw.avi"), "", 30.0}), HasSubstr("does not exist"));
   EXPECT_THAT(ErrorOf({dir.file("raw.xyz"), "", 30.0}), HasSubstr("unknown video type"));
   EXPECT_THAT(ErrorOf({dir.file("raw.avi"), "h265", 30.0}), HasSubstr("h265"));
-  EXPECT_THAT(ErrorOf({dir.file("f%d%d.png"), "", 30.0}), HasSubstr("exactly one"));
+  EXPECT_THAT(ErrorOf({dir.file("f%d%d.png"), "", 30.0}), HasSubstr("more than one number"));
   EXPECT_THAT(ErrorOf({dir.file("raw.avi"), "", 0.0}), HasSubstr("frame rate"));
 }
 

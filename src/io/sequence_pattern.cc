@@ -10,7 +10,7 @@ constexpr int kMaxDigits = 18;  // Every 18-digit number fits an int64_t.
 bool IsDigit(char c) { return c >= '0' && c <= '9'; }
 
 [[noreturn]] void Reject(const std::string& pattern, const std::string& problem) {
-  throw InputError("--input " + pattern + ": " + problem +
+  throw InputError(pattern + ": " + problem +
                    " (an image sequence pattern holds one %d or %0Nd, e.g. frames/%04d.png)");
 }
 

@@ -37,4 +37,24 @@ std::vector<size_t> FindCoincidentMarkers(
   return rejected;
 }
 
+std::vector<size_t> FindMarkersOnAMissingMarkersPlace(
+    const std::vector<MarkerObservation>& current,
+    const std::vector<std::optional<cv::Point2d>>& recent_px, double min_separation_px) {
+  CV_Assert(current.size() == recent_px.size());
+  std::vector<size_t> rejected;
+  for (size_t i = 0; i < current.size(); ++i) {
+    if (!current[i].observation.found()) continue;
+    const cv::Point2d p = *current[i].observation.position_px;
+    if (recent_px[i] && cv::norm(p - *recent_px[i]) < min_separation_px) continue;
+    for (size_t j = 0; j < current.size(); ++j) {
+      if (j == i || current[j].observation.found() || !recent_px[j]) continue;
+      if (cv::norm(p - *recent_px[j]) < min_separation_px) {
+        rejected.push_back(i);
+        break;
+      }
+    }
+  }
+  return rejected;
+}
+
 }  // namespace softsight

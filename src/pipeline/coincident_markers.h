@@ -27,4 +27,15 @@ std::vector<size_t> FindCoincidentMarkers(
     const std::vector<std::optional<cv::Point2d>>& previous_px,
     double min_separation_px = kCoincidentMarkerPx);
 
+// Indices (ascending) of found markers within `min_separation_px` of where another marker was
+// last believed (`recent_px`, present only for a position believed a few frames ago at most)
+// while that other marker is not found now. Two markers cannot swap places within a few frames:
+// such a report is the other marker seen in this one's colour (a decoding error that shifted the
+// colours of part of a frame, a look-alike at its place). A marker still at its own recent
+// position is kept.
+std::vector<size_t> FindMarkersOnAMissingMarkersPlace(
+    const std::vector<MarkerObservation>& current,
+    const std::vector<std::optional<cv::Point2d>>& recent_px,
+    double min_separation_px = kCoincidentMarkerPx);
+
 }  // namespace softsight

@@ -40,5 +40,32 @@ TEST(CoincidentMarkers, LostMarkersNeverConflict) {
               IsEmpty());
 }
 
+// A decoding error turned part of a frame's colours: the red base marker looked blue, the blue
+// tracker (lost a frame before) re-acquired it, while red itself was not found.
+TEST(MarkersOnAMissingMarkersPlace, AMarkerFoundWhereAMissingOneJustWasIsDropped) {
+  EXPECT_THAT(FindMarkersOnAMissingMarkersPlace({Lost(), At(221.6, 321.0), Lost()},
+                                                {cv::Point2d(222.3, 321.0),
+                                                 cv::Point2d(286.3, 223.0), std::nullopt}),
+              ElementsAre(1u));
+  // Without a recent position of its own (re-acquired after a long loss) it is dropped too.
+  EXPECT_THAT(FindMarkersOnAMissingMarkersPlace({Lost(), At(221.6, 321.0)},
+                                                {cv::Point2d(222.3, 321.0), std::nullopt}),
+              ElementsAre(1u));
+}
+
+TEST(MarkersOnAMissingMarkersPlace, FoundMarkersAndDistantOnesAreKept) {
+  // The other marker is found (that case is FindCoincidentMarkers'), or was elsewhere.
+  EXPECT_THAT(FindMarkersOnAMissingMarkersPlace({At(0, 0), At(0.5, 0)},
+                                                {cv::Point2d(0, 0), std::nullopt}),
+              IsEmpty());
+  EXPECT_THAT(FindMarkersOnAMissingMarkersPlace({Lost(), At(30, 0)},
+                                                {cv::Point2d(0, 0), cv::Point2d(28, 0)}),
+              IsEmpty());
+  // A marker still at its own recent position keeps it whatever the other's record says.
+  EXPECT_THAT(FindMarkersOnAMissingMarkersPlace({Lost(), At(5, 5)},
+                                                {cv::Point2d(5, 5), cv::Point2d(5.5, 5)}),
+              IsEmpty());
+}
+
 }  // namespace
 }  // namespace softsight

@@ -43,6 +43,9 @@ std::vector<size_t> BodyOrder(const TrackingConfig& config) {
   return body.size() == names.size() ? body : std::vector<size_t>();
 }
 
+// How long a marker's last believed position still says where it is ("a moment ago").
+constexpr int64_t kRecentFrames = 5;
+
 }  // namespace
 
 TrackingSession::TrackingSession(const TrackingConfig& config)
@@ -52,6 +55,9 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
     trackers_.push_back(CreateTracker(spec));
     initialised_.push_back(false);
     previous_px_.emplace_back();
+    believed_px_.emplace_back();
+    believed_frame_.push_back(0);
+    recent_px_.emplace_back();
     result_.markers.push_back({spec.name, {}});
     sizes.push_back(MarkerSizePx(spec));
   }
@@ -100,6 +106,18 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
       trackers_[i]->reset();
     }
+    // Nor can two markers swap places within a few frames: a marker found where another one,
+    // missing now, just was is that other marker in this one's colour (a decoding error that
+    // shifted the colours of part of the frame) or a look-alike at its place.
+    for (size_t i = 0; i < believed_px_.size(); ++i) {
+      const bool recent = believed_px_[i] && frame.index >= believed_frame_[i] &&
+                          frame.index - believed_frame_[i] <= kRecentFrames;
+      recent_px_[i] = recent ? believed_px_[i] : std::nullopt;
+    }
+    for (size_t i : FindMarkersOnAMissingMarkersPlace(result_.markers, recent_px_)) {
+      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+      trackers_[i]->reset();
+    }
     // A position next to decoded garbage is whatever the garbage made of the marker.
     for (size_t i = 0; i < result_.markers.size(); ++i) {
       const Observation& o = result_.markers[i].observation;
@@ -112,6 +130,10 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   for (size_t i : plausibility_->check(frame.index, result_.markers)) trackers_[i]->reset();
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
+    if (previous_px_[i]) {
+      believed_px_[i] = previous_px_[i];
+      believed_frame_[i] = frame.index;
+    }
   }
   measure(frame);
   result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
@@ -148,6 +170,8 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     trackers_[i]->init(frame.image, rect);
     initialised_[i] = true;
     plausibility_->forget(i);  // A person said where it is: no history to contradict that.
+    // ... nor another marker's last position there (the person may have swapped two markers).
+    std::fill(believed_px_.begin(), believed_px_.end(), std::nullopt);
     // Saved configs must reproduce what the mouse did: the template's own pixels (a rectangle
     // on the config's template frame would cut whatever is there, not this marker), which a
     // saved config writes as an image file beside itself, with where and on which frame it was
@@ -171,6 +195,10 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
       result_.markers[i].observation = trackers_[i]->update(frame.image);
     }
     previous_px_[i] = result_.markers[i].observation.position_px;
+    if (previous_px_[i]) {
+      believed_px_[i] = previous_px_[i];
+      believed_frame_[i] = frame.index;
+    }
     measure(frame);
     return result_;
   }
@@ -184,6 +212,7 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     config_.markers[i] = spec;
     initialised_[i] = false;
     plausibility_->forget(i);
+    believed_px_[i].reset();
     return;
   }
   throw InputError("no marker named '" + spec.name + "'");

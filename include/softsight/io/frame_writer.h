@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -11,9 +12,12 @@
 
 namespace softsight {
 
+struct SequencePattern;
+
 struct FrameWriterOptions {
-  // A video (*.avi, *.mkv: HuffYUV lossless by default; *.mp4: MPEG-4, lossy) or a printf pattern
-  // with one integer field, frames/%04d.png (one image per frame, named by the frame's index).
+  // A video (*.avi, *.mkv: HuffYUV lossless by default; *.mp4: MPEG-4, lossy) or an image pattern
+  // with one %d or %0Nd field, frames/%04d.png, "%%" for a literal % (one image per frame, named
+  // by the frame's index).
   std::string path;
   // Video codec: hfyu (HuffYUV, lossless, fast: the default), ffv1 (lossless, ~1.4x smaller,
   // 8-10x slower to encode; older recordings), mjpg (Motion JPEG,
@@ -52,7 +56,9 @@ class FrameWriter {
   std::string format_;
   cv::Size size_;
   cv::VideoWriter video_;
-  std::string name_;  // Reused file name buffer for image patterns.
+  // The file names of an image pattern (parsed: the path is never a printf format). Behind a
+  // pointer so this header does not need io's private pattern parser.
+  std::shared_ptr<const SequencePattern> pattern_;
   int64_t written_ = 0;
 };
 
