@@ -246,10 +246,12 @@ TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
   }
 }
 
-// 20 bits flipped in the middle of a lossless recording (the hostile trial's reproduction):
-// FFV1 checks its slices and the decoder says which frames it found damaged; HuffYUV has no
-// check, and a flip shifts the colours of the rest of the frame (the red base marker turned
-// blue, and the blue tracker re-acquired it). Either way no marker may be reported found more
+// 20 bits flipped in the middle of a lossless recording (the hostile trial's reproduction).
+// FFV1 as OpenCV writes it has no slice checksums: the decoder reports nothing, decodes garbage
+// down to some row until its next key frame and leaves the rest of the frame stale (seed 1: the
+// red base marker 3.4 px behind the truth). HuffYUV has no check either, and a flip shifts the
+// colours (or the pixels) of the rest of the frame (the red base marker turned blue, and the
+// blue tracker re-acquired it). Either way no marker may be reported found more
 // than 3 px from the truth: damaged frames lose markers, they must not move them.
 TEST(TrackCommand, BitFlipsInALosslessVideoNeverGiveAConfidentlyWrongPosition) {
   TempDir dir;

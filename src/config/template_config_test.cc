@@ -154,7 +154,7 @@ TEST(TemplateConfig, ATemplateFileThatIsNoRegularFileIsRefusedWithoutReadingIt) 
   ASSERT_EQ(mkfifo(dir.file("fifo.png").c_str(), 0600), 0);
   std::filesystem::create_directory(dir.file("folder.png"));
   for (const std::string& file :
-       {dir.file("fifo.png"), dir.file("folder.png"), std::string("/dev/null")}) {
+       {dir.file("folder.png"), std::string("/dev/null"), dir.file("fifo.png")}) {
     const std::string message = testing::ConfigErrorOf(
         "markers:\n  - name: red\n    template: {file: " + file + "}\n");
     EXPECT_THAT(message, HasSubstr("markers[0].template.file: '" + file +

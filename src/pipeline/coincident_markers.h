@@ -28,8 +28,8 @@ std::vector<size_t> FindCoincidentMarkers(
     double min_separation_px = kCoincidentMarkerPx);
 
 // Indices (ascending) of found markers within `min_separation_px` of where another marker was
-// last believed (`recent_px`, present only for a position believed a few frames ago at most)
-// while that other marker is not found now. Two markers cannot swap places within a few frames:
+// last believed (`recent_px`, present only for a position believed about a second ago at most)
+// while that other marker is not found now. Two markers cannot swap places within a second:
 // such a report is the other marker seen in this one's colour (a decoding error that shifted the
 // colours of part of a frame, a look-alike at its place). A marker still at its own recent
 // position is kept.

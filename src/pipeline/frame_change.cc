@@ -17,6 +17,12 @@ constexpr int kGarbageMemory = 10;
 // After this many changed frames in a row the footage itself changes that much (a moving
 // camera): the change becomes normal even when the frames do not look alike.
 constexpr int kLongestChangeRun = 10;
+// A frame with garbage in this share of its cells is one the decoder lost its place in: what is
+// not garbage may be a stale copy of an earlier frame (FFV1 with a corrupt context keeps decoding
+// garbage down to some row and leaves the rest of its buffer as it was), so nothing in it is
+// believed, however long it lasts. A camera does not turn a tenth of its picture into
+// random-byte texture at once (a garbage cell is 3x the texture it had, and > 45 grey levels).
+constexpr double kGarbageFrameFraction = 0.1;
 
 }  // namespace
 
@@ -101,15 +107,26 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     has_normal_ = true;
     whole_frame_changed_ = false;
     changed_fraction_ = 0.0;
+    garbage_fraction_ = 0.0;
     changed_run_ = 0;
     return;
   }
   summarise(bgr, now_);
   changed_fraction_ = changed_between(now_, normal_);
+  int garbage_cells = 0;
+  for (size_t i = 0; i < now_.size(); ++i) garbage_cells += Garbage(now_[i], normal_[i]) ? 1 : 0;
+  garbage_fraction_ = static_cast<double>(garbage_cells) / static_cast<double>(now_.size());
   // Footage that changes a lot from frame to frame (a moving camera) raises the bar.
   const double threshold = std::clamp(3.0 * usual_fraction_ + 0.15, 0.4, 0.95);
   bool normal = true;
-  if (changed_fraction_ > threshold) {
+  if (garbage_fraction_ >= kGarbageFrameFraction) {
+    // Never the new normal, and no step towards it: the normal frame stays the last one before
+    // the decoder went wrong, so the garbage stays garbage until a clean frame comes.
+    whole_frame_changed_ = true;
+    normal = false;
+    changed_run_ = 0;
+    alike_run_ = 0;
+  } else if (changed_fraction_ > threshold) {
     // Frames that look alike (a change that stays) count towards accepting it.
     const bool alike = changed_run_ > 0 && changed_between(now_, previous_) < 0.5 * threshold;
     ++changed_run_;

@@ -9,7 +9,9 @@
 //    whole frame changed. A change that persists (the light was switched on, the camera was
 //    bumped) becomes the new normal after a few frames.
 //  - a cell whose texture exploded (random bytes are ~85 grey levels between neighbours, camera
-//    images a few): decoded garbage there; markers in or next to it are not trusted.
+//    images a few): decoded garbage there; markers in or next to it are not trusted. Garbage in
+//    a tenth of the frame or more: the decoder lost its place, and the rest of the frame may be
+//    a stale copy of an earlier one; the whole frame is not believed for as long as it lasts.
 #pragma once
 
 #include <vector>
@@ -28,13 +30,16 @@ class FrameChangeDetector {
   // queries below. A frame of another size starts afresh (it is taken as normal).
   void observe(const cv::Mat& bgr);
 
-  // The frame changed all at once: nothing found in it can be trusted.
+  // The frame changed all at once, or is largely decoded garbage: nothing found in it can be
+  // trusted.
   bool whole_frame_changed() const { return whole_frame_changed_; }
   // The neighbourhood of `image_px` holds garbage (texture far beyond what it had).
   bool garbage_near(const cv::Point2d& image_px) const;
 
   // Fraction of cells that changed against the last normal frame (for tests and tuning).
   double changed_fraction() const { return changed_fraction_; }
+  // Fraction of cells holding garbage against the last normal frame (for tests and tuning).
+  double garbage_fraction() const { return garbage_fraction_; }
 
  private:
   struct Cell {
@@ -56,6 +61,7 @@ class FrameChangeDetector {
   bool has_normal_ = false;
   bool whole_frame_changed_ = false;
   double changed_fraction_ = 0.0;
+  double garbage_fraction_ = 0.0;
   double usual_fraction_ = 0.0;  // Running mean of changed_fraction_ over normal frames.
   int changed_run_ = 0;          // Consecutive frames that changed against the normal one.
   int alike_run_ = 0;            // ... of which the last ones looked like each other.

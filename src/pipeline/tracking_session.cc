@@ -43,8 +43,10 @@ std::vector<size_t> BodyOrder(const TrackingConfig& config) {
   return body.size() == names.size() ? body : std::vector<size_t>();
 }
 
-// How long a marker's last believed position still says where it is ("a moment ago").
-constexpr int64_t kRecentFrames = 5;
+// How long a marker's last believed position still says where it is ("a moment ago"): a second
+// at 30 fps. A damaged stretch of a recording lasts several frames; a marker that really moves
+// onto the place of one lost that long ago is missed for the frame or two it spends there.
+constexpr int64_t kRecentFrames = 30;
 
 }  // namespace
 
@@ -106,7 +108,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
       trackers_[i]->reset();
     }
-    // Nor can two markers swap places within a few frames: a marker found where another one,
+    // Nor can two markers swap places within a second: a marker found where another one,
     // missing now, just was is that other marker in this one's colour (a decoding error that
     // shifted the colours of part of the frame) or a look-alike at its place.
     for (size_t i = 0; i < believed_px_.size(); ++i) {

@@ -71,7 +71,7 @@ class TrackingSession {
   std::vector<bool> initialised_;
   std::vector<std::optional<cv::Point2d>> previous_px_;  // Last frame's positions.
   // Each marker's last believed position and its frame; recent_px_ holds those believed at most
-  // a few frames ago (reused per frame).
+  // about a second ago (reused per frame).
   std::vector<std::optional<cv::Point2d>> believed_px_;
   std::vector<int64_t> believed_frame_;
   std::vector<std::optional<cv::Point2d>> recent_px_;
