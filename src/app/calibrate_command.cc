@@ -6,6 +6,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <set>
 
 #include <opencv2/imgcodecs.hpp>
@@ -39,9 +40,12 @@ cv::Mat ReadImage(const std::string& file) {
 }
 
 
-// Every view in `input`: a folder (its image files in name order), a printf pattern (from index
-// 0 or 1 up to the first gap) or a video (every `step`-th frame).
-void ForEachView(const std::string& input, int step, const ViewCallback& callback) {
+// Every view in `input`: a folder (its image files in name order), a numbered pattern (every
+// file it names, in number order, whatever the first number and gaps) or a video (every
+// `step`-th frame). Returns what the report should say about the input (gaps in a pattern's
+// numbering), if anything.
+std::optional<std::string> ForEachView(const std::string& input, int step,
+                                       const ViewCallback& callback) {
   std::error_code error;
   if (fs::is_directory(input, error)) {
     std::vector<fs::path> files;
@@ -51,31 +55,27 @@ void ForEachView(const std::string& input, int step, const ViewCallback& callbac
     if (files.empty()) throw InputError("--input " + input + ": the folder holds no image files");
     std::sort(files.begin(), files.end());
     for (const fs::path& file : files) callback(file.filename().string(), ReadImage(file.string()));
-    return;
+    return std::nullopt;
   }
   if (input.find('%') != std::string::npos && !fs::exists(input, error)) {
-    // Parsed, never handed to printf: "%s" in the user's text must not be a format.
-    const SequencePattern pattern = ParseSequencePattern(input);
-    const auto Formatted = [&pattern](const std::string&, int index) {
-      return pattern.Format(index);
-    };
-    int index = fs::exists(Formatted(input, 0)) ? 0 : 1;
-    if (!fs::exists(Formatted(input, index))) {
-      throw InputError("--input " + input + ": no file matches the pattern (tried " +
-                       Formatted(input, 0) + " and " + Formatted(input, 1) + ")");
+    // Parsed, never handed to printf: "%s" in the user's text must not be a format. A gap
+    // (OpenCV's left01 .. left14 has no left10) is not the end: every file is a view, named by
+    // its file, and the report says which numbers were missing.
+    const std::vector<NumberedFile> files = ListSequenceFiles(ParseSequencePattern(input));
+    if (files.empty()) throw InputError("--input " + input + ": no file matches the pattern");
+    for (const NumberedFile& file : files) {
+      callback(fs::path(file.path).filename().string(), ReadImage(file.path));
     }
-    for (; fs::exists(Formatted(input, index)); ++index) {
-      const std::string file = Formatted(input, index);
-      callback(fs::path(file).filename().string(), ReadImage(file));
-    }
-    return;
+    const std::optional<std::string> gaps = DescribeNumberingGaps(files);
+    if (!gaps) return std::nullopt;
+    return "--input " + input + ": " + *gaps + "; every file found is a view, named by its file";
   }
   if (!fs::is_regular_file(input, error)) {
     throw InputError("--input " + input + ": no such file or folder");
   }
   if (IsImageFile(input)) {
     callback(fs::path(input).filename().string(), ReadImage(input));
-    return;
+    return std::nullopt;
   }
   cv::VideoCapture video(input);
   if (!video.isOpened()) {
@@ -85,6 +85,7 @@ void ForEachView(const std::string& input, int step, const ViewCallback& callbac
   for (int index = 0; video.read(frame); ++index) {
     if (index % step == 0) callback("frame " + std::to_string(index), frame);
   }
+  return std::nullopt;
 }
 
 ChessboardSpec BoardFrom(const CalibrateOptions& options) {
@@ -104,9 +105,10 @@ CalibrateSummary CalibrateCameraMode(const CalibrateOptions& options, const Ches
   calibration.board = board;
   calibration.estimate_k3 = options.estimate_k3;
   ChessboardCalibrator calibrator(calibration);
-  ForEachView(*options.input, options.step, [&](const std::string& name, const cv::Mat& image) {
-    calibrator.add(name, image);
-  });
+  const std::optional<std::string> input_note =
+      ForEachView(*options.input, options.step, [&](const std::string& name, const cv::Mat& image) {
+        calibrator.add(name, image);
+      });
   const CalibrationResult result = calibrator.calibrate();
   SaveCameraCalibration(result, board, options.out_file);
 
@@ -117,6 +119,7 @@ CalibrateSummary CalibrateCameraMode(const CalibrateOptions& options, const Ches
   summary.fx_px = result.camera.camera_matrix(0, 0);
   summary.fy_px = result.camera.camera_matrix(1, 1);
   const cv::Matx33d& k = result.camera.camera_matrix;
+  if (input_note) report << *input_note << "\n";
   report << std::fixed << std::setprecision(2);
   report << "board " << options.chessboard << " (" << board.square_mm << " mm squares) found in "
          << result.used.size() << " of " << summary.images << " images ("

@@ -14,6 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "calib/calibration_test_views.h"
+#include "sim/opencv_samples.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/chessboard.h"
@@ -122,6 +123,41 @@ TEST_F(CalibrateCommandTest, PrintfPatternAndVideoInputs) {
   EXPECT_TRUE(summary.not_found.empty());
   const double fx = testviews::Camera().camera_matrix(0, 0);
   EXPECT_NEAR(summary.fx_px, fx, 0.01 * fx);
+}
+
+// A numbered pattern with a gap (a view deleted as blurred) is not cut short at it: every file
+// is a view, and the report says which numbers were missing.
+TEST_F(CalibrateCommandTest, APatternWithAGapUsesEveryFileAndSaysSo) {
+  fs::create_directories(*dir_ / "gappy");
+  for (int i = 0; i < 10; ++i) {
+    if (i == 4) continue;
+    const std::string name = "view" + std::to_string(i) + ".png";
+    fs::copy_file(*dir_ / "views" / name, *dir_ / "gappy" / name,
+                  fs::copy_options::overwrite_existing);
+  }
+  CalibrateOptions options = CameraOptions();
+  options.input = (*dir_ / "gappy" / "view%d.png").string();
+  options.out_file = (*dir_ / "gappy.yaml").string();
+  std::ostringstream report;
+  const CalibrateSummary summary = RunCalibrate(options, report);
+  EXPECT_EQ(summary.images, 9) << report.str();
+  EXPECT_THAT(report.str(), HasSubstr("the numbering has gaps: 1 file number missing (first: 4)"));
+  EXPECT_THAT(report.str(), HasSubstr("found in 9 of 9 images"));
+  const double fx = testviews::Camera().camera_matrix(0, 0);
+  EXPECT_NEAR(summary.fx_px, fx, 0.01 * fx);
+}
+
+// OpenCV's sample chessboards are left01.jpg .. left14.jpg without left10 (opencv-doc).
+TEST_F(CalibrateCommandTest, OpenCvsSampleChessboardsThroughAPatternAreAllThirteenViews) {
+  if (!samples::OpenCvSample("left11.jpg")) GTEST_SKIP() << samples::MissingSampleMessage("left11.jpg");
+  CalibrateOptions options = CameraOptions();
+  options.input = samples::OpenCvSamplesDir() + "/left%02d.jpg";
+  options.out_file = (*dir_ / "left.yaml").string();
+  std::ostringstream report;
+  const CalibrateSummary summary = RunCalibrate(options, report);
+  EXPECT_EQ(summary.images, 13) << report.str();
+  EXPECT_THAT(report.str(), HasSubstr("1 file number missing (first: 10)"));
+  EXPECT_THAT(report.str(), HasSubstr("found in 13 of 13 images"));
 }
 
 std::string ErrorOf(const CalibrateOptions& options) {

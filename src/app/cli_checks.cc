@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <optional>
 #include <sstream>
 
+#include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -36,6 +38,34 @@ std::optional<FileId> IdOf(const std::string& path) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) return std::nullopt;
   return FileId{info.st_dev, info.st_ino};
+}
+
+// The input file an image-pattern output (frames/%04d.png) would write over: one in the
+// pattern's folder whose name the pattern writes. Nothing for other outputs, or a pattern the
+// writer will refuse anyway.
+const PathRole* InputAPatternWouldWrite(const std::string& output,
+                                        const std::vector<PathRole>& inputs) {
+  namespace fs = std::filesystem;
+  if (output.find('%') == std::string::npos || IdOf(output)) return nullptr;
+  SequencePattern pattern;
+  try {
+    pattern = ParseSequencePattern(output);
+  } catch (const InputError&) {
+    return nullptr;
+  }
+  const fs::path folder = fs::path(pattern.prefix).parent_path();
+  const SequencePattern names{fs::path(pattern.prefix).filename().string(), pattern.suffix,
+                              pattern.width};
+  for (const PathRole& input : inputs) {
+    const fs::path path(input.path);
+    if (!names.Match(path.filename().string())) continue;
+    std::error_code error;
+    if (fs::equivalent(folder.empty() ? fs::path(".") : folder,
+                       path.parent_path().empty() ? fs::path(".") : path.parent_path(), error)) {
+      return &input;
+    }
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -74,6 +104,10 @@ void RequireFiniteNumbers(CLI::App& app) {
 void CheckOutputsAreNotInputs(const std::vector<PathRole>& outputs,
                               const std::vector<PathRole>& inputs) {
   for (size_t i = 0; i < outputs.size(); ++i) {
+    if (const PathRole* input = InputAPatternWouldWrite(outputs[i].path, inputs)) {
+      throw InputError(outputs[i].role + " " + outputs[i].path + " would write " + input->role +
+                       " " + input->path + ": refusing to overwrite an input (choose another name)");
+    }
     const std::optional<FileId> out = IdOf(outputs[i].path);
     if (!out) continue;
     auto same = [&](const PathRole& other) {

@@ -24,7 +24,8 @@ struct PathRole {
 };
 
 // Throws InputError when an output is the same file (device and inode, so links and "./x" count)
-// as an input or as another output. Outputs that do not exist yet cannot be either.
+// as an input or as another output, or is an image pattern (frames/%04d.png) that would write
+// one of the inputs' names in their folder. Outputs that do not exist yet cannot be either.
 void CheckOutputsAreNotInputs(const std::vector<PathRole>& outputs,
                               const std::vector<PathRole>& inputs);
 

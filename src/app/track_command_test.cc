@@ -464,6 +464,15 @@ TEST_F(TrackRefuses, OutputThatIsAnInputAndLeavesItUntouched) {
   ExpectOneError(Track("-i '" + dir_.file("frames/f%d.png") + "' -o " +
                        dir_.file("frames/f2.png")),
                  "f2.png");
+  // An image-pattern output that would write over frames of the input (a folder or a pattern).
+  for (const std::string& input : {dir_.file("frames"), "'" + dir_.file("frames/f%d.png") + "'"}) {
+    ExpectOneError(Track("-i " + input + " -o " + dir_.file("o.csv") + " --record '" +
+                         dir_.file("frames/f%d.png") + "'"),
+                   "would write --input");
+    ExpectOneError(Track("-i " + input + " -o " + dir_.file("o.csv") + " --annotated '" +
+                         dir_.path().string() + "/./frames/f%d.png'"),
+                   "refusing to overwrite");
+  }
   EXPECT_EQ(testing::ReadTextFile(dir_.file("frames/f1.png")), frame_before);
 
   // A file the config names (the camera model).

@@ -185,42 +185,23 @@ bool IsImageFile(const fs::path& path) {
                      [&](const char* e) { return ext == e; });
 }
 
-// One file of an image sequence and the frame number its rows carry.
-struct SequenceFile {
-  int64_t index;
-  std::string path;
-};
-
 // A gap in the numbering is not silent: rows keep the files' numbers (so frame 7 is still the
 // seventh file's number after a missing one), and the source says which numbers were missing.
-std::optional<std::string> DescribeGaps(const std::vector<SequenceFile>& files) {
-  int64_t missing = 0;
-  std::string first_gap;
-  for (size_t i = 1; i < files.size(); ++i) {
-    const int64_t gap = files[i].index - files[i - 1].index - 1;
-    if (gap <= 0) continue;
-    if (missing == 0) {
-      first_gap = gap == 1 ? std::to_string(files[i - 1].index + 1)
-                           : std::to_string(files[i - 1].index + 1) + ".." +
-                                 std::to_string(files[i].index - 1);
-    }
-    missing += gap;
-  }
-  if (missing == 0) return std::nullopt;
-  return "the numbering has gaps: " + std::to_string(missing) + " file number" +
-         (missing == 1 ? "" : "s") + " missing (first: " + first_gap +
-         "); rows keep each file's number in `frame`";
+std::optional<std::string> DescribeGaps(const std::vector<NumberedFile>& files) {
+  const std::optional<std::string> gaps = DescribeNumberingGaps(files);
+  if (!gaps) return std::nullopt;
+  return *gaps + "; rows keep each file's number in `frame`";
 }
 
 class ImageSequenceSource : public FrameSource {
  public:
-  ImageSequenceSource(std::vector<SequenceFile> files, std::string description, double fps)
+  ImageSequenceSource(std::vector<NumberedFile> files, std::string description, double fps)
       : files_(std::move(files)), description_(std::move(description)), fps_(fps),
         gaps_(DescribeGaps(files_)) {}
 
   bool read(Frame& frame) override {
     if (next_ >= files_.size()) return false;
-    const SequenceFile& file = files_[next_];
+    const NumberedFile& file = files_[next_];
     decoded_ = cv::imread(file.path, cv::IMREAD_UNCHANGED);
     if (decoded_.empty()) {
       throw InputError(file.path + ": frame " + std::to_string(file.index) +
@@ -242,12 +223,12 @@ class ImageSequenceSource : public FrameSource {
   std::optional<std::string> note() const override { return gaps_; }
   std::vector<std::string> files() const override {
     std::vector<std::string> paths;
-    for (const SequenceFile& file : files_) paths.push_back(file.path);
+    for (const NumberedFile& file : files_) paths.push_back(file.path);
     return paths;
   }
 
  private:
-  std::vector<SequenceFile> files_;
+  std::vector<NumberedFile> files_;
   std::string description_;
   double fps_;
   std::optional<std::string> gaps_;
@@ -288,33 +269,20 @@ std::unique_ptr<FrameSource> OpenFolder(const std::string& folder, double fps) {
       }
     }
   }
-  std::vector<SequenceFile> files;
+  std::vector<NumberedFile> files;
   for (size_t i = 0; i < names.size(); ++i) {
     files.push_back({numbering ? *numbering->Match(names[i]) : static_cast<int64_t>(i),
                      (fs::path(folder) / names[i]).string()});
   }
   std::sort(files.begin(), files.end(),
-            [](const SequenceFile& a, const SequenceFile& b) { return a.index < b.index; });
+            [](const NumberedFile& a, const NumberedFile& b) { return a.index < b.index; });
   return std::make_unique<ImageSequenceSource>(std::move(files), "images " + folder, fps);
 }
 
 // Every file the pattern names, in number order, wherever the numbering starts or has gaps.
 std::unique_ptr<FrameSource> OpenPattern(const std::string& pattern, double fps) {
-  const SequencePattern parsed = ParseSequencePattern(pattern);
-  const size_t slash = parsed.prefix.find_last_of('/');
-  const std::string folder = slash == std::string::npos ? "." : parsed.prefix.substr(0, slash + 1);
-  const SequencePattern names{slash == std::string::npos ? parsed.prefix
-                                                         : parsed.prefix.substr(slash + 1),
-                              parsed.suffix, parsed.width};
-  std::vector<SequenceFile> files;
-  std::error_code error;
-  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
-    const std::optional<int64_t> index = names.Match(it->path().filename().string());
-    if (index && it->is_regular_file()) files.push_back({*index, parsed.Format(*index)});
-  }
+  std::vector<NumberedFile> files = ListSequenceFiles(ParseSequencePattern(pattern));
   if (files.empty()) throw InputError(pattern + ": no file matches this pattern");
-  std::sort(files.begin(), files.end(),
-            [](const SequenceFile& a, const SequenceFile& b) { return a.index < b.index; });
   return std::make_unique<ImageSequenceSource>(std::move(files), "images " + pattern, fps);
 }
 
@@ -416,7 +384,7 @@ std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
     throw InputError(input + ": no such file or folder");
   }
   if (IsImageFile(input)) {
-    return std::make_unique<ImageSequenceSource>(std::vector<SequenceFile>{{0, input}},
+    return std::make_unique<ImageSequenceSource>(std::vector<NumberedFile>{{0, input}},
                                                  "image " + input, spec.sequence_fps);
   }
   return std::make_unique<VideoFileSource>(input);

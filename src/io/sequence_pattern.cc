@@ -1,5 +1,9 @@
 #include "io/sequence_pattern.h"
 
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -83,6 +87,43 @@ SequencePattern ParseSequencePattern(const std::string& pattern) {
   }
   if (!have_number) Reject(pattern, "no %d in the pattern");
   return parsed;
+}
+
+std::vector<NumberedFile> ListSequenceFiles(const SequencePattern& pattern) {
+  namespace fs = std::filesystem;
+  const size_t slash = pattern.prefix.find_last_of('/');
+  const std::string folder = slash == std::string::npos ? "." : pattern.prefix.substr(0, slash + 1);
+  const SequencePattern names{slash == std::string::npos ? pattern.prefix
+                                                         : pattern.prefix.substr(slash + 1),
+                              pattern.suffix, pattern.width};
+  std::vector<NumberedFile> files;
+  std::error_code error;
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    const std::optional<int64_t> index = names.Match(it->path().filename().string());
+    std::error_code ignored;
+    if (index && it->is_regular_file(ignored)) files.push_back({*index, pattern.Format(*index)});
+  }
+  std::sort(files.begin(), files.end(),
+            [](const NumberedFile& a, const NumberedFile& b) { return a.index < b.index; });
+  return files;
+}
+
+std::optional<std::string> DescribeNumberingGaps(const std::vector<NumberedFile>& files) {
+  int64_t missing = 0;
+  std::string first_gap;
+  for (size_t i = 1; i < files.size(); ++i) {
+    const int64_t gap = files[i].index - files[i - 1].index - 1;
+    if (gap <= 0) continue;
+    if (missing == 0) {
+      first_gap = gap == 1 ? std::to_string(files[i - 1].index + 1)
+                           : std::to_string(files[i - 1].index + 1) + ".." +
+                                 std::to_string(files[i].index - 1);
+    }
+    missing += gap;
+  }
+  if (missing == 0) return std::nullopt;
+  return "the numbering has gaps: " + std::to_string(missing) + " file number" +
+         (missing == 1 ? "" : "s") + " missing (first: " + first_gap + ")";
 }
 
 }  // namespace softsight

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace softsight {
 
@@ -25,5 +26,19 @@ struct SequencePattern {
 // literal percent sign; anything else ("%s", "%n", "%5d", two numbers, none, a "%" in a folder
 // name) throws InputError naming the pattern and what is wrong.
 SequencePattern ParseSequencePattern(const std::string& pattern);
+
+// One existing file of a sequence and the number it stands for.
+struct NumberedFile {
+  int64_t index;
+  std::string path;
+};
+
+// Every regular file `pattern` names, in number order, wherever the numbering starts and
+// whatever gaps it has (left01 .. left09, left11 .. left14: thirteen files). Empty when none.
+std::vector<NumberedFile> ListSequenceFiles(const SequencePattern& pattern);
+
+// "the numbering has gaps: 3 file numbers missing (first: 5..7)" for `files` in number order,
+// nothing without gaps. A gap is never silent: callers say it, with what they number by.
+std::optional<std::string> DescribeNumberingGaps(const std::vector<NumberedFile>& files);
 
 }  // namespace softsight
