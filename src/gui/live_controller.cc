@@ -11,6 +11,7 @@
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/live_recording.h"
+#include "gui/range_edit.h"
 #include "gui/live_view.h"
 
 namespace softsight {
@@ -21,6 +22,9 @@ constexpr size_t kFpsWindow = 30;          // Frames averaged for the fps figure
 constexpr double kLatencySmoothing = 0.2;  // Exponential smoothing of the shown latency.
 const cv::Scalar kDragColour(0, 255, 0);
 const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
+// Mask view: the chosen blob, blobs that fit but were not chosen, rejected ones, the window.
+const cv::Scalar kMaskChosenColour(0, 255, 0), kMaskFitsColour(0, 255, 255);
+const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0);
 // Two clicks closer than this give no usable scale: each click is good to about 1 px, so the
 // scale would be off by several percent. A ruler across much of the image is best.
 constexpr double kMinScaleSpanPx = 20.0;
@@ -233,6 +237,9 @@ void LiveController::apply_spec(int marker, const MarkerSpec& spec,
     session_->respec(spec);
     if (hint && !hint->empty() && !frame_.empty()) {
       show(session_->reselect(spec.name, on_screen(), *hint));
+    } else if ((paused_ || ended_) && !frame_.empty()) {
+      // No new frame is coming: track the one on screen again, so the change shows at once.
+      show(session_->retrack(spec.name, on_screen()));
     }
   } catch (const InputError& e) {
     // A live edit that cannot be used is reported on screen; the session keeps running.
@@ -263,6 +270,36 @@ void LiveController::click(const cv::Point2d& p) {
   ++hsv_revision_;
   say(spec.name + ": h " + RangeText(pick->ranges.h) + " s " + RangeText(pick->ranges.s) +
       " v " + RangeText(pick->ranges.v) + (IsTemplateMethod(spec.method) ? " (used by the colour method)" : ""));
+}
+
+void LiveController::edit_range(const cv::Point2d& p, bool grow) {
+  if (frame_.empty()) return;
+  MarkerSpec spec = config().markers[active_];
+  if (IsTemplateMethod(spec.method) || spec.colour.gray) {
+    say(spec.name + ": ranges are edited for colour markers (m switches the method)");
+    return;
+  }
+  // The pixels within the picker's radius of the click (a 5 px radius: an 11 x 11 patch).
+  const int r = options_.picker.radius_px;
+  const cv::Rect patch = cv::Rect(cvRound(p.x) - r, cvRound(p.y) - r, 2 * r + 1, 2 * r + 1) &
+                         cv::Rect(0, 0, frame_.cols, frame_.rows);
+  if (patch.empty()) return;
+  cv::cvtColor(frame_(patch), hsv_patch_, cv::COLOR_BGR2HSV);
+  HsvRanges ranges{spec.colour.h, spec.colour.s, spec.colour.v};
+  if (grow) {
+    ranges = GrowRanges(ranges, hsv_patch_);
+  } else if (std::string why; !ShrinkRanges(ranges, hsv_patch_, &why)) {
+    say(spec.name + ": " + why);
+    return;
+  }
+  spec.colour.h = ranges.h;
+  spec.colour.s = ranges.s;
+  spec.colour.v = ranges.v;
+  spec.colour.auto_bgr.reset();
+  apply_spec(active_, spec, std::nullopt);
+  ++hsv_revision_;
+  say(spec.name + (grow ? ": added, h " : ": removed, h ") + RangeText(spec.colour.h) + " s " +
+      RangeText(spec.colour.s) + " v " + RangeText(spec.colour.v));
 }
 
 void LiveController::drag(const cv::Rect& dragged) {
@@ -557,7 +594,11 @@ void LiveController::on_event(const UiEvent& event) {
         // Where the button is released, so a person can press, aim and let go.
         scale_point(gesture.release);
       } else if (gesture.kind == PointerGesture::Kind::kClick) {
-        click(gesture.press);
+        if (event.shift || mask_view_) {
+          edit_range(gesture.press, !event.shift);
+        } else {
+          click(gesture.press);
+        }
       } else {
         drag(gesture.box);
       }
@@ -605,6 +646,12 @@ void LiveController::on_event(const UiEvent& event) {
         case kKeyEnd:
           request_playback(PlaybackRequest::Kind::kEnd);
           break;
+        case 'v':
+          mask_view_ = !mask_view_;
+          say(mask_view_ ? "mask view of " + config().markers[active_].name +
+                               ": click adds colours, shift-click removes them"
+                         : "mask view off");
+          break;
         case 'l':
           loop_ = !loop_;
           say(loop_ ? "loop on" : "loop off");
@@ -645,6 +692,53 @@ void LiveController::on_event(const UiEvent& event) {
   }
 }
 
+void LiveController::draw_mask_view(cv::Mat& top, const LiveLayout& view) {
+  // The active marker's member pixels in their own colours, everything else dimmed to a quarter:
+  // what the ranges take in, on the frame on screen.
+  const Tracker& tracker = session_->tracker(active_);
+  const bool has_mask = tracker.membership(frame_, mask_);
+  frame_.convertTo(mask_image_, -1, 0.25, 0);
+  if (has_mask) frame_.copyTo(mask_image_, mask_);
+  if (mask_image_.size() == top.size()) {
+    mask_image_.copyTo(top);
+  } else {
+    cv::resize(mask_image_, top, top.size(), 0, 0, cv::INTER_AREA);
+  }
+  const double scale = view.scale_x();
+  const double text = std::max(0.4, top.cols / 640.0 * 0.45);
+  if (const std::optional<cv::Rect> region = tracker.search_region()) {
+    const cv::Point2d a = view.to_view(cv::Point2d(region->tl()) - cv::Point2d(0.5, 0.5));
+    const cv::Point2d b = view.to_view(cv::Point2d(region->br()) - cv::Point2d(0.5, 0.5));
+    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+                  kMaskWindowColour, 1);
+    cv::putText(top, "searched", {cvRound(a.x) + 3, cvRound(b.y) - 4}, kFont, text * 0.8,
+                kMaskWindowColour, 1, cv::LINE_AA);
+  }
+  // Each candidate blob: a circle of its area, green chosen, yellow fitting, red rejected, with
+  // the verdict and what it was judged on.
+  for (const MarkerCandidate& c : tracker.candidates()) {
+    const cv::Point2d at = view.to_view(c.position_px);
+    const int radius = std::max(4, cvRound(std::sqrt(c.area_px / CV_PI) * scale) + 3);
+    const cv::Scalar colour = c.verdict == CandidateVerdict::kChosen ? kMaskChosenColour
+                              : c.verdict == CandidateVerdict::kFits ? kMaskFitsColour
+                                                                     : kMaskRejectedColour;
+    cv::circle(top, cv::Point(cvRound(at.x), cvRound(at.y)), radius, colour, 1, cv::LINE_AA);
+    const std::string label = std::string(CandidateVerdictName(c.verdict)) + " " +
+                              Number(c.area_px, 0) + " px2 circ " + Number(c.circularity, 2) +
+                              " misfit " + Number(c.misfit, 2);
+    const cv::Point origin(cvRound(at.x) + radius + 3, cvRound(at.y) + 4);
+    cv::putText(top, label, origin, kFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(top, label, origin, kFont, text * 0.8, colour, 1, cv::LINE_AA);
+  }
+  const ColourParams& c = config().markers[active_].colour;
+  const std::string title =
+      "MASK " + config().markers[active_].name +
+      (has_mask ? ": h " + RangeText(c.h) + " s " + RangeText(c.s) + " v " + RangeText(c.v)
+                : ": " + config().markers[active_].method + " has no colour mask");
+  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+}
+
 const cv::Mat& LiveController::canvas() {
   if (!dirty_ && !canvas_.empty()) return canvas_;
   const LiveLayout view = layout();
@@ -654,6 +748,8 @@ const cv::Mat& LiveController::canvas() {
     top.setTo(cv::Scalar(0, 0, 0));
     cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
                 cv::LINE_AA);
+  } else if (mask_view_) {
+    draw_mask_view(top, view);
   } else if (view.image.size() == annotated_.size()) {
     // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
     annotated_.copyTo(top);

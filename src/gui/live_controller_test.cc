@@ -13,6 +13,7 @@
 #include "gui/live_feed.h"
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
+#include "gui/range_edit.h"
 #include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
@@ -723,6 +724,116 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
+}
+
+TEST_F(LiveControllerTest, WhilePausedARangeChangeRetracksTheFrameOnScreenAtOnce) {
+  LiveController live(SceneConfig(), Options());
+  SceneTruth truth;
+  for (int i = 0; i < 4; ++i) truth = Feed(live, i);
+  ExpectAt(live, 1, truth, 0.3);
+  live.on_event(UiEvent::Key(' '));
+  ASSERT_TRUE(live.paused());
+  // Blue's hue range moved onto green's hue with the trackbars: blue's ring moves to the green
+  // blob at once, on the same frame.
+  live.on_event(UiEvent::Key('2'));
+  live.on_event(UiEvent::Trackbar(1, 75));
+  live.on_event(UiEvent::Trackbar(0, 45));
+  EXPECT_EQ(live.last_result()->frame_index, 3);
+  const auto& blue = live.last_result()->markers[1].observation;
+  ASSERT_TRUE(blue.found()) << live.message();
+  EXPECT_NEAR(blue.position_px->x, truth.markers[2].centroid_px->x, 0.3);
+  EXPECT_NEAR(blue.position_px->y, truth.markers[2].centroid_px->y, 0.3);
+  const cv::Mat canvas = live.canvas().clone();
+  EXPECT_GE(RingPoints(canvas, *truth.markers[2].centroid_px), 20);
+}
+
+TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRangeRetrackingAtOnce) {
+  TrackingConfig config = SceneConfig();
+  config.markers[1].colour.h = {117, 125};  // Blue (hue 112 here) is outside its range.
+  LiveController live(config, Options());
+  SceneTruth truth;
+  for (int i = 0; i < 4; ++i) truth = Feed(live, i);
+  EXPECT_FALSE(live.last_result()->markers[1].observation.found());
+  live.on_event(UiEvent::Key(' '));
+  live.on_event(UiEvent::Key('2'));
+  live.on_event(UiEvent::Key('v'));
+  ASSERT_TRUE(live.mask_view());
+  const cv::Point2d blue = *truth.markers[1].centroid_px;
+  const cv::Point2d red = *truth.markers[0].centroid_px;
+  cv::Mat frame;
+  scene_->render(3, frame);
+  {
+    // Nothing is a member: the whole image dimmed to a quarter, blue's pixel too.
+    const cv::Mat canvas = live.canvas();
+    const cv::Vec3b shown = canvas.at<cv::Vec3b>(cv::Point(blue));
+    const cv::Vec3b original = frame.at<cv::Vec3b>(cv::Point(blue));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(shown[c], original[c] * 0.25, 1.5);
+  }
+  // A click on blue adds its colours: blue is found there at once (still paused, same frame),
+  // its pixels shown in their own colours, red's still dimmed; the chosen blob is circled green.
+  Click(live, blue);
+  EXPECT_EQ(live.last_result()->frame_index, 3);
+  ExpectAt(live, 1, truth, 0.3);
+  EXPECT_EQ(live.config().markers[1].colour.h.lo, 112);
+  EXPECT_EQ(live.config().markers[1].colour.h.hi, 125);
+  {
+    const cv::Mat canvas = live.canvas();
+    EXPECT_EQ(canvas.at<cv::Vec3b>(cv::Point(blue)), frame.at<cv::Vec3b>(cv::Point(blue)));
+    const cv::Vec3b red_shown = canvas.at<cv::Vec3b>(cv::Point(red));
+    EXPECT_NEAR(red_shown[2], frame.at<cv::Vec3b>(cv::Point(red))[2] * 0.25, 1.5);
+    int green = 0;
+    for (int deg = 0; deg < 360; deg += 10) {
+      for (int radius = 9; radius <= 15; ++radius) {
+        const cv::Point p(cvRound(blue.x + radius * std::cos(deg * CV_PI / 180)),
+                          cvRound(blue.y + radius * std::sin(deg * CV_PI / 180)));
+        const cv::Vec3b px = canvas.at<cv::Vec3b>(p);
+        if (px[1] > 150 && px[1] > px[0] + 60 && px[1] > px[2] + 60) {  // Green, antialiased.
+          ++green;
+          break;
+        }
+      }
+    }
+    EXPECT_GE(green, 30) << "the chosen blob is not circled";
+  }
+  // Shift-click on blue takes its colours out again: blue is not found, at once.
+  live.on_event(UiEvent::Mouse(Type::kMouseDown, blue.x, blue.y, true));
+  live.on_event(UiEvent::Mouse(Type::kMouseUp, blue.x, blue.y, true));
+  EXPECT_EQ(live.last_result()->frame_index, 3);
+  EXPECT_FALSE(live.last_result()->markers[1].observation.found()) << live.message();
+  EXPECT_NE(live.message().find("removed"), std::string::npos) << live.message();
+}
+
+TEST(RangeEdit, GrowTakesInTheClickedColoursAcrossHueZeroAndShrinkCutsTheCheapestEnd) {
+  const auto pixels = [](std::vector<cv::Vec3b> hsv) {
+    return cv::Mat(hsv, true).reshape(3, 1);
+  };
+  // Red around hue 0: a range 170..5 grows to 8 (nearer than going down from 170).
+  HsvRanges red{{170, 5}, {100, 255}, {60, 255}};
+  red = GrowRanges(red, pixels({{8, 150, 200}, {2, 90, 50}}));
+  EXPECT_EQ(red.h.lo, 170);
+  EXPECT_EQ(red.h.hi, 8);
+  EXPECT_EQ(red.s.lo, 90);
+  EXPECT_EQ(red.v.lo, 50);
+  EXPECT_TRUE(InRanges(red, {175, 200, 200}));
+  EXPECT_TRUE(InRanges(red, {8, 150, 200}));
+  EXPECT_FALSE(InRanges(red, {12, 150, 200}));
+  // A pale patch (low saturation) taken out: the saturation's low end moves above it, which
+  // removes less than any other cut; the marker's saturated pixels stay in.
+  HsvRanges blue{{95, 125}, {40, 255}, {40, 255}};
+  std::string why;
+  ASSERT_TRUE(ShrinkRanges(blue, pixels({{100, 50, 200}, {110, 60, 180}}), &why)) << why;
+  EXPECT_EQ(blue.s.lo, 61);
+  EXPECT_EQ(blue.h.lo, 95);
+  EXPECT_FALSE(InRanges(blue, {100, 50, 200}));
+  EXPECT_TRUE(InRanges(blue, {107, 200, 150}));
+  // Hue cut across 0.
+  HsvRanges wrap{{170, 10}, {0, 255}, {0, 255}};
+  ASSERT_TRUE(ShrinkRanges(wrap, pixels({{8, 0, 0}, {9, 255, 255}}), &why)) << why;
+  EXPECT_EQ(wrap.h.lo, 170);
+  EXPECT_EQ(wrap.h.hi, 7);
+  // Nothing to take out.
+  EXPECT_FALSE(ShrinkRanges(wrap, pixels({{60, 100, 100}}), &why));
+  EXPECT_NE(why.find("not in the ranges"), std::string::npos);
 }
 
 TEST(LiveLayout, AFrameFitsTheScreenAndCanvasPixelsMapBackToImagePixels) {

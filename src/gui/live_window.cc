@@ -15,7 +15,7 @@ struct CallbackContext {
   LiveController* controller;
 };
 
-void OnMouse(int event, int x, int y, int /*flags*/, void* user) {
+void OnMouse(int event, int x, int y, int flags, void* user) {
   auto* context = static_cast<CallbackContext*>(user);
   UiEvent::Type type;
   switch (event) {
@@ -31,7 +31,8 @@ void OnMouse(int event, int x, int y, int /*flags*/, void* user) {
     default:
       return;
   }
-  context->controller->on_event(UiEvent::Mouse(type, x, y));
+  context->controller->on_event(
+      UiEvent::Mouse(type, x, y, (flags & cv::EVENT_FLAG_SHIFTKEY) != 0));
 }
 
 struct TrackbarContext {

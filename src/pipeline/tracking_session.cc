@@ -207,6 +207,25 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
   throw InputError("no marker named '" + marker + "'");
 }
 
+const FrameResult& TrackingSession::retrack(const std::string& marker, const Frame& frame) {
+  for (size_t i = 0; i < trackers_.size(); ++i) {
+    if (config_.markers[i].name != marker) continue;
+    if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
+    plausibility_->forget(i);
+    if (!initialised_[i]) {
+      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
+    } else if (frame_change_->whole_frame_changed()) {
+      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+    } else {
+      result_.markers[i].observation = trackers_[i]->update(frame.image);
+    }
+    previous_px_[i] = result_.markers[i].observation.position_px;
+    measure(frame);
+    return result_;
+  }
+  throw InputError("no marker named '" + marker + "'");
+}
+
 void TrackingSession::respec(const MarkerSpec& spec) {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (config_.markers[i].name != spec.name) continue;

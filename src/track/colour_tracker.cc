@@ -749,6 +749,21 @@ cv::Mat ColourTracker::prepare(const cv::Mat& src, cv::Mat& store) {
   return converted;
 }
 
+bool ColourTracker::membership(const cv::Mat& frame_bgr, cv::Mat& mask) const {
+  cv::Mat src = frame_bgr;
+  const int channels = gray_ ? 1 : 3;
+  if (src.channels() != channels) {
+    cv::cvtColor(frame_bgr, src, channels == 1 ? cv::COLOR_BGR2GRAY : cv::COLOR_GRAY2BGR);
+  }
+  if (gray_) {
+    cv::inRange(src, cv::Scalar(gray_->lo), cv::Scalar(gray_->hi), mask);
+  } else {
+    mask.create(src.size(), CV_8UC1);
+    fine_hsv_.Classify(src, mask);
+  }
+  return true;
+}
+
 void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask) {
   if (gray_) {
     const HsvRange& g = coarse ? *coarse_gray_ : *gray_;

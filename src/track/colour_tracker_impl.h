@@ -68,6 +68,10 @@ class ColourTracker : public Tracker {
   Observation update(const cv::Mat& frame_bgr) override;
   void reset() override;
   const std::vector<MarkerCandidate>& candidates() const override { return candidates_; }
+  bool membership(const cv::Mat& frame_bgr, cv::Mat& mask) const override;
+  std::optional<cv::Rect> search_region() const override {
+    return last_search_px_.empty() ? std::nullopt : std::optional<cv::Rect>(last_search_px_);
+  }
 
   // ---- Internals exposed for tests and benchmarks ------------------------------------------------
   // Every complete blob of the frame, whole-frame search at full resolution or coarse-to-fine

@@ -54,6 +54,10 @@ const std::vector<MarkerCandidate>& Tracker::candidates() const {
   return kNone;
 }
 
+bool Tracker::membership(const cv::Mat& /*frame_bgr*/, cv::Mat& /*mask*/) const { return false; }
+
+std::optional<cv::Rect> Tracker::search_region() const { return std::nullopt; }
+
 const char* CandidateVerdictName(CandidateVerdict verdict) {
   switch (verdict) {
     case CandidateVerdict::kChosen: return "chosen";

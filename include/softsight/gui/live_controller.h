@@ -34,10 +34,15 @@ struct UiEvent {
   int key = 0;              // kKey: the character ('q', ' ', '1') or 27 for Escape.
   int trackbar = 0;         // kTrackbar: index into kHsvTrackbars.
   int value = 0;            // kTrackbar: new position.
+  bool shift = false;       // Mouse events: the shift key was held.
 
-  static UiEvent Mouse(Type type, double x, double y) { return {type, {x, y}, 0, 0, 0}; }
-  static UiEvent Key(int key) { return {Type::kKey, {}, key, 0, 0}; }
-  static UiEvent Trackbar(int index, int value) { return {Type::kTrackbar, {}, 0, index, value}; }
+  static UiEvent Mouse(Type type, double x, double y, bool shift = false) {
+    return {type, {x, y}, 0, 0, 0, shift};
+  }
+  static UiEvent Key(int key) { return {Type::kKey, {}, key, 0, 0, false}; }
+  static UiEvent Trackbar(int index, int value) {
+    return {Type::kTrackbar, {}, 0, index, value, false};
+  }
 };
 
 // The six trackbars of the active marker's HSV ranges: name and maximum.
@@ -56,7 +61,7 @@ struct LiveKey {
 // keys); each has an ASCII twin in kLiveKeys for keyboards and scripts without them.
 inline constexpr int kKeyLeft = 0xFF51, kKeyRight = 0xFF53, kKeyHome = 0xFF50, kKeyEnd = 0xFF57;
 // The keys, as the on-screen help (`h`) lists them (key 0: a line about the mouse).
-inline constexpr std::array<LiveKey, 17> kLiveKeys = {{
+inline constexpr std::array<LiveKey, 19> kLiveKeys = {{
     {'h', "help on / off"},
     {' ', "pause / resume (at the end: play from the start)"},
     {'.', "step 1 frame forward (pauses)"},
@@ -72,8 +77,10 @@ inline constexpr std::array<LiveKey, 17> kLiveKeys = {{
     {'b', "reset the bending-distance reference"},
     {'m', "switch method (colour, sad, ssd, zncc)"},
     {'c', "mm scale: click 2 points (Esc cancels)"},
+    {'v', "mask view: active marker's pixels, blobs, window"},
     {'1', "1..9 active marker;  q / Esc quit"},
     {0, "drag a box: reselect; click: pick colour"},
+    {0, "mask view: click adds colours, shift-click removes"},
 }};
 
 // What a transport key asks of the source; LiveFeed carries it out (a camera cannot).
@@ -150,6 +157,9 @@ class LiveController {
   bool loop() const { return loop_; }
   bool recording() const { return recording_ != nullptr; }
   bool help_shown() const { return help_; }
+  // Mask view (`v`): the active marker's member pixels, its candidate blobs with the verdict on
+  // each, and its search region, instead of the annotated frame.
+  bool mask_view() const { return mask_view_; }
   // Scale mode (`c`): the next left clicks are the two scale points.
   bool scale_mode() const { return scale_mode_; }
   int active_marker() const { return active_; }
@@ -179,6 +189,9 @@ class LiveController {
  private:
 
   void click(const cv::Point2d& p);
+  // Mask view: the pixels around `p` added to (grow) or removed from the active marker's ranges.
+  void edit_range(const cv::Point2d& p, bool grow);
+  void draw_mask_view(cv::Mat& top, const LiveLayout& view);
   void drag(const cv::Rect& rect);
   void switch_method();
   void set_hsv(int trackbar, int value);
@@ -224,6 +237,8 @@ class LiveController {
   size_t frame_times_next_ = 0;
 
   bool paused_ = false, help_ = false, quit_ = false, ended_ = false, loop_ = false;
+  bool mask_view_ = false;
+  cv::Mat mask_, mask_image_, hsv_patch_;  // Mask view and range edits: reused buffers.
   std::optional<PlaybackRequest> playback_request_;
   int active_ = 0;
   int hsv_revision_ = 0;

@@ -62,6 +62,15 @@ class TrackingSession {
   // config's camera model, else the point itself (e.g. clicks to become scale_from_points).
   cv::Point2d measurement_point(const cv::Point2d& image_px) const;
 
+  // The frame on screen again, for marker `marker` alone, after its spec changed (respec) while
+  // the window is paused: its new tracker starts and tracks `frame` (the frame process() saw
+  // last) at once, so the effect of new ranges shows without a new frame. The config is not
+  // changed. Throws InputError for an unknown marker.
+  const FrameResult& retrack(const std::string& marker, const Frame& frame);
+  // The marker's tracker, for the mask view's diagnostics (candidates, membership, search
+  // region). `index` in config order.
+  const Tracker& tracker(size_t index) const { return *trackers_.at(index); }
+
   const TrackingConfig& config() const { return config_; }
 
  private:

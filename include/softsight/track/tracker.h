@@ -7,6 +7,7 @@
 #include <functional>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,13 @@ class Tracker {
   // The candidates the last update() (or init()) weighed, with the verdict on each; empty for
   // trackers that do not report them. Valid until the next update().
   virtual const std::vector<MarkerCandidate>& candidates() const;
+
+  // Diagnostics for the live window's mask view. The pixels of `frame_bgr` this tracker counts
+  // as its marker's colour (CV_8U, 255 = member; before filtering and morphology): false for
+  // trackers without such a notion (templates).
+  virtual bool membership(const cv::Mat& frame_bgr, cv::Mat& mask) const;
+  // The region the last update() searched, when the tracker restricts its search to one.
+  virtual std::optional<cv::Rect> search_region() const;
 };
 
 // The method of a marker whose config names none: template matching (zncc) when it has a
