@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <numeric>
 
@@ -29,6 +30,19 @@ constexpr double kListedRejectAreaPx = 20.0;
 constexpr size_t kMaxListedRejects = 40;
 // Markers of one body have about one size: a blob this many times another's area is not one of them.
 constexpr double kMaxAreaRatio = 6.0;
+// The markers of one body are made alike: their radii lie within this factor of their median
+// (perspective across one body changes them far less). A verified blob outside it, among a
+// majority inside, is not a marker (a stain of the bench with a clean edge); look-alikes outside
+// it do not stop init.
+constexpr double kBodySizeRatio = 1.4;
+// ... and as saturated: a verified blob below this fraction of their median saturation, among a
+// majority above it, is a pale stain rather than one of them.
+constexpr double kMinSaturationRatio = 0.6;
+// Neighbouring markers along a body are spaced within this factor of each other. Markers are put
+// on an actuator at even steps, and a constant-curvature bend keeps the chords between evenly
+// spaced markers equal (perspective changes them gradually): a blob off the body at an end of
+// the path breaks it. With the count given (--markers) the spacing is the user's business.
+constexpr double kMaxSpacingRatio = 1.6;
 // The verifying tracker must find the candidate within this many radii (and 1 px) of where the
 // search found it: the same blob, measured with the marker's own ranges.
 constexpr double kVerifyRadii = 0.25;
@@ -206,6 +220,26 @@ std::optional<double> EdgeWidthPx(const cv::Mat& bgr, const cv::Point2d& centre,
   }
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
   return widths[widths.size() / 2];
+}
+
+// Median HSV saturation of the disc of 0.6 radii around `centre`.
+double CoreSaturation(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
+  const double r = std::max(1.0, 0.6 * radius);
+  const cv::Rect box = cv::Rect(cvFloor(centre.x - r), cvFloor(centre.y - r), cvCeil(2 * r) + 2,
+                                cvCeil(2 * r) + 2) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (box.empty()) return 0;
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  std::vector<int> s;
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      if (std::hypot(box.x + x - centre.x, box.y + y - centre.y) <= r) {
+        s.push_back(hsv.at<cv::Vec3b>(y, x)[1]);
+      }
+    }
+  }
+  return Median(s);
 }
 
 int HueOf(const HsvRange& h) {
@@ -405,9 +439,15 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
   struct Verified {
     FoundMarker marker;
     int hue = 0;
+    double saturation = 0;  // Median over its core (colour markers).
   };
   std::vector<Verified> verified;
-  std::vector<std::string> look_alikes;
+  struct LookAlike {
+    std::string colour;
+    double radius_px = 0;
+    size_t rejected_index = 0;  // Its entry in finding.rejected.
+  };
+  std::vector<LookAlike> ambiguous;
   for (size_t i = 0; i < fitting.size(); ++i) {
     const Candidate& c = fitting[i];
     const double radius = RadiusOf(c.area_px);
@@ -488,10 +528,8 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
       alone = inside;
     } else if (!ok) {
       if (alone.status() == MarkerStatus::kAmbiguous) {
-        const std::string what = finding.intensity ? "dot" : HueName(hue);
-        if (std::find(look_alikes.begin(), look_alikes.end(), what) == look_alikes.end()) {
-          look_alikes.push_back(what);
-        }
+        ambiguous.push_back({finding.intensity ? "dot" : HueName(hue), radius,
+                             finding.rejected.size()});
         reject("ambiguous: " + std::to_string(std::max(2, alone.candidates)) +
                " look-alikes of its colour");
       } else if (alone.found()) {
@@ -507,7 +545,28 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
     v.marker.position_px = *alone.position_px;
     v.marker.radius_px = radius;
     v.hue = hue;
+    if (!finding.intensity) v.saturation = CoreSaturation(frame, c.position_px, radius);
     verified.push_back(v);
+  }
+  // Look-alikes that could be markers of this body make the finding unusable: init will not
+  // guess between them. Once markers are verified, the body's markers have about their size, so
+  // a pair of look-alikes of another size (a patch of the bench, twice as large) is only a reject.
+  std::vector<std::string> look_alikes;
+  double median_radius = 0;
+  if (!verified.empty()) {
+    std::vector<double> radii;
+    for (const Verified& v : verified) radii.push_back(v.marker.radius_px);
+    std::nth_element(radii.begin(), radii.begin() + radii.size() / 2, radii.end());
+    median_radius = radii[radii.size() / 2];
+  }
+  for (const LookAlike& a : ambiguous) {
+    const bool body_sized = verified.empty() || (a.radius_px >= median_radius / kBodySizeRatio &&
+                                                 a.radius_px <= median_radius * kBodySizeRatio);
+    if (!body_sized) {
+      finding.rejected[a.rejected_index].why += ", unlike the markers' size";
+    } else if (std::find(look_alikes.begin(), look_alikes.end(), a.colour) == look_alikes.end()) {
+      look_alikes.push_back(a.colour);
+    }
   }
   // Only blobs of about a marker's size are worth showing: texture specks are many.
   if (!verified.empty()) {
@@ -524,6 +583,37 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
               return a.radius_px > b.radius_px;
             });
   if (finding.rejected.size() > kMaxListedRejects) finding.rejected.resize(kMaxListedRejects);
+
+  // Markers of one body are made alike: with most of them agreeing, a blob of another size (a
+  // patch of the bench with a clean edge), then a pale one among vivid markers (a stain), is not
+  // one of them. Without such a majority the finding is refused below (sizes too different).
+  const auto drop_minority = [&](const std::function<double(const Verified&)>& value,
+                                 const std::function<bool(double, double)>& unlike_median) {
+    if (verified.size() < 3) return;
+    std::vector<double> values;
+    for (const Verified& v : verified) values.push_back(value(v));
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    const double median = values[values.size() / 2];
+    const auto unlike = [&](const Verified& v) { return unlike_median(value(v), median); };
+    const size_t outliers =
+        static_cast<size_t>(std::count_if(verified.begin(), verified.end(), unlike));
+    if (outliers * 2 >= verified.size()) return;
+    for (const Verified& v : verified) {
+      if (unlike(v)) {
+        finding.rejected.push_back({v.marker.position_px, v.marker.radius_px,
+                                    "unlike the other markers (size or paleness)"});
+      }
+    }
+    verified.erase(std::remove_if(verified.begin(), verified.end(), unlike), verified.end());
+  };
+  drop_minority([](const Verified& v) { return v.marker.radius_px; },
+                [](double r, double median) {
+                  return r < median / kBodySizeRatio || r > median * kBodySizeRatio;
+                });
+  if (!finding.intensity) {
+    drop_minority([](const Verified& v) { return v.saturation; },
+                  [](double s, double median) { return s < kMinSaturationRatio * median; });
+  }
 
   // ---- 4. Body order, names, measurement ---------------------------------------------------------
   std::vector<cv::Point2d> positions;
@@ -561,6 +651,12 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
     min_radius = std::min(min_radius, m.radius_px);
     max_radius = std::max(max_radius, m.radius_px);
   }
+  double min_segment = std::numeric_limits<double>::infinity(), max_segment = 0;
+  for (size_t i = 1; i < n; ++i) {
+    const double d = cv::norm(finding.markers[i].position_px - finding.markers[i - 1].position_px);
+    min_segment = std::min(min_segment, d);
+    max_segment = std::max(max_segment, d);
+  }
   const std::string rejected_count = std::to_string(finding.rejected.size());
   if (!look_alikes.empty()) {
     std::string text;
@@ -569,10 +665,28 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
                       "which is the marker: " + text + " (restrict the search to the actuator with --roi X,Y,W,H, or pick the "
                       "markers with `softsight pick`)";
   } else if (n == 0) {
+    // The reasons, most frequent first: what a person needs to change (light, focus, markers).
+    std::vector<std::pair<std::string, int>> reasons;
+    for (const RejectedCandidate& r : finding.rejected) {
+      const std::string reason = r.why.substr(0, r.why.find(" ("));
+      auto it = std::find_if(reasons.begin(), reasons.end(),
+                             [&](const auto& entry) { return entry.first == reason; });
+      if (it == reasons.end()) {
+        reasons.emplace_back(reason, 1);
+      } else {
+        ++it->second;
+      }
+    }
+    std::stable_sort(reasons.begin(), reasons.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    std::string why;
+    for (const auto& [reason, count] : reasons) {
+      why += (why.empty() ? ": " : ", ") + std::to_string(count) + " " + reason;
+    }
     finding.problem = std::string("no markers: no compact ") +
                       (finding.intensity ? "white or black dot" : "saturated blob") +
                       " stands out from its surroundings (" + rejected_count +
-                      " blobs rejected, see the picture)";
+                      " blobs of some size rejected" + why + "; see the picture)";
   } else if (options.expected_count && static_cast<int>(n) != *options.expected_count) {
     finding.problem = "found " + std::to_string(n) + " markers, expected " +
                       std::to_string(*options.expected_count) + " (see the picture)";
@@ -582,6 +696,14 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
                   "the blobs found differ too much in size to be the markers of one body (radius "
                   "%.1f to %.1f px): restrict the search with --roi X,Y,W,H",
                   min_radius, max_radius);
+    finding.problem = text;
+  } else if (n >= 3 && !options.expected_count && max_segment > kMaxSpacingRatio * min_segment) {
+    char text[220];
+    std::snprintf(text, sizeof(text),
+                  "the markers are unevenly spaced along the body (neighbours %.0f to %.0f px "
+                  "apart): one of them may not be a marker (--roi X,Y,W,H); if they are all markers, "
+                  "say how many with --markers N",
+                  min_segment, max_segment);
     finding.problem = text;
   } else if (order_ambiguous) {
     finding.problem = "the order along the body is ambiguous (two paths through the markers are "

@@ -45,9 +45,9 @@ struct MarkerFinderOptions {
   int min_saturation = 70;
   int min_value = 40;
   // Marker size limits: area in pixels, and the largest as a fraction of the frame area.
-  // Defaults 12 px (a disc of radius 2) and 0.5 % (radius 22 at VGA, 38 at 720p).
+  // Defaults 12 px (a disc of radius 2) and 2 % (radius 44 at VGA, 77 at 720p: close-ups).
   double min_area_px = 12.0;
-  double max_area_fraction = 0.005;
+  double max_area_fraction = 0.02;
   // The live window's click pick, used at each candidate's centre (its radius is shrunk to stay
   // inside small markers).
   HsvPickOptions picker;
