@@ -1,5 +1,6 @@
 #include "app/evaluate_command.h"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -290,6 +291,17 @@ TEST(EvaluateVideo, MarkersAreMatchedByNameAndWrongFindsCounted) {
   EXPECT_EQ(m.false_reports, 1);    // ... but it is there and found.
   EXPECT_EQ(m.wrong_finds, 1);      // green in frame 2.
   EXPECT_THAT(report.conditions, ::testing::HasSubstr("not in the truth (not scored): blue"));
+
+  // The command line: the built-in comparison's options do not mix with a recording.
+  const std::string cli = testing::SoftsightBinary() + " evaluate --input " + synth.out +
+                          " --truth " + video.truth_csv + " --config " + video.config_file +
+                          " --scene bench 2> " + dir.file("err.txt");
+  EXPECT_EQ(WEXITSTATUS(std::system(cli.c_str())), 2);
+  EXPECT_THAT(testing::ReadTextFile(dir.file("err.txt")), ::testing::HasSubstr("--scene"));
+  const std::string half = testing::SoftsightBinary() + " evaluate --input " + synth.out +
+                           " 2> " + dir.file("err2.txt");
+  EXPECT_EQ(WEXITSTATUS(std::system(half.c_str())), 2);
+  EXPECT_THAT(testing::ReadTextFile(dir.file("err2.txt")), ::testing::HasSubstr("--truth"));
 
   // A truth without any of the config's markers, or without frame numbers: one error each.
   testing::WriteTextFile(dir.file("bad.csv"), "frame,tip_x,tip_y\n0,1,2\n");

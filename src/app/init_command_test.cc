@@ -308,6 +308,22 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
     EXPECT_EQ(*a.roi, *b.roi);
   }
 
+  // Into an existing config: the first marker gets the pick, the others keep theirs.
+  SaveTrackingConfig(start, dir.file("base.yaml"));
+  PickOptions into = pick;
+  into.base_config = dir.file("base.yaml");
+  into.at_px = {clicks[0]};
+  into.config_out = dir.file("updated.yaml");
+  const TrackingConfig updated = RunPick(into);
+  ASSERT_EQ(updated.markers.size(), 3u);
+  EXPECT_EQ(updated.markers[0].colour.h.lo, picked.markers[0].colour.h.lo);
+  EXPECT_EQ(updated.markers[0].colour.s.lo, picked.markers[0].colour.s.lo);
+  EXPECT_EQ(updated.markers[1].colour.h.lo, start.markers[1].colour.h.lo);
+  EXPECT_FALSE(updated.markers[1].colour.roi.has_value());
+  EXPECT_EQ(updated.measure.base, start.measure.base);
+  into.at_px = {clicks[0], clicks[1], clicks[2], clicks[0]};
+  EXPECT_THROW(RunPick(into), InputError) << "more points than the config has markers";
+
   // A point on the background is one error naming the point.
   pick.at_px = {cv::Point2d(-50, 5)};
   try {
