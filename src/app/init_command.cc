@@ -267,11 +267,13 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
   sub.description(
       "Write a marker config without a GUI: find the markers in one frame by themselves (compact,\n"
       "saturated blobs of distinct colours; on gray video white or black dots), take each one's\n"
-      "HSV range from its own pixels (as a click in `live` does), order them from base to tip\n"
+      "HSV range from its own pixels (as a click in `live` does), order them from base (the end\n"
+      "that stays put in the frames that follow) to tip\n"
       "and write the config (markers, roi, triple or chain) plus a picture of what was found\n"
       "(green rings, numbered base to tip) and what was rejected (red crosses with the reason).\n"
       "A marker is written only when a tracker built from its range finds exactly that blob;\n"
-      "two look-alikes of one colour, no marker at all, or an unclear order: init writes no\n"
+      "two look-alikes of one colour, no marker at all, blobs unlike one body's markers, or an\n"
+      "unclear order: init writes no\n"
       "config, says why and exits 2. Check the picture, then run `softsight track`.\n"
       "Examples:\n"
       "  softsight init --input run.avi -o markers.yaml        (also writes markers.png)\n"
@@ -295,7 +297,8 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
                  "How many markers the body carries: any other count found is an error")
       ->check(NumberIn(1, 64));
   sub.add_option("--base", args->base,
-                 "X,Y near the base (the fixed end): default the end nearer the image border");
+                 "X,Y near the base (the fixed end). Default: the end that stays put over the next "
+                 "90 frames, else the end nearer the image border");
   sub.add_option("--fps", args->options.source.sequence_fps,
                  "Frame rate of an image sequence")
       ->capture_default_str()
