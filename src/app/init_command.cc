@@ -265,16 +265,15 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
   };
   auto args = std::make_shared<Args>();
   sub.description(
-      "Write a marker config without a GUI: find the markers in one frame by themselves (compact,\n"
-      "saturated blobs of distinct colours; on gray video white or black dots), take each one's\n"
-      "HSV range from its own pixels (as a click in `live` does), order them from base (the end\n"
-      "that stays put in the frames that follow) to tip\n"
-      "and write the config (markers, roi, triple or chain) plus a picture of what was found\n"
-      "(green rings, numbered base to tip) and what was rejected (red crosses with the reason).\n"
-      "A marker is written only when a tracker built from its range finds exactly that blob;\n"
-      "two look-alikes of one colour, no marker at all, blobs unlike one body's markers, or an\n"
-      "unclear order: init writes no\n"
-      "config, says why and exits 2. Check the picture, then run `softsight track`.\n"
+      "Write a marker config without a GUI: find the markers in one frame by themselves\n"
+      "(compact, saturated blobs of distinct colours; on gray video white or black dots), take\n"
+      "each one's HSV range from its own pixels (as a click in `live` does), order them from\n"
+      "base (the end that stays put in the frames that follow) to tip, and write the config\n"
+      "(markers, roi, triple or chain) plus a picture of what was found (green rings, numbered\n"
+      "base to tip) and what was rejected (red crosses with the reason). A marker is written\n"
+      "only when a tracker built from its range finds exactly that blob. Look-alikes of one\n"
+      "colour, no marker at all, blobs unlike one body's markers or an unclear order: init\n"
+      "writes no config, says why and exits 2. Check the picture, then run `softsight track`.\n"
       "Examples:\n"
       "  softsight init --input run.avi -o markers.yaml        (also writes markers.png)\n"
       "  softsight init --input run.avi --roi 100,40,400,380 --markers 3 -o markers.yaml");
