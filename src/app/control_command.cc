@@ -117,6 +117,15 @@ class ControlSink : public FrameSink {
     } else {
       sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
     }
+    // A command written for this frame: its latency from the frame's capture (absent when this
+    // step sent none).
+    const auto sent = link_.last_sent();
+    latency_command_ms_ =
+        sent >= frame.captured && frame.captured != std::chrono::steady_clock::time_point{}
+            ? std::optional<double>(
+                  std::chrono::duration<double, std::milli>(sent - frame.captured).count())
+            : std::nullopt;
+    if (latency_command_ms_) command_latencies_ms_.push_back(*latency_command_ms_);
     ++frames_;
     summary_.duration_s = sample_.time_s;
     summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
@@ -160,10 +169,19 @@ class ControlSink : public FrameSink {
     };
   }
 
+  // latency_command_ms: from the frame's capture to the serial command its step sent (goes
+  // between the CSV's latency_result_ms and latency_row_ms).
+  CsvColumn latency_column() const {
+    return NumberColumn("latency_command_ms",
+                        [this](const FrameResult&) { return latency_command_ms_; }, "%.3f");
+  }
+
   // The figures so far (frames, errors, pressures); the link's counters are the caller's.
   ControlSummary summary() const {
     ControlSummary out = summary_;
     out.frames = frames_;
+    std::vector<double> latencies = command_latencies_ms_;
+    SummariseTimes(latencies, &out.latency_command_ms_median, &out.latency_command_ms_p99);
     if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
     if (!step_points_.empty()) {
       out.metrics = ComputeStepMetrics(step_points_);
@@ -196,6 +214,8 @@ class ControlSink : public FrameSink {
   IdentificationExperiment* experiment_ = nullptr;
   std::vector<TrackingPoint> step_points_;
   ControlSample sample_;
+  std::optional<double> latency_command_ms_;
+  std::vector<double> command_latencies_ms_;
   ControlSummary summary_;
   int64_t frames_ = 0;
   double sum_sq_ = 0.0;
@@ -398,7 +418,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // The CSV is optional for an identification run (`softsight identify` without --csv).
   std::optional<CsvSink> csv;
   if (!options.csv_file.empty() || !options.identify) {
-    csv.emplace(options.csv_file, TrackingColumns(tracking_config, extra));
+    CsvColumnTable columns = TrackingColumns(tracking_config, extra);
+    columns.insert_before("latency_row_ms", control.latency_column());
+    csv.emplace(options.csv_file, std::move(columns));
   }
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
@@ -480,6 +502,10 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     throw;
   }
   collect();
+  summary.latency_result_ms_median = ran.latency_result_ms_median;
+  summary.latency_result_ms_p99 = ran.latency_result_ms_p99;
+  summary.latency_done_ms_median = ran.latency_done_ms_median;
+  summary.latency_done_ms_p99 = ran.latency_done_ms_p99;
   if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
     session.stop();
     throw IdentifyAbort("identify: the experiment did not finish (" +
@@ -537,6 +563,14 @@ std::string FormatControlSummary(const ControlSummary& s) {
                 s.max_pressure_kpa, static_cast<unsigned long long>(s.link_rejected),
                 static_cast<unsigned long long>(s.resends), s.board_rejected);
   out << line;
+  if (s.frames > 0) {
+    std::snprintf(line, sizeof(line),
+                  "latency from capture, median / p99: result %.3f / %.3f ms, serial command "
+                  "%.3f / %.3f ms, CSV row %.3f / %.3f ms\n",
+                  s.latency_result_ms_median, s.latency_result_ms_p99, s.latency_command_ms_median,
+                  s.latency_command_ms_p99, s.latency_done_ms_median, s.latency_done_ms_p99);
+    out << line;
+  }
   return out.str();
 }
 

@@ -63,6 +63,12 @@ struct ControlSummary {
   uint32_t board_rejected = 0;          // Lines from the host the board rejected.
   uint64_t resends = 0;
   std::string stop_reason;
+  // Latency per frame from its capture (the camera's frame handed over; the simulated rig's frame
+  // rendered) to the tracker's result, to the serial command sent, and to every output written
+  // (the CSV row), ms: median and 99th percentile.
+  double latency_result_ms_median = 0.0, latency_result_ms_p99 = 0.0;
+  double latency_command_ms_median = 0.0, latency_command_ms_p99 = 0.0;
+  double latency_done_ms_median = 0.0, latency_done_ms_p99 = 0.0;
   // Angle mode: rise and settling time, overshoot and steady-state error of the last step to a
   // constant target, RMS error over the run (control/step_metrics.h).
   StepMetrics metrics;

@@ -106,6 +106,18 @@ TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
   };
   const size_t angle = column("angle_deg"), truth = column("rig_true_angle_deg"),
                target = column("target_deg"), pressure = column("board_pressure_kpa");
+  // Capture -> result -> serial command -> CSV row, in that order, every frame.
+  const size_t to_result = column("latency_result_ms"), to_command = column("latency_command_ms"),
+               to_row = column("latency_row_ms");
+  EXPECT_LT(to_result, to_command);
+  EXPECT_LT(to_command, to_row);
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = SplitCsv(lines[i]);
+    ASSERT_GT(row.size(), to_row);
+    EXPECT_GE(std::stod(row[to_result]), 0.0) << "row " << i;
+    EXPECT_LE(std::stod(row[to_result]), std::stod(row[to_command])) << "row " << i;
+    EXPECT_LE(std::stod(row[to_command]), std::stod(row[to_row])) << "row " << i;
+  }
   // The tracker's angle against the rig's truth, and the settled result.
   double worst_tracking_deg = 0.0;
   for (size_t i = 1; i < lines.size(); ++i) {

@@ -59,6 +59,7 @@ std::optional<wire::Message> BoardLink::exchange(
       throw StopRequested();
     }
     transport_.write_line(line);
+    if (attempt == 0) last_sent_ = std::chrono::steady_clock::now();
     // One deadline per try: lines that are not the answer (chatter, stale answers, garbage) are
     // counted but never extend it.
     const int64_t deadline_ms = now_ms() + options_.reply_timeout_ms;

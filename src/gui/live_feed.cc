@@ -8,10 +8,14 @@ LiveFeed::LiveFeed(FrameSource& source, SeekableSource* seekable)
     : source_(source), paced_(dynamic_cast<PacedFrameSource*>(&source)), seekable_(seekable) {}
 
 bool LiveFeed::read(LiveController& controller, FrameOrder order) {
+  frame_.captured = {};
   if (!source_.read(frame_)) return false;
   if (seekable_) shown_ = seekable_->position() - 1;
   ended_ = false;
-  const SteadyClock::time_point captured = SteadyClock::now();
+  // A camera's frame carries its capture time (NewestFrameSource's thread); a played file's
+  // capture is the moment it is due and read. The recording's latency_*_ms columns count from it.
+  if (frame_.captured == SteadyClock::time_point{}) frame_.captured = SteadyClock::now();
+  const SteadyClock::time_point captured = frame_.captured;
   controller.set_dropped_frames(source_.dropped_frames());
   controller.on_frame(frame_, captured, order);
   ++fed_;

@@ -1,5 +1,6 @@
 #include "softsight/io/csv_columns.h"
 
+#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -19,6 +20,13 @@ CsvColumn MeasurementColumn(std::string name, std::optional<double> Measurement:
   return {std::move(name), [member](const FrameResult& r, std::string& row) {
             AppendNumber(row, r.measurement.*member, "%.4f");
           }};
+}
+
+// Milliseconds from `captured` to now; absent for a result without a capture time.
+std::optional<double> MillisecondsSince(std::chrono::steady_clock::time_point captured) {
+  if (captured == std::chrono::steady_clock::time_point{}) return std::nullopt;
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - captured)
+      .count();
 }
 
 }  // namespace
@@ -124,6 +132,17 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
     table.add(MeasurementColumn("tip_disp_mm", &Measurement::tip_disp_mm));
   }
   for (const CsvColumn& column : extra) table.add(column);
+  // Latency from the frame's capture (Frame::captured) to its result, and to this row: taken
+  // while the row is formatted, just before it is written, so every sink before the CSV (the
+  // controller's command) is in it. Timings, like proc_ms: they differ from run to run.
+  table.add({"latency_result_ms", [](const FrameResult& r, std::string& row) {
+               const bool stamped = r.captured != std::chrono::steady_clock::time_point{};
+               AppendNumber(row, stamped ? std::optional<double>(r.latency_result_ms) : std::nullopt,
+                            "%.3f");
+             }});
+  table.add({"latency_row_ms", [](const FrameResult& r, std::string& row) {
+               AppendNumber(row, MillisecondsSince(r.captured), "%.3f");
+             }});
   table.add({"proc_ms", [](const FrameResult& r, std::string& row) {
                AppendNumber(row, r.proc_ms, "%.4f");
              }});

@@ -41,7 +41,7 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
   EXPECT_EQ(testing::ReadLines(dir.file("a.csv")).at(0),
             "frame,time_s,red_x,red_y,red_found,red_score,red_status,blue_x,blue_y,blue_found,"
             "blue_score,blue_status,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,"
-            "tip_disp_px,proc_ms");
+            "tip_disp_px,latency_result_ms,latency_row_ms,proc_ms");
   {
     CsvWriter csv(dir.file("b.csv"),
                   TrackingColumns({"red"}, /*metric=*/true,
@@ -52,7 +52,7 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
   EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).at(0),
             "frame,time_s,red_x,red_y,red_found,red_score,red_status,angle_deg,chord_px,sagitta_px,"
             "radius_px,arc_length_px,tip_disp_px,chord_mm,sagitta_mm,radius_mm,arc_length_mm,"
-            "tip_disp_mm,target_deg,proc_ms");
+            "tip_disp_mm,target_deg,latency_result_ms,latency_row_ms,proc_ms");
 }
 
 TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
@@ -65,7 +65,7 @@ TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
   EXPECT_THAT(testing::SplitCsv(lines[1]),
               ElementsAre("7", "0.250000", "10.5000", "20.2500", "1", "0.9700", "found", "", "",
                           "0", "", "lost", "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
-                          "0.1250"));
+                          "", "", "0.1250"));  // No capture time: no latency.
 }
 
 TEST(CsvColumnTable, HeaderAndRowsComeFromTheSameColumns) {

@@ -40,6 +40,7 @@ void FrameGrabber::run() {
         if (stop_) break;
       }
       next.captured = SteadyClock::now();
+      next.frame.captured = next.captured;  // Travels with the frame: where its latency starts.
       ++captured_;
       std::lock_guard<std::mutex> lock(mutex_);
       if (slot_full_) ++dropped_;  // The consumer never saw the previous one: newest wins.

@@ -1,6 +1,7 @@
 #include "softsight/io/read_ahead_source.h"
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 namespace softsight {
@@ -41,7 +42,12 @@ void ReadAheadSource::decode_loop() {
     }
     bool got = false;
     try {
+      slot->captured = {};
       got = source_->read(*slot);
+      // A file's "capture" is its decoding: the latency of its frames counts the queue's wait.
+      if (got && slot->captured == std::chrono::steady_clock::time_point{}) {
+        slot->captured = std::chrono::steady_clock::now();
+      }
     } catch (...) {
       error = std::current_exception();
     }

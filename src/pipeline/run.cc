@@ -46,10 +46,13 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
   RunInfo info = DescribeRun(source, session, options);
   for (const std::string& name : info.marker_names) summary.markers.push_back({name, 0});
 
-  std::vector<double> proc_ms;
+  std::vector<double> proc_ms, latency_result_ms, latency_done_ms;
   if (info.frame_count) {
     // Reserved once: the loop does not reallocate for files (cameras grow it geometrically).
-    proc_ms.reserve(static_cast<size_t>(std::min<int64_t>(*info.frame_count, int64_t{1} << 22)));
+    const auto frames = static_cast<size_t>(std::min<int64_t>(*info.frame_count, int64_t{1} << 22));
+    for (std::vector<double>* times : {&proc_ms, &latency_result_ms, &latency_done_ms}) {
+      times->reserve(frames);
+    }
   }
   size_t begun = 0;  // Sinks whose begin() has run: exactly these get end().
   const auto begin_sinks = [&] {
@@ -61,6 +64,9 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
     summary.dropped = source.dropped_frames();
     if (const std::optional<std::string> note = source.note()) summary.notes.push_back(*note);
     SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
+    SummariseTimes(latency_result_ms, &summary.latency_result_ms_median,
+                   &summary.latency_result_ms_p99);
+    SummariseTimes(latency_done_ms, &summary.latency_done_ms_median, &summary.latency_done_ms_p99);
     summary.wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (size_t i = 0; i < begun; ++i) sinks[i]->end(summary);
@@ -77,9 +83,13 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
         summary.stop_reason = StopReason::kStopRequested;
         break;
       }
+      frame.captured = {};
       if (!source.read(frame)) {
         summary.stop_reason = StopReason::kEndOfInput;
         break;
+      }
+      if (frame.captured == std::chrono::steady_clock::time_point{}) {
+        frame.captured = std::chrono::steady_clock::now();
       }
       if (summary.frames == 0) {
         if (needs_colour && IsGrayscale(frame.image)) {
@@ -99,7 +109,11 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
       summary.statuses.add(result);
       summary.measured += result.measurement.angle_deg ? 1 : 0;
       proc_ms.push_back(result.proc_ms);
+      latency_result_ms.push_back(result.latency_result_ms);
       for (FrameSink* sink : sinks) sink->consume(frame, result);
+      latency_done_ms.push_back(std::chrono::duration<double, std::milli>(
+                                    std::chrono::steady_clock::now() - frame.captured)
+                                    .count());
       ++summary.frames;
       summary.last_index = frame.index;
     }

@@ -2,13 +2,17 @@
 // counts match the renderer's truth, and a stop request or an error ends the run with a summary.
 #include "softsight/pipeline/run.h"
 
+#include <algorithm>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
 #include "pipeline/scene_config_test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_writer.h"
+#include "softsight/io/read_ahead_source.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/sim/scene.h"
 
@@ -299,6 +303,74 @@ TEST(CsvSink, WritesOneCompleteRowPerFrameWithTheSourceIndex) {
     const std::vector<std::string> row = testing::SplitCsv(lines[i]);
     ASSERT_EQ(row.size(), columns);
     EXPECT_EQ(row[0], std::to_string(i - 1));
+  }
+}
+
+
+// The latency columns of a CSV row, by name: capture -> result, -> row (and -> command).
+struct RowLatency {
+  double result_ms, row_ms;
+};
+
+std::vector<RowLatency> LatencyRows(const std::string& csv) {
+  const std::vector<std::string> lines = testing::ReadLines(csv);
+  const std::vector<std::string> header = testing::SplitCsv(lines.at(0));
+  const auto column = [&](const std::string& name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(at, header.end()) << name;
+    return static_cast<size_t>(at - header.begin());
+  };
+  const size_t result = column("latency_result_ms"), row = column("latency_row_ms");
+  EXPECT_LT(result, row);
+  EXPECT_EQ(row + 1, column("proc_ms")) << "the timings end the row";
+  std::vector<RowLatency> rows;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> fields = testing::SplitCsv(lines[i]);
+    rows.push_back({std::stod(fields.at(result)), std::stod(fields.at(row))});
+  }
+  return rows;
+}
+
+// A live source's stand-in: frames rendered on demand, as a camera would hand them over.
+class LiveScene : public FrameSource {
+ public:
+  explicit LiveScene(int frames) : scene_(OpenSyntheticSource(SmallScene(frames), NoiseOptions{})) {}
+  bool read(Frame& frame) override { return scene_->read(frame); }
+  std::string description() const override { return "camera 7"; }
+  std::optional<int64_t> frame_count() const override { return std::nullopt; }
+  std::optional<double> fps() const override { return 30.0; }
+  bool is_live() const override { return true; }
+
+ private:
+  std::unique_ptr<FrameSource> scene_;
+};
+
+TEST(CsvSink, LatencyColumnsArePresentAndOrderedFromCaptureToResultToRow) {
+  TempDir dir;
+  // A file (its capture is its decoding, on the read-ahead thread) and a camera (its capture
+  // thread, newest frame wins).
+  for (bool live : {false, true}) {
+    std::unique_ptr<FrameSource> source;
+    if (live) {
+      source = std::make_unique<NewestFrameSource>(std::make_unique<LiveScene>(8));
+    } else {
+      source = std::make_unique<ReadAheadSource>(OpenSyntheticSource(SmallScene(8), NoiseOptions{}));
+    }
+    TrackingSession session(ThreeMarkerSceneConfig());
+    CsvSink csv(dir.file("run.csv"), TrackingColumns({"red", "blue", "green"}, false));
+    const RunSummary summary = RunPipeline(*source, session, {&csv});
+    ASSERT_GT(summary.frames, 0);
+    const std::vector<RowLatency> rows = LatencyRows(dir.file("run.csv"));
+    ASSERT_EQ(rows.size(), static_cast<size_t>(summary.frames));
+    for (const RowLatency& row : rows) {
+      EXPECT_GE(row.result_ms, 0.0) << (live ? "camera" : "file");
+      EXPECT_LE(row.result_ms, row.row_ms) << (live ? "camera" : "file");
+    }
+    EXPECT_GT(summary.latency_result_ms_median, 0.0);
+    EXPECT_LE(summary.latency_result_ms_median, summary.latency_result_ms_p99);
+    EXPECT_LE(summary.latency_result_ms_median, summary.latency_done_ms_median);
+    EXPECT_LE(summary.latency_done_ms_median, summary.latency_done_ms_p99);
+    EXPECT_THAT(summary.FullReport(), HasSubstr("latency from capture"));
   }
 }
 

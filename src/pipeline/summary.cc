@@ -82,6 +82,14 @@ std::string RunSummary::FullReport() const {
   std::snprintf(line, sizeof(line), "processing per frame: median %.3f ms, p99 %.3f ms\n",
                 proc_ms_median, proc_ms_p99);
   out += line;
+  if (frames > 0) {
+    std::snprintf(line, sizeof(line),
+                  "latency from capture (a file's frame: from its decoding): to the result "
+                  "median %.3f ms, p99 %.3f ms; to every output written median %.3f ms, p99 %.3f ms\n",
+                  latency_result_ms_median, latency_result_ms_p99, latency_done_ms_median,
+                  latency_done_ms_p99);
+    out += line;
+  }
   for (const std::string& note : notes) out += "note: " + note + "\n";
   if (stop_reason == StopReason::kError) out += "stopped by: " + error + "\n";
   return out;

@@ -1,5 +1,7 @@
 #include "softsight/pipeline/tracking_session.h"
 
+#include <chrono>
+
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
@@ -140,6 +142,13 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   measure(frame);
   result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
                     cv::getTickFrequency();
+  result_.captured = frame.captured;
+  result_.latency_result_ms =
+      frame.captured == std::chrono::steady_clock::time_point{}
+          ? 0.0
+          : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                      frame.captured)
+                .count();
   return result_;
 }
 

@@ -5,6 +5,7 @@
 // board says meanwhile, so a command ends within (retries + 1) * reply_timeout_ms.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -98,6 +99,9 @@ class BoardLink {
   BoardState heartbeat();
 
   const LinkStats& stats() const { return stats_; }
+  // When the last command was written to the port (its first try), on the steady clock: the end
+  // of a frame's capture-to-command latency.
+  std::chrono::steady_clock::time_point last_sent() const { return last_sent_; }
   const std::string& port_name() const { return transport_.name(); }
   const LinkOptions& options() const { return options_; }
 
@@ -117,6 +121,7 @@ class BoardLink {
   LinkEnvironment environment_;
   int32_t next_seq_ = 1;
   LinkStats stats_;
+  std::chrono::steady_clock::time_point last_sent_{};
 };
 
 }  // namespace softsight

@@ -7,6 +7,7 @@
 // - A value that cannot be computed is absent (std::optional), never 0 and never the last good value.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -21,6 +22,12 @@ struct Frame {
   cv::Mat image;        // 8-bit BGR (CV_8UC3); sources convert gray input only when asked to.
   int64_t index = 0;    // 0-based position in the source.
   double time_s = 0.0;  // Timestamp given by the source (video PTS, file rate, or wall clock).
+  // When the frame was read from its source, on this machine's steady clock: where its latency
+  // (FrameResult::latency_result_ms, the CSV's latency_*_ms) is counted from. A camera's: when
+  // the capture call returned it (the camera's own exposure-to-driver delay comes before); a
+  // file's: when it was decoded. Left at the epoch by a source, RunPipeline stamps it when
+  // read() returns.
+  std::chrono::steady_clock::time_point captured{};
 };
 
 // Why a marker has (or has no) position in a frame: the per-marker `<name>_status` CSV column.
@@ -96,6 +103,10 @@ struct FrameResult {
   std::vector<MarkerObservation> markers;  // In config order.
   Measurement measurement;
   double proc_ms = 0.0;                    // Tracking + measurement time for this frame.
+  // The frame's capture time (Frame::captured) and the time from it to this result (when the
+  // session finished the frame: reading, queueing and tracking included).
+  std::chrono::steady_clock::time_point captured{};
+  double latency_result_ms = 0.0;
 };
 
 }  // namespace softsight

@@ -6,7 +6,8 @@
 //   angle_deg, chord_px, sagitta_px, radius_px, arc_length_px, tip_disp_px,
 //   angle_<name>_deg per inner marker of the chain (none without a chain),
 //   chord_mm, sagitta_mm, radius_mm, arc_length_mm, tip_disp_mm (only with a metric model),
-//   any extra columns a caller adds (the controller's), proc_ms.
+//   any extra columns a caller adds (the controller's), latency_result_ms, latency_row_ms,
+//   proc_ms.
 // Undefined values are empty fields.
 #pragma once
 
@@ -54,7 +55,8 @@ class CsvColumnTable {
 
 // The tracking columns above for these markers (in FrameResult::markers order), an inner-angle
 // column per name of `inner_angle_markers` (Measurement::inner_angle_deg, in that order), the
-// _mm twins when `metric`, then `extra` (by name, before proc_ms), then proc_ms.
+// _mm twins when `metric`, then `extra`, then latency_result_ms and latency_row_ms (a caller's
+// latency column goes between them: insert_before("latency_row_ms")), then proc_ms.
 CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
                                const std::vector<CsvColumn>& extra = {},
                                const std::vector<std::string>& inner_angle_markers = {});

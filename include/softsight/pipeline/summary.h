@@ -40,6 +40,12 @@ struct RunSummary {
   int64_t measured = 0;                // Frames with an angle.
   double proc_ms_median = 0.0;         // FrameResult::proc_ms over the processed frames.
   double proc_ms_p99 = 0.0;
+  // Latency per frame from its capture (Frame::captured): to its result, and to the moment every
+  // sink had it (the CSV row written, the controller's command sent, the window drawn).
+  double latency_result_ms_median = 0.0;
+  double latency_result_ms_p99 = 0.0;
+  double latency_done_ms_median = 0.0;
+  double latency_done_ms_p99 = 0.0;
   double wall_s = 0.0;                 // Whole run, reading and sinks included.
   StopReason stop_reason = StopReason::kEndOfInput;
   // With kStopRequested, who asked, when the caller knows: "stopped by SIGTERM".
