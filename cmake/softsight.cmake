@@ -12,14 +12,13 @@ function(softsight_add_library module)
     PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS})
   add_library(softsight::${module} ALIAS ${target})
-  if(SOFTSIGHT_BUILD_PYTHON)
-    # The Python module is a shared object that links these static libraries: their code must be
-    # position independent. -fno-semantic-interposition keeps GCC inlining calls between the
-    # library's own functions (which plain -fPIC would forbid), so the programs stay as fast.
-    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
-    target_compile_options(${target} PRIVATE
-      $<$<CXX_COMPILER_ID:GNU>:-fno-semantic-interposition>)
-  endif()
+  # The program's command plugins and the Python module are shared objects that link these
+  # static libraries: their code must be position independent. -fno-semantic-interposition keeps
+  # GCC inlining calls between the library's own functions (which plain -fPIC would forbid), so
+  # the programs stay as fast.
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  target_compile_options(${target} PRIVATE
+    $<$<CXX_COMPILER_ID:GNU>:-fno-semantic-interposition>)
 endfunction()
 
 # softsight_add_test(<module> SOURCES ... DEPS ...)
@@ -32,7 +31,9 @@ function(softsight_add_test module)
   set(target softsight_${module}_test)
   add_executable(${target} ${ARG_SOURCES})
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
-  target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
+  # Test code may use any OpenCV module (writing fixtures, reading images), whatever its module links.
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} ${OpenCV_LIBS} GTest::gtest GTest::gmock
+                                          GTest::gtest_main)
   # End-to-end tests find the program and the repository through these (env vars of the same
   # names override them).
   target_compile_definitions(${target} PRIVATE
@@ -51,7 +52,8 @@ function(softsight_add_benchmark name)
   set(target softsight_${name}_benchmark)
   add_executable(${target} ${ARG_SOURCES})
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
-  target_link_libraries(${target} PRIVATE ${ARG_DEPS} benchmark::benchmark benchmark::benchmark_main)
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} ${OpenCV_LIBS} benchmark::benchmark
+                                          benchmark::benchmark_main)
 endfunction()
 
 # softsight_check_public_headers()

@@ -1,110 +1,91 @@
 // softsight: measure soft robots with a camera. See README.md.
-#include <csignal>
-#include <exception>
+//
+// The launcher: it links no OpenCV, so `softsight --version` and `softsight --help` start in a
+// few milliseconds (the whole program linked ~260 shared libraries and took 0.3 s to start).
+// A command runs in the plugin that holds it, loaded from beside this program
+// (app/command_table.h says which; app/command_line.h what it does).
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <climits>
+#include <filesystem>
 #include <iostream>
-#include <map>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/core/utils/logger.hpp>
 
-#include "app/cli_checks.h"
-#include "app/commands.h"
+#include "app/command_table.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
 namespace softsight {
 namespace {
 
-struct CommandEntry {
-  const char* name;
-  const char* summary;
-  CommandRunner (*setup)(CLI::App& sub);
-};
+// The first word that is not an option: the command, when there is one.
+const CommandInfo* ChosenCommand(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (argv[i][0] != '-') return FindCommand(argv[i]);
+  }
+  return nullptr;
+}
 
-// The subcommands, in the order --help lists them.
-const CommandEntry kCommands[] = {
-    {"demo", "Render the built-in demo scene, track it and write a CSV (start here)",
-     SetupDemoCommand},
-    {"track", "Track markers in a video or image sequence and write per-frame measurements",
-     SetupTrackCommand},
-    {"init", "Find the markers in a frame by themselves and write a config (no GUI)",
-     SetupInitCommand},
-    {"pick", "Write a config with the colours at given pixels, as clicks in `live` give them",
-     SetupPickCommand},
-    {"synth", "Render a synthetic actuator video with exact ground truth", SetupSynthCommand},
-    {"evaluate", "Compare the tracking methods' accuracy and speed on a rendered scene",
-     SetupEvaluateCommand},
-    {"calibrate", "Calibrate the camera from chessboard views, or the plane's mm per pixel",
-     SetupCalibrateCommand},
-    {"live", "Live window on a camera or video: overlay, mouse recalibration, recording",
-     SetupLiveCommand},
-    {"control", "Close the loop: bend the actuator to a target angle over the serial link",
-     SetupControlCommand},
-    {"identify", "Identify the actuator (steps, PRBS) and write a config with gains from the model",
-     SetupIdentifyCommand},
-    {"rig", "Simulated pressure-control board + actuator on a pseudo-terminal (no hardware)",
-     SetupRigCommand},
-    {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",
-     SetupPlotCommand},
-    {"config", "Print every config key with its default and range (--doc), or check a config",
-     SetupConfigCommand},
-};
+// softsight_<plugin>.so beside the program (the build tree), or in ../lib/softsight (installed).
+std::vector<std::filesystem::path> PluginCandidates(const char* plugin) {
+  char self[PATH_MAX];
+  const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  const std::filesystem::path dir =
+      length > 0 ? std::filesystem::path(std::string(self, static_cast<size_t>(length))).parent_path()
+                 : std::filesystem::path(".");
+  const std::string file = std::string("softsight_") + plugin + ".so";
+  return {dir / file, dir / ".." / "lib" / "softsight" / file};
+}
 
-int Main(int argc, char** argv) {
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_WARNING);
-  // A file-size limit (ulimit -f) must surface as a failed write() with EFBIG, which the CSV
-  // writer reports after cutting the file back to its last complete row, not kill the process.
-  std::signal(SIGXFSZ, SIG_IGN);
-  CLI::App app{
-      "softsight measures soft robots with a camera: it finds coloured markers on an actuator,\n"
-      "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
-      "close the control loop over a serial link. Run `softsight <command> --help` for details."};
+int RunPlugin(const CommandInfo& command, int argc, char** argv) {
+  std::string why;
+  for (const std::filesystem::path& path : PluginCandidates(command.plugin)) {
+    if (!std::filesystem::exists(path)) continue;
+    void* plugin = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (plugin == nullptr) {
+      why = dlerror();
+      break;
+    }
+    const auto entry = reinterpret_cast<PluginEntry>(dlsym(plugin, kPluginEntry));
+    if (entry == nullptr) {
+      why = path.string() + " has no " + kPluginEntry;
+      break;
+    }
+    return entry(argc, argv);  // The plugin stays loaded until the process ends.
+  }
+  if (why.empty()) why = PluginCandidates(command.plugin).front().string() + " not found";
+  std::cerr << "softsight " << command.name << ": error: cannot load the program's "
+            << command.plugin << " plugin: " << EscapeForMessage(why)
+            << " (it is installed beside the softsight program)\n";
+  return 1;
+}
+
+// No command given: --help and --version, or the usage error, from the table alone.
+int RunWithoutCommand(int argc, char** argv) {
+  CLI::App app{kProgramDescription};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("softsight ") + kVersion);
-  std::map<const CLI::App*, CommandRunner> runners;
-  for (const CommandEntry& entry : kCommands) {
-    CLI::App* sub = app.add_subcommand(entry.name, entry.summary);
-    runners[sub] = entry.setup(*sub);
-    // control and rig check every number in their own options' Check(), with their messages.
-    const std::string name = entry.name;
-    if (name != "control" && name != "rig") RequireFiniteNumbers(*sub);
-  }
+  for (const CommandInfo& command : kCommandTable) app.add_subcommand(command.name, command.summary);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
-    // One line like every other error, naming the command it was for.
-    const std::vector<CLI::App*> parsed = app.get_subcommands();
-    const std::string command =
-        parsed.empty() ? "softsight" : "softsight " + parsed.front()->get_name();
-    std::cerr << command << ": error: " << EscapeForMessage(e.what()) << " (see " << command
-              << " --help)\n";
+    std::cerr << "softsight: error: " << EscapeForMessage(e.what()) << " (see softsight --help)\n";
     return kInputErrorExitCode;
   }
-  const CLI::App* chosen = app.get_subcommands().front();
-  // Messages may quote the user's bytes (a config's text, a file name): one escaped line each.
-  try {
-    return runners.at(chosen)();
-  } catch (const InputError& e) {
-    std::cerr << "softsight " << chosen->get_name() << ": error: " << EscapeForMessage(e.what())
-              << "\n";
-    return kInputErrorExitCode;
-  } catch (const cv::Exception& e) {
-    std::cerr << "softsight " << chosen->get_name()
-              << ": OpenCV error: " << EscapeForMessage(e.what()) << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    // A bug, not the user's fault, but still one line and an exit code rather than an abort.
-    std::cerr << "softsight " << chosen->get_name()
-              << ": internal error: " << EscapeForMessage(e.what()) << "\n";
-    return 1;
-  }
+  return kInputErrorExitCode;  // Not reached: a known command goes to its plugin.
 }
 
 }  // namespace
 }  // namespace softsight
 
-int main(int argc, char** argv) { return softsight::Main(argc, argv); }
+int main(int argc, char** argv) {
+  if (const softsight::CommandInfo* command = softsight::ChosenCommand(argc, argv)) {
+    return softsight::RunPlugin(*command, argc, argv);
+  }
+  return softsight::RunWithoutCommand(argc, argv);
+}

@@ -1,0 +1,69 @@
+#include "app/command_line.h"
+
+#include <csignal>
+#include <exception>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
+
+#include "app/cli_checks.h"
+#include "app/command_table.h"
+#include "softsight/core/error.h"
+#include "softsight/version.h"
+
+namespace softsight {
+
+int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& commands) {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_WARNING);
+  // A file-size limit (ulimit -f) must surface as a failed write() with EFBIG, which the CSV
+  // writer reports after cutting the file back to its last complete row, not kill the process.
+  std::signal(SIGXFSZ, SIG_IGN);
+  CLI::App app{kProgramDescription};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("softsight ") + kVersion);
+  std::map<const CLI::App*, CommandRunner> runners;
+  for (const CommandSetup& entry : commands) {
+    const CommandInfo* info = FindCommand(entry.name);
+    CLI::App* sub = app.add_subcommand(entry.name, info != nullptr ? info->summary : "");
+    runners[sub] = entry.setup(*sub);
+    // control and rig check every number in their own options' Check(), with their messages.
+    const std::string name = entry.name;
+    if (name != "control" && name != "rig") RequireFiniteNumbers(*sub);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
+    // One line like every other error, naming the command it was for.
+    const std::vector<CLI::App*> parsed = app.get_subcommands();
+    const std::string command =
+        parsed.empty() ? "softsight" : "softsight " + parsed.front()->get_name();
+    std::cerr << command << ": error: " << EscapeForMessage(e.what()) << " (see " << command
+              << " --help)\n";
+    return kInputErrorExitCode;
+  }
+  const CLI::App* chosen = app.get_subcommands().front();
+  // Messages may quote the user's bytes (a config's text, a file name): one escaped line each.
+  try {
+    return runners.at(chosen)();
+  } catch (const InputError& e) {
+    std::cerr << "softsight " << chosen->get_name() << ": error: " << EscapeForMessage(e.what())
+              << "\n";
+    return kInputErrorExitCode;
+  } catch (const cv::Exception& e) {
+    std::cerr << "softsight " << chosen->get_name()
+              << ": OpenCV error: " << EscapeForMessage(e.what()) << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    // A bug, not the user's fault, but still one line and an exit code rather than an abort.
+    std::cerr << "softsight " << chosen->get_name()
+              << ": internal error: " << EscapeForMessage(e.what()) << "\n";
+    return 1;
+  }
+}
+
+}  // namespace softsight

@@ -1,0 +1,63 @@
+// The subcommands of `softsight`, as --help lists them, and the plugin each one lives in.
+//
+// The program itself (main.cc) is a small launcher that links no OpenCV: `softsight --version`
+// and `softsight --help` answer from this table alone, in a few milliseconds. A command is run
+// by the plugin beside the program that holds it (loaded with dlopen): softsight_commands.so
+// for every command but `live`, softsight_live.so for `live`, the only one that needs the GUI's
+// libraries (highgui and its Qt/GTK and X11), which therefore load only for it.
+#pragma once
+
+#include <cstring>
+
+namespace softsight {
+
+struct CommandInfo {
+  const char* name;
+  const char* summary;
+  const char* plugin;  // softsight_<plugin>.so.
+};
+
+inline constexpr char kProgramDescription[] =
+    "softsight measures soft robots with a camera: it finds coloured markers on an actuator,\n"
+    "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
+    "close the control loop over a serial link. Run `softsight <command> --help` for details.";
+
+// In the order --help lists them.
+inline constexpr CommandInfo kCommandTable[] = {
+    {"demo", "Render the built-in demo scene, track it and write a CSV (start here)", "commands"},
+    {"track", "Track markers in a video or image sequence and write per-frame measurements",
+     "commands"},
+    {"init", "Find the markers in a frame by themselves and write a config (no GUI)", "commands"},
+    {"pick", "Write a config with the colours at given pixels, as clicks in `live` give them",
+     "commands"},
+    {"synth", "Render a synthetic actuator video with exact ground truth", "commands"},
+    {"evaluate", "Compare the tracking methods' accuracy and speed on a rendered scene",
+     "commands"},
+    {"calibrate", "Calibrate the camera from chessboard views, or the plane's mm per pixel",
+     "commands"},
+    {"live", "Live window on a camera or video: overlay, mouse recalibration, recording", "live"},
+    {"control", "Close the loop: bend the actuator to a target angle over the serial link",
+     "commands"},
+    {"identify", "Identify the actuator (steps, PRBS) and write a config with gains from the model",
+     "commands"},
+    {"rig", "Simulated pressure-control board + actuator on a pseudo-terminal (no hardware)",
+     "commands"},
+    {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",
+     "commands"},
+    {"config", "Print every config key with its default and range (--doc), or check a config",
+     "commands"},
+};
+
+inline const CommandInfo* FindCommand(const char* name) {
+  for (const CommandInfo& command : kCommandTable) {
+    if (std::strcmp(command.name, name) == 0) return &command;
+  }
+  return nullptr;
+}
+
+// What a plugin exports: runs `softsight <command> ...` (argv as main() got it) and returns the
+// exit code.
+inline constexpr char kPluginEntry[] = "softsight_run_command";
+using PluginEntry = int (*)(int argc, char** argv);
+
+}  // namespace softsight

@@ -1,0 +1,10 @@
+// softsight_live.so: the `live` command, the only one that needs the GUI's libraries (highgui,
+// its toolkit, X11); they load with this plugin only.
+#include "app/command_line.h"
+#include "app/command_table.h"
+
+extern "C" __attribute__((visibility("default"))) int softsight_run_command(int argc, char** argv) {
+  using namespace softsight;
+  static const std::vector<CommandSetup> kCommands = {{"live", SetupLiveCommand}};
+  return RunCommandLine(argc, argv, kCommands);
+}
