@@ -118,6 +118,20 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
   summary = RunPipeline(*source, session, sinks, run);
+  for (const std::optional<VideoSink>* video : {&annotated, &recording}) {
+    if (!video->has_value()) continue;
+    const VideoSink& sink = **video;
+    if (sink.error() && summary.ok()) {
+      summary.stop_reason = StopReason::kError;
+      summary.error = *sink.error();
+    }
+    if (sink.dropped_frames() > 0) {
+      // Never silent: a camera outran the encoder (a file's run waits for it instead).
+      summary.notes.push_back(sink.path() + ": " + std::to_string(sink.dropped_frames()) + " of " +
+                              std::to_string(summary.frames) +
+                              " frames not recorded (the encoder fell behind the camera)");
+    }
+  }
   if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {
     summary.stop_detail = StopSignalReason(stop.signal());
   }

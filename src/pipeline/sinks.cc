@@ -4,6 +4,8 @@
 #include <utility>
 #include <vector>
 
+#include "softsight/core/error.h"
+
 namespace softsight {
 
 CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<CsvColumn>& extra) {
@@ -28,30 +30,36 @@ VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> 
   options_.path = std::move(path);
   options_.codec = std::move(codec);
   options_.fps = fps.value_or(30.0);
-  writer_ = std::make_unique<FrameWriter>(options_);  // Checks path and codec now.
+  writer_ = std::make_unique<AsyncFrameWriter>(options_, policy_);  // Checks path and codec now.
 }
 
 void VideoSink::begin(const RunInfo& info) {
-  if (!fps_ && info.fps && *info.fps > 0.0) {
-    options_.fps = *info.fps;
-    writer_ = std::make_unique<FrameWriter>(options_);
+  // A camera cannot wait for the encoder; a file can, and its recording keeps every frame.
+  const WhenEncoderBehind policy = info.live ? WhenEncoderBehind::kDrop : WhenEncoderBehind::kWait;
+  if ((!fps_ && info.fps && *info.fps > 0.0) || policy != policy_) {
+    if (!fps_ && info.fps && *info.fps > 0.0) options_.fps = *info.fps;
+    policy_ = policy;
+    writer_.reset();  // Nothing written yet: the file is made again with the right rate.
+    writer_ = std::make_unique<AsyncFrameWriter>(options_, policy_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
 }
 
 void VideoSink::consume(const Frame& frame, const FrameResult& result) {
-  if (!draw_) {
-    writer_->write(frame.image, frame.index);
-    return;
-  }
-  frame.image.copyTo(canvas_);
-  draw_(canvas_, result);
-  writer_->write(canvas_, frame.index);
+  cv::Mat* slot = writer_->acquire();
+  if (slot == nullptr) return;  // The encoder is behind a camera: dropped, and counted.
+  frame.image.copyTo(*slot);    // Into the queue's own buffer: no allocation once it has one.
+  if (draw_) draw_(*slot, result);
+  writer_->commit(frame.index);
 }
 
 void VideoSink::end(const RunSummary& summary) {
   (void)summary;
-  writer_->close();
+  try {
+    writer_->close();
+  } catch (const InputError& e) {
+    error_ = e.what();
+  }
 }
 
 }  // namespace softsight

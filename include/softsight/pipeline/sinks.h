@@ -11,6 +11,7 @@
 
 #include "softsight/config/config.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/io/async_frame_writer.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/pipeline/sink.h"
@@ -43,22 +44,32 @@ using FrameDrawer = std::function<void(cv::Mat& canvas, const FrameResult& resul
 // Every processed frame to a video or image pattern: as read (`draw` empty: the raw recording,
 // lossless by default, which `track` reproduces row for row), or with `draw` applied (the
 // annotated video). The video's rate is options.fps, or the source's when that is absent.
+// Encoding runs on its own thread (AsyncFrameWriter), so the pipeline does not wait for it. When
+// the encoder falls behind a live source (a camera), a frame is dropped from the video and counted
+// (dropped_frames(): the caller reports it); a file's run waits for it and never drops one.
 class VideoSink : public FrameSink {
  public:
   // Checks the path and codec at once (FrameWriter). `fps` absent: the source's, else 30.
   VideoSink(std::string path, std::string codec, std::optional<double> fps, FrameDrawer draw = {});
   void begin(const RunInfo& info) override;
   void consume(const Frame& frame, const FrameResult& result) override;
+  // Finishes the video. An encoder error met while finishing cannot be thrown from here: see
+  // error().
   void end(const RunSummary& summary) override;
 
-  const FrameWriter& writer() const { return *writer_; }
+  const std::string& path() const { return options_.path; }
+  int64_t written_frames() const { return writer_->queued(); }  // Once end() has run.
+  int64_t dropped_frames() const { return writer_->dropped(); }
+  // The encoder's error that end() met (a full disk while the last frames were written).
+  const std::optional<std::string>& error() const { return error_; }
 
  private:
   FrameWriterOptions options_;
   std::optional<double> fps_;
   FrameDrawer draw_;
-  std::unique_ptr<FrameWriter> writer_;
-  cv::Mat canvas_;  // Reused: no allocation per frame.
+  WhenEncoderBehind policy_ = WhenEncoderBehind::kWait;
+  std::unique_ptr<AsyncFrameWriter> writer_;
+  std::optional<std::string> error_;
 };
 
 }  // namespace softsight

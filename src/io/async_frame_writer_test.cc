@@ -1,0 +1,117 @@
+#include "softsight/io/async_frame_writer.h"
+
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "core/test_util.h"
+#include "softsight/io/frame_source.h"
+
+namespace softsight {
+namespace {
+
+using testing::TempDir;
+
+// Frame `i`: a textured image that differs from every other frame everywhere.
+cv::Mat NumberedFrame(int i) {
+  cv::Mat image(96, 128, CV_8UC3);
+  cv::RNG rng(static_cast<uint64_t>(i) + 1);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  cv::putText(image, std::to_string(i), {10, 60}, cv::FONT_HERSHEY_SIMPLEX, 1.2, {255, 255, 255}, 2);
+  return image;
+}
+
+std::vector<Frame> ReadBack(const std::string& path) {
+  std::unique_ptr<FrameSource> source = OpenFrameSource({path, {}, 30.0});
+  std::vector<Frame> frames;
+  Frame frame;
+  while (source->read(frame)) {
+    frames.push_back(frame);
+    frames.back().image = frame.image.clone();
+  }
+  return frames;
+}
+
+bool SameImage(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExact) {
+  TempDir dir;
+  const std::string path = dir.file("rec.avi");
+  {
+    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kWait, /*capacity=*/2);
+    EXPECT_EQ(writer.format(), "HuffYUV video (lossless)");
+    for (int i = 0; i < 40; ++i) {
+      cv::Mat* slot = writer.acquire();
+      ASSERT_NE(slot, nullptr) << "kWait never drops";
+      NumberedFrame(i).copyTo(*slot);
+      writer.commit(i);
+    }
+    writer.close();
+    EXPECT_EQ(writer.queued(), 40);
+    EXPECT_EQ(writer.dropped(), 0);
+  }
+  const std::vector<Frame> frames = ReadBack(path);
+  ASSERT_EQ(frames.size(), 40u);
+  for (int i = 0; i < 40; ++i) {
+    EXPECT_EQ(frames[i].index, i);
+    EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
+  }
+}
+
+// Holds the encoder in front of the first frame until released.
+class EncoderGate {
+ public:
+  void wait(int64_t index) {
+    if (index != 0) return;
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return open_; });
+  }
+  void open() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool open_ = false;
+};
+
+TEST(AsyncFrameWriter, ACameraRecordingDropsAndCountsWhatTheEncoderCannotTake) {
+  TempDir dir;
+  const std::string path = dir.file("rec.avi");
+  EncoderGate gate;
+  {
+    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kDrop, /*capacity=*/2,
+                            [&gate](int64_t index) { gate.wait(index); });
+    // Frame 0 is held at the encoder and frame 1 waits behind it: the queue of 2 is full, so
+    // frames 2..4 are dropped, at once, and counted.
+    std::vector<int64_t> taken;
+    for (int i = 0; i < 5; ++i) {
+      cv::Mat* slot = writer.acquire();
+      if (slot == nullptr) continue;
+      NumberedFrame(i).copyTo(*slot);
+      writer.commit(i);
+      taken.push_back(i);
+    }
+    EXPECT_EQ(taken, (std::vector<int64_t>{0, 1}));
+    EXPECT_EQ(writer.dropped(), 3);
+    gate.open();
+    writer.close();
+    EXPECT_EQ(writer.queued(), 2);
+  }
+  const std::vector<Frame> frames = ReadBack(path);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_TRUE(SameImage(frames[0].image, NumberedFrame(0)));
+  EXPECT_TRUE(SameImage(frames[1].image, NumberedFrame(1))) << "the frame queued, not a later one";
+}
+
+}  // namespace
+}  // namespace softsight
