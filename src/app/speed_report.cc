@@ -1,0 +1,133 @@
+// softsight_speed_report CONFIG VIDEO OUT_DIR: what a user waits for when tracking a recording,
+// each figure beside references measured in the same run on the same file, so the ratios hold
+// on another (or a busier) machine. Prints Markdown table rows for the README (scripts/bench.sh).
+//   - one BGR -> gray pass over the video's first frame (the per-frame reference of every table),
+//   - a bare decode loop of the file (OpenFrameSource, nothing else),
+//   - `track`'s pipeline (CSV written) with decoding in line, then decoding on its own thread
+//     (ReadAheadSource, as `track` runs), wall time per frame,
+//   - the tracking alone (median proc_ms of the same runs).
+// Each is the median of `kRepeats` runs. A benchmark, not a test: it asserts nothing.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/config/config.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/io/read_ahead_source.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sinks.h"
+#include "softsight/pipeline/tracking_session.h"
+
+namespace softsight {
+namespace {
+
+constexpr int kRepeats = 3;
+using Clock = std::chrono::steady_clock;
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// One BGR -> gray pass over `frame`, ms (median of 200).
+double GrayPassMs(const cv::Mat& frame) {
+  cv::Mat gray;
+  std::vector<double> times;
+  for (int i = 0; i < 200; ++i) {
+    const auto start = Clock::now();
+    cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+    times.push_back(MsSince(start));
+  }
+  return Median(times);
+}
+
+struct Pass {
+  double ms_per_frame;
+  double proc_ms_median = 0.0;
+  int64_t frames;
+};
+
+Pass DecodeOnly(const std::string& video) {
+  std::unique_ptr<FrameSource> source = OpenFrameSource({video, {}, 30.0});
+  Frame frame;
+  int64_t frames = 0;
+  const auto start = Clock::now();
+  while (source->read(frame)) ++frames;
+  return {MsSince(start) / static_cast<double>(std::max<int64_t>(frames, 1)), 0.0, frames};
+}
+
+Pass Track(const TrackingConfig& config, const std::string& video, const std::string& csv,
+           bool read_ahead) {
+  std::unique_ptr<FrameSource> source = OpenFrameSource({video, {}, 30.0});
+  if (read_ahead) source = std::make_unique<ReadAheadSource>(std::move(source));
+  TrackingSession session(config);
+  CsvSink sink(csv, TrackingColumns(config));
+  const auto start = Clock::now();
+  const RunSummary summary = RunPipeline(*source, session, {&sink});
+  const double ms = MsSince(start);
+  return {ms / static_cast<double>(std::max<int64_t>(summary.frames, 1)), summary.proc_ms_median,
+          summary.frames};
+}
+
+int Main(int argc, char** argv) {
+  if (argc != 4) {
+    std::cerr << "usage: softsight_speed_report CONFIG VIDEO OUT_DIR\n";
+    return 2;
+  }
+  const TrackingConfig config = LoadTrackingConfig(argv[1]);
+  const std::string video = argv[2];
+  const std::string csv = (std::filesystem::path(argv[3]) / "speed_report.csv").string();
+  Frame first;
+  OpenFrameSource({video, {}, 30.0})->read(first);
+
+  std::vector<double> gray, decode, inline_ms, ahead_ms, proc;
+  int64_t frames = 0;
+  for (int r = 0; r < kRepeats; ++r) {
+    // Interleaved, so a change of the machine's load touches every figure alike.
+    gray.push_back(GrayPassMs(first.image));
+    decode.push_back(DecodeOnly(video).ms_per_frame);
+    const Pass in_line = Track(config, video, csv, false);
+    const Pass ahead = Track(config, video, csv, true);
+    inline_ms.push_back(in_line.ms_per_frame);
+    ahead_ms.push_back(ahead.ms_per_frame);
+    proc.push_back(in_line.proc_ms_median);
+    proc.push_back(ahead.proc_ms_median);
+    frames = ahead.frames;
+  }
+  const double g = Median(gray), d = Median(decode), a = Median(inline_ms), b = Median(ahead_ms),
+               p = Median(proc);
+  char row[512];
+  std::snprintf(row, sizeof(row),
+                "| `track` of a %dx%d file (%lld frames, %s), wall time per frame: decoding in line "
+                "/ on its own thread (as `track` runs) | %.3f / %.3f ms (%.2fx faster; bare decode "
+                "loop of the file %.3f ms, tracking alone %.3f ms, gray pass %.3f ms) | | max(decode, "
+                "track) |\n",
+                first.image.cols, first.image.rows, static_cast<long long>(frames),
+                std::filesystem::path(video).extension().string().c_str(), a, b, a / b, d, p, g);
+  std::cout << row;
+  return 0;
+}
+
+}  // namespace
+}  // namespace softsight
+
+int main(int argc, char** argv) {
+  try {
+    return softsight::Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "softsight_speed_report: " << e.what() << "\n";
+    return 2;
+  }
+}
