@@ -36,6 +36,8 @@ inline constexpr CommandInfo kCommandTable[] = {
     {"calibrate", "Calibrate the camera from chessboard views, or the plane's mm per pixel",
      "commands"},
     {"live", "Live window on a camera or video: overlay, mouse recalibration, recording", "live"},
+    {"cameras", "List the V4L2 cameras with their pixel formats, sizes and frame rates",
+     "commands"},
     {"control", "Close the loop: bend the actuator to a target angle over the serial link",
      "commands"},
     {"identify", "Identify the actuator (steps, PRBS) and write a config with gains from the model",

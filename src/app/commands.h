@@ -22,6 +22,7 @@ CommandRunner SetupDemoCommand(CLI::App& sub);
 CommandRunner SetupCalibrateCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
+CommandRunner SetupCamerasCommand(CLI::App& sub);
 CommandRunner SetupConfigCommand(CLI::App& sub);
 CommandRunner SetupInitCommand(CLI::App& sub);
 CommandRunner SetupPickCommand(CLI::App& sub);

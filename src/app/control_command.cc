@@ -11,6 +11,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/stop_request.h"
 #include "softsight/control/board_link.h"
@@ -374,7 +375,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (options.camera) {
     FrameSourceSpec spec;
     spec.camera = options.camera;
+    spec.capture = MergeCaptureOptions(options.capture_args,
+                                       tracking_config.capture.value_or(CameraSettings{}));
+    CameraSettingsReport accepted;
+    spec.capture_report = &accepted;
     source = std::make_unique<NewestFrameSource>(OpenFrameSource(spec));
+    PrintCaptureReport(accepted);
   } else if (options.rig_frames) {
     source = std::make_unique<RigFileSource>(*options.rig_frames, options.fps);
   } else if (options.input) {
@@ -612,6 +618,7 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
 
 CommandRunner SetupControlCommand(CLI::App& sub) {
   auto o = std::make_shared<ControlOptions>();
+  AddCaptureOptions(sub, &o->capture_args);
   sub.description(
       "Close the loop: track the markers, turn the bending-angle error into a pressure setpoint\n"
       "(the outer loop) and send it over the serial link to the board, whose inner loop holds\n"

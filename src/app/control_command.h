@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -23,6 +24,9 @@ struct ControlOptions {
   // sequence (replayed through the loop as fast as it decodes, its timestamps the loop's clock).
   // None of them with `simulate`: the simulated rig is rendered.
   std::optional<int> camera;
+  // The --camera-* options' texts by capture key (app/capture_options.h), over the config's
+  // `capture:` section.
+  std::map<std::string, std::string> capture_args;
   std::optional<std::string> rig_frames;
   std::optional<std::string> input;
   // What to do (one of): target angle, profile file, open-loop pressure, open-loop duty.

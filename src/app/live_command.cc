@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "app/capture_options.h"
 #include "app/commands.h"
 #include "gui/seekable_source.h"
 #include "softsight/core/error.h"
@@ -31,6 +32,7 @@ struct LiveArgs {
   std::optional<double> scale_distance_mm;
   bool no_pace = false;
   bool no_trackbars = false;
+  CaptureArgs capture;
 };
 
 // markers.yaml -> markers.live.yaml beside it: saving never overwrites the hand-written config.
@@ -40,7 +42,7 @@ std::string DefaultSavePath(const std::string& config) {
 }
 
 int RunLive(const LiveArgs& args) {
-  if (args.camera.has_value() == !args.input.empty()) {
+  if (args.camera.has_value() && !args.input.empty()) {
     throw InputError("give exactly one of --camera N or --input VIDEO");
   }
   std::string why;
@@ -50,11 +52,32 @@ int RunLive(const LiveArgs& args) {
                      "`softsight track --config " +
                      args.config + " --input VIDEO --csv out.csv`");
   }
-  const TrackingConfig config = LoadTrackingConfig(args.config, args.method);
+  TrackingConfig config = LoadTrackingConfig(args.config, args.method);
+  // The camera's settings: the config's `capture:` section, the --camera-* options on top.
+  const CameraSettings capture =
+      MergeCaptureOptions(args.capture, config.capture.value_or(CameraSettings{}));
+  std::optional<int> camera = args.camera;
+  if (!camera && args.input.empty()) camera = capture.device;
+  if (camera.has_value() == !args.input.empty()) {
+    throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
+                     args.config + ")");
+  }
   FrameSourceSpec spec;
-  spec.camera = args.camera;
+  spec.camera = camera;
   spec.input = args.input;
+  spec.capture = capture;
+  CameraSettingsReport accepted;
+  spec.capture_report = &accepted;
   std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  spec.capture_report = nullptr;  // The reopener (files) needs none.
+  if (camera) {
+    // What the camera accepted is printed, and saved with every recording's config (and by `s`).
+    PrintCaptureReport(accepted);
+    if (!capture.empty()) {
+      config.capture = accepted.accepted;
+      config.capture->device = camera;
+    }
+  }
   SeekableSource* seekable = nullptr;
   if (!source->is_live()) {
     // The transport keys (step, seek, loop) read the file again from its start when they go
@@ -117,6 +140,8 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "as scale_from_points, so `softsight track` with the saved config gives the same mm.\n"
       "A recording writes <prefix>-NNN.csv, .avi (annotated), .raw.avi (lossless) and .yaml;\n"
       "`softsight track --config <prefix>-NNN.yaml --input <prefix>-NNN.raw.avi` reproduces it.\n"
+      "Camera settings (capture: in the config, or the --camera-* options below) are applied\n"
+      "when the camera opens, read back and printed; `softsight cameras` lists the modes.\n"
       "Needs a display; without one use `softsight track`.\n"
       "Example: softsight live --camera 0 --config markers.yaml");
   auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
@@ -141,6 +166,7 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
   sub.add_flag("--no-pace", args->no_pace,
                "Read a video file as fast as it decodes instead of at its frame rate");
   sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");
+  AddCaptureOptions(sub, &args->capture);
   return [args] { return RunLive(*args); };
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "app/cli_checks.h"
+#include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/stop_request.h"
@@ -144,6 +145,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   // Several inputs (or an output folder) run as a batch: one CSV per input (track_many.h).
   auto inputs = std::make_shared<std::vector<std::string>>();
   auto jobs = std::make_shared<int>(DefaultJobs());
+  auto capture = std::make_shared<CaptureArgs>();
+  AddCaptureOptions(sub, capture.get());
   sub.description(
       "Track the markers of a config in a video (or image sequence) and write one CSV row per\n"
       "frame: every marker's centroid, the bending angle, chord, sagitta, radius of curvature,\n"
@@ -193,7 +196,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       ->check(NumberIn(0, 1e15));
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
-  return [options, inputs, jobs] {
+  return [options, inputs, jobs, capture] {
     const bool to_folder = IsOutputFolder(options->csv_file);
     if (inputs->size() > 1 || to_folder) {
       if (!to_folder) {
@@ -208,6 +211,12 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       return RunTrackMany(many, std::cerr);
     }
     if (!inputs->empty()) options->source.input = inputs->front();
+    if (options->source.camera) {
+      // The camera's settings: the config's `capture:` section, the --camera-* options on top
+      // (what it accepted is in the summary's note).
+      options->source.capture = MergeCaptureOptions(
+          *capture, LoadTrackingConfig(options->config_file).capture.value_or(CameraSettings{}));
+    }
     RunSummary summary;
     try {
       RunTrack(*options, &summary);

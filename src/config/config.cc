@@ -8,7 +8,9 @@
 #include "control/control_options.h"
 #include "geometry/measure_options.h"
 #include "config/config_sections.h"
+#include "config/option_yaml.h"
 #include "config/yaml_map.h"
+#include "io/camera_options.h"
 #include "track/track_options.h"
 #include "softsight/core/error.h"
 
@@ -106,6 +108,15 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
     config.control.emplace();
     ReadControlConfig(control, &*config.control);
   }
+  if (top.has("capture")) {
+    // Every key, unit and range is a row of CameraSettingsTable() (io/camera_settings.cc).
+    YamlMap capture = top.map("capture");
+    config.capture.emplace();
+    ReadOptions(capture, CameraSettingsTable(), &*config.capture);
+    capture.finish();
+    std::string problem;
+    if (!config.capture->Check(&problem)) FailAtKey(capture, problem);
+  }
   if (top.has("recording")) {
     YamlMap recording = top.map("recording");
     RecordingOrigin origin;
@@ -151,6 +162,11 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
+  if (config.capture && !(*config.capture == CameraSettings{})) {
+    out << YAML::Key << "capture" << YAML::Value << YAML::BeginMap;
+    WriteOptions(CameraSettingsTable(), *config.capture, out);
+    out << YAML::EndMap;
+  }
   if (config.recording) {
     out << YAML::Key << "recording" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "first_frame" << YAML::Value << config.recording->first_frame;

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include "control/control_options.h"
+#include "config/option_yaml.h"
+#include "io/camera_options.h"
+#include "softsight/config/config.h"
 #include "geometry/measure_options.h"
 #include "config/config_sections.h"
 #include "config/config_test_util.h"
@@ -55,7 +58,46 @@ TEST(OptionTables, MeasureOptions) {
       .Run();
 }
 
+TEST(OptionTables, CameraSettings) {
+  testing::OptionTableSuite<CameraSettings>{
+      CameraSettingsTable(), "capture",
+      [](YamlMap& m, CameraSettings* c) {
+        ReadOptions(m, CameraSettingsTable(), c);
+        m.finish();
+        std::string problem;
+        if (!c->Check(&problem)) FailAtKey(m, problem);
+      },
+      [](const CameraSettings& c, YAML::Emitter& out) {
+        WriteOptions(CameraSettingsTable(), c, out);
+      },
+      [](const CameraSettings& c, std::string* e) { return c.Check(e); }}
+      .Run();
+}
+
+TEST(OptionTables, TheCaptureSectionRoundTripsThroughAConfigFile) {
+  TrackingConfig config;
+  MarkerSpec red;
+  red.name = "red";
+  config.markers = {red};
+  CameraSettings capture;
+  capture.device = 2;
+  capture.width = 1280;
+  capture.height = 720;
+  capture.fps = 60;
+  capture.pixel_format = CameraSettings::PixelFormat::kYuyv;
+  capture.exposure = 156;
+  capture.white_balance_k = 4600;
+  config.capture = capture;
+  const std::string file = ::testing::TempDir() + "/softsight_capture_round_trip.yaml";
+  SaveTrackingConfig(config, file);
+  const TrackingConfig again = LoadTrackingConfig(file);
+  ASSERT_TRUE(again.capture);
+  EXPECT_EQ(*again.capture, capture);
+}
+
 TEST(OptionTables, TheExamplesMentionEveryKey) {
+  EXPECT_EQ(testing::KeysMissingFrom(CameraSettingsTable(), Example("markers.yaml")),
+            std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
             std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(TemplateParamsOptions(), Example("markers_template.yaml")),

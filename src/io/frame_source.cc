@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "io/camera_options.h"
 #include "io/decoder_log.h"
 #include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
@@ -288,11 +289,18 @@ std::unique_ptr<FrameSource> OpenPattern(const std::string& pattern, double fps)
 
 class CameraSource : public FrameSource {
  public:
-  explicit CameraSource(int index) : index_(index) {
+  CameraSource(int index, const CameraSettings& settings, CameraSettingsReport* report)
+      : index_(index) {
     if (!capture_.open(index, cv::CAP_V4L2) || !capture_.isOpened()) {
       throw InputError("camera " + std::to_string(index) +
-                       ": cannot open (is it plugged in? try `ls /dev/video*`)");
+                       ": cannot open (is it plugged in? try `softsight cameras`)");
     }
+    // Before the first frame: the settings (camera_settings.h), read back and reported.
+    OpenCvCaptureBackend backend(capture_);
+    CameraSettingsReport applied = ApplyCameraSettings(backend, settings, description());
+    note_ = applied.summary;
+    for (const std::string& line : applied.refused) note_ += "\n" + line;
+    if (report) *report = std::move(applied);
     start_ = std::chrono::steady_clock::now();
   }
 
@@ -315,9 +323,12 @@ class CameraSource : public FrameSource {
     return fps > 0 ? std::optional<double>(fps) : std::nullopt;
   }
   bool is_live() const override { return true; }
+  // What the camera accepted of its settings, and what it refused (for the run's summary).
+  std::optional<std::string> note() const override { return note_; }
 
  private:
   int index_;
+  std::string note_;
   cv::VideoCapture capture_;
   cv::Mat decoded_;
   int64_t next_index_ = 0;
@@ -364,7 +375,9 @@ bool IsGrayscale(const cv::Mat& frame_bgr) {
 }
 
 std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
-  if (spec.camera) return std::make_unique<CameraSource>(*spec.camera);
+  if (spec.camera) {
+    return std::make_unique<CameraSource>(*spec.camera, spec.capture, spec.capture_report);
+  }
   const std::string& input = spec.input;
   if (input.empty()) {
     throw InputError("no input given (use --input VIDEO|FOLDER|PATTERN or --camera N)");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "softsight/calib/camera_calibration.h"
+#include "softsight/io/camera_settings.h"
 #include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
@@ -37,6 +38,10 @@ struct TrackingConfig {
   // The `control:` section (gains, limits, rig), when the file has one: `softsight control`.
   std::optional<ControlConfig> control;
   std::optional<RecordingOrigin> recording;  // Written by live recordings only.
+  // The `capture:` section: the camera's resolution, rate, pixel format, exposure, gain, white
+  // balance and focus (softsight/io/camera_settings.h). (`camera:` names the lens calibration.)
+  // A live recording saves what the camera accepted.
+  std::optional<CameraSettings> capture;
   std::string source_file;             // Where this config was read from ("" if built in code).
   // Every file reading this config opened: the config itself, then the camera, plane and
   // template image files it names (resolved), so no output may overwrite one of them.

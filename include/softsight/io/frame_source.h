@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "softsight/core/types.h"
+#include "softsight/io/camera_settings.h"
 
 namespace softsight {
 
@@ -64,6 +65,10 @@ struct FrameSourceSpec {
   // synthetic scene ("synth:bending").
   std::string input;
   std::optional<int> camera;           // V4L2 camera index (live).
+  // The camera's capture settings (config `capture:` and --camera-* options), applied when it
+  // opens; what it accepted goes to `capture_report` when given. Ignored for files.
+  CameraSettings capture = {};
+  CameraSettingsReport* capture_report = nullptr;
   // Frame rate for image sequences, whose files carry no timestamps (frames per second).
   double sequence_fps = 30.0;
 };

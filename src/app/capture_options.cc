@@ -1,0 +1,70 @@
+#include "app/capture_options.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <iostream>
+
+#include "io/camera_options.h"
+#include "softsight/core/error.h"
+
+namespace softsight {
+namespace {
+
+std::string FlagOf(const std::string& key) {
+  std::string flag = "--camera-" + key;
+  for (char& c : flag) {
+    if (c == '_') c = '-';
+  }
+  return flag;
+}
+
+}  // namespace
+
+void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
+  for (const Option<CameraSettings>& option : CameraSettingsTable()) {
+    std::string help = option.doc;
+    if (!option.unit.empty()) help += " [" + option.unit + "]";
+    help += "; " + OptionRangeText(option) + " (config: capture." + option.key + ")";
+    // The map's nodes stay where they are: the option writes into its own entry.
+    sub.add_option(FlagOf(option.key), (*args)[option.key], help)->group("Camera settings");
+  }
+}
+
+CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings settings) {
+  for (const Option<CameraSettings>& option : CameraSettingsTable()) {
+    const auto it = args.find(option.key);
+    if (it == args.end() || it->second.empty()) continue;
+    const std::string& text = it->second;
+    const std::string flag = FlagOf(option.key);
+    OptionValue value;
+    char* end = nullptr;
+    errno = 0;
+    if (option.kind == OptionKind::kInt) {
+      const long long number = std::strtoll(text.c_str(), &end, 10);
+      if (end == text.c_str() || *end != '\0' || errno != 0) {
+        throw InputError(flag + " " + text + ": not a whole number");
+      }
+      value = static_cast<int64_t>(number);
+    } else if (option.kind == OptionKind::kDouble) {
+      const double number = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || errno != 0) {
+        throw InputError(flag + " " + text + ": not a number");
+      }
+      value = number;
+    } else {
+      value = text;
+    }
+    if (const std::optional<std::string> problem = OptionProblem(option, value)) {
+      throw InputError(flag + " " + text + ": " + *problem);
+    }
+    option.set(settings, value);
+  }
+  return settings;
+}
+
+void PrintCaptureReport(const CameraSettingsReport& report) {
+  std::cerr << report.summary << "\n";
+  for (const std::string& line : report.refused) std::cerr << line << "\n";
+}
+
+}  // namespace softsight

@@ -1,0 +1,30 @@
+// The camera's capture settings as command-line options of live, track and control, made from
+// the settings' option table (io/camera_options.h), so each setting is described once:
+// --camera-width, --camera-height, --camera-fps, --camera-pixel-format, --camera-exposure,
+// --camera-gain, --camera-white-balance, --camera-focus (and --camera-device).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "softsight/io/camera_settings.h"
+
+namespace softsight {
+
+// The texts given on the command line, by table key.
+using CaptureArgs = std::map<std::string, std::string>;
+
+// Registers one option per row of the table on `sub`; `args` must outlive parsing.
+void AddCaptureOptions(CLI::App& sub, CaptureArgs* args);
+
+// The config's settings with the command line's on top. Throws InputError naming the option
+// ("--camera-width 5: must lie within 16..8192").
+CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings settings);
+
+// What the camera accepted, on stderr: the summary line, then one line per refused setting.
+void PrintCaptureReport(const CameraSettingsReport& report);
+
+}  // namespace softsight
