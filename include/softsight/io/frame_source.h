@@ -65,12 +65,12 @@ struct FrameSourceSpec {
   // synthetic scene ("synth:bending").
   std::string input;
   std::optional<int> camera;           // V4L2 camera index (live).
+  // Frame rate for image sequences, whose files carry no timestamps (frames per second).
+  double sequence_fps = 30.0;
   // The camera's capture settings (config `capture:` and --camera-* options), applied when it
   // opens; what it accepted goes to `capture_report` when given. Ignored for files.
   CameraSettings capture = {};
   CameraSettingsReport* capture_report = nullptr;
-  // Frame rate for image sequences, whose files carry no timestamps (frames per second).
-  double sequence_fps = 30.0;
 };
 
 // Opens the source; throws InputError naming the file or camera when it cannot be read.
