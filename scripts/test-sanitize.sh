@@ -1,20 +1,23 @@
 #!/usr/bin/env bash
-# The whole test suite again, built with AddressSanitizer + UBSan (-DSOFTSIGHT_SANITIZE=ON) in
-# build-sanitize/ (README's second, optional test command; CI runs it after scripts/test.sh).
-# Any memory error, leak (system libraries in scripts/sanitizer/lsan.supp aside) or undefined
-# behaviour fails the test that caused it.
+# The whole test suite again, built with AddressSanitizer + UBSan in build-sanitize/ (clang, -O1;
+# README's second, optional test command; CI runs it after scripts/test.sh). Any memory error,
+# leak (system libraries in scripts/sanitizer/lsan.supp aside) or undefined behaviour fails the
+# test that caused it. The same tree holds the fuzz targets (scripts/fuzz.sh), built here too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/sanitizer/env.sh
-GENERATOR=()
-command -v ninja >/dev/null && GENERATOR=(-G Ninja)
-# -O1: sanitizer reports keep their line numbers, and the suite stays fast enough. No -Werror:
-# GCC's flow warnings (-Wmaybe-uninitialized) misfire on sanitizer-instrumented code; the plain
-# build (scripts/test.sh) is the one that holds warnings at zero.
-cmake -S . -B build-sanitize "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DSOFTSIGHT_SANITIZE=ON \
-  -DSOFTSIGHT_BUILD_BENCHMARKS=OFF -DSOFTSIGHT_WERROR=OFF "$@"
+source scripts/sanitizer/configure.sh
+ConfigureSanitizeTree "$@"
 cmake --build build-sanitize --parallel "$(nproc)"
+# Left to the plain suite (scripts/test.sh runs every test):
+# - two tests of exact rendered pixels: clang renders the synthetic scenes slightly differently
+#   from GCC (the golden hashes differ even for the plain bending scene), so the hashes, and the
+#   noise-4 textured bench whose detection rate a test holds at >= 95 %, are GCC's pictures;
+# - 14 of the 16 identification runs on simulated plants: the same code on other plant
+#   parameters, 8-10 s each under ASan; the shipped plant's two runs stay.
+# (A parameterised test's name goes on with "  # GetParam() = ...".)
+SKIP='^(SceneGoldenTest\.DefaultScenesRenderAsBefore$|ColourVerification\.BenchWithLookAlikesAndNoRoi$'
+SKIP+='|Identify/Plants\..*/(big_laggy|big_stiff|mid|stiff_fast|stiff_slow|weak_fast|weak_slow) )'
 cd build-sanitize
-ctest --output-on-failure --parallel "$(nproc)" --timeout 480
+ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -E "$SKIP"
