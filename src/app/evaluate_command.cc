@@ -458,14 +458,15 @@ std::string BaseName(const std::string& path) {
 EvaluateReport RunVideoEvaluate(const VideoEvaluateOptions& options) {
   const TrackingConfig config = LoadTrackingConfig(options.config_file);
   const TruthTable truth = ReadTruthTable(options.truth_csv, config);
+  std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
   if (options.csv_file) {
     std::vector<PathRole> inputs = {{"--truth", options.truth_csv}, {"--config", options.config_file}};
-    if (options.source.input.rfind(kSyntheticPrefix, 0) != 0) {
-      inputs.push_back({"--input", options.source.input});
+    for (size_t i = 0; i < config.files_read.size(); ++i) {
+      inputs.push_back({"a file the config names:", config.files_read[i]});
     }
+    for (const std::string& file : source->files()) inputs.push_back({"--input", file});
     CheckOutputsAreNotInputs({{"--csv", *options.csv_file}}, inputs);
   }
-  std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
   if (source->is_live()) throw InputError("evaluate --input needs a recording, not a camera");
   TrackingSession session(config);
   TruthTableSink score(truth);

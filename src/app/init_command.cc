@@ -58,11 +58,13 @@ std::string PictureBeside(const std::string& config_file) {
   return (has_extension ? config_file.substr(0, dot) : config_file) + ".png";
 }
 
+// Before anything is written: no output may be a file the input reads (a video, or any file of
+// an image sequence), the base config, or another output.
 void CheckOutputs(const std::vector<PathRole>& outputs, const FrameSourceSpec& source,
                   const std::optional<std::string>& base_config = std::nullopt) {
   std::vector<PathRole> inputs;
-  if (!source.input.empty() && source.input.rfind(kSyntheticPrefix, 0) != 0) {
-    inputs.push_back({"--input", source.input});
+  for (const std::string& file : OpenFrameSource(source)->files()) {
+    inputs.push_back({"--input", file});
   }
   if (base_config) inputs.push_back({"--config", *base_config});
   CheckOutputsAreNotInputs(outputs, inputs);

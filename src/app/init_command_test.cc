@@ -196,6 +196,16 @@ TEST(InitCommand, LookAlikesOfAMarkerColourAreRefusedNotGuessed) {
   }
   EXPECT_FALSE(std::filesystem::exists(init.config_out));
 
+  // No output may overwrite the input's frames.
+  const std::string frame_before = testing::ReadTextFile(dir.file("f0.png"));
+  init.picture_out = dir.file("f0.png");
+  EXPECT_THROW(RunInit(init), InputError);
+  init.picture_out.reset();
+  init.config_out = dir.file("f0.png");
+  EXPECT_THROW(RunInit(init), InputError);
+  EXPECT_EQ(testing::ReadTextFile(dir.file("f0.png")), frame_before);
+  init.config_out = dir.file("init.yaml");
+
   // Restricted to the actuator's area, the same frame gives the three markers.
   init.finder.search_px = cv::Rect(180, 50, 80, 300);
   init.finder.expected_count = 3;
@@ -323,6 +333,12 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
   EXPECT_EQ(updated.measure.base, start.measure.base);
   into.at_px = {clicks[0], clicks[1], clicks[2], clicks[0]};
   EXPECT_THROW(RunPick(into), InputError) << "more points than the config has markers";
+
+  // The frame pick reads is never overwritten.
+  PickOptions over = pick;
+  over.config_out = dir.file("f0.png");
+  EXPECT_THROW(RunPick(over), InputError);
+  EXPECT_FALSE(cv::imread(dir.file("f0.png")).empty());
 
   // A point on the background is one error naming the point.
   pick.at_px = {cv::Point2d(-50, 5)};
