@@ -110,12 +110,12 @@ int Main(int argc, char** argv) {
                p = Median(proc);
   char row[512];
   std::snprintf(row, sizeof(row),
-                "| `track` of a %dx%d file (%lld frames, %s), wall time per frame: decoding in line "
-                "/ on its own thread (as `track` runs) | %.3f / %.3f ms (%.2fx faster; bare decode "
-                "loop of the file %.3f ms, tracking alone %.3f ms, gray pass %.3f ms) | | max(decode, "
-                "track) |\n",
-                first.image.cols, first.image.rows, static_cast<long long>(frames),
-                std::filesystem::path(video).extension().string().c_str(), a, b, a / b, d, p, g);
+                "| `track`, %dx%d %s file (%lld frames): wall time per frame with decoding in line "
+                "/ on its own thread (as `track` runs) | %.3f / %.3f ms (%.2fx) | bare decode loop "
+                "of the file %.3f ms/frame, tracking alone %.3f ms, gray pass %.3f ms |\n",
+                first.image.cols, first.image.rows,
+                std::filesystem::path(video).extension().string().c_str(),
+                static_cast<long long>(frames), a, b, a / b, d, p, g);
   std::cout << row;
   return 0;
 }
