@@ -21,6 +21,7 @@
 #include <sstream>
 #include <thread>
 
+#include "gui/live_layout.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/config/config.h"
 #include "softsight/io/csv_reader.h"
@@ -212,8 +213,8 @@ class LiveWindowTest : public ::testing::Test {
   }
 
   // Starts Xvfb on a free display (-displayfd picks it) writing its screen to dir_.
-  std::string StartXvfb() {
-    xvfb_ = Spawn({"Xvfb", "-displayfd", "1", "-screen", "0", "800x720x24", "-fbdir", dir_.string(),
+  std::string StartXvfb(const std::string& screen = "800x720x24") {
+    xvfb_ = Spawn({"Xvfb", "-displayfd", "1", "-screen", "0", screen, "-fbdir", dir_.string(),
                    "-nolisten", "tcp"},
                   {});
     if (xvfb_.pid < 0) return "";
@@ -344,6 +345,90 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
 
   ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &xdotool_output), 0) << xdotool_output;
   EXPECT_EQ(WaitExit(live, 20s), 0);
+}
+
+// A 720p video on a 1366x768 laptop screen: the window fits, stepping back lands on the right
+// frame (the rings on screen on that frame's truth, scaled), and a click at a scaled position
+// picks the colours of the image pixel under it.
+TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRightPixels) {
+  SceneOptions scene;
+  scene.size = cv::Size(1280, 720);
+  scene.length_px = 480;
+  scene.width_px = 60;
+  scene.marker_radius_px = 18;
+  scene.frame_count = 12;
+  SyntheticScene renderer(scene);
+  const std::string video = (dir_ / "scene.avi").string();
+  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
+  ASSERT_TRUE(writer.isOpened());
+  cv::Mat image;
+  std::vector<SceneTruth> truth;
+  for (int i = 0; i < scene.frame_count; ++i) {
+    truth.push_back(renderer.render(i, image));
+    writer.write(image);
+  }
+  writer.release();
+  const std::string config = (dir_ / "markers.yaml").string();
+  std::ofstream(config) << "markers:\n"
+                           "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
+                           "  - name: blue\n    hsv: {h: [95, 125], s: [80, 255], v: [40, 255]}\n";
+  const std::string display = StartXvfb("1366x768x24");
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  live_ = Spawn({binary_, "live", "--input", video, "--config", config, "--no-trackbars"},
+                {"DISPLAY=" + display}, true);
+  ASSERT_GT(live_.pid, 0);
+  std::string output;
+  ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  std::string out;
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
+                        "windowfocus", "--sync"},
+                       env, &out),
+            0)
+      << out;
+  // The layout the window uses for this frame on this screen (Xvfb puts the window at 0,0).
+  const LiveLayout layout = ComputeLiveLayout(scene.size, 180, 0, MaxCanvasForScreen({1366, 768}));
+  ASSERT_LE(layout.canvas.width, 1366);
+  ASSERT_LE(layout.canvas.height, 768);
+  const auto expect_rings_on = [&](int index) {
+    std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
+    const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+    ASSERT_FALSE(screen.empty());
+    // The strip chart's dark background is on screen, under the scaled image.
+    const cv::Rect chart = layout.chart & cv::Rect(0, 0, screen.cols, screen.rows);
+    EXPECT_EQ(chart, layout.chart);
+    EXPECT_LT(cv::mean(screen(chart))[0], 70);
+    for (int m = 0; m < 2; ++m) {
+      const cv::Point2d at = layout.to_view(*truth[index].markers[m].centroid_px);
+      EXPECT_GE(RingPixels(screen, at, cvRound(12 * layout.scale_x())), 18)
+          << truth[index].markers[m].name << " frame " << index;
+    }
+  };
+  expect_rings_on(11);
+  // Two steps back: frame 9, said on stdout and shown.
+  ASSERT_EQ(RunProcess({"xdotool", "key", "comma"}, env, &out), 0) << out;
+  ASSERT_TRUE(WaitForOutput(live_, "live: frame 10 ", 20s, &output)) << output;
+  ASSERT_EQ(RunProcess({"xdotool", "key", "comma"}, env, &out), 0) << out;
+  ASSERT_TRUE(WaitForOutput(live_, "live: frame 9 ", 20s, &output)) << output;
+  expect_rings_on(9);
+  // A click at blue's scaled place picks blue's colours around that image pixel.
+  const cv::Point2d blue = layout.to_view(*truth[9].markers[1].centroid_px);
+  ASSERT_EQ(RunProcess({"xdotool", "key", "2", "mousemove", std::to_string(cvRound(blue.x)),
+                        std::to_string(cvRound(blue.y)), "click", "1", "sleep", "0.3", "key", "s"},
+                       env, &out),
+            0)
+      << out;
+  ASSERT_TRUE(WaitForOutput(live_, "live: saved", 20s, &output)) << output;
+  const TrackingConfig picked = LoadTrackingConfig((dir_ / "markers.live.yaml").string());
+  const MarkerSpec& spec = picked.markers[1];
+  ASSERT_TRUE(spec.colour.roi);
+  const cv::Point2d centre(spec.colour.roi->x + spec.colour.roi->width / 2.0,
+                           spec.colour.roi->y + spec.colour.roi->height / 2.0);
+  EXPECT_NEAR(centre.x, truth[9].markers[1].centroid_px->x, 0.5 / layout.scale_x() + 1.0);
+  EXPECT_NEAR(centre.y, truth[9].markers[1].centroid_px->y, 0.5 / layout.scale_y() + 1.0);
+  ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;
+  EXPECT_EQ(WaitExit(live_, 20s), 0);
+  live_.pid = -1;
 }
 
 // The lines of a CSV without its timing columns (they differ from run to run).
