@@ -6,8 +6,9 @@
 // How: the recently read frames are kept in a ring (a step back, or a second back, is a copy),
 // and a position outside it is reached by reopening the source and reading forward to it. That
 // is exact for every source (no keyframe or container-index guesswork, which OpenCV's
-// CAP_PROP_POS_FRAMES does on some codecs), at the cost of decoding up to the target: about a
-// second for a 7 s 720p clip, longer for long files. The end is found by reading to it once;
+// CAP_PROP_POS_FRAMES does on some codecs), at the cost of decoding up to the target: measured
+// 0.74-0.88 s to decode all of a 7 s (210-frame) 1280x720 HuffYUV clip on the idle 2-core
+// development machine; longer for long files. The end is found by reading to it once;
 // afterwards the length is known.
 #pragma once
 
