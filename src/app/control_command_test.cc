@@ -16,6 +16,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "app/scene_markers_test_util.h"
 #include "core/test_util.h"
 #include "control/protocol.h"
 #include "softsight/core/error.h"
@@ -37,15 +38,7 @@ std::string Example() {
 
 // The markers of examples/rig.yaml (the synthetic scene's); the control section stays at its
 // defaults, which are the example's values.
-const char* kMarkers = R"(markers:
-  - name: red
-    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
-  - name: blue
-    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
-  - name: green
-    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
-triple: [red, blue, green]
-)";
+const char* const kMarkers = testing::kSceneMarkersYaml;
 
 TEST(ControlConfig, ReadsTheExampleAndRejectsBadKeys) {
   const ControlConfig config = LoadControlConfig(Example());

@@ -27,6 +27,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "app/scene_markers_test_util.h"
 #include "core/test_util.h"
 #include "control/board.h"
 #include "control/protocol.h"
@@ -189,15 +190,7 @@ class HostileBoard {
   std::thread thread_;
 };
 
-const char* kMarkers = R"(markers:
-  - name: red
-    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
-  - name: blue
-    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
-  - name: green
-    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
-triple: [red, blue, green]
-)";
+const char* const kMarkers = testing::kSceneMarkersYaml;
 
 // The rendered actuator as the one frame `--rig-frames` keeps reading.
 void WriteFrame(const std::string& file) {

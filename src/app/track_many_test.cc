@@ -11,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "app/scene_markers_test_util.h"
 #include "core/test_util.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/sim/scene.h"
@@ -21,15 +22,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::TempDir;
 
-const char* kConfig = R"(markers:
-  - name: red
-    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
-  - name: blue
-    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
-  - name: green
-    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
-triple: [red, blue, green]
-)";
+const char* const kConfig = testing::kSceneMarkersYaml;
 
 // A short rendered bending clip (lossless), a different texture per seed.
 std::string RenderClip(const std::string& path, int frames, unsigned seed) {
