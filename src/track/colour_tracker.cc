@@ -72,7 +72,6 @@ constexpr double kAdaptShape = 0.1;
 constexpr double kAdaptMinRange = 0.5;
 constexpr double kAdaptMaxRange = 4.0;
 
-// ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
 // A marker lost this many frames in a row, with exactly one candidate near where it was last
 // seen that fits it in everything but brightness (same chroma, size, shape, contrast), is taken
 // to be under a new light and its colour relearned. Half a second at 30 fps: a passing shadow or a
@@ -80,6 +79,8 @@ constexpr double kAdaptMaxRange = 4.0;
 constexpr int kRelearnAfterFrames = 15;
 // How near, in learned radii (plus one per frame lost): it may have moved while it was lost.
 constexpr double kRelearnRadii = 6.0;
+
+// ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
 constexpr int kAutoHueTolerance = 12;        // hue units (2 degrees each)
 constexpr int kAutoGraySaturation = 40;      // below: the nominal colour is a gray level
 
