@@ -17,7 +17,7 @@
 #include "core/test_util.h"
 #include "sim/opencv_samples.h"
 #include "softsight/core/error.h"
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {

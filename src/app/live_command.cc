@@ -8,14 +8,10 @@
 
 #include "app/capture_options.h"
 #include "app/commands.h"
-#include "gui/seekable_source.h"
 #include "softsight/core/error.h"
-#include "softsight/io/frame_grabber.h"
-#include "softsight/gui/live_controller.h"
 #include "softsight/gui/live_window.h"
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
-#include "softsight/io/paced_source.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {
@@ -78,41 +74,25 @@ int RunLive(const LiveArgs& args) {
       config.capture->device = camera;
     }
   }
-  SeekableSource* seekable = nullptr;
-  if (!source->is_live()) {
-    // The transport keys (step, seek, loop) read the file again from its start when they go
-    // back further than the frames kept in memory.
-    auto playable = std::make_unique<SeekableSource>(std::move(source),
-                                                     [spec] { return OpenFrameSource(spec); });
-    seekable = playable.get();
-    source = std::move(playable);
-  }
-
   LiveOptions options;
   options.save_config_path =
       args.save_config.empty() ? DefaultSavePath(args.config) : args.save_config;
   options.record_prefix = args.record_prefix;
   options.chart.window_s = args.window_s;
-  options.record_fps = source->fps();
   options.scale_distance_mm = args.scale_distance_mm;
-  LiveController controller(config, options);
+  if (std::string problem; !options.Check(&problem)) throw InputError("live options: " + problem);
   std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
             << " markers; press h in the window for help\n";
-  // Pacing belongs to the source: a camera keeps only its newest frame (drops are counted and
-  // shown); a file or image sequence plays every frame at its own rate and pauses with the
-  // window (or, with --no-pace, as fast as it decodes).
-  if (source->is_live()) {
-    source = std::make_unique<NewestFrameSource>(std::move(source));
-  } else if (!args.no_pace) {
-    source = std::make_unique<PacedFrameSource>(std::move(source));
-  }
   LiveWindowOptions window;
   window.trackbars = !args.no_trackbars;
-  const int code = RunLiveWindow(controller, *source, window, seekable);
-  if (!controller.last_recording().empty()) {
-    std::cerr << "softsight live: last recording " << controller.last_recording() << ".*\n";
+  window.pace_files = !args.no_pace;
+  FrameSourceOpener reopen;
+  if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
+  const LiveRunResult run = RunLiveWindow(config, std::move(source), options, window, reopen);
+  if (!run.last_recording.empty()) {
+    std::cerr << "softsight live: last recording " << run.last_recording << ".*\n";
   }
-  return code;
+  return run.exit_code;
 }
 
 }  // namespace

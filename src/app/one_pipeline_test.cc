@@ -10,7 +10,7 @@
 #include "app/track_command.h"
 #include "core/test_util.h"
 #include "gui/live_feed.h"
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sinks.h"

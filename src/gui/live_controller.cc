@@ -1,4 +1,4 @@
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,27 +18,15 @@ namespace softsight {
 namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-constexpr size_t kFpsWindow = 30;          // Frames averaged for the fps figure.
-constexpr double kLatencySmoothing = 0.2;  // Exponential smoothing of the shown latency.
 const cv::Scalar kDragColour(0, 255, 0);
 const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
 // Mask view: the chosen blob, blobs that fit but were not chosen, rejected ones, the window.
 const cv::Scalar kMaskChosenColour(0, 255, 0), kMaskFitsColour(0, 255, 255);
 const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0);
-// Two clicks closer than this give no usable scale: each click is good to about 1 px, so the
-// scale would be off by several percent. A ruler across much of the image is best.
-constexpr double kMinScaleSpanPx = 20.0;
 
 std::string Number(double value, int precision) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.*f", precision, value);
-  return text;
-}
-
-// 50 -> "50", 12.5 -> "12.5": the distance as a person typed it.
-std::string Distance(double mm) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", mm);
   return text;
 }
 
@@ -48,33 +36,11 @@ std::string RangeText(const HsvRange& r) {
 
 }  // namespace
 
-bool LiveOptions::Check(std::string* error) const {
-  if (select_box_px < 4 || select_box_px > 1000) {
-    *error = "select_box_px must be in 4..1000, got " + std::to_string(select_box_px);
-    return false;
-  }
-  if (click_slop_px < 0 || click_slop_px > 100) {
-    *error = "click_slop_px must be in 0..100, got " + std::to_string(click_slop_px);
-    return false;
-  }
-  if (record_fps && !(*record_fps > 0 && *record_fps <= 100000)) {
-    *error = "record_fps must be in (0, 100000], got " + std::to_string(*record_fps);
-    return false;
-  }
-  if (scale_distance_mm && !(std::isfinite(*scale_distance_mm) && *scale_distance_mm > 0 &&
-                            *scale_distance_mm <= 1e6)) {
-    *error = "scale_distance_mm must be in (0, 1e6] mm, got " + std::to_string(*scale_distance_mm);
-    return false;
-  }
-  if (record_prefix.empty()) {
-    *error = "record_prefix must not be empty";
-    return false;
-  }
-  return chart.Check(error) && picker.Check(error) && overlay.Check(error);
-}
-
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options)
-    : options_(std::move(options)), chart_(options_.chart), pointer_(std::make_unique<LivePointer>(options_.click_slop_px)) {
+    : options_(std::move(options)),
+      chart_(options_.chart),
+      pointer_(std::make_unique<LivePointer>(options_.click_slop_px)),
+      scale_(options_.scale_distance_mm) {
   std::string error;
   if (!options_.Check(&error)) throw InputError("live options: " + error);
   if (config.markers.empty()) throw InputError(config.source_file + ": no markers to track");
@@ -84,7 +50,6 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   // The session holds the only copy of the config: every live edit goes through it, and `s`
   // and recordings save what it holds.
   session_ = std::make_unique<TrackingSession>(config);
-  frame_times_.reserve(kFpsWindow);
   say("press h for help");
 }
 
@@ -125,25 +90,11 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   }
 
   // Frame rate over the last frames that produced a result, latency from capture to result.
-  const SteadyClock::time_point now = SteadyClock::now();
-  if (frame_times_.size() < kFpsWindow) {
-    frame_times_.push_back(now);
-  } else {
-    frame_times_[frame_times_next_] = now;
-  }
-  frame_times_next_ = (frame_times_next_ + 1) % kFpsWindow;
-  if (frame_times_.size() >= 2) {
-    const auto oldest =
-        frame_times_.size() < kFpsWindow ? frame_times_.front() : frame_times_[frame_times_next_];
-    const double span_s = std::chrono::duration<double>(now - oldest).count();
-    if (span_s > 0) fps_ = (frame_times_.size() - 1) / span_s;
-  }
+  meter_.result_at(SteadyClock::now());
   record_frame(frame, result);
   // Latency: from capture to the annotated (and recorded) result, as the window is about to show
   // it. The overlay shows the smoothed value up to the previous frame.
-  const double latency =
-      std::chrono::duration<double, std::milli>(SteadyClock::now() - captured).count();
-  latency_ms_ = latency_ms_ ? *latency_ms_ + kLatencySmoothing * (latency - *latency_ms_) : latency;
+  meter_.latency(std::chrono::duration<double, std::milli>(SteadyClock::now() - captured).count());
   dirty_ = true;
 }
 
@@ -155,8 +106,8 @@ void LiveController::redraw_annotated() {
 
 void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) const {
   OverlayStatus status;
-  status.fps = fps_;
-  status.latency_ms = latency_ms_;
+  status.fps = meter_.fps();
+  status.latency_ms = meter_.latency_ms();
   DrawOverlay(image, result, options_.overlay, status);
 }
 
@@ -383,67 +334,39 @@ void LiveController::save_config() {
   }
 }
 
-std::string LiveController::scale_hint() const {
-  const std::string d = Distance(*options_.scale_distance_mm);
-  return scale_clicks_.empty()
-             ? "scale: click point 1 of 2, " + d + " mm apart; Esc cancels"
-             : "scale: click point 2, " + d + " mm from point 1; Esc cancels";
-}
-
 void LiveController::start_scale() {
-  if (!options_.scale_distance_mm) {
-    say("scale: start live with --scale-distance-mm D, the true distance of the points to click");
-    return;
-  }
-  if (recording_) {
+  if (recording_ && options_.scale_distance_mm) {
     // The CSV's columns (with or without _mm) are fixed when a recording starts.
     say("scale: stop the recording first (r)");
     return;
   }
-  scale_mode_ = true;
-  scale_clicks_.clear();
-  say(scale_hint());
+  say(scale_.start());
 }
 
 void LiveController::cancel_scale() {
-  scale_mode_ = false;
-  scale_clicks_.clear();
+  scale_.stop();
   pointer_->forget_pointer();
   say("scale: cancelled, unchanged");
 }
 
 void LiveController::scale_point(const cv::Point2d& p) {
-  scale_clicks_.push_back(p);
-  if (scale_clicks_.size() < 2) {
-    say(scale_hint());
-    return;
-  }
   // The scale is in the pixels the measurements use (undistorted with a camera model), and
   // those are the points a saved config holds as scale_from_points.
-  const double distance_mm = *options_.scale_distance_mm;
-  const cv::Point2d a = session_->measurement_point(scale_clicks_[0]);
-  const cv::Point2d b = session_->measurement_point(scale_clicks_[1]);
-  const double span_px = cv::norm(a - b);
-  if (span_px < kMinScaleSpanPx) {
-    scale_clicks_.clear();
-    say("scale: the points are " + Number(span_px, 1) + " px apart, too close (at least " +
-        Number(kMinScaleSpanPx, 0) + "); click the first point again");
+  std::string message;
+  const std::optional<MetricModel> metric = scale_.add(p, session_->measurement_point(p), &message);
+  if (!metric) {
+    say(message);
     return;
   }
-  MetricModel metric;
-  const bool replaces_plane = config().measure.metric.plane_mm_from_image.has_value();
+  const bool replaced_plane = config().measure.metric.plane_mm_from_image.has_value();
   try {
-    metric.scale_mm_per_px = ScaleFromTwoPoints(a, b, distance_mm, "scale points");
-    metric.scale_points = MetricModel::ScalePoints{a, b, distance_mm};
-    session_->set_metric(metric);
+    session_->set_metric(*metric);
   } catch (const InputError& e) {
-    scale_clicks_.clear();
+    scale_.restart();
     say(std::string(e.what()) + "; click the first point again");
     return;
   }
-  const bool replaced_plane = replaces_plane;
-  scale_mode_ = false;
-  scale_clicks_.clear();
+  scale_.stop();
   pointer_->forget_pointer();
   // Measure the frame on screen again, so the mm values appear now, also while paused. The
   // strip chart restarts in mm: its px history cannot share the new axis.
@@ -453,19 +376,19 @@ void LiveController::scale_point(const cv::Point2d& p) {
     chart_.clear();
     chart_.add(*last_result_);
   }
-  say("scale " + Number(*metric.scale_mm_per_px, 4) + " mm/px (" + Distance(distance_mm) +
-      " mm over " + Number(span_px, 1) + " px" +
-      (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
+  say("scale " + Number(*metric->scale_mm_per_px, 4) + " mm/px (" +
+      DistanceText(*options_.scale_distance_mm) + " mm over " + Number(scale_.span_px(), 1) +
+      " px" + (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
 }
 
 void LiveController::draw_scale_points(cv::Mat& top, const LiveLayout& view) const {
-  for (const cv::Point2d& clicked : scale_clicks_) {
+  for (const cv::Point2d& clicked : scale_.points()) {
     const cv::Point2d p = view.to_view(clicked);
     cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS, 15,
                    1, cv::LINE_AA);
   }
-  if (const auto& pointer = pointer_->pointer(); scale_clicks_.size() == 1 && pointer) {
-    const cv::Point2d a = view.to_view(scale_clicks_[0]), b = view.to_view(*pointer);
+  if (const auto& pointer = pointer_->pointer(); scale_.points().size() == 1 && pointer) {
+    const cv::Point2d a = view.to_view(scale_.points()[0]), b = view.to_view(*pointer);
     cv::line(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
              kScaleColour, 1, cv::LINE_AA);
   }
@@ -506,7 +429,7 @@ void LiveController::toggle_recording() {
     }
     RunInfo info;
     info.frame_size = frame_.size();
-    info.fps = options_.record_fps.value_or(fps_.value_or(30.0));
+    info.fps = options_.record_fps.value_or(meter_.fps().value_or(30.0));
     for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
     const MetricModel& metric = snapshot.measure.metric;
     info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
@@ -584,13 +507,13 @@ void LiveController::on_event(const UiEvent& event) {
       break;
     case Type::kMouseMove:
       // In scale mode the pointer is followed without a button too: the line to the first point.
-      if (pointer_->move(at, scale_mode_)) dirty_ = true;
+      if (pointer_->move(at, scale_.active())) dirty_ = true;
       break;
     case Type::kMouseUp: {
       const PointerGesture gesture = pointer_->up(at, in_image);
       if (gesture.kind == PointerGesture::Kind::kNone) break;
       dirty_ = true;
-      if (scale_mode_) {
+      if (scale_.active()) {
         // Where the button is released, so a person can press, aim and let go.
         scale_point(gesture.release);
       } else if (gesture.kind == PointerGesture::Kind::kClick) {
@@ -676,7 +599,7 @@ void LiveController::on_event(const UiEvent& event) {
           start_scale();
           break;
         case 27:
-          if (scale_mode_) {
+          if (scale_.active()) {
             cancel_scale();
             break;
           }
@@ -774,9 +697,9 @@ const cv::Mat& LiveController::canvas() {
   lines.push_back(state);
   if (!message_.empty()) lines.push_back(message_);
   // The hint stays while picking, whatever other keys say meanwhile.
-  if (scale_mode_ && message_ != scale_hint()) lines.push_back(scale_hint());
+  if (scale_.active() && message_ != scale_.hint()) lines.push_back(scale_.hint());
   DrawStatusLines(top, lines, recording_ != nullptr);
-  if (scale_mode_) {
+  if (scale_.active()) {
     draw_scale_points(top, view);
   } else if (pointer_->press() && pointer_->pointer()) {
     const cv::Point2d a = view.to_view(*pointer_->press());

@@ -1,6 +1,6 @@
 // The live window's logic, driven through the same event interface the highgui adapter uses, on
 // rendered scenes with exact truth.
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 
 #include <gtest/gtest.h>
 

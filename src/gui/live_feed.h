@@ -14,7 +14,7 @@
 
 #include "gui/seekable_source.h"
 #include "softsight/core/types.h"
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/paced_source.h"
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 
 namespace softsight {
 namespace {

@@ -6,7 +6,11 @@
 #include <iostream>
 #include <opencv2/highgui.hpp>
 
+#include "gui/live_controller.h"
 #include "gui/live_feed.h"
+#include "gui/seekable_source.h"
+#include "softsight/io/frame_grabber.h"
+#include "softsight/io/paced_source.h"
 
 namespace softsight {
 namespace {
@@ -75,8 +79,13 @@ cv::Size ScreenSize() {
   return size;
 }
 
-int RunLiveWindow(LiveController& controller, FrameSource& source,
-                  const LiveWindowOptions& options, SeekableSource* seekable) {
+namespace {
+
+// The window's loop: one window, its mouse callback, six trackbars and the keys. Everything it
+// decides is the controller's; this only moves events in and images out. `seekable`: the source
+// under `source`'s pacing when the transport keys can seek in it; null for a camera.
+int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindowOptions& options,
+                SeekableSource* seekable) {
   const std::string& title = options.title;
   // The canvas is scaled to the screen (a 720p frame with its chart is taller than a laptop's
   // screen); mouse positions come back in canvas pixels and the controller maps them.
@@ -145,6 +154,35 @@ int RunLiveWindow(LiveController& controller, FrameSource& source,
   if (options.trackbars) cv::destroyWindow(sliders);
   cv::waitKey(1);
   return 0;
+}
+
+}  // namespace
+
+LiveRunResult RunLiveWindow(const TrackingConfig& config, std::unique_ptr<FrameSource> source,
+                            LiveOptions options, const LiveWindowOptions& window,
+                            FrameSourceOpener reopen) {
+  SeekableSource* seekable = nullptr;
+  if (!source->is_live() && reopen) {
+    // The transport keys (step, seek, loop) read the file again from its start when they go
+    // back further than the frames kept in memory.
+    auto playable = std::make_unique<SeekableSource>(std::move(source), std::move(reopen));
+    seekable = playable.get();
+    source = std::move(playable);
+  }
+  if (!options.record_fps) options.record_fps = source->fps();
+  LiveController controller(config, std::move(options));
+  // Pacing belongs to the source: a camera keeps only its newest frame (drops are counted and
+  // shown); a file or image sequence plays every frame at its own rate and pauses with the
+  // window (or, unpaced, as fast as it decodes).
+  if (source->is_live()) {
+    source = std::make_unique<NewestFrameSource>(std::move(source));
+  } else if (window.pace_files) {
+    source = std::make_unique<PacedFrameSource>(std::move(source));
+  }
+  LiveRunResult result;
+  result.exit_code = RunLiveLoop(controller, *source, window, seekable);
+  result.last_recording = controller.last_recording();
+  return result;
 }
 
 }  // namespace softsight

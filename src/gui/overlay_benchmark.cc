@@ -2,9 +2,9 @@
 // chart, and the whole controller step (track + measure + draw + compose) at VGA and 720p.
 #include <benchmark/benchmark.h>
 
-#include "softsight/gui/live_controller.h"
+#include "gui/live_controller.h"
 #include "softsight/gui/overlay.h"
-#include "softsight/gui/strip_chart.h"
+#include "gui/strip_chart.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "softsight/gui/strip_chart.h"
+#include "gui/strip_chart.h"
 
 namespace softsight {
 namespace {

@@ -1,4 +1,4 @@
-#include "softsight/gui/strip_chart.h"
+#include "gui/strip_chart.h"
 
 #include <algorithm>
 #include <cmath>

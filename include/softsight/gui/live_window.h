@@ -1,17 +1,19 @@
-// The thin highgui adapter around LiveController: one window, its mouse callback, six trackbars
-// and the key loop. Everything it decides is the controller's; this file only moves events in
-// and images out.
+// The live window (`softsight live`) for library users: a camera or a file, tracked and measured
+// with the overlay, strip chart, mouse recalibration, HSV picking, recording and config saving.
+// Everything the window decides lives in src/gui (the controller, its view and its recording);
+// this header is the whole of what a program calls.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "softsight/gui/live_controller.h"
+#include "softsight/config/config.h"
+#include "softsight/gui/live_options.h"
 #include "softsight/io/frame_source.h"
 
 namespace softsight {
-
-class SeekableSource;  // gui/seekable_source.h: a file the transport keys can seek in.
 
 // True when a window can be opened (an X display answers, or a Wayland socket is named);
 // otherwise false with `why` saying what is missing.
@@ -23,17 +25,29 @@ struct LiveWindowOptions {
   std::string trackbar_title = "HSV ranges (softsight)";
   // The screen the window must fit (the canvas is scaled down to it); empty: the X screen's.
   cv::Size screen_px;
+  // A file or image sequence plays at its own frame rate and pauses with the window (default);
+  // false: as fast as it decodes (never dropping a frame either way).
+  bool pace_files = true;
 };
 
-// Runs the window until the controller asks to quit or the window is closed. Frames come from
-// `source` through a LiveFeed: a PacedFrameSource for a file (every frame, at its rate, paused
-// with the window), a NewestFrameSource for a camera (stale frames dropped and counted). On
-// stdout: each message the window shows, as "live: <message>" (after the key or click that caused
-// it has been handled), and "end of input" once the last frame of a file source is on screen.
-// `seekable`: the source under `source`'s pacing when it is a file, image sequence or rendered
-// scene (the transport keys step and seek in it); null for a camera.
-// Returns the exit code (0).
-int RunLiveWindow(LiveController& controller, FrameSource& source,
-                  const LiveWindowOptions& options = {}, SeekableSource* seekable = nullptr);
+// Opens the same input again from its first frame: how the transport keys (step back, seek,
+// loop) reach frames no longer held in memory. Empty for a camera.
+using FrameSourceOpener = std::function<std::unique_ptr<FrameSource>()>;
+
+struct LiveRunResult {
+  int exit_code = 0;
+  // Where the last recording's files went (prefix without extension); empty if none.
+  std::string last_recording;
+};
+
+// Runs the window on `source` until `q`, Escape or the window is closed. A camera (is_live())
+// keeps only its newest frame (drops are counted and shown); a file plays every frame (paced
+// per `window.pace_files`) and, with `reopen`, can be stepped and seeked. On stdout: each message
+// the window shows, as "live: <message>", and "end of input" once a file's last frame is on
+// screen. `options.record_fps` defaults to the source's rate. Throws InputError for a bad config
+// or options, before any window opens.
+LiveRunResult RunLiveWindow(const TrackingConfig& config, std::unique_ptr<FrameSource> source,
+                            LiveOptions options, const LiveWindowOptions& window = {},
+                            FrameSourceOpener reopen = {});
 
 }  // namespace softsight

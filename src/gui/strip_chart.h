@@ -1,5 +1,6 @@
 // A scrolling strip chart of the last seconds: angle, bending distance and arc length, one lane
-// each, drawn under the live image. Keeps the recent samples; absent values are gaps.
+// each, drawn under the live image. Keeps the recent samples; absent values are gaps. Internal
+// to gui (and its tests).
 #pragma once
 
 #include <deque>
@@ -8,15 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "softsight/gui/live_options.h"  // StripChartOptions
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {
-
-struct StripChartOptions {
-  double window_s = 10.0;  // Time span shown, seconds. Longer shows slower trends, less detail.
-  int height_px = 180;     // Height of the whole chart (three lanes) under the image.
-  bool Check(std::string* error) const;
-};
 
 class StripChart {
  public:

@@ -1,6 +1,7 @@
-// The live window's logic as a state machine, free of any window system: it is fed frames and
-// user events (mouse, keys, trackbars) and produces the image to show. The highgui adapter
-// (live_window.h) only forwards events and shows canvas(); tests drive the controller directly.
+// Internal to gui (and the tests). The live window's logic as a state machine, free of any window
+// system: it is fed frames and user events (mouse, keys, trackbars) and produces the image to
+// show. The highgui loop (live_window.cc) only forwards events and shows canvas(); tests drive
+// the controller directly.
 //
 // Mouse: drag a rectangle over a marker to (re)select it (template / colour ROI, the paper's
 // real-time recalibration); click a marker to calibrate its HSV ranges from the pixels around
@@ -16,8 +17,11 @@
 
 #include "softsight/calib/hsv_picker.h"
 #include "softsight/io/frame_grabber.h"
+#include "softsight/gui/live_options.h"
 #include "softsight/gui/overlay.h"
-#include "softsight/gui/strip_chart.h"
+#include "gui/rate_meter.h"
+#include "gui/scale_clicks.h"
+#include "gui/strip_chart.h"
 #include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
 
@@ -97,30 +101,6 @@ enum class FrameOrder {
   kJump,  // Not the next frame (seek, step back, loop, restart): trackers search afresh.
 };
 
-struct LiveOptions {
-  // Where `s` writes the config. Default: empty, which makes the command choose
-  // <config stem>.live.yaml beside the loaded config.
-  std::string save_config_path;
-  // Recordings go to <prefix>-NNN.csv, .avi (annotated), .raw.avi (frames as captured, for
-  // `softsight track`) and .yaml (the config reproducing the run on the raw video).
-  std::string record_prefix = "live";
-  // Side of the box cut around a marker when it needs a new template (method switch, start of a
-  // recording), px. Default 32: a 10-20 px marker plus context.
-  int select_box_px = 32;
-  // Frame rate written into recorded videos, frames per second: the source's nominal rate when
-  // known (absent: the measured processing rate). The CSV's time_s is always the source's.
-  std::optional<double> record_fps;
-  // A press and release closer than this is a click (colour pick), farther a drag (reselect), px.
-  int click_slop_px = 4;
-  // The true distance between the two points clicked in scale mode (`c`), e.g. the ends of a
-  // ruler lying in the actuator's plane, mm. Absent (default): `c` only says how to set it.
-  std::optional<double> scale_distance_mm;
-  StripChartOptions chart;
-  HsvPickOptions picker;
-  OverlayOptions overlay;  // base/middle/tip filled from the config by the controller.
-
-  bool Check(std::string* error) const;
-};
 
 class LiveController {
  public:
@@ -161,7 +141,7 @@ class LiveController {
   // each, and its search region, instead of the annotated frame.
   bool mask_view() const { return mask_view_; }
   // Scale mode (`c`): the next left clicks are the two scale points.
-  bool scale_mode() const { return scale_mode_; }
+  bool scale_mode() const { return scale_.active(); }
   int active_marker() const { return active_; }
   // The config as edited live (what `s` saves): the session's, the only copy.
   const TrackingConfig& config() const;
@@ -177,8 +157,8 @@ class LiveController {
   // counts twice), so the window can log each one once.
   const std::string& message() const { return message_; }
   int64_t message_count() const { return message_count_; }
-  std::optional<double> latency_ms() const { return latency_ms_; }
-  std::optional<double> fps() const { return fps_; }
+  std::optional<double> latency_ms() const { return meter_.latency_ms(); }
+  std::optional<double> fps() const { return meter_.fps(); }
   // The active marker's ranges in kHsvTrackbars order, and a counter that changes whenever they
   // or the active marker change, so the adapter knows when to move its trackbars.
   std::array<int, 6> active_hsv() const;
@@ -200,7 +180,6 @@ class LiveController {
   void start_scale();
   void cancel_scale();
   void scale_point(const cv::Point2d& p);
-  std::string scale_hint() const;
   void draw_scale_points(cv::Mat& top, const LiveLayout& view) const;
   LiveLayout layout() const;
   void select_marker(int index);
@@ -232,9 +211,7 @@ class LiveController {
   cv::Size max_canvas_;  // Empty: no screen known.
   bool dirty_ = true;
   std::optional<FrameResult> last_result_;
-  std::optional<double> latency_ms_, fps_;
-  std::vector<SteadyClock::time_point> frame_times_;  // Ring of recent result times, for fps.
-  size_t frame_times_next_ = 0;
+  RateMeter meter_;
 
   bool paused_ = false, help_ = false, quit_ = false, ended_ = false, loop_ = false;
   bool mask_view_ = false;
@@ -243,8 +220,7 @@ class LiveController {
   int active_ = 0;
   int hsv_revision_ = 0;
   std::unique_ptr<LivePointer> pointer_;
-  bool scale_mode_ = false;
-  std::vector<cv::Point2d> scale_clicks_;  // Scale mode: the points so far, image pixels.
+  ScaleClicks scale_;
   std::string message_;
   int64_t message_count_ = 0;
   std::unique_ptr<LiveRecording> recording_;

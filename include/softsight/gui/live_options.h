@@ -1,0 +1,46 @@
+// The settings of the live window (`softsight live`, RunLiveWindow in live_window.h): where it
+// saves and records, how the mouse selects, the strip chart, the colour picker and the overlay.
+// Plain option structs with defaults and a Check() that names the bad field.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "softsight/calib/hsv_picker.h"
+#include "softsight/gui/overlay.h"
+
+namespace softsight {
+
+// The scrolling strip chart under the live image: angle, bending distance and arc length.
+struct StripChartOptions {
+  double window_s = 10.0;  // Time span shown, seconds. Longer shows slower trends, less detail.
+  int height_px = 180;     // Height of the whole chart (three lanes) under the image.
+  bool Check(std::string* error) const;
+};
+
+struct LiveOptions {
+  // Where `s` writes the config. Default: empty, which makes the command choose
+  // <config stem>.live.yaml beside the loaded config.
+  std::string save_config_path;
+  // Recordings go to <prefix>-NNN.csv, .avi (annotated), .raw.avi (frames as captured, for
+  // `softsight track`) and .yaml (the config reproducing the run on the raw video).
+  std::string record_prefix = "live";
+  // Side of the box cut around a marker when it needs a new template (method switch, start of a
+  // recording), px. Default 32: a 10-20 px marker plus context.
+  int select_box_px = 32;
+  // Frame rate written into recorded videos, frames per second: the source's nominal rate when
+  // known (absent: the measured processing rate). The CSV's time_s is always the source's.
+  std::optional<double> record_fps;
+  // A press and release closer than this is a click (colour pick), farther a drag (reselect), px.
+  int click_slop_px = 4;
+  // The true distance between the two points clicked in scale mode (`c`), e.g. the ends of a
+  // ruler lying in the actuator's plane, mm. Absent (default): `c` only says how to set it.
+  std::optional<double> scale_distance_mm;
+  StripChartOptions chart;
+  HsvPickOptions picker;
+  OverlayOptions overlay;  // base/middle/tip filled from the config by the window.
+
+  bool Check(std::string* error) const;
+};
+
+}  // namespace softsight
