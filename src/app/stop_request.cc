@@ -1,5 +1,8 @@
 #include "app/stop_request.h"
 
+#include <pthread.h>
+#include <signal.h>
+
 namespace softsight {
 namespace {
 
@@ -19,6 +22,13 @@ StopRequest::StopRequest() {
   g_stop_signal = 0;
   previous_int_ = std::signal(SIGINT, OnStopSignal);
   previous_term_ = std::signal(SIGTERM, OnStopSignal);
+  // A parent may start this process with both signals blocked until the handler is in place
+  // (`track` with several inputs does): one that arrived meanwhile is delivered now.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
 }
 
 StopRequest::~StopRequest() {

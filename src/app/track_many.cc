@@ -80,6 +80,18 @@ Child Spawn(const TrackManyOptions& options, size_t input, const std::string& cs
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 1);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], 2);
+  // The child starts with SIGINT and SIGTERM blocked, and its StopRequest unblocks them once its
+  // handler is in place: a Ctrl-C that reaches a child still loading (the whole process group
+  // gets it) waits for the handler and stops the run cleanly, instead of killing the child
+  // before it could write its summary.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t held;
+  sigemptyset(&held);
+  sigaddset(&held, SIGINT);
+  sigaddset(&held, SIGTERM);
+  posix_spawnattr_setsigmask(&attributes, &held);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   const std::vector<std::string> args = ChildArguments(options, options.inputs[input], csv);
   std::vector<char*> argv;
   for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
@@ -87,8 +99,9 @@ Child Spawn(const TrackManyOptions& options, size_t input, const std::string& cs
   Child child;
   child.input = input;
   const int error =
-      posix_spawn(&child.pid, options.program.c_str(), &actions, nullptr, argv.data(), environ);
+      posix_spawn(&child.pid, options.program.c_str(), &actions, &attributes, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   close(pipe_fds[1]);
   if (error != 0) {
     close(pipe_fds[0]);

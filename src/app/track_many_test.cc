@@ -2,7 +2,9 @@
 // number of jobs, a failing input is reported and the others complete.
 #include "app/track_many.h"
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::TempDir;
 
 const char* const kConfig = testing::kSceneMarkersYaml;
@@ -149,6 +152,76 @@ TEST(TrackMany, RefusesSeveralInputsIntoOneFileAndACsvThatIsAnInput) {
   run = RunProgram("track" + config + " -i " + clip + " -i synth:bending -o " + dir.file("o") + "/ --annotated x.avi", dir);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.stderr_text, HasSubstr("--annotated"));
+}
+
+// Ctrl-C in the terminal reaches the whole process group: the parent and every running child.
+// Every child stops cleanly (complete rows, its summary), inputs not started are skipped, what
+// had already finished is kept whole, and the run exits 130 (128 + SIGINT).
+TEST(TrackMany, CtrlCStopsEveryJobExits130AndKeepsTheFinishedOutputs) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  const std::string clip = RenderClip(dir.file("short.avi"), 12, 1);
+  const std::string single = dir.file("single.csv");
+  ASSERT_EQ(RunProgram("track -q -c " + dir.file("markers.yaml") + " -i " + clip + " -o " + single, dir)
+                .exit_code,
+            0);
+  // The short clip finishes first; the rendered scenes (300 frames) are still running, or not
+  // yet started, when the interrupt comes.
+  const std::string out = dir.file("out") + "/";
+  const std::string err = dir.file("many.err");
+  const std::string command = "exec " + testing::SoftsightBinary() + " track -c " +
+                              dir.file("markers.yaml") + " -i " + clip +
+                              " -i synth:bending -i synth:wedge1 -i synth:wedge4 -o " + out +
+                              " --jobs 2 2> " + err;
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    setpgid(0, 0);  // A process group of its own, as a shell's foreground job.
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  setpgid(pid, pid);  // Either side may run first.
+  // Interrupt once the short clip's line is out (its CSV is then complete): no timing involved,
+  // the 60 s are only a bound for a broken build.
+  const std::string finished = "[1/4] " + clip + " -> " + out + "short.csv: 12 frames (end of input)";
+  for (int waited_ms = 0;
+       waited_ms < 60000 && testing::ReadTextFile(err).find(finished) == std::string::npos;
+       waited_ms += 5) {
+    usleep(5000);
+  }
+  ASSERT_THAT(testing::ReadTextFile(err), HasSubstr(finished));
+  kill(-pid, SIGINT);  // The group, as the terminal sends it.
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string report = testing::ReadTextFile(err);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping: " << report;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << report;
+  EXPECT_THAT(report, HasSubstr("4 inputs, --jobs 2: 1 done, ")) << "every other one stopped";
+  EXPECT_THAT(report, Not(HasSubstr("failed"))) << report;
+  EXPECT_THAT(report, Not(HasSubstr("killed"))) << report;
+  // The finished output is the single run's, row for row.
+  EXPECT_EQ(RowsWithoutTimings(out + "short.csv"), RowsWithoutTimings(single));
+  // A stopped job's CSV holds complete rows only, fewer than the scene's 300; one not started
+  // has none.
+  int stopped = 0;
+  for (const char* name : {"synth_bending", "synth_wedge1", "synth_wedge4"}) {
+    const std::string csv = out + name + ".csv";
+    if (!std::filesystem::exists(csv)) {
+      EXPECT_THAT(report, HasSubstr("not started (stop requested)")) << name;
+      continue;
+    }
+    ++stopped;
+    EXPECT_THAT(report, HasSubstr("synth:" + std::string(name + 6) + " -> " + csv + ": "));
+    const std::vector<std::string> lines = testing::ReadLines(csv);
+    ASSERT_GE(lines.size(), 1u) << name << ": the header at least";
+    EXPECT_LT(lines.size(), 301u) << name << " ran to its end before the interrupt";
+    const size_t columns = testing::SplitCsv(lines[0]).size();
+    for (size_t i = 1; i < lines.size(); ++i) {
+      EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << name << " row " << i;
+    }
+  }
+  EXPECT_GE(stopped, 1) << "the second job was running when the interrupt came";
+  EXPECT_THAT(report, HasSubstr(std::to_string(stopped) + " stopped"));
 }
 
 }  // namespace
