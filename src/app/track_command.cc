@@ -74,22 +74,26 @@ TrackingConfig LoadTrackConfig(const TrackOptions& options) {
 }
 
 RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
-                    const std::vector<FrameSink*>& more_sinks) {
+                    const std::vector<FrameSink*>& more_sinks, const TrackSeams& seams) {
   RunSummary local;
   RunSummary& summary = summary_out != nullptr ? *summary_out : local;
   summary = RunSummary{};
 
   const TrackingConfig config = LoadTrackConfig(options);
-  std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
+  std::unique_ptr<FrameSource> source =
+      seams.open_source ? seams.open_source() : OpenFrameSource(options.source);
   CheckOutputs(options, config, *source);
   // A camera is read in its own thread, newest frame wins (drops are counted in the summary);
   // a file, image sequence or rendered scene is decoded on its own thread a few frames ahead,
   // so decoding overlaps tracking, and never drops one.
-  if (source->is_live()) {
+  if (seams.open_source) {
+    // A test's stand-in, read as it is.
+  } else if (source->is_live()) {
     source = std::make_unique<NewestFrameSource>(std::move(source));
   } else {
     source = std::make_unique<ReadAheadSource>(std::move(source));
   }
+  const bool live = source->is_live();
   TrackingSession session(config);
 
   // Sinks in the order they see each frame; every output is opened (and checked) before the run.
@@ -102,12 +106,13 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
                       [overlay = OverlayOptionsFor(config.measure)](
                           cv::Mat& canvas, const FrameResult& result) {
                         DrawOverlay(canvas, result, overlay);
-                      });
+                      },
+                      seams.before_encode);
     sinks.push_back(&*annotated);
   }
   std::optional<VideoSink> recording;
   if (options.record_file) {
-    recording.emplace(*options.record_file, "", std::nullopt);
+    recording.emplace(*options.record_file, "", std::nullopt, FrameDrawer{}, seams.before_encode);
     sinks.push_back(&*recording);
   }
   sinks.insert(sinks.end(), more_sinks.begin(), more_sinks.end());
@@ -119,6 +124,10 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
   summary = RunPipeline(*source, session, sinks, run);
+  double row_median = 0.0, row_p99 = 0.0;
+  csv.summarise_row_latency(&row_median, &row_p99);
+  summary.latency_row_ms_median = row_median;
+  summary.latency_row_ms_p99 = row_p99;
   for (const std::optional<VideoSink>* video : {&annotated, &recording}) {
     if (!video->has_value()) continue;
     const VideoSink& sink = **video;
@@ -126,11 +135,13 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
       summary.stop_reason = StopReason::kError;
       summary.error = *sink.error();
     }
-    if (sink.dropped_frames() > 0) {
-      // Never silent: a camera outran the encoder (a file's run waits for it instead).
+    // Never silent: a camera outran the encoder (a file's run waits for it instead). A camera's
+    // run says so also when nothing was lost.
+    if (sink.dropped_frames() > 0 || live) {
       summary.notes.push_back(sink.path() + ": " + std::to_string(sink.dropped_frames()) + " of " +
-                              std::to_string(summary.frames) +
-                              " frames not recorded (the encoder fell behind the camera)");
+                              std::to_string(summary.frames) + " frames not recorded" +
+                              (sink.dropped_frames() > 0 ? " (the encoder fell behind the camera)"
+                                                         : " (the encoder kept up)"));
     }
   }
   if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,11 +37,21 @@ struct TrackOptions {
 // shares). Throws InputError naming the file and key.
 TrackingConfig LoadTrackConfig(const TrackOptions& options);
 
+// What a test puts in RunTrack's place of the outside world. Empty members: the real thing.
+struct TrackSeams {
+  // The source the run reads, in place of OpenFrameSource(options.source) and its thread (a
+  // camera's stand-in that hands over frames on the pipeline's own thread).
+  std::function<std::unique_ptr<FrameSource>()> open_source;
+  // Called on a recording's encoding thread before each frame is encoded (AsyncFrameWriter's
+  // before_encode): a test holds it there so that the encoder falls behind.
+  std::function<void(int64_t index)> before_encode;
+};
+
 // Runs the whole job through RunPipeline. Throws InputError for bad input, before the run
 // (config, source, outputs) or from it (a corrupt frame, a full disk; every CSV row written
 // before stays intact). `summary_out` (optional) receives the summary even when it throws.
 // `more_sinks` see every frame after the command's own (e.g. demo's truth scorer).
 RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out = nullptr,
-                    const std::vector<FrameSink*>& more_sinks = {});
+                    const std::vector<FrameSink*>& more_sinks = {}, const TrackSeams& seams = {});
 
 }  // namespace softsight

@@ -56,7 +56,7 @@ std::string RunSummary::BriefReport() const {
 
 std::string RunSummary::FullReport() const {
   std::string out;
-  char line[256];
+  char line[384];
   std::snprintf(line, sizeof(line), "frames: %lld from %s in %.2f s (%s)\n",
                 static_cast<long long>(frames), source.c_str(), wall_s,
                 stop_detail.empty() ? StopReasonName(stop_reason) : stop_detail.c_str());
@@ -83,10 +83,15 @@ std::string RunSummary::FullReport() const {
                 proc_ms_median, proc_ms_p99);
   out += line;
   if (frames > 0) {
+    char row[96] = "";
+    if (latency_row_ms_median && latency_row_ms_p99) {
+      std::snprintf(row, sizeof(row), "; to the CSV row median %.3f ms, p99 %.3f ms",
+                    *latency_row_ms_median, *latency_row_ms_p99);
+    }
     std::snprintf(line, sizeof(line),
                   "latency from capture (a file's frame: from its decoding): to the result "
-                  "median %.3f ms, p99 %.3f ms; to every output written median %.3f ms, p99 %.3f ms\n",
-                  latency_result_ms_median, latency_result_ms_p99, latency_done_ms_median,
+                  "median %.3f ms, p99 %.3f ms%s; to every output written median %.3f ms, p99 %.3f ms\n",
+                  latency_result_ms_median, latency_result_ms_p99, row, latency_done_ms_median,
                   latency_done_ms_p99);
     out += line;
   }

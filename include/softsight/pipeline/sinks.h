@@ -30,12 +30,18 @@ CsvColumnTable TrackingColumns(const TrackingConfig& config,
 class CsvSink : public FrameSink {
  public:
   CsvSink(const std::string& path, CsvColumnTable columns);
+  void begin(const RunInfo& info) override;
   void consume(const Frame& frame, const FrameResult& result) override;
 
   const std::string& path() const { return writer_.path(); }
+  // The latency from each frame's capture (Frame::captured) to its row written (the write
+  // returned), median and p99 over the rows so far, ms; 0 and 0 without rows. For the summary:
+  // the CSV's latency_row_ms column is taken just before the write.
+  void summarise_row_latency(double* median_ms, double* p99_ms) const;
 
  private:
   CsvWriter writer_;
+  std::vector<double> row_latency_ms_;  // Reserved in begin() for a file's frame count.
 };
 
 // Draws the result on a copy of the frame (the overlay lives in gui: the caller passes it).
@@ -50,7 +56,9 @@ using FrameDrawer = std::function<void(cv::Mat& canvas, const FrameResult& resul
 class VideoSink : public FrameSink {
  public:
   // Checks the path and codec at once (FrameWriter). `fps` absent: the source's, else 30.
-  VideoSink(std::string path, std::string codec, std::optional<double> fps, FrameDrawer draw = {});
+  // `before_encode` (tests): AsyncFrameWriter's hook on the encoding thread.
+  VideoSink(std::string path, std::string codec, std::optional<double> fps, FrameDrawer draw = {},
+            std::function<void(int64_t index)> before_encode = {});
   void begin(const RunInfo& info) override;
   void consume(const Frame& frame, const FrameResult& result) override;
   // Finishes the video. An encoder error met while finishing cannot be thrown from here: see
@@ -67,6 +75,7 @@ class VideoSink : public FrameSink {
   FrameWriterOptions options_;
   std::optional<double> fps_;
   FrameDrawer draw_;
+  std::function<void(int64_t)> before_encode_;
   WhenEncoderBehind policy_ = WhenEncoderBehind::kWait;
   std::unique_ptr<AsyncFrameWriter> writer_;
   std::optional<std::string> error_;

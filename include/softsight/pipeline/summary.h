@@ -46,6 +46,10 @@ struct RunSummary {
   double latency_result_ms_p99 = 0.0;
   double latency_done_ms_median = 0.0;
   double latency_done_ms_p99 = 0.0;
+  // To the CSV row written (CsvSink::summarise_row_latency), when the command that owns the CSV
+  // filled it in; absent: not reported.
+  std::optional<double> latency_row_ms_median;
+  std::optional<double> latency_row_ms_p99;
   double wall_s = 0.0;                 // Whole run, reading and sinks included.
   StopReason stop_reason = StopReason::kEndOfInput;
   // With kStopRequested, who asked, when the caller knows: "stopped by SIGTERM".
