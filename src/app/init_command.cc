@@ -170,10 +170,18 @@ InitResult RunInit(const InitOptions& options) {
                options.source);
   const Frame frame = ReadFrameAt(options.source, options.frame);
   MarkerFinderOptions finder = options.finder;
-  finder.write_roi = options.frame == 0;
+  // The rois apply from this frame on: the index `track` will give it (an image sequence's
+  // numbering, a video's position).
+  finder.frame_index = frame.index;
   InitResult result;
   result.finding = FindMarkers(frame.image, finder);
   MarkerFinding& finding = result.finding;
+  if (options.frame > 0 && !finding.intensity && !finder.search_px) {
+    // A marker told apart by its colour alone needs no roi: without one `track` follows it from
+    // the input's first frame, where a roi (holding from this frame on) would leave it not
+    // started. Identical dots and markers found in a search region keep theirs.
+    for (FoundMarker& m : finding.markers) m.spec.colour.roi.reset();
+  }
   if (finding.ok() && finding.markers.size() >= 2 && !finder.base_near_px) {
     // The base is where the body is clamped: the video shows it better than the image border.
     std::string seen;
@@ -236,12 +244,16 @@ TrackingConfig RunPick(const PickOptions& options) {
       throw InputError("--at " + std::string(where) + " in frame " +
                        std::to_string(options.frame) + ": " + why);
     }
+    // The pick's roi holds from this frame on (at frame 0 the marker may have been elsewhere).
+    const int roi_frame = static_cast<int>(std::clamp<int64_t>(frame.index, 0, 1000000000));
     if (options.base_config) {
       ApplyColourPick(*pick, &config.markers[i].colour);
+      config.markers[i].colour.roi_frame = roi_frame;
     } else {
       MarkerSpec spec;
       spec.method = "colour";
       ApplyColourPick(*pick, &spec.colour);
+      spec.colour.roi_frame = roi_frame;
       const HsvRange& h = pick->ranges.h;
       const int hue = h.lo <= h.hi ? (h.lo + h.hi) / 2 : ((h.lo + h.hi + 180) / 2) % 180;
       std::string name = HueName(hue);
@@ -283,8 +295,9 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
                  "Video file, folder of images, printf pattern (frames/%04d.png) or synth:NAME")
       ->required();
   sub.add_option("--frame", args->options.frame,
-                 "Which frame to analyse, counting from 0. Rois are written only for frame 0 "
-                 "(track looks there on its first frame)")
+                 "Which frame to analyse, counting from 0. After the first, markers told apart "
+                 "by colour get no roi (track finds them from the first frame); dots and --roi "
+                 "finds get a roi from this frame on (not started before it)")
       ->capture_default_str()
       ->check(NumberIn(0, 1e12));
   sub.add_option("-o,--out", args->options.config_out, "The config to write (YAML)")

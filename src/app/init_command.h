@@ -29,7 +29,7 @@ struct InitOptions {
   int64_t frame = 0;                 // Position of the analysed frame in the input.
   std::string config_out = "init.yaml";
   std::optional<std::string> picture_out;  // Default: the config's name with .png.
-  MarkerFinderOptions finder;        // write_roi is set from `frame` (rois only on frame 0).
+  MarkerFinderOptions finder;        // frame_index is set from `frame` (rois apply from it).
 };
 
 struct InitResult {

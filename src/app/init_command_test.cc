@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <map>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -18,6 +19,9 @@
 #include "sim/opencv_samples.h"
 #include "softsight/core/error.h"
 #include "gui/live_controller.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/tracking_session.h"
+#include "softsight/sim/plate_scene.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
@@ -231,10 +235,53 @@ TEST(InitCommand, WhiteDotsOnGrayVideoGetAGrayRangeAndARoiEach) {
     EXPECT_TRUE(m.colour.gray && m.colour.roi) << m.name;
   }
   EXPECT_EQ(result.config.measure.chain.size(), 5u);
-  // Identical dots need their rois, which track applies on the first frame: another frame is
-  // refused rather than written with rois that would be wrong there.
-  init.frame = 10;
-  EXPECT_THROW(RunInit(init), InputError);
+  for (const MarkerSpec& m : result.config.markers) EXPECT_EQ(m.colour.roi_frame, 0) << m.name;
+}
+
+// Identical dots need their rois, which hold where the dots are on the analysed frame: on a later
+// frame they apply from it, and before it the dots are not started (at frame 0 the plate stood
+// elsewhere, and a roi there would hold another dot or none).
+TEST(InitCommand, RoisFoundOnALaterFrameApplyFromThatFrame) {
+  TempDir dir;
+  InitOptions init;
+  init.source.input = "synth:plate";
+  init.config_out = dir.file("plate.yaml");
+  init.frame = 12;
+  const InitResult result = RunInit(init);
+  ASSERT_EQ(result.config.markers.size(), 5u);
+  for (const MarkerSpec& m : result.config.markers) {
+    ASSERT_TRUE(m.colour.roi) << m.name;
+    EXPECT_EQ(m.colour.roi_frame, 12) << m.name;
+  }
+  PlateScene truth_scene(PlateSceneOptions{});
+  cv::Mat truth_image;
+  // init names the dots in body order: the truth's dot of each is the one it found on frame 12.
+  const SceneTruth analysed = truth_scene.render(12, truth_image);
+  std::vector<size_t> truth_of(5);
+  for (size_t m = 0; m < 5; ++m) {
+    for (size_t t = 0; t < 5; ++t) {
+      if (cv::norm(result.finding.markers[m].position_px - *analysed.markers[t].centroid_px) < 1.0) {
+        truth_of[m] = t;
+      }
+    }
+  }
+  TrackingSession session(LoadTrackingConfig(init.config_out));
+  const std::unique_ptr<FrameSource> source = OpenFrameSource({"synth:plate", {}, 30.0});
+  Frame frame;
+  for (int i = 0; i < 20 && source->read(frame); ++i) {
+    const SceneTruth truth = truth_scene.render(i, truth_image);
+    const FrameResult& result_i = session.process(frame);
+    for (size_t m = 0; m < 5; ++m) {
+      const Observation& o = result_i.markers[m].observation;
+      if (i < 12) {
+        EXPECT_EQ(o.status(), MarkerStatus::kNotStarted) << "frame " << i << " dot " << m;
+      } else {
+        ASSERT_TRUE(o.found()) << "frame " << i << " dot " << m;
+        EXPECT_LT(cv::norm(*o.position_px - *truth.markers[truth_of[m]].centroid_px), 0.2)
+            << "frame " << i << " dot " << m;
+      }
+    }
+  }
 }
 
 // Golden real data: OpenCV's smarties.png (opencv-doc), a real photograph of candies with
@@ -347,6 +394,92 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("--at -50,5"));
+  }
+}
+
+// Every marker's position per frame (frame index -> positions in config order).
+class PositionSink : public FrameSink {
+ public:
+  void consume(const Frame& frame, const FrameResult& result) override {
+    std::vector<std::optional<cv::Point2d>>& row = rows[frame.index];
+    for (const MarkerObservation& m : result.markers) row.push_back(m.observation.position_px);
+  }
+  std::map<int64_t, std::vector<std::optional<cv::Point2d>>> rows;
+};
+
+// A pick at frame N > 0 of a moving scene, by `pick --frame N` and by clicks in the live window
+// on that frame (then `s`): `track` with either saved config gives live's positions from frame N
+// on, and nothing before N (the rois are where the markers are at N, not at frame 0).
+TEST(PickCommand, APickAtALaterFrameTracksLikeLiveFromThatFrameAndNotBefore) {
+  constexpr int kPickFrame = 9;
+  TempDir dir;
+  const Clip clip = RenderBenchClip(dir, SceneOptions{}.markers, 16, 3);
+  std::vector<cv::Point2d> clicks;
+  for (const MarkerTruth& m : clip.truth[kPickFrame].markers) clicks.push_back(*m.centroid_px);
+  ASSERT_GT(cv::norm(clicks.back() - *clip.truth[0].markers.back().centroid_px), 32.0)
+      << "the tip moves out of its pick's box";
+
+  TrackingConfig start;  // What live starts from: ranges that find nothing (wrong hue).
+  for (const SceneMarker& m : clip.scene.markers) {
+    MarkerSpec spec;
+    spec.name = m.name;
+    spec.colour.h = {20, 30};
+    start.markers.push_back(spec);
+  }
+  start.measure = SceneMeasureOptions(clip.scene);
+  LiveOptions options;
+  options.save_config_path = dir.file("live.yaml");
+  LiveController live(start, options);
+  std::map<int64_t, std::vector<std::optional<cv::Point2d>>> live_rows;
+  const std::unique_ptr<FrameSource> source = OpenFrameSource({clip.video, {}, 30.0});
+  Frame frame;
+  while (source->read(frame)) {
+    live.on_frame(frame, SteadyClock::now());
+    if (frame.index == kPickFrame) {
+      for (size_t i = 0; i < clicks.size(); ++i) {
+        live.on_event(UiEvent::Key('1' + static_cast<int>(i)));
+        live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseDown, clicks[i].x, clicks[i].y));
+        live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseUp, clicks[i].x, clicks[i].y));
+      }
+      live.on_event(UiEvent::Key('s'));
+    }
+    ASSERT_TRUE(live.last_result().has_value());
+    for (const MarkerObservation& m : live.last_result()->markers) {
+      live_rows[frame.index].push_back(m.observation.position_px);
+    }
+  }
+
+  PickOptions pick;
+  pick.source.input = clip.video;
+  pick.frame = kPickFrame;
+  pick.at_px = clicks;
+  pick.config_out = dir.file("pick.yaml");
+  RunPick(pick);
+  for (const std::string& config : {dir.file("pick.yaml"), dir.file("live.yaml")}) {
+    SCOPED_TRACE(config);
+    const TrackingConfig saved = LoadTrackingConfig(config);
+    for (const MarkerSpec& m : saved.markers) EXPECT_EQ(m.colour.roi_frame, kPickFrame) << m.name;
+    TrackOptions track;
+    track.config_file = config;
+    track.source.input = clip.video;
+    track.csv_file = dir.file("track.csv");
+    track.quiet = true;
+    PositionSink positions;
+    RunTrack(track, nullptr, {&positions});
+    ASSERT_EQ(positions.rows.size(), clip.truth.size());
+    for (const auto& [index, row] : positions.rows) {
+      for (size_t m = 0; m < row.size(); ++m) {
+        if (index < kPickFrame) {
+          EXPECT_FALSE(row[m].has_value()) << "frame " << index << " marker " << m;
+          continue;
+        }
+        ASSERT_TRUE(row[m] && live_rows[index][m]) << "frame " << index << " marker " << m;
+        EXPECT_LT(cv::norm(*row[m] - *live_rows[index][m]), 1e-3)
+            << "frame " << index << " marker " << m;
+        EXPECT_LT(cv::norm(*row[m] - *clip.truth[index].markers[m].centroid_px), 0.5)
+            << "frame " << index << " marker " << m;
+      }
+    }
   }
 }
 

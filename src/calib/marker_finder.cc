@@ -290,6 +290,9 @@ void MarkerFinderOptions::Check() const {
   if (expected_count && (*expected_count < 1 || *expected_count > 64)) {
     throw InputError("marker count must be in 1..64, got " + std::to_string(*expected_count));
   }
+  if (frame_index < 0 || frame_index > 1000000000) {
+    throw InputError("frame " + std::to_string(frame_index) + ": must be in 0..1000000000");
+  }
   if (min_saturation < 1 || min_saturation > 255) {
     throw InputError("min_saturation must be in 1..255, got " + std::to_string(min_saturation));
   }
@@ -632,8 +635,8 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
       if (same > 0) name += "_" + std::to_string(same + 1);
     }
     v.marker.spec.name = name;
-    if (!options.write_roi && !finding.intensity && !options.search_px) {
-      v.marker.spec.colour.roi.reset();
+    if (v.marker.spec.colour.roi) {
+      v.marker.spec.colour.roi_frame = static_cast<int>(options.frame_index);
     }
     finding.markers.push_back(v.marker);
   }
@@ -708,11 +711,6 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
   } else if (order_ambiguous) {
     finding.problem = "the order along the body is ambiguous (two paths through the markers are "
                       "about as short): choose a frame where the actuator is less bent (--frame)";
-  } else if (!options.write_roi && (finding.intensity || options.search_px)) {
-    finding.problem = std::string(finding.intensity ? "identical dots" : "markers found in a search "
-                                                                       "region") +
-                      " need a roi each, which `track` applies on the input's first frame: use "
-                      "the first frame (--frame 0)";
   }
   return finding;
 }

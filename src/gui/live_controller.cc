@@ -420,6 +420,7 @@ void LiveController::toggle_recording() {
       if (!position) continue;
       const cv::Rect box = box_around(*position);
       spec.colour.roi = box;
+      spec.colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
       if (IsTemplateMethod(spec.method)) {
         spec.templ.rect = box;
         spec.templ.template_frame = 0;

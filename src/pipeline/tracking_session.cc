@@ -194,7 +194,9 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
       templ.image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
       templ.image_file.clear();
     } else {
+      // The roi holds from this frame on: at frame 0 the marker was elsewhere.
       config_.markers[i].colour.roi = rect;
+      config_.markers[i].colour.roi_frame = static_cast<int>(std::max<int64_t>(0, frame.index));
     }
     // The selection's frame is tracked by the new tracker at once, as `track` tracks a template's
     // reference frame: the window shows the new result now, and the tracker has seen the frames

@@ -7,6 +7,7 @@
 
 #include "core/test_util.h"
 #include "pipeline/scene_config_test_util.h"
+#include "softsight/calib/hsv_picker.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/scene.h"
@@ -86,6 +87,53 @@ TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
   EXPECT_EQ(session.config().markers[1].colour.roi, cv::Rect(10, 20, 30, 40));
   EXPECT_THROW(session.reselect("yellow", clip.frames[0], cv::Rect(0, 0, 5, 5)),
                InputError);
+}
+
+// What the live window does when a person clicks a colour marker at frame N > 0 and saves (`s`):
+// the pick's ranges and search box go to the session, which tracks frame N with them and records
+// the roi with its frame; `track` with the saved config must then give the same positions from
+// frame N on, and before N nothing (at frame 0 the marker was ~40 px from the pick's box).
+TEST(TrackingSession, AColourPickAtALaterFrameIsSavedWithItsFrameAndTrackReproducesIt) {
+  constexpr int kPickFrame = 10;
+  const Clip clip = Render(14, {}, /*stretch=*/3);
+  TrackingConfig config = ThreeMarkerSceneConfig();
+  config.markers[2].colour.h = {20, 30};  // green's ranges are wrong (yellow) until the pick
+  TrackingSession live(config);
+  std::vector<std::optional<cv::Point2d>> live_green(clip.frames.size());
+  for (int i = 0; i < static_cast<int>(clip.frames.size()); ++i) {
+    const FrameResult* result = &live.process(clip.frames[i]);
+    if (i == kPickFrame) {
+      const cv::Point2d at = *clip.truth[i].markers[2].centroid_px;
+      const auto pick = PickMarkerColourAt(clip.frames[i].image, at, HsvPickOptions{}, 32);
+      ASSERT_TRUE(pick.has_value());
+      MarkerSpec spec = live.config().markers[2];
+      ApplyColourPick(*pick, &spec.colour);
+      live.respec(spec);
+      result = &live.reselect("green", clip.frames[i], pick->roi);
+    }
+    live_green[i] = result->markers[2].observation.position_px;
+  }
+  EXPECT_EQ(live.config().markers[2].colour.roi_frame, kPickFrame);
+  const cv::Point2d at_pick = *clip.truth[kPickFrame].markers[2].centroid_px;
+  ASSERT_GT(cv::norm(at_pick - *clip.truth[0].markers[2].centroid_px), 30.0);
+
+  testing::TempDir dir;
+  SaveTrackingConfig(live.config(), dir.file("live.yaml"));
+  const TrackingConfig saved = LoadTrackingConfig(dir.file("live.yaml"));
+  EXPECT_EQ(saved.markers[2].colour.roi_frame, kPickFrame);
+  TrackingSession track(saved);
+  for (int i = 0; i < static_cast<int>(clip.frames.size()); ++i) {
+    const Observation& green = track.process(clip.frames[i]).markers[2].observation;
+    if (i < kPickFrame) {
+      EXPECT_EQ(green.status(), MarkerStatus::kNotStarted) << "frame " << i;
+      continue;
+    }
+    ASSERT_TRUE(green.found()) << "frame " << i;
+    ASSERT_TRUE(live_green[i].has_value()) << "frame " << i;
+    EXPECT_LT(cv::norm(*green.position_px - *live_green[i]), 1e-3) << "frame " << i;
+    EXPECT_LT(cv::norm(*green.position_px - *clip.truth[i].markers[2].centroid_px), 0.3)
+        << "frame " << i;
+  }
 }
 
 TEST(TrackingSession, CameraModelMeasuresUndistortedPositionsButReportsRecordedOnes) {

@@ -142,6 +142,10 @@ OptionTable<ColourParams> MakeTable() {
           .Range(0, 65535)
           .Unit("px")
           .Doc("[x, y, w, h] where the first acquisition looks (a dragged rectangle)"),
+      IntOption<P>("roi_frame", &P::roi_frame)
+          .Range(0, 1e9)
+          .Doc("frame the roi was picked on: the marker is not started before it (no roi: "
+               "tracking starts there)"),
       IntOption<P>("window", &P::window_px)
           .Range(8, 4096)
           .Or(0, "search the whole frame")

@@ -359,6 +359,8 @@ void ColourTracker::reset() {
 }
 
 bool ColourTracker::start(const Frame& frame) {
+  // A roi picked at a later frame says nothing of where the marker is before it.
+  if (frame.index < params_.roi_frame) return false;
   // Without a roi there is nothing to learn before the first update: it acquires on the whole
   // frame.
   if (params_.roi) init(frame.image, *params_.roi);

@@ -18,6 +18,7 @@
 //    Three markers give the paper's triple, more a chain (as sim/scene.h's SceneMeasureOptions).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,7 +34,7 @@ namespace softsight {
 struct MarkerFinderOptions {
   // Only candidates whose centre lies in this rectangle (frame pixels) count; absent: the whole
   // frame. Restricting the search to the actuator removes look-alikes elsewhere; each marker then
-  // gets a roi, which `track` applies on the input's first frame.
+  // gets a roi, which `track` applies from the analysed frame on (frame_index).
   std::optional<cv::Rect> search_px;
   // How many markers the body carries; absent: as many as are verified. A different count is a
   // problem (the finding is not usable), never a silent choice.
@@ -54,10 +55,9 @@ struct MarkerFinderOptions {
   // Side of each marker's roi (as live's click box, `LiveOptions::select_box_px`), px; at least
   // four marker radii, and smaller than the distance to the nearest other candidate.
   int roi_side_px = 32;
-  // Whether the config gets a roi per marker. Rois are where the markers are in the analysed
-  // frame, and `track` applies them on the input's first frame, so they are written only when the
-  // analysed frame is that one; identical dots, which need them, are refused otherwise.
-  bool write_roi = true;
+  // Index (Frame::index) of the analysed frame in its input. Rois are where the markers are in
+  // that frame, so each applies from it on (ColourParams::roi_frame; not started before).
+  int64_t frame_index = 0;
 
   // Throws InputError naming the field when an option is unusable.
   void Check() const;

@@ -42,7 +42,7 @@ class TrackingSession {
   // (re-cuts a template, or restricts the colour tracker's acquisition). The new tracker tracks
   // that frame at once; returns the frame's result with it. config() records the selection so a
   // saved config reproduces it: a template's pixels, rect and frame index (tracking starts there
-  // and then), a colour marker's search box. Throws InputError for an unknown marker or a
+  // and then), a colour marker's search box and its frame (roi_frame: from there on). Throws InputError for an unknown marker or a
   // rectangle the tracker cannot use.
   const FrameResult& reselect(const std::string& marker, const Frame& frame, const cv::Rect& rect);
   // Replace a marker's spec (new HSV ranges or method) and rebuild its tracker.

@@ -102,6 +102,14 @@ struct ColourParams {
   // full of glints and highlight rims). Later re-acquisitions search the whole frame,
   // preferring candidates that fit the learned model best, near the last known position.
   std::optional<cv::Rect> roi;
+  // The frame (Frame::index) the roi was picked on: a pick or drag at frame N (live, `softsight
+  // pick --frame N`, `init --frame N`) says where the marker is then, not at frame 0, where it
+  // may have been anywhere. Before this frame the marker is not started (status not_started,
+  // nothing reported: where it was then nobody showed, and a whole-frame search could take a
+  // look-alike for it); on it the first acquisition looks in the roi and learns the marker's
+  // model there, as the pick did. Without a roi it is just the frame tracking starts at.
+  // Default 0: from the first frame.
+  int roi_frame = 0;
   // Side of the square window searched around the constant-velocity prediction while tracking;
   // at least 4 reference radii. Smaller is faster but needs widening sooner for fast markers.
   // 0: search the whole frame every frame, choosing the blob nearest the prediction (several

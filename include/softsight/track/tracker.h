@@ -54,9 +54,10 @@ class Tracker {
   virtual void init(const cv::Mat& frame_bgr, const cv::Rect& hint) = 0;
 
   // Starts the tracker from what its parameters say, on the first frame where it can: a colour
-  // tracker at once (restricted to its roi when one is set); a template tracker from its template
-  // image, or from its rect once frame.index reaches its template frame. Returns false while it
-  // cannot start (no template yet, or the template's frame is still ahead): its marker is then not
+  // tracker once frame.index reaches its roi frame (learning its marker in its roi when one is
+  // set); a template tracker from its template image, or from its rect once frame.index reaches
+  // its template frame. Returns false while it cannot start (no template yet, or the roi's or
+  // template's frame is still ahead): its marker is then not
   // started, and the caller asks again with the next frame. Throws InputError as init() does.
   virtual bool start(const Frame& frame) = 0;
 
