@@ -42,6 +42,68 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   return spec;
 }
 
+// The `changes:` list of a live recording's config (ConfigChange): each entry an `after_frame`
+// and exactly one of `respec:` (a marker as under `markers:`), `reselect: {marker, rect}`,
+// `retrack: <marker>` or `reset_tip_reference: true`, in frame order, naming known markers.
+std::vector<ConfigChange> ReadChanges(const YAML::Node& list, const std::string& file,
+                                      const std::set<std::string>& names,
+                                      const std::optional<std::string>& method_override,
+                                      std::vector<std::string>* files_read) {
+  if (!list.IsSequence()) {
+    throw InputError(file + ": changes: expected a list (written by live recordings)");
+  }
+  std::vector<ConfigChange> changes;
+  for (size_t i = 0; i < list.size(); ++i) {
+    YamlMap entry(list[i], file, "changes[" + std::to_string(i) + "]");
+    ConfigChange change;
+    change.after_frame = entry.integer("after_frame", 0, 1 << 30).value_or(-1);
+    if (change.after_frame < 0) entry.fail("after_frame", "every change needs its frame");
+    if (!changes.empty() && change.after_frame < changes.back().after_frame) {
+      entry.fail("after_frame", "changes must be in frame order");
+    }
+    const int kinds = entry.has("respec") + entry.has("reselect") + entry.has("retrack") +
+                      entry.has("reset_tip_reference");
+    if (kinds != 1) {
+      entry.fail("after_frame",
+                 "each change is one of respec, reselect, retrack or reset_tip_reference");
+    }
+    if (entry.has("respec")) {
+      change.kind = ConfigChange::Kind::kRespec;
+      YamlMap marker = entry.map("respec");
+      change.spec = ReadMarker(marker, method_override);
+      change.marker = change.spec.name;
+      if (!change.spec.templ.image_file.empty()) {
+        files_read->push_back(ResolveBesideFile(file, change.spec.templ.image_file));
+      }
+    } else if (entry.has("reselect")) {
+      change.kind = ConfigChange::Kind::kReselect;
+      YamlMap reselect = entry.map("reselect");
+      change.marker = reselect.string("marker").value_or("");
+      const auto rect = reselect.integers("rect", 4, 0, 1 << 20);
+      if (!rect || (*rect)[2] <= 0 || (*rect)[3] <= 0) {
+        reselect.fail("rect", "expected [x, y, width, height] with a positive size");
+      }
+      change.rect = cv::Rect((*rect)[0], (*rect)[1], (*rect)[2], (*rect)[3]);
+      reselect.finish();
+    } else if (entry.has("retrack")) {
+      change.kind = ConfigChange::Kind::kRetrack;
+      change.marker = entry.string("retrack").value_or("");
+    } else {
+      change.kind = ConfigChange::Kind::kResetTipReference;
+      if (!entry.boolean("reset_tip_reference").value_or(false)) {
+        entry.fail("reset_tip_reference", "only `true` is a change");
+      }
+    }
+    if (names.count(change.marker) == 0 && change.kind != ConfigChange::Kind::kResetTipReference) {
+      entry.fail(change.kind == ConfigChange::Kind::kRetrack ? "retrack" : "after_frame",
+                 "'" + change.marker + "' is not the name of a marker in this file");
+    }
+    entry.finish();
+    changes.push_back(std::move(change));
+  }
+  return changes;
+}
+
 void CheckMethodOverride(const std::optional<std::string>& method_override) {
   if (method_override) {
     const std::vector<std::string> methods = TrackerMethods();
@@ -125,8 +187,21 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
     recording.finish();
     config.recording = origin;
   }
+  if (top.has("changes")) {
+    config.changes =
+        ReadChanges(top.node("changes"), file, names, method_override, &config.files_read);
+  }
   top.finish();
   return config;
+}
+
+void WriteMarker(const MarkerSpec& spec, YAML::Emitter& out) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << spec.name;
+  out << YAML::Key << "method" << YAML::Value << spec.method;
+  WriteColourParams(spec.colour, out);
+  WriteTemplateParams(spec.templ, out);
+  out << YAML::EndMap;
 }
 
 }  // namespace
@@ -151,14 +226,7 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::Comment("softsight tracking config (see examples/markers.yaml for every key)");
   out << YAML::BeginMap;
   out << YAML::Key << "markers" << YAML::Value << YAML::BeginSeq;
-  for (const MarkerSpec& spec : config.markers) {
-    out << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << spec.name;
-    out << YAML::Key << "method" << YAML::Value << spec.method;
-    WriteColourParams(spec.colour, out);
-    WriteTemplateParams(spec.templ, out);
-    out << YAML::EndMap;
-  }
+  for (const MarkerSpec& spec : config.markers) WriteMarker(spec, out);
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
@@ -173,6 +241,32 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
     out << YAML::Key << "first_time_s" << YAML::Value << YAML::Precision(17)
         << config.recording->first_time_s;
     out << YAML::EndMap;
+  }
+  if (!config.changes.empty()) {
+    out << YAML::Key << "changes" << YAML::Value << YAML::BeginSeq;
+    for (const ConfigChange& change : config.changes) {
+      out << YAML::BeginMap << YAML::Key << "after_frame" << YAML::Value << change.after_frame;
+      switch (change.kind) {
+        case ConfigChange::Kind::kRespec:
+          out << YAML::Key << "respec" << YAML::Value;
+          WriteMarker(change.spec, out);
+          break;
+        case ConfigChange::Kind::kReselect:
+          out << YAML::Key << "reselect" << YAML::Value << YAML::Flow << YAML::BeginMap
+              << YAML::Key << "marker" << YAML::Value << change.marker << YAML::Key << "rect"
+              << YAML::Value << YAML::Flow << YAML::BeginSeq << change.rect.x << change.rect.y
+              << change.rect.width << change.rect.height << YAML::EndSeq << YAML::EndMap;
+          break;
+        case ConfigChange::Kind::kRetrack:
+          out << YAML::Key << "retrack" << YAML::Value << change.marker;
+          break;
+        case ConfigChange::Kind::kResetTipReference:
+          out << YAML::Key << "reset_tip_reference" << YAML::Value << true;
+          break;
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
   }
   if (config.control) {
     out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;

@@ -186,11 +186,14 @@ void LiveController::apply_spec(int marker, const MarkerSpec& spec,
                                 const std::optional<cv::Rect>& hint) {
   try {
     session_->respec(spec);
+    recorded(ConfigChange::Respec(spec));
     if (hint && !hint->empty() && !frame_.empty()) {
       show(session_->reselect(spec.name, on_screen(), *hint));
+      recorded(ConfigChange::Reselect(spec.name, *hint));
     } else if ((paused_ || ended_) && !frame_.empty()) {
       // No new frame is coming: track the one on screen again, so the change shows at once.
       show(session_->retrack(spec.name, on_screen()));
+      recorded(ConfigChange::Retrack(spec.name));
     }
   } catch (const InputError& e) {
     // A live edit that cannot be used is reported on screen; the session keeps running.
@@ -275,6 +278,7 @@ void LiveController::drag(const cv::Rect& dragged) {
     // The session remembers the selection in its config (the template's pixels, or the colour
     // search box), so that `s` saves it.
     show(session_->reselect(spec.name, on_screen(), rect));
+    recorded(ConfigChange::Reselect(spec.name, rect));
   } catch (const InputError& e) {
     say(e.what());
     return;
@@ -412,22 +416,12 @@ void LiveController::toggle_recording() {
     // screen as its frame 0, every tracker is rebuilt from the saved config exactly as `track`
     // builds it (a search box, or a template cut on frame 0, around where each marker is now),
     // and the bending-distance reference restarts at that frame.
-    TrackingConfig snapshot = config();
-    snapshot.recording.reset();
-    for (int i = 0; i < static_cast<int>(snapshot.markers.size()); ++i) {
-      MarkerSpec& spec = snapshot.markers[i];
+    std::vector<std::optional<cv::Rect>> boxes;
+    for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
       const auto position = position_of(i);
-      if (!position) continue;
-      const cv::Rect box = box_around(*position);
-      spec.colour.roi = box;
-      spec.colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
-      if (IsTemplateMethod(spec.method)) {
-        spec.templ.rect = box;
-        spec.templ.template_frame = 0;
-        spec.templ.image = cv::Mat();
-        spec.templ.image_file.clear();
-      }
+      boxes.push_back(position ? std::optional(box_around(*position)) : std::nullopt);
     }
+    const TrackingConfig snapshot = RecordingStartConfig(config(), boxes);
     RunInfo info;
     info.frame_size = frame_.size();
     info.fps = options_.record_fps.value_or(meter_.fps().value_or(30.0));
@@ -459,6 +453,18 @@ void LiveController::show(const FrameResult& result) {
   last_result_ = result;
   redraw_annotated();
   dirty_ = true;
+}
+
+void LiveController::recorded(ConfigChange change) {
+  if (!recording_) return;
+  try {
+    recording_->log(std::move(change));
+  } catch (const InputError& e) {
+    // The recording could not keep the edit, so it no longer reproduces the window: stop it
+    // (what is written stays) and say why.
+    toggle_recording();
+    say(e.what());
+  }
 }
 
 void LiveController::record_frame(const Frame& frame, const FrameResult& result) {
@@ -591,6 +597,7 @@ void LiveController::on_event(const UiEvent& event) {
           break;
         case 'b':
           session_->reset_tip_reference();
+          recorded(ConfigChange::ResetTipReference());
           say("bending distance: the next tip position is the new reference");
           break;
         case 'm':

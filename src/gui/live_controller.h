@@ -193,6 +193,8 @@ class LiveController {
   void redraw_annotated();
   void draw_overlay(cv::Mat& image, const FrameResult& result) const;
   void record_frame(const Frame& frame, const FrameResult& result);
+  // An edit just made to the session: a running recording keeps it (its config reproduces it).
+  void recorded(ConfigChange change);
   // The frame on screen, as the session saw it (no copy of the pixels).
   Frame on_screen() const;
   // A new result for the frame on screen (a reselection): shown, not recorded again.

@@ -14,6 +14,7 @@
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/range_edit.h"
+#include "gui/live_test_util.h"
 #include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
@@ -31,59 +32,15 @@ namespace {
 namespace fs = std::filesystem;
 using Type = UiEvent::Type;
 
-MarkerSpec ColourMarker(const std::string& name, HsvRange h) {
-  MarkerSpec spec;
-  spec.name = name;
-  spec.method = "colour";
-  spec.colour.h = h;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
-  return spec;
-}
+using testing::CsvRowsWithoutTiming;
+using testing::RingPoints;
 
-TrackingConfig SceneConfig() {
-  TrackingConfig config;
-  config.markers = {ColourMarker("red", {170, 10}), ColourMarker("blue", {95, 125}),
-                    ColourMarker("green", {45, 75})};
-  config.measure.base = "red";
-  config.measure.middle = "blue";
-  config.measure.tip = "green";
-  config.source_file = "test config";
-  return config;
-}
-
-// How many of 24 points on a circle of the overlay's ring radius around `centre` are the ring's
-// yellow (in canvas pixels = image pixels).
-int RingPoints(const cv::Mat& canvas, const cv::Point2d& centre, double radius = 12) {
-  int ring = 0;
-  for (int deg = 0; deg < 360; deg += 15) {
-    const cv::Point p(cvRound(centre.x + radius * std::cos(deg * CV_PI / 180)),
-                      cvRound(centre.y + radius * std::sin(deg * CV_PI / 180)));
-    bool yellow = false;
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const cv::Point q = p + cv::Point(dx, dy);
-        if (q.x < 0 || q.y < 0 || q.x >= canvas.cols || q.y >= canvas.rows) continue;
-        const cv::Vec3b px = canvas.at<cv::Vec3b>(q);
-        yellow |= px[0] < 80 && px[1] > 200 && px[2] > 200;
-      }
-    }
-    ring += yellow;
-  }
-  return ring;
-}
+TrackingConfig SceneConfig() { return testing::LiveTestConfig(); }
 
 class LiveControllerTest : public ::testing::Test {
  protected:
   LiveControllerTest() {
-    SceneOptions scene;
-    scene.size = cv::Size(320, 240);
-    scene.length_px = 160;
-    scene.width_px = 24;
-    scene.marker_radius_px = 8;
-    scene.frame_count = 60;
-    scene.max_bend_deg = 120;
-    scene_ = std::make_unique<SyntheticScene>(scene);
+    scene_ = std::make_unique<SyntheticScene>(testing::LiveTestScene(60, 120));
     dir_ = fs::temp_directory_path() /
            ("softsight_live_test_" +
             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
@@ -512,18 +469,6 @@ TEST_F(LiveControllerTest, BadOptionsOrConfigAreInputErrors) {
 namespace softsight {
 namespace {
 
-// The lines of a CSV without its timing columns (they differ from run to run).
-std::vector<std::string> RowsWithoutTiming(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::string> rows;
-  for (std::string line; std::getline(in, line);) {
-    // The timings end every row: latency_result_ms, latency_row_ms, proc_ms.
-    for (int timing = 0; timing < 3; ++timing) line.erase(line.rfind(','));
-    rows.push_back(line);
-  }
-  return rows;
-}
-
 // `softsight track --config <config> --input <video> --csv <csv>`, through the same pipeline.
 void Track(const std::string& config_file, const std::string& video, const std::string& csv) {
   const TrackingConfig config = LoadTrackingConfig(config_file);
@@ -559,16 +504,7 @@ class LiveFileTest : public LiveControllerTest {
   // The rendered scene as a lossless 30 fps video, the file a person would play in `live`.
   std::string WriteVideo(int frames) {
     const std::string path = (dir_ / "scene.avi").string();
-    FrameWriterOptions options;
-    options.path = path;
-    options.fps = 30.0;
-    FrameWriter writer(options);
-    cv::Mat image;
-    for (int i = 0; i < frames; ++i) {
-      scene_->render(i, image);
-      writer.write(image, i);
-    }
-    writer.close();
+    testing::WriteSceneVideo(*scene_, frames, path);
     return path;
   }
   std::unique_ptr<PacedFrameSource> PlayFile(const std::string& path, FakeClock& clock) {
@@ -624,8 +560,8 @@ TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrack
   // Re-tracking the raw recording with its saved config gives the same rows, frame and time_s
   // included (the config's `recording:` key says where the raw video starts).
   Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
-  const std::vector<std::string> live_rows = RowsWithoutTiming(prefix + ".csv");
-  const std::vector<std::string> again = RowsWithoutTiming((dir_ / "again.csv").string());
+  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+  const std::vector<std::string> again = CsvRowsWithoutTiming((dir_ / "again.csv").string());
   ASSERT_EQ(live_rows.size(), 12u);  // Header and 11 rows.
   EXPECT_EQ(again, live_rows);
 }

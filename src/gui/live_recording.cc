@@ -1,5 +1,6 @@
 #include "gui/live_recording.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -33,9 +34,10 @@ LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& conf
   sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps));
   sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw)));
   for (auto& sink : sinks_) sink->begin(info);
-  TrackingConfig saved = config;
-  saved.recording = origin;
-  SaveTrackingConfig(saved, prefix_ + ".yaml");
+  saved_ = config;
+  saved_.recording = origin;
+  saved_.changes.clear();
+  SaveTrackingConfig(saved_, prefix_ + ".yaml");
 }
 
 LiveRecording::~LiveRecording() {
@@ -47,6 +49,54 @@ LiveRecording::~LiveRecording() {
 void LiveRecording::consume(const Frame& frame, const FrameResult& result) {
   for (auto& sink : sinks_) sink->consume(frame, result);
   ++frames_;
+}
+
+void LiveRecording::log(ConfigChange change) {
+  // The raw video's index of the frame on screen: the recording holds consecutive frames from
+  // its first (a camera's dropped frames are not in it, so the source's numbers would not do).
+  change.after_frame = std::max<int64_t>(0, frames_ - 1);
+  if (change.kind == ConfigChange::Kind::kRespec) {
+    ColourParams& colour = change.spec.colour;
+    colour.roi_frame = static_cast<int>(std::min<int64_t>(colour.roi_frame, change.after_frame));
+    TemplateParams& templ = change.spec.templ;
+    // A start frame the window set (a reselection's, in the source's numbers) is already behind:
+    // the new tracker starts on the next frame, live and in `track` alike.
+    templ.template_frame =
+        static_cast<int>(std::min<int64_t>(templ.template_frame, change.after_frame));
+    if (!templ.image.empty()) {
+      const std::filesystem::path yaml(prefix_ + ".yaml");
+      const std::string name = yaml.stem().string() + "." +
+                               std::to_string(saved_.changes.size() + 1) + "." +
+                               change.spec.name + ".png";
+      const std::string path = (yaml.parent_path() / name).string();
+      if (!cv::imwrite(path, templ.image)) {
+        throw InputError(path + ": cannot write the template image");
+      }
+      templ.image_file = name;  // Relative to the config, as the reader resolves it.
+    }
+  }
+  saved_.changes.push_back(std::move(change));
+  SaveTrackingConfig(saved_, prefix_ + ".yaml");
+}
+
+TrackingConfig RecordingStartConfig(const TrackingConfig& config,
+                                    const std::vector<std::optional<cv::Rect>>& boxes) {
+  TrackingConfig start = config;
+  start.recording.reset();
+  start.changes.clear();
+  for (size_t i = 0; i < start.markers.size() && i < boxes.size(); ++i) {
+    if (!boxes[i]) continue;
+    MarkerSpec& spec = start.markers[i];
+    spec.colour.roi = *boxes[i];
+    spec.colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
+    if (IsTemplateMethod(spec.method)) {
+      spec.templ.rect = *boxes[i];
+      spec.templ.template_frame = 0;
+      spec.templ.image = cv::Mat();
+      spec.templ.image_file.clear();
+    }
+  }
+  return start;
 }
 
 namespace {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,15 +31,29 @@ class LiveRecording {
 
   // Every processed frame, in order. Throws InputError (a full disk).
   void consume(const Frame& frame, const FrameResult& result);
+  // A live edit of the session made after the last frame consumed (at least one frame has
+  // been): kept in the recording's config, which is written again at once (the .yaml on disk is
+  // always whole), so re-tracking the raw video makes the same edit after the same frame. A
+  // respecified template's pixels go beside it as <prefix>.<n>.<marker>.png. Throws InputError
+  // (an unwritable file).
+  void log(ConfigChange change);
 
   const std::string& prefix() const { return prefix_; }
   int64_t frames() const { return frames_; }
 
  private:
   std::string prefix_;
+  TrackingConfig saved_;  // The .yaml: the starting config, origin and the edits so far.
   std::vector<std::unique_ptr<FrameSink>> sinks_;
   int64_t frames_ = 0;
 };
+
+// What the session runs from a recording's first frame on, so that `track` on the raw video
+// builds every tracker as the window does: each marker found on the frame on screen starts from
+// `boxes[i]` around it (the colour tracker's search box; a template cut there on frame 0), the
+// others as configured. `boxes` in config order (absent: the marker is not found now).
+TrackingConfig RecordingStartConfig(const TrackingConfig& config,
+                                    const std::vector<std::optional<cv::Rect>>& boxes);
 
 // Writes `config` (what the window runs) to `path` for `softsight track`: templates held as pixels
 // (selected live, or read from a file) go beside it as `<path stem>.<marker>.png`, named by the

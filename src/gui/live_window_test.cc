@@ -17,11 +17,11 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <sstream>
 #include <thread>
 
 #include "gui/live_layout.h"
+#include "gui/live_test_util.h"
 #include "softsight/gui/overlay.h"
 #include "softsight/config/config.h"
 #include "softsight/io/csv_reader.h"
@@ -168,26 +168,8 @@ cv::Mat ReadXwdScreen(const std::string& path) {
   return image;
 }
 
-// How many of 24 points around `centre` at `radius` have a yellow pixel (the overlay's marker
-// ring, overlay_colour::kMarker) within one pixel.
-int RingPixels(const cv::Mat& image, cv::Point2d centre, int radius) {
-  int ring = 0;
-  for (int deg = 0; deg < 360; deg += 15) {
-    const cv::Point p(cvRound(centre.x + radius * std::cos(deg * CV_PI / 180)),
-                      cvRound(centre.y + radius * std::sin(deg * CV_PI / 180)));
-    bool yellow = false;
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const cv::Point q = p + cv::Point(dx, dy);
-        if (q.x < 0 || q.y < 0 || q.x >= image.cols || q.y >= image.rows) continue;
-        const cv::Vec3b px = image.at<cv::Vec3b>(q);
-        yellow |= px[0] < 80 && px[1] > 200 && px[2] > 200;
-      }
-    }
-    ring += yellow;
-  }
-  return ring;
-}
+using testing::CsvRowsWithoutTiming;
+using testing::RingPoints;
 
 class LiveWindowTest : public ::testing::Test {
  protected:
@@ -233,31 +215,13 @@ class LiveWindowTest : public ::testing::Test {
 
 TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   // A short rendered video and a config for its three markers.
-  SceneOptions scene;
-  scene.size = cv::Size(320, 240);
-  scene.length_px = 160;
-  scene.width_px = 24;
-  scene.marker_radius_px = 8;
-  scene.frame_count = 12;
-  scene.max_bend_deg = 90;
-  SyntheticScene renderer(scene);
+  SyntheticScene renderer(testing::LiveTestScene(12, 90));
   const std::string video = (dir_ / "scene.avi").string();
-  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
-  ASSERT_TRUE(writer.isOpened());
-  cv::Mat image, last;
-  SceneTruth truth;
-  for (int i = 0; i < scene.frame_count; ++i) {
-    truth = renderer.render(i, image);
-    writer.write(image);
-  }
-  writer.release();
-  last = image.clone();
+  testing::WriteSceneVideo(renderer, 12, video);
+  cv::Mat last;
+  const SceneTruth truth = renderer.render(11, last);
   const std::string config = (dir_ / "markers.yaml").string();
-  std::ofstream(config) << "markers:\n"
-                           "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
-                           "  - name: blue\n    hsv: {h: [95, 125], s: [80, 255], v: [40, 255]}\n"
-                           "  - name: green\n    hsv: {h: [45, 75], s: [80, 255], v: [40, 255]}\n"
-                           "triple: [red, blue, green]\n";
+  std::ofstream(config) << testing::kLiveTestMarkersYaml;
 
   const std::string display = StartXvfb();
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
@@ -291,8 +255,8 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   // The frame itself carries no overlay; on screen, each marker has its ring around the truth.
   for (const MarkerTruth& marker : truth.markers) {
     ASSERT_TRUE(marker.centroid_px);
-    EXPECT_EQ(RingPixels(last, *marker.centroid_px, 12), 0) << marker.name;
-    EXPECT_GE(RingPixels(screen, *marker.centroid_px + cv::Point2d(offset), 12), 20)
+    EXPECT_EQ(RingPoints(last, *marker.centroid_px, 12), 0) << marker.name;
+    EXPECT_GE(RingPoints(screen, *marker.centroid_px + cv::Point2d(offset), 12), 20)
         << marker.name << " at " << *marker.centroid_px << " + " << offset;
   }
   // The strip chart is drawn under the image: its dark background.
@@ -359,15 +323,8 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
   scene.frame_count = 12;
   SyntheticScene renderer(scene);
   const std::string video = (dir_ / "scene.avi").string();
-  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
-  ASSERT_TRUE(writer.isOpened());
-  cv::Mat image;
   std::vector<SceneTruth> truth;
-  for (int i = 0; i < scene.frame_count; ++i) {
-    truth.push_back(renderer.render(i, image));
-    writer.write(image);
-  }
-  writer.release();
+  testing::WriteSceneVideo(renderer, scene.frame_count, video, &truth);
   const std::string config = (dir_ / "markers.yaml").string();
   std::ofstream(config) << "markers:\n"
                            "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
@@ -400,7 +357,7 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
     EXPECT_LT(cv::mean(screen(chart))[0], 70);
     for (int m = 0; m < 2; ++m) {
       const cv::Point2d at = layout.to_view(*truth[index].markers[m].centroid_px);
-      EXPECT_GE(RingPixels(screen, at, cvRound(12 * layout.scale_x())), 18)
+      EXPECT_GE(RingPoints(screen, at, cvRound(12 * layout.scale_x())), 18)
           << truth[index].markers[m].name << " frame " << index;
     }
   };
@@ -431,43 +388,16 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
   live_.pid = -1;
 }
 
-// The lines of a CSV without its timing columns (they differ from run to run).
-std::vector<std::string> CsvRowsWithoutTiming(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::string> rows;
-  for (std::string line; std::getline(in, line);) {
-    // The timings end every row: latency_result_ms, latency_row_ms, proc_ms.
-    for (int timing = 0; timing < 3; ++timing) line.erase(line.rfind(','));
-    rows.push_back(line);
-  }
-  return rows;
-}
-
-TEST_F(LiveWindowTest, RecordingAPausedVideoKeepsTheSourcesFramesAndTrackReproducesIt) {
+// Record, pause, switch every marker to template matching and drag a new template for blue on
+// the paused frame, resume, stop: the CSV names the source's frames, and `track` on the raw
+// recording with its saved config (which keeps the edits) gives the same rows.
+TEST_F(LiveWindowTest, RecordingAPausedVideoWithEditsKeepsTheSourcesFramesAndTrackReproducesIt) {
   // A 3 s rendered video at 30 fps, played by the real window.
-  SceneOptions scene;
-  scene.size = cv::Size(320, 240);
-  scene.length_px = 160;
-  scene.width_px = 24;
-  scene.marker_radius_px = 8;
-  scene.frame_count = 90;
-  scene.max_bend_deg = 90;
-  SyntheticScene renderer(scene);
+  SyntheticScene renderer(testing::LiveTestScene(90, 90));
   const std::string video = (dir_ / "scene.avi").string();
-  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, scene.size);
-  ASSERT_TRUE(writer.isOpened());
-  cv::Mat image;
-  for (int i = 0; i < scene.frame_count; ++i) {
-    renderer.render(i, image);
-    writer.write(image);
-  }
-  writer.release();
+  testing::WriteSceneVideo(renderer, 90, video);
   const std::string config = (dir_ / "markers.yaml").string();
-  std::ofstream(config) << "markers:\n"
-                           "  - name: red\n    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}\n"
-                           "  - name: blue\n    hsv: {h: [95, 125], s: [80, 255], v: [40, 255]}\n"
-                           "  - name: green\n    hsv: {h: [45, 75], s: [80, 255], v: [40, 255]}\n"
-                           "triple: [red, blue, green]\n";
+  std::ofstream(config) << testing::kLiveTestMarkersYaml;
   const std::string display = StartXvfb();
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
   live_ = Spawn({binary_, "live", "--input", video, "--config", config, "--no-trackbars",
@@ -486,14 +416,35 @@ TEST_F(LiveWindowTest, RecordingAPausedVideoKeepsTheSourcesFramesAndTrackReprodu
   // depends on the machine; what is checked below holds for any number (the window reads keys
   // only after a frame is on screen, so `r` always has a frame to start with).
   std::string output;
-  for (const auto& [key, said] : std::vector<std::pair<std::string, std::string>>{
-           {"r", "live: recording to "},
-           {"space", "live: paused"},
-           {"space", "live: running"},
-           {"r", "live: recorded "}}) {
+  const auto key_then = [&](const std::string& key, const std::string& said) {
     ASSERT_EQ(RunProcess({"xdotool", "key", key}, env, &out), 0) << out;
     ASSERT_TRUE(WaitForOutput(live_, said, 60s, &output)) << key << ": " << output;
-  }
+  };
+  key_then("r", "live: recording to ");
+  key_then("space", "live: paused");
+  // One step: the window says which frame is on screen, so the drag can be put around blue.
+  key_then("period", "live: frame ");
+  const size_t said = output.rfind("live: frame ") + std::string("live: frame ").size();
+  ASSERT_TRUE(output.find(" s)\n", said) != std::string::npos ||
+              WaitForOutput(live_, " s)\n", 20s, &output))
+      << output;
+  const int on_screen = std::stoi(output.substr(said));
+  key_then("m", "live: method: sad");
+  cv::Mat image;
+  // The window is at 0,0 and the 320x240 frame is not scaled on this screen.
+  const cv::Point2d blue = *renderer.render(on_screen, image).markers[1].centroid_px;
+  const cv::Point from(cvRound(blue.x) - 10, cvRound(blue.y) - 12);
+  const cv::Point to(cvRound(blue.x) + 13, cvRound(blue.y) + 10);
+  ASSERT_EQ(RunProcess({"xdotool", "mousemove", std::to_string(from.x), std::to_string(from.y),
+                        "mousedown", "1", "mousemove", std::to_string(from.x + 5),
+                        std::to_string(from.y + 5), "mousemove", std::to_string(to.x),
+                        std::to_string(to.y), "mouseup", "1"},
+                       env, &out),
+            0)
+      << out;
+  ASSERT_TRUE(WaitForOutput(live_, "live: blue: reselected", 20s, &output)) << output;
+  key_then("space", "live: running");
+  key_then("r", "live: recorded ");
   ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
   ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;
   EXPECT_EQ(WaitExit(live_, 20s), 0);
@@ -517,6 +468,12 @@ TEST_F(LiveWindowTest, RecordingAPausedVideoKeepsTheSourcesFramesAndTrackReprodu
             0)
       << out;
   EXPECT_EQ(CsvRowsWithoutTiming(again), rows);
+  // The edits are in the recording's config, after the frame they were made on.
+  const TrackingConfig recorded = LoadTrackingConfig(prefix + ".yaml");
+  ASSERT_FALSE(recorded.changes.empty());
+  EXPECT_EQ(recorded.changes.back().kind, ConfigChange::Kind::kReselect);
+  EXPECT_EQ(recorded.changes.back().marker, "blue");
+  EXPECT_EQ(recorded.changes.back().after_frame, on_screen - static_cast<int64_t>(first));
 }
 
 TEST_F(LiveWindowTest, WithoutADisplayOneErrorSuggestsTrack) {

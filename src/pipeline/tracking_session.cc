@@ -149,7 +149,36 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
           : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
                                                       frame.captured)
                 .count();
+  if (next_change_ < config_.changes.size() &&
+      config_.changes[next_change_].after_frame <= frame.index) {
+    apply_changes(frame);
+  }
   return result_;
+}
+
+void TrackingSession::apply_changes(const Frame& frame) {
+  // The live window made these edits after showing (and recording) this frame's row: the row
+  // stays as it was, and the trackers, checks and measurer continue from the edits, as live.
+  const FrameResult row = result_;
+  while (next_change_ < config_.changes.size() &&
+         config_.changes[next_change_].after_frame <= frame.index) {
+    const ConfigChange change = config_.changes[next_change_++];  // A copy: respec edits config_.
+    switch (change.kind) {
+      case ConfigChange::Kind::kRespec:
+        respec(change.spec);
+        break;
+      case ConfigChange::Kind::kReselect:
+        reselect(change.marker, frame, change.rect);
+        break;
+      case ConfigChange::Kind::kRetrack:
+        retrack(change.marker, frame);
+        break;
+      case ConfigChange::Kind::kResetTipReference:
+        reset_tip_reference();
+        break;
+    }
+  }
+  result_ = row;
 }
 
 void TrackingSession::measure(const Frame& frame) {

@@ -28,6 +28,28 @@ struct RecordingOrigin {
   double first_time_s = 0.0;  // Source timestamp of the input's frame 0, seconds.
 };
 
+// One edit the live window made while a recording ran (a marker reselected or respecified, a
+// paused frame tracked again, the bending-distance reference reset), kept with the recording's
+// config so that re-tracking its raw video makes the same edit at the same place: after the row
+// of frame `after_frame` (the raw video's own index, from 0), as the window made it after
+// showing that frame. Written by live recordings only (the `changes:` key); the session applies
+// them in order.
+struct ConfigChange {
+  enum class Kind { kRespec, kReselect, kRetrack, kResetTipReference };
+  Kind kind = Kind::kRespec;
+  int64_t after_frame = 0;
+  MarkerSpec spec;     // kRespec: the marker's new spec (spec.name says which marker).
+  std::string marker;  // kReselect, kRetrack: which marker.
+  cv::Rect rect;       // kReselect: where the marker is on frame `after_frame`.
+
+  static ConfigChange Respec(const MarkerSpec& spec) { return {Kind::kRespec, 0, spec, spec.name, {}}; }
+  static ConfigChange Reselect(const std::string& marker, const cv::Rect& rect) {
+    return {Kind::kReselect, 0, {}, marker, rect};
+  }
+  static ConfigChange Retrack(const std::string& marker) { return {Kind::kRetrack, 0, {}, marker, {}}; }
+  static ConfigChange ResetTipReference() { return {Kind::kResetTipReference, 0, {}, {}, {}}; }
+};
+
 struct TrackingConfig {
   std::vector<MarkerSpec> markers;
   MeasureOptions measure;              // Triple, chain, tip reference, metric model.
@@ -38,6 +60,7 @@ struct TrackingConfig {
   // The `control:` section (gains, limits, rig), when the file has one: `softsight control`.
   std::optional<ControlConfig> control;
   std::optional<RecordingOrigin> recording;  // Written by live recordings only.
+  std::vector<ConfigChange> changes;         // Likewise: edits made while recording, in order.
   // The `capture:` section: the camera's resolution, rate, pixel format, exposure, gain, white
   // balance and focus (softsight/io/camera_settings.h). (`camera:` names the lens calibration.)
   // A live recording saves what the camera accepted.

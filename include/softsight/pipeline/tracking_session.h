@@ -27,7 +27,8 @@ class TrackingSession {
   ~TrackingSession();
 
   // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
-  // frame) trackers are initialised from the config's ROIs and template rectangles. Only
+  // frame) trackers are initialised from the config's ROIs and template rectangles. A live
+  // recording's edits (config.changes) are made after the row of their frame, as live. Only
   // plausible reports are found (pipeline/marker_plausibility.h, pipeline/frame_change.h): in a
   // frame that changed all at once (another video's frame, a flash) no marker is found and the
   // trackers do not see it; a report next to decoded garbage, that jumps against the marker's
@@ -75,6 +76,9 @@ class TrackingSession {
 
  private:
   void measure(const Frame& frame);  // result_.measurement from result_.markers.
+  // The config's recorded live edits (config.changes) due after `frame`, the frame just processed.
+  void apply_changes(const Frame& frame);
+  size_t next_change_ = 0;  // The first of config_.changes not yet applied.
   TrackingConfig config_;
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;
