@@ -5,12 +5,16 @@
 # a busier machine. Prints the Markdown table to stdout; the machine's load average is printed
 # with it (on a shared machine, compare ratios, not absolute times).
 #   scripts/bench.sh [WORK_DIR]     (default: bench_out/, reused: rendered videos are kept)
-# Takes about 2 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
+# Then the README's per-frame "Speed" table of the trackers and recordings, from the Google
+# Benchmark programs (their JSON kept in WORK_DIR), each row beside the BGR -> gray pass its own
+# program measured in the same run.
+# Takes about 4 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WORK=${1:-bench_out}
 mkdir -p "$WORK"
-cmake --build build --target softsight softsight_speed_report >/dev/null
+cmake --build build --target softsight softsight_speed_report softsight_colour_tracker_benchmark \
+  softsight_template_matching_benchmark softsight_frame_writer_benchmark >/dev/null
 S=build/src/app/softsight
 CFG=examples/markers.yaml
 PY=$(command -v python3)
@@ -86,4 +90,84 @@ proc = statistics.median(float(r["proc_ms"]) for r in rows)
 print(f"| latency over the simulated rig ({len(rows)} frames, 640x480): capture -> result / -> "
       f"serial command / -> CSV row | {dist('latency_result_ms')} / {dist('latency_command_ms')} / "
       f"{dist('latency_row_ms')} | tracking alone (proc_ms) median {proc:.3f} ms |")
+PYEOF
+
+# The trackers and recordings per frame (Google Benchmark). The colour program runs OpenCV
+# single-threaded and also reports thread CPU time; the recording program reports the process's
+# CPU time (FFmpeg decodes on helper threads) and runs on one core. Their console output goes to
+# WORK_DIR/*.log.
+echo
+echo "Per frame (Google Benchmark), load average $(cut -d' ' -f1-3 /proc/loadavg):"
+echo
+build/src/track/softsight_colour_tracker_benchmark --benchmark_out_format=json --benchmark_out="$WORK/colour.json" >/dev/null 2>"$WORK/colour.log"
+build/src/track/softsight_template_matching_benchmark --benchmark_out_format=json \
+  --benchmark_filter='BM_(TrackWindowed|AcquireWholeFrame/2|SadVector/1|SadPlainScalar/1|SadAutoVectorisedLoop/1|BaselineWholeFrameMatchTemplate|GrayConversion)' \
+  --benchmark_out="$WORK/template.json" >/dev/null 2>"$WORK/template.log"
+taskset -c 0 build/src/io/softsight_frame_writer_benchmark --benchmark_out_format=json \
+  --benchmark_out="$WORK/writer.json" >/dev/null 2>"$WORK/writer.log"
+
+"$PY" - "$WORK" <<'PYEOF'
+import json, os, sys
+
+work = sys.argv[1]
+def load(name):
+    with open(os.path.join(work, name)) as f:
+        return {b["name"]: b for b in json.load(f)["benchmarks"]}
+colour, templ, writer = load("colour.json"), load("template.json"), load("writer.json")
+
+def ms(b, key="real_time"):  # A benchmark's time in ms, whatever its unit.
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
+    return b[key] * scale
+
+print("| what | 640x480 | 1280x720 | reference in the same run |")
+print("| --- | --- | --- | --- |")
+g = {s: colour[f"BM_GrayReference/{s}"] for s in ("640/480", "1280/720")}
+gray_ref = (f"gray pass {g['640/480']['ms_per_frame']:.3f} / {g['1280/720']['ms_per_frame']:.3f} ms "
+            f"(thread CPU {g['640/480']['cpu_ms_per_frame']:.3f} / {g['1280/720']['cpu_ms_per_frame']:.3f} ms)")
+def colour_row(what, name):
+    a, b = colour[f"{name}/640/480"], colour[f"{name}/1280/720"]
+    cell = lambda r: (f"{r['ms_per_frame']:.3f} ms ({r['x_gray']:.2f}x gray), thread CPU "
+                      f"{r['cpu_ms_per_frame']:.3f} ms ({r['cpu_x_gray']:.2f}x)")
+    print(f"| {what} | {cell(a)} | {cell(b)} | {gray_ref} |")
+colour_row("colour (verified, soft centroid), ROI tracking, 3 markers", "BM_ColourRoi3")
+colour_row("colour, whole frame every frame (`window: 0`)", "BM_ColourFullFrame3")
+colour_row("colour, re-acquiring every frame", "BM_ColourReacquire3")
+t, r = colour["BM_AutoColourBenchTrack3"], colour["BM_AutoColourBenchReacquire3"]
+print(f"| colour, `auto_colour` on the bench with look-alikes: tracking / re-acquiring every frame "
+      f"| median {t['median_ms']:.3f} / {r['median_ms']:.3f} ms, p99 {t['p99_ms']:.3f} / {r['p99_ms']:.3f} ms "
+      f"({t['x_gray']:.1f}x / {r['x_gray']:.1f}x gray); thread CPU median {t['cpu_median_ms']:.3f} / "
+      f"{r['cpu_median_ms']:.3f} ms, p99 {t['cpu_p99_ms']:.3f} / {r['cpu_p99_ms']:.3f} ms | | "
+      f"gray pass of the same frames {t['gray_median_ms']:.3f} ms |")
+
+tg = ms(templ["BM_GrayConversion"])
+tref = f"gray pass {tg:.3f} ms"
+def methods(colour_arg):
+    return [ms(templ[f"BM_TrackWindowed/{m}/{colour_arg}"]) for m in (0, 1, 2)]
+for arg, label in ((0, "gray"), (1, "colour")):
+    sad, ssd, zncc = methods(arg)
+    print(f"| template, windowed tracking, {label}, 3 markers: SAD / SSD / ZNCC | {sad:.3f} / {ssd:.3f} / "
+          f"{zncc:.3f} ms ({sad / tg:.1f}x / {ssd / tg:.1f}x / {zncc / tg:.1f}x gray) | | {tref} |")
+zg, zc = ms(templ["BM_AcquireWholeFrame/2/0"]), ms(templ["BM_AcquireWholeFrame/2/1"])
+print(f"| template, full-frame acquisition (pyramid), ZNCC gray / colour, 3 markers | {zg:.2f} / {zc:.2f} ms "
+      f"({zg / tg:.0f}x / {zc / tg:.0f}x gray) | | {tref} |")
+kernel, scalar, auto = (templ[n]["real_time"] for n in ("BM_SadVector/1", "BM_SadPlainScalar/1",
+                                                         "BM_SadAutoVectorisedLoop/1"))
+print(f"| SAD kernel (64x64 search, 32x32 template) vs a plain scalar loop / the loop as GCC "
+      f"auto-vectorises it at -O3 | {kernel:.1f} us vs {scalar:.0f} us ({scalar / kernel:.1f}x) / "
+      f"{auto:.1f} us ({auto / kernel:.1f}x) | | {tref} |")
+cc, sq = ms(templ["BM_BaselineWholeFrameMatchTemplate/1"]), ms(templ["BM_BaselineWholeFrameMatchTemplate/0"])
+gray_sad, gray_ssd, gray_zncc = methods(0)
+print(f"| baseline: `cv::matchTemplate` on the full frame per marker, every frame: CCOEFF_NORMED / SQDIFF; "
+      f"windowed tracking against it | {cc:.1f} / {sq:.1f} ms; ZNCC {cc / gray_zncc:.0f}x, SSD "
+      f"{sq / gray_ssd:.0f}x faster | | {tref} |")
+
+wg = ms(writer["BM_GrayReference"])
+def fps(kind, codec, noise):
+    return writer[f"BM_{kind}/codec:{codec}/noise:{noise}/process_time"]["items_per_second"]
+for noise, label in ((0, "clean scene"), (4, "sensor noise sigma 4")):
+    he, hd = fps("Encode", 1, noise), fps("Decode", 1, noise)
+    fe, fd = fps("Encode", 0, noise), fps("Decode", 0, noise)
+    print(f"| lossless recording (HuffYUV) at 640x480, {label}: encode / decode, process CPU time "
+          f"on one core | {he:.0f} / {hd:.0f} fps (FFV1 {fe:.0f} / {fd:.0f}: {he / fe:.1f}x / {hd / fd:.1f}x) "
+          f"| | gray pass {wg:.3f} ms |")
 PYEOF
