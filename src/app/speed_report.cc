@@ -5,7 +5,11 @@
 //   - a bare decode loop of the file (OpenFrameSource, nothing else),
 //   - `track`'s pipeline (CSV written) with decoding in line, then decoding on its own thread
 //     (ReadAheadSource, as `track` runs), wall time per frame,
-//   - the tracking alone (median proc_ms of the same runs).
+//   - the tracking alone (median proc_ms of the same runs),
+//   - the process's CPU time per frame (every thread: FFmpeg decodes on helper threads) of the
+//     decode loop and of the threaded run: on N cores the run cannot take less wall time than
+//     its CPU time / N, which is the bound to compare the threaded run with (decoding may
+//     already keep every core busy, and then max(decode, track) is out of reach).
 // Each is the median of `kRepeats` runs. A benchmark, not a test: it asserts nothing.
 #include <algorithm>
 #include <chrono>
@@ -14,7 +18,10 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <time.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -41,6 +48,13 @@ double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+// CPU time of the whole process (every thread) so far, ms.
+double ProcessCpuMs() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
+}
+
 // One BGR -> gray pass over `frame`, ms (median of 200).
 double GrayPassMs(const cv::Mat& frame) {
   cv::Mat gray;
@@ -57,6 +71,7 @@ struct Pass {
   double ms_per_frame;
   double proc_ms_median = 0.0;
   int64_t frames;
+  double cpu_ms_per_frame = 0.0;  // The process's, every thread.
 };
 
 Pass DecodeOnly(const std::string& video) {
@@ -64,8 +79,10 @@ Pass DecodeOnly(const std::string& video) {
   Frame frame;
   int64_t frames = 0;
   const auto start = Clock::now();
+  const double cpu_start = ProcessCpuMs();
   while (source->read(frame)) ++frames;
-  return {MsSince(start) / static_cast<double>(std::max<int64_t>(frames, 1)), 0.0, frames};
+  const double n = static_cast<double>(std::max<int64_t>(frames, 1));
+  return {MsSince(start) / n, 0.0, frames, (ProcessCpuMs() - cpu_start) / n};
 }
 
 Pass Track(const TrackingConfig& config, const std::string& video, const std::string& csv,
@@ -75,10 +92,11 @@ Pass Track(const TrackingConfig& config, const std::string& video, const std::st
   TrackingSession session(config);
   CsvSink sink(csv, TrackingColumns(config));
   const auto start = Clock::now();
+  const double cpu_start = ProcessCpuMs();
   const RunSummary summary = RunPipeline(*source, session, {&sink});
   const double ms = MsSince(start);
-  return {ms / static_cast<double>(std::max<int64_t>(summary.frames, 1)), summary.proc_ms_median,
-          summary.frames};
+  const double n = static_cast<double>(std::max<int64_t>(summary.frames, 1));
+  return {ms / n, summary.proc_ms_median, summary.frames, (ProcessCpuMs() - cpu_start) / n};
 }
 
 int Main(int argc, char** argv) {
@@ -92,14 +110,17 @@ int Main(int argc, char** argv) {
   Frame first;
   OpenFrameSource({video, {}, 30.0})->read(first);
 
-  std::vector<double> gray, decode, inline_ms, ahead_ms, proc;
+  std::vector<double> gray, decode, inline_ms, ahead_ms, proc, decode_cpu, ahead_cpu;
   int64_t frames = 0;
   for (int r = 0; r < kRepeats; ++r) {
     // Interleaved, so a change of the machine's load touches every figure alike.
     gray.push_back(GrayPassMs(first.image));
-    decode.push_back(DecodeOnly(video).ms_per_frame);
+    const Pass decoded = DecodeOnly(video);
+    decode.push_back(decoded.ms_per_frame);
+    decode_cpu.push_back(decoded.cpu_ms_per_frame);
     const Pass in_line = Track(config, video, csv, false);
     const Pass ahead = Track(config, video, csv, true);
+    ahead_cpu.push_back(ahead.cpu_ms_per_frame);
     inline_ms.push_back(in_line.ms_per_frame);
     ahead_ms.push_back(ahead.ms_per_frame);
     proc.push_back(in_line.proc_ms_median);
@@ -107,15 +128,19 @@ int Main(int argc, char** argv) {
     frames = ahead.frames;
   }
   const double g = Median(gray), d = Median(decode), a = Median(inline_ms), b = Median(ahead_ms),
-               p = Median(proc);
-  char row[512];
+               p = Median(proc), dc = Median(decode_cpu), bc = Median(ahead_cpu);
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  char row[1024];
   std::snprintf(row, sizeof(row),
                 "| `track`, %dx%d %s file (%lld frames): wall time per frame with decoding in line "
                 "/ on its own thread (as `track` runs) | %.3f / %.3f ms (%.2fx) | bare decode loop "
-                "of the file %.3f ms/frame, tracking alone %.3f ms, gray pass %.3f ms |\n",
+                "of the file %.3f ms/frame, tracking alone %.3f ms, gray pass %.3f ms; CPU time "
+                "per frame (every thread): decode loop %.3f ms (%.1f cores busy), `track` on its "
+                "own thread %.3f ms, so at least %.3f ms of wall time on %u cores |\n",
                 first.image.cols, first.image.rows,
                 std::filesystem::path(video).extension().string().c_str(),
-                static_cast<long long>(frames), a, b, a / b, d, p, g);
+                static_cast<long long>(frames), a, b, a / b, d, p, g, dc, dc / d, bc,
+                bc / cores, cores);
   std::cout << row;
   return 0;
 }
