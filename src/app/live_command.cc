@@ -89,6 +89,7 @@ int RunLive(const LiveArgs& args) {
   FrameSourceOpener reopen;
   if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
   const LiveRunResult run = RunLiveWindow(config, std::move(source), options, window, reopen);
+  std::cerr << run.summary.Report();
   if (!run.last_recording.empty()) {
     std::cerr << "softsight live: last recording " << run.last_recording << ".*\n";
   }

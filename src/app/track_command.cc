@@ -125,7 +125,8 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   run.stop_requested = [&stop] { return stop.requested(); };
   summary = RunPipeline(*source, session, sinks, run);
   double row_median = 0.0, row_p99 = 0.0;
-  csv.summarise_row_latency(&row_median, &row_p99);
+  std::vector<double> row_latencies = csv.row_latencies_ms();  // Sorted by SummariseTimes.
+  SummariseTimes(row_latencies, &row_median, &row_p99);
   summary.latency_row_ms_median = row_median;
   summary.latency_row_ms_p99 = row_p99;
   for (const std::optional<VideoSink>* video : {&annotated, &recording}) {

@@ -36,11 +36,13 @@ std::string RangeText(const HsvRange& r) {
 
 }  // namespace
 
-LiveController::LiveController(const TrackingConfig& config, LiveOptions options)
+LiveController::LiveController(const TrackingConfig& config, LiveOptions options,
+                               std::function<void(int64_t index)> before_encode)
     : options_(std::move(options)),
       chart_(options_.chart),
       pointer_(std::make_unique<LivePointer>(options_.click_slop_px)),
-      scale_(options_.scale_distance_mm) {
+      scale_(options_.scale_distance_mm),
+      before_encode_(std::move(before_encode)) {
   std::string error;
   if (!options_.Check(&error)) throw InputError("live options: " + error);
   if (config.markers.empty()) throw InputError(config.source_file + ": no markers to track");
@@ -80,6 +82,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   ended_ = false;
   frame_time_s_ = frame.time_s;
   const FrameResult& result = session_->process(frame);
+  stats_.add_result(result);
   chart_.add(result);
   if (order != FrameOrder::kNext) {
     // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
@@ -402,6 +405,7 @@ void LiveController::toggle_recording() {
   if (recording_) {
     const int64_t frames = recording_->frames();
     last_recording_ = recording_->prefix();
+    stats_.add_recording(*recording_);
     recording_.reset();  // Closes the CSV and both videos.
     say("recorded " + std::to_string(frames) + " frames to " + last_recording_ + ".*");
     return;
@@ -425,6 +429,7 @@ void LiveController::toggle_recording() {
     RunInfo info;
     info.frame_size = frame_.size();
     info.fps = options_.record_fps.value_or(meter_.fps().value_or(30.0));
+    info.live = live_source_;
     for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
     const MetricModel& metric = snapshot.measure.metric;
     info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
@@ -432,7 +437,8 @@ void LiveController::toggle_recording() {
     // `track` on it numbers and times the rows as the source did, like the live CSV.
     auto recording = std::make_unique<LiveRecording>(
         options_.record_prefix, snapshot, info, RecordingOrigin{frame_index_, frame_time_s_},
-        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); });
+        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); },
+        before_encode_);
 
     for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
     session_->reset_tip_reference();

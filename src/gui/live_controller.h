@@ -19,6 +19,7 @@
 #include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_options.h"
 #include "softsight/gui/overlay.h"
+#include "gui/live_run_stats.h"
 #include "gui/rate_meter.h"
 #include "gui/scale_clicks.h"
 #include "gui/strip_chart.h"
@@ -104,8 +105,10 @@ enum class FrameOrder {
 
 class LiveController {
  public:
-  // Builds the tracking session. Throws InputError on a bad config.
-  LiveController(const TrackingConfig& config, LiveOptions options);
+  // Builds the tracking session. Throws InputError on a bad config. `before_encode` (tests):
+  // the recordings' encoder hook (AsyncFrameWriter), to make an encoder fall behind.
+  LiveController(const TrackingConfig& config, LiveOptions options,
+                 std::function<void(int64_t index)> before_encode = {});
   ~LiveController();
 
   // A new frame (kNext: ignored while paused). Tracks, measures, records, redraws. A jump stops
@@ -165,6 +168,11 @@ class LiveController {
   int hsv_revision() const { return hsv_revision_; }
   // Where the previous recording's files went (prefix without extension); empty if none.
   const std::string& last_recording() const { return last_recording_; }
+  // The source is a camera: a recording's video whose encoder falls behind then drops frames
+  // and counts them, instead of holding up the window (a file's recording waits).
+  void set_live_source(bool live) { live_source_ = live; }
+  // The run so far, for the end summary (a recording still open counted too).
+  LiveRunSummary run_summary() const { return stats_.summary(dropped_, recording_.get()); }
 
  private:
 
@@ -227,6 +235,9 @@ class LiveController {
   int64_t message_count_ = 0;
   std::unique_ptr<LiveRecording> recording_;
   std::string last_recording_;
+  bool live_source_ = false;
+  std::function<void(int64_t)> before_encode_;
+  LiveRunStats stats_;
 };
 
 }  // namespace softsight

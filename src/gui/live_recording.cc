@@ -27,12 +27,20 @@ std::string FreePrefix(const std::string& base) {
 }  // namespace
 
 LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& config,
-                             const RunInfo& info, const RecordingOrigin& origin, FrameDrawer draw)
+                             const RunInfo& info, const RecordingOrigin& origin, FrameDrawer draw,
+                             std::function<void(int64_t index)> before_encode)
     : prefix_(FreePrefix(base)) {
-  sinks_.push_back(
-      std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config)));
-  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps));
-  sinks_.push_back(std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw)));
+  auto csv = std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config));
+  auto raw = std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps, FrameDrawer{},
+                                         before_encode);
+  auto annotated = std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw),
+                                               before_encode);
+  csv_ = csv.get();
+  raw_ = raw.get();
+  annotated_ = annotated.get();
+  sinks_.push_back(std::move(csv));
+  sinks_.push_back(std::move(raw));
+  sinks_.push_back(std::move(annotated));
   for (auto& sink : sinks_) sink->begin(info);
   saved_ = config;
   saved_.recording = origin;

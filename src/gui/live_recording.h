@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,8 +26,12 @@ class LiveRecording {
   // (its `recording:` key) so that re-tracking the raw video names the source's frames.
   // `draw` draws the overlay of the annotated video. Throws InputError (unwritable folder, no
   // free number, no codec) with nothing left open.
+  // `info.live` (a camera): a video whose encoder falls behind drops frames and counts them
+  // instead of holding up the window. `before_encode` (tests): both videos' encoder hook
+  // (AsyncFrameWriter).
   LiveRecording(const std::string& base, const TrackingConfig& config, const RunInfo& info,
-                const RecordingOrigin& origin, FrameDrawer draw);
+                const RecordingOrigin& origin, FrameDrawer draw,
+                std::function<void(int64_t index)> before_encode = {});
   ~LiveRecording();  // Closes every file (end() of each sink).
 
   // Every processed frame, in order. Throws InputError (a full disk).
@@ -40,11 +45,19 @@ class LiveRecording {
 
   const std::string& prefix() const { return prefix_; }
   int64_t frames() const { return frames_; }
+  // For the run's summary: capture -> CSV row per recorded frame (CsvSink::row_latencies_ms),
+  // and the frames each video could not take (a camera's encoder fell behind).
+  const std::vector<double>& row_latencies_ms() const { return csv_->row_latencies_ms(); }
+  int64_t raw_dropped() const { return raw_->dropped_frames(); }
+  int64_t annotated_dropped() const { return annotated_->dropped_frames(); }
 
  private:
   std::string prefix_;
   TrackingConfig saved_;  // The .yaml: the starting config, origin and the edits so far.
   std::vector<std::unique_ptr<FrameSink>> sinks_;
+  CsvSink* csv_;         // In sinks_.
+  VideoSink* raw_;       // In sinks_.
+  VideoSink* annotated_; // In sinks_.
   int64_t frames_ = 0;
 };
 

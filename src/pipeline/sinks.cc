@@ -44,10 +44,6 @@ void CsvSink::consume(const Frame& frame, const FrameResult& result) {
   }
 }
 
-void CsvSink::summarise_row_latency(double* median_ms, double* p99_ms) const {
-  std::vector<double> sorted = row_latency_ms_;  // Once, at the end of a run.
-  SummariseTimes(sorted, median_ms, p99_ms);
-}
 
 VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> fps,
                      FrameDrawer draw, std::function<void(int64_t index)> before_encode)

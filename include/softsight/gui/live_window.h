@@ -4,6 +4,7 @@
 // this header is the whole of what a program calls.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -34,10 +35,31 @@ struct LiveWindowOptions {
 // loop) reach frames no longer held in memory. Empty for a camera.
 using FrameSourceOpener = std::function<std::unique_ptr<FrameSource>()>;
 
+// What a run of the window measured, for its end summary (Report(): `softsight live` prints it).
+struct LiveRunSummary {
+  int64_t frames = 0;             // Frames tracked (played, stepped to or seeked to).
+  int64_t dropped_by_source = 0;  // A camera's frames skipped: the newest frame wins.
+  // Capture -> result (FrameResult::latency_result_ms) over the tracked frames, ms.
+  double latency_result_ms_median = 0.0;
+  double latency_result_ms_p99 = 0.0;
+  // The recordings of the run, together: frames recorded (CSV rows), capture -> CSV row written
+  // (0 when nothing was recorded), and the frames each video could not take because its encoder
+  // fell behind a camera (a file's recording waits for the encoder instead).
+  int64_t recorded_frames = 0;
+  double latency_row_ms_median = 0.0;
+  double latency_row_ms_p99 = 0.0;
+  int64_t raw_video_dropped = 0;
+  int64_t annotated_video_dropped = 0;
+
+  // "live: 600 frames, 0 dropped by the source" and the latency and recording lines.
+  std::string Report() const;
+};
+
 struct LiveRunResult {
   int exit_code = 0;
   // Where the last recording's files went (prefix without extension); empty if none.
   std::string last_recording;
+  LiveRunSummary summary;
 };
 
 // Runs the window on `source` until `q`, Escape or the window is closed. A camera (is_live())

@@ -35,9 +35,9 @@ class CsvSink : public FrameSink {
 
   const std::string& path() const { return writer_.path(); }
   // The latency from each frame's capture (Frame::captured) to its row written (the write
-  // returned), median and p99 over the rows so far, ms; 0 and 0 without rows. For the summary:
-  // the CSV's latency_row_ms column is taken just before the write.
-  void summarise_row_latency(double* median_ms, double* p99_ms) const;
+  // returned), ms, in row order: for the summary (SummariseTimes). The CSV's latency_row_ms
+  // column is taken just before the write.
+  const std::vector<double>& row_latencies_ms() const { return row_latency_ms_; }
 
  private:
   CsvWriter writer_;

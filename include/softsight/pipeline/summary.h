@@ -46,7 +46,7 @@ struct RunSummary {
   double latency_result_ms_p99 = 0.0;
   double latency_done_ms_median = 0.0;
   double latency_done_ms_p99 = 0.0;
-  // To the CSV row written (CsvSink::summarise_row_latency), when the command that owns the CSV
+  // To the CSV row written (CsvSink::row_latencies_ms), when the command that owns the CSV
   // filled it in; absent: not reported.
   std::optional<double> latency_row_ms_median;
   std::optional<double> latency_row_ms_p99;
