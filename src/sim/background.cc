@@ -99,7 +99,8 @@ void RenderBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* ba
   const int screws = 3 + rng.uniform(0, 3);
   const double screw_scale = std::min(w, h) / 480.0;
   for (int i = 0; i < screws; ++i) {
-    const cv::Point2d c(rng.uniform(0.05, 0.95) * w, rng.uniform(0.05, 0.95) * h);
+    const double cy = rng.uniform(0.05, 0.95) * h;  // Before x: see DrawBgr.
+    const cv::Point2d c(rng.uniform(0.05, 0.95) * w, cy);
     const double r = rng.uniform(5.0, 9.0) * screw_scale + 1.0;
     const int grey = rng.uniform(120, 175);
     cv::circle(ss, to_ss(c), cvRound(r * s), cv::Scalar(60, 60, 62), cv::FILLED, cv::LINE_8);
@@ -126,17 +127,30 @@ float Smoothstep(float edge0, float edge1, float x) {
 // A patch's colour class, so that every seed has some of each.
 enum class PatchTint { kDark, kReddish, kGreenish, kBluish };
 
+// A colour drawn channel by channel from [lo, hi) ranges, red first, then green, then blue.
+// Every random draw of the renderer is its own statement (or an element of a braced list, which
+// C++ evaluates in order): the order of a call's arguments is left open by C++, GCC evaluated
+// them last to first and clang first to last, so the pictures depended on the compiler. The
+// order kept is GCC's, which drew the pictures the README's figures were measured on
+// (SceneGoldenTest pins them).
+cv::Vec3f DrawBgr(cv::RNG& rng, cv::Vec2f b, cv::Vec2f g, cv::Vec2f r) {
+  const float red = rng.uniform(r[0], r[1]);
+  const float green = rng.uniform(g[0], g[1]);
+  const float blue = rng.uniform(b[0], b[1]);
+  return {blue, green, red};
+}
+
 cv::Vec3f PatchColour(PatchTint tint, const cv::Vec3f& wood, cv::RNG& rng) {
   const float v = static_cast<float>(rng.uniform(0.6, 1.1));
   switch (tint) {
     case PatchTint::kDark: return wood * static_cast<float>(rng.uniform(0.3, 0.55));
     // Hues near the marker colours, saturation from dull to marker-like.
     case PatchTint::kReddish:
-      return cv::Vec3f(rng.uniform(35.f, 80.f), rng.uniform(35.f, 75.f), rng.uniform(120.f, 175.f)) * v;
+      return DrawBgr(rng, {35.f, 80.f}, {35.f, 75.f}, {120.f, 175.f}) * v;
     case PatchTint::kGreenish:
-      return cv::Vec3f(rng.uniform(55.f, 95.f), rng.uniform(110.f, 160.f), rng.uniform(50.f, 100.f)) * v;
+      return DrawBgr(rng, {55.f, 95.f}, {110.f, 160.f}, {50.f, 100.f}) * v;
     case PatchTint::kBluish:
-      return cv::Vec3f(rng.uniform(120.f, 175.f), rng.uniform(80.f, 120.f), rng.uniform(40.f, 85.f)) * v;
+      return DrawBgr(rng, {120.f, 175.f}, {80.f, 120.f}, {40.f, 85.f}) * v;
   }
   return wood;
 }
@@ -186,7 +200,8 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
   for (int i = 0; i < patches; ++i) {
     const PatchTint tint = static_cast<PatchTint>((i + static_cast<int>(seed)) % 4);
     const cv::Vec3f colour = PatchColour(tint, wood, rng);
-    const cv::Point2d c(rng.uniform(-0.05, 1.05) * w, rng.uniform(-0.05, 1.05) * h);
+    const double cy = rng.uniform(-0.05, 1.05) * h;  // Before x: see DrawBgr.
+    const cv::Point2d c(rng.uniform(-0.05, 1.05) * w, cy);
     const double ra = rng.uniform(18.0, 75.0) * scale, rb = ra * rng.uniform(0.4, 1.0);
     const double t = rng.uniform(0.0, CV_PI);
     const double opacity = rng.uniform(0.45, 0.9);
@@ -229,7 +244,8 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
                               {228, 230, 232},   // white tape
                               {200, 150, 70}};   // blue painter's tape
   for (int i = 0; i < 2; ++i) {
-    const cv::Point2d c(rng.uniform(0.1, 0.9) * w, rng.uniform(0.1, 0.9) * h);
+    const double cy = rng.uniform(0.1, 0.9) * h;  // Before x: see DrawBgr.
+    const cv::Point2d c(rng.uniform(0.1, 0.9) * w, cy);
     const double length = rng.uniform(0.3, 0.6) * std::max(w, h);
     const double width = rng.uniform(14.0, 26.0) * scale + 2;
     const double a = rng.uniform(0.0, CV_PI);

@@ -19,7 +19,10 @@ void CorruptFrame(CorruptionKind kind, uint64_t seed, const cv::Mat& other_frame
       cv::Rect block = block_px;
       if (block.empty()) {
         const int bw = std::max(1, w / 2), bh = std::max(1, h / 2);
-        block = cv::Rect(rng.uniform(0, w - bw + 1), rng.uniform(0, h - bh + 1), bw, bh);
+        // y before x, as GCC evaluated the arguments when they were both draws: the frames
+        // must not depend on the compiler, which C++ leaves free to order a call's arguments.
+        const int y = rng.uniform(0, h - bh + 1);
+        block = cv::Rect(rng.uniform(0, w - bw + 1), y, bw, bh);
       }
       block &= cv::Rect(0, 0, w, h);
       if (!block.empty()) {

@@ -85,7 +85,10 @@ std::vector<Distractor> MakeMarkerDistractors(const SceneOptions& scene, uint64_
   for (const Wanted& want : wanted) {
     const double extent = std::max(want.radii.width, want.radii.height);
     for (int attempt = 0; attempt < kTriesPerDistractor; ++attempt) {
-      const cv::Point2d c(rng.uniform(0.0, w - 1.0), rng.uniform(0.0, h - 1.0));
+      // y before x, as GCC evaluated the arguments when they were both draws: the scene must
+      // not depend on the compiler, which C++ leaves free to order a call's arguments.
+      const double cy = rng.uniform(0.0, h - 1.0);
+      const cv::Point2d c(rng.uniform(0.0, w - 1.0), cy);
       // Distance to the nearest pixel centre of the swept area or border, from the nearest
       // pixel: +-0.71 px, covered by rounding the need up by one pixel.
       const int px = std::clamp(cvRound(c.x), 0, w - 1), py = std::clamp(cvRound(c.y), 0, h - 1);
