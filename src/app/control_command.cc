@@ -442,6 +442,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     info = session.start();
   } catch (const StopRequested&) {
     summary.stop_reason = StopSignalReason(stop.signal());
+    summary.stop_signal = stop.signal();
     return summary;
   }
   if (const std::optional<double> asked = session.pressure_clamped_from()) {
@@ -499,6 +500,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
     collect();
     summary.stop_reason = StopSignalReason(stop.signal());
+    summary.stop_signal = stop.signal();
     session.stop();
     return summary;
   } catch (const std::exception&) {
@@ -514,9 +516,13 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   summary.latency_done_ms_p99 = ran.latency_done_ms_p99;
   if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
     session.stop();
-    throw IdentifyAbort("identify: the experiment did not finish (" +
-                        std::string(stop.requested() ? "interrupted" : "the frames ran out") +
-                        " at " + FormatNumber(summary.duration_s) + " s); vented");
+    if (stop.requested()) {  // Not a failure: the caller says which signal and exits 130/143.
+      summary.stop_reason = StopSignalReason(stop.signal());
+      summary.stop_signal = stop.signal();
+      return summary;
+    }
+    throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
+                        FormatNumber(summary.duration_s) + " s); vented");
   }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
@@ -526,6 +532,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     case StopReason::kStopRequested:
       summary.stop_reason =
           control.done() ? "duration reached" : StopSignalReason(stop.signal());
+      if (!control.done()) summary.stop_signal = stop.signal();
       break;
     case StopReason::kError:
       // The session's destructor sends STOP on the way out.
@@ -684,6 +691,12 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       identify.identify_options.closed_loop_s = *closed_loop_s;
       identify.csv_file = IdentifyCsvBeside(o->csv_file);
       const ControlSummary found = RunControl(identify);
+      if (found.stop_signal != 0) {
+        // Vented; the loop never starts. Said even with --quiet: nothing was tuned.
+        std::cerr << "control --auto-tune: " << found.stop_reason << " during the identification at "
+                  << FormatNumber(found.duration_s) << " s; vented, the loop not started\n";
+        return ExitCodeAfterStop(0);  // 130 / 143.
+      }
       if (!found.identified) throw InputError("control --auto-tune: the identification stopped");
       if (!o->quiet) std::cerr << FormatIdentifyOutcome(*found.identified);
       run.controller = found.identified->tuned;

@@ -67,6 +67,9 @@ struct ControlSummary {
   uint32_t board_rejected = 0;          // Lines from the host the board rejected.
   uint64_t resends = 0;
   std::string stop_reason;
+  // SIGINT or SIGTERM when a signal stopped the run (stop_reason says so), else 0. An
+  // identification a signal stopped returns without `identified` instead of throwing.
+  int stop_signal = 0;
   // Latency per frame from its capture (the camera's frame handed over; the simulated rig's frame
   // rendered) to the tracker's result, to the serial command sent, and to every output written
   // (the CSV row), ms: median and 99th percentile.

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
 
@@ -51,7 +52,8 @@ std::string ModelCsv(const IdentifyOutcome& found) {
   return out;
 }
 
-IdentifyOutcome RunIdentify(const IdentifyCommandOptions& options) {
+std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options,
+                                           ControlSummary* stopped_out) {
   if (options.output_file.empty()) throw InputError("identify: give the config to write (-o)");
   if (SameFile(options.config_file, options.output_file)) {
     throw InputError("identify: -o " + options.output_file +
@@ -74,6 +76,10 @@ IdentifyOutcome RunIdentify(const IdentifyCommandOptions& options) {
   run.identify = true;
   run.identify_options.closed_loop_s = options.closed_loop_s;
   ControlSummary summary = RunControl(run);
+  if (summary.stop_signal != 0) {
+    if (stopped_out != nullptr) *stopped_out = summary;
+    return std::nullopt;
+  }
   if (!summary.identified) {
     throw IdentifyAbort("identify: the experiment stopped (" + summary.stop_reason +
                         "); vented, nothing written");
@@ -133,9 +139,16 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
       throw InputError("--closed-loop-s " + std::to_string(*o->closed_loop_s) +
                        ": must be a number in (0, 100]");
     }
-    const IdentifyOutcome found = RunIdentify(*o);
+    ControlSummary stopped;
+    const std::optional<IdentifyOutcome> found = RunIdentify(*o, &stopped);
+    if (!found) {
+      // Said even with --quiet: nothing was written.
+      std::fprintf(stderr, "identify: %s during the experiment at %.2f s; vented, nothing written\n",
+                   stopped.stop_reason.c_str(), stopped.duration_s);
+      return ExitCodeAfterStop(0);  // 130 / 143, as for a process the signal killed.
+    }
     if (!o->quiet) {
-      std::cerr << FormatIdentifyOutcome(found);
+      std::cerr << FormatIdentifyOutcome(*found);
       std::cerr << "identify: wrote " << o->output_file << "\n";
     }
     return 0;

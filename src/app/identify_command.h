@@ -27,8 +27,11 @@ struct IdentifyCommandOptions {
 
 // Runs the experiment, fits, tunes and writes output_file (only when everything succeeded).
 // Throws InputError (IdentifyAbort for an experiment stopped for safety) after venting; the
-// output is then not written. Refuses an output that is the input.
-IdentifyOutcome RunIdentify(const IdentifyCommandOptions& options);
+// output is then not written. Refuses an output that is the input. Ctrl-C or SIGTERM during the
+// experiment is no error: it vents, writes nothing and returns nullopt, with the run's summary
+// (stop_reason, stop_signal, duration) in `stopped_out`.
+std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options,
+                                           ControlSummary* stopped_out = nullptr);
 
 // The model CSV: time_s, identify_phase, setpoint_kpa, board_pressure_kpa, model_pressure_kpa,
 // angle_deg, model_angle_deg (softsight plot draws measured against model).

@@ -2,7 +2,9 @@
 // through the tracker, the board over a real pseudo-terminal, simulated time.
 #include "app/identify_command.h"
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -19,6 +21,7 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::ReadLines;
 using testing::ReadTextFile;
 using testing::SplitCsv;
@@ -26,6 +29,26 @@ using testing::TempDir;
 using testing::WriteTextFile;
 
 std::string Example() { return testing::SourceDir() + "/examples/rig.yaml"; }
+
+// Runs `softsight ARGS 2> err_file`, sends `signal` once `csv` holds a few rows (the handlers
+// are installed before the first row; the experiment takes hundreds), and returns the wait
+// status.
+int SignalOnceRowsAreWritten(const std::string& args, const std::string& csv,
+                             const std::string& err_file, int signal) {
+  const std::string command =
+      std::string("exec \"") + testing::SoftsightBinary() + "\" " + args + " 2> " + err_file;
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  while (ReadLines(csv).size() < 4 && waitpid(pid, &status, WNOHANG) == 0) usleep(5000);
+  kill(pid, signal);
+  waitpid(pid, &status, 0);
+  return status;
+}
 
 TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTheInput) {
   TempDir dir;
@@ -39,7 +62,9 @@ TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTh
   o.csv_file = dir.file("ident.csv");
   o.model_csv_file = dir.file("model.csv");
   o.quiet = true;
-  const IdentifyOutcome found = RunIdentify(o);
+  const std::optional<IdentifyOutcome> ran = RunIdentify(o);
+  ASSERT_TRUE(ran);
+  const IdentifyOutcome& found = *ran;
   EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));  // Never touched.
 
   // The example's plant: 6 deg of bend per kPa, 0.4 deg of angle per degree of bend; lag 0.15 s.
@@ -160,6 +185,47 @@ TEST(ControlCommand, AutoTuneIdentifiesThenRunsTheLoopWithTheGainsFound) {
                         "settling_2deg_s,overshoot_percent,steady_state_error_deg,rms_error_deg");
   EXPECT_EQ(SplitCsv(metrics[1]).size(), 9u);
   EXPECT_GT(ReadLines(identify.csv_file).size(), 300u);
+}
+
+TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), ReadTextFile(Example()));
+  const std::string csv = dir.file("ident.csv");
+  const int status = SignalOnceRowsAreWritten(
+      "identify --config " + dir.file("rig.yaml") + " --simulate -o " + dir.file("tuned.yaml") +
+          " --csv " + csv,
+      csv, dir.file("err.txt"), SIGINT);
+  const std::string err = ReadTextFile(dir.file("err.txt"));
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT, not the error path: " << err;
+  EXPECT_THAT(err, HasSubstr("identify: stopped by Ctrl-C (SIGINT) during the experiment at "));
+  EXPECT_THAT(err, HasSubstr("; vented, nothing written"));
+  EXPECT_THAT(err, Not(HasSubstr("error"))) << "an interrupted experiment is not a failure";
+  EXPECT_FALSE(std::ifstream(dir.file("tuned.yaml")).good());
+  // Every row written before the signal is whole.
+  const std::vector<std::string> rows = ReadLines(csv);
+  ASSERT_GE(rows.size(), 4u);
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(SplitCsv(rows[i]).size(), SplitCsv(rows[0]).size()) << "row " << i;
+  }
+}
+
+TEST(ControlCommand, AutoTuneStoppedBySigtermDuringTheIdentificationExits143WithoutTheLoop) {
+  TempDir dir;
+  const std::string identify_csv = dir.file("run_identify.csv");
+  const int status = SignalOnceRowsAreWritten(
+      "control --config " + Example() + " --simulate --auto-tune --target-deg 120 --csv " +
+          dir.file("run.csv"),
+      identify_csv, dir.file("err.txt"), SIGTERM);
+  const std::string err = ReadTextFile(dir.file("err.txt"));
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << "128 + SIGTERM, not the error path: " << err;
+  EXPECT_THAT(err, HasSubstr("control --auto-tune: stopped by SIGTERM during the identification "
+                             "at "));
+  EXPECT_THAT(err, HasSubstr("; vented, the loop not started"));
+  EXPECT_THAT(err, Not(HasSubstr("error")));
+  EXPECT_GE(ReadLines(identify_csv).size(), 4u);
+  EXPECT_FALSE(std::ifstream(dir.file("run.csv")).good()) << "the closed loop never started";
 }
 
 }  // namespace
