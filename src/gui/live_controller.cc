@@ -15,26 +15,6 @@
 #include "gui/live_view.h"
 
 namespace softsight {
-namespace {
-
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-const cv::Scalar kDragColour(0, 255, 0);
-const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
-// Mask view: the chosen blob, blobs that fit but were not chosen, rejected ones, the window.
-const cv::Scalar kMaskChosenColour(0, 255, 0), kMaskFitsColour(0, 255, 255);
-const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0);
-
-std::string Number(double value, int precision) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.*f", precision, value);
-  return text;
-}
-
-std::string RangeText(const HsvRange& r) {
-  return std::to_string(r.lo) + ".." + std::to_string(r.hi);
-}
-
-}  // namespace
 
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options,
                                std::function<void(int64_t index)> before_encode)
@@ -88,7 +68,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
     // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
     // (stdout too, for the terminal and for scripts driving the window).
     record_frame(frame, result);
-    say("frame " + std::to_string(frame.index) + " (" + Number(frame.time_s, 3) + " s)");
+    say("frame " + std::to_string(frame.index) + " (" + FixedText(frame.time_s, 3) + " s)");
     return;
   }
 
@@ -383,22 +363,9 @@ void LiveController::scale_point(const cv::Point2d& p) {
     chart_.clear();
     chart_.add(*last_result_);
   }
-  say("scale " + Number(*metric->scale_mm_per_px, 4) + " mm/px (" +
-      DistanceText(*options_.scale_distance_mm) + " mm over " + Number(scale_.span_px(), 1) +
+  say("scale " + FixedText(*metric->scale_mm_per_px, 4) + " mm/px (" +
+      DistanceText(*options_.scale_distance_mm) + " mm over " + FixedText(scale_.span_px(), 1) +
       " px" + (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
-}
-
-void LiveController::draw_scale_points(cv::Mat& top, const LiveLayout& view) const {
-  for (const cv::Point2d& clicked : scale_.points()) {
-    const cv::Point2d p = view.to_view(clicked);
-    cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS, 15,
-                   1, cv::LINE_AA);
-  }
-  if (const auto& pointer = pointer_->pointer(); scale_.points().size() == 1 && pointer) {
-    const cv::Point2d a = view.to_view(scale_.points()[0]), b = view.to_view(*pointer);
-    cv::line(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
-             kScaleColour, 1, cv::LINE_AA);
-  }
 }
 
 void LiveController::toggle_recording() {
@@ -629,70 +596,7 @@ void LiveController::on_event(const UiEvent& event) {
   }
 }
 
-void LiveController::draw_mask_view(cv::Mat& top, const LiveLayout& view) {
-  // The active marker's member pixels in their own colours, everything else dimmed to a quarter:
-  // what the ranges take in, on the frame on screen.
-  const Tracker& tracker = session_->tracker(active_);
-  const bool has_mask = tracker.membership(frame_, mask_);
-  frame_.convertTo(mask_image_, -1, 0.25, 0);
-  if (has_mask) frame_.copyTo(mask_image_, mask_);
-  if (mask_image_.size() == top.size()) {
-    mask_image_.copyTo(top);
-  } else {
-    cv::resize(mask_image_, top, top.size(), 0, 0, cv::INTER_AREA);
-  }
-  const double scale = view.scale_x();
-  const double text = std::max(0.4, top.cols / 640.0 * 0.45);
-  if (const std::optional<cv::Rect> region = tracker.search_region()) {
-    const cv::Point2d a = view.to_view(cv::Point2d(region->tl()) - cv::Point2d(0.5, 0.5));
-    const cv::Point2d b = view.to_view(cv::Point2d(region->br()) - cv::Point2d(0.5, 0.5));
-    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
-                  kMaskWindowColour, 1);
-    cv::putText(top, "searched", {cvRound(a.x) + 3, cvRound(b.y) - 4}, kFont, text * 0.8,
-                kMaskWindowColour, 1, cv::LINE_AA);
-  }
-  // Each candidate blob: a circle of its area, green chosen, yellow fitting, red rejected, with
-  // the verdict and what it was judged on.
-  for (const MarkerCandidate& c : tracker.candidates()) {
-    const cv::Point2d at = view.to_view(c.position_px);
-    const int radius = std::max(4, cvRound(std::sqrt(c.area_px / CV_PI) * scale) + 3);
-    const cv::Scalar colour = c.verdict == CandidateVerdict::kChosen ? kMaskChosenColour
-                              : c.verdict == CandidateVerdict::kFits ? kMaskFitsColour
-                                                                     : kMaskRejectedColour;
-    cv::circle(top, cv::Point(cvRound(at.x), cvRound(at.y)), radius, colour, 1, cv::LINE_AA);
-    const std::string label = std::string(CandidateVerdictName(c.verdict)) + " " +
-                              Number(c.area_px, 0) + " px2 circ " + Number(c.circularity, 2) +
-                              " misfit " + Number(c.misfit, 2);
-    const cv::Point origin(cvRound(at.x) + radius + 3, cvRound(at.y) + 4);
-    cv::putText(top, label, origin, kFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
-    cv::putText(top, label, origin, kFont, text * 0.8, colour, 1, cv::LINE_AA);
-  }
-  const ColourParams& c = config().markers[active_].colour;
-  const std::string title =
-      "MASK " + config().markers[active_].name +
-      (has_mask ? ": h " + RangeText(c.h) + " s " + RangeText(c.s) + " v " + RangeText(c.v)
-                : ": " + config().markers[active_].method + " has no colour mask");
-  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-}
-
-const cv::Mat& LiveController::canvas() {
-  if (!dirty_ && !canvas_.empty()) return canvas_;
-  const LiveLayout view = layout();
-  canvas_.create(view.canvas, CV_8UC3);
-  cv::Mat top = canvas_(view.image);
-  if (annotated_.empty()) {
-    top.setTo(cv::Scalar(0, 0, 0));
-    cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
-                cv::LINE_AA);
-  } else if (mask_view_) {
-    draw_mask_view(top, view);
-  } else if (view.image.size() == annotated_.size()) {
-    // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
-    annotated_.copyTo(top);
-  } else {
-    cv::resize(annotated_, top, view.image.size(), 0, 0, cv::INTER_AREA);
-  }
+std::vector<std::string> LiveController::status_lines() const {
   std::vector<std::string> lines;
   std::string state;
   if (recording_) state += "REC " + recording_->prefix() + "  ";
@@ -703,32 +607,32 @@ const cv::Mat& LiveController::canvas() {
   state +=
       "active: " + config().markers[active_].name + " (" + config().markers[active_].method + ")";
   if (const auto& scale = config().measure.metric.scale_mm_per_px) {
-    state += "  " + Number(*scale, 4) + " mm/px";
-  }
-  if (view.image.size() != view.image_px) {
-    state += "  view " + std::to_string(cvRound(100 * view.scale_x())) + "%";
+    state += "  " + FixedText(*scale, 4) + " mm/px";
   }
   lines.push_back(state);
   if (!message_.empty()) lines.push_back(message_);
   // The hint stays while picking, whatever other keys say meanwhile.
   if (scale_.active() && message_ != scale_.hint()) lines.push_back(scale_.hint());
-  DrawStatusLines(top, lines, recording_ != nullptr);
-  if (scale_.active()) {
-    draw_scale_points(top, view);
-  } else if (pointer_->press() && pointer_->pointer()) {
-    const cv::Point2d a = view.to_view(*pointer_->press());
-    const cv::Point2d b = view.to_view(*pointer_->pointer());
-    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
-                  kDragColour, 1);
-  }
-  cv::Mat bottom = canvas_(view.chart);
-  chart_.draw(bottom);
-  if (!view.help.empty()) {
-    cv::Mat panel = canvas_(view.help);
-    DrawHelpPanel(panel);
-  }
+  return lines;
+}
+
+const cv::Mat& LiveController::canvas() {
+  if (!dirty_ && !view_.canvas().empty()) return view_.canvas();
+  LiveViewState state;
+  state.frame = &frame_;
+  state.annotated = &annotated_;
+  state.lines = status_lines();
+  state.recording = recording_ != nullptr;
+  state.mask_view = mask_view_;
+  state.tracker = &session_->tracker(active_);
+  state.active = &config().markers[active_];
+  state.scale_mode = scale_.active();
+  state.scale_points = scale_.points();
+  state.press = pointer_->press();
+  state.pointer = pointer_->pointer();
+  state.chart = &chart_;
   dirty_ = false;
-  return canvas_;
+  return view_.compose(layout(), state);
 }
 
 }  // namespace softsight

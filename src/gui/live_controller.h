@@ -20,6 +20,7 @@
 #include "softsight/gui/live_options.h"
 #include "softsight/gui/overlay.h"
 #include "gui/live_run_stats.h"
+#include "gui/live_view.h"
 #include "gui/rate_meter.h"
 #include "gui/scale_clicks.h"
 #include "gui/strip_chart.h"
@@ -30,7 +31,6 @@ namespace softsight {
 
 class LiveRecording;  // gui/live_recording.h: the files of one recording.
 class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
-struct LiveLayout;    // gui/live_layout.h: where the image, chart and help go on the canvas.
 
 struct UiEvent {
   enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
@@ -179,7 +179,6 @@ class LiveController {
   void click(const cv::Point2d& p);
   // Mask view: the pixels around `p` added to (grow) or removed from the active marker's ranges.
   void edit_range(const cv::Point2d& p, bool grow);
-  void draw_mask_view(cv::Mat& top, const LiveLayout& view);
   void drag(const cv::Rect& rect);
   void switch_method();
   void set_hsv(int trackbar, int value);
@@ -188,8 +187,10 @@ class LiveController {
   void start_scale();
   void cancel_scale();
   void scale_point(const cv::Point2d& p);
-  void draw_scale_points(cv::Mat& top, const LiveLayout& view) const;
   LiveLayout layout() const;
+  // The state line (recording, pause, end, loop, drops, active marker, scale), the last message
+  // and the scale hint.
+  std::vector<std::string> status_lines() const;
   void select_marker(int index);
   // A transport key: refused while recording (except a step forward), else queued for the feed.
   void request_playback(PlaybackRequest::Kind kind, double seconds = 0.0);
@@ -217,7 +218,7 @@ class LiveController {
   double frame_time_s_ = 0.0;  // The source's timestamp of frame_.
   int64_t dropped_ = 0;
   cv::Mat annotated_;  // frame_ + overlay (what annotated video records).
-  cv::Mat canvas_;
+  LiveView view_;  // Draws the canvas; dirty_ says when it must.
   cv::Size max_canvas_;  // Empty: no screen known.
   bool dirty_ = true;
   std::optional<FrameResult> last_result_;
@@ -225,7 +226,7 @@ class LiveController {
 
   bool paused_ = false, help_ = false, quit_ = false, ended_ = false, loop_ = false;
   bool mask_view_ = false;
-  cv::Mat mask_, mask_image_, hsv_patch_;  // Mask view and range edits: reused buffers.
+  cv::Mat hsv_patch_;  // Range edits: a reused buffer.
   std::optional<PlaybackRequest> playback_request_;
   int active_ = 0;
   int hsv_revision_ = 0;

@@ -1,9 +1,11 @@
-// The small parts the live controller is made of, each on its own: the rate meter and the
-// scale clicks (the pointer, layout and range edits are tested in live_controller_test.cc).
+// The small parts the live controller is made of, each on its own: the rate meter, the scale
+// clicks and the view (the pointer, layout and range edits are tested in live_controller_test.cc).
 #include <gtest/gtest.h>
 
 #include <chrono>
 
+#include "gui/live_layout.h"
+#include "gui/live_view.h"
 #include "gui/rate_meter.h"
 #include "gui/scale_clicks.h"
 
@@ -90,6 +92,48 @@ TEST(ScaleClicks, PointsTooCloseStartOverAndWithoutADistanceItOnlySaysHow) {
   ScaleClicks no_distance(std::nullopt);
   EXPECT_NE(no_distance.start().find("--scale-distance-mm"), std::string::npos);
   EXPECT_FALSE(no_distance.active());
+}
+
+TEST(LiveView, TheFrameTheChartUnderItTheHelpBesideItAndTheDragBoxOrTheScalePoints) {
+  const cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(100, 100, 100));
+  const StripChart chart;
+  LiveViewState state;
+  state.frame = &frame;
+  state.annotated = &frame;
+  state.lines = {"state line"};
+  state.press = cv::Point2d(10, 10);
+  state.pointer = cv::Point2d(50, 40);
+  state.chart = &chart;
+  const LiveLayout layout = ComputeLiveLayout(frame.size(), 180, HelpPanelWidth(), {});
+  LiveView view;
+  const cv::Mat canvas = view.compose(layout, state).clone();
+  ASSERT_EQ(canvas.size(), layout.canvas);
+  EXPECT_EQ(canvas.at<cv::Vec3b>(100, 100), cv::Vec3b(100, 100, 100));  // The frame, unscaled.
+  EXPECT_EQ(canvas.at<cv::Vec3b>(10, 30), cv::Vec3b(0, 255, 0));         // The drag box's top.
+  EXPECT_EQ(canvas.at<cv::Vec3b>(25, 50), cv::Vec3b(0, 255, 0));         // ... its right side.
+  EXPECT_EQ(canvas.at<cv::Vec3b>(25, 30), cv::Vec3b(100, 100, 100));     // Not filled.
+  ASSERT_FALSE(layout.help.empty());
+  EXPECT_EQ(canvas.at<cv::Vec3b>(layout.help.y + 2, layout.help.x + 2), cv::Vec3b(24, 24, 24));
+  EXPECT_EQ(layout.chart.y, 240);
+  EXPECT_LT(cv::mean(canvas(layout.chart))[0], 70) << "the chart's dark background";
+
+  // Scale mode: the first point's cross and the line to the pointer, no drag box.
+  state.scale_mode = true;
+  state.scale_points = {cv::Point2d(100, 60)};
+  state.pointer = cv::Point2d(200, 60);
+  const cv::Mat scaling = view.compose(layout, state);
+  // Cyan, anti-aliased.
+  const auto cyan = [](const cv::Vec3b& px) { return px[0] > 200 && px[1] > 200 && px[2] < 40; };
+  EXPECT_TRUE(cyan(scaling.at<cv::Vec3b>(60, 150))) << "on the line";
+  EXPECT_TRUE(cyan(scaling.at<cv::Vec3b>(54, 100))) << "the cross's upper arm";
+  EXPECT_FALSE(cyan(scaling.at<cv::Vec3b>(80, 150)));
+  EXPECT_EQ(scaling.at<cv::Vec3b>(10, 30), cv::Vec3b(100, 100, 100));  // No drag box.
+
+  // No frame yet: a black image with a note, the chart still under it.
+  const cv::Mat none;
+  state.annotated = &none;
+  const cv::Mat waiting = view.compose(layout, state);
+  EXPECT_EQ(waiting.at<cv::Vec3b>(100, 300), cv::Vec3b(0, 0, 0));
 }
 
 }  // namespace

@@ -1,14 +1,127 @@
 #include "gui/live_view.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <opencv2/imgproc.hpp>
 
 #include "gui/live_controller.h"
+#include "gui/range_edit.h"
 
 namespace softsight {
 namespace {
+
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+const cv::Scalar kDragColour(0, 255, 0);
+const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
+// Mask view: the chosen blob, blobs that fit but were not chosen, rejected ones, the window.
+const cv::Scalar kMaskChosenColour(0, 255, 0), kMaskFitsColour(0, 255, 255);
+const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0);
+
 }  // namespace
+
+std::string FixedText(double value, int precision) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.*f", precision, value);
+  return text;
+}
+
+const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& state) {
+  canvas_.create(view.canvas, CV_8UC3);
+  cv::Mat top = canvas_(view.image);
+  const cv::Mat& annotated = *state.annotated;
+  if (annotated.empty()) {
+    top.setTo(cv::Scalar(0, 0, 0));
+    cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
+  } else if (state.mask_view) {
+    draw_mask_view(top, view, state);
+  } else if (view.image.size() == annotated.size()) {
+    // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
+    annotated.copyTo(top);
+  } else {
+    cv::resize(annotated, top, view.image.size(), 0, 0, cv::INTER_AREA);
+  }
+  std::vector<std::string> lines = state.lines;
+  if (!lines.empty() && view.image.size() != view.image_px) {
+    lines.front() += "  view " + std::to_string(cvRound(100 * view.scale_x())) + "%";
+  }
+  DrawStatusLines(top, lines, state.recording);
+  if (state.scale_mode) {
+    for (const cv::Point2d& clicked : state.scale_points) {
+      const cv::Point2d p = view.to_view(clicked);
+      cv::drawMarker(top, cv::Point(cvRound(p.x), cvRound(p.y)), kScaleColour, cv::MARKER_CROSS,
+                     15, 1, cv::LINE_AA);
+    }
+    if (state.scale_points.size() == 1 && state.pointer) {
+      // The line from the first point to the pointer.
+      const cv::Point2d a = view.to_view(state.scale_points[0]), b = view.to_view(*state.pointer);
+      cv::line(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+               kScaleColour, 1, cv::LINE_AA);
+    }
+  } else if (state.press && state.pointer) {
+    const cv::Point2d a = view.to_view(*state.press);
+    const cv::Point2d b = view.to_view(*state.pointer);
+    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+                  kDragColour, 1);
+  }
+  cv::Mat bottom = canvas_(view.chart);
+  state.chart->draw(bottom);
+  if (!view.help.empty()) {
+    cv::Mat panel = canvas_(view.help);
+    DrawHelpPanel(panel);
+  }
+  return canvas_;
+}
+
+void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveViewState& state) {
+  // The active marker's member pixels in their own colours, everything else dimmed to a quarter:
+  // what the ranges take in, on the frame on screen.
+  const Tracker& tracker = *state.tracker;
+  const cv::Mat& frame = *state.frame;
+  const bool has_mask = tracker.membership(frame, mask_);
+  frame.convertTo(mask_image_, -1, 0.25, 0);
+  if (has_mask) frame.copyTo(mask_image_, mask_);
+  if (mask_image_.size() == top.size()) {
+    mask_image_.copyTo(top);
+  } else {
+    cv::resize(mask_image_, top, top.size(), 0, 0, cv::INTER_AREA);
+  }
+  const double scale = view.scale_x();
+  const double text = std::max(0.4, top.cols / 640.0 * 0.45);
+  if (const std::optional<cv::Rect> region = tracker.search_region()) {
+    const cv::Point2d a = view.to_view(cv::Point2d(region->tl()) - cv::Point2d(0.5, 0.5));
+    const cv::Point2d b = view.to_view(cv::Point2d(region->br()) - cv::Point2d(0.5, 0.5));
+    cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
+                  kMaskWindowColour, 1);
+    cv::putText(top, "searched", {cvRound(a.x) + 3, cvRound(b.y) - 4}, kFont, text * 0.8,
+                kMaskWindowColour, 1, cv::LINE_AA);
+  }
+  // Each candidate blob: a circle of its area, green chosen, yellow fitting, red rejected, with
+  // the verdict and what it was judged on.
+  for (const MarkerCandidate& c : tracker.candidates()) {
+    const cv::Point2d at = view.to_view(c.position_px);
+    const int radius = std::max(4, cvRound(std::sqrt(c.area_px / CV_PI) * scale) + 3);
+    const cv::Scalar colour = c.verdict == CandidateVerdict::kChosen ? kMaskChosenColour
+                              : c.verdict == CandidateVerdict::kFits ? kMaskFitsColour
+                                                                     : kMaskRejectedColour;
+    cv::circle(top, cv::Point(cvRound(at.x), cvRound(at.y)), radius, colour, 1, cv::LINE_AA);
+    const std::string label = std::string(CandidateVerdictName(c.verdict)) + " " +
+                              FixedText(c.area_px, 0) + " px2 circ " + FixedText(c.circularity, 2) +
+                              " misfit " + FixedText(c.misfit, 2);
+    const cv::Point origin(cvRound(at.x) + radius + 3, cvRound(at.y) + 4);
+    cv::putText(top, label, origin, kFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(top, label, origin, kFont, text * 0.8, colour, 1, cv::LINE_AA);
+  }
+  const ColourParams& c = state.active->colour;
+  const std::string title =
+      "MASK " + state.active->name +
+      (has_mask ? ": h " + RangeText(c.h) + " s " + RangeText(c.s) + " v " + RangeText(c.v)
+                : ": " + state.active->method + " has no colour mask");
+  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+}
+
 
 void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red) {
   const double scale = std::max(0.4, top.cols / 640.0 * 0.5);

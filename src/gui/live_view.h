@@ -1,12 +1,45 @@
-// Drawing of the live window's own layer over the annotated frame: the status lines at the
-// bottom and the key help. Drawing only: the controller decides what to show. Internal to gui.
+// Drawing of the live window: the canvas composed of the annotated frame (or the mask view), the
+// window's own layer over it (status lines, the drag box, the scale points), the strip chart
+// under it and the key help beside it. Drawing only: the controller decides what to show and
+// hands it over as a LiveViewState. Internal to gui.
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "gui/live_layout.h"
+#include "gui/strip_chart.h"
+#include "softsight/track/tracker.h"
+
 namespace softsight {
+
+// What one canvas shows, read from the controller (pointers to its members, valid for the call).
+struct LiveViewState {
+  const cv::Mat* frame = nullptr;      // The frame on screen as captured (the mask view's base).
+  const cv::Mat* annotated = nullptr;  // The frame with the overlay; empty: no frame yet.
+  std::vector<std::string> lines;      // Status lines, the state line first.
+  bool recording = false;              // The state line in red.
+  bool mask_view = false;              // The active marker's mask instead of the annotated frame.
+  const Tracker* tracker = nullptr;    // Mask view: the active marker's tracker ...
+  const MarkerSpec* active = nullptr;  // ... and its spec (for the title).
+  bool scale_mode = false;             // The scale points instead of the drag box.
+  std::vector<cv::Point2d> scale_points;     // Image pixels.
+  std::optional<cv::Point2d> press, pointer;  // The mouse, image pixels (drag box, scale line).
+  const StripChart* chart = nullptr;
+};
+
+class LiveView {
+ public:
+  // Draws the canvas for `layout` (reusing its buffers) and returns it.
+  const cv::Mat& compose(const LiveLayout& layout, const LiveViewState& state);
+  const cv::Mat& canvas() const { return canvas_; }
+
+ private:
+  void draw_mask_view(cv::Mat& top, const LiveLayout& layout, const LiveViewState& state);
+  cv::Mat canvas_, mask_, mask_image_;  // Reused buffers: no allocation per frame.
+};
 
 // The lines at the bottom of the image, the first (the state line) in red when `first_red`
 // (recording).
@@ -16,5 +49,8 @@ void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool f
 // hidden): the width it needs, and the drawing into `panel` (text shrinks if it is too low).
 int HelpPanelWidth();
 void DrawHelpPanel(cv::Mat& panel);
+
+// 12.3456 with precision 2 -> "12.35": figures in messages and on screen.
+std::string FixedText(double value, int precision);
 
 }  // namespace softsight

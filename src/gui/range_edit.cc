@@ -19,6 +19,10 @@ bool InLinear(const HsvRange& r, int x) { return x >= r.lo && x <= r.hi; }
 
 }  // namespace
 
+std::string RangeText(const HsvRange& range) {
+  return std::to_string(range.lo) + ".." + std::to_string(range.hi);
+}
+
 bool InRanges(const HsvRanges& ranges, const cv::Vec3b& hsv) {
   return InHue(ranges.h, hsv[0]) && InLinear(ranges.s, hsv[1]) && InLinear(ranges.v, hsv[2]);
 }

@@ -14,6 +14,9 @@ struct HsvRanges {
   HsvRange h, s, v;
 };
 
+// "170..10": a range as the window shows it.
+std::string RangeText(const HsvRange& range);
+
 // True when the HSV pixel lies in all three ranges.
 bool InRanges(const HsvRanges& ranges, const cv::Vec3b& hsv);
 
