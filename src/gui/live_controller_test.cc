@@ -803,12 +803,7 @@ TEST(LiveLayout, AFrameFitsTheScreenAndCanvasPixelsMapBackToImagePixels) {
 }
 
 TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRightPixels) {
-  SceneOptions options;
-  options.size = cv::Size(1280, 720);
-  options.length_px = 480;
-  options.width_px = 60;
-  options.marker_radius_px = 18;
-  options.frame_count = 10;
+  const SceneOptions options = testing::LiveTest720pScene(10);
   SyntheticScene scene(options);
   LiveOptions live_options;
   live_options.save_config_path = (fs::temp_directory_path() / "softsight_fit_test.yaml").string();

@@ -29,6 +29,18 @@ inline SceneOptions LiveTestScene(int frame_count, double max_bend_deg) {
   return scene;
 }
 
+// The same actuator at 1280x720 (markers 18 px in radius), taller than a laptop's screen with
+// the chart under it.
+inline SceneOptions LiveTest720pScene(int frame_count) {
+  SceneOptions scene;
+  scene.size = cv::Size(1280, 720);
+  scene.length_px = 480;
+  scene.width_px = 60;
+  scene.marker_radius_px = 18;
+  scene.frame_count = frame_count;
+  return scene;
+}
+
 // The scene's markers by hue, and the triple.
 inline constexpr const char* kLiveTestMarkersYaml =
     "markers:\n"

@@ -315,12 +315,7 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
 // frame (the rings on screen on that frame's truth, scaled), and a click at a scaled position
 // picks the colours of the image pixel under it.
 TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRightPixels) {
-  SceneOptions scene;
-  scene.size = cv::Size(1280, 720);
-  scene.length_px = 480;
-  scene.width_px = 60;
-  scene.marker_radius_px = 18;
-  scene.frame_count = 12;
+  const SceneOptions scene = testing::LiveTest720pScene(12);
   SyntheticScene renderer(scene);
   const std::string video = (dir_ / "scene.avi").string();
   std::vector<SceneTruth> truth;
