@@ -176,7 +176,7 @@ Pickles as where it came from (the path or the dict), so a Dask worker reloads a
           "methods",
           [](const PyConfig& c) {
             py::dict out;
-            for (const MarkerSpec& spec : c.config.markers) out[py::str(spec.name)] = spec.method;
+            for (const MarkerSpec& spec : c.config.markers) out[py::str(spec.name)] = TrackerMethodName(spec.params);
             return out;
           },
           "Each marker's tracking method: colour, sad, ssd or zncc.")
@@ -209,7 +209,7 @@ Pickles as where it came from (the path or the dict), so a Dask worker reloads a
            [](const PyConfig& c) {
              std::string names;
              for (const MarkerSpec& spec : c.config.markers) {
-               names += (names.empty() ? "" : ", ") + spec.name + " (" + spec.method + ")";
+               names += (names.empty() ? "" : ", ") + spec.name + " (" + TrackerMethodName(spec.params) + ")";
              }
              return "softsight.Config(" + std::string(py::repr(c.origin)) + ": " + names + ")";
            })

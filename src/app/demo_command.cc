@@ -31,10 +31,11 @@ TrackingConfig ConfigFor(const SceneOptions& scene) {
   for (const SceneMarker& marker : scene.markers) {
     MarkerSpec spec;
     spec.name = marker.name;
-    spec.colour = ThresholdsFor(marker.bgr);
+    ColourParams colour = ThresholdsFor(marker.bgr);
     // The demo renders with sensor noise: a light smoothing, as a person would add.
-    spec.colour.filter = ColourParams::Filter::kGaussian;
-    spec.colour.filter_ksize = 3;
+    colour.filter = ColourParams::Filter::kGaussian;
+    colour.filter_ksize = 3;
+    spec.params = colour;
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(scene);

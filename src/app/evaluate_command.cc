@@ -174,12 +174,13 @@ TrackingConfig EvaluateMethodConfig(const std::string& method,
   for (size_t i = 0; i < scene.markers.size(); ++i) {
     MarkerSpec spec;
     spec.name = scene.markers[i].name;
-    spec.method = method;
+    ColourParams colour;
+    TemplateParams templ;
     if (!IsTemplateMethod(method)) {
-      spec.colour = ThresholdsFor(scene.markers[i].bgr);
+      colour = ThresholdsFor(scene.markers[i].bgr);
       if (options.noise.sigma > 0) {
-        spec.colour.filter = ColourParams::Filter::kGaussian;
-        spec.colour.filter_ksize = 5;
+        colour.filter = ColourParams::Filter::kGaussian;
+        colour.filter_ksize = 5;
       }
     } else {
       const std::optional<cv::Point2d>& centre = first.markers[i].centroid_px;
@@ -187,12 +188,13 @@ TrackingConfig EvaluateMethodConfig(const std::string& method,
         throw InputError("marker '" + spec.name +
                          "' is hidden on frame 0: no template can be dragged around it");
       }
-      spec.templ.colour = mode == std::optional<std::string>("colour");
-      spec.templ.template_frame = 0;
-      spec.templ.rect = DraggedRect(*centre, scene.marker_radius_px);
-      if (options.rect_centre) spec.templ.report = TemplateReport::kRectCentre;
-      if (options.square_mask) spec.templ.round_mask = false;
+      templ.colour = mode == std::optional<std::string>("colour");
+      templ.template_frame = 0;
+      templ.rect = DraggedRect(*centre, scene.marker_radius_px);
+      if (options.rect_centre) templ.report = TemplateReport::kRectCentre;
+      if (options.square_mask) templ.round_mask = false;
     }
+    spec.params = ParamsForMethod(method, colour, templ);
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(scene);

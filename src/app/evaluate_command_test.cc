@@ -272,9 +272,9 @@ TEST(EvaluateVideo, MarkersAreMatchedByNameAndWrongFindsCounted) {
   for (const SceneMarker& m : synth.scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.colour = EvaluateMethodConfig("colour", std::nullopt, SmallScene(), truths[0])
+    spec.params = EvaluateMethodConfig("colour", std::nullopt, SmallScene(), truths[0])
                       .markers[config.markers.size()]
-                      .colour;
+                      .params;
     config.markers.push_back(spec);
   }
   SaveTrackingConfig(config, dir.file("config.yaml"));

@@ -180,7 +180,7 @@ InitResult RunInit(const InitOptions& options) {
     // A marker told apart by its colour alone needs no roi: without one `track` follows it from
     // the input's first frame, where a roi (holding from this frame on) would leave it not
     // started. Identical dots and markers found in a search region keep theirs.
-    for (FoundMarker& m : finding.markers) m.spec.colour.roi.reset();
+    for (FoundMarker& m : finding.markers) std::get<ColourParams>(m.spec.params).roi.reset();
   }
   if (finding.ok() && finding.markers.size() >= 2 && !finder.base_near_px) {
     // The base is where the body is clamped: the video shows it better than the image border.
@@ -247,13 +247,17 @@ TrackingConfig RunPick(const PickOptions& options) {
     // The pick's roi holds from this frame on (at frame 0 the marker may have been elsewhere).
     const int roi_frame = static_cast<int>(std::clamp<int64_t>(frame.index, 0, 1000000000));
     if (options.base_config) {
-      ApplyColourPick(*pick, &config.markers[i].colour);
-      config.markers[i].colour.roi_frame = roi_frame;
+      // A template marker becomes a colour marker: the pick is its colour.
+      ColourParams colour;
+      if (const auto* had = std::get_if<ColourParams>(&config.markers[i].params)) colour = *had;
+      ApplyColourPick(*pick, &colour);
+      colour.roi_frame = roi_frame;
+      config.markers[i].params = colour;
     } else {
       MarkerSpec spec;
-      spec.method = "colour";
-      ApplyColourPick(*pick, &spec.colour);
-      spec.colour.roi_frame = roi_frame;
+      ColourParams& colour = spec.params.emplace<ColourParams>();
+      ApplyColourPick(*pick, &colour);
+      colour.roi_frame = roi_frame;
       const HsvRange& h = pick->ranges.h;
       const int hue = h.lo <= h.hi ? (h.lo + h.hi) / 2 : ((h.lo + h.hi + 180) / 2) % 180;
       std::string name = HueName(hue);
@@ -337,7 +341,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
       char line[256];
       std::snprintf(line, sizeof(line), "%zu %s at (%.2f, %.2f), radius %.1f px: ", i + 1,
                     m.spec.name.c_str(), m.position_px.x, m.position_px.y, m.radius_px);
-      std::cout << line << Describe(m.spec.colour) << "\n";
+      std::cout << line << Describe(std::get<ColourParams>(m.spec.params)) << "\n";
     }
     if (result.config.measure.has_triple()) {
       std::cout << "triple: " << result.config.measure.base << ", "
@@ -390,7 +394,7 @@ CommandRunner SetupPickCommand(CLI::App& sub) {
     const TrackingConfig config = RunPick(options);
     for (size_t i = 0; i < options.at_px.size(); ++i) {
       const MarkerSpec& m = config.markers[i];
-      std::cout << m.name << ": " << Describe(m.colour) << "\n";
+      std::cout << m.name << ": " << Describe(std::get<ColourParams>(m.params)) << "\n";
     }
     std::cout << "wrote " << options.config_out << "\n";
     return 0;

@@ -78,7 +78,7 @@ std::string WriteHandConfig(const Clip& clip, const TempDir& dir) {
   for (const SceneMarker& m : clip.scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.colour = ThresholdsFor(m.bgr);
+    spec.params = ThresholdsFor(m.bgr);
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(clip.scene);
@@ -232,10 +232,10 @@ TEST(InitCommand, WhiteDotsOnGrayVideoGetAGrayRangeAndARoiEach) {
   EXPECT_TRUE(result.finding.intensity);
   ASSERT_EQ(result.config.markers.size(), 5u);
   for (const MarkerSpec& m : result.config.markers) {
-    EXPECT_TRUE(m.colour.gray && m.colour.roi) << m.name;
+    EXPECT_TRUE(std::get<ColourParams>(m.params).gray && std::get<ColourParams>(m.params).roi) << m.name;
   }
   EXPECT_EQ(result.config.measure.chain.size(), 5u);
-  for (const MarkerSpec& m : result.config.markers) EXPECT_EQ(m.colour.roi_frame, 0) << m.name;
+  for (const MarkerSpec& m : result.config.markers) EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, 0) << m.name;
 }
 
 // Identical dots need their rois, which hold where the dots are on the analysed frame: on a later
@@ -250,8 +250,8 @@ TEST(InitCommand, RoisFoundOnALaterFrameApplyFromThatFrame) {
   const InitResult result = RunInit(init);
   ASSERT_EQ(result.config.markers.size(), 5u);
   for (const MarkerSpec& m : result.config.markers) {
-    ASSERT_TRUE(m.colour.roi) << m.name;
-    EXPECT_EQ(m.colour.roi_frame, 12) << m.name;
+    ASSERT_TRUE(std::get<ColourParams>(m.params).roi) << m.name;
+    EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, 12) << m.name;
   }
   PlateScene truth_scene(PlateSceneOptions{});
   cv::Mat truth_image;
@@ -341,7 +341,7 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
   for (const SceneMarker& m : scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.colour = ThresholdsFor(m.bgr);
+    spec.params = ThresholdsFor(m.bgr);
     start.markers.push_back(spec);
   }
   start.measure = SceneMeasureOptions(scene);
@@ -353,8 +353,8 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
     live.on_event(UiEvent::Key('1' + static_cast<int>(i)));
     live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseDown, clicks[i].x, clicks[i].y));
     live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseUp, clicks[i].x, clicks[i].y));
-    const ColourParams& a = picked.markers[i].colour;
-    const ColourParams& b = live.config().markers[i].colour;
+    const ColourParams& a = std::get<ColourParams>(picked.markers[i].params);
+    const ColourParams& b = std::get<ColourParams>(live.config().markers[i].params);
     EXPECT_EQ(a.h.lo, b.h.lo);
     EXPECT_EQ(a.h.hi, b.h.hi);
     EXPECT_EQ(a.s.lo, b.s.lo);
@@ -373,10 +373,10 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
   into.config_out = dir.file("updated.yaml");
   const TrackingConfig updated = RunPick(into);
   ASSERT_EQ(updated.markers.size(), 3u);
-  EXPECT_EQ(updated.markers[0].colour.h.lo, picked.markers[0].colour.h.lo);
-  EXPECT_EQ(updated.markers[0].colour.s.lo, picked.markers[0].colour.s.lo);
-  EXPECT_EQ(updated.markers[1].colour.h.lo, start.markers[1].colour.h.lo);
-  EXPECT_FALSE(updated.markers[1].colour.roi.has_value());
+  EXPECT_EQ(std::get<ColourParams>(updated.markers[0].params).h.lo, std::get<ColourParams>(picked.markers[0].params).h.lo);
+  EXPECT_EQ(std::get<ColourParams>(updated.markers[0].params).s.lo, std::get<ColourParams>(picked.markers[0].params).s.lo);
+  EXPECT_EQ(std::get<ColourParams>(updated.markers[1].params).h.lo, std::get<ColourParams>(start.markers[1].params).h.lo);
+  EXPECT_FALSE(std::get<ColourParams>(updated.markers[1].params).roi.has_value());
   EXPECT_EQ(updated.measure.base, start.measure.base);
   into.at_px = {clicks[0], clicks[1], clicks[2], clicks[0]};
   EXPECT_THROW(RunPick(into), InputError) << "more points than the config has markers";
@@ -423,7 +423,7 @@ TEST(PickCommand, APickAtALaterFrameTracksLikeLiveFromThatFrameAndNotBefore) {
   for (const SceneMarker& m : clip.scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.colour.h = {20, 30};
+    std::get<ColourParams>(spec.params).h = {20, 30};
     start.markers.push_back(spec);
   }
   start.measure = SceneMeasureOptions(clip.scene);
@@ -458,7 +458,7 @@ TEST(PickCommand, APickAtALaterFrameTracksLikeLiveFromThatFrameAndNotBefore) {
   for (const std::string& config : {dir.file("pick.yaml"), dir.file("live.yaml")}) {
     SCOPED_TRACE(config);
     const TrackingConfig saved = LoadTrackingConfig(config);
-    for (const MarkerSpec& m : saved.markers) EXPECT_EQ(m.colour.roi_frame, kPickFrame) << m.name;
+    for (const MarkerSpec& m : saved.markers) EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, kPickFrame) << m.name;
     TrackOptions track;
     track.config_file = config;
     track.source.input = clip.video;

@@ -41,7 +41,7 @@ Rendered RenderAndTrack(const testing::TempDir& dir, double max_bend_deg) {
   for (const SceneMarker& m : synth.scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.colour = ThresholdsFor(m.bgr);
+    spec.params = ThresholdsFor(m.bgr);
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(synth.scene);

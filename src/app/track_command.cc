@@ -26,9 +26,10 @@ namespace {
 
 void CheckRunnable(const TrackingConfig& config, const TrackOptions& options) {
   for (const MarkerSpec& spec : config.markers) {
-    if (IsTemplateMethod(spec.method) && spec.templ.image.empty() && !spec.templ.rect) {
+    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+    if (templ && templ->image.empty() && !templ->rect) {
       throw InputError(options.config_file + ": marker '" + spec.name + "' uses template matching (" +
-                       spec.method +
+                       TrackerMethodName(spec.params) +
                        ") but has no template: give `template: {frame: 0, rect: [x, y, w, h]}` "
                        "or `template: {file: marker.png}`");
     }
@@ -64,7 +65,9 @@ int DefaultJobs() {
 TrackingConfig LoadTrackConfig(const TrackOptions& options) {
   TrackingConfig config = LoadTrackingConfig(options.config_file, options.method);
   if (options.template_colour) {
-    for (MarkerSpec& spec : config.markers) spec.templ.colour = *options.template_colour;
+    for (MarkerSpec& spec : config.markers) {
+      if (auto* templ = std::get_if<TemplateParams>(&spec.params)) templ->colour = *options.template_colour;
+    }
   }
   CheckRunnable(config, options);
   if (options.max_frames && *options.max_frames < 0) {

@@ -86,8 +86,7 @@ bool IsGrayFrame(const cv::Mat& frame) {
 std::vector<MarkerCandidate> Probe(const cv::Mat& frame, const ColourParams& colour) {
   MarkerSpec spec;
   spec.name = "probe";
-  spec.method = "colour";
-  spec.colour = colour;
+  spec.params = colour;
   const auto tracker = CreateTracker(spec);
   Frame f;
   f.image = frame;
@@ -479,7 +478,7 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
       continue;
     }
     MarkerSpec spec;
-    spec.method = "colour";
+    ColourParams& colour = spec.params.emplace<ColourParams>();
     int hue = 0;
     if (finding.intensity) {
       cv::Mat gray;
@@ -489,9 +488,9 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
         reject("contrast (no clear level between the dot and its surroundings)");
         continue;
       }
-      spec.colour.gray = *range;
-      spec.colour.roi = cv::Rect(cvRound(c.position_px.x) - side / 2,
-                                 cvRound(c.position_px.y) - side / 2, side, side) & frame_rect;
+      colour.gray = *range;
+      colour.roi = cv::Rect(cvRound(c.position_px.x) - side / 2,
+                            cvRound(c.position_px.y) - side / 2, side, side) & frame_rect;
     } else {
       HsvPickOptions picker = options.picker;
       picker.radius_px = std::clamp(static_cast<int>(std::floor(0.6 * radius)), 1,
@@ -502,14 +501,14 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
         reject("colour pick: " + why);
         continue;
       }
-      ApplyColourPick(*pick, &spec.colour);
+      ApplyColourPick(*pick, &colour);
       hue = HueOf(pick->ranges.h);
     }
     const double tolerance = std::max(1.0, kVerifyRadii * radius);
     auto verify = [&](bool with_roi, Observation* observation) {
       MarkerSpec probe_spec = spec;
       probe_spec.name = "verify";
-      if (!with_roi) probe_spec.colour.roi.reset();
+      if (!with_roi) std::get<ColourParams>(probe_spec.params).roi.reset();
       const auto tracker = CreateTracker(probe_spec);
       Frame f;
       f.image = frame;
@@ -635,9 +634,8 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
       if (same > 0) name += "_" + std::to_string(same + 1);
     }
     v.marker.spec.name = name;
-    if (v.marker.spec.colour.roi) {
-      v.marker.spec.colour.roi_frame = static_cast<int>(options.frame_index);
-    }
+    ColourParams& colour = std::get<ColourParams>(v.marker.spec.params);
+    if (colour.roi) colour.roi_frame = static_cast<int>(options.frame_index);
     finding.markers.push_back(v.marker);
   }
   const size_t n = finding.markers.size();
@@ -737,7 +735,8 @@ cv::Mat DrawMarkerFinding(const cv::Mat& input, const MarkerFinding& finding) {
   }
   for (size_t i = 0; i < finding.markers.size(); ++i) {
     const FoundMarker& m = finding.markers[i];
-    if (m.spec.colour.roi) cv::rectangle(image, *m.spec.colour.roi, roi_colour, 1);
+    const ColourParams& colour = std::get<ColourParams>(m.spec.params);
+    if (colour.roi) cv::rectangle(image, *colour.roi, roi_colour, 1);
     const cv::Point p(cvRound(m.position_px.x), cvRound(m.position_px.y));
     cv::circle(image, p, cvRound(m.radius_px) + 3, ok_colour, 2, cv::LINE_AA);
     cv::putText(image, std::to_string(i + 1) + " " + m.spec.name,

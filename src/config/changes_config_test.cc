@@ -24,8 +24,10 @@ TEST(ConfigChanges, EveryKindIsWrittenAndReadBackInOrder) {
   testing::WriteTextFile(dir.file("m.yaml"), kMarkers);
   TrackingConfig config = LoadTrackingConfig(dir.file("m.yaml"));
   MarkerSpec sad = config.markers[1];
-  sad.method = "sad";
-  sad.colour.h = {90, 140};
+  TemplateParams templ;
+  templ.rect = cv::Rect(40, 50, 23, 22);
+  templ.min_zncc = 0.7;
+  sad.params = ParamsForMethod("sad", {}, templ);
   config.changes = {ConfigChange::Respec(sad), ConfigChange::Reselect("blue", {10, 20, 23, 22}),
                     ConfigChange::Retrack("red"), ConfigChange::ResetTipReference()};
   config.changes[0].after_frame = 3;
@@ -40,11 +42,12 @@ TEST(ConfigChanges, EveryKindIsWrittenAndReadBackInOrder) {
     EXPECT_EQ(back.changes[i].after_frame, config.changes[i].after_frame) << i;
     EXPECT_EQ(back.changes[i].marker, config.changes[i].marker) << i;
   }
-  EXPECT_EQ(back.changes[0].spec.method, "sad");
-  EXPECT_EQ(back.changes[0].spec.colour.h.lo, 90);
-  EXPECT_EQ(back.changes[0].spec.colour.h.hi, 140);
+  EXPECT_EQ(TrackerMethodName(back.changes[0].spec.params), "sad");
+  const TemplateParams& back_templ = std::get<TemplateParams>(back.changes[0].spec.params);
+  EXPECT_EQ(back_templ.rect, cv::Rect(40, 50, 23, 22));
+  EXPECT_DOUBLE_EQ(back_templ.min_zncc, 0.7);
   EXPECT_EQ(back.changes[1].rect, cv::Rect(10, 20, 23, 22));
-  EXPECT_EQ(back.markers[1].method, "colour");  // The start is unchanged.
+  EXPECT_EQ(TrackerMethodName(back.markers[1].params), "colour");  // The start is unchanged.
 }
 
 TEST(ConfigChanges, MalformedEntriesAreOneLineNamingTheEntry) {

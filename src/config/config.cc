@@ -17,31 +17,6 @@
 namespace softsight {
 namespace {
 
-MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override) {
-  MarkerSpec spec;
-  spec.name = marker.string("name").value_or("");
-  if (spec.name.empty()) marker.fail("name", "every marker needs a name");
-  for (char c : spec.name) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
-      marker.fail("name", "'" + spec.name +
-                              "' must use letters, digits, '_' or '-' (it prefixes CSV columns)");
-    }
-  }
-  const bool has_template = marker.has("template");
-  const std::vector<std::string> methods = TrackerMethods();
-  spec.method = marker.choice("method", methods).value_or(DefaultTrackerMethod(has_template));
-  if (method_override) spec.method = *method_override;
-  ReadColourParams(marker, &spec.colour);
-  ReadTemplateParams(marker, &spec.templ);
-  marker.finish();
-
-  std::string problem;
-  if (!spec.colour.Check(&problem) || !spec.templ.Check(&problem)) {
-    throw InputError(marker.file() + ": marker '" + spec.name + "': " + problem);
-  }
-  return spec;
-}
-
 // The `changes:` list of a live recording's config (ConfigChange): each entry an `after_frame`
 // and exactly one of `respec:` (a marker as under `markers:`), `reselect: {marker, rect}`,
 // `retrack: <marker>` or `reset_tip_reference: true`, in frame order, naming known markers.
@@ -70,10 +45,10 @@ std::vector<ConfigChange> ReadChanges(const YAML::Node& list, const std::string&
     if (entry.has("respec")) {
       change.kind = ConfigChange::Kind::kRespec;
       YamlMap marker = entry.map("respec");
-      change.spec = ReadMarker(marker, method_override);
+      change.spec = ReadMarker(marker, method_override, &change.template_file);
       change.marker = change.spec.name;
-      if (!change.spec.templ.image_file.empty()) {
-        files_read->push_back(ResolveBesideFile(file, change.spec.templ.image_file));
+      if (!change.template_file.empty()) {
+        files_read->push_back(ResolveBesideFile(file, change.template_file));
       }
     } else if (entry.has("reselect")) {
       change.kind = ConfigChange::Kind::kReselect;
@@ -130,10 +105,12 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
   std::set<std::string> names;
   for (size_t i = 0; i < markers.size(); ++i) {
     YamlMap marker(markers[i], file, "markers[" + std::to_string(i) + "]");
-    MarkerSpec spec = ReadMarker(marker, method_override);
+    std::string template_file;
+    MarkerSpec spec = ReadMarker(marker, method_override, &template_file);
     if (!names.insert(spec.name).second) {
       marker.fail("name", "marker name '" + spec.name + "' is used twice");
     }
+    if (!template_file.empty()) config.template_files[spec.name] = template_file;
     config.markers.push_back(std::move(spec));
   }
 
@@ -151,10 +128,8 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
   check_names("chain", config.measure.chain);
   config.files_read.push_back(file);
   if (const auto plane = top.string("plane")) config.files_read.push_back(ResolveBesideFile(file, *plane));
-  for (const MarkerSpec& spec : config.markers) {
-    if (!spec.templ.image_file.empty()) {
-      config.files_read.push_back(ResolveBesideFile(file, spec.templ.image_file));
-    }
+  for (const auto& [name, image_file] : config.template_files) {
+    config.files_read.push_back(ResolveBesideFile(file, image_file));
   }
   if (const auto camera = top.string("camera")) {
     config.camera_file = *camera;
@@ -195,16 +170,51 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
   return config;
 }
 
-void WriteMarker(const MarkerSpec& spec, YAML::Emitter& out) {
-  out << YAML::BeginMap;
-  out << YAML::Key << "name" << YAML::Value << spec.name;
-  out << YAML::Key << "method" << YAML::Value << spec.method;
-  WriteColourParams(spec.colour, out);
-  WriteTemplateParams(spec.templ, out);
-  out << YAML::EndMap;
+}  // namespace
+
+MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
+                      std::string* template_file) {
+  MarkerSpec spec;
+  spec.name = marker.string("name").value_or("");
+  if (spec.name.empty()) marker.fail("name", "every marker needs a name");
+  for (char c : spec.name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
+      marker.fail("name", "'" + spec.name +
+                              "' must use letters, digits, '_' or '-' (it prefixes CSV columns)");
+    }
+  }
+  const bool has_template = marker.has("template");
+  std::string method =
+      marker.choice("method", TrackerMethods()).value_or(DefaultTrackerMethod(has_template));
+  if (method_override) method = *method_override;
+  // Both methods' keys are read and checked (a typo or a bad value in either is an error), and
+  // the marker is the chosen method's parameters.
+  ColourParams colour;
+  TemplateSection templ;
+  ReadColourParams(marker, &colour);
+  ReadTemplateParams(marker, &templ);
+  marker.finish();
+  spec.params = ParamsForMethod(method, colour, templ.params);
+  *template_file = std::holds_alternative<TemplateParams>(spec.params) ? templ.file : "";
+
+  std::string problem;
+  const bool ok = std::visit([&](const auto& params) { return params.Check(&problem); },
+                             spec.params);
+  if (!ok) throw InputError(marker.file() + ": marker '" + spec.name + "': " + problem);
+  return spec;
 }
 
-}  // namespace
+void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << spec.name;
+  out << YAML::Key << "method" << YAML::Value << TrackerMethodName(spec.params);
+  if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
+    WriteColourParams(*colour, out);
+  } else {
+    WriteTemplateParams({std::get<TemplateParams>(spec.params), template_file}, out);
+  }
+  out << YAML::EndMap;
+}
 
 TrackingConfig LoadTrackingConfig(const std::string& file,
                                   const std::optional<std::string>& method_override) {
@@ -226,7 +236,10 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::Comment("softsight tracking config (see examples/markers.yaml for every key)");
   out << YAML::BeginMap;
   out << YAML::Key << "markers" << YAML::Value << YAML::BeginSeq;
-  for (const MarkerSpec& spec : config.markers) WriteMarker(spec, out);
+  for (const MarkerSpec& spec : config.markers) {
+    const auto file = config.template_files.find(spec.name);
+    WriteMarker(spec, file == config.template_files.end() ? "" : file->second, out);
+  }
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);
   if (config.camera_file) out << YAML::Key << "camera" << YAML::Value << *config.camera_file;
@@ -249,7 +262,7 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
       switch (change.kind) {
         case ConfigChange::Kind::kRespec:
           out << YAML::Key << "respec" << YAML::Value;
-          WriteMarker(change.spec, out);
+          WriteMarker(change.spec, change.template_file, out);
           break;
         case ConfigChange::Kind::kReselect:
           out << YAML::Key << "reselect" << YAML::Value << YAML::Flow << YAML::BeginMap
@@ -295,7 +308,7 @@ std::string DocumentConfig() {
       "    # ---- colour tracking\n";
   doc += DescribeOptions(ColourParamsOptions(), 4);
   doc += "    # ---- template matching (method sad, ssd or zncc)\n";
-  doc += DescribeOptions(TemplateParamsOptions(), 4);
+  doc += DescribeOptions(TemplateSectionOptions(), 4);
   doc += "# ---- measurements (triple and chain name markers above)\n";
   doc += DescribeOptions(MeasureOptionsTable(), 0);
   doc +=

@@ -5,11 +5,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <optional>
+#include <string>
+
+#include "core/option_table.h"
 #include "config/yaml_map.h"
 #include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/template_tracker.h"
+#include "softsight/track/tracker.h"
 
 namespace softsight {
 
@@ -17,9 +22,27 @@ namespace softsight {
 void ReadColourParams(YamlMap& marker, ColourParams* params);
 void WriteColourParams(const ColourParams& params, YAML::Emitter& out);
 
-// template_config.cc: a marker's `template:` key and matching options.
-void ReadTemplateParams(YamlMap& marker, TemplateParams* params);
-void WriteTemplateParams(const TemplateParams& params, YAML::Emitter& out);
+// template_config.cc: a marker's `template:` key and matching options, and the image file the
+// template may come from (`template.file`): the file is the config's business, not the
+// tracker's, so it is kept here beside the parameters (its pixels go into params.image).
+struct TemplateSection {
+  TemplateParams params;
+  std::string file;  // `template.file` as written, relative to the config file; "" when none.
+};
+// TemplateParams' option table (track/track_options.h) plus template.file.
+const OptionTable<TemplateSection>& TemplateSectionOptions();
+// Reads the keys into `section`; a newly named file is read into section->params.image.
+void ReadTemplateParams(YamlMap& marker, TemplateSection* section);
+void WriteTemplateParams(const TemplateSection& section, YAML::Emitter& out);
+
+// config.cc: one entry of `markers:`: its name, method (`method_override` replaces it) and that
+// method's keys (the other method's keys are read and checked too, but not kept: a marker is one
+// method's parameters). `template_file` gets the marker's template.file ("" when none).
+MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
+                      std::string* template_file);
+// The same keys back: name, method, and the keys of the marker's parameters that differ from the
+// defaults (`template_file` as template.file for a template marker).
+void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out);
 
 // metric_config.cc: top-level scale_mm_per_px / plane keys.
 void ReadMetricModel(YamlMap& top, MetricModel* metric);

@@ -33,12 +33,12 @@ TEST(Config, LoadsTheDocumentedExample) {
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
   ASSERT_EQ(config.markers.size(), 3u);
   EXPECT_EQ(config.markers[0].name, "red");
-  EXPECT_EQ(config.markers[0].method, "colour");
-  EXPECT_EQ(config.markers[0].colour.h.lo, 170);
-  EXPECT_EQ(config.markers[0].colour.h.hi, 10);
-  ASSERT_TRUE(config.markers[0].colour.roi.has_value());
-  EXPECT_EQ(*config.markers[0].colour.roi, cv::Rect(150, 300, 40, 40));
-  EXPECT_FALSE(config.markers[1].colour.roi.has_value());
+  EXPECT_EQ(TrackerMethodName(config.markers[0].params), "colour");
+  EXPECT_EQ(std::get<ColourParams>(config.markers[0].params).h.lo, 170);
+  EXPECT_EQ(std::get<ColourParams>(config.markers[0].params).h.hi, 10);
+  ASSERT_TRUE(std::get<ColourParams>(config.markers[0].params).roi.has_value());
+  EXPECT_EQ(*std::get<ColourParams>(config.markers[0].params).roi, cv::Rect(150, 300, 40, 40));
+  EXPECT_FALSE(std::get<ColourParams>(config.markers[1].params).roi.has_value());
   EXPECT_EQ(config.measure.base, "red");
   EXPECT_EQ(config.measure.middle, "blue");
   EXPECT_EQ(config.measure.tip, "green");
@@ -50,7 +50,7 @@ TEST(Config, MethodOverrideAppliesToEveryMarkerAndUnknownMethodIsRejected) {
   TempDir dir;
   testing::WriteTextFile(dir.file("markers.yaml"), kValid);
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"), "zncc");
-  for (const MarkerSpec& spec : config.markers) EXPECT_EQ(spec.method, "zncc");
+  for (const MarkerSpec& spec : config.markers) EXPECT_EQ(TrackerMethodName(spec.params), "zncc");
   EXPECT_THROW(LoadTrackingConfig(dir.file("markers.yaml"), "magic"), InputError);
 }
 
@@ -63,11 +63,14 @@ TEST(Config, SavedConfigLoadsBackToTheSameValues) {
   ASSERT_EQ(again.markers.size(), original.markers.size());
   for (size_t i = 0; i < again.markers.size(); ++i) {
     EXPECT_EQ(again.markers[i].name, original.markers[i].name);
-    EXPECT_EQ(again.markers[i].method, original.markers[i].method);
-    EXPECT_EQ(again.markers[i].colour.h.lo, original.markers[i].colour.h.lo);
-    EXPECT_EQ(again.markers[i].colour.h.hi, original.markers[i].colour.h.hi);
-    EXPECT_EQ(again.markers[i].colour.s.lo, original.markers[i].colour.s.lo);
-    EXPECT_EQ(again.markers[i].colour.roi, original.markers[i].colour.roi);
+    EXPECT_EQ(TrackerMethodName(again.markers[i].params),
+              TrackerMethodName(original.markers[i].params));
+    const ColourParams& a = std::get<ColourParams>(again.markers[i].params);
+    const ColourParams& b = std::get<ColourParams>(original.markers[i].params);
+    EXPECT_EQ(a.h.lo, b.h.lo);
+    EXPECT_EQ(a.h.hi, b.h.hi);
+    EXPECT_EQ(a.s.lo, b.s.lo);
+    EXPECT_EQ(a.roi, b.roi);
   }
   EXPECT_EQ(again.measure.middle, "blue");
   EXPECT_EQ(again.measure.metric.scale_mm_per_px, original.measure.metric.scale_mm_per_px);
@@ -141,8 +144,8 @@ TEST(Config, ShippedMarkerExamplesLoad) {
   EXPECT_TRUE(config.measure.metric.scale_mm_per_px.has_value());
   const TrackingConfig templates = LoadTrackingConfig(dir + "markers_template.yaml");
   ASSERT_EQ(templates.markers.size(), 5u);
-  EXPECT_EQ(templates.markers[0].templ.rect, cv::Rect(388, 367, 25, 25));
-  EXPECT_EQ(templates.markers[4].method, "zncc");
+  EXPECT_EQ(std::get<TemplateParams>(templates.markers[0].params).rect, cv::Rect(388, 367, 25, 25));
+  EXPECT_EQ(TrackerMethodName(templates.markers[4].params), "zncc");
 }
 
 TEST(Config, ShippedRigExampleLoadsWithItsControlSection) {

@@ -31,12 +31,16 @@ TEST(OptionTables, ColourParams) {
       .Run();
 }
 
-TEST(OptionTables, TemplateParams) {
-  testing::OptionTableSuite<TemplateParams>{
-      TemplateParamsOptions(), "markers[0]",
-      [](YamlMap& m, TemplateParams* p) { ReadTemplateParams(m, p); },
-      [](const TemplateParams& p, YAML::Emitter& out) { WriteTemplateParams(p, out); },
-      [](const TemplateParams& p, std::string* e) { return p.Check(e); }}
+TEST(OptionTables, TemplateParamsAndTheirFile) {
+  testing::OptionTableSuite<TemplateSection>{
+      TemplateSectionOptions(), "markers[0]",
+      [](YamlMap& m, TemplateSection* p) { ReadTemplateParams(m, p); },
+      [](const TemplateSection& p, YAML::Emitter& out) { WriteTemplateParams(p, out); },
+      [](const TemplateSection& p, std::string* e) {
+        // With a file, the reader also wants rect to be the image's size, which it alone knows
+        // (the suite's image is 8x8): not combined here (TemplateConfig.ImageWithRect... tests it).
+        return p.params.Check(e) && (p.file.empty() || !p.params.rect);
+      }}
       .Run();
 }
 
@@ -100,7 +104,7 @@ TEST(OptionTables, TheExamplesMentionEveryKey) {
             std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(ColourParamsOptions(), Example("markers.yaml")),
             std::vector<std::string>{});
-  EXPECT_EQ(testing::KeysMissingFrom(TemplateParamsOptions(), Example("markers_template.yaml")),
+  EXPECT_EQ(testing::KeysMissingFrom(TemplateSectionOptions(), Example("markers_template.yaml")),
             std::vector<std::string>{});
   EXPECT_EQ(testing::KeysMissingFrom(MeasureOptionsTable(), Example("markers.yaml")),
             std::vector<std::string>{});
@@ -175,13 +179,18 @@ TEST(OptionTables, GeneratedDocumentationIsAConfigThatReadsBackToTheDefaults) {
   const TrackingConfig config = LoadTrackingConfig(file);
   ASSERT_EQ(config.markers.size(), 1u);
   const ColourParams colour_defaults;
-  const TemplateParams template_defaults;
   for (const auto& o : ColourParamsOptions()) {
-    EXPECT_EQ(o.get(config.markers[0].colour), o.get(colour_defaults)) << o.key;
+    EXPECT_EQ(o.get(std::get<ColourParams>(config.markers[0].params)), o.get(colour_defaults))
+        << o.key;
     EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;
   }
-  for (const auto& o : TemplateParamsOptions()) {
-    EXPECT_EQ(o.get(config.markers[0].templ), o.get(template_defaults)) << o.key;
+  // The marker is a colour marker; read as a template marker, its template keys are the defaults.
+  const TrackingConfig as_template = LoadTrackingConfig(file, "zncc");
+  const TemplateSection template_defaults;
+  EXPECT_TRUE(as_template.template_files.empty());
+  const TemplateSection read{std::get<TemplateParams>(as_template.markers[0].params), ""};
+  for (const auto& o : TemplateSectionOptions()) {
+    EXPECT_EQ(o.get(read), o.get(template_defaults)) << o.key;
     EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;
   }
   ASSERT_TRUE(config.control);

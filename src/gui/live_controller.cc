@@ -32,6 +32,12 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   // The session holds the only copy of the config: every live edit goes through it, and `s`
   // and recordings save what it holds.
   session_ = std::make_unique<TrackingSession>(config);
+  for (const MarkerSpec& spec : config.markers) {
+    const auto* colour = std::get_if<ColourParams>(&spec.params);
+    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+    colour_aside_.push_back(colour ? *colour : ColourParams{});
+    template_aside_.push_back(templ ? *templ : TemplateParams{});
+  }
   say("press h for help");
 }
 
@@ -199,20 +205,25 @@ void LiveController::click(const cv::Point2d& p) {
   }
   active_ = marker;
   MarkerSpec spec = config().markers[marker];
-  ApplyColourPick(*pick, &spec.colour);
-  const cv::Rect box = pick->roi;
-  // The colour tracker looks for the marker around the click first; a template tracker keeps
-  // its template (the ranges are stored for the colour method).
-  apply_spec(marker, spec, IsTemplateMethod(spec.method) ? std::nullopt : std::optional(box));
+  auto* colour = std::get_if<ColourParams>(&spec.params);
+  if (colour) {
+    // The colour tracker looks for the marker around the click first.
+    ApplyColourPick(*pick, colour);
+    apply_spec(marker, spec, pick->roi);
+  } else {
+    // A template marker keeps its template; the ranges are kept for the colour method.
+    ApplyColourPick(*pick, &colour_aside_[marker]);
+  }
   ++hsv_revision_;
   say(spec.name + ": h " + RangeText(pick->ranges.h) + " s " + RangeText(pick->ranges.s) +
-      " v " + RangeText(pick->ranges.v) + (IsTemplateMethod(spec.method) ? " (used by the colour method)" : ""));
+      " v " + RangeText(pick->ranges.v) + (colour ? "" : " (used by the colour method)"));
 }
 
 void LiveController::edit_range(const cv::Point2d& p, bool grow) {
   if (frame_.empty()) return;
   MarkerSpec spec = config().markers[active_];
-  if (IsTemplateMethod(spec.method) || spec.colour.gray) {
+  auto* colour = std::get_if<ColourParams>(&spec.params);
+  if (!colour || colour->gray) {
     say(spec.name + ": ranges are edited for colour markers (m switches the method)");
     return;
   }
@@ -222,21 +233,22 @@ void LiveController::edit_range(const cv::Point2d& p, bool grow) {
                          cv::Rect(0, 0, frame_.cols, frame_.rows);
   if (patch.empty()) return;
   cv::cvtColor(frame_(patch), hsv_patch_, cv::COLOR_BGR2HSV);
-  HsvRanges ranges{spec.colour.h, spec.colour.s, spec.colour.v};
+  HsvRanges ranges{colour->h, colour->s, colour->v};
   if (grow) {
     ranges = GrowRanges(ranges, hsv_patch_);
   } else if (std::string why; !ShrinkRanges(ranges, hsv_patch_, &why)) {
     say(spec.name + ": " + why);
     return;
   }
-  spec.colour.h = ranges.h;
-  spec.colour.s = ranges.s;
-  spec.colour.v = ranges.v;
-  spec.colour.auto_bgr.reset();
+  colour->h = ranges.h;
+  colour->s = ranges.s;
+  colour->v = ranges.v;
+  colour->auto_bgr.reset();
+  const std::string text = "h " + RangeText(colour->h) + " s " + RangeText(colour->s) + " v " +
+                           RangeText(colour->v);
   apply_spec(active_, spec, std::nullopt);
   ++hsv_revision_;
-  say(spec.name + (grow ? ": added, h " : ": removed, h ") + RangeText(spec.colour.h) + " s " +
-      RangeText(spec.colour.s) + " v " + RangeText(spec.colour.v));
+  say(spec.name + (grow ? ": added, " : ": removed, ") + text);
 }
 
 void LiveController::drag(const cv::Rect& dragged) {
@@ -274,12 +286,19 @@ void LiveController::drag(const cv::Rect& dragged) {
 
 void LiveController::switch_method() {
   const std::vector<std::string> methods = TrackerMethods();
-  const auto current = std::find(methods.begin(), methods.end(), config().markers[active_].method);
+  const auto current =
+      std::find(methods.begin(), methods.end(), TrackerMethodName(config().markers[active_].params));
   const std::string next =
       current == methods.end() || current + 1 == methods.end() ? methods.front() : *(current + 1);
   for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
     MarkerSpec spec = config().markers[i];
-    spec.method = next;
+    // The set in use now is set aside, to come back to; the other one comes back.
+    if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
+      colour_aside_[i] = *colour;
+    } else {
+      template_aside_[i] = std::get<TemplateParams>(spec.params);
+    }
+    spec.params = ParamsForMethod(next, colour_aside_[i], template_aside_[i]);
     std::optional<cv::Rect> hint;
     if (const auto position = position_of(i); position && !frame_.empty()) {
       hint = box_around(*position);
@@ -295,18 +314,27 @@ void LiveController::set_hsv(int trackbar, int value) {
   if (trackbar < 0 || trackbar >= static_cast<int>(kHsvTrackbars.size())) return;
   value = std::clamp(value, 0, kHsvTrackbars[trackbar].max);
   MarkerSpec spec = config().markers[active_];
-  HsvRange* ranges[3] = {&spec.colour.h, &spec.colour.s, &spec.colour.v};
+  // A template marker's ranges are the ones set aside for its colour method.
+  auto* own = std::get_if<ColourParams>(&spec.params);
+  ColourParams& colour = own ? *own : colour_aside_[active_];
+  HsvRange* ranges[3] = {&colour.h, &colour.s, &colour.v};
   int& field = trackbar % 2 == 0 ? ranges[trackbar / 2]->lo : ranges[trackbar / 2]->hi;
   if (field == value) return;  // The adapter moving its own trackbar: nothing changed.
   field = value;
-  spec.colour.auto_bgr.reset();
-  apply_spec(active_, spec, std::nullopt);
-  say(spec.name + ": h " + RangeText(spec.colour.h) + " s " + RangeText(spec.colour.s) + " v " +
-      RangeText(spec.colour.v));
+  colour.auto_bgr.reset();
+  const std::string text = spec.name + ": h " + RangeText(colour.h) + " s " +
+                           RangeText(colour.s) + " v " + RangeText(colour.v);
+  if (own) apply_spec(active_, spec, std::nullopt);
+  say(text);
+}
+
+ColourParams LiveController::colour_of(int marker) const {
+  const auto* own = std::get_if<ColourParams>(&config().markers[marker].params);
+  return own ? *own : colour_aside_[marker];
 }
 
 std::array<int, 6> LiveController::active_hsv() const {
-  const ColourParams& c = config().markers[active_].colour;
+  const ColourParams c = colour_of(active_);
   return {c.h.lo, c.h.hi, c.s.lo, c.s.hi, c.v.lo, c.v.hi};
 }
 
@@ -605,7 +633,8 @@ std::vector<std::string> LiveController::status_lines() const {
   if (loop_) state += "LOOP  ";
   if (dropped_ > 0) state += "dropped " + std::to_string(dropped_) + "  ";
   state +=
-      "active: " + config().markers[active_].name + " (" + config().markers[active_].method + ")";
+      "active: " + config().markers[active_].name + " (" +
+      TrackerMethodName(config().markers[active_].params) + ")";
   if (const auto& scale = config().measure.metric.scale_mm_per_px) {
     state += "  " + FixedText(*scale, 4) + " mm/px";
   }

@@ -199,6 +199,8 @@ class LiveController {
   std::optional<cv::Point2d> position_of(int marker) const;
   cv::Rect box_around(const cv::Point2d& p) const;
   void apply_spec(int marker, const MarkerSpec& spec, const std::optional<cv::Rect>& hint);
+  // Marker `marker`'s colour parameters: its own for a colour marker, else those set aside.
+  ColourParams colour_of(int marker) const;
   void redraw_annotated();
   void draw_overlay(cv::Mat& image, const FrameResult& result) const;
   void record_frame(const Frame& frame, const FrameResult& result);
@@ -230,6 +232,11 @@ class LiveController {
   std::optional<PlaybackRequest> playback_request_;
   int active_ = 0;
   int hsv_revision_ = 0;
+  // Per marker (config order), the parameters of the method it does not use now: a marker is one
+  // method's parameters (MarkerSpec), so a colour pick on a template marker, and the template of a
+  // marker switched to colour, are kept here for `m` to switch back to.
+  std::vector<ColourParams> colour_aside_;
+  std::vector<TemplateParams> template_aside_;
   std::unique_ptr<LivePointer> pointer_;
   ScaleClicks scale_;
   std::string message_;

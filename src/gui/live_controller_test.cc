@@ -109,7 +109,7 @@ TEST_F(LiveControllerTest, TracksAndShowsTheOverlayAboveTheStripChart) {
 
 TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   TrackingConfig config = SceneConfig();
-  config.markers[1].colour.h = {140, 160};  // Wrong: nothing in the scene has this hue.
+  std::get<ColourParams>(config.markers[1].params).h = {140, 160};  // Wrong: nothing in the scene has this hue.
   LiveController live(config, Options());
   SceneTruth truth = Feed(live, 0);
   ASSERT_FALSE(live.last_result()->markers[1].observation.found());
@@ -118,7 +118,7 @@ TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   EXPECT_EQ(live.active_marker(), 1);
   const int revision = live.hsv_revision();
   Click(live, *truth.markers[1].centroid_px);
-  const HsvRange h = live.config().markers[1].colour.h;
+  const HsvRange h = std::get<ColourParams>(live.config().markers[1].params).h;
   EXPECT_LT(h.lo, h.hi);
   EXPECT_LE(h.lo, 105);  // The blue marker's hue is about 107.
   EXPECT_GE(h.hi, 109);
@@ -132,9 +132,9 @@ TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   // Saving writes what the click did; loading it gives the same ranges.
   live.on_event(UiEvent::Key('s'));
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
-  EXPECT_EQ(saved.markers[1].colour.h.lo, h.lo);
-  EXPECT_EQ(saved.markers[1].colour.h.hi, h.hi);
-  EXPECT_EQ(saved.markers[1].colour.s.lo, live.config().markers[1].colour.s.lo);
+  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.lo, h.lo);
+  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.hi, h.hi);
+  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).s.lo, std::get<ColourParams>(live.config().markers[1].params).s.lo);
 }
 
 TEST_F(LiveControllerTest, ClickOnAFoundMarkerPicksThatMarker) {
@@ -142,19 +142,19 @@ TEST_F(LiveControllerTest, ClickOnAFoundMarkerPicksThatMarker) {
   const SceneTruth truth = Feed(live, 0);
   Click(live, *truth.markers[2].centroid_px);  // Green, while red is active.
   EXPECT_EQ(live.active_marker(), 2);
-  const HsvRange h = live.config().markers[2].colour.h;
+  const HsvRange h = std::get<ColourParams>(live.config().markers[2].params).h;
   EXPECT_LE(h.lo, 60);
   EXPECT_GE(h.hi, 60);
   // A click on the grey background changes nothing and says why.
-  const HsvRange before = live.config().markers[2].colour.h;
+  const HsvRange before = std::get<ColourParams>(live.config().markers[2].params).h;
   Click(live, {5, 5});
   EXPECT_NE(live.message().find("not a coloured marker"), std::string::npos) << live.message();
-  EXPECT_EQ(live.config().markers[2].colour.h.lo, before.lo);
+  EXPECT_EQ(std::get<ColourParams>(live.config().markers[2].params).h.lo, before.lo);
 }
 
 TEST_F(LiveControllerTest, DragSelectsATemplateForTheMarkerInTheBox) {
   TrackingConfig config = SceneConfig();
-  for (MarkerSpec& spec : config.markers) spec.method = "zncc";  // No templates yet.
+  for (MarkerSpec& spec : config.markers) spec.params = ParamsForMethod("zncc", {}, {});  // No templates yet.
   LiveController live(config, Options());
   SceneTruth truth = Feed(live, 0);
   for (int m = 0; m < 3; ++m) EXPECT_FALSE(live.last_result()->markers[m].observation.found());
@@ -163,8 +163,8 @@ TEST_F(LiveControllerTest, DragSelectsATemplateForTheMarkerInTheBox) {
   const cv::Point2d red = *truth.markers[0].centroid_px;
   Drag(live, red - cv::Point2d(14, 14), red + cv::Point2d(14, 14));
   EXPECT_NE(live.message().find("red: reselected"), std::string::npos) << live.message();
-  ASSERT_TRUE(live.config().markers[0].templ.rect);
-  EXPECT_EQ(live.config().markers[0].templ.rect->width, 28);
+  ASSERT_TRUE(std::get<TemplateParams>(live.config().markers[0].params).rect);
+  EXPECT_EQ(std::get<TemplateParams>(live.config().markers[0].params).rect->width, 28);
   live.on_event(UiEvent::Key('3'));
   const cv::Point2d green = *truth.markers[2].centroid_px;
   Drag(live, green + cv::Point2d(14, 14), green - cv::Point2d(14, 14));  // Any direction.
@@ -217,7 +217,7 @@ TEST_F(LiveControllerTest, KeysPauseHelpSelectAndQuit) {
   live.on_event(UiEvent::Trackbar(0, 45));  // H lo of green: unchanged.
   EXPECT_EQ(live.hsv_revision(), revision);
   live.on_event(UiEvent::Trackbar(5, 200));  // V hi.
-  EXPECT_EQ(live.config().markers[2].colour.v.hi, 200);
+  EXPECT_EQ(std::get<ColourParams>(live.config().markers[2].params).v.hi, 200);
   EXPECT_EQ(live.active_hsv()[5], 200);
 
   EXPECT_FALSE(live.quit_requested());
@@ -243,14 +243,42 @@ TEST_F(LiveControllerTest, SwitchingMethodKeepsTrackingWithTemplatesCutWhereMark
   SceneTruth truth;
   for (int i = 0; i < 3; ++i) truth = Feed(live, i);
   live.on_event(UiEvent::Key('m'));
-  const std::string method = live.config().markers[0].method;
+  const std::string method = TrackerMethodName(live.config().markers[0].params);
   EXPECT_NE(method, "colour");
-  for (const MarkerSpec& spec : live.config().markers) EXPECT_EQ(spec.method, method);
+  for (const MarkerSpec& spec : live.config().markers) EXPECT_EQ(TrackerMethodName(spec.params), method);
   EXPECT_NE(live.message().find("method: " + method), std::string::npos);
   for (int i = 3; i < 8; ++i) truth = Feed(live, i);
   // The template trackers' own accuracy on a bending body (their templates include the band
   // behind the marker) is the template tests' business; here: every marker is still followed.
   for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 1.5);
+}
+
+// A marker is one method's parameters; the live window keeps the other method's aside, so a
+// colour pick made while a template is matched waits for the colour method, and switching through
+// every method comes back to it.
+TEST_F(LiveControllerTest, SwitchingBackToColourRestoresTheRangesPickedWhileMatchingTemplates) {
+  LiveController live(SceneConfig(), Options());
+  SceneTruth truth;
+  for (int i = 0; i < 3; ++i) truth = Feed(live, i);
+  live.on_event(UiEvent::Key('m'));  // colour -> sad
+  truth = Feed(live, 3);
+  live.on_event(UiEvent::Key('2'));
+  Click(live, *truth.markers[1].centroid_px);
+  EXPECT_EQ(TrackerMethodName(live.config().markers[1].params), "sad") << "the template stays";
+  EXPECT_NE(live.message().find("(used by the colour method)"), std::string::npos)
+      << live.message();
+  const std::array<int, 6> picked = live.active_hsv();
+  EXPECT_NE(picked, (std::array<int, 6>{95, 125, 80, 255, 40, 255})) << "the pick's own ranges";
+  for (int k = 0; k < 3; ++k) live.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
+  ASSERT_EQ(TrackerMethodName(live.config().markers[1].params), "colour");
+  const ColourParams& blue = std::get<ColourParams>(live.config().markers[1].params);
+  EXPECT_EQ((std::array<int, 6>{blue.h.lo, blue.h.hi, blue.s.lo, blue.s.hi, blue.v.lo, blue.v.hi}),
+            picked);
+  const ColourParams& red = std::get<ColourParams>(live.config().markers[0].params);
+  EXPECT_EQ(red.h.lo, 170);  // Not picked: the config's ranges.
+  EXPECT_EQ(red.h.hi, 10);
+  for (int i = 4; i < 8; ++i) truth = Feed(live, i);
+  for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 0.5);
 }
 
 TEST_F(LiveControllerTest, RecordingIsReproducedByTrackingTheRawVideoWithItsConfig) {
@@ -577,7 +605,7 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
   // 7; then a drag re-cuts blue's template on frame 12, off-centre (a person's box is never
   // centred to the pixel).
   for (int i = 0; i < 3; ++i) live.on_event(UiEvent::Key('m'));
-  ASSERT_EQ(live.config().markers[0].method, "zncc");
+  ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "zncc");
   std::vector<FrameResult> shown = {*live.last_result()};  // Frame 7 with the new templates.
   while (feed.step(live)) {
     shown.push_back(*live.last_result());
@@ -595,9 +623,9 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
     EXPECT_TRUE(fs::exists(dir_ / ("saved." + std::string(marker) + ".png"))) << marker;
   }
   const TrackingConfig reloaded = LoadTrackingConfig(saved);
-  EXPECT_EQ(reloaded.markers[0].templ.template_frame, 7);
-  EXPECT_EQ(reloaded.markers[1].templ.template_frame, 12);
-  EXPECT_EQ(reloaded.markers[1].templ.rect->size(), cv::Size(23, 22));
+  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[0].params).template_frame, 7);
+  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[1].params).template_frame, 12);
+  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[1].params).rect->size(), cv::Size(23, 22));
 
   Track(saved, video, (dir_ / "tracked.csv").string());
   const CsvTable table = ReadCsvTable((dir_ / "tracked.csv").string());
@@ -660,8 +688,8 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   while (feed.step(live)) shown.push_back(*live.last_result());
   live.on_event(UiEvent::Key('s'));
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
-  EXPECT_EQ(saved.markers[1].colour.h.lo, 92);
-  EXPECT_EQ(saved.markers[1].colour.h.hi, 128);
+  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.lo, 92);
+  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
 }
@@ -689,7 +717,7 @@ TEST_F(LiveControllerTest, WhilePausedARangeChangeRetracksTheFrameOnScreenAtOnce
 
 TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRangeRetrackingAtOnce) {
   TrackingConfig config = SceneConfig();
-  config.markers[1].colour.h = {117, 125};  // Blue (hue 112 here) is outside its range.
+  std::get<ColourParams>(config.markers[1].params).h = {117, 125};  // Blue (hue 112 here) is outside its range.
   LiveController live(config, Options());
   SceneTruth truth;
   for (int i = 0; i < 4; ++i) truth = Feed(live, i);
@@ -714,8 +742,8 @@ TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRange
   Click(live, blue);
   EXPECT_EQ(live.last_result()->frame_index, 3);
   ExpectAt(live, 1, truth, 0.3);
-  EXPECT_EQ(live.config().markers[1].colour.h.lo, 112);
-  EXPECT_EQ(live.config().markers[1].colour.h.hi, 125);
+  EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.lo, 112);
+  EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.hi, 125);
   {
     const cv::Mat canvas = live.canvas();
     EXPECT_EQ(canvas.at<cv::Vec3b>(cv::Point(blue)), frame.at<cv::Vec3b>(cv::Point(blue)));
@@ -841,16 +869,16 @@ TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRight
   live.on_event(UiEvent::Mouse(Type::kMouseUp, std::round(on_canvas.x), std::round(on_canvas.y)));
   EXPECT_EQ(live.active_marker(), 1);
   const MarkerSpec& spec = live.config().markers[1];
-  ASSERT_TRUE(spec.colour.roi) << live.message();
-  const cv::Point2d centre(spec.colour.roi->x + spec.colour.roi->width / 2.0,
-                           spec.colour.roi->y + spec.colour.roi->height / 2.0);
+  ASSERT_TRUE(std::get<ColourParams>(spec.params).roi) << live.message();
+  const cv::Point2d centre(std::get<ColourParams>(spec.params).roi->x + std::get<ColourParams>(spec.params).roi->width / 2.0,
+                           std::get<ColourParams>(spec.params).roi->y + std::get<ColourParams>(spec.params).roi->height / 2.0);
   // Rounding the click to a canvas pixel moves it by up to half a canvas pixel, and the box is
   // cut around the nearest image pixel.
   const double scale = live.to_view({1, 0}).x - live.to_view({0, 0}).x;
   EXPECT_NEAR(centre.x, blue.x, 0.5 / scale + 1.0) << live.message();
   EXPECT_NEAR(centre.y, blue.y, 0.5 / scale + 1.0);
-  EXPECT_LT(spec.colour.h.lo, 107);  // Blue's hue, about 107.
-  EXPECT_GT(spec.colour.h.hi, 107);
+  EXPECT_LT(std::get<ColourParams>(spec.params).h.lo, 107);  // Blue's hue, about 107.
+  EXPECT_GT(std::get<ColourParams>(spec.params).h.hi, 107);
 }
 
 class LivePlaybackTest : public LiveFileTest {

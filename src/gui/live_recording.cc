@@ -63,12 +63,15 @@ void LiveRecording::log(ConfigChange change) {
   // The raw video's index of the frame on screen: the recording holds consecutive frames from
   // its first (a camera's dropped frames are not in it, so the source's numbers would not do).
   change.after_frame = std::max<int64_t>(0, frames_ - 1);
-  if (change.kind == ConfigChange::Kind::kRespec) {
-    ColourParams& colour = change.spec.colour;
-    colour.roi_frame = static_cast<int>(std::min<int64_t>(colour.roi_frame, change.after_frame));
-    TemplateParams& templ = change.spec.templ;
-    // A start frame the window set (a reselection's, in the source's numbers) is already behind:
-    // the new tracker starts on the next frame, live and in `track` alike.
+  // A start frame the window set (a reselection's, in the source's numbers) is already behind:
+  // the new tracker starts on the next frame, live and in `track` alike.
+  if (auto* colour = std::get_if<ColourParams>(&change.spec.params);
+      colour && change.kind == ConfigChange::Kind::kRespec) {
+    colour->roi_frame = static_cast<int>(std::min<int64_t>(colour->roi_frame, change.after_frame));
+  }
+  auto* templ_params = std::get_if<TemplateParams>(&change.spec.params);
+  if (templ_params && change.kind == ConfigChange::Kind::kRespec) {
+    TemplateParams& templ = *templ_params;
     templ.template_frame =
         static_cast<int>(std::min<int64_t>(templ.template_frame, change.after_frame));
     if (!templ.image.empty()) {
@@ -80,7 +83,7 @@ void LiveRecording::log(ConfigChange change) {
       if (!cv::imwrite(path, templ.image)) {
         throw InputError(path + ": cannot write the template image");
       }
-      templ.image_file = name;  // Relative to the config, as the reader resolves it.
+      change.template_file = name;  // Relative to the config, as the reader resolves it.
     }
   }
   saved_.changes.push_back(std::move(change));
@@ -95,13 +98,15 @@ TrackingConfig RecordingStartConfig(const TrackingConfig& config,
   for (size_t i = 0; i < start.markers.size() && i < boxes.size(); ++i) {
     if (!boxes[i]) continue;
     MarkerSpec& spec = start.markers[i];
-    spec.colour.roi = *boxes[i];
-    spec.colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
-    if (IsTemplateMethod(spec.method)) {
-      spec.templ.rect = *boxes[i];
-      spec.templ.template_frame = 0;
-      spec.templ.image = cv::Mat();
-      spec.templ.image_file.clear();
+    if (auto* templ = std::get_if<TemplateParams>(&spec.params)) {
+      templ->rect = *boxes[i];
+      templ->template_frame = 0;
+      templ->image = cv::Mat();
+      start.template_files.erase(spec.name);
+    } else {
+      ColourParams& colour = std::get<ColourParams>(spec.params);
+      colour.roi = *boxes[i];
+      colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
     }
   }
   return start;
@@ -116,16 +121,17 @@ namespace {
 TrackingConfig WithTemplateImages(const TrackingConfig& config, const std::string& path) {
   TrackingConfig saved = config;
   const std::filesystem::path file(path);
-  for (MarkerSpec& spec : saved.markers) {
-    if (!IsTemplateMethod(spec.method) || spec.templ.image.empty()) continue;
+  for (const MarkerSpec& spec : saved.markers) {
+    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+    if (!templ || templ->image.empty()) continue;
     const std::string name = file.stem().string() + "." + spec.name + ".png";
     const std::string image_path = (file.parent_path() / name).string();
-    if (!cv::imwrite(image_path, spec.templ.image)) {
+    if (!cv::imwrite(image_path, templ->image)) {
       throw InputError(image_path + ": cannot write the template image");
     }
     // Relative to the config, as the reader resolves it. A template selected live keeps its rect
     // and frame: `track` starts it there and then, as the selection did.
-    spec.templ.image_file = name;
+    saved.template_files[spec.name] = name;
   }
   return saved;
 }

@@ -22,10 +22,10 @@ using testing::TempDir;
 MarkerSpec ColourMarker(const std::string& name, HsvRange h) {
   MarkerSpec spec;
   spec.name = name;
-  spec.method = "colour";
-  spec.colour.h = h;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
+  ColourParams& colour = spec.params.emplace<ColourParams>();
+  colour.h = h;
+  colour.s = {80, 255};
+  colour.v = {40, 255};
   return spec;
 }
 

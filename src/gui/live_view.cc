@@ -113,11 +113,11 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
     cv::putText(top, label, origin, kFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(top, label, origin, kFont, text * 0.8, colour, 1, cv::LINE_AA);
   }
-  const ColourParams& c = state.active->colour;
+  const auto* c = std::get_if<ColourParams>(&state.active->params);  // A mask is a colour's.
   const std::string title =
       "MASK " + state.active->name +
-      (has_mask ? ": h " + RangeText(c.h) + " s " + RangeText(c.s) + " v " + RangeText(c.v)
-                : ": " + state.active->method + " has no colour mask");
+      (has_mask && c ? ": h " + RangeText(c->h) + " s " + RangeText(c->s) + " v " + RangeText(c->v)
+                     : ": " + TrackerMethodName(state.active->params) + " has no colour mask");
   cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
   cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
 }

@@ -70,9 +70,10 @@ void BM_LiveControllerFrame(benchmark::State& state) {
   auto marker = [](const char* name, HsvRange h) {
     MarkerSpec spec;
     spec.name = name;
-    spec.colour.h = h;
-    spec.colour.s = {80, 255};
-    spec.colour.v = {40, 255};
+    ColourParams& colour = spec.params.emplace<ColourParams>();
+    colour.h = h;
+    colour.s = {80, 255};
+    colour.v = {40, 255};
     return spec;
   };
   config.markers = {marker("red", {170, 10}), marker("blue", {95, 125}),

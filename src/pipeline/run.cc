@@ -13,7 +13,8 @@ namespace {
 // tracked on gray video as well; only the others make a gray video an error.
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
-    if (IsTemplateMethod(spec.method) ? spec.templ.colour : spec.colour.NeedsColour()) return true;
+    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+    if (templ ? templ->colour : std::get<ColourParams>(spec.params).NeedsColour()) return true;
   }
   return false;
 }

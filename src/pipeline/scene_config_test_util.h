@@ -13,9 +13,10 @@ namespace softsight::testing {
 inline MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
   MarkerSpec spec;
   spec.name = name;
-  spec.colour.h = hue;
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
+  ColourParams& colour = std::get<ColourParams>(spec.params);
+  colour.h = hue;
+  colour.s = {80, 255};
+  colour.v = {40, 255};
   return spec;
 }
 

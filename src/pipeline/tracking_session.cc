@@ -19,13 +19,13 @@ namespace {
 // the marker; the colour tracker's window is at least 4 marker radii (its documented minimum).
 double MarkerSizePx(const MarkerSpec& spec) {
   double size = 0.0;
-  if (IsTemplateMethod(spec.method)) {
-    if (spec.templ.rect) size = 0.5 * std::max(spec.templ.rect->width, spec.templ.rect->height);
-    if (!spec.templ.image.empty()) size = 0.5 * std::max(spec.templ.image.cols, spec.templ.image.rows);
-  } else if (spec.colour.roi) {
-    size = 0.5 * std::max(spec.colour.roi->width, spec.colour.roi->height);
-  } else if (spec.colour.window_px > 0) {
-    size = 0.25 * spec.colour.window_px;
+  if (const auto* templ = std::get_if<TemplateParams>(&spec.params)) {
+    if (templ->rect) size = 0.5 * std::max(templ->rect->width, templ->rect->height);
+    if (!templ->image.empty()) size = 0.5 * std::max(templ->image.cols, templ->image.rows);
+  } else if (const ColourParams& colour = std::get<ColourParams>(spec.params); colour.roi) {
+    size = 0.5 * std::max(colour.roi->width, colour.roi->height);
+  } else if (colour.window_px > 0) {
+    size = 0.25 * colour.window_px;
   }
   return std::clamp(size > 0.0 ? size : 16.0, 4.0, 64.0);
 }
@@ -216,16 +216,17 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     // on the config's template frame would cut whatever is there, not this marker), which a
     // saved config writes as an image file beside itself, with where and on which frame it was
     // selected, so that `track` starts it there and then, as here.
-    if (IsTemplateMethod(config_.markers[i].method)) {
-      TemplateParams& templ = config_.markers[i].templ;
-      templ.rect = rect;
-      templ.template_frame = static_cast<int>(std::max<int64_t>(0, frame.index));
-      templ.image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
-      templ.image_file.clear();
+    const int frame_index = static_cast<int>(std::max<int64_t>(0, frame.index));
+    if (auto* templ = std::get_if<TemplateParams>(&config_.markers[i].params)) {
+      templ->rect = rect;
+      templ->template_frame = frame_index;
+      templ->image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
+      config_.template_files.erase(marker);  // The file holds the old template.
     } else {
       // The roi holds from this frame on: at frame 0 the marker was elsewhere.
-      config_.markers[i].colour.roi = rect;
-      config_.markers[i].colour.roi_frame = static_cast<int>(std::max<int64_t>(0, frame.index));
+      ColourParams& colour = std::get<ColourParams>(config_.markers[i].params);
+      colour.roi = rect;
+      colour.roi_frame = frame_index;
     }
     // The selection's frame is tracked by the new tracker at once, as `track` tracks a template's
     // reference frame: the window shows the new result now, and the tracker has seen the frames
@@ -270,6 +271,12 @@ void TrackingSession::respec(const MarkerSpec& spec) {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (config_.markers[i].name != spec.name) continue;
     trackers_[i] = CreateTracker(spec);
+    // A template file names the pixels it was read into; a spec without them is no longer it.
+    const auto* before = std::get_if<TemplateParams>(&config_.markers[i].params);
+    const auto* after = std::get_if<TemplateParams>(&spec.params);
+    if (!before || !after || before->image.data != after->image.data) {
+      config_.template_files.erase(spec.name);
+    }
     config_.markers[i] = spec;
     initialised_[i] = false;
     plausibility_->forget(i);

@@ -387,8 +387,7 @@ TEST(TrackerRegistry, TellsTemplateMethodsFromColour) {
 TEST(TrackerRegistry, BuildsColourTrackersAndRejectsBadSpecs) {
   MarkerSpec spec;
   spec.name = "tip";
-  spec.method = "colour";
-  spec.colour = RedParams();
+  spec.params = RedParams();
   std::unique_ptr<Tracker> tracker = CreateTracker(spec);
   cv::Mat image = Background();
   const cv::Point2d truth = PaintDisc(image, {77.7, 55.5}, 6, kRed);
@@ -399,16 +398,15 @@ TEST(TrackerRegistry, BuildsColourTrackersAndRejectsBadSpecs) {
   const std::vector<std::string> methods = TrackerMethods();
   EXPECT_EQ(methods.front(), "colour");
 
-  spec.method = "telepathy";
   try {
-    CreateTracker(spec);
+    ParamsForMethod("telepathy", {}, {});
     FAIL() << "unknown method accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("telepathy"), std::string::npos);
-    EXPECT_NE(std::string(e.what()).find("'tip'"), std::string::npos);
   }
-  spec.method = "colour";
-  spec.colour.window_px = 3;
+  ColourParams small_window;
+  small_window.window_px = 3;
+  spec.params = small_window;
   try {
     CreateTracker(spec);
     FAIL() << "bad window accepted";

@@ -31,8 +31,6 @@ OptionTable<TemplateParams> MakeTable() {
           .Range(0, 65535)
           .Unit("px")
           .Doc("[x, y, w, h] on the reference frame (what the mouse drags; with file: where it was)"),
-      StringOption<P>("template.file", &P::image_file)
-          .Doc("template image, relative to the config file (with rect: selected there live)"),
       BoolOption<P>("template.colour", &P::colour)
           .Doc("match BGR, not gray (3x the work; tells look-alike markers apart)"),
       BoolOption<P>("template.contrast_gray", &P::contrast_gray)

@@ -647,8 +647,7 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
     tracking_ = true;
     scan_pending_ = true;
   } else {
-    const std::string where =
-        params_.image_file.empty() ? std::string("template image") : params_.image_file;
+    const std::string where = "template image";
     if (params_.image.empty()) {
       throw InputError(
           "template: none given (set template.rect or template.file, or select the "
@@ -664,7 +663,7 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
       native = params_.image;
     } else {
       projection_ = previous;
-      throw InputError(where + ": template image must be 8-bit BGR" +
+      throw InputError(where + " must be 8-bit BGR" +
                        std::string(params_.colour ? " for colour matching" : " or gray"));
     }
     try {
@@ -1089,9 +1088,8 @@ bool TemplateParams::Check(std::string* error) const {
   }
   if (rect && !image.empty() && rect->size() != image.size()) {
     // With an image, rect says where it was selected: the image's own size.
-    const std::string named = image_file.empty() ? std::string() : " '" + image_file + "'";
-    return Fail(error, "template.rect: " + RectText(*rect) + " is not the size of the image" +
-                           named + " (" + std::to_string(image.cols) + "x" +
+    return Fail(error, "template.rect: " + RectText(*rect) + " is not the size of the image (" +
+                           std::to_string(image.cols) + "x" +
                            std::to_string(image.rows) + " px)");
   }
   const int cn = colour ? 3 : 1;

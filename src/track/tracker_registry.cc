@@ -1,4 +1,5 @@
-// The name -> factory table behind CreateTracker: adding a method is one row.
+// The method names and what each builds, the only place they are spelled: adding a method is one
+// row (and, for a new kind of tracker, one MarkerParams alternative).
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,12 +11,20 @@
 namespace softsight {
 namespace {
 
-using Factory = std::unique_ptr<Tracker> (*)(const MarkerSpec& spec);
-
+// A method: its name (spelled here only), the parameter set it uses, and for template matching
+// its measure.
 struct Method {
   const char* name;
-  Factory create;
   bool uses_template;
+  MatchMeasure measure;  // Template methods only.
+};
+
+// In the order --help lists them.
+const Method kMethods[] = {
+    {"colour", false, MatchMeasure::kZncc},
+    {"sad", true, MatchMeasure::kSad},
+    {"ssd", true, MatchMeasure::kSsd},
+    {"zncc", true, MatchMeasure::kZncc},
 };
 
 // Each factory checks its own parameters, so the error names the marker and the bad field.
@@ -23,29 +32,11 @@ struct Method {
   throw InputError("marker '" + spec.name + "': " + problem);
 }
 
-std::unique_ptr<Tracker> CreateColour(const MarkerSpec& spec) {
-  std::string problem;
-  if (!spec.colour.Check(&problem)) BadParams(spec, problem);
-  return std::make_unique<ColourTracker>(spec.colour);
+std::string MethodList() {
+  std::string list;
+  for (const Method& method : kMethods) list += (list.empty() ? "" : ", ") + std::string(method.name);
+  return list;
 }
-
-// Template matching: the method name picks the measure.
-template <MatchMeasure kMeasure>
-std::unique_ptr<Tracker> CreateTemplate(const MarkerSpec& spec) {
-  TemplateParams params = spec.templ;
-  params.measure = kMeasure;
-  std::string problem;
-  if (!params.Check(&problem)) BadParams(spec, problem);
-  return CreateTemplateTracker(params);
-}
-
-// In the order --help lists them.
-const Method kMethods[] = {
-    {"colour", &CreateColour, false},
-    {"sad", &CreateTemplate<MatchMeasure::kSad>, true},
-    {"ssd", &CreateTemplate<MatchMeasure::kSsd>, true},
-    {"zncc", &CreateTemplate<MatchMeasure::kZncc>, true},
-};
 
 }  // namespace
 
@@ -73,13 +64,36 @@ const char* CandidateVerdictName(CandidateVerdict verdict) {
 }
 
 std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec) {
-  for (const Method& method : kMethods) {
-    if (spec.method == method.name) return method.create(spec);
+  std::string problem;
+  if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
+    if (!colour->Check(&problem)) BadParams(spec, problem);
+    return std::make_unique<ColourTracker>(*colour);
   }
-  std::string list;
-  for (const Method& method : kMethods) list += (list.empty() ? "" : ", ") + std::string(method.name);
-  throw InputError("marker '" + spec.name + "': unknown method '" + spec.method + "' (choose " +
-                   list + ")");
+  const TemplateParams& templ = std::get<TemplateParams>(spec.params);
+  if (!templ.Check(&problem)) BadParams(spec, problem);
+  return CreateTemplateTracker(templ);
+}
+
+std::string TrackerMethodName(const MarkerParams& params) {
+  const auto* templ = std::get_if<TemplateParams>(&params);
+  for (const Method& method : kMethods) {
+    if (method.uses_template == (templ != nullptr) && (!templ || method.measure == templ->measure)) {
+      return method.name;
+    }
+  }
+  return kMethods[0].name;  // Unreachable: every measure has its method.
+}
+
+MarkerParams ParamsForMethod(const std::string& method, const ColourParams& colour,
+                             const TemplateParams& templ) {
+  for (const Method& m : kMethods) {
+    if (method != m.name) continue;
+    if (!m.uses_template) return colour;
+    TemplateParams params = templ;
+    params.measure = m.measure;
+    return params;
+  }
+  throw InputError("unknown method '" + method + "' (choose " + MethodList() + ")");
 }
 
 const char* DefaultTrackerMethod(bool has_template) { return has_template ? "zncc" : "colour"; }

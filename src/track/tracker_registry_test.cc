@@ -52,7 +52,7 @@ cv::Rect RectAround(const cv::Point2d& centre, int side) {
 MarkerSpec SpecFor(const std::string& method, const std::string& name = "m") {
   MarkerSpec spec;
   spec.name = name;
-  spec.method = method;
+  spec.params = ParamsForMethod(method, {}, {});
   return spec;
 }
 
@@ -71,9 +71,8 @@ TEST(TrackerRegistry, EveryMethodIsBuiltByItsNameAndTheDefaultsAreRegistered) {
   for (const std::string& method : methods) {
     EXPECT_NE(CreateTracker(SpecFor(method)), nullptr) << method;
   }
-  const MarkerSpec unknown = SpecFor("optical_flow");
   try {
-    CreateTracker(unknown);
+    ParamsForMethod("optical_flow", {}, {});
     FAIL() << "an unknown method must be refused";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("optical_flow"), std::string::npos) << e.what();
@@ -82,6 +81,28 @@ TEST(TrackerRegistry, EveryMethodIsBuiltByItsNameAndTheDefaultsAreRegistered) {
     }
   }
   EXPECT_FALSE(IsTemplateMethod("optical_flow"));
+}
+
+// A marker is one method's parameters: the registry turns a method name into them (keeping the
+// given parameters of that kind) and names the method they select, and nothing else spells it.
+TEST(TrackerRegistry, MethodNamesAndParametersMapOneToOne) {
+  ColourParams colour;
+  colour.window_px = 40;
+  TemplateParams templ;
+  templ.colour = true;
+  templ.min_zncc = 0.7;
+  for (const std::string& method : TrackerMethods()) {
+    const MarkerParams params = ParamsForMethod(method, colour, templ);
+    EXPECT_EQ(TrackerMethodName(params), method);
+    EXPECT_EQ(std::holds_alternative<TemplateParams>(params), IsTemplateMethod(method)) << method;
+    if (const auto* t = std::get_if<TemplateParams>(&params)) {
+      EXPECT_TRUE(t->colour) << method;
+      EXPECT_DOUBLE_EQ(t->min_zncc, 0.7) << method;
+    } else {
+      EXPECT_EQ(std::get<ColourParams>(params).window_px, 40);
+    }
+  }
+  EXPECT_EQ(TrackerMethodName(MarkerSpec{}.params), "colour");
 }
 
 // A rectangle on frame 3 names where the marker is on frame 3: the tracker waits for that frame,
@@ -93,8 +114,9 @@ TEST(TrackerRegistry, TemplateTrackerStartsItselfOnItsTemplateFrame) {
     if (!IsTemplateMethod(method)) continue;
     for (size_t m = 0; m < s.truth[0].markers.size(); ++m) {
       MarkerSpec spec = SpecFor(method, s.truth[0].markers[m].name);
-      spec.templ.template_frame = kTemplateFrame;
-      spec.templ.rect = RectAround(*s.truth[kTemplateFrame].markers[m].centroid_px, kTemplatePx);
+      TemplateParams& templ = std::get<TemplateParams>(spec.params);
+      templ.template_frame = kTemplateFrame;
+      templ.rect = RectAround(*s.truth[kTemplateFrame].markers[m].centroid_px, kTemplatePx);
       const auto tracker = CreateTracker(spec);
       for (int i = 0; i < kTemplateFrame; ++i) {
         EXPECT_FALSE(tracker->start(s.frames[i])) << method << " frame " << i;
@@ -122,10 +144,11 @@ TEST(TrackerRegistry, TemplateTrackerFromAnImageStartsOnTheFirstFrame) {
   const Sequence& s = Rendered();
   const size_t m = 1;
   MarkerSpec spec = SpecFor(DefaultTrackerMethod(true));
-  spec.templ.colour = true;
-  spec.templ.image =
+  TemplateParams& templ = std::get<TemplateParams>(spec.params);
+  templ.colour = true;
+  templ.image =
       s.frames[0].image(RectAround(*s.truth[0].markers[m].centroid_px, kTemplatePx)).clone();
-  spec.templ.template_frame = kFrames;  // Where a rect would be cut; an image needs no frame.
+  templ.template_frame = kFrames;  // Where a rect would be cut; an image needs no frame.
   const auto tracker = CreateTracker(spec);
   ASSERT_TRUE(tracker->start(s.frames[0]));
   for (int i = 0; i < kFrames; ++i) {
@@ -138,11 +161,12 @@ TEST(TrackerRegistry, ColourTrackerStartsOnItsFirstFrameWithinItsRoi) {
   const Sequence& s = Rendered();
   MarkerSpec spec = SpecFor(DefaultTrackerMethod(false));
   // Every colour is a marker: what is found depends only on where the tracker may look.
-  spec.colour.h = {0, 179};
-  spec.colour.s = {80, 255};
-  spec.colour.v = {40, 255};
+  ColourParams& colour = std::get<ColourParams>(spec.params);
+  colour.h = {0, 179};
+  colour.s = {80, 255};
+  colour.v = {40, 255};
   for (size_t m = 0; m < s.truth[0].markers.size(); ++m) {
-    spec.colour.roi = RectAround(*s.truth[0].markers[m].centroid_px, 2 * kTemplatePx);
+    colour.roi = RectAround(*s.truth[0].markers[m].centroid_px, 2 * kTemplatePx);
     const auto tracker = CreateTracker(spec);
     ASSERT_TRUE(tracker->start(s.frames[0]));
     EXPECT_LT(ErrorPx(tracker->update(s.frames[0].image), s.truth[0].markers[m]), 0.3)

@@ -3,6 +3,7 @@
 // examples/markers.yaml documents every key.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,17 +42,28 @@ struct ConfigChange {
   MarkerSpec spec;     // kRespec: the marker's new spec (spec.name says which marker).
   std::string marker;  // kReselect, kRetrack: which marker.
   cv::Rect rect;       // kReselect: where the marker is on frame `after_frame`.
+  // kRespec: the image file of spec's template (as TrackingConfig::template_files), "" if none.
+  std::string template_file;
 
-  static ConfigChange Respec(const MarkerSpec& spec) { return {Kind::kRespec, 0, spec, spec.name, {}}; }
-  static ConfigChange Reselect(const std::string& marker, const cv::Rect& rect) {
-    return {Kind::kReselect, 0, {}, marker, rect};
+  static ConfigChange Respec(const MarkerSpec& spec) {
+    return {Kind::kRespec, 0, spec, spec.name, {}, {}};
   }
-  static ConfigChange Retrack(const std::string& marker) { return {Kind::kRetrack, 0, {}, marker, {}}; }
-  static ConfigChange ResetTipReference() { return {Kind::kResetTipReference, 0, {}, {}, {}}; }
+  static ConfigChange Reselect(const std::string& marker, const cv::Rect& rect) {
+    return {Kind::kReselect, 0, {}, marker, rect, {}};
+  }
+  static ConfigChange Retrack(const std::string& marker) {
+    return {Kind::kRetrack, 0, {}, marker, {}, {}};
+  }
+  static ConfigChange ResetTipReference() { return {Kind::kResetTipReference, 0, {}, {}, {}, {}}; }
 };
 
 struct TrackingConfig {
   std::vector<MarkerSpec> markers;
+  // Marker name -> the image file its template was read from (`template.file`, as written:
+  // relative to the config file), so that a saved config names it again. The pixels themselves
+  // are the marker's TemplateParams::image; a template selected anew has no file until a saver
+  // (the live window's `s`) writes one.
+  std::map<std::string, std::string> template_files;
   MeasureOptions measure;              // Triple, chain, tip reference, metric model.
   // Lens model from `softsight calibrate` (the `camera:` key, relative to the config file).
   // Trackers work on the frames as recorded; measurements use undistorted marker positions.

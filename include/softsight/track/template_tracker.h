@@ -75,8 +75,8 @@ inline constexpr int kMaxTemplateValues = 33025;
 struct TemplateParams {
   MatchMeasure measure = MatchMeasure::kZncc;
   bool colour = false;  // Match on BGR instead of gray (3x the work).
-  // Where the template comes from: a rectangle on a reference frame, or an image file (loaded by
-  // the caller into `image`, BGR or gray). When `image` is empty the tracker takes it from init()'s
+  // Where the template comes from: a rectangle on a reference frame, or an image (read by the
+  // caller, e.g. the config reader from `template.file`, into `image`, BGR or gray). When `image` is empty the tracker takes it from init()'s
   // hint. A non-empty hint always wins (that is how a person re-selects a template at run time).
   // With both `image` and `rect` (a template selected live and saved), the image is the template
   // and `rect`, its size, is where it was selected on `template_frame`: init() without a hint
@@ -84,7 +84,6 @@ struct TemplateParams {
   int template_frame = 0;
   std::optional<cv::Rect> rect;
   cv::Mat image;
-  std::string image_file;  // Where `image` was read from, so a saved config names it.
   // Match only the ellipse inscribed in the template rectangle (a disc for a square one), so the
   // background in the rectangle's corners, which rotates with the body or is clutter behind a
   // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a

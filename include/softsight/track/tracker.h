@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -80,24 +81,37 @@ class Tracker {
   virtual std::optional<cv::Rect> search_region() const;
 };
 
-// The method of a marker whose config names none: template matching (zncc) when it has a
-// template, else colour.
-const char* DefaultTrackerMethod(bool has_template);
+// A marker's tracking parameters: one of the methods' parameter sets. ColourParams: colour (or
+// gray-level) thresholding; TemplateParams: template matching, whose measure (sad, ssd, zncc) and
+// gray/colour choice it carries. The other method's parameters are not part of a marker: the live
+// window remembers them while a person switches methods.
+using MarkerParams = std::variant<ColourParams, TemplateParams>;
 
 // Everything needed to build the tracker of one marker.
 struct MarkerSpec {
-  std::string name;                   // Unique; prefixes the marker's CSV columns.
-  std::string method = DefaultTrackerMethod(false);  // A name from TrackerMethods().
-  ColourParams colour;                // Used by the colour method.
-  TemplateParams templ;               // Used by the template methods.
+  std::string name;     // Unique; prefixes the marker's CSV columns.
+  MarkerParams params;  // Colour by default.
 };
 
-// Builds the tracker for `spec.method`. Throws InputError naming the marker when the method is
-// unknown or its parameters fail their Check().
+// Builds the tracker for `spec.params`. Throws InputError naming the marker when its parameters
+// fail their Check().
 std::unique_ptr<Tracker> CreateTracker(const MarkerSpec& spec);
 
-// The names CreateTracker accepts, in the order --help lists them.
+// The method names (the registry's, the only place they are spelled), in the order --help lists
+// them: colour, sad, ssd, zncc.
 std::vector<std::string> TrackerMethods();
+
+// The name of the method `params` select ("colour", or the template's measure: "sad", ...).
+std::string TrackerMethodName(const MarkerParams& params);
+
+// The parameters of `method`: `colour` for the colour method, else `templ` with the method's
+// measure. Throws InputError listing the methods when `method` is not one of them.
+MarkerParams ParamsForMethod(const std::string& method, const ColourParams& colour,
+                             const TemplateParams& templ);
+
+// The method of a marker whose config names none: template matching (zncc) when it has a
+// template, else colour.
+const char* DefaultTrackerMethod(bool has_template);
 
 // True for the methods that match a template (sad, ssd, zncc): they need a template rectangle or
 // image, and a person selects the marker by dragging a box. False for colour and unknown names.
