@@ -1,9 +1,7 @@
 // `softsight track --camera`'s end summary: the latency from capture to the result, to the CSV
 // row and to every output, and the frames a recording could not take, counted exactly. A camera's
 // stand-in and a held encoder (TrackSeams) make the encoder fall behind without any timing.
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,6 +9,7 @@
 #include "app/scene_markers_test_util.h"
 #include "app/track_command.h"
 #include "core/test_util.h"
+#include "io/encoder_gate_test_util.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/sim/scene.h"
 
@@ -18,27 +17,9 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::EncoderGate;
+using testing::FramesInVideo;
 using testing::TempDir;
-
-// Holds a recording's encoder in front of its first frame until opened.
-class EncoderGate {
- public:
-  void wait(int64_t index) {
-    if (index != 0) return;
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return open_; });
-  }
-  void open() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    open_ = true;
-    changed_.notify_all();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  bool open_ = false;
-};
 
 // A camera's stand-in: rendered frames handed over on the pipeline's thread, live (so the
 // recording drops what its encoder cannot take, as for a camera). At its end it opens the gate:
@@ -68,24 +49,22 @@ class CameraStandIn : public FrameSource {
   std::unique_ptr<FrameSource> scene_;
 };
 
-int64_t FramesIn(const std::string& video) {
-  std::unique_ptr<FrameSource> source = OpenFrameSource({video, {}, 30.0});
-  Frame frame;
-  int64_t frames = 0;
-  while (source->read(frame)) ++frames;
-  return frames;
-}
-
-TEST(TrackCamera, SummaryGivesTheLatenciesAndCountsEveryFrameTheRecordingDropped) {
-  TempDir dir;
+// A camera run's options: a CSV and a raw recording in `dir`, no progress or summary printed.
+TrackOptions CameraRun(const TempDir& dir) {
   testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
-  static constexpr int kFrames = 16;
-  EncoderGate gate;
   TrackOptions options;
   options.config_file = dir.file("markers.yaml");
   options.csv_file = dir.file("run.csv");
   options.record_file = dir.file("rec.avi");
   options.quiet = true;
+  return options;
+}
+
+TEST(TrackCamera, SummaryGivesTheLatenciesAndCountsEveryFrameTheRecordingDropped) {
+  TempDir dir;
+  static constexpr int kFrames = 16;
+  EncoderGate gate;
+  const TrackOptions options = CameraRun(dir);
   TrackSeams seams;
   seams.open_source = [&gate] { return std::make_unique<CameraStandIn>(kFrames, gate); };
   seams.before_encode = [&gate](int64_t index) { gate.wait(index); };
@@ -94,7 +73,7 @@ TEST(TrackCamera, SummaryGivesTheLatenciesAndCountsEveryFrameTheRecordingDropped
   ASSERT_EQ(summary.frames, kFrames);
   // The encoder held at frame 0 and its queue of 8 full: at least the frames after the queue
   // were dropped, and the count is exactly what is missing from the video.
-  const int64_t recorded = FramesIn(dir.file("rec.avi"));
+  const int64_t recorded = FramesInVideo(dir.file("rec.avi"));
   const int64_t dropped = kFrames - recorded;
   EXPECT_GE(dropped, kFrames - 9);
   EXPECT_GE(recorded, 1);
@@ -116,18 +95,13 @@ TEST(TrackCamera, SummaryGivesTheLatenciesAndCountsEveryFrameTheRecordingDropped
 
 TEST(TrackCamera, ACameraRunSaysSoAlsoWhenTheRecordingLostNothing) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
   EncoderGate gate;
   gate.open();  // The encoder keeps up: a queue of 8 for 4 frames.
-  TrackOptions options;
-  options.config_file = dir.file("markers.yaml");
-  options.csv_file = dir.file("run.csv");
-  options.record_file = dir.file("rec.avi");
-  options.quiet = true;
+  const TrackOptions options = CameraRun(dir);
   TrackSeams seams;
   seams.open_source = [&gate] { return std::make_unique<CameraStandIn>(4, gate); };
   const RunSummary summary = RunTrack(options, nullptr, {}, seams);
-  EXPECT_EQ(FramesIn(dir.file("rec.avi")), 4);
+  EXPECT_EQ(FramesInVideo(dir.file("rec.avi")), 4);
   EXPECT_THAT(summary.FullReport(), HasSubstr(dir.file("rec.avi") + ": 0 of 4 frames not recorded (the encoder kept up)"));
 }
 

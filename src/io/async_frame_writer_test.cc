@@ -1,7 +1,5 @@
 #include "softsight/io/async_frame_writer.h"
 
-#include <condition_variable>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -9,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/test_util.h"
+#include "io/encoder_gate_test_util.h"
 #include "softsight/io/frame_source.h"
 
 namespace softsight {
@@ -64,30 +63,10 @@ TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExac
   }
 }
 
-// Holds the encoder in front of the first frame until released.
-class EncoderGate {
- public:
-  void wait(int64_t index) {
-    if (index != 0) return;
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return open_; });
-  }
-  void open() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    open_ = true;
-    changed_.notify_all();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  bool open_ = false;
-};
-
 TEST(AsyncFrameWriter, ACameraRecordingDropsAndCountsWhatTheEncoderCannotTake) {
   TempDir dir;
   const std::string path = dir.file("rec.avi");
-  EncoderGate gate;
+  testing::EncoderGate gate;  // Holds frame 0.
   {
     AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kDrop, /*capacity=*/2,
                             [&gate](int64_t index) { gate.wait(index); });
