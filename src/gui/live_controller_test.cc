@@ -694,6 +694,70 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
 }
 
+// Every kind of live edit made while a recording runs reaches the recording's config: track on
+// the raw video with it gives the window's rows, before and after each edit.
+TEST_F(LiveFileTest, EditsWhileRecordingAreKeptInTheRecordingsConfigThatTrackReproduces) {
+  const std::string video = WriteVideo(24);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveOptions options = Options();
+  options.record_fps = 30.0;
+  LiveController live(SceneConfig(), options);
+  LiveFeed feed(*source);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key('r'));  // Recording from frame 2.
+  ASSERT_TRUE(live.recording()) << live.message();
+  while (feed.step(live)) {
+    const int64_t frame = live.last_result()->frame_index;
+    if (frame == 4) {  // Blue's hue moved with the trackbars (a respec).
+      live.on_event(UiEvent::Key('2'));
+      live.on_event(UiEvent::Trackbar(0, 92));
+      live.on_event(UiEvent::Trackbar(1, 128));
+    } else if (frame == 6) {  // Every marker to SAD: templates cut where they are (respec, reselect).
+      live.on_event(UiEvent::Key('m'));
+      ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "sad") << live.message();
+    } else if (frame == 8) {  // Blue's template re-cut by a drag, off-centre.
+      const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+      Drag(live, blue - cv::Point2d(10, 12), blue + cv::Point2d(13, 10));
+      ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
+    } else if (frame == 10) {  // A new bending-distance reference.
+      live.on_event(UiEvent::Key('b'));
+    } else if (frame == 12) {  // Paused: red's colour ranges, kept aside while it matches a
+                               // template, change; the session does not (no change is logged).
+      live.on_event(UiEvent::Key(' '));
+      live.on_event(UiEvent::Key('1'));
+      live.on_event(UiEvent::Trackbar(2, 70));
+      live.on_event(UiEvent::Key(' '));
+    } else if (frame == 15) {
+      live.on_event(UiEvent::Key('r'));
+      ASSERT_FALSE(live.recording());
+    }
+  }
+  const std::string prefix = live.last_recording();
+  const TrackingConfig recorded = LoadTrackingConfig(prefix + ".yaml");
+  // 2 respecs (one a trackbar each), 3 x (respec + reselect), 1 reselect, 1 reset.
+  ASSERT_EQ(recorded.changes.size(), 10u);
+  EXPECT_EQ(recorded.changes.front().after_frame, 2);  // Frame 4 is the recording's frame 2.
+  EXPECT_EQ(recorded.changes.back().kind, ConfigChange::Kind::kResetTipReference);
+  EXPECT_EQ(recorded.changes.back().after_frame, 8);
+  const ConfigChange& drag = recorded.changes[8];
+  EXPECT_EQ(drag.kind, ConfigChange::Kind::kReselect);
+  EXPECT_EQ(drag.marker, "blue");
+  EXPECT_EQ(drag.rect.size(), cv::Size(23, 22));
+  EXPECT_EQ(TrackerMethodName(recorded.markers[1].params), "colour") << "the start stays as it was";
+
+  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+  ASSERT_EQ(live_rows.size(), 15u);  // Header and frames 2..15.
+  EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+  // Without the edits the rows differ after the first of them: the test can fail.
+  TrackingConfig unedited = recorded;
+  unedited.changes.clear();
+  SaveTrackingConfig(unedited, (dir_ / "unedited.yaml").string());
+  Track((dir_ / "unedited.yaml").string(), prefix + ".raw.avi", (dir_ / "unedited.csv").string());
+  EXPECT_NE(CsvRowsWithoutTiming((dir_ / "unedited.csv").string()), live_rows);
+}
+
 TEST_F(LiveControllerTest, WhilePausedARangeChangeRetracksTheFrameOnScreenAtOnce) {
   LiveController live(SceneConfig(), Options());
   SceneTruth truth;
