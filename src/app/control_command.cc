@@ -240,7 +240,7 @@ class RigClockSink : public FrameSink {
   std::optional<double> previous_s_;
 };
 
-std::string FormatNumber(double v) {
+std::string ShortNumber(double v) {
   char text[32];
   std::snprintf(text, sizeof(text), "%g", v);
   return text;
@@ -265,8 +265,8 @@ void CheckOption(const char* option, const std::optional<double>& value, double 
   const double v = *value;
   const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
   if (!ok) {
-    throw InputError(std::string(option) + " " + FormatNumber(v) + ": must be a number in " +
-                     (lo_open ? "(" : "[") + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+    throw InputError(std::string(option) + " " + ShortNumber(v) + ": must be a number in " +
+                     (lo_open ? "(" : "[") + ShortNumber(lo) + ", " + ShortNumber(hi) + "]");
   }
 }
 
@@ -450,9 +450,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     std::fprintf(stderr,
                  "control: --pressure-kpa %s is above the limit of %s kPa (control.controller."
                  "max_kpa, at most the board's limit); sending %s kPa\n",
-                 FormatNumber(*asked).c_str(),
-                 FormatNumber(session.controller().options().max_kpa).c_str(),
-                 FormatNumber(session.pressure_target_kpa()).c_str());
+                 ShortNumber(*asked).c_str(),
+                 ShortNumber(session.controller().options().max_kpa).c_str(),
+                 ShortNumber(session.pressure_target_kpa()).c_str());
   }
   if (options.identify) {
     experiment.emplace(options.identify_options,
@@ -522,7 +522,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       return summary;
     }
     throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
-                        FormatNumber(summary.duration_s) + " s); vented");
+                        ShortNumber(summary.duration_s) + " s); vented");
   }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
@@ -694,7 +694,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       if (found.stop_signal != 0) {
         // Vented; the loop never starts. Said even with --quiet: nothing was tuned.
         std::cerr << "control --auto-tune: " << found.stop_reason << " during the identification at "
-                  << FormatNumber(found.duration_s) << " s; vented, the loop not started\n";
+                  << ShortNumber(found.duration_s) << " s; vented, the loop not started\n";
         return ExitCodeAfterStop(0);  // 130 / 143.
       }
       if (!found.identified) throw InputError("control --auto-tune: the identification stopped");

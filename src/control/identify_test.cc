@@ -20,7 +20,7 @@
 namespace softsight {
 namespace {
 
-constexpr double kFps = 30.0;
+constexpr double kCameraFps = 30.0;
 
 struct PlantCase {
   const char* name;
@@ -75,9 +75,9 @@ class Bench {
     IdentificationExperiment experiment(
         options, IdentificationCeiling(session.controller().options(), info.pressure_limit_kpa));
     for (int k = 0; !experiment.done(); ++k) {
-      if (k > 0) rig_.advance(1.0 / kFps);
+      if (k > 0) rig_.advance(1.0 / kCameraFps);
       if (before_frame) before_frame(k);
-      const double t = k / kFps;
+      const double t = k / kCameraFps;
       const ControlSample s = StepIdentification(experiment, session, t, camera(t));
       max_setpoint_kpa = std::max(max_setpoint_kpa, s.setpoint_kpa.value_or(0.0));
       if (k > 100000) throw std::runtime_error("the experiment does not end");
@@ -94,9 +94,9 @@ class Bench {
     ControlSession session(controller, link_, target);
     session.start();
     std::vector<TrackingPoint> out;
-    for (int k = 0; k <= std::lround(seconds * kFps); ++k) {
-      if (k > 0) rig_.advance(1.0 / kFps);
-      const double t = k / kFps;
+    for (int k = 0; k <= std::lround(seconds * kCameraFps); ++k) {
+      if (k > 0) rig_.advance(1.0 / kCameraFps);
+      const double t = k / kCameraFps;
       const double truth = rig_.snapshot().angle_deg;
       const ControlSample s = session.step(t, camera(t));
       out.push_back({s.time_s, *s.target_deg, truth});
@@ -136,7 +136,7 @@ Identified IdentifyPlant(const PlantCase& c, Bench& bench) {
   const IdentificationExperiment experiment = bench.identify(base);
   out.model = FitActuatorModel(experiment);
 
-  out.tuned = TuneController(&out.model, base, 1.0 / kFps);
+  out.tuned = TuneController(&out.model, base, 1.0 / kCameraFps);
   out.max_setpoint_kpa = bench.max_setpoint_kpa;
   out.after = bench.rig().snapshot();
   return out;
@@ -188,7 +188,7 @@ TEST_P(Plants, IdentificationRecoversTheStaticSlopeAndTheLag) {
   EXPECT_NEAR(id.tuned.ff_kpa_per_deg, 1.0 / model.slope_deg_per_kpa, 1e-12);
   EXPECT_GT(id.tuned.kp_kpa_per_deg, 0.0);
   EXPECT_GT(id.tuned.ki_kpa_per_deg_s, 0.0);
-  EXPECT_GE(model.closed_loop_s, 3.0 / kFps - 1e-12);  // Three camera periods at least.
+  EXPECT_GE(model.closed_loop_s, 3.0 / kCameraFps - 1e-12);  // Three camera periods at least.
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -217,7 +217,7 @@ TEST_P(Plants, TheGainsFromTheModelSettleAStepAndFollowASine) {
   const TargetProfile sine_profile =
       TargetProfile::Parse("step 140\nhold 2\nsine 140 20 0.25 8\n", "sine.txt");
   std::vector<TrackingPoint> sine = bench.control(id.tuned, sine_profile, 10.0);
-  sine.erase(sine.begin(), sine.begin() + static_cast<long>(2 * kFps));  // The sine only.
+  sine.erase(sine.begin(), sine.begin() + static_cast<long>(2 * kCameraFps));  // The sine only.
   const StepMetrics sine_metrics = ComputeStepMetrics(sine);
   std::printf("loop %-10s kp %.3f ki %.3f lead %.3f s | step 180 -> 120: rise %.2f s, settling "
               "+-1 deg %.2f s, +-2 deg %.2f s, overshoot %.1f %%, steady-state %+.2f deg | sine "

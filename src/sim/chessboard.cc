@@ -10,23 +10,21 @@
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 cv::Mat DistortionMat(const std::vector<double>& distortion) {
   if (distortion.empty()) return cv::Mat();
   return cv::Mat(distortion, /*copyData=*/true).reshape(1, 1);
 }
 
 cv::Matx33d RotationX(double deg) {
-  const double a = deg * kPi / 180.0, c = std::cos(a), s = std::sin(a);
+  const double a = deg * CV_PI / 180.0, c = std::cos(a), s = std::sin(a);
   return {1, 0, 0, 0, c, -s, 0, s, c};
 }
 cv::Matx33d RotationY(double deg) {
-  const double a = deg * kPi / 180.0, c = std::cos(a), s = std::sin(a);
+  const double a = deg * CV_PI / 180.0, c = std::cos(a), s = std::sin(a);
   return {c, 0, s, 0, 1, 0, -s, 0, c};
 }
 cv::Matx33d RotationZ(double deg) {
-  const double a = deg * kPi / 180.0, c = std::cos(a), s = std::sin(a);
+  const double a = deg * CV_PI / 180.0, c = std::cos(a), s = std::sin(a);
   return {c, -s, 0, s, c, 0, 0, 0, 1};
 }
 

@@ -15,7 +15,6 @@
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxDots = 16;
 constexpr double kMaxTiltDeg = 75.0;
 constexpr double kMaxScale = 10.0;
@@ -105,9 +104,9 @@ struct PlateScene::Impl {
     // Tilt rises to the maximum at a third, falls back, and rises again at the end, so the
     // largest tilt meets both the smallest and the largest scale; the axis and the in-plane
     // roll turn meanwhile.
-    const double tilt = o.max_tilt_deg * (1 - std::cos(3 * kPi * t)) / 2 * kPi / 180;
-    const double axis = (axis0_deg + 120 * t) * kPi / 180;
-    const double roll = (roll0_deg + 40 * t) * kPi / 180;
+    const double tilt = o.max_tilt_deg * (1 - std::cos(3 * CV_PI * t)) / 2 * CV_PI / 180;
+    const double axis = (axis0_deg + 120 * t) * CV_PI / 180;
+    const double roll = (roll0_deg + 40 * t) * CV_PI / 180;
     cv::Matx33d rz(std::cos(roll), -std::sin(roll), 0, std::sin(roll), std::cos(roll), 0, 0, 0, 1);
     const cv::Matx33d tilt_r = AxisRotation(cv::Vec3d(std::cos(axis), std::sin(axis), 0), tilt);
     // The tilt is against the line of sight to the plate's centre, not the optical axis, so the
@@ -145,9 +144,9 @@ struct PlateScene::Impl {
       return (lo + hi) / 2 + (hi - lo) / 2 * 0.85 * std::sin(phase);
     };
     const cv::Point2d offset(
-        wander(margin - principal.x - x0, w - 1 - margin - principal.x - x1, 2 * kPi * t + phase_x),
+        wander(margin - principal.x - x0, w - 1 - margin - principal.x - x1, 2 * CV_PI * t + phase_x),
         wander(margin - principal.y - y0, h - 1 - margin - principal.y - y1,
-               3 * kPi * t + phase_y));
+               3 * CV_PI * t + phase_y));
     return pose(t, offset);
   }
 
@@ -184,8 +183,8 @@ PlateScene::PlateScene(PlateSceneOptions options, NoiseOptions noise, RenderOpti
   cv::RNG rng(o.seed * 0xBF58476D1CE4E5B9ull + 0x94D049BB133111EBull);
   m.roll0_deg = rng.uniform(-20.0, 20.0);
   m.axis0_deg = rng.uniform(0.0, 180.0);
-  m.phase_x = rng.uniform(0.0, 2 * kPi);
-  m.phase_y = rng.uniform(0.0, 2 * kPi);
+  m.phase_x = rng.uniform(0.0, 2 * CV_PI);
+  m.phase_y = rng.uniform(0.0, 2 * CV_PI);
 
   // The whole plate must stay in front of the camera (and not graze it) in every frame.
   for (int i = 0; i < o.frame_count; ++i) {

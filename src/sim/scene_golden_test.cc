@@ -26,7 +26,7 @@ uint64_t PixelHash(const cv::Mat& image) {
   return h;
 }
 
-SceneOptions SmallScene(SceneKind kind) {
+SceneOptions GoldenScene(SceneKind kind) {
   SceneOptions o;
   o.kind = kind;
   o.size = cv::Size(320, 240);
@@ -38,7 +38,7 @@ SceneOptions SmallScene(SceneKind kind) {
 }
 
 uint64_t SceneHash(SceneKind kind, bool camera_effects) {
-  const SceneOptions o = SmallScene(kind);
+  const SceneOptions o = GoldenScene(kind);
   NoiseOptions noise;
   std::vector<Occluder> occluders;
   if (camera_effects) {
@@ -77,7 +77,7 @@ TEST(SceneGoldenTest, DefaultScenesRenderAsBefore) {
 // compiler (C++ leaves the order of a call's arguments open, so each draw has its own statement).
 // The hashes are GCC's pictures from before that rule (commit 7ba7cc3); clang must draw the same.
 TEST(SceneGoldenTest, BenchPlateAndCorruptionRenderAsBefore) {
-  SceneOptions bench = SmallScene(SceneKind::kBending);
+  SceneOptions bench = GoldenScene(SceneKind::kBending);
   bench.background = BackgroundKind::kBench;
   bench.distractors = MakeMarkerDistractors(bench, 5);
   SyntheticScene bench_scene(bench);
@@ -94,7 +94,7 @@ TEST(SceneGoldenTest, BenchPlateAndCorruptionRenderAsBefore) {
   for (int i : {0, 21, 39}) h = h * 31 + PixelHash((plate_scene.render(i, image), image));
   EXPECT_EQ(h, 0xb34a93643e82fe27ull) << "plate";
 
-  SyntheticScene plain(SmallScene(SceneKind::kBending));
+  SyntheticScene plain(GoldenScene(SceneKind::kBending));
   cv::Mat other;
   plain.render(30, other);
   const std::pair<CorruptionKind, uint64_t> corruptions[] = {
