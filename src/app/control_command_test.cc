@@ -16,6 +16,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "app/program_test_util.h"
 #include "app/scene_markers_test_util.h"
 #include "core/test_util.h"
 #include "control/protocol.h"
@@ -396,21 +397,10 @@ TEST(ControlCommand, CtrlCVentsPrintsTheSummaryAndExits130) {
   TempDir dir;
   WriteTextFile(dir.file("rig.yaml"), kMarkers);
   const std::string csv = dir.file("run.csv");
-  const std::string command = std::string("exec \"") + testing::SoftsightBinary() +
-                              "\" control --config " + dir.file("rig.yaml") +
-                              " --simulate --target-deg 120 --duration-s 600 --csv " + csv +
-                              " 2> " + dir.file("ctl.err");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  // Interrupt once a few rows are on disk (the handler is installed before the first row).
-  for (int wait_ms = 0; wait_ms < 30000 && ReadLines(csv).size() < 4; wait_ms += 5) usleep(5000);
-  kill(pid, SIGINT);
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const int status = testing::RunAndSignalOnceRowsAreWritten(
+      "control --config " + dir.file("rig.yaml") +
+          " --simulate --target-deg 120 --duration-s 600 --csv " + csv,
+      csv, 4, SIGINT, dir.file("ctl.err"));
   const std::string err = ReadTextFile(dir.file("ctl.err"));
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
   EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT, after the summary: " << err;

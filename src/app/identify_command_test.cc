@@ -2,9 +2,7 @@
 // through the tracker, the board over a real pseudo-terminal, simulated time.
 #include "app/identify_command.h"
 
-#include <signal.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -13,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "app/program_test_util.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
@@ -30,25 +29,6 @@ using testing::WriteTextFile;
 
 std::string Example() { return testing::SourceDir() + "/examples/rig.yaml"; }
 
-// Runs `softsight ARGS 2> err_file`, sends `signal` once `csv` holds a few rows (the handlers
-// are installed before the first row; the experiment takes hundreds), and returns the wait
-// status.
-int SignalOnceRowsAreWritten(const std::string& args, const std::string& csv,
-                             const std::string& err_file, int signal) {
-  const std::string command =
-      std::string("exec \"") + testing::SoftsightBinary() + "\" " + args + " 2> " + err_file;
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  int status = 0;
-  while (ReadLines(csv).size() < 4 && waitpid(pid, &status, WNOHANG) == 0) usleep(5000);
-  kill(pid, signal);
-  waitpid(pid, &status, 0);
-  return status;
-}
 
 TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTheInput) {
   TempDir dir;
@@ -191,10 +171,10 @@ TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {
   TempDir dir;
   WriteTextFile(dir.file("rig.yaml"), ReadTextFile(Example()));
   const std::string csv = dir.file("ident.csv");
-  const int status = SignalOnceRowsAreWritten(
+  const int status = testing::RunAndSignalOnceRowsAreWritten(
       "identify --config " + dir.file("rig.yaml") + " --simulate -o " + dir.file("tuned.yaml") +
           " --csv " + csv,
-      csv, dir.file("err.txt"), SIGINT);
+      csv, 4, SIGINT, dir.file("err.txt"));
   const std::string err = ReadTextFile(dir.file("err.txt"));
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
   EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT, not the error path: " << err;
@@ -213,10 +193,10 @@ TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {
 TEST(ControlCommand, AutoTuneStoppedBySigtermDuringTheIdentificationExits143WithoutTheLoop) {
   TempDir dir;
   const std::string identify_csv = dir.file("run_identify.csv");
-  const int status = SignalOnceRowsAreWritten(
+  const int status = testing::RunAndSignalOnceRowsAreWritten(
       "control --config " + Example() + " --simulate --auto-tune --target-deg 120 --csv " +
           dir.file("run.csv"),
-      identify_csv, dir.file("err.txt"), SIGTERM);
+      identify_csv, 4, SIGTERM, dir.file("err.txt"));
   const std::string err = ReadTextFile(dir.file("err.txt"));
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly: " << err;
   EXPECT_EQ(WEXITSTATUS(status), 143) << "128 + SIGTERM, not the error path: " << err;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "app/control_command.h"
+#include "app/scene_markers_test_util.h"
 #include "app/track_command.h"
 #include "core/test_util.h"
 #include "gui/live_feed.h"
@@ -25,16 +26,7 @@ using testing::SplitCsv;
 using testing::TempDir;
 using testing::WriteTextFile;
 
-const char* kMarkers = R"(markers:
-  - name: red
-    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
-  - name: blue
-    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
-  - name: green
-    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
-triple: [red, blue, green]
-scale_mm_per_px: 0.2
-)";
+const std::string kMarkers = testing::kScaledSceneMarkersYaml;
 
 // A CSV as columns by name; checks that every row has the header's field count.
 struct Csv {

@@ -16,6 +16,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "app/program_test_util.h"
+#include "app/scene_markers_test_util.h"
 #include "app/truth_sink.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
@@ -27,16 +29,8 @@ namespace {
 using ::testing::HasSubstr;
 using testing::TempDir;
 
-const char* kConfig = R"(markers:
-  - name: red
-    hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}
-  - name: blue
-    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
-  - name: green
-    hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}
-triple: [red, blue, green]
-scale_mm_per_px: 0.2
-)";
+// The scene's markers with a scale, so the millimetre columns are written too.
+const std::string kConfig = testing::kScaledSceneMarkersYaml;
 
 struct RenderedClip {
   std::string video;
@@ -322,26 +316,19 @@ TEST(TrackCommand, BadConfigAndMissingInputExitWithCodeTwo) {
   EXPECT_EQ(run.exit_code, 2) << "missing required options";
 }
 
+// `track` on the built-in bending scene (300 frames), sent `signal` once `rows` CSV lines are on
+// disk; returns the wait status.
+int TrackSignalledAfterRows(const TempDir& dir, size_t rows, int signal) {
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  return testing::RunAndSignalOnceRowsAreWritten(
+      "track -c " + dir.file("markers.yaml") + " -i synth:bending -o " + dir.file("out.csv"),
+      dir.file("out.csv"), rows, signal, dir.file("stderr.txt"));
+}
+
 TEST(TrackCommand, CtrlCStopsWithASummaryAndEveryRowComplete) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
   const std::string csv = dir.file("out.csv");
-  const std::string command = "exec " + testing::SoftsightBinary() + " track -c " +
-                              dir.file("markers.yaml") + " -i synth:bending -o " + csv + " 2> " +
-                              dir.file("stderr.txt");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  // Interrupt once a few rows are on disk (the handler is installed by then).
-  for (int wait_ms = 0; wait_ms < 20000 && testing::ReadLines(csv).size() < 6; wait_ms += 5) {
-    usleep(5000);
-  }
-  kill(pid, SIGINT);
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const int status = TrackSignalledAfterRows(dir, 6, SIGINT);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
   EXPECT_EQ(WEXITSTATUS(status), 130) << "128 + SIGINT: an interrupted run is not a complete one";
   EXPECT_THAT(testing::ReadTextFile(dir.file("stderr.txt")), HasSubstr("stopped by Ctrl-C"));
@@ -369,23 +356,7 @@ TEST(TrackCommand, TemplateMethodWithoutTemplateIsRefused) {
 
 TEST(TrackCommand, SigtermStopsWithItsOwnReasonAndExitCode) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
-  const std::string csv = dir.file("out.csv");
-  const std::string command = "exec " + testing::SoftsightBinary() + " track -c " +
-                              dir.file("markers.yaml") + " -i synth:bending -o " + csv + " 2> " +
-                              dir.file("stderr.txt");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  for (int wait_ms = 0; wait_ms < 20000 && testing::ReadLines(csv).size() < 4; wait_ms += 5) {
-    usleep(5000);
-  }
-  kill(pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const int status = TrackSignalledAfterRows(dir, 4, SIGTERM);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
   EXPECT_EQ(WEXITSTATUS(status), 143);
   const std::string text = testing::ReadTextFile(dir.file("stderr.txt"));
@@ -482,7 +453,7 @@ TEST_F(TrackRefuses, OutputThatIsAnInputAndLeavesItUntouched) {
                          "   data: [500., 0., 320., 0., 500., 240., 0., 0., 1.]\n"
                          "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n"
                          "   dt: d\n   data: [0., 0., 0., 0., 0.]\n");
-  testing::WriteTextFile(dir_.file("with_camera.yaml"), std::string(kConfig) + "camera: camera.yaml\n");
+  testing::WriteTextFile(dir_.file("with_camera.yaml"), kConfig + "camera: camera.yaml\n");
   const std::string camera_before = testing::ReadTextFile(dir_.file("camera.yaml"));
   const ProgramRun run = RunBinary("track -q -c " + dir_.file("with_camera.yaml") + " -i " +
                                        clip_.video + " -o " + dir_.file("camera.yaml"),
@@ -509,7 +480,7 @@ TEST_F(TrackRefuses, ConfigWithRandomBytesOrAComplexKeyInOneEscapedLine) {
       ASSERT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << "raw control character";
     }
   }
-  testing::WriteTextFile(dir_.file("key.yaml"), std::string(kConfig) + "? [a, b]\n: 1\n");
+  testing::WriteTextFile(dir_.file("key.yaml"), kConfig + "? [a, b]\n: 1\n");
   ExpectOneError(RunBinary("track -q -c " + dir_.file("key.yaml") + " -i " + clip_.video + " -o " +
                                dir_.file("o.csv"),
                            dir_),

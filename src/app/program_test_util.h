@@ -1,0 +1,40 @@
+// Running the `softsight` program from the app's tests (test code only): a run interrupted by a
+// signal once its CSV has rows, as a user's Ctrl-C or a service manager's SIGTERM would.
+#pragma once
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "core/test_util.h"
+
+namespace softsight::testing {
+
+// Runs `softsight ARGS 2> stderr_file`, sends `signal` once `csv` holds `rows` lines (or when
+// the program has ended by itself), and returns the wait status. The commands install their
+// handlers before the first row, so a run signalled after its rows ends through its own path.
+// Waits on the file, not on a clock: no sleep decides the outcome.
+inline int RunAndSignalOnceRowsAreWritten(const std::string& args, const std::string& csv,
+                                          size_t rows, int signal,
+                                          const std::string& stderr_file) {
+  const std::string command =
+      "exec \"" + SoftsightBinary() + "\" " + args + " 2> \"" + stderr_file + "\"";
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  while (ReadLines(csv).size() < rows) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return status;  // Ended before the signal.
+    usleep(2000);
+  }
+  kill(pid, signal);
+  waitpid(pid, &status, 0);
+  return status;
+}
+
+}  // namespace softsight::testing
