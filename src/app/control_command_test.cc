@@ -73,8 +73,8 @@ TEST(ControlConfig, ReadsTheExampleAndRejectsBadKeys) {
               HasSubstr("chamber_volume_ml"));
 }
 
-TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
-  TempDir dir;
+// The simulated rig's step from straight (180 deg) to 120 deg over 4 s, its CSV in `dir`.
+ControlOptions SimulatedStepTo120(const TempDir& dir) {
   WriteTextFile(dir.file("rig.yaml"), kMarkers);
   ControlOptions options;
   options.config_file = dir.file("rig.yaml");
@@ -83,6 +83,12 @@ TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
   options.duration_s = 4.0;
   options.csv_file = dir.file("run.csv");
   options.quiet = true;
+  return options;
+}
+
+TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
+  TempDir dir;
+  const ControlOptions options = SimulatedStepTo120(dir);
   const ControlSummary summary = RunControl(options);
   EXPECT_EQ(summary.frames, 121);
   EXPECT_EQ(summary.measured, 121);
@@ -134,15 +140,8 @@ TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
 // and --metrics-csv writes them.
 TEST(ControlCommand, SimulatedStepSummaryGivesRiseSettlingOvershootSteadyStateAndRms) {
   TempDir dir;
-  WriteTextFile(dir.file("rig.yaml"), kMarkers);
-  ControlOptions options;
-  options.config_file = dir.file("rig.yaml");
-  options.simulate = true;
-  options.target_deg = 120.0;
-  options.duration_s = 4.0;
-  options.csv_file = dir.file("run.csv");
+  ControlOptions options = SimulatedStepTo120(dir);
   options.metrics_csv_file = dir.file("metrics.csv");
-  options.quiet = true;
   const ControlSummary summary = RunControl(options);
   const StepMetrics& m = summary.metrics;
   ASSERT_TRUE(m.rise_time_s && m.settling_1deg_s && m.settling_2deg_s && m.overshoot_percent &&
