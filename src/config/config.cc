@@ -179,7 +179,8 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   if (spec.name.empty()) marker.fail("name", "every marker needs a name");
   for (char c : spec.name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
-      marker.fail("name", "'" + spec.name +
+      // Escaped: the name may hold a line break or any byte, and the message is one line.
+      marker.fail("name", "'" + EscapeForMessage(spec.name) +
                               "' must use letters, digits, '_' or '-' (it prefixes CSV columns)");
     }
   }
