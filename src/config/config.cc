@@ -180,8 +180,11 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   for (char c : spec.name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
       // Escaped: the name may hold a line break or any byte, and the message is one line.
-      marker.fail("name", "'" + EscapeForMessage(spec.name) +
-                              "' must use letters, digits, '_' or '-' (it prefixes CSV columns)");
+      // (Appended, not "'" + ...: GCC 12 warns falsely about operator+ of a literal there.)
+      std::string message = "'";
+      message += EscapeForMessage(spec.name);
+      message += "' must use letters, digits, '_' or '-' (it prefixes CSV columns)";
+      marker.fail("name", message);
     }
   }
   const bool has_template = marker.has("template");
