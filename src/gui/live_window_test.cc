@@ -124,6 +124,14 @@ int RunProcess(const std::vector<std::string>& argv, const std::vector<std::stri
   return WaitExit(child, 10s);
 }
 
+// Gives the live window the keyboard once it is mapped (xdotool waits for it), so the keys and
+// clicks that follow reach it. Returns xdotool's exit code.
+int FocusLiveWindow(const std::vector<std::string>& env, std::string* output) {
+  return RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
+                     "windowfocus", "--sync"},
+                    env, output);
+}
+
 uint32_t ReadU32(const std::string& data, size_t offset, bool big_endian) {
   const auto* b = reinterpret_cast<const unsigned char*>(data.data() + offset);
   return big_endian ? (uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3])
@@ -268,11 +276,7 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   // Keys through the real window: h shows the help over the image, q quits cleanly.
   std::string xdotool_output;
   const std::vector<std::string> env = {"DISPLAY=" + display};
-  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
-                        "windowfocus", "--sync"},
-                       env, &xdotool_output),
-            0)
-      << xdotool_output;
+  ASSERT_EQ(FocusLiveWindow(env, &xdotool_output), 0) << xdotool_output;
   ASSERT_EQ(RunProcess({"xdotool", "key", "h"}, env, &xdotool_output), 0) << xdotool_output;
   std::this_thread::sleep_for(700ms);
   const cv::Mat with_help = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
@@ -333,11 +337,7 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
   ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
   const std::vector<std::string> env = {"DISPLAY=" + display};
   std::string out;
-  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
-                        "windowfocus", "--sync"},
-                       env, &out),
-            0)
-      << out;
+  ASSERT_EQ(FocusLiveWindow(env, &out), 0) << out;
   // The layout the window uses for this frame on this screen (Xvfb puts the window at 0,0).
   const LiveLayout layout = ComputeLiveLayout(scene.size, 180, 0, MaxCanvasForScreen({1366, 768}));
   ASSERT_LE(layout.canvas.width, 1366);
@@ -401,11 +401,7 @@ TEST_F(LiveWindowTest, RecordingAPausedVideoWithEditsKeepsTheSourcesFramesAndTra
   ASSERT_GT(live_.pid, 0);
   const std::vector<std::string> env = {"DISPLAY=" + display};
   std::string out;
-  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name", "softsight live",
-                        "windowfocus", "--sync"},
-                       env, &out),
-            0)
-      << out;
+  ASSERT_EQ(FocusLiveWindow(env, &out), 0) << out;
   // Record, pause, resume, stop: each key once the window has said it handled the one before
   // (its messages on stdout), so no key waits on a clock. How many frames fall between the keys
   // depends on the machine; what is checked below holds for any number (the window reads keys
