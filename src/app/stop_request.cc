@@ -32,6 +32,10 @@ StopRequest::StopRequest() {
 }
 
 StopRequest::~StopRequest() {
+  // Once a stop was asked for, the process is winding down to exit with 128 + signal: a second
+  // stop signal (the terminal's to the whole process group and the one `track` with several
+  // inputs forwards to each job arrive close together) must not kill it before that.
+  if (g_stop_signal != 0) return;
   std::signal(SIGINT, previous_int_);
   std::signal(SIGTERM, previous_term_);
 }
