@@ -139,13 +139,16 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
       summary.stop_reason = StopReason::kError;
       summary.error = *sink.error();
     }
-    // Never silent: a camera outran the encoder (a file's run waits for it instead). A camera's
-    // run says so also when nothing was lost.
-    if (sink.dropped_frames() > 0 || live) {
-      summary.notes.push_back(sink.path() + ": " + std::to_string(sink.dropped_frames()) + " of " +
-                              std::to_string(summary.frames) + " frames not recorded" +
-                              (sink.dropped_frames() > 0 ? " (the encoder fell behind the camera)"
-                                                         : " (the encoder kept up)"));
+    // A recording keeps every frame of the CSV. Never silent: an encoder that fell a whole
+    // queue behind held up the run (a camera's frames skipped meanwhile are the source's drops,
+    // counted above). A camera's run says so also when it did not.
+    if (sink.waited_frames() > 0 || live) {
+      const int64_t waited = sink.waited_frames();
+      summary.notes.push_back(
+          sink.path() + ": all " + std::to_string(summary.frames) + " frames recorded" +
+          (waited > 0 ? "; the encoder fell behind and held up the run at " +
+                            std::to_string(waited) + " of them"
+                      : " (the encoder kept up)"));
     }
   }
   if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {

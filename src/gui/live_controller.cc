@@ -10,7 +10,7 @@
 #include "softsight/core/error.h"
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
-#include "gui/live_recording.h"
+#include "gui/live_recording.h"  // SaveLiveConfig
 #include "gui/range_edit.h"
 #include "gui/live_view.h"
 
@@ -21,8 +21,7 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
     : options_(std::move(options)),
       chart_(options_.chart),
       pointer_(std::make_unique<LivePointer>(options_.click_slop_px)),
-      scale_(options_.scale_distance_mm),
-      before_encode_(std::move(before_encode)) {
+      scale_(options_.scale_distance_mm) {
   std::string error;
   if (!options_.Check(&error)) throw InputError("live options: " + error);
   if (config.markers.empty()) throw InputError(config.source_file + ": no markers to track");
@@ -30,8 +29,9 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   options_.overlay.middle = config.measure.middle;
   options_.overlay.tip = config.measure.tip;
   // The session holds the only copy of the config: every live edit goes through it, and `s`
-  // and recordings save what it holds.
-  session_ = std::make_unique<TrackingSession>(config);
+  // and recordings save what it holds; the pipeline feeds it and its sinks (the recording).
+  pipeline_ = std::make_unique<LivePipeline>(
+      config, LiveRecordingSettings{options_.record_prefix, false, std::move(before_encode)});
   for (const MarkerSpec& spec : config.markers) {
     const auto* colour = std::get_if<ColourParams>(&spec.params);
     const auto* templ = std::get_if<TemplateParams>(&spec.params);
@@ -43,7 +43,21 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
 
 LiveController::~LiveController() = default;
 
-const TrackingConfig& LiveController::config() const { return session_->config(); }
+const TrackingConfig& LiveController::config() const { return pipeline_->config(); }
+
+TrackingSession& LiveController::session() { return pipeline_->session(); }
+
+bool LiveController::recording() const { return pipeline_->recording(); }
+
+const std::string& LiveController::last_recording() const { return pipeline_->last_recording(); }
+
+LiveRunSummary LiveController::run_summary() const { return pipeline_->summary(dropped_); }
+
+void LiveController::set_live_source(bool live) { pipeline_->set_live_source(live); }
+
+void LiveController::report_recording_failure() {
+  if (auto failure = pipeline_->take_recording_failure()) say(*failure);
+}
 
 void LiveController::say(const std::string& message) {
   message_ = message;
@@ -56,31 +70,31 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   if (paused_ && order == FrameOrder::kNext) return;
   CV_Assert(frame.image.type() == CV_8UC3);
   if (order == FrameOrder::kJump) {
-    if (recording_) {
+    if (recording()) {
       toggle_recording();
       say(message_ + " (stopped: the playback jumped)");
     }
-    session_->jump();
+    session().jump();
     chart_.clear();  // Its time axis cannot run backwards.
   }
   frame.image.copyTo(frame_);
   frame_index_ = frame.index;
   ended_ = false;
   frame_time_s_ = frame.time_s;
-  const FrameResult& result = session_->process(frame);
-  stats_.add_result(result);
+  // Tracked, counted and (while recording) recorded by the pipeline.
+  const FrameResult& result = pipeline_->process(frame);
   chart_.add(result);
+  show(result);
+  report_recording_failure();
   if (order != FrameOrder::kNext) {
     // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
     // (stdout too, for the terminal and for scripts driving the window).
-    record_frame(frame, result);
     say("frame " + std::to_string(frame.index) + " (" + FixedText(frame.time_s, 3) + " s)");
     return;
   }
 
   // Frame rate over the last frames that produced a result, latency from capture to result.
   meter_.result_at(SteadyClock::now());
-  record_frame(frame, result);
   // Latency: from capture to the annotated (and recorded) result, as the window is about to show
   // it. The overlay shows the smoothed value up to the previous frame.
   meter_.latency(std::chrono::duration<double, std::milli>(SteadyClock::now() - captured).count());
@@ -112,7 +126,7 @@ std::optional<PlaybackRequest> LiveController::take_playback_request() {
 }
 
 void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds) {
-  if (recording_ && kind != PlaybackRequest::Kind::kStepForward) {
+  if (recording() && kind != PlaybackRequest::Kind::kStepForward) {
     // The recording's raw video must be re-trackable: its frames follow each other.
     say("stop the recording first (r): a recording holds consecutive frames");
     return;
@@ -125,9 +139,9 @@ void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds
 }
 
 void LiveController::restart() {
-  if (recording_) toggle_recording();
+  if (recording()) toggle_recording();
   request_playback(PlaybackRequest::Kind::kStart);
-  session_->reset_tip_reference();
+  session().reset_tip_reference();
   paused_ = false;
   say("restart: from the first frame, trackers afresh");
 }
@@ -174,15 +188,13 @@ void LiveController::select_marker(int index) {
 void LiveController::apply_spec(int marker, const MarkerSpec& spec,
                                 const std::optional<cv::Rect>& hint) {
   try {
-    session_->respec(spec);
-    recorded(ConfigChange::Respec(spec));
+    // A running recording keeps each edit: the session tells it (LivePipeline).
+    session().respec(spec);
     if (hint && !hint->empty() && !frame_.empty()) {
-      show(session_->reselect(spec.name, on_screen(), *hint));
-      recorded(ConfigChange::Reselect(spec.name, *hint));
+      show(session().reselect(spec.name, on_screen(), *hint));
     } else if ((paused_ || ended_) && !frame_.empty()) {
       // No new frame is coming: track the one on screen again, so the change shows at once.
-      show(session_->retrack(spec.name, on_screen()));
-      recorded(ConfigChange::Retrack(spec.name));
+      show(session().retrack(spec.name, on_screen()));
     }
   } catch (const InputError& e) {
     // A live edit that cannot be used is reported on screen; the session keeps running.
@@ -272,8 +284,7 @@ void LiveController::drag(const cv::Rect& dragged) {
   try {
     // The session remembers the selection in its config (the template's pixels, or the colour
     // search box), so that `s` saves it.
-    show(session_->reselect(spec.name, on_screen(), rect));
-    recorded(ConfigChange::Reselect(spec.name, rect));
+    show(session().reselect(spec.name, on_screen(), rect));
   } catch (const InputError& e) {
     say(e.what());
     return;
@@ -350,7 +361,7 @@ void LiveController::save_config() {
 }
 
 void LiveController::start_scale() {
-  if (recording_ && options_.scale_distance_mm) {
+  if (recording() && options_.scale_distance_mm) {
     // The CSV's columns (with or without _mm) are fixed when a recording starts.
     say("scale: stop the recording first (r)");
     return;
@@ -368,14 +379,14 @@ void LiveController::scale_point(const cv::Point2d& p) {
   // The scale is in the pixels the measurements use (undistorted with a camera model), and
   // those are the points a saved config holds as scale_from_points.
   std::string message;
-  const std::optional<MetricModel> metric = scale_.add(p, session_->measurement_point(p), &message);
+  const std::optional<MetricModel> metric = scale_.add(p, session().measurement_point(p), &message);
   if (!metric) {
     say(message);
     return;
   }
   const bool replaced_plane = config().measure.metric.plane_mm_from_image.has_value();
   try {
-    session_->set_metric(*metric);
+    session().set_metric(*metric);
   } catch (const InputError& e) {
     scale_.restart();
     say(std::string(e.what()) + "; click the first point again");
@@ -387,7 +398,7 @@ void LiveController::scale_point(const cv::Point2d& p) {
   // strip chart restarts in mm: its px history cannot share the new axis.
   if (!frame_.empty()) {
     const Frame again{frame_, frame_index_, frame_time_s_};
-    record_frame(again, session_->process(again));
+    show(pipeline_->measure_again(again));
     chart_.clear();
     chart_.add(*last_result_);
   }
@@ -397,12 +408,9 @@ void LiveController::scale_point(const cv::Point2d& p) {
 }
 
 void LiveController::toggle_recording() {
-  if (recording_) {
-    const int64_t frames = recording_->frames();
-    last_recording_ = recording_->prefix();
-    stats_.add_recording(*recording_);
-    recording_.reset();  // Closes the CSV and both videos.
-    say("recorded " + std::to_string(frames) + " frames to " + last_recording_ + ".*");
+  if (recording()) {
+    const int64_t frames = pipeline_->stop_recording();
+    say("recorded " + std::to_string(frames) + " frames to " + last_recording() + ".*");
     return;
   }
   if (frame_.empty()) {
@@ -412,38 +420,22 @@ void LiveController::toggle_recording() {
   try {
     // The recording must be reproducible: `softsight track --config <prefix>.yaml --input
     // <prefix>.raw.avi` has to give the same rows. So the recording starts with the frame on
-    // screen as its frame 0, every tracker is rebuilt from the saved config exactly as `track`
-    // builds it (a search box, or a template cut on frame 0, around where each marker is now),
-    // and the bending-distance reference restarts at that frame.
+    // screen as its frame 0, and every tracker is rebuilt from the saved config exactly as
+    // `track` builds it: a search box, or a template cut on frame 0, around where each marker is
+    // now (LivePipeline::start_recording).
     std::vector<std::optional<cv::Rect>> boxes;
     for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
       const auto position = position_of(i);
       boxes.push_back(position ? std::optional(box_around(*position)) : std::nullopt);
     }
-    const TrackingConfig snapshot = RecordingStartConfig(config(), boxes);
-    RunInfo info;
-    info.frame_size = frame_.size();
-    info.fps = options_.record_fps.value_or(meter_.fps().value_or(30.0));
-    info.live = live_source_;
-    for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
-    const MetricModel& metric = snapshot.measure.metric;
-    info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
-    // The raw video's frame 0 is this source frame: its config says so (`recording:`), so that
-    // `track` on it numbers and times the rows as the source did, like the live CSV.
-    auto recording = std::make_unique<LiveRecording>(
-        options_.record_prefix, snapshot, info, RecordingOrigin{frame_index_, frame_time_s_},
-        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); },
-        before_encode_);
-
-    for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
-    session_->reset_tip_reference();
-    recording_ = std::move(recording);
     const Frame again{frame_.clone(), frame_index_, frame_time_s_};
-    record_frame(again, session_->process(again));
+    show(pipeline_->start_recording(
+        again, boxes, options_.record_fps.value_or(meter_.fps().value_or(30.0)),
+        [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); }));
     ++hsv_revision_;
-    say("recording to " + recording_->prefix() + ".*");
+    say("recording to " + pipeline_->recording_prefix() + ".*");
+    report_recording_failure();
   } catch (const InputError& e) {
-    recording_.reset();
     say(e.what());
   }
 }
@@ -454,31 +446,6 @@ void LiveController::show(const FrameResult& result) {
   last_result_ = result;
   redraw_annotated();
   dirty_ = true;
-}
-
-void LiveController::recorded(ConfigChange change) {
-  if (!recording_) return;
-  try {
-    recording_->log(std::move(change));
-  } catch (const InputError& e) {
-    // The recording could not keep the edit, so it no longer reproduces the window: stop it
-    // (what is written stays) and say why.
-    toggle_recording();
-    say(e.what());
-  }
-}
-
-void LiveController::record_frame(const Frame& frame, const FrameResult& result) {
-  show(result);
-  if (!recording_) return;
-  // Rows carry the source's frame index and timestamp, as every CSV does.
-  try {
-    recording_->consume(frame, result);
-  } catch (const InputError& e) {
-    // A full disk: stop recording (what is written stays), keep the window running.
-    toggle_recording();
-    say(e.what());
-  }
 }
 
 void LiveController::set_screen(cv::Size screen_px) {
@@ -501,6 +468,12 @@ cv::Point2d LiveController::to_image(const cv::Point2d& view_px) const {
 }
 
 void LiveController::on_event(const UiEvent& event) {
+  handle(event);
+  // An edit the running recording could not keep stopped it: say so, over the edit's message.
+  report_recording_failure();
+}
+
+void LiveController::handle(const UiEvent& event) {
   using Type = UiEvent::Type;
   // The pointer works in image pixels: the canvas may show the image scaled down.
   const LiveLayout view = layout();
@@ -597,8 +570,7 @@ void LiveController::on_event(const UiEvent& event) {
           save_config();
           break;
         case 'b':
-          session_->reset_tip_reference();
-          recorded(ConfigChange::ResetTipReference());
+          session().reset_tip_reference();
           say("bending distance: the next tip position is the new reference");
           break;
         case 'm':
@@ -614,7 +586,7 @@ void LiveController::on_event(const UiEvent& event) {
           }
           [[fallthrough]];
         case 'q':
-          if (recording_) toggle_recording();
+          if (recording()) toggle_recording();
           quit_ = true;
           break;
         default:
@@ -627,7 +599,7 @@ void LiveController::on_event(const UiEvent& event) {
 std::vector<std::string> LiveController::status_lines() const {
   std::vector<std::string> lines;
   std::string state;
-  if (recording_) state += "REC " + recording_->prefix() + "  ";
+  if (recording()) state += "REC " + pipeline_->recording_prefix() + "  ";
   if (paused_) state += "PAUSED  ";
   if (ended_) state += "END  ";
   if (loop_) state += "LOOP  ";
@@ -651,9 +623,9 @@ const cv::Mat& LiveController::canvas() {
   state.frame = &frame_;
   state.annotated = &annotated_;
   state.lines = status_lines();
-  state.recording = recording_ != nullptr;
+  state.recording = recording();
   state.mask_view = mask_view_;
-  state.tracker = &session_->tracker(active_);
+  state.tracker = &pipeline_->session().tracker(active_);
   state.active = &config().markers[active_];
   state.scale_mode = scale_.active();
   state.scale_points = scale_.points();

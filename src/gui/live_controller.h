@@ -19,7 +19,7 @@
 #include "softsight/io/frame_grabber.h"
 #include "softsight/gui/live_options.h"
 #include "softsight/gui/overlay.h"
-#include "gui/live_run_stats.h"
+#include "gui/live_pipeline.h"
 #include "gui/live_view.h"
 #include "gui/rate_meter.h"
 #include "gui/scale_clicks.h"
@@ -29,7 +29,6 @@
 
 namespace softsight {
 
-class LiveRecording;  // gui/live_recording.h: the files of one recording.
 class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
 
 struct UiEvent {
@@ -138,7 +137,7 @@ class LiveController {
   bool ended() const { return ended_; }
   // Loop (`l`): at the end, play on from the first frame.
   bool loop() const { return loop_; }
-  bool recording() const { return recording_ != nullptr; }
+  bool recording() const;
   bool help_shown() const { return help_; }
   // Mask view (`v`): the active marker's member pixels, its candidate blobs with the verdict on
   // each, and its search region, instead of the annotated frame.
@@ -167,15 +166,19 @@ class LiveController {
   std::array<int, 6> active_hsv() const;
   int hsv_revision() const { return hsv_revision_; }
   // Where the previous recording's files went (prefix without extension); empty if none.
-  const std::string& last_recording() const { return last_recording_; }
-  // The source is a camera: a recording's video whose encoder falls behind then drops frames
-  // and counts them, instead of holding up the window (a file's recording waits).
-  void set_live_source(bool live) { live_source_ = live; }
+  const std::string& last_recording() const;
+  // The source is a camera: a recording's videos get a deeper queue, so an encoder's hiccup does
+  // not hold up the window; they still keep every frame (LivePipeline).
+  void set_live_source(bool live);
   // The run so far, for the end summary (a recording still open counted too).
-  LiveRunSummary run_summary() const { return stats_.summary(dropped_, recording_.get()); }
+  LiveRunSummary run_summary() const;
 
  private:
 
+  void handle(const UiEvent& event);
+  TrackingSession& session();
+  // The recording stopped by itself (a full disk, an edit it could not keep): say why.
+  void report_recording_failure();
   void click(const cv::Point2d& p);
   // Mask view: the pixels around `p` added to (grow) or removed from the active marker's ranges.
   void edit_range(const cv::Point2d& p, bool grow);
@@ -203,9 +206,6 @@ class LiveController {
   ColourParams colour_of(int marker) const;
   void redraw_annotated();
   void draw_overlay(cv::Mat& image, const FrameResult& result) const;
-  void record_frame(const Frame& frame, const FrameResult& result);
-  // An edit just made to the session: a running recording keeps it (its config reproduces it).
-  void recorded(ConfigChange change);
   // The frame on screen, as the session saw it (no copy of the pixels).
   Frame on_screen() const;
   // A new result for the frame on screen (a reselection): shown, not recorded again.
@@ -213,7 +213,8 @@ class LiveController {
   void say(const std::string& message);
 
   LiveOptions options_;
-  std::unique_ptr<TrackingSession> session_;
+  // The session (the only copy of the config) and the run's sinks: statistics, the recording.
+  std::unique_ptr<LivePipeline> pipeline_;
   StripChart chart_;
   cv::Mat frame_;  // The frame on screen, as captured.
   int64_t frame_index_ = -1;
@@ -241,11 +242,6 @@ class LiveController {
   ScaleClicks scale_;
   std::string message_;
   int64_t message_count_ = 0;
-  std::unique_ptr<LiveRecording> recording_;
-  std::string last_recording_;
-  bool live_source_ = false;
-  std::function<void(int64_t)> before_encode_;
-  LiveRunStats stats_;
 };
 
 }  // namespace softsight

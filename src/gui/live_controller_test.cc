@@ -331,6 +331,29 @@ TEST_F(LiveControllerTest, RecordingIsReproducedByTrackingTheRawVideoWithItsConf
   EXPECT_EQ(live.last_recording(), (dir_ / "rec-002").string());
 }
 
+// The session tells the running recording of each edit; one it cannot keep (its config cannot be
+// written) stops the recording, keeps what it wrote, and says why; the window runs on.
+TEST_F(LiveControllerTest, AnEditTheRecordingCannotKeepStopsItKeepsItsRowsAndSaysWhy) {
+  LiveController live(SceneConfig(), Options());
+  for (int i = 0; i < 3; ++i) Feed(live, i);
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  for (int i = 3; i < 6; ++i) Feed(live, i);
+  const std::string prefix = (dir_ / "rec-001").string();
+  // The config can no longer be written: a folder stands where the file was.
+  fs::remove(prefix + ".yaml");
+  fs::create_directory(prefix + ".yaml");
+  live.on_event(UiEvent::Key('b'));  // An edit: the bending reference restarts.
+  EXPECT_FALSE(live.recording());
+  EXPECT_THAT(live.message(), ::testing::StartsWith("recorded 4 frames to " + prefix + ".*; "));
+  EXPECT_THAT(live.message(), ::testing::HasSubstr(prefix + ".yaml"));
+  EXPECT_EQ(live.last_recording(), prefix);
+  EXPECT_EQ(ReadCsvTable(prefix + ".csv").row_count(), 4u);
+  Feed(live, 6);
+  EXPECT_TRUE(live.last_result()->markers[0].observation.found());
+  EXPECT_EQ(live.run_summary().recorded_frames, 4);
+}
+
 // Scale mode takes the point where the button is released; press and release at one spot.
 void ScaleClick(LiveController& live, cv::Point2d p) {
   live.on_event(UiEvent::Mouse(Type::kMouseDown, p.x, p.y));

@@ -26,9 +26,9 @@ class LiveRecording {
   // (its `recording:` key) so that re-tracking the raw video names the source's frames.
   // `draw` draws the overlay of the annotated video. Throws InputError (unwritable folder, no
   // free number, no codec) with nothing left open.
-  // `info.live` (a camera): a video whose encoder falls behind drops frames and counts them
-  // instead of holding up the window. `before_encode` (tests): both videos' encoder hook
-  // (AsyncFrameWriter).
+  // The videos keep every frame: an encoder a whole queue behind holds up the window (counted;
+  // `info.live`, a camera: a deeper queue, see VideoSink). `before_encode` (tests): both videos'
+  // encoder hook (AsyncFrameWriter).
   LiveRecording(const std::string& base, const TrackingConfig& config, const RunInfo& info,
                 const RecordingOrigin& origin, FrameDrawer draw,
                 std::function<void(int64_t index)> before_encode = {});
@@ -46,10 +46,9 @@ class LiveRecording {
   const std::string& prefix() const { return prefix_; }
   int64_t frames() const { return frames_; }
   // For the run's summary: capture -> CSV row per recorded frame (CsvSink::row_latencies_ms),
-  // and the frames each video could not take (a camera's encoder fell behind).
+  // and the frames at which the window waited for a video's encoder (its queue was full).
   const std::vector<double>& row_latencies_ms() const { return csv_->row_latencies_ms(); }
-  int64_t raw_dropped() const { return raw_->dropped_frames(); }
-  int64_t annotated_dropped() const { return annotated_->dropped_frames(); }
+  int64_t encoder_waits() const { return raw_->waited_frames() + annotated_->waited_frames(); }
 
  private:
   std::string prefix_;

@@ -24,7 +24,7 @@ class LiveRunStats {
  private:
   std::vector<double> result_ms_;  // Grows geometrically: one double per frame.
   std::vector<double> row_ms_;
-  int64_t recorded_ = 0, raw_dropped_ = 0, annotated_dropped_ = 0;
+  int64_t recorded_ = 0, encoder_waits_ = 0;
 };
 
 }  // namespace softsight

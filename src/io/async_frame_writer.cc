@@ -60,6 +60,7 @@ cv::Mat* AsyncFrameWriter::acquire() {
       ++dropped_;
       return nullptr;
     }
+    ++waited_;
     freed_cv_.wait(lock, [this] { return count_ < ring_.size() || done_; });
   }
   if (error_) std::rethrow_exception(std::exchange(error_, nullptr));

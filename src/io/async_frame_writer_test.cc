@@ -1,6 +1,7 @@
 #include "softsight/io/async_frame_writer.h"
 
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -59,6 +60,40 @@ TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExac
   ASSERT_EQ(frames.size(), 40u);
   for (int i = 0; i < 40; ++i) {
     EXPECT_EQ(frames[i].index, i);
+    EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
+  }
+}
+
+TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLosesNone) {
+  TempDir dir;
+  const std::string path = dir.file("rec.avi");
+  testing::EncoderGate gate;  // Holds frame 0.
+  {
+    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kWait, /*capacity=*/2,
+                            [&gate](int64_t index) { gate.wait(index); });
+    // Frame 0 is held at the encoder and frame 1 waits behind it: the producer's frame 2 waits
+    // for a free buffer until the encoder goes on.
+    std::thread producer([&writer] {
+      for (int i = 0; i < 5; ++i) {
+        cv::Mat* slot = writer.acquire();
+        ASSERT_NE(slot, nullptr) << "kWait never drops";
+        NumberedFrame(i).copyTo(*slot);
+        writer.commit(i);
+      }
+    });
+    while (writer.waited() == 0) std::this_thread::yield();  // The producer is held up.
+    EXPECT_EQ(writer.queued(), 2);
+    gate.open();
+    producer.join();
+    writer.close();
+    EXPECT_EQ(writer.queued(), 5);
+    EXPECT_EQ(writer.dropped(), 0);
+    EXPECT_GE(writer.waited(), 1);
+    EXPECT_LE(writer.waited(), 3) << "only frames 2..4 can find the queue full";
+  }
+  const std::vector<Frame> frames = ReadBack(path);
+  ASSERT_EQ(frames.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
     EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
   }
 }

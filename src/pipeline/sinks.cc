@@ -13,6 +13,18 @@ namespace {
 
 // Frames a recording queues for its encoder (AsyncFrameWriter's buffers: 7 MB at VGA).
 constexpr size_t kQueuedFrames = 8;
+// A camera's recording queues about two seconds of frames, at most this many bytes.
+constexpr double kCameraQueueBytes = 256.0 * 1024 * 1024;
+
+size_t CameraQueueFrames(cv::Size frame_size, double fps) {
+  // Buffers are allocated only as the queue fills, so the depth costs memory only while the
+  // encoder is behind.
+  const double frame_bytes = 3.0 * std::max(1, frame_size.area());
+  const double two_seconds = 2.0 * (fps > 0.0 ? fps : 30.0);
+  const double by_memory = kCameraQueueBytes / frame_bytes;
+  return static_cast<size_t>(std::clamp(std::min(two_seconds, by_memory),
+                                        static_cast<double>(kQueuedFrames), 240.0));
+}
 
 }  // namespace
 
@@ -52,24 +64,29 @@ VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> 
   options_.codec = std::move(codec);
   options_.fps = fps.value_or(30.0);
   // Checks path and codec now.
-  writer_ = std::make_unique<AsyncFrameWriter>(options_, policy_, kQueuedFrames, before_encode_);
+  capacity_ = kQueuedFrames;
+  writer_ = std::make_unique<AsyncFrameWriter>(options_, WhenEncoderBehind::kWait, capacity_,
+                                               before_encode_);
 }
 
+
 void VideoSink::begin(const RunInfo& info) {
-  // A camera cannot wait for the encoder; a file can, and its recording keeps every frame.
-  const WhenEncoderBehind policy = info.live ? WhenEncoderBehind::kDrop : WhenEncoderBehind::kWait;
-  if ((!fps_ && info.fps && *info.fps > 0.0) || policy != policy_) {
+  // Every frame is kept (the recording and the CSV hold the same frames). A camera gets a deeper
+  // queue: its frames keep coming while the encoder has a hiccup.
+  const size_t capacity =
+      info.live ? CameraQueueFrames(info.frame_size, info.fps.value_or(options_.fps)) : kQueuedFrames;
+  if ((!fps_ && info.fps && *info.fps > 0.0) || capacity != capacity_) {
     if (!fps_ && info.fps && *info.fps > 0.0) options_.fps = *info.fps;
-    policy_ = policy;
+    capacity_ = capacity;
     writer_.reset();  // Nothing written yet: the file is made again with the right rate.
-    writer_ = std::make_unique<AsyncFrameWriter>(options_, policy_, kQueuedFrames, before_encode_);
+    writer_ = std::make_unique<AsyncFrameWriter>(options_, WhenEncoderBehind::kWait, capacity_,
+                                                 before_encode_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
 }
 
 void VideoSink::consume(const Frame& frame, const FrameResult& result) {
-  cv::Mat* slot = writer_->acquire();
-  if (slot == nullptr) return;  // The encoder is behind a camera: dropped, and counted.
+  cv::Mat* slot = writer_->acquire();  // Waits while the queue is full (counted).
   frame.image.copyTo(*slot);    // Into the queue's own buffer: no allocation once it has one.
   if (draw_) draw_(*slot, result);
   writer_->commit(frame.index);

@@ -77,6 +77,7 @@ TrackingSession::~TrackingSession() = default;
 
 const FrameResult& TrackingSession::process(const Frame& frame) {
   const int64_t start = cv::getTickCount();
+  last_frame_ = frame.index;
   // A live recording's raw video names the live source's frames (config.recording).
   result_.frame_index = frame.index;
   result_.time_s = frame.time_s;
@@ -243,6 +244,7 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
       believed_frame_[i] = frame.index;
     }
     measure(frame);
+    edited(ConfigChange::Reselect(marker, rect));
     return result_;
   }
   throw InputError("no marker named '" + marker + "'");
@@ -262,6 +264,7 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
     }
     previous_px_[i] = result_.markers[i].observation.position_px;
     measure(frame);
+    edited(ConfigChange::Retrack(marker));
     return result_;
   }
   throw InputError("no marker named '" + marker + "'");
@@ -281,12 +284,22 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     initialised_[i] = false;
     plausibility_->forget(i);
     believed_px_[i].reset();
+    edited(ConfigChange::Respec(spec));
     return;
   }
   throw InputError("no marker named '" + spec.name + "'");
 }
 
-void TrackingSession::reset_tip_reference() { measurer_.reset_tip_reference(); }
+void TrackingSession::reset_tip_reference() {
+  measurer_.reset_tip_reference();
+  edited(ConfigChange::ResetTipReference());
+}
+
+void TrackingSession::edited(ConfigChange change) const {
+  if (!edit_listener_) return;
+  change.after_frame = std::max<int64_t>(0, last_frame_);
+  edit_listener_(change);
+}
 
 void TrackingSession::jump() {
   for (size_t i = 0; i < trackers_.size(); ++i) {

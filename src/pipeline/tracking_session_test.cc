@@ -1,5 +1,7 @@
 #include "softsight/pipeline/tracking_session.h"
 
+#include <vector>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
@@ -87,6 +89,47 @@ TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
   EXPECT_EQ(std::get<ColourParams>(session.config().markers[1].params).roi, cv::Rect(10, 20, 30, 40));
   EXPECT_THROW(session.reselect("yellow", clip.frames[0], cv::Rect(0, 0, 5, 5)),
                InputError);
+}
+
+// Whoever keeps live edits (a recording) hears of each edit once, after it is made, with the
+// frame it follows; a failed edit is not reported; a config's own changes replayed are edits too.
+TEST(TrackingSession, TellsItsEditListenerOfEachEditWithTheFrameItFollows) {
+  const Clip clip = Render(4);
+  TrackingConfig config = ThreeMarkerSceneConfig();
+  ConfigChange replayed = ConfigChange::ResetTipReference();
+  replayed.after_frame = 3;
+  config.changes.push_back(replayed);
+  TrackingSession session(config);
+  std::vector<ConfigChange> heard;
+  session.set_edit_listener([&heard](const ConfigChange& change) { heard.push_back(change); });
+  session.process(clip.frames[0]);
+  session.process(clip.frames[1]);
+  MarkerSpec spec = session.config().markers[0];
+  std::get<ColourParams>(spec.params).h = {5, 25};
+  session.respec(spec);
+  session.reselect("blue", clip.frames[1], cv::Rect(10, 20, 30, 40));
+  EXPECT_THROW(session.reselect("yellow", clip.frames[1], cv::Rect(0, 0, 5, 5)), InputError);
+  session.process(clip.frames[2]);
+  session.retrack("green", clip.frames[2]);
+  session.reset_tip_reference();
+  session.process(clip.frames[3]);  // Replays the config's change after frame 3.
+
+  ASSERT_EQ(heard.size(), 5u);
+  EXPECT_EQ(heard[0].kind, ConfigChange::Kind::kRespec);
+  EXPECT_EQ(heard[0].spec.name, spec.name);
+  EXPECT_EQ(std::get<ColourParams>(heard[0].spec.params).h.hi, 25);
+  EXPECT_EQ(heard[0].after_frame, 1);
+  EXPECT_EQ(heard[1].kind, ConfigChange::Kind::kReselect);
+  EXPECT_EQ(heard[1].marker, "blue");
+  EXPECT_EQ(heard[1].rect, cv::Rect(10, 20, 30, 40));
+  EXPECT_EQ(heard[1].after_frame, 1);
+  EXPECT_EQ(heard[2].kind, ConfigChange::Kind::kRetrack);
+  EXPECT_EQ(heard[2].marker, "green");
+  EXPECT_EQ(heard[2].after_frame, 2);
+  EXPECT_EQ(heard[3].kind, ConfigChange::Kind::kResetTipReference);
+  EXPECT_EQ(heard[3].after_frame, 2);
+  EXPECT_EQ(heard[4].kind, ConfigChange::Kind::kResetTipReference);
+  EXPECT_EQ(heard[4].after_frame, 3);
 }
 
 // What the live window does when a person clicks a colour marker at frame N > 0 and saves (`s`):

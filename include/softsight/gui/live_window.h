@@ -42,14 +42,14 @@ struct LiveRunSummary {
   // Capture -> result (FrameResult::latency_result_ms) over the tracked frames, ms.
   double latency_result_ms_median = 0.0;
   double latency_result_ms_p99 = 0.0;
-  // The recordings of the run, together: frames recorded (CSV rows), capture -> CSV row written
-  // (0 when nothing was recorded), and the frames each video could not take because its encoder
-  // fell behind a camera (a file's recording waits for the encoder instead).
+  // The recordings of the run, together: frames recorded (CSV rows; both videos hold each one),
+  // capture -> CSV row written (0 when nothing was recorded), and how often the window waited
+  // for a video's encoder because its queue was full (a camera's frames skipped meanwhile are in
+  // dropped_by_source).
   int64_t recorded_frames = 0;
   double latency_row_ms_median = 0.0;
   double latency_row_ms_p99 = 0.0;
-  int64_t raw_video_dropped = 0;
-  int64_t annotated_video_dropped = 0;
+  int64_t encoder_waits = 0;
 
   // "live: 600 frames, 0 dropped by the source" and the latency and recording lines.
   std::string Report() const;

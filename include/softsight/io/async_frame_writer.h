@@ -7,6 +7,7 @@
 // Single producer: call acquire/commit/close from one thread (the pipeline's).
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -56,6 +57,9 @@ class AsyncFrameWriter {
   const std::string& path() const { return path_; }
   const std::string& format() const { return format_; }
   int64_t dropped() const { return dropped_; }
+  // Frames for which acquire() had to wait for the encoder (kWait): how often it held up the
+  // pipeline. May be read from any thread.
+  int64_t waited() const { return waited_.load(); }
   int64_t queued() const { return queued_; }  // Frames committed (written once close() returns).
 
  private:
@@ -76,6 +80,7 @@ class AsyncFrameWriter {
   bool closing_ = false, done_ = false;
   std::exception_ptr error_;
   int64_t dropped_ = 0, queued_ = 0;
+  std::atomic<int64_t> waited_{0};
   std::thread thread_;
 };
 

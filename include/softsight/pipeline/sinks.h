@@ -50,9 +50,12 @@ using FrameDrawer = std::function<void(cv::Mat& canvas, const FrameResult& resul
 // Every processed frame to a video or image pattern: as read (`draw` empty: the raw recording,
 // lossless by default, which `track` reproduces row for row), or with `draw` applied (the
 // annotated video). The video's rate is options.fps, or the source's when that is absent.
-// Encoding runs on its own thread (AsyncFrameWriter), so the pipeline does not wait for it. When
-// the encoder falls behind a live source (a camera), a frame is dropped from the video and counted
-// (dropped_frames(): the caller reports it); a file's run waits for it and never drops one.
+// Encoding runs on its own thread (AsyncFrameWriter), behind a queue of frames, so the pipeline
+// does not wait for it. The video keeps every frame it is given, so a recording and its CSV hold
+// the same frames: an encoder that falls behind by a full queue holds up the pipeline (counted:
+// waited_frames()), and a camera meanwhile drops its stale frames as the source does, counted in
+// the run's summary. For a camera (RunInfo::live) the queue holds about two seconds of frames
+// (at most 256 MB), so only an encoder that stays slower than the camera holds it up.
 class VideoSink : public FrameSink {
  public:
   // Checks the path and codec at once (FrameWriter). `fps` absent: the source's, else 30.
@@ -67,7 +70,8 @@ class VideoSink : public FrameSink {
 
   const std::string& path() const { return options_.path; }
   int64_t written_frames() const { return writer_->queued(); }  // Once end() has run.
-  int64_t dropped_frames() const { return writer_->dropped(); }
+  // Frames for which the pipeline had to wait for the encoder (its queue was full).
+  int64_t waited_frames() const { return writer_->waited(); }
   // The encoder's error that end() met (a full disk while the last frames were written).
   const std::optional<std::string>& error() const { return error_; }
 
@@ -76,7 +80,7 @@ class VideoSink : public FrameSink {
   std::optional<double> fps_;
   FrameDrawer draw_;
   std::function<void(int64_t)> before_encode_;
-  WhenEncoderBehind policy_ = WhenEncoderBehind::kWait;
+  size_t capacity_;
   std::unique_ptr<AsyncFrameWriter> writer_;
   std::optional<std::string> error_;
 };

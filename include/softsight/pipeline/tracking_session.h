@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,7 +75,18 @@ class TrackingSession {
 
   const TrackingConfig& config() const { return config_; }
 
+  // Who keeps the live edits (a live recording, whose config must reproduce them): told of each
+  // respec, reselect, retrack and reset_tip_reference once it is made, as a ConfigChange
+  // (`after_frame`: the index of the frame process() saw last). Edits happen only here, so a
+  // recording cannot miss one. A config's own `changes:` replayed by process() are edits too.
+  // The listener must not call back into the session. Empty: nobody listens.
+  using EditListener = std::function<void(const ConfigChange& change)>;
+  void set_edit_listener(EditListener listener) { edit_listener_ = std::move(listener); }
+
  private:
+  void edited(ConfigChange change) const;  // Tells the listener, if any.
+  EditListener edit_listener_;
+  int64_t last_frame_ = -1;  // The index of the frame process() saw last.
   void measure(const Frame& frame);  // result_.measurement from result_.markers.
   // The config's recorded live edits (config.changes) due after `frame`, the frame just processed.
   void apply_changes(const Frame& frame);
