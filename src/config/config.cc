@@ -106,11 +106,13 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
   for (size_t i = 0; i < markers.size(); ++i) {
     YamlMap marker(markers[i], file, "markers[" + std::to_string(i) + "]");
     std::string template_file;
-    MarkerSpec spec = ReadMarker(marker, method_override, &template_file);
+    std::optional<ColourParams> colour_aside;
+    MarkerSpec spec = ReadMarker(marker, method_override, &template_file, &colour_aside);
     if (!names.insert(spec.name).second) {
       marker.fail("name", "marker name '" + spec.name + "' is used twice");
     }
     if (!template_file.empty()) config.template_files[spec.name] = template_file;
+    if (colour_aside) config.colour_aside[spec.name] = *colour_aside;
     config.markers.push_back(std::move(spec));
   }
 
@@ -173,7 +175,7 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
 }  // namespace
 
 MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
-                      std::string* template_file) {
+                      std::string* template_file, std::optional<ColourParams>* colour_aside) {
   MarkerSpec spec;
   spec.name = marker.string("name").value_or("");
   if (spec.name.empty()) marker.fail("name", "every marker needs a name");
@@ -200,6 +202,10 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   marker.finish();
   spec.params = ParamsForMethod(method, colour, templ.params);
   *template_file = std::holds_alternative<TemplateParams>(spec.params) ? templ.file : "";
+  if (colour_aside != nullptr && std::holds_alternative<TemplateParams>(spec.params)) {
+    // Range-checked key by key above; the rules across fields are checked when it is used.
+    *colour_aside = colour;
+  }
 
   std::string problem;
   const bool ok = std::visit([&](const auto& params) { return params.Check(&problem); },
@@ -208,13 +214,15 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   return spec;
 }
 
-void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out) {
+void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out,
+                 const ColourParams* colour_aside) {
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << spec.name;
   out << YAML::Key << "method" << YAML::Value << TrackerMethodName(spec.params);
   if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
     WriteColourParams(*colour, out);
   } else {
+    if (colour_aside != nullptr) WriteColourParams(*colour_aside, out);
     WriteTemplateParams({std::get<TemplateParams>(spec.params), template_file}, out);
   }
   out << YAML::EndMap;
@@ -242,7 +250,9 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::Key << "markers" << YAML::Value << YAML::BeginSeq;
   for (const MarkerSpec& spec : config.markers) {
     const auto file = config.template_files.find(spec.name);
-    WriteMarker(spec, file == config.template_files.end() ? "" : file->second, out);
+    const auto aside = config.colour_aside.find(spec.name);
+    WriteMarker(spec, file == config.template_files.end() ? "" : file->second, out,
+                aside == config.colour_aside.end() ? nullptr : &aside->second);
   }
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);

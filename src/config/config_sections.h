@@ -36,13 +36,16 @@ void ReadTemplateParams(YamlMap& marker, TemplateSection* section);
 void WriteTemplateParams(const TemplateSection& section, YAML::Emitter& out);
 
 // config.cc: one entry of `markers:`: its name, method (`method_override` replaces it) and that
-// method's keys (the other method's keys are read and checked too, but not kept: a marker is one
-// method's parameters). `template_file` gets the marker's template.file ("" when none).
+// method's keys (the other method's keys are read and checked too: a marker is one method's
+// parameters). `template_file` gets the marker's template.file ("" when none); `colour_aside`
+// (may be null), for a template marker, its colour keys (kept for the colour method).
 MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
-                      std::string* template_file);
+                      std::string* template_file, std::optional<ColourParams>* colour_aside = nullptr);
 // The same keys back: name, method, and the keys of the marker's parameters that differ from the
-// defaults (`template_file` as template.file for a template marker).
-void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out);
+// defaults (`template_file` as template.file for a template marker; `colour_aside`, when given
+// for a template marker, as its colour keys).
+void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out,
+                 const ColourParams* colour_aside = nullptr);
 
 // metric_config.cc: top-level scale_mm_per_px / plane keys.
 void ReadMetricModel(YamlMap& top, MetricModel* metric);

@@ -1,5 +1,6 @@
 #include "softsight/config/config.h"
 
+#include <array>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -74,6 +75,34 @@ TEST(Config, SavedConfigLoadsBackToTheSameValues) {
   }
   EXPECT_EQ(again.measure.middle, "blue");
   EXPECT_EQ(again.measure.metric.scale_mm_per_px, original.measure.metric.scale_mm_per_px);
+}
+
+// A template marker's colour keys are its colour method's parameters: kept, saved, read back.
+TEST(Config, ATemplateMarkersColourKeysAreKeptForTheColourMethod) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), R"(markers:
+  - name: red
+    method: zncc
+    hsv: {h: [160, 5], s: [90, 255], v: [50, 255]}
+    template: {rect: [10, 20, 16, 16]}
+  - name: blue
+    hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
+)");
+  const TrackingConfig original = LoadTrackingConfig(dir.file("markers.yaml"));
+  ASSERT_EQ(original.colour_aside.size(), 1u) << "a colour marker has none";
+  EXPECT_EQ(original.colour_aside.at("red").h.lo, 160);
+  EXPECT_EQ(original.colour_aside.at("red").v.lo, 50);
+  SaveTrackingConfig(original, dir.file("saved.yaml"));
+  const TrackingConfig again = LoadTrackingConfig(dir.file("saved.yaml"));
+  EXPECT_EQ(TrackerMethodName(again.markers[0].params), "zncc");
+  ASSERT_EQ(again.colour_aside.count("red"), 1u);
+  const ColourParams& a = again.colour_aside.at("red");
+  const ColourParams& b = original.colour_aside.at("red");
+  EXPECT_EQ((std::array<int, 6>{a.h.lo, a.h.hi, a.s.lo, a.s.hi, a.v.lo, a.v.hi}),
+            (std::array<int, 6>{b.h.lo, b.h.hi, b.s.lo, b.s.hi, b.v.lo, b.v.hi}));
+  // --method colour uses them.
+  const TrackingConfig colour = LoadTrackingConfig(dir.file("saved.yaml"), "colour");
+  EXPECT_EQ(std::get<ColourParams>(colour.markers[0].params).h.lo, 160);
 }
 
 TEST(Config, UnknownKeyIsNamedWithFileAndLine) {

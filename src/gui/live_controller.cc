@@ -35,7 +35,11 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   for (const MarkerSpec& spec : config.markers) {
     const auto* colour = std::get_if<ColourParams>(&spec.params);
     const auto* templ = std::get_if<TemplateParams>(&spec.params);
-    colour_aside_.push_back(colour ? *colour : ColourParams{});
+    // A template marker's colour keys in the file are its colour method's parameters.
+    const auto aside = config.colour_aside.find(spec.name);
+    colour_aside_.push_back(colour ? *colour
+                                   : aside != config.colour_aside.end() ? aside->second
+                                                                        : ColourParams{});
     template_aside_.push_back(templ ? *templ : TemplateParams{});
   }
   say("press h for help");
@@ -353,7 +357,17 @@ void LiveController::save_config() {
   const std::string path =
       options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
   try {
-    SaveLiveConfig(config(), path);
+    // The session's config, and each template marker's colour parameters as the window keeps
+    // them (ranges picked or moved while it matched templates), so that loading the file and
+    // switching back to colour finds them again.
+    TrackingConfig saved = config();
+    saved.colour_aside.clear();
+    for (size_t i = 0; i < saved.markers.size(); ++i) {
+      if (std::holds_alternative<TemplateParams>(saved.markers[i].params)) {
+        saved.colour_aside[saved.markers[i].name] = colour_aside_[i];
+      }
+    }
+    SaveLiveConfig(saved, path);
     say("saved " + path);
   } catch (const InputError& e) {
     say(e.what());

@@ -281,6 +281,47 @@ TEST_F(LiveControllerTest, SwitchingBackToColourRestoresTheRangesPickedWhileMatc
   for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 0.5);
 }
 
+// `s` saves the colour ranges picked while a marker matched templates beside its template keys;
+// a window started from the saved file finds them again when it switches back to colour.
+TEST_F(LiveControllerTest, RangesPickedWhileMatchingTemplatesAreSavedAndComeBackFromTheFile) {
+  std::array<int, 6> picked{};
+  {
+    LiveController live(SceneConfig(), Options());
+    SceneTruth truth;
+    for (int i = 0; i < 3; ++i) truth = Feed(live, i);
+    live.on_event(UiEvent::Key('m'));  // colour -> sad
+    truth = Feed(live, 3);
+    live.on_event(UiEvent::Key('2'));
+    Click(live, *truth.markers[1].centroid_px);
+    picked = live.active_hsv();
+    ASSERT_NE(picked, (std::array<int, 6>{95, 125, 80, 255, 40, 255})) << "the pick's own ranges";
+    live.on_event(UiEvent::Key('s'));
+  }
+  const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
+  ASSERT_EQ(TrackerMethodName(saved.markers[1].params), "sad");
+  ASSERT_EQ(saved.colour_aside.count("blue"), 1u);
+  const ColourParams& aside = saved.colour_aside.at("blue");
+  EXPECT_EQ((std::array<int, 6>{aside.h.lo, aside.h.hi, aside.s.lo, aside.s.hi, aside.v.lo,
+                                aside.v.hi}),
+            picked);
+  // The same file with --method colour tracks blue with the picked ranges.
+  const TrackingConfig as_colour = LoadTrackingConfig((dir_ / "saved.yaml").string(), "colour");
+  EXPECT_EQ(std::get<ColourParams>(as_colour.markers[1].params).h.lo, picked[0]);
+
+  LiveController again(saved, Options());
+  SceneTruth truth;
+  for (int i = 4; i < 6; ++i) truth = Feed(again, i);
+  again.on_event(UiEvent::Key('2'));
+  EXPECT_EQ(again.active_hsv(), picked) << "the trackbars show the saved colour ranges";
+  for (int k = 0; k < 3; ++k) again.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
+  ASSERT_EQ(TrackerMethodName(again.config().markers[1].params), "colour");
+  const ColourParams& blue = std::get<ColourParams>(again.config().markers[1].params);
+  EXPECT_EQ((std::array<int, 6>{blue.h.lo, blue.h.hi, blue.s.lo, blue.s.hi, blue.v.lo, blue.v.hi}),
+            picked);
+  for (int i = 6; i < 9; ++i) truth = Feed(again, i);
+  ExpectAt(again, 1, truth, 0.5);
+}
+
 TEST_F(LiveControllerTest, RecordingIsReproducedByTrackingTheRawVideoWithItsConfig) {
   LiveController live(SceneConfig(), Options());
   for (int i = 0; i < 3; ++i) Feed(live, i);
