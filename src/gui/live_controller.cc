@@ -31,7 +31,7 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   // The session holds the only copy of the config: every live edit goes through it, and `s`
   // and recordings save what it holds; the pipeline feeds it and its sinks (the recording).
   pipeline_ = std::make_unique<LivePipeline>(
-      config, LiveRecordingSettings{options_.record_prefix, false, std::move(before_encode)});
+      config, LiveRecordingSettings{options_.record_prefix, std::move(before_encode)});
   for (const MarkerSpec& spec : config.markers) {
     const auto* colour = std::get_if<ColourParams>(&spec.params);
     const auto* templ = std::get_if<TemplateParams>(&spec.params);
@@ -57,7 +57,9 @@ const std::string& LiveController::last_recording() const { return pipeline_->la
 
 LiveRunSummary LiveController::run_summary() const { return pipeline_->summary(dropped_); }
 
-void LiveController::set_live_source(bool live) { pipeline_->set_live_source(live); }
+void LiveController::describe_source(const FrameSource& source) {
+  pipeline_->describe_source(source);
+}
 
 void LiveController::report_recording_failure() {
   if (auto failure = pipeline_->take_recording_failure()) say(*failure);

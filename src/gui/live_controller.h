@@ -167,9 +167,10 @@ class LiveController {
   int hsv_revision() const { return hsv_revision_; }
   // Where the previous recording's files went (prefix without extension); empty if none.
   const std::string& last_recording() const;
-  // The source is a camera: a recording's videos get a deeper queue, so an encoder's hiccup does
-  // not hold up the window; they still keep every frame (LivePipeline).
-  void set_live_source(bool live);
+  // Before the first frame: where the frames come from, for the end summary; a camera's
+  // recordings get a deeper queue, so an encoder's hiccup does not hold up the window (they
+  // still keep every frame: LivePipeline).
+  void describe_source(const FrameSource& source);
   // The run so far, for the end summary (a recording still open counted too).
   LiveRunSummary run_summary() const;
 

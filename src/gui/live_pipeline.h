@@ -1,9 +1,10 @@
 // Internal to gui (and the tests). The live window's data flow, apart from its input and its
-// view: a frame -> the tracking session (the only owner of the config) -> the run's sinks, which
-// are the run's statistics and, while one runs, a recording (its CSV, raw and annotated videos,
-// and the config that reproduces it). The controller maps keys and the mouse to calls here and
-// to edits of session(); the session tells a running recording of every edit it makes, so the
-// recording's config keeps each one without the controller having to remember to.
+// view: a frame -> the tracking session (the only owner of the config) -> the run (PipelineRun:
+// the same work per frame and the same summary as every command's RunPipeline) -> its sinks: a
+// recording (its CSV, raw and annotated videos, and the config that reproduces it) joins the
+// run while it records. The controller maps keys and the mouse to calls here and to edits of
+// session(); the session tells a running recording of every edit it makes, so the recording's
+// config keeps each one without the controller having to remember to.
 #pragma once
 
 #include <cstdint>
@@ -13,8 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "gui/live_run_stats.h"
 #include "softsight/config/config.h"
+#include "softsight/gui/live_window.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/run.h"
 #include "softsight/core/types.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -26,7 +29,6 @@ class LiveRecording;
 // Where and how recordings are written.
 struct LiveRecordingSettings {
   std::string prefix = "softsight-live";  // Files <prefix>-NNN.{csv,raw.avi,avi,yaml}.
-  bool live_source = false;  // A camera: the videos get a deeper queue (see VideoSink).
   // Tests: both videos' encoder hook (AsyncFrameWriter), to make an encoder fall behind.
   std::function<void(int64_t index)> before_encode;
 };
@@ -36,6 +38,10 @@ class LivePipeline {
   // Builds the tracking session. Throws InputError on a bad config.
   LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings);
   ~LivePipeline();  // Closes a running recording (what it wrote stays).
+
+  // The frames come from `source` (its description, rate and liveness, for the summary and the
+  // recordings): before the first frame.
+  void describe_source(const FrameSource& source);
 
   TrackingSession& session() { return *session_; }
   const TrackingSession& session() const { return *session_; }
@@ -62,8 +68,6 @@ class LivePipeline {
   // Closes the recording's files; returns how many frames it holds. No recording: 0.
   int64_t stop_recording();
   bool recording() const { return recording_ != nullptr; }
-  // The source is a camera (see LiveRecordingSettings::live_source); for the next recording.
-  void set_live_source(bool live) { settings_.live_source = live; }
   // The running recording's file prefix (without extension); empty when none runs.
   std::string recording_prefix() const;
   // The last closed recording's prefix; empty if none.
@@ -72,19 +76,31 @@ class LivePipeline {
   // not keep: "recorded N frames to P.*; <the error>"), once.
   std::optional<std::string> take_recording_failure();
 
-  // The run so far, for the end summary (a recording still open counted too).
+  // The run so far, for the end summary (a recording still open counted too): what every command
+  // reports, with the recordings' CSV-row latency and a note per recording.
   LiveRunSummary summary(int64_t dropped_by_source) const;
 
  private:
   // A recording that cannot keep a frame or an edit stops, keeping what it wrote.
   void fail(const std::string& why);
 
+  // What a closed (or still open) recording adds to the summary.
+  void count_recording(const LiveRecording& recording, std::vector<double>* row_ms,
+                       std::vector<std::string>* notes, int64_t* recorded, int64_t* waits) const;
+
   LiveRecordingSettings settings_;
   std::unique_ptr<TrackingSession> session_;
+  std::unique_ptr<PipelineRun> run_;
   std::unique_ptr<LiveRecording> recording_;
+  class RecordingInRun;
+  std::unique_ptr<RecordingInRun> in_run_;  // The recording's place among the run's sinks.
+  std::optional<std::string> frame_failure_;  // A frame the recording could not take.
   std::string last_recording_;
   std::optional<std::string> failure_;
-  LiveRunStats stats_;
+  // The closed recordings: their CSV rows' latencies, one note each, frames, encoder waits.
+  std::vector<double> row_ms_;
+  std::vector<std::string> notes_;
+  int64_t recorded_ = 0, encoder_waits_ = 0;
 };
 
 }  // namespace softsight

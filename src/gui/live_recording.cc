@@ -29,7 +29,7 @@ std::string FreePrefix(const std::string& base) {
 LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& config,
                              const RunInfo& info, const RecordingOrigin& origin, FrameDrawer draw,
                              std::function<void(int64_t index)> before_encode)
-    : prefix_(FreePrefix(base)) {
+    : prefix_(FreePrefix(base)), info_(info) {
   auto csv = std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config));
   auto raw = std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps, FrameDrawer{},
                                          before_encode);
@@ -41,7 +41,6 @@ LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& conf
   sinks_.push_back(std::move(csv));
   sinks_.push_back(std::move(raw));
   sinks_.push_back(std::move(annotated));
-  for (auto& sink : sinks_) sink->begin(info);
   saved_ = config;
   saved_.recording = origin;
   saved_.changes.clear();
@@ -49,9 +48,24 @@ LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& conf
 }
 
 LiveRecording::~LiveRecording() {
-  RunSummary summary;
-  summary.frames = frames_;
-  for (auto& sink : sinks_) sink->end(summary);
+  if (begun_ && !ended_) {
+    RunSummary summary;
+    summary.frames = frames_;
+    end(summary);
+  }
+}
+
+void LiveRecording::begin(const RunInfo& /*info*/) {
+  for (auto& sink : sinks_) sink->begin(info_);
+  begun_ = true;
+}
+
+void LiveRecording::end(const RunSummary& summary) {
+  if (!begun_ || ended_) return;
+  ended_ = true;
+  RunSummary own = summary;
+  own.frames = frames_;
+  for (auto& sink : sinks_) sink->end(own);
 }
 
 void LiveRecording::consume(const Frame& frame, const FrameResult& result) {

@@ -18,10 +18,12 @@
 
 namespace softsight {
 
-class LiveRecording {
+class LiveRecording : public FrameSink {
  public:
   // Opens <base>-NNN.csv, .raw.avi, .avi and writes .yaml, with the first NNN whose CSV does not
-  // exist (nothing is overwritten). `config` is what the session runs from this frame on;
+  // exist (nothing is overwritten); begin() (with `info`'s frame size) starts the files. It
+  // joins the live run (PipelineRun::join) for the frames that follow its first.
+  // `config` is what the session runs from this frame on;
   // `origin` the source frame and time of the recording's first frame, saved with the config
   // (its `recording:` key) so that re-tracking the raw video names the source's frames.
   // `draw` draws the overlay of the annotated video. Throws InputError (unwritable folder, no
@@ -32,10 +34,15 @@ class LiveRecording {
   LiveRecording(const std::string& base, const TrackingConfig& config, const RunInfo& info,
                 const RecordingOrigin& origin, FrameDrawer draw,
                 std::function<void(int64_t index)> before_encode = {});
-  ~LiveRecording();  // Closes every file (end() of each sink).
+  ~LiveRecording() override;  // Closes every file, if end() has not.
 
+  // Starts the files for frames of the size given at construction (`info` is the run's: the
+  // recording keeps its own, from its config).
+  void begin(const RunInfo& info) override;
   // Every processed frame, in order. Throws InputError (a full disk).
-  void consume(const Frame& frame, const FrameResult& result);
+  void consume(const Frame& frame, const FrameResult& result) override;
+  // Closes every file (end() of each sink).
+  void end(const RunSummary& summary) override;
   // A live edit of the session made after the last frame consumed (at least one frame has
   // been): kept in the recording's config, which is written again at once (the .yaml on disk is
   // always whole), so re-tracking the raw video makes the same edit after the same frame. A
@@ -52,6 +59,8 @@ class LiveRecording {
 
  private:
   std::string prefix_;
+  RunInfo info_;  // The recording's own: its markers, metric, frame size and rate.
+  bool begun_ = false, ended_ = false;
   TrackingConfig saved_;  // The .yaml: the starting config, origin and the edits so far.
   std::vector<std::unique_ptr<FrameSink>> sinks_;
   CsvSink* csv_;         // In sinks_.

@@ -32,6 +32,16 @@ void Feed(LiveController& live, SyntheticScene& scene, int first, int count) {
   }
 }
 
+// A camera as the window's source sees it: live, no frame count (frames come from Feed).
+class CameraStandIn : public FrameSource {
+ public:
+  bool read(Frame&) override { return false; }
+  std::string description() const override { return "camera 3"; }
+  std::optional<int64_t> frame_count() const override { return std::nullopt; }
+  std::optional<double> fps() const override { return 30.0; }
+  bool is_live() const override { return true; }
+};
+
 SceneOptions SmallScene() {
   SceneOptions scene;
   scene.size = {320, 240};
@@ -47,7 +57,7 @@ TEST(LiveSummary, ACameraRecordingKeepsEveryFrameWhileItsEncoderIsHeld) {
   LiveOptions options;
   options.record_prefix = dir.file("rec");
   LiveController live(testing::ThreeMarkerSceneConfig(), options, [&gate](int64_t index) { gate.wait(index); });
-  live.set_live_source(true);
+  live.describe_source(CameraStandIn());
   SyntheticScene scene(SmallScene());
   Feed(live, scene, 0, 2);
   live.on_event(UiEvent::Key('r'));
@@ -61,21 +71,31 @@ TEST(LiveSummary, ACameraRecordingKeepsEveryFrameWhileItsEncoderIsHeld) {
   const std::string prefix = live.last_recording();
 
   const LiveRunSummary summary = live.run_summary();
-  EXPECT_EQ(summary.frames, 22);
+  EXPECT_EQ(summary.run.frames, 22);
   EXPECT_EQ(summary.recorded_frames, 21) << "the frame on screen, then 2..21";
   EXPECT_EQ(FramesInVideo(prefix + ".raw.avi"), 21);
   EXPECT_EQ(FramesInVideo(prefix + ".avi"), 21);
   EXPECT_EQ(summary.encoder_waits, 0);
-  EXPECT_GT(summary.latency_result_ms_median, 0.0);
-  EXPECT_LE(summary.latency_result_ms_median, summary.latency_result_ms_p99);
-  EXPECT_GT(summary.latency_row_ms_median, 0.0);
-  EXPECT_LE(summary.latency_row_ms_median, summary.latency_row_ms_p99);
+  // The summary every command gives (PipelineRun): found rates, latencies, the source.
+  ASSERT_EQ(summary.run.markers.size(), 3u);
+  for (const MarkerRunSummary& marker : summary.run.markers) {
+    EXPECT_EQ(marker.found, 22) << marker.name;
+  }
+  EXPECT_EQ(summary.run.first_index, 0);
+  EXPECT_EQ(summary.run.last_index, 21);
+  EXPECT_GT(summary.run.latency_result_ms_median, 0.0);
+  EXPECT_LE(summary.run.latency_result_ms_median, summary.run.latency_result_ms_p99);
+  ASSERT_TRUE(summary.run.latency_row_ms_median && summary.run.latency_row_ms_p99);
+  EXPECT_GT(*summary.run.latency_row_ms_median, 0.0);
+  EXPECT_LE(*summary.run.latency_row_ms_median, *summary.run.latency_row_ms_p99);
   const std::string report = summary.Report();
-  EXPECT_THAT(report, HasSubstr("live: 22 frames tracked, 0 dropped by the source"));
-  EXPECT_THAT(report, HasSubstr("latency from capture to the result median"));
-  EXPECT_THAT(report, HasSubstr("recorded 21 frames, each in the CSV and both videos; latency "
-                                "from capture to the CSV row median"));
-  EXPECT_THAT(report, HasSubstr("live: the recordings' encoders kept up"));
+  EXPECT_THAT(report, HasSubstr("frames: 22 from camera 3 in"));
+  EXPECT_THAT(report, HasSubstr("(the window was closed)"));
+  EXPECT_THAT(report, HasSubstr("source frames 0..21, 0 dropped by the source"));
+  EXPECT_THAT(report, HasSubstr("to the result median"));
+  EXPECT_THAT(report, HasSubstr("to the CSV row median"));
+  EXPECT_THAT(report, HasSubstr("note: " + prefix + ".*: recorded 21 frames, each in the CSV and "
+                                "both videos (the encoders kept up)"));
 }
 
 TEST(LiveSummary, AFileRecordingWaitsForItsEncoderAndARecordingStillOpenIsCounted) {
@@ -85,12 +105,12 @@ TEST(LiveSummary, AFileRecordingWaitsForItsEncoderAndARecordingStillOpenIsCounte
   LiveController live(testing::ThreeMarkerSceneConfig(), options);
   SyntheticScene scene(SmallScene());
   Feed(live, scene, 0, 3);
-  EXPECT_THAT(live.run_summary().Report(), HasSubstr("live: nothing recorded"));
+  EXPECT_THAT(live.run_summary().Report(), HasSubstr("note: nothing recorded"));
   live.on_event(UiEvent::Key('r'));
   ASSERT_TRUE(live.recording()) << live.message();
   Feed(live, scene, 3, 12);
   const LiveRunSummary summary = live.run_summary();  // Still recording, as when the window closes.
-  EXPECT_EQ(summary.frames, 15);
+  EXPECT_EQ(summary.run.frames, 15);
   EXPECT_EQ(summary.recorded_frames, 13);
   EXPECT_EQ(summary.encoder_waits, 0);
   // The recording is still open: its videos are closed by the window, then hold every frame.

@@ -171,7 +171,7 @@ LiveRunResult RunLiveWindow(const TrackingConfig& config, std::unique_ptr<FrameS
   }
   if (!options.record_fps) options.record_fps = source->fps();
   LiveController controller(config, std::move(options));
-  controller.set_live_source(source->is_live());
+  controller.describe_source(*source);
   // Pacing belongs to the source: a camera keeps only its newest frame (drops are counted and
   // shown); a file or image sequence plays every frame at its own rate and pauses with the
   // window (or, unpaced, as fast as it decodes).

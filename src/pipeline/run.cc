@@ -4,6 +4,8 @@
 #include <chrono>
 #include <string>
 
+#include <opencv2/core.hpp>
+
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -38,100 +40,140 @@ RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
   return info;
 }
 
-RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
-                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const TrackingConfig& config = session.config();
-  RunSummary summary;
-  summary.source = source.description();
-  RunInfo info = DescribeRun(source, session, options);
-  for (const std::string& name : info.marker_names) summary.markers.push_back({name, 0});
-
-  std::vector<double> proc_ms, latency_result_ms, latency_done_ms;
-  if (info.frame_count) {
+PipelineRun::PipelineRun(TrackingSession& session, RunInfo info, std::vector<FrameSink*> sinks)
+    : session_(session),
+      info_(std::move(info)),
+      sinks_(std::move(sinks)),
+      needs_colour_(NeedsColour(session.config())),
+      start_(std::chrono::steady_clock::now()) {
+  summary_.source = info_.source;
+  for (const std::string& name : info_.marker_names) summary_.markers.push_back({name, 0});
+  if (info_.frame_count) {
     // Reserved once: the loop does not reallocate for files (cameras grow it geometrically).
-    const auto frames = static_cast<size_t>(std::min<int64_t>(*info.frame_count, int64_t{1} << 22));
-    for (std::vector<double>* times : {&proc_ms, &latency_result_ms, &latency_done_ms}) {
+    const auto frames = static_cast<size_t>(std::min<int64_t>(*info_.frame_count, int64_t{1} << 22));
+    for (std::vector<double>* times : {&proc_ms_, &latency_result_ms_, &latency_done_ms_}) {
       times->reserve(frames);
     }
   }
-  size_t begun = 0;  // Sinks whose begin() has run: exactly these get end().
-  const auto begin_sinks = [&] {
-    for (; begun < sinks.size(); ++begun) sinks[begun]->begin(info);
-  };
-  const bool needs_colour = NeedsColour(config);
+}
 
-  const auto finish = [&] {
-    summary.dropped = source.dropped_frames();
-    if (const std::optional<std::string> note = source.note()) summary.notes.push_back(*note);
-    SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
-    SummariseTimes(latency_result_ms, &summary.latency_result_ms_median,
-                   &summary.latency_result_ms_p99);
-    SummariseTimes(latency_done_ms, &summary.latency_done_ms_median, &summary.latency_done_ms_p99);
-    summary.wall_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    for (size_t i = 0; i < begun; ++i) sinks[i]->end(summary);
-  };
+void PipelineRun::describe_source(const FrameSource& source) {
+  CV_Assert(summary_.frames == 0);
+  RunInfo described = DescribeRun(source, session_);
+  info_.source = described.source;
+  info_.fps = described.fps;
+  info_.live = described.live;
+  info_.frame_count = described.frame_count;
+  summary_.source = info_.source;
+}
 
+void PipelineRun::begin_sinks() {
+  for (; begun_ < sinks_.size(); ++begun_) sinks_[begun_]->begin(info_);
+}
+
+void PipelineRun::join(FrameSink& sink) { joined_.push_back(&sink); }
+
+void PipelineRun::leave(FrameSink& sink) {
+  joined_.erase(std::remove(joined_.begin(), joined_.end(), &sink), joined_.end());
+}
+
+const FrameResult& PipelineRun::process(Frame& frame) {
+  if (frame.captured == std::chrono::steady_clock::time_point{}) {
+    frame.captured = std::chrono::steady_clock::now();
+  }
+  if (summary_.frames == 0) {
+    if (needs_colour_ && IsGrayscale(frame.image)) {
+      throw InputError(summary_.source +
+                       ": the video is grayscale, but colour tracking needs colour (use "
+                       "--method zncc, which matches in gray, or a gray-level range "
+                       "`gray: [lo, hi]` for white or black markers)");
+    }
+    info_.frame_size = frame.image.size();
+    begin_sinks();
+    summary_.first_index = frame.index;
+  }
+  const FrameResult& result = session_.process(frame);
+  for (size_t i = 0; i < result.markers.size(); ++i) {
+    summary_.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
+  }
+  summary_.statuses.add(result);
+  summary_.measured += result.measurement.angle_deg ? 1 : 0;
+  proc_ms_.push_back(result.proc_ms);
+  latency_result_ms_.push_back(result.latency_result_ms);
+  for (FrameSink* sink : sinks_) sink->consume(frame, result);
+  for (FrameSink* sink : joined_) sink->consume(frame, result);
+  latency_done_ms_.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frame.captured)
+          .count());
+  ++summary_.frames;
+  summary_.last_index = frame.index;
+  return result;
+}
+
+RunSummary PipelineRun::summary() const {
+  RunSummary summary = summary_;
+  std::vector<double> proc = proc_ms_, result = latency_result_ms_, done = latency_done_ms_;
+  SummariseTimes(proc, &summary.proc_ms_median, &summary.proc_ms_p99);
+  SummariseTimes(result, &summary.latency_result_ms_median, &summary.latency_result_ms_p99);
+  SummariseTimes(done, &summary.latency_done_ms_median, &summary.latency_done_ms_p99);
+  summary.wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  return summary;
+}
+
+RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<std::string> notes,
+                               std::string error) {
+  CV_Assert(!finished_);
+  finished_ = true;
+  // An empty source, or a stop before the first frame: the sinks still see begin() and end().
+  if (summary_.frames == 0 && reason != StopReason::kError) begin_sinks();
+  RunSummary summary = this->summary();
+  summary.stop_reason = reason;
+  summary.dropped = dropped;
+  summary.notes = std::move(notes);
+  summary.error = std::move(error);
+  for (size_t i = 0; i < begun_; ++i) sinks_[i]->end(summary);
+  return summary;
+}
+
+RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
+                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
+  PipelineRun run(session, DescribeRun(source, session, options), sinks);
+  const auto notes = [&source] {
+    std::vector<std::string> notes;
+    if (const std::optional<std::string> note = source.note()) notes.push_back(*note);
+    return notes;
+  };
+  StopReason reason = StopReason::kEndOfInput;
+  std::string error;
   Frame frame;
   try {
     for (;;) {
-      if (options.max_frames && summary.frames >= *options.max_frames) {
-        summary.stop_reason = StopReason::kMaxFrames;
+      if (options.max_frames && run.frames() >= *options.max_frames) {
+        reason = StopReason::kMaxFrames;
         break;
       }
       if (options.stop_requested && options.stop_requested()) {
-        summary.stop_reason = StopReason::kStopRequested;
+        reason = StopReason::kStopRequested;
         break;
       }
       frame.captured = {};
       if (!source.read(frame)) {
-        summary.stop_reason = StopReason::kEndOfInput;
+        reason = StopReason::kEndOfInput;
         break;
       }
-      if (frame.captured == std::chrono::steady_clock::time_point{}) {
-        frame.captured = std::chrono::steady_clock::now();
-      }
-      if (summary.frames == 0) {
-        if (needs_colour && IsGrayscale(frame.image)) {
-          throw InputError(summary.source +
-                           ": the video is grayscale, but colour tracking needs colour (use "
-                           "--method zncc, which matches in gray, or a gray-level range "
-                           "`gray: [lo, hi]` for white or black markers)");
-        }
-        info.frame_size = frame.image.size();
-        begin_sinks();
-        summary.first_index = frame.index;
-      }
-      const FrameResult& result = session.process(frame);
-      for (size_t i = 0; i < result.markers.size(); ++i) {
-        summary.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
-      }
-      summary.statuses.add(result);
-      summary.measured += result.measurement.angle_deg ? 1 : 0;
-      proc_ms.push_back(result.proc_ms);
-      latency_result_ms.push_back(result.latency_result_ms);
-      for (FrameSink* sink : sinks) sink->consume(frame, result);
-      latency_done_ms.push_back(std::chrono::duration<double, std::milli>(
-                                    std::chrono::steady_clock::now() - frame.captured)
-                                    .count());
-      ++summary.frames;
-      summary.last_index = frame.index;
+      run.process(frame);
     }
-    if (begun == 0) begin_sinks();  // An empty source: sinks still see begin() and end().
-  } catch (const InputError& error) {
-    summary.stop_reason = StopReason::kError;
-    summary.error = error.what();
-  } catch (const std::exception& error) {
+  } catch (const InputError& e) {
+    reason = StopReason::kError;
+    error = e.what();
+  } catch (const std::exception& e) {
     // Not a user error (a bug, or a caller's own exception such as a stop raised mid-wait):
     // the sinks still close their files, then it goes on to the caller.
-    summary.stop_reason = StopReason::kError;
-    summary.error = error.what();
-    finish();
+    run.finish(StopReason::kError, source.dropped_frames(), notes(), e.what());
     throw;
   }
-  finish();
-  return summary;
+  return run.finish(reason, source.dropped_frames(), notes(), std::move(error));
 }
 
 }  // namespace softsight

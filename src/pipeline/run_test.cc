@@ -265,6 +265,46 @@ TEST(RunPipeline, ARunOfNoFramesStillBeginsAndEndsEverySink) {
   EXPECT_FALSE(summary.first_index);
 }
 
+// A loop of the caller's own (the live window) drives a PipelineRun frame by frame: the same
+// counts and summary as RunPipeline gives for the same frames; a sink joining mid-run gets only
+// the frames after it joined and is begun and ended by its owner, not by the run.
+TEST(PipelineRun, FrameByFrameGivesRunPipelinesSummaryAndAJoinedSinkOnlyItsFrames) {
+  std::unique_ptr<FrameSource> reference = OpenSyntheticSource(SmallScene(8), NoiseOptions{});
+  TrackingSession reference_session(ThreeMarkerSceneConfig());
+  const RunSummary expected = RunPipeline(*reference, reference_session, {});
+
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(8), NoiseOptions{});
+  TrackingSession session(ThreeMarkerSceneConfig());
+  RecordingSink fixed, joined;
+  PipelineRun run(session, DescribeRun(*source, session), {&fixed});
+  Frame frame;
+  for (int i = 0; source->read(frame); ++i) {
+    if (i == 3) run.join(joined);
+    if (i == 6) run.leave(joined);
+    const FrameResult& result = run.process(frame);
+    EXPECT_EQ(result.frame_index, i);
+  }
+  EXPECT_EQ(run.frames(), 8);
+  EXPECT_EQ(fixed.begins, 1);
+  EXPECT_EQ(fixed.info.frame_size, cv::Size(320, 240)) << "begun at the first frame";
+  EXPECT_EQ(fixed.indices.size(), 8u);
+  EXPECT_EQ(joined.indices, (std::vector<int64_t>{3, 4, 5}));
+  const RunSummary summary = run.finish(StopReason::kEndOfInput, 0);
+  EXPECT_EQ(fixed.ends, 1);
+  EXPECT_EQ(fixed.ended_with.frames, 8);
+  EXPECT_EQ(joined.begins, 0);
+  EXPECT_EQ(joined.ends, 0);
+  EXPECT_EQ(summary.frames, expected.frames);
+  EXPECT_EQ(summary.first_index, expected.first_index);
+  EXPECT_EQ(summary.last_index, expected.last_index);
+  EXPECT_EQ(summary.measured, expected.measured);
+  ASSERT_EQ(summary.markers.size(), expected.markers.size());
+  for (size_t i = 0; i < summary.markers.size(); ++i) {
+    EXPECT_EQ(summary.markers[i].found, expected.markers[i].found) << summary.markers[i].name;
+  }
+  EXPECT_EQ(summary.source, expected.source);
+}
+
 TEST(RunPipeline, GrayFramesForColourTrackingAreAnErrorNamingTheSource) {
   class GraySource : public FrameSource {
    public:

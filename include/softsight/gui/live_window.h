@@ -13,6 +13,7 @@
 #include "softsight/config/config.h"
 #include "softsight/gui/live_options.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/pipeline/summary.h"
 
 namespace softsight {
 
@@ -37,22 +38,18 @@ using FrameSourceOpener = std::function<std::unique_ptr<FrameSource>()>;
 
 // What a run of the window measured, for its end summary (Report(): `softsight live` prints it).
 struct LiveRunSummary {
-  int64_t frames = 0;             // Frames tracked (played, stepped to or seeked to).
-  int64_t dropped_by_source = 0;  // A camera's frames skipped: the newest frame wins.
-  // Capture -> result (FrameResult::latency_result_ms) over the tracked frames, ms.
-  double latency_result_ms_median = 0.0;
-  double latency_result_ms_p99 = 0.0;
-  // The recordings of the run, together: frames recorded (CSV rows; both videos hold each one),
-  // capture -> CSV row written (0 when nothing was recorded), and how often the window waited
-  // for a video's encoder because its queue was full (a camera's frames skipped meanwhile are in
-  // dropped_by_source).
+  // The run as every command reports it (PipelineRun): frames tracked (played, stepped to or
+  // sought to), each marker's found rate and why it was not found, the frames the source dropped
+  // (a camera: newest frame wins), processing time, the latency from capture to the result and
+  // (when something was recorded) to the recordings' CSV rows, and a note per recording.
+  RunSummary run;
+  // The recordings together: frames recorded (CSV rows; both videos hold each one), and how
+  // often the window waited for a video's encoder because its queue was full (a camera's frames
+  // skipped meanwhile are the source's drops).
   int64_t recorded_frames = 0;
-  double latency_row_ms_median = 0.0;
-  double latency_row_ms_p99 = 0.0;
   int64_t encoder_waits = 0;
 
-  // "live: 600 frames, 0 dropped by the source" and the latency and recording lines.
-  std::string Report() const;
+  std::string Report() const { return run.FullReport(); }
 };
 
 struct LiveRunResult {

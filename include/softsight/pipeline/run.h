@@ -1,11 +1,14 @@
-// The one run loop: frames from a source, through the session, to every sink, until the source
-// ends, max_frames are done, a stop is requested or an InputError occurs; then one summary.
-// `track`, `control`, `demo`, `evaluate` and `live` all run through it.
+// The one run: frames from a source, through the session, to every sink, until the source ends,
+// max_frames are done, a stop is requested or an InputError occurs; then one summary.
+// `track`, `control`, `demo` and `evaluate` run through RunPipeline; `live` through PipelineRun,
+// the same work per frame and the same summary, in the window's own loop.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "softsight/io/frame_source.h"
@@ -21,6 +24,54 @@ struct RunOptions {
   // Polled before each frame is read; true ends the run cleanly with kStopRequested (every sink
   // still gets end()). Empty: never. Called from the running thread: make it cheap (a flag).
   std::function<bool()> stop_requested;
+};
+
+// One run, frame by frame: RunPipeline's work per frame and its summary, for a caller whose own
+// loop decides when a frame comes (the live window plays, pauses, steps and seeks as the user
+// says, and a recording joins and leaves the run). RunPipeline is this class driven by a source.
+class PipelineRun {
+ public:
+  // `info` as DescribeRun gives it (frame_size is set from the first frame). `sinks` begin at
+  // the first frame and end in finish(). The session must outlive the run.
+  PipelineRun(TrackingSession& session, RunInfo info, std::vector<FrameSink*> sinks = {});
+  // Before the first frame: the source the frames come from (its description, rate, whether it
+  // is live, its frame count), for the sinks' begin() and the summary.
+  void describe_source(const FrameSource& source);
+
+  // The frame through the session and to every sink, counted in the summary. `frame.captured`
+  // unset: stamped now. At the first frame a session that needs colour refuses a grayscale frame
+  // and the sinks begin. Throws InputError (from the session or a sink; RunPipeline ends the run
+  // with it).
+  const FrameResult& process(Frame& frame);
+  // A sink joining the run after it began (its owner has begun it: a live recording), and
+  // leaving it (its owner ends it); leave() of a sink not in the run does nothing.
+  void join(FrameSink& sink);
+  void leave(FrameSink& sink);
+  const RunInfo& info() const { return info_; }
+  int64_t frames() const { return summary_.frames; }  // Processed so far.
+
+  // The summary so far: frames, found counts, timings, the first and last source index. Why the
+  // run stopped and the source's drops are finish()'s.
+  RunSummary summary() const;
+  // Ends the run (once): the summary with why it stopped, the source's drops and notes, and
+  // `error` (kError); every sink begun gets end(summary). A run that stopped before its first
+  // frame without an error still begins and ends its sinks.
+  RunSummary finish(StopReason reason, int64_t dropped = 0, std::vector<std::string> notes = {},
+                    std::string error = {});
+
+ private:
+  void begin_sinks();
+
+  TrackingSession& session_;
+  RunInfo info_;
+  std::vector<FrameSink*> sinks_;
+  size_t begun_ = 0;  // sinks_[0, begun_) have begun.
+  std::vector<FrameSink*> joined_;  // Begun and ended by their owners.
+  bool needs_colour_;
+  bool finished_ = false;
+  std::chrono::steady_clock::time_point start_;
+  RunSummary summary_;
+  std::vector<double> proc_ms_, latency_result_ms_, latency_done_ms_;
 };
 
 // Runs the pipeline. Pacing is the source's business (a camera decorator drops stale frames, a
