@@ -30,7 +30,7 @@ constexpr double kResidualFollow = 0.1;
 
 MarkerPlausibility::MarkerPlausibility(std::vector<double> size_px, std::vector<size_t> body)
     : size_px_(std::move(size_px)), body_(std::move(body)), tracks_(size_px_.size()),
-      ratio_(size_px_.size()) {
+      ratio_(size_px_.size()), supported_(size_px_.size(), false) {
   for (size_t i : body_) CV_Assert(i < size_px_.size());
   if (body_.size() < 3) body_.clear();
   rejected_.reserve(size_px_.size());
@@ -86,7 +86,7 @@ void MarkerPlausibility::check_arrangement(std::vector<MarkerObservation>& marke
       // A marker the motion does not vouch for (just re-acquired) must fit more closely: its
       // report is all there is.
       const bool adjacent = k == *previous + 1;
-      const bool unsupported = !ratio_[a] || !ratio_[b];
+      const bool unsupported = !supported_[a] || !supported_[b];
       const double max_stretch = unsupported ? kMaxStretchUnsupported : kMaxStretch;
       const double min_stretch = unsupported ? 1.0 / kMaxStretchUnsupported : kMinStretch;
       const bool broken = d > max_stretch * span || (adjacent && d < min_stretch * span);
@@ -94,8 +94,10 @@ void MarkerPlausibility::check_arrangement(std::vector<MarkerObservation>& marke
         previous = k;
         continue;
       }
-      // The culprit: the one the motion supports less. No history is no support.
-      const std::optional<double> ra = ratio_[a], rb = ratio_[b];
+      // The culprit: the one the motion supports less. No history is no support, and nor is a
+      // report after frames in which the marker was not believed.
+      const std::optional<double> ra = supported_[a] ? ratio_[a] : std::nullopt;
+      const std::optional<double> rb = supported_[b] ? ratio_[b] : std::nullopt;
       if (!ra && !rb) {
         reject(a, markers);
         reject(b, markers);
@@ -154,8 +156,13 @@ const std::vector<size_t>& MarkerPlausibility::check(int64_t frame_index,
   rejected_.clear();
   for (size_t i = 0; i < markers.size(); ++i) {
     ratio_[i].reset();
+    supported_[i] = false;
     if (!markers[i].observation.found()) continue;
     ratio_[i] = motion_ratio(i, frame_index, *markers[i].observation.position_px);
+    // The motion vouches for a report only from one frame to the next: across frames in which
+    // the marker was not believed (covered, lost) its bound grows with the gap, and a look-alike
+    // that appeared meanwhile nearby fits it; such a report is checked like a re-acquisition.
+    supported_[i] = ratio_[i].has_value() && frame_index - tracks_[i].last_frame == 1;
     if (ratio_[i] && *ratio_[i] > 1.0) reject(i, markers);
   }
   check_arrangement(markers);

@@ -10,7 +10,8 @@
 //    their spacing changes smoothly. The segment lengths between neighbours along the body are
 //    learned from the first frames in which all of them are found and agree, and then follow
 //    slowly; a segment more than 1.5x longer or shorter than 0.6x its learned length in one frame
-//    is a broken arrangement (1.25x either way for a marker just re-acquired), and so is a gap (markers not found in between) longer than 1.5x the
+//    is a broken arrangement (1.25x either way for a marker just re-acquired, or back after frames
+//    in which it was not believed), and so is a gap (markers not found in between) longer than 1.5x the
 //    segments it spans. Of the two markers of a broken segment, the one the motion supports
 //    less is the culprit (a marker just re-acquired has no support; when neither has, both).
 // A marker re-acquired after being lost, or after it was found implausible, is checked against
@@ -68,6 +69,8 @@ class MarkerPlausibility {
   std::vector<double> segment_px_;           // Learned, one per neighbour pair along the body.
   std::vector<std::vector<double>> learning_;  // Candidate lengths from the first frames.
   std::vector<std::optional<double>> ratio_;   // This frame's motion ratios (reused).
+  // This frame: the motion vouches for the report (believed in the frame before, and no jump).
+  std::vector<bool> supported_;
   std::vector<size_t> rejected_;               // This frame's result (reused).
 };
 

@@ -71,6 +71,16 @@ constexpr double kShapeTolerance = 0.3;
 constexpr double kAdaptShape = 0.1;
 constexpr double kAdaptMinRange = 0.5;
 constexpr double kAdaptMaxRange = 4.0;
+// A blob whose asymmetry (ColourBlob::asymmetry_px) exceeds the learned marker's by more than
+// this many of its radii, and at least kPartialMinPx, is a marker partly covered: the centroid of
+// what is visible lies that far from the marker's centre, so it is not reported. A tenth of the
+// radius: a disc a quarter covered by a straight edge shifts its visible centroid by 0.22 radii,
+// a twentieth covered by 0.05; 1 px keeps the pixel grid's own wobble of small markers out.
+constexpr double kPartialRadii = 0.1;
+constexpr double kPartialMinPx = 1.0;
+// A marker partly seen where it should be is held there (its window searched, nothing else) for
+// at most this many frames: a second at 30 fps, long enough for a hand or a tool to pass.
+constexpr int kHoldCoveredFrames = 30;
 
 // A marker lost this many frames in a row, with exactly one candidate near where it was last
 // seen that fits it in everything but brightness (same chroma, size, shape, contrast), is taken
@@ -352,6 +362,7 @@ void ColourTracker::check_frame(const cv::Mat& frame) const {
 }
 
 void ColourTracker::reset() {
+  held_frames_ = 0;
   last_px_.reset();
   velocity_px_ = cv::Point2d(0, 0);
   tracking_ = false;
@@ -398,6 +409,7 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
   }
   candidates_.clear();
   partly_seen_ = false;
+  partly_out_ = false;
   Choice choice;
   if (tracking_ && params_.window_px > 0) {
     choice = track_in_windows(frame_bgr);
@@ -420,12 +432,21 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
     }
     if (choice.blob) candidates_[chosen].verdict = CandidateVerdict::kChosen;
   }
+  if (!choice.blob && tracking_ && partly_seen_ && held_frames_ < kHoldCoveredFrames) {
+    // What is left of the marker is where it should be (covered, or leaving the frame): it is
+    // not measured, and not looked for elsewhere either, where a look-alike would be all there
+    // is. The window stays on it.
+    choice.status = partly_out_ ? MarkerStatus::kOutOfFrame : MarkerStatus::kCovered;
+    choice.hold = true;
+    return report(choice);
+  }
   if (!choice.blob) {
     const bool was_tracking = tracking_;
     const cv::Point2d predicted = last_px_.value_or(cv::Point2d()) + velocity_px_;
     choice = acquire(frame_bgr);
     if (!choice.blob && was_tracking && choice.status == MarkerStatus::kLost) {
-      if (!cv::Rect2d(-0.5, -0.5, frame_bgr.cols, frame_bgr.rows).contains(predicted)) {
+      if (partly_out_ ||
+          !cv::Rect2d(-0.5, -0.5, frame_bgr.cols, frame_bgr.rows).contains(predicted)) {
         choice.status = MarkerStatus::kOutOfFrame;
       } else if (partly_seen_) {
         choice.status = MarkerStatus::kCovered;
@@ -442,8 +463,15 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
 
 void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
   if (!model_) {
-    model_ = ColourModel{blob.area_px, blob.area_px, blob.circularity, blob.core_colour};
+    model_ = ColourModel{blob.area_px, blob.area_px, blob.circularity, blob.core_colour,
+                         blob.asymmetry_px};
     return;
+  }
+  // Asymmetry follows only down: a marker learned while partly covered is learned whole later,
+  // never the other way round.
+  if (tracking && blob.asymmetry_px < model_->asymmetry_px) {
+    model_->asymmetry_px += std::max(params_.adapt_rate, 0.1) *
+                            (blob.asymmetry_px - model_->asymmetry_px);
   }
   if (!tracking || params_.adapt_rate <= 0) return;
   // Follow slow changes only: a marker growing in perspective, the light drifting. A sudden one
@@ -458,7 +486,15 @@ void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
 }
 
 Observation ColourTracker::report(const Choice& choice) {
+  if (!choice.blob && choice.hold) {
+    ++held_frames_;
+    ++lost_frames_;
+    // The window follows where the marker goes meanwhile (behind the cover, out of the frame).
+    if (last_px_) *last_px_ += velocity_px_;
+    return Observation::NotFound(choice.status);
+  }
   if (!choice.blob) {
+    held_frames_ = 0;
     tracking_ = false;
     velocity_px_ = cv::Point2d(0, 0);
     ++lost_frames_;
@@ -468,7 +504,9 @@ Observation ColourTracker::report(const Choice& choice) {
   learn(blob, tracking_);
   lost_frames_ = 0;
   last_seen_px_ = blob.centroid_px;
-  velocity_px_ = tracking_ ? blob.centroid_px - *last_px_ : cv::Point2d(0, 0);
+  // After frames held covered, the step from the last position spans them: no velocity.
+  velocity_px_ = tracking_ && held_frames_ == 0 ? blob.centroid_px - *last_px_ : cv::Point2d(0, 0);
+  held_frames_ = 0;
   last_px_ = blob.centroid_px;
   tracking_ = true;
   acquire_roi_.reset();
@@ -502,6 +540,15 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
       model_ ? params_.min_circularity
              : std::max(params_.min_circularity, kMinCircularityWithoutModel);
   if (b.circularity < min_circularity || !b.measured) return {CandidateVerdict::kShape, kInf};
+  // Part of it hidden: beyond the frame's edge, or covered (more asymmetric than the marker).
+  // Judged on for its misfit: a partial blob that would fit is a rival of the others (it may be
+  // the marker) and is never reported itself.
+  bool partial = b.at_frame_edge;
+  if (model_) {
+    const double radius = std::sqrt(model_->area_px / CV_PI);
+    const double tolerance = std::max(kPartialMinPx, kPartialRadii * radius);
+    partial = partial || b.asymmetry_px > model_->asymmetry_px + tolerance;
+  }
   if (!model_ && !acquire_roi_ && b.core_px < kMinCorePxWithoutModel) {
     return {CandidateVerdict::kSize, kInf};
   }
@@ -552,7 +599,7 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
     if (colour > 1) return {CandidateVerdict::kColour, kInf};
     misfit += colour;
   }
-  return {CandidateVerdict::kFits, misfit};
+  return {partial ? CandidateVerdict::kPartial : CandidateVerdict::kFits, misfit};
 }
 
 ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
@@ -575,24 +622,36 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     const ColourBlob* best = nullptr;
     size_t best_index = 0;
     double best_dist = std::numeric_limits<double>::infinity();
+    double nearest_partial = std::numeric_limits<double>::infinity();
     for (const ColourBlob& b : blobs_) {
       const auto [verdict, misfit] = judge(b);
       candidates_.push_back(candidate(b, verdict, misfit));
       // What is left of a covered marker: of its colour, smaller than it (often a sliver, so of
       // any shape), and within its own radius (plus one frame's motion) of where it should be.
-      if ((verdict == CandidateVerdict::kSize || verdict == CandidateVerdict::kShape) && model_ &&
-          b.area_px < model_->area_px &&
+      // So is a partial blob there (part of it covered, or beyond the frame's edge).
+      const bool smaller = (verdict == CandidateVerdict::kSize ||
+                            verdict == CandidateVerdict::kShape) &&
+                           model_ && b.area_px < model_->area_px;
+      if ((smaller || verdict == CandidateVerdict::kPartial) && model_ &&
           cv::norm(b.centroid_px - predicted) <= ref_radius + cv::norm(velocity_px_) + 1.0) {
         partly_seen_ = true;
+        if (b.at_frame_edge) partly_out_ = true;
+      }
+      const double d = cv::norm(b.centroid_px - predicted);
+      if (verdict == CandidateVerdict::kPartial && std::isfinite(misfit)) {
+        nearest_partial = std::min(nearest_partial, d);
       }
       if (verdict != CandidateVerdict::kFits) continue;
-      const double d = cv::norm(b.centroid_px - predicted);
       if (d < best_dist) {
         best_dist = d;
         best = &b;
         best_index = candidates_.size() - 1;
       }
     }
+    // The marker partly hidden (covered, or leaving the frame) nearer than the best whole blob:
+    // that is where the marker is, and what is left of it is not measured. A look-alike farther
+    // away is not it.
+    if (nearest_partial < best_dist) return Choice{};
     // A blob cut by the window's border may be the marker extending outside, and nearer than
     // the best complete one: never report a clipped centroid, look wider instead.
     bool nearer_clipped = false;
@@ -639,15 +698,26 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   candidates_.clear();
   size_t best = 0;
   double best_cost = std::numeric_limits<double>::infinity(), second_cost = best_cost;
+  double partial_cost = best_cost;  // The best rival partly hidden ...
+  bool partial_at_edge = false;     // ... and whether it is cut by the frame's edge.
   for (const ColourBlob& b : blobs_) {
     auto [verdict, misfit] = judge(b);
     if (verdict == CandidateVerdict::kFits && acquire_roi_ && !roi_area.contains(b.centroid_px)) {
       verdict = CandidateVerdict::kOutsideRoi;
     }
     candidates_.push_back(candidate(b, verdict, misfit));
-    if (verdict != CandidateVerdict::kFits) continue;
+    const bool partial = verdict == CandidateVerdict::kPartial && std::isfinite(misfit);
+    if (verdict != CandidateVerdict::kFits && !partial) continue;
     double cost = misfit;
     if (last_px_) cost += cv::norm(b.centroid_px - *last_px_) / diagonal;
+    if (partial) {
+      // Partly hidden: never the one reported, but a rival (it may be the marker).
+      if (cost < partial_cost) {
+        partial_cost = cost;
+        partial_at_edge = b.at_frame_edge;
+      }
+      continue;
+    }
     const size_t index = candidates_.size() - 1;
     if (cost < best_cost) {
       second_cost = best_cost;
@@ -658,7 +728,14 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
     }
   }
   Choice choice;
-  if (!std::isfinite(best_cost)) return choice;  // kLost: nothing fits.
+  if (!std::isfinite(best_cost)) {
+    // kLost: nothing whole fits; what fits is partly hidden.
+    if (std::isfinite(partial_cost)) {
+      choice.status = partial_at_edge ? MarkerStatus::kOutOfFrame : MarkerStatus::kCovered;
+    }
+    return choice;
+  }
+  second_cost = std::min(second_cost, partial_cost);
   // Before a model is learned, the misfit knows only the configured ranges and a compact,
   // contrasted shape: it cannot tell a marker from a look-alike (a glint, a dot of the bench), so
   // a whole-frame first acquisition needs the one candidate that fits at all.
@@ -864,6 +941,9 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
                    (open_right && in_region.x + in_region.width == region.width) ||
                    (open_bottom && in_region.y + in_region.height == region.height);
     blob.bbox_px = in_region + region.tl();
+    blob.at_frame_edge = blob.bbox_px.x == 0 || blob.bbox_px.y == 0 ||
+                         blob.bbox_px.x + blob.bbox_px.width == frame.cols ||
+                         blob.bbox_px.y + blob.bbox_px.height == frame.rows;
     if (!blob.clipped) {
       if (blob.area_px < params_.min_area_px) continue;
       if (params_.max_area_px > 0 && blob.area_px > params_.max_area_px) continue;
@@ -903,6 +983,28 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     std::memset(own.ptr<uchar>(y), 0, static_cast<size_t>(size.width));
   }
   labeller_.Draw(component, own, padded.tl() - labelled_tl);
+  // Asymmetry: the binary centroid against the centre of the smallest circle around the blob
+  // (its convex hull's points are among each row's leftmost and rightmost pixels).
+  edge_points_.clear();
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* row = own.ptr<uchar>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < size.width; ++x) {
+      if (!row[x]) continue;
+      if (first < 0) first = x;
+      last = x;
+    }
+    if (first < 0) continue;
+    edge_points_.emplace_back(first, y);
+    if (last != first) edge_points_.emplace_back(last, y);
+  }
+  if (!edge_points_.empty()) {
+    cv::Point2f circle_centre;
+    float circle_radius = 0.0f;
+    cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
+    const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
+    blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
+  }
   // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
   // core = more than kSoftBand inside, reach = within kRingOuter outside.
   cv::Mat distance = Scratch(distance_store_, size, CV_16U);

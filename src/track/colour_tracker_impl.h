@@ -36,6 +36,14 @@ struct ColourBlob {
   double circularity = 0;          // See ColourParams::min_circularity.
   cv::Rect bbox_px;
   bool clipped = false;            // Touches a region edge that is not a frame edge: incomplete.
+  // Touches the frame's edge: the marker may go on beyond it, so its centroid is not the
+  // marker's centre (never reported).
+  bool at_frame_edge = false;
+  // How far the binary centroid lies from the centre of the smallest circle enclosing the blob
+  // (set with the colour statistics). About 0 for a whole disc, ellipse or any shape symmetric
+  // about its centre, whatever its size (uniform shrinking under a dimmer light keeps it 0); a
+  // marker partly covered shows the centroid's shift towards what is left of it.
+  double asymmetry_px = 0;
   bool measured = false;           // The colour statistics below are set.
   // Mean colour (B, G, R, or the gray level in [0]) of the blob's core (2 px inside its edge, or
   // the whole blob when that is empty) and of its surroundings (a ring 3-4 px outside, pixels of
@@ -56,6 +64,10 @@ struct ColourModel {
   double first_area_px = 0;  // The area when learned: area_px stays within 1/2..4x of it.
   double circularity = 1;
   cv::Vec3d colour;          // Core colour.
+  // The marker's own asymmetry (ColourBlob::asymmetry_px) when whole: learned at acquisition and
+  // following only downwards while tracking (a marker first seen partly covered is learned
+  // whole later). A blob more asymmetric than this by more than the tolerance is partial.
+  double asymmetry_px = 0;
 };
 
 class ColourTracker : public Tracker {
@@ -121,6 +133,7 @@ class ColourTracker : public Tracker {
     std::optional<ColourBlob> blob;
     MarkerStatus status = MarkerStatus::kLost;
     int tied = 0;  // With kAmbiguous: how many candidates fitted about equally.
+    bool hold = false;  // Not found, but partly seen where expected: keep the window there.
   };
   void check_frame(const cv::Mat& frame) const;
   Choice track_in_windows(const cv::Mat& frame);
@@ -152,6 +165,8 @@ class ColourTracker : public Tracker {
   // The last windowed search saw a blob of the marker's colour where the marker was expected,
   // too small to be measured: the marker is covered rather than gone.
   bool partly_seen_ = false;
+  bool partly_out_ = false;
+  int held_frames_ = 0;  // Frames in a row the marker was held covered (partly seen).  // ... and that blob touched the frame's edge: it is leaving the frame.
   // Frames since the marker was last found, and where that was (kept through reset(): the
   // relearning below looks there).
   int lost_frames_ = 0;
@@ -168,6 +183,7 @@ class ColourTracker : public Tracker {
   std::vector<ColourBlob> blobs_, pending_;
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;
+  std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.
 };
 
 }  // namespace softsight

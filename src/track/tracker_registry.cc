@@ -59,6 +59,7 @@ const char* CandidateVerdictName(CandidateVerdict verdict) {
     case CandidateVerdict::kColour: return "colour";
     case CandidateVerdict::kContrast: return "contrast";
     case CandidateVerdict::kOutsideRoi: return "outside_roi";
+    case CandidateVerdict::kPartial: return "partial";
   }
   return "fits";
 }

@@ -31,9 +31,11 @@ enum class CandidateVerdict : uint8_t {
   kColour,      // Its colour is not the marker's (tint or brightness).
   kContrast,    // Does not stand out from its surroundings (a patch of background texture).
   kOutsideRoi,  // Outside the region the first acquisition is restricted to.
+  kPartial,     // Part of the marker is hidden (covered, or beyond the frame's edge): the centroid
+                // of what is left is not the marker's centre.
 };
 
-// "chosen", "fits", "clipped", "size", "shape", "colour", "contrast", "outside_roi".
+// "chosen", "fits", "clipped", "size", "shape", "colour", "contrast", "outside_roi", "partial".
 const char* CandidateVerdictName(CandidateVerdict verdict);
 
 struct MarkerCandidate {
