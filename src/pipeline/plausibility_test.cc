@@ -360,6 +360,30 @@ TEST(MarkerPlausibility, LearnsTheArrangementAndRejectsTheMarkerThatBreaksIt) {
   EXPECT_TRUE(rules.check(5, markers).empty());
 }
 
+// A marker back after frames in which it was not found is not vouched for by its motion, even
+// within the motion's (gap-widened) bound: like a re-acquisition it must fit its segments within
+// 1.25x. A look-alike 1.33x from its neighbour is refused; back at 1.1x it is believed.
+TEST(MarkerPlausibility, AMarkerBackAfterAGapFitsTheArrangementLikeAReacquisition) {
+  MarkerPlausibility rules({19, 19, 19}, {0, 1, 2});
+  for (int64_t f = 0; f < 4; ++f) {
+    auto markers = Chain3({100, 100.0 + f}, {100, 200.0 + f}, {100, 300.0 + f});
+    EXPECT_TRUE(rules.check(f, markers).empty()) << f;
+  }
+  // b not found for two frames.
+  for (int64_t f = 4; f < 6; ++f) {
+    auto markers = Chain3({100, 100.0 + f}, {100, 0}, {100, 300.0 + f});
+    markers[1].observation = Observation::NotFound(MarkerStatus::kCovered);
+    EXPECT_TRUE(rules.check(f, markers).empty()) << f;
+  }
+  // Then reported 45 px from its prediction (the gap's bound for a 19 px marker is 60 px), 133 px
+  // from a: refused.
+  auto markers = Chain3({100, 106}, {140, 239}, {100, 306});
+  EXPECT_EQ(rules.check(6, markers), std::vector<size_t>{1});
+  // Where it belongs (a-b 1.1x): believed.
+  markers = Chain3({100, 107}, {100, 217}, {100, 307});
+  EXPECT_TRUE(rules.check(7, markers).empty());
+}
+
 TEST(MarkerPlausibility, AJumpAgainstTheMotionIsImplausibleWithoutAnyArrangement) {
   MarkerPlausibility rules({5}, {});
   std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
