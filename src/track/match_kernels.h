@@ -80,19 +80,28 @@ class PreparedTemplate {
   std::vector<uint8_t> bytes_;  // [row][chunk] 16 bytes: template values, masked bytes zero.
   std::vector<uint8_t> mask_;   // [row][chunk] 16 bytes: 0xFF where the byte counts.
   std::vector<int16_t> words_;  // [row][chunk] 16 values: the bytes widened to 16 bits.
-  // Masked templates only: [row][chunk] 16 values, -1 where the byte counts (an AND mask), and
-  // per channel c, [c][row][chunk] 16 values, 1 where the byte counts and is of channel c.
-  std::vector<int16_t> mask_words_;
-  std::vector<int16_t> channel_words_;
+  // Masked templates only: the counted pixels of row r are the runs [run_rows_[r],
+  // run_rows_[r + 1]) of runs_, each the pixel columns [begin, end). ZNCC takes the window sums
+  // over the mask from row prefix sums, two look-ups per run (a round mask has one run a row).
+  struct Run {
+    int begin, end;
+  };
+  std::vector<int> run_rows_;
+  std::vector<Run> runs_;
 };
 
 // Fast kernels. `image` has the template's type and is at least as large. `result` is
 // (re)allocated only when its size or type changes, so a tracker reusing it allocates nothing.
 void MatchSad(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
-// Scratch buffers for ZNCC (window sums via integral images, and the cross-correlation map).
+// Scratch buffers for ZNCC: the window sums (integral images; for a masked template, row prefix
+// sums and one map row of sums over the mask) and the cross-correlation map. The masked path
+// keeps them in vectors, which keep their capacity when a tracker matches windows of changing
+// sizes, so its matching allocates nothing from frame to frame.
 struct ZnccScratch {
   cv::Mat sum, sum_sq, cross;
+  std::vector<uint32_t> prefix_sum, prefix_sum_sq, row_sum, row_sum_sq;
+  std::vector<int> cross_values;
 };
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
