@@ -95,73 +95,72 @@ struct KernelAccess {
 
 namespace {
 
+// MatchCrossCorrelation with the buffer for the widened image given (defined below).
+void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+                      std::vector<int16_t>& widened);
+
 // Masked ZNCC from the cross-correlation map and window sums over the mask. The sums come from
 // per-row prefix sums of I (per channel) and of I^2 (over the channels): for a run [b, e) of a
-// template row, sum I over it at placement x is P[x + e] - P[x + b]. Whole map rows are summed
-// at once (the loops over x vectorise), in unsigned 32-bit arithmetic: the prefix sums of a
-// wide image may wrap around, their differences do not (a window's sums fit, see
-// kMaxTemplateValues), so the sums are exact, as summed pixel by pixel. About twice as fast as
-// summing I and I^2 over the mask at every placement beside sum I*T (the window search is the
-// template tracker's largest cost).
+// template row, sum I over it at placement x is P[x + e] - P[x + b]. The prefix sums of a pixel
+// are kept together (kChannels sums, then the squares'), so one loop over a map row adds a run's
+// sums of every placement of the row, all of them (it vectorises). The arithmetic is unsigned
+// 32-bit: the prefix sums of a wide image may wrap around, their differences do not (a window's
+// sums fit, see kMaxTemplateValues), so the sums are exact, as summed pixel by pixel. About twice
+// as fast as summing I and I^2 over the mask at every placement beside sum I*T (the window
+// search is the template tracker's largest cost).
+template <int kChannels>
 void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
                 ZnccScratch& scratch) {
+  constexpr int kPerPixel = kChannels + 1;
   const cv::Size size = ResultSize(image, t.size());
   scratch.cross_values.resize(size.area());
   cv::Mat cross_map(size, CV_32S, scratch.cross_values.data());  // create() keeps it there.
-  MatchCrossCorrelation(image, t, cross_map);
-  const int cn = t.channels();
-  const size_t sum_step = static_cast<size_t>(image.cols + 1) * cn;
-  const size_t sq_step = static_cast<size_t>(image.cols) + 1;
-  scratch.prefix_sum.resize(sum_step * image.rows);
-  scratch.prefix_sum_sq.resize(sq_step * image.rows);
+  CrossCorrelation(image, t, cross_map, scratch.widened);
+  const int image_cols = image.cols;
+  const size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
+  scratch.prefix_sum.resize(prefix_step * image.rows);
   for (int y = 0; y < image.rows; ++y) {
-    const uint8_t* p = image.ptr<uint8_t>(y);
-    uint32_t* s = scratch.prefix_sum.data() + sum_step * y;
-    uint32_t* q = scratch.prefix_sum_sq.data() + sq_step * y;
-    uint32_t acc[3] = {0, 0, 0};
-    uint32_t acc_sq = 0;
-    for (int c = 0; c < cn; ++c) s[c] = 0;
-    q[0] = 0;
-    for (int x = 0; x < image.cols; ++x) {
-      for (int c = 0; c < cn; ++c) {
-        const uint32_t v = p[x * cn + c];
+    const uint8_t* __restrict p = image.ptr<uint8_t>(y);
+    uint32_t* __restrict s = scratch.prefix_sum.data() + prefix_step * y;
+    uint32_t acc[kPerPixel] = {};
+    for (int k = 0; k < kPerPixel; ++k) s[k] = 0;
+    for (int x = 0; x < image_cols; ++x) {
+      s += kPerPixel;
+      for (int c = 0; c < kChannels; ++c) {
+        const uint32_t v = p[x * kChannels + c];
         acc[c] += v;
-        acc_sq += v * v;
-        s[(x + 1) * cn + c] = acc[c];
+        acc[kChannels] += v * v;
+        s[c] = acc[c];
       }
-      q[x + 1] = acc_sq;
+      s[kChannels] = acc[kChannels];
     }
   }
   result.create(size, CV_32F);
   const int cols = result.cols;
-  scratch.row_sum.resize(static_cast<size_t>(cols) * cn);
-  scratch.row_sum_sq.resize(cols);
+  const int row_values = cols * kPerPixel;
+  scratch.row_sum.resize(row_values);
   uint32_t* __restrict row_sum = scratch.row_sum.data();
-  uint32_t* __restrict row_sum_sq = scratch.row_sum_sq.data();
   const std::vector<int>& run_rows = KernelAccess::RunRows(t);
   const auto* runs = KernelAccess::Runs(t);
+  const int rows = t.size().height;
   const int64_t n = t.count();
   for (int y = 0; y < result.rows; ++y) {
-    std::fill(row_sum, row_sum + cols * cn, 0u);
-    std::fill(row_sum_sq, row_sum_sq + cols, 0u);
-    for (int r = 0; r < t.size().height; ++r) {
-      const uint32_t* s = scratch.prefix_sum.data() + sum_step * (y + r);
-      const uint32_t* q = scratch.prefix_sum_sq.data() + sq_step * (y + r);
+    std::fill(row_sum, row_sum + row_values, 0u);
+    for (int r = 0; r < rows; ++r) {
+      const uint32_t* s = scratch.prefix_sum.data() + prefix_step * (y + r);
       for (int k = run_rows[r]; k < run_rows[r + 1]; ++k) {
-        const uint32_t* s_end = s + runs[k].end * cn;
-        const uint32_t* s_begin = s + runs[k].begin * cn;
-        for (int i = 0; i < cols * cn; ++i) row_sum[i] += s_end[i] - s_begin[i];
-        const uint32_t* q_end = q + runs[k].end;
-        const uint32_t* q_begin = q + runs[k].begin;
-        for (int x = 0; x < cols; ++x) row_sum_sq[x] += q_end[x] - q_begin[x];
+        const uint32_t* __restrict end = s + runs[k].end * kPerPixel;
+        const uint32_t* __restrict begin = s + runs[k].begin * kPerPixel;
+        for (int i = 0; i < row_values; ++i) row_sum[i] += end[i] - begin[i];
       }
     }
     const int* cross = cross_map.ptr<int>(y);
     float* out = result.ptr<float>(y);
     for (int x = 0; x < cols; ++x) {
+      const uint32_t* sums_here = row_sum + x * kPerPixel;
       int64_t sums[3] = {0, 0, 0};
-      for (int c = 0; c < cn; ++c) sums[c] = row_sum[x * cn + c];
-      out[x] = ZnccFromSums(n, cross[x], sums, row_sum_sq[x], cn, t);
+      for (int c = 0; c < kChannels; ++c) sums[c] = sums_here[c];
+      out[x] = ZnccFromSums(n, cross[x], sums, sums_here[kChannels], kChannels, t);
     }
   }
 }
@@ -256,17 +255,23 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     tail_hi_ = row_bytes_ - 8;
   }
   chunks_per_row_ = full_chunks_ + (has_tail_ ? 1 : 0);
-  // The row byte lane `i` of a row's chunks reads; -1 when it reads nothing new.
-  auto byte_of = [&](int i) {
-    if (i < covered) return i;
-    const int lane = i - covered;
-    // Low half: the bytes not yet covered by the full chunks.
-    if (lane < 8) return tail_lo_ + lane >= covered ? tail_lo_ + lane : -1;
-    // High half: only when the tail is 8 bytes or more, beyond what the low half took.
-    const int b = tail_hi_ + lane - 8;
-    return rem >= 8 && b >= covered + 8 ? b : -1;
-  };
+  // The row byte each lane of a row's chunks reads (the same in every row); -1 when it reads
+  // nothing new.
   const int per_row = chunks_per_row_ * 16;
+  lane_bytes_.resize(per_row);
+  for (int i = 0; i < per_row; ++i) {
+    const int lane = i - covered;
+    if (i < covered) {
+      lane_bytes_[i] = i;
+    } else if (lane < 8) {
+      // Low half: the bytes not yet covered by the full chunks.
+      lane_bytes_[i] = tail_lo_ + lane >= covered ? tail_lo_ + lane : -1;
+    } else {
+      // High half: only when the tail is 8 bytes or more, beyond what the low half took.
+      const int b = tail_hi_ + lane - 8;
+      lane_bytes_[i] = rem >= 8 && b >= covered + 8 ? b : -1;
+    }
+  }
   const size_t total = static_cast<size_t>(per_row) * templ.rows;
   bytes_.assign(total, 0);
   mask_.assign(total, 0);
@@ -276,8 +281,8 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     const uint8_t* m = masked ? mask_image_.ptr<uint8_t>(r) : nullptr;
     const size_t row = static_cast<size_t>(r) * per_row;
     for (int i = 0; i < per_row; ++i) {
-      const int b = byte_of(i);
-      if (b < 0 || (m && !m[b / cn])) continue;
+      const int b = lane_bytes_[i];
+      if (b < 0 || (m && !m[cn == 1 ? b : b / 3])) continue;
       bytes_[row + i] = p[b];
       mask_[row + i] = 0xFF;
       words_[row + i] = p[b];
@@ -460,23 +465,85 @@ inline int SsdAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
   return cv::v_reduce_sum(acc);
 }
 
-// sum I * T: the template words are zero where masked, so no mask is needed.
-inline int CrossAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
+// sum I * T at one placement of an image already widened to 16 bits (`step` values a row): the
+// template words are zero where masked, so no mask is needed. Widening the image once instead
+// of at every placement (which unpacked each byte again for each of the placements covering
+// it) takes the shuffles out of the inner loop, half of its instructions.
+inline int CrossAt(const int16_t* p, size_t step, const PreparedTemplate& t) {
   const int rows = KA::Rows(t);
   const int full = KA::FullChunks(t);
-  const int chunks = KA::ChunksPerRow(t);
+  const bool tail = KA::HasTail(t);
   const int lo = KA::TailLo(t), hi = KA::TailHi(t);
   const int16_t* tw = KA::Words(t);
-  cv::v_int32x4 acc = cv::v_setzero_s32();
+  cv::v_int32x4 acc0 = cv::v_setzero_s32(), acc1 = cv::v_setzero_s32();
   for (int r = 0; r < rows; ++r, p += step) {
-    for (int c = 0; c < chunks; ++c, tw += 16) {
-      cv::v_uint16x8 a, b;
-      cv::v_expand(LoadChunk(p, c, full, lo, hi), a, b);
-      acc = cv::v_dotprod(cv::v_reinterpret_as_s16(a), cv::v_load(tw), acc);
-      acc = cv::v_dotprod(cv::v_reinterpret_as_s16(b), cv::v_load(tw + 8), acc);
+    for (int c = 0; c < full; ++c, tw += 16) {
+      acc0 = cv::v_dotprod(cv::v_load(p + 16 * c), cv::v_load(tw), acc0);
+      acc1 = cv::v_dotprod(cv::v_load(p + 16 * c + 8), cv::v_load(tw + 8), acc1);
+    }
+    if (tail) {
+      acc0 = cv::v_dotprod(cv::v_load(p + lo), cv::v_load(tw), acc0);
+      acc1 = cv::v_dotprod(cv::v_load(p + hi), cv::v_load(tw + 8), acc1);
+      tw += 16;
     }
   }
-  return cv::v_reduce_sum(acc);
+  return cv::v_reduce_sum(acc0 + acc1);
+}
+
+// CrossAt for the four placements x .. x + 3 (pixel stride `cn`) at once: each template chunk is
+// loaded once for the four, and the loop's overhead per row is shared.
+inline void CrossAt4(const int16_t* p, int cn, size_t step, const PreparedTemplate& t, int* out) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const bool tail = KA::HasTail(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const int16_t* tw = KA::Words(t);
+  cv::v_int32x4 acc0 = cv::v_setzero_s32(), acc1 = cv::v_setzero_s32();
+  cv::v_int32x4 acc2 = cv::v_setzero_s32(), acc3 = cv::v_setzero_s32();
+  const int16_t* p1 = p + cn;
+  const int16_t* p2 = p + 2 * cn;
+  const int16_t* p3 = p + 3 * cn;
+  auto add = [&](int a, int b, const int16_t* w) {
+    const cv::v_int16x8 ta = cv::v_load(w), tb = cv::v_load(w + 8);
+    acc0 = cv::v_dotprod(cv::v_load(p + a), ta, acc0);
+    acc1 = cv::v_dotprod(cv::v_load(p1 + a), ta, acc1);
+    acc2 = cv::v_dotprod(cv::v_load(p2 + a), ta, acc2);
+    acc3 = cv::v_dotprod(cv::v_load(p3 + a), ta, acc3);
+    acc0 = cv::v_dotprod(cv::v_load(p + b), tb, acc0);
+    acc1 = cv::v_dotprod(cv::v_load(p1 + b), tb, acc1);
+    acc2 = cv::v_dotprod(cv::v_load(p2 + b), tb, acc2);
+    acc3 = cv::v_dotprod(cv::v_load(p3 + b), tb, acc3);
+  };
+  for (int r = 0; r < rows; ++r, p += step, p1 += step, p2 += step, p3 += step) {
+    for (int c = 0; c < full; ++c, tw += 16) add(16 * c, 16 * c + 8, tw);
+    if (tail) {
+      add(lo, hi, tw);
+      tw += 16;
+    }
+  }
+  out[0] = cv::v_reduce_sum(acc0);
+  out[1] = cv::v_reduce_sum(acc1);
+  out[2] = cv::v_reduce_sum(acc2);
+  out[3] = cv::v_reduce_sum(acc3);
+}
+
+void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
+                    std::vector<int16_t>& widened) {
+  const int cn = t.channels();
+  const int row_values = image.cols * cn;
+  widened.resize(static_cast<size_t>(row_values) * image.rows);
+  for (int y = 0; y < image.rows; ++y) {
+    const uint8_t* p = image.ptr<uint8_t>(y);
+    int16_t* w = widened.data() + static_cast<size_t>(row_values) * y;
+    for (int i = 0; i < row_values; ++i) w[i] = p[i];
+  }
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    const int16_t* p = widened.data() + static_cast<size_t>(row_values) * y;
+    int x = 0;
+    for (; x + 3 < result.cols; x += 4) CrossAt4(p + x * cn, cn, row_values, t, out + x);
+    for (; x < result.cols; ++x) out[x] = CrossAt(p + x * cn, row_values, t);
+  }
 }
 
 template <int (*At)(const uint8_t*, size_t, const PreparedTemplate&)>
@@ -528,17 +595,29 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
   ScalarMap(image, templ.image(), templ.mask(), result, SqDiff);
 }
 
-void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+namespace {
+
+// ZNCC keeps the widened image in its scratch.
+void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+                      std::vector<int16_t>& widened) {
   CV_Assert(!templ.empty());
   CheckInputs(image, templ.image(), templ.mask());
 #if CV_SIMD128
   if (KernelAccess::Vectorised(templ)) {
     result.create(ResultSize(image, templ.size()), CV_32S);
-    VectorMap<CrossAt>(image, templ, result);
+    VectorCrossMap(image, templ, result, widened);
     return;
   }
 #endif
+  (void)widened;
   ScalarMap(image, templ.image(), templ.mask(), result, Product);
+}
+
+}  // namespace
+
+void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+  std::vector<int16_t> widened;
+  CrossCorrelation(image, templ, result, widened);
 }
 
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
@@ -547,10 +626,14 @@ void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& res
   CheckInputs(image, templ.image(), templ.mask());
   const int cn = templ.channels();
   if (templ.masked()) {
-    MaskedZncc(image, templ, result, scratch);
+    if (cn == 1) {
+      MaskedZncc<1>(image, templ, result, scratch);
+    } else {
+      MaskedZncc<3>(image, templ, result, scratch);
+    }
     return;
   }
-  MatchCrossCorrelation(image, templ, scratch.cross);
+  CrossCorrelation(image, templ, scratch.cross, scratch.widened);
   // Window sums from integral images: exact (32-bit sums, 64-bit float squares < 2^53).
   cv::integral(image, scratch.sum, scratch.sum_sq, CV_32S, CV_64F);
   result.create(scratch.cross.size(), CV_32F);

@@ -80,6 +80,7 @@ class PreparedTemplate {
   std::vector<uint8_t> bytes_;  // [row][chunk] 16 bytes: template values, masked bytes zero.
   std::vector<uint8_t> mask_;   // [row][chunk] 16 bytes: 0xFF where the byte counts.
   std::vector<int16_t> words_;  // [row][chunk] 16 values: the bytes widened to 16 bits.
+  std::vector<int> lane_bytes_;  // Preparation's scratch: the row byte each lane of a row reads.
   // Masked templates only: the counted pixels of row r are the runs [run_rows_[r],
   // run_rows_[r + 1]) of runs_, each the pixel columns [begin, end). ZNCC takes the window sums
   // over the mask from row prefix sums, two look-ups per run (a round mask has one run a row).
@@ -100,8 +101,9 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
 // sizes, so its matching allocates nothing from frame to frame.
 struct ZnccScratch {
   cv::Mat sum, sum_sq, cross;
-  std::vector<uint32_t> prefix_sum, prefix_sum_sq, row_sum, row_sum_sq;
+  std::vector<uint32_t> prefix_sum, row_sum;
   std::vector<int> cross_values;
+  std::vector<int16_t> widened;  // The image widened to 16 bits for the cross-correlation.
 };
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);

@@ -1066,13 +1066,14 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     const cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
                                          params_.search_margin_px);
     if ((window & frame_rect).empty()) return Lose(MarkerStatus::kOutOfFrame);
-    // Around the window, the margin the later windows need when the marker is found in it: the
-    // measurement (kFineMarginPx around the match), the neighbouring rungs of the scale search
-    // (5 % larger) and the template update's patch. A window not covered is converted alone.
-    const cv::Size size = search_template().size();
-    const int around = kFineMarginPx + 3 + (std::max(size.width, size.height) + 32) / 33;
-    ConvertAround(frame_bgr, cv::Rect(window.x - around, window.y - around,
-                                      window.width + 2 * around, window.height + 2 * around));
+    // The window and a little around it: the later windows (the measurement, kFineMarginPx
+    // around the match; the neighbouring rungs of the scale search; the template update's
+    // patch) lie in it while the marker is found near where it was predicted, which is most
+    // frames; one that does not is converted on its own. (Converting all of them, kFineMarginPx
+    // and more around the whole window, cost more than the few it saves.)
+    constexpr int kAroundPx = 2;
+    ConvertAround(frame_bgr, cv::Rect(window.x - kAroundPx, window.y - kAroundPx,
+                                      window.width + 2 * kAroundPx, window.height + 2 * kAroundPx));
     hit = Search(frame_bgr, window, search_template(), true);
     if (hit && hit->on_inner_edge) hit.reset();  // Moving faster than the window: acquire.
   }
