@@ -99,23 +99,20 @@ namespace {
 void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                       std::vector<int16_t>& widened);
 
-// Masked ZNCC from the cross-correlation map and window sums over the mask. The sums come from
-// per-row prefix sums of I (per channel) and of I^2 (over the channels): for a run [b, e) of a
-// template row, sum I over it at placement x is P[x + e] - P[x + b]. The prefix sums of a pixel
-// are kept together (kChannels sums, then the squares'), so one loop over a map row adds a run's
-// sums of every placement of the row, all of them (it vectorises). The arithmetic is unsigned
-// 32-bit: the prefix sums of a wide image may wrap around, their differences do not (a window's
-// sums fit, see kMaxTemplateValues), so the sums are exact, as summed pixel by pixel. About twice
-// as fast as summing I and I^2 over the mask at every placement beside sum I*T (the window
-// search is the template tracker's largest cost).
-template <int kChannels>
-void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
-                ZnccScratch& scratch) {
+// Window sums over the template's counted pixels, one map row at a time: calls
+// `row_done(y, sums)` for each row y of the map, sums[x * (kChannels + 1) + c] = sum of channel c
+// and sums[x * (kChannels + 1) + kChannels] = sum of I^2 over the channels, at placement (x, y).
+// They come from per-row prefix sums P of the image: for a run [b, e) of a template row, the sum
+// over it at placement x is P[x + e] - P[x + b]. A pixel's prefix sums are kept together, so one
+// loop over a map row adds a run's sums for every placement of the row (it vectorises). The
+// arithmetic is unsigned 32-bit: the prefix sums of a wide image may wrap around, their
+// differences do not (a window's sums fit, see kMaxTemplateValues), so the sums are exact, as
+// summed pixel by pixel.
+template <int kChannels, typename RowDone>
+void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& scratch,
+                RowDone row_done) {
   constexpr int kPerPixel = kChannels + 1;
   const cv::Size size = ResultSize(image, t.size());
-  scratch.cross_values.resize(size.area());
-  cv::Mat cross_map(size, CV_32S, scratch.cross_values.data());  // create() keeps it there.
-  CrossCorrelation(image, t, cross_map, scratch.widened);
   const int image_cols = image.cols;
   const size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
   scratch.prefix_sum.resize(prefix_step * image.rows);
@@ -135,16 +132,13 @@ void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result
       s[kChannels] = acc[kChannels];
     }
   }
-  result.create(size, CV_32F);
-  const int cols = result.cols;
-  const int row_values = cols * kPerPixel;
+  const int row_values = size.width * kPerPixel;
   scratch.row_sum.resize(row_values);
   uint32_t* __restrict row_sum = scratch.row_sum.data();
   const std::vector<int>& run_rows = KernelAccess::RunRows(t);
   const auto* runs = KernelAccess::Runs(t);
   const int rows = t.size().height;
-  const int64_t n = t.count();
-  for (int y = 0; y < result.rows; ++y) {
+  for (int y = 0; y < size.height; ++y) {
     std::fill(row_sum, row_sum + row_values, 0u);
     for (int r = 0; r < rows; ++r) {
       const uint32_t* s = scratch.prefix_sum.data() + prefix_step * (y + r);
@@ -154,15 +148,58 @@ void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result
         for (int i = 0; i < row_values; ++i) row_sum[i] += end[i] - begin[i];
       }
     }
-    const int* cross = cross_map.ptr<int>(y);
-    float* out = result.ptr<float>(y);
-    for (int x = 0; x < cols; ++x) {
-      const uint32_t* sums_here = row_sum + x * kPerPixel;
-      int64_t sums[3] = {0, 0, 0};
-      for (int c = 0; c < kChannels; ++c) sums[c] = sums_here[c];
-      out[x] = ZnccFromSums(n, cross[x], sums, sums_here[kChannels], kChannels, t);
-    }
+    row_done(y, static_cast<const uint32_t*>(row_sum));
   }
+}
+
+// The cross-correlation map in the scratch's buffer (create() keeps it there).
+cv::Mat CrossMap(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& scratch) {
+  const cv::Size size = ResultSize(image, t.size());
+  scratch.cross_values.resize(size.area());
+  cv::Mat cross(size, CV_32S, scratch.cross_values.data());
+  CrossCorrelation(image, t, cross, scratch.widened);
+  return cross;
+}
+
+// Masked ZNCC from the cross-correlation map and the window sums over the mask: about twice as
+// fast as summing I and I^2 over the mask at every placement beside sum I*T (the window search
+// is the template tracker's largest cost).
+template <int kChannels>
+void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
+                ZnccScratch& scratch) {
+  const cv::Mat cross = CrossMap(image, t, scratch);
+  result.create(cross.size(), CV_32F);
+  const int64_t n = t.count();
+  WindowSums<kChannels>(image, t, scratch, [&](int y, const uint32_t* row_sums) {
+    const int* cross_row = cross.ptr<int>(y);
+    float* out = result.ptr<float>(y);
+    for (int x = 0; x < result.cols; ++x) {
+      const uint32_t* here = row_sums + x * (kChannels + 1);
+      int64_t sums[3] = {0, 0, 0};
+      for (int c = 0; c < kChannels; ++c) sums[c] = here[c];
+      out[x] = ZnccFromSums(n, cross_row[x], sums, here[kChannels], kChannels, t);
+    }
+  });
+}
+
+// SSD = sum I^2 - 2 sum I*T + sum T^2 over the counted pixels, exactly (64-bit; the result fits
+// 32 bits, see kMaxTemplateValues): from the same cross-correlation and window sums as ZNCC,
+// which cost about half of subtracting, squaring and summing at every placement.
+template <int kChannels>
+void SsdFromSums(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
+                 ZnccScratch& scratch) {
+  const cv::Mat cross = CrossMap(image, t, scratch);
+  result.create(cross.size(), CV_32S);
+  int64_t templ_sq = 0;
+  for (int c = 0; c < kChannels; ++c) templ_sq += t.sum_sq()[c];
+  WindowSums<kChannels>(image, t, scratch, [&](int y, const uint32_t* row_sums) {
+    const int* cross_row = cross.ptr<int>(y);
+    int* out = result.ptr<int>(y);
+    for (int x = 0; x < result.cols; ++x) {
+      const int64_t image_sq = row_sums[x * (kChannels + 1) + kChannels];
+      out[x] = static_cast<int>(image_sq - 2 * int64_t{cross_row[x]} + templ_sq);
+    }
+  });
 }
 
 }  // namespace
@@ -220,23 +257,25 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     sum_sq_[c] = sum_sq[c];
   }
   scaled_variance_ = variance;
-  if (masked) {
-    run_rows_.reserve(templ.rows + 1);
-    for (int r = 0; r < templ.rows; ++r) {
-      run_rows_.push_back(static_cast<int>(runs_.size()));
-      const uint8_t* m = mask_image_.ptr<uint8_t>(r);
-      for (int j = 0; j < templ.cols;) {
-        if (!m[j]) {
-          ++j;
-          continue;
-        }
-        const int begin = j;
-        while (j < templ.cols && m[j]) ++j;
-        runs_.push_back({begin, j});
-      }
-    }
+  run_rows_.reserve(templ.rows + 1);
+  for (int r = 0; r < templ.rows; ++r) {
     run_rows_.push_back(static_cast<int>(runs_.size()));
+    if (!masked) {
+      runs_.push_back({0, templ.cols});
+      continue;
+    }
+    const uint8_t* m = mask_image_.ptr<uint8_t>(r);
+    for (int j = 0; j < templ.cols;) {
+      if (!m[j]) {
+        ++j;
+        continue;
+      }
+      const int begin = j;
+      while (j < templ.cols && m[j]) ++j;
+      runs_.push_back({begin, j});
+    }
   }
+  run_rows_.push_back(static_cast<int>(runs_.size()));
 
   row_bytes_ = templ.cols * cn;
   full_chunks_ = 0;
@@ -442,29 +481,6 @@ void VectorSadMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& resu
   }
 }
 
-template <bool kMasked>
-inline int SsdAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
-  const int rows = KA::Rows(t);
-  const int full = KA::FullChunks(t);
-  const int chunks = KA::ChunksPerRow(t);
-  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
-  const uint8_t* tb = KA::Bytes(t);
-  const uint8_t* tm = KA::Mask(t);
-  cv::v_int32x4 acc = cv::v_setzero_s32();
-  for (int r = 0; r < rows; ++r, p += step) {
-    for (int c = 0; c < chunks; ++c, tb += 16, tm += 16) {
-      cv::v_uint8x16 d = cv::v_absdiff(LoadChunk(p, c, full, lo, hi), cv::v_load(tb));
-      if (kMasked || c >= full) d &= cv::v_load(tm);
-      cv::v_uint16x8 a, b;
-      cv::v_expand(d, a, b);
-      const cv::v_int16x8 sa = cv::v_reinterpret_as_s16(a), sb = cv::v_reinterpret_as_s16(b);
-      acc = cv::v_dotprod(sa, sa, acc);
-      acc = cv::v_dotprod(sb, sb, acc);
-    }
-  }
-  return cv::v_reduce_sum(acc);
-}
-
 // sum I * T at one placement of an image already widened to 16 bits (`step` values a row): the
 // template words are zero where masked, so no mask is needed. Widening the image once instead
 // of at every placement (which unpacked each byte again for each of the placements covering
@@ -546,17 +562,6 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
   }
 }
 
-template <int (*At)(const uint8_t*, size_t, const PreparedTemplate&)>
-void VectorMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result) {
-  const int cn = t.channels();
-  const size_t step = image.step[0];
-  for (int y = 0; y < result.rows; ++y) {
-    int* out = result.ptr<int>(y);
-    const uint8_t* p = image.ptr<uint8_t>(y);
-    for (int x = 0; x < result.cols; ++x) out[x] = At(p + x * cn, step, t);
-  }
-}
-
 }  // namespace
 
 #endif  // CV_SIMD128
@@ -578,21 +583,27 @@ void MatchSad(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
   ScalarMap(image, templ.image(), templ.mask(), result, AbsDiff);
 }
 
-void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+              ZnccScratch& scratch) {
   CV_Assert(!templ.empty());
   CheckInputs(image, templ.image(), templ.mask());
 #if CV_SIMD128
   if (KernelAccess::Vectorised(templ)) {
-    result.create(ResultSize(image, templ.size()), CV_32S);
-    if (templ.masked()) {
-      VectorMap<SsdAt<true>>(image, templ, result);
+    if (templ.channels() == 1) {
+      SsdFromSums<1>(image, templ, result, scratch);
     } else {
-      VectorMap<SsdAt<false>>(image, templ, result);
+      SsdFromSums<3>(image, templ, result, scratch);
     }
     return;
   }
 #endif
+  (void)scratch;
   ScalarMap(image, templ.image(), templ.mask(), result, SqDiff);
+}
+
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
+  ZnccScratch scratch;
+  MatchSsd(image, templ, result, scratch);
 }
 
 namespace {

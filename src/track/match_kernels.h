@@ -81,9 +81,9 @@ class PreparedTemplate {
   std::vector<uint8_t> mask_;   // [row][chunk] 16 bytes: 0xFF where the byte counts.
   std::vector<int16_t> words_;  // [row][chunk] 16 values: the bytes widened to 16 bits.
   std::vector<int> lane_bytes_;  // Preparation's scratch: the row byte each lane of a row reads.
-  // Masked templates only: the counted pixels of row r are the runs [run_rows_[r],
-  // run_rows_[r + 1]) of runs_, each the pixel columns [begin, end). ZNCC takes the window sums
-  // over the mask from row prefix sums, two look-ups per run (a round mask has one run a row).
+  // The counted pixels of row r are the runs [run_rows_[r], run_rows_[r + 1]) of runs_, each the
+  // pixel columns [begin, end) (unmasked: the whole row). Masked ZNCC and SSD take the window
+  // sums over them from row prefix sums, two look-ups per run (a round mask has one run a row).
   struct Run {
     int begin, end;
   };
@@ -94,17 +94,21 @@ class PreparedTemplate {
 // Fast kernels. `image` has the template's type and is at least as large. `result` is
 // (re)allocated only when its size or type changes, so a tracker reusing it allocates nothing.
 void MatchSad(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
-void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
-// Scratch buffers for ZNCC: the window sums (integral images; for a masked template, row prefix
-// sums and one map row of sums over the mask) and the cross-correlation map. The masked path
-// keeps them in vectors, which keep their capacity when a tracker matches windows of changing
-// sizes, so its matching allocates nothing from frame to frame.
+// Scratch buffers for ZNCC and SSD: the window sums (integral images for unmasked ZNCC; else row
+// prefix sums and one map row of sums over the counted pixels) and the cross-correlation map,
+// which both are built on. Vectors keep their capacity when a tracker matches windows of
+// changing sizes, so its matching allocates nothing from frame to frame.
 struct ZnccScratch {
   cv::Mat sum, sum_sq, cross;
   std::vector<uint32_t> prefix_sum, row_sum;
   std::vector<int> cross_values;
   std::vector<int16_t> widened;  // The image widened to 16 bits for the cross-correlation.
 };
+// SSD = sum I^2 - 2 sum I*T + sum T^2, from the window sums and the cross-correlation (exact).
+// Without `scratch`, its buffers are allocated for the call.
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+              ZnccScratch& scratch);
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
 // sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC is built on.

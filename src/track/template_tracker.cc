@@ -757,7 +757,7 @@ void TemplateTracker::Similarity(const cv::Mat& image, const PreparedTemplate& t
       raw_.convertTo(sim, CV_32F, -per_value);  // Minus the mean absolute difference.
       break;
     case MatchMeasure::kSsd:
-      MatchSsd(image, templ, raw_);
+      MatchSsd(image, templ, raw_, zncc_);
       raw_.convertTo(sim, CV_32F, -per_value);  // Minus the mean squared difference.
       break;
     case MatchMeasure::kZncc: MatchZncc(image, templ, sim, zncc_); break;
