@@ -85,6 +85,16 @@ HsvClassifier::HsvClassifier(const HsvBox& box) : box_(box) {
       ++intervals_;
     }
   }
+  // The sectors of the largest channel whose hues can come within a unit of an interval (the
+  // vector path's "near" test, below): red's t lies in [-30, 30], green's in [30, 90], blue's in
+  // [90, 150].
+  hue_sectors_ = 0;
+  for (int sector = 0; sector < 3; ++sector) {
+    const int lo = -30 + 60 * sector, hi = lo + 60;
+    for (int i = 0; i < intervals_; ++i) {
+      if (hi > t_lo_[i] - 1 && lo < t_hi_[i] + 1) hue_sectors_ |= 1 << sector;
+    }
+  }
 }
 
 void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
@@ -136,6 +146,10 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     near_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 31));
   }
   const v_uint8x16 gray_in = gray_in_ ? v_setall_u8(0xff) : v_setzero_u8();
+  const v_uint8x16 sector_r = v_setall_u8(hue_sectors_ & 1 ? 0xff : 0);
+  const v_uint8x16 sector_g = v_setall_u8(hue_sectors_ & 2 ? 0xff : 0);
+  const v_uint8x16 sector_b = v_setall_u8(hue_sectors_ & 4 ? 0xff : 0);
+  const bool sectors_can_fail = !full_hue_ && hue_sectors_ != 7;
   alignas(16) uchar undecided[16];
 
   // In / out decisions for 8 pixels (16-bit lanes).
@@ -170,7 +184,11 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     out |= ~hue_near;
   };
 
-  for (; x + 16 <= n; x += 16) {
+  for (; x < n && n >= 16; x += 16) {
+    // The row's last pixels: the last 16 again, overlapping the previous chunk (each pixel's
+    // result depends on it alone), so no pixel of a row of 16 or more takes the scalar formula
+    // for being in the tail (on the tracker's windows, a tenth of the pixels did).
+    if (x + 16 > n) x = n - 16;
     v_uint8x16 b8, g8, r8;
     v_load_deinterleave(bgr + 3 * x, b8, g8, r8);
     const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
@@ -185,6 +203,17 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
                                                     v_mul_wrap(d1, k255) > v_mul_wrap(s_lo1, vv1)))) {
       v_store(mask + x, v_setzero_u8());
       continue;
+    }
+    // Likewise when none of the 16 has its largest channel in a sector whose hues reach the
+    // box (decide() would find none of them near a hue interval; a flat pixel has no hue).
+    if (sectors_can_fail) {
+      const v_uint8x16 is_r = v8 == r8, is_g = (v8 == g8) & ~is_r, is_b = ~(is_r | is_g);
+      const v_uint8x16 may_be_in = (is_r & sector_r) | (is_g & sector_g) | (is_b & sector_b) |
+                                   ((d8 == v_setzero_u8()) & gray_in);
+      if (!v_check_any(v_ok & may_be_in)) {
+        v_store(mask + x, v_setzero_u8());
+        continue;
+      }
     }
     v_uint16x8 b0, b1, g0, g1, r0, r1;
     v_expand(b8, b0, b1);

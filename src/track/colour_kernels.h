@@ -58,6 +58,9 @@ class HsvClassifier {
   int intervals_ = 0;
   std::array<int, 3> t_lo_{}, t_hi_{};
   bool gray_in_ = false;  // Whether a pixel with max == min (hue 0, saturation 0) is in (given V).
+  // Bit k set: hues of pixels whose largest channel is red (k = 0), green (1) or blue (2) can be
+  // in the box or within a unit of it; 16 pixels of none of those sectors are out at once.
+  int hue_sectors_ = 7;
 };
 
 // The OpenCV route the classifier replaces, for tests and benchmarks: cvtColor to HSV, a hue LUT

@@ -336,6 +336,8 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
   }
   acquire_roi_ = params_.roi;
+  opencv_in_windows_ = gray_ || params_.filter != ColourParams::Filter::kNone ||
+                       (!kernel_.empty() && !morph_cross_ && !morph_square_);
 }
 
 void ColourTracker::check_frame(const cv::Mat& frame) const {
@@ -788,7 +790,15 @@ void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
   }
   // A window is a few thousand pixels: handing its pieces to OpenCV's thread pool (TBB) costs
   // more than the work (connected components alone doubles). Run the window as one OpenCV
-  // parallel region of a single task: OpenCV executes parallel loops nested in it inline.
+  // parallel region of a single task: OpenCV executes parallel loops nested in it inline. Only
+  // OpenCV's own filters, conversions and morphology parallelise; without them (the default
+  // pipeline: our kernels alone) the window runs directly, since the region itself costs a few
+  // allocations and microseconds per window, and a re-acquisition analyses dozens.
+  const bool opencv_parallel = opencv_in_windows_ || frame.channels() != (gray_ ? 1 : 3);
+  if (!opencv_parallel) {
+    analyse_region(frame, region, blobs);
+    return;
+  }
   cv::parallel_for_(cv::Range(0, 1),
                     [&](const cv::Range&) { analyse_region(frame, region, blobs); });
 }
