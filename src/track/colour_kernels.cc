@@ -404,6 +404,26 @@ cv::Rect NonZeroBounds(const cv::Mat& mask) {
   return cv::Rect(left, top, right - left + 1, bottom - top + 1);
 }
 
+void NonZeroPoints(const cv::Mat& mask, std::vector<cv::Point>& points) {
+  CV_Assert(mask.type() == CV_8UC1);
+  points.clear();
+  for (int y = 0; y < mask.rows; ++y) {
+    const uchar* row = mask.ptr<uchar>(y);
+    int x = 0;
+#if CV_SIMD128
+    for (; x + 16 <= mask.cols; x += 16) {
+      const int bits = cv::v_signmask(cv::v_load(row + x) != cv::v_setzero_u8());
+      for (int rest = bits; rest != 0; rest &= rest - 1) {
+        points.emplace_back(x + __builtin_ctz(static_cast<unsigned>(rest)), y);
+      }
+    }
+#endif
+    for (; x < mask.cols; ++x) {
+      if (row[x]) points.emplace_back(x, y);
+    }
+  }
+}
+
 int RunLabeller::Find(int i) {
   while (parent_[static_cast<size_t>(i)] != i) {
     parent_[static_cast<size_t>(i)] = parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])];

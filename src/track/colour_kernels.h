@@ -78,6 +78,11 @@ void OpenClose3x3Reference(cv::Mat& mask, bool cross);
 // none, reading 16 pixels at a time (the tracker's replacement for cv::boundingRect(mask)).
 cv::Rect NonZeroBounds(const cv::Mat& mask);
 
+// The nonzero pixels of `mask` (CV_8UC1, any strides) in raster order into `points` (reused
+// storage), reading 16 pixels at a time: cv::findNonZero, which counts them first and then
+// visits every pixel again.
+void NonZeroPoints(const cv::Mat& mask, std::vector<cv::Point>& points);
+
 // 8-connected components of a binary mask (nonzero = in) from its runs: rows are scanned 16
 // bytes at a time, so the cost is the mask's area / 16 plus its runs, where
 // cv::connectedComponentsWithStats visits every pixel (which dominated whole-frame searches of
