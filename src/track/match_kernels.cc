@@ -84,7 +84,6 @@ struct KernelAccess {
   static bool HasTail(const PreparedTemplate& t) { return t.has_tail_; }
   static int TailLo(const PreparedTemplate& t) { return t.tail_lo_; }
   static int TailHi(const PreparedTemplate& t) { return t.tail_hi_; }
-  static int ChunksPerRow(const PreparedTemplate& t) { return t.chunks_per_row_; }
   static int Rows(const PreparedTemplate& t) { return t.image_.rows; }
   static const uint8_t* Bytes(const PreparedTemplate& t) { return t.bytes_.data(); }
   static const uint8_t* Mask(const PreparedTemplate& t) { return t.mask_.data(); }
@@ -161,9 +160,9 @@ cv::Mat CrossMap(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& s
   return cross;
 }
 
-// Masked ZNCC from the cross-correlation map and the window sums over the mask: about twice as
-// fast as summing I and I^2 over the mask at every placement beside sum I*T (the window search
-// is the template tracker's largest cost).
+// Masked ZNCC from the cross-correlation map and the window sums over the mask (1.4x faster on
+// the tracker's 48x48 window than summing I and I^2 over the mask at every placement beside
+// sum I*T; the window search is the template tracker's largest cost).
 template <int kChannels>
 void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
                 ZnccScratch& scratch) {
@@ -184,7 +183,7 @@ void MaskedZncc(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result
 
 // SSD = sum I^2 - 2 sum I*T + sum T^2 over the counted pixels, exactly (64-bit; the result fits
 // 32 bits, see kMaxTemplateValues): from the same cross-correlation and window sums as ZNCC,
-// which cost about half of subtracting, squaring and summing at every placement.
+// 1.5-1.9x faster than subtracting, squaring and summing at every placement.
 template <int kChannels>
 void SsdFromSums(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
                  ZnccScratch& scratch) {
@@ -389,11 +388,6 @@ void MatchZnccReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& res
 namespace {
 
 using KA = KernelAccess;
-
-// Loads the image bytes of chunk `c` of a row (the tail chunk as two in-row 8-byte halves).
-inline cv::v_uint8x16 LoadChunk(const uint8_t* p, int c, int full, int lo, int hi) {
-  return c < full ? cv::v_load(p + 16 * c) : cv::v_load_halves(p + lo, p + hi);
-}
 
 // SAD of one placement. v_reduce_sad (psadbw on x86) sums 16 absolute differences in one step;
 // masked bytes are zeroed on both sides, so they add |0 - 0| = 0.

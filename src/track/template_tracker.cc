@@ -807,12 +807,14 @@ std::optional<Hit> TemplateTracker::Search(const cv::Mat& frame, cv::Rect region
   m.score = ScoreOf(m.similarity);
   // SAD and SSD alone accept any patch whose grey levels are close enough, e.g. a smooth
   // background patch once the light has changed: one ZNCC at the best placement checks shape.
-  m.zncc = params_.measure == MatchMeasure::kZncc ? m.score : ZnccAt(region_, best, templ, shape_, zncc_);
+  m.zncc = params_.measure == MatchMeasure::kZncc ? m.score
+                                                  : ZnccAt(region_, best, templ, shape_, zncc_);
   cv::Point rival;
   if (find_rival && params_.ambiguity_margin > 0 &&
       RivalIn(sim_, best, std::max(2, std::min(size.width, size.height) / 2), &rival)) {
-    m.rival_zncc = params_.measure == MatchMeasure::kZncc ? sim_.at<float>(rival)
-                                                          : ZnccAt(region_, rival, templ, shape_, zncc_);
+    m.rival_zncc = params_.measure == MatchMeasure::kZncc
+                       ? sim_.at<float>(rival)
+                       : ZnccAt(region_, rival, templ, shape_, zncc_);
   }
   m.on_inner_edge =
       (best.x == 0 && region.x > 0) || (best.x == sim_.cols - 1 && region.br().x < frame.cols) ||
@@ -981,8 +983,9 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
     for (int c = 0; c < cn; ++c) mean += per_channel[c] / cn;
     fix.score = params_.measure == MatchMeasure::kSsd ? std::sqrt(mean) : mean;
   }
-  fix.zncc = params_.measure == MatchMeasure::kZncc ? fine_sim_.at<float>(best)
-                                                    : ZnccAt(fine_, best, rung.templ, shape_, zncc_);
+  fix.zncc = params_.measure == MatchMeasure::kZncc
+                 ? fine_sim_.at<float>(best)
+                 : ZnccAt(fine_, best, rung.templ, shape_, zncc_);
   return fix;
 }
 
