@@ -147,30 +147,37 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
                    k5 = v_setall_u16(5);
   const v_uint16x8 all16 = v_setall_u16(0xffff), none16 = v_setzero_u16();
   const bool s_lo_can_fail = box_.s.lo > 0, s_hi_can_fail = box_.s.hi < 255;
-  std::array<v_uint16x8, 3> in_a, in_b, near_a, near_b;
+  // A hue test A d <= 30 N' <= B d is one comparison: 30 N' - A d <= (B - A) d, unsigned, where
+  // a value below A d wraps around to more than any width (all products are below 45900).
+  std::array<v_uint16x8, 3> in_a, in_width, near_a, near_width, near_b;
   std::array<bool, 3> near_a_any{};
   for (int i = 0; i < intervals_; ++i) {
     in_a[i] = v_setall_u16(static_cast<ushort>(t_lo_[i] + 30));
-    in_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 30));
+    in_width[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] - t_lo_[i]));
     near_a_any[i] = t_lo_[i] + 29 < 0;  // No t lies below: the lower side never excludes.
     near_a[i] = v_setall_u16(static_cast<ushort>(std::max(0, t_lo_[i] + 29)));
+    near_width[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] - t_lo_[i] + 2));
     near_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 31));
   }
+  const v_uint16x8 one16 = v_setall_u16(1), two16 = v_setall_u16(2);
+  // a <= b, unsigned: the saturating difference is 0.
+  auto at_most = [&](const v_uint16x8& a, const v_uint16x8& b) { return (a - b) == none16; };
   const v_uint8x16 gray_in = gray_in_ ? v_setall_u8(0xff) : v_setzero_u8();
   const v_uint8x16 sector_r = v_setall_u8(hue_sectors_ & 1 ? 0xff : 0);
   const v_uint8x16 sector_g = v_setall_u8(hue_sectors_ & 2 ? 0xff : 0);
   const v_uint8x16 sector_b = v_setall_u8(hue_sectors_ & 4 ? 0xff : 0);
   const bool sectors_can_fail = !full_hue_ && hue_sectors_ != 7;
 
-  // In / out decisions for 8 pixels (16-bit lanes).
+  // In / out decisions for 8 pixels (16-bit lanes). `s255` is 255 diff, `above_lo1` whether it
+  // exceeds (lo - 1) v (computed once for the early exit below).
   auto decide = [&](const v_uint16x8& b, const v_uint16x8& g, const v_uint16x8& r,
-                    const v_uint16x8& v, const v_uint16x8& d, v_uint16x8& in, v_uint16x8& out) {
+                    const v_uint16x8& v, const v_uint16x8& d, const v_uint16x8& s255,
+                    const v_uint16x8& above_lo1, v_uint16x8& in, v_uint16x8& out) {
     in = all16;
     out = none16;
-    const v_uint16x8 s255 = v_mul_wrap(d, k255);
     if (s_lo_can_fail) {
-      in &= s255 >= v_mul_wrap(s_lo, v);
-      out |= s255 <= v_mul_wrap(s_lo1, v);
+      in &= at_most(v_mul_wrap(s_lo, v), s255);
+      out |= ~above_lo1;
     }
     if (s_hi_can_fail) {
       in &= s255 <= v_mul_wrap(s_hi, v);
@@ -184,11 +191,14 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     const v_uint16x8 t30 = v_mul_wrap(v_select(is_r, n_r, v_select(is_g, n_g, n_b)), k30);
     v_uint16x8 hue_in = none16, hue_near = none16;
     for (int i = 0; i < intervals_; ++i) {
-      const v_uint16x8 below_b = t30 <= v_mul_wrap(in_b[i], d);
-      hue_in |= (t30 >= v_mul_wrap(in_a[i], d)) & below_b;
-      const v_uint16x8 above_near_a =
-          near_a_any[i] ? all16 : (t30 > v_mul_wrap(near_a[i], d));
-      hue_near |= above_near_a & (t30 < v_mul_wrap(near_b[i], d));
+      hue_in |= at_most(v_sub_wrap(t30, v_mul_wrap(in_a[i], d)), v_mul_wrap(in_width[i], d));
+      if (near_a_any[i]) {
+        hue_near |= at_most(v_add_wrap(t30, one16), v_mul_wrap(near_b[i], d));
+      } else {
+        // near_a d < 30 N' < near_b d (d >= 1 here; flat pixels are decided apart).
+        hue_near |= at_most(v_sub_wrap(t30, v_add_wrap(v_mul_wrap(near_a[i], d), one16)),
+                            v_sub_wrap(v_mul_wrap(near_width[i], d), two16));
+      }
     }
     in &= hue_in;
     out |= ~hue_near;
@@ -204,18 +214,10 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
     const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
     const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
-    v_uint16x8 vv0, vv1, d0, d1;
-    v_expand(v8, vv0, vv1);
-    v_expand(d8, d0, d1);
-    // Most pixels of a scene are far from the marker's value or saturation: when all 16 are out
-    // on those alone (exact, as above), the hue is not needed.
-    if (s_lo_can_fail && !v_check_any(v_ok & v_pack(v_mul_wrap(d0, k255) > v_mul_wrap(s_lo1, vv0),
-                                                    v_mul_wrap(d1, k255) > v_mul_wrap(s_lo1, vv1)))) {
-      v_store(mask + x, v_setzero_u8());
-      continue;
-    }
-    // Likewise when none of the 16 has its largest channel in a sector whose hues reach the
-    // box (decide() would find none of them near a hue interval; a flat pixel has no hue).
+    // Most pixels of a scene are far from the marker's hue, value or saturation: when all 16
+    // are out on those alone (exact, as above), the full test is not needed. First (8-bit, the
+    // cheapest) when none of the 16 has its largest channel in a sector whose hues reach the box
+    // (decide() would find none of them near a hue interval; a flat pixel has no hue).
     if (sectors_can_fail) {
       const v_uint8x16 is_r = v8 == r8, is_g = (v8 == g8) & ~is_r, is_b = ~(is_r | is_g);
       const v_uint8x16 may_be_in = (is_r & sector_r) | (is_g & sector_g) | (is_b & sector_b) |
@@ -225,13 +227,26 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
         continue;
       }
     }
+    v_uint16x8 vv0, vv1, d0, d1;
+    v_expand(v8, vv0, vv1);
+    v_expand(d8, d0, d1);
+    const v_uint16x8 s255_0 = v_mul_wrap(d0, k255), s255_1 = v_mul_wrap(d1, k255);
+    v_uint16x8 above_lo1_0 = all16, above_lo1_1 = all16;
+    if (s_lo_can_fail) {
+      above_lo1_0 = ~at_most(s255_0, v_mul_wrap(s_lo1, vv0));
+      above_lo1_1 = ~at_most(s255_1, v_mul_wrap(s_lo1, vv1));
+      if (!v_check_any(v_ok & v_pack(above_lo1_0, above_lo1_1))) {
+        v_store(mask + x, v_setzero_u8());
+        continue;
+      }
+    }
     v_uint16x8 b0, b1, g0, g1, r0, r1;
     v_expand(b8, b0, b1);
     v_expand(g8, g0, g1);
     v_expand(r8, r0, r1);
     v_uint16x8 in0, in1, out0, out1;
-    decide(b0, g0, r0, vv0, d0, in0, out0);
-    decide(b1, g1, r1, vv1, d1, in1, out1);
+    decide(b0, g0, r0, vv0, d0, s255_0, above_lo1_0, in0, out0);
+    decide(b1, g1, r1, vv1, d1, s255_1, above_lo1_1, in1, out1);
     v_uint8x16 in = v_pack(in0, in1) & v_ok;
     v_uint8x16 out = v_pack(out0, out1) | ~v_ok;
     // max == min: hue 0 and saturation 0 exactly.
