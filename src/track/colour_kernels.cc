@@ -85,6 +85,16 @@ HsvClassifier::HsvClassifier(const HsvBox& box) : box_(box) {
       ++intervals_;
     }
   }
+  // The sectors of the largest channel whose hues can come within a unit of an interval (the
+  // vector path's "near" test, below): red's t lies in [-30, 30], green's in [30, 90], blue's in
+  // [90, 150].
+  hue_sectors_ = 0;
+  for (int sector = 0; sector < 3; ++sector) {
+    const int lo = -30 + 60 * sector, hi = lo + 60;
+    for (int i = 0; i < intervals_; ++i) {
+      if (hi > t_lo_[i] - 1 && lo < t_hi_[i] + 1) hue_sectors_ |= 1 << sector;
+    }
+  }
 }
 
 void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
@@ -101,7 +111,18 @@ void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
 
 void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
   CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
-  for (int y = 0; y < bgr.rows; ++y) ClassifyRow(bgr.ptr<uchar>(y), mask.ptr<uchar>(y), bgr.cols);
+  // A window's rows are short, separate streams of the frame, which is usually not in the cache
+  // yet: the hardware prefetcher does not follow them, and waiting for the loads was a good part
+  // of the classifier's time. The rows two ahead are asked for while this one is classified.
+  const size_t row_bytes = static_cast<size_t>(bgr.cols) * 3;
+  for (int y = 0; y < bgr.rows; ++y) {
+    if (y + 2 < bgr.rows) {
+      const uchar* ahead = bgr.ptr<uchar>(y + 2);
+      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
+      __builtin_prefetch(ahead + row_bytes - 1);
+    }
+    ClassifyRow(bgr.ptr<uchar>(y), mask.ptr<uchar>(y), bgr.cols);
+  }
 }
 
 // The vector path decides each pixel from exact integer inequalities where they are conclusive,
@@ -126,27 +147,37 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
                    k5 = v_setall_u16(5);
   const v_uint16x8 all16 = v_setall_u16(0xffff), none16 = v_setzero_u16();
   const bool s_lo_can_fail = box_.s.lo > 0, s_hi_can_fail = box_.s.hi < 255;
-  std::array<v_uint16x8, 3> in_a, in_b, near_a, near_b;
+  // A hue test A d <= 30 N' <= B d is one comparison: 30 N' - A d <= (B - A) d, unsigned, where
+  // a value below A d wraps around to more than any width (all products are below 45900).
+  std::array<v_uint16x8, 3> in_a, in_width, near_a, near_width, near_b;
   std::array<bool, 3> near_a_any{};
   for (int i = 0; i < intervals_; ++i) {
     in_a[i] = v_setall_u16(static_cast<ushort>(t_lo_[i] + 30));
-    in_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 30));
+    in_width[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] - t_lo_[i]));
     near_a_any[i] = t_lo_[i] + 29 < 0;  // No t lies below: the lower side never excludes.
     near_a[i] = v_setall_u16(static_cast<ushort>(std::max(0, t_lo_[i] + 29)));
+    near_width[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] - t_lo_[i] + 2));
     near_b[i] = v_setall_u16(static_cast<ushort>(t_hi_[i] + 31));
   }
+  const v_uint16x8 one16 = v_setall_u16(1), two16 = v_setall_u16(2);
+  // a <= b, unsigned: the saturating difference is 0.
+  auto at_most = [&](const v_uint16x8& a, const v_uint16x8& b) { return (a - b) == none16; };
   const v_uint8x16 gray_in = gray_in_ ? v_setall_u8(0xff) : v_setzero_u8();
-  alignas(16) uchar undecided[16];
+  const v_uint8x16 sector_r = v_setall_u8(hue_sectors_ & 1 ? 0xff : 0);
+  const v_uint8x16 sector_g = v_setall_u8(hue_sectors_ & 2 ? 0xff : 0);
+  const v_uint8x16 sector_b = v_setall_u8(hue_sectors_ & 4 ? 0xff : 0);
+  const bool sectors_can_fail = !full_hue_ && hue_sectors_ != 7;
 
-  // In / out decisions for 8 pixels (16-bit lanes).
+  // In / out decisions for 8 pixels (16-bit lanes). `s255` is 255 diff, `above_lo1` whether it
+  // exceeds (lo - 1) v (computed once for the early exit below).
   auto decide = [&](const v_uint16x8& b, const v_uint16x8& g, const v_uint16x8& r,
-                    const v_uint16x8& v, const v_uint16x8& d, v_uint16x8& in, v_uint16x8& out) {
+                    const v_uint16x8& v, const v_uint16x8& d, const v_uint16x8& s255,
+                    const v_uint16x8& above_lo1, v_uint16x8& in, v_uint16x8& out) {
     in = all16;
     out = none16;
-    const v_uint16x8 s255 = v_mul_wrap(d, k255);
     if (s_lo_can_fail) {
-      in &= s255 >= v_mul_wrap(s_lo, v);
-      out |= s255 <= v_mul_wrap(s_lo1, v);
+      in &= at_most(v_mul_wrap(s_lo, v), s255);
+      out |= ~above_lo1;
     }
     if (s_hi_can_fail) {
       in &= s255 <= v_mul_wrap(s_hi, v);
@@ -160,39 +191,62 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     const v_uint16x8 t30 = v_mul_wrap(v_select(is_r, n_r, v_select(is_g, n_g, n_b)), k30);
     v_uint16x8 hue_in = none16, hue_near = none16;
     for (int i = 0; i < intervals_; ++i) {
-      const v_uint16x8 below_b = t30 <= v_mul_wrap(in_b[i], d);
-      hue_in |= (t30 >= v_mul_wrap(in_a[i], d)) & below_b;
-      const v_uint16x8 above_near_a =
-          near_a_any[i] ? all16 : (t30 > v_mul_wrap(near_a[i], d));
-      hue_near |= above_near_a & (t30 < v_mul_wrap(near_b[i], d));
+      hue_in |= at_most(v_sub_wrap(t30, v_mul_wrap(in_a[i], d)), v_mul_wrap(in_width[i], d));
+      if (near_a_any[i]) {
+        hue_near |= at_most(v_add_wrap(t30, one16), v_mul_wrap(near_b[i], d));
+      } else {
+        // near_a d < 30 N' < near_b d (d >= 1 here; flat pixels are decided apart).
+        hue_near |= at_most(v_sub_wrap(t30, v_add_wrap(v_mul_wrap(near_a[i], d), one16)),
+                            v_sub_wrap(v_mul_wrap(near_width[i], d), two16));
+      }
     }
     in &= hue_in;
     out |= ~hue_near;
   };
 
-  for (; x + 16 <= n; x += 16) {
+  for (; x < n && n >= 16; x += 16) {
+    // The row's last pixels: the last 16 again, overlapping the previous chunk (each pixel's
+    // result depends on it alone), so no pixel of a row of 16 or more takes the scalar formula
+    // for being in the tail (on the tracker's windows, a tenth of the pixels did).
+    if (x + 16 > n) x = n - 16;
     v_uint8x16 b8, g8, r8;
     v_load_deinterleave(bgr + 3 * x, b8, g8, r8);
     const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
     const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
     const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
+    // Most pixels of a scene are far from the marker's hue, value or saturation: when all 16
+    // are out on those alone (exact, as above), the full test is not needed. First (8-bit, the
+    // cheapest) when none of the 16 has its largest channel in a sector whose hues reach the box
+    // (decide() would find none of them near a hue interval; a flat pixel has no hue).
+    if (sectors_can_fail) {
+      const v_uint8x16 is_r = v8 == r8, is_g = (v8 == g8) & ~is_r, is_b = ~(is_r | is_g);
+      const v_uint8x16 may_be_in = (is_r & sector_r) | (is_g & sector_g) | (is_b & sector_b) |
+                                   ((d8 == v_setzero_u8()) & gray_in);
+      if (!v_check_any(v_ok & may_be_in)) {
+        v_store(mask + x, v_setzero_u8());
+        continue;
+      }
+    }
     v_uint16x8 vv0, vv1, d0, d1;
     v_expand(v8, vv0, vv1);
     v_expand(d8, d0, d1);
-    // Most pixels of a scene are far from the marker's value or saturation: when all 16 are out
-    // on those alone (exact, as above), the hue is not needed.
-    if (s_lo_can_fail && !v_check_any(v_ok & v_pack(v_mul_wrap(d0, k255) > v_mul_wrap(s_lo1, vv0),
-                                                    v_mul_wrap(d1, k255) > v_mul_wrap(s_lo1, vv1)))) {
-      v_store(mask + x, v_setzero_u8());
-      continue;
+    const v_uint16x8 s255_0 = v_mul_wrap(d0, k255), s255_1 = v_mul_wrap(d1, k255);
+    v_uint16x8 above_lo1_0 = all16, above_lo1_1 = all16;
+    if (s_lo_can_fail) {
+      above_lo1_0 = ~at_most(s255_0, v_mul_wrap(s_lo1, vv0));
+      above_lo1_1 = ~at_most(s255_1, v_mul_wrap(s_lo1, vv1));
+      if (!v_check_any(v_ok & v_pack(above_lo1_0, above_lo1_1))) {
+        v_store(mask + x, v_setzero_u8());
+        continue;
+      }
     }
     v_uint16x8 b0, b1, g0, g1, r0, r1;
     v_expand(b8, b0, b1);
     v_expand(g8, g0, g1);
     v_expand(r8, r0, r1);
     v_uint16x8 in0, in1, out0, out1;
-    decide(b0, g0, r0, vv0, d0, in0, out0);
-    decide(b1, g1, r1, vv1, d1, in1, out1);
+    decide(b0, g0, r0, vv0, d0, s255_0, above_lo1_0, in0, out0);
+    decide(b1, g1, r1, vv1, d1, s255_1, above_lo1_1, in1, out1);
     v_uint8x16 in = v_pack(in0, in1) & v_ok;
     v_uint8x16 out = v_pack(out0, out1) | ~v_ok;
     // max == min: hue 0 and saturation 0 exactly.
@@ -201,14 +255,12 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     out = v_select(flat, ~in, out);
     v_store(mask + x, in);
     const v_uint8x16 open = ~(in | out);
-    if (v_check_any(open)) {
-      v_store_aligned(undecided, open);
-      for (int k = 0; k < 16; ++k) {
-        if (!undecided[k]) continue;
-        const uchar* p = bgr + 3 * (x + k);
-        const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
-        mask[x + k] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
-      }
+    // The undecided pixels, one bit each: visited by their bits rather than by 16 tests.
+    for (int bits = v_signmask(open); bits != 0; bits &= bits - 1) {
+      const int k = __builtin_ctz(static_cast<unsigned>(bits));
+      const uchar* p = bgr + 3 * (x + k);
+      const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+      mask[x + k] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
     }
   }
 #endif
@@ -365,6 +417,26 @@ cv::Rect NonZeroBounds(const cv::Mat& mask) {
   }
   if (top < 0) return cv::Rect();
   return cv::Rect(left, top, right - left + 1, bottom - top + 1);
+}
+
+void NonZeroPoints(const cv::Mat& mask, std::vector<cv::Point>& points) {
+  CV_Assert(mask.type() == CV_8UC1);
+  points.clear();
+  for (int y = 0; y < mask.rows; ++y) {
+    const uchar* row = mask.ptr<uchar>(y);
+    int x = 0;
+#if CV_SIMD128
+    for (; x + 16 <= mask.cols; x += 16) {
+      const int bits = cv::v_signmask(cv::v_load(row + x) != cv::v_setzero_u8());
+      for (int rest = bits; rest != 0; rest &= rest - 1) {
+        points.emplace_back(x + __builtin_ctz(static_cast<unsigned>(rest)), y);
+      }
+    }
+#endif
+    for (; x < mask.cols; ++x) {
+      if (row[x]) points.emplace_back(x, y);
+    }
+  }
 }
 
 int RunLabeller::Find(int i) {

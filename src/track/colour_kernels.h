@@ -58,6 +58,9 @@ class HsvClassifier {
   int intervals_ = 0;
   std::array<int, 3> t_lo_{}, t_hi_{};
   bool gray_in_ = false;  // Whether a pixel with max == min (hue 0, saturation 0) is in (given V).
+  // Bit k set: hues of pixels whose largest channel is red (k = 0), green (1) or blue (2) can be
+  // in the box or within a unit of it; 16 pixels of none of those sectors are out at once.
+  int hue_sectors_ = 7;
 };
 
 // The OpenCV route the classifier replaces, for tests and benchmarks: cvtColor to HSV, a hue LUT
@@ -74,6 +77,11 @@ void OpenClose3x3Reference(cv::Mat& mask, bool cross);
 // The bounding box of the nonzero pixels of `mask` (CV_8UC1, any strides), empty when there are
 // none, reading 16 pixels at a time (the tracker's replacement for cv::boundingRect(mask)).
 cv::Rect NonZeroBounds(const cv::Mat& mask);
+
+// The nonzero pixels of `mask` (CV_8UC1, any strides) in raster order into `points` (reused
+// storage), reading 16 pixels at a time: cv::findNonZero, which counts them first and then
+// visits every pixel again.
+void NonZeroPoints(const cv::Mat& mask, std::vector<cv::Point>& points);
 
 // 8-connected components of a binary mask (nonzero = in) from its runs: rows are scanned 16
 // bytes at a time, so the cost is the mask's area / 16 plus its runs, where

@@ -147,6 +147,23 @@ TEST(ColourKernels, NonZeroBoundsIsTheBoxOfTheNonzeroPixels) {
   }
 }
 
+TEST(ColourKernels, NonZeroPointsAreFindNonZerosPoints) {
+  cv::RNG rng(13);
+  std::vector<cv::Point> points, expected;
+  for (int trial = 0; trial < 300; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 70), 1 + rng.uniform(0, 30));
+    cv::Mat parent(size.height + 2, size.width + 5, CV_8U, cv::Scalar(255));
+    cv::Mat mask = parent(cv::Rect(2, 1, size.width, size.height));  // A strided view.
+    cv::Mat noise(size, CV_32F);
+    rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+    const double density = trial % 3 == 0 ? 0.0 : trial % 3 == 1 ? 0.05 : 0.5;
+    cv::Mat(noise < density).copyTo(mask);
+    NonZeroPoints(mask, points);
+    cv::findNonZero(mask, expected);
+    EXPECT_EQ(points, expected) << size << " density " << density;
+  }
+}
+
 TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
   cv::RNG rng(5);
   RunLabeller labeller;

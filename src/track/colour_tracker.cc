@@ -346,6 +346,8 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
   }
   acquire_roi_ = params_.roi;
+  opencv_in_windows_ = gray_ || params_.filter != ColourParams::Filter::kNone ||
+                       (!kernel_.empty() && !morph_cross_ && !morph_square_);
 }
 
 void ColourTracker::check_frame(const cv::Mat& frame) const {
@@ -865,7 +867,15 @@ void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
   }
   // A window is a few thousand pixels: handing its pieces to OpenCV's thread pool (TBB) costs
   // more than the work (connected components alone doubles). Run the window as one OpenCV
-  // parallel region of a single task: OpenCV executes parallel loops nested in it inline.
+  // parallel region of a single task: OpenCV executes parallel loops nested in it inline. Only
+  // OpenCV's own filters, conversions and morphology parallelise; without them (the default
+  // pipeline: our kernels alone) the window runs directly, since the region itself costs a few
+  // allocations and microseconds per window, and a re-acquisition analyses dozens.
+  const bool opencv_parallel = opencv_in_windows_ || frame.channels() != (gray_ ? 1 : 3);
+  if (!opencv_parallel) {
+    analyse_region(frame, region, blobs);
+    return;
+  }
   cv::parallel_for_(cv::Range(0, 1),
                     [&](const cv::Range&) { analyse_region(frame, region, blobs); });
 }
@@ -1177,16 +1187,22 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
   cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
   // The pixel cv::resize's INTER_NEAREST_EXACT takes, (i + 1/2) * factor, copied directly.
   const int channels = src.channels(), half = factor / 2;
+  const size_t row_bytes = static_cast<size_t>(src.cols) * channels;
   for (int y = 0; y < coarse_rows; ++y) {
+    // The next sampled row is asked for while this one is copied: every factor-th row of a frame
+    // not yet in the cache is a pattern the hardware prefetcher does not follow, and the copy
+    // waited on every line.
+    if (y + 1 < coarse_rows) {
+      const uchar* ahead = src.ptr<uchar>((y + 1) * factor + half);
+      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
+    }
     const uchar* in = src.ptr<uchar>(y * factor + half) + half * channels;
     uchar* out = sampled.ptr<uchar>(y);
     const int step = factor * channels;
     if (channels == 3) {
-      for (int x = 0; x < coarse_cols; ++x, in += step, out += 3) {
-        out[0] = in[0];
-        out[1] = in[1];
-        out[2] = in[2];
-      }
+      // Pixel by pixel as one copy: byte by byte, GCC built vectors from the bytes through the
+      // stack, a stall per 16 bytes that cost as much as classifying them.
+      for (int x = 0; x < coarse_cols; ++x, in += step, out += 3) std::memcpy(out, in, 3);
     } else {
       for (int x = 0; x < coarse_cols; ++x, in += step) out[x] = in[0];
     }
@@ -1197,7 +1213,7 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
   // Group the candidate cells by tiles of kTile x kTile cells, 8-connected tiles together:
   // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
   windows_.clear();
-  cv::findNonZero(mask, points_);
+  NonZeroPoints(mask, points_);
   // A blob that can be the marker has radius >= factor (as acquire_downsample chooses it), so it
   // holds at least two 8-adjacent sample points: a lone lit sample is a speck of background texture.
   if (min_blob_radius_px() >= factor) {

@@ -150,6 +150,9 @@ class ColourTracker : public Tracker {
   int margin_px_ = 0;       // Filter radius + 4 morphology radii (+1).
   HsvClassifier fine_hsv_, coarse_hsv_;  // The marker test, and the lenient coarse one.
   bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
+  // A window's analysis calls OpenCV functions that may parallelise (gray inRange, a pre-filter,
+  // morphology other than 3x3), besides a colour conversion of a frame of the other kind.
+  bool opencv_in_windows_ = false;
   std::optional<HsvRange> gray_, coarse_gray_;  // Gray-level mode (`gray`, or a nominal gray).
   std::optional<cv::Vec3d> nominal_;          // auto_bgr: the colour model until one is learned.
 

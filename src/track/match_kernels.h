@@ -17,8 +17,8 @@
 //
 // Why not cv::matchTemplate everywhere: it computes in float (SSD not exact; ZNCC off by ~1e-4
 // and unstable on near-flat windows). Measured (template_matching_benchmark, 32x32 template): on
-// the tracker's 48x48 window these kernels are faster (SSD 24 vs 33 us, ZNCC 22 vs 35 us); on a
-// whole VGA frame OpenCV's DFT-based matchTemplate is 3x faster (SSD 7.0 vs 23 ms). The tracker
+// the tracker's 48x48 window these kernels are faster (SSD 13 vs 31 us, ZNCC 12 vs 30 us); on a
+// whole VGA frame OpenCV's DFT-based matchTemplate is faster (SSD 7.3 vs 10.2 ms). The tracker
 // only meets large regions at coarse pyramid levels, so it uses these exact kernels throughout,
 // which also makes windowed and whole-frame results bit-identical.
 #pragma once
@@ -80,20 +80,35 @@ class PreparedTemplate {
   std::vector<uint8_t> bytes_;  // [row][chunk] 16 bytes: template values, masked bytes zero.
   std::vector<uint8_t> mask_;   // [row][chunk] 16 bytes: 0xFF where the byte counts.
   std::vector<int16_t> words_;  // [row][chunk] 16 values: the bytes widened to 16 bits.
-  // Masked templates only: [row][chunk] 16 values, -1 where the byte counts (an AND mask), and
-  // per channel c, [c][row][chunk] 16 values, 1 where the byte counts and is of channel c.
-  std::vector<int16_t> mask_words_;
-  std::vector<int16_t> channel_words_;
+  std::vector<int> lane_bytes_;  // Preparation's scratch: the row byte each lane of a row reads.
+  // The counted pixels of row r are the runs [run_rows_[r], run_rows_[r + 1]) of runs_, each the
+  // pixel columns [begin, end) (unmasked: the whole row). Masked ZNCC and SSD take the window
+  // sums over them from row prefix sums, two look-ups per run (a round mask has one run a row).
+  struct Run {
+    int begin, end;
+  };
+  std::vector<int> run_rows_;
+  std::vector<Run> runs_;
 };
 
 // Fast kernels. `image` has the template's type and is at least as large. `result` is
 // (re)allocated only when its size or type changes, so a tracker reusing it allocates nothing.
 void MatchSad(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
-void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
-// Scratch buffers for ZNCC (window sums via integral images, and the cross-correlation map).
+// Scratch buffers for ZNCC and SSD: the window sums (integral images for unmasked ZNCC; else row
+// prefix sums and one map row of sums over the counted pixels) and the cross-correlation map,
+// which both are built on. Vectors keep their capacity when a tracker matches windows of
+// changing sizes, so its matching allocates nothing from frame to frame.
 struct ZnccScratch {
   cv::Mat sum, sum_sq, cross;
+  std::vector<uint32_t> prefix_sum, row_sum;
+  std::vector<int> cross_values;
+  std::vector<int16_t> widened;  // The image widened to 16 bits for the cross-correlation.
 };
+// SSD = sum I^2 - 2 sum I*T + sum T^2, from the window sums and the cross-correlation (exact).
+// Without `scratch`, its buffers are allocated for the call.
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
+              ZnccScratch& scratch);
+void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
 // sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC is built on.

@@ -98,6 +98,76 @@ TEST(MatchKernelsTest, RandomImagesMatchReferencesExactlyOrWithin1e4) {
   }
 }
 
+// The ellipse inscribed in a template of `size`, as the tracker's round mask: one run of pixels
+// per row, the masked ZNCC's common case.
+cv::Mat EllipseMask(cv::Size size) {
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
+  const double cx = (size.width - 1) / 2.0, cy = (size.height - 1) / 2.0;
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const double u = (x - cx) / (size.width / 2.0), v = (y - cy) / (size.height / 2.0);
+      if (u * u + v * v <= 1.0) mask.at<uint8_t>(y, x) = 255;
+    }
+  }
+  return mask;
+}
+
+TEST(MatchKernelsTest, MaskedZnccMatchesReferenceForRoundMasksEmptyRowsAndOnePlacement) {
+  // Masks of one run per row, with rows that count nothing, and images of the template's size
+  // (one placement: the tracker's drift check); one scratch reused over sizes that shrink and
+  // grow, as a tracker reuses it.
+  cv::RNG rng(20261202);
+  PreparedTemplate prepared;
+  ZnccScratch scratch;
+  cv::Mat fast, reference;
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(Name(c));
+    const cv::Mat templ = RandomImage(rng, {c.width, c.height}, c.channels);
+    cv::Mat round = EllipseMask(templ.size());
+    cv::Mat holed = round.clone();
+    holed.row(c.height / 2).setTo(0);  // A row without runs.
+    if (c.width > 2) holed.at<uint8_t>(0, c.width / 2) = 0;
+    for (const cv::Mat& mask : {round, holed}) {
+      if (cv::countNonZero(mask) == static_cast<int>(mask.total())) continue;  // Unmasked.
+      if (!prepared.Prepare(templ, mask)) continue;  // Flat under this mask.
+      ASSERT_TRUE(prepared.masked());
+      for (const cv::Size& extra : {cv::Size(0, 0), cv::Size(17, 12), cv::Size(3, 0)}) {
+        SCOPED_TRACE(std::to_string(extra.width) + "+" + std::to_string(extra.height));
+        const cv::Mat image =
+            RandomImage(rng, {c.width + extra.width, c.height + extra.height}, c.channels);
+        MatchZncc(image, prepared, fast, scratch);
+        MatchZnccReference(image, templ, reference, mask);
+        int nan_mismatch = 0;
+        EXPECT_LE(MaxZnccError(fast, reference, &nan_mismatch), 1e-4);
+        EXPECT_EQ(nan_mismatch, 0);
+      }
+    }
+  }
+}
+
+TEST(MatchKernelsTest, MaskedZnccExactOnImagesWhoseRowSumsExceed32Bits) {
+  // The masked window sums come from row prefix sums that wrap around on a wide bright image;
+  // their differences must not.
+  cv::RNG rng(17);
+  cv::Mat image(4, 23000, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::Mat noise = RandomImage(rng, {200, 4}, 3);
+  noise.copyTo(image(cv::Rect(22800, 0, 200, 4)));
+  const cv::Mat templ = noise(cv::Rect(150, 0, 5, 4)).clone();
+  const cv::Mat mask = EllipseMask(templ.size());
+  PreparedTemplate prepared;
+  ASSERT_TRUE(prepared.Prepare(templ, mask));
+  ZnccScratch scratch;
+  cv::Mat fast, reference;
+  const cv::Rect tail(22700, 0, 300, 4);
+  MatchZncc(image, prepared, fast, scratch);
+  MatchZnccReference(image(tail), templ, reference, mask);
+  int nan_mismatch = 0;
+  EXPECT_LE(MaxZnccError(fast(cv::Rect(22700, 0, reference.cols, 1)), reference, &nan_mismatch),
+            1e-4);
+  EXPECT_EQ(nan_mismatch, 0);
+  EXPECT_NEAR(fast.at<float>(0, 22950), 1.0f, 1e-6);  // Where the template was cut.
+}
+
 TEST(MatchKernelsTest, MaskedPixelsDoNotMatter) {
   // Changing the image under masked-out template pixels changes no score.
   cv::RNG rng(99);

@@ -122,8 +122,9 @@ BENCHMARK(BM_SadPlainScalar)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicroseco
 void BM_SsdVector(benchmark::State& state) {
   KernelInput in(SizeOf(state));
   cv::Mat result;
+  ZnccScratch scratch;
   for (auto _ : state) {
-    MatchSsd(in.image, in.prepared, result);
+    MatchSsd(in.image, in.prepared, result, scratch);
     benchmark::DoNotOptimize(result.data);
   }
 }

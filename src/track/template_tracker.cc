@@ -148,12 +148,12 @@ cv::Mat RoundMask(const cv::Size& size) {
   return mask;
 }
 
-// ZNCC of `templ` placed at `top_left` of `image` (scalar reference: one placement).
+// ZNCC of `templ` placed at `top_left` of `image` (one placement, by the vector kernel: the
+// scalar reference here was a tenth of the tracker's time).
 double ZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
-              cv::Mat& scratch) {
-  MatchZnccReference(image(cv::Rect(top_left, templ.size())), templ.image(), scratch,
-                     templ.mask());
-  return scratch.at<float>(0, 0);  // NaN on a flat window: fails every comparison.
+              cv::Mat& result, ZnccScratch& scratch) {
+  MatchZncc(image(cv::Rect(top_left, templ.size())), templ, result, scratch);
+  return result.at<float>(0, 0);  // NaN on a flat window: fails every comparison.
 }
 
 // The point about which `templ` is most nearly point-symmetric, in template coordinates: the
@@ -416,6 +416,8 @@ class TemplateTracker final : public Tracker {
     return adapts() ? working_ : rungs_[rung_].templ;
   }
   void ToNative(const cv::Mat& frame, cv::Mat& out) const;
+  void ConvertAround(const cv::Mat& frame, const cv::Rect& rect);
+  void Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat& out);
   // The one channel the blob is measured in: native gray, or colour projected on its axis.
   void BlobChannel(const cv::Mat& native, cv::Mat& out) const {
     if (native.channels() == 1) {
@@ -474,7 +476,12 @@ class TemplateTracker final : public Tracker {
   bool scan_pending_ = false;           // Scan for look-alikes at the first match after a hint.
 
   // Buffers reused from frame to frame.
-  cv::Mat region_, fine_, raw_, sim_, fine_sim_, patch_, resized_, candidate_, shape_;
+  cv::Mat region_, fine_, raw_, sim_, fine_sim_, rung_sim_, patch_, resized_, candidate_, shape_;
+  // The frame around the marker in the matched channel(s), converted once per update: the
+  // search, the measurement, the scale search and the template update each look at a window of
+  // it (they overlap; converting each on its own was a seventh of the tracker's time).
+  cv::Mat native_;
+  cv::Rect native_rect_;  // Where native_ lies in the frame; empty when not converted.
   std::vector<cv::Mat> levels_;
   std::vector<cv::Point> candidates_;
   cv::Mat level_sim_;
@@ -486,6 +493,26 @@ class TemplateTracker final : public Tracker {
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;
 };
+
+// Converts the part `rect` of the frame (clipped to it) for the windows of this update.
+void TemplateTracker::ConvertAround(const cv::Mat& frame, const cv::Rect& rect) {
+  native_rect_ = rect & cv::Rect(0, 0, frame.cols, frame.rows);
+  if (native_rect_.empty()) return;
+  ToNative(frame(native_rect_), native_);
+}
+
+// The window `rect` of the frame in the matched channel(s): a view of the part converted this
+// update when it covers the window (the conversion is per pixel, so the values are the same),
+// else converted on its own.
+void TemplateTracker::Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat& out) {
+  if (!native_rect_.empty() && (rect & native_rect_) == rect) {
+    out = native_(rect - native_rect_.tl());
+    return;
+  }
+  // `out` may still be a view of native_: converting into it would overwrite that.
+  if (!out.empty() && out.datastart == native_.datastart) out.release();
+  ToNative(frame(rect), out);
+}
 
 void TemplateTracker::ToNative(const cv::Mat& frame, cv::Mat& out) const {
   if (frame.channels() == 1) {
@@ -697,7 +724,7 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
                                                    : std::max(frame.cols, frame.rows);
   const cv::Rect region = WindowAround(centre_px, size, radius) & cv::Rect(0, 0, frame.cols, frame.rows);
   if (region.width < size.width || region.height < size.height) return;
-  ToNative(frame(region), region_);
+  Native(frame, region, region_);
   MatchZncc(region_, templ, sim_, zncc_);
   const cv::Point2d own = centre_px - HalfSize(size) - cv::Point2d(region.tl());
   const int distinct = std::max(2, std::min(size.width, size.height) / 2);
@@ -730,7 +757,7 @@ void TemplateTracker::Similarity(const cv::Mat& image, const PreparedTemplate& t
       raw_.convertTo(sim, CV_32F, -per_value);  // Minus the mean absolute difference.
       break;
     case MatchMeasure::kSsd:
-      MatchSsd(image, templ, raw_);
+      MatchSsd(image, templ, raw_, zncc_);
       raw_.convertTo(sim, CV_32F, -per_value);  // Minus the mean squared difference.
       break;
     case MatchMeasure::kZncc: MatchZncc(image, templ, sim, zncc_); break;
@@ -769,7 +796,7 @@ std::optional<Hit> TemplateTracker::Search(const cv::Mat& frame, cv::Rect region
   const cv::Size size = templ.size();
   region &= cv::Rect(0, 0, frame.cols, frame.rows);
   if (region.width < size.width || region.height < size.height) return std::nullopt;
-  ToNative(frame(region), region_);
+  Native(frame, region, region_);
   Similarity(region_, templ, sim_);
   cv::Point best;
   if (!BestIn(sim_, &best)) return std::nullopt;
@@ -780,12 +807,14 @@ std::optional<Hit> TemplateTracker::Search(const cv::Mat& frame, cv::Rect region
   m.score = ScoreOf(m.similarity);
   // SAD and SSD alone accept any patch whose grey levels are close enough, e.g. a smooth
   // background patch once the light has changed: one ZNCC at the best placement checks shape.
-  m.zncc = params_.measure == MatchMeasure::kZncc ? m.score : ZnccAt(region_, best, templ, shape_);
+  m.zncc = params_.measure == MatchMeasure::kZncc ? m.score
+                                                  : ZnccAt(region_, best, templ, shape_, zncc_);
   cv::Point rival;
   if (find_rival && params_.ambiguity_margin > 0 &&
       RivalIn(sim_, best, std::max(2, std::min(size.width, size.height) / 2), &rival)) {
-    m.rival_zncc = params_.measure == MatchMeasure::kZncc ? sim_.at<float>(rival)
-                                                          : ZnccAt(region_, rival, templ, shape_);
+    m.rival_zncc = params_.measure == MatchMeasure::kZncc
+                       ? sim_.at<float>(rival)
+                       : ZnccAt(region_, rival, templ, shape_, zncc_);
   }
   m.on_inner_edge =
       (best.x == 0 && region.x > 0) || (best.x == sim_.cols - 1 && region.br().x < frame.cols) ||
@@ -924,7 +953,7 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   const cv::Rect window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
   if (window.width < size.width || window.height < size.height) return std::nullopt;
-  ToNative(frame(window), fine_);
+  Native(frame, window, fine_);
   Similarity(fine_, rung.templ, fine_sim_);
   cv::Point best;
   if (!BestIn(fine_sim_, &best)) return std::nullopt;
@@ -954,8 +983,9 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
     for (int c = 0; c < cn; ++c) mean += per_channel[c] / cn;
     fix.score = params_.measure == MatchMeasure::kSsd ? std::sqrt(mean) : mean;
   }
-  fix.zncc = params_.measure == MatchMeasure::kZncc ? fine_sim_.at<float>(best)
-                                                    : ZnccAt(fine_, best, rung.templ, shape_);
+  fix.zncc = params_.measure == MatchMeasure::kZncc
+                 ? fine_sim_.at<float>(best)
+                 : ZnccAt(fine_, best, rung.templ, shape_, zncc_);
   return fix;
 }
 
@@ -967,10 +997,10 @@ double TemplateTracker::RungZncc(const cv::Mat& frame, int index, const cv::Poin
   const cv::Size size = rung->templ.size();
   const cv::Rect window = WindowAround(centre_px, size, 1);
   if ((window & cv::Rect(0, 0, frame.cols, frame.rows)) != window) return kNoRival;
-  ToNative(frame(window), fine_);
-  MatchZncc(fine_, rung->templ, fine_sim_, zncc_);
+  Native(frame, window, fine_);
+  MatchZncc(fine_, rung->templ, rung_sim_, zncc_);
   cv::Point best;
-  return BestIn(fine_sim_, &best) ? fine_sim_.at<float>(best) : kNoRival;
+  return BestIn(rung_sim_, &best) ? rung_sim_.at<float>(best) : kNoRival;
 }
 
 // Scale search: the neighbouring rungs of the ladder against the current one, at the match.
@@ -992,7 +1022,7 @@ cv::Point2d TemplateTracker::Recentre(const cv::Mat& frame, const Fix& fix) {
   const cv::Size size = rung.templ.size();
   const cv::Rect at = WindowAround(fix.centre, size, 0);
   if ((at & cv::Rect(0, 0, frame.cols, frame.rows)) != at) return fix.reported;
-  ToNative(frame(at), blob_native_);
+  Native(frame, at, blob_native_);
   BlobChannel(blob_native_, blob_gray_);
   cv::Point2d centroid;
   double area = 0;
@@ -1008,7 +1038,7 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
   const cv::Size size = rung.templ.size();
   const cv::Rect around = WindowAround(centre_px, size, 2);
   if ((around & cv::Rect(0, 0, frame.cols, frame.rows)) != around) return;
-  ToNative(frame(around), region_);
+  Native(frame, around, region_);
   // getRectSubPix centres the patch on its geometric centre, which centre_px is.
   cv::getRectSubPix(region_, size, centre_px - cv::Point2d(around.tl()), patch_, CV_32F);
   if (working_f_.size() != size) {
@@ -1021,10 +1051,7 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
                   working_f_);
   working_f_.convertTo(candidate_, CV_8U);
   // Drift guard: the updated template must still resemble the first at this scale.
-  const float similarity = [&] {
-    MatchZnccReference(candidate_, rung.templ.image(), shape_, rung.templ.mask());
-    return shape_.at<float>(0, 0);
-  }();
+  const double similarity = ZnccAt(candidate_, {0, 0}, rung.templ, shape_, zncc_);
   if (!(similarity >= params_.drift_min_zncc) || !working_.Prepare(candidate_, working_mask_)) {
     RestoreWorkingTemplate();  // Drifted: back to the first template at this scale.
     return;
@@ -1036,11 +1063,20 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   CV_Assert(frame_bgr.type() == CV_8UC3 || frame_bgr.type() == CV_8UC1);
   if (rungs_.empty()) return Observation::NotFound(MarkerStatus::kNotStarted);  // No template.
   const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
+  native_rect_ = cv::Rect();  // A new frame: nothing converted yet.
   std::optional<Hit> hit;
   if (tracking_) {
     const cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
                                          params_.search_margin_px);
     if ((window & frame_rect).empty()) return Lose(MarkerStatus::kOutOfFrame);
+    // The window and a little around it: the later windows (the measurement, kFineMarginPx
+    // around the match; the neighbouring rungs of the scale search; the template update's
+    // patch) lie in it while the marker is found near where it was predicted, which is most
+    // frames; one that does not is converted on its own. (Converting all of them, kFineMarginPx
+    // and more around the whole window, cost more than the few it saves.)
+    constexpr int kAroundPx = 2;
+    ConvertAround(frame_bgr, cv::Rect(window.x - kAroundPx, window.y - kAroundPx,
+                                      window.width + 2 * kAroundPx, window.height + 2 * kAroundPx));
     hit = Search(frame_bgr, window, search_template(), true);
     if (hit && hit->on_inner_edge) hit.reset();  // Moving faster than the window: acquire.
   }
