@@ -81,6 +81,10 @@ constexpr double kPartialMinPx = 1.0;
 // A marker partly seen where it should be is held there (its window searched, nothing else) for
 // at most this many frames: a second at 30 fps, long enough for a hand or a tool to pass.
 constexpr int kHoldCoveredFrames = 30;
+// A lone candidate within this of where a candidate tied before (in a first acquisition without
+// a model or roi) has not moved since: it is that candidate (sensor noise moves a static blob's
+// centroid by hundredths of a pixel).
+constexpr double kRivalStillPx = 0.5;
 
 // A marker lost this many frames in a row, with exactly one candidate near where it was last
 // seen that fits it in everything but brightness (same chroma, size, shape, contrast), is taken
@@ -743,15 +747,51 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   // a whole-frame first acquisition needs the one candidate that fits at all.
   const double margin = !model_ && !acquire_roi_ ? std::numeric_limits<double>::infinity()
                                                  : params_.ambiguity_margin;
+  const bool by_uniqueness = !model_ && !acquire_roi_;
   if (std::isfinite(second_cost) && second_cost - best_cost < margin) {
     choice.status = MarkerStatus::kAmbiguous;
+    if (by_uniqueness) rivals_.clear();
     for (size_t i = 0; i < candidates_.size(); ++i) {
-      if (candidates_[i].verdict != CandidateVerdict::kFits) continue;
+      const bool partial = candidates_[i].verdict == CandidateVerdict::kPartial &&
+                           std::isfinite(candidates_[i].misfit);
+      if (candidates_[i].verdict != CandidateVerdict::kFits && !partial) continue;
       double cost = candidates_[i].misfit;
       if (last_px_) cost += cv::norm(blobs_[i].centroid_px - *last_px_) / diagonal;
-      if (cost - best_cost < margin) ++choice.tied;
+      if (!partial && cost - best_cost < margin) ++choice.tied;
+      if (by_uniqueness) {
+        // A partial rival too: the marker leaving the frame is one.
+        rivals_.push_back({blobs_[i].centroid_px, std::sqrt(blobs_[i].area_px / CV_PI)});
+      }
     }
     return choice;
+  }
+  if (by_uniqueness && !rivals_.empty()) {
+    // The one candidate left may be one of those that were tied before, still exactly in its
+    // place (a look-alike of the background does not move; a marker on a bending body does).
+    // If another of them is still there (a blob in its place that no longer fits: the checks told
+    // them apart), the candidate is the marker. If another has vanished, it may have been the
+    // marker (gone, or covered) and the one left a look-alike: as ambiguous as before. A
+    // candidate that has moved, or is in none of their places, is the marker.
+    const ColourBlob& only = blobs_[best];
+    const auto at = [](const cv::Point2d& p, const Rival& rival) {
+      return cv::norm(p - rival.position_px) <= rival.radius_px + 2.0;
+    };
+    bool was_a_rival = false, a_rival_vanished = false;
+    for (const Rival& rival : rivals_) {
+      if (cv::norm(only.centroid_px - rival.position_px) <= kRivalStillPx) {
+        was_a_rival = true;
+        continue;
+      }
+      bool still_there = false;
+      for (const ColourBlob& b : blobs_) still_there = still_there || at(b.centroid_px, rival);
+      a_rival_vanished = a_rival_vanished || !still_there;
+    }
+    if (was_a_rival && a_rival_vanished) {
+      choice.status = MarkerStatus::kAmbiguous;
+      choice.tied = 2;
+      return choice;
+    }
+    rivals_.clear();
   }
   candidates_[best].verdict = CandidateVerdict::kChosen;
   choice.blob = blobs_[best];

@@ -159,6 +159,13 @@ class ColourTracker : public Tracker {
   // The marker, learned at acquisition.
   std::optional<ColourModel> model_;
   std::optional<cv::Rect> acquire_roi_;       // Restricts acquisitions until the first success.
+  // The candidates that were tied when a first acquisition by uniqueness (no model, no roi) last
+  // found several: a later lone candidate in one of their places is one of them still.
+  struct Rival {
+    cv::Point2d position_px;
+    double radius_px = 0;
+  };
+  std::vector<Rival> rivals_;
   std::vector<MarkerCandidate> candidates_;   // Of the last search.
 
   // Motion.

@@ -339,6 +339,31 @@ TEST(ColourTracker, ConstantVelocityKeepsAFastMarkerInTheSmallWindow) {
   }
 }
 
+// Without a roi or a learned model, two discs of the marker's colour are ambiguous; when one of
+// them goes, the one left in its place is still one of the two (a look-alike of the background
+// when the actuator has left): ambiguous, never found. A lone disc elsewhere is the marker.
+TEST(ColourTracker, ALookAlikeLeftAloneInItsPlaceIsStillAmbiguous) {
+  ColourTracker tracker(RedParams());
+  const cv::Point2d marker(80.5, 120.5), look_alike(240.5, 60.5);
+  cv::Mat both = Background();
+  PaintDisc(both, marker, 9, kRed);
+  PaintDisc(both, look_alike, 9, kRed);
+  EXPECT_EQ(tracker.update(both).status(), MarkerStatus::kAmbiguous);
+  cv::Mat left = Background();
+  PaintDisc(left, look_alike, 9, kRed);  // The marker has gone.
+  for (int i = 0; i < 5; ++i) {
+    const Observation obs = tracker.update(left);
+    EXPECT_FALSE(obs.found()) << i;
+    EXPECT_EQ(obs.status(), MarkerStatus::kAmbiguous) << i;
+  }
+  cv::Mat moved = Background();
+  const cv::Point2d elsewhere(160.5, 180.5);
+  PaintDisc(moved, elsewhere, 9, kRed);  // One disc, in neither place.
+  const Observation obs = tracker.update(moved);
+  ASSERT_TRUE(obs.found());
+  EXPECT_LT(cv::norm(*obs.position_px - elsewhere), 0.01);
+}
+
 TEST(ColourTracker, MarkerLeavingThroughTheFrameEdge) {
   // Filter and morphology near the frame's edge: the window, the whole-frame search and the
   // full-resolution search must agree exactly. A marker that touches the frame's edge is partly
