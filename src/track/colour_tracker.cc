@@ -78,6 +78,8 @@ constexpr double kAdaptMaxRange = 4.0;
 // a twentieth covered by 0.05; 1 px keeps the pixel grid's own wobble of small markers out.
 constexpr double kPartialRadii = 0.1;
 constexpr double kPartialMinPx = 1.0;
+// A blob with less than this fraction of the learned area is partial too (see judge()).
+constexpr double kWholeAreaFraction = 0.55;
 // A marker partly seen where it should be is held there (its window searched, nothing else) for
 // at most this many frames: a second at 30 fps, long enough for a hand or a tool to pass.
 constexpr int kHoldCoveredFrames = 30;
@@ -578,6 +580,10 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
       size = std::log(ratio) / std::log(params_.max_area_factor);
     }
     misfit += size;
+    // Little more than half its learned area at once (the area follows slow changes only): a
+    // disc cut beyond its centre, whose centroid is more than 0.4 radii off. The asymmetry cannot
+    // tell: the smallest circle around less than half a disc is no longer the disc's.
+    partial = partial || ratio < kWholeAreaFraction;
   }
   // Contrast to its own surroundings.
   if (!(b.contrast >= kMinContrast)) return {CandidateVerdict::kContrast, kInf};
