@@ -69,6 +69,20 @@ class LiveControllerTest : public ::testing::Test {
     live.on_event(UiEvent::Mouse(Type::kMouseUp, to.x, to.y));
   }
 
+  // Feeds frames 0..3, switching every marker to SAD after frame 2, and clicks blue on frame 3:
+  // the ranges picked, kept for blue's colour method.
+  std::array<int, 6> PickBlueWhileMatchingSad(LiveController& live) {
+    for (int i = 0; i < 3; ++i) Feed(live, i);
+    live.on_event(UiEvent::Key('m'));  // colour -> sad
+    const SceneTruth truth = Feed(live, 3);
+    live.on_event(UiEvent::Key('2'));
+    Click(live, *truth.markers[1].centroid_px);
+    return live.active_hsv();
+  }
+  static std::array<int, 6> RangesOf(const ColourParams& c) {
+    return {c.h.lo, c.h.hi, c.s.lo, c.s.hi, c.v.lo, c.v.hi};
+  }
+
   LiveOptions Options() const {
     LiveOptions options;
     options.record_prefix = (dir_ / "rec").string();
@@ -258,25 +272,18 @@ TEST_F(LiveControllerTest, SwitchingMethodKeepsTrackingWithTemplatesCutWhereMark
 // every method comes back to it.
 TEST_F(LiveControllerTest, SwitchingBackToColourRestoresTheRangesPickedWhileMatchingTemplates) {
   LiveController live(SceneConfig(), Options());
-  SceneTruth truth;
-  for (int i = 0; i < 3; ++i) truth = Feed(live, i);
-  live.on_event(UiEvent::Key('m'));  // colour -> sad
-  truth = Feed(live, 3);
-  live.on_event(UiEvent::Key('2'));
-  Click(live, *truth.markers[1].centroid_px);
+  const std::array<int, 6> picked = PickBlueWhileMatchingSad(live);
   EXPECT_EQ(TrackerMethodName(live.config().markers[1].params), "sad") << "the template stays";
   EXPECT_NE(live.message().find("(used by the colour method)"), std::string::npos)
       << live.message();
-  const std::array<int, 6> picked = live.active_hsv();
   EXPECT_NE(picked, (std::array<int, 6>{95, 125, 80, 255, 40, 255})) << "the pick's own ranges";
   for (int k = 0; k < 3; ++k) live.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
   ASSERT_EQ(TrackerMethodName(live.config().markers[1].params), "colour");
-  const ColourParams& blue = std::get<ColourParams>(live.config().markers[1].params);
-  EXPECT_EQ((std::array<int, 6>{blue.h.lo, blue.h.hi, blue.s.lo, blue.s.hi, blue.v.lo, blue.v.hi}),
-            picked);
+  EXPECT_EQ(RangesOf(std::get<ColourParams>(live.config().markers[1].params)), picked);
   const ColourParams& red = std::get<ColourParams>(live.config().markers[0].params);
   EXPECT_EQ(red.h.lo, 170);  // Not picked: the config's ranges.
   EXPECT_EQ(red.h.hi, 10);
+  SceneTruth truth;
   for (int i = 4; i < 8; ++i) truth = Feed(live, i);
   for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 0.5);
 }
@@ -287,23 +294,14 @@ TEST_F(LiveControllerTest, RangesPickedWhileMatchingTemplatesAreSavedAndComeBack
   std::array<int, 6> picked{};
   {
     LiveController live(SceneConfig(), Options());
-    SceneTruth truth;
-    for (int i = 0; i < 3; ++i) truth = Feed(live, i);
-    live.on_event(UiEvent::Key('m'));  // colour -> sad
-    truth = Feed(live, 3);
-    live.on_event(UiEvent::Key('2'));
-    Click(live, *truth.markers[1].centroid_px);
-    picked = live.active_hsv();
+    picked = PickBlueWhileMatchingSad(live);
     ASSERT_NE(picked, (std::array<int, 6>{95, 125, 80, 255, 40, 255})) << "the pick's own ranges";
     live.on_event(UiEvent::Key('s'));
   }
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
   ASSERT_EQ(TrackerMethodName(saved.markers[1].params), "sad");
   ASSERT_EQ(saved.colour_aside.count("blue"), 1u);
-  const ColourParams& aside = saved.colour_aside.at("blue");
-  EXPECT_EQ((std::array<int, 6>{aside.h.lo, aside.h.hi, aside.s.lo, aside.s.hi, aside.v.lo,
-                                aside.v.hi}),
-            picked);
+  EXPECT_EQ(RangesOf(saved.colour_aside.at("blue")), picked);
   // The same file with --method colour tracks blue with the picked ranges.
   const TrackingConfig as_colour = LoadTrackingConfig((dir_ / "saved.yaml").string(), "colour");
   EXPECT_EQ(std::get<ColourParams>(as_colour.markers[1].params).h.lo, picked[0]);
@@ -315,9 +313,7 @@ TEST_F(LiveControllerTest, RangesPickedWhileMatchingTemplatesAreSavedAndComeBack
   EXPECT_EQ(again.active_hsv(), picked) << "the trackbars show the saved colour ranges";
   for (int k = 0; k < 3; ++k) again.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
   ASSERT_EQ(TrackerMethodName(again.config().markers[1].params), "colour");
-  const ColourParams& blue = std::get<ColourParams>(again.config().markers[1].params);
-  EXPECT_EQ((std::array<int, 6>{blue.h.lo, blue.h.hi, blue.s.lo, blue.s.hi, blue.v.lo, blue.v.hi}),
-            picked);
+  EXPECT_EQ(RangesOf(std::get<ColourParams>(again.config().markers[1].params)), picked);
   for (int i = 6; i < 9; ++i) truth = Feed(again, i);
   ExpectAt(again, 1, truth, 0.5);
 }
