@@ -5,12 +5,11 @@
 
 namespace softsight {
 
-AsyncFrameWriter::AsyncFrameWriter(FrameWriterOptions options, WhenEncoderBehind policy,
-                                   size_t capacity, std::function<void(int64_t)> before_encode)
+AsyncFrameWriter::AsyncFrameWriter(FrameWriterOptions options, size_t capacity,
+                                   std::function<void(int64_t)> before_encode)
     : writer_(std::move(options)),
       path_(writer_.path()),
       format_(writer_.format()),
-      policy_(policy),
       before_encode_(std::move(before_encode)),
       ring_(std::max<size_t>(capacity, 1)) {
   thread_ = std::thread([this] { encode_loop(); });
@@ -56,10 +55,6 @@ void AsyncFrameWriter::encode_loop() {
 cv::Mat* AsyncFrameWriter::acquire() {
   std::unique_lock<std::mutex> lock(mutex_);
   if (count_ == ring_.size() && !error_) {
-    if (policy_ == WhenEncoderBehind::kDrop) {
-      ++dropped_;
-      return nullptr;
-    }
     ++waited_;
     freed_cv_.wait(lock, [this] { return count_ < ring_.size() || done_; });
   }

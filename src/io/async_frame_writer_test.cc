@@ -44,17 +44,16 @@ TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExac
   TempDir dir;
   const std::string path = dir.file("rec.avi");
   {
-    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kWait, /*capacity=*/2);
+    AsyncFrameWriter writer({path, "hfyu", 30.0}, /*capacity=*/2);
     EXPECT_EQ(writer.format(), "HuffYUV video (lossless)");
     for (int i = 0; i < 40; ++i) {
       cv::Mat* slot = writer.acquire();
-      ASSERT_NE(slot, nullptr) << "kWait never drops";
+      ASSERT_NE(slot, nullptr) << "never dropped";
       NumberedFrame(i).copyTo(*slot);
       writer.commit(i);
     }
     writer.close();
     EXPECT_EQ(writer.queued(), 40);
-    EXPECT_EQ(writer.dropped(), 0);
   }
   const std::vector<Frame> frames = ReadBack(path);
   ASSERT_EQ(frames.size(), 40u);
@@ -69,14 +68,14 @@ TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLose
   const std::string path = dir.file("rec.avi");
   testing::EncoderGate gate;  // Holds frame 0.
   {
-    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kWait, /*capacity=*/2,
+    AsyncFrameWriter writer({path, "hfyu", 30.0}, /*capacity=*/2,
                             [&gate](int64_t index) { gate.wait(index); });
     // Frame 0 is held at the encoder and frame 1 waits behind it: the producer's frame 2 waits
     // for a free buffer until the encoder goes on.
     std::thread producer([&writer] {
       for (int i = 0; i < 5; ++i) {
         cv::Mat* slot = writer.acquire();
-        ASSERT_NE(slot, nullptr) << "kWait never drops";
+        ASSERT_NE(slot, nullptr) << "never dropped";
         NumberedFrame(i).copyTo(*slot);
         writer.commit(i);
       }
@@ -87,7 +86,6 @@ TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLose
     producer.join();
     writer.close();
     EXPECT_EQ(writer.queued(), 5);
-    EXPECT_EQ(writer.dropped(), 0);
     EXPECT_GE(writer.waited(), 1);
     EXPECT_LE(writer.waited(), 3) << "only frames 2..4 can find the queue full";
   }
@@ -96,35 +94,6 @@ TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLose
   for (int i = 0; i < 5; ++i) {
     EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
   }
-}
-
-TEST(AsyncFrameWriter, ACameraRecordingDropsAndCountsWhatTheEncoderCannotTake) {
-  TempDir dir;
-  const std::string path = dir.file("rec.avi");
-  testing::EncoderGate gate;  // Holds frame 0.
-  {
-    AsyncFrameWriter writer({path, "hfyu", 30.0}, WhenEncoderBehind::kDrop, /*capacity=*/2,
-                            [&gate](int64_t index) { gate.wait(index); });
-    // Frame 0 is held at the encoder and frame 1 waits behind it: the queue of 2 is full, so
-    // frames 2..4 are dropped, at once, and counted.
-    std::vector<int64_t> taken;
-    for (int i = 0; i < 5; ++i) {
-      cv::Mat* slot = writer.acquire();
-      if (slot == nullptr) continue;
-      NumberedFrame(i).copyTo(*slot);
-      writer.commit(i);
-      taken.push_back(i);
-    }
-    EXPECT_EQ(taken, (std::vector<int64_t>{0, 1}));
-    EXPECT_EQ(writer.dropped(), 3);
-    gate.open();
-    writer.close();
-    EXPECT_EQ(writer.queued(), 2);
-  }
-  const std::vector<Frame> frames = ReadBack(path);
-  ASSERT_EQ(frames.size(), 2u);
-  EXPECT_TRUE(SameImage(frames[0].image, NumberedFrame(0)));
-  EXPECT_TRUE(SameImage(frames[1].image, NumberedFrame(1))) << "the frame queued, not a later one";
 }
 
 }  // namespace

@@ -1,8 +1,7 @@
 // A FrameWriter that encodes on its own thread, behind a bounded queue of frame buffers, so the
 // pipeline does not wait for the encoder (HuffYUV at VGA takes ~2 ms a frame, MJPG more on a
-// loaded machine). What happens when the encoder falls behind and the queue is full is the
-// caller's choice: wait for a free buffer (a file's recording never loses a frame), or drop the
-// frame and count it (a camera, which cannot wait: the drop is reported, never silent).
+// loaded machine). It never loses a frame: when the encoder falls a whole queue behind, acquire()
+// waits for a free buffer, and the frames that waited are counted (waited()).
 //
 // Single producer: call acquire/commit/close from one thread (the pipeline's).
 #pragma once
@@ -25,18 +24,13 @@
 
 namespace softsight {
 
-enum class WhenEncoderBehind {
-  kWait,  // acquire() waits for a free buffer: no frame is lost (files).
-  kDrop,  // acquire() returns nullptr at once and the frame is counted as dropped (cameras).
-};
-
 class AsyncFrameWriter {
  public:
   // Checks the path and codec at once, as FrameWriter does (throws InputError). `capacity`:
   // frames queued at most (>= 1), each a buffer kept for the recording and reused.
   // `before_encode` (tests): called on the encoding thread before each frame is encoded, with its
   // index; a test holds the encoder there to fill the queue.
-  AsyncFrameWriter(FrameWriterOptions options, WhenEncoderBehind policy, size_t capacity = 8,
+  AsyncFrameWriter(FrameWriterOptions options, size_t capacity = 8,
                    std::function<void(int64_t index)> before_encode = {});
   ~AsyncFrameWriter();  // Finishes what is queued (close()), errors swallowed.
   AsyncFrameWriter(const AsyncFrameWriter&) = delete;
@@ -45,9 +39,8 @@ class AsyncFrameWriter {
   // Opens the video for frames of `size` now, on this thread (its errors are InputErrors here).
   void open(cv::Size size);
   // A free buffer to fill with the next frame (8-bit BGR of the first frame's size; it may still
-  // hold an older frame), or nullptr when the queue is full under kDrop (the frame is counted in
-  // dropped()). Rethrows the encoder's error (InputError naming the file and frame) once it met
-  // one. Follow a non-null acquire() with commit().
+  // hold an older frame), once there is one. Rethrows the encoder's error (InputError naming the file and frame) once it met
+  // one. Follow every acquire() with commit().
   cv::Mat* acquire();
   // Queues the buffer acquire() returned, as the frame with this index.
   void commit(int64_t index);
@@ -56,8 +49,7 @@ class AsyncFrameWriter {
 
   const std::string& path() const { return path_; }
   const std::string& format() const { return format_; }
-  int64_t dropped() const { return dropped_; }
-  // Frames for which acquire() had to wait for the encoder (kWait): how often it held up the
+  // Frames for which acquire() had to wait for the encoder: how often it held up the
   // pipeline. May be read from any thread.
   int64_t waited() const { return waited_.load(); }
   int64_t queued() const { return queued_; }  // Frames committed (written once close() returns).
@@ -67,7 +59,6 @@ class AsyncFrameWriter {
 
   FrameWriter writer_;  // Used by the encoding thread once it runs (after open()).
   std::string path_, format_;
-  WhenEncoderBehind policy_;
   std::function<void(int64_t)> before_encode_;
   std::mutex mutex_;
   std::condition_variable queued_cv_, freed_cv_;
@@ -79,7 +70,7 @@ class AsyncFrameWriter {
   size_t head_ = 0, count_ = 0;
   bool closing_ = false, done_ = false;
   std::exception_ptr error_;
-  int64_t dropped_ = 0, queued_ = 0;
+  int64_t queued_ = 0;
   std::atomic<int64_t> waited_{0};
   std::thread thread_;
 };
