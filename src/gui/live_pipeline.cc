@@ -1,7 +1,5 @@
 #include "gui/live_pipeline.h"
 
-#include <cstdio>
-
 #include "gui/live_recording.h"
 #include "softsight/core/error.h"
 
@@ -9,11 +7,8 @@ namespace softsight {
 
 LivePipeline::LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings)
     : settings_(std::move(settings)), session_(std::make_unique<TrackingSession>(config)) {
-  RunInfo info;
+  RunInfo info = DescribeMarkers(config);
   info.source = "live";
-  for (const MarkerSpec& spec : config.markers) info.marker_names.push_back(spec.name);
-  const MetricModel& metric = config.measure.metric;
-  info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
   run_ = std::make_unique<PipelineRun>(*session_, std::move(info));
   in_run_ = std::make_unique<RecordingInRun>(*this);
   session_->set_edit_listener([this](const ConfigChange& change) {
@@ -74,16 +69,13 @@ const FrameResult& LivePipeline::start_recording(
     FrameDrawer draw) {
   if (recording_) stop_recording();
   const TrackingConfig snapshot = RecordingStartConfig(config(), boxes);
-  RunInfo info;
+  RunInfo info = DescribeMarkers(snapshot);
   info.source = run_->info().source;
   info.frame_size = frame.image.size();
   info.fps = fps;
   // A camera's videos get a deeper queue (VideoSink), so a hiccup of the encoder does not hold
   // up the window; they still keep every frame.
   info.live = run_->info().live;
-  for (const MarkerSpec& spec : snapshot.markers) info.marker_names.push_back(spec.name);
-  const MetricModel& metric = snapshot.measure.metric;
-  info.metric = metric.scale_mm_per_px || metric.plane_mm_from_image;
   // The raw video's frame 0 is this source frame: its config says so (`recording:`), so that
   // `track` on it numbers and times the rows as the source did, like the live CSV. Opening the
   // files first: when that fails, the session is as it was.

@@ -23,9 +23,17 @@ bool NeedsColour(const TrackingConfig& config) {
 
 }  // namespace
 
+RunInfo DescribeMarkers(const TrackingConfig& config) {
+  RunInfo info;
+  for (const MarkerSpec& spec : config.markers) info.marker_names.push_back(spec.name);
+  const MetricModel& metric = config.measure.metric;
+  info.metric = metric.scale_mm_per_px.has_value() || metric.plane_mm_from_image.has_value();
+  return info;
+}
+
 RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
                     const RunOptions& options) {
-  RunInfo info;
+  RunInfo info = DescribeMarkers(session.config());
   info.source = source.description();
   info.fps = source.fps();
   info.live = source.is_live();
@@ -33,10 +41,6 @@ RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
   if (options.max_frames && (!info.frame_count || *options.max_frames < *info.frame_count)) {
     info.frame_count = options.max_frames;
   }
-  const TrackingConfig& config = session.config();
-  for (const MarkerSpec& spec : config.markers) info.marker_names.push_back(spec.name);
-  const MetricModel& metric = config.measure.metric;
-  info.metric = metric.scale_mm_per_px.has_value() || metric.plane_mm_from_image.has_value();
   return info;
 }
 

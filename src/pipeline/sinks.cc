@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "softsight/core/error.h"
+#include "softsight/pipeline/run.h"
 
 namespace softsight {
 namespace {
@@ -29,10 +30,8 @@ size_t CameraQueueFrames(cv::Size frame_size, double fps) {
 }  // namespace
 
 CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<CsvColumn>& extra) {
-  std::vector<std::string> names;
-  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
-  const MetricModel& metric = config.measure.metric;
-  return TrackingColumns(names, metric.scale_mm_per_px || metric.plane_mm_from_image, extra,
+  const RunInfo markers = DescribeMarkers(config);
+  return TrackingColumns(markers.marker_names, markers.metric, extra,
                          config.measure.inner_markers());
 }
 
@@ -65,8 +64,7 @@ VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> 
   options_.fps = fps.value_or(30.0);
   // Checks path and codec now.
   capacity_ = kQueuedFrames;
-  writer_ = std::make_unique<AsyncFrameWriter>(options_, WhenEncoderBehind::kWait, capacity_,
-                                               before_encode_);
+  writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
 }
 
 
@@ -79,8 +77,7 @@ void VideoSink::begin(const RunInfo& info) {
     if (!fps_ && info.fps && *info.fps > 0.0) options_.fps = *info.fps;
     capacity_ = capacity;
     writer_.reset();  // Nothing written yet: the file is made again with the right rate.
-    writer_ = std::make_unique<AsyncFrameWriter>(options_, WhenEncoderBehind::kWait, capacity_,
-                                                 before_encode_);
+    writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
 }

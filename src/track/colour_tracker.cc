@@ -650,7 +650,7 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
         if (b.at_frame_edge) partly_out_ = true;
       }
       const double d = cv::norm(b.centroid_px - predicted);
-      if (verdict == CandidateVerdict::kPartial && std::isfinite(misfit)) {
+      if (verdict == CandidateVerdict::kPartial) {
         nearest_partial = std::min(nearest_partial, d);
       }
       if (verdict != CandidateVerdict::kFits) continue;
@@ -718,7 +718,7 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
       verdict = CandidateVerdict::kOutsideRoi;
     }
     candidates_.push_back(candidate(b, verdict, misfit));
-    const bool partial = verdict == CandidateVerdict::kPartial && std::isfinite(misfit);
+    const bool partial = verdict == CandidateVerdict::kPartial;
     if (verdict != CandidateVerdict::kFits && !partial) continue;
     double cost = misfit;
     if (last_px_) cost += cv::norm(b.centroid_px - *last_px_) / diagonal;
@@ -758,8 +758,7 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
     choice.status = MarkerStatus::kAmbiguous;
     if (by_uniqueness) rivals_.clear();
     for (size_t i = 0; i < candidates_.size(); ++i) {
-      const bool partial = candidates_[i].verdict == CandidateVerdict::kPartial &&
-                           std::isfinite(candidates_[i].misfit);
+      const bool partial = candidates_[i].verdict == CandidateVerdict::kPartial;
       if (candidates_[i].verdict != CandidateVerdict::kFits && !partial) continue;
       double cost = candidates_[i].misfit;
       if (last_px_) cost += cv::norm(blobs_[i].centroid_px - *last_px_) / diagonal;

@@ -99,7 +99,8 @@ class ColourTracker : public Tracker {
   const std::optional<ColourModel>& model() const { return model_; }
   // True when pixels are classified by gray level (`gray`, or a nominal gray `auto_bgr`).
   bool gray_mode() const { return gray_.has_value(); }
-  // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit). With
+  // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit; infinite for a
+  // rejection; kPartial is a blob that fits but is partly hidden, with its finite misfit). With
   // `any_brightness` the learned colour's brightness is not held against it (its chroma is).
   std::pair<CandidateVerdict, double> judge(const ColourBlob& blob,
                                             bool any_brightness = false) const;

@@ -84,6 +84,10 @@ class PipelineRun {
 RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options = {});
 
+// What a run of `config` tells its sinks of the markers: their names, and whether measurements
+// come in millimetres. DescribeRun adds the source.
+RunInfo DescribeMarkers(const TrackingConfig& config);
+
 // What RunPipeline tells its sinks in begin() (frame_size left empty: the first frame's). For a
 // sink that joins a run late (a recording started in the live window), so it is told the same.
 RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
