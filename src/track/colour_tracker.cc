@@ -374,7 +374,11 @@ void ColourTracker::reset() {
   last_px_.reset();
   velocity_px_ = cv::Point2d(0, 0);
   tracking_ = false;
-  acquire_roi_ = params_.roi;
+  // The roi says where the marker is when tracking starts; once it has been found (a model is
+  // learned), it may be anywhere the camera and the body have taken it since: a search after a
+  // reset (a report found implausible, a jump of the camera) covers the whole frame, judged by
+  // the model, as after any loss.
+  if (!model_) acquire_roi_ = params_.roi;
 }
 
 bool ColourTracker::start(const Frame& frame) {
@@ -403,8 +407,8 @@ void ColourTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
   }
   // A new selection is a new calibration: learn the model again, inside the hint.
   params_.roi = hint & frame_rect;
-  reset();
   model_.reset();
+  reset();
   frame_size_ = frame_bgr.size();
   report(acquire(frame_bgr));
 }

@@ -293,6 +293,33 @@ TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {
   EXPECT_NEAR(*next.score, 1.0, 1e-12);
 }
 
+// The roi says where the marker is when tracking starts. A tracker reset after that (the
+// session found a report implausible, e.g. when the camera was bumped) searches the whole frame
+// with the model it learned: the roi was where the marker was, not where it must be. Before it
+// was ever found, a reset keeps the roi.
+TEST(ColourTracker, AResetAfterTheFirstAcquisitionSearchesBeyondTheRoi) {
+  ColourParams params = RedParams();
+  params.roi = cv::Rect(40, 40, 40, 40);
+  cv::Mat image = Background();
+  PaintDisc(image, {60, 60}, 8, kRed);
+  ColourTracker tracker(params);
+  ASSERT_TRUE(tracker.update(image).found());
+
+  // The camera jumped: the marker is now far from the roi (and from the tracking window).
+  image = Background();
+  const cv::Point2d moved = PaintDisc(image, {230.5, 170.5}, 8, kRed);
+  tracker.reset();
+  const Observation found = tracker.update(image);
+  ASSERT_TRUE(found.found()) << MarkerStatusName(found.status());
+  EXPECT_NEAR(found.position_px->x, moved.x, 1e-9);
+  EXPECT_NEAR(found.position_px->y, moved.y, 1e-9);
+
+  // Never found yet: the roi still bounds the search, after a reset too.
+  ColourTracker fresh(params);
+  fresh.reset();
+  EXPECT_FALSE(fresh.update(image).found());
+}
+
 TEST(ColourTracker, BadFramesAndHintsAreInputErrors) {
   ColourTracker tracker(RedParams());
   cv::Mat image = Background();

@@ -68,7 +68,8 @@ class Tracker {
   // tracker never reports a stale or predicted position.
   virtual Observation update(const cv::Mat& frame_bgr) = 0;
 
-  // Forgets position and velocity; the next update() acquires on the full frame (or the ROI).
+  // Forgets position and velocity; the next update() acquires on the full frame (or, for a
+  // marker never found yet, in its roi) with what the tracker learned of the marker's looks.
   virtual void reset() = 0;
 
   // The candidates the last update() (or init()) weighed, with the verdict on each; empty for
