@@ -23,6 +23,11 @@ constexpr int kLongestChangeRun = 10;
 // believed, however long it lasts. A camera does not turn a tenth of its picture into
 // random-byte texture at once (a garbage cell is 3x the texture it had, and > 45 grey levels).
 constexpr double kGarbageFrameFraction = 0.1;
+// A frame that changed as a whole but, once the change of light is taken out, in no more than
+// this share of its cells is the same picture in another light (what moved: the actuator).
+// Another video of the same rig, lit otherwise, still differs where its actuator is (a quarter
+// of the cells in the tests).
+constexpr double kRelitChangedFraction = 0.08;
 
 }  // namespace
 
@@ -58,6 +63,12 @@ void FrameChangeDetector::summarise(const cv::Mat& bgr, std::vector<Cell>& cells
       }
       if (pairs > 0) cell.texture += texture / (3.0f * static_cast<float>(pairs));
       ++counts[static_cast<size_t>(cy) * cols_ + cx];
+      // The sample's place in the cell's 8 x 8 grid (a border cell's extra samples are left out).
+      const int sx = (x - cx * cell_px_) / step_, sy = (y - cy * cell_px_) / step_;
+      if (sx < kSamplesPerCell && sy < kSamplesPerCell) {
+        cell.gray[static_cast<size_t>(sy * kSamplesPerCell + sx)] =
+            static_cast<uint8_t>((p[0] + p[1] + p[2]) / 3);
+      }
     }
   }
   for (size_t i = 0; i < cells.size(); ++i) {
@@ -70,13 +81,67 @@ void FrameChangeDetector::summarise(const cv::Mat& bgr, std::vector<Cell>& cells
   }
 }
 
-bool FrameChangeDetector::Changed(const Cell& now, const Cell& before) {
+namespace {
+
+// Correlation of two cells' samples, or 1 when either is too flat to tell (noise alone, whose
+// pattern changes from frame to frame, correlates with nothing).
+float PatternCorrelation(const std::array<uint8_t, 64>& a, const std::array<uint8_t, 64>& b) {
+  // Standard deviation of the samples below which a cell is flat: well above a camera's noise.
+  constexpr float kTexturedSpread = 10.0f;
+  float sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const float x = a[i], y = b[i];
+    sa += x;
+    sb += y;
+    saa += x * x;
+    sbb += y * y;
+    sab += x * y;
+  }
+  const float n = static_cast<float>(a.size());
+  const float va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  const float flat = kTexturedSpread * kTexturedSpread * n;
+  if (va < flat || vb < flat) return 1.0f;
+  return (sab - sa * sb / n) / std::sqrt(va * vb);
+}
+
+}  // namespace
+
+bool FrameChangeDetector::Changed(const Cell& now, const Cell& before, const cv::Vec3f& gain,
+                                  bool relit) {
   // 30 grey levels of mean colour over a whole cell: a marker moving a few pixels inside it
-  // changes the mean by less; the picture being replaced, by more.
-  const float colour = std::max({std::abs(now.b - before.b), std::abs(now.g - before.g),
-                                 std::abs(now.r - before.r)});
-  return colour > 30.0f || now.texture > 2.0f * before.texture + 10.0f ||
-         now.texture < 0.5f * before.texture - 10.0f;
+  // changes the mean by less; the picture being replaced, by more. Compared after the row's
+  // change of light, which scales the texture too, and which leaves the pattern of a textured
+  // cell as it was.
+  const float colour =
+      std::max({std::abs(now.b - gain[0] * before.b), std::abs(now.g - gain[1] * before.g),
+                std::abs(now.r - gain[2] * before.r)});
+  const float texture = before.texture * (gain[0] + gain[1] + gain[2]) / 3.0f;
+  return colour > 30.0f || now.texture > 2.0f * texture + 10.0f ||
+         now.texture < 0.5f * texture - 10.0f ||
+         (relit && PatternCorrelation(now.gray, before.gray) < 0.3f);
+}
+
+cv::Vec3f FrameChangeDetector::row_gain(const std::vector<Cell>& now,
+                                        const std::vector<Cell>& before, int row) {
+  // Cells darker than this say little about a gain (noise and black level dominate).
+  constexpr float kDarkest = 24.0f;
+  constexpr float kLeast = 1.0f / 3.0f, kMost = 3.0f;
+  cv::Vec3f gain(1.0f, 1.0f, 1.0f);
+  const size_t first = static_cast<size_t>(row) * cols_;
+  for (int c = 0; c < 3; ++c) {
+    ratios_.clear();
+    for (size_t i = first; i < first + static_cast<size_t>(cols_); ++i) {
+      const float b = c == 0 ? before[i].b : c == 1 ? before[i].g : before[i].r;
+      const float n = c == 0 ? now[i].b : c == 1 ? now[i].g : now[i].r;
+      if (b >= kDarkest) ratios_.push_back(n / b);
+    }
+    // Half the row's cells at least must say: a change confined to a few cells is not the light.
+    if (ratios_.size() * 2 < static_cast<size_t>(cols_) || ratios_.empty()) continue;
+    auto middle = ratios_.begin() + static_cast<std::ptrdiff_t>(ratios_.size() / 2);
+    std::nth_element(ratios_.begin(), middle, ratios_.end());
+    if (*middle >= kLeast && *middle <= kMost) gain[c] = *middle;
+  }
+  return gain;
 }
 
 bool FrameChangeDetector::Garbage(const Cell& now, const Cell& before) {
@@ -86,9 +151,15 @@ bool FrameChangeDetector::Garbage(const Cell& now, const Cell& before) {
 }
 
 double FrameChangeDetector::changed_between(const std::vector<Cell>& a,
-                                            const std::vector<Cell>& b) const {
+                                            const std::vector<Cell>& b, bool relit) {
   int changed = 0;
-  for (size_t i = 0; i < a.size(); ++i) changed += Changed(a[i], b[i]) ? 1 : 0;
+  for (int row = 0; row < rows_; ++row) {
+    const cv::Vec3f gain = relit ? row_gain(a, b, row) : cv::Vec3f(1.0f, 1.0f, 1.0f);
+    const size_t first = static_cast<size_t>(row) * cols_;
+    for (size_t i = first; i < first + static_cast<size_t>(cols_); ++i) {
+      changed += Changed(a[i], b[i], gain, relit) ? 1 : 0;
+    }
+  }
   return a.empty() ? 0.0 : static_cast<double>(changed) / static_cast<double>(a.size());
 }
 
@@ -104,6 +175,7 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     normal_ = now_;
     previous_ = now_;
     garbage_.assign(now_.size(), 0);
+    ratios_.reserve(static_cast<size_t>(cols_));
     has_normal_ = true;
     whole_frame_changed_ = false;
     changed_fraction_ = 0.0;
@@ -112,7 +184,7 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     return;
   }
   summarise(bgr, now_);
-  changed_fraction_ = changed_between(now_, normal_);
+  changed_fraction_ = changed_between(now_, normal_, false);
   int garbage_cells = 0;
   for (size_t i = 0; i < now_.size(); ++i) garbage_cells += Garbage(now_[i], normal_[i]) ? 1 : 0;
   garbage_fraction_ = static_cast<double>(garbage_cells) / static_cast<double>(now_.size());
@@ -126,9 +198,15 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     normal = false;
     changed_run_ = 0;
     alike_run_ = 0;
+  } else if (changed_fraction_ > threshold &&
+             changed_between(now_, normal_, true) <= kRelitChangedFraction) {
+    // The light changed (a flicker, the exposure) and little else: the picture is the same.
+    whole_frame_changed_ = false;
+    changed_run_ = 0;
+    alike_run_ = 0;
   } else if (changed_fraction_ > threshold) {
     // Frames that look alike (a change that stays) count towards accepting it.
-    const bool alike = changed_run_ > 0 && changed_between(now_, previous_) < 0.5 * threshold;
+    const bool alike = changed_run_ > 0 && changed_between(now_, previous_, false) < 0.5 * threshold;
     ++changed_run_;
     alike_run_ = alike ? alike_run_ + 1 : 1;
     normal = alike_run_ >= kFramesToAcceptAChange || changed_run_ >= kLongestChangeRun;

@@ -7,13 +7,22 @@
 // difference of neighbouring samples). Each frame is compared with the last frame judged normal:
 //  - most cells changed at once (far more than the footage's usual frame-to-frame change): the
 //    whole frame changed. A change that persists (the light was switched on, the camera was
-//    bumped) becomes the new normal after a few frames.
+//    bumped) becomes the new normal after a few frames. A change of the light alone is not a
+//    change of the picture: such a frame is compared again, each row of cells after the gain
+//    (per channel) that best maps the normal frame's row onto it (the median of the cells'
+//    ratios, 1/3x to 3x), and where the light changes nothing else either (the pattern inside a
+//    textured cell still correlates), and at most a few cells changed (where the actuator
+//    moved), it is believed: a flickering lamp, the camera's exposure, a rolling shutter's bands
+//    under mains light. A frame from another video of the same rig, lit otherwise, still differs
+//    where its actuator is.
 //  - a cell whose texture exploded (random bytes are ~85 grey levels between neighbours, camera
 //    images a few): decoded garbage there; markers in or next to it are not trusted. Garbage in
 //    a tenth of the frame or more: the decoder lost its place, and the rest of the frame may be
 //    a stale copy of an earlier one; the whole frame is not believed for as long as it lasts.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -45,11 +54,15 @@ class FrameChangeDetector {
   struct Cell {
     float b = 0, g = 0, r = 0;  // Mean colour.
     float texture = 0;          // Mean |difference| of horizontally and vertically adjacent samples.
+    std::array<uint8_t, 64> gray{};  // The cell's 8 x 8 samples, (b + g + r) / 3.
   };
   void summarise(const cv::Mat& bgr, std::vector<Cell>& cells);
-  static bool Changed(const Cell& now, const Cell& before);
+  static bool Changed(const Cell& now, const Cell& before, const cv::Vec3f& gain, bool relit);
   static bool Garbage(const Cell& now, const Cell& before);
-  double changed_between(const std::vector<Cell>& a, const std::vector<Cell>& b) const;
+  // The per-channel gain that maps row `row` of `before` onto `now` (1 where it cannot tell).
+  cv::Vec3f row_gain(const std::vector<Cell>& now, const std::vector<Cell>& before, int row);
+  // Share of cells changed from `b` to `a`; `relit`: after each row's change of light.
+  double changed_between(const std::vector<Cell>& a, const std::vector<Cell>& b, bool relit);
 
   cv::Size size_;             // Of the frames summarised so far.
   int step_ = 1;              // Sample spacing in pixels.
@@ -57,6 +70,7 @@ class FrameChangeDetector {
   int cols_ = 0, rows_ = 0;   // Cells per row and column.
   std::vector<Cell> now_, normal_, previous_;  // Reused: no allocation per frame.
   std::vector<int> counts_;                    // Samples per cell (summarise's scratch).
+  std::vector<float> ratios_;                  // row_gain's scratch.
   std::vector<unsigned char> garbage_;         // Per cell: frames in a row it held garbage.
   bool has_normal_ = false;
   bool whole_frame_changed_ = false;

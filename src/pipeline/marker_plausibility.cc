@@ -25,6 +25,16 @@ constexpr double kSegmentFollow = 0.1;
 // Smoothing of the velocity and of the usual prediction error.
 constexpr double kVelocityFollow = 0.5;
 constexpr double kResidualFollow = 0.1;
+// A moving marker (at least this fast, px per frame) reported within kRepeatPx of where it was
+// last believed is in a repeated frame: a camera or a converter that fills its frame rate by
+// repeating frames (a 30 fps file from a webcam that delivered 15) shows the body still for a
+// frame, then moved by two frames' worth. Up to kMotionMemoryFrames such frames in a row leave
+// the marker's motion history as it was, so the step after them is predicted and bounded over
+// all the frames it took; a marker still for longer has stopped, and is learned as stopped.
+// (Sensor noise moves a still marker's centroid by hundredths of a pixel, so a real stop soon
+// reads as a stop too.)
+constexpr double kMovingPxPerFrame = 1.0;
+constexpr double kRepeatPx = 0.05;
 
 }  // namespace
 
@@ -113,6 +123,25 @@ void MarkerPlausibility::check_arrangement(std::vector<MarkerObservation>& marke
   }
 }
 
+void MarkerPlausibility::check_suspects(std::vector<MarkerObservation>& markers) {
+  // Only a learned arrangement can vouch; without one a suspect is believed as before.
+  if (segment_px_.empty()) return;
+  const auto found = [&](size_t k) { return markers[body_[k]].observation.found(); };
+  for (size_t k = 0; k < body_.size(); ++k) {
+    const size_t b = body_[k];
+    if (!tracks_[b].suspect || !found(k)) continue;
+    const cv::Point2d p = *markers[b].observation.position_px;
+    bool vouched = false;
+    for (const size_t n : {k - 1, k + 1}) {  // k - 1 wraps past the first: out of range.
+      if (n >= body_.size() || !found(n)) continue;
+      const double span = segment_px_[std::min(k, n)];
+      const double d = cv::norm(p - *markers[body_[n]].observation.position_px);
+      vouched = vouched || (d <= kMaxStretchUnsupported * span && d * kMaxStretchUnsupported >= span);
+    }
+    if (!vouched) reject(b, markers);
+  }
+}
+
 void MarkerPlausibility::learn(const std::vector<MarkerObservation>& markers) {
   if (body_.empty()) return;
   const auto position = [&](size_t k) { return markers[body_[k]].observation.position_px; };
@@ -166,6 +195,7 @@ const std::vector<size_t>& MarkerPlausibility::check(int64_t frame_index,
     if (ratio_[i] && *ratio_[i] > 1.0) reject(i, markers);
   }
   check_arrangement(markers);
+  check_suspects(markers);
   std::sort(rejected_.begin(), rejected_.end());
   rejected_.erase(std::unique(rejected_.begin(), rejected_.end()), rejected_.end());
 
@@ -173,15 +203,24 @@ const std::vector<size_t>& MarkerPlausibility::check(int64_t frame_index,
   for (size_t i = 0; i < markers.size(); ++i) {
     Track& t = tracks_[i];
     if (std::binary_search(rejected_.begin(), rejected_.end(), i)) {
-      t = Track();  // Its tracker searches afresh: the next report is a re-acquisition.
+      t = Track();  // Its tracker searches afresh: the next report is a re-acquisition ...
+      t.suspect = true;  // ... that the arrangement must vouch for.
       continue;
     }
+    if (markers[i].observation.found()) t.suspect = false;
     if (!markers[i].observation.found()) {
       if (t.last && frame_index - t.last_frame > kMotionMemoryFrames) t.reacquiring = true;
       continue;
     }
     const cv::Point2d p = *markers[i].observation.position_px;
     const int64_t gap = frame_index - t.last_frame;
+    const bool still = t.last && !t.reacquiring && gap >= 1 && cv::norm(p - *t.last) <= kRepeatPx;
+    if (still && t.has_velocity && cv::norm(t.velocity) >= kMovingPxPerFrame &&
+        t.still_frames < kMotionMemoryFrames) {
+      ++t.still_frames;  // A repeated frame, perhaps: the history waits.
+      continue;
+    }
+    t.still_frames = still ? t.still_frames + 1 : 0;
     if (t.last && !t.reacquiring && gap >= 1) {
       const cv::Point2d step = (p - *t.last) * (1.0 / static_cast<double>(gap));
       const cv::Point2d predicted = *t.last + (t.has_velocity ? t.velocity : step) *

@@ -5,7 +5,9 @@
 //  - Motion: a marker tracked in the last frames has a predicted position (constant velocity);
 //    a report farther from it than the marker's size, plus the speed it had, plus the prediction
 //    error usual for it, is a jump (a look-alike, a corrupted frame). After a frame in which
-//    nothing was believed the prediction reaches over the gap.
+//    nothing was believed the prediction reaches over the gap, and so it does after a repeated
+//    frame (a moving marker standing exactly still for a frame or two: the footage repeats
+//    frames to fill its rate).
 //  - Arrangement: markers on one body (the chain, else the triple) keep their order along it and
 //    their spacing changes smoothly. The segment lengths between neighbours along the body are
 //    learned from the first frames in which all of them are found and agree, and then follow
@@ -16,6 +18,13 @@
 //    less is the culprit (a marker just re-acquired has no support; when neither has, both).
 // A marker re-acquired after being lost, or after it was found implausible, is checked against
 // the arrangement only, never against its stale position: it may have moved anywhere meanwhile.
+// A marker found implausible stays suspect until the arrangement vouches for it: its next reports
+// are believed only beside a neighbour along the body found in the same frame, the segment
+// between them within 1.25x of its learned length either way (the camera was bumped: the markers
+// come back together, in their arrangement). A suspect report with no neighbour to check it
+// against (the body was taken away and a look-alike of the background is all there is) is not
+// believed. Markers off the body, or on a body whose arrangement is not learned yet, cannot be
+// vouched for and are believed as before.
 // Known limit: segment lengths say nothing of direction, so a look-alike at about the right
 // distance from a believed neighbour passes on re-acquisition (the angle at the neighbour would
 // tell, but it may change a lot during a long occlusion).
@@ -56,11 +65,14 @@ class MarkerPlausibility {
     bool has_velocity = false;
     double residual_px = 0.0;         // Running mean of |position - prediction|.
     bool reacquiring = true;          // No motion history to check against.
+    int still_frames = 0;             // Reports in a row exactly where it was (see .cc).
+    bool suspect = false;             // Found implausible, not vouched for since (see above).
   };
   // Motion residual over its bound (> 1: a jump); absent when there is no history to check.
   std::optional<double> motion_ratio(size_t i, int64_t frame, const cv::Point2d& p) const;
   void reject(size_t i, std::vector<MarkerObservation>& markers);
   void check_arrangement(std::vector<MarkerObservation>& markers);
+  void check_suspects(std::vector<MarkerObservation>& markers);
   void learn(const std::vector<MarkerObservation>& markers);
 
   std::vector<double> size_px_;

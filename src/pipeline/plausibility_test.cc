@@ -118,17 +118,18 @@ TEST(Plausibility, CorruptedFramesNeverYieldAPositionMoreThan3PxOff) {
 
 TEST(Plausibility, AWholeFrameChangeIsNotBelievedAndAChangeThatStaysBecomesNormal) {
   SyntheticScene scene = Scene(300);
+  // Another video: the same kind of rig on another bench, bent further.
+  SyntheticScene other = Scene(300, 240, /*seed=*/77);
   cv::Mat image;
   TrackingSession session(ThreeMarkerSceneConfig());
   for (int i = 0; i < 5; ++i) {
     scene.render(i, image);
     session.process(Frame{image, i, i / 30.0});
   }
-  // The light goes up by half and stays: three frames are not believed, then tracking goes on.
+  // From frame 5 on the other video: three frames are not believed, then tracking goes on there.
   int implausible = 0;
   for (int i = 5; i < 15; ++i) {
-    const SceneTruth truth = scene.render(i, image);
-    image.convertTo(image, -1, 1.0, 70.0);
+    const SceneTruth truth = other.render(200 + i, image);
     const FrameResult& result = session.process(Frame{image, i, i / 30.0});
     for (size_t m = 0; m < 3; ++m) {
       const Observation& o = result.markers[m].observation;
@@ -136,8 +137,7 @@ TEST(Plausibility, AWholeFrameChangeIsNotBelievedAndAChangeThatStaysBecomesNorma
         EXPECT_LT(cv::norm(*o.position_px - *truth.markers[m].centroid_px), 0.5) << i;
       } else {
         // While the change is not believed: implausible. Once it is the new normal the session
-        // believes its trackers again; a colour tracker whose learned marker colour no longer
-        // fits 70 grey levels brighter reports the marker lost, never at a wrong place.
+        // believes its trackers again, which report a marker lost, never at a wrong place.
         EXPECT_TRUE(o.status() == MarkerStatus::kImplausible || o.status() == MarkerStatus::kLost)
             << i;
         implausible += o.status() == MarkerStatus::kImplausible;
@@ -145,6 +145,32 @@ TEST(Plausibility, AWholeFrameChangeIsNotBelievedAndAChangeThatStaysBecomesNorma
     }
   }
   EXPECT_GE(implausible, 3) << "the first changed frame is not believed";
+}
+
+// A change of the light alone (a flickering lamp: every frame brighter or darker by up to 40 %,
+// or the light going up by half at once) is not a change of the picture: every frame is
+// believed and every marker found where it is. Before, 2 frames in 3 were `implausible`.
+TEST(Plausibility, AFlickeringLightLeavesEveryFrameBelieved) {
+  SyntheticScene scene = Scene(300);
+  cv::Mat image;
+  TrackingSession session(ThreeMarkerSceneConfig());
+  cv::RNG rng(7);
+  int found = 0, implausible = 0;
+  for (int i = 0; i < 40; ++i) {
+    const SceneTruth truth = scene.render(i, image);
+    const double gain = i < 5 ? 1.0 : i < 30 ? rng.uniform(0.6, 1.4) : 1.5;
+    image.convertTo(image, -1, gain, 0.0);
+    const FrameResult& result = session.process(Frame{image, i, i / 30.0});
+    for (size_t m = 0; m < 3; ++m) {
+      const Observation& o = result.markers[m].observation;
+      implausible += o.status() == MarkerStatus::kImplausible;
+      if (!o.found()) continue;
+      ++found;
+      EXPECT_LT(cv::norm(*o.position_px - *truth.markers[m].centroid_px), 0.5) << i;
+    }
+  }
+  EXPECT_EQ(implausible, 0);
+  EXPECT_GE(found, 3 * 40 - 6) << "a marker lost in more than a few frames of flicker";
 }
 
 // A look-alike of the tip marker appears far from it for one frame while the tip is covered:
@@ -397,6 +423,78 @@ TEST(MarkerPlausibility, AJumpAgainstTheMotionIsImplausibleWithoutAnyArrangement
   // Its next report is a re-acquisition: believed wherever it is.
   ball[0].observation = Observation{cv::Point2d(400.0, 300.0), 1.0};
   EXPECT_TRUE(rules.check(11, ball).empty());
+}
+
+// A marker found implausible stays suspect until the arrangement vouches for it: alone (its
+// neighbour not found) it is not believed wherever it is reported; beside its neighbour at the
+// learned spacing it is, and then it is tracked as before. This is what keeps a look-alike of the
+// background from being taken for a marker once the body has been taken away, while markers that
+// all jump together (the camera was bumped) come back at once.
+TEST(MarkerPlausibility, AMarkerFoundImplausibleIsBelievedOnlyWhereItsNeighbourVouchesForIt) {
+  MarkerPlausibility rules({5, 5, 5}, {0, 1, 2});
+  for (int64_t f = 0; f < 4; ++f) {
+    auto markers = Chain3({100.0 + f, 100}, {200.0 + f, 100}, {300.0 + f, 100});
+    ASSERT_TRUE(rules.check(f, markers).empty()) << f;
+  }
+  // The body is gone; c's tracker reports a look-alike 150 px away: a jump.
+  auto markers = Chain3({0, 0}, {0, 0}, {450, 300});
+  markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
+  markers[1].observation = Observation::NotFound(MarkerStatus::kLost);
+  EXPECT_EQ(rules.check(4, markers), std::vector<size_t>{2});
+  // The look-alike again, for frames on end: with no neighbour to vouch, never believed.
+  for (int64_t f = 5; f < 20; ++f) {
+    markers = Chain3({0, 0}, {0, 0}, {450, 300});
+    markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
+    markers[1].observation = Observation::NotFound(MarkerStatus::kLost);
+    EXPECT_EQ(rules.check(f, markers), std::vector<size_t>{2}) << f;
+    EXPECT_EQ(markers[2].observation.status(), MarkerStatus::kImplausible);
+  }
+  // Something at b's place, but c's report 200 px from it (2x the segment): neither is believed.
+  markers = Chain3({0, 0}, {250, 150}, {450, 150});
+  markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
+  EXPECT_EQ(rules.check(20, markers), (std::vector<size_t>{1, 2}));
+  // The body back, moved 60 px (the camera was bumped): c beside b at the learned spacing.
+  markers = Chain3({160, 160}, {260, 160}, {360, 160});
+  EXPECT_TRUE(rules.check(21, markers).empty());
+  // And tracked from there by its motion as before.
+  markers = Chain3({161, 160}, {261, 160}, {361, 160});
+  EXPECT_TRUE(rules.check(22, markers).empty());
+}
+
+// Footage that starts repeating frames to fill its rate (a webcam that falls to a third of its
+// rate in dim light): a marker moving 10 px per frame stands exactly still for two frames, then
+// moves three frames' worth. Its motion history waits out the repeats, so the step after them
+// is believed. Without that, the 30 px step (against a bound of 5 px plus the 2.5 px per frame
+// its speed had decayed to) was refused at every pose.
+TEST(MarkerPlausibility, RepeatedFramesDoNotMakeTheNextStepAJump) {
+  MarkerPlausibility rules({5}, {});
+  std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
+  for (int64_t f = 0; f < 40; ++f) {
+    // 10 px/frame; from frame 10 on each pose three times.
+    const double x = f < 10 ? 10.0 + 10.0 * f : 110.0 + 30.0 * static_cast<double>((f - 10) / 3);
+    ball[0].observation = Observation{cv::Point2d(x, 10.0), 1.0};
+    EXPECT_TRUE(rules.check(f, ball).empty()) << "frame " << f;
+  }
+  // A jump after repeated frames is still one: 100 px off the course it had.
+  ball[0].observation = Observation{cv::Point2d(410.0, 110.0), 1.0};
+  EXPECT_EQ(rules.check(40, ball), std::vector<size_t>{0});
+}
+
+// A marker that stops for good is learned as stopped once it has stood still longer than a
+// repeat lasts: a look-alike 40 px away afterwards is a jump, not a step of its old speed.
+TEST(MarkerPlausibility, AMarkerThatStopsIsLearnedAsStopped) {
+  MarkerPlausibility rules({5}, {});
+  std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
+  for (int64_t f = 0; f < 10; ++f) {
+    ball[0].observation = Observation{cv::Point2d(10.0 + 20.0 * f, 10.0), 1.0};  // 20 px/frame.
+    EXPECT_TRUE(rules.check(f, ball).empty()) << f;
+  }
+  for (int64_t f = 10; f < 20; ++f) {  // Stopped where frame 9 left it.
+    ball[0].observation = Observation{cv::Point2d(190.0, 10.0), 1.0};
+    EXPECT_TRUE(rules.check(f, ball).empty()) << f;
+  }
+  ball[0].observation = Observation{cv::Point2d(230.0, 10.0), 1.0};
+  EXPECT_EQ(rules.check(20, ball), std::vector<size_t>{0});
 }
 
 }  // namespace
