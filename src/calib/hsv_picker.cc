@@ -27,6 +27,11 @@ HsvRange LinearRange(std::vector<double> values, const HsvPickOptions& o, int ma
           std::clamp(static_cast<int>(std::ceil(hi)), 0, 255)};
 }
 
+std::vector<double> SortedCopy(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values;
+}
+
 int WrapHue(int h) { return ((h % kHueCount) + kHueCount) % kHueCount; }
 
 }  // namespace
@@ -51,6 +56,9 @@ bool HsvPickOptions::Check(std::string* error) const {
   }
   if (value_margin < 0 || value_margin > 255) {
     return fail("value_margin must be in 0..255, got " + std::to_string(value_margin));
+  }
+  if (!(darkest_light > 0 && darkest_light <= 1)) {
+    return fail("darkest_light must be in (0, 1], got " + std::to_string(darkest_light));
   }
   if (min_saturation < 0 || min_saturation > 255) {
     return fail("min_saturation must be in 0..255, got " + std::to_string(min_saturation));
@@ -116,7 +124,10 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   }
   // Saturation never goes below min_saturation: below it the hue test means nothing.
   pick.s = LinearRange(std::move(sat), options, options.saturation_margin, options.min_saturation);
-  pick.v = LinearRange(std::move(val), options, options.value_margin, 0);
+  pick.v = LinearRange(val, options, options.value_margin, 0);
+  const int darkest = static_cast<int>(std::floor(options.darkest_light *
+                                                  Percentile(SortedCopy(val), options.low_percentile)));
+  pick.v = {std::min(pick.v.lo, darkest), 255};
   return pick;
 }
 

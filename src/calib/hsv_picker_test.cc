@@ -126,6 +126,33 @@ TEST(HsvPickerTest, GreyPatchOrClickOutsideGivesNoRange) {
   EXPECT_FALSE(PickHsvFromSamples({}, HsvPickOptions{}, &why));
 }
 
+// Brightness follows the light: the value range reaches down to 0.4 of the sampled values and up
+// to 255, so the marker, picked at value ~180, is still in range when its light falls to 45 % or
+// rises; hue and saturation keep their margins. darkest_light 1 keeps the additive margin only.
+TEST(HsvPickerTest, TheValueRangeFollowsTheLight) {
+  const cv::Mat hsv = HsvPatchImage(60, 3, 1);
+  const auto pick = PickHsvRange(ToBgr(hsv), {30, 30}, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  // 5th percentile of value ~170 (180 - noise): 0.4 of it is ~68.
+  EXPECT_GE(pick->v.lo, 60);
+  EXPECT_LE(pick->v.lo, 72);
+  EXPECT_EQ(pick->v.hi, 255);
+  for (const double gain : {0.45, 1.35}) {
+    cv::Mat relit = hsv.clone();
+    for (auto it = relit.begin<cv::Vec3b>(); it != relit.end<cv::Vec3b>(); ++it) {
+      (*it)[2] = cv::saturate_cast<uchar>((*it)[2] * gain);
+    }
+    EXPECT_DOUBLE_EQ(AcceptedFraction(ToBgr(relit), *pick, {30, 30}, 11, true), 1.0) << gain;
+    EXPECT_DOUBLE_EQ(AcceptedFraction(ToBgr(relit), *pick, {30, 30}, 13, false), 0.0) << gain;
+  }
+  HsvPickOptions margin_only;
+  margin_only.darkest_light = 1.0;
+  const auto tight = PickHsvRange(ToBgr(hsv), {30, 30}, margin_only);
+  ASSERT_TRUE(tight);
+  EXPECT_GE(tight->v.lo, 110);  // ~170 - 50.
+  EXPECT_LE(tight->v.lo, 125);
+}
+
 TEST(HsvPickerTest, OptionsCheckNamesTheField) {
   std::string error;
   EXPECT_TRUE(HsvPickOptions{}.Check(&error));
@@ -138,6 +165,10 @@ TEST(HsvPickerTest, OptionsCheckNamesTheField) {
   o.hue_margin = 95;
   EXPECT_FALSE(o.Check(&error));
   EXPECT_NE(error.find("hue_margin"), std::string::npos);
+  o = {};
+  o.darkest_light = 0.0;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("darkest_light"), std::string::npos);
   o = {};
   o.radius_px = -1;
   EXPECT_FALSE(o.Check(&error));

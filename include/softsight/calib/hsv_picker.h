@@ -29,6 +29,12 @@ struct HsvPickOptions {
   int hue_margin = 6;
   int saturation_margin = 40;
   int value_margin = 50;
+  // Value (brightness) scales with the light, hue and saturation do not: the value range reaches
+  // down to this fraction of the sampled values (or value_margin below them, whichever is lower)
+  // and up to 255, so the marker stays in range while its light falls to this fraction (a cloud,
+  // a lamp switched off, the camera's exposure) or rises. The tracker's learned model tells the
+  // marker from a look-alike of the same hue in another light. Default 0.4; 1 keeps the margin only.
+  double darkest_light = 0.4;
   // Pixels less saturated than this have no meaningful hue; they do not vote for the hue range.
   // A patch where fewer than half the pixels reach it is not a coloured marker. Default 40.
   int min_saturation = 40;
