@@ -136,11 +136,12 @@ int Main(int argc, char** argv) {
                 "/ on its own thread (as `track` runs) | %.3f / %.3f ms (%.2fx) | bare decode loop "
                 "of the file %.3f ms/frame, tracking alone %.3f ms, gray pass %.3f ms; CPU time "
                 "per frame (every thread): decode loop %.3f ms (%.1f cores busy), `track` on its "
-                "own thread %.3f ms, so at least %.3f ms of wall time on %u cores |\n",
+                "own thread %.3f ms, so at least %.3f ms of wall time on %u cores; max(decode, "
+                "tracking) %.3f ms, the threaded run %.2fx of it |\n",
                 first.image.cols, first.image.rows,
                 std::filesystem::path(video).extension().string().c_str(),
                 static_cast<long long>(frames), a, b, a / b, d, p, g, dc, dc / d, bc,
-                bc / cores, cores);
+                bc / cores, cores, std::max(d, p), b / std::max(d, p));
   std::cout << row;
   return 0;
 }
