@@ -33,6 +33,12 @@ constexpr int kRefineMarginPx = 2;          // Search margin per pyramid level w
 constexpr int kCandidates = 3;              // Coarse peaks refined to full resolution.
 constexpr int kMaxRecentre = 4;             // Re-centrings of the final window onto its peak.
 constexpr int kFineMarginPx = 3;            // First-template search around the working match.
+// A match within this of the last one, while the marker moved at least kMovingPx per frame, is
+// a repeated frame (footage that repeats frames to fill its rate): the velocity is kept for the
+// next new frame, at most kMaxRepeats times in a row (longer, and the marker has stopped).
+constexpr double kRepeatPx = 0.05;
+constexpr double kMovingPx = 1.0;
+constexpr int kMaxRepeats = 2;
 constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
@@ -406,6 +412,7 @@ class TemplateTracker final : public Tracker {
     tracking_ = false;
     last_centre_.reset();
     velocity_px_ = {0, 0};
+    repeats_ = 0;
     lost_frames_ = 0;
   }
 
@@ -452,6 +459,7 @@ class TemplateTracker final : public Tracker {
   Observation Lose(MarkerStatus why, int candidates = 0) {
     tracking_ = false;  // Keep last_centre_: the next acquisition looks around it.
     velocity_px_ = {0, 0};
+    repeats_ = 0;
     ++lost_frames_;
     return Observation::NotFound(why, candidates);
   }
@@ -467,6 +475,10 @@ class TemplateTracker final : public Tracker {
   std::vector<PreparedTemplate> coarse_;  // Acquisition pyramid of the search template, [0] unused.
   std::optional<cv::Point2d> last_centre_;  // Last known template centre (last match or hint).
   cv::Point2d velocity_px_{0, 0};       // Per frame; zero unless the last two frames matched.
+  int repeats_ = 0;                     // Repeated frames in a row (see kRepeatPx).
+  // The footage was seen repeating frames: the next frame may show the marker where it was, or
+  // a step on, so the tracking window spans both.
+  bool footage_repeats_ = false;
   bool tracking_ = false;               // The previous update found the marker (or the hint).
   int lost_frames_ = 0;                 // Updates since the marker was last found.
   // Distance to the nearest look-alike seen around the marker (at the selected scale), or
@@ -711,6 +723,7 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
     scan_pending_ = true;
   }
   velocity_px_ = {0, 0};
+  repeats_ = 0;
   lost_frames_ = 0;
   look_alike_px_ = std::numeric_limits<double>::infinity();
 }
@@ -1066,8 +1079,11 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   native_rect_ = cv::Rect();  // A new frame: nothing converted yet.
   std::optional<Hit> hit;
   if (tracking_) {
-    const cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
-                                         params_.search_margin_px);
+    cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
+                                   params_.search_margin_px);
+    if (footage_repeats_) {
+      window |= WindowAround(*last_centre_, search_template().size(), params_.search_margin_px);
+    }
     if ((window & frame_rect).empty()) return Lose(MarkerStatus::kOutOfFrame);
     // The window and a little around it: the later windows (the measurement, kFineMarginPx
     // around the match; the neighbouring rungs of the scale search; the template update's
@@ -1102,7 +1118,15 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     if (adapts()) RestoreWorkingTemplate();  // The working template may have drifted.
     return Lose(MarkerStatus::kLost);
   }
-  velocity_px_ = tracking_ ? fix->centre - *last_centre_ : cv::Point2d(0, 0);
+  const cv::Point2d step = tracking_ ? fix->centre - *last_centre_ : cv::Point2d(0, 0);
+  if (tracking_ && cv::norm(step) <= kRepeatPx && cv::norm(velocity_px_) >= kMovingPx &&
+      repeats_ < kMaxRepeats) {
+    ++repeats_;  // A repeated frame: the velocity is the next new frame's.
+    footage_repeats_ = true;
+  } else {
+    repeats_ = 0;
+    velocity_px_ = step;
+  }
   last_centre_ = fix->centre;
   tracking_ = true;
   lost_frames_ = 0;

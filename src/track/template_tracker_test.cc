@@ -538,6 +538,37 @@ TEST(TemplateTrackerTest, LookAlikeNeighbourIsNeverTakenForACoveredMarker) {
   }
 }
 
+// Footage that repeats every frame three times (a camera delivering a third of the file's
+// rate): the dot stands still for two frames, then moves three frames' worth, faster and faster
+// (4 px more each time, up to 32 px). The velocity is kept over the repeats and the window spans
+// "where it was" and "a step on", so every frame is found; without that, a step beyond the
+// acquisition's first reach (16 px) was lost.
+TEST(TemplateTrackerTest, FootageThatRepeatsFramesIsTrackedThroughTheJumps) {
+  for (const char* method : kMethods) {
+    SCOPED_TRACE(method);
+    MarkerSpec spec;
+    spec.name = "dot";
+    spec.params = ParamsForMethod(method, {}, {});
+    const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+    int found = 0, wrong = 0;
+    double x = 20.3;
+    for (int pose = 0; pose < 9; ++pose) {
+      x += 4.0 * pose;
+      const cv::Point2d a(x, 80.6);
+      const cv::Mat frame = TwoDots(a, {-100, -100}, 7.0);  // One dot: the other is off the card.
+      for (int repeat = 0; repeat < 3; ++repeat) {
+        if (pose == 0 && repeat == 0) tracker->init(frame, RectAround(a, 21));
+        const Observation o = tracker->update(frame);
+        if (!o.found()) continue;
+        ++found;
+        if (cv::norm(*o.position_px - a) > 0.5) ++wrong;
+      }
+    }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_EQ(found, 27);
+  }
+}
+
 // Two look-alikes within the region searched after a loss: neither is reported.
 TEST(TemplateTrackerTest, TwoLookAlikesInTheSearchedRegionAreAmbiguous) {
   const cv::Point2d a(80.4, 80.2), b(112.7, 81.1);
