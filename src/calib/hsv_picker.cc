@@ -27,11 +27,6 @@ HsvRange LinearRange(std::vector<double> values, const HsvPickOptions& o, int ma
           std::clamp(static_cast<int>(std::ceil(hi)), 0, 255)};
 }
 
-std::vector<double> SortedCopy(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values;
-}
-
 int WrapHue(int h) { return ((h % kHueCount) + kHueCount) % kHueCount; }
 
 }  // namespace
@@ -124,10 +119,10 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   }
   // Saturation never goes below min_saturation: below it the hue test means nothing.
   pick.s = LinearRange(std::move(sat), options, options.saturation_margin, options.min_saturation);
-  pick.v = LinearRange(val, options, options.value_margin, 0);
-  const int darkest = static_cast<int>(std::floor(options.darkest_light *
-                                                  Percentile(SortedCopy(val), options.low_percentile)));
-  pick.v = {std::min(pick.v.lo, darkest), 255};
+  std::sort(val.begin(), val.end());  // Once, for the margin's range and the darkest light's.
+  const int darkest =
+      static_cast<int>(std::floor(options.darkest_light * Percentile(val, options.low_percentile)));
+  pick.v = {std::min(LinearRange(std::move(val), options, options.value_margin, 0).lo, darkest), 255};
   return pick;
 }
 

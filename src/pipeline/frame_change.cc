@@ -136,7 +136,7 @@ cv::Vec3f FrameChangeDetector::row_gain(const std::vector<Cell>& now,
       if (b >= kDarkest) ratios_.push_back(n / b);
     }
     // Half the row's cells at least must say: a change confined to a few cells is not the light.
-    if (ratios_.size() * 2 < static_cast<size_t>(cols_) || ratios_.empty()) continue;
+    if (ratios_.size() * 2 < static_cast<size_t>(cols_)) continue;  // cols_ >= 1: never empty.
     auto middle = ratios_.begin() + static_cast<std::ptrdiff_t>(ratios_.size() / 2);
     std::nth_element(ratios_.begin(), middle, ratios_.end());
     if (*middle >= kLeast && *middle <= kMost) gain[c] = *middle;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "track/repeated_frames.h"
+
 namespace softsight {
 namespace {
 
@@ -25,16 +27,10 @@ constexpr double kSegmentFollow = 0.1;
 // Smoothing of the velocity and of the usual prediction error.
 constexpr double kVelocityFollow = 0.5;
 constexpr double kResidualFollow = 0.1;
-// A moving marker (at least this fast, px per frame) reported within kRepeatPx of where it was
-// last believed is in a repeated frame: a camera or a converter that fills its frame rate by
-// repeating frames (a 30 fps file from a webcam that delivered 15) shows the body still for a
-// frame, then moved by two frames' worth. Up to kMotionMemoryFrames such frames in a row leave
-// the marker's motion history as it was, so the step after them is predicted and bounded over
-// all the frames it took; a marker still for longer has stopped, and is learned as stopped.
-// (Sensor noise moves a still marker's centroid by hundredths of a pixel, so a real stop soon
-// reads as a stop too.)
-constexpr double kMovingPxPerFrame = 1.0;
-constexpr double kRepeatPx = 0.05;
+// Repeated frames (track/repeated_frames.h) leave a marker's motion history as it was, so the
+// step after them is predicted and bounded over all the frames it took: they must fit in the
+// motion's memory.
+static_assert(kMaxRepeatedFrames <= kMotionMemoryFrames);
 
 }  // namespace
 
@@ -214,9 +210,9 @@ const std::vector<size_t>& MarkerPlausibility::check(int64_t frame_index,
     }
     const cv::Point2d p = *markers[i].observation.position_px;
     const int64_t gap = frame_index - t.last_frame;
-    const bool still = t.last && !t.reacquiring && gap >= 1 && cv::norm(p - *t.last) <= kRepeatPx;
-    if (still && t.has_velocity && cv::norm(t.velocity) >= kMovingPxPerFrame &&
-        t.still_frames < kMotionMemoryFrames) {
+    const bool still =
+        t.last && !t.reacquiring && gap >= 1 && cv::norm(p - *t.last) <= kRepeatStillPx;
+    if (still && t.has_velocity && IsRepeatedFrame(p - *t.last, t.velocity, t.still_frames)) {
       ++t.still_frames;  // A repeated frame, perhaps: the history waits.
       continue;
     }

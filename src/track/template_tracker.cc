@@ -10,6 +10,7 @@
 #include "softsight/core/error.h"
 #include "softsight/track/tracker.h"
 #include "track/match_kernels.h"
+#include "track/repeated_frames.h"
 #include "track/track_options.h"
 
 namespace softsight {
@@ -33,12 +34,6 @@ constexpr int kRefineMarginPx = 2;          // Search margin per pyramid level w
 constexpr int kCandidates = 3;              // Coarse peaks refined to full resolution.
 constexpr int kMaxRecentre = 4;             // Re-centrings of the final window onto its peak.
 constexpr int kFineMarginPx = 3;            // First-template search around the working match.
-// A match within this of the last one, while the marker moved at least kMovingPx per frame, is
-// a repeated frame (footage that repeats frames to fill its rate): the velocity is kept for the
-// next new frame, at most kMaxRepeats times in a row (longer, and the marker has stopped).
-constexpr double kRepeatPx = 0.05;
-constexpr double kMovingPx = 1.0;
-constexpr int kMaxRepeats = 2;
 constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
@@ -475,7 +470,7 @@ class TemplateTracker final : public Tracker {
   std::vector<PreparedTemplate> coarse_;  // Acquisition pyramid of the search template, [0] unused.
   std::optional<cv::Point2d> last_centre_;  // Last known template centre (last match or hint).
   cv::Point2d velocity_px_{0, 0};       // Per frame; zero unless the last two frames matched.
-  int repeats_ = 0;                     // Repeated frames in a row (see kRepeatPx).
+  int repeats_ = 0;                     // Repeated frames in a row (track/repeated_frames.h).
   // The footage was seen repeating frames: the next frame may show the marker where it was, or
   // a step on, so the tracking window spans both.
   bool footage_repeats_ = false;
@@ -1119,8 +1114,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     return Lose(MarkerStatus::kLost);
   }
   const cv::Point2d step = tracking_ ? fix->centre - *last_centre_ : cv::Point2d(0, 0);
-  if (tracking_ && cv::norm(step) <= kRepeatPx && cv::norm(velocity_px_) >= kMovingPx &&
-      repeats_ < kMaxRepeats) {
+  if (tracking_ && IsRepeatedFrame(step, velocity_px_, repeats_)) {
     ++repeats_;  // A repeated frame: the velocity is the next new frame's.
     footage_repeats_ = true;
   } else {
