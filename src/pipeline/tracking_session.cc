@@ -9,6 +9,7 @@
 #include "pipeline/coincident_markers.h"
 #include "pipeline/frame_change.h"
 #include "pipeline/marker_plausibility.h"
+#include "pipeline/marker_tracks.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -67,6 +68,8 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
   }
   frame_change_ = std::make_unique<FrameChangeDetector>();
   plausibility_ = std::make_unique<MarkerPlausibility>(sizes, BodyOrder(config_));
+  tracks_ = std::make_unique<MarkerTracks>(sizes);
+  candidate_lists_.resize(trackers_.size());
   if (config_.camera) {
     undistorter_.emplace(*config_.camera);
     undistorted_ = result_.markers;
@@ -100,9 +103,33 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
         result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
       }
     }
+    tracks_->skip();
   } else {
     for (size_t i = 0; i < trackers_.size(); ++i) {
       if (initialised_[i]) result_.markers[i].observation = trackers_[i]->update(frame.image);
+      candidate_lists_[i] = initialised_[i] ? &trackers_[i]->candidates() : nullptr;
+    }
+    // Which candidate is which marker, for all markers at once with their motion: a report no
+    // motion explains, or that another marker's track explains better, is not believed; a
+    // candidate the tracker weighed but did not choose may be its marker.
+    const std::vector<MarkerTracks::Decision>& decisions =
+        tracks_->associate(result_.markers, candidate_lists_);
+    for (size_t i = 0; i < trackers_.size(); ++i) {
+      switch (decisions[i].action) {
+        case MarkerTracks::Decision::Action::kKeep:
+          break;
+        case MarkerTracks::Decision::Action::kReject:
+          trackers_[i]->reset();
+          break;
+        case MarkerTracks::Decision::Action::kAdopt:
+          if (std::optional<Observation> o = trackers_[i]->adopt(decisions[i].candidate)) {
+            result_.markers[i].observation = *o;
+          } else {
+            result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
+            trackers_[i]->reset();
+          }
+          break;
+      }
     }
     // Two markers cannot be at one place: a report that jumped onto another marker (a
     // look-alike re-acquired while its own marker is covered) is dropped, and its tracker
@@ -133,6 +160,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     }
   }
   for (size_t i : plausibility_->check(frame.index, result_.markers)) trackers_[i]->reset();
+  if (!frame_change_->whole_frame_changed()) tracks_->commit(result_.markers);
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
     if (previous_px_[i]) {
@@ -211,6 +239,7 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     trackers_[i]->init(frame.image, rect);
     initialised_[i] = true;
     plausibility_->forget(i);  // A person said where it is: no history to contradict that.
+    tracks_->forget(i);
     // ... nor another marker's last position there (the person may have swapped two markers).
     std::fill(believed_px_.begin(), believed_px_.end(), std::nullopt);
     // Saved configs must reproduce what the mouse did: the template's own pixels (a rectangle
@@ -255,6 +284,7 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
     if (config_.markers[i].name != marker) continue;
     if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
     plausibility_->forget(i);
+    tracks_->forget(i);
     if (!initialised_[i]) {
       result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
     } else if (frame_change_->whole_frame_changed()) {
@@ -283,6 +313,7 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     config_.markers[i] = spec;
     initialised_[i] = false;
     plausibility_->forget(i);
+    tracks_->forget(i);
     believed_px_[i].reset();
     edited(ConfigChange::Respec(spec));
     return;
@@ -305,6 +336,7 @@ void TrackingSession::jump() {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (initialised_[i]) trackers_[i]->reset();
     plausibility_->forget(i);
+    tracks_->forget(i);
     previous_px_[i].reset();
   }
   frame_change_ = std::make_unique<FrameChangeDetector>();

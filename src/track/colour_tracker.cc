@@ -44,6 +44,11 @@ constexpr double kMembershipDeadband = 0.12;
 // Noise floor (gray levels) in the contrast's denominator: perfectly flat synthetic colours
 // would otherwise make any difference infinitely significant.
 constexpr double kContrastNoiseFloor = 2.0;
+// The core's own spread counts half in the contrast: a marker's core varies by itself when the
+// marker is blurred by its motion (its colour ramps along the streak: a dot moving three of its
+// widths a frame still stands out), while a patch of background texture differs from its
+// surroundings by less than they vary, whatever its core does.
+constexpr double kCoreSigmaWeight = 0.5;
 
 // ---- Verification (ColourTracker::judge) -----------------------------------------------------------
 // A candidate whose contrast is below this does not stand out from its surroundings.
@@ -419,6 +424,38 @@ Observation ColourTracker::update(const cv::Mat& frame_bgr) {
     if (!frame_size_.empty()) reset();
     frame_size_ = frame_bgr.size();
   }
+  saved_ = State{model_, acquire_roi_, last_px_, last_seen_px_, velocity_px_, tracking_,
+                 held_frames_, lost_frames_};
+  return search(frame_bgr);
+}
+
+std::optional<Observation> ColourTracker::adopt(size_t index) {
+  if (index >= candidates_.size() || candidates_.size() != blobs_.size()) return std::nullopt;
+  const CandidateVerdict verdict = candidates_[index].verdict;
+  if (verdict != CandidateVerdict::kFits && verdict != CandidateVerdict::kChosen) {
+    return std::nullopt;
+  }
+  // Back to before the last report, then report this candidate as the choice.
+  model_ = saved_.model;
+  acquire_roi_ = saved_.acquire_roi;
+  last_px_ = saved_.last_px;
+  last_seen_px_ = saved_.last_seen_px;
+  velocity_px_ = saved_.velocity_px;
+  tracking_ = saved_.tracking;
+  held_frames_ = saved_.held_frames;
+  lost_frames_ = saved_.lost_frames;
+  if (!model_) return std::nullopt;  // Nothing learned to verify it against.
+  for (MarkerCandidate& c : candidates_) {
+    if (c.verdict == CandidateVerdict::kChosen) c.verdict = CandidateVerdict::kFits;
+  }
+  candidates_[index].verdict = CandidateVerdict::kChosen;
+  Choice choice;
+  choice.blob = blobs_[index];
+  choice.status = MarkerStatus::kFound;
+  return report(choice);
+}
+
+Observation ColourTracker::search(const cv::Mat& frame_bgr) {
   candidates_.clear();
   partly_seen_ = false;
   partly_out_ = false;
@@ -1135,7 +1172,8 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   blob->ring_sigma = std::sqrt(ring_var);
   const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
   const double axis2 = axis.dot(axis);
-  blob->contrast = std::sqrt(axis2) / (blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  blob->contrast = std::sqrt(axis2) /
+                   (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
   blob->measured = true;
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
 

@@ -80,6 +80,7 @@ class ColourTracker : public Tracker {
   Observation update(const cv::Mat& frame_bgr) override;
   void reset() override;
   const std::vector<MarkerCandidate>& candidates() const override { return candidates_; }
+  std::optional<Observation> adopt(size_t index) override;
   bool membership(const cv::Mat& frame_bgr, cv::Mat& mask) const override;
   std::optional<cv::Rect> search_region() const override {
     return last_search_px_.empty() ? std::nullopt : std::optional<cv::Rect>(last_search_px_);
@@ -137,6 +138,7 @@ class ColourTracker : public Tracker {
     bool hold = false;  // Not found, but partly seen where expected: keep the window there.
   };
   void check_frame(const cv::Mat& frame) const;
+  Observation search(const cv::Mat& frame);  // update() without the snapshot.
   Choice track_in_windows(const cv::Mat& frame);
   Choice acquire(const cv::Mat& frame);
   // After a lasting change of the light: the one blob near where the marker was last seen that
@@ -184,6 +186,18 @@ class ColourTracker : public Tracker {
   std::optional<cv::Point2d> last_seen_px_;
   cv::Size frame_size_;
   cv::Rect last_search_px_;
+
+  // What the tracker knew before the last update() reported, so adopt() can report another of
+  // its candidates as if it had chosen that one.
+  struct State {
+    std::optional<ColourModel> model;
+    std::optional<cv::Rect> acquire_roi;
+    std::optional<cv::Point2d> last_px, last_seen_px;
+    cv::Point2d velocity_px;
+    bool tracking = false;
+    int held_frames = 0, lost_frames = 0;
+  };
+  State saved_;
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;

@@ -47,6 +47,8 @@ const std::vector<MarkerCandidate>& Tracker::candidates() const {
 
 bool Tracker::membership(const cv::Mat& /*frame_bgr*/, cv::Mat& /*mask*/) const { return false; }
 
+std::optional<Observation> Tracker::adopt(size_t /*index*/) { return std::nullopt; }
+
 std::optional<cv::Rect> Tracker::search_region() const { return std::nullopt; }
 
 const char* CandidateVerdictName(CandidateVerdict verdict) {

@@ -18,6 +18,7 @@ namespace softsight {
 
 class FrameChangeDetector;
 class MarkerPlausibility;
+class MarkerTracks;
 
 // FrameResult (one frame's observations + measurement) is a core value type: core/types.h.
 
@@ -102,6 +103,8 @@ class TrackingSession {
   std::vector<std::optional<cv::Point2d>> recent_px_;
   std::unique_ptr<FrameChangeDetector> frame_change_;
   std::unique_ptr<MarkerPlausibility> plausibility_;
+  std::unique_ptr<MarkerTracks> tracks_;  // Motion models and the global association.
+  std::vector<const std::vector<MarkerCandidate>*> candidate_lists_;  // Reused per frame.
   Measurer measurer_;
   std::optional<Undistorter> undistorter_;     // Present when the config names a camera file.
   std::vector<MarkerObservation> undistorted_; // Reused: what the measurer sees with a lens model.

@@ -76,6 +76,14 @@ class Tracker {
   // trackers that do not report them. Valid until the next update().
   virtual const std::vector<MarkerCandidate>& candidates() const;
 
+  // The session's association (which marker is which candidate, decided for all markers at once
+  // with their motion) chose candidate `index` of candidates() as this tracker's marker, in
+  // place of what the last update() reported: the tracker continues from it as if it had chosen
+  // it itself, and returns the observation it reports for it. Absent when it cannot (a
+  // candidate that does not fit, or a tracker without candidates); the caller then reports the
+  // marker not found and resets the tracker.
+  virtual std::optional<Observation> adopt(size_t index);
+
   // Diagnostics for the live window's mask view. The pixels of `frame_bgr` this tracker counts
   // as its marker's colour (CV_8U, 255 = member; before filtering and morphology): false for
   // trackers without such a notion (templates).

@@ -1,0 +1,222 @@
+// The association's parts against exact answers: the minimum-cost assignment (against brute
+// force), the motion model (a constant-velocity and an accelerating path), and the track
+// manager's decisions (a look-alike another track explains, a jump, a candidate the tracker did
+// not choose, a repeated frame).
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/assignment.h"
+#include "pipeline/marker_tracks.h"
+#include "pipeline/motion_model.h"
+
+namespace softsight {
+namespace {
+
+double BruteForceCost(const std::vector<std::vector<double>>& cost,
+                      const std::vector<double>& unassigned) {
+  // Every way of giving each marker a distinct candidate or none.
+  const size_t markers = cost.size(), candidates = cost.empty() ? 0 : cost[0].size();
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<int> choice(markers, -1);
+  const auto recurse = [&](auto&& self, size_t m, std::vector<bool>& used, double sum) -> void {
+    if (m == markers) {
+      best = std::min(best, sum);
+      return;
+    }
+    self(self, m + 1, used, sum + unassigned[m]);
+    for (size_t c = 0; c < candidates; ++c) {
+      if (used[c] || !std::isfinite(cost[m][c])) continue;
+      used[c] = true;
+      self(self, m + 1, used, sum + cost[m][c]);
+      used[c] = false;
+    }
+  };
+  std::vector<bool> used(candidates, false);
+  recurse(recurse, 0, used, 0.0);
+  return best;
+}
+
+TEST(AssignMinimumCost, EqualsBruteForceOnRandomMatricesWithForbiddenPairs) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> value(0.0, 2.0);
+  std::uniform_int_distribution<int> size(0, 5);
+  for (int trial = 0; trial < 300; ++trial) {
+    const size_t markers = static_cast<size_t>(size(rng)), candidates = static_cast<size_t>(size(rng));
+    std::vector<std::vector<double>> cost(markers, std::vector<double>(candidates));
+    std::vector<double> unassigned(markers);
+    for (size_t m = 0; m < markers; ++m) {
+      unassigned[m] = value(rng);
+      for (size_t c = 0; c < candidates; ++c) {
+        cost[m][c] = rng() % 3 == 0 ? kForbidden : value(rng);
+      }
+    }
+    const std::vector<int> assigned = AssignMinimumCost(cost, unassigned);
+    ASSERT_EQ(assigned.size(), markers);
+    double sum = 0.0;
+    std::vector<int> taken;
+    for (size_t m = 0; m < markers; ++m) {
+      if (assigned[m] < 0) {
+        sum += unassigned[m];
+        continue;
+      }
+      ASSERT_TRUE(std::isfinite(cost[m][static_cast<size_t>(assigned[m])])) << "trial " << trial;
+      sum += cost[m][static_cast<size_t>(assigned[m])];
+      taken.push_back(assigned[m]);
+    }
+    std::sort(taken.begin(), taken.end());
+    EXPECT_TRUE(std::adjacent_find(taken.begin(), taken.end()) == taken.end()) << "trial " << trial;
+    EXPECT_NEAR(sum, BruteForceCost(cost, unassigned), 1e-9) << "trial " << trial;
+  }
+}
+
+TEST(AssignMinimumCost, TwoMarkersWantingOneCandidateGiveItToTheCheaper) {
+  // Marker 0 near candidate 0 (cost 0.1), marker 1 farther (0.6) and with nothing else.
+  const std::vector<int> a = AssignMinimumCost({{0.1}, {0.6}}, {1.5, 1.5});
+  EXPECT_EQ(a, (std::vector<int>{0, -1}));
+}
+
+TEST(MotionModel, LearnsAConstantVelocityAndPredictsItExactly) {
+  MotionModel model;
+  model.start({100, 50});
+  for (int f = 1; f <= 20; ++f) {
+    model.predict();
+    model.update({100 + 30.0 * f, 50 - 4.0 * f});
+  }
+  model.predict();
+  EXPECT_NEAR(model.position().x, 100 + 30.0 * 21, 0.05);
+  EXPECT_NEAR(model.position().y, 50 - 4.0 * 21, 0.05);
+  // A report a marker's width off the straight path is far outside a steady marker's gate.
+  EXPECT_LT(model.distance2({730, -34}), 1.0);
+  EXPECT_GT(model.distance2({745, -34}), 16.0);
+}
+
+TEST(MotionModel, AnAcceleratingMarkerStaysInsideItsGate) {
+  MotionModel model;
+  model.start({60, 150});
+  double worst = 0.0;
+  for (int f = 1; f <= 15; ++f) {
+    model.predict();
+    const double x = f <= 10 ? 60 + 3.0 * f * f : 360 + 60.0 * (f - 10);
+    if (f >= 2) worst = std::max(worst, model.distance2({x, 150}));
+    model.update({x, 150});
+  }
+  EXPECT_LT(worst, 16.0);
+}
+
+TEST(MotionModel, ItsUncertaintyGrowsWhileTheMarkerIsNotSeen) {
+  MotionModel model;
+  model.start({0, 0});
+  for (int f = 1; f <= 10; ++f) {
+    model.predict();
+    model.update({5.0 * f, 0});
+  }
+  double before = 0.0;
+  for (int f = 0; f < 10; ++f) {
+    model.predict();
+    EXPECT_GT(model.sigma_px(), before);
+    before = model.sigma_px();
+  }
+}
+
+std::vector<MarkerObservation> Reports(const std::vector<std::optional<cv::Point2d>>& at) {
+  std::vector<MarkerObservation> markers;
+  for (size_t i = 0; i < at.size(); ++i) {
+    MarkerObservation m;
+    m.name = std::string(1, static_cast<char>('a' + i));
+    if (at[i]) m.observation.position_px = *at[i];
+    markers.push_back(m);
+  }
+  return markers;
+}
+
+MarkerCandidate Candidate(const cv::Point2d& p, CandidateVerdict verdict) {
+  MarkerCandidate c;
+  c.position_px = p;
+  c.verdict = verdict;
+  return c;
+}
+
+// Two markers moving right at 10 px a frame, 100 px apart, for `frames` frames.
+MarkerTracks TwoMovingTracks(int frames) {
+  MarkerTracks tracks({6.0, 6.0});
+  for (int f = 0; f < frames; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(10.0 * f, 0), cv::Point2d(100 + 10.0 * f, 0)});
+    const std::vector<MarkerCandidate> a = {Candidate(*m[0].observation.position_px, CandidateVerdict::kChosen)};
+    const std::vector<MarkerCandidate> b = {Candidate(*m[1].observation.position_px, CandidateVerdict::kChosen)};
+    tracks.associate(m, {&a, &b});
+    tracks.commit(m);
+  }
+  return tracks;
+}
+
+TEST(MarkerTracks, AReportOnAnotherMarkersPredictedPlaceIsNotBelieved) {
+  MarkerTracks tracks = TwoMovingTracks(10);
+  // Frame 10: marker 0's tracker lost its marker and re-acquired on marker 1's twin.
+  std::vector<MarkerObservation> m = Reports({cv::Point2d(200, 0), cv::Point2d(200, 0)});
+  const std::vector<MarkerCandidate> list = {Candidate({200, 0}, CandidateVerdict::kChosen)};
+  const auto& d = tracks.associate(m, {&list, &list});
+  EXPECT_EQ(d[0].action, MarkerTracks::Decision::Action::kReject);
+  EXPECT_FALSE(m[0].observation.found());
+  EXPECT_EQ(m[0].observation.status(), MarkerStatus::kImplausible);
+  EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_TRUE(m[1].observation.found());
+}
+
+TEST(MarkerTracks, ACandidateTheTrackerDidNotChooseIsAdoptedWhereTheMotionSaysTheMarkerIs) {
+  MarkerTracks tracks = TwoMovingTracks(10);
+  // Marker 0's tracker chose the twin at marker 1's place; its own marker was a candidate too.
+  std::vector<MarkerObservation> m = Reports({cv::Point2d(200, 0), cv::Point2d(200, 0)});
+  const std::vector<MarkerCandidate> a = {Candidate({100, 0}, CandidateVerdict::kFits),
+                                          Candidate({200, 0}, CandidateVerdict::kChosen)};
+  const std::vector<MarkerCandidate> b = {Candidate({200, 0}, CandidateVerdict::kChosen)};
+  const auto& d = tracks.associate(m, {&a, &b});
+  ASSERT_EQ(d[0].action, MarkerTracks::Decision::Action::kAdopt);
+  EXPECT_EQ(d[0].candidate, 0u);
+  EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kKeep);
+}
+
+TEST(MarkerTracks, AJumpNoMotionExplainsIsNotBelievedButAMarkerBackWithinItsReachIs) {
+  MarkerTracks tracks({6.0});
+  const std::vector<MarkerCandidate> none;
+  for (int f = 0; f < 10; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(100 + 5.0 * f, 100)});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+  }
+  // 200 px away in one frame: a look-alike.
+  std::vector<MarkerObservation> jump = Reports({cv::Point2d(350, 100)});
+  EXPECT_EQ(tracks.associate(jump, {&none})[0].action, MarkerTracks::Decision::Action::kReject);
+  tracks.commit(jump);
+  // Lost for two frames; back where its motion took it.
+  std::vector<MarkerObservation> lost = Reports({std::nullopt});
+  tracks.associate(lost, {&none});
+  tracks.commit(lost);
+  std::vector<MarkerObservation> back = Reports({cv::Point2d(160, 100)});
+  EXPECT_EQ(tracks.associate(back, {&none})[0].action, MarkerTracks::Decision::Action::kKeep);
+}
+
+TEST(MarkerTracks, ARepeatedFrameIsBelievedAndTheStepAfterItIsExpected) {
+  MarkerTracks tracks({4.0});
+  const std::vector<MarkerCandidate> none;
+  double x = 0;
+  for (int f = 0; f < 10; ++f, x += 16) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(x, 0)});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+  }
+  // The footage repeats the last frame: the marker exactly where it was.
+  std::vector<MarkerObservation> repeat = Reports({cv::Point2d(x - 16, 0)});
+  EXPECT_EQ(tracks.associate(repeat, {&none})[0].action, MarkerTracks::Decision::Action::kKeep);
+  tracks.commit(repeat);
+  // Then two frames' worth at once.
+  std::vector<MarkerObservation> next = Reports({cv::Point2d(x + 16, 0)});
+  EXPECT_EQ(tracks.associate(next, {&none})[0].action, MarkerTracks::Decision::Action::kKeep);
+}
+
+}  // namespace
+}  // namespace softsight

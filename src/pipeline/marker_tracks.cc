@@ -1,0 +1,213 @@
+#include "pipeline/marker_tracks.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/assignment.h"
+#include "track/repeated_frames.h"
+
+namespace softsight {
+namespace {
+
+// The gate: a squared Mahalanobis distance of 16 is 4 sigma (2 degrees of freedom: a report
+// inside it by chance 1 time in 3000).
+constexpr double kGate2 = 16.0;
+// Candidates within this of each other are one blob seen by several trackers.
+constexpr double kSamePlacePx = 1.0;
+// Costs (unitless): an allowed pair costs its distance2 / kGate2 (at most 1) plus a little of
+// the tracker's misfit; a first acquisition (no track yet) costs more than any allowed pair, so
+// a candidate a started track explains goes to that track; leaving a marker unassigned costs
+// more than both, so a marker takes a candidate whenever one is allowed.
+constexpr double kMisfitWeight = 0.05;
+constexpr double kFirstAcquisitionCost = 1.2;
+constexpr double kUnassignedCost = 1.5;
+
+double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
+  const cv::Point2d ab = b - a;
+  const double len2 = ab.dot(ab);
+  const double u = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return cv::norm(p - (a + u * ab));
+}
+
+bool Fits(CandidateVerdict v) {
+  return v == CandidateVerdict::kFits || v == CandidateVerdict::kChosen;
+}
+
+}  // namespace
+
+MarkerTracks::MarkerTracks(std::vector<double> size_px, MotionModelOptions motion)
+    : size_px_(std::move(size_px)) {
+  for (size_t i = 0; i < size_px_.size(); ++i) {
+    Track track;
+    track.motion = MotionModel(motion);
+    tracks_.push_back(track);
+  }
+  decisions_.resize(size_px_.size());
+  entries_.resize(size_px_.size());
+  cost_.resize(size_px_.size());
+  unassigned_.resize(size_px_.size());
+  report_pooled_.resize(size_px_.size());
+}
+
+void MarkerTracks::forget(size_t i) {
+  Track& t = tracks_.at(i);
+  t.motion.clear();
+  t.last_px.reset();
+  t.repeats = 0;
+  t.misses = 0;
+}
+
+void MarkerTracks::predict_all() {
+  for (Track& t : tracks_) {
+    if (!t.predicted) t.motion.predict();
+    t.predicted = true;
+  }
+}
+
+void MarkerTracks::skip() {
+  predict_all();
+  for (Track& t : tracks_) t.predicted = false;
+}
+
+size_t MarkerTracks::pool(const cv::Point2d& p) {
+  for (size_t k = 0; k < pooled_.size(); ++k) {
+    if (cv::norm(pooled_[k].position_px - p) <= kSamePlacePx) return k;
+  }
+  pooled_.push_back({p});
+  return pooled_.size() - 1;
+}
+
+const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
+    std::vector<MarkerObservation>& markers,
+    const std::vector<const std::vector<MarkerCandidate>*>& candidates) {
+  CV_Assert(markers.size() == tracks_.size() && candidates.size() == tracks_.size());
+  predict_all();
+  pooled_.clear();
+  for (size_t i = 0; i < markers.size(); ++i) {
+    decisions_[i] = Decision{};
+    entries_[i].clear();
+    report_pooled_[i].reset();
+    tracks_[i].repeated = false;
+    const Observation& o = markers[i].observation;
+    if (o.found()) {
+      // The report, with its candidate's misfit when the tracker lists it.
+      double misfit = 0.0;
+      std::optional<size_t> index;
+      const std::vector<MarkerCandidate>* list = candidates[i];
+      for (size_t c = 0; list && c < list->size(); ++c) {
+        if ((*list)[c].verdict == CandidateVerdict::kChosen &&
+            cv::norm((*list)[c].position_px - *o.position_px) <= kSamePlacePx) {
+          misfit = (*list)[c].misfit;
+          index = c;
+        }
+      }
+      report_pooled_[i] = pool(*o.position_px);
+      entries_[i].push_back({*report_pooled_[i], index, misfit});
+    }
+    // The other candidates that fit the marker: the one the tracker did not choose (a twin it
+    // could not tell apart, or one farther from its own prediction) may be the marker.
+    if (!tracks_[i].motion.started() || !candidates[i]) continue;
+    const std::vector<MarkerCandidate>& list = *candidates[i];
+    for (size_t c = 0; c < list.size(); ++c) {
+      if (!Fits(list[c].verdict)) continue;
+      const size_t k = pool(list[c].position_px);
+      if (report_pooled_[i] && k == *report_pooled_[i]) continue;
+      entries_[i].push_back({k, c, list[c].misfit});
+    }
+  }
+  // The cost matrix.
+  for (size_t i = 0; i < markers.size(); ++i) {
+    cost_[i].assign(pooled_.size(), kForbidden);
+    unassigned_[i] = kUnassignedCost;
+    const Track& t = tracks_[i];
+    for (const Entry& e : entries_[i]) {
+      const cv::Point2d p = pooled_[e.pooled].position_px;
+      if (!t.motion.started()) {
+        // No track yet: the tracker's own first acquisition (its report only).
+        if (report_pooled_[i] && e.pooled == *report_pooled_[i]) {
+          cost_[i][e.pooled] = kFirstAcquisitionCost;
+        }
+        continue;
+      }
+      // A repeated frame: the marker exactly where it was while moving (the footage repeats
+      // frames); its motion waits for the next new frame.
+      const bool repeated = t.last_px && cv::norm(p - *t.last_px) <= kRepeatStillPx &&
+                            IsRepeatedFrame(p - *t.last_px, t.motion.velocity(), t.repeats);
+      const double d2 = t.motion.distance2(p);
+      const double dist = cv::norm(p - t.motion.position());
+      // Inside the gate, or within what the marker covers in a frame at its speed plus its own
+      // size (it may stop or turn sharply within one frame: a bounce, a start).
+      bool inside = d2 <= kGate2 || dist <= size_px_[i] + cv::norm(t.motion.velocity()) || repeated;
+      if (!inside && t.misses > 0 && t.last_px) {
+        // Coasting: the marker may have stopped, slowed or kept going since it was last seen.
+        // Its reach is anywhere between where it was and where it would be now, plus the
+        // gate's radius.
+        inside = DistanceToSegment(p, *t.last_px, t.motion.position()) <=
+                 size_px_[i] + std::sqrt(kGate2) * t.motion.sigma_px();
+      }
+      if (!inside) continue;
+      cost_[i][e.pooled] =
+          (repeated ? 0.0 : std::min(d2, kGate2) / kGate2) + kMisfitWeight * std::min(e.misfit, 2.0);
+    }
+  }
+  const std::vector<int> assigned = AssignMinimumCost(cost_, unassigned_);
+  for (size_t i = 0; i < markers.size(); ++i) {
+    Observation& o = markers[i].observation;
+    if (assigned[i] < 0) {
+      if (o.found()) {
+        decisions_[i].action = Decision::Action::kReject;
+        o = Observation::NotFound(MarkerStatus::kImplausible);
+      }
+      continue;
+    }
+    const size_t k = static_cast<size_t>(assigned[i]);
+    if (report_pooled_[i] && k == *report_pooled_[i]) {
+      if (tracks_[i].last_px && cv::norm(*o.position_px - *tracks_[i].last_px) <= kRepeatStillPx &&
+          IsRepeatedFrame(*o.position_px - *tracks_[i].last_px, tracks_[i].motion.velocity(),
+                          tracks_[i].repeats)) {
+        tracks_[i].repeated = true;
+      }
+      continue;  // kKeep.
+    }
+    for (const Entry& e : entries_[i]) {
+      if (e.pooled != k || !e.tracker_index) continue;
+      decisions_[i].action = Decision::Action::kAdopt;
+      decisions_[i].candidate = *e.tracker_index;
+    }
+    if (decisions_[i].action != Decision::Action::kAdopt && o.found()) {
+      decisions_[i].action = Decision::Action::kReject;
+      o = Observation::NotFound(MarkerStatus::kImplausible);
+    }
+  }
+  return decisions_;
+}
+
+void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
+  CV_Assert(markers.size() == tracks_.size());
+  for (size_t i = 0; i < markers.size(); ++i) {
+    Track& t = tracks_[i];
+    if (!t.predicted) t.motion.predict();
+    t.predicted = false;
+    const Observation& o = markers[i].observation;
+    if (!o.found()) {
+      t.repeats = 0;
+      ++t.misses;
+      continue;
+    }
+    t.misses = 0;
+    const cv::Point2d p = *o.position_px;
+    if (t.repeated && t.last_px && cv::norm(p - *t.last_px) <= kRepeatStillPx) {
+      ++t.repeats;  // The prediction has moved on a frame, as the marker did behind the repeat.
+      continue;
+    }
+    t.repeats = 0;
+    if (!t.motion.started()) {
+      t.motion.start(p);
+    } else {
+      t.motion.update(p);
+    }
+    t.last_px = p;
+  }
+}
+
+}  // namespace softsight

@@ -1,0 +1,100 @@
+// Track management and global association: which of this frame's candidates is which marker.
+//
+// Each marker has a track: a motion model (pipeline/motion_model.h) that predicts where it is
+// and how far from there it can be. Per frame, every marker's candidates (its tracker's report
+// and every other candidate its tracker found to fit the marker's model) are pooled; one
+// candidate seen by several trackers (identical markers) is one candidate. The assignment of
+// markers to candidates is solved globally at minimum cost (pipeline/assignment.h): the cost of
+// a pair is its squared Mahalanobis distance from the marker's prediction, and a pair outside
+// the marker's gate is not allowed. So two markers never take one candidate, a look-alike that
+// another marker's track explains goes to that marker (or to nobody), and a report that no
+// motion since the marker was last believed explains is not believed.
+//
+// Track states: none (never believed: the tracker's first acquisition, verified by its own model,
+// is taken as it is, unless a started track claims that candidate), tentative (one believed
+// report: velocity unknown, the gate is wide), confirmed, and coasting (not believed in the last
+// frames: still predicted, its gate growing with the time since, so a re-acquisition must lie
+// where a plausible motion could have taken the marker meanwhile).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/motion_model.h"
+#include "softsight/core/types.h"
+#include "softsight/track/tracker.h"
+
+namespace softsight {
+
+class MarkerTracks {
+ public:
+  // What the session does with a marker's tracker after association.
+  struct Decision {
+    enum class Action : uint8_t {
+      kKeep,    // The report stands (or there was none).
+      kReject,  // The report is not believed: NotFound(kImplausible), the tracker searches afresh.
+      kAdopt,   // Candidate `candidate` of the tracker's last update is the marker.
+    };
+    Action action = Action::kKeep;
+    size_t candidate = 0;
+  };
+
+  // `size_px[i]`: about marker i's radius. A report within it of the prediction is always inside
+  // the gate (a start, a stop, a sharp turn within one frame).
+  explicit MarkerTracks(std::vector<double> size_px, MotionModelOptions motion = {});
+
+  // The association of this frame. `markers`: the trackers' reports; `candidates[i]`: what
+  // marker i's tracker weighed (may be empty). Rejected reports are turned into
+  // NotFound(kImplausible) here; adopted ones are left to the caller (the tracker makes the
+  // candidate its report). Returns one decision per marker (reused).
+  const std::vector<Decision>& associate(
+      std::vector<MarkerObservation>& markers,
+      const std::vector<const std::vector<MarkerCandidate>*>& candidates);
+  // The frame's believed reports (after every other check) update the tracks. Call once per
+  // frame after associate().
+  void commit(const std::vector<MarkerObservation>& markers);
+  // A frame in which nothing was believed (it changed as a whole): the tracks are predicted over
+  // it, nothing else.
+  void skip();
+  // Marker i starts afresh (re-selected, re-specified, or the video jumped): no motion.
+  void forget(size_t i);
+
+  // For tests: marker i's motion model.
+  const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
+
+ private:
+  struct Track {
+    MotionModel motion;
+    bool predicted = false;       // predict() ran for this frame.
+    int repeats = 0;              // Reports in a row exactly where the last one was.
+    int misses = 0;               // Frames since the last believed report.
+    std::optional<cv::Point2d> last_px;  // The last believed report.
+    bool repeated = false;        // This frame's report is a repeated frame (see commit).
+  };
+  struct Pooled {
+    cv::Point2d position_px;
+  };
+  void predict_all();
+  size_t pool(const cv::Point2d& p);
+
+  std::vector<double> size_px_;
+  std::vector<Track> tracks_;
+  std::vector<Decision> decisions_;
+  // Per frame, reused: the pooled candidates, each marker's (pooled index, tracker index,
+  // misfit) entries, the cost matrix and the report's pooled index per marker.
+  std::vector<Pooled> pooled_;
+  struct Entry {
+    size_t pooled;
+    std::optional<size_t> tracker_index;  // Absent: the report itself (no candidate list).
+    double misfit;
+  };
+  std::vector<std::vector<Entry>> entries_;
+  std::vector<std::vector<double>> cost_;
+  std::vector<double> unassigned_;
+  std::vector<std::optional<size_t>> report_pooled_;
+};
+
+}  // namespace softsight

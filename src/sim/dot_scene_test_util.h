@@ -1,0 +1,180 @@
+// An independent renderer for tests (test code only): free markers of any shape moving along
+// given paths over a textured background, drawn with OpenCV's own shapes at 4x and area-averaged
+// down, with optional motion blur (sub-frame exposures) and sensor noise. It shares no code with
+// sim/scene.cc, so the trackers are tried on footage they were not developed against: carts on a
+// track, dots on a hand-held plate, a sticker on a wheel, a disc behind a paddle.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight::testing {
+
+// Where a shape is at time t (in frames; fractional for motion blur) and how it is turned.
+struct DotPose {
+  cv::Point2d centre_px;
+  double angle_deg = 0.0;
+  bool visible = true;
+  double scale = 1.0;  // Of the shape's radii (a plate coming closer).
+};
+
+struct DotShape {
+  cv::Size2d radii_px{5, 5};        // Semi-axes (an ellipse; equal: a disc).
+  cv::Vec3b bgr{0, 220, 230};
+  // A highlight: a smaller bright ellipse inside the shape, offset from its centre (a specular
+  // reflection on a glossy puck).
+  std::optional<cv::Vec3b> highlight_bgr;
+  double highlight_fraction = 0.35;   // Of the radii.
+  cv::Point2d highlight_offset{0.3, -0.3};  // In radii.
+  std::function<DotPose(double t)> path;
+};
+
+// A rectangle over everything (a paddle, a hand), from frame `first` to `last`, moving.
+struct DotCover {
+  std::function<cv::Rect2d(double t)> rect_px;
+  int first = 0, last = 1 << 30;
+  cv::Vec3b bgr{60, 60, 60};
+};
+
+struct DotSceneOptions {
+  cv::Size size{640, 480};
+  uint64_t seed = 1;
+  double noise_sigma = 2.0;
+  int blur_samples = 1;       // Sub-frame exposures per frame (1: none).
+  double exposure = 0.5;      // Fraction of the frame interval the shutter is open.
+  // Background: mean gray with low-frequency blotches and fine grain; `clutter` adds gray
+  // rectangles and discs (not of any shape's colour unless `clutter_bgr` says so).
+  double background_level = 110;
+  int clutter = 0;
+  std::optional<cv::Vec3b> clutter_bgr;
+};
+
+class DotScene {
+ public:
+  DotScene(DotSceneOptions options, std::vector<DotShape> shapes, std::vector<DotCover> covers = {})
+      : options_(options), shapes_(std::move(shapes)), covers_(std::move(covers)) {
+    MakeBackground();
+  }
+
+  const std::vector<DotShape>& shapes() const { return shapes_; }
+
+  // The exact centre of shape `s` at frame `frame` (mid-exposure), absent when not visible.
+  std::optional<cv::Point2d> truth(size_t s, int frame) const {
+    const DotPose pose = shapes_[s].path(frame);
+    if (!pose.visible) return std::nullopt;
+    return pose.centre_px;
+  }
+
+  // Frame `frame`, CV_8UC3.
+  cv::Mat render(int frame) const {
+    constexpr int kSs = 4;
+    const cv::Size big(options_.size.width * kSs, options_.size.height * kSs);
+    cv::Mat accumulated(options_.size, CV_32FC3, cv::Scalar::all(0));
+    const int samples = std::max(1, options_.blur_samples);
+    cv::Mat canvas, small;
+    for (int k = 0; k < samples; ++k) {
+      const double t = samples == 1 ? frame
+                                    : frame + options_.exposure * ((k + 0.5) / samples - 0.5);
+      background_big_.copyTo(canvas);
+      for (const DotShape& shape : shapes_) {
+        const DotPose pose = shape.path(t);
+        if (!pose.visible) continue;
+        const cv::Size2d radii = shape.radii_px * pose.scale;
+        DrawEllipse(canvas, pose.centre_px, radii, pose.angle_deg, shape.bgr);
+        if (shape.highlight_bgr) {
+          const double a = pose.angle_deg * CV_PI / 180.0;
+          const cv::Point2d off(shape.highlight_offset.x * radii.width,
+                                shape.highlight_offset.y * radii.height);
+          const cv::Point2d c = pose.centre_px + cv::Point2d(off.x * std::cos(a) - off.y * std::sin(a),
+                                                             off.x * std::sin(a) + off.y * std::cos(a));
+          DrawEllipse(canvas, c, radii * shape.highlight_fraction, pose.angle_deg,
+                      *shape.highlight_bgr);
+        }
+      }
+      for (const DotCover& cover : covers_) {
+        if (frame < cover.first || frame > cover.last) continue;
+        const cv::Rect2d r = cover.rect_px(t);
+        const cv::Point tl(cvRound((r.x + 0.5) * kSs), cvRound((r.y + 0.5) * kSs));
+        const cv::Point br(cvRound((r.x + r.width + 0.5) * kSs) - 1,
+                           cvRound((r.y + r.height + 0.5) * kSs) - 1);
+        cv::rectangle(canvas, tl, br, cv::Scalar(cover.bgr), cv::FILLED);
+      }
+      cv::resize(canvas, small, options_.size, 0, 0, cv::INTER_AREA);
+      cv::accumulate(small, accumulated);
+    }
+    accumulated *= 1.0 / samples;
+    cv::Mat noise(options_.size, CV_32FC3);
+    cv::RNG rng(options_.seed * 7919 + static_cast<uint64_t>(frame) + 1);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.noise_sigma);
+    accumulated += noise;
+    cv::Mat out;
+    accumulated.convertTo(out, CV_8UC3);
+    return out;
+  }
+
+  // A rectangle around shape `s` at frame 0, as a person would drag it (`margin` px around).
+  cv::Rect roi(size_t s, int frame = 0, int margin = 6) const {
+    const cv::Point2d c = *truth(s, frame);
+    const double r = std::max(shapes_[s].radii_px.width, shapes_[s].radii_px.height) + margin;
+    return cv::Rect(cvFloor(c.x - r), cvFloor(c.y - r), cvCeil(2 * r) + 1, cvCeil(2 * r) + 1);
+  }
+
+ private:
+  static void DrawEllipse(cv::Mat& big, const cv::Point2d& centre, const cv::Size2d& radii,
+                          double angle_deg, const cv::Vec3b& bgr) {
+    constexpr int kSs = 4, kShift = 4;
+    const double scale = kSs * (1 << kShift);
+    // Output pixel-centre convention: output x covers big columns [4x, 4x + 4), so its centre
+    // at x maps to big coordinate 4 (x + 0.5) in the big image's own pixel-centre convention
+    // minus 0.5.
+    const cv::Point c(cvRound((centre.x + 0.5) * scale - 0.5 * (1 << kShift)),
+                      cvRound((centre.y + 0.5) * scale - 0.5 * (1 << kShift)));
+    const cv::Size axes(cvRound(radii.width * scale), cvRound(radii.height * scale));
+    cv::ellipse(big, c, axes, angle_deg, 0, 360, cv::Scalar(bgr), cv::FILLED, cv::LINE_8, kShift);
+  }
+
+  void MakeBackground() {
+    constexpr int kSs = 4;
+    cv::RNG rng(options_.seed);
+    cv::Mat blotches(options_.size.height / 16 + 2, options_.size.width / 16 + 2, CV_32FC3);
+    rng.fill(blotches, cv::RNG::NORMAL, 0.0, 18.0);
+    cv::Mat low;
+    cv::resize(blotches, low, options_.size, 0, 0, cv::INTER_CUBIC);
+    cv::Mat grain(options_.size, CV_32FC3);
+    rng.fill(grain, cv::RNG::NORMAL, 0.0, 6.0);
+    cv::GaussianBlur(grain, grain, cv::Size(0, 0), 0.8);
+    cv::Mat bg = low + grain + cv::Scalar::all(options_.background_level);
+    cv::Mat bg8;
+    bg.convertTo(bg8, CV_8UC3);
+    cv::resize(bg8, background_big_,
+               cv::Size(options_.size.width * kSs, options_.size.height * kSs), 0, 0,
+               cv::INTER_LINEAR);
+    for (int k = 0; k < options_.clutter; ++k) {
+      const cv::Point2d c(rng.uniform(0.0, options_.size.width * 1.0),
+                          rng.uniform(0.0, options_.size.height * 1.0));
+      const int level = rng.uniform(40, 220);
+      const cv::Vec3b bgr = options_.clutter_bgr ? *options_.clutter_bgr
+                                                 : cv::Vec3b(level, level, level);
+      if (k % 2 == 0) {
+        const cv::Size2d radii(rng.uniform(3.0, 30.0), rng.uniform(3.0, 30.0));
+        DrawEllipse(background_big_, c, radii, rng.uniform(0.0, 180.0), bgr);
+      } else {
+        const cv::Rect r(cvRound(c.x * kSs), cvRound(c.y * kSs), rng.uniform(8, 200),
+                         rng.uniform(8, 200));
+        cv::rectangle(background_big_, r, cv::Scalar(bgr), cv::FILLED);
+      }
+    }
+  }
+
+  DotSceneOptions options_;
+  std::vector<DotShape> shapes_;
+  std::vector<DotCover> covers_;
+  cv::Mat background_big_;
+};
+
+}  // namespace softsight::testing
