@@ -9,10 +9,17 @@ namespace softsight {
 
 std::vector<int> AssignMinimumCost(const std::vector<std::vector<double>>& cost,
                                    const std::vector<double>& unassigned) {
+  MinimumCostAssignment solver;
+  return solver.solve(cost, unassigned);
+}
+
+const std::vector<int>& MinimumCostAssignment::solve(const std::vector<std::vector<double>>& cost,
+                                                     const std::vector<double>& unassigned) {
   const size_t markers = cost.size();
   CV_Assert(unassigned.size() == markers);
   const size_t candidates = markers == 0 ? 0 : cost[0].size();
-  std::vector<int> result(markers, -1);
+  std::vector<int>& result = result_;
+  result.assign(markers, -1);
   if (markers == 0) return result;
   // Square problem of side markers + candidates: row m may take candidate c or its own
   // "unassigned" column; a dummy row per candidate takes a candidate nobody gets, or a dummy
@@ -37,9 +44,18 @@ std::vector<int> AssignMinimumCost(const std::vector<std::vector<double>>& cost,
   };
   // Kuhn-Munkres with potentials (1-based arrays, column 0 a sentinel).
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<double> u(n + 1, 0.0), v(n + 1, 0.0), minv(n + 1);
-  std::vector<size_t> p(n + 1, 0), way(n + 1, 0);
-  std::vector<char> used(n + 1);
+  std::vector<double>& u = u_;
+  std::vector<double>& v = v_;
+  std::vector<double>& minv = minv_;
+  std::vector<size_t>& p = p_;
+  std::vector<size_t>& way = way_;
+  std::vector<char>& used = used_;
+  u.assign(n + 1, 0.0);
+  v.assign(n + 1, 0.0);
+  minv.resize(n + 1);
+  p.assign(n + 1, 0);
+  way.assign(n + 1, 0);
+  used.resize(n + 1);
   for (size_t i = 1; i <= n; ++i) {
     p[0] = i;
     size_t j0 = 0;

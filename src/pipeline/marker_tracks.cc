@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "pipeline/assignment.h"
 #include "track/repeated_frames.h"
 
 namespace softsight {
@@ -150,7 +149,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
           (repeated ? 0.0 : std::min(d2, kGate2) / kGate2) + kMisfitWeight * std::min(e.misfit, 2.0);
     }
   }
-  const std::vector<int> assigned = AssignMinimumCost(cost_, unassigned_);
+  const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
   for (size_t i = 0; i < markers.size(); ++i) {
     Observation& o = markers[i].observation;
     if (assigned[i] < 0) {

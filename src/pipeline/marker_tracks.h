@@ -23,6 +23,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/assignment.h"
 #include "pipeline/motion_model.h"
 #include "softsight/core/types.h"
 #include "softsight/track/tracker.h"
@@ -95,6 +96,7 @@ class MarkerTracks {
   std::vector<std::vector<double>> cost_;
   std::vector<double> unassigned_;
   std::vector<std::optional<size_t>> report_pooled_;
+  MinimumCostAssignment solver_;
 };
 
 }  // namespace softsight
