@@ -141,8 +141,14 @@ class DotScene {
   void MakeBackground() {
     constexpr int kSs = 4;
     cv::RNG rng(options_.seed);
-    cv::Mat blotches(options_.size.height / 16 + 2, options_.size.width / 16 + 2, CV_32FC3);
-    rng.fill(blotches, cv::RNG::NORMAL, 0.0, 18.0);
+    // Blotches of brightness (18 levels) with a little tint (6 levels per channel), as a bench
+    // under one light.
+    const cv::Size coarse(options_.size.width / 16 + 2, options_.size.height / 16 + 2);
+    cv::Mat level(coarse, CV_32F), tint(coarse, CV_32FC3), blotches;
+    rng.fill(level, cv::RNG::NORMAL, 0.0, 18.0);
+    rng.fill(tint, cv::RNG::NORMAL, 0.0, 6.0);
+    cv::cvtColor(level, blotches, cv::COLOR_GRAY2BGR);
+    blotches += tint;
     cv::Mat low;
     cv::resize(blotches, low, options_.size, 0, 0, cv::INTER_CUBIC);
     cv::Mat grain(options_.size, CV_32FC3);

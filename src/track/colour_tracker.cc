@@ -69,6 +69,18 @@ constexpr double kBrightnessTolerance = 1.6;
 // The learned shape: a candidate less circular than the model by this much is at its limit
 // (and never below min_circularity).
 constexpr double kShapeTolerance = 0.3;
+// A pixel of a blob's own mask that was a hole (see FillHoles): part of its region, not of its
+// colour.
+constexpr uchar kFilledHole = 128;
+// A partly hidden round marker is placed at the centre of its visible rim (RimCentre) when it
+// was learned round (circularity >= 0.85) and large enough for a rim (area >= 28 px, radius 3),
+// the blob has less than 0.97 of its area, at least 170 degrees of the rim show (half the disc,
+// less the pixels where the cut meets the rim), and the rim points lie within 0.5 px RMS.
+constexpr double kMinRimCircularity = 0.85;
+constexpr double kMinRimArea = 28.0;
+constexpr double kWholeRimFraction = 0.97;
+constexpr double kMinRimArcDeg = 170.0;
+constexpr double kMaxRimRmsPx = 0.5;
 // Adaptation while tracking only from frames where the marker's shape is within kAdaptShape of
 // the learned one (a partial cover changes it; growth and tilt change it slowly); the reference
 // area stays within kAdaptMinRange..kAdaptMaxRange times the first one. A jump in area is not
@@ -550,7 +562,7 @@ Observation ColourTracker::report(const Choice& choice) {
     return Observation::NotFound(choice.status, choice.tied);
   }
   const ColourBlob& blob = *choice.blob;
-  learn(blob, tracking_);
+  if (!blob.rim_placed) learn(blob, tracking_);  // What is left of it is not its looks.
   lost_frames_ = 0;
   last_seen_px_ = blob.centroid_px;
   // After frames held covered, the step from the last position spans them: no velocity.
@@ -585,15 +597,19 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
   if (b.area_px < params_.min_area_px || (params_.max_area_px > 0 && b.area_px > params_.max_area_px)) {
     return {CandidateVerdict::kSize, kInf};
   }
+  // Without a model and a roi the first acquisition takes the one compact candidate; in a roi a
+  // person showed the marker, and the configured limit holds (an elongated sticker).
   const double min_circularity =
-      model_ ? params_.min_circularity
-             : std::max(params_.min_circularity, kMinCircularityWithoutModel);
+      model_ || acquire_roi_ ? params_.min_circularity
+                             : std::max(params_.min_circularity, kMinCircularityWithoutModel);
   if (b.circularity < min_circularity || !b.measured) return {CandidateVerdict::kShape, kInf};
   // Part of it hidden: beyond the frame's edge, or covered (more asymmetric than the marker).
   // Judged on for its misfit: a partial blob that would fit is a rival of the others (it may be
   // the marker) and is never reported itself.
-  bool partial = b.at_frame_edge;
-  if (model_) {
+  // A blob placed at the centre of its visible rim is partial no more: its position is the
+  // marker's.
+  bool partial = b.at_frame_edge && !b.rim_placed;
+  if (model_ && !b.rim_placed) {
     const double radius = std::sqrt(model_->area_px / CV_PI);
     const double tolerance = std::max(kPartialMinPx, kPartialRadii * radius);
     partial = partial || b.asymmetry_px > model_->asymmetry_px + tolerance;
@@ -603,9 +619,13 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
   }
   double misfit = 0;
   // Shape: 0 as round as the model (a disc without one), 1 at the limit.
+  // Before a model, in a roi, any shape down to the configured limit may be the marker (the
+  // person showed it): the span reaches that limit.
   const double ref_circularity = model_ ? model_->circularity : 1.0;
   const double shape_span =
-      std::max(0.05, std::min(kShapeTolerance, ref_circularity - min_circularity));
+      model_ || !acquire_roi_
+          ? std::max(0.05, std::min(kShapeTolerance, ref_circularity - min_circularity))
+          : std::max(0.05, ref_circularity - min_circularity);
   const double shape = std::max(0.0, ref_circularity - b.circularity) / shape_span;
   if (shape > 1) return {CandidateVerdict::kShape, kInf};
   misfit += shape;
@@ -624,7 +644,7 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
     // Little more than half its learned area at once (the area follows slow changes only): a
     // disc cut beyond its centre, whose centroid is more than 0.4 radii off. The asymmetry cannot
     // tell: the smallest circle around less than half a disc is no longer the disc's.
-    partial = partial || ratio < kWholeAreaFraction;
+    partial = partial || (ratio < kWholeAreaFraction && !b.rim_placed);
   }
   // Contrast to its own surroundings.
   if (!(b.contrast >= kMinContrast)) return {CandidateVerdict::kContrast, kInf};
@@ -685,12 +705,15 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
       const bool smaller = (verdict == CandidateVerdict::kSize ||
                             verdict == CandidateVerdict::kShape) &&
                            model_ && b.area_px < model_->area_px;
+      const double d = cv::norm(b.centroid_px - predicted);
       if ((smaller || verdict == CandidateVerdict::kPartial) && model_ &&
-          cv::norm(b.centroid_px - predicted) <= ref_radius + cv::norm(velocity_px_) + 1.0) {
+          d <= ref_radius + cv::norm(velocity_px_) + 1.0) {
         partly_seen_ = true;
         if (b.at_frame_edge) partly_out_ = true;
+        // A sliver of it where it should be is the marker covered, as much as a partial blob:
+        // a whole look-alike farther away is not it.
+        nearest_partial = std::min(nearest_partial, d);
       }
-      const double d = cv::norm(b.centroid_px - predicted);
       if (verdict == CandidateVerdict::kPartial) {
         nearest_partial = std::min(nearest_partial, d);
       }
@@ -880,6 +903,37 @@ ColourTracker::Choice ColourTracker::relearn(const cv::Point2d& last_seen) {
   return choice;
 }
 
+std::optional<double> ColourTracker::rim_radius_px() const {
+  if (!model_ || model_->circularity < kMinRimCircularity || model_->area_px < kMinRimArea) {
+    return std::nullopt;
+  }
+  // The centres of a disc's edge pixels lie half a pixel inside its outline.
+  return std::sqrt(model_->area_px / CV_PI) - 0.5;
+}
+
+std::optional<cv::Point2d> ColourTracker::RimCentre(const ColourBlob& blob) const {
+  const std::optional<double> radius = rim_radius_px();
+  if (!blob.rim || !radius) return std::nullopt;
+  const RimFit& fit = *blob.rim;
+  // Half of the rim or more, densely on the circle (a disc's edge has about 1.1 pixels per
+  // pixel of its length), within half a pixel of it.
+  const double expected = 2 * CV_PI * *radius * fit.arc_deg / 360.0;
+  if (fit.arc_deg < kMinRimArcDeg || fit.rms_px > kMaxRimRmsPx || fit.rim_points < 0.8 * expected) {
+    return std::nullopt;
+  }
+  // What is left of the marker lies inside its circle: a blob reaching outside it is not this
+  // marker partly hidden (a look-alike touching it, another shape).
+  const double reach = *radius + 1.0;
+  const cv::Point2d c = fit.centre_px;
+  const cv::Rect2d circle_box(c.x - reach, c.y - reach, 2 * reach, 2 * reach);
+  if (blob.bbox_px.x < circle_box.x || blob.bbox_px.y < circle_box.y ||
+      blob.bbox_px.x + blob.bbox_px.width - 1 > circle_box.x + circle_box.width ||
+      blob.bbox_px.y + blob.bbox_px.height - 1 > circle_box.y + circle_box.height) {
+    return std::nullopt;
+  }
+  return c;
+}
+
 double ColourTracker::min_blob_radius_px() const {
   const double min_area = std::max(params_.min_area_px,
                                    params_.min_area_fraction * (model_ ? model_->area_px : 0.0));
@@ -1058,10 +1112,41 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
       // 6. Colour statistics and the soft centroid, for blobs that may be the marker.
       if (blob.circularity >= params_.min_circularity) {
         measure(filtered, mask, static_cast<int>(i), box, labelled.tl(), extended.tl(), &blob);
+        if (blob.rim_placed) blob.centroid_px = blob.rim->centre_px;  // Over the soft centroid.
       }
     }
     blobs->push_back(blob);
   }
+}
+
+void ColourTracker::FillHoles(cv::Mat& own, cv::Point own_origin, ColourBlob* blob) {
+  // A hole is a part of the blob's background that does not reach the outside: a specular
+  // highlight on a glossy marker, a glint, pixels noise pushed out of the range. They are part of
+  // the marker: its area, centroid and shape are the filled region's, and its colour and ring
+  // are measured around the filled region (a highlight inside is not its surroundings).
+  cv::Mat outside = Scratch(holes_store_, cv::Size(own.cols + 2, own.rows + 2), CV_8U);
+  outside.setTo(0);
+  own.copyTo(outside(cv::Rect(1, 1, own.cols, own.rows)));
+  cv::floodFill(outside, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 4);
+  int filled = 0;
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* o = outside.ptr<uchar>(y + 1) + 1;
+    uchar* w = own.ptr<uchar>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      if (o[x] == 0) {
+        w[x] = kFilledHole;
+        ++filled;
+      }
+    }
+  }
+  if (filled == 0) return;
+  const cv::Moments m = cv::moments(own, true);
+  if (!(m.m00 > 0)) return;
+  blob->area_px = m.m00;
+  blob->binary_centroid_px =
+      cv::Point2d(m.m10 / m.m00 + own_origin.x, m.m01 / m.m00 + own_origin.y);
+  blob->centroid_px = blob->binary_centroid_px;
+  blob->circularity = m.m00 * m.m00 / (2.0 * CV_PI * (m.mu20 + m.mu02 + m.m00 / 6.0));
 }
 
 void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int component,
@@ -1079,6 +1164,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     std::memset(own.ptr<uchar>(y), 0, static_cast<size_t>(size.width));
   }
   labeller_.Draw(component, own, padded.tl() - labelled_tl);
+  FillHoles(own, padded.tl() + origin, blob);
   // Asymmetry: the binary centroid against the centre of the smallest circle around the blob
   // (its convex hull's points are among each row's leftmost and rightmost pixels).
   edge_points_.clear();
@@ -1124,7 +1210,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   for (int y = 0; y < size.height && core_empty; ++y) {
     const uchar* ow = own.ptr<uchar>(y);
     const uint16_t* d = distance.ptr<uint16_t>(y);
-    for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] && d[x] > kNear);
+    for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] == 255 && d[x] > kNear);
   }
   const int core_depth = core_empty ? 0 : kNear;
   const bool pure_core = !core_empty;
@@ -1141,7 +1227,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     const uchar* ot = others.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) {
       const uchar* c = p + x * channels;
-      if (ow[x] && d[x] > core_depth) {
+      if (ow[x] == 255 && d[x] > core_depth) {  // A filled hole is not the marker's colour.
         for (int k = 0; k < channels; ++k) {
           core_sum[k] += c[k];
           core_sq[k] += c[k] * c[k];
@@ -1175,6 +1261,32 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   blob->contrast = std::sqrt(axis2) /
                    (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
   blob->measured = true;
+  // A round marker partly hidden: the circle of its radius through its edge (not where the
+  // frame cuts it).
+  if (const std::optional<double> radius = rim_radius_px();
+      radius && blob->area_px < kWholeRimFraction * model_->area_px) {
+    edge_points_.clear();
+    const cv::Point frame_origin = padded.tl() + origin;
+    for (int y = 0; y < size.height; ++y) {
+      const uchar* ow = own.ptr<uchar>(y);
+      for (int x = 0; x < size.width; ++x) {
+        if (!ow[x]) continue;
+        const bool edge = x == 0 || y == 0 || x == size.width - 1 || y == size.height - 1 ||
+                          !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
+                          !own.ptr<uchar>(y + 1)[x];
+        const int fx = x + frame_origin.x, fy = y + frame_origin.y;
+        const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
+                                   fy == frame_size_.height - 1;
+        if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
+      }
+    }
+    rim_points_.assign(edge_points_.begin(), edge_points_.end());
+    blob->rim = FitRimOfRadius(rim_points_, *radius);
+    if (const std::optional<cv::Point2d> centre = RimCentre(*blob)) {
+      blob->centroid_px = *centre;
+      blob->rim_placed = true;
+    }
+  }
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
 
   // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the

@@ -23,6 +23,7 @@
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/tracker.h"
 #include "track/colour_kernels.h"
+#include "track/rim_fit.h"
 
 namespace softsight {
 
@@ -56,6 +57,11 @@ struct ColourBlob {
   // |core - ring| / (core_sigma + ring_sigma + 2): how clearly the blob stands out from what
   // surrounds it. A printed or painted marker scores far above a patch of background texture.
   double contrast = 0;
+  // For a blob smaller than a round marker's learned area (set with the colour statistics): the
+  // circle of the marker's radius fitted to its edge (track/rim_fit.h), whose centre is the
+  // marker's when what is left of it shows enough of its rim (see RimCentre).
+  std::optional<RimFit> rim;
+  bool rim_placed = false;  // centroid_px is the rim's centre (a good fit: see RimCentre).
 };
 
 // What the tracker knows of its marker: learned at the first acquisition, adapted while tracking.
@@ -124,6 +130,10 @@ class ColourTracker : public Tracker {
   // latter's in the frame.
   void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
+  // Fills the holes of the blob's mask `own` (whose top-left pixel is `own_origin` in the frame)
+  // and, when there were any, sets the blob's area, centroids and circularity from the filled
+  // mask.
+  void FillHoles(cv::Mat& own, cv::Point own_origin, ColourBlob* blob);
   // Every complete blob of `region`: analyse, growing the region around clipped blobs.
   void complete_blobs(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs);
   // Coarse candidates -> full-resolution windows -> complete blobs.
@@ -137,6 +147,13 @@ class ColourTracker : public Tracker {
     int tied = 0;  // With kAmbiguous: how many candidates fitted about equally.
     bool hold = false;  // Not found, but partly seen where expected: keep the window there.
   };
+  // The marker's centre from a partial blob's rim fit, when the fit is good: half of the rim or
+  // more shows, the points on it lie within half a pixel of the circle, and none of the blob's
+  // edge lies outside it.
+  std::optional<cv::Point2d> RimCentre(const ColourBlob& blob) const;
+  // The radius of the circle a round marker's edge pixels lie on; absent for markers that are
+  // not round (their model's circularity below 0.85).
+  std::optional<double> rim_radius_px() const;
   void check_frame(const cv::Mat& frame) const;
   Observation search(const cv::Mat& frame);  // update() without the snapshot.
   Choice track_in_windows(const cv::Mat& frame);
@@ -201,7 +218,7 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
-  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
+  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, holes_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
@@ -209,6 +226,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;
   std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.
+  std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
 };
 
 }  // namespace softsight

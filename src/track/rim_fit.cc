@@ -1,0 +1,89 @@
+#include "track/rim_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace softsight {
+namespace {
+
+// Rim points and their spread around `c`.
+int CountInliers(const std::vector<cv::Point2d>& pts, const cv::Point2d& c, double r, double tol) {
+  int n = 0;
+  for (const cv::Point2d& p : pts) n += std::abs(cv::norm(p - c) - r) <= tol ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, double radius_px,
+                                     double inlier_px) {
+  const size_t n = edge_px.size();
+  if (n < 6 || !(radius_px > 0)) return std::nullopt;
+  // Candidate centres: the two circles of the radius through pairs of points about a quarter of
+  // the boundary apart (pairs too close give unstable centres). At most ~64 pairs.
+  const size_t step = std::max<size_t>(1, n / 64);
+  const size_t offset = std::max<size_t>(1, n / 4);
+  cv::Point2d best_centre;
+  int best_inliers = 0;
+  for (size_t i = 0; i < n; i += step) {
+    const cv::Point2d a = edge_px[i], b = edge_px[(i + offset) % n];
+    const cv::Point2d mid = 0.5 * (a + b), ab = b - a;
+    const double half = 0.5 * cv::norm(ab);
+    if (half < 1.0 || half > radius_px) continue;
+    const double h = std::sqrt(radius_px * radius_px - half * half);
+    const cv::Point2d normal(-ab.y / (2 * half), ab.x / (2 * half));
+    for (const double sign : {1.0, -1.0}) {
+      const cv::Point2d c = mid + sign * h * normal;
+      const int inliers = CountInliers(edge_px, c, radius_px, inlier_px);
+      if (inliers > best_inliers) {
+        best_inliers = inliers;
+        best_centre = c;
+      }
+    }
+  }
+  if (best_inliers < 6) return std::nullopt;
+  // Gauss-Newton on the rim points: minimise sum (|p - c| - r)^2 over c, re-selecting the rim.
+  cv::Point2d c = best_centre;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    cv::Matx22d jtj = cv::Matx22d::zeros();
+    cv::Vec2d jtr(0, 0);
+    int used = 0;
+    for (const cv::Point2d& p : edge_px) {
+      const cv::Point2d d = c - p;
+      const double dist = cv::norm(d);
+      if (dist < 1e-9 || std::abs(dist - radius_px) > inlier_px) continue;
+      const cv::Vec2d j(d.x / dist, d.y / dist);  // d(dist)/dc
+      const double residual = dist - radius_px;
+      jtj += j * j.t();
+      jtr += j * residual;
+      ++used;
+    }
+    if (used < 6) break;
+    const double det = jtj(0, 0) * jtj(1, 1) - jtj(0, 1) * jtj(1, 0);
+    if (!(std::abs(det) > 1e-12)) break;
+    const cv::Vec2d delta(-(jtj(1, 1) * jtr[0] - jtj(0, 1) * jtr[1]) / det,
+                          -(-jtj(1, 0) * jtr[0] + jtj(0, 0) * jtr[1]) / det);
+    c += cv::Point2d(delta[0], delta[1]);
+    if (std::hypot(delta[0], delta[1]) < 1e-4) break;
+  }
+  RimFit fit;
+  fit.centre_px = c;
+  std::vector<double> angles;
+  double sum2 = 0;
+  for (const cv::Point2d& p : edge_px) {
+    const double residual = cv::norm(p - c) - radius_px;
+    if (std::abs(residual) > inlier_px) continue;
+    sum2 += residual * residual;
+    angles.push_back(std::atan2(p.y - c.y, p.x - c.x));
+  }
+  fit.rim_points = static_cast<int>(angles.size());
+  if (fit.rim_points < 6) return std::nullopt;
+  fit.rms_px = std::sqrt(sum2 / fit.rim_points);
+  std::sort(angles.begin(), angles.end());
+  double largest_gap = angles.front() + 2 * CV_PI - angles.back();
+  for (size_t k = 1; k < angles.size(); ++k) largest_gap = std::max(largest_gap, angles[k] - angles[k - 1]);
+  fit.arc_deg = (2 * CV_PI - largest_gap) * 180.0 / CV_PI;
+  return fit;
+}
+
+}  // namespace softsight

@@ -1,0 +1,57 @@
+// The circle of known radius through a partly hidden disc's rim, against exact circles.
+#include "track/rim_fit.h"
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+namespace softsight {
+namespace {
+
+// The edge pixels (4-neighbour boundary) of a disc of `radius` at `centre`, rasterised, with the
+// pixels right of x = `cut` removed (a straight-edged cover), and the cut's own edge included.
+std::vector<cv::Point2d> CutDiscEdge(const cv::Point2d& centre, double radius, double cut) {
+  cv::Mat mask(80, 80, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < mask.rows; ++y) {
+    for (int x = 0; x < mask.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) <= radius && x <= cut) mask.at<uchar>(y, x) = 255;
+    }
+  }
+  std::vector<cv::Point2d> edge;
+  for (int y = 1; y + 1 < mask.rows; ++y) {
+    for (int x = 1; x + 1 < mask.cols; ++x) {
+      if (!mask.at<uchar>(y, x)) continue;
+      if (!mask.at<uchar>(y, x - 1) || !mask.at<uchar>(y, x + 1) || !mask.at<uchar>(y - 1, x) ||
+          !mask.at<uchar>(y + 1, x)) {
+        edge.emplace_back(x, y);
+      }
+    }
+  }
+  return edge;
+}
+
+TEST(RimFit, AHalfCoveredDiscsRimGivesItsCentreWithinAFifthOfAPixel) {
+  const cv::Point2d centre(40.3, 39.6);
+  const double radius = 10;
+  for (const double cut : {60.0, 45.0, 40.3, 38.0}) {  // Whole, a quarter, a half, 60 % cut.
+    const std::optional<RimFit> fit = FitRimOfRadius(CutDiscEdge(centre, radius, cut), radius - 0.5);
+    ASSERT_TRUE(fit) << "cut " << cut;
+    EXPECT_LT(cv::norm(fit->centre_px - centre), 0.2) << "cut " << cut;
+    EXPECT_LT(fit->rms_px, 0.5) << "cut " << cut;
+    // The rim spans 360 degrees for the whole disc, else twice the angle from the centre to
+    // where the cut meets the circle, measured on the uncut side.
+    const double c = std::clamp((cut - centre.x) / radius, -1.0, 1.0);
+    const double arc = cut >= centre.x + radius ? 360.0 : 2.0 * std::acos(-c) * 180.0 / CV_PI;
+    EXPECT_NEAR(fit->arc_deg, arc, 15.0) << "cut " << cut;
+  }
+}
+
+TEST(RimFit, TooFewPointsOrNoRadiusGiveNoFit) {
+  EXPECT_FALSE(FitRimOfRadius({{0, 0}, {1, 0}, {2, 0}}, 5.0));
+  EXPECT_FALSE(FitRimOfRadius(CutDiscEdge({40, 40}, 10, 60), 0.0));
+}
+
+}  // namespace
+}  // namespace softsight
