@@ -258,9 +258,7 @@ TrackingConfig RunPick(const PickOptions& options) {
       ColourParams& colour = spec.params.emplace<ColourParams>();
       ApplyColourPick(*pick, &colour);
       colour.roi_frame = roi_frame;
-      const HsvRange& h = pick->ranges.h;
-      const int hue = h.lo <= h.hi ? (h.lo + h.hi) / 2 : ((h.lo + h.hi + 180) / 2) % 180;
-      std::string name = HueName(hue);
+      std::string name = PickName(pick->ranges);
       int same = 0;
       for (const MarkerSpec& m : config.markers) {
         if (m.name == name || m.name.rfind(name + "_", 0) == 0) ++same;

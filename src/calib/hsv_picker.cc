@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <opencv2/imgproc.hpp>
 
 namespace softsight {
@@ -126,6 +127,82 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   return pick;
 }
 
+namespace {
+
+// How far a white or black dot's gray levels must stand from its surroundings'.
+constexpr int kMinDotContrast = 20;
+
+// A white or black dot at the click: the disc's gray levels against a ring around it. The dot
+// may be larger than the sampled disc, so rings 3 px wide at growing distances are tried and the
+// one that stands farthest from the disc is its surroundings.
+std::optional<HsvPick> PickGrayDot(const cv::Mat& bgr, cv::Point2d click_px, int radius,
+                                   std::string* why) {
+  constexpr int kRingStarts[] = {3, 6, 9, 12, 16, 20, 25, 30};
+  constexpr int kRingWidth = 3;
+  const int outer = radius + kRingStarts[std::size(kRingStarts) - 1] + kRingWidth;
+  const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
+  const cv::Rect box = cv::Rect(centre.x - outer, centre.y - outer, 2 * outer + 1, 2 * outer + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const std::string plain = *why + ", nor a white or black dot (its gray levels do not stand " +
+                            std::to_string(kMinDotContrast) + " above or below its surroundings')";
+  if (box.empty()) {
+    *why = plain;
+    return std::nullopt;
+  }
+  cv::Mat gray;
+  cv::cvtColor(bgr(box), gray, cv::COLOR_BGR2GRAY);
+  std::vector<double> disc;
+  std::vector<std::vector<double>> rings(std::size(kRingStarts));
+  for (int y = 0; y < gray.rows; ++y) {
+    for (int x = 0; x < gray.cols; ++x) {
+      const double d = std::hypot(box.x + x - click_px.x, box.y + y - click_px.y);
+      const double level = gray.at<uchar>(y, x);
+      if (d <= radius + 0.5) disc.push_back(level);
+      for (size_t k = 0; k < rings.size(); ++k) {
+        if (d >= radius + kRingStarts[k] && d < radius + kRingStarts[k] + kRingWidth) {
+          rings[k].push_back(level);
+        }
+      }
+    }
+  }
+  if (disc.empty()) {
+    *why = plain;
+    return std::nullopt;
+  }
+  std::sort(disc.begin(), disc.end());
+  const double disc_lo = Percentile(disc, 10), disc_hi = Percentile(disc, 90);
+  double best_white = -1e9, best_black = -1e9, white_level = 0, black_level = 0;
+  for (std::vector<double>& ring : rings) {
+    if (ring.size() < 8) continue;
+    std::sort(ring.begin(), ring.end());
+    const double ring_lo = Percentile(ring, 10), ring_hi = Percentile(ring, 90);
+    if (disc_lo - ring_hi > best_white) {
+      best_white = disc_lo - ring_hi;
+      white_level = 0.5 * (disc_lo + ring_hi);
+    }
+    if (ring_lo - disc_hi > best_black) {
+      best_black = ring_lo - disc_hi;
+      black_level = 0.5 * (disc_hi + ring_lo);
+    }
+  }
+  HsvPick pick;
+  pick.h = {0, kHueCount - 1};
+  pick.s = {0, 255};
+  pick.v = {0, 255};
+  pick.sample_count = static_cast<int>(disc.size());
+  if (best_white >= kMinDotContrast) {
+    pick.gray = HsvRange{static_cast<int>(std::floor(white_level)), 255};
+  } else if (best_black >= kMinDotContrast) {
+    pick.gray = HsvRange{0, static_cast<int>(std::ceil(black_level))};
+  } else {
+    *why = plain;
+    return std::nullopt;
+  }
+  return pick;
+}
+
+}  // namespace
+
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
                                     const HsvPickOptions& options, std::string* why_not) {
   CV_Assert(bgr.type() == CV_8UC3);
@@ -148,7 +225,13 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
     if (why_not != nullptr) *why_not = "the click is outside the image";
     return std::nullopt;
   }
-  return PickHsvFromSamples(samples, options, why_not);
+  std::string why;
+  std::optional<HsvPick> pick = PickHsvFromSamples(samples, options, &why);
+  if (!pick && why.rfind("not a coloured marker", 0) == 0) {
+    pick = PickGrayDot(bgr, click_px, options.radius_px, &why);
+  }
+  if (!pick && why_not != nullptr) *why_not = why;
+  return pick;
 }
 
 std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point2d click_px,
@@ -169,8 +252,14 @@ void ApplyColourPick(const MarkerColourPick& pick, ColourParams* colour) {
   colour->s = pick.ranges.s;
   colour->v = pick.ranges.v;
   colour->auto_bgr.reset();
-  colour->gray.reset();
+  colour->gray = pick.ranges.gray;
   colour->roi = pick.roi;
+}
+
+std::string PickName(const HsvPick& pick) {
+  if (pick.gray) return pick.gray->hi == 255 ? "white" : "black";
+  const HsvRange& h = pick.h;
+  return HueName(h.lo <= h.hi ? (h.lo + h.hi) / 2 : ((h.lo + h.hi + 180) / 2) % 180);
 }
 
 const char* HueName(int hue) {

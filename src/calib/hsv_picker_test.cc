@@ -202,3 +202,49 @@ TEST(HsvPickerTest, RenderedSceneMarkersArePickedAndSeparated) {
 
 }  // namespace
 }  // namespace softsight
+
+namespace softsight {
+namespace {
+
+// A disc of `level` (radius 8) on a gray background of 110 with a little noise.
+cv::Mat GrayDotImage(int level) {
+  cv::Mat image(80, 80, CV_8UC3, cv::Scalar::all(110));
+  cv::Mat noise(image.size(), CV_8UC3);
+  cv::randu(noise, 0, 6);
+  image += noise;
+  cv::circle(image, {40, 40}, 8, cv::Scalar::all(level), cv::FILLED, cv::LINE_AA);
+  return image;
+}
+
+TEST(HsvPickerTest, AWhiteOrBlackDotGivesAGrayLevelRangeBetweenItAndItsSurroundings) {
+  std::string why;
+  const auto white = PickHsvRange(GrayDotImage(235), {40, 40}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(white) << why;
+  ASSERT_TRUE(white->gray);
+  EXPECT_EQ(white->gray->hi, 255);
+  EXPECT_GT(white->gray->lo, 120);  // Above the background ...
+  EXPECT_LT(white->gray->lo, 230);  // ... and below the dot.
+  EXPECT_EQ(PickName(*white), "white");
+  const auto black = PickHsvRange(GrayDotImage(20), {40, 40}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(black) << why;
+  ASSERT_TRUE(black->gray);
+  EXPECT_EQ(black->gray->lo, 0);
+  EXPECT_GT(black->gray->hi, 25);
+  EXPECT_LT(black->gray->hi, 105);
+  EXPECT_EQ(PickName(*black), "black");
+  // The colour tracker built from the pick finds the dot.
+  MarkerColourPick pick;
+  pick.ranges = *white;
+  pick.roi = cv::Rect(24, 24, 32, 32);
+  ColourParams colour;
+  ApplyColourPick(pick, &colour);
+  EXPECT_TRUE(colour.gray);
+  // Plain background (no dot) stays refused, saying why.
+  cv::Mat plain(80, 80, CV_8UC3, cv::Scalar::all(110));
+  EXPECT_FALSE(PickHsvRange(plain, {40, 40}, HsvPickOptions{}, &why));
+  EXPECT_NE(why.find("not a coloured marker"), std::string::npos) << why;
+  EXPECT_NE(why.find("nor a white or black dot"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace softsight

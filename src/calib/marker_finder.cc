@@ -71,6 +71,7 @@ std::string Point(const cv::Point2d& p) {
   return text;
 }
 
+// A frame whose channels are equal everywhere: gray video stored as colour.
 bool IsGrayFrame(const cv::Mat& frame) {
   if (frame.channels() == 1) return true;
   for (int y = 0; y < frame.rows; ++y) {
@@ -80,6 +81,24 @@ bool IsGrayFrame(const cv::Mat& frame) {
     }
   }
   return true;
+}
+
+// A frame with hardly any colour: gray footage after a codec's chroma and a sensor's noise (each
+// channel a few levels apart), or a gray bench with white dots. Fewer than 1 % of the pixels (one
+// in four of every fourth row sampled) have channels more than 16 levels apart.
+bool IsNearlyGrayFrame(const cv::Mat& frame) {
+  constexpr int kMaxChannelSpread = 16;
+  int64_t sampled = 0, coloured = 0;
+  for (int y = 0; y < frame.rows; y += 4) {
+    const cv::Vec3b* row = frame.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < frame.cols; x += 4) {
+      const int lo = std::min({row[x][0], row[x][1], row[x][2]});
+      const int hi = std::max({row[x][0], row[x][1], row[x][2]});
+      ++sampled;
+      if (hi - lo > kMaxChannelSpread) ++coloured;
+    }
+  }
+  return coloured * 100 < sampled;
 }
 
 // One probe of the colour tracker's whole-frame first acquisition with `colour`: what it weighed.
@@ -371,6 +390,14 @@ std::vector<size_t> OrderAlongBody(const std::vector<cv::Point2d>& points, cv::S
   return best;
 }
 
+namespace {
+
+// FindMarkers on a BGR frame, looking for saturated blobs or (`intensity`) white or black dots.
+MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& options,
+                            bool intensity);
+
+}  // namespace
+
 MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& options) {
   options.Check();
   if (input.empty() || input.depth() != CV_8U || (input.channels() != 1 && input.channels() != 3)) {
@@ -378,8 +405,28 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
   }
   cv::Mat frame = input;
   if (input.channels() == 1) cv::cvtColor(input, frame, cv::COLOR_GRAY2BGR);
+  if (IsGrayFrame(frame)) return FindMarkersAs(frame, options, true);
+  MarkerFinding colour = FindMarkersAs(frame, options, false);
+  // Hardly any colour and no coloured blob that could be a marker at all (not look-alikes
+  // refused, which stay refused): white or black dots on footage stored in colour.
+  if (colour.markers.empty() && colour.problem.rfind("no markers", 0) == 0 &&
+      IsNearlyGrayFrame(frame)) {
+    MarkerFinding dots = FindMarkersAs(frame, options, true);
+    if (!dots.markers.empty()) {
+      dots.notes.push_back("no coloured marker in a frame with hardly any colour: white or black "
+                           "dots, by gray level");
+      return dots;
+    }
+  }
+  return colour;
+}
+
+namespace {
+
+MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& options,
+                            bool intensity) {
   MarkerFinding finding;
-  finding.intensity = IsGrayFrame(frame);
+  finding.intensity = intensity;
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   const cv::Rect search = options.search_px ? (*options.search_px & frame_rect) : frame_rect;
   if (search.empty()) throw InputError("the search region lies outside the frame");
@@ -707,11 +754,18 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
                   min_segment, max_segment);
     finding.problem = text;
   } else if (order_ambiguous) {
-    finding.problem = "the order along the body is ambiguous (two paths through the markers are "
-                      "about as short): choose a frame where the actuator is less bent (--frame)";
+    // Markers in no clear order (a plate of dots, markers on several bodies) are still the
+    // markers: written to track their positions, with no body to measure, rather than refused.
+    finding.measure = MeasureOptions();
+    finding.notes.push_back("the order along a body is ambiguous (two paths through the markers "
+                            "are about as short): the markers are written without a body "
+                            "(positions only); name base, middle and tip under `measure:` for "
+                            "angles, or choose a frame where the actuator is less bent (--frame)");
   }
   return finding;
 }
+
+}  // namespace
 
 cv::Mat DrawMarkerFinding(const cv::Mat& input, const MarkerFinding& finding) {
   cv::Mat image;

@@ -1,9 +1,12 @@
-// The body order of marker_finder.h on points with a known order.
+// The body order of marker_finder.h on points with a known order, and the finder on footage of
+// its own renderer.
 #include "softsight/calib/marker_finder.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
+
+#include "sim/dot_scene_test_util.h"
 
 namespace softsight {
 namespace {
@@ -38,6 +41,44 @@ TEST(OrderAlongBody, WithoutAHintTheBaseIsTheEndNearerTheBorder) {
   const std::vector<size_t> order = OrderAlongBody(line, cv::Size(640, 480), std::nullopt);
   EXPECT_EQ(order.front(), 2u);
   EXPECT_EQ(order.back(), 0u);
+}
+
+}  // namespace
+}  // namespace softsight
+
+namespace softsight {
+namespace {
+
+// White dots on a gray bench, filmed by a gray camera and stored in colour (each channel with a
+// level or two of its own noise: the frame is not exactly gray), laid out as a plate (two rows of two and one in the middle: no order along a
+// body). The finder finds them by gray level, each with its roi, and writes them without a body.
+TEST(MarkerFinder, WhiteDotsOnColourFootageOfAGrayBenchAreFoundAndWrittenWithoutABody) {
+  testing::DotSceneOptions options;
+  options.noise_sigma = 1.5;
+  options.tint_sigma = 0.0;
+  const cv::Point2d layout[5] = {{260, 200}, {380, 200}, {320, 240}, {260, 280}, {380, 280}};
+  std::vector<testing::DotShape> shapes;
+  for (const cv::Point2d& p : layout) {
+    shapes.push_back({{7, 7}, {240, 240, 240}, {}, 0, {}, [p](double) { return testing::DotPose{p}; }});
+  }
+  const testing::DotScene scene(options, shapes);
+  const cv::Mat frame = scene.render(0);
+  const MarkerFinding finding = FindMarkers(frame, MarkerFinderOptions{});
+  ASSERT_TRUE(finding.ok()) << finding.problem;
+  EXPECT_TRUE(finding.intensity);
+  ASSERT_EQ(finding.markers.size(), 5u);
+  for (const FoundMarker& m : finding.markers) {
+    double nearest = 1e9;
+    for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
+    EXPECT_LT(nearest, 0.5) << m.spec.name;
+    const ColourParams& colour = std::get<ColourParams>(m.spec.params);
+    EXPECT_TRUE(colour.gray && colour.roi) << m.spec.name;
+  }
+  EXPECT_FALSE(finding.measure.has_triple());
+  EXPECT_TRUE(finding.measure.chain.empty());
+  bool said = false;
+  for (const std::string& note : finding.notes) said = said || note.find("without a body") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 }  // namespace

@@ -233,8 +233,11 @@ void LiveController::click(const cv::Point2d& p) {
     ApplyColourPick(*pick, &colour_aside_[marker]);
   }
   ++hsv_revision_;
-  say(spec.name + ": h " + RangeText(pick->ranges.h) + " s " + RangeText(pick->ranges.s) +
-      " v " + RangeText(pick->ranges.v) + (colour ? "" : " (used by the colour method)"));
+  const std::string ranges = pick->ranges.gray
+                                 ? "gray " + RangeText(*pick->ranges.gray)
+                                 : "h " + RangeText(pick->ranges.h) + " s " +
+                                       RangeText(pick->ranges.s) + " v " + RangeText(pick->ranges.v);
+  say(spec.name + ": " + ranges + (colour ? "" : " (used by the colour method)"));
 }
 
 void LiveController::edit_range(const cv::Point2d& p, bool grow) {

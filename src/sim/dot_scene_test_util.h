@@ -50,6 +50,7 @@ struct DotSceneOptions {
   // Background: mean gray with low-frequency blotches and fine grain; `clutter` adds gray
   // rectangles and discs (not of any shape's colour unless `clutter_bgr` says so).
   double background_level = 110;
+  double tint_sigma = 6.0;  // Per-channel tint of the blotches (0: a gray bench).
   int clutter = 0;
   std::optional<cv::Vec3b> clutter_bgr;
 };
@@ -146,7 +147,7 @@ class DotScene {
     const cv::Size coarse(options_.size.width / 16 + 2, options_.size.height / 16 + 2);
     cv::Mat level(coarse, CV_32F), tint(coarse, CV_32FC3), blotches;
     rng.fill(level, cv::RNG::NORMAL, 0.0, 18.0);
-    rng.fill(tint, cv::RNG::NORMAL, 0.0, 6.0);
+    rng.fill(tint, cv::RNG::NORMAL, 0.0, std::max(options_.tint_sigma, 1e-9));
     cv::cvtColor(level, blotches, cv::COLOR_GRAY2BGR);
     blotches += tint;
     cv::Mat low;

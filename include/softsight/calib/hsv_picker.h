@@ -45,8 +45,13 @@ struct HsvPickOptions {
 
 struct HsvPick {
   HsvRange h, s, v;         // Ready for ColourParams (h.lo > h.hi when the range wraps through 0).
+  // A white or black dot (PickHsvRange on a patch without colour that stands out from its
+  // surroundings by its gray level): the gray-level range (ColourParams::gray) halfway between
+  // the dot's levels and its surroundings', open towards white (or black). h, s, v are then the
+  // full ranges.
   int sample_count = 0;     // Pixels sampled inside the image.
   double hue_spread = 0.0;  // Width of the hue percentile interval before margins, hue units.
+  std::optional<HsvRange> gray;
 };
 
 // Picks ranges from HSV samples (CV_8UC3 pixels as produced by cv::cvtColor(BGR2HSV)). Returns
@@ -56,7 +61,9 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
                                           std::string* why_not = nullptr);
 
 // Picks ranges from the disc of `options.radius_px` around `click_px` (pixel-centre convention)
-// in a BGR image. Pixels outside the image are skipped.
+// in a BGR image. Pixels outside the image are skipped. A patch without colour is a white or
+// black dot when its gray levels (10th to 90th percentile) all lie at least 20 above (or below)
+// those of a ring 3 to 6 px outside the disc: the pick is then a gray-level range.
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
                                     const HsvPickOptions& options, std::string* why_not = nullptr);
 
@@ -75,12 +82,15 @@ std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point
                                                    std::string* why_not = nullptr);
 
 // Makes `colour` track the picked colour: its h, s, v ranges and roi become the pick's, and an
-// automatic colour or gray-level range it had is dropped (the pick replaces them).
+// automatic colour or gray-level range it had is dropped (the pick replaces them); a white or
+// black dot's pick sets the gray-level range.
 void ApplyColourPick(const MarkerColourPick& pick, ColourParams* colour);
 
 // A colour name for an 8-bit hue (0..179): red, orange, yellow, green, cyan, blue, purple,
 // magenta. Used to name the markers `init` and `pick` write.
 const char* HueName(int hue);
+// The name `init` and `pick` give a picked marker: the hue's name, or "white" / "black".
+std::string PickName(const HsvPick& pick);
 
 // True when an 8-bit HSV pixel lies inside the three ranges (hue wrap included). The reference the
 // tests and the live window's preview use; the colour tracker has its own vectorised threshold.
