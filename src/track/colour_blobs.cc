@@ -1,0 +1,549 @@
+// ColourTracker, part 2 of 3: detection. Classify, filter and clean a region, label its blobs
+// and measure each (centroids, shape, holes, colour against its surroundings, the rim fit of a
+// partly hidden round marker).
+#include "softsight/track/colour_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "softsight/core/error.h"
+#include "track/colour_tracker_impl.h"
+#include "track/colour_tracker_parts.h"
+#include "track/track_options.h"
+
+namespace softsight {
+
+using namespace colour_internal;  // NOLINT: the tracker's own constants and helpers.
+
+void ColourTracker::find_blobs(const cv::Mat& frame_bgr, int downsample,
+                               std::vector<ColourBlob>* blobs) {
+  check_frame(frame_bgr);
+  blobs->clear();
+  const cv::Rect frame_rect(cv::Point(0, 0), frame_bgr.size());
+  if (downsample > 1) {
+    coarse_to_fine(frame_bgr, frame_rect, downsample, blobs);
+  } else {
+    complete_blobs(frame_bgr, frame_rect, blobs);
+  }
+  std::sort(blobs->begin(), blobs->end(), CentroidBefore);
+}
+
+cv::Mat ColourTracker::prepare(const cv::Mat& src, cv::Mat& store) {
+  const int channels = gray_ ? 1 : 3;
+  if (src.channels() == channels) return src;
+  cv::Mat converted = Scratch(store, src.size(), CV_MAKETYPE(CV_8U, channels));
+  cv::cvtColor(src, converted, channels == 1 ? cv::COLOR_BGR2GRAY : cv::COLOR_GRAY2BGR);
+  return converted;
+}
+
+bool ColourTracker::membership(const cv::Mat& frame_bgr, cv::Mat& mask) const {
+  cv::Mat src = frame_bgr;
+  const int channels = gray_ ? 1 : 3;
+  if (src.channels() != channels) {
+    cv::cvtColor(frame_bgr, src, channels == 1 ? cv::COLOR_BGR2GRAY : cv::COLOR_GRAY2BGR);
+  }
+  if (gray_) {
+    cv::inRange(src, cv::Scalar(gray_->lo), cv::Scalar(gray_->hi), mask);
+  } else {
+    mask.create(src.size(), CV_8UC1);
+    fine_hsv_.Classify(src, mask);
+  }
+  return true;
+}
+
+void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask) {
+  if (gray_) {
+    const HsvRange& g = coarse ? *coarse_gray_ : *gray_;
+    cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
+    return;
+  }
+  // One pass, bit-exact with cvtColor(BGR2HSV) + inRange (track/colour_kernels.h).
+  (coarse ? coarse_hsv_ : fine_hsv_).Classify(src, mask);
+}
+
+void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
+                            std::vector<ColourBlob>* blobs) {
+  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
+  region &= frame_rect;
+  if (region.empty()) return;
+  if (region.area() >= kCoarseMinArea) {
+    analyse_region(frame, region, blobs);
+    return;
+  }
+  // A window is a few thousand pixels: handing its pieces to OpenCV's thread pool (TBB) costs
+  // more than the work (connected components alone doubles). Run the window as one OpenCV
+  // parallel region of a single task: OpenCV executes parallel loops nested in it inline. Only
+  // OpenCV's own filters, conversions and morphology parallelise; without them (the default
+  // pipeline: our kernels alone) the window runs directly, since the region itself costs a few
+  // allocations and microseconds per window, and a re-acquisition analyses dozens.
+  const bool opencv_parallel = opencv_in_windows_ || frame.channels() != (gray_ ? 1 : 3);
+  if (!opencv_parallel) {
+    analyse_region(frame, region, blobs);
+    return;
+  }
+  cv::parallel_for_(cv::Range(0, 1),
+                    [&](const cv::Range&) { analyse_region(frame, region, blobs); });
+}
+
+void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
+                                   std::vector<ColourBlob>* blobs) {
+  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
+  const int m = margin_px_;
+  const cv::Rect extended =
+      cv::Rect(region.x - m, region.y - m, region.width + 2 * m, region.height + 2 * m) &
+      frame_rect;
+  // A view into the frame (when it has the channels the classifier needs), so near the frame's
+  // edges the filter sees the same border as a whole-frame pass would.
+  const cv::Mat src = prepare(frame(extended), prepared_store_);
+
+  // 1. Filter.
+  cv::Mat filtered = src;
+  if (params_.filter == ColourParams::Filter::kGaussian) {
+    filtered = Scratch(filtered_store_, extended.size(), src.type());
+    cv::GaussianBlur(src, filtered, cv::Size(params_.filter_ksize, params_.filter_ksize), 0);
+  } else if (params_.filter == ColourParams::Filter::kMedian) {
+    filtered = Scratch(filtered_store_, extended.size(), src.type());
+    cv::medianBlur(src, filtered, params_.filter_ksize);
+  }
+
+  // 2. Binarise.
+  cv::Mat mask = Scratch(mask_store_, extended.size(), CV_8U);
+  classify(filtered, false, mask);
+
+  // 3. Opening then closing, only where it can change anything: outside the bounding box of the
+  //    marker-coloured pixels the mask is 0 and stays 0 (opening only removes, closing only fills
+  //    between pixels), so morphology and labelling work on that box plus the reach of the four
+  //    passes. Beyond the box the parent mask holds zeros, exactly what a whole pass would read.
+  const cv::Rect extended_local(cv::Point(0, 0), extended.size());
+  cv::Rect active = NonZeroBounds(mask);
+  if (active.empty()) return;
+  if (!kernel_.empty()) {
+    const int reach = 4 * (params_.morph_size / 2) + 1;
+    active = cv::Rect(active.x - reach, active.y - reach, active.width + 2 * reach,
+                      active.height + 2 * reach) &
+             extended_local;
+    cv::Mat cleaned = mask(active);
+    if (morph_cross_ || morph_square_) {
+      // The reach padding keeps `active`'s border rows zero, so reading the outside as the
+      // border (the kernel) equals reading the parent's zeros (morphologyEx on the view).
+      OpenClose3x3(cleaned, morph_cross_, morph_store_);
+    } else {
+      cv::Mat opened = Scratch(morph_store_, active.size(), CV_8U);
+      cv::morphologyEx(cleaned, opened, cv::MORPH_OPEN, kernel_);
+      cv::morphologyEx(opened, cleaned, cv::MORPH_CLOSE, kernel_);
+    }
+  }
+
+  // 4. Blobs of the region proper (the margin only fed the filters); the region is 0 outside
+  //    `labelled`, so its components are the region's components.
+  const cv::Rect inner_local(region.tl() - extended.tl(), region.size());
+  const cv::Rect labelled = active & inner_local;
+  if (labelled.empty()) return;
+  const cv::Point offset = labelled.tl() - inner_local.tl();  // Of `labelled` in the region.
+  labeller_.Label(mask(labelled));
+  const bool open_left = region.x > 0;
+  const bool open_top = region.y > 0;
+  const bool open_right = region.x + region.width < frame.cols;
+  const bool open_bottom = region.y + region.height < frame.rows;
+  const std::vector<RunLabeller::Component>& components = labeller_.components();
+  for (size_t i = 0; i < components.size(); ++i) {
+    const RunLabeller::Component& comp = components[i];
+    const cv::Rect& box = comp.box;
+    const cv::Rect in_region = box + offset;
+    ColourBlob blob;
+    blob.area_px = comp.area;
+    blob.clipped = (open_left && in_region.x == 0) || (open_top && in_region.y == 0) ||
+                   (open_right && in_region.x + in_region.width == region.width) ||
+                   (open_bottom && in_region.y + in_region.height == region.height);
+    blob.bbox_px = in_region + region.tl();
+    blob.at_frame_edge = blob.bbox_px.x == 0 || blob.bbox_px.y == 0 ||
+                         blob.bbox_px.x + blob.bbox_px.width == frame.cols ||
+                         blob.bbox_px.y + blob.bbox_px.height == frame.rows;
+    if (!blob.clipped) {
+      if (blob.area_px < params_.min_area_px) continue;
+      if (params_.max_area_px > 0 && blob.area_px > params_.max_area_px) continue;
+      // 5. Centroid from the binary moments of this blob alone (exact integer sums relative to
+      //    its box, as cv::moments of its own pixels), then the box's integer offset in the frame.
+      const double m00 = comp.area, inv_m00 = 1.0 / m00;
+      const double cx = static_cast<double>(comp.m10) * inv_m00;
+      const double cy = static_cast<double>(comp.m01) * inv_m00;
+      blob.binary_centroid_px = cv::Point2d(cx + blob.bbox_px.x, cy + blob.bbox_px.y);
+      blob.centroid_px = blob.binary_centroid_px;
+      // Polar moment of the pixels as unit squares (each adds 1/6 about its own centre).
+      const double mu20 = static_cast<double>(comp.m20) - static_cast<double>(comp.m10) * cx;
+      const double mu02 = static_cast<double>(comp.m02) - static_cast<double>(comp.m01) * cy;
+      const double polar = mu20 + mu02 + m00 / 6.0;
+      blob.circularity = m00 * m00 / (2.0 * CV_PI * polar);
+      // 6. Colour statistics and the soft centroid, for blobs that may be the marker.
+      if (blob.circularity >= params_.min_circularity) {
+        measure(filtered, mask, static_cast<int>(i), box, labelled.tl(), extended.tl(), &blob);
+        if (blob.rim_placed) blob.centroid_px = blob.rim->centre_px;  // Over the soft centroid.
+      }
+    }
+    blobs->push_back(blob);
+  }
+}
+
+void ColourTracker::FillHoles(cv::Mat& own, cv::Point own_origin, ColourBlob* blob) {
+  // A hole is a part of the blob's background that does not reach the outside: a specular
+  // highlight on a glossy marker, a glint, pixels noise pushed out of the range. They are part of
+  // the marker: its area, centroid and shape are the filled region's, and its colour and ring
+  // are measured around the filled region (a highlight inside is not its surroundings).
+  cv::Mat outside = Scratch(holes_store_, cv::Size(own.cols + 2, own.rows + 2), CV_8U);
+  outside.setTo(0);
+  own.copyTo(outside(cv::Rect(1, 1, own.cols, own.rows)));
+  cv::floodFill(outside, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 4);
+  int filled = 0;
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* o = outside.ptr<uchar>(y + 1) + 1;
+    uchar* w = own.ptr<uchar>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      if (o[x] == 0) {
+        w[x] = kFilledHole;
+        ++filled;
+      }
+    }
+  }
+  if (filled == 0) return;
+  const cv::Moments m = cv::moments(own, true);
+  if (!(m.m00 > 0)) return;
+  blob->area_px = m.m00;
+  blob->binary_centroid_px =
+      cv::Point2d(m.m10 / m.m00 + own_origin.x, m.m01 / m.m00 + own_origin.y);
+  blob->centroid_px = blob->binary_centroid_px;
+  blob->circularity = m.m00 * m.m00 / (2.0 * CV_PI * (m.mu20 + m.mu02 + m.m00 / 6.0));
+}
+
+void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int component,
+                            const cv::Rect& box, cv::Point labelled_tl, cv::Point origin,
+                            ColourBlob* blob) {
+  // The blob's box in `filtered`, padded by the ring's reach.
+  const cv::Rect box_local = box + labelled_tl;
+  const cv::Rect padded =
+      cv::Rect(box_local.x - kRingOuter - 1, box_local.y - kRingOuter - 1,
+               box_local.width + 2 * kRingOuter + 2, box_local.height + 2 * kRingOuter + 2) &
+      cv::Rect(cv::Point(0, 0), filtered.size());
+  const cv::Size size = padded.size();
+  cv::Mat own = Scratch(blob_store_, size, CV_8U);
+  for (int y = 0; y < size.height; ++y) {
+    std::memset(own.ptr<uchar>(y), 0, static_cast<size_t>(size.width));
+  }
+  labeller_.Draw(component, own, padded.tl() - labelled_tl);
+  FillHoles(own, padded.tl() + origin, blob);
+  // Asymmetry: the binary centroid against the centre of the smallest circle around the blob
+  // (its convex hull's points are among each row's leftmost and rightmost pixels).
+  edge_points_.clear();
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* row = own.ptr<uchar>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < size.width; ++x) {
+      if (!row[x]) continue;
+      if (first < 0) first = x;
+      last = x;
+    }
+    if (first < 0) continue;
+    edge_points_.emplace_back(first, y);
+    if (last != first) edge_points_.emplace_back(last, y);
+  }
+  if (!edge_points_.empty()) {
+    cv::Point2f circle_centre;
+    float circle_radius = 0.0f;
+    cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
+    const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
+    blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
+  }
+  // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
+  // core = more than kSoftBand inside, reach = within kRingOuter outside.
+  cv::Mat distance = Scratch(distance_store_, size, CV_16U);
+  ChamferToEdge(own, distance);
+  constexpr int kNear = 3 * kSoftBand, kReach = 3 * kRingOuter;
+  const cv::Mat pixels = filtered(padded);
+  const cv::Mat others = mask(padded);
+  const int channels = pixels.channels();
+
+  // The local background varies around a marker (the body's edge, texture): the ring is split
+  // into kSectors angular sectors about the blob's centroid, and an edge pixel's background is
+  // interpolated between the two sectors nearest its direction.
+  const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
+  auto sector_of = [&](int x, int y) {
+    const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
+    return std::clamp(u, 0.0, kSectors - 1e-9);
+  };
+
+  // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
+  bool core_empty = true;
+  for (int y = 0; y < size.height && core_empty; ++y) {
+    const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* d = distance.ptr<uint16_t>(y);
+    for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] == 255 && d[x] > kNear);
+  }
+  const int core_depth = core_empty ? 0 : kNear;
+  const bool pure_core = !core_empty;
+
+  // Pass 1: core colour, ring colour (overall and per sector).
+  cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
+  std::array<cv::Vec3d, kSectors> sector_sum{};
+  std::array<int, kSectors> sector_n{};
+  double core_n = 0, ring_n = 0;
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* d = distance.ptr<uint16_t>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const uchar* c = p + x * channels;
+      if (ow[x] == 255 && d[x] > core_depth) {  // A filled hole is not the marker's colour.
+        for (int k = 0; k < channels; ++k) {
+          core_sum[k] += c[k];
+          core_sq[k] += c[k] * c[k];
+        }
+        core_n += 1;
+      } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
+        const int sector = static_cast<int>(sector_of(x, y));
+        for (int k = 0; k < channels; ++k) {
+          ring_sum[k] += c[k];
+          ring_sq[k] += c[k] * c[k];
+          sector_sum[sector][k] += c[k];
+        }
+        ++sector_n[sector];
+        ring_n += 1;
+      }
+    }
+  }
+  if (core_n < 1 || ring_n < 3) return;  // Crowded by other blobs: no local background.
+  double core_var = 0, ring_var = 0;
+  for (int k = 0; k < channels; ++k) {
+    blob->core_colour[k] = core_sum[k] / core_n;
+    blob->ring_colour[k] = ring_sum[k] / ring_n;
+    core_var += std::max(0.0, core_sq[k] / core_n - blob->core_colour[k] * blob->core_colour[k]);
+    ring_var += std::max(0.0, ring_sq[k] / ring_n - blob->ring_colour[k] * blob->ring_colour[k]);
+  }
+  blob->core_px = pure_core ? static_cast<int>(core_n) : 0;
+  blob->core_sigma = std::sqrt(core_var);
+  blob->ring_sigma = std::sqrt(ring_var);
+  const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
+  const double axis2 = axis.dot(axis);
+  blob->contrast = std::sqrt(axis2) /
+                   (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  blob->measured = true;
+  // A round marker partly hidden: the circle of its radius through its edge (not where the
+  // frame cuts it).
+  if (const std::optional<double> radius = rim_radius_px();
+      radius && blob->area_px < kWholeRimFraction * model_->area_px) {
+    edge_points_.clear();
+    const cv::Point frame_origin = padded.tl() + origin;
+    for (int y = 0; y < size.height; ++y) {
+      const uchar* ow = own.ptr<uchar>(y);
+      for (int x = 0; x < size.width; ++x) {
+        if (!ow[x]) continue;
+        const bool edge = x == 0 || y == 0 || x == size.width - 1 || y == size.height - 1 ||
+                          !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
+                          !own.ptr<uchar>(y + 1)[x];
+        const int fx = x + frame_origin.x, fy = y + frame_origin.y;
+        const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
+                                   fy == frame_size_.height - 1;
+        if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
+      }
+    }
+    rim_points_.assign(edge_points_.begin(), edge_points_.end());
+    blob->rim = FitRimOfRadius(rim_points_, *radius);
+    if (const std::optional<cv::Point2d> centre = RimCentre(*blob)) {
+      blob->centroid_px = *centre;
+      blob->rim_placed = true;
+    }
+  }
+  if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
+
+  // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
+  // pixel's colour lies between its local background (0) and the core colour (1), on the line
+  // through them. Pixels of other blobs count 0.
+  std::array<cv::Vec3d, kSectors> sector_mean;
+  for (int i = 0; i < kSectors; ++i) {
+    sector_mean[i] = sector_n[i] >= 2 ? sector_sum[i] / sector_n[i] : blob->ring_colour;
+  }
+  const cv::Vec3d& f = blob->core_colour;
+  const double deadband_scale = 1.0 / (1.0 - 2.0 * kMembershipDeadband);
+  double sw = 0, sx = 0, sy = 0;
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uint16_t* dist = distance.ptr<uint16_t>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    double row_w = 0, row_x = 0;
+    for (int x = 0; x < size.width; ++x) {
+      if (!ow[x] && dist[x] > kNear) continue;  // Beyond the band.
+      double w = 1.0;
+      if (!(ow[x] && dist[x] > kNear)) {
+        if (ot[x] && !ow[x]) continue;
+        const uchar* c = p + x * channels;
+        // Sector centres sit at i + 0.5.
+        const double u = sector_of(x, y) - 0.5;
+        const double lower = std::floor(u);
+        const double t = u - lower;
+        const int i0 = (static_cast<int>(lower) + kSectors) % kSectors;
+        const int i1 = (i0 + 1) % kSectors;
+        double num = 0, den = 0;
+        for (int k = 0; k < channels; ++k) {
+          const double g = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
+          const double d = f[k] - g;
+          num += (c[k] - g) * d;
+          den += d * d;
+        }
+        w = den > 1.0 ? std::clamp((num / den - kMembershipDeadband) * deadband_scale, 0.0, 1.0)
+                      : (ow[x] ? 1.0 : 0.0);
+      }
+      row_w += w;
+      row_x += w * x;
+    }
+    sw += row_w;
+    sx += row_x;
+    sy += row_w * y;
+  }
+  if (sw <= 0) return;
+  // Offsets added as one integer: the same blob in a window and in the whole frame gives the
+  // same bits.
+  blob->centroid_px = cv::Point2d(sx / sw + (padded.x + origin.x), sy / sw + (padded.y + origin.y));
+}
+
+void ColourTracker::complete_blobs(const cv::Mat& frame, cv::Rect region,
+                                   std::vector<ColourBlob>* blobs) {
+  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
+  region &= frame_rect;
+  for (int round = 0; round < kMaxGrowRounds && !region.empty(); ++round) {
+    pending_.clear();
+    analyse(frame, region, &pending_);
+    cv::Rect grown = region;
+    bool clipped = false;
+    const int pad = std::max(16, std::min(region.width, region.height) / 2);
+    for (const ColourBlob& b : pending_) {
+      if (!b.clipped) continue;
+      clipped = true;
+      grown |= cv::Rect(b.bbox_px.x - pad, b.bbox_px.y - pad, b.bbox_px.width + 2 * pad,
+                        b.bbox_px.height + 2 * pad);
+    }
+    if (!clipped) {
+      blobs->insert(blobs->end(), pending_.begin(), pending_.end());
+      return;
+    }
+    region = grown & frame_rect;
+  }
+  // Something long and thin keeps leaving the region: the whole frame has no clipped blobs.
+  pending_.clear();
+  analyse(frame, frame_rect, &pending_);
+  blobs->insert(blobs->end(), pending_.begin(), pending_.end());
+}
+
+void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
+                                   std::vector<ColourBlob>* blobs) {
+  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
+  region &= frame_rect;
+  const int coarse_cols = region.width / factor;
+  const int coarse_rows = region.height / factor;
+  if (coarse_cols < 4 || coarse_rows < 4) {
+    complete_blobs(frame, region, blobs);
+    return;
+  }
+  // One pixel per cell of factor x factor pixels (its centre). Sampling, not averaging: a blob
+  // of radius >= factor always holds several sample points, and a sample is a real pixel of the
+  // frame, not a mix of marker and background. Columns beyond a multiple of the factor are
+  // covered by the last cell's window below.
+  const cv::Mat src = frame(cv::Rect(region.x, region.y, coarse_cols * factor, coarse_rows * factor));
+  cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
+  // The pixel cv::resize's INTER_NEAREST_EXACT takes, (i + 1/2) * factor, copied directly.
+  const int channels = src.channels(), half = factor / 2;
+  const size_t row_bytes = static_cast<size_t>(src.cols) * channels;
+  for (int y = 0; y < coarse_rows; ++y) {
+    // The next sampled row is asked for while this one is copied: every factor-th row of a frame
+    // not yet in the cache is a pattern the hardware prefetcher does not follow, and the copy
+    // waited on every line.
+    if (y + 1 < coarse_rows) {
+      const uchar* ahead = src.ptr<uchar>((y + 1) * factor + half);
+      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
+    }
+    const uchar* in = src.ptr<uchar>(y * factor + half) + half * channels;
+    uchar* out = sampled.ptr<uchar>(y);
+    const int step = factor * channels;
+    if (channels == 3) {
+      // Pixel by pixel as one copy: byte by byte, GCC built vectors from the bytes through the
+      // stack, a stall per 16 bytes that cost as much as classifying them.
+      for (int x = 0; x < coarse_cols; ++x, in += step, out += 3) std::memcpy(out, in, 3);
+    } else {
+      for (int x = 0; x < coarse_cols; ++x, in += step) out[x] = in[0];
+    }
+  }
+  const cv::Mat coarse = prepare(sampled, coarse_prepared_store_);
+  cv::Mat mask = Scratch(coarse_mask_store_, coarse.size(), CV_8U);
+  classify(coarse, true, mask);
+  // Group the candidate cells by tiles of kTile x kTile cells, 8-connected tiles together:
+  // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
+  windows_.clear();
+  NonZeroPoints(mask, points_);
+  // A blob that can be the marker has radius >= factor (as acquire_downsample chooses it), so it
+  // holds at least two 8-adjacent sample points: a lone lit sample is a speck of background texture.
+  if (min_blob_radius_px() >= factor) {
+    auto alone = [&](const cv::Point& p) {
+      for (int y = std::max(0, p.y - 1); y <= std::min(mask.rows - 1, p.y + 1); ++y) {
+        const uchar* row = mask.ptr<uchar>(y);
+        for (int x = std::max(0, p.x - 1); x <= std::min(mask.cols - 1, p.x + 1); ++x) {
+          if ((x != p.x || y != p.y) && row[x]) return false;
+        }
+      }
+      return true;
+    };
+    points_.erase(std::remove_if(points_.begin(), points_.end(), alone), points_.end());
+  }
+  if (points_.empty()) return;
+  const cv::Size grid((coarse_cols + kTile - 1) / kTile, (coarse_rows + kTile - 1) / kTile);
+  cv::Mat tiles = Scratch(tiles_store_, grid, CV_8U);
+  tiles.setTo(0);
+  for (const cv::Point& p : points_) tiles.at<uchar>(p.y / kTile, p.x / kTile) = 255;
+  cv::Mat labels = Scratch(coarse_labels_store_, grid, CV_32S);
+  int count = 0;
+  cv::parallel_for_(cv::Range(0, 1), [&](const cv::Range&) {  // Inline: see analyse().
+    count = cv::connectedComponentsWithStats(tiles, labels, coarse_stats_, coarse_centroids_, 8,
+                                             CV_32S);
+  });
+  // The cells' own bounding box per tile group, so windows stay tight.
+  boxes_.assign(static_cast<size_t>(count), cv::Rect());
+  for (const cv::Point& p : points_) {
+    cv::Rect& box = boxes_[static_cast<size_t>(labels.at<int>(p.y / kTile, p.x / kTile))];
+    box = box.empty() ? cv::Rect(p.x, p.y, 1, 1) : (box | cv::Rect(p.x, p.y, 1, 1));
+  }
+  // Each group becomes a full-resolution window: its cells plus one cell all round.
+  for (int i = 1; i < count; ++i) {
+    const cv::Rect& cells = boxes_[static_cast<size_t>(i)];
+    const int x0 = cells.x - 1, y0 = cells.y - 1;
+    const int x1 = cells.x + cells.width + 1, y1 = cells.y + cells.height + 1;
+    const int right = x1 >= coarse_cols ? region.width : x1 * factor;
+    const int bottom = y1 >= coarse_rows ? region.height : y1 * factor;
+    const cv::Rect window(region.x + x0 * factor, region.y + y0 * factor,
+                          right - x0 * factor, bottom - y0 * factor);
+    windows_.push_back(window & frame_rect);
+  }
+  // Overlapping windows merge, so a blob is analysed (and completed) once.
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (size_t a = 0; a < windows_.size() && !merged; ++a) {
+      for (size_t b = a + 1; b < windows_.size(); ++b) {
+        if ((windows_[a] & windows_[b]).empty()) continue;
+        windows_[a] |= windows_[b];
+        windows_.erase(windows_.begin() + static_cast<std::ptrdiff_t>(b));
+        merged = true;
+        break;
+      }
+    }
+  }
+  const size_t first = blobs->size();
+  for (const cv::Rect& window : windows_) complete_blobs(frame, window, blobs);
+  // Regions grown around clipped blobs may overlap: keep each blob once.
+  std::sort(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(), CentroidBefore);
+  blobs->erase(std::unique(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(),
+                           SameBlob),
+               blobs->end());
+}
+
+}  // namespace softsight
