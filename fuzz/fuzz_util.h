@@ -7,19 +7,26 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 namespace softsight::fuzz {
 
-// A scratch file `name` in a folder made once per process (removed by the OS's tmp cleaning;
-// a fuzz run makes one folder).
+// A scratch file `name` in a folder made once per process and removed with what it holds when
+// the process ends normally (a fuzz run that finds a crash leaves it, beside the crash input).
 inline std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_t size) {
-  static const std::string folder = [] {
-    std::string pattern = "/tmp/softsight_fuzz_XXXXXX";
-    if (mkdtemp(pattern.data()) == nullptr) std::abort();
-    return pattern;
-  }();
-  const std::string path = folder + "/" + name;
+  struct Folder {
+    std::string path = "/tmp/softsight_fuzz_XXXXXX";
+    Folder() {
+      if (mkdtemp(path.data()) == nullptr) std::abort();
+    }
+    ~Folder() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const Folder folder;
+  const std::string path = folder.path + "/" + name;
   // A new file each time, not the old one truncated: ext4 flushes a file rewritten through
   // truncation on close (auto_da_alloc), 3-4 ms per input, which made the run wait on the disk.
   std::remove(path.c_str());

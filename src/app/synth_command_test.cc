@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <sys/wait.h>
 
@@ -22,10 +23,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A new empty folder `name`; every folder made so is removed when the test program ends.
 fs::path FreshDir(const std::string& name) {
+  struct Made {
+    std::vector<fs::path> folders;
+    ~Made() {
+      std::error_code ignored;
+      for (const fs::path& f : folders) fs::remove_all(f, ignored);
+    }
+  };
+  static Made made;
   const fs::path dir = fs::path(::testing::TempDir()) / ("softsight_synth_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
+  made.folders.push_back(dir);
   return dir;
 }
 

@@ -44,10 +44,19 @@ Errors CompareCorners(const std::vector<cv::Point2f>& found, const std::vector<c
   return e;
 }
 
+// A file in one folder for the whole suite, removed when the test program ends.
 std::string TempPath(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("softsight_calib_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
+  struct Folder {
+    fs::path path =
+        fs::temp_directory_path() / ("softsight_calib_test_" + std::to_string(getpid()));
+    Folder() { fs::create_directories(path); }
+    ~Folder() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Folder folder;
+  return (folder.path / name).string();
 }
 
 // Rendering and calibrating is the slow part: done once for the whole suite.

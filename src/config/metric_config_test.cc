@@ -16,10 +16,19 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+// One folder for the whole suite, removed when the test program ends.
 fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / ("softsight_metric_config_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
+  struct Folder {
+    fs::path path = fs::temp_directory_path() /
+                    ("softsight_metric_config_test_" + std::to_string(getpid()));
+    Folder() { fs::create_directories(path); }
+    ~Folder() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Folder folder;
+  return folder.path;
 }
 
 // Reads the metric keys of `yaml` as if it were the config file `name` in TempDir().

@@ -1,5 +1,7 @@
 // Every option of every table: YAML round trip, the same message from the file and from Check(),
 // sane int ranges, and the example configs mentioning every key (option_table_test_util.h).
+#include <cstdio>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -95,6 +97,7 @@ TEST(OptionTables, TheCaptureSectionRoundTripsThroughAConfigFile) {
   const std::string file = ::testing::TempDir() + "/softsight_capture_round_trip.yaml";
   SaveTrackingConfig(config, file);
   const TrackingConfig again = LoadTrackingConfig(file);
+  std::remove(file.c_str());
   ASSERT_TRUE(again.capture);
   EXPECT_EQ(*again.capture, capture);
 }
