@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Regenerates the README's table "Speed where users wait" (issue 13): every figure is printed
+# Regenerates the table "Speed where users wait" of docs/measurements.md (issue 13): every figure is printed
 # beside references measured in the same run, on the same files (a bare decode loop of the file,
 # one BGR -> gray pass over its frame, /bin/true for start-up), so the ratios hold on another or
 # a busier machine. Prints the Markdown table to stdout; the machine's load average is printed
 # with it (on a shared machine, compare ratios, not absolute times).
 #   scripts/bench.sh [WORK_DIR]     (default: bench_out/, reused: rendered videos are kept)
-# Then the README's per-frame "Speed" table of the trackers and recordings, from the Google
+# Then the per-frame "Speed" table of docs/measurements.md of the trackers and recordings, from the Google
 # Benchmark programs (their JSON kept in WORK_DIR), each row beside the BGR -> gray pass its own
 # program measured in the same run.
 # Takes about 4 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
