@@ -4,6 +4,7 @@
 // frame has a few markers and a few dozen candidates, so a plain O(n^3) solver is microseconds.
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <vector>
 
@@ -24,7 +25,7 @@ class MinimumCostAssignment {
 
  private:
   std::vector<double> u_, v_, minv_;
-  std::vector<size_t> p_, way_;
+  std::vector<std::size_t> p_, way_;
   std::vector<char> used_;
   std::vector<int> result_;
 };
