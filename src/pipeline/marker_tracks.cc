@@ -28,6 +28,16 @@ double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::P
   return cv::norm(p - (a + u * ab));
 }
 
+}  // namespace
+
+// A report at `p` is a repeated frame of track `t`: the marker exactly where it was last
+// believed while moving (track/repeated_frames.h); its motion waits for the next new frame.
+bool MarkerTracks::IsRepeat(const Track& t, const cv::Point2d& p) {
+  return t.last_px && IsRepeatedFrame(p - *t.last_px, t.motion.velocity(), t.repeats);
+}
+
+namespace {
+
 bool Fits(CandidateVerdict v) {
   return v == CandidateVerdict::kFits || v == CandidateVerdict::kChosen;
 }
@@ -128,10 +138,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
         }
         continue;
       }
-      // A repeated frame: the marker exactly where it was while moving (the footage repeats
-      // frames); its motion waits for the next new frame.
-      const bool repeated = t.last_px && cv::norm(p - *t.last_px) <= kRepeatStillPx &&
-                            IsRepeatedFrame(p - *t.last_px, t.motion.velocity(), t.repeats);
+      const bool repeated = IsRepeat(t, p);
       const double d2 = t.motion.distance2(p);
       const double dist = cv::norm(p - t.motion.position());
       // Inside the gate, or within what the marker covers in a frame at its speed plus its own
@@ -161,11 +168,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     }
     const size_t k = static_cast<size_t>(assigned[i]);
     if (report_pooled_[i] && k == *report_pooled_[i]) {
-      if (tracks_[i].last_px && cv::norm(*o.position_px - *tracks_[i].last_px) <= kRepeatStillPx &&
-          IsRepeatedFrame(*o.position_px - *tracks_[i].last_px, tracks_[i].motion.velocity(),
-                          tracks_[i].repeats)) {
-        tracks_[i].repeated = true;
-      }
+      tracks_[i].repeated = IsRepeat(tracks_[i], *o.position_px);
       continue;  // kKeep.
     }
     for (const Entry& e : entries_[i]) {

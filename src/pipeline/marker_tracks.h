@@ -78,6 +78,7 @@ class MarkerTracks {
   struct Pooled {
     cv::Point2d position_px;
   };
+  static bool IsRepeat(const Track& t, const cv::Point2d& p);
   void predict_all();
   size_t pool(const cv::Point2d& p);
 
