@@ -34,6 +34,10 @@ struct PyConfig {
 // The name a config given as a dict has in error messages ("<dict>: markers[0].name: ...").
 inline constexpr const char* kDictConfigName = "<dict>";
 
+// A path given as str, bytes or os.PathLike, as the bytes the file system sees (os.fsencode);
+// nothing for other values. Throws InputError for a path holding a NUL byte.
+std::optional<std::string> AsPath(const py::handle& source);
+
 // A config from a path (str or os.PathLike), a mapping or a Config. `method` overrides every
 // marker's method (as `--method`). Throws InputError with the library's messages.
 PyConfig LoadPyConfig(const py::handle& source, const std::optional<std::string>& method);
@@ -42,7 +46,10 @@ TrackingConfig ResolveConfig(const py::handle& source, const std::optional<std::
 // A Python value as a YAML node with no marks (so messages name keys, not lines): mappings,
 // lists and tuples, str, bool, int, float (inf and nan as YAML's .inf and .nan), None, os.PathLike
 // and numpy scalars. Throws InputError naming `file` and the key path for anything else.
-YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::string& path);
+// Deeper than this a Python config is refused (InputError) rather than recursed into.
+inline constexpr int kMaxConfigDepth = 64;
+YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::string& path,
+                  int depth = 0);
 
 // A header on the pixels of `array` when its layout allows it (no copy): uint8, HxWx3 (BGR) or
 // HxW (gray), each row's pixels contiguous, rows any distance apart (slices of a bigger image

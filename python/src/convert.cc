@@ -22,20 +22,34 @@ std::string FloatText(double value) {
   return py::str(py::float_(value));  // Python's shortest round-trip text ("0.1", "1e-05").
 }
 
-std::optional<std::string> AsPath(const py::handle& source) {
-  if (py::isinstance<py::str>(source)) return source.cast<std::string>();
-  if (py::hasattr(source, "__fspath__")) {
-    return py::module_::import("os").attr("fspath")(source).cast<std::string>();
-  }
-  return std::nullopt;
-}
-
 }  // namespace
 
-YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::string& path) {
+std::optional<std::string> AsPath(const py::handle& source) {
+  if (!py::isinstance<py::str>(source) && !py::isinstance<py::bytes>(source) &&
+      !py::hasattr(source, "__fspath__")) {
+    return std::nullopt;
+  }
+  // os.fsencode gives the bytes the file system sees: the same for a str, a bytes path and a
+  // pathlib.Path, also for names that are not UTF-8 (Python's surrogateescape).
+  const std::string path = py::bytes(py::module_::import("os").attr("fsencode")(source));
+  if (path.find('\0') != std::string::npos) {
+    throw InputError(EscapeForMessage(path) + ": a path holding a NUL byte");
+  }
+  return path;
+}
+
+YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::string& path,
+                  int depth) {
   const auto error = [&](const std::string& problem) {
-    return InputError(file + ": " + (path.empty() ? "top level" : path) + ": " + problem);
+    return InputError(file + ": " + (path.empty() ? "top level" : EscapeForMessage(path, 200)) +
+                      ": " + problem);
   };
+  // A config is a few levels deep; the bound keeps a dict that contains itself, or one nested
+  // thousands deep, from overflowing the stack (the recursion below is one frame per level).
+  if (depth > kMaxConfigDepth) {
+    throw error("nested deeper than " + std::to_string(kMaxConfigDepth) +
+                " levels (a dict or list that contains itself?)");
+  }
   if (value.is_none()) return YAML::Node(YAML::NodeType::Null);
   if (py::isinstance<py::bool_>(value)) return YAML::Node(value.cast<bool>() ? "true" : "false");
   if (py::isinstance<py::str>(value)) return YAML::Node(value.cast<std::string>());
@@ -49,7 +63,7 @@ YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::s
                     " is not a string (config keys are names)");
       }
       const std::string name = key.cast<std::string>();
-      node[name] = ToYaml(value[key], file, path.empty() ? name : path + "." + name);
+      node[name] = ToYaml(value[key], file, path.empty() ? name : path + "." + name, depth + 1);
     }
     return node;
   }
@@ -58,14 +72,14 @@ YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::s
     YAML::Node node(YAML::NodeType::Sequence);
     size_t i = 0;
     for (const py::handle item : value) {
-      node.push_back(ToYaml(item, file, path + "[" + std::to_string(i++) + "]"));
+      node.push_back(ToYaml(item, file, path + "[" + std::to_string(i++) + "]", depth + 1));
     }
     return node;
   }
   if (AsPath(value)) return YAML::Node(*AsPath(value));
   // numpy scalars: np.int64 is not an int, np.float32 not a float.
   if (py::hasattr(value, "dtype") && py::hasattr(value, "item")) {
-    return ToYaml(value.attr("item")(), file, path);
+    return ToYaml(value.attr("item")(), file, path, depth + 1);
   }
   throw error("a " + Describe(value) +
               " cannot be a config value (use numbers, strings, lists, dicts)");
@@ -81,7 +95,7 @@ PyConfig LoadPyConfig(const py::handle& source, const std::optional<std::string>
   out.method = method;
   if (const std::optional<std::string> path = AsPath(source)) {
     out.config = LoadTrackingConfig(*path, method);
-    out.origin = py::str(*path);
+    out.origin = py::module_::import("os").attr("fsdecode")(py::bytes(*path));
     return out;
   }
   if (py::isinstance<py::dict>(source) || py::hasattr(source, "keys")) {

@@ -1,6 +1,7 @@
 // softsight.Session: frames from the caller's own code (numpy arrays) through a TrackingSession.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 
 #include <opencv2/imgproc.hpp>
@@ -9,6 +10,7 @@
 #include "bindings.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 
@@ -20,7 +22,16 @@ class PySession {
   explicit PySession(TrackingConfig config)
       : session_(config), columns_(TrackingColumns(config).names()) {}
 
-  FrameResult process(const py::array& image, double time_s, std::optional<int64_t> index) {
+  FrameResult process(const py::object& frame_object, double time_s,
+                      std::optional<int64_t> index) {
+    // Checked here rather than by pybind11's overload matching, whose message quotes the whole
+    // value (megabytes for a list of pixels).
+    if (!py::isinstance<py::array>(frame_object)) {
+      throw py::type_error("frame: a numpy array (HxWx3 BGR or HxW gray, uint8) as "
+                           "cv2.VideoCapture.read() gives, got " +
+                           std::string(py::str(py::type::of(frame_object).attr("__name__"))));
+    }
+    const py::array image = py::reinterpret_borrow<py::array>(frame_object);
     py::object copy;  // Holds a contiguous copy when the array's layout needs one.
     const cv::Mat pixels =
         ImageHeader(image, "frame " + std::to_string(index.value_or(next_index_)), &copy);
@@ -29,6 +40,11 @@ class PySession {
     last_call_released_gil_ = PyGILState_Check() == 0;
     const int64_t frame_index = index.value_or(next_index_);
     const std::string what = "frame " + std::to_string(frame_index);
+    // A NaN or negative time would reach the CSV and the motion model as if measured.
+    if (!(std::isfinite(time_s) && time_s >= 0.0)) {
+      throw InputError(what + ": time_s " + ShortNumber(time_s) + " must be a finite number >= 0");
+    }
+    if (frame_index < 0) throw InputError(what + ": a frame index must be >= 0");
     Frame frame;
     frame.index = frame_index;
     frame.time_s = time_s;
@@ -41,6 +57,12 @@ class PySession {
       frame.image = pixels;  // A header on the caller's pixels: no copy.
     }
     if (first_size_.empty()) {
+      // As track() and the program refuse a gray video: colour markers on gray frames would
+      // only ever be "lost", which reads as a tracking failure rather than a wrong input. Only a
+      // one-channel array is judged: a dark colour frame (a camera warming up) is not gray input.
+      if (NeedsColour(session_.config()) && pixels.channels() == 1) {
+        throw InputError(what + ": a gray frame, but " + GrayFrameProblem());
+      }
       first_size_ = frame.image.size();
     } else if (frame.image.size() != first_size_) {
       throw InputError(what + ": " + std::to_string(frame.image.cols) + "x" +

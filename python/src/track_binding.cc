@@ -179,14 +179,24 @@ py::dict SummaryDict(const RunSummary& s) {
 // so far, as the CLI keeps the rows it wrote).
 py::tuple Track(const py::object& input, const py::object& config_source,
                 std::optional<int64_t> max_frames, bool progress,
-                const std::optional<std::string>& csv, double fps,
+                const py::object& csv_path, double fps,
                 const std::optional<std::string>& method) {
   if (max_frames && *max_frames < 0) {
     throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
   }
   const TrackingConfig config = ResolveConfig(config_source, method);
   FrameSourceSpec spec;
-  spec.input = py::str(py::module_::import("os").attr("fspath")(input));
+  const std::optional<std::string> input_path = AsPath(input);
+  if (!input_path) {
+    throw py::type_error("input: a path (str, bytes or os.PathLike) or synth:NAME, got " +
+                         std::string(py::str(py::type::of(input).attr("__name__"))));
+  }
+  spec.input = *input_path;
+  std::optional<std::string> csv;
+  if (!csv_path.is_none()) {
+    csv = AsPath(csv_path);
+    if (!csv) throw py::type_error("csv: a path (str, bytes or os.PathLike)");
+  }
   spec.sequence_fps = fps;
   RunSummary summary;
   const CsvColumnTable table = TrackingColumns(config);
@@ -199,6 +209,11 @@ py::tuple Track(const py::object& input, const py::object& config_source,
     std::optional<CsvSink> file;
     std::vector<FrameSink*> sinks = {&rows};
     if (csv) {
+      // The same guard as the program's: the CSV may not be the video, an image of the
+      // sequence, the config or a file the config names.
+      std::vector<PathRole> inputs = ConfigInputs(config);
+      for (const std::string& name : source->files()) inputs.push_back({"input", name});
+      CheckOutputsAreNotInputs({{"csv", *csv}}, inputs);
       file.emplace(*csv, TrackingColumns(config));
       sinks.push_back(&*file);
     }

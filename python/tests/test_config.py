@@ -99,3 +99,18 @@ def test_version_and_licence_agree_with_the_program():
     # The package metadata beside the module (build tree and installed alike).
     assert importlib.metadata.version("softsight") == softsight.__version__
     assert importlib.metadata.metadata("softsight")["License"] == "Apache-2.0"
+
+
+def test_a_dict_that_contains_itself_or_nests_too_deep_is_an_input_error():
+    looped = {"markers": []}
+    looped["markers"].append({"name": "a", "colour": looped})
+    deep = {"markers": []}
+    inner = deep
+    for _ in range(30000):
+        inner["x"] = {}
+        inner = inner["x"]
+    for config in (looped, deep):
+        for call in (softsight.load_config, softsight.Session):
+            with pytest.raises(softsight.InputError) as error:
+                call(config)
+            assert "nested deeper than 64" in str(error.value)

@@ -149,3 +149,30 @@ def test_result_fields_are_none_where_the_csv_is_empty(markers_yaml):
     with pytest.raises(KeyError):
         r["nobody"]
     assert session.columns[:2] == ["frame", "time_s"] and session.columns[-1] == "proc_ms"
+
+
+def test_gray_frames_with_colour_markers_raise_like_track_does(markers_yaml):
+    session = softsight.Session(str(markers_yaml))
+    with pytest.raises(softsight.InputError) as error:
+        session.process(np.zeros((480, 640), np.uint8), 0.0)
+    assert "gray frame" in str(error.value) and "colour tracking needs colour" in str(error.value)
+
+
+def test_a_time_that_is_not_a_finite_non_negative_number_is_refused(markers_yaml):
+    session = softsight.Session(str(markers_yaml))
+    frame = np.zeros((480, 640, 3), np.uint8)
+    for bad in (float("nan"), float("inf"), -0.5):
+        with pytest.raises(softsight.InputError) as error:
+            session.process(frame, bad)
+        assert "time_s" in str(error.value)
+    with pytest.raises(softsight.InputError) as error:
+        session.process(frame, 0.0, -3)
+    assert "frame -3: a frame index must be >= 0" in str(error.value)
+    assert session.process(frame, 0.0).frame == 0  # Nothing refused was counted.
+
+
+def test_a_list_as_frame_is_a_short_type_error(markers_yaml):
+    session = softsight.Session(str(markers_yaml))
+    with pytest.raises(TypeError) as error:
+        session.process([[0] * 640] * 480, 0.0)
+    assert "frame: a numpy array" in str(error.value) and len(str(error.value)) < 200

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -100,3 +102,28 @@ def test_to_pandas_with_pandas():
     pandas = pytest.importorskip("pandas")
     frame = softsight.Table({"frame": np.arange(3), "angle_deg": np.array([180.0, np.nan, 90.0])}).to_pandas()
     assert isinstance(frame, pandas.DataFrame) and list(frame.columns) == ["frame", "angle_deg"]
+
+
+def test_the_csv_never_overwrites_the_video_or_the_config(bending_video, markers_yaml, tmp_path):
+    video = tmp_path / "v.avi"
+    video.write_bytes(bending_video.read_bytes())
+    config = tmp_path / "m.yaml"
+    config.write_text(Path(markers_yaml).read_text())
+    before = (video.read_bytes(), config.read_text())
+    for target in (video, config, tmp_path / "." / "m.yaml"):
+        with pytest.raises(softsight.InputError) as error:
+            softsight.track(video, config, csv=target)
+        assert "refusing to overwrite an input" in str(error.value)
+    assert (video.read_bytes(), config.read_text()) == before
+
+
+def test_bytes_and_pathlib_paths_name_the_same_file_and_a_nul_is_refused(bending_video,
+                                                                          markers_yaml):
+    as_text = softsight.track(str(bending_video), markers_yaml, max_frames=3)
+    as_bytes = softsight.track(os.fsencode(bending_video), os.fsencode(markers_yaml),
+                               max_frames=3)
+    assert as_bytes.rows == as_text.rows == 3
+    assert list(as_bytes["angle_deg"]) == list(as_text["angle_deg"])
+    with pytest.raises(softsight.InputError) as error:
+        softsight.track(str(bending_video) + "\0x", markers_yaml)
+    assert "a path holding a NUL byte" in str(error.value)

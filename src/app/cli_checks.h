@@ -1,11 +1,13 @@
 // Checks every command shares before it reads or writes anything: numbers from the command line
-// are finite and in range, and no output path is one of the run's inputs.
+// are finite and in range (the output guard itself lives in the library: softsight/io/output_guard.h).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "softsight/io/output_guard.h"  // PathRole, CheckOutputsAreNotInputs: every command's guard.
 
 namespace softsight {
 
@@ -17,16 +19,5 @@ CLI::Validator NumberIn(double min, double max);
 // can forget it: `--fps inf`, `--noise nan` are refused with one line naming the option. main()
 // applies it to every command but control and rig, whose options' Check() does the same.
 void RequireFiniteNumbers(CLI::App& app);
-
-struct PathRole {
-  std::string role;  // How the user named it: "--csv", "--input", "the config's camera file".
-  std::string path;
-};
-
-// Throws InputError when an output is the same file (device and inode, so links and "./x" count)
-// as an input or as another output, or is an image pattern (frames/%04d.png) that would write
-// one of the inputs' names in their folder. Outputs that do not exist yet cannot be either.
-void CheckOutputsAreNotInputs(const std::vector<PathRole>& outputs,
-                              const std::vector<PathRole>& inputs);
 
 }  // namespace softsight

@@ -2,6 +2,7 @@
 
 #include <csignal>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <string>
@@ -52,6 +53,13 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
     return runners.at(chosen)();
   } catch (const InputError& e) {
     std::cerr << "softsight " << chosen->get_name() << ": error: " << EscapeForMessage(e.what())
+              << "\n";
+    return kInputErrorExitCode;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the user gave that the file system cannot resolve (a loop of symbolic links, a
+    // name too long, a folder without permission): the user's input, said as such.
+    std::cerr << "softsight " << chosen->get_name() << ": error: "
+              << EscapeForMessage(e.path1().string()) << ": " << EscapeForMessage(e.code().message())
               << "\n";
     return kInputErrorExitCode;
   } catch (const cv::Exception& e) {

@@ -240,21 +240,8 @@ class RigClockSink : public FrameSink {
   std::optional<double> previous_s_;
 };
 
-std::string ShortNumber(double v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", v);
-  return text;
-}
-
 // The longest identification experiment: far more than the steps and the PRBS take.
 constexpr double kMaxIdentifyS = 600.0;
-
-void WriteTextFileOrThrow(const std::string& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw InputError(file + ": cannot write it");
-}
 
 // The one check of every number from the command line: finite and in [lo, hi] (or (lo, hi] with
 // `lo_open`), else one error naming the option. CLI11 reads "nan" and "inf" as numbers, and every
@@ -276,6 +263,7 @@ void CheckOptions(const ControlOptions& o) {
   CheckOption("--pwm", o.pwm, -1.0, 1.0);
   CheckOption("--duration-s", o.duration_s, 0.0, 7 * 86400.0, /*lo_open=*/true);  // A week.
   CheckOption("--fps", o.fps, 0.0, 1000.0, /*lo_open=*/true);
+  CheckOption("--closed-loop-s", o.identify_options.closed_loop_s, 0.0, 100.0, /*lo_open=*/true);
   if (o.sim_supersample < 1 || o.sim_supersample > 8) {
     throw InputError("sim_supersample " + std::to_string(o.sim_supersample) + ": must be in 1..8");
   }
@@ -333,6 +321,15 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     target = MakeTarget(options);
   }
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
+  // Before the board is opened: no output may be an input or another output of this command.
+  std::vector<PathRole> outputs{{"--csv", options.csv_file},
+                                {"--metrics-csv", options.metrics_csv_file}};
+  outputs.insert(outputs.end(), options.other_outputs.begin(), options.other_outputs.end());
+  std::vector<PathRole> inputs = ConfigInputs(tracking_config);
+  if (options.profile_file) inputs.push_back({"--profile", *options.profile_file});
+  if (options.input) inputs.push_back({"--input", *options.input});
+  if (options.rig_frames) inputs.push_back({"--rig-frames", *options.rig_frames});
+  CheckOutputsAreNotInputs(outputs, inputs);
   // LoadTrackingConfig has read and checked the `control:` section; defaults without one.
   ControlConfig config = tracking_config.control.value_or(ControlConfig{});
   if (options.controller) {
@@ -388,6 +385,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     spec.input = *options.input;
     spec.sequence_fps = options.fps;
     source = OpenFrameSource(spec);
+    // An image sequence's every file is an input too (the pattern itself is not a file).
+    for (const std::string& file : source->files()) inputs.push_back({"--input", file});
+    CheckOutputsAreNotInputs(outputs, inputs);
   } else {
     SceneOptions scene_options;
     scene_options.fps = options.fps;
@@ -445,6 +445,20 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     summary.stop_signal = stop.signal();
     return summary;
   }
+  // Every frame carries one command; frames further apart than the board's watchdog allows
+  // would have the actuator vented between any two of them, silently. Refused, naming the rate.
+  if (const std::optional<double> fps = source->fps(); fps && *fps > 0.0) {
+    const double period_ms = 1000.0 / *fps;
+    // A fifth of the watchdog's time is left for the frame's own jitter and the answer.
+    const double longest_period_ms = 0.8 * info.watchdog_ms;
+    if (period_ms > longest_period_ms * (1.0 + 1e-9)) {
+      throw InputError("control: frames every " + ShortNumber(period_ms) + " ms (" +
+                       ShortNumber(*fps) + " fps) but the board's watchdog vents after " +
+                       std::to_string(info.watchdog_ms) + " ms without a command: use at least " +
+                       ShortNumber(1000.0 / longest_period_ms) +
+                       " fps; nothing sent but the handshake, vented");
+    }
+  }
   if (const std::optional<double> asked = session.pressure_clamped_from()) {
     // Said once, even with --quiet: the run does not do what the command line says.
     std::fprintf(stderr,
@@ -455,9 +469,16 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                  ShortNumber(session.pressure_target_kpa()).c_str());
   }
   if (options.identify) {
-    experiment.emplace(options.identify_options,
-                       IdentificationCeiling(session.controller().options(),
-                                             info.pressure_limit_kpa));
+    const double ceiling_kpa =
+        IdentificationCeiling(session.controller().options(), info.pressure_limit_kpa);
+    const double min_kpa = session.controller().options().min_kpa;
+    if (!(min_kpa < ceiling_kpa)) {
+      // Every setpoint would be raised to min_kpa, above the ceiling the experiment announces.
+      throw InputError("identify: control.controller.min_kpa " + ShortNumber(min_kpa) +
+                       " kPa is not below the experiment's ceiling of " + ShortNumber(ceiling_kpa) +
+                       " kPa (control.controller.max_kpa and the board's limit); vented");
+    }
+    experiment.emplace(options.identify_options, ceiling_kpa);
     control.identify(&*experiment);
     if (!options.quiet) {
       std::fprintf(stderr,
@@ -492,6 +513,22 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     summary = control.summary();
     summary.link_rejected = link.stats().rejected_lines;
     summary.resends = link.stats().resends;
+    if (session.duty_held_at_limit() > 0) {
+      summary.notes.push_back(
+          "valves held closed (duty 0) in " + std::to_string(session.duty_held_at_limit()) +
+          " frames: the pressure had reached control.controller.max_kpa (" +
+          ShortNumber(session.controller().options().max_kpa) + " kPa)");
+    }
+    if (session.watchdog_answers() > 0) {
+      summary.notes.push_back(
+          "the board's watchdog had vented in " + std::to_string(session.watchdog_answers()) +
+          " answers: commands came too far apart (a camera slower than the watchdog?)");
+    }
+    if (session.limit_answers() > 0) {
+      summary.notes.push_back("the board's pressure guard overrode the outputs in " +
+                              std::to_string(session.limit_answers()) +
+                              " answers: the pressure reached the board's limit");
+    }
   };
   RunSummary ran;
   try {
@@ -552,7 +589,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     summary.identified = std::move(outcome);
   }
   if (!options.metrics_csv_file.empty()) {
-    WriteTextFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.metrics));
+    WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.metrics));
   }
   return summary;
 }
@@ -570,6 +607,7 @@ std::string FormatControlSummary(const ControlSummary& s) {
     out << line;
   }
   if (s.metrics.step_to_deg) out << FormatStepMetrics(s.metrics) << "\n";
+  for (const std::string& note : s.notes) out << "note: " << note << "\n";
   std::snprintf(line, sizeof(line),
                 "max board pressure %.2f kPa; link: %llu rejected lines from the board, %llu "
                 "resends; board rejected %u lines\n",
@@ -690,6 +728,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       identify.metrics_csv_file.clear();
       identify.identify_options.closed_loop_s = *closed_loop_s;
       identify.csv_file = IdentifyCsvBeside(o->csv_file);
+      identify.other_outputs = {{"--csv", o->csv_file}, {"--metrics-csv", o->metrics_csv_file}};
       const ControlSummary found = RunControl(identify);
       if (found.stop_signal != 0) {
         // Vented; the loop never starts. Said even with --quiet: nothing was tuned.

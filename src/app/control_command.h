@@ -7,10 +7,12 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "control/identify.h"
 #include "control/step_metrics.h"
 #include "softsight/control/session.h"
+#include "softsight/io/output_guard.h"
 
 namespace softsight {
 
@@ -47,6 +49,10 @@ struct ControlOptions {
   // Replaces the config's control.controller (the gains `--auto-tune` found).
   std::optional<ControllerOptions> controller;
   std::string metrics_csv_file;         // The step-response figures (StepMetricsCsv), if given.
+  // Outputs the same command writes in another step (identify's config and model CSV; the loop's
+  // CSV and metrics after --auto-tune's identification): checked with this run's own before the
+  // board is opened, so no step can write over another's file or an input.
+  std::vector<PathRole> other_outputs;
 };
 
 // What an identification run found.
@@ -80,6 +86,9 @@ struct ControlSummary {
   // constant target, RMS error over the run (control/step_metrics.h).
   StepMetrics metrics;
   std::optional<IdentifyOutcome> identified;
+  // What the run did other than asked, one line each (FormatControlSummary prints them): the
+  // valves held closed at max_kpa in duty mode, board answers that were not believed.
+  std::vector<std::string> notes;
 };
 
 // Runs the loop. Throws InputError for bad input or a failed link (e.g. the port disappears);

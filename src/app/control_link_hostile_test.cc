@@ -309,7 +309,9 @@ void ExpectCleanEnd(const HostileRun& run, bool port_open, const std::string& wh
 
 TEST(HostileBoard, ChatterWithoutAnswersEndsAtTheDeadline) {
   const HostileRun run = RunAgainst(Hostility::kChatter);
-  ExpectCleanEnd(run, true, "no answer to SETP after 3 tries");
+  // The board talks but says nothing usable: the message says so rather than "no answer".
+  ExpectCleanEnd(run, true, "no usable answer to SETP");
+  EXPECT_THAT(run.err, HasSubstr("no '$' at the start"));
 }
 
 TEST(HostileBoard, SilenceEndsAtTheDeadline) {
@@ -324,7 +326,8 @@ TEST(HostileBoard, StaleAnswersAreNotTakenForAnswers) {
 
 TEST(HostileBoard, CorruptedAnswersAreRejected) {
   const HostileRun run = RunAgainst(Hostility::kCorrupt);
-  ExpectCleanEnd(run, true, "no answer to SETP after 3 tries");
+  ExpectCleanEnd(run, true, "no usable answer to SETP");
+  EXPECT_THAT(run.err, HasSubstr("CRC mismatch"));
 }
 
 TEST(HostileBoard, ThePortClosing) {

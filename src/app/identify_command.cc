@@ -2,8 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -11,26 +9,9 @@
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/io/output_guard.h"
 
 namespace softsight {
-namespace {
-
-// Whether two paths name the same file (also through links, `./`, `..`), whether or not the
-// second exists yet.
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec)) return true;
-  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
-}
-
-void WriteOrThrow(const std::string& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw InputError(file + ": cannot write it");
-}
-
-}  // namespace
 
 std::string ModelCsv(const IdentifyOutcome& found) {
   const std::vector<double> angles = PredictAngles(found.model, found.samples);
@@ -55,10 +36,6 @@ std::string ModelCsv(const IdentifyOutcome& found) {
 std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options,
                                            ControlSummary* stopped_out) {
   if (options.output_file.empty()) throw InputError("identify: give the config to write (-o)");
-  if (SameFile(options.config_file, options.output_file)) {
-    throw InputError("identify: -o " + options.output_file +
-                     " is the input config; the input is never overwritten: give a new file");
-  }
   // The input as it is, read (and checked) before the actuator moves.
   TrackingConfig config = LoadTrackingConfig(options.config_file);
 
@@ -75,6 +52,9 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
   run.quiet = options.quiet;
   run.identify = true;
   run.identify_options.closed_loop_s = options.closed_loop_s;
+  // Checked with the experiment's CSV before the actuator moves: minutes of experiment are not
+  // lost to an output that cannot be written, nor is the input config written over.
+  run.other_outputs = {{"-o", options.output_file}, {"--model-csv", options.model_csv_file}};
   ControlSummary summary = RunControl(run);
   if (summary.stop_signal != 0) {
     if (stopped_out != nullptr) *stopped_out = summary;
@@ -94,7 +74,7 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
     throw InputError("identify: the gains found are outside the allowed ranges (control." +
                      problem + "); nothing written");
   }
-  if (!options.model_csv_file.empty()) WriteOrThrow(options.model_csv_file, ModelCsv(found));
+  if (!options.model_csv_file.empty()) WriteWholeFileOrThrow(options.model_csv_file, ModelCsv(found));
   SaveTrackingConfig(config, options.output_file);
   return found;
 }

@@ -90,7 +90,7 @@ TEST(IdentifyCommand, RefusesToOverwriteTheInputConfig) {
       RunIdentify(o);
       ADD_FAILURE() << same;
     } catch (const InputError& e) {
-      EXPECT_THAT(e.what(), HasSubstr("is the input config; the input is never overwritten"));
+      EXPECT_THAT(e.what(), HasSubstr("is the config " + input));
     }
   }
   EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));

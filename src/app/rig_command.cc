@@ -74,6 +74,9 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
     scene->render_at_bend(s.bend_deg, s.time_s, 0, image);
     WriteAtomically(*options.frames_file, image);  // A first frame before anyone connects.
   }
+  if (options.disconnect_after_replies) {
+    server.set_reply_limit(static_cast<uint64_t>(*options.disconnect_after_replies));
+  }
   std::printf("rig: serving on %s\n", server.port().c_str());
   std::fflush(stdout);
 

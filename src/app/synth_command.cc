@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -12,12 +11,11 @@
 #include "app/commands.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
+#include "softsight/io/output_guard.h"
 #include "softsight/sim/builtin_scenes.h"
 
 namespace softsight {
 namespace {
-
-namespace fs = std::filesystem;
 
 void AppendNumber(std::string* line, const std::optional<double>& value) {
   *line += ',';
@@ -25,15 +23,6 @@ void AppendNumber(std::string* line, const std::optional<double>& value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.6f", *value);
   *line += buffer;
-}
-
-// Fails early, with the path, when the folder an output goes to does not exist.
-void CheckParentFolder(const std::string& path, const std::string& what) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent)) {
-    throw InputError(path + ": cannot write the " + what + ": folder '" + parent.string() +
-                     "' does not exist");
-  }
 }
 
 // Parses "x,y,w,h,first,last".
@@ -134,8 +123,10 @@ SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* trut
   const cv::Size size = plate ? options.plate->size : options.scene.size;
   const double fps = plate ? options.plate->fps : options.scene.fps;
   const int frame_count = plate ? plate->frame_count() : scene->frame_count();
-  if (options.truth_csv) CheckParentFolder(*options.truth_csv, "truth CSV");
   if (options.out.empty()) throw InputError("--out: give the output video or image pattern");
+  // Both outputs are checked (writable, not one file) before either is created.
+  CheckOutputsAreNotInputs({{"--out", options.out}, {"--truth", options.truth_csv.value_or("")}},
+                           {});
   FrameWriter sink({options.out, options.codec, fps});
   sink.open(size);  // Fails here, before the truth file is created.
   std::ofstream truth_file;

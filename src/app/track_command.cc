@@ -42,10 +42,7 @@ void CheckOutputs(const TrackOptions& options, const TrackingConfig& config,
   std::vector<PathRole> outputs{{"--csv", options.csv_file}};
   if (options.annotated_file) outputs.push_back({"--annotated", *options.annotated_file});
   if (options.record_file) outputs.push_back({"--record", *options.record_file});
-  std::vector<PathRole> inputs;
-  for (size_t i = 0; i < config.files_read.size(); ++i) {
-    inputs.push_back({i == 0 ? "the config" : "a file the config names:", config.files_read[i]});
-  }
+  std::vector<PathRole> inputs = ConfigInputs(config);
   for (const std::string& file : source.files()) inputs.push_back({"--input", file});
   CheckOutputsAreNotInputs(outputs, inputs);
 }

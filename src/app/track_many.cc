@@ -164,9 +164,7 @@ int RunTrackMany(const TrackManyOptions& options, std::ostream& report) {
   for (size_t i = 0; i < csvs.size(); ++i) {
     outputs.push_back({"the CSV of --input " + options.inputs[i], csvs[i]});
   }
-  for (size_t i = 0; i < config.files_read.size(); ++i) {
-    inputs.push_back({i == 0 ? "the config" : "a file the config names:", config.files_read[i]});
-  }
+  for (const PathRole& file : ConfigInputs(config)) inputs.push_back(file);
   for (const std::string& input : options.inputs) {
     // A folder's images are checked by its own run; here every input as given.
     if (!fs::is_directory(input)) inputs.push_back({"--input", input});

@@ -179,6 +179,12 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
   MarkerSpec spec;
   spec.name = marker.string("name").value_or("");
   if (spec.name.empty()) marker.fail("name", "every marker needs a name");
+  // Every CSV column of the marker starts with its name: a huge name is a huge header.
+  constexpr size_t kMaxNameLength = 64;
+  if (spec.name.size() > kMaxNameLength) {
+    marker.fail("name", "a name of " + std::to_string(spec.name.size()) + " characters; at most " +
+                            std::to_string(kMaxNameLength) + " (it prefixes CSV columns)");
+  }
   for (char c : spec.name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) {
       // Escaped: the name may hold a line break or any byte, and the message is one line.
@@ -243,6 +249,14 @@ TrackingConfig ReadTrackingConfig(const YAML::Node& root, const std::string& fil
   }
 }
 
+std::vector<PathRole> ConfigInputs(const TrackingConfig& config) {
+  std::vector<PathRole> inputs;
+  for (size_t i = 0; i < config.files_read.size(); ++i) {
+    inputs.push_back({i == 0 ? "the config" : "a file the config names:", config.files_read[i]});
+  }
+  return inputs;
+}
+
 void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   YAML::Emitter out;
   out << YAML::Comment("softsight tracking config (see examples/markers.yaml for every key)");
@@ -302,9 +316,8 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   }
   out << YAML::EndMap;
 
-  std::ofstream stream(file);
-  stream << out.c_str() << "\n";
-  if (!stream) throw InputError(file + ": cannot write config");
+  // Whole or not at all: a config that cannot be written completely leaves the old one.
+  WriteWholeFileOrThrow(file, std::string(out.c_str()) + "\n");
 }
 
 std::string DocumentConfig() {

@@ -32,6 +32,23 @@ const char* ErrorName(int32_t code) {
   }
 }
 
+// Why a $STATE answer cannot be what a board measures, or nullptr when it can.
+const char* ImplausibleState(const wire::Message& m) {
+  const double pressure_kpa = m.args[2] * 1e-3;
+  const double setpoint_kpa = m.args[3] * 1e-3;
+  if (!(pressure_kpa >= kMinSensedPressureKpa && pressure_kpa <= kMaxSensedPressureKpa)) {
+    return "a sensed pressure below vacuum or above any sensor's range";
+  }
+  if (!(setpoint_kpa >= 0.0 && setpoint_kpa <= kMaxBoardPressureLimitKpa)) {
+    return "an echoed setpoint outside 0..1000 kPa";
+  }
+  if (m.args[4] < -1000 || m.args[4] > 1000) return "a duty outside -1..1";
+  if (m.args[5] < 0 || m.args[5] >= 2 * wire::kFlagRejected) return "undefined flag bits";
+  if (m.args[6] < 0) return "a negative count of rejected lines";
+  if (m.args[1] < 0) return "a negative board clock";
+  return nullptr;
+}
+
 }  // namespace
 
 bool LinkOptions::Check(std::string* error) const {
@@ -52,8 +69,11 @@ int64_t BoardLink::now_ms() const {
 
 std::optional<wire::Message> BoardLink::exchange(
     const std::string& line, bool honour_stop,
-    const std::function<Verdict(const wire::Message&)>& classify) {
+    const std::function<Verdict(const wire::Message&)>& classify, int64_t budget_ms,
+    uint64_t* rejected, std::string* why) {
+  const int64_t give_up_ms = budget_ms > 0 ? now_ms() + budget_ms : 0;
   for (int attempt = 0; attempt <= options_.retries; ++attempt) {
+    if (give_up_ms != 0 && now_ms() >= give_up_ms) break;
     if (attempt > 0) ++stats_.resends;
     if (honour_stop && environment_.stop_requested && environment_.stop_requested()) {
       throw StopRequested();
@@ -62,7 +82,8 @@ std::optional<wire::Message> BoardLink::exchange(
     if (attempt == 0) last_sent_ = std::chrono::steady_clock::now();
     // One deadline per try: lines that are not the answer (chatter, stale answers, garbage) are
     // counted but never extend it.
-    const int64_t deadline_ms = now_ms() + options_.reply_timeout_ms;
+    int64_t deadline_ms = now_ms() + options_.reply_timeout_ms;
+    if (give_up_ms != 0) deadline_ms = std::min(deadline_ms, give_up_ms);
     while (true) {
       if (honour_stop && environment_.stop_requested && environment_.stop_requested()) {
         throw StopRequested();
@@ -81,6 +102,8 @@ std::optional<wire::Message> BoardLink::exchange(
         ++stats_.stale_answers;
       } else {
         ++stats_.rejected_lines;
+        if (rejected != nullptr) ++*rejected;
+        if (why != nullptr && status != wire::DecodeStatus::kOk) *why = wire::DecodeStatusName(status);
       }
     }
   }
@@ -157,18 +180,38 @@ BoardState BoardLink::request(wire::MessageType type, int32_t value, const char*
   next_seq_ = next_seq_ >= 999999 ? 1 : next_seq_ + 1;
   command.args[0] = seq;
   command.args[1] = value;
-  const bool honour_stop = type != wire::MessageType::kStop;
-  const std::optional<wire::Message> reply =
-      exchange(Encode(command), honour_stop, [seq](const wire::Message& m) {
-        if (wire::IsHostCommand(m.type)) return Verdict::kRejected;
+  const bool is_stop = type == wire::MessageType::kStop;
+  uint64_t rejected = 0;
+  std::string why;
+  const std::optional<wire::Message> reply = exchange(
+      Encode(command), /*honour_stop=*/!is_stop,
+      [seq, &why](const wire::Message& m) {
+        if (wire::IsHostCommand(m.type)) {
+          why = "a host command echoed back";
+          return Verdict::kRejected;
+        }
         if (m.type == wire::MessageType::kHelloReply || m.args[0] != seq) return Verdict::kStale;
+        if (m.type == wire::MessageType::kState) {
+          if (const char* problem = ImplausibleState(m)) {
+            why = problem;
+            return Verdict::kRejected;
+          }
+        }
         return Verdict::kAnswer;
-      });
+      },
+      is_stop ? kMaxStopMs : 0, &rejected, &why);
   if (!reply) {
+    if (rejected > 0) {
+      // The board talks, but nothing it said could be used: not a power or cable problem.
+      throw InputError(port_name() + ": no usable answer to " + what + ": " +
+                       std::to_string(rejected) + " lines from the board rejected (last: " + why +
+                       "); check the board's firmware, baud rate and sensor");
+    }
     throw InputError(port_name() + ": no answer to " + what + " after " +
-                     std::to_string(options_.retries + 1) + " tries of " +
-                     std::to_string(options_.reply_timeout_ms) +
-                     " ms; is the board still powered and running the softsight firmware?");
+                     (is_stop ? std::to_string(kMaxStopMs) + " ms (the board's watchdog vents)"
+                              : std::to_string(options_.retries + 1) + " tries of " +
+                                    std::to_string(options_.reply_timeout_ms) + " ms") +
+                     "; is the board still powered and running the softsight firmware?");
   }
   const wire::Message& m = *reply;
   if (m.type == wire::MessageType::kError) {

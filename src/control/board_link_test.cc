@@ -137,7 +137,7 @@ TEST(BoardLink, AChatteringBoardCannotExtendTheReplyDeadline) {
     link.heartbeat();
     FAIL() << "expected an error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("serial port /dev/fake0: no answer to PING after 3 tries"),
+    EXPECT_NE(std::string(e.what()).find("serial port /dev/fake0: no usable answer to PING"),
               std::string::npos)
         << e.what();
   }
@@ -363,6 +363,167 @@ TEST(ControlSession, RefusesNonFiniteTargets) {
     EXPECT_THROW(ControlSession(ControllerOptions{}, link, duty), InputError) << v;
   }
   EXPECT_TRUE(fake.written.empty());  // Nothing was sent.
+}
+
+
+// ---- Second hostile round: what the board says is believed only when it is physically possible;
+// the host never commands more than its own limits; a stop ends in bounded time. ----
+
+// Rewrites every $STATE answer's argument `index` to `value` (the other answers pass through).
+std::function<std::string(const std::string&)> StateArgument(int index, int32_t value) {
+  return [index, value](const std::string& answer) {
+    wire::Message m = Decode(answer);
+    if (m.type != wire::MessageType::kState) return answer;
+    m.args[index] = value;
+    return Encode(wire::MessageType::kState,
+                  {m.args[0], m.args[1], m.args[2], m.args[3], m.args[4], m.args[5], m.args[6]});
+  };
+}
+
+TEST(BoardLink, PhysicallyImpossibleAnswersAreRejectedNeverUsed) {
+  struct Case {
+    int index;
+    int32_t value;
+    const char* why;
+  };
+  const Case cases[] = {
+      {2, -1000000000, "below vacuum"},           // -1,000,000 kPa.
+      {2, 2000001000, "above any sensor's range"},  // 2000.001 kPa.
+      {3, 1000000000, "echoed setpoint outside"},  // 1e6 kPa.
+      {4, 999999, "a duty outside -1..1"},
+      {5, -1, "undefined flag bits"},
+      {5, 255, "undefined flag bits"},
+      {6, -5, "negative count of rejected lines"},
+      {1, -20, "negative board clock"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.why);
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    link.handshake();
+    fake.rewrite = StateArgument(c.index, c.value);
+    try {
+      link.set_pressure_kpa(10.0);
+      ADD_FAILURE() << "an impossible answer was taken";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("serial port /dev/fake0: no usable answer to SETP: 3 lines from the "
+                          "board rejected"),
+                std::string::npos)
+          << what;
+      EXPECT_NE(what.find(c.why), std::string::npos) << what;
+    }
+  }
+  // The edges themselves are possible: full vacuum and a duty of exactly -1.
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  link.handshake();
+  fake.rewrite = StateArgument(2, -101325);
+  EXPECT_DOUBLE_EQ(link.set_pressure_kpa(0.0).pressure_kpa, -101.325);
+  fake.rewrite = StateArgument(4, -1000);
+  EXPECT_DOUBLE_EQ(link.set_duty(-1.0).duty, -1.0);
+}
+
+TEST(BoardLink, AStopEndsWithinItsBoundHoweverLongTheTimeoutsAre) {
+  FakeBoard fake;
+  LinkOptions options;
+  options.reply_timeout_ms = 10000;  // Both the largest allowed: 110 s for an ordinary command.
+  options.retries = 10;
+  BoardLink link(fake, options, SimulatedClock(fake));
+  link.handshake();
+  fake.rewrite = [](const std::string&) { return std::string(); };  // The board falls silent.
+  const int64_t sent_ms = fake.now;
+  try {
+    link.stop();
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no answer to STOP after 1500 ms (the board's watchdog "
+                                         "vents)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_LE(fake.now - sent_ms, kMaxStopMs);
+  EXPECT_GE(fake.now - sent_ms, kMaxStopMs - BoardLink::kStopPollMs);
+}
+
+TEST(ControlSession, AMinKpaAtOrAboveTheBoardLimitSendsNoSetpointOnlyStop) {
+  for (double min_kpa : {50.0, 60.0}) {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    ControllerOptions options;
+    options.min_kpa = min_kpa;
+    options.max_kpa = 70.0;
+    try {
+      ControlSession session(options, link, ControlTarget{});
+      session.start();
+      session.step(0.0, 150.0);
+      ADD_FAILURE() << "min_kpa " << min_kpa << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not below the board's pressure limit of 50 kPa"),
+                std::string::npos)
+          << e.what();
+    }
+    const std::vector<std::string> words = fake.words();
+    EXPECT_EQ(std::count(words.begin(), words.end(), "SETP"), 0);
+    ASSERT_FALSE(words.empty());
+    EXPECT_EQ(words.back(), "STOP");
+  }
+}
+
+TEST(ControlSession, TheCsvSetpointIsTheClampedOneOnTheWire) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  ControllerOptions options;
+  options.min_kpa = 40.0;
+  options.max_kpa = 45.0;
+  ControlSession session(options, link, ControlTarget{});  // Target straight: the PI asks ~0.
+  session.start();
+  for (int i = 0; i < 5; ++i) {
+    const ControlSample sample = session.step(0.1 * i, 180.0);
+    if (!sample.setpoint_kpa) continue;  // A vent has no setpoint.
+    const wire::Message sent = Decode(fake.written.back());
+    EXPECT_DOUBLE_EQ(*sample.setpoint_kpa, sent.args[1] * 1e-3) << "frame " << i;
+    EXPECT_GE(*sample.setpoint_kpa, 40.0);
+    EXPECT_LE(*sample.setpoint_kpa, 45.0);
+  }
+}
+
+TEST(ControlSession, OpenLoopDutyClosesTheValvesBeforeMaxKpa) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  // The chamber rises 4 kPa per frame while the valve is open; it never rises when closed.
+  int32_t pressure_pa = 0;
+  fake.rewrite = [&pressure_pa, &fake](const std::string& answer) {
+    wire::Message m = Decode(answer);
+    if (m.type != wire::MessageType::kState) return answer;
+    const wire::Message command = Decode(fake.written.back());
+    if (command.type == wire::MessageType::kSetDuty && command.args[1] > 0) pressure_pa += 4000;
+    return Encode(wire::MessageType::kState,
+                  {m.args[0], m.args[1], pressure_pa, m.args[3], m.args[4], m.args[5], m.args[6]});
+  };
+  ControllerOptions options;
+  options.max_kpa = 30.0;
+  ControlTarget target;
+  target.mode = ControlMode::kDuty;
+  target.duty = 1.0;
+  ControlSession session(options, link, target);
+  session.start();
+  double highest_kpa = 0.0;
+  for (int i = 0; i < 30; ++i) {
+    highest_kpa = std::max(highest_kpa, session.step(0.05 * i, std::nullopt).board.pressure_kpa);
+  }
+  EXPECT_LE(highest_kpa, 30.0);
+  EXPECT_GE(highest_kpa, 26.0);  // It did inflate up to the limit, not stop short.
+  EXPECT_GT(session.duty_held_at_limit(), 20);
+  // Venting is always allowed.
+  FakeBoard fake2;
+  BoardLink link2(fake2, LinkOptions{}, SimulatedClock(fake2));
+  target.duty = -1.0;
+  ControlSession venting(options, link2, target);
+  venting.start();
+  venting.step(0.0, std::nullopt);
+  EXPECT_EQ(Decode(fake2.written.back()).args[1], -1000);
+  EXPECT_EQ(venting.duty_held_at_limit(), 0);
 }
 
 }  // namespace

@@ -34,7 +34,9 @@ AngleController::AngleController(const ControllerOptions& options) : options_(op
 }
 
 void AngleController::limit_max_kpa(double max_kpa) {
-  options_.max_kpa = std::max(options_.min_kpa + 1e-3, std::min(options_.max_kpa, max_kpa));
+  // Never above the board's limit; ControlSession::start() refuses a min_kpa that is not below
+  // it, so the range stays non-empty.
+  options_.max_kpa = std::min(options_.max_kpa, max_kpa);
 }
 
 void AngleController::reset() {

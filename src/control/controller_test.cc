@@ -1,8 +1,10 @@
 #include "softsight/control/controller.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "softsight/control/profile.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -127,15 +129,18 @@ TEST(TargetProfile, StepsRampsAndSines) {
   EXPECT_DOUBLE_EQ(TargetProfile::Parse("step 100\n", "x").at(3.0), 100.0);
 }
 
+// The message of the InputError that parsing `text` as prof.txt throws, or "no error".
+std::string ProfileError(const std::string& text) {
+  try {
+    TargetProfile::Parse(text, "prof.txt");
+  } catch (const InputError& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 TEST(TargetProfile, ErrorsNameFileLineAndProblem) {
-  auto error_of = [](const std::string& text) {
-    try {
-      TargetProfile::Parse(text, "prof.txt");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto error_of = ProfileError;
   EXPECT_EQ(error_of("hold 1\nstep 200\n"),
             "prof.txt:2: step: angle 200.000000 deg is outside 0..180 (the angle at the middle "
             "marker)");
@@ -146,6 +151,51 @@ TEST(TargetProfile, ErrorsNameFileLineAndProblem) {
   EXPECT_NE(error_of("sine 170 20 1 1\n").find("outside 0..180"), std::string::npos);
   EXPECT_NE(error_of("# nothing\n").find("no segments"), std::string::npos);
   EXPECT_NE(error_of("hold -1\n").find("must be > 0"), std::string::npos);
+}
+
+
+// Every loop and allocation driven by the profile's values is bounded: a profile is a short text.
+TEST(TargetProfile, BoundsOnLengthSegmentsFrequencyAndSize) {
+  const auto error_of = ProfileError;
+  EXPECT_THAT(error_of("hold 1e18\n"), ::testing::HasSubstr("prof.txt:1: hold: the profile would "
+                                                            "last 1e+18 s, longer than a week"));
+  // A week in total, however it is split.
+  EXPECT_THAT(error_of("hold 400000\nramp 100 400000\n"),
+              ::testing::HasSubstr("prof.txt:2: ramp: the profile would last"));
+  EXPECT_EQ(error_of("hold 600000\n"), "no error");
+  EXPECT_THAT(error_of("sine 90 20 1000 1\n"),
+              ::testing::HasSubstr("prof.txt:1: sine: frequency 1000 Hz must be in (0, 100]"));
+  EXPECT_THAT(error_of("sine 90 20 0 1\n"), ::testing::HasSubstr("frequency 0 Hz"));
+  std::string many;
+  for (size_t i = 0; i <= TargetProfile::kMaxSegments; ++i) many += "hold 1\n";
+  EXPECT_THAT(error_of(many), ::testing::HasSubstr("more than 10000 segments"));
+
+  testing::TempDir dir;
+  std::string big(TargetProfile::kMaxBytes + 10, '#');
+  testing::WriteTextFile(dir.file("big.txt"), big);
+  EXPECT_THROW(
+      {
+        try {
+          TargetProfile::Load(dir.file("big.txt"));
+        } catch (const InputError& e) {
+          EXPECT_THAT(e.what(), ::testing::HasSubstr("big.txt: larger than 1 MiB"));
+          throw;
+        }
+      },
+      InputError);
+  try {
+    TargetProfile::Load("/dev/zero");  // Endless: read only up to the bound.
+    ADD_FAILURE() << "/dev/zero accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("/dev/zero: larger than 1 MiB"));
+  }
+  testing::WriteTextFile(dir.file("nul.txt"), std::string("step 120\n\0step 90\n", 18));
+  try {
+    TargetProfile::Load(dir.file("nul.txt"));
+    ADD_FAILURE() << "a NUL byte accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("not a text file"));
+  }
 }
 
 }  // namespace

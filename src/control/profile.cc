@@ -68,8 +68,15 @@ TargetProfile TargetProfile::Parse(std::string_view text, const std::string& sou
       if (!(v > 0.0)) {
         throw InputError(where + keyword + ": duration " + std::to_string(v) + " s must be > 0");
       }
+      if (t + v > kMaxSeconds) {
+        throw InputError(where + keyword + ": the profile would last " + ShortNumber(t + v) +
+                         " s, longer than a week (" + ShortNumber(kMaxSeconds) + " s)");
+      }
       return v;
     };
+    if (p.segments_.size() >= kMaxSegments) {
+      throw InputError(where + "more than " + std::to_string(kMaxSegments) + " segments");
+    }
     Segment s;
     s.start_s = t;
     s.from_deg = current;
@@ -108,7 +115,11 @@ TargetProfile TargetProfile::Parse(std::string_view text, const std::string& sou
       }
       angle(s.to_deg - s.amplitude_deg);
       angle(s.to_deg + s.amplitude_deg);
-      s.frequency_hz = duration(values[2]);
+      s.frequency_hz = values[2];
+      if (!(s.frequency_hz > 0.0 && s.frequency_hz <= kMaxFrequencyHz)) {
+        throw InputError(where + "sine: frequency " + ShortNumber(values[2]) + " Hz must be in (0, " +
+                         ShortNumber(kMaxFrequencyHz) + "]");
+      }
       s.duration_s = duration(values[3]);
       current = s.to_deg + s.amplitude_deg *
                                std::sin(2.0 * M_PI * s.frequency_hz * s.duration_s);
@@ -138,11 +149,20 @@ TargetProfile TargetProfile::Parse(std::string_view text, const std::string& sou
 }
 
 TargetProfile TargetProfile::Load(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file + ": cannot read the target profile");
-  std::stringstream text;
-  text << in.rdbuf();
-  return Parse(text.str(), file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(EscapeForMessage(file) + ": cannot read the target profile");
+  // Read in bounded pieces: /dev/zero or a huge file is refused, not read until memory ends.
+  std::string text(kMaxBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  if (text.size() > kMaxBytes) {
+    throw InputError(EscapeForMessage(file) + ": larger than " + std::to_string(kMaxBytes >> 20) +
+                     " MiB; a target profile is a short text of segments (docs/control.md)");
+  }
+  if (text.find('\0') != std::string::npos) {
+    throw InputError(EscapeForMessage(file) + ": not a text file (it holds NUL bytes)");
+  }
+  return Parse(text, EscapeForMessage(file));
 }
 
 double TargetProfile::at(double time_s) const {

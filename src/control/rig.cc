@@ -158,6 +158,7 @@ void RigServer::disconnect() {
   port_closed_ = true;
   if (server_.joinable()) server_.join();
   std::lock_guard<std::mutex> lock(write_mutex_);
+  flush_locked();  // Answers already queued reach the host before the line goes dead.
   pty_.close();
 }
 
@@ -170,8 +171,13 @@ void RigServer::serve() {
       std::lock_guard<std::mutex> lock(write_mutex_);
       waiting_to_write = !pending_.empty();
     }
+    // At the reply limit nothing more is read: the last answers are delivered, then the line is
+    // dead until disconnect() closes it.
+    const bool at_limit = reply_limit_ != 0 && replies_ >= reply_limit_;
+    if (at_limit && !waiting_to_write) break;
     // A short timeout: shutdown and disconnect are seen within 5 ms whatever the host does.
-    pollfd p{pty_.master_fd(), static_cast<short>(POLLIN | (waiting_to_write ? POLLOUT : 0)), 0};
+    pollfd p{pty_.master_fd(),
+             static_cast<short>((at_limit ? 0 : POLLIN) | (waiting_to_write ? POLLOUT : 0)), 0};
     const int ready = ::poll(&p, 1, 5);
     if (ready > 0 && (p.revents & POLLOUT) != 0) {
       std::lock_guard<std::mutex> lock(write_mutex_);
@@ -197,6 +203,7 @@ void RigServer::serve() {
       std::string line = replies.substr(start, end == std::string::npos ? end : end - start + 1);
       start = end == std::string::npos ? replies.size() : end + 1;
       if (filter_) line = filter_(line);
+      if (reply_limit_ != 0 && replies_ >= reply_limit_) break;  // The cable is pulled here.
       if (!enqueue_locked(line)) {
         ++dropped_replies_;
       } else if (!line.empty()) {

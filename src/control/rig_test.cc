@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -275,7 +277,10 @@ TEST(ClosedLoop, GarbageAndBitFlippedAnswersAreRejectedAndCounted) {
 TEST(ClosedLoop, CorruptedCommandsAreRejectedByTheBoardAndNeverActedOn) {
   LoopHarness h;
   h.link().handshake();
-  auto transport = OpenSerialTransport(h.server().port(), 115200);
+  // A second writer on the line, under the host's lock (which only softsight processes honour).
+  const int fd = ::open(h.server().port().c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  auto transport = MakeFdTransport(fd, "a second writer");
   // A setpoint with one flipped bit in its value ("30000" -> "38000"), CRC unchanged.
   wire::Message setp;
   setp.type = wire::MessageType::kSetPressure;
@@ -437,6 +442,41 @@ TEST(Handshake, MissingPortIsOneClearError) {
     EXPECT_NE(std::string(e.what()).find("serial port /dev/does-not-exist-42"), std::string::npos)
         << e.what();
   }
+}
+
+
+// Two hosts on one board: the second would reset it under the first one's loop. The port is
+// locked while open; the second open is one error, and the first host goes on.
+TEST(Handshake, ASecondHostOnThePortIsRefusedAndTheFirstGoesOn) {
+  LoopHarness h;
+  h.link().handshake();
+  try {
+    OpenSerialTransport(h.server().port(), 115200);
+    ADD_FAILURE() << "a second host opened the port";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "serial port " + h.server().port() +
+                                         ": in use by another softsight process; one host per "
+                                         "board");
+  }
+  EXPECT_NO_THROW(h.link().heartbeat());
+}
+
+TEST(Handshake, APathThatIsNoTerminalIsOneErrorNamingWhatItIs) {
+  const std::string file = ::testing::TempDir() + "softsight_not_a_port.txt";
+  std::FILE* f = std::fopen(file.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fclose(f);
+  for (const auto& [path, what] : {std::pair<std::string, std::string>{"/dev/null", "a device that is not a terminal"},
+                                   {file, "a regular file, not a serial device"}}) {
+    try {
+      OpenSerialTransport(path, 115200);
+      ADD_FAILURE() << path << " opened";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("serial port " + path + ": " + what), std::string::npos)
+          << e.what();
+    }
+  }
+  std::remove(file.c_str());
 }
 
 }  // namespace

@@ -51,6 +51,13 @@ BoardInfo ControlSession::start() {
   started_ = true;
   stopped_ = false;
   board_limit_kpa_ = info.pressure_limit_kpa;
+  if (!(controller_.options().min_kpa < info.pressure_limit_kpa)) {
+    stop();
+    throw InputError("control.controller.min_kpa: " + FormatNumber(controller_.options().min_kpa) +
+                     " kPa is not below the board's pressure limit of " +
+                     FormatNumber(info.pressure_limit_kpa) + " kPa (" + link_.port_name() +
+                     "); no setpoint sent, vented");
+  }
   controller_.limit_max_kpa(info.pressure_limit_kpa);
   const double max_kpa = controller_.options().max_kpa;
   if (target_.mode == ControlMode::kPressure && target_.pressure_kpa > max_kpa) {
@@ -60,12 +67,16 @@ BoardInfo ControlSession::start() {
   return info;
 }
 
-BoardState ControlSession::send_pressure(double setpoint_kpa) {
+BoardState ControlSession::send_pressure(double setpoint_kpa, std::optional<double>* sent) {
   const ControllerOptions& c = controller_.options();
-  return link_.set_pressure_kpa(std::clamp(setpoint_kpa, c.min_kpa, c.max_kpa));
+  *sent = std::clamp(setpoint_kpa, c.min_kpa, c.max_kpa);
+  return link_.set_pressure_kpa(**sent);
 }
 
 const BoardState& ControlSession::checked(const BoardState& state) {
+  last_pressure_kpa_ = state.pressure_kpa;
+  if (state.watchdog()) ++watchdog_answers_;
+  if (state.limit()) ++limit_answers_;
   if (state.pressure_kpa > board_limit_kpa_) {
     stopped_ = true;
     try {
@@ -73,9 +84,8 @@ const BoardState& ControlSession::checked(const BoardState& state) {
     } catch (const std::exception&) {
       // Reported below; the board's watchdog vents when the commands stop.
     }
-    throw InputError(link_.port_name() + ": the board reports " +
-                     FormatNumber(state.pressure_kpa) + " kPa, above its own limit of " +
-                     FormatNumber(board_limit_kpa_) +
+    throw InputError(link_.port_name() + ": the board reports " + FormatNumber(state.pressure_kpa) +
+                     " kPa, above its own limit of " + FormatNumber(board_limit_kpa_) +
                      " kPa (sensor or guard fault); sent STOP to vent, stopping");
   }
   return state;
@@ -95,20 +105,33 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
       if (out.action == ControllerOutput::Action::kVent) {
         sample.board = checked(link_.stop());
       } else {
-        sample.setpoint_kpa = out.setpoint_kpa;
-        sample.board = checked(send_pressure(out.setpoint_kpa));
+        sample.board = checked(send_pressure(out.setpoint_kpa, &sample.setpoint_kpa));
       }
       break;
     }
     case ControlMode::kPressure:
       sample.action = ControllerOutput::Action::kTrack;
-      sample.setpoint_kpa = target_.pressure_kpa;
-      sample.board = checked(send_pressure(target_.pressure_kpa));
+      sample.board = checked(send_pressure(target_.pressure_kpa, &sample.setpoint_kpa));
       break;
     case ControlMode::kDuty:
       sample.action = ControllerOutput::Action::kTrack;
+      // Open-loop inflation stops at the host's own limit, not only at the board's guard: while
+      // the sensed pressure is at max_kpa the valves stay closed (venting is always allowed).
       sample.duty_command = target_.duty;
-      sample.board = checked(link_.set_duty(target_.duty));
+      // The next frame's pressure is foreseen from the rise of the last frame that inflated: the
+      // valves close a frame early rather than one late.
+      if (target_.duty > 0.0 &&
+          last_pressure_kpa_ + inflate_rise_kpa_ >= controller_.options().max_kpa) {
+        sample.duty_command = 0.0;
+        ++duty_held_at_limit_;
+      }
+      {
+        const double before_kpa = last_pressure_kpa_;
+        sample.board = checked(link_.set_duty(*sample.duty_command));
+        if (*sample.duty_command > 0.0) {
+          inflate_rise_kpa_ = std::max(0.0, last_pressure_kpa_ - before_kpa);
+        }
+      }
       break;
   }
   return sample;
@@ -121,9 +144,7 @@ ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
   sample.time_s = time_s - *start_time_s_;
   sample.measured_deg = measured_deg;
   sample.action = ControllerOutput::Action::kTrack;
-  const ControllerOptions& c = controller_.options();
-  sample.setpoint_kpa = std::clamp(setpoint_kpa, c.min_kpa, c.max_kpa);
-  sample.board = checked(send_pressure(*sample.setpoint_kpa));
+  sample.board = checked(send_pressure(setpoint_kpa, &sample.setpoint_kpa));
   return sample;
 }
 

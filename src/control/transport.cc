@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <pty.h>
 #include <termios.h>
 #include <unistd.h>
@@ -141,19 +143,76 @@ class SerialTransport : public Transport {
       throw InputError(name_ + ": cannot open (" + std::strerror(errno) +
                        "); is the board plugged in? try `ls /dev/ttyACM* /dev/ttyUSB*`");
     }
+    RefuseWhatIsNotATerminal(port);
     try {
       port_->Open(port);
+    } catch (const std::exception& e) {
+      throw InputError(name_ + ": cannot open (" + e.what() +
+                       "); check the device path and that you may access it (group dialout)");
+    }
+    // A second host on the same port would reset the board under the first one's loop; the lock
+    // is advisory but every softsight process takes it, and it goes with the descriptor.
+    if (::flock(port_->GetFileDescriptor(), LOCK_EX | LOCK_NB) != 0) {
+      const int error = errno;
+      ClosePort();
+      throw InputError(name_ + ": " +
+                       (error == EWOULDBLOCK ? std::string("in use by another softsight process")
+                                             : std::string("cannot lock (") +
+                                                   std::strerror(error) + ")") +
+                       "; one host per board");
+    }
+    try {
       port_->SetBaudRate(rate);
       port_->SetCharacterSize(LibSerial::CharacterSize::CHAR_SIZE_8);
       port_->SetParity(LibSerial::Parity::PARITY_NONE);
       port_->SetStopBits(LibSerial::StopBits::STOP_BITS_1);
       port_->SetFlowControl(LibSerial::FlowControl::FLOW_CONTROL_NONE);
     } catch (const std::exception& e) {
-      throw InputError(name_ + ": cannot open (" + e.what() +
-                       "); check the device path and that you may access it (group dialout)");
+      // Closed here: LibSerial's destructor would throw again while the exception is in flight.
+      ClosePort();
+      throw InputError(name_ + ": cannot set up the port (" + e.what() +
+                       "); is it a serial device?");
     }
   }
-  ~SerialTransport() override {
+  ~SerialTransport() override { ClosePort(); }
+  void write_line(std::string_view line) override {
+    WriteAll(port_->GetFileDescriptor(), line, name_);
+  }
+  std::optional<std::string> read_line(int timeout_ms) override {
+    return reader_.read_line(port_->GetFileDescriptor(), timeout_ms, name_);
+  }
+  const std::string& name() const override { return name_; }
+
+ private:
+  // LibSerial only finds out that a path is no terminal after opening it, and then throws from its
+  // destructor: check first, with the kind of file named.
+  void RefuseWhatIsNotATerminal(const std::string& port) const {
+    const int fd = ::open(port.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+      throw InputError(name_ + ": cannot open (" + std::strerror(errno) +
+                       "); check the device path and that you may access it (group dialout)");
+    }
+    struct stat st {};
+    const bool stat_ok = ::fstat(fd, &st) == 0;
+    const bool terminal = ::isatty(fd) == 1;
+    ::close(fd);
+    if (stat_ok && !S_ISCHR(st.st_mode)) {
+      const char* kind = S_ISREG(st.st_mode)    ? "a regular file"
+                         : S_ISFIFO(st.st_mode) ? "a FIFO"
+                         : S_ISDIR(st.st_mode)  ? "a folder"
+                         : S_ISSOCK(st.st_mode) ? "a socket"
+                                                : "not a character device";
+      throw InputError(name_ + ": " + kind + ", not a serial device; the board is usually " +
+                       "/dev/ttyACM0 or /dev/ttyUSB0");
+    }
+    if (!terminal) {
+      throw InputError(name_ + ": a device that is not a terminal (e.g. /dev/null), not a " +
+                       "serial port; the board is usually /dev/ttyACM0 or /dev/ttyUSB0");
+    }
+  }
+
+  void ClosePort() {
+    if (!port_) return;
     try {
       if (port_->IsOpen()) port_->Close();
       return;
@@ -182,15 +241,7 @@ class SerialTransport : public Transport {
     if (fd >= 0) ::close(fd);
     (void)port_.release();
   }
-  void write_line(std::string_view line) override {
-    WriteAll(port_->GetFileDescriptor(), line, name_);
-  }
-  std::optional<std::string> read_line(int timeout_ms) override {
-    return reader_.read_line(port_->GetFileDescriptor(), timeout_ms, name_);
-  }
-  const std::string& name() const override { return name_; }
 
- private:
   std::unique_ptr<LibSerial::SerialPort> port_ = std::make_unique<LibSerial::SerialPort>();
   std::string name_;
   LineReader reader_;

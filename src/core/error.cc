@@ -1,5 +1,7 @@
 #include "softsight/core/error.h"
 
+#include <cstdio>
+
 namespace softsight {
 namespace {
 
@@ -53,6 +55,12 @@ std::string EscapeForMessage(std::string_view text, size_t max_bytes) {
     }
   }
   return out;
+}
+
+std::string ShortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
 }
 
 }  // namespace softsight

@@ -17,4 +17,16 @@ TEST(EscapeForMessage, KeepsPrintableTextAndUtf8AndEscapesTheRest) {
 }
 
 }  // namespace
+
+// Every InputError is one line, whoever threw it: a config value "a\nb" reaches a library caller
+// as the text a\nb, not as two lines (the config fuzz target traps on a raw newline).
+TEST(InputError, IsOneLineWhateverItWasGiven) {
+  EXPECT_STREQ(InputError("m.yaml:3: method: 'a\nb' is not one of: colour").what(),
+               "m.yaml:3: method: 'a\\nb' is not one of: colour");
+  EXPECT_STREQ(InputError(std::string("x\x01\ry")).what(), "x\\x01\\x0dy");
+  // Already escaped text is left as it is.
+  EXPECT_STREQ(InputError("a\\nb").what(), "a\\nb");
+  EXPECT_STREQ(InputError("45 kPa, \xc2\xb0").what(), "45 kPa, \xc2\xb0");
+}
+
 }  // namespace softsight

@@ -1,23 +1,32 @@
 #include "softsight/io/csv_writer.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
 #include "softsight/core/error.h"
+#include "softsight/io/output_guard.h"
 
 namespace softsight {
 
 CsvWriter::CsvWriter(const std::string& path, CsvColumnTable columns)
     : path_(path), columns_(std::move(columns)) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  // Opened without O_TRUNC: the file is emptied only once this writer holds its lock, so a
+  // second program naming a CSV another one is writing is refused and leaves it intact.
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
   if (fd_ < 0) {
-    throw InputError(path + ": cannot write CSV (" + std::strerror(errno) + ")");
+    throw InputError(EscapeForMessage(path) + ": cannot write CSV (" + std::strerror(errno) + ")");
   }
   row_ = columns_.header();
   try {
+    LockOutputOrThrow(fd_, path);
+    struct stat info {};
+    if (::fstat(fd_, &info) == 0 && S_ISREG(info.st_mode) && ::ftruncate(fd_, 0) != 0) {
+      throw InputError(EscapeForMessage(path) + ": cannot empty it (" + std::strerror(errno) + ")");
+    }
     put(std::nullopt);
   } catch (...) {
     ::close(fd_);

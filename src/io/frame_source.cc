@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <variant>
 #include <vector>
 
@@ -37,6 +38,36 @@ void ToBgr(const cv::Mat& decoded, cv::Mat& bgr) {
     ToBgr(eight_bit, bgr);
   }
 }
+
+// Which packets of a video are key frames (decodable on their own), read on demand from a second,
+// demux-only capture (no decoding: OpenCV's raw mode), in step with the frames asked about. A
+// file OpenCV cannot read that way is taken as all key frames (damage stays in its frame).
+class KeyFrameIndex {
+ public:
+  explicit KeyFrameIndex(const std::string& path) : path_(path) {}
+  // The first key frame after `index`, counted as the decoder counts frames; INT64_MAX when the
+  // stream has none after it (the damage lasts to the end).
+  int64_t next_after(int64_t index) {
+    if (!opened_) {
+      opened_ = true;
+      usable_ = raw_.open(path_, cv::CAP_FFMPEG, {cv::CAP_PROP_FORMAT, -1}) && raw_.isOpened();
+    }
+    if (!usable_) return index + 1;
+    while (true) {
+      if (last_key_ > index) return last_key_;
+      if (!raw_.grab()) return std::numeric_limits<int64_t>::max();
+      const int64_t packet = packets_++;
+      if (raw_.get(cv::CAP_PROP_LRF_HAS_KEY_FRAME) != 0.0) last_key_ = packet;
+    }
+  }
+
+ private:
+  std::string path_;
+  cv::VideoCapture raw_;
+  bool opened_ = false, usable_ = false;
+  int64_t packets_ = 0;
+  int64_t last_key_ = -1;
+};
 
 // A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
 // - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) is damaged: it gets
@@ -138,6 +169,13 @@ class VideoFileSource : public FrameSource {
       if (DecoderErrorCount() != errors_before) {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
+        // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
+        // in every frame decoded from this one, silently, until the next key frame.
+        suspect_until_ = std::max(suspect_until_, key_frames_.next_after(index));
+        continue;
+      }
+      if (index < suspect_until_) {
+        ++predicted_from_damaged_;
         continue;
       }
       out.index = index;
@@ -153,9 +191,15 @@ class VideoFileSource : public FrameSource {
   // "<lead> 3 damaged frames left out (first: frame 16, decoder: mjpeg: ...)", or "".
   std::string damage_summary(const std::string& lead) const {
     if (damaged_ == 0) return "";
-    return lead + " " + std::to_string(damaged_) + " frame" + (damaged_ == 1 ? "" : "s") +
-           " the decoder found damaged " + (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
-           std::to_string(first_damaged_) + ", decoder: " + LastDecoderError() + ")";
+    std::string text = lead + " " + std::to_string(damaged_) + " frame" +
+                       (damaged_ == 1 ? "" : "s") + " the decoder found damaged " +
+                       (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
+                       std::to_string(first_damaged_) + ", decoder: " + LastDecoderError() + ")";
+    if (predicted_from_damaged_ > 0) {
+      text += ", and " + std::to_string(predicted_from_damaged_) +
+              " decoded from them up to the next key frame";
+    }
+    return text;
   }
 
   // At the end of the stream: damage and a shortfall are errors, reported after every good row.
@@ -178,6 +222,9 @@ class VideoFileSource : public FrameSource {
   int64_t decoded_ = 0;     // Frames the decoder returned, damaged ones included.
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
+  KeyFrameIndex key_frames_{path_};
+  int64_t suspect_until_ = 0;           // Frames before this index follow a damaged one.
+  int64_t predicted_from_damaged_ = 0;  // Left out for that reason.
   double last_time_s_ = -1.0;
   std::optional<int64_t> frame_count_;
   std::optional<double> fps_;

@@ -364,8 +364,15 @@ std::vector<double> NiceTicks(double lo, double hi, int max_ticks) {
   if (!(hi > lo)) return ticks;
   const double step = NiceStep(hi - lo, max_ticks);
   const double eps = step * 1e-9;
-  for (double k = std::ceil((lo - eps) / step); k * step <= hi + eps; k += 1) {
-    double tick = k * step;
+  const double first = std::ceil((lo - eps) / step);
+  // Counted, not stepped until past `hi`: far from zero (a time of 1e15 s) adding one step may
+  // not change a double, and the loop would never end. NiceStep gives at most max_ticks + 1
+  // ticks; the bound holds whatever the values.
+  const int most = 2 * std::max(1, max_ticks) + 2;
+  for (int i = 0; i < most; ++i) {
+    double tick = (first + i) * step;
+    if (tick > hi + eps) break;
+    if (!ticks.empty() && !(tick > ticks.back())) break;  // No resolution left at this magnitude.
     if (std::abs(tick) < eps) tick = 0.0;  // No "-0".
     ticks.push_back(tick);
   }

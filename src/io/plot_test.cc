@@ -138,6 +138,17 @@ TEST(NiceTicksTest, RoundStepsCoverRange) {
   EXPECT_EQ(FormatTick(-1e-17, 0.1), "0.0");
 }
 
+TEST(NiceTicksTest, FarFromZeroTheTicksAreBoundedAndIncreasing) {
+  // At 1e15 a step of 0.2 is below a double's resolution: a loop stepping until past `hi` never
+  // ended (a 20-byte CSV ran plot out of memory).
+  for (const auto& [lo, hi] : {std::pair{1e15, 1e15 + 1.0}, std::pair{-1e300, 1e300},
+                               std::pair{1e300, 1.0000001e300}, std::pair{5e15, 5e15 + 8.0}}) {
+    const std::vector<double> ticks = NiceTicks(lo, hi, 5);
+    EXPECT_LE(ticks.size(), 12u) << lo;
+    for (size_t i = 1; i < ticks.size(); ++i) EXPECT_GT(ticks[i], ticks[i - 1]) << lo;
+  }
+}
+
 TEST_F(PlotTest, PngCurvesLieWhereTheDataSays) {
   const std::string csv =
       WriteCsv("run.csv", 101, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);

@@ -9,10 +9,6 @@
 #include "softsight/core/error.h"
 
 namespace softsight {
-namespace {
-
-// A marker whose colour range accepts gray pixels (a gray-level range, white or black dots) is
-// tracked on gray video as well; only the others make a gray video an error.
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
     const auto* templ = std::get_if<TemplateParams>(&spec.params);
@@ -21,7 +17,10 @@ bool NeedsColour(const TrackingConfig& config) {
   return false;
 }
 
-}  // namespace
+std::string GrayFrameProblem() {
+  return "colour tracking needs colour (use --method zncc, which matches in gray, or a "
+         "gray-level range `gray: [lo, hi]` for white or black markers)";
+}
 
 RunInfo DescribeMarkers(const TrackingConfig& config) {
   RunInfo info;
@@ -87,10 +86,7 @@ const FrameResult& PipelineRun::process(Frame& frame) {
   }
   if (summary_.frames == 0) {
     if (needs_colour_ && IsGrayscale(frame.image)) {
-      throw InputError(summary_.source +
-                       ": the video is grayscale, but colour tracking needs colour (use "
-                       "--method zncc, which matches in gray, or a gray-level range "
-                       "`gray: [lo, hi]` for white or black markers)");
+      throw InputError(summary_.source + ": the video is grayscale, but " + GrayFrameProblem());
     }
     info_.frame_size = frame.image.size();
     begin_sinks();
@@ -164,6 +160,14 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
       frame.captured = {};
       if (!source.read(frame)) {
         reason = StopReason::kEndOfInput;
+        if (run.frames() == 0) {
+          // A file that ends before its first frame is a wrong input, not a run: a CSV of only a
+          // header, exit 0, would read as "tracked, nothing found".
+          reason = StopReason::kError;
+          error = run.summary().source +
+                  ": no frames to read (an empty video or folder, a start past its end, or frames "
+                  "that cannot be decoded)";
+        }
         break;
       }
       run.process(frame);

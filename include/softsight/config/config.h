@@ -10,6 +10,7 @@
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/io/camera_settings.h"
+#include "softsight/io/output_guard.h"
 #include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
@@ -86,6 +87,10 @@ struct TrackingConfig {
   // template image files it names (resolved), so no output may overwrite one of them.
   std::vector<std::string> files_read;
 };
+
+// The files a run of `config` reads, as inputs for CheckOutputsAreNotInputs: the config itself
+// ("the config") and every file it names ("a file the config names:").
+std::vector<PathRole> ConfigInputs(const TrackingConfig& config);
 
 // Reads and checks a config file. `method_override` (from --method) replaces every marker's
 // method. Throws InputError naming file, line and key.

@@ -50,6 +50,19 @@ class StopRequested : public std::runtime_error {
 // or corrupted board configuration.
 constexpr double kMaxBoardPressureLimitKpa = 1000.0;
 
+// The range a sensed pressure can physically have, kPa (gauge): from full vacuum to the highest
+// reading a soft-robot pressure sensor gives (twice the highest limit a board may report).
+// An answer outside it, or with a duty outside -1..1, an echoed setpoint outside
+// 0..kMaxBoardPressureLimitKpa, undefined flag bits or negative counts, is not believed: it is
+// counted as a rejected line and the command sent again, never used or written.
+constexpr double kMinSensedPressureKpa = -101.325;
+constexpr double kMaxSensedPressureKpa = 2 * kMaxBoardPressureLimitKpa;
+
+// The longest a STOP may take, all retries together, ms: venting is tried at once and again,
+// but a silent board cannot hold the exit for retries x reply_timeout_ms (up to 110 s); its
+// watchdog vents on its own when the commands stop.
+constexpr int kMaxStopMs = 1500;
+
 // What the board said in its $HI answer.
 struct BoardInfo {
   int protocol_version = 0;
@@ -95,7 +108,8 @@ class BoardLink {
   BoardState set_pressure_kpa(double setpoint_kpa);
   BoardState set_duty(double duty);  // [-1, 1]; > 0 inflate, < 0 vent.
   BoardState read_state();
-  BoardState stop();                 // Vent to the safe state (ignores stop requests).
+  // Vent to the safe state (ignores stop requests; gives up after kMaxStopMs).
+  BoardState stop();
   BoardState heartbeat();
 
   const LinkStats& stats() const { return stats_; }
@@ -108,11 +122,13 @@ class BoardLink {
  private:
   enum class Verdict { kAnswer, kStale, kRejected };
   // Sends `line` up to retries + 1 times and returns the first line `classify` calls the answer;
-  // nothing when every try passed its deadline. Throws StopRequested when `honour_stop` and the
-  // user asked to stop.
+  // nothing when every try passed its deadline, or all of them `budget_ms` (> 0). Throws
+  // StopRequested when `honour_stop` and the user asked to stop. `rejected` receives how many
+  // lines of this exchange were rejected, and `why` the reason for the last one.
   std::optional<wire::Message> exchange(
       const std::string& line, bool honour_stop,
-      const std::function<Verdict(const wire::Message&)>& classify);
+      const std::function<Verdict(const wire::Message&)>& classify, int64_t budget_ms = 0,
+      uint64_t* rejected = nullptr, std::string* why = nullptr);
   BoardState request(wire::MessageType type, int32_t value, const char* what);
   int64_t now_ms() const;
 

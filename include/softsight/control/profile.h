@@ -19,6 +19,14 @@ namespace softsight {
 
 class TargetProfile {
  public:
+  // Bounds on what a profile may ask, so a tiny file cannot start unbounded work: its text (a
+  // hand-written profile is a few hundred bytes), its segments, its length (the same week that
+  // bounds --duration-s) and a sine's frequency (far above what a soft actuator follows).
+  static constexpr size_t kMaxBytes = 1 << 20;
+  static constexpr size_t kMaxSegments = 10000;
+  static constexpr double kMaxSeconds = 7 * 86400.0;
+  static constexpr double kMaxFrequencyHz = 100.0;
+
   struct Segment {
     enum class Kind { kHold, kRamp, kSine };
     Kind kind = Kind::kHold;
@@ -33,7 +41,7 @@ class TargetProfile {
   // A constant target.
   static TargetProfile Constant(double angle_deg);
   // Parses the text format above. `source` names the file in errors. Throws InputError
-  // "file:line: problem".
+  // "file:line: problem", also for a profile beyond the bounds above.
   static TargetProfile Parse(std::string_view text, const std::string& source);
   // Reads and parses a profile file; throws InputError naming the file.
   static TargetProfile Load(const std::string& file);

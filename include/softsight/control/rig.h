@@ -117,6 +117,9 @@ class RigServer {
   uint64_t dropped_replies() const { return dropped_replies_; }
   // Answer lines queued for the host so far (a count tests and `rig` can wait on, unlike time).
   uint64_t replies() const { return replies_; }
+  // After this many answer lines the server answers nothing more (0: no limit): a pulled cable at
+  // a point that does not depend on timing. Call disconnect() once replies() reaches it.
+  void set_reply_limit(uint64_t limit) { reply_limit_ = limit; }
 
  private:
   void serve();
@@ -134,6 +137,7 @@ class RigServer {
   std::string pending_;  // Bytes for the host not yet taken by the pty (write_mutex_).
   std::atomic<uint64_t> dropped_replies_{0};
   std::atomic<uint64_t> replies_{0};
+  std::atomic<uint64_t> reply_limit_{0};
   std::atomic<bool> port_closed_{false};
   std::atomic<bool> contacted_{false};
   std::atomic<bool> shutdown_{false};

@@ -37,7 +37,9 @@ struct ControlSample {
 // Safety is structural: once start() has shaken hands, the session sends STOP when it ends,
 // however it ends (the end of the run, a board ERR, a failed link, a fault, any exception), unless
 // stop() already has. Every pressure command is clamped to the controller's max_kpa (itself at
-// most the board's limit), and every answer is checked against the board's limit.
+// most the board's limit) and the sample records the clamped value, the one on the wire; in duty
+// mode the valves are closed (duty 0) while the sensed pressure is at max_kpa; every answer is
+// checked against the board's limit.
 class ControlSession {
  public:
   // `link` must outlive the session. Throws InputError when the options or the target (NaN,
@@ -49,7 +51,8 @@ class ControlSession {
   ControlSession& operator=(const ControlSession&) = delete;
 
   // Handshake; the controller's max_kpa is clamped to the board's limit, and so is an open-loop
-  // pressure target (see pressure_clamped_from()). Throws InputError.
+  // pressure target (see pressure_clamped_from()). Throws InputError (after venting) when the
+  // controller's min_kpa is not below the board's limit: every setpoint would be above it.
   BoardInfo start();
   // One frame at `time_s` (the frame's timestamp). Throws InputError when the link fails, the
   // board refuses a command, or the board reports a pressure above its limit (a fault: the
@@ -67,9 +70,17 @@ class ControlSession {
   // The pressure the open-loop target sends (after the clamp).
   double pressure_target_kpa() const { return target_.pressure_kpa; }
   const AngleController& controller() const { return controller_; }
+  // Duty mode: frames in which the duty asked for was replaced by 0 (valves closed) because the
+  // sensed pressure had reached max_kpa.
+  int64_t duty_held_at_limit() const { return duty_held_at_limit_; }
+  // Answers to this session's commands in which the board said its watchdog had vented, or its
+  // pressure guard was overriding the outputs: the actuator did not do what was sent.
+  int64_t watchdog_answers() const { return watchdog_answers_; }
+  int64_t limit_answers() const { return limit_answers_; }
 
  private:
-  BoardState send_pressure(double setpoint_kpa);
+  // Sends the setpoint clamped to [min_kpa, max_kpa]; `sent` receives the clamped value.
+  BoardState send_pressure(double setpoint_kpa, std::optional<double>* sent);
   // Throws (after venting) when the board says its pressure is above its own limit.
   const BoardState& checked(const BoardState& state);
 
@@ -79,6 +90,11 @@ class ControlSession {
   std::optional<double> start_time_s_;
   std::optional<double> pressure_clamped_from_;
   double board_limit_kpa_ = 0.0;
+  double last_pressure_kpa_ = 0.0;  // Sensed in the last answer.
+  double inflate_rise_kpa_ = 0.0;   // The rise over the last frame that inflated (duty mode).
+  int64_t duty_held_at_limit_ = 0;
+  int64_t watchdog_answers_ = 0;
+  int64_t limit_answers_ = 0;
   bool started_ = false;
   bool stopped_ = false;
 };

@@ -7,6 +7,7 @@
 // - a broken invariant is a programming error and asserts (CV_DbgAssert / assert).
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -15,14 +16,24 @@ namespace softsight {
 
 inline constexpr int kInputErrorExitCode = 2;
 
-class InputError : public std::runtime_error {
- public:
-  explicit InputError(const std::string& message) : std::runtime_error(message) {}
-};
 
 // `text` made safe for a one-line message: control characters, DEL and bytes that are not valid
 // UTF-8 become \xNN (a newline \n), so a random-bytes config or file name cannot break the line
 // or the terminal. Texts longer than `max_bytes` are cut and end in "...".
 std::string EscapeForMessage(std::string_view text, size_t max_bytes = 400);
+
+// The one exception type for what a user can fix. The message is made one line here, for every
+// caller (the program, the library's users, Python): a value read from a file may hold a newline
+// or control bytes, and each throw site need not remember to escape it.
+class InputError : public std::runtime_error {
+ public:
+  explicit InputError(const std::string& message)
+      : std::runtime_error(EscapeForMessage(message, kMaxInputErrorBytes)) {}
+  static constexpr size_t kMaxInputErrorBytes = 4096;
+};
+
+// A number as messages show it: the shortest of fixed and exponent form, 6 significant digits
+// ("45", "0.25", "1e+18", "inf").
+std::string ShortNumber(double value);
 
 }  // namespace softsight

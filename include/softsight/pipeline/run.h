@@ -84,6 +84,12 @@ class PipelineRun {
 RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options = {});
 
+// Whether a run of `config` needs colour frames: a marker whose colour range accepts gray pixels
+// (a gray-level range, white or black dots) is tracked on gray video as well; only the others
+// make gray frames an error, said with GrayFrameProblem() ("colour tracking needs colour (...)").
+bool NeedsColour(const TrackingConfig& config);
+std::string GrayFrameProblem();
+
 // What a run of `config` tells its sinks of the markers: their names, and whether measurements
 // come in millimetres. DescribeRun adds the source.
 RunInfo DescribeMarkers(const TrackingConfig& config);
