@@ -139,10 +139,21 @@ class ControlSink : public FrameSink {
       summary_.final_error_deg = e;
     }
     if (sample_.target_deg) collect_step_point(*sample_.target_deg);
+    // Closed loop asking for max_kpa, frame after frame: a target the actuator may not reach.
+    const bool at_limit = experiment_ == nullptr && sample_.target_deg && sample_.setpoint_kpa &&
+                          *sample_.setpoint_kpa >= session_.controller().options().max_kpa - 1e-9;
+    if (!at_limit) {
+      at_limit_since_s_.reset();
+    } else {
+      if (!at_limit_since_s_) at_limit_since_s_ = sample_.time_s;
+      longest_at_limit_s_ = std::max(longest_at_limit_s_, sample_.time_s - *at_limit_since_s_);
+    }
     if (stop_at_duration_ && sample_.time_s >= duration_s_) done_ = true;
   }
 
   bool done() const { return done_; }
+  // The longest stretch of frame time the closed loop spent asking for max_kpa.
+  double longest_at_output_limit_s() const { return longest_at_limit_s_; }
 
   // The controller's CSV columns: target_deg, setpoint_kpa, board_pressure_kpa,
   // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected.
@@ -213,6 +224,8 @@ class ControlSink : public FrameSink {
   }
 
   IdentificationExperiment* experiment_ = nullptr;
+  std::optional<double> at_limit_since_s_;  // Frame time the output reached max_kpa, while there.
+  double longest_at_limit_s_ = 0.0;
   std::vector<TrackingPoint> step_points_;
   ControlSample sample_;
   std::optional<double> latency_command_ms_;
@@ -336,6 +349,30 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     std::string problem;
     if (!options.controller->Check(&problem)) throw InputError("control.controller: " + problem);
     config.controller = *options.controller;
+  }
+  if (options.model) config.model = *options.model;
+  // Reach, before the board is opened: a target the identified actuator cannot hold would run
+  // the whole duration at the output limit, "not settled".
+  std::optional<std::string> limited_to_reach;
+  if (target.mode == ControlMode::kAngle && !options.identify) {
+    if (const std::optional<std::string> problem =
+            OutsideReach(config.model, target.profile.lowest_deg(),
+                         target.profile.highest_deg(), config.controller.max_kpa)) {
+      const std::string what =
+          options.profile_file ? "--profile " + EscapeForMessage(*options.profile_file)
+                               : "--target-deg " + ShortNumber(target.profile.at(0.0));
+      if (!options.allow_saturation) {
+        throw InputError(what + ": " + *problem +
+                         "; nothing sent (--allow-saturation runs it with the target limited to "
+                         "the reach)");
+      }
+      const ActuatorReach reach = ReachOf(config.model, config.controller.max_kpa);
+      target.profile = target.profile.ClampedTo(reach.most_bent_deg, reach.straightest_deg);
+      limited_to_reach = what + ": " + *problem + "; the target was limited to " +
+                         FixedNumber(reach.most_bent_deg, 1) + ".." +
+                         FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)";
+      if (!options.quiet) std::fprintf(stderr, "control: %s\n", limited_to_reach->c_str());
+    }
   }
   const double duration_s = options.duration_s.value_or(
       options.identify ? kMaxIdentifyS
@@ -513,6 +550,14 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     summary = control.summary();
     summary.link_rejected = link.stats().rejected_lines;
     summary.resends = link.stats().resends;
+    if (limited_to_reach) summary.notes.push_back(*limited_to_reach);
+    const double max_kpa = session.controller().options().max_kpa;
+    if (control.longest_at_output_limit_s() > 1.0) {
+      summary.notes.push_back(
+          "the outer loop's output stayed at its limit (" + ShortNumber(max_kpa) + " kPa) for " +
+          FixedNumber(control.longest_at_output_limit_s(), 1) +
+          " s: the target may be beyond the actuator's reach (`softsight identify` measures it)");
+    }
     if (session.duty_held_at_limit() > 0) {
       summary.notes.push_back(
           "valves held closed (duty 0) in " + std::to_string(session.duty_held_at_limit()) +
@@ -714,6 +759,9 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                "beside --csv as *_identify.csv), then run the loop with the gains it found");
   sub.add_option("--closed-loop-s", *closed_loop_s,
                  "With --auto-tune: the SIMC closed-loop time (default max(dead time, 3 camera periods))");
+  sub.add_flag("--allow-saturation", o->allow_saturation,
+               "Run a target beyond the identified actuator's reach (control.model) limited to "
+               "that reach, instead of refusing it");
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
   return [o, auto_tune, closed_loop_s] {
     ControlOptions run = *o;
@@ -739,6 +787,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       if (!found.identified) throw InputError("control --auto-tune: the identification stopped");
       if (!o->quiet) std::cerr << FormatIdentifyOutcome(*found.identified);
       run.controller = found.identified->tuned;
+      run.model = found.identified->model;  // Its reach is checked before the loop starts.
     } else if (closed_loop_s->has_value()) {
       throw InputError("control: --closed-loop-s needs --auto-tune");
     }

@@ -48,6 +48,10 @@ struct ControlOptions {
   IdentifyOptions identify_options;
   // Replaces the config's control.controller (the gains `--auto-tune` found).
   std::optional<ControllerOptions> controller;
+  // Replaces the config's control.model (what `--auto-tune` identified): its reach is checked.
+  std::optional<ActuatorModel> model;
+  // A target beyond the model's reach runs, limited to the reach, instead of being refused.
+  bool allow_saturation = false;
   std::string metrics_csv_file;         // The step-response figures (StepMetricsCsv), if given.
   // Outputs the same command writes in another step (identify's config and model CSV; the loop's
   // CSV and metrics after --auto-tune's identification): checked with this run's own before the

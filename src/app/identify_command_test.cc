@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 #include <gmock/gmock.h>
@@ -165,6 +166,76 @@ TEST(ControlCommand, AutoTuneIdentifiesThenRunsTheLoopWithTheGainsFound) {
                         "settling_2deg_s,overshoot_percent,steady_state_error_deg,rms_error_deg");
   EXPECT_EQ(SplitCsv(metrics[1]).size(), 9u);
   EXPECT_GT(ReadLines(identify.csv_file).size(), 300u);
+}
+
+// The stiff plant (3 deg of bend per kPa): at the 45 kPa output limit it bends to ~130 deg. Its
+// identified model says so, and `control` refuses 120 deg before the board is opened, naming
+// the reach and the pressure 120 deg would need; --allow-saturation runs it limited to the reach.
+// Without a model the run says the output stayed at its limit.
+TEST(ControlCommand, ATargetBeyondTheIdentifiedReachIsRefusedBeforeAnythingIsSent) {
+  TempDir dir;
+  std::string stiff = ReadTextFile(Example());
+  const size_t at = stiff.find("bend_deg_per_kpa: 6.0");
+  ASSERT_NE(at, std::string::npos);
+  stiff.replace(at, std::string("bend_deg_per_kpa: 6.0").size(), "bend_deg_per_kpa: 3.0");
+  WriteTextFile(dir.file("stiff.yaml"), stiff);
+  IdentifyCommandOptions identify;
+  identify.config_file = dir.file("stiff.yaml");
+  identify.output_file = dir.file("tuned.yaml");
+  identify.simulate = true;
+  identify.sim_supersample = 1;
+  identify.quiet = true;
+  const std::optional<IdentifyOutcome> found = RunIdentify(identify);
+  ASSERT_TRUE(found);
+  EXPECT_NEAR(found->model.valid_min_deg, 130.0, 2.0);
+
+  ControlOptions o;
+  o.config_file = dir.file("tuned.yaml");
+  o.simulate = true;
+  o.sim_supersample = 1;
+  o.target_deg = 120.0;
+  o.duration_s = 3.0;
+  o.csv_file = dir.file("run.csv");
+  o.quiet = true;
+  try {
+    RunControl(o);
+    ADD_FAILURE() << "an unreachable target ran";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--target-deg 120: 120.0 deg is beyond the actuator's reach: "
+                                    "it bends to 1"));
+    EXPECT_THAT(e.what(), HasSubstr("deg would need about 5"));
+    EXPECT_THAT(e.what(), HasSubstr("nothing sent"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(o.csv_file)) << "the run started";
+  // A profile that leaves the reach: the same refusal.
+  WriteTextFile(dir.file("p.txt"), "step 150\nhold 1\nsine 140 25 0.5 2\n");
+  ControlOptions profiled = o;
+  profiled.target_deg.reset();
+  profiled.profile_file = dir.file("p.txt");
+  EXPECT_THROW(RunControl(profiled), InputError);
+  EXPECT_FALSE(std::filesystem::exists(o.csv_file));
+
+  // Run on purpose: the target limited to the reach, said in the summary.
+  o.allow_saturation = true;
+  const ControlSummary saturated = RunControl(o);
+  ASSERT_FALSE(saturated.notes.empty());
+  EXPECT_THAT(saturated.notes.front(), HasSubstr("the target was limited to 1"));
+  const std::vector<std::string> rows = ReadLines(o.csv_file);
+  ASSERT_GT(rows.size(), 10u);
+  const std::vector<std::string> header = SplitCsv(rows[0]);
+  const size_t target_column =
+      std::find(header.begin(), header.end(), "target_deg") - header.begin();
+  ASSERT_LT(target_column, header.size());
+  EXPECT_NEAR(std::stod(SplitCsv(rows.back())[target_column]), found->model.valid_min_deg, 1e-3);
+
+  // Without a model (the plain stiff config): the run says its output sat at the limit.
+  ControlOptions unmodelled = o;
+  unmodelled.config_file = dir.file("stiff.yaml");
+  unmodelled.allow_saturation = false;
+  unmodelled.csv_file = dir.file("plain.csv");
+  const ControlSummary plain = RunControl(unmodelled);
+  EXPECT_THAT(FormatControlSummary(plain),
+              HasSubstr("note: the outer loop's output stayed at its limit (45 kPa) for "));
 }
 
 TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {

@@ -1,8 +1,13 @@
 #include "softsight/control/controller.h"
 
+#include <algorithm>
+#include <optional>
+#include <string>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "softsight/control/actuator_model.h"
 #include "softsight/control/profile.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
@@ -196,6 +201,68 @@ TEST(TargetProfile, BoundsOnLengthSegmentsFrequencyAndSize) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("not a text file"));
   }
+}
+
+
+TEST(TargetProfile, LowestAndHighestIncludeASinesSwingAndClampingLimitsThem) {
+  const TargetProfile p = TargetProfile::Parse("step 150\nhold 1\nsine 140 25 0.5 4\nramp 170 1\n",
+                                               "x");
+  EXPECT_DOUBLE_EQ(p.lowest_deg(), 115.0);
+  EXPECT_DOUBLE_EQ(p.highest_deg(), 170.0);
+  const TargetProfile clamped = p.ClampedTo(130.0, 160.0);
+  EXPECT_DOUBLE_EQ(clamped.lowest_deg(), 130.0);
+  EXPECT_DOUBLE_EQ(clamped.highest_deg(), 160.0);
+  for (double t = 0.0; t < 7.0; t += 0.01) {
+    EXPECT_DOUBLE_EQ(clamped.at(t), std::clamp(p.at(t), 130.0, 160.0)) << t;
+  }
+  EXPECT_DOUBLE_EQ(TargetProfile::Constant(120.0).lowest_deg(), 120.0);
+}
+
+// The stiff plant of issue 23 as `softsight identify` measured it: 1.2 deg/kPa at the middle
+// marker from 3 kPa, bent to 130.25 deg at the 45 kPa output limit.
+ActuatorModel StiffPlant() {
+  ActuatorModel m;
+  m.straight_deg = 180.0;
+  m.bend_start_kpa = 3.0;
+  m.slope_deg_per_kpa = 1.2;
+  m.static_rms_deg = 0.06;
+  m.valid_max_kpa = 44.95;
+  m.valid_min_deg = 130.25;
+  m.valid_max_deg = 180.0;
+  return m;
+}
+
+TEST(ActuatorReach, ATargetBeyondTheIdentifiedRangeIsNamedWithThePressureItNeeds) {
+  const ActuatorModel m = StiffPlant();
+  EXPECT_DOUBLE_EQ(PressureForAngle(m, 180.0), 3.0);
+  EXPECT_DOUBLE_EQ(PressureForAngle(m, 120.0), 53.0);
+  EXPECT_EQ(OutsideReach(m, 120.0, 180.0, 45.0),
+            std::optional<std::string>(
+                "120.0 deg is beyond the actuator's reach: it bends to 130.2..180.0 deg up to 45.0 "
+                "kPa (control.model, from `softsight identify`); 120.0 deg would need about 53.0 "
+                "kPa"));
+  // Within the range, and within the tolerance (0.5 deg) at its edges: reachable.
+  EXPECT_FALSE(OutsideReach(m, 131.0, 180.0, 45.0));
+  EXPECT_FALSE(OutsideReach(m, 129.8, 180.0, 45.0));
+  EXPECT_TRUE(OutsideReach(m, 129.7, 180.0, 45.0));
+  // A lower output limit than the identification had: less reach (180 - 1.2 * (30 - 3)).
+  const ActuatorReach lower = ReachOf(m, 30.0);
+  EXPECT_DOUBLE_EQ(lower.most_bent_deg, 180.0 - 1.2 * 27.0);
+  EXPECT_DOUBLE_EQ(lower.up_to_kpa, 30.0);
+  EXPECT_TRUE(OutsideReach(m, 140.0, 180.0, 30.0));
+  // Straighter than vented.
+  ActuatorModel bent_at_rest = m;
+  bent_at_rest.valid_max_deg = bent_at_rest.straight_deg = 175.0;
+  EXPECT_THAT(OutsideReach(bent_at_rest, 150.0, 180.0, 45.0).value_or(""),
+              ::testing::HasSubstr("180.0 deg is straighter than the actuator gets when vented "
+                                   "(175.0 deg"));
+  // Past the end stop no pressure helps.
+  ActuatorModel stops = m;
+  stops.saturation_kpa = 40.0;
+  EXPECT_THAT(OutsideReach(stops, 120.0, 180.0, 45.0).value_or(""),
+              ::testing::HasSubstr("it stops bending from 40.0 kPa, so no pressure gives 120.0 deg"));
+  // No model: everything is reachable as far as the host knows.
+  EXPECT_FALSE(OutsideReach(ActuatorModel{}, 0.0, 180.0, 45.0));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "softsight/control/profile.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -166,6 +167,33 @@ TargetProfile TargetProfile::Load(const std::string& file) {
 }
 
 double TargetProfile::at(double time_s) const {
+  return std::clamp(unclamped_at(time_s), clamp_lowest_deg_, clamp_highest_deg_);
+}
+
+double TargetProfile::lowest_deg() const {
+  double lowest = start_deg_;
+  for (const Segment& s : segments_) {
+    lowest = std::min({lowest, s.from_deg, s.to_deg - s.amplitude_deg});
+  }
+  return std::clamp(lowest, clamp_lowest_deg_, clamp_highest_deg_);
+}
+
+double TargetProfile::highest_deg() const {
+  double highest = start_deg_;
+  for (const Segment& s : segments_) {
+    highest = std::max({highest, s.from_deg, s.to_deg + s.amplitude_deg});
+  }
+  return std::clamp(highest, clamp_lowest_deg_, clamp_highest_deg_);
+}
+
+TargetProfile TargetProfile::ClampedTo(double lowest_deg, double highest_deg) const {
+  TargetProfile out = *this;
+  out.clamp_lowest_deg_ = std::max(clamp_lowest_deg_, lowest_deg);
+  out.clamp_highest_deg_ = std::max(out.clamp_lowest_deg_, std::min(clamp_highest_deg_, highest_deg));
+  return out;
+}
+
+double TargetProfile::unclamped_at(double time_s) const {
   if (segments_.empty() || time_s < 0.0) return start_deg_;
   // Segments are few (a profile file is written by hand): a linear scan is fine.
   const Segment* active = &segments_.front();

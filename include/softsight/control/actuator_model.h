@@ -3,6 +3,7 @@
 // pressures are gauge kPa. All zero (the default) means "not identified": nothing is written.
 #pragma once
 
+#include <optional>
 #include <string>
 
 namespace softsight {
@@ -39,5 +40,27 @@ struct ActuatorModel {
   // Returns false and names the bad field.
   bool Check(std::string* error) const;
 };
+
+// The pressure the static map needs to hold `angle_deg` (on the mid line between the up and down
+// branches): bend_start_kpa at straight_deg and above, then slope_deg_per_kpa per kPa.
+double PressureForAngle(const ActuatorModel& model, double angle_deg);
+
+// What the identification saw the actuator reach, as a run with output limit `max_kpa` can hold
+// it: from the most bent angle (valid_min_deg, or less bending when max_kpa is below the
+// pressure that gave it) to the straightest (valid_max_deg, vented).
+struct ActuatorReach {
+  double most_bent_deg = 0.0;
+  double straightest_deg = 180.0;
+  double up_to_kpa = 0.0;  // The pressure the most bent angle took.
+};
+ActuatorReach ReachOf(const ActuatorModel& model, double max_kpa);
+
+// Nothing when every target in [lowest_deg, highest_deg] lies within ReachOf(model, max_kpa),
+// with a tolerance of the larger of 0.5 deg and twice the static fit's residual; else the reason,
+// one line naming the reachable range and the pressure the target would need, e.g. "120 deg is
+// beyond the actuator's reach: it bends to 130.25..180 deg up to 45 kPa (...); 120 deg would
+// need about 48.4 kPa". A model not identified reaches everything.
+std::optional<std::string> OutsideReach(const ActuatorModel& model, double lowest_deg,
+                                        double highest_deg, double max_kpa);
 
 }  // namespace softsight

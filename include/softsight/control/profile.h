@@ -47,13 +47,23 @@ class TargetProfile {
   static TargetProfile Load(const std::string& file);
 
   double at(double time_s) const;
+  // The lowest and highest target the profile asks for (a sine's full swing included).
+  double lowest_deg() const;
+  double highest_deg() const;
+  // The same profile with every target limited to [lowest_deg, highest_deg] (a target beyond the
+  // actuator's reach, run on purpose: `control --allow-saturation`).
+  TargetProfile ClampedTo(double lowest_deg, double highest_deg) const;
   // End of the last segment (0 for a constant target).
   double duration_s() const { return duration_s_; }
   const std::vector<Segment>& segments() const { return segments_; }
 
  private:
+  double unclamped_at(double time_s) const;
+
   double start_deg_ = 180.0;
   double duration_s_ = 0.0;
+  double clamp_lowest_deg_ = 0.0;
+  double clamp_highest_deg_ = 180.0;
   std::vector<Segment> segments_;
 };
 
