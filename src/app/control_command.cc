@@ -199,6 +199,15 @@ class ControlSink : public FrameSink {
       out.metrics = ComputeStepMetrics(step_points_);
       out.metrics.rms_error_deg = out.rms_error_deg;  // Over the whole run, not the last step.
     }
+    out.steps = ComputeEveryStepMetrics(run_points_);
+    // A target that moves (a ramp, a sine), not only jumps: how it is followed.
+    int changes = 0;
+    for (size_t k = 1; k < run_points_.size(); ++k) {
+      changes += run_points_[k].target_deg != run_points_[k - 1].target_deg;
+    }
+    if (changes > static_cast<int>(out.steps.size()) + 10) {
+      out.tracking = ComputeTrackingMetrics(run_points_);
+    }
     return out;
   }
 
@@ -221,12 +230,16 @@ class ControlSink : public FrameSink {
       step_points_.push_back(before);
     }
     if (step_points_.size() < kMaxStepPoints) step_points_.push_back(point);
+    if (run_points_.size() < kMaxStepPoints) run_points_.push_back(point);
   }
 
   IdentificationExperiment* experiment_ = nullptr;
   std::optional<double> at_limit_since_s_;  // Frame time the output reached max_kpa, while there.
   double longest_at_limit_s_ = 0.0;
   std::vector<TrackingPoint> step_points_;
+  // Every frame of the run (its first hour), for the figures of each step of a staircase and the
+  // tracking of a moving target.
+  std::vector<TrackingPoint> run_points_;
   ControlSample sample_;
   std::optional<double> latency_command_ms_;
   std::vector<double> command_latencies_ms_;
@@ -634,7 +647,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     summary.identified = std::move(outcome);
   }
   if (!options.metrics_csv_file.empty()) {
-    WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.metrics));
+    WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.steps));
   }
   return summary;
 }
@@ -651,7 +664,18 @@ std::string FormatControlSummary(const ControlSummary& s) {
                   *s.rms_error_deg, s.final_error_deg.value_or(0.0));
     out << line;
   }
-  if (s.metrics.step_to_deg) out << FormatStepMetrics(s.metrics) << "\n";
+  if (s.steps.size() > 1) {
+    // A staircase: each step's figures (its RMS error over that step).
+    for (size_t i = 0; i < s.steps.size(); ++i) {
+      out << "step " << i + 1 << " of " << s.steps.size() << ": "
+          << FormatStepMetrics(s.steps[i], "the step") << "\n";
+    }
+  } else if (s.steps.size() == 1 && s.tracking) {
+    out << FormatStepMetrics(s.steps.front(), "the step") << "\n";  // Before the target moves.
+  } else if (s.metrics.step_to_deg) {
+    out << FormatStepMetrics(s.metrics) << "\n";
+  }
+  if (s.tracking) out << FormatTrackingMetrics(*s.tracking) << "\n";
   for (const std::string& note : s.notes) out << "note: " << note << "\n";
   std::snprintf(line, sizeof(line),
                 "max board pressure %.2f kPa; link: %llu rejected lines from the board, %llu "

@@ -89,6 +89,11 @@ struct ControlSummary {
   // Angle mode: rise and settling time, overshoot and steady-state error of the last step to a
   // constant target, RMS error over the run (control/step_metrics.h).
   StepMetrics metrics;
+  // Every step of the run (a staircase profile: one per jump of the target), each with its own
+  // figures and RMS error; the metrics CSV has one row per step.
+  std::vector<StepMetrics> steps;
+  // A target that moves (ramps, sines): RMS error, lag, and the error with the lag taken out.
+  std::optional<TrackingMetrics> tracking;
   std::optional<IdentifyOutcome> identified;
   // What the run did other than asked, one line each (FormatControlSummary prints them): the
   // valves held closed at max_kpa in duty mode, board answers that were not believed.

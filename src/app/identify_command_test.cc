@@ -238,6 +238,54 @@ TEST(ControlCommand, ATargetBeyondTheIdentifiedReachIsRefusedBeforeAnythingIsSen
               HasSubstr("note: the outer loop's output stayed at its limit (45 kPa) for "));
 }
 
+// The profiles people run on soft actuators, after `identify`: a staircase gets each step's
+// figures (summary and metrics CSV, a row per step) and a slow sine its tracking error and lag.
+TEST(ControlCommand, AStaircaseGetsEveryStepsFiguresAndASineItsTrackingError) {
+  TempDir dir;
+  IdentifyCommandOptions identify;
+  identify.config_file = Example();
+  identify.output_file = dir.file("tuned.yaml");
+  identify.simulate = true;
+  identify.sim_supersample = 1;
+  identify.quiet = true;
+  ASSERT_TRUE(RunIdentify(identify));
+
+  WriteTextFile(dir.file("stairs.txt"), "step 150\nhold 2\nstep 130\nhold 2\nstep 160\nhold 2\n");
+  ControlOptions o;
+  o.config_file = dir.file("tuned.yaml");
+  o.simulate = true;
+  o.sim_supersample = 1;
+  o.profile_file = dir.file("stairs.txt");
+  o.csv_file = dir.file("stairs.csv");
+  o.metrics_csv_file = dir.file("stairs_metrics.csv");
+  o.quiet = true;
+  const ControlSummary stairs = RunControl(o);
+  ASSERT_EQ(stairs.steps.size(), 3u) << FormatControlSummary(stairs);
+  const double to[] = {150.0, 130.0, 160.0};
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(*stairs.steps[i].step_to_deg, to[i]);
+    ASSERT_TRUE(stairs.steps[i].settling_1deg_s) << FormatStepMetrics(stairs.steps[i]);
+    EXPECT_LT(*stairs.steps[i].settling_1deg_s, 2.0);
+  }
+  EXPECT_FALSE(stairs.tracking) << "a staircase has no moving target";
+  EXPECT_THAT(FormatControlSummary(stairs), HasSubstr("step 3 of 3: step 13"));
+  EXPECT_EQ(ReadLines(o.metrics_csv_file).size(), 4u);
+
+  WriteTextFile(dir.file("sine.txt"), "step 140\nhold 1.5\nsine 140 20 0.5 6\n");
+  o.profile_file = dir.file("sine.txt");
+  o.csv_file = dir.file("sine.csv");
+  o.metrics_csv_file.clear();
+  const ControlSummary sine = RunControl(o);
+  ASSERT_TRUE(sine.tracking) << FormatControlSummary(sine);
+  ASSERT_TRUE(sine.tracking->rms_error_deg && sine.tracking->lag_s);
+  // The response follows within a few degrees and a fraction of the 2 s period.
+  EXPECT_LT(*sine.tracking->rms_error_deg, 5.0) << FormatControlSummary(sine);
+  EXPECT_GE(*sine.tracking->lag_s, 0.0);
+  EXPECT_LT(*sine.tracking->lag_s, 0.5);
+  EXPECT_LE(*sine.tracking->rms_error_without_lag_deg, *sine.tracking->rms_error_deg);
+  EXPECT_THAT(FormatControlSummary(sine), HasSubstr("tracking: RMS error "));
+}
+
 TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {
   TempDir dir;
   WriteTextFile(dir.file("rig.yaml"), ReadTextFile(Example()));

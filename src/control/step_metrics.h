@@ -51,11 +51,32 @@ struct StepMetrics {
 StepMetrics ComputeStepMetrics(const std::vector<TrackingPoint>& points,
                                const StepMetricsOptions& options = {});
 
+// The figures of every step of a staircase: the run cut at each jump of the target (the run's
+// start counts as one when the response starts away from the first target), each piece scored
+// as ComputeStepMetrics scores a run, its RMS error over the piece. Pieces whose target is not
+// constant (a ramp, a sine) or that move less than min_step_deg are left out.
+std::vector<StepMetrics> ComputeEveryStepMetrics(const std::vector<TrackingPoint>& points,
+                                                 const StepMetricsOptions& options = {});
+
+// How a moving target (a ramp, a slow sine) is followed: the RMS error, the delay of the response
+// behind the target (the shift, in whole frames up to max_lag_s, that makes the RMS error
+// smallest) and the RMS error once that delay is taken out (what is left is amplitude and shape).
+struct TrackingMetrics {
+  std::optional<double> rms_error_deg;
+  std::optional<double> lag_s;
+  std::optional<double> rms_error_without_lag_deg;
+};
+TrackingMetrics ComputeTrackingMetrics(const std::vector<TrackingPoint>& points,
+                                       double max_lag_s = 2.0);
+// "tracking: RMS error 1.85 deg, lag 0.20 s (RMS 0.41 deg with the lag taken out)".
+std::string FormatTrackingMetrics(const TrackingMetrics& metrics);
+
 // "rise 0.42 s, settling +-1 deg 1.10 s, +-2 deg 0.80 s, overshoot 2.1 %, steady-state error
 // +0.05 deg, RMS error 6.31 deg" (figures that are absent are said so: "not settled").
-std::string FormatStepMetrics(const StepMetrics& metrics);
+// `rms_span` names what the RMS error covers ("the run"; "the step" for one of a staircase).
+std::string FormatStepMetrics(const StepMetrics& metrics, const char* rms_span = "the run");
 
-// The CSV of the figures: a header line and one line of values (empty where absent).
-std::string StepMetricsCsv(const StepMetrics& metrics);
+// The CSV of the figures: a header line and one line of values per step (empty where absent).
+std::string StepMetricsCsv(const std::vector<StepMetrics>& steps);
 
 }  // namespace softsight

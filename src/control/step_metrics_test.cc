@@ -114,8 +114,71 @@ TEST(StepMetrics, MissingMeasurementsAreSkippedAndNoneGivesNothing) {
   const StepMetrics none = ComputeStepMetrics(run);
   EXPECT_FALSE(none.rms_error_deg);
   EXPECT_FALSE(none.settling_1deg_s);
-  const std::string csv = StepMetricsCsv(none);
+  const std::string csv = StepMetricsCsv({none});
   EXPECT_EQ(csv.substr(csv.find('\n') + 1), ",,,,,,,,\n");
+}
+
+
+// A staircase 180 -> 150 -> 130 -> 160, two seconds a step, each followed by a first-order
+// response (tau 0.2 s) from where the last one ended: each step gets its own closed-form figures.
+TEST(StepMetrics, EveryStepOfAStaircaseGetsItsOwnFigures) {
+  const double tau = 0.2;
+  const double targets[] = {150.0, 130.0, 160.0};
+  std::vector<TrackingPoint> points;
+  double from = 180.0;
+  for (int step = 0; step < 3; ++step) {
+    for (int k = 0; k < 2000; ++k) {
+      const double u = k * kDt;
+      points.push_back({step * 2.0 + u, targets[step],
+                        targets[step] + (from - targets[step]) * std::exp(-u / tau)});
+    }
+    from = points.back().measured_deg.value();
+  }
+  const std::vector<StepMetrics> steps = ComputeEveryStepMetrics(points);
+  ASSERT_EQ(steps.size(), 3u);
+  for (int step = 0; step < 3; ++step) {
+    SCOPED_TRACE(step);
+    const StepMetrics& m = steps[step];
+    EXPECT_DOUBLE_EQ(*m.step_to_deg, targets[step]);
+    EXPECT_NEAR(*m.step_time_s, step * 2.0, kDt);
+    const double size = std::abs(*m.step_from_deg - targets[step]);
+    EXPECT_NEAR(size, step == 0 ? 30.0 : step == 1 ? 20.0 : 30.0, 0.01);
+    ASSERT_TRUE(m.settling_1deg_s);
+    EXPECT_NEAR(*m.settling_1deg_s, tau * std::log(size), 3e-3);
+    EXPECT_NEAR(*m.rise_time_s, tau * std::log(9.0), 3e-3);
+    EXPECT_DOUBLE_EQ(*m.overshoot_percent, 0.0);
+  }
+  // A ramp between holds is no step, a jump held shorter than 0.5 s neither, nor a start at the
+  // target.
+  std::vector<TrackingPoint> ramp;
+  for (int k = 0; k < 3000; ++k) {
+    const double t = k * kDt;
+    const double target = t < 1.0 ? 150.0 : t < 2.0 ? 150.0 - 20.0 * (t - 1.0) : 130.0;
+    ramp.push_back({t, target, target});
+  }
+  ramp[2500].target_deg = 120.0;  // One frame's jump.
+  EXPECT_TRUE(ComputeEveryStepMetrics(ramp).empty());
+  EXPECT_TRUE(ComputeEveryStepMetrics({}).empty());  // A run without an angle target.
+  EXPECT_FALSE(ComputeTrackingMetrics({}).rms_error_deg);
+}
+
+// The response is the target 0.2 s late: the lag is found to the frame and, taken out, leaves no
+// error; the RMS error with the lag is the sine's own difference over 0.2 s.
+TEST(TrackingMetrics, ADelayedSineGivesItsLagAndNoErrorWithoutIt) {
+  const double dt = 1.0 / 30.0, lag = 6 * dt, amplitude = 20.0, hz = 0.5;
+  std::vector<TrackingPoint> points;
+  for (int k = 0; k < 300; ++k) {
+    const double t = k * dt;
+    points.push_back({t, 140.0 + amplitude * std::sin(2 * kPi * hz * t),
+                      140.0 + amplitude * std::sin(2 * kPi * hz * (t - lag))});
+  }
+  const TrackingMetrics m = ComputeTrackingMetrics(points);
+  ASSERT_TRUE(m.lag_s && m.rms_error_deg && m.rms_error_without_lag_deg);
+  EXPECT_NEAR(*m.lag_s, lag, 1e-9);
+  EXPECT_LT(*m.rms_error_without_lag_deg, 1e-6);
+  // sin(a) - sin(a - d) has amplitude 2 sin(d / 2): its RMS is that over sqrt(2).
+  EXPECT_NEAR(*m.rms_error_deg, amplitude * 2.0 * std::sin(kPi * hz * lag) / std::sqrt(2.0), 0.05);
+  EXPECT_EQ(FormatTrackingMetrics(m).substr(0, 24), "tracking: RMS error 8.74");
 }
 
 }  // namespace
