@@ -218,5 +218,75 @@ TEST(MarkerTracks, ARepeatedFrameIsBelievedAndTheStepAfterItIsExpected) {
   EXPECT_EQ(tracks.associate(next, {&none})[0].action, MarkerTracks::Decision::Action::kKeep);
 }
 
+
+// A soft actuator at rest, then a sudden step of pressure: the tip marker, still for 60 frames
+// (its learned acceleration at the minimum), leaps 40 px in one frame and goes on. Its gate
+// rejects the first reports; three in a row on one smooth motion restart the track, and from
+// then on it is followed. Never is a report believed at a place it was not.
+TEST(MarkerTracks, AMarkerThatStartsMovingSuddenlyIsReacquiredOnItsOwnSmoothReports) {
+  MarkerTracks tracks({8.0});
+  const std::vector<MarkerCandidate> none;
+  for (int f = 0; f < 60; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(220, 80)});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+  }
+  // 40, 30, 22, 16, 12, ... px a frame (a first-order approach to 310, 130).
+  cv::Point2d at(220, 80);
+  const cv::Point2d end(310, 130);
+  int believed_from = -1;
+  for (int f = 0; f < 15; ++f) {
+    at += 0.45 * (end - at);
+    std::vector<MarkerObservation> m = Reports({at});
+    tracks.associate(m, {&none});
+    if (m[0].observation.found()) {
+      EXPECT_LT(cv::norm(*m[0].observation.position_px - at), 1e-9);
+      if (believed_from < 0) believed_from = f;
+    } else {
+      EXPECT_LT(believed_from, 0) << "lost again at frame " << f;
+    }
+    tracks.commit(m);
+  }
+  EXPECT_EQ(believed_from, 2) << "restarted on the third report of the run";
+}
+
+// The same rule takes nothing another marker explains, and no run far from where the marker was.
+TEST(MarkerTracks, NoRunStartsFarAwayOrOnAnotherMarkersPlace) {
+  const std::vector<MarkerCandidate> none;
+  // One marker at rest; a look-alike appears 200 px away and stays (its own smooth "run").
+  {
+    MarkerTracks tracks({8.0});
+    for (int f = 0; f < 30; ++f) {
+      std::vector<MarkerObservation> m = Reports({cv::Point2d(100, 100)});
+      tracks.associate(m, {&none});
+      tracks.commit(m);
+    }
+    for (int f = 0; f < 6; ++f) {
+      std::vector<MarkerObservation> m = Reports({cv::Point2d(300 + 5.0 * f, 100)});
+      EXPECT_EQ(tracks.associate(m, {&none})[0].action, MarkerTracks::Decision::Action::kReject)
+          << "frame " << f;
+      tracks.commit(m);
+    }
+  }
+  // Two markers 60 px apart: marker 0's tracker jumps onto marker 1 and follows it.
+  {
+    MarkerTracks tracks({8.0, 8.0});
+    for (int f = 0; f < 30; ++f) {
+      std::vector<MarkerObservation> m = Reports({cv::Point2d(100, 100), cv::Point2d(160, 100)});
+      tracks.associate(m, {&none, &none});
+      tracks.commit(m);
+    }
+    for (int f = 0; f < 6; ++f) {
+      const cv::Point2d b(160 + 2.0 * f, 100);
+      std::vector<MarkerObservation> m = Reports({b, b});
+      const auto& d = tracks.associate(m, {&none, &none});
+      EXPECT_NE(d[0].action, MarkerTracks::Decision::Action::kKeep) << "frame " << f;
+      EXPECT_FALSE(m[0].observation.found()) << "frame " << f;
+      EXPECT_TRUE(m[1].observation.found());
+      tracks.commit(m);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace softsight

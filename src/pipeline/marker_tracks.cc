@@ -20,6 +20,15 @@ constexpr double kSamePlacePx = 1.0;
 constexpr double kMisfitWeight = 0.05;
 constexpr double kFirstAcquisitionCost = 1.2;
 constexpr double kUnassignedCost = 1.5;
+// Rejected reports in a row, on one smooth motion, that restart a track: 0.1 s at 30 fps.
+constexpr int kReacquireFrames = 3;
+// How far a rejected report may lie from where the run's constant velocity puts it: the
+// marker's size plus this fraction of the run's step (it may be slowing down or speeding up).
+constexpr double kRunStepTolerance = 0.5;
+// A run must start where a sudden start could have taken the marker since it was last believed:
+// within its size plus this per frame (the motion model's largest acceleration, 40 px/frame^2)
+// for at most kReacquireFrames frames. A look-alike far away starts no run.
+constexpr double kMaxStartStepPx = 40.0;
 
 double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
   const cv::Point2d ab = b - a;
@@ -61,6 +70,8 @@ MarkerTracks::MarkerTracks(std::vector<double> size_px, MotionModelOptions motio
 void MarkerTracks::forget(size_t i) {
   Track& t = tracks_.at(i);
   t.motion.clear();
+  t.pending_px.reset();
+  t.restart = false;
   t.last_px.reset();
   t.repeats = 0;
   t.misses = 0;
@@ -159,13 +170,22 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
   const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
   for (size_t i = 0; i < markers.size(); ++i) {
     Observation& o = markers[i].observation;
+    tracks_[i].restart = false;
     if (assigned[i] < 0) {
       if (o.found()) {
+        if (tracks_[i].motion.started() && report_pooled_[i] &&
+            ExtendsARejectedRun(i, *o.position_px)) {
+          tracks_[i].restart = true;  // kKeep: the report stands, the track restarts on it.
+          continue;
+        }
         decisions_[i].action = Decision::Action::kReject;
         o = Observation::NotFound(MarkerStatus::kImplausible);
+      } else {
+        tracks_[i].pending_px.reset();  // The run is broken.
       }
       continue;
     }
+    tracks_[i].pending_px.reset();
     const size_t k = static_cast<size_t>(assigned[i]);
     if (report_pooled_[i] && k == *report_pooled_[i]) {
       tracks_[i].repeated = IsRepeat(tracks_[i], *o.position_px);
@@ -182,6 +202,60 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     }
   }
   return decisions_;
+}
+
+bool MarkerTracks::ExplainedByAnother(size_t i, const cv::Point2d& p) const {
+  for (size_t j = 0; j < tracks_.size(); ++j) {
+    const Track& t = tracks_[j];
+    if (j == i || !t.motion.started()) continue;
+    const double reach = size_px_[j] + cv::norm(t.motion.velocity()) +
+                         std::sqrt(kGate2) * t.motion.sigma_px();
+    if (cv::norm(p - t.motion.position()) <= reach ||
+        (t.last_px && cv::norm(p - *t.last_px) <= reach)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
+  Track& t = tracks_[i];
+  // A look-alike another marker's track could take is that marker's business, not a run.
+  if (ExplainedByAnother(i, p)) {
+    t.pending_px.reset();
+    return false;
+  }
+  const auto starts_a_run = [&] {
+    if (!t.last_px) return false;
+    const double frames = std::min(1 + t.misses, kReacquireFrames);
+    return cv::norm(p - *t.last_px) <= size_px_[i] + kMaxStartStepPx * frames;
+  };
+  bool extends = false;
+  if (t.pending_px) {
+    if (!t.pending_step_px) {
+      extends = true;  // The second report of a run: its step is the run's first velocity.
+    } else {
+      const cv::Point2d expected = *t.pending_px + *t.pending_step_px;
+      extends = cv::norm(p - expected) <=
+                size_px_[i] + kRunStepTolerance * cv::norm(*t.pending_step_px);
+    }
+  }
+  if (!extends) {
+    if (starts_a_run()) {
+      t.pending_px = p;
+      t.pending_step_px.reset();
+      t.pending_reports = 1;
+    } else {
+      t.pending_px.reset();
+    }
+    return false;
+  }
+  t.pending_step_px = p - *t.pending_px;
+  t.pending_px = p;
+  ++t.pending_reports;
+  if (t.pending_reports < kReacquireFrames) return false;
+  t.pending_px.reset();
+  return true;
 }
 
 void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
@@ -203,8 +277,9 @@ void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
       continue;
     }
     t.repeats = 0;
-    if (!t.motion.started()) {
+    if (!t.motion.started() || t.restart) {
       t.motion.start(p);
+      t.restart = false;
     } else {
       t.motion.update(p);
     }

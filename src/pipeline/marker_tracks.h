@@ -14,7 +14,11 @@
 // is taken as it is, unless a started track claims that candidate), tentative (one believed
 // report: velocity unknown, the gate is wide), confirmed, and coasting (not believed in the last
 // frames: still predicted, its gate growing with the time since, so a re-acquisition must lie
-// where a plausible motion could have taken the marker meanwhile).
+// where a plausible motion could have taken the marker meanwhile). A marker that moved faster
+// than its track allowed (a soft actuator at rest, then a sudden step of pressure) is not lost for
+// good: when its tracker's own reports, rejected by the gate, follow one smooth motion of their
+// own for kReacquireFrames frames in a row and no other marker's track explains any of them, the
+// track restarts on them (the first frames stay not believed).
 #pragma once
 
 #include <cstdint>
@@ -74,11 +78,22 @@ class MarkerTracks {
     int misses = 0;               // Frames since the last believed report.
     std::optional<cv::Point2d> last_px;  // The last believed report.
     bool repeated = false;        // This frame's report is a repeated frame (see commit).
+    // Reports the gate rejected, while they follow one motion of their own: the last one, the
+    // step between the last two, how many in a row.
+    std::optional<cv::Point2d> pending_px;
+    std::optional<cv::Point2d> pending_step_px;
+    int pending_reports = 0;
+    bool restart = false;         // This frame's report restarts the track (see commit).
   };
   struct Pooled {
     cv::Point2d position_px;
   };
   static bool IsRepeat(const Track& t, const cv::Point2d& p);
+  // Whether a started track other than `i`'s could take a report at `p`.
+  bool ExplainedByAnother(size_t i, const cv::Point2d& p) const;
+  // Marker i's report at `p` was rejected: true when it extends a run of rejected reports that
+  // follows one smooth motion for kReacquireFrames frames (the track then restarts on it).
+  bool ExtendsARejectedRun(size_t i, const cv::Point2d& p);
   void predict_all();
   size_t pool(const cv::Point2d& p);
 
