@@ -594,6 +594,11 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
   // The inverse of the two lags (1 + tau1 s)(1 + tau2 s) and, to first order, of the dead times.
   c.ff_lead_s = std::min(10.0, m.lag_s + m.pressure_lag_s + m.dead_time_s + m.pressure_dead_time_s);
   c.ff_lead2_s2 = std::min(100.0, m.lag_s * m.pressure_lag_s);
+  // The slew limit must not be the slowest part of the loop: the setpoint may cross the whole
+  // output range in two closed-loop times, or the loop is no faster than the ramp (the config's
+  // gentle 60 kPa/s held a 40 deg step to ~0.7 s and left the lead to the integral, which then
+  // overshot). A gentler loop: a longer closed-loop time (--closed-loop-s).
+  c.max_rate_kpa_per_s = std::clamp((c.max_kpa - c.min_kpa) / (2.0 * tau_c), 1.0, 1000.0);
   return c;
 }
 

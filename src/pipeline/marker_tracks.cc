@@ -25,10 +25,10 @@ constexpr int kReacquireFrames = 3;
 // How far a rejected report may lie from where the run's constant velocity puts it: the
 // marker's size plus this fraction of the run's step (it may be slowing down or speeding up).
 constexpr double kRunStepTolerance = 0.5;
-// A run must start where a sudden start could have taken the marker since it was last believed:
-// within its size plus this per frame (the motion model's largest acceleration, 40 px/frame^2)
-// for at most kReacquireFrames frames. A look-alike far away starts no run.
-constexpr double kMaxStartStepPx = 40.0;
+// A run must start where it could have left the marker's last believed place at the run's own
+// speed: within twice the marker's size plus this many of its steps per frame since (counted up
+// to kReacquireFrames). A look-alike that stands still, or moves, far from there starts no run.
+constexpr double kRunStartSteps = 1.5;
 
 double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
   const cv::Point2d ab = b - a;
@@ -225,15 +225,14 @@ bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
     t.pending_px.reset();
     return false;
   }
-  const auto starts_a_run = [&] {
-    if (!t.last_px) return false;
-    const double frames = std::min(1 + t.misses, kReacquireFrames);
-    return cv::norm(p - *t.last_px) <= size_px_[i] + kMaxStartStepPx * frames;
-  };
   bool extends = false;
   if (t.pending_px) {
     if (!t.pending_step_px) {
-      extends = true;  // The second report of a run: its step is the run's first velocity.
+      // The second report of a run: its step is the run's first velocity, and the run must have
+      // been able to leave the marker's last place at that speed.
+      const double step_px = cv::norm(p - *t.pending_px);
+      extends = t.last_px && cv::norm(*t.pending_px - *t.last_px) <=
+                                 2.0 * size_px_[i] + kRunStartSteps * t.pending_gap * step_px;
     } else {
       const cv::Point2d expected = *t.pending_px + *t.pending_step_px;
       extends = cv::norm(p - expected) <=
@@ -241,13 +240,10 @@ bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
     }
   }
   if (!extends) {
-    if (starts_a_run()) {
-      t.pending_px = p;
-      t.pending_step_px.reset();
-      t.pending_reports = 1;
-    } else {
-      t.pending_px.reset();
-    }
+    t.pending_px = p;
+    t.pending_step_px.reset();
+    t.pending_reports = 1;
+    t.pending_gap = std::min(1 + t.misses, kReacquireFrames);
     return false;
   }
   t.pending_step_px = p - *t.pending_px;

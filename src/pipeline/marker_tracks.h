@@ -18,7 +18,8 @@
 // than its track allowed (a soft actuator at rest, then a sudden step of pressure) is not lost for
 // good: when its tracker's own reports, rejected by the gate, follow one smooth motion of their
 // own for kReacquireFrames frames in a row and no other marker's track explains any of them, the
-// track restarts on them (the first frames stay not believed).
+// track restarts on them (the first frames stay not believed). The run must also be able to have
+// left the marker's last believed place at its own speed: a look-alike elsewhere starts none.
 #pragma once
 
 #include <cstdint>
@@ -67,6 +68,10 @@ class MarkerTracks {
   // Marker i starts afresh (re-selected, re-specified, or the video jumped): no motion.
   void forget(size_t i);
 
+  // Whether this frame's report of marker i restarts its track (a run of its tracker's own
+  // reports the gate had rejected): its motion before is no evidence against it.
+  bool restarting(size_t i) const { return tracks_.at(i).restart; }
+
   // For tests: marker i's motion model.
   const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
 
@@ -83,6 +88,7 @@ class MarkerTracks {
     std::optional<cv::Point2d> pending_px;
     std::optional<cv::Point2d> pending_step_px;
     int pending_reports = 0;
+    int pending_gap = 1;          // Frames from the last believed report to the run's first.
     bool restart = false;         // This frame's report restarts the track (see commit).
   };
   struct Pooled {

@@ -117,6 +117,9 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     for (size_t i = 0; i < trackers_.size(); ++i) {
       switch (decisions[i].action) {
         case MarkerTracks::Decision::Action::kKeep:
+          // A track restarted on its tracker's own run of reports: the motion the plausibility
+          // check remembers is the one that run left behind; the arrangement still judges it.
+          if (tracks_->restarting(i)) plausibility_->forget(i);
           break;
         case MarkerTracks::Decision::Action::kReject:
           trackers_[i]->reset();
