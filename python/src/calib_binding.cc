@@ -1,4 +1,6 @@
 // softsight.calib: chessboard calibration, undistortion and the metric scale, on numpy arrays.
+#include <cmath>
+
 #include <pybind11/stl.h>
 
 #include "bindings.h"
@@ -36,12 +38,43 @@ py::dict CameraDict(const CameraIntrinsics& camera) {
   return out;
 }
 
+// A camera dict, checked as the camera file reader checks a file: a missing key or a value
+// OpenCV would refuse deep inside is an InputError naming the key, not a KeyError or an OpenCV
+// RuntimeError.
 CameraIntrinsics ToCamera(const py::dict& camera) {
+  for (const char* key : {"image_size", "camera_matrix", "distortion"}) {
+    if (!camera.contains(key)) {
+      throw InputError(std::string("camera: missing key '") + key +
+                       "' (a camera is {'image_size': (w, h), 'camera_matrix': 3x3, "
+                       "'distortion': (k1, k2, p1, p2[, k3])}, as load_camera gives)");
+    }
+  }
   CameraIntrinsics out;
-  const auto size = camera["image_size"].cast<std::pair<int, int>>();
+  std::pair<int, int> size;
+  try {
+    size = camera["image_size"].cast<std::pair<int, int>>();
+    out.distortion = camera["distortion"].cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw InputError("camera: image_size must be (width, height) and distortion a list of numbers");
+  }
+  if (size.first <= 0 || size.second <= 0) {
+    throw InputError("camera: image_size (" + std::to_string(size.first) + ", " +
+                     std::to_string(size.second) + ") must be positive");
+  }
   out.image_size = {size.first, size.second};
   out.camera_matrix = ToMatrix(camera["camera_matrix"], "camera_matrix");
-  out.distortion = camera["distortion"].cast<std::vector<double>>();
+  const size_t n = out.distortion.size();
+  if (n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
+    throw InputError("camera: distortion has " + std::to_string(n) +
+                     " coefficients; OpenCV takes 4, 5, 8, 12 or 14");
+  }
+  for (double v : out.distortion) {
+    if (!std::isfinite(v)) throw InputError("camera: distortion holds a value that is not finite");
+  }
+  const cv::Matx33d k = out.camera_matrix;
+  if (!(k(0, 0) > 0.0 && k(1, 1) > 0.0 && std::isfinite(k(0, 2)) && std::isfinite(k(1, 2)))) {
+    throw InputError("camera: camera_matrix needs positive, finite focal lengths (fx, fy)");
+  }
   return out;
 }
 

@@ -78,7 +78,13 @@ class PyScene {
     const cv::Size s = size();
     py::array_t<uint8_t> image;
     if (out) {
-      image = py::array_t<uint8_t>::ensure(*out);
+      // Drawn into as it is: an array of another type would be converted into a copy, and the
+      // caller's `out` left untouched.
+      if (!out->dtype().is(py::dtype::of<uint8_t>())) {
+        throw py::value_error("out: expected a uint8 array, got " +
+                              std::string(py::str(out->dtype())));
+      }
+      image = py::reinterpret_borrow<py::array_t<uint8_t>>(*out);
       if (!image || image.ndim() != 3 || image.shape(0) != s.height || image.shape(1) != s.width ||
           image.shape(2) != 3 || !(image.flags() & py::array::c_style) || !image.writeable()) {
         throw py::value_error("out: expected a writable C-contiguous uint8 array of shape (" +

@@ -68,6 +68,9 @@ def test_the_renderer_and_its_truth_against_the_session():
         p = {name: (t["x"], t["y"]) for name, t in truth["markers"].items()}
         assert geometry.angle_deg(p["red"], p["blue"], p["green"]) == pytest.approx(
             truth["measurement"]["angle_deg"], abs=1e-9)
+    # An `out` of another type is refused, not converted into a copy and left untouched.
+    with pytest.raises(ValueError, match="out: expected a uint8 array, got float32"):
+        scene.render(0, out=np.zeros((480, 640, 3), np.float32))
     plate = sim.Scene("plate", frames=3)
     image, truth = plate.render(2)
     assert image.shape == (480, 640, 3) and list(truth["markers"]) == plate.marker_names
@@ -107,3 +110,17 @@ def test_calibration_recovers_known_intrinsics():
     assert calib.scale_from_two_points((0, 0), (100, 0), 50.0) == pytest.approx(0.5)
     with pytest.raises(softsight.InputError):
         calib.Calibrator().calibrate()  # No views.
+
+
+def test_a_bad_camera_dict_is_an_input_error_naming_the_key():
+    good = {"image_size": (640, 480), "camera_matrix": np.array([[500.0, 0, 320], [0, 500.0, 240],
+                                                                  [0, 0, 1]]),
+            "distortion": (0.1, -0.05, 0.0, 0.0)}
+    points = np.array([[100.0, 100.0], [320.0, 240.0]], np.float32)
+    assert calib.undistort_points(points, good).shape == (2, 2)
+    for broken, what in ((dict(good, distortion=(0.1, 0.2, 0.3)), "3 coefficients"),
+                         ({k: v for k, v in good.items() if k != "distortion"}, "'distortion'"),
+                         (dict(good, image_size=(0, 480)), "image_size"),
+                         (dict(good, camera_matrix=np.zeros((3, 3))), "focal lengths")):
+        with pytest.raises(softsight.InputError, match=what):
+            calib.undistort_points(points, broken)
