@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "control/plant.h"
@@ -186,6 +188,28 @@ TEST(Plant, BendsWithPressureAndShowsHysteresis) {
   while (plant.pressure_pa() > 20000.0) plant.step(0.002, ValveOutputs{0.0f, 0.3f, 0.0f});
   plant.step(2.0, hold);
   EXPECT_GT(plant.bend_deg(), up_bend + 2.0);
+}
+
+// A tube between the valves and the chamber: the chamber sees the valves' drive tube_delay_s
+// later, so its pressure is the tubeless plant's shifted by the delay.
+TEST(Plant, ATubeDelaysWhatTheValvesDoByItsDelay) {
+  PlantOptions without;
+  PlantOptions with = without;
+  with.tube_delay_s = 0.05;
+  PneumaticPlant direct(without), tubed(with);
+  const ValveOutputs inflate{1.0f, 0.0f, 1.0f};
+  std::vector<double> direct_kpa;
+  for (int k = 0; k < 100; ++k) {  // 0.2 s in 2 ms steps.
+    direct.step(0.002, inflate);
+    tubed.step(0.002, inflate);
+    direct_kpa.push_back(direct.pressure_pa() * 1e-3);
+    if (k < 24) {
+      EXPECT_EQ(tubed.pressure_pa(), 0.0) << "the flow is still in the tube at " << (k + 1) * 2 << " ms";
+    } else {
+      EXPECT_NEAR(tubed.pressure_pa() * 1e-3, k >= 25 ? direct_kpa[k - 25] : 0.0, 1e-6) << k;
+    }
+  }
+  EXPECT_GT(tubed.pressure_pa(), 1000.0);
 }
 
 TEST(Plant, PaperAngleRelatesToTheRenderersBend) {

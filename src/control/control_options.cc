@@ -175,6 +175,10 @@ OptionTable<PlantOptions> MakePlant() {
           .Range(0, 90)
           .Unit("deg")
           .Doc("width of the play operator"),
+      DoubleOption<P>("tube_delay_s", &P::tube_delay_s)
+          .Range(0, 0.5)
+          .Unit("s")
+          .Doc("transport delay of the tube from the valves to the chamber and its sensor"),
   };
 }
 

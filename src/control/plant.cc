@@ -24,6 +24,8 @@ bool PlantOptions::Check(std::string* error) const {
 
 PneumaticPlant::PneumaticPlant(const PlantOptions& options) : options_(options) {
   assert(options_.Check(nullptr));
+  const auto substeps = static_cast<size_t>(std::lround(options_.tube_delay_s / kSubstepS));
+  tube_.assign(substeps, ValveOutputs{});
 }
 
 double PneumaticPlant::equilibrium_bend_deg(double pressure_pa) const {
@@ -42,9 +44,15 @@ void PneumaticPlant::step(double dt_s, const ValveOutputs& drive) {
     const double h = std::min(kSubstepS, remaining);
     remaining -= h;
     const double p = pressure_pa_;
-    const double q_in = drive.inflate * drive.pump * pump_m3_s * std::max(0.0, 1.0 - p / stall_pa);
+    ValveOutputs acting = drive;
+    if (!tube_.empty()) {  // What the valves did tube_delay_s ago reaches the chamber now.
+      std::swap(acting, tube_[tube_next_]);
+      tube_next_ = (tube_next_ + 1) % tube_.size();
+    }
+    const double q_in =
+        acting.inflate * acting.pump * pump_m3_s * std::max(0.0, 1.0 - p / stall_pa);
     const double q_out =
-        drive.deflate * vent_m3_s * std::sqrt(std::max(0.0, p) / kRefPa) + leak_m3_s * p / kRefPa;
+        acting.deflate * vent_m3_s * std::sqrt(std::max(0.0, p) / kRefPa) + leak_m3_s * p / kRefPa;
     // The vent cannot pull the chamber below atmospheric pressure.
     pressure_pa_ = std::max(0.0, p + h * gain_pa_per_m3 * (q_in - q_out));
 

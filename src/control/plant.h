@@ -6,10 +6,13 @@
 //   Q_out = vent duty * vent flow at 10 kPa * sqrt(p / 10 kPa) + leak * p / 10 kPa
 // Bending: the equilibrium bend grows linearly with pressure above `bend_start_kpa`; a play
 // (backlash) operator of width `hysteresis_deg` models the silicone's hysteresis, and a first-order
-// lag `bend_lag_s` its viscoelastic response.
+// lag `bend_lag_s` its viscoelastic response. A tube of `tube_delay_s` between the valves and the
+// chamber delays the valves' drive: the flows act with the drive of tube_delay_s ago.
 //
 // Private to control: the rig (softsight/control/rig.h) runs it; its options are RigOptions::plant.
 #pragma once
+
+#include <vector>
 
 #include "softsight/control/board_config.h"
 #include "softsight/control/rig.h"  // PlantOptions
@@ -29,6 +32,9 @@ class PneumaticPlant {
 
  private:
   PlantOptions options_;
+  // The drive of the last tube_delay_s, one entry per substep (a ring, sized once).
+  std::vector<ValveOutputs> tube_;
+  size_t tube_next_ = 0;
   double pressure_pa_ = 0.0;
   double play_deg_ = 0.0;  // Output of the play operator (the hysteresis state).
   double bend_deg_ = 0.0;

@@ -34,6 +34,10 @@ struct PlantOptions {
   double max_bend_deg = 300.0;           // Mechanical end stop of the bend. Default 300 deg.
   double bend_lag_s = 0.15;              // Time constant of the bending response. Default 0.15 s.
   double hysteresis_deg = 3.0;           // Width of the play operator. Default 3 deg.
+  // Transport delay of the tube between the valves and the chamber (where the sensor is): the
+  // valves' flow reaches the chamber this much later, which makes a fast inner loop oscillate.
+  // Default 0 (no tube), at most 0.5 s.
+  double tube_delay_s = 0.0;
 
   bool Check(std::string* error) const;
 };
