@@ -1,5 +1,6 @@
 // Conversions between Python objects and the library's types, and the Config class.
 #include <cmath>
+#include <filesystem>
 #include <cstring>
 
 #include <pybind11/stl.h>
@@ -20,6 +21,28 @@ std::string FloatText(double value) {
   if (std::isnan(value)) return ".nan";
   if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
   return py::str(py::float_(value));  // Python's shortest round-trip text ("0.1", "1e-05").
+}
+
+// The config with the files it names relative to itself (`template.file`, `camera:`) made
+// relative to `target`, where it is saved, so the saved config names the same files from there.
+TrackingConfig RebasedConfig(const TrackingConfig& config, const std::string& target) {
+  namespace fs = std::filesystem;
+  const auto rebased = [&](const std::string& path) {
+    if (path.empty() || fs::path(path).is_absolute()) return path;
+    std::error_code error;
+    const fs::path from = config.source_file.empty() || config.source_file == kDictConfigName
+                              ? fs::current_path(error)
+                              : fs::absolute(config.source_file, error).parent_path();
+    const fs::path to = fs::absolute(target, error).parent_path();
+    if (error) return path;
+    const fs::path relative = (from / path).lexically_normal().lexically_proximate(to);
+    return relative.empty() ? path : relative.string();
+  };
+  TrackingConfig out = config;
+  for (auto& [name, file] : out.template_files) file = rebased(file);
+  if (out.camera_file) out.camera_file = rebased(*out.camera_file);
+  for (ConfigChange& change : out.changes) change.template_file = rebased(change.template_file);
+  return out;
 }
 
 }  // namespace
@@ -216,7 +239,9 @@ Pickles as where it came from (the path or the dict), so a Dask worker reloads a
           "Where the config came from: the path, or (a copy of) the dict.")
       .def(
           "save", [](const PyConfig& c, const py::object& path) {
-            SaveTrackingConfig(c.config, *AsPath(path));
+            const std::optional<std::string> file = AsPath(path);
+            if (!file) throw py::type_error("path: a str, bytes or os.PathLike");
+            SaveTrackingConfig(RebasedConfig(c.config, *file), *file);
           },
           py::arg("path"), "Writes the config as YAML that load_config reads to the same values.")
       .def("__repr__",

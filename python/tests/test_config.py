@@ -114,3 +114,23 @@ def test_a_dict_that_contains_itself_or_nests_too_deep_is_an_input_error():
             with pytest.raises(softsight.InputError) as error:
                 call(config)
             assert "nested deeper than 64" in str(error.value)
+
+
+def test_save_into_another_folder_keeps_naming_the_template_file(tmp_path):
+    import numpy as np
+    import cv2
+    here = tmp_path / "here"
+    there = tmp_path / "there" / "deeper"
+    here.mkdir()
+    there.mkdir(parents=True)
+    image = np.zeros((21, 21, 3), np.uint8)
+    cv2.circle(image, (10, 10), 6, (0, 0, 255), -1)
+    cv2.imwrite(str(here / "dot.png"), image)
+    (here / "m.yaml").write_text("markers:\n  - name: dot\n    method: zncc\n"
+                                 "    template: {file: dot.png}\n")
+    config = softsight.load_config(here / "m.yaml")
+    config.save(there / "copy.yaml")
+    text = (there / "copy.yaml").read_text()
+    assert "../../here/dot.png" in text
+    again = softsight.load_config(there / "copy.yaml")  # Finds the image from its new folder.
+    assert again.methods["dot"] == "zncc"
