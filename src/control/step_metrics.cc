@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <utility>
 
 namespace softsight {
 namespace {
@@ -142,12 +141,16 @@ std::string FormatStepMetrics(const StepMetrics& m, const char* rms_span) {
 
 namespace {
 
-// The pieces of a run that are steps: from a jump of the target (or the run's start) to the next
-// jump, the target constant for at least steady_window_s after it. [begin, end) into `points`;
-// `begin` is the frame before the jump, where the response starts from.
-std::vector<std::pair<size_t, size_t>> StepPieces(const std::vector<TrackingPoint>& points,
-                                                  const StepMetricsOptions& options) {
-  std::vector<std::pair<size_t, size_t>> pieces;
+// A piece of a run that is a step: from a jump of the target (or the run's start) to the next
+// jump, the target constant for at least steady_window_s after it. Indices into the points:
+// `begin` is the frame before the jump (where the response starts from), `first` the jump's.
+struct StepPiece {
+  size_t begin, first, end;
+};
+
+std::vector<StepPiece> StepPieces(const std::vector<TrackingPoint>& points,
+                                  const StepMetricsOptions& options) {
+  std::vector<StepPiece> pieces;
   if (points.empty()) return pieces;
   std::vector<size_t> starts{0};
   for (size_t k = 1; k < points.size(); ++k) {
@@ -162,7 +165,7 @@ std::vector<std::pair<size_t, size_t>> StepPieces(const std::vector<TrackingPoin
             options.step_threshold_deg;
     // Held long enough to settle (not a frame of a ramp or a sine that moved by more).
     if (jumped && points[end - 1].time_s - points[first].time_s >= options.steady_window_s) {
-      pieces.push_back({first == 0 ? 0 : first - 1, end});
+      pieces.push_back({first == 0 ? 0 : first - 1, first, end});
     }
   }
   return pieces;
@@ -174,9 +177,9 @@ std::vector<StepMetrics> ComputeEveryStepMetrics(const std::vector<TrackingPoint
                                                  const StepMetricsOptions& options) {
   std::vector<StepMetrics> steps;
   std::vector<TrackingPoint> piece;
-  for (const auto& [begin, end] : StepPieces(points, options)) {
-    piece.assign(points.begin() + static_cast<std::ptrdiff_t>(begin),
-                 points.begin() + static_cast<std::ptrdiff_t>(end));
+  for (const StepPiece& p : StepPieces(points, options)) {
+    piece.assign(points.begin() + static_cast<std::ptrdiff_t>(p.begin),
+                 points.begin() + static_cast<std::ptrdiff_t>(p.end));
     const StepMetrics m = ComputeStepMetrics(piece, options);
     if (m.step_to_deg && m.overshoot_percent) steps.push_back(m);
   }
@@ -189,9 +192,9 @@ TrackingMetrics ComputeTrackingMetrics(const std::vector<TrackingPoint>& points,
   if (points.size() < 3) return out;
   // Scored where the target moves: the steps (and their settling) have their own figures.
   std::vector<bool> scored(points.size(), true);
-  for (const auto& [begin, end] : StepPieces(points, StepMetricsOptions{})) {
-    std::fill(scored.begin() + static_cast<std::ptrdiff_t>(begin + 1),
-              scored.begin() + static_cast<std::ptrdiff_t>(end), false);
+  for (const StepPiece& p : StepPieces(points, StepMetricsOptions{})) {
+    std::fill(scored.begin() + static_cast<std::ptrdiff_t>(p.first),
+              scored.begin() + static_cast<std::ptrdiff_t>(p.end), false);
   }
   if (std::find(scored.begin(), scored.end(), true) == scored.end()) return out;
   // The frame period: the median spacing (a dropped frame does not change it).

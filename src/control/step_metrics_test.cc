@@ -181,5 +181,22 @@ TEST(TrackingMetrics, ADelayedSineGivesItsLagAndNoErrorWithoutIt) {
   EXPECT_EQ(FormatTrackingMetrics(m).substr(0, 24), "tracking: RMS error 8.74");
 }
 
+
+// A step held 1.5 s, then a sine followed exactly: the step's frames (its first one too, 30 deg
+// off) are the step's business; the tracking error is the sine's, zero.
+TEST(TrackingMetrics, TheStepBeforeTheMotionIsNotCounted) {
+  const double dt = 1.0 / 30.0;
+  std::vector<TrackingPoint> points;
+  for (int k = 0; k < 45; ++k) points.push_back({k * dt, 150.0, 150.0 + 30.0 * std::exp(-k * dt / 0.1)});
+  for (int k = 45; k < 240; ++k) {
+    const double target = 150.0 + 20.0 * std::sin(2 * kPi * 0.5 * (k - 45) * dt);
+    points.push_back({k * dt, target, target});
+  }
+  const TrackingMetrics m = ComputeTrackingMetrics(points);
+  ASSERT_TRUE(m.rms_error_deg);
+  EXPECT_LT(*m.rms_error_deg, 1e-9);
+  EXPECT_DOUBLE_EQ(*m.lag_s, 0.0);
+}
+
 }  // namespace
 }  // namespace softsight
