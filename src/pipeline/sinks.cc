@@ -1,5 +1,9 @@
 #include "softsight/pipeline/sinks.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <string>
@@ -7,6 +11,7 @@
 #include <vector>
 
 #include "softsight/core/error.h"
+#include "softsight/io/output_guard.h"
 #include "softsight/pipeline/run.h"
 
 namespace softsight {
@@ -56,15 +61,53 @@ void CsvSink::consume(const Frame& frame, const FrameResult& result) {
 }
 
 
+namespace {
+
+// The lock of a video file this run writes: taken on an existing file before the encoder
+// truncates it (another run's recording is refused, not cut), and on a new one once the encoder
+// has made it. -1 for an image pattern or a device, which are not one regular file.
+int LockVideoFile(const std::string& path, bool may_create_first) {
+  if (path.find('%') != std::string::npos) return -1;
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) {
+    if (!may_create_first) return -1;  // Not made yet: locked once the encoder has made it.
+  } else if (!S_ISREG(info.st_mode)) {
+    return -1;
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return -1;  // The encoder names what is wrong with the path.
+  try {
+    LockOutputOrThrow(fd, path);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  return fd;
+}
+
+}  // namespace
+
 VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> fps,
                      FrameDrawer draw, std::function<void(int64_t index)> before_encode)
     : fps_(fps), draw_(std::move(draw)), before_encode_(std::move(before_encode)) {
   options_.path = std::move(path);
   options_.codec = std::move(codec);
   options_.fps = fps.value_or(30.0);
+  lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/false);
   // Checks path and codec now.
   capacity_ = kQueuedFrames;
-  writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
+  try {
+    writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
+    if (lock_fd_ < 0) lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/true);
+  } catch (...) {
+    if (lock_fd_ >= 0) ::close(lock_fd_);
+    throw;
+  }
+}
+
+VideoSink::~VideoSink() {
+  writer_.reset();  // Finished (and the file closed) before its lock goes.
+  if (lock_fd_ >= 0) ::close(lock_fd_);
 }
 
 
@@ -80,6 +123,7 @@ void VideoSink::begin(const RunInfo& info) {
     writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
+  if (lock_fd_ < 0) lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/true);
 }
 
 void VideoSink::consume(const Frame& frame, const FrameResult& result) {

@@ -6,8 +6,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
 
 #include "core/test_util.h"
+#include "softsight/core/error.h"
 
 namespace softsight {
 namespace {
@@ -33,6 +35,46 @@ TEST(CsvColumnTable, AChainHasAnAngleColumnPerInnerMarker) {
   EXPECT_EQ(fields.at(*table.find("angle_c_deg")), "150.2500");
   EXPECT_EQ(fields.at(*table.find("angle_b_deg")), "");
   EXPECT_FALSE(TrackingColumns(TrackingConfig{}).find("angle_deg_deg"));
+}
+
+
+// Two runs writing one video: the second is refused before it truncates anything, and the first
+// one's recording is whole. (flock locks are per open file, so this holds within one process too.)
+TEST(VideoSink, ASecondWriterOfTheSameVideoIsRefusedAndTheFirstStaysWhole) {
+  testing::TempDir dir;
+  const std::string path = dir.file("run.avi");
+  RunInfo info;
+  info.frame_size = cv::Size(64, 48);
+  info.fps = 30.0;
+  Frame frame;
+  frame.image = cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 0, 255));
+  FrameResult result;
+  {
+    VideoSink first(path, "mjpg", 30.0);
+    first.begin(info);
+    for (int i = 0; i < 5; ++i) {
+      frame.index = i;
+      first.consume(frame, result);
+    }
+    try {
+      VideoSink second(path, "mjpg", 30.0);
+      ADD_FAILURE() << "a second writer opened " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("another program is writing this file"),
+                std::string::npos)
+          << e.what();
+    }
+    first.end(RunSummary{});
+    EXPECT_FALSE(first.error());
+  }
+  cv::VideoCapture video(path);
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  cv::Mat image;
+  while (video.read(image)) ++frames;
+  EXPECT_EQ(frames, 5);
+  // Once the first has finished, the file may be written again.
+  EXPECT_NO_THROW(VideoSink(path, "mjpg", 30.0));
 }
 
 }  // namespace

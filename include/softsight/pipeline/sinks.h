@@ -60,8 +60,13 @@ class VideoSink : public FrameSink {
  public:
   // Checks the path and codec at once (FrameWriter). `fps` absent: the source's, else 30.
   // `before_encode` (tests): AsyncFrameWriter's hook on the encoding thread.
+  // A video file is locked (flock) while it is written: a second writer of it is refused with
+  // InputError before it truncates anything.
   VideoSink(std::string path, std::string codec, std::optional<double> fps, FrameDrawer draw = {},
             std::function<void(int64_t index)> before_encode = {});
+  ~VideoSink() override;
+  VideoSink(const VideoSink&) = delete;
+  VideoSink& operator=(const VideoSink&) = delete;
   void begin(const RunInfo& info) override;
   void consume(const Frame& frame, const FrameResult& result) override;
   // Finishes the video. An encoder error met while finishing cannot be thrown from here: see
@@ -83,6 +88,7 @@ class VideoSink : public FrameSink {
   size_t capacity_;
   std::unique_ptr<AsyncFrameWriter> writer_;
   std::optional<std::string> error_;
+  int lock_fd_ = -1;  // Holds the file's lock while this sink lives (-1: a pattern or device).
 };
 
 }  // namespace softsight
