@@ -1,7 +1,6 @@
 #include "softsight/pipeline/sinks.h"
 
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -63,19 +62,14 @@ void CsvSink::consume(const Frame& frame, const FrameResult& result) {
 
 namespace {
 
-// The lock of a video file this run writes: taken on an existing file before the encoder
-// truncates it (another run's recording is refused, not cut), and on a new one once the encoder
-// has made it. -1 for an image pattern or a device, which are not one regular file.
-int LockVideoFile(const std::string& path, bool may_create_first) {
+// The lock of a video file this run writes, when the file exists: taken before the encoder
+// truncates an existing file (another run's recording is refused, not cut), and again once the
+// encoder has made a new one. -1 for an image pattern or a file not there yet; devices and FIFOs
+// are opened without blocking and not locked (LockOutputOrThrow).
+int LockVideoFileIfItExists(const std::string& path) {
   if (path.find('%') != std::string::npos) return -1;
-  struct stat info {};
-  if (::stat(path.c_str(), &info) != 0) {
-    if (!may_create_first) return -1;  // Not made yet: locked once the encoder has made it.
-  } else if (!S_ISREG(info.st_mode)) {
-    return -1;
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return -1;  // The encoder names what is wrong with the path.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return -1;  // Not made yet, or the encoder names what is wrong with the path.
   try {
     LockOutputOrThrow(fd, path);
   } catch (...) {
@@ -93,12 +87,12 @@ VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> 
   options_.path = std::move(path);
   options_.codec = std::move(codec);
   options_.fps = fps.value_or(30.0);
-  lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/false);
+  lock_fd_ = LockVideoFileIfItExists(options_.path);
   // Checks path and codec now.
   capacity_ = kQueuedFrames;
   try {
     writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
-    if (lock_fd_ < 0) lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/true);
+    if (lock_fd_ < 0) lock_fd_ = LockVideoFileIfItExists(options_.path);
   } catch (...) {
     if (lock_fd_ >= 0) ::close(lock_fd_);
     throw;
@@ -123,7 +117,7 @@ void VideoSink::begin(const RunInfo& info) {
     writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
-  if (lock_fd_ < 0) lock_fd_ = LockVideoFile(options_.path, /*may_create_first=*/true);
+  if (lock_fd_ < 0) lock_fd_ = LockVideoFileIfItExists(options_.path);
 }
 
 void VideoSink::consume(const Frame& frame, const FrameResult& result) {
