@@ -147,7 +147,7 @@ TEST(AssociationScenes, TwoIdenticalMarkersOnTwoCartsKeepTheirIdentities) {
 
 // A white dot circling slowly on a gray bench; four identical dots slide in from the right edge
 // and come to rest 35-60 px from its path, then drift.
-TEST(AssociationScenes, IdenticalDotsComingIntoViewDoNotTakeTheTrackedOnesPlace) {
+DotScene DotsComingIntoView() {
   DotSceneOptions options;
   options.clutter = 12;
   std::vector<DotShape> shapes;
@@ -164,7 +164,11 @@ TEST(AssociationScenes, IdenticalDotsComingIntoViewDoNotTakeTheTrackedOnesPlace)
       return DotPose{p, 0, p.x < 660};
     }});
   }
-  const DotScene scene(options, shapes);
+  return DotScene(options, shapes);
+}
+
+TEST(AssociationScenes, IdenticalDotsComingIntoViewDoNotTakeTheTrackedOnesPlace) {
+  const DotScene scene = DotsComingIntoView();
   TrackingConfig config;
   config.markers = {WhiteDot("dot", scene.roi(0))};
   const int count = 150;
@@ -175,7 +179,7 @@ TEST(AssociationScenes, IdenticalDotsComingIntoViewDoNotTakeTheTrackedOnesPlace)
 
 // A hand-held plate with five white dots over a cluttered background: it moves, turns and comes
 // closer (the dots grow by half); every dot has its own roi.
-TEST(AssociationScenes, FiveWhiteDotsOnAMovingPlateAreEachFollowedInEveryFrame) {
+DotScene WhiteDotPlate() {
   DotSceneOptions options;
   options.clutter = 30;
   const cv::Point2d layout[5] = {{-60, -40}, {60, -40}, {0, 0}, {-60, 40}, {60, 40}};
@@ -191,7 +195,11 @@ TEST(AssociationScenes, FiveWhiteDotsOnAMovingPlateAreEachFollowedInEveryFrame) 
     };
     shapes.push_back({{7, 7}, {240, 240, 240}, {}, 0, {}, [pose](double t) { return pose(t); }});
   }
-  const DotScene scene(options, shapes);
+  return DotScene(options, shapes);
+}
+
+TEST(AssociationScenes, FiveWhiteDotsOnAMovingPlateAreEachFollowedInEveryFrame) {
+  const DotScene scene = WhiteDotPlate();
   TrackingConfig config;
   std::vector<size_t> shape_of;
   for (size_t k = 0; k < 5; ++k) {
@@ -282,9 +290,9 @@ TEST(AssociationScenes, APalePuckWithAHighlightIsFound) {
   EXPECT_GE(s.found, count - 2);
 }
 
-// An elongated sticker (28 x 8 px) on a bicycle rim turning 5 degrees a frame: it goes round
-// and turns with the wheel.
-TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
+// A bicycle rim (a dark tyre, a gray rim) with an elongated sticker (28 x 8 px) on it, the
+// wheel turning 5 degrees a frame: the sticker goes round and turns with it.
+DotScene TurningRim() {
   DotSceneOptions options;
   std::vector<DotShape> shapes;
   shapes.push_back({{130, 130}, {40, 40, 40}, {}, 0, {}, [](double) { return DotPose{{320, 240}}; }});
@@ -293,7 +301,13 @@ TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
     const double a = 5.0 * t * CV_PI / 180;
     return DotPose{{320 + 121 * std::cos(a), 240 + 121 * std::sin(a)}, 5.0 * t + 90};
   }});
-  const DotScene scene(options, shapes);
+  return DotScene(options, shapes);
+}
+
+// An elongated sticker (28 x 8 px) on a bicycle rim turning 5 degrees a frame: it goes round
+// and turns with the wheel.
+TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
+  const DotScene scene = TurningRim();
   MarkerSpec spec = testing::ColourMarker("sticker", {10, 30});
   std::get<ColourParams>(spec.params).roi = scene.roi(2);
   std::get<ColourParams>(spec.params).min_circularity = 0.2;
@@ -305,29 +319,104 @@ TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
   EXPECT_GE(s.found, count - 3);
 }
 
-// A template box dragged over that sticker, mostly tyre: the tyre looks the same however the
-// wheel turns, the sticker does not stay in the box. ZNCC must follow the sticker or say it lost
-// it, never stay on the tyre.
-TEST(AssociationScenes, ATemplateMostlyOfBackgroundFollowsItsMarkerOrLosesIt) {
-  DotSceneOptions options;
-  std::vector<DotShape> shapes;
-  shapes.push_back({{130, 130}, {40, 40, 40}, {}, 0, {}, [](double) { return DotPose{{320, 240}}; }});
-  shapes.push_back({{112, 112}, {120, 120, 120}, {}, 0, {}, [](double) { return DotPose{{320, 240}}; }});
-  shapes.push_back({{14, 4}, {40, 200, 240}, {}, 0, {}, [](double t) {
-    const double a = 5.0 * t * CV_PI / 180;
-    return DotPose{{320 + 121 * std::cos(a), 240 + 121 * std::sin(a)}, 5.0 * t + 90};
-  }});
-  const DotScene scene(options, shapes);
+// ---- Template markers (SAD, SSD, ZNCC) on the same footage ---------------------------------
+
+constexpr const char* kTemplateMethods[] = {"zncc", "ssd", "sad"};
+
+// A box dragged around shape `s` on frame 0 (6 px of background on every side).
+MarkerSpec TemplateDot(const std::string& name, const std::string& method, const cv::Rect& rect) {
   MarkerSpec spec;
-  spec.name = "sticker";
-  TemplateParams templ;
-  templ.rect = scene.roi(2, 0, 14);
-  spec.params = templ;
-  TrackingConfig config;
-  config.markers = {spec};
-  const int count = 48;
-  const SceneScore s = TrackScene(scene, config, {2}, count, 3.0)[0];
-  EXPECT_EQ(s.wrong, 0) << s.first_wrong;
+  spec.name = name;
+  spec.params = ParamsForMethod(method, {}, {});
+  std::get<TemplateParams>(spec.params).rect = rect;
+  return spec;
+}
+
+// The carts, one box per cart dot or both. Every method follows the slow cart's dot at 30 px a
+// frame (it used to be lost after frame 0 and then found on the other cart's dot passing its
+// last place: the re-acquisition grew by 8 px a frame and stopped short of a cart corner it had
+// taken for a look-alike); ZNCC and SAD follow the accelerating one too. None is ever reported
+// on the other cart's dot.
+TEST(AssociationScenes, TemplateMarkersOnTheCartsKeepTheirIdentities) {
+  const DotScene scene = TwoCarts();
+  for (const char* method : kTemplateMethods) {
+    SCOPED_TRACE(method);
+    const bool follows_fast = std::string(method) != "ssd";  // SSD: 10 of 16 (blur streaks).
+    TrackingConfig fast, slow, both;
+    fast.markers = {TemplateDot("fast", method, scene.roi(2))};
+    slow.markers = {TemplateDot("slow", method, scene.roi(3))};
+    both.markers = {fast.markers[0], slow.markers[0]};
+    const SceneScore f = TrackScene(scene, fast, {2}, kCartFrames, 3.0)[0];
+    const SceneScore s = TrackScene(scene, slow, {3}, kCartFrames, 1.5)[0];
+    const std::vector<SceneScore> b = TrackScene(scene, both, {2, 3}, kCartFrames, 3.0);
+    for (const SceneScore* score : {&f, &s, &b[0], &b[1]}) {
+      EXPECT_EQ(score->wrong, 0) << score->first_wrong;
+    }
+    EXPECT_GE(s.found, kCartFrames - 1);
+    EXPECT_GE(b[1].found, kCartFrames - 1);
+    if (follows_fast) {
+      EXPECT_GE(f.found, kCartFrames - 1);
+      EXPECT_GE(b[0].found, kCartFrames - 1);
+    } else {
+      EXPECT_GE(f.found, kCartFrames / 2);
+    }
+  }
+}
+
+TEST(AssociationScenes, ATemplateMarkerIsNotTakenForIdenticalDotsComingIntoView) {
+  const DotScene scene = DotsComingIntoView();
+  for (const char* method : kTemplateMethods) {
+    SCOPED_TRACE(method);
+    TrackingConfig config;
+    config.markers = {TemplateDot("dot", method, scene.roi(0))};
+    const int count = 150;
+    const SceneScore s = TrackScene(scene, config, {0}, count, 1.5)[0];
+    EXPECT_EQ(s.wrong, 0) << s.first_wrong;
+    // SAD and SSD compare grey levels, background included: clutter behind a moving dot costs
+    // them 13-14 frames.
+    EXPECT_GE(s.found, std::string(method) == "zncc" ? count - 2 : count - 20);
+  }
+}
+
+// The plate of white dots over clutter, a box per dot: ZNCC follows every dot in every frame.
+// SAD and SSD lose the dots whose surroundings change most (8-33 of 200 found for two of them:
+// a known limit), but never report one elsewhere.
+TEST(AssociationScenes, TemplateMarkersOnAMovingPlateAreFollowedOrLostNeverSwapped) {
+  const DotScene scene = WhiteDotPlate();
+  for (const char* method : kTemplateMethods) {
+    SCOPED_TRACE(method);
+    TrackingConfig config;
+    std::vector<size_t> shape_of;
+    for (size_t k = 0; k < 5; ++k) {
+      config.markers.push_back(
+          TemplateDot(std::string(1, static_cast<char>('a' + k)), method, scene.roi(k)));
+      shape_of.push_back(k);
+    }
+    const int count = 200;
+    const std::vector<SceneScore> s = TrackScene(scene, config, shape_of, count, 1.5);
+    for (size_t m = 0; m < s.size(); ++m) {
+      EXPECT_EQ(s[m].wrong, 0) << config.markers[m].name << ": " << s[m].first_wrong;
+      if (std::string(method) == "zncc") {
+        EXPECT_GE(s[m].found, count - 4) << config.markers[m].name;
+      }
+    }
+  }
+}
+
+// A template box dragged over the rim's sticker, mostly tyre: the tyre looks the same however
+// the wheel turns, the sticker does not stay in the box. A match must contain the template's
+// own blob (the sticker), and follows it: SAD used to stay on the tyre, 2.6-3.8 px behind the
+// sticker, for three frames.
+TEST(AssociationScenes, ATemplateMostlyOfBackgroundFollowsItsMarkerOrLosesIt) {
+  const DotScene scene = TurningRim();
+  for (const char* method : kTemplateMethods) {
+    SCOPED_TRACE(method);
+    TrackingConfig config;
+    config.markers = {TemplateDot("sticker", method, scene.roi(2, 0, 14))};
+    const int count = 48;
+    const SceneScore s = TrackScene(scene, config, {2}, count, 1.5)[0];
+    EXPECT_EQ(s.wrong, 0) << s.first_wrong;
+  }
 }
 
 }  // namespace

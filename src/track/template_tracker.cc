@@ -44,8 +44,6 @@ constexpr double kScaleHysteresis = 0.003;
 constexpr double kMinSymmetry = 0.5;
 
 constexpr double kNoRival = -std::numeric_limits<double>::infinity();
-// A place whose ZNCC is within this below min_zncc counts as a look-alike of the marker.
-constexpr double kLookAlikeSlack = 0.1;
 
 std::string RectText(const cv::Rect& r) {
   return cv::format("[%d, %d, %d, %d]", r.x, r.y, r.width, r.height);
@@ -234,6 +232,13 @@ bool SplitLevels(const cv::Mat& gray, const cv::Mat& mask, double* low, double* 
 }
 
 constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker and background.
+// The blob at a match has at least this fraction of the learned blob's area (at the current
+// scale), and at most its inverse: a tilt to 60 degrees halves a disc's area.
+constexpr double kMinBlobAreaRatio = 0.4;
+// A match may move onto its blob by at least this much (px; more for larger templates).
+constexpr double kMinBlobShiftPx = 2.0;
+// A blob this close to where the match puts it agrees with the match (px).
+constexpr double kBlobAgreePx = 1.0;
 
 class BlobMeter {
  public:
@@ -257,51 +262,8 @@ class BlobMeter {
   bool Measure(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
                cv::Point2d* centroid, double* area) {
     double low = 0, high = 0;
-    if (!SplitLevels(gray, mask, &low, &high) || high - low < kMinBlobContrast) return false;
-    const double threshold = (low + high) / 2;
-    auto inside = [&](int x, int y) {
-      return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
-             (mask.empty() || mask.at<uint8_t>(y, x));
-    };
-    auto marker = [&](int x, int y) {
-      const double v = gray.at<uint8_t>(y, x);
-      return bright_ ? v > threshold : v < threshold;
-    };
-    // Seed: the marker pixel nearest the guess.
-    cv::Point seed(-1, -1);
-    double nearest = 8.0;  // Squared distance: within 2 px (and a bit).
-    const int gx = static_cast<int>(std::lround(guess.x)), gy = static_cast<int>(std::lround(guess.y));
-    for (int y = gy - 2; y <= gy + 2; ++y) {
-      for (int x = gx - 2; x <= gx + 2; ++x) {
-        if (!inside(x, y) || !marker(x, y)) continue;
-        const double d = (x - guess.x) * (x - guess.x) + (y - guess.y) * (y - guess.y);
-        if (d <= nearest) {
-          nearest = d;
-          seed = {x, y};
-        }
-      }
-    }
-    if (seed.x < 0) return false;
-    // 4-connected flood fill of the marker side; touching the border means not separated.
-    label_.create(gray.size(), CV_8UC1);
-    label_.setTo(0);
-    stack_.clear();
-    stack_.push_back(seed);
-    label_.at<uint8_t>(seed) = 1;
-    cv::Rect box(seed, cv::Size(1, 1));
-    while (!stack_.empty()) {
-      const cv::Point p = stack_.back();
-      stack_.pop_back();
-      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return false;
-      box |= cv::Rect(p, cv::Size(1, 1));
-      const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
-      for (const cv::Point& q : next) {
-        if (!inside(q.x, q.y)) return false;  // Reaches the mask's edge.
-        if (label_.at<uint8_t>(q) || !marker(q.x, q.y)) continue;
-        label_.at<uint8_t>(q) = 1;
-        stack_.push_back(q);
-      }
-    }
+    if (!Segment(gray, mask, guess, &low, &high)) return false;
+    const cv::Rect box = box_;
     // The levels right at the blob: the marker's from its interior (pixels whose 4 neighbours are
     // all in the component), the background's from a ring 3-4 px outside it. Otsu's class means
     // would take them from the whole patch, where shading and texture of the surroundings differ
@@ -328,7 +290,7 @@ class BlobMeter {
       for (int x = grown.x; x < grown.br().x; ++x) {
         const int d = label_.at<uint8_t>(y, x) ? 0 : distance(x, y);
         dist_.at<uint8_t>(y, x) = static_cast<uint8_t>(d);
-        if (!inside(x, y)) continue;
+        if (!IsInside(gray, mask, x, y)) continue;
         if (d == 0 && label_.at<uint8_t>(y - 1, x) && label_.at<uint8_t>(y + 1, x) &&
             label_.at<uint8_t>(y, x - 1) && label_.at<uint8_t>(y, x + 1)) {
           fg_sum += gray.at<uint8_t>(y, x);
@@ -346,7 +308,7 @@ class BlobMeter {
     double sw = 0, sx = 0, sy = 0;
     for (int y = grown.y; y < grown.br().y; ++y) {
       for (int x = grown.x; x < grown.br().x; ++x) {
-        if (!inside(x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
+        if (!IsInside(gray, mask, x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
         const double w = std::clamp((gray.at<uint8_t>(y, x) - bg) / (fg - bg), 0.0, 1.0);
         sw += w;
         sx += w * x;
@@ -359,12 +321,88 @@ class BlobMeter {
     return true;
   }
 
+  // The marker-side component nearest `guess`, as Measure finds it, with its binary centroid and
+  // pixel count: a quick check that the blob is there (a fraction of Measure's cost).
+  bool Locate(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
+              cv::Point2d* centroid, double* area) {
+    double low = 0, high = 0;
+    if (!Segment(gray, mask, guess, &low, &high)) return false;
+    const cv::Moments m = cv::moments(label_(box_), true);
+    if (!(m.m00 > 0)) return false;
+    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+    *area = m.m00;
+    return true;
+  }
+
   double area() const { return area_; }  // At selection, px.
 
  private:
+  // Splits the patch into its two classes (low, high: their levels) and fills the marker-side
+  // component nearest `guess` into label_ (box_). False without contrast, without such a
+  // component within 2 px, or when it reaches the patch's or mask's edge.
+  bool Segment(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess, double* low,
+               double* high) {
+    if (!SplitLevels(gray, mask, low, high) || *high - *low < kMinBlobContrast) return false;
+    const double threshold = (*low + *high) / 2;
+    const std::optional<cv::Point> seed = SeedNear(gray, mask, guess, threshold);
+    return seed && Fill(gray, mask, *seed, threshold);
+  }
+  bool IsInside(const cv::Mat& gray, const cv::Mat& mask, int x, int y) const {
+    return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
+           (mask.empty() || mask.at<uint8_t>(y, x));
+  }
+  bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
+    const double v = gray.at<uint8_t>(y, x);
+    return bright_ ? v > threshold : v < threshold;
+  }
+  // The marker-side pixel nearest `guess` at `threshold`, within 2 px (and a bit).
+  std::optional<cv::Point> SeedNear(const cv::Mat& gray, const cv::Mat& mask,
+                                    const cv::Point2d& guess, double threshold) const {
+    std::optional<cv::Point> seed;
+    double nearest = 8.0;  // Squared distance.
+    const int gx = static_cast<int>(std::lround(guess.x)), gy = static_cast<int>(std::lround(guess.y));
+    for (int y = gy - 2; y <= gy + 2; ++y) {
+      for (int x = gx - 2; x <= gx + 2; ++x) {
+        if (!IsInside(gray, mask, x, y) || !IsMarker(gray, x, y, threshold)) continue;
+        const double d = (x - guess.x) * (x - guess.x) + (y - guess.y) * (y - guess.y);
+        if (d <= nearest) {
+          nearest = d;
+          seed = cv::Point(x, y);
+        }
+      }
+    }
+    return seed;
+  }
+  // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
+  // box_). False when it reaches the patch's or the mask's edge: not separated there.
+  bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
+    label_.create(gray.size(), CV_8UC1);
+    label_.setTo(0);
+    stack_.clear();
+    stack_.push_back(seed);
+    label_.at<uint8_t>(seed) = 1;
+    box_ = cv::Rect(seed, cv::Size(1, 1));
+    while (!stack_.empty()) {
+      const cv::Point p = stack_.back();
+      stack_.pop_back();
+      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return false;
+      box_ |= cv::Rect(p, cv::Size(1, 1));
+      const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
+      for (const cv::Point& q : next) {
+        if (!IsInside(gray, mask, q.x, q.y)) return false;  // Reaches the mask's edge.
+        if (label_.at<uint8_t>(q) || !IsMarker(gray, q.x, q.y, threshold)) continue;
+        label_.at<uint8_t>(q) = 1;
+        stack_.push_back(q);
+      }
+    }
+    return true;
+  }
+
+
   bool bright_ = true;
   double area_ = 0;
   cv::Mat label_, dist_;
+  cv::Rect box_;
   std::vector<cv::Point> stack_;
 };
 
@@ -430,7 +468,7 @@ class TemplateTracker final : public Tracker {
       cv::cvtColor(native, out, cv::COLOR_BGR2GRAY);
     }
   }
-  cv::Point2d Recentre(const cv::Mat& frame, const Fix& fix);
+  std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
   cv::Mat MaskFor(const cv::Size& size) const {
     return params_.round_mask ? RoundMask(size) : cv::Mat();
   }
@@ -496,7 +534,8 @@ class TemplateTracker final : public Tracker {
   ZnccScratch zncc_;
   // Re-centring on the marker's blob (report: centre, when the template shows a blob).
   BlobMeter blob_;
-  bool blob_ok_ = false;
+  bool blob_ok_ = false;                // The template shows a blob (its foreground).
+  cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;
 };
@@ -578,16 +617,15 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   }
   original_ = templ.clone();
   anchor_px_ = HalfSize(templ.size());
-  blob_ok_ = false;
-  if (params_.report == TemplateReport::kCentre) {
-    blob_projection_ = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
-    cv::Mat gray;
-    BlobChannel(templ, gray);
-    cv::Point2d centroid;
-    blob_ok_ = blob_.Learn(gray, MaskFor(templ.size()), &centroid);
-    if (blob_ok_) anchor_px_ = centroid;
-  }
-  if (!blob_ok_ && params_.report != TemplateReport::kRectCentre) {
+  // The marker's blob in the template (its foreground), whatever point is reported: every
+  // match must contain it (see Recentre).
+  blob_projection_ = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
+  cv::Mat gray;
+  BlobChannel(templ, gray);
+  blob_ok_ = blob_.Learn(gray, MaskFor(templ.size()), &blob_anchor_px_);
+  if (params_.report == TemplateReport::kCentre && blob_ok_) anchor_px_ = blob_anchor_px_;
+  if (params_.report == TemplateReport::kSymmetry ||
+      (params_.report == TemplateReport::kCentre && !blob_ok_)) {
     // The turned template is matched unmasked: a mask shrunk with it would cut the rim of a
     // disc, which is what carries its position.
     double strength = 0.0;
@@ -736,7 +774,10 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
   MatchZncc(region_, templ, sim_, zncc_);
   const cv::Point2d own = centre_px - HalfSize(size) - cv::Point2d(region.tl());
   const int distinct = std::max(2, std::min(size.width, size.height) / 2);
-  const double floor = params_.min_zncc - kLookAlikeSlack;
+  // A look-alike is a place the tracker would accept as its marker (ZNCC >= min_zncc): a corner
+  // of the cart that carries a small dot scores 0.7 against it, and taking it for a look-alike
+  // held re-acquisition too close to follow the dot at 30 px a frame.
+  const double floor = params_.min_zncc;
   for (int y = 0; y < sim_.rows; ++y) {
     const float* row = sim_.ptr<float>(y);
     for (int x = 0; x < sim_.cols; ++x) {
@@ -855,7 +896,6 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   cv::Rect region = frame_rect;
   if (last_centre_) {
-    const int64_t grown = int64_t{params_.search_margin_px} * (2 + lost_frames_);
     int64_t limit = params_.acquire_radius_px > 0 ? params_.acquire_radius_px
                                                   : std::max(frame.cols, frame.rows);
     if (std::isfinite(look_alike_px_)) {
@@ -863,7 +903,11 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
           limit, std::max<int64_t>(params_.search_margin_px,
                                    static_cast<int64_t>(0.5 * look_alike_px_ * rung_scale())));
     }
-    region = WindowAround(*last_centre_, size, static_cast<int>(std::min(grown, limit))) &
+    // The whole radius at once: a marker that outran the tracking window (a cart at 30 px a
+    // frame from rest) moves on while a region growing by a margin per frame follows it. A
+    // look-alike inside the radius makes the search ambiguous, and the session's motion gate
+    // judges where the match lies.
+    region = WindowAround(*last_centre_ + velocity_px_, size, static_cast<int>(limit)) &
              frame_rect;
   }
   if (region.width < size.width || region.height < size.height) return std::nullopt;
@@ -1023,22 +1067,44 @@ void TemplateTracker::UpdateScale(const cv::Mat& frame, const Fix& fix) {
   if (!adapts()) coarse_.clear();  // The search template changed.
 }
 
-// The marker's soft centroid in the patch at the match; the first template's anchor when the
-// blob cannot be separated there (merged with something of its level, or cut by the frame).
-cv::Point2d TemplateTracker::Recentre(const cv::Mat& frame, const Fix& fix) {
+// How far the marker's blob (the template's foreground) lies from where the match puts it:
+// the match is then moved by it, so the position follows the marker, not the background
+// around it. A template mostly of background (a box dragged around a small sticker on a tyre)
+// matches the tyre well after the sticker has moved on along it. Empty when the blob is not in
+// the match: no component of the marker's side within 2 px of where the template puts it, one
+// merged with its surroundings (it reaches the patch's edge), one whose area is far from the
+// learned blob's at this scale, or one farther than a quarter of the template.
+std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, const Fix& fix) {
   const Rung& rung = rungs_[rung_];
   const cv::Size size = rung.templ.size();
   const cv::Rect at = WindowAround(fix.centre, size, 0);
-  if ((at & cv::Rect(0, 0, frame.cols, frame.rows)) != at) return fix.reported;
+  if ((at & cv::Rect(0, 0, frame.cols, frame.rows)) != at) return std::nullopt;
   Native(frame, at, blob_native_);
   BlobChannel(blob_native_, blob_gray_);
+  // Where the template puts its blob (patch coordinates): the learned centroid at this rung.
+  const cv::Point2d expected =
+      fix.centre - HalfSize(size) - cv::Point2d(at.tl()) +
+      cv::Point2d((blob_anchor_px_.x + 0.5) * size.width / original_.cols - 0.5,
+                  (blob_anchor_px_.y + 0.5) * size.height / original_.rows - 0.5);
   cv::Point2d centroid;
   double area = 0;
-  if (!blob_.Measure(blob_gray_, rung.templ.mask(), fix.reported - cv::Point2d(at.tl()),
-                     &centroid, &area)) {
-    return fix.reported;
+  if (!blob_.Locate(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
+    return std::nullopt;
   }
-  return cv::Point2d(at.tl()) + centroid;
+  const double learned = blob_.area() * rung_scale() * rung_scale();
+  if (!(area >= kMinBlobAreaRatio * learned && area <= learned / kMinBlobAreaRatio)) {
+    return std::nullopt;
+  }
+  cv::Point2d shift = centroid - expected;
+  if (cv::norm(shift) > kBlobAgreePx) {  // To be applied: measured with the soft centroid.
+    if (!blob_.Measure(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
+      return std::nullopt;
+    }
+    shift = centroid - expected;
+  }
+  const double reach = std::max(kMinBlobShiftPx, 0.25 * std::min(size.width, size.height));
+  if (!(cv::norm(shift) <= reach)) return std::nullopt;
+  return shift;
 }
 
 void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px) {
@@ -1089,7 +1155,9 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     ConvertAround(frame_bgr, cv::Rect(window.x - kAroundPx, window.y - kAroundPx,
                                       window.width + 2 * kAroundPx, window.height + 2 * kAroundPx));
     hit = Search(frame_bgr, window, search_template(), true);
-    if (hit && hit->on_inner_edge) hit.reset();  // Moving faster than the window: acquire.
+    // Moving faster than the window (its best is on the window's edge, or is no match at all
+    // because the marker left it): acquire.
+    if (hit && (hit->on_inner_edge || !Accept(*hit))) hit.reset();
   }
   if (!hit) hit = Acquire(frame_bgr);
   if (!hit || !Accept(*hit)) return Lose(MarkerStatus::kLost);
@@ -1113,7 +1181,23 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     if (adapts()) RestoreWorkingTemplate();  // The working template may have drifted.
     return Lose(MarkerStatus::kLost);
   }
-  const cv::Point2d step = tracking_ ? fix->centre - *last_centre_ : cv::Point2d(0, 0);
+  // The template's blob must be in the match, and the match follows it: a template that holds
+  // more background than marker is otherwise found on the background the marker has left.
+  Fix at = *fix;
+  if (blob_ok_) {
+    const std::optional<cv::Point2d> shift = BlobShift(frame_bgr, at);
+    if (!shift) {
+      if (adapts()) RestoreWorkingTemplate();
+      return Lose(MarkerStatus::kLost);
+    }
+    // Within kBlobAgreePx the two agree (a blob's centroid is less precise than the match of a
+    // template that shows the marker well): the match stands.
+    if (cv::norm(*shift) > kBlobAgreePx) {
+      at.centre += *shift;
+      at.reported += *shift;
+    }
+  }
+  const cv::Point2d step = tracking_ ? at.centre - *last_centre_ : cv::Point2d(0, 0);
   if (tracking_ && IsRepeatedFrame(step, velocity_px_, repeats_)) {
     ++repeats_;  // A repeated frame: the velocity is the next new frame's.
     footage_repeats_ = true;
@@ -1121,13 +1205,13 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     repeats_ = 0;
     velocity_px_ = step;
   }
-  last_centre_ = fix->centre;
+  last_centre_ = at.centre;
   tracking_ = true;
   lost_frames_ = 0;
-  if (params_.scale_search) UpdateScale(frame_bgr, *fix);
-  if (adapts()) UpdateTemplate(frame_bgr, fix->centre);
+  if (params_.scale_search) UpdateScale(frame_bgr, at);
+  if (adapts()) UpdateTemplate(frame_bgr, at.centre);
   Observation observation;
-  observation.position_px = blob_ok_ ? Recentre(frame_bgr, *fix) : fix->reported;
+  observation.position_px = at.reported;
   observation.score = hit->score;
   return observation;
 }

@@ -5,11 +5,16 @@
 // otherwise Observation::NotFound says why:
 //   found      the best match passes the measure's threshold (min_zncc, and max_sad / max_ssd),
 //              no distinct second peak in the searched region comes within ambiguity_margin of
-//              it (ZNCC), and the matched patch is still consistent with the FIRST template at
-//              the current scale (ZNCC >= drift_min_zncc);
+//              it (ZNCC), the matched patch is still consistent with the FIRST template at
+//              the current scale (ZNCC >= drift_min_zncc), and, when the selected template shows
+//              a blob (a dot or sticker standing out from what is around it: its foreground),
+//              that blob is in the match: within 2 px of where the template puts it, of about
+//              its learned area (0.4x-2.5x), separated from its surroundings. A match the blob
+//              lies more than 1 px from is moved onto it (a box mostly of background, e.g. tyre
+//              around a sticker, matches the background well after the sticker moved on);
 //   ambiguous  two distinct places fit about equally (look-alike markers, e.g. white dots): the
 //              tracker never picks one of them;
-//   lost       nothing in the searched region fits;
+//   lost       nothing in the searched region fits (or the template's blob is not in the match);
 //   out_of_frame  the predicted window lies outside the image.
 // The reported position is the marker's centre, not the rectangle's: by default the template's
 // centre of point symmetry (a dot's centroid; found once, on the selected template), mapped into
@@ -31,8 +36,10 @@
 // background in the rectangle's corners, which turns with the body, does not count.
 //
 // Search: while tracking, only a window around the position predicted by constant velocity is
-// searched; at start the window around the hint; after a loss the region grows frame by frame
-// around the last known position up to acquire_radius_px, coarse-to-fine over an image pyramid.
+// searched; at start the window around the hint; when the marker outran that window, or after
+// a loss, the region within acquire_radius_px of the last known position (and its velocity), at
+// most half the distance to the nearest look-alike seen at selection, coarse-to-fine over an
+// image pyramid.
 // The integer best match is refined to sub-pixel by a 1-D fit per axis on the score surface: a
 // parabola for SSD and ZNCC (their surfaces are quadratic near the peak), the equiangular "V" fit
 // for SAD (its surface is |d|-like; a parabola would pull the estimate halfway back).
@@ -140,11 +147,13 @@ struct TemplateParams {
   // constant-velocity prediction. It must exceed the largest change of velocity between two
   // frames (px/frame^2); the cost grows with its square. Default 8.
   int search_margin_px = 8;
-  // After a loss the region searched around the last known position grows by search_margin_px
-  // per frame lost, up to this radius; 0 lets it grow to the whole frame. Small keeps look-alike
-  // markers from being taken for a hidden one (a look-alike in the region makes the search
-  // ambiguous at best); large re-finds a marker that moved far while hidden. Without a known
-  // position (template from a file, or after reset()) the whole frame is searched. Default 64.
+  // When the marker moved beyond the tracking window, or after a loss, the region searched is
+  // within this radius of the last known position (moved on by the last velocity); 0: the whole
+  // frame. A look-alike seen at selection (a place scoring min_zncc or more) bounds it to half its
+  // distance, so a covered marker is not swapped for its twin; small keeps look-alikes out (one in
+  // the region makes the search ambiguous at best); large re-finds a marker that moved far while
+  // hidden (a cart at 30 px a frame from rest). Without a known position (template from a file,
+  // or after reset()) the whole frame is searched. Default 64.
   int acquire_radius_px = 64;
   // Acquisition pyramid: at most this many levels (1 = full resolution only). Fewer are used when
   // the template would shrink below 8 px at the coarsest level.
