@@ -73,9 +73,15 @@ YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::s
     throw error("nested deeper than " + std::to_string(kMaxConfigDepth) +
                 " levels (a dict or list that contains itself?)");
   }
-  if (value.is_none()) return YAML::Node(YAML::NodeType::Null);
+  // None would read as "not given" (the default: no mm columns for scale_mm_per_px), silently.
+  if (value.is_none()) throw error("None is not a config value (leave the key out for its default)");
   if (py::isinstance<py::bool_>(value)) return YAML::Node(value.cast<bool>() ? "true" : "false");
-  if (py::isinstance<py::str>(value)) return YAML::Node(value.cast<std::string>());
+  if (py::isinstance<py::str>(value)) {
+    // Tagged as YAML tags a quoted scalar: "0.25" stays a string, refused where a number goes.
+    YAML::Node node(value.cast<std::string>());
+    node.SetTag("!");
+    return node;
+  }
   if (py::isinstance<py::int_>(value)) return YAML::Node(std::string(py::str(value)));
   if (py::isinstance<py::float_>(value)) return YAML::Node(FloatText(value.cast<double>()));
   if (py::isinstance<py::dict>(value) || py::hasattr(value, "keys")) {

@@ -91,6 +91,15 @@ def test_values_of_the_wrong_type_in_a_dict():
         softsight.load_config({"markers": {3: "x"}})
     with pytest.raises(TypeError):
         softsight.load_config(42)
+    markers = [{"name": "red", "hsv": {"h": [170, 10], "s": [80, 255], "v": [40, 255]}}]
+    # A str is text, even when it spells a number; None is no value (it used to drop the mm
+    # columns silently).
+    with pytest.raises(softsight.InputError,
+                       match=r"^<dict>:.*scale_mm_per_px: expected a number, got the string '0.25'"):
+        softsight.load_config({"markers": markers, "scale_mm_per_px": "0.25"})
+    with pytest.raises(softsight.InputError, match=r"^<dict>: scale_mm_per_px: None is not a config"):
+        softsight.load_config({"markers": markers, "scale_mm_per_px": None})
+    assert "tip_disp_mm" not in softsight.load_config({"markers": markers}).columns
 
 
 def test_version_and_licence_agree_with_the_program():

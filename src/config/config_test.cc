@@ -129,6 +129,17 @@ TEST(Config, WrongTypeIsNamed) {
   EXPECT_THAT(error, HasSubstr("'lots'"));
 }
 
+// A quoted number is a string in YAML: the writer typed it as text (a Python str, a tool that
+// quotes everything), and reading it as a number would hide that.
+TEST(Config, AQuotedNumberOrBooleanIsRefusedAsAString) {
+  std::string text = kValid;
+  text.replace(text.find("0.2"), 3, "\"0.2\"");
+  const std::string error = testing::ConfigErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("scale_mm_per_px: expected a number, got the string '0.2' (quoted)"));
+  std::string unquoted = kValid;  // The same value unquoted loads.
+  EXPECT_EQ(testing::ConfigErrorOf(unquoted), "");
+}
+
 TEST(Config, HueOutsideRangeIsNamed) {
   std::string text = kValid;
   text.replace(text.find("[100, 130]"), 10, "[100, 200]");

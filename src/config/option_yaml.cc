@@ -9,11 +9,11 @@ namespace {
 std::string Shown(const YAML::Node& node) { return ShownInMessage(node); }  // one spelling
 
 bool DecodeInt(const YAML::Node& node, int64_t* value) {
-  return node.IsScalar() && YAML::convert<int64_t>::decode(node, *value);
+  return IsValueScalar(node) && YAML::convert<int64_t>::decode(node, *value);
 }
 
 bool DecodeDouble(const YAML::Node& node, double* value) {
-  return node.IsScalar() && YAML::convert<double>::decode(node, *value);
+  return IsValueScalar(node) && YAML::convert<double>::decode(node, *value);
 }
 
 // YAML's spelling of a double (.nan and .inf are YAML's; Check() rejects them anyway).
@@ -33,7 +33,7 @@ std::optional<OptionValue> ReadOptionValue(YamlMap& map, const std::string& leaf
   switch (spec.kind) {
     case OptionKind::kBool: {
       bool b = false;
-      if (!node.IsScalar() || !YAML::convert<bool>::decode(node, b)) {
+      if (!IsValueScalar(node) || !YAML::convert<bool>::decode(node, b)) {
         map.fail(leaf, "expected true or false, got " + Shown(node));
       }
       value = b;

@@ -20,7 +20,13 @@ std::string LineOf(const YAML::Node& node) {
   return std::to_string(mark.line + 1) + ":";
 }
 
+// The tag yaml-cpp gives a quoted scalar (and the Python package a str): YAML's non-specific "!".
+constexpr const char* kQuotedTag = "!";
+
 std::string Shown(const YAML::Node& node) {
+  if (node.IsScalar() && node.Tag() == kQuotedTag) {
+    return "the string '" + EscapeForMessage(node.Scalar(), 60) + "' (quoted)";
+  }
   if (node.IsScalar()) return "'" + EscapeForMessage(node.Scalar(), 60) + "'";
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a mapping";
@@ -37,6 +43,8 @@ std::string Range(T min, T max) {
 }  // namespace
 
 std::string ShownInMessage(const YAML::Node& node) { return Shown(node); }
+
+bool IsValueScalar(const YAML::Node& node) { return node.IsScalar() && node.Tag() != kQuotedTag; }
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
     : node_(node), file_(std::move(file)), path_(std::move(path)) {
@@ -103,7 +111,7 @@ std::optional<double> YamlMap::number(const std::string& key, double min, double
   if (!has(key)) return std::nullopt;
   const YAML::Node child = node_[key];
   double value = 0;
-  if (!child.IsScalar() || !YAML::convert<double>::decode(child, value) || !std::isfinite(value)) {
+  if (!IsValueScalar(child) || !YAML::convert<double>::decode(child, value) || !std::isfinite(value)) {
     fail(key, "expected a number, got " + Shown(child));
   }
   if (value < min || value > max) {
@@ -116,7 +124,7 @@ std::optional<int> YamlMap::integer(const std::string& key, int min, int max) {
   if (!has(key)) return std::nullopt;
   const YAML::Node child = node_[key];
   int value = 0;
-  if (!child.IsScalar() || !YAML::convert<int>::decode(child, value)) {
+  if (!IsValueScalar(child) || !YAML::convert<int>::decode(child, value)) {
     fail(key, "expected a whole number, got " + Shown(child));
   }
   if (value < min || value > max) {
@@ -129,7 +137,7 @@ std::optional<bool> YamlMap::boolean(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const YAML::Node child = node_[key];
   bool value = false;
-  if (!child.IsScalar() || !YAML::convert<bool>::decode(child, value)) {
+  if (!IsValueScalar(child) || !YAML::convert<bool>::decode(child, value)) {
     fail(key, "expected true or false, got " + Shown(child));
   }
   return value;
@@ -165,7 +173,7 @@ std::optional<std::vector<int>> YamlMap::integers(const std::string& key, size_t
   std::vector<int> values;
   for (const YAML::Node& item : child) {
     int value = 0;
-    if (!item.IsScalar() || !YAML::convert<int>::decode(item, value)) {
+    if (!IsValueScalar(item) || !YAML::convert<int>::decode(item, value)) {
       fail(key, "expected whole numbers, got " + Shown(item));
     }
     if (value < min || value > max) {
@@ -187,7 +195,7 @@ std::optional<std::vector<double>> YamlMap::numbers(const std::string& key, size
   std::vector<double> values;
   for (const YAML::Node& item : child) {
     double value = 0;
-    if (!item.IsScalar() || !YAML::convert<double>::decode(item, value) || !std::isfinite(value)) {
+    if (!IsValueScalar(item) || !YAML::convert<double>::decode(item, value) || !std::isfinite(value)) {
       fail(key, "expected numbers, got " + Shown(item));
     }
     if (value < min || value > max) {

@@ -53,6 +53,10 @@ class YamlMap {
 
 // How an error message shows a value from the file: 'text' for a scalar, "a list", "a mapping".
 std::string ShownInMessage(const YAML::Node& node);
+// True for a scalar that may be read as a number or true/false: one not quoted. A quoted "0.25"
+// is a string in YAML (and a Python str in a config dict): taking it for a number would accept a
+// value its writer typed as text.
+bool IsValueScalar(const YAML::Node& node);
 
 // A path written in a config file, relative to that file's folder unless absolute.
 std::string ResolveBesideFile(const std::string& config_file, const std::string& path);
