@@ -136,8 +136,11 @@ TEST(Config, AQuotedNumberOrBooleanIsRefusedAsAString) {
   text.replace(text.find("0.2"), 3, "\"0.2\"");
   const std::string error = testing::ConfigErrorOf(text);
   EXPECT_THAT(error, HasSubstr("scale_mm_per_px: expected a number, got the string '0.2' (quoted)"));
-  std::string unquoted = kValid;  // The same value unquoted loads.
-  EXPECT_EQ(testing::ConfigErrorOf(unquoted), "");
+  EXPECT_EQ(testing::ConfigErrorOf(kValid), "");  // The same value unquoted loads.
+  std::string flag = kValid;  // A quoted true is text too.
+  flag.replace(flag.find("    roi:"), 0, "    template: {round: 'true'}\n");
+  EXPECT_THAT(testing::ConfigErrorOf(flag),
+              HasSubstr("expected true or false, got the string 'true' (quoted)"));
 }
 
 TEST(Config, HueOutsideRangeIsNamed) {

@@ -398,7 +398,6 @@ class BlobMeter {
     return true;
   }
 
-
   bool bright_ = true;
   double area_ = 0;
   cv::Mat label_, dist_;
@@ -469,6 +468,12 @@ class TemplateTracker final : public Tracker {
     }
   }
   std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
+  // A point of the selected template in a rung of `size`. Template coordinates scale about the
+  // pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
+  cv::Point2d ToRung(const cv::Point2d& p, const cv::Size& size) const {
+    return {(p.x + 0.5) * size.width / original_.cols - 0.5,
+            (p.y + 0.5) * size.height / original_.rows - 0.5};
+  }
   cv::Mat MaskFor(const cv::Size& size) const {
     return params_.round_mask ? RoundMask(size) : cv::Mat();
   }
@@ -532,7 +537,7 @@ class TemplateTracker final : public Tracker {
   cv::Mat level_sim_;
   cv::Mat projection_;  // Gray only: 1x4 BGR weights + offset, or empty for plain luma.
   ZnccScratch zncc_;
-  // Re-centring on the marker's blob (report: centre, when the template shows a blob).
+  // The marker's blob in the template: every match is verified against it (BlobShift).
   BlobMeter blob_;
   bool blob_ok_ = false;                // The template shows a blob (its foreground).
   cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
@@ -618,7 +623,7 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   original_ = templ.clone();
   anchor_px_ = HalfSize(templ.size());
   // The marker's blob in the template (its foreground), whatever point is reported: every
-  // match must contain it (see Recentre).
+  // match must contain it (see BlobShift).
   blob_projection_ = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
   cv::Mat gray;
   BlobChannel(templ, gray);
@@ -656,9 +661,7 @@ const Rung* TemplateTracker::RungAt(int index) {
       cv::Mat scaled;
       cv::resize(original_, scaled, size, 0, 0, scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
       if (rung.templ.Prepare(scaled, MaskFor(size))) {
-        // Template coordinates scale about the pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
-        rung.anchor = {(anchor_px_.x + 0.5) * size.width / original_.cols - 0.5,
-                       (anchor_px_.y + 0.5) * size.height / original_.rows - 0.5};
+        rung.anchor = ToRung(anchor_px_, size);
       }
     }
   }
@@ -1067,9 +1070,11 @@ void TemplateTracker::UpdateScale(const cv::Mat& frame, const Fix& fix) {
   if (!adapts()) coarse_.clear();  // The search template changed.
 }
 
-// How far the marker's blob (the template's foreground) lies from where the match puts it:
-// the match is then moved by it, so the position follows the marker, not the background
-// around it. A template mostly of background (a box dragged around a small sticker on a tyre)
+// How far to move the match onto the marker's blob (the template's foreground), so the position
+// follows the marker, not the background around it. Zero when the blob lies within
+// kBlobAgreePx of where the match puts it (a blob's centroid is less precise than the match of a
+// template that shows the marker well), except with report: centre, whose position is the blob's
+// soft centroid in every frame. A template mostly of background (a box dragged around a small sticker on a tyre)
 // matches the tyre well after the sticker has moved on along it. Empty when the blob is not in
 // the match: no component of the marker's side within 2 px of where the template puts it, one
 // merged with its surroundings (it reaches the patch's edge), one whose area is far from the
@@ -1083,9 +1088,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   BlobChannel(blob_native_, blob_gray_);
   // Where the template puts its blob (patch coordinates): the learned centroid at this rung.
   const cv::Point2d expected =
-      fix.centre - HalfSize(size) - cv::Point2d(at.tl()) +
-      cv::Point2d((blob_anchor_px_.x + 0.5) * size.width / original_.cols - 0.5,
-                  (blob_anchor_px_.y + 0.5) * size.height / original_.rows - 0.5);
+      fix.centre - HalfSize(size) - cv::Point2d(at.tl()) + ToRung(blob_anchor_px_, size);
   cv::Point2d centroid;
   double area = 0;
   if (!blob_.Locate(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
@@ -1096,12 +1099,14 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
     return std::nullopt;
   }
   cv::Point2d shift = centroid - expected;
-  if (cv::norm(shift) > kBlobAgreePx) {  // To be applied: measured with the soft centroid.
-    if (!blob_.Measure(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
-      return std::nullopt;
-    }
-    shift = centroid - expected;
+  if (params_.report != TemplateReport::kCentre && cv::norm(shift) <= kBlobAgreePx) {
+    return cv::Point2d(0, 0);
   }
+  // To be applied: measured with the soft centroid.
+  if (!blob_.Measure(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
+    return std::nullopt;
+  }
+  shift = centroid - expected;
   const double reach = std::max(kMinBlobShiftPx, 0.25 * std::min(size.width, size.height));
   if (!(cv::norm(shift) <= reach)) return std::nullopt;
   return shift;
@@ -1190,12 +1195,8 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
       if (adapts()) RestoreWorkingTemplate();
       return Lose(MarkerStatus::kLost);
     }
-    // Within kBlobAgreePx the two agree (a blob's centroid is less precise than the match of a
-    // template that shows the marker well): the match stands.
-    if (cv::norm(*shift) > kBlobAgreePx) {
-      at.centre += *shift;
-      at.reported += *shift;
-    }
+    at.centre += *shift;
+    at.reported += *shift;
   }
   const cv::Point2d step = tracking_ ? at.centre - *last_centre_ : cv::Point2d(0, 0);
   if (tracking_ && IsRepeatedFrame(step, velocity_px_, repeats_)) {
