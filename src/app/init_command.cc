@@ -1,6 +1,7 @@
 // `softsight init` and `softsight pick`: see init_command.h.
 #include "app/init_command.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -176,23 +177,32 @@ InitResult RunInit(const InitOptions& options) {
   InitResult result;
   result.finding = FindMarkers(frame.image, finder);
   MarkerFinding& finding = result.finding;
-  if (options.frame > 0 && !finding.intensity && !finder.search_px) {
+  if (options.frame > 0) {
     // A marker told apart by its colour alone needs no roi: without one `track` follows it from
     // the input's first frame, where a roi (holding from this frame on) would leave it not
-    // started. Identical dots and markers found in a search region keep theirs.
-    for (FoundMarker& m : finding.markers) std::get<ColourParams>(m.spec.params).roi.reset();
+    // started. Identical markers and markers among look-alikes outside a search region keep theirs.
+    for (FoundMarker& m : finding.markers) {
+      if (!m.needs_roi && !finding.intensity && !finder.search_px) {
+        std::get<ColourParams>(m.spec.params).roi.reset();
+      }
+    }
   }
   if (finding.ok() && finding.markers.size() >= 2 && !finder.base_near_px) {
     // The base is where the body is clamped: the video shows it better than the image border.
     std::string seen;
     const std::optional<bool> last_fixed = LastEndIsFixed(options, finding, &seen);
     if (last_fixed && *last_fixed) ReverseBodyOrder(&finding);
-    finding.notes.front() =
-        "base: " + finding.markers.front().spec.name +
-        (last_fixed ? " (the end that stays put: " + seen + ")"
-                    : " (the end nearer the image border, as the video does not show which end "
-                      "is fixed: " + seen + "; --base X,Y chooses)");
+    const auto base_note =
+        std::find_if(finding.notes.begin(), finding.notes.end(),
+                     [](const std::string& note) { return note.rfind("base: ", 0) == 0; });
+    if (base_note != finding.notes.end()) {
+      *base_note = "base: " + finding.markers.front().spec.name +
+                   (last_fixed ? " (the end that stays put: " + seen + ")"
+                               : " (the end nearer the image border, as the video does not show "
+                                 "which end is fixed: " + seen + "; --base X,Y chooses)");
+    }
   }
+
   result.picture_file = options.picture_out.value_or(PictureBeside(options.config_out));
   const cv::Mat picture = DrawMarkerFinding(frame.image, result.finding);
   bool written = false;

@@ -46,6 +46,14 @@ constexpr double kMaxSpacingRatio = 1.6;
 // The verifying tracker must find the candidate within this many radii (and 1 px) of where the
 // search found it: the same blob, measured with the marker's own ranges.
 constexpr double kVerifyRadii = 0.25;
+// Blobs of one colour that the colour alone cannot tell apart are identical markers (a dot on
+// each of two carts, a row of pucks) when their radii lie within this factor of each other and
+// their core saturation and brightness within this fraction: printed or cut from one sheet, they
+// differ far less (perspective, a highlight), while patches of the bench differ more. Their
+// hues (the centres of their picked ranges) lie within kTwinHueApart.
+constexpr double kTwinSizeRatio = 1.25;
+constexpr int kTwinHueApart = 5;  // OpenCV hue units (0..180); red and orange are 10 apart.
+constexpr double kTwinLooksRatio = 0.8;
 // A second body order within this fraction of the shortest path's length makes the order ambiguous.
 constexpr double kOrderAmbiguity = 0.10;
 // A marker's edge fades (80 % -> 20 %) within at most this many pixels, or this many radii for
@@ -173,10 +181,11 @@ std::optional<HsvRange> DotRange(const cv::Mat& gray, const cv::Point2d& centre,
 
 // How sharply a blob's colour gives way to its surroundings: along rays from its centre, the
 // distance over which the colour goes from 80 % to 20 % of the way between its core (the disc of
-// half its radius) and its surroundings (the ring 3..5 px outside it), in pixels (median over
-// the rays). A printed or painted marker's edge takes 1-3 px (anti-aliasing, a little blur); a
-// patch of stain or shading on a bench fades over many. Absent when the core and the ring have
-// the same colour.
+// half its radius) and its surroundings (the ring 3..5 px outside it), in pixels. A printed or
+// painted marker's edge takes 1-3 px (anti-aliasing, a little blur); a patch of stain or shading
+// on a bench fades over many. The first quartile over the rays, not the median: a marker blurred
+// by its motion fades along the motion only and stays sharp across it, while a stain fades all
+// round. Absent when the core and the ring have the same colour.
 std::optional<double> EdgeWidthPx(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
   constexpr int kRays = 16;
   auto sample = [&](double x, double y, cv::Vec3d* out) {
@@ -193,28 +202,36 @@ std::optional<double> EdgeWidthPx(const cv::Mat& bgr, const cv::Point2d& centre,
     return true;
   };
   const double inner = 0.5 * radius, ring_in = radius + 3, ring_out = radius + 5;
-  cv::Vec3d core(0, 0, 0), ring(0, 0, 0);
-  int core_n = 0, ring_n = 0;
+  std::vector<double> core_samples[3], ring_samples[3];  // Per channel (B, G, R).
   for (int k = 0; k < kRays; ++k) {
     const double a = 2 * CV_PI * k / kRays;
     const cv::Point2d dir(std::cos(a), std::sin(a));
     cv::Vec3d p;
     for (double d = 0; d <= inner; d += 0.5) {
       if (sample(centre.x + d * dir.x, centre.y + d * dir.y, &p)) {
-        core += p;
-        ++core_n;
+        for (int ch = 0; ch < 3; ++ch) core_samples[ch].push_back(p[ch]);
       }
     }
     for (double d = ring_in; d <= ring_out; d += 0.5) {
       if (sample(centre.x + d * dir.x, centre.y + d * dir.y, &p)) {
-        ring += p;
-        ++ring_n;
+        for (int ch = 0; ch < 3; ++ch) ring_samples[ch].push_back(p[ch]);
       }
     }
   }
-  if (core_n == 0 || ring_n == 0) return std::nullopt;
-  core /= core_n;
-  ring /= ring_n;
+  if (core_samples[0].empty() || ring_samples[0].empty()) return std::nullopt;
+  // The core's median, not its mean: a glossy marker's highlight covers a good part of its core,
+  // and the mean would put the marker's own colour part of the way to the ring's, as if its edge
+  // began inside it. The ring's mean: a grainy bench's median follows its grain.
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  cv::Vec3d core, ring;
+  for (int ch = 0; ch < 3; ++ch) {
+    core[ch] = median(core_samples[ch]);
+    ring[ch] = std::accumulate(ring_samples[ch].begin(), ring_samples[ch].end(), 0.0) /
+              static_cast<double>(ring_samples[ch].size());
+  }
   const cv::Vec3d span = core - ring;
   const double span2 = span.dot(span);
   if (span2 < 15.0 * 15.0) return std::nullopt;
@@ -236,28 +253,69 @@ std::optional<double> EdgeWidthPx(const cv::Mat& bgr, const cv::Point2d& centre,
     if (d80 && d20) widths.push_back(*d20 - *d80);
     else widths.push_back(ring_out - inner);  // Never fades within reach: as wide as can be.
   }
-  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  return widths[widths.size() / 2];
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 4, widths.end());
+  return widths[widths.size() / 4];
 }
 
-// Median HSV saturation of the disc of 0.6 radii around `centre`.
-double CoreSaturation(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
+// Median HSV saturation and value of the disc of 0.6 radii around `centre`.
+struct CoreLooks {
+  double saturation = 0;
+  double value = 0;
+};
+CoreLooks CoreLooksOf(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
   const double r = std::max(1.0, 0.6 * radius);
   const cv::Rect box = cv::Rect(cvFloor(centre.x - r), cvFloor(centre.y - r), cvCeil(2 * r) + 2,
                                 cvCeil(2 * r) + 2) &
                        cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (box.empty()) return 0;
+  if (box.empty()) return {};
   cv::Mat hsv;
   cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
-  std::vector<int> s;
+  std::vector<int> s, v;
   for (int y = 0; y < hsv.rows; ++y) {
     for (int x = 0; x < hsv.cols; ++x) {
       if (std::hypot(box.x + x - centre.x, box.y + y - centre.y) <= r) {
         s.push_back(hsv.at<cv::Vec3b>(y, x)[1]);
+        v.push_back(hsv.at<cv::Vec3b>(y, x)[2]);
       }
     }
   }
-  return Median(s);
+  return {Median(s), Median(v)};
+}
+
+// A pale marker's picked range reaches down to the saturation of a tinted bench, and the blob
+// it selects then merges with a patch of the bench of its hue whenever it passes one. Like a
+// two-class threshold, the saturation bound is placed half way between the marker's core and the
+// most saturated of its surroundings (the 99.5th percentile over the square of five radii, at
+// least 32 px, each side of it, less the marker's own disc and 3 px around it; pixels outside the
+// hue and value ranges count as grey); it is only ever raised, and never to the core's median.
+void KeepSaturationAboveSurroundings(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
+                                     double core_saturation, ColourParams* colour) {
+  const double ring_in = radius + 3, ring_out = std::max(5 * radius, 32.0);
+  const cv::Rect box = cv::Rect(cvFloor(centre.x - ring_out), cvFloor(centre.y - ring_out),
+                                cvCeil(2 * ring_out) + 2, cvCeil(2 * ring_out) + 2) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (box.empty()) return;
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  const auto in = [](int x, const HsvRange& r) {
+    return r.lo <= r.hi ? (x >= r.lo && x <= r.hi) : (x >= r.lo || x <= r.hi);
+  };
+  std::vector<int> ring;
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const double d = std::hypot(box.x + x - centre.x, box.y + y - centre.y);
+      if (d < ring_in) continue;
+      const cv::Vec3b& p = hsv.at<cv::Vec3b>(y, x);
+      ring.push_back(in(p[0], colour->h) && in(p[2], colour->v) ? p[1] : 0);
+    }
+  }
+  if (ring.size() < 20) return;
+  const size_t k = ring.size() * 995 / 1000;
+  std::nth_element(ring.begin(), ring.begin() + k, ring.end());
+  const int bench = ring[k];
+  if (bench < colour->s.lo) return;
+  const int raised = static_cast<int>(std::ceil(0.5 * (bench + core_saturation)));
+  if (raised > colour->s.lo && raised < core_saturation) colour->s.lo = raised;
 }
 
 int HueOf(const HsvRange& h) {
@@ -488,11 +546,13 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
   struct Verified {
     FoundMarker marker;
     int hue = 0;
-    double saturation = 0;  // Median over its core (colour markers).
+    CoreLooks looks;     // Medians over its core (colour markers).
+    bool twin = false;   // One of several alike blobs of its colour, told apart by its roi.
   };
   std::vector<Verified> verified;
   struct LookAlike {
     std::string colour;
+    int hue = 0;
     double radius_px = 0;
     size_t rejected_index = 0;  // Its entry in finding.rejected.
   };
@@ -565,8 +625,9 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
     };
     Observation alone;
     bool ok = verify(false, &alone);
-    const bool needs_roi = finding.intensity || options.search_px.has_value();
-    if (!ok && needs_roi && (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
+    bool twin = false, needs_roi = false;
+    if (!ok && (finding.intensity || options.search_px) &&
+        (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
       // Identical dots, or look-alikes outside the search region: told apart by a roi each.
       Observation inside;
       ok = verify(true, &inside);
@@ -575,9 +636,20 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
         continue;
       }
       alone = inside;
-    } else if (!ok) {
+      needs_roi = true;
+    } else if (!ok && alone.status() == MarkerStatus::kAmbiguous) {
+      // Several blobs of its colour: identical markers (a dot on each of two carts, a row of
+      // pucks) when they are all alike, which is decided once all are seen; a roi tells them
+      // apart. Found in its roi, it is a twin until then.
+      Observation inside;
+      if (verify(true, &inside)) {
+        ok = twin = needs_roi = true;
+        alone = inside;
+      }
+    }
+    if (!ok) {
       if (alone.status() == MarkerStatus::kAmbiguous) {
-        ambiguous.push_back({finding.intensity ? "dot" : HueName(hue), radius,
+        ambiguous.push_back({finding.intensity ? "dot" : HueName(hue), hue, radius,
                              finding.rejected.size()});
         reject("ambiguous: " + std::to_string(std::max(2, alone.candidates)) +
                " look-alikes of its colour");
@@ -589,13 +661,81 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       }
       continue;
     }
+    if (!finding.intensity) {
+      // Tightened only once verified with the picked ranges, and kept only when the marker is
+      // still found with them: it steadies the tracking of a marker, never makes a blob one.
+      const MarkerSpec picked = spec;
+      const int picked_lo = colour.s.lo;
+      KeepSaturationAboveSurroundings(frame, c.position_px, radius,
+                                      CoreLooksOf(frame, c.position_px, radius).saturation, &colour);
+      Observation tightened;
+      if (colour.s.lo != picked_lo && !verify(needs_roi, &tightened)) spec = picked;
+    }
     Verified v;
     v.marker.spec = spec;
     v.marker.position_px = *alone.position_px;
     v.marker.radius_px = radius;
+    v.marker.needs_roi = needs_roi;
     v.hue = hue;
-    if (!finding.intensity) v.saturation = CoreSaturation(frame, c.position_px, radius);
+    if (!finding.intensity) v.looks = CoreLooksOf(frame, c.position_px, radius);
+    v.twin = twin;
     verified.push_back(v);
+  }
+  // Twins of one colour are markers only when they are alike in everything a tracker can see
+  // (size, saturation, brightness) and no look-alike of theirs stayed unresolved: then each is
+  // followed in its own roi. Otherwise (a larger, a darker, a half-sized patch of a marker's
+  // colour) init cannot tell which of them is the marker and will not guess.
+  // A refused group's twins become look-alikes of their colour, which may refuse another group
+  // near that colour: refused groups are taken out until every group left is alike.
+  const auto hues_apart = [](int a, int b) { return std::min(std::abs(a - b), 180 - std::abs(a - b)); };
+  const auto twin_group = [&](size_t i) {
+    std::vector<size_t> group;
+    for (size_t j = 0; j < verified.size(); ++j) {
+      if (verified[j].twin && hues_apart(verified[j].hue, verified[i].hue) <= kTwinHueApart) {
+        group.push_back(j);
+      }
+    }
+    return group;
+  };
+  const auto group_alike = [&](const std::vector<size_t>& group) {
+    double r_lo = 1e9, r_hi = 0, s_lo = 1e9, s_hi = 0, v_lo = 1e9, v_hi = 0;
+    for (size_t j : group) {
+      const Verified& t = verified[j];
+      r_lo = std::min(r_lo, t.marker.radius_px), r_hi = std::max(r_hi, t.marker.radius_px);
+      s_lo = std::min(s_lo, t.looks.saturation), s_hi = std::max(s_hi, t.looks.saturation);
+      v_lo = std::min(v_lo, t.looks.value), v_hi = std::max(v_hi, t.looks.value);
+    }
+    const int hue = verified[group.front()].hue;
+    const bool unresolved = std::any_of(ambiguous.begin(), ambiguous.end(), [&](const LookAlike& a) {
+      return hues_apart(a.hue, hue) <= kHueReach;
+    });
+    return group.size() >= 2 && !unresolved && r_hi <= kTwinSizeRatio * r_lo &&
+           s_lo >= kTwinLooksRatio * s_hi && v_lo >= kTwinLooksRatio * v_hi;
+  };
+  for (bool refused = true; refused;) {
+    refused = false;
+    for (size_t i = 0; i < verified.size() && !refused; ++i) {
+      if (!verified[i].twin) continue;
+      const std::vector<size_t> group = twin_group(i);
+      if (group_alike(group)) continue;
+      for (size_t j : group) {
+        const Verified& t = verified[j];
+        ambiguous.push_back({HueName(t.hue), t.hue, t.marker.radius_px, finding.rejected.size()});
+        finding.rejected.push_back({t.marker.position_px, t.marker.radius_px,
+                                    "ambiguous: look-alikes of its colour that differ from it"});
+      }
+      for (size_t k = group.size(); k-- > 0;) verified.erase(verified.begin() + group[k]);
+      refused = true;
+    }
+  }
+  for (size_t i = 0; i < verified.size(); ++i) {
+    if (!verified[i].twin) continue;
+    const std::vector<size_t> group = twin_group(i);
+    for (size_t j : group) verified[j].twin = false;  // Settled: markers, a roi each.
+    finding.notes.push_back(std::to_string(group.size()) + " alike " +
+                            HueName(verified[i].hue) +
+                            " blobs are taken as identical markers, each told apart by its roi "
+                            "(restrict the search with --roi X,Y,W,H if some are not markers)");
   }
   // Look-alikes that could be markers of this body make the finding unusable: init will not
   // guess between them. Once markers are verified, the body's markers have about their size, so
@@ -660,7 +800,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
                   return r < median / kBodySizeRatio || r > median * kBodySizeRatio;
                 });
   if (!finding.intensity) {
-    drop_minority([](const Verified& v) { return v.saturation; },
+    drop_minority([](const Verified& v) { return v.looks.saturation; },
                   [](double s, double median) { return s < kMinSaturationRatio * median; });
   }
 

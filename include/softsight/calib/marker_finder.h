@@ -74,6 +74,9 @@ struct FoundMarker {
   MarkerSpec spec;              // Name, method colour, ranges (and roi) ready for a config.
   cv::Point2d position_px;      // Where the verifying tracker found it in the frame.
   double radius_px = 0;         // Of a disc of the blob's area.
+  // Its colour alone does not tell it from other blobs of the frame (identical markers, or
+  // look-alikes outside the search region): only its roi does, so the roi must stay.
+  bool needs_roi = false;
 };
 
 struct MarkerFinding {
