@@ -62,12 +62,28 @@ constexpr double kOrderAmbiguity = 0.10;
 // stains of a textured bench (3.5-4 px measured on the renderer's bench) do not.
 constexpr double kMaxEdgeWidthPx = 2.5;
 constexpr double kMaxEdgeWidthRadii = 0.15;
+// Elongated stickers and bars: a whole-frame search takes only compact blobs (the colour tracker's
+// rule without a model: elongated patches of a colour are common), so coloured blobs it refused
+// for their shape alone, down to this circularity, are candidates too: one is a marker only when
+// it fills its moment ellipse (the ellipse of its area's second moments) to at least
+// kMinEllipseFill (an ellipse fills it exactly, a bar 0.955, a ragged stain or an object's rim far
+// less) and is verified in its own roi, where the configured shape limit holds. Its marker takes
+// kStickerCircularity of its own circularity as its min_circularity (a turning bar's pixel
+// outline varies).
+constexpr double kMinCandidateCircularity = 0.3;
+constexpr double kMinEllipseFill = 0.9;
+constexpr double kStickerCircularity = 0.6;
+// ... and is at least twice this wide (its ellipse's minor semi-axis): a narrower elongated blob
+// is a streak, a thread or a fragment of an edge as often as a sticker.
+constexpr double kMinStickerHalfWidthPx = 3.0;
 // Paths through at most this many markers are searched exhaustively.
 constexpr size_t kExactOrderMax = 8;
 
 struct Candidate {
   cv::Point2d position_px;
   double area_px = 0;
+  double circularity = 1;
+  bool elongated = false;  // Refused by the whole-frame search for its shape alone.
   std::optional<HsvRange> band_gray;  // Gray-level band that found it (gray frames).
 };
 
@@ -280,6 +296,66 @@ CoreLooks CoreLooksOf(const cv::Mat& bgr, const cv::Point2d& centre, double radi
     }
   }
   return {Median(s), Median(v)};
+}
+
+// Blobs of `colour` other than `c` in the whole frame with 0.5-2x its area and at least the
+// circularity its marker accepts: what the marker could be taken for once it is lost.
+int ElongatedLookAlikes(const cv::Mat& frame, const ColourParams& colour, const Candidate& c) {
+  ColourParams probe = colour;
+  probe.roi.reset();
+  int others = 0;
+  for (const MarkerCandidate& o : Probe(frame, probe)) {
+    const bool shaped = o.verdict == CandidateVerdict::kFits ||
+                        o.verdict == CandidateVerdict::kChosen ||
+                        (o.verdict == CandidateVerdict::kShape &&
+                         o.circularity >= colour.min_circularity);
+    if (shaped && o.area_px >= 0.5 * c.area_px && o.area_px <= 2 * c.area_px &&
+        cv::norm(o.position_px - c.position_px) > RadiusOf(c.area_px)) {
+      ++others;
+    }
+  }
+  return others;
+}
+
+// The blob of `colour` at `centre` against its moment ellipse (the ellipse with its area's second
+// moments): how fully it fills it (1 for an ellipse, 0.955 for a bar, less for ragged or hollow
+// shapes) and the ellipse's minor semi-axis. Zeros when no blob of `colour` lies at `centre`.
+// Looked at within `reach_px` of `centre`.
+struct EllipseFit {
+  double fill = 0;
+  double minor_px = 0;
+};
+EllipseFit FitMomentEllipse(const cv::Mat& bgr, const ColourParams& colour,
+                            const cv::Point2d& centre, double reach_px) {
+  const cv::Rect box = cv::Rect(cvFloor(centre.x - reach_px), cvFloor(centre.y - reach_px),
+                                cvCeil(2 * reach_px) + 2, cvCeil(2 * reach_px) + 2) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (box.empty()) return {};
+  cv::Mat hsv, mask, wrapped;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  const HsvRange& h = colour.h;
+  const int h_hi = h.lo <= h.hi ? h.hi : 179;
+  cv::inRange(hsv, cv::Scalar(h.lo, colour.s.lo, colour.v.lo),
+              cv::Scalar(h_hi, colour.s.hi, colour.v.hi), mask);
+  if (h.lo > h.hi) {  // Wrapped through red.
+    cv::inRange(hsv, cv::Scalar(0, colour.s.lo, colour.v.lo),
+                cv::Scalar(h.hi, colour.s.hi, colour.v.hi), wrapped);
+    mask |= wrapped;
+  }
+  cv::Mat labels;
+  cv::connectedComponents(mask, labels, 8, CV_32S);
+  const cv::Point at(cvRound(centre.x) - box.x, cvRound(centre.y) - box.y);
+  if (!cv::Rect(0, 0, labels.cols, labels.rows).contains(at)) return {};
+  const int label = labels.at<int>(at);
+  if (label == 0) return {};
+  const cv::Moments m = cv::moments(labels == label, true);
+  if (m.m00 < 1) return {};
+  const double cxx = m.mu20 / m.m00, cyy = m.mu02 / m.m00, cxy = m.mu11 / m.m00;
+  const double det = cxx * cyy - cxy * cxy;
+  if (det <= 0) return {};
+  const double smaller_variance =
+      0.5 * (cxx + cyy) - std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
+  return {m.m00 / (4 * CV_PI * std::sqrt(det)), 2 * std::sqrt(std::max(0.0, smaller_variance))};
 }
 
 // A pale marker's picked range reaches down to the saturation of a tinted bench, and the blob
@@ -518,8 +594,12 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
   for (const ColourParams& band : bands) {
     for (const MarkerCandidate& c : Probe(frame, band)) {
       if (!search_area.contains(c.position_px)) continue;
-      Candidate candidate{c.position_px, c.area_px, band.gray};
+      Candidate candidate{c.position_px, c.area_px, c.circularity, false, band.gray};
       if (c.verdict == CandidateVerdict::kFits || c.verdict == CandidateVerdict::kChosen) {
+        Merge(&fitting, candidate);
+      } else if (!finding.intensity && c.verdict == CandidateVerdict::kShape &&
+                 c.circularity >= kMinCandidateCircularity && c.area_px >= options.min_area_px) {
+        candidate.elongated = true;
         Merge(&fitting, candidate);
       } else if (c.area_px >= kListedRejectAreaPx) {
         rejects.emplace_back(candidate, RejectReason(c.verdict));
@@ -548,6 +628,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
     int hue = 0;
     CoreLooks looks;     // Medians over its core (colour markers).
     bool twin = false;   // One of several alike blobs of its colour, told apart by its roi.
+    bool elongated = false;
   };
   std::vector<Verified> verified;
   struct LookAlike {
@@ -610,6 +691,18 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       }
       ApplyColourPick(*pick, &colour);
       hue = HueOf(pick->ranges.h);
+      if (c.elongated) {
+        const EllipseFit fit = FitMomentEllipse(frame, colour, c.position_px, 4 * radius + 4);
+        if (fit.fill < kMinEllipseFill || fit.minor_px < kMinStickerHalfWidthPx) {
+          char why[112];
+          std::snprintf(why, sizeof(why),
+                        "shape (not compact, nor an ellipse or a bar: fills %.2f of its ellipse, "
+                        "%.1f px wide)", fit.fill, 2 * fit.minor_px);
+          reject(why);
+          continue;
+        }
+        colour.min_circularity = std::floor(100 * kStickerCircularity * c.circularity) / 100;
+      }
     }
     const double tolerance = std::max(1.0, kVerifyRadii * radius);
     auto verify = [&](bool with_roi, Observation* observation) {
@@ -624,8 +717,21 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       return observation->found() && cv::norm(*observation->position_px - c.position_px) <= tolerance;
     };
     Observation alone;
-    bool ok = verify(false, &alone);
-    bool twin = false, needs_roi = false;
+    bool twin = false, needs_roi = c.elongated;
+    bool ok = verify(needs_roi, &alone);
+    if (!ok && c.elongated) {
+      reject(std::string("not verified in its roi (") + MarkerStatusName(alone.status()) + ")");
+      continue;
+    }
+    if (ok && c.elongated) {
+      // Verified in its roi only, so it must be alone in the frame in another way: no other
+      // blob of its colour, of about its area, as elongated or rounder.
+      const int others = ElongatedLookAlikes(frame, colour, c);
+      if (others > 0) {
+        reject("ambiguous: " + std::to_string(others + 1) + " look-alikes of its colour and shape");
+        continue;
+      }
+    }
     if (!ok && (finding.intensity || options.search_px) &&
         (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
       // Identical dots, or look-alikes outside the search region: told apart by a roi each.
@@ -679,7 +785,21 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
     v.hue = hue;
     if (!finding.intensity) v.looks = CoreLooksOf(frame, c.position_px, radius);
     v.twin = twin;
+    v.elongated = c.elongated;
     verified.push_back(v);
+  }
+  // The markers of one body are of one kind: beside round markers, an elongated blob is a patch
+  // of the scene, not a sticker of theirs.
+  if (std::any_of(verified.begin(), verified.end(), [](const Verified& v) { return !v.elongated; })) {
+    for (const Verified& v : verified) {
+      if (v.elongated) {
+        finding.rejected.push_back({v.marker.position_px, v.marker.radius_px,
+                                    "elongated, unlike the round markers"});
+      }
+    }
+    verified.erase(std::remove_if(verified.begin(), verified.end(),
+                                  [](const Verified& v) { return v.elongated; }),
+                   verified.end());
   }
   // Twins of one colour are markers only when they are alike in everything a tracker can see
   // (size, saturation, brightness) and no look-alike of theirs stayed unresolved: then each is

@@ -404,6 +404,26 @@ TEST(AssociationScenes, InitTakesIdenticalPucksAsMarkersAndRefusesUnlikeLookAlik
   }
 }
 
+// The rim's elongated sticker: init proposes it (a bar, filling its moment ellipse), with a
+// min_circularity of its own, and the marker is followed round two turns of the wheel.
+TEST(AssociationScenes, InitTakesTheRimsElongatedStickerAndItIsFollowed) {
+  const DotScene scene = TurningRim();
+  MarkerFinding finding;
+  const TrackingConfig config = InitConfig(scene, &finding);
+  ASSERT_TRUE(finding.ok()) << finding.problem << [&] {
+    std::string why;
+    for (const auto& r : finding.rejected) why += "; " + r.why;
+    return why;
+  }();
+  ASSERT_EQ(finding.markers.size(), 1u);
+  EXPECT_LT(cv::norm(finding.markers[0].position_px - *scene.truth(2, 0)), 0.5);
+  EXPECT_LT(std::get<ColourParams>(config.markers[0].params).min_circularity, 0.5);
+  const int count = 144;  // Two turns.
+  const SceneScore s = TrackScene(scene, config, {2}, count, 1.5)[0];
+  EXPECT_EQ(s.wrong, 0) << s.first_wrong;
+  EXPECT_GE(s.found, count - 3);
+}
+
 // ---- Template markers (SAD, SSD, ZNCC) on the same footage ---------------------------------
 
 constexpr const char* kTemplateMethods[] = {"zncc", "ssd", "sad"};
