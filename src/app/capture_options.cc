@@ -62,6 +62,22 @@ CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings setti
   return settings;
 }
 
+void RefuseCaptureWithoutCamera(const CaptureArgs& args, const std::optional<CameraSettings>& config,
+                                const std::string& config_path, const std::string& source,
+                                std::ostream& notes) {
+  for (const Option<CameraSettings>& option : CameraSettingsTable()) {
+    const auto it = args.find(option.key);
+    if (it != args.end() && !it->second.empty()) {
+      throw InputError(FlagOf(option.key) + " " + it->second + ": camera settings apply to a " +
+                       "camera (--camera N), and the frames come from " + source);
+    }
+  }
+  if (config && !config->empty()) {
+    notes << "note: " << config_path << ": its capture: settings are for a camera and are not "
+          << "used with " << source << "\n";
+  }
+}
+
 void PrintCaptureReport(const CameraSettingsReport& report) {
   std::cerr << report.summary << "\n";
   for (const std::string& line : report.refused) std::cerr << line << "\n";

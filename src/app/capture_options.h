@@ -6,6 +6,8 @@
 
 #include <map>
 #include <memory>
+#include <optional>
+#include <ostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -23,6 +25,14 @@ void AddCaptureOptions(CLI::App& sub, CaptureArgs* args);
 // The config's settings with the command line's on top. Throws InputError naming the option
 // ("--camera-width 5: must lie within 16..8192").
 CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings settings);
+
+// Capture settings apply to a camera only. With frames from elsewhere (`source`: "the file
+// run.avi", "the simulated rig"), a --camera-* option on the command line is refused (it asked
+// for what cannot happen: InputError naming the option), and a config's `capture:` section (a
+// live recording saves one) is said on `notes` to be left unused.
+void RefuseCaptureWithoutCamera(const CaptureArgs& args, const std::optional<CameraSettings>& config,
+                                const std::string& config_path, const std::string& source,
+                                std::ostream& notes);
 
 // What the camera accepted, on stderr: the summary line, then one line per refused setting.
 void PrintCaptureReport(const CameraSettingsReport& report);

@@ -347,6 +347,13 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     target = MakeTarget(options);
   }
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
+  if (!options.camera) {
+    RefuseCaptureWithoutCamera(options.capture_args, tracking_config.capture, options.config_file,
+                               options.input        ? "the file " + *options.input
+                               : options.rig_frames ? "the rig's frames " + *options.rig_frames
+                                                    : std::string("the simulated rig"),
+                               std::cerr);
+  }
   // Before the board is opened: no output may be an input or another output of this command.
   std::vector<PathRole> outputs{{"--csv", options.csv_file},
                                 {"--metrics-csv", options.metrics_csv_file}};

@@ -206,6 +206,24 @@ TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
   EXPECT_THROW(RunControl(options), InputError);  // Board and simulation.
 }
 
+// Camera settings for frames that come from no camera cannot be carried out: refused, naming the
+// option and where the frames come from, before a port is opened or a file written.
+TEST(ControlCommand, RefusesCameraSettingsWithoutACamera) {
+  ControlOptions options;
+  options.config_file = Example();
+  options.simulate = true;
+  options.target_deg = 120.0;
+  options.csv_file = "/nonexistent/x.csv";
+  options.capture_args["fps"] = "30";
+  try {
+    RunControl(options);
+    FAIL() << "camera settings for the simulated rig were accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--camera-fps 30: camera settings apply to a camera "
+                                    "(--camera N), and the frames come from the simulated rig"));
+  }
+}
+
 TEST(ControlCommand, RefusesNonFiniteAndOutOfRangeNumbersNamingTheOption) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();

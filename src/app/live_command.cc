@@ -58,6 +58,10 @@ int RunLive(const LiveArgs& args) {
     throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
                      args.config + ")");
   }
+  if (!camera) {
+    RefuseCaptureWithoutCamera(args.capture, config.capture, args.config, "the file " + args.input,
+                               std::cerr);
+  }
   FrameSourceSpec spec;
   spec.camera = camera;
   spec.input = args.input;

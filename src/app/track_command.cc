@@ -212,6 +212,13 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
   return [options, inputs, jobs, capture] {
+    if (!options->source.camera) {
+      const std::string source = inputs->size() == 1   ? "the file " + inputs->front()
+                                 : inputs->empty()      ? "the file " + options->source.input
+                                                        : "files";
+      RefuseCaptureWithoutCamera(*capture, LoadTrackingConfig(options->config_file).capture,
+                                 options->config_file, source, std::cerr);
+    }
     const bool to_folder = IsOutputFolder(options->csv_file);
     if (inputs->size() > 1 || to_folder) {
       if (!to_folder) {

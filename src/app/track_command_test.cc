@@ -75,6 +75,35 @@ ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::ReadTextFile(dir.file("stderr.txt"))};
 }
 
+// Camera settings with frames from a file: a --camera-* option cannot be carried out and is
+// refused before anything is written; a config's capture: section (a live recording saves one)
+// is said to be unused, and the run goes on.
+TEST(TrackCommand, CameraSettingsWithAFileAreRefusedOnTheCommandLineAndNotedFromTheConfig) {
+  TempDir dir;
+  const RenderedClip clip = RenderClip(dir, 3);
+  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  const ProgramRun refused =
+      RunBinary("track --config " + dir.file("markers.yaml") + " --input " + clip.video +
+                    " --csv " + dir.file("a.csv") + " --camera-exposure 120",
+                dir);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.stderr_text,
+              HasSubstr("--camera-exposure 120: camera settings apply to a camera (--camera N), "
+                        "and the frames come from the file " + clip.video));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.csv")));
+
+  testing::WriteTextFile(dir.file("recorded.yaml"),
+                         std::string(kConfig) + "capture:\n  exposure: 120\n");
+  const ProgramRun noted = RunBinary("track --config " + dir.file("recorded.yaml") + " --input " +
+                                         clip.video + " --csv " + dir.file("b.csv"),
+                                     dir);
+  EXPECT_EQ(noted.exit_code, 0) << noted.stderr_text;
+  EXPECT_THAT(noted.stderr_text, HasSubstr("note: " + dir.file("recorded.yaml") +
+                                           ": its capture: settings are for a camera and are not "
+                                           "used with the file " + clip.video));
+  EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).size(), 4u);
+}
+
 TEST(TrackCommand, RenderedVideoGivesTruthWithinTolerances) {
   TempDir dir;
   const RenderedClip clip = RenderClip(dir, 40);

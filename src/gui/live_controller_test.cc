@@ -1064,11 +1064,12 @@ TEST_F(LivePlaybackTest, StepSeekStartEndLandOnTheSourcesFramesWithTheOverlayOnT
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 3);
   EXPECT_GT(seekable_->frames_decoded(), decoded);
-  Key(live, '>');
+  Key(live, '>');  // End: the last frame, and the end of input at once (nothing follows it).
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 39);
-  EXPECT_FALSE(live.ended());
-  Key(live, '.');  // Past the last frame: END, the last frame stays.
+  EXPECT_TRUE(live.ended());
+  EXPECT_TRUE(feed.ended());
+  Key(live, '.');  // Past the last frame: still END, the last frame stays.
   EXPECT_FALSE(feed.step(live));
   EXPECT_TRUE(live.ended());
   ExpectShowing(live, 39);
@@ -1117,6 +1118,31 @@ TEST_F(LivePlaybackTest, PlayingOnAfterASeekKeepsTheFilesRateAndEndKeepsEveryKey
   ExpectShowing(live, 1);
   EXPECT_GE(clock_.now - at_start, std::chrono::milliseconds(33));
   EXPECT_LE(clock_.now - at_start, std::chrono::milliseconds(34));
+}
+
+// After End, space plays from the first frame (as at the end of playing), saying so: it used to
+// say "running", read past the end and say "end of input".
+TEST_F(LivePlaybackTest, SpaceAfterEndPlaysFromTheStart) {
+  const std::string video = WriteVideo(12);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  ASSERT_TRUE(feed.step(live));
+  Key(live, ' ');  // Paused.
+  EXPECT_TRUE(live.paused());
+  Key(live, kKeyEnd);
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 11);
+  EXPECT_TRUE(live.ended());
+  EXPECT_EQ(live.message().rfind("end of input", 0), 0u) << live.message();
+  Key(live, ' ');
+  EXPECT_EQ(live.message(), "playing from the first frame");
+  EXPECT_FALSE(live.paused());
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 0);
+  EXPECT_FALSE(live.ended());
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 1);
 }
 
 TEST_F(LivePlaybackTest, LoopWrapsToTheFirstFrameAndRestartStartsTheTrackersAfresh) {

@@ -29,9 +29,20 @@ bool LiveFeed::jump_to(int64_t position, LiveController& controller) {
   if (paced_) paced_->pause();
   seekable_->seek(position);
   bool got = read(controller, FrameOrder::kJump);
-  if (!got && seekable_->seek_last()) got = read(controller, FrameOrder::kJump);  // Past the end.
+  if (!got && seekable_->seek_last()) {  // Past the end: the last frame, and the end.
+    got = read(controller, FrameOrder::kJump);
+    if (got) reached_end(controller);
+  }
   if (paced_ && !was_paused) paced_->resume();
   return got;
+}
+
+void LiveFeed::reached_end(LiveController& controller) {
+  // The last frame is on screen and nothing follows it: the end, at once (space then plays from
+  // the start, as after playing to the end), unless looping wraps to the first frame.
+  if (controller.loop()) return;
+  ended_ = true;
+  controller.on_end_of_input();
 }
 
 bool LiveFeed::carry_out(const PlaybackRequest& request, LiveController& controller) {
@@ -66,6 +77,7 @@ bool LiveFeed::carry_out(const PlaybackRequest& request, LiveController& control
       const bool was_paused = paced_ && paced_->paused();
       if (paced_) paced_->pause();
       const bool got = seekable_->seek_last() && read(controller, FrameOrder::kJump);
+      if (got) reached_end(controller);
       if (paced_ && !was_paused) paced_->resume();
       return got;
     }

@@ -29,7 +29,8 @@ class LiveFeed {
 
   // Carries out a pending transport request, or reads and feeds the next frame unless the
   // controller is paused or the source has ended (or, looping, feeds the first frame again).
-  // Returns true when a frame was fed. Calls controller.on_end_of_input() at each end.
+  // Returns true when a frame was fed. Calls controller.on_end_of_input() at each end: reading
+  // past the last frame, or showing it by End or a seek beyond it.
   // An InputError from the source (a frame that does not decode) reaches the caller.
   bool step(LiveController& controller);
 
@@ -41,6 +42,7 @@ class LiveFeed {
   // Reads the frame at `position` at once (the paced clock restarts at it) and feeds it.
   bool jump_to(int64_t position, LiveController& controller);
   bool read(LiveController& controller, FrameOrder order);
+  void reached_end(LiveController& controller);
 
   FrameSource& source_;
   PacedFrameSource* paced_;   // &source_ when it is paced, else null.
