@@ -67,7 +67,9 @@ void LiveController::report_recording_failure() {
 
 void LiveController::say(const std::string& message) {
   message_ = message;
-  ++message_count_;
+  // Bounded: a window that never takes them (a test) keeps only the latest.
+  if (unlogged_.size() >= 64) unlogged_.erase(unlogged_.begin());
+  unlogged_.push_back(message);
   dirty_ = true;
 }
 
@@ -75,10 +77,14 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
                               FrameOrder order) {
   if (paused_ && order == FrameOrder::kNext) return;
   CV_Assert(frame.image.type() == CV_8UC3);
+  bool recording_stopped = false;
   if (order == FrameOrder::kJump) {
     if (recording()) {
-      toggle_recording();
-      say(message_ + " (stopped: the playback jumped)");
+      // Said on screen until the next message (not replaced by the frame's), and logged.
+      const int64_t frames = pipeline_->stop_recording();
+      say("recorded " + std::to_string(frames) + " frames to " + last_recording() +
+          ".* (stopped: " + (loop_ ? "the loop went back to the first frame)" : "the playback jumped)"));
+      recording_stopped = true;
     }
     session().jump();
     chart_.clear();  // Its time axis cannot run backwards.
@@ -95,7 +101,9 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   if (order != FrameOrder::kNext) {
     // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
     // (stdout too, for the terminal and for scripts driving the window).
-    say("frame " + std::to_string(frame.index) + " (" + FixedText(frame.time_s, 3) + " s)");
+    if (!recording_stopped) {
+      say("frame " + std::to_string(frame.index) + " (" + FixedText(frame.time_s, 3) + " s)");
+    }
     return;
   }
 

@@ -155,10 +155,15 @@ class LiveController {
   }
   int64_t dropped_frames() const { return dropped_; }
   const std::optional<FrameResult>& last_result() const { return last_result_; }
-  // The last message on screen, and how many have been said so far (the same text said twice
-  // counts twice), so the window can log each one once.
+  // The last message on screen, and every message said since the last call (oldest first), so
+  // the window logs each one once, also those a later one replaced on screen within one frame
+  // (the recording a loop's wrap stopped, then the wrap).
   const std::string& message() const { return message_; }
-  int64_t message_count() const { return message_count_; }
+  std::vector<std::string> take_messages() {
+    std::vector<std::string> said;
+    said.swap(unlogged_);
+    return said;
+  }
   std::optional<double> latency_ms() const { return meter_.latency_ms(); }
   std::optional<double> fps() const { return meter_.fps(); }
   // The active marker's ranges in kHsvTrackbars order, and a counter that changes whenever they
@@ -242,7 +247,7 @@ class LiveController {
   std::unique_ptr<LivePointer> pointer_;
   ScaleClicks scale_;
   std::string message_;
-  int64_t message_count_ = 0;
+  std::vector<std::string> unlogged_;  // Said since the last take_messages().
 };
 
 }  // namespace softsight

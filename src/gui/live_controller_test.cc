@@ -1165,8 +1165,15 @@ TEST_F(LivePlaybackTest, LoopWrapsToTheFirstFrameAndRestartStartsTheTrackersAfre
   ASSERT_TRUE(live.recording());
   Key(live, '[');  // Refused while recording.
   EXPECT_NE(live.message().find("stop the recording first"), std::string::npos);
+  live.take_messages();
   while (live.last_result()->frame_index != 0) ASSERT_TRUE(feed.step(live));
   EXPECT_FALSE(live.recording());
+  // Said, on screen and in the log: the wrap's frame message does not replace it.
+  const std::string said = "recorded 3 frames to " + live.last_recording() +
+                           ".* (stopped: the loop went back to the first frame)";
+  EXPECT_EQ(live.message(), said);
+  const std::vector<std::string> log = live.take_messages();
+  EXPECT_NE(std::find(log.begin(), log.end(), said), log.end());
   const CsvTable table = ReadCsvTable(live.last_recording() + ".csv");
   ASSERT_EQ(table.row_count(), 3u);  // Frames 7, 8, 9.
   EXPECT_EQ(*table.values[*table.find("frame")][0], 7.0);

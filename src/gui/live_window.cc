@@ -112,7 +112,7 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
   }
 
   bool end_announced = false;
-  int64_t logged_messages = controller.message_count();
+  controller.take_messages();  // Said while setting up: the terminal has the start-up lines.
   LiveFeed feed(source, seekable);
   while (!controller.quit_requested()) {
     // A paced file waits in read() until its frame is due (at most one frame period); a camera
@@ -135,11 +135,10 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
         controller.on_event(UiEvent::Key(code));
       }
     }
-    if (controller.message_count() != logged_messages) {
-      // What the window said (recording started, paused, saved ...) also goes to stdout, one
-      // line each, for the terminal's scrollback and for scripts that drive the window.
-      std::cout << "live: " << controller.message() << std::endl;
-      logged_messages = controller.message_count();
+    // What the window said (recording started, paused, saved ...) also goes to stdout, one
+    // line each, for the terminal's scrollback and for scripts that drive the window.
+    for (const std::string& said : controller.take_messages()) {
+      std::cout << "live: " << said << std::endl;
     }
     if (options.trackbars && controller.hsv_revision() != shown_revision) {
       const std::array<int, 6> hsv = controller.active_hsv();
