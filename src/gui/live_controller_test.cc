@@ -654,6 +654,37 @@ TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrack
   EXPECT_EQ(again, live_rows);
 }
 
+// A recording started after edits made while paused (every marker switched to SAD, a box dragged
+// on empty background for the active one) reproduces under `track`: the recording starts from a
+// session built afresh from its config, not one that keeps what it learned before (the markers'
+// arrangement, their motion), which made live say `implausible` where `track` said `found`.
+TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
+  const std::string video = WriteVideo(30);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveOptions options = Options();
+  options.record_fps = 30.0;
+  LiveController live(SceneConfig(), options);
+  LiveFeed feed(*source);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key(' '));
+  ASSERT_TRUE(live.paused());
+  live.on_event(UiEvent::Key('m'));  // colour -> sad
+  ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "sad");
+  Drag(live, {20, 20}, {44, 44});  // Empty background, for the active marker.
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  live.on_event(UiEvent::Key(' '));
+  for (int i = 0; i < 12; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_FALSE(live.recording());
+  const std::string prefix = live.last_recording();
+  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+  ASSERT_EQ(live_rows.size(), 14u);  // Header, the frame on screen, 12 frames.
+  EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+}
+
 TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfterTheReselection) {
   const std::string video = WriteVideo(30);
   FakeClock clock;

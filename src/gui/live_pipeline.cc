@@ -83,9 +83,10 @@ const FrameResult& LivePipeline::start_recording(
       settings_.prefix, snapshot, info, RecordingOrigin{frame.index, frame.time_s},
       std::move(draw), settings_.before_encode);
   recording->begin(info);
-  // Rebuilt before the recording listens: these are its start, not edits made during it.
-  for (const MarkerSpec& spec : snapshot.markers) session_->respec(spec);
-  session_->reset_tip_reference();
+  // Built afresh from the recording's config before the recording listens (these are its start,
+  // not edits made during it): `track` on the recording starts from that config alone, without
+  // what this session learned before (the body's arrangement, the markers' motion).
+  session_->restart(snapshot);
   recording_ = std::move(recording);
   // The frame on screen again, as the recording's first row (the run counted it already).
   const FrameResult& result = session_->process(frame);

@@ -77,6 +77,14 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
 }
 
 TrackingSession::~TrackingSession() = default;
+TrackingSession::TrackingSession(TrackingSession&&) noexcept = default;
+TrackingSession& TrackingSession::operator=(TrackingSession&&) noexcept = default;
+
+void TrackingSession::restart(const TrackingConfig& config) {
+  TrackingSession fresh(config);  // Throws before anything here changes.
+  fresh.edit_listener_ = std::move(edit_listener_);
+  *this = std::move(fresh);
+}
 
 const FrameResult& TrackingSession::process(const Frame& frame) {
   const int64_t start = cv::getTickCount();

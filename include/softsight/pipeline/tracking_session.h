@@ -27,6 +27,15 @@ class TrackingSession {
   // Builds one tracker per configured marker. Throws InputError on a bad spec.
   explicit TrackingSession(const TrackingConfig& config);
   ~TrackingSession();
+  TrackingSession(TrackingSession&&) noexcept;
+  TrackingSession& operator=(TrackingSession&&) noexcept;
+
+  // Starts over as a session newly built from `config`: trackers, motion models, the learned
+  // arrangement of the body, the frame-change reference and the bending-distance reference, all
+  // as a new session has them (a live recording's start, which `track` on the recording must
+  // reproduce from its config alone). The edit listener stays. Throws InputError on a bad spec,
+  // and then changes nothing.
+  void restart(const TrackingConfig& config);
 
   // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
   // frame) trackers are initialised from the config's ROIs and template rectangles. A live
