@@ -685,6 +685,30 @@ TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
   EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
 }
 
+// The same edits at the end of the input, then a one-row recording: reproduced too.
+TEST_F(LiveFileTest, AOneRowRecordingAtTheEndAfterEditsReproducesUnderTrack) {
+  const std::string video = WriteVideo(12);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveOptions options = Options();
+  options.record_fps = 30.0;
+  LiveController live(SceneConfig(), options);
+  LiveFeed feed(*source);
+  while (feed.step(live)) {
+  }
+  ASSERT_TRUE(live.ended());
+  live.on_event(UiEvent::Key('m'));
+  Drag(live, {20, 20}, {44, 44});
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  live.on_event(UiEvent::Key('r'));
+  const std::string prefix = live.last_recording();
+  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+  ASSERT_EQ(live_rows.size(), 2u);
+  EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+}
+
 TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfterTheReselection) {
   const std::string video = WriteVideo(30);
   FakeClock clock;
