@@ -655,7 +655,7 @@ TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrack
 }
 
 // A recording started after edits made while paused (every marker switched to SAD, a box dragged
-// on empty background for the active one) reproduces under `track`: the recording starts from a
+// on empty background and refused, a box dragged around a marker) reproduces under `track`: the recording starts from a
 // session built afresh from its config, not one that keeps what it learned before (the markers'
 // arrangement, their motion), which made live say `implausible` where `track` said `found`.
 TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
@@ -671,7 +671,15 @@ TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
   ASSERT_TRUE(live.paused());
   live.on_event(UiEvent::Key('m'));  // colour -> sad
   ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "sad");
-  Drag(live, {20, 20}, {44, 44});  // Empty background, for the active marker.
+  // A box on empty background is refused, saying why; the active marker keeps its template.
+  const cv::Rect before = *std::get<TemplateParams>(live.config().markers[0].params).rect;
+  Drag(live, {20, 20}, {44, 44});
+  EXPECT_NE(live.message().find("holds no marker"), std::string::npos) << live.message();
+  EXPECT_EQ(*std::get<TemplateParams>(live.config().markers[0].params).rect, before);
+  // A box around blue, off its centre: blue's template is re-cut.
+  const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+  Drag(live, blue - cv::Point2d(9, 11), blue + cv::Point2d(12, 10));
+  ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
   live.on_event(UiEvent::Key('r'));
   ASSERT_TRUE(live.recording()) << live.message();
   live.on_event(UiEvent::Key(' '));

@@ -468,6 +468,9 @@ class TemplateTracker final : public Tracker {
     }
   }
   std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
+  // Whether `templ` (native) would show its marker's blob, as SetTemplate learns it; changes
+  // nothing.
+  bool ShowsAMarker(const cv::Mat& templ) const;
   // A point of the selected template in a rung of `size`. Template coordinates scale about the
   // pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
   cv::Point2d ToRung(const cv::Point2d& p, const cv::Size& size) const {
@@ -694,6 +697,21 @@ bool TemplateTracker::start(const Frame& frame) {
   return false;
 }
 
+bool TemplateTracker::ShowsAMarker(const cv::Mat& templ) const {
+  cv::Mat gray;
+  const cv::Mat projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
+  if (templ.channels() == 1) {
+    gray = templ;
+  } else if (!projection.empty()) {
+    cv::transform(templ, gray, projection);
+  } else {
+    cv::cvtColor(templ, gray, cv::COLOR_BGR2GRAY);
+  }
+  BlobMeter meter;
+  cv::Point2d centroid;
+  return meter.Learn(gray, MaskFor(templ.size()), &centroid);
+}
+
 void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
   CV_Assert(frame_bgr.type() == CV_8UC3 || frame_bgr.type() == CV_8UC1);
   if (!hint.empty()) {
@@ -711,6 +729,14 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
     cv::Mat native;
     ToNative(frame_bgr(hint), native);
     try {
+      // A box a person drags must hold a marker: a blob at its centre, wholly inside it and
+      // standing out from its surroundings. A box of background (or cutting a marker) would be
+      // matched wherever that background looks alike, and never lost.
+      if (!ShowsAMarker(native)) {
+        throw InputError("the box " + RectText(hint) + " holds no marker (nothing at its centre "
+                         "stands out from its surroundings): drag it around a marker, with some "
+                         "background on every side");
+      }
       SetTemplate(native.clone(), "template rect " + RectText(hint));
     } catch (const InputError&) {
       projection_ = previous;
