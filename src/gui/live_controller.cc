@@ -95,7 +95,6 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   frame_time_s_ = frame.time_s;
   // Tracked, counted and (while recording) recorded by the pipeline.
   const FrameResult& result = pipeline_->process(frame);
-  chart_.add(result);
   show(result);
   report_recording_failure();
   if (order != FrameOrder::kNext) {
@@ -471,6 +470,7 @@ Frame LiveController::on_screen() const { return Frame{frame_, frame_index_, fra
 
 void LiveController::show(const FrameResult& result) {
   last_result_ = result;
+  chart_.add(result);  // A frame measured again (re-tracked, reselected) replaces its sample.
   redraw_annotated();
   dirty_ = true;
 }

@@ -155,6 +155,7 @@ class LiveController {
   }
   int64_t dropped_frames() const { return dropped_; }
   const std::optional<FrameResult>& last_result() const { return last_result_; }
+  const StripChart& chart() const { return chart_; }
   // The last message on screen, and every message said since the last call (oldest first), so
   // the window logs each one once, also those a later one replaced on screen within one frame
   // (the recording a loop's wrap stopped, then the wrap).

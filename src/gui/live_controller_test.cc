@@ -926,9 +926,14 @@ TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRange
   }
   // A click on blue adds its colours: blue is found there at once (still paused, same frame),
   // its pixels shown in their own colours, red's still dimmed; the chosen blob is circled green.
+  EXPECT_FALSE(live.chart().newest(0).has_value());  // No angle without blue.
   Click(live, blue);
   EXPECT_EQ(live.last_result()->frame_index, 3);
   ExpectAt(live, 1, truth, 0.3);
+  // The strip chart reads the re-tracked frame's angle, as the text block does.
+  ASSERT_TRUE(live.last_result()->measurement.angle_deg.has_value());
+  EXPECT_EQ(live.chart().newest(0), live.last_result()->measurement.angle_deg);
+  EXPECT_EQ(live.chart().size(), 4u);
   EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.lo, 112);
   EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.hi, 125);
   {

@@ -187,6 +187,15 @@ TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
       flat.rect.y + (flat.y_max - 5.0) / (flat.y_max - flat.y_min) * (flat.rect.height - 1);
   EXPECT_TRUE(ColourWithin(area, {chart.x_of(12.0), y_flat}, StripChart::kColours[1], 1));
 
+  // The newest frame measured again (a paused re-track) replaces its sample.
+  FrameResult again;
+  again.time_s = 600 / 30.0;
+  again.measurement.angle_deg = 116.9;
+  chart.add(again);
+  EXPECT_EQ(chart.size(), 301u);
+  EXPECT_EQ(chart.newest(0), 116.9);
+  EXPECT_FALSE(chart.newest(1).has_value());
+
   // Time going backwards (a new source) restarts the chart.
   FrameResult restart;
   restart.time_s = 0.0;

@@ -46,6 +46,7 @@ StripChart::StripChart(StripChartOptions options) : options_(options) {
 
 void StripChart::add(const FrameResult& result) {
   if (!samples_.empty() && result.time_s < samples_.back().time_s) samples_.clear();
+  if (!samples_.empty() && result.time_s == samples_.back().time_s) samples_.pop_back();
   const Measurement& m = result.measurement;
   const bool metric = m.tip_disp_mm.has_value() || m.arc_length_mm.has_value();
   Sample sample{result.time_s,

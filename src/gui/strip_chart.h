@@ -19,7 +19,8 @@ class StripChart {
   explicit StripChart(StripChartOptions options = {});
 
   // Appends a frame's measurements (mm when the frame has them, else px) and forgets samples
-  // older than the window. Time going backwards (a new source) restarts the chart.
+  // older than the window. Time going backwards (a new source) restarts the chart; the frame of
+  // the newest sample measured again (a paused re-track) replaces it.
   void add(const FrameResult& result);
   void clear();
 
@@ -39,6 +40,10 @@ class StripChart {
   double x_of(double time_s) const;
 
   size_t size() const { return samples_.size(); }
+  // The newest sample's value in lane `i` (what its label reads), absent when not measured.
+  std::optional<double> newest(int i) const {
+    return samples_.empty() ? std::nullopt : samples_.back().values[i];
+  }
   const StripChartOptions& options() const { return options_; }
 
   static const cv::Scalar kColours[3];
