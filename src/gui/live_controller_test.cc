@@ -1022,6 +1022,28 @@ TEST(LiveLayout, AFrameFitsTheScreenAndCanvasPixelsMapBackToImagePixels) {
   EXPECT_EQ(small.canvas, cv::Size(320, 420));
 }
 
+// The trackbar window goes beside the canvas where there is room, else under it, else into the
+// screen's bottom-right corner; it never starts over the canvas's top-left text block.
+TEST(LiveLayout, TheTrackbarWindowIsPlacedBesideTheCanvasNotOverIt) {
+  const auto overlaps_text = [](cv::Point at, cv::Size canvas) {
+    return cv::Rect(at, kTrackbarWindowPx).contains({10, 10}) && canvas.area() > 0;
+  };
+  // A 640x480 frame with its chart on a 1920x1080 screen: to the right.
+  const cv::Point right = TrackbarWindowPlace({1920, 1080}, {640, 660});
+  EXPECT_GE(right.x, 640);
+  EXPECT_EQ(right.y, 0);
+  // A 1280x720 frame on a 1366x768 laptop (canvas 1296x668 after scaling) with the help panel:
+  // neither right nor under fits, the bottom-right corner.
+  const cv::Point corner = TrackbarWindowPlace({1366, 768}, {1334, 668});
+  EXPECT_FALSE(overlaps_text(corner, {1334, 668}));
+  EXPECT_LE(corner.x + kTrackbarWindowPx.width, 1366);
+  EXPECT_LE(corner.y + kTrackbarWindowPx.height, 768);
+  // A wide but short canvas: under it.
+  const cv::Point under = TrackbarWindowPlace({1366, 1080}, {1300, 420});
+  EXPECT_EQ(under.x, 0);
+  EXPECT_GE(under.y, 420);
+}
+
 TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRightPixels) {
   const SceneOptions options = testing::LiveTest720pScene(10);
   SyntheticScene scene(options);

@@ -42,4 +42,16 @@ LiveLayout ComputeLiveLayout(cv::Size image_px, int chart_height_px, int help_wi
   return layout;
 }
 
+cv::Point TrackbarWindowPlace(cv::Size screen_px, cv::Size canvas_px) {
+  const cv::Size room(kTrackbarWindowPx.width + kScreenMarginWidthPx,
+                      kTrackbarWindowPx.height + kScreenMarginHeightPx);
+  if (canvas_px.width + room.width <= screen_px.width) {
+    return {canvas_px.width + kScreenMarginWidthPx / 2, 0};
+  }
+  if (canvas_px.height + room.height <= screen_px.height) {
+    return {0, canvas_px.height + kScreenMarginHeightPx / 2};
+  }
+  return {std::max(0, screen_px.width - room.width), std::max(0, screen_px.height - room.height)};
+}
+
 }  // namespace softsight

@@ -38,4 +38,11 @@ LiveLayout ComputeLiveLayout(cv::Size image_px, int chart_height_px, int help_wi
 // The largest canvas for a screen of `screen_px` (the margins above taken off).
 cv::Size MaxCanvasForScreen(cv::Size screen_px);
 
+// Where the trackbar window's top-left corner goes, with the main window at the screen's
+// top-left: right of the canvas when it fits there, else under it, else in the screen's
+// bottom-right corner (away from the text block at the image's top-left). About the size six
+// OpenCV trackbars take.
+inline const cv::Size kTrackbarWindowPx{360, 280};
+cv::Point TrackbarWindowPlace(cv::Size screen_px, cv::Size canvas_px);
+
 }  // namespace softsight

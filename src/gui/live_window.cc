@@ -8,6 +8,7 @@
 
 #include "gui/live_controller.h"
 #include "gui/live_feed.h"
+#include "gui/live_layout.h"
 #include "gui/seekable_source.h"
 #include "softsight/io/frame_grabber.h"
 #include "softsight/io/paced_source.h"
@@ -89,7 +90,9 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
   const std::string& title = options.title;
   // The canvas is scaled to the screen (a 720p frame with its chart is taller than a laptop's
   // screen); mouse positions come back in canvas pixels and the controller maps them.
-  controller.set_screen(options.screen_px.area() > 0 ? options.screen_px : ScreenSize());
+  const cv::Size screen = options.screen_px.area() > 0 ? options.screen_px : ScreenSize();
+  controller.set_screen(screen);
+  cv::Size placed_for;  // The canvas size the trackbar window was placed beside.
   // GUI_NORMAL: no toolbar or status bar, so image pixels are canvas pixels.
   cv::namedWindow(title, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
   CallbackContext mouse{&controller};
@@ -145,7 +148,19 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
       for (size_t i = 0; i < kHsvTrackbars.size(); ++i) {
         cv::setTrackbarPos(kHsvTrackbars[i].name, sliders, hsv[i]);
       }
+      // The window says whose ranges it edits.
+      const int active = controller.active_marker();
+      cv::setWindowTitle(sliders, "HSV of " + controller.config().markers[active].name +
+                                      " (1-9 chooses)");
       shown_revision = controller.hsv_revision();
+    }
+    if (options.trackbars && controller.canvas().size() != placed_for) {
+      // Beside the canvas, not over it (without a window manager every window opens at 0,0,
+      // over the text block); again when the canvas grows (the help panel).
+      placed_for = controller.canvas().size();
+      cv::moveWindow(title, 0, 0);
+      const cv::Point at = TrackbarWindowPlace(screen, placed_for);
+      cv::moveWindow(sliders, at.x, at.y);
     }
     if (cv::getWindowProperty(title, cv::WND_PROP_VISIBLE) < 1) break;  // Closed by the user.
   }
