@@ -88,6 +88,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
     }
     session().jump();
     chart_.clear();  // Its time axis cannot run backwards.
+    meter_.restart();  // Nor the source's speed.
   }
   frame.image.copyTo(frame_);
   frame_index_ = frame.index;
@@ -107,7 +108,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   }
 
   // Frame rate over the last frames that produced a result, latency from capture to result.
-  meter_.result_at(SteadyClock::now());
+  meter_.result_at(SteadyClock::now(), frame.time_s);
   // Latency: from capture to the annotated (and recorded) result, as the window is about to show
   // it. The overlay shows the smoothed value up to the previous frame.
   meter_.latency(std::chrono::duration<double, std::milli>(SteadyClock::now() - captured).count());
@@ -123,6 +124,7 @@ void LiveController::redraw_annotated() {
 void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) const {
   OverlayStatus status;
   status.fps = meter_.fps();
+  status.speed = meter_.speed();
   status.latency_ms = meter_.latency_ms();
   DrawOverlay(image, result, options_.overlay, status);
 }
@@ -553,6 +555,7 @@ void LiveController::handle(const UiEvent& event) {
             break;
           }
           paused_ = !paused_;
+          meter_.restart();  // A pause is no slow playback: the rates start over.
           say(paused_ ? "paused" : "running");
           break;
         case '.':

@@ -19,27 +19,44 @@ TEST(RateMeter, FpsIsResultsPerSecondOverTheLast30AndLatencyIsSmoothed) {
   RateMeter meter;
   const Clock::time_point t0{};
   EXPECT_FALSE(meter.fps());
-  meter.result_at(t0);
+  meter.result_at(t0, 0.0);
   EXPECT_FALSE(meter.fps()) << "one result is no rate";
-  meter.result_at(t0);
+  meter.result_at(t0, 0.0);
   EXPECT_FALSE(meter.fps()) << "no time passed";
-  // 30 results 40 ms apart after the two at t0: the ring holds the last 30, 29 intervals.
+  // 30 results 40 ms apart after the two at t0, of a 25 fps file: the ring holds the last 30,
+  // 29 intervals; the file plays in real time.
   Clock::time_point t = t0;
+  double media = 0.0;
   for (int i = 0; i < 30; ++i) {
     t += milliseconds(40);
-    meter.result_at(t);
+    media += 0.04;
+    meter.result_at(t, media);
   }
   ASSERT_TRUE(meter.fps());
   EXPECT_NEAR(*meter.fps(), 25.0, 1e-9);
+  EXPECT_NEAR(*meter.speed(), 1.0, 1e-9);
   // The window slides: 29 more 10 ms apart replace every old time but the newest.
   for (int i = 0; i < 28; ++i) {
     t += milliseconds(10);
-    meter.result_at(t);
+    media += 0.01;
+    meter.result_at(t, media);
   }
   EXPECT_NEAR(*meter.fps(), 29.0 / (0.040 + 28 * 0.010), 1e-9) << "one 40 ms interval left";
   t += milliseconds(10);
-  meter.result_at(t);
+  media += 0.01;
+  meter.result_at(t, media);
   EXPECT_NEAR(*meter.fps(), 100.0, 1e-9);
+  // A 30 fps file (33.3 ms a frame) shown every 50 ms plays at two thirds of its speed.
+  for (int i = 0; i < 30; ++i) {
+    t += milliseconds(50);
+    media += 1.0 / 30;
+    meter.result_at(t, media);
+  }
+  EXPECT_NEAR(*meter.fps(), 20.0, 1e-9);
+  EXPECT_NEAR(*meter.speed(), 2.0 / 3.0, 1e-9);
+  meter.restart();  // A jump: no rate until two more results.
+  EXPECT_FALSE(meter.fps());
+  EXPECT_FALSE(meter.speed());
 
   EXPECT_FALSE(meter.latency_ms());
   meter.latency(10.0);

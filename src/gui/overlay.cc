@@ -10,6 +10,9 @@ namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kShift = 4;  // Sub-pixel drawing: coordinates in 1/16 px.
+// A file shown at less than this fraction of its own speed is said to play slower than real time
+// (a loaded machine, a large frame): its figures come from every frame, only later.
+constexpr double kSlowPlaybackSpeed = 0.9;
 // A radius of this many arc lengths or more reads "straight". The arc then turns by less than
 // 1/25 rad (2.3 deg) and its sagitta is under 1/200 of its length (s = L^2 / 8R): 0.5 px on a
 // 100 px actuator, only a few times the centroid noise (0.03-0.1 px). The radius's digits would
@@ -153,10 +156,16 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
     std::snprintf(buffer, sizeof(buffer), "proc %.2f ms", result.proc_ms);
     timing += buffer;
     if (status.latency_ms) {
-      std::snprintf(buffer, sizeof(buffer), "  latency %.0f ms", *status.latency_ms);
+      // Capture to screen: more than the run summary's capture-to-result latency by the drawing
+      // and the window's own wait for the frame.
+      std::snprintf(buffer, sizeof(buffer), "  to screen %.0f ms", *status.latency_ms);
       timing += buffer;
     }
     lines.emplace_back(timing, overlay_colour::kText);
+    if (status.speed && *status.speed < kSlowPlaybackSpeed) {
+      std::snprintf(buffer, sizeof(buffer), "%.2fx real time: slower than the video", *status.speed);
+      lines.emplace_back(buffer, overlay_colour::kLost);
+    }
     if (!lost.empty()) lines.emplace_back("LOST: " + lost, overlay_colour::kLost);
     for (const std::string& note : status.notes) lines.emplace_back(note, overlay_colour::kText);
 

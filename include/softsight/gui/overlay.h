@@ -44,7 +44,8 @@ OverlayOptions OverlayOptionsFor(const MeasureOptions& measure);
 // Figures only a live run knows; absent ones are not shown.
 struct OverlayStatus {
   std::optional<double> fps;         // Processed frames per second.
-  std::optional<double> latency_ms;  // Capture to result.
+  std::optional<double> speed;       // Source seconds per second (below 0.9: said).
+  std::optional<double> latency_ms;  // Capture to the result on screen.
   std::vector<std::string> notes;    // Extra lines (e.g. "REC live-001", "PAUSED").
 };
 
