@@ -126,6 +126,17 @@ void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) con
   status.fps = meter_.fps();
   status.speed = meter_.speed();
   status.latency_ms = meter_.latency_ms();
+  for (const MarkerSpec& spec : config().markers) {
+    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+    std::optional<cv::Size> size;
+    if (templ && !templ->image.empty()) size = templ->image.size();
+    if (templ && !size && templ->rect) size = templ->rect->size();
+    if (size) {
+      status.template_boxes.push_back(OverlayStatus::TemplateBox{*size, TrackerMethodName(spec.params)});
+    } else {
+      status.template_boxes.emplace_back();
+    }
+  }
   DrawOverlay(image, result, options_.overlay, status);
 }
 

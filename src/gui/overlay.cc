@@ -1,6 +1,7 @@
 #include "softsight/gui/overlay.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
@@ -221,6 +222,25 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
              kShift);
     OutlinedText(frame_bgr, marker.name, cv::Point(cvRound(p.x) + r + 3, cvRound(p.y) - r), scale,
                  overlay_colour::kMarker);
+    // A template marker: the template's box where it matched, and the match's score (the
+    // paper's display of SAD, SSD and ZNCC).
+    const size_t index = static_cast<size_t>(&marker - result.markers.data());
+    if (index < status.template_boxes.size() && status.template_boxes[index]) {
+      const OverlayStatus::TemplateBox& box = *status.template_boxes[index];
+      const cv::Point2d half(box.size_px.width / 2.0, box.size_px.height / 2.0);
+      cv::rectangle(frame_bgr, Fixed(p - half), Fixed(p + half), overlay_colour::kTemplate, 1,
+                    cv::LINE_AA, kShift);
+      std::string label = box.method;
+      for (char& c : label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      if (marker.observation.score) {
+        char number[32];
+        std::snprintf(number, sizeof(number), " %.3g", *marker.observation.score);
+        label += number;
+      }
+      OutlinedText(frame_bgr, label,
+                   cv::Point(cvRound(p.x - half.x), cvRound(p.y + half.y) + cvRound(14 * scale / 0.5)),
+                   scale, overlay_colour::kTemplate);
+    }
   }
 }
 

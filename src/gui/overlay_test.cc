@@ -130,6 +130,34 @@ TEST(DrawOverlayTest, RingsAtFoundMarkersArcAndTriangleBetweenThem) {
   EXPECT_EQ(CountColour(frame, overlay_colour::kLost, 60), 0);  // Nobody lost.
 }
 
+// A template marker's box (the template's size, centred where it matched) and its method and
+// score; colour markers get none.
+TEST(DrawOverlayTest, TemplateMarkersShowTheirBoxAndScore) {
+  cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  FrameResult result = ThreeMarkers(true);
+  result.markers[1].observation.score = 0.97;
+  OverlayStatus status;
+  status.template_boxes = {std::nullopt, OverlayStatus::TemplateBox{{30, 24}, "zncc"},
+                           std::nullopt};
+  DrawOverlay(frame, result, Triple(), status);
+  const cv::Point2d p = *result.markers[1].observation.position_px;
+  for (const cv::Point2d& edge : {p + cv::Point2d(-15, 0), p + cv::Point2d(15, 0),
+                                  p + cv::Point2d(0, -12), p + cv::Point2d(0, 12)}) {
+    EXPECT_TRUE(ColourWithin(frame, edge, overlay_colour::kTemplate, 1)) << edge;
+  }
+  // The label under the box.
+  EXPECT_GT(CountColour(frame(cv::Rect(cvRound(p.x) - 16, cvRound(p.y) + 13, 60, 16)),
+                        overlay_colour::kTemplate, 60),
+            10);
+  // Only the template marker has a box.
+  int boxed = 0;
+  for (const MarkerObservation& m : result.markers) {
+    boxed += ColourWithin(frame, *m.observation.position_px + cv::Point2d(15, 0),
+                          overlay_colour::kTemplate, 1);
+  }
+  EXPECT_EQ(boxed, 1);
+}
+
 TEST(DrawOverlayTest, LostMarkerIsFlaggedInRedAndNotDrawn) {
   cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
   const FrameResult result = ThreeMarkers(false);

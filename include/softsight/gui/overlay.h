@@ -21,6 +21,7 @@ inline const cv::Scalar kTriangle(255, 255, 255);  // Base-middle-tip triangle (
 inline const cv::Scalar kArc(255, 0, 255);         // Fitted arc (magenta).
 inline const cv::Scalar kLost(0, 0, 255);          // Lost-marker flags (red).
 inline const cv::Scalar kText(255, 255, 255);
+inline const cv::Scalar kTemplate(255, 200, 0);    // A template marker's box and score (sky blue).
 }  // namespace overlay_colour
 
 struct OverlayOptions {
@@ -44,9 +45,16 @@ OverlayOptions OverlayOptionsFor(const MeasureOptions& measure);
 // Figures only a live run knows; absent ones are not shown.
 struct OverlayStatus {
   std::optional<double> fps;         // Processed frames per second.
-  std::optional<double> speed;       // Source seconds per second (below 0.9: said).
   std::optional<double> latency_ms;  // Capture to the result on screen.
+  std::optional<double> speed;       // Source seconds per second (below 0.9: said).
   std::vector<std::string> notes;    // Extra lines (e.g. "REC live-001", "PAUSED").
+  // Template markers (by index in result.markers; empty entries for colour markers): the
+  // template's box is drawn around each one found, with its method and match score.
+  struct TemplateBox {
+    cv::Size size_px;
+    std::string method;  // "sad", "ssd", "zncc".
+  };
+  std::vector<std::optional<TemplateBox>> template_boxes;
 };
 
 // True when the radius is too large against the arc length to be told from a straight
