@@ -181,17 +181,19 @@ TEST(DrawOverlayTest, OptionsCheckNamesTheField) {
 }
 
 TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
-  StripChart chart(StripChartOptions{.window_s = 10.0, .height_px = 180});
+  StripChart chart(StripChartOptions{.window_s = 10.0, .height_px = 240});
   for (int i = 0; i <= 600; ++i) {  // 20 s at 30 fps; the chart keeps the last 10 s.
     FrameResult r;
     r.time_s = i / 30.0;
     if (i < 450 || i > 480) r.measurement.angle_deg = 90.0 + 2.0 * r.time_s;  // Gap 15..16 s.
     r.measurement.tip_disp_px = 5.0;
     r.measurement.arc_length_px = 100.0 + r.time_s;
+    // The radius: 60 px, then straight (a radius of 100 arc lengths: a gap) after 18 s.
+    r.measurement.radius_px = i < 540 ? 60.0 : 100 * (100.0 + r.time_s);
     chart.add(r);
   }
   EXPECT_EQ(chart.size(), 301u);  // 10..20 s inclusive.
-  cv::Mat area(180, 600, CV_8UC3);
+  cv::Mat area(240, 600, CV_8UC3);
   chart.draw(area);
   const auto& lane = chart.lane(0);
   auto y_of = [&](double v) {
@@ -214,6 +216,17 @@ TEST(StripChartTest, CurvesScrollAndGapsStayGaps) {
   const double y_flat =
       flat.rect.y + (flat.y_max - 5.0) / (flat.y_max - flat.y_min) * (flat.rect.height - 1);
   EXPECT_TRUE(ColourWithin(area, {chart.x_of(12.0), y_flat}, StripChart::kColours[1], 1));
+  // The radius lane: flat at 60 px, then a gap where it reads straight.
+  const auto& radius = chart.lane(3);
+  EXPECT_EQ(radius.label, "radius [px]");
+  const double y_radius =
+      radius.rect.y + (radius.y_max - 60.0) / (radius.y_max - radius.y_min) * (radius.rect.height - 1);
+  // (The line sits between two pixel rows there: both are half its colour.)
+  EXPECT_GT(CountColour(area(cv::Rect(cvRound(chart.x_of(12.0)) - 1, cvRound(y_radius) - 1, 3, 3)),
+                        StripChart::kColours[3], 70),
+            0);
+  EXPECT_LT(radius.y_max, 100.0) << "a straight radius flattened the lane";
+  EXPECT_FALSE(chart.newest(3).has_value());
 
   // The newest frame measured again (a paused re-track) replaces its sample.
   FrameResult again;

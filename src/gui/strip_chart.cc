@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "softsight/gui/overlay.h"  // ReadsStraight
 #include "softsight/io/plot.h"
 
 namespace softsight {
@@ -25,7 +26,8 @@ const cv::Scalar kLabel(220, 220, 220);
 }  // namespace
 
 // Same hues as the plot command's series, brightened for a dark background.
-const cv::Scalar StripChart::kColours[3] = {{255, 170, 60}, {120, 220, 60}, {220, 150, 240}};
+const cv::Scalar StripChart::kColours[kLanes] = {
+    {255, 170, 60}, {120, 220, 60}, {220, 150, 240}, {80, 200, 255}};
 
 bool StripChartOptions::Check(std::string* error) const {
   if (!(window_s > 0.1 && window_s <= 3600)) {
@@ -49,9 +51,13 @@ void StripChart::add(const FrameResult& result) {
   if (!samples_.empty() && result.time_s == samples_.back().time_s) samples_.pop_back();
   const Measurement& m = result.measurement;
   const bool metric = m.tip_disp_mm.has_value() || m.arc_length_mm.has_value();
+  // A radius too large to tell from straight is a gap, as the overlay reads it "straight": its
+  // thousands of px would flatten the lane.
+  std::optional<double> radius = metric ? m.radius_mm : m.radius_px;
+  if (ReadsStraight(m)) radius.reset();
   Sample sample{result.time_s,
                 {m.angle_deg, metric ? m.tip_disp_mm : m.tip_disp_px,
-                 metric ? m.arc_length_mm : m.arc_length_px},
+                 metric ? m.arc_length_mm : m.arc_length_px, radius},
                 metric};
   samples_.push_back(sample);
   while (!samples_.empty() && samples_.front().time_s < result.time_s - options_.window_s) {
@@ -70,18 +76,19 @@ void StripChart::draw(cv::Mat& area) const {
   area.setTo(kBackground);
   const bool metric = !samples_.empty() && samples_.back().metric;
   const char* unit = metric ? "mm" : "px";
-  const std::string names[3] = {"angle [deg]", std::string("bending dist [") + unit + "]",
-                                std::string("arc length [") + unit + "]"};
-  const int lane_height = area.rows / 3;
+  const std::string names[kLanes] = {"angle [deg]", std::string("bending dist [") + unit + "]",
+                                     std::string("arc length [") + unit + "]",
+                                     std::string("radius [") + unit + "]"};
+  const int lane_height = area.rows / kLanes;
   t_right_ = samples_.empty() ? 0.0 : samples_.back().time_s;
 
   // The value ranges and tick labels of all lanes first: the left margin is as wide as the
   // widest label (a 5-digit arc length or a negative distance is not cut off).
-  std::vector<double> ticks[3];
-  std::vector<std::string> tick_text[3];
+  std::vector<double> ticks[kLanes];
+  std::vector<std::string> tick_text[kLanes];
   int label_width = 0, baseline = 0;
   const int text_height = cv::getTextSize("0", kFont, kFontScale, 1, &baseline).height;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < kLanes; ++i) {
     Lane& lane = lanes_[i];
     lane.label = names[i];
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -120,7 +127,7 @@ void StripChart::draw(cv::Mat& area) const {
   x_width_ = std::max(1, area.cols - left - kRight);
 
   std::vector<cv::Point> run;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < kLanes; ++i) {
     Lane& lane = lanes_[i];
     lane.rect = cv::Rect(left, i * lane_height + 3, static_cast<int>(x_width_), lane_height - 6);
     const double lo = lane.y_min, hi = lane.y_max;

@@ -1,5 +1,5 @@
-// A scrolling strip chart of the last seconds: angle, bending distance and arc length, one lane
-// each, drawn under the live image. Keeps the recent samples; absent values are gaps. Internal
+// A scrolling strip chart of the last seconds: angle, bending distance, arc length and radius of
+// curvature, one lane each, drawn under the live image. Keeps the recent samples; absent values are gaps. Internal
 // to gui (and its tests).
 #pragma once
 
@@ -28,7 +28,7 @@ class StripChart {
   void draw(cv::Mat& area) const;
 
   // The lane rectangles and value ranges of the last draw(), for tests: lane 0 angle,
-  // 1 bending distance, 2 arc length.
+  // 1 bending distance, 2 arc length, 3 radius.
   struct Lane {
     cv::Rect rect;
     double y_min = 0, y_max = 1;
@@ -46,17 +46,18 @@ class StripChart {
   }
   const StripChartOptions& options() const { return options_; }
 
-  static const cv::Scalar kColours[3];
+  static constexpr int kLanes = 4;
+  static const cv::Scalar kColours[kLanes];
 
  private:
   struct Sample {
     double time_s;
-    std::optional<double> values[3];
+    std::optional<double> values[kLanes];
     bool metric;
   };
   StripChartOptions options_;
   std::deque<Sample> samples_;
-  mutable Lane lanes_[3];
+  mutable Lane lanes_[kLanes];
   mutable double x_left_ = 0, x_width_ = 1, t_right_ = 0;
 };
 

@@ -14,7 +14,7 @@ namespace softsight {
 // The scrolling strip chart under the live image: angle, bending distance and arc length.
 struct StripChartOptions {
   double window_s = 10.0;  // Time span shown, seconds. Longer shows slower trends, less detail.
-  int height_px = 180;     // Height of the whole chart (three lanes) under the image.
+  int height_px = 220;     // Height of the whole chart (four lanes) under the image.
   bool Check(std::string* error) const;
 };
 
