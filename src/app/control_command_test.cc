@@ -361,7 +361,10 @@ bool ReadUntil(int fd, const std::string& until, std::string* text, int timeout_
 
 TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   TempDir dir;
-  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  // A reply deadline no stall of a loaded machine reaches: a re-send would be answered twice and
+  // take one of the rig's 40 answers from the rows counted below.
+  WriteTextFile(dir.file("rig.yaml"),
+                std::string(kMarkers) + "control:\n  link:\n    reply_timeout_ms: 3000\n");
   std::string port;
   const std::string frames = dir.file("rig.png");
   // The cable is pulled after the rig's 40th answer: the handshake and a dozen or more frames'
