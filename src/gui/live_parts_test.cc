@@ -111,6 +111,32 @@ TEST(ScaleClicks, PointsTooCloseStartOverAndWithoutADistanceItOnlySaysHow) {
   EXPECT_FALSE(no_distance.active());
 }
 
+// The status and message lines never overlap, at the sizes the window shows a 1280x720 frame at
+// (100 % and 74 %) and at VGA: rows are spaced by the outlined text's height (a fixed 22 px let
+// them overlap once the text grew with the image), the last inside the image.
+TEST(LiveView, StatusLinesAreSpacedByTheirHeightAndWrappedToTheImage) {
+  const std::vector<std::string> lines = {
+      "REC live-001  PAUSED  active: blue (zncc)  view 74%",
+      "blue: reselected in [200, 180, 23, 22]"};
+  for (const cv::Size size : {cv::Size(1280, 720), cv::Size(947, 533), cv::Size(640, 480)}) {
+    double scale = 0;
+    const std::vector<PlacedStatusRow> rows = PlaceStatusLines(size, lines, &scale);
+    ASSERT_EQ(rows.size(), 2u) << size;
+    int baseline = 0;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const cv::Size text = cv::getTextSize(rows[i].text, cv::FONT_HERSHEY_SIMPLEX, scale, 4, &baseline);
+      EXPECT_LE(rows[i].origin.y + baseline, size.height) << size << " row " << i;
+      if (i > 0) {
+        // This row's top (origin - height) lies below the previous row's bottom (origin + baseline).
+        EXPECT_GT(rows[i].origin.y - text.height, rows[i - 1].origin.y + baseline)
+            << size << " rows " << i - 1 << " and " << i << " overlap";
+      }
+    }
+    EXPECT_EQ(rows.front().from, 0u);
+    EXPECT_EQ(rows.back().from, 1u);
+  }
+}
+
 TEST(LiveView, TheFrameTheChartUnderItTheHelpBesideItAndTheDragBoxOrTheScalePoints) {
   const cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(100, 100, 100));
   const StripChart chart;

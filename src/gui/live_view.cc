@@ -123,16 +123,34 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
 }
 
 
+std::vector<PlacedStatusRow> PlaceStatusLines(cv::Size size, const std::vector<std::string>& lines,
+                                              double* text_scale) {
+  constexpr int kMargin = 8, kOutline = 4;
+  const double scale = std::max(0.4, size.width / 640.0 * 0.5);
+  *text_scale = scale;
+  int baseline = 0;
+  const cv::Size ag = cv::getTextSize("Ag", kFont, scale, kOutline, &baseline);
+  const int descent = baseline;
+  const int row_height = ag.height + descent + 4;  // Outlined rows never touch.
+  // One row per line, not wrapped: more rows would cover the markers at the image's bottom; a
+  // message longer than the image is also on stdout.
+  std::vector<PlacedStatusRow> rows;
+  for (size_t i = 0; i < lines.size(); ++i) rows.push_back({lines[i], {}, i});
+  int y = size.height - descent - 4 - row_height * static_cast<int>(rows.size() - 1);
+  for (PlacedStatusRow& r : rows) {
+    r.origin = {kMargin, y};
+    y += row_height;
+  }
+  return rows;
+}
+
 void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red) {
-  const double scale = std::max(0.4, top.cols / 640.0 * 0.5);
-  int y = top.rows - 10 - 22 * static_cast<int>(lines.size() - 1);
-  for (const std::string& text : lines) {
-    cv::putText(top, text, {8, y}, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-    cv::putText(top, text, {8, y}, kFont, scale,
-                first_red && &text == &lines.front() ? cv::Scalar(80, 80, 255)
-                                                     : cv::Scalar(255, 255, 255),
-                1, cv::LINE_AA);
-    y += 22;
+  double scale = 1;
+  for (const PlacedStatusRow& row : PlaceStatusLines(top.size(), lines, &scale)) {
+    cv::putText(top, row.text, row.origin, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+    cv::putText(top, row.text, row.origin, kFont, scale,
+                first_red && row.from == 0 ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
   }
 }
 
