@@ -10,6 +10,15 @@
 namespace softsight {
 namespace {
 
+// A status with a frame rate and a latency, nothing else.
+OverlayStatus Status(double fps, double latency_ms) {
+  OverlayStatus status;
+  status.fps = fps;
+  status.latency_ms = latency_ms;
+  return status;
+}
+
+
 SceneOptions Scene(int width, int height) {
   SceneOptions scene;
   scene.size = cv::Size(width, height);
@@ -39,7 +48,7 @@ void BM_DrawOverlay(benchmark::State& state) {
   const OverlayOptions options = OverlayOptionsFor(measure);
   for (auto _ : state) {
     frame.copyTo(canvas);
-    DrawOverlay(canvas, result, options, OverlayStatus{30.0, 20.0, {}});
+    DrawOverlay(canvas, result, options, Status(30.0, 20.0));
     benchmark::DoNotOptimize(canvas.data);
   }
 }

@@ -10,6 +10,15 @@
 namespace softsight {
 namespace {
 
+// A status with a frame rate and a latency, nothing else.
+OverlayStatus Status(double fps, double latency_ms) {
+  OverlayStatus status;
+  status.fps = fps;
+  status.latency_ms = latency_ms;
+  return status;
+}
+
+
 bool IsColour(const cv::Mat& image, cv::Point2d p, const cv::Scalar& bgr, int tolerance = 50) {
   const int x = cvRound(p.x), y = cvRound(p.y);
   if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) return false;
@@ -109,7 +118,7 @@ OverlayOptions Triple() {
 TEST(DrawOverlayTest, RingsAtFoundMarkersArcAndTriangleBetweenThem) {
   cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
   const FrameResult result = ThreeMarkers(true);
-  DrawOverlay(frame, result, Triple(), OverlayStatus{30.0, 12.0, {}});
+  DrawOverlay(frame, result, Triple(), Status(30.0, 12.0));
   for (const MarkerObservation& m : result.markers) {
     const cv::Point2d p = *m.observation.position_px;
     for (double deg = 0; deg < 360; deg += 30) {
