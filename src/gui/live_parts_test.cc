@@ -4,6 +4,8 @@
 
 #include <chrono>
 
+#include <opencv2/imgproc.hpp>
+
 #include "gui/live_layout.h"
 #include "gui/live_view.h"
 #include "gui/rate_meter.h"
