@@ -26,7 +26,7 @@ void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
     if (!option.unit.empty()) help += " [" + option.unit + "]";
     help += "; " + OptionRangeText(option) + " (config: capture." + option.key + ")";
     // The map's nodes stay where they are: the option writes into its own entry.
-    sub.add_option(FlagOf(option.key), (*args)[option.key], help)->group("Camera settings");
+    sub.add_option(FlagOf(option.key), (*args)[option.key], help)->group("Camera settings (with --camera N only)");
   }
 }
 

@@ -212,7 +212,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
   return [options, inputs, jobs, capture] {
-    if (!options->source.camera) {
+    const bool from_files = !inputs->empty() || !options->source.input.empty();
+    if (!options->source.camera && from_files) {  // Neither: the missing input is said below.
       const std::string source = inputs->size() == 1   ? "the file " + inputs->front()
                                  : inputs->empty()      ? "the file " + options->source.input
                                                         : "files";
