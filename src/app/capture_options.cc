@@ -26,7 +26,8 @@ void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
     if (!option.unit.empty()) help += " [" + option.unit + "]";
     help += "; " + OptionRangeText(option) + " (config: capture." + option.key + ")";
     // The map's nodes stay where they are: the option writes into its own entry.
-    sub.add_option(FlagOf(option.key), (*args)[option.key], help)->group("Camera settings (with --camera N only)");
+    sub.add_option(FlagOf(option.key), (*args)[option.key], help)
+        ->group("Camera settings (with --camera N only)");
   }
 }
 
@@ -62,7 +63,8 @@ CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings setti
   return settings;
 }
 
-void RefuseCaptureWithoutCamera(const CaptureArgs& args, const std::optional<CameraSettings>& config,
+void RefuseCaptureWithoutCamera(const CaptureArgs& args,
+                                const std::optional<CameraSettings>& config,
                                 const std::string& config_path, const std::string& source,
                                 std::ostream& notes) {
   for (const Option<CameraSettings>& option : CameraSettingsTable()) {

@@ -30,7 +30,8 @@ CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings setti
 // run.avi", "the simulated rig"), a --camera-* option on the command line is refused (it asked
 // for what cannot happen: InputError naming the option), and a config's `capture:` section (a
 // live recording saves one) is said on `notes` to be left unused.
-void RefuseCaptureWithoutCamera(const CaptureArgs& args, const std::optional<CameraSettings>& config,
+void RefuseCaptureWithoutCamera(const CaptureArgs& args,
+                                const std::optional<CameraSettings>& config,
                                 const std::string& config_path, const std::string& source,
                                 std::ostream& notes);
 

@@ -89,6 +89,22 @@ struct Candidate {
 
 double RadiusOf(double area_px) { return std::sqrt(std::max(area_px, 0.0) / CV_PI); }
 
+// The pixels within `reach_px` of `centre` (a square), cut to the frame of `size`.
+cv::Rect SquareAround(const cv::Point2d& centre, double reach_px, cv::Size size) {
+  return cv::Rect(cvFloor(centre.x - reach_px), cvFloor(centre.y - reach_px),
+                  cvCeil(2 * reach_px) + 2, cvCeil(2 * reach_px) + 2) &
+         cv::Rect(0, 0, size.width, size.height);
+}
+
+// The pixels of `bgr` that a colour tracker with `colour` counts as its marker's (255), by the
+// tracker's own classifier: hue ranges through red included.
+void ColourMembership(const cv::Mat& bgr, const ColourParams& colour, cv::Mat& mask) {
+  MarkerSpec spec;
+  spec.name = "membership";
+  spec.params = colour;
+  CreateTracker(spec)->membership(bgr, mask);
+}
+
 std::string Point(const cv::Point2d& p) {
   char text[64];
   std::snprintf(text, sizeof(text), "(%.1f, %.1f)", p.x, p.y);
@@ -280,9 +296,7 @@ struct CoreLooks {
 };
 CoreLooks CoreLooksOf(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
   const double r = std::max(1.0, 0.6 * radius);
-  const cv::Rect box = cv::Rect(cvFloor(centre.x - r), cvFloor(centre.y - r), cvCeil(2 * r) + 2,
-                                cvCeil(2 * r) + 2) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = SquareAround(centre, r, bgr.size());
   if (box.empty()) return {};
   cv::Mat hsv;
   cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
@@ -327,21 +341,10 @@ struct EllipseFit {
 };
 EllipseFit FitMomentEllipse(const cv::Mat& bgr, const ColourParams& colour,
                             const cv::Point2d& centre, double reach_px) {
-  const cv::Rect box = cv::Rect(cvFloor(centre.x - reach_px), cvFloor(centre.y - reach_px),
-                                cvCeil(2 * reach_px) + 2, cvCeil(2 * reach_px) + 2) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = SquareAround(centre, reach_px, bgr.size());
   if (box.empty()) return {};
-  cv::Mat hsv, mask, wrapped;
-  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
-  const HsvRange& h = colour.h;
-  const int h_hi = h.lo <= h.hi ? h.hi : 179;
-  cv::inRange(hsv, cv::Scalar(h.lo, colour.s.lo, colour.v.lo),
-              cv::Scalar(h_hi, colour.s.hi, colour.v.hi), mask);
-  if (h.lo > h.hi) {  // Wrapped through red.
-    cv::inRange(hsv, cv::Scalar(0, colour.s.lo, colour.v.lo),
-                cv::Scalar(h.hi, colour.s.hi, colour.v.hi), wrapped);
-    mask |= wrapped;
-  }
+  cv::Mat mask;
+  ColourMembership(bgr(box), colour, mask);
   cv::Mat labels;
   cv::connectedComponents(mask, labels, 8, CV_32S);
   const cv::Point at(cvRound(centre.x) - box.x, cvRound(centre.y) - box.y);
@@ -367,22 +370,20 @@ EllipseFit FitMomentEllipse(const cv::Mat& bgr, const ColourParams& colour,
 void KeepSaturationAboveSurroundings(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
                                      double core_saturation, ColourParams* colour) {
   const double ring_in = radius + 3, ring_out = std::max(5 * radius, 32.0);
-  const cv::Rect box = cv::Rect(cvFloor(centre.x - ring_out), cvFloor(centre.y - ring_out),
-                                cvCeil(2 * ring_out) + 2, cvCeil(2 * ring_out) + 2) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = SquareAround(centre, ring_out, bgr.size());
   if (box.empty()) return;
-  cv::Mat hsv;
+  // Within the hue and value ranges, whatever the saturation.
+  ColourParams any_saturation = *colour;
+  any_saturation.s = {0, 255};
+  cv::Mat hsv, in_range;
+  ColourMembership(bgr(box), any_saturation, in_range);
   cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
-  const auto in = [](int x, const HsvRange& r) {
-    return r.lo <= r.hi ? (x >= r.lo && x <= r.hi) : (x >= r.lo || x <= r.hi);
-  };
   std::vector<int> ring;
   for (int y = 0; y < hsv.rows; ++y) {
     for (int x = 0; x < hsv.cols; ++x) {
       const double d = std::hypot(box.x + x - centre.x, box.y + y - centre.y);
       if (d < ring_in) continue;
-      const cv::Vec3b& p = hsv.at<cv::Vec3b>(y, x);
-      ring.push_back(in(p[0], colour->h) && in(p[2], colour->v) ? p[1] : 0);
+      ring.push_back(in_range.at<uchar>(y, x) ? hsv.at<cv::Vec3b>(y, x)[1] : 0);
     }
   }
   if (ring.size() < 20) return;
@@ -767,13 +768,14 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       }
       continue;
     }
+    CoreLooks looks;
     if (!finding.intensity) {
+      looks = CoreLooksOf(frame, c.position_px, radius);
       // Tightened only once verified with the picked ranges, and kept only when the marker is
       // still found with them: it steadies the tracking of a marker, never makes a blob one.
       const MarkerSpec picked = spec;
       const int picked_lo = colour.s.lo;
-      KeepSaturationAboveSurroundings(frame, c.position_px, radius,
-                                      CoreLooksOf(frame, c.position_px, radius).saturation, &colour);
+      KeepSaturationAboveSurroundings(frame, c.position_px, radius, looks.saturation, &colour);
       Observation tightened;
       if (colour.s.lo != picked_lo && !verify(needs_roi, &tightened)) spec = picked;
     }
@@ -783,7 +785,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
     v.marker.radius_px = radius;
     v.marker.needs_roi = needs_roi;
     v.hue = hue;
-    if (!finding.intensity) v.looks = CoreLooksOf(frame, c.position_px, radius);
+    v.looks = looks;
     v.twin = twin;
     v.elongated = c.elongated;
     verified.push_back(v);

@@ -81,9 +81,8 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   if (order == FrameOrder::kJump) {
     if (recording()) {
       // Said on screen until the next message (not replaced by the frame's), and logged.
-      const int64_t frames = pipeline_->stop_recording();
-      say("recorded " + std::to_string(frames) + " frames to " + last_recording() +
-          ".* (stopped: " + (loop_ ? "the loop went back to the first frame)" : "the playback jumped)"));
+      say(stop_recording() + " (stopped: " +
+          (loop_ ? "the loop went back to the first frame)" : "the playback jumped)"));
       recording_stopped = true;
     }
     session().jump();
@@ -122,19 +121,22 @@ void LiveController::redraw_annotated() {
 }
 
 void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) const {
-  OverlayStatus status;
+  OverlayStatus& status = overlay_status_;  // Reused: its vectors keep their storage.
   status.fps = meter_.fps();
   status.speed = meter_.speed();
   status.latency_ms = meter_.latency_ms();
-  for (const MarkerSpec& spec : config().markers) {
-    const auto* templ = std::get_if<TemplateParams>(&spec.params);
+  const std::vector<MarkerSpec>& markers = config().markers;
+  status.template_boxes.resize(markers.size());
+  for (size_t i = 0; i < markers.size(); ++i) {
+    const auto* templ = std::get_if<TemplateParams>(&markers[i].params);
     std::optional<cv::Size> size;
     if (templ && !templ->image.empty()) size = templ->image.size();
     if (templ && !size && templ->rect) size = templ->rect->size();
     if (size) {
-      status.template_boxes.push_back(OverlayStatus::TemplateBox{*size, TrackerMethodName(spec.params)});
+      status.template_boxes[i] =
+          OverlayStatus::TemplateBox{*size, TrackerMethodName(markers[i].params)};
     } else {
-      status.template_boxes.emplace_back();
+      status.template_boxes[i].reset();
     }
   }
   DrawOverlay(image, result, options_.overlay, status);
@@ -446,10 +448,14 @@ void LiveController::scale_point(const cv::Point2d& p) {
       " px" + (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
 }
 
+std::string LiveController::stop_recording() {
+  const int64_t frames = pipeline_->stop_recording();
+  return "recorded " + std::to_string(frames) + " frames to " + last_recording() + ".*";
+}
+
 void LiveController::toggle_recording() {
   if (recording()) {
-    const int64_t frames = pipeline_->stop_recording();
-    say("recorded " + std::to_string(frames) + " frames to " + last_recording() + ".*");
+    say(stop_recording());
     return;
   }
   if (frame_.empty()) {

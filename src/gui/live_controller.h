@@ -193,6 +193,8 @@ class LiveController {
   void switch_method();
   void set_hsv(int trackbar, int value);
   void toggle_recording();
+  // Stops the running recording and says what it kept ("recorded N frames to P.*").
+  std::string stop_recording();
   void save_config();
   void start_scale();
   void cancel_scale();
@@ -249,6 +251,7 @@ class LiveController {
   ScaleClicks scale_;
   std::string message_;
   std::vector<std::string> unlogged_;  // Said since the last take_messages().
+  mutable OverlayStatus overlay_status_;  // draw_overlay's, reused per frame.
 };
 
 }  // namespace softsight

@@ -655,9 +655,10 @@ TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrack
 }
 
 // A recording started after edits made while paused (every marker switched to SAD, a box dragged
-// on empty background and refused, a box dragged around a marker) reproduces under `track`: the recording starts from a
-// session built afresh from its config, not one that keeps what it learned before (the markers'
-// arrangement, their motion), which made live say `implausible` where `track` said `found`.
+// on empty background and refused, a box dragged around a marker) reproduces under `track`: the
+// recording starts from a session built afresh from its config, not one that keeps what it
+// learned before (the markers' arrangement, their motion), which made live say `implausible`
+// where `track` said `found`.
 TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
   const std::string video = WriteVideo(30);
   FakeClock clock;

@@ -12,6 +12,7 @@ namespace softsight {
 namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr int kStatusOutline = 4;  // The dark outline under the status lines' text, px.
 const cv::Scalar kDragColour(0, 255, 0);
 const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
 // Mask view: the chosen blob, blobs that fit but were not chosen, rejected ones, the window.
@@ -123,33 +124,28 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
 }
 
 
-std::vector<PlacedStatusRow> PlaceStatusLines(cv::Size size, const std::vector<std::string>& lines,
-                                              double* text_scale) {
-  constexpr int kMargin = 8, kOutline = 4;
+std::vector<cv::Point> PlaceStatusLines(cv::Size size, size_t count, double* text_scale) {
   const double scale = std::max(0.4, size.width / 640.0 * 0.5);
   *text_scale = scale;
   int baseline = 0;
-  const cv::Size ag = cv::getTextSize("Ag", kFont, scale, kOutline, &baseline);
-  const int descent = baseline;
-  const int row_height = ag.height + descent + 4;  // Outlined rows never touch.
+  const int height = cv::getTextSize("Ag", kFont, scale, kStatusOutline, &baseline).height;
+  const int row_height = height + baseline + 4;  // Outlined rows never touch.
   // One row per line, not wrapped: more rows would cover the markers at the image's bottom; a
   // message longer than the image is also on stdout.
-  std::vector<PlacedStatusRow> rows;
-  for (size_t i = 0; i < lines.size(); ++i) rows.push_back({lines[i], {}, i});
-  int y = size.height - descent - 4 - row_height * static_cast<int>(rows.size() - 1);
-  for (PlacedStatusRow& r : rows) {
-    r.origin = {kMargin, y};
-    y += row_height;
-  }
-  return rows;
+  std::vector<cv::Point> origins;
+  int y = size.height - baseline - 4 - row_height * (static_cast<int>(count) - 1);
+  for (size_t i = 0; i < count; ++i, y += row_height) origins.emplace_back(8, y);
+  return origins;
 }
 
 void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red) {
   double scale = 1;
-  for (const PlacedStatusRow& row : PlaceStatusLines(top.size(), lines, &scale)) {
-    cv::putText(top, row.text, row.origin, kFont, scale, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-    cv::putText(top, row.text, row.origin, kFont, scale,
-                first_red && row.from == 0 ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255), 1,
+  const std::vector<cv::Point> origins = PlaceStatusLines(top.size(), lines.size(), &scale);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    cv::putText(top, lines[i], origins[i], kFont, scale, cv::Scalar(0, 0, 0), kStatusOutline,
+                cv::LINE_AA);
+    cv::putText(top, lines[i], origins[i], kFont, scale,
+                first_red && i == 0 ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255), 1,
                 cv::LINE_AA);
   }
 }

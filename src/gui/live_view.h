@@ -45,16 +45,10 @@ class LiveView {
 // (recording).
 void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red);
 
-// Where DrawStatusLines puts its text on an image of `size`: a row per line, 8 px from the left,
-// spaced by the outlined text's height (at any text scale), the last at the image's bottom.
-// `from` is the index of the line each row comes from.
-struct PlacedStatusRow {
-  std::string text;
-  cv::Point origin;  // putText's baseline origin.
-  size_t from = 0;
-};
-std::vector<PlacedStatusRow> PlaceStatusLines(cv::Size size, const std::vector<std::string>& lines,
-                                              double* text_scale);
+// Where DrawStatusLines puts its `count` lines on an image of `size` (putText's baseline
+// origins): 8 px from the left, spaced by the outlined text's height at `text_scale`, the last at
+// the image's bottom.
+std::vector<cv::Point> PlaceStatusLines(cv::Size size, size_t count, double* text_scale);
 
 // The key list (kLiveKeys) as a compact panel beside the image (never over it, so no marker is
 // hidden): the width it needs, and the drawing into `panel` (text shrinks if it is too low).

@@ -164,7 +164,8 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
     }
     lines.emplace_back(timing, overlay_colour::kText);
     if (status.speed && *status.speed < kSlowPlaybackSpeed) {
-      std::snprintf(buffer, sizeof(buffer), "%.2fx real time: slower than the video", *status.speed);
+      std::snprintf(buffer, sizeof(buffer), "%.2fx real time: slower than the video",
+                    *status.speed);
       lines.emplace_back(buffer, overlay_colour::kLost);
     }
     if (!lost.empty()) lines.emplace_back("LOST: " + lost, overlay_colour::kLost);
@@ -237,9 +238,8 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
         std::snprintf(number, sizeof(number), " %.3g", *marker.observation.score);
         label += number;
       }
-      OutlinedText(frame_bgr, label,
-                   cv::Point(cvRound(p.x - half.x), cvRound(p.y + half.y) + cvRound(14 * scale / 0.5)),
-                   scale, overlay_colour::kTemplate);
+      const cv::Point under(cvRound(p.x - half.x), cvRound(p.y + half.y) + cvRound(28 * scale));
+      OutlinedText(frame_bgr, label, under, scale, overlay_colour::kTemplate);
     }
   }
 }

@@ -322,6 +322,15 @@ TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
 
 // ---- init's markers on the same footage -----------------------------------------------------
 
+// Which of `shapes` of `scene` lies nearest `p` on frame 0.
+size_t NearestShape(const DotScene& scene, const cv::Point2d& p, const std::vector<size_t>& shapes) {
+  size_t nearest = shapes.front();
+  for (size_t s : shapes) {
+    if (cv::norm(p - *scene.truth(s, 0)) < cv::norm(p - *scene.truth(nearest, 0))) nearest = s;
+  }
+  return nearest;
+}
+
 // What `init` writes for frame 0 of `scene` (FindMarkers), as a config.
 TrackingConfig InitConfig(const DotScene& scene, MarkerFinding* finding) {
   *finding = FindMarkers(scene.render(0));
@@ -342,7 +351,7 @@ TEST(AssociationScenes, InitTakesTheCartsIdenticalDotsAsTwoMarkersThatKeepTheirI
   for (const FoundMarker& m : finding.markers) {
     EXPECT_TRUE(m.needs_roi);
     ASSERT_TRUE(std::get<ColourParams>(m.spec.params).roi.has_value());
-    const size_t dot = cv::norm(m.position_px - *scene.truth(2, 0)) < 2 ? 2 : 3;
+    const size_t dot = NearestShape(scene, m.position_px, {2, 3});
     EXPECT_LT(cv::norm(m.position_px - *scene.truth(dot, 0)), 0.5);
     shape_of.push_back(dot);
   }
@@ -373,14 +382,7 @@ TEST(AssociationScenes, InitTakesIdenticalPucksAsMarkersAndRefusesUnlikeLookAlik
   ASSERT_EQ(finding.markers.size(), 3u);
   std::vector<size_t> shape_of;
   for (const FoundMarker& m : finding.markers) {
-    size_t nearest = 0;
-    for (size_t s = 1; s < 3; ++s) {
-      if (cv::norm(m.position_px - *pucks.truth(s, 0)) <
-          cv::norm(m.position_px - *pucks.truth(nearest, 0))) {
-        nearest = s;
-      }
-    }
-    shape_of.push_back(nearest);
+    shape_of.push_back(NearestShape(pucks, m.position_px, {0, 1, 2}));
   }
   EXPECT_NE(shape_of[0], shape_of[1]);
   EXPECT_NE(shape_of[1], shape_of[2]);

@@ -240,6 +240,18 @@ constexpr double kMinBlobShiftPx = 2.0;
 // A blob this close to where the match puts it agrees with the match (px).
 constexpr double kBlobAgreePx = 1.0;
 
+// The one channel a template's blob is measured in: native gray, or colour projected on its
+// axis (`projection`, see ContrastProjection; empty: luma).
+void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out) {
+  if (native.channels() == 1) {
+    out = native;
+  } else if (!projection.empty()) {
+    cv::transform(native, out, projection);
+  } else {
+    cv::cvtColor(native, out, cv::COLOR_BGR2GRAY);
+  }
+}
+
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
@@ -459,13 +471,7 @@ class TemplateTracker final : public Tracker {
   void Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat& out);
   // The one channel the blob is measured in: native gray, or colour projected on its axis.
   void BlobChannel(const cv::Mat& native, cv::Mat& out) const {
-    if (native.channels() == 1) {
-      out = native;
-    } else if (!blob_projection_.empty()) {
-      cv::transform(native, out, blob_projection_);
-    } else {
-      cv::cvtColor(native, out, cv::COLOR_BGR2GRAY);
-    }
+    BlobChannelOf(native, blob_projection_, out);
   }
   std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
   // Whether `templ` (native) would show its marker's blob, as SetTemplate learns it; changes
@@ -606,6 +612,17 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   return m;
 }
 
+// The marker's blob in a selected template (its foreground): the channel it shows best
+// (`projection`: ContrastProjection on colour, else empty) and the blob learned in it. False
+// when the template shows none.
+bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
+                       BlobMeter* meter, cv::Point2d* anchor) {
+  *projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
+  cv::Mat gray;
+  BlobChannelOf(templ, *projection, gray);
+  return meter->Learn(gray, mask, anchor);
+}
+
 void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where) {
   if (templ.cols < kMinTemplatePx || templ.rows < kMinTemplatePx) {
     throw InputError(where + ": template is " + std::to_string(templ.cols) + "x" +
@@ -627,10 +644,8 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   anchor_px_ = HalfSize(templ.size());
   // The marker's blob in the template (its foreground), whatever point is reported: every
   // match must contain it (see BlobShift).
-  blob_projection_ = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
-  cv::Mat gray;
-  BlobChannel(templ, gray);
-  blob_ok_ = blob_.Learn(gray, MaskFor(templ.size()), &blob_anchor_px_);
+  blob_ok_ = LearnTemplateBlob(templ, MaskFor(templ.size()), &blob_projection_, &blob_,
+                               &blob_anchor_px_);
   if (params_.report == TemplateReport::kCentre && blob_ok_) anchor_px_ = blob_anchor_px_;
   if (params_.report == TemplateReport::kSymmetry ||
       (params_.report == TemplateReport::kCentre && !blob_ok_)) {
@@ -698,18 +713,10 @@ bool TemplateTracker::start(const Frame& frame) {
 }
 
 bool TemplateTracker::ShowsAMarker(const cv::Mat& templ) const {
-  cv::Mat gray;
-  const cv::Mat projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
-  if (templ.channels() == 1) {
-    gray = templ;
-  } else if (!projection.empty()) {
-    cv::transform(templ, gray, projection);
-  } else {
-    cv::cvtColor(templ, gray, cv::COLOR_BGR2GRAY);
-  }
+  cv::Mat projection;
   BlobMeter meter;
   cv::Point2d centroid;
-  return meter.Learn(gray, MaskFor(templ.size()), &centroid);
+  return LearnTemplateBlob(templ, MaskFor(templ.size()), &projection, &meter, &centroid);
 }
 
 void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
