@@ -24,10 +24,12 @@ function(softsight_add_library module)
   set(target softsight_${module})
   add_library(${target} STATIC ${ARG_SOURCES})
   target_include_directories(${target}
-    PUBLIC ${PROJECT_SOURCE_DIR}/include
+    PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS})
+  # softsight::<module>, the same name in this tree and for find_package(softsight) users.
   add_library(softsight::${module} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${module})
   # The program's command plugins and the Python module are shared objects that link these
   # static libraries: their code must be position independent. -fno-semantic-interposition keeps
   # GCC inlining calls between the library's own functions (which plain -fPIC would forbid), so

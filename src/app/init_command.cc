@@ -15,7 +15,7 @@
 #include "app/cli_checks.h"
 #include "app/commands.h"
 #include "softsight/core/error.h"
-#include "softsight/gui/live_options.h"
+#include "gui/live_options.h"
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {

@@ -9,7 +9,7 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "softsight/core/error.h"
-#include "softsight/gui/live_window.h"
+#include "gui/live_window.h"
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/track/tracker.h"

@@ -30,7 +30,8 @@ const CommandInfo* ChosenCommand(int argc, char** argv) {
   return nullptr;
 }
 
-// softsight_<plugin>.so beside the program (the build tree), or in ../lib/softsight (installed).
+// softsight_<plugin>.so beside the program (the build tree), or in <libdir>/softsight (installed;
+// SOFTSIGHT_PLUGIN_DIR_FROM_BIN is that folder relative to the program's, e.g. ../lib/softsight).
 std::vector<std::filesystem::path> PluginCandidates(const char* plugin) {
   char self[PATH_MAX];
   const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
@@ -38,7 +39,7 @@ std::vector<std::filesystem::path> PluginCandidates(const char* plugin) {
       length > 0 ? std::filesystem::path(std::string(self, static_cast<size_t>(length))).parent_path()
                  : std::filesystem::path(".");
   const std::string file = std::string("softsight_") + plugin + ".so";
-  return {dir / file, dir / ".." / "lib" / "softsight" / file};
+  return {dir / file, dir / SOFTSIGHT_PLUGIN_DIR_FROM_BIN / file};
 }
 
 int RunPlugin(const CommandInfo& command, int argc, char** argv) {

@@ -14,7 +14,7 @@
 #include "app/stop_request.h"
 #include "app/track_many.h"
 #include "softsight/core/error.h"
-#include "softsight/gui/overlay.h"
+#include "gui/overlay.h"
 #include "softsight/io/frame_grabber.h"
 #include "softsight/io/read_ahead_source.h"
 #include "softsight/pipeline/run.h"

@@ -17,8 +17,8 @@
 
 #include "softsight/calib/hsv_picker.h"
 #include "softsight/io/frame_grabber.h"
-#include "softsight/gui/live_options.h"
-#include "softsight/gui/overlay.h"
+#include "gui/live_options.h"
+#include "gui/overlay.h"
 #include "gui/live_pipeline.h"
 #include "gui/live_view.h"
 #include "gui/rate_meter.h"

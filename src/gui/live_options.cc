@@ -1,4 +1,4 @@
-#include "softsight/gui/live_options.h"
+#include "gui/live_options.h"
 
 #include <cmath>
 

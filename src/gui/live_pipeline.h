@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "softsight/config/config.h"
-#include "softsight/gui/live_window.h"
+#include "gui/live_window.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/core/types.h"

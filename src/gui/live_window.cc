@@ -1,4 +1,4 @@
-#include "softsight/gui/live_window.h"
+#include "gui/live_window.h"
 
 #include <X11/Xlib.h>
 

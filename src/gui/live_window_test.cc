@@ -22,7 +22,7 @@
 
 #include "gui/live_layout.h"
 #include "gui/live_test_util.h"
-#include "softsight/gui/overlay.h"
+#include "gui/overlay.h"
 #include "softsight/config/config.h"
 #include "softsight/io/csv_reader.h"
 #include "softsight/sim/scene.h"

@@ -3,7 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include "gui/live_controller.h"
-#include "softsight/gui/overlay.h"
+#include "gui/overlay.h"
 #include "gui/strip_chart.h"
 #include "softsight/sim/scene.h"
 

@@ -1,4 +1,4 @@
-#include "softsight/gui/overlay.h"
+#include "gui/overlay.h"
 
 #include <gtest/gtest.h>
 

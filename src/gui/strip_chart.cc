@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "softsight/gui/overlay.h"  // ReadsStraight
+#include "gui/overlay.h"  // ReadsStraight
 #include "softsight/io/plot.h"
 
 namespace softsight {

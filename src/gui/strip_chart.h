@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "softsight/gui/live_options.h"  // StripChartOptions
+#include "gui/live_options.h"  // StripChartOptions
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {

@@ -10,7 +10,7 @@
 #include "pipeline/marker_plausibility.h"
 #include "pipeline/scene_config_test_util.h"
 #include "softsight/pipeline/tracking_session.h"
-#include "softsight/sim/corruption.h"
+#include "sim/corruption.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {

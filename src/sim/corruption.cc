@@ -1,4 +1,4 @@
-#include "softsight/sim/corruption.h"
+#include "sim/corruption.h"
 
 #include <algorithm>
 

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "softsight/sim/corruption.h"
+#include "sim/corruption.h"
 #include "softsight/sim/plate_scene.h"
 #include "softsight/sim/scene.h"
 

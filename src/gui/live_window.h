@@ -11,7 +11,7 @@
 #include <string>
 
 #include "softsight/config/config.h"
-#include "softsight/gui/live_options.h"
+#include "gui/live_options.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/summary.h"
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "softsight/calib/hsv_picker.h"
-#include "softsight/gui/overlay.h"
+#include "gui/overlay.h"
 
 namespace softsight {
 

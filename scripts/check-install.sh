@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The installed library and Python package, used as an outside project would (ctest install.*):
+#   check-install.sh prefix   BUILD WORK  cmake --install of BUILD into WORK/prefix
+#   check-install.sh cmake    BUILD WORK  examples/library built with find_package(softsight), run
+#   check-install.sh pkg-config BUILD WORK  the same source built with `pkg-config softsight` only
+#   check-install.sh pip      BUILD WORK  `pip install --no-build-isolation .` into a fresh virtual
+#                                         environment (reusing BUILD), imported, used, uninstalled
+# Each step prints what it checks and exits non-zero at the first thing that is wrong.
+set -euo pipefail
+mode=$1 build=$(cd "$2" && pwd) work=$3
+source_dir=$(cd "$(dirname "$0")/.." && pwd)
+prefix=$work/prefix
+config=$source_dir/examples/markers.yaml
+fail() { echo "check-install ($mode): $*" >&2; exit 1; }
+
+case $mode in
+  prefix)
+    rm -rf "$prefix"
+    cmake --install "$build" --prefix "$prefix" >/dev/null
+    for f in include/softsight/pipeline/tracking_session.h include/softsight/version.h \
+             bin/softsight; do
+      [ -e "$prefix/$f" ] || fail "$f not installed"
+    done
+    # Only the API: what the program or the tests alone use is not installed.
+    for f in include/softsight/gui include/softsight/sim/corruption.h; do
+      [ ! -e "$prefix/$f" ] || fail "$f installed, but it is not part of the library's API"
+    done
+    # The installed program finds its plugins from where it was installed.
+    "$prefix/bin/softsight" synth --help >/dev/null || fail "the installed program cannot run synth"
+    echo "check-install: installed into $prefix"
+    ;;
+  cmake)
+    out=$work/cmake-example
+    rm -rf "$out"
+    cmake -S "$source_dir/examples/library" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" \
+          -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake --build "$out" >/dev/null
+    "$out/track_rendered" "$config" 30
+    ;;
+  pkg-config)
+    out=$work/pkg-config-example
+    mkdir -p "$out"
+    pc_dir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")
+    [ -n "$pc_dir" ] || fail "no softsight.pc under $prefix"
+    flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs softsight)
+    # shellcheck disable=SC2086  # the flags are words
+    c++ -std=c++20 -O1 "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags
+    "$out/track_rendered" "$config" 30
+    ;;
+  pip)
+    venv=$work/venv
+    rm -rf "$venv"
+    # The interpreter the build was configured for (ctest passes it; a pyenv python3 first on PATH
+    # lacks Debian's numpy, setuptools and wheel).
+    "${SOFTSIGHT_PYTHON:-/usr/bin/python3}" -m venv --system-site-packages "$venv"  # numpy, dask: Debian
+    # pip builds in the source tree; SOFTSIGHT_BUILD_DIR makes it reuse this build's extension.
+    (cd "$source_dir" && SOFTSIGHT_BUILD_DIR=$build PIP_NO_INDEX=1 \
+       "$venv/bin/pip" install --no-build-isolation --no-deps -q .) || fail "pip install failed"
+    cd "$work"   # Not the source tree: the package must come from the environment.
+    env -u PYTHONPATH "$venv/bin/python" - "$config" <<'PY'
+import sys, softsight, importlib.metadata as m
+assert softsight.__file__.startswith(sys.prefix), softsight.__file__
+assert m.version("softsight") == softsight.__version__
+table = softsight.track("synth:bending", sys.argv[1], max_frames=10)
+found = int(table["red_found"].sum())
+assert found == 10, f"red found in {found} of 10 frames"
+print("check-install: pip-installed softsight", softsight.__version__, "found red in", found, "of 10 frames")
+PY
+    "$venv/bin/pip" uninstall -y -q softsight || fail "pip uninstall failed"
+    left=$(find "$venv/lib" -maxdepth 3 -name 'softsight*')
+    [ -z "$left" ] || fail "pip uninstall left $left"
+    echo "check-install: pip uninstall removed it"
+    ;;
+  *) fail "unknown mode (prefix, cmake, pkg-config, pip)" ;;
+esac
