@@ -9,6 +9,7 @@
 
 #include "bindings.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {

@@ -19,6 +19,7 @@
 #include "softsight/control/transport.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/core/format.h"
 #include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/run.h"

@@ -21,6 +21,7 @@
 #include "app/truth_sink.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/core/format.h"
 #include "softsight/io/csv_reader.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
@@ -58,14 +59,9 @@ void CheckNames(const std::vector<std::string>& names, const std::vector<std::st
   }
 }
 
-std::string FormatNumber(double value, int decimals) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
-  return text;
-}
 
 std::string FormatOptional(const std::optional<double>& value, int decimals) {
-  return value ? FormatNumber(*value, decimals) : std::string("n/a");
+  return value ? FixedNumber(*value, decimals) : std::string("n/a");
 }
 
 // One evaluated configuration: a method and, for templates, a mode.
@@ -307,8 +303,8 @@ std::string FormatEvaluateMarkdown(const EvaluateReport& report) {
         << " | " << FormatOptional(m.precision_rms_px, 3) << " | "
         << FormatOptional(m.precision_max_px, 3) << " | " << m.misses << " / " << m.visible
         << " | " << m.wrong_finds << " | " << m.false_reports << " / " << m.hidden << " | "
-        << FormatOptional(m.angle_rms_deg, 3) << " | " << FormatNumber(m.proc_ms_median, 3)
-        << " | " << FormatNumber(m.proc_ms_p99, 3) << " |\n";
+        << FormatOptional(m.angle_rms_deg, 3) << " | " << FixedNumber(m.proc_ms_median, 3)
+        << " | " << FixedNumber(m.proc_ms_p99, 3) << " |\n";
   }
   out << "\nCentroid: |tracked - true| over found, visible (>= 50%) marker-frames. Precision: the "
          "same after removing each marker's constant offset measured on its first found frame "
@@ -323,7 +319,7 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
          "centroid_max_px,precision_rms_px,precision_max_px,angle_rms_deg,angle_frames,"
          "proc_ms_median,proc_ms_p99,centroid_p95_px,wrong_finds\n";
   const auto field = [](const std::optional<double>& value) {
-    return value ? FormatNumber(*value, 6) : std::string();
+    return value ? FixedNumber(*value, 6) : std::string();
   };
   for (const MethodResult& m : report.methods) {
     out << m.method << "," << m.mode.value_or("") << "," << report.frames << "," << m.visible
@@ -331,7 +327,7 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
         << "," << field(m.centroid_rms_px) << "," << field(m.centroid_max_px) << ","
         << field(m.precision_rms_px) << "," << field(m.precision_max_px) << ","
         << field(m.angle_rms_deg) << "," << m.angle_frames << ","
-        << FormatNumber(m.proc_ms_median, 6) << "," << FormatNumber(m.proc_ms_p99, 6) << ","
+        << FixedNumber(m.proc_ms_median, 6) << "," << FixedNumber(m.proc_ms_p99, 6) << ","
         << field(m.centroid_p95_px) << "," << m.wrong_finds << "\n";
   }
   out.flush();

@@ -16,6 +16,7 @@
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {

@@ -50,8 +50,6 @@ std::string StopSignalReason(int signal) {
   return "stopped by signal " + std::to_string(signal);
 }
 
-int LastStopSignal() { return g_last_stop_signal; }
-
 int ExitCodeAfterStop(int code) {
   const int signal = g_last_stop_signal;
   return signal != 0 ? 128 + signal : code;

@@ -33,10 +33,6 @@ class StopRequest {
 // For a summary: "stopped by Ctrl-C (SIGINT)", "stopped by SIGTERM".
 std::string StopSignalReason(int signal);
 
-// The signal that stopped a command during this process (0: none), kept after the StopRequest
-// is gone so a command can turn it into its exit code after the summary is printed.
-int LastStopSignal();
-
 // 128 + signal for a run a signal stopped, else `code`.
 int ExitCodeAfterStop(int code);
 

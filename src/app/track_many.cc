@@ -19,6 +19,7 @@
 #include "app/cli_checks.h"
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 #include "softsight/io/frame_source.h"
 
 extern char** environ;
@@ -50,11 +51,6 @@ struct Child {
   std::string output;
 };
 
-std::string FormatNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.17g", value);
-  return text;
-}
 
 // `softsight track` on one input with the shared options (the `=` forms keep a value that starts
 // with '-' a value).
@@ -65,7 +61,7 @@ std::vector<std::string> ChildArguments(const TrackManyOptions& options, const s
                                    "--input=" + input, "--csv=" + csv, "--brief"};
   if (common.method) args.push_back("--method=" + *common.method);
   if (common.template_colour) args.push_back(*common.template_colour ? "--colour" : "--gray");
-  args.push_back("--fps=" + FormatNumber(common.source.sequence_fps));
+  args.push_back("--fps=" + RoundTripNumber(common.source.sequence_fps));
   if (common.max_frames) args.push_back("--max-frames=" + std::to_string(*common.max_frames));
   return args;
 }

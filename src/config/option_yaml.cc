@@ -3,10 +3,10 @@
 #include <cmath>
 #include <cstdint>
 
+#include "softsight/core/format.h"
+
 namespace softsight {
 namespace {
-
-std::string Shown(const YAML::Node& node) { return ShownInMessage(node); }  // one spelling
 
 bool DecodeInt(const YAML::Node& node, int64_t* value) {
   return IsValueScalar(node) && YAML::convert<int64_t>::decode(node, *value);
@@ -20,7 +20,7 @@ bool DecodeDouble(const YAML::Node& node, double* value) {
 std::string Number(double d) {
   if (std::isnan(d)) return ".nan";
   if (std::isinf(d)) return d > 0 ? ".inf" : "-.inf";
-  return FormatDouble(d);
+  return RoundTripNumber(d);
 }
 
 }  // namespace
@@ -34,33 +34,33 @@ std::optional<OptionValue> ReadOptionValue(YamlMap& map, const std::string& leaf
     case OptionKind::kBool: {
       bool b = false;
       if (!IsValueScalar(node) || !YAML::convert<bool>::decode(node, b)) {
-        map.fail(leaf, "expected true or false, got " + Shown(node));
+        map.fail(leaf, "expected true or false, got " + ShownInMessage(node));
       }
       value = b;
       break;
     }
     case OptionKind::kInt: {
       int64_t i = 0;
-      if (!DecodeInt(node, &i)) map.fail(leaf, "expected a whole number, got " + Shown(node));
+      if (!DecodeInt(node, &i)) map.fail(leaf, "expected a whole number, got " + ShownInMessage(node));
       value = i;
       break;
     }
     case OptionKind::kDouble: {
       double d = 0;
-      if (!DecodeDouble(node, &d)) map.fail(leaf, "expected a number, got " + Shown(node));
+      if (!DecodeDouble(node, &d)) map.fail(leaf, "expected a number, got " + ShownInMessage(node));
       value = d;
       break;
     }
     case OptionKind::kEnum:
     case OptionKind::kString:
-      if (!node.IsScalar()) map.fail(leaf, "expected text, got " + Shown(node));
+      if (!node.IsScalar()) map.fail(leaf, "expected text, got " + ShownInMessage(node));
       value = node.Scalar();
       break;
     case OptionKind::kStrings: {
       if (!node.IsSequence() || (spec.count > 0 && node.size() != spec.count)) {
         map.fail(leaf, "expected a list of " +
                            (spec.count > 0 ? std::to_string(spec.count) + " " : std::string()) +
-                           "names, got " + Shown(node));
+                           "names, got " + ShownInMessage(node));
       }
       std::vector<std::string> names;
       for (const YAML::Node& item : node) {
@@ -77,7 +77,7 @@ std::optional<OptionValue> ReadOptionValue(YamlMap& map, const std::string& leaf
       if (!node.IsSequence() || (spec.count > 0 && node.size() != spec.count)) {
         map.fail(leaf, "expected a list of " +
                            (spec.count > 0 ? std::to_string(spec.count) + " " : std::string()) +
-                           what + ", got " + Shown(node));
+                           what + ", got " + ShownInMessage(node));
       }
       std::vector<int64_t> int_list;
       std::vector<double> double_list;

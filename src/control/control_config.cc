@@ -5,6 +5,7 @@
 #include "control/control_options.h"
 #include "core/option_table.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 

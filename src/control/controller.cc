@@ -1,4 +1,5 @@
 #include "softsight/control/controller.h"
+#include "softsight/core/format.h"
 
 #include <algorithm>
 #include <cassert>
@@ -14,19 +15,10 @@ bool ControllerOptions::Check(std::string* error) const {
     return Fail(error, *problem);
   }
   if (!(max_kpa > min_kpa)) {
-    return Fail(error, "max_kpa: " + FormatDouble(max_kpa) + " must be above min_kpa (" +
-                           FormatDouble(min_kpa) + ")");
+    return Fail(error, "max_kpa: " + RoundTripNumber(max_kpa) + " must be above min_kpa (" +
+                           RoundTripNumber(min_kpa) + ")");
   }
   return true;
-}
-
-const char* ActionName(ControllerOutput::Action action) {
-  switch (action) {
-    case ControllerOutput::Action::kTrack: return "track";
-    case ControllerOutput::Action::kHold: return "hold";
-    case ControllerOutput::Action::kVent: return "vent";
-  }
-  return "?";
 }
 
 AngleController::AngleController(const ControllerOptions& options) : options_(options) {

@@ -6,20 +6,13 @@
 #include <cstdio>
 #include <limits>
 
+#include "softsight/core/format.h"
+
 namespace softsight {
 namespace {
 
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.3g", v);
-  return text;
-}
 
-std::string Seconds(double v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.2f s", v);
-  return text;
-}
+std::string Seconds(double v) { return FixedNumber(v, 2) + " s"; }
 
 // Solves the 3x3 system a x = b (Cramer's rule); false when it is (nearly) singular.
 bool Solve3(const double a[3][3], const double b[3], double x[3]) {
@@ -164,7 +157,7 @@ IdentificationExperiment::IdentificationExperiment(const IdentifyOptions& option
                                                    double ceiling_kpa)
     : options_(options), ceiling_kpa_(ceiling_kpa) {
   if (!(ceiling_kpa > 0.0) || !std::isfinite(ceiling_kpa)) {
-    throw InputError("identify: the pressure ceiling " + Number(ceiling_kpa) +
+    throw InputError("identify: the pressure ceiling " + ShortNumber(ceiling_kpa, 3) +
                      " kPa must be positive (control.controller.max_kpa, the board's limit)");
   }
   if (options_.levels < 3) throw InputError("identify: at least 3 pressure levels");
@@ -227,7 +220,7 @@ void IdentificationExperiment::start_prbs(double time_s) {
   const double span = top - m.bend_start_kpa;
   if (!(span > 0.0)) {
     throw IdentifyAbort("identify: no linear range between the bend start (" +
-                        Number(m.bend_start_kpa) + " kPa) and the saturation (" + Number(top) +
+                        ShortNumber(m.bend_start_kpa, 3) + " kPa) and the saturation (" + ShortNumber(top, 3) +
                         " kPa)");
   }
   prbs_centre_kpa_ = m.bend_start_kpa + 0.5 * span;
@@ -253,7 +246,7 @@ double IdentificationExperiment::next(double time_s, std::optional<double> angle
     if (time_s - *lost_since_s_ >= options_.lost_s) {
       throw IdentifyAbort("identify: markers lost for " + Seconds(time_s - *lost_since_s_) +
                           " at " + Seconds(time_s) + " (" +
-                          Number(samples_.empty() ? 0.0 : samples_.back().pressure_kpa) +
+                          ShortNumber(samples_.empty() ? 0.0 : samples_.back().pressure_kpa, 3) +
                           " kPa); vented");
     }
   } else {
@@ -282,15 +275,15 @@ double IdentificationExperiment::next(double time_s, std::optional<double> angle
         static_points_.push_back(p);
         if (p.pressure_kpa < 0.5 * setpoint_kpa_ && setpoint_kpa_ > 2.0) {
           throw IdentifyAbort("identify: the pressure does not follow the setpoint: " +
-                              Number(p.pressure_kpa) + " kPa after " +
-                              Seconds(time_s - hold_start_s_) + " at " + Number(setpoint_kpa_) +
+                              ShortNumber(p.pressure_kpa, 3) + " kPa after " +
+                              Seconds(time_s - hold_start_s_) + " at " + ShortNumber(setpoint_kpa_, 3) +
                               " kPa (leak, pump or valve?); vented");
         }
         if (2 * level_ >= options_.levels &&
             std::abs(*straight_deg_ - p.angle_deg) < options_.min_response_deg) {
           throw IdentifyAbort("identify: the angle does not respond: " +
-                              Number(*straight_deg_ - p.angle_deg) + " deg of bend at " +
-                              Number(p.pressure_kpa) + " kPa (tubing, markers, config?); vented");
+                              ShortNumber(*straight_deg_ - p.angle_deg, 3) + " deg of bend at " +
+                              ShortNumber(p.pressure_kpa, 3) + " kPa (tubing, markers, config?); vented");
         }
         if (level_ < options_.levels) {
           ++level_;
@@ -340,8 +333,8 @@ void IdentificationExperiment::answered(double pressure_kpa) {
   if (samples_.empty()) return;
   samples_.back().pressure_kpa = pressure_kpa;
   if (pressure_kpa > ceiling_kpa_ + options_.over_ceiling_kpa) {
-    throw IdentifyAbort("identify: the sensed pressure " + Number(pressure_kpa) +
-                        " kPa is above the experiment's ceiling of " + Number(ceiling_kpa_) +
+    throw IdentifyAbort("identify: the sensed pressure " + ShortNumber(pressure_kpa, 3) +
+                        " kPa is above the experiment's ceiling of " + ShortNumber(ceiling_kpa_, 3) +
                         " kPa; vented");
   }
 }
@@ -368,8 +361,8 @@ ActuatorModel FitStaticMap(const std::vector<StaticPoint>& points, double straig
   }
   LineFit fit;
   auto no_bend = [&] {
-    return IdentifyAbort("identify: the angle does not respond: " + Number(straight_deg - min_deg) +
-                         " deg of bend up to " + Number(max_kpa) + " kPa; vented");
+    return IdentifyAbort("identify: the angle does not respond: " + ShortNumber(straight_deg - min_deg, 3) +
+                         " deg of bend up to " + ShortNumber(max_kpa, 3) + " kPa; vented");
   };
   if (bent.size() < 3 || !FitBranches(bent, &fit) || !(fit.slope > 0.0)) throw no_bend();
 

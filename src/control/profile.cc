@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {

@@ -15,6 +15,7 @@
 #include "control/plant.h"
 #include "control/protocol.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 
@@ -23,11 +24,11 @@ bool RigOptions::Check(std::string* error) const {
   // only rules across fields here.
   if (const auto problem = CheckOptions(RigOptionsTable(), *this)) return Fail(error, *problem);
   if (board.guard_margin_pa + board.guard_release_pa >= board.pressure_limit_pa) {
-    return Fail(error, "board.guard_margin_kpa: " + FormatDouble(board.guard_margin_pa / 1e3) +
+    return Fail(error, "board.guard_margin_kpa: " + RoundTripNumber(board.guard_margin_pa / 1e3) +
                            " plus guard_release_kpa (" +
-                           FormatDouble(board.guard_release_pa / 1e3) +
+                           RoundTripNumber(board.guard_release_pa / 1e3) +
                            ") must stay below pressure_limit_kpa (" +
-                           FormatDouble(board.pressure_limit_pa / 1e3) + ")");
+                           RoundTripNumber(board.pressure_limit_pa / 1e3) + ")");
   }
   // The board's own check (the firmware runs it too); the table's ranges are stricter.
   if (const char* problem = CheckBoardConfig(board)) return Fail(error, std::string("board: ") + problem);

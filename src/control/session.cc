@@ -4,15 +4,11 @@
 #include <cstdio>
 
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {
 
-std::string FormatNumber(double v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", v);
-  return text;
-}
 
 const ControllerOptions& Checked(const ControllerOptions& options) {
   std::string error;
@@ -27,11 +23,11 @@ ControlSession::ControlSession(const ControllerOptions& options, BoardLink& link
     : controller_(Checked(options)), link_(link), target_(std::move(target)) {
   // Comparisons are false for NaN: test for the good range, not against the bad one.
   if (!(target_.duty >= -1.0 && target_.duty <= 1.0)) {
-    throw InputError("--pwm " + FormatNumber(target_.duty) + ": duty must be in -1..1");
+    throw InputError("--pwm " + ShortNumber(target_.duty) + ": duty must be in -1..1");
   }
   if (!(target_.pressure_kpa >= 0.0 && target_.pressure_kpa <= kMaxBoardPressureLimitKpa)) {
-    throw InputError("--pressure-kpa " + FormatNumber(target_.pressure_kpa) +
-                     ": must be a number in 0.." + FormatNumber(kMaxBoardPressureLimitKpa));
+    throw InputError("--pressure-kpa " + ShortNumber(target_.pressure_kpa) +
+                     ": must be a number in 0.." + ShortNumber(kMaxBoardPressureLimitKpa));
   }
 }
 
@@ -53,9 +49,9 @@ BoardInfo ControlSession::start() {
   board_limit_kpa_ = info.pressure_limit_kpa;
   if (!(controller_.options().min_kpa < info.pressure_limit_kpa)) {
     stop();
-    throw InputError("control.controller.min_kpa: " + FormatNumber(controller_.options().min_kpa) +
+    throw InputError("control.controller.min_kpa: " + ShortNumber(controller_.options().min_kpa) +
                      " kPa is not below the board's pressure limit of " +
-                     FormatNumber(info.pressure_limit_kpa) + " kPa (" + link_.port_name() +
+                     ShortNumber(info.pressure_limit_kpa) + " kPa (" + link_.port_name() +
                      "); no setpoint sent, vented");
   }
   controller_.limit_max_kpa(info.pressure_limit_kpa);
@@ -84,8 +80,8 @@ const BoardState& ControlSession::checked(const BoardState& state) {
     } catch (const std::exception&) {
       // Reported below; the board's watchdog vents when the commands stop.
     }
-    throw InputError(link_.port_name() + ": the board reports " + FormatNumber(state.pressure_kpa) +
-                     " kPa, above its own limit of " + FormatNumber(board_limit_kpa_) +
+    throw InputError(link_.port_name() + ": the board reports " + ShortNumber(state.pressure_kpa) +
+                     " kPa, above its own limit of " + ShortNumber(board_limit_kpa_) +
                      " kPa (sensor or guard fault); sent STOP to vent, stopping");
   }
   return state;

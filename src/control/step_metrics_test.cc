@@ -2,13 +2,13 @@
 #include "control/step_metrics.h"
 
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDt = 0.001;  // Fine sampling: interpolation errors far below the tolerances.
 
 // A step from 180 to 120 deg at t = 0 followed by `response(t)` (the angle).
@@ -48,7 +48,7 @@ TEST(StepMetrics, UnderdampedSecondOrderOvershoot) {
   });
   const StepMetrics m = ComputeStepMetrics(run);
   ASSERT_TRUE(m.overshoot_percent);
-  EXPECT_NEAR(*m.overshoot_percent, 100.0 * std::exp(-zeta * kPi / std::sqrt(1 - zeta * zeta)), 0.01);
+  EXPECT_NEAR(*m.overshoot_percent, 100.0 * std::exp(-zeta * std::numbers::pi / std::sqrt(1 - zeta * zeta)), 0.01);
   ASSERT_TRUE(m.settling_1deg_s);
   // The envelope 60 e^(-zeta wn t) / sqrt(1 - zeta^2) bounds the error: settled before it is 1.
   EXPECT_LT(*m.settling_1deg_s, std::log(60.0 / std::sqrt(1 - zeta * zeta)) / (zeta * wn));
@@ -92,13 +92,13 @@ TEST(StepMetrics, ASineHasAnRmsErrorButNoStepFigures) {
   std::vector<TrackingPoint> points;
   for (int k = 0; k <= 8000; ++k) {
     const double t = k * kDt;
-    points.push_back({t, 140.0 + a * std::sin(2 * kPi * f * t),
-                      140.0 + a * std::sin(2 * kPi * f * (t - lag))});
+    points.push_back({t, 140.0 + a * std::sin(2 * std::numbers::pi * f * t),
+                      140.0 + a * std::sin(2 * std::numbers::pi * f * (t - lag))});
   }
   const StepMetrics m = ComputeStepMetrics(points);
   ASSERT_TRUE(m.rms_error_deg);
   // |a e^{iwt} - a e^{iw(t - lag)}| = 2 a sin(w lag / 2); RMS is that over sqrt(2).
-  EXPECT_NEAR(*m.rms_error_deg, 2 * a * std::sin(kPi * f * lag) / std::sqrt(2.0), 0.01);
+  EXPECT_NEAR(*m.rms_error_deg, 2 * a * std::sin(std::numbers::pi * f * lag) / std::sqrt(2.0), 0.01);
   EXPECT_FALSE(m.rise_time_s);
   EXPECT_FALSE(m.settling_1deg_s);
   EXPECT_FALSE(m.overshoot_percent);
@@ -169,15 +169,15 @@ TEST(TrackingMetrics, ADelayedSineGivesItsLagAndNoErrorWithoutIt) {
   std::vector<TrackingPoint> points;
   for (int k = 0; k < 300; ++k) {
     const double t = k * dt;
-    points.push_back({t, 140.0 + amplitude * std::sin(2 * kPi * hz * t),
-                      140.0 + amplitude * std::sin(2 * kPi * hz * (t - lag))});
+    points.push_back({t, 140.0 + amplitude * std::sin(2 * std::numbers::pi * hz * t),
+                      140.0 + amplitude * std::sin(2 * std::numbers::pi * hz * (t - lag))});
   }
   const TrackingMetrics m = ComputeTrackingMetrics(points);
   ASSERT_TRUE(m.lag_s && m.rms_error_deg && m.rms_error_without_lag_deg);
   EXPECT_NEAR(*m.lag_s, lag, 1e-9);
   EXPECT_LT(*m.rms_error_without_lag_deg, 1e-6);
   // sin(a) - sin(a - d) has amplitude 2 sin(d / 2): its RMS is that over sqrt(2).
-  EXPECT_NEAR(*m.rms_error_deg, amplitude * 2.0 * std::sin(kPi * hz * lag) / std::sqrt(2.0), 0.05);
+  EXPECT_NEAR(*m.rms_error_deg, amplitude * 2.0 * std::sin(std::numbers::pi * hz * lag) / std::sqrt(2.0), 0.05);
   EXPECT_EQ(FormatTrackingMetrics(m).substr(0, 24), "tracking: RMS error 8.74");
 }
 
@@ -189,7 +189,7 @@ TEST(TrackingMetrics, TheStepBeforeTheMotionIsNotCounted) {
   std::vector<TrackingPoint> points;
   for (int k = 0; k < 45; ++k) points.push_back({k * dt, 150.0, 150.0 + 30.0 * std::exp(-k * dt / 0.1)});
   for (int k = 45; k < 240; ++k) {
-    const double target = 150.0 + 20.0 * std::sin(2 * kPi * 0.5 * (k - 45) * dt);
+    const double target = 150.0 + 20.0 * std::sin(2 * std::numbers::pi * 0.5 * (k - 45) * dt);
     points.push_back({k * dt, target, target});
   }
   const TrackingMetrics m = ComputeTrackingMetrics(points);

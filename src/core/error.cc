@@ -59,18 +59,4 @@ std::string EscapeForMessage(std::string_view text, size_t max_bytes) {
   return out;
 }
 
-std::string ShortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-
-std::string FixedNumber(double value, int decimals) {
-  char text[64];
-  // Beyond 1e15 a fixed form is long noise: the short form then.
-  if (!(std::abs(value) < 1e15)) return ShortNumber(value);
-  std::snprintf(text, sizeof(text), "%.*f", std::clamp(decimals, 0, 9), value);
-  return text;
-}
-
 }  // namespace softsight

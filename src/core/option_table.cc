@@ -1,8 +1,12 @@
 #include "core/option_table.h"
 
+#include "softsight/core/format.h"
+
 #include <charconv>
 #include <cmath>
 #include <sstream>
+
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {
@@ -11,7 +15,7 @@ std::string Bound(double value) {
   if (std::floor(value) == value && std::fabs(value) < 1e7) {
     return std::to_string(static_cast<int64_t>(value));
   }
-  return FormatDouble(value);
+  return RoundTripNumber(value);
 }
 
 // What a value must satisfy, as the end of "x must ...": "lie within 0..1", "be at least 1".
@@ -90,12 +94,6 @@ std::string NamesText(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::string FormatDouble(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
-
 double FloatAsDouble(float value) {
   if (!std::isfinite(value)) return static_cast<double>(value);
   char buffer[64];
@@ -109,7 +107,7 @@ std::string OptionValueText(const OptionValue& value) {
   struct Visitor {
     std::string operator()(bool b) const { return b ? "true" : "false"; }
     std::string operator()(int64_t i) const { return std::to_string(i); }
-    std::string operator()(double d) const { return FormatDouble(d); }
+    std::string operator()(double d) const { return RoundTripNumber(d); }
     std::string operator()(const std::string& s) const { return Printable(s); }
     std::string operator()(const std::vector<int64_t>& list) const {
       std::string text = "[";
@@ -118,7 +116,7 @@ std::string OptionValueText(const OptionValue& value) {
     }
     std::string operator()(const std::vector<double>& list) const {
       std::string text = "[";
-      for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + FormatDouble(list[i]);
+      for (size_t i = 0; i < list.size(); ++i) text += (i ? ", " : "") + RoundTripNumber(list[i]);
       return text + "]";
     }
     std::string operator()(const std::vector<std::string>& list) const {

@@ -72,7 +72,6 @@ std::optional<std::string> OptionProblem(const OptionSpec& spec, const OptionVal
 // The value as a person writes it in YAML: 0.5, 12, true, median, [170, 10]. Doubles use the
 // shortest text that reads back to the identical double.
 std::string OptionValueText(const OptionValue& value);
-std::string FormatDouble(double value);
 // The double whose shortest text is the float's shortest text (0.1f -> 0.1).
 double FloatAsDouble(float value);
 

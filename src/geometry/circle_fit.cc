@@ -1,11 +1,11 @@
 #include "softsight/geometry/circle_fit.h"
 
 #include <cmath>
+#include <numbers>
 
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 cv::Point2d Mean(const std::vector<cv::Point2d>& points) {
   cv::Point2d mean(0.0, 0.0);
@@ -118,8 +118,8 @@ std::optional<double> ArcLengthThroughPoints(const CircleFit& circle,
     if (i > 0) {
       // Signed step in (-pi, pi]: the shorter way round between neighbours.
       double step = angle - previous;
-      if (step > kPi) step -= 2.0 * kPi;
-      if (step <= -kPi) step += 2.0 * kPi;
+      if (step > std::numbers::pi) step -= 2.0 * std::numbers::pi;
+      if (step <= -std::numbers::pi) step += 2.0 * std::numbers::pi;
       total += step;
     }
     previous = angle;

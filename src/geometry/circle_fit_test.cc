@@ -1,6 +1,7 @@
 #include "softsight/geometry/circle_fit.h"
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -14,13 +15,12 @@ namespace {
 using ::testing::DoubleNear;
 using ::testing::Optional;
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::vector<cv::Point2d> Arc(cv::Point2d centre, double radius, double from_deg, double to_deg,
                              int count) {
   std::vector<cv::Point2d> points;
   for (int i = 0; i < count; ++i) {
-    const double a = (from_deg + (to_deg - from_deg) * i / (count - 1)) * kPi / 180.0;
+    const double a = (from_deg + (to_deg - from_deg) * i / (count - 1)) * std::numbers::pi / 180.0;
     points.push_back(centre + radius * cv::Point2d(std::cos(a), std::sin(a)));
   }
   return points;
@@ -97,7 +97,7 @@ TEST(CircleFitTest, ArcThroughPointsTakesTheMinorArcForAShortSpread) {
   const std::vector<cv::Point2d> points = Arc({0, 0}, 80.0, 20.0, 80.0, 4);
   const std::optional<CircleFit> fit = FitCircleTaubin(points);
   ASSERT_TRUE(fit.has_value());
-  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(80.0 * kPi / 3, 1e-8)));
+  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(80.0 * std::numbers::pi / 3, 1e-8)));
 }
 
 TEST(CircleFitTest, ArcThroughPointsTakesTheMajorArcPastAHalfCircle) {
@@ -105,9 +105,9 @@ TEST(CircleFitTest, ArcThroughPointsTakesTheMajorArcPastAHalfCircle) {
   std::vector<cv::Point2d> points = Arc({100, 50}, 40.0, 0.0, 270.0, 6);
   const std::optional<CircleFit> fit = FitCircleTaubin(points);
   ASSERT_TRUE(fit.has_value());
-  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(40.0 * 1.5 * kPi, 1e-8)));
+  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(40.0 * 1.5 * std::numbers::pi, 1e-8)));
   std::reverse(points.begin(), points.end());
-  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(40.0 * 1.5 * kPi, 1e-8)));
+  EXPECT_THAT(ArcLengthThroughPoints(*fit, points), Optional(DoubleNear(40.0 * 1.5 * std::numbers::pi, 1e-8)));
 }
 
 TEST(CircleFitTest, ArcThroughPointsCanExceedAFullTurn) {
@@ -116,7 +116,7 @@ TEST(CircleFitTest, ArcThroughPointsCanExceedAFullTurn) {
   const std::optional<CircleFit> fit = FitCircleTaubin(points);
   ASSERT_TRUE(fit.has_value());
   EXPECT_THAT(ArcLengthThroughPoints(*fit, points),
-              Optional(DoubleNear(30.0 * 400.0 * kPi / 180.0, 1e-8)));
+              Optional(DoubleNear(30.0 * 400.0 * std::numbers::pi / 180.0, 1e-8)));
 }
 
 TEST(CircleFitTest, ArcThroughThreePointsAgreesWithEq9) {

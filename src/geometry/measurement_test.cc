@@ -1,6 +1,7 @@
 #include "softsight/geometry/measurement.h"
 
 #include <cmath>
+#include <numbers>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,7 +15,6 @@ using ::testing::DoubleNear;
 using ::testing::HasSubstr;
 using ::testing::Optional;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTol = 1e-9;
 
 MarkerObservation Seen(const std::string& name, double x, double y) {
@@ -31,7 +31,7 @@ MeasureOptions Triple() {
 }
 
 cv::Point2d OnCircle(cv::Point2d centre, double radius, double angle_deg) {
-  const double a = angle_deg * kPi / 180.0;
+  const double a = angle_deg * std::numbers::pi / 180.0;
   return centre + radius * cv::Point2d(std::cos(a), std::sin(a));
 }
 
@@ -45,7 +45,7 @@ TEST(MeasurerTest, HalfCircleTripleInAnyOrderWithoutMetric) {
   EXPECT_THAT(m.chord_px, Optional(DoubleNear(80.0, kTol)));
   EXPECT_THAT(m.sagitta_px, Optional(DoubleNear(40.0, kTol)));
   EXPECT_THAT(m.radius_px, Optional(DoubleNear(40.0, kTol)));
-  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(40.0 * kPi, 1e-7)));
+  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(40.0 * std::numbers::pi, 1e-7)));
   EXPECT_THAT(m.circumradius_px, Optional(DoubleNear(40.0, kTol)));
   EXPECT_THAT(m.tip_disp_px, Optional(DoubleNear(0.0, kTol)));  // First frame: the reference.
   EXPECT_EQ(m.chord_mm, std::nullopt);
@@ -140,7 +140,7 @@ TEST(MeasurerTest, ScaleMetricMultipliesEveryLength) {
   EXPECT_THAT(m.chord_mm, Optional(DoubleNear(16.0, kTol)));
   EXPECT_THAT(m.sagitta_mm, Optional(DoubleNear(8.0, kTol)));
   EXPECT_THAT(m.radius_mm, Optional(DoubleNear(8.0, kTol)));
-  EXPECT_THAT(m.arc_length_mm, Optional(DoubleNear(8.0 * kPi, 1e-7)));
+  EXPECT_THAT(m.arc_length_mm, Optional(DoubleNear(8.0 * std::numbers::pi, 1e-7)));
   EXPECT_THAT(m.tip_disp_mm, Optional(DoubleNear(2.0, kTol)));
 }
 
@@ -171,7 +171,7 @@ void ExpectSameMm(const Measurement& a, const Measurement& b) {
 TEST(MeasurerTest, PureScaleHomographyAgreesWithTheScaleModel) {
   // A rotation by 30 degrees, a scale of 0.25 mm/px and a translation change no length beyond
   // the scale.
-  const double s = 0.25, c = std::cos(kPi / 6), n = std::sin(kPi / 6);
+  const double s = 0.25, c = std::cos(std::numbers::pi / 6), n = std::sin(std::numbers::pi / 6);
   const cv::Matx33d similarity(s * c, -s * n, 12.0, s * n, s * c, -40.0, 0, 0, 1);
   const cv::Matx33d pure_scale(s, 0, 0, 0, s, 0, 0, 0, 1);
   const std::vector<MarkerObservation> first = {Seen("green", 300, 200)};
@@ -182,7 +182,7 @@ TEST(MeasurerTest, PureScaleHomographyAgreesWithTheScaleModel) {
     const auto [by_scale, by_plane] = MeasureBoth(Triple(), h, s, first, second);
     ExpectSameMm(by_scale, by_plane);
     EXPECT_THAT(by_plane.radius_mm, Optional(DoubleNear(90.0 * s, 1e-9)));
-    EXPECT_THAT(by_plane.arc_length_mm, Optional(DoubleNear(90.0 * s * 220.0 * kPi / 180, 1e-9)));
+    EXPECT_THAT(by_plane.arc_length_mm, Optional(DoubleNear(90.0 * s * 220.0 * std::numbers::pi / 180, 1e-9)));
     EXPECT_EQ(by_scale.angle_deg, by_plane.angle_deg);
   }
 }
@@ -238,7 +238,7 @@ TEST(MeasurerTest, ChainRadiusAndArcComeFromTheCircleFit) {
   // 240 degrees of an 80 px circle: the major arc, 80 * 4 pi / 3.
   const Measurement m = measurer.measure(ChainOnCircle({300, 200}, 80.0, 150.0, -90.0));
   EXPECT_THAT(m.radius_px, Optional(DoubleNear(80.0, 1e-8)));
-  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(80.0 * 4.0 * kPi / 3.0, 1e-8)));
+  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(80.0 * 4.0 * std::numbers::pi / 3.0, 1e-8)));
   EXPECT_THAT(m.angle_deg, Optional(DoubleNear(60.0, 1e-8)));  // From the triple.
 }
 
@@ -248,7 +248,7 @@ TEST(MeasurerTest, ChainUsesTheFoundMarkersAndNeedsThree) {
   markers[1] = Lost("c1");
   Measurement m = measurer.measure(markers);
   EXPECT_THAT(m.radius_px, Optional(DoubleNear(50.0, 1e-8)));
-  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(50.0 * 2.0 * kPi / 3.0, 1e-8)));
+  EXPECT_THAT(m.arc_length_px, Optional(DoubleNear(50.0 * 2.0 * std::numbers::pi / 3.0, 1e-8)));
   markers[3] = Lost("c2");
   markers[2] = Lost("blue");
   m = measurer.measure(markers);

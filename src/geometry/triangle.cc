@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 double Cross(const cv::Point2d& u, const cv::Point2d& v) { return u.x * v.y - u.y * v.x; }
 
@@ -27,7 +27,7 @@ std::optional<double> AngleAtMiddleDeg(const cv::Point2d& base, const cv::Point2
   // Eq. 7 with l1^2 + l2^2 - l3^2 written as 2 u.v (the same number, without the cancellation
   // that costs digits near 180 degrees); the clamp keeps rounding from leaving acos' domain.
   const double cosine = std::clamp(u.dot(v) / (l1 * l2), -1.0, 1.0);
-  return std::acos(cosine) * 180.0 / kPi;
+  return std::acos(cosine) * 180.0 / std::numbers::pi;
 }
 
 double Chord(const cv::Point2d& base, const cv::Point2d& tip) {
@@ -56,7 +56,7 @@ std::optional<double> ArcLengthFromChordSagitta(double chord, double sagitta) {
   if (!radius) return chord;  // Straight.
   // c / 2R <= 1 always holds in exact arithmetic (equality at the half circle, d = R = c / 2).
   const double half_angle = std::asin(std::min(1.0, chord / (2.0 * *radius)));
-  const double theta = sagitta > *radius ? 2.0 * kPi - 2.0 * half_angle : 2.0 * half_angle;
+  const double theta = sagitta > *radius ? 2.0 * std::numbers::pi - 2.0 * half_angle : 2.0 * half_angle;
   return *radius * theta;
 }
 

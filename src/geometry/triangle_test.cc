@@ -1,6 +1,7 @@
 #include "softsight/geometry/triangle.h"
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -13,11 +14,10 @@ using ::testing::DoubleNear;
 using ::testing::Eq;
 using ::testing::Optional;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTol = 1e-9;
 
 cv::Point2d OnCircle(cv::Point2d centre, double radius, double angle_deg) {
-  const double a = angle_deg * kPi / 180.0;
+  const double a = angle_deg * std::numbers::pi / 180.0;
   return centre + radius * cv::Point2d(std::cos(a), std::sin(a));
 }
 
@@ -48,7 +48,7 @@ TEST(TriangleTest, RightAngleAtMiddleIsAHalfCircle) {
   EXPECT_NEAR(m.chord, 10.0 * std::sqrt(2.0), kTol);
   EXPECT_THAT(m.sagitta, Optional(DoubleNear(r, kTol)));
   EXPECT_THAT(m.radius, Optional(DoubleNear(r, kTol)));
-  EXPECT_THAT(m.arc_length, Optional(DoubleNear(kPi * r, kTol)));
+  EXPECT_THAT(m.arc_length, Optional(DoubleNear(std::numbers::pi * r, kTol)));
   EXPECT_THAT(m.circumradius, Optional(DoubleNear(r, kTol)));
 }
 
@@ -57,7 +57,7 @@ TEST(TriangleTest, HalfCircleOfRadius40) {
   const TriangleMeasures m = MeasureTriangle({-40, 0}, {0, 40}, {40, 0});
   EXPECT_THAT(m.angle_deg, Optional(DoubleNear(90.0, kTol)));
   EXPECT_THAT(m.radius, Optional(DoubleNear(40.0, kTol)));
-  EXPECT_THAT(m.arc_length, Optional(DoubleNear(40.0 * kPi, 1e-7)));
+  EXPECT_THAT(m.arc_length, Optional(DoubleNear(40.0 * std::numbers::pi, 1e-7)));
 }
 
 TEST(TriangleTest, QuarterCircleIsTheMinorArc) {
@@ -70,7 +70,7 @@ TEST(TriangleTest, QuarterCircleIsTheMinorArc) {
   EXPECT_THAT(m.sagitta, Optional(DoubleNear(100.0 * (1.0 - std::sqrt(0.5)), kTol)));
   EXPECT_THAT(m.angle_deg, Optional(DoubleNear(135.0, kTol)));
   EXPECT_THAT(m.radius, Optional(DoubleNear(100.0, kTol)));
-  EXPECT_THAT(m.arc_length, Optional(DoubleNear(100.0 * kPi / 2.0, kTol)));
+  EXPECT_THAT(m.arc_length, Optional(DoubleNear(100.0 * std::numbers::pi / 2.0, kTol)));
   EXPECT_THAT(m.circumradius, Optional(DoubleNear(100.0, kTol)));
 }
 
@@ -83,7 +83,7 @@ TEST(TriangleTest, PastAHalfCircleIsTheMajorArc) {
   EXPECT_NEAR(m.chord, 50.0 * std::sqrt(2.0), kTol);
   EXPECT_THAT(m.sagitta, Optional(DoubleNear(50.0 + 25.0 * std::sqrt(2.0), kTol)));
   EXPECT_THAT(m.radius, Optional(DoubleNear(50.0, kTol)));
-  EXPECT_THAT(m.arc_length, Optional(DoubleNear(50.0 * 1.5 * kPi, kTol)));
+  EXPECT_THAT(m.arc_length, Optional(DoubleNear(50.0 * 1.5 * std::numbers::pi, kTol)));
   EXPECT_THAT(m.angle_deg, Optional(DoubleNear(45.0, kTol)));
 }
 
@@ -92,8 +92,8 @@ TEST(TriangleTest, ArcLengthIsContinuousThroughTheHalfCircle) {
   const double c = 80.0;
   const double below = *ArcLengthFromChordSagitta(c, 40.0 - 1e-6);
   const double above = *ArcLengthFromChordSagitta(c, 40.0 + 1e-6);
-  EXPECT_NEAR(below, 40.0 * kPi, 1e-4);
-  EXPECT_NEAR(above, 40.0 * kPi, 1e-4);
+  EXPECT_NEAR(below, 40.0 * std::numbers::pi, 1e-4);
+  EXPECT_NEAR(above, 40.0 * std::numbers::pi, 1e-4);
   EXPECT_LT(below, above);
 }
 
@@ -152,7 +152,7 @@ TEST(TriangleTest, AllThreeCoincidentGivesNothingButAZeroChord) {
 // Eq. 7 exactly as the paper writes it, for comparison.
 double LawOfCosinesDeg(cv::Point2d r, cv::Point2d b, cv::Point2d g) {
   const double l1 = cv::norm(r - b), l2 = cv::norm(b - g), l3 = cv::norm(r - g);
-  return std::acos((l1 * l1 + l2 * l2 - l3 * l3) / (2 * l1 * l2)) * 180.0 / kPi;
+  return std::acos((l1 * l1 + l2 * l2 - l3 * l3) / (2 * l1 * l2)) * 180.0 / std::numbers::pi;
 }
 
 TEST(TriangleTest, AngleMatchesTheLawOfCosinesOnRandomTriangles) {
@@ -178,7 +178,7 @@ TEST(TriangleTest, Eq8EqualsCircumradiusWhenTheMiddleIsMidArc) {
     ASSERT_TRUE(m.radius && m.circumradius && m.arc_length) << s << " " << r;
     EXPECT_NEAR(*m.radius, r, 1e-9 * r * 1e3);
     EXPECT_NEAR(*m.circumradius, r, 1e-9 * r * 1e3);
-    EXPECT_NEAR(*m.arc_length, r * s * kPi / 180.0, 1e-9 * r * 1e3) << s;
+    EXPECT_NEAR(*m.arc_length, r * s * std::numbers::pi / 180.0, 1e-9 * r * 1e3) << s;
   }
 }
 

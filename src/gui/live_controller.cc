@@ -8,6 +8,7 @@
 
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/live_recording.h"  // SaveLiveConfig
@@ -101,7 +102,7 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
     // A frame the user stepped or seeked to: no figure of the playing rate; say which it is
     // (stdout too, for the terminal and for scripts driving the window).
     if (!recording_stopped) {
-      say("frame " + std::to_string(frame.index) + " (" + FixedText(frame.time_s, 3) + " s)");
+      say("frame " + std::to_string(frame.index) + " (" + FixedNumber(frame.time_s, 3) + " s)");
     }
     return;
   }
@@ -443,8 +444,8 @@ void LiveController::scale_point(const cv::Point2d& p) {
     chart_.clear();
     chart_.add(*last_result_);
   }
-  say("scale " + FixedText(*metric->scale_mm_per_px, 4) + " mm/px (" +
-      DistanceText(*options_.scale_distance_mm) + " mm over " + FixedText(scale_.span_px(), 1) +
+  say("scale " + FixedNumber(*metric->scale_mm_per_px, 4) + " mm/px (" +
+      DistanceText(*options_.scale_distance_mm) + " mm over " + FixedNumber(scale_.span_px(), 1) +
       " px" + (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
 }
 
@@ -655,7 +656,7 @@ std::vector<std::string> LiveController::status_lines() const {
       "active: " + config().markers[active_].name + " (" +
       TrackerMethodName(config().markers[active_].params) + ")";
   if (const auto& scale = config().measure.metric.scale_mm_per_px) {
-    state += "  " + FixedText(*scale, 4) + " mm/px";
+    state += "  " + FixedNumber(*scale, 4) + " mm/px";
   }
   lines.push_back(state);
   if (!message_.empty()) lines.push_back(message_);

@@ -6,12 +6,14 @@
 #include <opencv2/imgproc.hpp>
 
 #include "gui/live_controller.h"
+#include "gui/overlay.h"
 #include "gui/range_edit.h"
+
+#include "softsight/core/format.h"
 
 namespace softsight {
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr int kStatusOutline = 4;  // The dark outline under the status lines' text, px.
 const cv::Scalar kDragColour(0, 255, 0);
 const cv::Scalar kScaleColour(255, 255, 0);  // Cyan: unlike any overlay colour.
@@ -21,11 +23,6 @@ const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0
 
 }  // namespace
 
-std::string FixedText(double value, int precision) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.*f", precision, value);
-  return text;
-}
 
 const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& state) {
   canvas_.create(view.canvas, CV_8UC3);
@@ -33,7 +30,7 @@ const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& st
   const cv::Mat& annotated = *state.annotated;
   if (annotated.empty()) {
     top.setTo(cv::Scalar(0, 0, 0));
-    cv::putText(top, "waiting for frames...", {20, 40}, kFont, 0.7, cv::Scalar(255, 255, 255), 1,
+    cv::putText(top, "waiting for frames...", {20, 40}, kGuiFont, 0.7, cv::Scalar(255, 255, 255), 1,
                 cv::LINE_AA);
   } else if (state.mask_view) {
     draw_mask_view(top, view, state);
@@ -95,7 +92,7 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
     const cv::Point2d b = view.to_view(cv::Point2d(region->br()) - cv::Point2d(0.5, 0.5));
     cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
                   kMaskWindowColour, 1);
-    cv::putText(top, "searched", {cvRound(a.x) + 3, cvRound(b.y) - 4}, kFont, text * 0.8,
+    cv::putText(top, "searched", {cvRound(a.x) + 3, cvRound(b.y) - 4}, kGuiFont, text * 0.8,
                 kMaskWindowColour, 1, cv::LINE_AA);
   }
   // Each candidate blob: a circle of its area, green chosen, yellow fitting, red rejected, with
@@ -108,19 +105,19 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
                                                                      : kMaskRejectedColour;
     cv::circle(top, cv::Point(cvRound(at.x), cvRound(at.y)), radius, colour, 1, cv::LINE_AA);
     const std::string label = std::string(CandidateVerdictName(c.verdict)) + " " +
-                              FixedText(c.area_px, 0) + " px2 circ " + FixedText(c.circularity, 2) +
-                              " misfit " + FixedText(c.misfit, 2);
+                              FixedNumber(c.area_px, 0) + " px2 circ " + FixedNumber(c.circularity, 2) +
+                              " misfit " + FixedNumber(c.misfit, 2);
     const cv::Point origin(cvRound(at.x) + radius + 3, cvRound(at.y) + 4);
-    cv::putText(top, label, origin, kFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
-    cv::putText(top, label, origin, kFont, text * 0.8, colour, 1, cv::LINE_AA);
+    cv::putText(top, label, origin, kGuiFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(top, label, origin, kGuiFont, text * 0.8, colour, 1, cv::LINE_AA);
   }
   const auto* c = std::get_if<ColourParams>(&state.active->params);  // A mask is a colour's.
   const std::string title =
       "MASK " + state.active->name +
       (has_mask && c ? ": h " + RangeText(c->h) + " s " + RangeText(c->s) + " v " + RangeText(c->v)
                      : ": " + TrackerMethodName(state.active->params) + " has no colour mask");
-  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-  cv::putText(top, title, {8, 22}, kFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(top, title, {8, 22}, kGuiFont, text, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+  cv::putText(top, title, {8, 22}, kGuiFont, text, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
 }
 
 
@@ -128,7 +125,7 @@ std::vector<cv::Point> PlaceStatusLines(cv::Size size, size_t count, double* tex
   const double scale = std::max(0.4, size.width / 640.0 * 0.5);
   *text_scale = scale;
   int baseline = 0;
-  const int height = cv::getTextSize("Ag", kFont, scale, kStatusOutline, &baseline).height;
+  const int height = cv::getTextSize("Ag", kGuiFont, scale, kStatusOutline, &baseline).height;
   const int row_height = height + baseline + 4;  // Outlined rows never touch.
   // One row per line, not wrapped: more rows would cover the markers at the image's bottom; a
   // message longer than the image is also on stdout.
@@ -142,9 +139,9 @@ void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool f
   double scale = 1;
   const std::vector<cv::Point> origins = PlaceStatusLines(top.size(), lines.size(), &scale);
   for (size_t i = 0; i < lines.size(); ++i) {
-    cv::putText(top, lines[i], origins[i], kFont, scale, cv::Scalar(0, 0, 0), kStatusOutline,
+    cv::putText(top, lines[i], origins[i], kGuiFont, scale, cv::Scalar(0, 0, 0), kStatusOutline,
                 cv::LINE_AA);
-    cv::putText(top, lines[i], origins[i], kFont, scale,
+    cv::putText(top, lines[i], origins[i], kGuiFont, scale,
                 first_red && i == 0 ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255), 1,
                 cv::LINE_AA);
   }
@@ -173,7 +170,7 @@ std::string KeyName(int key) {
 int HelpPanelWidth() {
   int width = 0, baseline = 0;
   for (const LiveKey& k : kLiveKeys) {
-    width = std::max(width, cv::getTextSize(k.what, kFont, kHelpScale, 1, &baseline).width);
+    width = std::max(width, cv::getTextSize(k.what, kGuiFont, kHelpScale, 1, &baseline).width);
   }
   return 2 * kHelpMargin + kHelpKeyColumn + width;
 }
@@ -186,13 +183,13 @@ void DrawHelpPanel(cv::Mat& panel) {
   const double scale = kHelpScale * fit;
   const int line = std::max(6, cvRound(kHelpLine * fit));
   int y = kHelpMargin + line;
-  cv::putText(panel, "keys (h hides)", {kHelpMargin, y}, kFont, scale, cv::Scalar(120, 220, 255), 1,
+  cv::putText(panel, "keys (h hides)", {kHelpMargin, y}, kGuiFont, scale, cv::Scalar(120, 220, 255), 1,
               cv::LINE_AA);
   for (const LiveKey& k : kLiveKeys) {
     y += line;
-    cv::putText(panel, KeyName(k.key), {kHelpMargin, y}, kFont, scale, cv::Scalar(120, 220, 255),
+    cv::putText(panel, KeyName(k.key), {kHelpMargin, y}, kGuiFont, scale, cv::Scalar(120, 220, 255),
                 1, cv::LINE_AA);
-    cv::putText(panel, k.what, {kHelpMargin + cvRound(kHelpKeyColumn * fit), y}, kFont, scale,
+    cv::putText(panel, k.what, {kHelpMargin + cvRound(kHelpKeyColumn * fit), y}, kGuiFont, scale,
                 cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
   }
 }

@@ -11,6 +11,7 @@
 
 #include "gui/live_layout.h"
 #include "gui/strip_chart.h"
+#include "softsight/core/format.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {
@@ -55,7 +56,5 @@ std::vector<cv::Point> PlaceStatusLines(cv::Size size, size_t count, double* tex
 int HelpPanelWidth();
 void DrawHelpPanel(cv::Mat& panel);
 
-// 12.3456 with precision 2 -> "12.35": figures in messages and on screen.
-std::string FixedText(double value, int precision);
 
 }  // namespace softsight

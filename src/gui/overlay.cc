@@ -7,10 +7,11 @@
 #include <opencv2/imgproc.hpp>
 
 namespace softsight {
+
+static_assert(kGuiFont == cv::FONT_HERSHEY_SIMPLEX);
+
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-constexpr int kShift = 4;  // Sub-pixel drawing: coordinates in 1/16 px.
 // A file shown at less than this fraction of its own speed is said to play slower than real time
 // (a loaded machine, a large frame): its figures come from every frame, only later.
 constexpr double kSlowPlaybackSpeed = 0.9;
@@ -22,7 +23,7 @@ constexpr double kSlowPlaybackSpeed = 0.9;
 constexpr double kStraightRadiusPerArcLength = 25.0;
 
 cv::Point Fixed(const cv::Point2d& p) {
-  return {cvRound(p.x * (1 << kShift)), cvRound(p.y * (1 << kShift))};
+  return {cvRound(p.x * (1 << kSubPixelShift)), cvRound(p.y * (1 << kSubPixelShift))};
 }
 
 const std::optional<cv::Point2d>* Find(const FrameResult& result, const std::string& name) {
@@ -52,8 +53,8 @@ std::string Value(const char* label, const std::optional<double>& value_mm,
 void OutlinedText(cv::Mat& image, const std::string& text, cv::Point origin, double scale,
                   const cv::Scalar& colour) {
   const int thickness = std::max(1, cvRound(scale * 2));
-  cv::putText(image, text, origin, kFont, scale, cv::Scalar(0, 0, 0), thickness + 2, cv::LINE_AA);
-  cv::putText(image, text, origin, kFont, scale, colour, thickness, cv::LINE_AA);
+  cv::putText(image, text, origin, kGuiFont, scale, cv::Scalar(0, 0, 0), thickness + 2, cv::LINE_AA);
+  cv::putText(image, text, origin, kGuiFont, scale, colour, thickness, cv::LINE_AA);
 }
 
 }  // namespace
@@ -173,10 +174,10 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
 
     // Darken the block behind the text so it reads on any background.
     int baseline = 0;
-    const int height = cv::getTextSize("Ag", kFont, scale, line, &baseline).height + baseline + 4;
+    const int height = cv::getTextSize("Ag", kGuiFont, scale, line, &baseline).height + baseline + 4;
     int width = 0;
     for (const auto& [text, colour] : lines) {
-      width = std::max(width, cv::getTextSize(text, kFont, scale, line, &baseline).width);
+      width = std::max(width, cv::getTextSize(text, kGuiFont, scale, line, &baseline).width);
     }
     const cv::Rect block = cv::Rect(0, 0, width + 12, height * static_cast<int>(lines.size()) + 8) &
                            cv::Rect(0, 0, frame_bgr.cols, frame_bgr.rows);
@@ -195,9 +196,9 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
   const auto* tip = Find(result, options.tip);
   if (base && middle && tip && *base && *middle && *tip) {
     const cv::Point2d b = **base, md = **middle, t = **tip;
-    cv::line(frame_bgr, Fixed(b), Fixed(md), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
-    cv::line(frame_bgr, Fixed(md), Fixed(t), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
-    cv::line(frame_bgr, Fixed(t), Fixed(b), overlay_colour::kTriangle, 1, cv::LINE_AA, kShift);
+    cv::line(frame_bgr, Fixed(b), Fixed(md), overlay_colour::kTriangle, 1, cv::LINE_AA, kSubPixelShift);
+    cv::line(frame_bgr, Fixed(md), Fixed(t), overlay_colour::kTriangle, 1, cv::LINE_AA, kSubPixelShift);
+    cv::line(frame_bgr, Fixed(t), Fixed(b), overlay_colour::kTriangle, 1, cv::LINE_AA, kSubPixelShift);
     std::vector<cv::Point2d> arc;
     if (m.radius_px) arc = ArcPoints(b, md, t, *m.radius_px);
     if (arc.empty() && m.sagitta_px && *m.sagitta_px == 0) arc = {b, t};  // Straight.
@@ -205,7 +206,7 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
       std::vector<cv::Point> fixed;
       fixed.reserve(arc.size());
       for (const cv::Point2d& p : arc) fixed.push_back(Fixed(p));
-      cv::polylines(frame_bgr, fixed, false, overlay_colour::kArc, line, cv::LINE_AA, kShift);
+      cv::polylines(frame_bgr, fixed, false, overlay_colour::kArc, line, cv::LINE_AA, kSubPixelShift);
     }
   }
 
@@ -214,13 +215,13 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
     if (!marker.observation.found()) continue;
     const cv::Point2d p = *marker.observation.position_px;
     const int r = options.marker_ring_px;
-    cv::circle(frame_bgr, Fixed(p), r << kShift, overlay_colour::kMarker, ring_thickness,
-               cv::LINE_AA, kShift);
+    cv::circle(frame_bgr, Fixed(p), r << kSubPixelShift, overlay_colour::kMarker, ring_thickness,
+               cv::LINE_AA, kSubPixelShift);
     const cv::Point2d dx(r / 2.0, 0), dy(0, r / 2.0);
     cv::line(frame_bgr, Fixed(p - dx), Fixed(p + dx), overlay_colour::kMarker, 1, cv::LINE_AA,
-             kShift);
+             kSubPixelShift);
     cv::line(frame_bgr, Fixed(p - dy), Fixed(p + dy), overlay_colour::kMarker, 1, cv::LINE_AA,
-             kShift);
+             kSubPixelShift);
     OutlinedText(frame_bgr, marker.name, cv::Point(cvRound(p.x) + r + 3, cvRound(p.y) - r), scale,
                  overlay_colour::kMarker);
     // A template marker: the template's box where it matched, and the match's score (the
@@ -230,7 +231,7 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
       const OverlayStatus::TemplateBox& box = *status.template_boxes[index];
       const cv::Point2d half(box.size_px.width / 2.0, box.size_px.height / 2.0);
       cv::rectangle(frame_bgr, Fixed(p - half), Fixed(p + half), overlay_colour::kTemplate, 1,
-                    cv::LINE_AA, kShift);
+                    cv::LINE_AA, kSubPixelShift);
       std::string label = box.method;
       for (char& c : label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       if (marker.observation.score) {

@@ -24,6 +24,11 @@ inline const cv::Scalar kText(255, 255, 255);
 inline const cv::Scalar kTemplate(255, 200, 0);    // A template marker's box and score (sky blue).
 }  // namespace overlay_colour
 
+// How the gui draws: one font for every text, and sub-pixel coordinates in 1/16 px
+// (cv::circle / cv::polylines `shift`), so a marker's ring sits where its centroid is.
+inline constexpr int kGuiFont = 0;  // cv::FONT_HERSHEY_SIMPLEX (imgproc.hpp is not needed here).
+inline constexpr int kSubPixelShift = 4;
+
 struct OverlayOptions {
   // The triple (and optional chain) by marker name, as in MeasureOptions: which markers the
   // triangle and the arc join.

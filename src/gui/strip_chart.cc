@@ -13,12 +13,10 @@
 namespace softsight {
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.4;
 constexpr int kLeft = 40;      // The least room for value labels; more when they are wider.
 constexpr int kLabelPad = 4;  // Between a value label and the lane, and the chart's edge.
 constexpr int kRight = 8;
-constexpr int kShift = 4;
 const cv::Scalar kBackground(32, 32, 32);
 const cv::Scalar kGridColour(70, 70, 70);
 const cv::Scalar kLabel(220, 220, 220);
@@ -87,7 +85,7 @@ void StripChart::draw(cv::Mat& area) const {
   std::vector<double> ticks[kLanes];
   std::vector<std::string> tick_text[kLanes];
   int label_width = 0, baseline = 0;
-  const int text_height = cv::getTextSize("0", kFont, kFontScale, 1, &baseline).height;
+  const int text_height = cv::getTextSize("0", kGuiFont, kFontScale, 1, &baseline).height;
   for (int i = 0; i < kLanes; ++i) {
     Lane& lane = lanes_[i];
     lane.label = names[i];
@@ -119,7 +117,7 @@ void StripChart::draw(cv::Mat& area) const {
     for (double v : ticks[i]) {
       tick_text[i].push_back(FormatTick(v, step));
       label_width = std::max(
-          label_width, cv::getTextSize(tick_text[i].back(), kFont, kFontScale, 1, &baseline).width);
+          label_width, cv::getTextSize(tick_text[i].back(), kGuiFont, kFontScale, 1, &baseline).width);
     }
   }
   const int left = std::clamp(label_width + 2 * kLabelPad, kLeft, std::max(kLeft, area.cols / 3));
@@ -141,9 +139,9 @@ void StripChart::draw(cv::Mat& area) const {
       cv::line(area, {r.x, y}, {r.x + r.width - 1, y}, kGridColour, 1);
       // Centred on its grid line, but kept inside the lane (a tick at the lane's edge).
       const int text_y = std::clamp(y + text_height / 2, r.y + text_height, r.y + r.height - 1);
-      const int width = cv::getTextSize(tick_text[i][k], kFont, kFontScale, 1, &baseline).width;
+      const int width = cv::getTextSize(tick_text[i][k], kGuiFont, kFontScale, 1, &baseline).width;
       const int text_x = left - kLabelPad - width;  // Right-aligned against the lane.
-      cv::putText(area, tick_text[i][k], {text_x, text_y}, kFont, kFontScale, kLabel, 1,
+      cv::putText(area, tick_text[i][k], {text_x, text_y}, kGuiFont, kFontScale, kLabel, 1,
                   cv::LINE_AA);
       lane.tick_labels.emplace_back(text_x, text_y - text_height, width, text_height + baseline);
     }
@@ -158,15 +156,15 @@ void StripChart::draw(cv::Mat& area) const {
       }
       label += value;
     }
-    cv::putText(area, label, {r.x + 6, r.y + 14}, kFont, kFontScale, kColours[i], 1, cv::LINE_AA);
+    cv::putText(area, label, {r.x + 6, r.y + 14}, kGuiFont, kFontScale, kColours[i], 1, cv::LINE_AA);
 
     cv::Mat lane_area = area(r);
     run.clear();
     auto flush = [&] {
       if (run.size() == 1) {
-        cv::circle(lane_area, run[0], 2 << kShift, kColours[i], cv::FILLED, cv::LINE_AA, kShift);
+        cv::circle(lane_area, run[0], 2 << kSubPixelShift, kColours[i], cv::FILLED, cv::LINE_AA, kSubPixelShift);
       } else if (run.size() > 1) {
-        cv::polylines(lane_area, run, false, kColours[i], 1, cv::LINE_AA, kShift);
+        cv::polylines(lane_area, run, false, kColours[i], 1, cv::LINE_AA, kSubPixelShift);
       }
       run.clear();
     };
@@ -175,14 +173,14 @@ void StripChart::draw(cv::Mat& area) const {
         flush();
         continue;
       }
-      run.emplace_back(cvRound((x_of(s.time_s) - r.x) * (1 << kShift)),
-                       cvRound((y_of(*s.values[i]) - r.y) * (1 << kShift)));
+      run.emplace_back(cvRound((x_of(s.time_s) - r.x) * (1 << kSubPixelShift)),
+                       cvRound((y_of(*s.values[i]) - r.y) * (1 << kSubPixelShift)));
     }
     flush();
   }
   char span[32];
   std::snprintf(span, sizeof(span), "last %g s", options_.window_s);
-  cv::putText(area, span, {area.cols - kRight - 70, area.rows - 6}, kFont, kFontScale, kLabel, 1,
+  cv::putText(area, span, {area.cols - kRight - 70, area.rows - 6}, kGuiFont, kFontScale, kLabel, 1,
               cv::LINE_AA);
 }
 

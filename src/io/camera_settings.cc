@@ -1,3 +1,4 @@
+#include "softsight/core/format.h"
 #include "softsight/io/camera_settings.h"
 
 #include <fcntl.h>
@@ -100,11 +101,6 @@ OptionTable<CameraSettings> MakeTable() {
   };
 }
 
-std::string Text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
 
 std::string FourccText(double fourcc) {
   const auto code = static_cast<uint32_t>(fourcc);
@@ -141,8 +137,8 @@ CameraSettingsReport ApplyCameraSettings(CaptureBackend& backend, const CameraSe
     const bool took = backend.set(property, value);
     const double now = backend.get(property);
     if (!took || !(std::abs(now - value) <= tolerance)) {
-      report.refused.push_back(camera_name + ": " + name + " " + Text(value) + " refused, kept " +
-                               Text(now));
+      report.refused.push_back(camera_name + ": " + name + " " + ShortNumber(value) + " refused, kept " +
+                               ShortNumber(now));
     }
     if (accepted) *accepted = now;
   };
@@ -186,16 +182,16 @@ CameraSettingsReport ApplyCameraSettings(CaptureBackend& backend, const CameraSe
     apply("focus", cv::CAP_PROP_FOCUS, *settings.focus, &report.accepted.focus, 1e-6);
   }
   // What the camera runs at now, given or not.
-  report.summary = camera_name + ": " + Text(backend.get(cv::CAP_PROP_FRAME_WIDTH)) + "x" +
-                   Text(backend.get(cv::CAP_PROP_FRAME_HEIGHT)) + " " +
-                   Text(backend.get(cv::CAP_PROP_FPS)) + " fps " +
+  report.summary = camera_name + ": " + ShortNumber(backend.get(cv::CAP_PROP_FRAME_WIDTH)) + "x" +
+                   ShortNumber(backend.get(cv::CAP_PROP_FRAME_HEIGHT)) + " " +
+                   ShortNumber(backend.get(cv::CAP_PROP_FPS)) + " fps " +
                    FourccText(backend.get(cv::CAP_PROP_FOURCC));
-  if (report.accepted.exposure) report.summary += " exposure " + Text(*report.accepted.exposure);
-  if (report.accepted.gain) report.summary += " gain " + Text(*report.accepted.gain);
+  if (report.accepted.exposure) report.summary += " exposure " + ShortNumber(*report.accepted.exposure);
+  if (report.accepted.gain) report.summary += " gain " + ShortNumber(*report.accepted.gain);
   if (report.accepted.white_balance_k) {
-    report.summary += " white_balance " + Text(*report.accepted.white_balance_k) + " K";
+    report.summary += " white_balance " + ShortNumber(*report.accepted.white_balance_k) + " K";
   }
-  if (report.accepted.focus) report.summary += " focus " + Text(*report.accepted.focus);
+  if (report.accepted.focus) report.summary += " focus " + ShortNumber(*report.accepted.focus);
   return report;
 }
 
@@ -242,7 +238,7 @@ std::vector<std::string> ListCameras() {
              ++interval.index) {
           if (interval.type != V4L2_FRMIVAL_TYPE_DISCRETE || interval.discrete.numerator == 0) break;
           if (!rates.empty()) rates += '/';
-          rates += Text(static_cast<double>(interval.discrete.denominator) /
+          rates += ShortNumber(static_cast<double>(interval.discrete.denominator) /
                         interval.discrete.numerator);
         }
         if (!rates.empty()) line += "@" + rates;

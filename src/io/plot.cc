@@ -1,3 +1,4 @@
+#include "softsight/core/format.h"
 #include "softsight/io/plot.h"
 
 #include <algorithm>
@@ -319,11 +320,6 @@ std::string SvgColour(const cv::Scalar& bgr) {
   return buffer;
 }
 
-std::string Num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.2f", v);
-  return buffer;
-}
 
 // ---- Raster text helpers -----------------------------------------------------------------------
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
@@ -588,16 +584,16 @@ std::string RenderPlotSvg(const PlotData& data, const PlotLayout& layout) {
     svg << "<g>\n";
     for (double t : panel.x_ticks) {
       const double x = panel.to_pixel(t, panel.y_min).x;
-      svg << "<line x1=\"" << Num(x) << "\" y1=\"" << r.y << "\" x2=\"" << Num(x) << "\" y2=\""
-          << Num(bottom) << "\" stroke=\"#e1e1e1\"/>\n"
-          << "<text x=\"" << Num(x) << "\" y=\"" << Num(bottom + 17) << "\" text-anchor=\"middle\">"
+      svg << "<line x1=\"" << FixedNumber(x, 2) << "\" y1=\"" << r.y << "\" x2=\"" << FixedNumber(x, 2) << "\" y2=\""
+          << FixedNumber(bottom, 2) << "\" stroke=\"#e1e1e1\"/>\n"
+          << "<text x=\"" << FixedNumber(x, 2) << "\" y=\"" << FixedNumber(bottom + 17, 2) << "\" text-anchor=\"middle\">"
           << FormatTick(t, x_step) << "</text>\n";
     }
     for (double v : panel.y_ticks) {
       const double y = panel.to_pixel(panel.x_min, v).y;
-      svg << "<line x1=\"" << r.x << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(right) << "\" y2=\""
-          << Num(y) << "\" stroke=\"#e1e1e1\"/>\n"
-          << "<text x=\"" << r.x - 7 << "\" y=\"" << Num(y + 4) << "\" text-anchor=\"end\">"
+      svg << "<line x1=\"" << r.x << "\" y1=\"" << FixedNumber(y, 2) << "\" x2=\"" << FixedNumber(right, 2) << "\" y2=\""
+          << FixedNumber(y, 2) << "\" stroke=\"#e1e1e1\"/>\n"
+          << "<text x=\"" << r.x - 7 << "\" y=\"" << FixedNumber(y + 4, 2) << "\" text-anchor=\"end\">"
           << FormatTick(v, y_step) << "</text>\n";
     }
     svg << "<rect x=\"" << r.x << "\" y=\"" << r.y << "\" width=\"" << r.width - 1 << "\" height=\""
@@ -623,14 +619,14 @@ std::string RenderPlotSvg(const PlotData& data, const PlotLayout& layout) {
       const std::string colour = SvgColour(series.bgr);
       for (const auto& run : Runs(data, layout, panel, series)) {
         if (run.size() == 1) {
-          svg << "<circle cx=\"" << Num(run[0].x) << "\" cy=\"" << Num(run[0].y)
+          svg << "<circle cx=\"" << FixedNumber(run[0].x, 2) << "\" cy=\"" << FixedNumber(run[0].y, 2)
               << "\" r=\"3\" fill=\"" << colour << "\"/>\n";
           continue;
         }
         svg << "<polyline fill=\"none\" stroke=\"" << colour
             << "\" stroke-width=\"2\" stroke-linejoin=\"round\" points=\"";
         for (size_t i = 0; i < run.size(); ++i) {
-          svg << (i ? " " : "") << Num(run[i].x) << ',' << Num(run[i].y);
+          svg << (i ? " " : "") << FixedNumber(run[i].x, 2) << ',' << FixedNumber(run[i].y, 2);
         }
         svg << "\"/>\n";
       }

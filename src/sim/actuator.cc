@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -11,8 +12,7 @@
 namespace softsight::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegToRad = kPi / 180.0;
+constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 // Looks: pale translucent silicone; grey rigid parts. All low-saturation, so only the markers
 // carry colour an HSV threshold could pick.

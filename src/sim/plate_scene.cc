@@ -1,3 +1,4 @@
+#include "softsight/core/format.h"
 #include "softsight/sim/plate_scene.h"
 
 #include <algorithm>
@@ -24,11 +25,6 @@ constexpr double kMarginRadii = 2.5;
 // Margin kept between the plate and the image border where the path has room for it.
 constexpr double kBorderFraction = 0.03;
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 bool Fail(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
@@ -57,23 +53,23 @@ bool PlateSceneOptions::Check(std::string* error) const {
   if (frame_count < 1) {
     return Fail(error, "frame_count: must be at least 1, got " + std::to_string(frame_count));
   }
-  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + Num(fps));
+  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + ShortNumber(fps));
   if (dot_count < 1 || dot_count > kMaxDots) {
     return Fail(error, "dot_count: must be in [1, " + std::to_string(kMaxDots) + "], got " +
                            std::to_string(dot_count));
   }
   if (!(std::isfinite(dot_radius_px) && dot_radius_px > 0 && dot_radius_px <= 200)) {
-    return Fail(error, "dot_radius_px: must be in (0, 200], got " + Num(dot_radius_px));
+    return Fail(error, "dot_radius_px: must be in (0, 200], got " + ShortNumber(dot_radius_px));
   }
   if (!(std::isfinite(max_tilt_deg) && max_tilt_deg >= 0 && max_tilt_deg <= kMaxTiltDeg)) {
-    return Fail(error, "max_tilt_deg: must be in [0, " + Num(kMaxTiltDeg) + "], got " +
-                           Num(max_tilt_deg));
+    return Fail(error, "max_tilt_deg: must be in [0, " + ShortNumber(kMaxTiltDeg) + "], got " +
+                           ShortNumber(max_tilt_deg));
   }
   if (!(std::isfinite(scale_start) && scale_start > 0 && scale_start <= kMaxScale)) {
-    return Fail(error, "scale_start: must be in (0, " + Num(kMaxScale) + "], got " + Num(scale_start));
+    return Fail(error, "scale_start: must be in (0, " + ShortNumber(kMaxScale) + "], got " + ShortNumber(scale_start));
   }
   if (!(std::isfinite(scale_end) && scale_end > 0 && scale_end <= kMaxScale)) {
-    return Fail(error, "scale_end: must be in (0, " + Num(kMaxScale) + "], got " + Num(scale_end));
+    return Fail(error, "scale_end: must be in (0, " + ShortNumber(kMaxScale) + "], got " + ShortNumber(scale_end));
   }
   if (const std::string bad = sim::CheckDistractors(distractors); !bad.empty()) {
     return Fail(error, bad);
@@ -193,7 +189,7 @@ PlateScene::PlateScene(PlateSceneOptions options, NoiseOptions noise, RenderOpti
       const cv::Vec3d q = h * cv::Vec3d(c.x, c.y, 1.0);
       if (!(q[2] > 0.05 * m.focal_px / std::max(o.scale_start, o.scale_end))) {
         throw InputError("plate scene: the plate (" + std::to_string(o.dot_count) +
-                         " dots of radius " + Num(r) + " px) reaches behind the camera at frame " +
+                         " dots of radius " + ShortNumber(r) + " px) reaches behind the camera at frame " +
                          std::to_string(i) + ": lower max_tilt_deg, the scales or the dot size");
       }
     }

@@ -1,7 +1,9 @@
+#include "softsight/core/format.h"
 #include "softsight/sim/scene.h"
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -18,15 +20,9 @@
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Beyond this the bending band would run into its own base.
 constexpr double kMaxBendingDeg = 330.0;
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 bool Fail(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
@@ -43,15 +39,15 @@ bool SceneOptions::Check(std::string* error) const {
   if (frame_count < 1) {
     return Fail(error, "frame_count: must be at least 1, got " + std::to_string(frame_count));
   }
-  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + Num(fps));
+  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + ShortNumber(fps));
   if (!(std::isfinite(length_px) && length_px > 0)) {
-    return Fail(error, "length_px: must be > 0, got " + Num(length_px));
+    return Fail(error, "length_px: must be > 0, got " + ShortNumber(length_px));
   }
   if (!(std::isfinite(width_px) && width_px > 0)) {
-    return Fail(error, "width_px: must be > 0, got " + Num(width_px));
+    return Fail(error, "width_px: must be > 0, got " + ShortNumber(width_px));
   }
   if (!(std::isfinite(marker_radius_px) && marker_radius_px > 0)) {
-    return Fail(error, "marker_radius_px: must be > 0, got " + Num(marker_radius_px));
+    return Fail(error, "marker_radius_px: must be > 0, got " + ShortNumber(marker_radius_px));
   }
   if (oscillate && oscillate_cycles < 1) {
     return Fail(error, "oscillate_cycles: must be at least 1, got " +
@@ -59,20 +55,20 @@ bool SceneOptions::Check(std::string* error) const {
   }
   if (kind == SceneKind::kBending) {
     if (!(std::isfinite(max_bend_deg) && max_bend_deg > 0 && max_bend_deg <= kMaxBendingDeg)) {
-      return Fail(error, "max_bend_deg: must be in (0, " + Num(kMaxBendingDeg) + "], got " +
-                             Num(max_bend_deg));
+      return Fail(error, "max_bend_deg: must be in (0, " + ShortNumber(kMaxBendingDeg) + "], got " +
+                             ShortNumber(max_bend_deg));
     }
     // The inner edge must keep a positive radius at the strongest bend.
-    const double min_radius_px = length_px / (max_bend_deg * kPi / 180.0);
+    const double min_radius_px = length_px / (max_bend_deg * std::numbers::pi / 180.0);
     if (width_px / 2 >= min_radius_px) {
-      return Fail(error, "width_px: " + Num(width_px) + " is too wide for a bend of " +
-                             Num(max_bend_deg) + " degrees over length_px " + Num(length_px) +
-                             " (at most " + Num(2 * min_radius_px) + ")");
+      return Fail(error, "width_px: " + ShortNumber(width_px) + " is too wide for a bend of " +
+                             ShortNumber(max_bend_deg) + " degrees over length_px " + ShortNumber(length_px) +
+                             " (at most " + ShortNumber(2 * min_radius_px) + ")");
     }
   } else if (sim::PlateLengthPx(*this) < 2 * marker_radius_px) {
-    return Fail(error, "length_px: " + Num(length_px) + " is too short for the " +
+    return Fail(error, "length_px: " + ShortNumber(length_px) + " is too short for the " +
                            SceneKindName(kind) + " plates to carry markers of radius " +
-                           Num(marker_radius_px));
+                           ShortNumber(marker_radius_px));
   }
   if (const std::string bad = sim::CheckDistractors(distractors); !bad.empty()) {
     return Fail(error, bad);
@@ -88,7 +84,7 @@ bool SceneOptions::Check(std::string* error) const {
     }
     if (!(marker.body_fraction >= 0 && marker.body_fraction <= 1)) {
       return Fail(error, "markers: '" + marker.name + "' body_fraction must be in [0, 1], got " +
-                             Num(marker.body_fraction));
+                             ShortNumber(marker.body_fraction));
     }
   }
   return true;
@@ -96,16 +92,16 @@ bool SceneOptions::Check(std::string* error) const {
 
 bool NoiseOptions::Check(std::string* error) const {
   if (!(std::isfinite(sigma) && sigma >= 0 && sigma <= 128)) {
-    return Fail(error, "noise sigma: must be in [0, 128] grey levels, got " + Num(sigma));
+    return Fail(error, "noise sigma: must be in [0, 128] grey levels, got " + ShortNumber(sigma));
   }
   if (!(std::isfinite(blur_sigma_px) && blur_sigma_px >= 0 && blur_sigma_px <= 50)) {
-    return Fail(error, "blur_sigma_px: must be in [0, 50], got " + Num(blur_sigma_px));
+    return Fail(error, "blur_sigma_px: must be in [0, 50], got " + ShortNumber(blur_sigma_px));
   }
   if (!(std::isfinite(gain_start) && gain_start > 0)) {
-    return Fail(error, "gain_start: must be > 0, got " + Num(gain_start));
+    return Fail(error, "gain_start: must be > 0, got " + ShortNumber(gain_start));
   }
   if (!(std::isfinite(gain_end) && gain_end > 0)) {
-    return Fail(error, "gain_end: must be > 0, got " + Num(gain_end));
+    return Fail(error, "gain_end: must be > 0, got " + ShortNumber(gain_end));
   }
   return true;
 }
@@ -219,7 +215,7 @@ double SyntheticScene::bend_at(int index) const {
   const SceneOptions& o = impl_->scene;
   const double t = o.frame_count > 1 ? std::clamp(index / double(o.frame_count - 1), 0.0, 1.0) : 0.0;
   // A raised cosine: starts and ends at rest velocity, like an actuator filled by a pump.
-  const double phase = o.oscillate ? 2 * kPi * o.oscillate_cycles * t : kPi * t;
+  const double phase = o.oscillate ? 2 * std::numbers::pi * o.oscillate_cycles * t : std::numbers::pi * t;
   return max_bend_deg() * (1 - std::cos(phase)) / 2;
 }
 

@@ -1,6 +1,7 @@
 #include "softsight/sim/scene.h"
 
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -12,7 +13,6 @@
 namespace softsight {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Small images and few frames keep the suite fast; the geometry scales with the options.
 SceneOptions SmallScene(SceneKind kind = SceneKind::kBending) {
@@ -69,7 +69,7 @@ TEST(SyntheticSceneTest, BendingMarkersLieOnTheCentreLineArc) {
   for (double bend : {30.0, 90.0, 180.0, 240.0}) {
     const SceneTruth truth = scene.render_at_bend(bend, 0.0, 0, image);
     ASSERT_TRUE(truth.centreline_radius_px.has_value());
-    const double k = bend * kPi / 180 / options.length_px;
+    const double k = bend * std::numbers::pi / 180 / options.length_px;
     EXPECT_NEAR(*truth.centreline_radius_px, 1 / k, 1e-9);
     for (size_t a = 0; a < 3; ++a) {
       for (size_t b = a + 1; b < 3; ++b) {
@@ -108,7 +108,7 @@ TEST(SyntheticSceneTest, HalfCircleMeasurementMatchesTheArc) {
   SyntheticScene scene(options);
   cv::Mat image;
   const SceneTruth truth = scene.render_at_bend(180.0, 1.0, 0, image);
-  const double radius = options.length_px / kPi;
+  const double radius = options.length_px / std::numbers::pi;
   ASSERT_TRUE(truth.measurement.radius_px.has_value());
   EXPECT_NEAR(*truth.measurement.radius_px, radius, 0.02);
   ASSERT_TRUE(truth.measurement.arc_length_px.has_value());
@@ -132,7 +132,7 @@ TEST(SyntheticSceneTest, HalfOccludedMarkerShiftsAwayFromTheOccluder) {
   ASSERT_TRUE(blue.centroid_px.has_value());
   EXPECT_NEAR(blue.visible_fraction, 0.5, 0.02);
   // A half disc's centroid lies 4 r / (3 pi) from the centre.
-  const double shift = 4 * options.marker_radius_px / (3 * kPi);
+  const double shift = 4 * options.marker_radius_px / (3 * std::numbers::pi);
   EXPECT_NEAR(blue.centroid_px->x, centre.x - shift, 0.1);
   EXPECT_NEAR(blue.centroid_px->y, centre.y, 0.02);
   // The occluder is active only in its frame range.

@@ -27,7 +27,7 @@ Option<ColourParams> HsvOption(const char* key, HsvRange ColourParams::*range, i
       .AppliesIf([](const ColourParams& p) { return !p.auto_bgr && !p.gray; });
 }
 
-OptionTable<ColourParams> MakeTable() {
+OptionTable<ColourParams> MakeColourTable() {
   using P = ColourParams;
   return {
       HsvOption("hsv.h", &P::h, 179, "hue [lo, hi], OpenCV's 0..179; lo > hi wraps round red"),
@@ -164,7 +164,7 @@ OptionTable<ColourParams> MakeTable() {
 }  // namespace
 
 const OptionTable<ColourParams>& ColourParamsOptions() {
-  static const OptionTable<ColourParams> table = MakeTable();
+  static const OptionTable<ColourParams> table = MakeColourTable();
   return table;
 }
 

@@ -1,6 +1,7 @@
 // ColourTracker, part 1 of 3: the search (see colour_tracker_impl.h): windows around the
 // prediction, whole-frame acquisition, relearning after a change of light, and the motion and
 // model it keeps.
+#include "softsight/core/format.h"
 #include "softsight/track/colour_tracker.h"
 
 #include <algorithm>
@@ -31,8 +32,8 @@ bool ColourParams::Check(std::string* error) const {
     }
   }
   if (max_area_px != 0.0 && max_area_px < min_area_px) {
-    why << "blob.max_area: " << FormatDouble(max_area_px)
-        << " must be 0 (no limit) or at least blob.min_area (" << FormatDouble(min_area_px) << ")";
+    why << "blob.max_area: " << RoundTripNumber(max_area_px)
+        << " must be 0 (no limit) or at least blob.min_area (" << RoundTripNumber(min_area_px) << ")";
     return Fail(error, why.str());
   }
   if (roi && (roi->width <= 0 || roi->height <= 0)) {

@@ -4,7 +4,7 @@
 namespace softsight {
 namespace {
 
-OptionTable<TemplateParams> MakeTable() {
+OptionTable<TemplateParams> MakeTemplateTable() {
   using P = TemplateParams;
   return {
       IntOption<P>("template.frame", &P::template_frame)
@@ -85,7 +85,7 @@ OptionTable<TemplateParams> MakeTable() {
 }  // namespace
 
 const OptionTable<TemplateParams>& TemplateParamsOptions() {
-  static const OptionTable<TemplateParams> table = MakeTable();
+  static const OptionTable<TemplateParams> table = MakeTemplateTable();
   return table;
 }
 

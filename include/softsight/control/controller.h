@@ -69,8 +69,6 @@ struct ControllerOutput {
   std::optional<double> error_deg;    // measured - target, when measured.
 };
 
-const char* ActionName(ControllerOutput::Action action);
-
 class AngleController {
  public:
   explicit AngleController(const ControllerOptions& options);

@@ -32,10 +32,5 @@ class InputError : public std::runtime_error {
   static constexpr size_t kMaxInputErrorBytes = 4096;
 };
 
-// A number as messages show it: the shortest of fixed and exponent form, 6 significant digits
-// ("45", "0.25", "1e+18", "inf").
-std::string ShortNumber(double value);
-// A measured figure with `decimals` digits after the point ("130.3"; "nan", "inf" as they are).
-std::string FixedNumber(double value, int decimals);
 
 }  // namespace softsight
