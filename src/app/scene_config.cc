@@ -9,7 +9,7 @@ ColourParams ThresholdsFor(const cv::Vec3b& bgr) {
   cv::cvtColor(pixel, hsv, cv::COLOR_BGR2HSV);
   const int hue = hsv.at<cv::Vec3b>(0, 0)[0];
   ColourParams params;
-  params.h = {(hue + 180 - 12) % 180, (hue + 12) % 180};
+  params.h = HsvRange::HueAround(hue, 12);
   params.s = {80, 255};
   params.v = {40, 255};
   params.filter = ColourParams::Filter::kNone;

@@ -8,7 +8,7 @@
 namespace softsight {
 namespace {
 
-constexpr int kHueCount = 180;  // OpenCV's 8-bit hue: 0..179, two degrees per step.
+constexpr int kHueCount = HsvRange::kHueCycle;  // OpenCV's 8-bit hue: 0..179, two degrees per step.
 
 // Linear-interpolated percentile of sorted values, `percent` in [0, 100].
 double Percentile(const std::vector<double>& sorted, double percent) {
@@ -28,7 +28,6 @@ HsvRange LinearRange(std::vector<double> values, const HsvPickOptions& o, int ma
           std::clamp(static_cast<int>(std::ceil(hi)), 0, 255)};
 }
 
-int WrapHue(int h) { return ((h % kHueCount) + kHueCount) % kHueCount; }
 
 }  // namespace
 
@@ -116,7 +115,7 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   if (hi - lo + 1 >= kHueCount) {
     pick.h = {0, kHueCount - 1};  // Covers every hue: saturation and value do the separating.
   } else {
-    pick.h = {WrapHue(lo), WrapHue(hi)};
+    pick.h = {HsvRange::WrapHue(lo), HsvRange::WrapHue(hi)};
   }
   // Saturation never goes below min_saturation: below it the hue test means nothing.
   pick.s = LinearRange(std::move(sat), options, options.saturation_margin, options.min_saturation);
@@ -259,11 +258,11 @@ void ApplyColourPick(const MarkerColourPick& pick, ColourParams* colour) {
 std::string PickName(const HsvPick& pick) {
   if (pick.gray) return pick.gray->hi == 255 ? "white" : "black";
   const HsvRange& h = pick.h;
-  return HueName(h.lo <= h.hi ? (h.lo + h.hi) / 2 : ((h.lo + h.hi + 180) / 2) % 180);
+  return HueName(h.hue_centre());
 }
 
 const char* HueName(int hue) {
-  hue = WrapHue(hue);
+  hue = HsvRange::WrapHue(hue);
   if (hue < 9 || hue >= 170) return "red";
   if (hue < 20) return "orange";
   if (hue < 35) return "yellow";
@@ -275,9 +274,7 @@ const char* HueName(int hue) {
 }
 
 bool HsvInRange(const cv::Vec3b& hsv, const HsvRange& h, const HsvRange& s, const HsvRange& v) {
-  const bool hue_ok =
-      h.lo <= h.hi ? (hsv[0] >= h.lo && hsv[0] <= h.hi) : (hsv[0] >= h.lo || hsv[0] <= h.hi);
-  return hue_ok && hsv[1] >= s.lo && hsv[1] <= s.hi && hsv[2] >= v.lo && hsv[2] <= v.hi;
+  return h.contains_hue(hsv[0]) && s.contains(hsv[1]) && v.contains(hsv[2]);
 }
 
 }  // namespace softsight

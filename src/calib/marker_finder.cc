@@ -395,10 +395,6 @@ void KeepSaturationAboveSurroundings(const cv::Mat& bgr, const cv::Point2d& cent
   if (raised > colour->s.lo && raised < core_saturation) colour->s.lo = raised;
 }
 
-int HueOf(const HsvRange& h) {
-  if (h.lo <= h.hi) return (h.lo + h.hi) / 2;
-  return ((h.lo + h.hi + 180) / 2) % 180;  // Wrapped through 0.
-}
 
 double PathLength(const std::vector<cv::Point2d>& points, const std::vector<size_t>& order) {
   double length = 0;
@@ -586,7 +582,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
     probe.s = {options.min_saturation, 255};
     probe.v = {options.min_value, 255};
     for (int centre = 0; centre < 180; centre += kHueStep) {
-      probe.h = {(centre + 180 - kHueReach) % 180, (centre + kHueReach) % 180};
+      probe.h = HsvRange::HueAround(centre, kHueReach);
       bands.push_back(probe);
     }
   }
@@ -691,7 +687,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
         continue;
       }
       ApplyColourPick(*pick, &colour);
-      hue = HueOf(pick->ranges.h);
+      hue = pick->ranges.h.hue_centre();
       if (c.elongated) {
         const EllipseFit fit = FitMomentEllipse(frame, colour, c.position_px, 4 * radius + 4);
         if (fit.fill < kMinEllipseFill || fit.minor_px < kMinStickerHalfWidthPx) {

@@ -6,25 +6,13 @@
 #include <vector>
 
 namespace softsight {
-namespace {
-
-constexpr int kHueCycle = 180;
-
-// Offset of hue `h` from the range's low end going up (mod 180), and the range's width - 1.
-int HueOffset(const HsvRange& r, int h) { return ((h - r.lo) % kHueCycle + kHueCycle) % kHueCycle; }
-int HueSpan(const HsvRange& r) { return HueOffset(r, r.hi); }
-
-bool InHue(const HsvRange& r, int h) { return HueOffset(r, h) <= HueSpan(r); }
-bool InLinear(const HsvRange& r, int x) { return x >= r.lo && x <= r.hi; }
-
-}  // namespace
 
 std::string RangeText(const HsvRange& range) {
   return std::to_string(range.lo) + ".." + std::to_string(range.hi);
 }
 
 bool InRanges(const HsvRanges& ranges, const cv::Vec3b& hsv) {
-  return InHue(ranges.h, hsv[0]) && InLinear(ranges.s, hsv[1]) && InLinear(ranges.v, hsv[2]);
+  return ranges.h.contains_hue(hsv[0]) && ranges.s.contains(hsv[1]) && ranges.v.contains(hsv[2]);
 }
 
 HsvRanges GrowRanges(HsvRanges ranges, const cv::Mat& hsv_pixels) {
@@ -32,10 +20,10 @@ HsvRanges GrowRanges(HsvRanges ranges, const cv::Mat& hsv_pixels) {
   for (int y = 0; y < hsv_pixels.rows; ++y) {
     for (int x = 0; x < hsv_pixels.cols; ++x) {
       const cv::Vec3b p = hsv_pixels.at<cv::Vec3b>(y, x);
-      if (!InHue(ranges.h, p[0])) {
+      if (!ranges.h.contains_hue(p[0])) {
         // Extend whichever end is nearer on the circle.
-        const int above = HueOffset({ranges.h.hi, ranges.h.hi}, p[0]);  // hi -> p going up.
-        const int below = HueOffset({p[0], p[0]}, ranges.h.lo);         // p -> lo going up.
+        const int above = HsvRange{ranges.h.hi, ranges.h.hi}.hue_offset(p[0]);  // hi -> p going up.
+        const int below = HsvRange{p[0], p[0]}.hue_offset(ranges.h.lo);         // p -> lo going up.
         (above <= below ? ranges.h.hi : ranges.h.lo) = p[0];
       }
       ranges.s.lo = std::min<int>(ranges.s.lo, p[1]);
@@ -62,7 +50,7 @@ bool ShrinkRanges(HsvRanges& ranges, const cv::Mat& hsv_pixels, std::string* why
       if (!InRanges(ranges, p)) continue;
       ++members;
       for (int c = 0; c < 3; ++c) {
-        const int offset = c == 0 ? HueOffset(*r[0], p[0]) : p[c] - r[c]->lo;
+        const int offset = c == 0 ? r[0]->hue_offset(p[0]) : p[c] - r[c]->lo;
         lowest[c] = std::min(lowest[c], offset);
         highest[c] = std::max(highest[c], offset);
       }
@@ -78,7 +66,7 @@ bool ShrinkRanges(HsvRanges& ranges, const cv::Mat& hsv_pixels, std::string* why
   int best_channel = -1;
   bool best_from_below = false;
   for (int c = 0; c < 3; ++c) {
-    const int span = c == 0 ? HueSpan(*r[0]) : r[c]->hi - r[c]->lo;
+    const int span = c == 0 ? r[0]->hue_span() : r[c]->hi - r[c]->lo;
     const double width = span + 1.0;
     if (highest[c] < span) {  // Something stays above the cut.
       const double cost = (highest[c] + 1) / width;
@@ -101,8 +89,8 @@ bool ShrinkRanges(HsvRanges& ranges, const cv::Mat& hsv_pixels, std::string* why
     cut.hi = base + lowest[best_channel] - 1;
   }
   if (best_channel == 0) {
-    cut.lo %= kHueCycle;
-    cut.hi = (cut.hi % kHueCycle + kHueCycle) % kHueCycle;
+    cut.lo = HsvRange::WrapHue(cut.lo);
+    cut.hi = HsvRange::WrapHue(cut.hi);
   }
   return true;
 }

@@ -13,6 +13,7 @@
 #include "softsight/core/error.h"
 #include "track/colour_tracker_impl.h"
 #include "track/colour_tracker_parts.h"
+#include "track/soft_centroid.h"
 #include "track/track_options.h"
 
 namespace softsight {
@@ -366,7 +367,6 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     sector_mean[i] = sector_n[i] >= 2 ? sector_sum[i] / sector_n[i] : blob->ring_colour;
   }
   const cv::Vec3d& f = blob->core_colour;
-  const double deadband_scale = 1.0 / (1.0 - 2.0 * kMembershipDeadband);
   double sw = 0, sx = 0, sy = 0;
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
@@ -386,15 +386,12 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
         const double t = u - lower;
         const int i0 = (static_cast<int>(lower) + kSectors) % kSectors;
         const int i1 = (i0 + 1) % kSectors;
-        double num = 0, den = 0;
+        double background[3], core[3];
         for (int k = 0; k < channels; ++k) {
-          const double g = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
-          const double d = f[k] - g;
-          num += (c[k] - g) * d;
-          den += d * d;
+          background[k] = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
+          core[k] = f[k];
         }
-        w = den > 1.0 ? std::clamp((num / den - kMembershipDeadband) * deadband_scale, 0.0, 1.0)
-                      : (ow[x] ? 1.0 : 0.0);
+        w = track_internal::Membership(c, channels, background, core, kMembershipDeadband, ow[x] != 0);
       }
       row_w += w;
       row_x += w * x;

@@ -38,7 +38,7 @@ inline int ShiftedNumerator(int b, int g, int r, int v, int diff) {
 }  // namespace
 
 bool HsvBox::ContainsHue(int hue) const {
-  return h.lo <= h.hi ? hue >= h.lo && hue <= h.hi : hue >= h.lo || hue <= h.hi;
+  return h.contains_hue(hue);
 }
 
 cv::Vec3b BgrToHsvExact(uchar b, uchar g, uchar r) {
@@ -56,7 +56,7 @@ cv::Vec3b BgrToHsvExact(uchar b, uchar g, uchar r) {
 }
 
 HsvClassifier::HsvClassifier(const HsvBox& box) : box_(box) {
-  full_hue_ = (box.h.lo == 0 && box.h.hi >= 179) || (box.h.lo > box.h.hi && box.h.lo <= box.h.hi + 1);
+  full_hue_ = box.h.covers_all_hues();
   gray_in_ = box.ContainsHue(0) && box.s.lo == 0;
   if (full_hue_) return;
   // Rounded hue u in 0..179 comes from the unrounded t in [-30, 150): u = round(t), plus 180 when
@@ -67,7 +67,7 @@ HsvClassifier::HsvClassifier(const HsvBox& box) : box_(box) {
     if (a <= 149) parts[n++] = {a, std::min(b, 149)};
     if (b >= 150) parts[n++] = {std::max(a, 150) - 180, b - 180};
   };
-  if (box.h.lo <= box.h.hi) {
+  if (!box.h.wraps()) {
     add(box.h.lo, std::min(box.h.hi, 179));
   } else {
     add(box.h.lo, 179);
@@ -274,7 +274,7 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
 void ClassifyHsvOpenCv(const cv::Mat& bgr, const HsvBox& box, cv::Mat& mask) {
   cv::Mat hsv;
   cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
-  if (box.h.lo <= box.h.hi) {
+  if (!box.h.wraps()) {
     cv::inRange(hsv, cv::Scalar(box.h.lo, box.s.lo, box.v.lo),
                 cv::Scalar(box.h.hi, box.s.hi, box.v.hi), mask);
     return;
@@ -282,13 +282,13 @@ void ClassifyHsvOpenCv(const cv::Mat& bgr, const HsvBox& box, cv::Mat& mask) {
   // Wrapping hue: rotate it so the range starts at 0, then one inRange.
   cv::Mat lut(1, 256, CV_8UC3);
   for (int i = 0; i < 256; ++i) {
-    const int hue = i < 180 ? (i - box.h.lo + 180) % 180 : 255;
+    const int hue = i < 180 ? box.h.hue_offset(i) : 255;
     lut.at<cv::Vec3b>(0, i) = cv::Vec3b(static_cast<uchar>(hue), static_cast<uchar>(i),
                                         static_cast<uchar>(i));
   }
   cv::LUT(hsv, lut, hsv);
   cv::inRange(hsv, cv::Scalar(0, box.s.lo, box.v.lo),
-              cv::Scalar(box.h.hi + 180 - box.h.lo, box.s.hi, box.v.hi), mask);
+              cv::Scalar(box.h.hue_span(), box.s.hi, box.v.hi), mask);
 }
 
 namespace {

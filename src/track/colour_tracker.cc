@@ -56,7 +56,7 @@ bool ColourParams::NeedsColour() const {
     cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
     return hsv.at<cv::Vec3b>(0, 0)[1] >= kAutoGraySaturation;
   }
-  return !(HueIsFull(h) && s.lo == 0);
+  return !(h.covers_all_hues() && s.lo == 0);
 }
 
 ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
@@ -94,7 +94,7 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
       gray_ = HsvRange{std::max(0, l - reach), std::min(255, l + reach)};
       nominal_ = cv::Vec3d(l, 0, 0);
     } else {
-      h = HsvRange{(n[0] - kAutoHueTolerance + 180) % 180, (n[0] + kAutoHueTolerance) % 180};
+      h = HsvRange::HueAround(n[0], kAutoHueTolerance);
       s = HsvRange{std::max(30, n[1] / 2), 255};
       v = HsvRange{std::max(30, n[2] * 2 / 5), 255};
       nominal_ = cv::Vec3d(c[0], c[1], c[2]);

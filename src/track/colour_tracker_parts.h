@@ -145,10 +145,6 @@ inline bool SameBlob(const ColourBlob& a, const ColourBlob& b) {
   return a.bbox_px == b.bbox_px && a.area_px == b.area_px && a.centroid_px == b.centroid_px;
 }
 
-inline bool HueIsFull(const HsvRange& h) {
-  return (h.lo == 0 && h.hi == 179) || (h.lo > h.hi && h.lo == h.hi + 1);
-}
-
 // A pseudo-angle of (dx, dy) in [0, 4): monotonic in atan2 (one unit per quadrant), without a
 // transcendental function. 0 for (0, 0).
 inline double DiamondAngle(double dx, double dy) {
@@ -261,12 +257,7 @@ inline int MorphShape(ColourParams::Shape shape) {
 // The coarse test with a pre-filter: hue widened by kCoarseHueSlack each side, lower S and V
 // bounds lowered by a quarter and the upper ones raised a quarter of the way to 255.
 inline HsvBox CoarseBox(const ColourParams& p) {
-  const int span = p.h.lo <= p.h.hi ? p.h.hi - p.h.lo : p.h.hi + 180 - p.h.lo;
-  HsvRange h{0, 179};
-  if (span + 2 * kCoarseHueSlack < 179) {
-    h.lo = (p.h.lo - kCoarseHueSlack + 180) % 180;
-    h.hi = (p.h.hi + kCoarseHueSlack) % 180;
-  }
+  const HsvRange h = p.h.hue_widened(kCoarseHueSlack);
   const HsvRange s{p.s.lo * 3 / 4, p.s.hi + (255 - p.s.hi) / 4};
   const HsvRange v{p.v.lo * 3 / 4, p.v.hi + (255 - p.v.hi) / 4};
   return HsvBox::Make(h, s, v);

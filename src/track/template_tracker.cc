@@ -11,6 +11,7 @@
 #include "softsight/track/tracker.h"
 #include "track/match_kernels.h"
 #include "track/repeated_frames.h"
+#include "track/soft_centroid.h"
 #include "track/track_options.h"
 
 namespace softsight {
@@ -321,7 +322,7 @@ class BlobMeter {
     for (int y = grown.y; y < grown.br().y; ++y) {
       for (int x = grown.x; x < grown.br().x; ++x) {
         if (!IsInside(gray, mask, x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
-        const double w = std::clamp((gray.at<uint8_t>(y, x) - bg) / (fg - bg), 0.0, 1.0);
+        const double w = track_internal::Membership(&gray.at<uint8_t>(y, x), 1, &bg, &fg, 0.0, false);
         sw += w;
         sx += w * x;
         sy += w * y;

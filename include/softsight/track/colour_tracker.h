@@ -19,16 +19,11 @@
 
 #include <opencv2/core.hpp>
 
+#include "softsight/core/hsv_range.h"
 #include "softsight/core/types.h"
 
 namespace softsight {
 
-// An inclusive range of one 8-bit HSV channel. For hue (0..179) lo > hi wraps around 0:
-// {170, 10} means 170..179 and 0..10 (red).
-struct HsvRange {
-  int lo = 0;
-  int hi = 255;
-};
 
 struct ColourParams {
   // ---- Pre-filter -------------------------------------------------------------------------------
