@@ -54,8 +54,14 @@ case $mode in
     # lacks Debian's numpy, setuptools and wheel).
     "${SOFTSIGHT_PYTHON:-/usr/bin/python3}" -m venv --system-site-packages "$venv"  # numpy, dask: Debian
     # pip builds in the source tree; SOFTSIGHT_BUILD_DIR makes it reuse this build's extension.
-    (cd "$source_dir" && SOFTSIGHT_BUILD_DIR=$build PIP_NO_INDEX=1 \
-       "$venv/bin/pip" install --no-build-isolation --no-deps -q .) || fail "pip install failed"
+    # Its own temporary folder and no cache: nothing shared with other pip runs on the machine.
+    mkdir -p "$work/pip-tmp"
+    if ! (cd "$source_dir" && TMPDIR=$work/pip-tmp SOFTSIGHT_BUILD_DIR=$build PIP_NO_INDEX=1 \
+          PIP_NO_CACHE_DIR=1 "$venv/bin/pip" install --no-build-isolation --no-deps . \
+          > "$work/pip-install.log" 2>&1); then
+      tail -n 30 "$work/pip-install.log" >&2
+      fail "pip install failed (whole log: $work/pip-install.log)"
+    fi
     cd "$work"   # Not the source tree: the package must come from the environment.
     env -u PYTHONPATH "$venv/bin/python" - "$config" <<'PY'
 import sys, softsight, importlib.metadata as m
