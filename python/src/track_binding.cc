@@ -167,6 +167,12 @@ py::dict SummaryDict(const RunSummary& s) {
   out["measured"] = s.measured;
   out["proc_ms_median"] = s.proc_ms_median;
   out["proc_ms_p99"] = s.proc_ms_p99;
+  // Capture to result, and to the CSV row written (CsvSink::report: absent without a csv=).
+  out["latency_result_ms_median"] = s.latency_result_ms_median;
+  out["latency_result_ms_p99"] = s.latency_result_ms_p99;
+  const auto optional = [](const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::object(py::none()); };
+  out["latency_row_ms_median"] = optional(s.latency_row_ms_median);
+  out["latency_row_ms_p99"] = optional(s.latency_row_ms_p99);
   out["wall_s"] = s.wall_s;
   out["stop_reason"] = StopReasonName(s.stop_reason);
   out["error"] = s.ok() ? py::object(py::none()) : py::object(py::str(s.error));

@@ -56,6 +56,10 @@ def test_track_gives_exactly_the_cli_csv(bending_video, markers_yaml, tmp_path):
     assert summary["frames"] == 24 and summary["stop_reason"] == "end of input"
     assert summary["found_rate"] == {"red": 1.0, "blue": 1.0, "green": 1.0}
     assert summary["error"] is None
+    # The CSV sink's own figure (FrameSink::report), as `track` prints it: capture to row written
+    # comes after capture to result.
+    assert summary["latency_row_ms_median"] is not None
+    assert summary["latency_row_ms_median"] >= summary["latency_result_ms_median"] > 0
 
 
 def test_track_a_builtin_scene_with_max_frames(markers_yaml, tmp_path):
@@ -65,6 +69,7 @@ def test_track_a_builtin_scene_with_max_frames(markers_yaml, tmp_path):
     expected = read_csv(out)
     table = softsight.track("synth:bending", markers_yaml, max_frames=5)
     assert table.rows == 5 and table.summary["stop_reason"] == "max frames reached"
+    assert table.summary["latency_row_ms_median"] is None  # No CSV written, no row latency.
     for name in expected:
         if name != "proc_ms" and not name.startswith("latency_"):
             assert as_text(table[name], name) == expected[name], name

@@ -93,7 +93,6 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   } else {
     source = std::make_unique<ReadAheadSource>(std::move(source));
   }
-  const bool live = source->is_live();
   TrackingSession session(config);
 
   // Sinks in the order they see each frame; every output is opened (and checked) before the run.
@@ -123,31 +122,8 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   RunOptions run;
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
+  // The sinks add their own figures (CSV row latency, encoder errors and waits): FrameSink::report.
   summary = RunPipeline(*source, session, sinks, run);
-  double row_median = 0.0, row_p99 = 0.0;
-  std::vector<double> row_latencies = csv.row_latencies_ms();  // Sorted by SummariseTimes.
-  SummariseTimes(row_latencies, &row_median, &row_p99);
-  summary.latency_row_ms_median = row_median;
-  summary.latency_row_ms_p99 = row_p99;
-  for (const std::optional<VideoSink>* video : {&annotated, &recording}) {
-    if (!video->has_value()) continue;
-    const VideoSink& sink = **video;
-    if (sink.error() && summary.ok()) {
-      summary.stop_reason = StopReason::kError;
-      summary.error = *sink.error();
-    }
-    // A recording keeps every frame of the CSV. Never silent: an encoder that fell a whole
-    // queue behind held up the run (a camera's frames skipped meanwhile are the source's drops,
-    // counted above). A camera's run says so also when it did not.
-    if (sink.waited_frames() > 0 || live) {
-      const int64_t waited = sink.waited_frames();
-      summary.notes.push_back(
-          sink.path() + ": all " + std::to_string(summary.frames) + " frames recorded" +
-          (waited > 0 ? "; the encoder fell behind and held up the run at " +
-                            std::to_string(waited) + " of them"
-                      : " (the encoder kept up)"));
-    }
-  }
   if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {
     summary.stop_detail = StopSignalReason(stop.signal());
   }

@@ -133,6 +133,7 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
   summary.notes = std::move(notes);
   summary.error = std::move(error);
   for (size_t i = 0; i < begun_; ++i) sinks_[i]->end(summary);
+  for (size_t i = 0; i < begun_; ++i) sinks_[i]->report(summary);
   return summary;
 }
 

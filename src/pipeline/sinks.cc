@@ -49,6 +49,15 @@ void CsvSink::begin(const RunInfo& info) {
   }
 }
 
+void CsvSink::report(RunSummary& summary) const {
+  if (row_latency_ms_.empty()) return;
+  std::vector<double> sorted = row_latency_ms_;  // SummariseTimes sorts; once per run.
+  double median = 0.0, p99 = 0.0;
+  SummariseTimes(sorted, &median, &p99);
+  summary.latency_row_ms_median = median;
+  summary.latency_row_ms_p99 = p99;
+}
+
 void CsvSink::consume(const Frame& frame, const FrameResult& result) {
   (void)frame;
   writer_.write(result);
@@ -106,6 +115,7 @@ VideoSink::~VideoSink() {
 
 
 void VideoSink::begin(const RunInfo& info) {
+  live_ = info.live;
   // Every frame is kept (the recording and the CSV hold the same frames). A camera gets a deeper
   // queue: its frames keep coming while the encoder has a hiccup.
   const size_t capacity =
@@ -133,6 +143,23 @@ void VideoSink::end(const RunSummary& summary) {
     writer_->close();
   } catch (const InputError& e) {
     error_ = e.what();
+  }
+}
+
+void VideoSink::report(RunSummary& summary) const {
+  if (error_ && summary.ok()) {
+    summary.stop_reason = StopReason::kError;
+    summary.error = *error_;
+  }
+  // A recording keeps every frame of the CSV. Never silent: an encoder that fell a whole queue
+  // behind held up the run (a camera's frames skipped meanwhile are the source's drops, counted
+  // in the summary). A camera's run says so also when it did not.
+  const int64_t waited = waited_frames();
+  if (waited > 0 || live_) {
+    summary.notes.push_back(path() + ": all " + std::to_string(summary.frames) + " frames recorded" +
+                            (waited > 0 ? "; the encoder fell behind and held up the run at " +
+                                              std::to_string(waited) + " of them"
+                                        : " (the encoder kept up)"));
   }
 }
 

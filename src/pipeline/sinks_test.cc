@@ -1,6 +1,7 @@
 // The sinks' column table of a run: TrackingColumns(config) from the markers and the chain.
 #include "softsight/pipeline/sinks.h"
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,7 +10,11 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/test_util.h"
+#include "softsight/config/config.h"
 #include "softsight/core/error.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {
 namespace {
@@ -75,6 +80,46 @@ TEST(VideoSink, ASecondWriterOfTheSameVideoIsRefusedAndTheFirstStaysWhole) {
   EXPECT_EQ(frames, 5);
   // Once the first has finished, the file may be written again.
   EXPECT_NO_THROW(VideoSink(path, "mjpg", 30.0));
+}
+
+}  // namespace
+}  // namespace softsight
+
+namespace softsight {
+namespace {
+
+FrameSourceSpec BendingScene() {
+  FrameSourceSpec spec;
+  spec.input = "synth:bending";
+  return spec;
+}
+
+// A sink's own figures reach the run's summary through FrameSink::report, for every caller of
+// RunPipeline: the CSV's capture-to-row latency (which comes after capture-to-result), and a
+// sink that reports nothing leaves it absent.
+TEST(FrameSink, ReportAddsTheCsvRowLatencyToTheRunsSummary) {
+  testing::TempDir dir;
+  const TrackingConfig config =
+      LoadTrackingConfig(std::string(SOFTSIGHT_TEST_SOURCE_DIR) + "/examples/markers.yaml");
+  {
+    TrackingSession session(config);
+    std::unique_ptr<FrameSource> source = OpenFrameSource(BendingScene());
+    CsvSink csv(dir.file("run.csv"), TrackingColumns(config));
+    RunOptions options;
+    options.max_frames = 6;
+    const RunSummary summary = RunPipeline(*source, session, {&csv}, options);
+    ASSERT_EQ(summary.frames, 6);
+    ASSERT_TRUE(summary.latency_row_ms_median.has_value());
+    ASSERT_TRUE(summary.latency_row_ms_p99.has_value());
+    EXPECT_GE(*summary.latency_row_ms_median, summary.latency_result_ms_median);
+    EXPECT_GE(*summary.latency_row_ms_p99, *summary.latency_row_ms_median);
+  }
+  TrackingSession session(config);
+  std::unique_ptr<FrameSource> source = OpenFrameSource(BendingScene());
+  RunOptions options;
+  options.max_frames = 3;
+  const RunSummary summary = RunPipeline(*source, session, {}, options);
+  EXPECT_FALSE(summary.latency_row_ms_median.has_value());
 }
 
 }  // namespace

@@ -42,6 +42,11 @@ class FrameSink {
   // Once at the end of every run that called begin(), whatever the reason, with the summary.
   // Must not throw.
   virtual void end(const RunSummary& summary) { (void)summary; }
+  // After every sink's end(), in sink order: adds to the run's summary what only this sink knows
+  // (the CSV's capture-to-row latency, a video encoder's error or waits), so every caller of
+  // RunPipeline (track, control, Python) reports the same figures without patching them in.
+  // Must not throw.
+  virtual void report(RunSummary& summary) const { (void)summary; }
 };
 
 }  // namespace softsight

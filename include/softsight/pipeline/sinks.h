@@ -38,6 +38,8 @@ class CsvSink : public FrameSink {
   // returned), ms, in row order: for the summary (SummariseTimes). The CSV's latency_row_ms
   // column is taken just before the write.
   const std::vector<double>& row_latencies_ms() const { return row_latency_ms_; }
+  // The summary's latency_row_ms_median / _p99 (when any row carried a capture time).
+  void report(RunSummary& summary) const override;
 
  private:
   CsvWriter writer_;
@@ -77,6 +79,9 @@ class VideoSink : public FrameSink {
   int64_t written_frames() const { return writer_->queued(); }  // Once end() has run.
   // Frames for which the pipeline had to wait for the encoder (its queue was full).
   int64_t waited_frames() const { return writer_->waited(); }
+  // The encoder's error ends an ok run as an error; a note says that every frame was recorded
+  // and whether the encoder held up the run (always for a camera's run, else when it did).
+  void report(RunSummary& summary) const override;
   // The encoder's error that end() met (a full disk while the last frames were written).
   const std::optional<std::string>& error() const { return error_; }
 
@@ -88,6 +93,7 @@ class VideoSink : public FrameSink {
   size_t capacity_;
   std::unique_ptr<AsyncFrameWriter> writer_;
   std::optional<std::string> error_;
+  bool live_ = false;  // RunInfo::live: a camera's run.
   int lock_fd_ = -1;  // Holds the file's lock while this sink lives (-1: a pattern or device).
 };
 
