@@ -12,6 +12,7 @@
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/io/run_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -210,7 +211,8 @@ py::tuple Track(const py::object& input, const py::object& config_source,
   bool interrupted = false;
   {
     py::gil_scoped_release release;
-    std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+    // Decoded ahead on its own thread, as `softsight track` reads it (io/run_source.h).
+    std::unique_ptr<FrameSource> source = SourceForRun(OpenFrameSource(spec), FilePacing::kReadAhead);
     TrackingSession session(config);
     std::optional<CsvSink> file;
     std::vector<FrameSink*> sinks = {&rows};

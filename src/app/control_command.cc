@@ -20,8 +20,8 @@
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
 #include "softsight/core/format.h"
-#include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/io/run_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -434,7 +434,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                                        tracking_config.capture.value_or(CameraSettings{}));
     CameraSettingsReport accepted;
     spec.capture_report = &accepted;
-    source = std::make_unique<NewestFrameSource>(OpenFrameSource(spec));
+    source = SourceForRun(OpenFrameSource(spec), FilePacing::kInCallersThread);  // Newest frame wins.
     PrintCaptureReport(accepted);
   } else if (options.rig_frames) {
     source = std::make_unique<RigFileSource>(*options.rig_frames, options.fps);

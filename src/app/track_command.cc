@@ -15,8 +15,7 @@
 #include "app/track_many.h"
 #include "softsight/core/error.h"
 #include "gui/overlay.h"
-#include "softsight/io/frame_grabber.h"
-#include "softsight/io/read_ahead_source.h"
+#include "softsight/io/run_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -83,16 +82,8 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   std::unique_ptr<FrameSource> source =
       seams.open_source ? seams.open_source() : OpenFrameSource(options.source);
   CheckOutputs(options, config, *source);
-  // A camera is read in its own thread, newest frame wins (drops are counted in the summary);
-  // a file, image sequence or rendered scene is decoded on its own thread a few frames ahead,
-  // so decoding overlaps tracking, and never drops one.
-  if (seams.open_source) {
-    // A test's stand-in, read as it is.
-  } else if (source->is_live()) {
-    source = std::make_unique<NewestFrameSource>(std::move(source));
-  } else {
-    source = std::make_unique<ReadAheadSource>(std::move(source));
-  }
+  // A test's stand-in is read as it is; a file is decoded ahead (io/run_source.h).
+  if (!seams.open_source) source = SourceForRun(std::move(source), FilePacing::kReadAhead);
   TrackingSession session(config);
 
   // Sinks in the order they see each frame; every output is opened (and checked) before the run.

@@ -10,8 +10,7 @@
 #include "gui/live_feed.h"
 #include "gui/live_layout.h"
 #include "gui/seekable_source.h"
-#include "softsight/io/frame_grabber.h"
-#include "softsight/io/paced_source.h"
+#include "softsight/io/run_source.h"
 
 namespace softsight {
 namespace {
@@ -189,11 +188,8 @@ LiveRunResult RunLiveWindow(const TrackingConfig& config, std::unique_ptr<FrameS
   // Pacing belongs to the source: a camera keeps only its newest frame (drops are counted and
   // shown); a file or image sequence plays every frame at its own rate and pauses with the
   // window (or, unpaced, as fast as it decodes).
-  if (source->is_live()) {
-    source = std::make_unique<NewestFrameSource>(std::move(source));
-  } else if (window.pace_files) {
-    source = std::make_unique<PacedFrameSource>(std::move(source));
-  }
+  source = SourceForRun(std::move(source),
+                        window.pace_files ? FilePacing::kRealTime : FilePacing::kInCallersThread);
   LiveRunResult result;
   result.exit_code = RunLiveLoop(controller, *source, window, seekable);
   result.last_recording = controller.last_recording();
