@@ -13,6 +13,7 @@
 
 #include "app/capture_options.h"
 #include "app/commands.h"
+#include "app/control_parts.h"
 #include "app/stop_request.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
@@ -30,242 +31,10 @@
 namespace softsight {
 namespace {
 
-// Frames of a rig running in another process (`softsight rig --pty --frames FILE`), which
-// rewrites FILE atomically (write + rename) at its frame rate: read it at `fps`, wall clock.
-class RigFileSource : public FrameSource {
- public:
-  RigFileSource(std::string file, double fps) : file_(std::move(file)), fps_(fps) {}
-  bool read(Frame& frame) override {
-    const auto period = std::chrono::duration<double>(1.0 / fps_);
-    if (index_ == 0) start_ = std::chrono::steady_clock::now();
-    std::this_thread::sleep_until(start_ + std::chrono::duration_cast<
-                                               std::chrono::steady_clock::duration>(period * index_));
-    cv::Mat image = cv::imread(file_, cv::IMREAD_COLOR);
-    if (image.empty()) {
-      throw InputError(file_ + ": cannot read the rig's frame at frame " + std::to_string(index_) +
-                       " (is `softsight rig --frames " + file_ + "` running?)");
-    }
-    frame.image = image;
-    frame.index = index_;
-    frame.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    ++index_;
-    return true;
-  }
-  std::string description() const override { return "rig frames " + file_; }
-  std::optional<int64_t> frame_count() const override { return std::nullopt; }
-  std::optional<double> fps() const override { return fps_; }
-  bool is_live() const override { return true; }
-
- private:
-  std::string file_;
-  double fps_;
-  int64_t index_ = 0;
-  std::chrono::steady_clock::time_point start_;
-};
-
-// The simulated rig's camera: each frame renders the rig's current bend, then the rig advances by
-// one frame period, in lock-step with the loop (simulated time: as fast as it can). Ends after
-// `duration_s`.
-class SimulatedRigSource : public FrameSource {
- public:
-  SimulatedRigSource(SimulatedRig& rig, SyntheticScene& scene, double fps, double duration_s)
-      : rig_(rig), scene_(scene), fps_(fps),
-        frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1) {}
-  bool read(Frame& frame) override {
-    if (index_ >= frames_) return false;
-    if (index_ > 0) rig_.advance(1.0 / fps_);
-    truth_ = rig_.snapshot();
-    const double t = static_cast<double>(index_) / fps_;
-    scene_.render_at_bend(truth_->bend_deg, t, static_cast<int>(index_), frame.image);
-    frame.index = index_++;
-    frame.time_s = t;
-    return true;
-  }
-  std::string description() const override { return "simulated rig"; }
-  std::optional<int64_t> frame_count() const override { return frames_; }
-  std::optional<double> fps() const override { return fps_; }
-  // The rig's state when the last frame was rendered.
-  const std::optional<RigSnapshot>& truth() const { return truth_; }
-
- private:
-  SimulatedRig& rig_;
-  SyntheticScene& scene_;
-  double fps_;
-  int64_t frames_;
-  int64_t index_ = 0;
-  std::optional<RigSnapshot> truth_;
-};
-
-// The controller as a sink: one step per frame with the measured angle. Its columns (by name)
-// read the step of the frame being written, so it must come before the CSV sink.
-class ControlSink : public FrameSink {
- public:
-  // With `stop_at_duration`, done() turns true once `duration_s` of frame time has passed (a
-  // camera or the rig's frame file, which have no end of their own).
-  ControlSink(ControlSession& session, const BoardLink& link, double duration_s,
-              bool stop_at_duration)
-      : session_(session), link_(link), duration_s_(duration_s),
-        stop_at_duration_(stop_at_duration) {}
-
-  // From then on each frame runs this experiment (open loop) instead of the closed loop, until
-  // it is done.
-  void identify(IdentificationExperiment* experiment) { experiment_ = experiment; }
-
-  void consume(const Frame& frame, const FrameResult& result) override {
-    if (experiment_ != nullptr) {
-      sample_ = StepIdentification(*experiment_, session_, frame.time_s,
-                                   result.measurement.angle_deg);
-      if (experiment_->done()) done_ = true;
-    } else {
-      sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
-    }
-    // A command written for this frame: its latency from the frame's capture (absent when this
-    // step sent none).
-    const auto sent = link_.last_sent();
-    latency_command_ms_ =
-        sent >= frame.captured && frame.captured != std::chrono::steady_clock::time_point{}
-            ? std::optional<double>(
-                  std::chrono::duration<double, std::milli>(sent - frame.captured).count())
-            : std::nullopt;
-    if (latency_command_ms_) command_latencies_ms_.push_back(*latency_command_ms_);
-    ++frames_;
-    summary_.duration_s = sample_.time_s;
-    summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
-    summary_.board_rejected = sample_.board.board_rejected;
-    if (sample_.measured_deg) ++summary_.measured;
-    if (sample_.measured_deg && sample_.target_deg) {
-      const double e = *sample_.measured_deg - *sample_.target_deg;
-      sum_sq_ += e * e;
-      ++errors_;
-      summary_.final_error_deg = e;
-    }
-    if (sample_.target_deg) collect_step_point(*sample_.target_deg);
-    // Closed loop asking for max_kpa, frame after frame: a target the actuator may not reach.
-    const bool at_limit = experiment_ == nullptr && sample_.target_deg && sample_.setpoint_kpa &&
-                          *sample_.setpoint_kpa >= session_.controller().options().max_kpa - 1e-9;
-    if (!at_limit) {
-      at_limit_since_s_.reset();
-    } else {
-      if (!at_limit_since_s_) at_limit_since_s_ = sample_.time_s;
-      longest_at_limit_s_ = std::max(longest_at_limit_s_, sample_.time_s - *at_limit_since_s_);
-    }
-    if (stop_at_duration_ && sample_.time_s >= duration_s_) done_ = true;
-  }
-
-  bool done() const { return done_; }
-  // The longest stretch of frame time the closed loop spent asking for max_kpa.
-  double longest_at_output_limit_s() const { return longest_at_limit_s_; }
-
-  // The controller's CSV columns: target_deg, setpoint_kpa, board_pressure_kpa,
-  // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected.
-  std::vector<CsvColumn> columns() const {
-    const auto column = [this](const char* name, auto value) {
-      return NumberColumn(name, [this, value](const FrameResult&) -> std::optional<double> {
-        return value(sample_);
-      });
-    };
-    using S = const ControlSample&;
-    return {
-        column("target_deg", [](S s) { return s.target_deg; }),
-        column("setpoint_kpa", [](S s) { return s.setpoint_kpa; }),
-        column("board_pressure_kpa", [](S s) { return s.board.pressure_kpa; }),
-        column("board_setpoint_kpa", [](S s) { return s.board.setpoint_kpa; }),
-        column("duty", [](S s) { return s.board.duty; }),
-        column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
-        column("control_action",
-               [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
-        NumberColumn("link_rejected",
-                     [this](const FrameResult&) -> std::optional<double> {
-                       return static_cast<double>(link_.stats().rejected_lines);
-                     }),
-        column("board_rejected", [](S s) { return static_cast<double>(s.board.board_rejected); }),
-    };
-  }
-
-  // latency_command_ms: from the frame's capture to the serial command its step sent (goes
-  // between the CSV's latency_result_ms and latency_row_ms).
-  CsvColumn latency_column() const {
-    return NumberColumn("latency_command_ms",
-                        [this](const FrameResult&) { return latency_command_ms_; }, "%.3f");
-  }
-
-  // The figures so far (frames, errors, pressures); the link's counters are the caller's.
-  ControlSummary summary() const {
-    ControlSummary out = summary_;
-    out.frames = frames_;
-    std::vector<double> latencies = command_latencies_ms_;
-    SummariseTimes(latencies, &out.latency_command_ms_median, &out.latency_command_ms_p99);
-    if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
-    if (!step_points_.empty()) {
-      out.metrics = ComputeStepMetrics(step_points_);
-      out.metrics.rms_error_deg = out.rms_error_deg;  // Over the whole run, not the last step.
-    }
-    out.steps = ComputeEveryStepMetrics(run_points_);
-    // A target that moves (a ramp, a sine), not only jumps: how it is followed.
-    int changes = 0;
-    for (size_t k = 1; k < run_points_.size(); ++k) {
-      changes += run_points_[k].target_deg != run_points_[k - 1].target_deg;
-    }
-    if (changes > static_cast<int>(out.steps.size()) + 10) {
-      out.tracking = ComputeTrackingMetrics(run_points_);
-    }
-    return out;
-  }
-
- private:
-  ControlSession& session_;
-  const BoardLink& link_;
-  double duration_s_;
-  bool stop_at_duration_;
-  // The frames since the target last jumped (with the one before the jump), for the step
-  // figures, at most kMaxStepPoints of them (an hour at 30 fps): a longer hold keeps its first
-  // hour, which is where a step settles.
-  static constexpr size_t kMaxStepPoints = 108000;
-  void collect_step_point(double target_deg) {
-    const TrackingPoint point{sample_.time_s, target_deg, sample_.measured_deg};
-    const StepMetricsOptions defaults;
-    if (!step_points_.empty() &&
-        std::abs(target_deg - step_points_.back().target_deg) > defaults.step_threshold_deg) {
-      const TrackingPoint before = step_points_.back();
-      step_points_.clear();
-      step_points_.push_back(before);
-    }
-    if (step_points_.size() < kMaxStepPoints) step_points_.push_back(point);
-    if (run_points_.size() < kMaxStepPoints) run_points_.push_back(point);
-  }
-
-  IdentificationExperiment* experiment_ = nullptr;
-  std::optional<double> at_limit_since_s_;  // Frame time the output reached max_kpa, while there.
-  double longest_at_limit_s_ = 0.0;
-  std::vector<TrackingPoint> step_points_;
-  // Every frame of the run (its first hour), for the figures of each step of a staircase and the
-  // tracking of a moving target.
-  std::vector<TrackingPoint> run_points_;
-  ControlSample sample_;
-  std::optional<double> latency_command_ms_;
-  std::vector<double> command_latencies_ms_;
-  ControlSummary summary_;
-  int64_t frames_ = 0;
-  double sum_sq_ = 0.0;
-  int64_t errors_ = 0;
-  bool done_ = false;
-};
-
-// A simulated board with frames from elsewhere (--simulate --input): its clock follows the
-// frames' timestamps, as it would follow the wall clock on a bench.
-class RigClockSink : public FrameSink {
- public:
-  explicit RigClockSink(SimulatedRig& rig) : rig_(rig) {}
-  void consume(const Frame& frame, const FrameResult& result) override {
-    (void)result;
-    if (previous_s_ && frame.time_s > *previous_s_) rig_.advance(frame.time_s - *previous_s_);
-    previous_s_ = frame.time_s;
-  }
-
- private:
-  SimulatedRig& rig_;
-  std::optional<double> previous_s_;
-};
+using control_parts::ControlSink;
+using control_parts::RigClockSink;
+using control_parts::RigFileSource;
+using control_parts::SimulatedRigSource;
 
 // The longest identification experiment: far more than the steps and the PRBS take.
 constexpr double kMaxIdentifyS = 600.0;
@@ -318,13 +87,10 @@ ControlTarget MakeTarget(const ControlOptions& o) {
   return target;
 }
 
-}  // namespace
-
-ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary_out) {
-  ControlSummary local;
-  ControlSummary& summary = summary_out != nullptr ? *summary_out : local;
-  summary = ControlSummary{};
-
+// What the command line asks, checked before anything is opened: one frame source, a board or
+// the simulation, every number, and the target (none for an identification, which runs open
+// loop at the experiment's pressures for as long as it takes, bounded by --duration-s).
+ControlTarget CheckedTarget(const ControlOptions& options) {
   const int sources =
       (options.camera ? 1 : 0) + (options.rig_frames ? 1 : 0) + (options.input ? 1 : 0);
   if (sources > 1 || (sources == 0 && !options.simulate)) {
@@ -335,18 +101,270 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     throw InputError("control: give --port DEVICE for a board, or --simulate (not both)");
   }
   CheckOptions(options);
-  // Identification: open loop at the experiment's pressures (the target is only the session's
-  // starting point), for as long as the experiment takes (bounded by --duration-s).
-  ControlTarget target;
-  if (options.identify) {
-    if (options.target_deg || options.profile_file || options.pressure_kpa || options.pwm) {
-      throw InputError("identify: no target option (--target-deg, --profile, --pressure-kpa, "
-                       "--pwm): the experiment chooses the pressures");
-    }
-    target.mode = ControlMode::kPressure;
-  } else {
-    target = MakeTarget(options);
+  if (!options.identify) return MakeTarget(options);
+  if (options.target_deg || options.profile_file || options.pressure_kpa || options.pwm) {
+    throw InputError("identify: no target option (--target-deg, --profile, --pressure-kpa, "
+                     "--pwm): the experiment chooses the pressures");
   }
+  ControlTarget target;
+  target.mode = ControlMode::kPressure;
+  return target;
+}
+
+// The config's `control:` section (checked by LoadTrackingConfig; defaults without one), with
+// the command line's controller and model over it.
+ControlConfig ControlConfigFor(const ControlOptions& options, const TrackingConfig& tracking) {
+  ControlConfig config = tracking.control.value_or(ControlConfig{});
+  if (options.controller) {
+    std::string problem;
+    if (!options.controller->Check(&problem)) throw InputError("control.controller: " + problem);
+    config.controller = *options.controller;
+  }
+  if (options.model) config.model = *options.model;
+  return config;
+}
+
+// Reach, before the board is opened: a target the identified actuator cannot hold would run the
+// whole duration at the output limit, "not settled". Refused, or with --allow-saturation limited
+// to the reach (the returned note says so).
+std::optional<std::string> KeepTargetInReach(const ControlOptions& options,
+                                             const ControlConfig& config, ControlTarget* target) {
+  if (target->mode != ControlMode::kAngle || options.identify) return std::nullopt;
+  const std::optional<std::string> problem =
+      OutsideReach(config.model, target->profile.lowest_deg(), target->profile.highest_deg(),
+                   config.controller.max_kpa);
+  if (!problem) return std::nullopt;
+  const std::string what = options.profile_file
+                               ? "--profile " + EscapeForMessage(*options.profile_file)
+                               : "--target-deg " + ShortNumber(target->profile.at(0.0));
+  if (!options.allow_saturation) {
+    throw InputError(what + ": " + *problem +
+                     "; nothing sent (--allow-saturation runs it with the target limited to the "
+                     "reach)");
+  }
+  const ActuatorReach reach = ReachOf(config.model, config.controller.max_kpa);
+  target->profile = target->profile.ClampedTo(reach.most_bent_deg, reach.straightest_deg);
+  std::string note = what + ": " + *problem + "; the target was limited to " +
+                     FixedNumber(reach.most_bent_deg, 1) + ".." +
+                     FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)";
+  if (!options.quiet) std::fprintf(stderr, "control: %s\n", note.c_str());
+  return note;
+}
+
+double RunDuration(const ControlOptions& options, const ControlTarget& target) {
+  if (options.duration_s) return *options.duration_s;
+  if (options.identify) return kMaxIdentifyS;
+  if (target.mode == ControlMode::kAngle && target.profile.duration_s() > 0.0) {
+    return target.profile.duration_s() + 2.0;
+  }
+  return 10.0;
+}
+
+// The frames: a camera (newest frame wins), the rig's frame file, a video or image sequence
+// (each of whose files is an input no output may overwrite), or the simulated rig rendered in
+// lock-step (`rendered`, which also gives the rig's truth columns).
+struct ControlFrames {
+  std::unique_ptr<FrameSource> source;
+  std::unique_ptr<SyntheticScene> scene;  // The simulated rig's renderer.
+  SimulatedRigSource* rendered = nullptr;
+};
+
+ControlFrames OpenControlFrames(const ControlOptions& options, const TrackingConfig& tracking,
+                                SimulatedRig* rig, double duration_s,
+                                const std::vector<PathRole>& outputs, std::vector<PathRole> inputs) {
+  ControlFrames frames;
+  if (options.camera) {
+    FrameSourceSpec spec;
+    spec.camera = options.camera;
+    spec.capture =
+        MergeCaptureOptions(options.capture_args, tracking.capture.value_or(CameraSettings{}));
+    CameraSettingsReport accepted;
+    spec.capture_report = &accepted;
+    frames.source = SourceForRun(OpenFrameSource(spec), FilePacing::kInCallersThread);
+    PrintCaptureReport(accepted);
+  } else if (options.rig_frames) {
+    frames.source = std::make_unique<RigFileSource>(*options.rig_frames, options.fps);
+  } else if (options.input) {
+    FrameSourceSpec spec;
+    spec.input = *options.input;
+    spec.sequence_fps = options.fps;
+    frames.source = OpenFrameSource(spec);
+    for (const std::string& file : frames.source->files()) inputs.push_back({"--input", file});
+    CheckOutputsAreNotInputs(outputs, inputs);
+  } else {
+    SceneOptions scene_options;
+    scene_options.fps = options.fps;
+    RenderOptions render;
+    render.supersample = options.sim_supersample;
+    frames.scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
+    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *frames.scene, options.fps, duration_s);
+    frames.rendered = rig_source.get();
+    frames.source = std::move(rig_source);
+  }
+  return frames;
+}
+
+// The CSV's columns beyond tracking: the controller's, the experiment's phase, and the
+// simulated rig's truth (what the actuator really did).
+std::vector<CsvColumn> ControlColumns(const ControlSink& control,
+                                      const std::optional<IdentificationExperiment>& experiment,
+                                      bool identify, const SimulatedRigSource* rendered) {
+  std::vector<CsvColumn> extra = control.columns();
+  if (identify) {
+    extra.push_back(NumberColumn("identify_phase", [&experiment](const FrameResult&) {
+      return experiment && !experiment->samples().empty()
+                 ? std::optional<double>(experiment->samples().back().phase)
+                 : std::nullopt;
+    }));
+  }
+  if (rendered != nullptr) {
+    extra.push_back(NumberColumn("rig_true_angle_deg", [rendered](const FrameResult&) {
+      const std::optional<RigSnapshot>& truth = rendered->truth();
+      return truth ? std::optional<double>(truth->angle_deg) : std::nullopt;
+    }));
+    extra.push_back(NumberColumn("rig_pressure_kpa", [rendered](const FrameResult&) {
+      const std::optional<RigSnapshot>& truth = rendered->truth();
+      return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
+    }));
+  }
+  return extra;
+}
+
+// Every frame carries one command; frames further apart than the board's watchdog allows would
+// have the actuator vented between any two of them, silently. Refused, naming the rate.
+void CheckFrameRateAgainstWatchdog(const FrameSource& source, const BoardInfo& info) {
+  const std::optional<double> fps = source.fps();
+  if (!fps || !(*fps > 0.0)) return;
+  const double period_ms = 1000.0 / *fps;
+  // A fifth of the watchdog's time is left for the frame's own jitter and the answer.
+  const double longest_period_ms = 0.8 * info.watchdog_ms;
+  if (period_ms > longest_period_ms * (1.0 + 1e-9)) {
+    throw InputError("control: frames every " + ShortNumber(period_ms) + " ms (" +
+                     ShortNumber(*fps) + " fps) but the board's watchdog vents after " +
+                     std::to_string(info.watchdog_ms) + " ms without a command: use at least " +
+                     ShortNumber(1000.0 / longest_period_ms) +
+                     " fps; nothing sent but the handshake, vented");
+  }
+}
+
+// The identification experiment, once the board's pressure limit is known.
+void StartIdentification(const ControlOptions& options, const ControlSession& session,
+                         const BoardInfo& info, std::optional<IdentificationExperiment>* experiment,
+                         ControlSink* control) {
+  const double ceiling_kpa =
+      IdentificationCeiling(session.controller().options(), info.pressure_limit_kpa);
+  const double min_kpa = session.controller().options().min_kpa;
+  if (!(min_kpa < ceiling_kpa)) {
+    // Every setpoint would be raised to min_kpa, above the ceiling the experiment announces.
+    throw InputError("identify: control.controller.min_kpa " + ShortNumber(min_kpa) +
+                     " kPa is not below the experiment's ceiling of " + ShortNumber(ceiling_kpa) +
+                     " kPa (control.controller.max_kpa and the board's limit); vented");
+  }
+  experiment->emplace(options.identify_options, ceiling_kpa);
+  control->identify(&**experiment);
+  if (!options.quiet) {
+    std::fprintf(stderr,
+                 "identify: steps of %.3g kPa up to %.3g kPa and back, then a PRBS around a "
+                 "working point; vents and stops on lost markers, no response or a pressure "
+                 "above the ceiling\n",
+                 (*experiment)->ceiling_kpa() / options.identify_options.levels,
+                 (*experiment)->ceiling_kpa());
+  }
+}
+
+// What the run is about to do: a pressure asked above the limit (said even with --quiet: the
+// run does not do what the command line says), the board, and the outer loop's gains.
+void AnnounceRun(const ControlOptions& options, const Transport& transport, const BoardInfo& info,
+                 const ControlSession& session) {
+  if (const std::optional<double> asked = session.pressure_clamped_from()) {
+    std::fprintf(stderr,
+                 "control: --pressure-kpa %s is above the limit of %s kPa (control.controller."
+                 "max_kpa, at most the board's limit); sending %s kPa\n",
+                 ShortNumber(*asked).c_str(),
+                 ShortNumber(session.controller().options().max_kpa).c_str(),
+                 ShortNumber(session.pressure_target_kpa()).c_str());
+  }
+  if (options.quiet) return;
+  std::fprintf(stderr,
+               "control: %s: board protocol %d, pressure limit %.1f kPa, inner loop %d Hz, "
+               "watchdog %d ms\n",
+               transport.name().c_str(), info.protocol_version, info.pressure_limit_kpa,
+               info.loop_hz, info.watchdog_ms);
+  if (options.identify) return;  // The experiment runs open loop: the gains play no part.
+  const ControllerOptions& c = session.controller().options();
+  std::fprintf(stderr,
+               "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
+               "bias %.3g kPa, ff %.3g kPa/deg, hysteresis %.3g kPa, lead %.3g s, output "
+               "%.3g..%.3g kPa, slew %.3g kPa/s, hold %.3g s\n",
+               c.kp_kpa_per_deg, c.ki_kpa_per_deg_s, c.kd_kpa_s_per_deg, c.bias_kpa,
+               c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.min_kpa, c.max_kpa,
+               c.max_rate_kpa_per_s, c.hold_s);
+}
+
+// The controller's figures, the link's counts, and a note for each thing the run did other than
+// asked.
+void CollectControlSummary(const ControlSink& control, const BoardLink& link,
+                           const ControlSession& session,
+                           const std::optional<std::string>& limited_to_reach,
+                           ControlSummary* summary) {
+  *summary = control.summary();
+  summary->link_rejected = link.stats().rejected_lines;
+  summary->resends = link.stats().resends;
+  if (limited_to_reach) summary->notes.push_back(*limited_to_reach);
+  const double max_kpa = session.controller().options().max_kpa;
+  if (control.longest_at_output_limit_s() > 1.0) {
+    summary->notes.push_back(
+        "the outer loop's output stayed at its limit (" + ShortNumber(max_kpa) + " kPa) for " +
+        FixedNumber(control.longest_at_output_limit_s(), 1) +
+        " s: the target may be beyond the actuator's reach (`softsight identify` measures it)");
+  }
+  if (session.duty_held_at_limit() > 0) {
+    summary->notes.push_back("valves held closed (duty 0) in " +
+                             std::to_string(session.duty_held_at_limit()) +
+                             " frames: the pressure had reached control.controller.max_kpa (" +
+                             ShortNumber(max_kpa) + " kPa)");
+  }
+  if (session.watchdog_answers() > 0) {
+    summary->notes.push_back(
+        "the board's watchdog had vented in " + std::to_string(session.watchdog_answers()) +
+        " answers: commands came too far apart (a camera slower than the watchdog?)");
+  }
+  if (session.limit_answers() > 0) {
+    summary->notes.push_back("the board's pressure guard overrode the outputs in " +
+                             std::to_string(session.limit_answers()) +
+                             " answers: the pressure reached the board's limit");
+  }
+}
+
+// The identified model and the gains tuned from it.
+IdentifyOutcome IdentifiedFrom(const IdentificationExperiment& experiment,
+                               const ControlConfig& config, const ControlOptions& options) {
+  IdentifyOutcome outcome;
+  outcome.model = FitActuatorModel(experiment);
+  const std::vector<IdentifySample>& samples = experiment.samples();
+  const double frame_period_s = (samples.back().time_s - samples.front().time_s) /
+                                static_cast<double>(std::max<size_t>(1, samples.size() - 1));
+  outcome.tuned = TuneController(&outcome.model, config.controller, frame_period_s,
+                                 options.identify_options.closed_loop_s);
+  outcome.samples = samples;
+  return outcome;
+}
+
+void StoppedBySignal(const StopRequest& stop, ControlSummary* summary) {
+  summary->stop_reason = StopSignalReason(stop.signal());
+  summary->stop_signal = stop.signal();
+}
+
+}  // namespace
+
+// The wiring: checks, the board (a device, or the simulated rig behind a real pseudo-terminal),
+// the frames, the sinks, the handshake, the run, and its summary.
+ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary_out) {
+  ControlSummary local;
+  ControlSummary& summary = summary_out != nullptr ? *summary_out : local;
+  summary = ControlSummary{};
+
+  ControlTarget target = CheckedTarget(options);
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
   if (!options.camera) {
     RefuseCaptureWithoutCamera(options.capture_args, tracking_config.capture, options.config_file,
@@ -364,134 +382,43 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (options.input) inputs.push_back({"--input", *options.input});
   if (options.rig_frames) inputs.push_back({"--rig-frames", *options.rig_frames});
   CheckOutputsAreNotInputs(outputs, inputs);
-  // LoadTrackingConfig has read and checked the `control:` section; defaults without one.
-  ControlConfig config = tracking_config.control.value_or(ControlConfig{});
-  if (options.controller) {
-    std::string problem;
-    if (!options.controller->Check(&problem)) throw InputError("control.controller: " + problem);
-    config.controller = *options.controller;
-  }
-  if (options.model) config.model = *options.model;
-  // Reach, before the board is opened: a target the identified actuator cannot hold would run
-  // the whole duration at the output limit, "not settled".
-  std::optional<std::string> limited_to_reach;
-  if (target.mode == ControlMode::kAngle && !options.identify) {
-    if (const std::optional<std::string> problem =
-            OutsideReach(config.model, target.profile.lowest_deg(),
-                         target.profile.highest_deg(), config.controller.max_kpa)) {
-      const std::string what =
-          options.profile_file ? "--profile " + EscapeForMessage(*options.profile_file)
-                               : "--target-deg " + ShortNumber(target.profile.at(0.0));
-      if (!options.allow_saturation) {
-        throw InputError(what + ": " + *problem +
-                         "; nothing sent (--allow-saturation runs it with the target limited to "
-                         "the reach)");
-      }
-      const ActuatorReach reach = ReachOf(config.model, config.controller.max_kpa);
-      target.profile = target.profile.ClampedTo(reach.most_bent_deg, reach.straightest_deg);
-      limited_to_reach = what + ": " + *problem + "; the target was limited to " +
-                         FixedNumber(reach.most_bent_deg, 1) + ".." +
-                         FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)";
-      if (!options.quiet) std::fprintf(stderr, "control: %s\n", limited_to_reach->c_str());
-    }
-  }
-  const double duration_s = options.duration_s.value_or(
-      options.identify ? kMaxIdentifyS
-      : target.mode == ControlMode::kAngle && target.profile.duration_s() > 0.0
-          ? target.profile.duration_s() + 2.0
-          : 10.0);
+  const ControlConfig config = ControlConfigFor(options, tracking_config);
+  const std::optional<std::string> limited_to_reach = KeepTargetInReach(options, config, &target);
+  const double duration_s = RunDuration(options, target);
 
-  // The board: a device, or the simulated rig behind a real pseudo-terminal.
   std::unique_ptr<SimulatedRig> rig;
   std::unique_ptr<RigServer> rig_server;
-  std::string port;
   if (options.simulate) {
     rig = std::make_unique<SimulatedRig>(config.rig);
     rig_server = std::make_unique<RigServer>(*rig);
-    port = rig_server->port();
-  } else {
-    port = *options.port;
   }
   // Ctrl-C and SIGTERM from here on: polled between frames and inside every wait for the board.
   const StopRequest stop;
-  std::unique_ptr<Transport> transport = OpenSerialTransport(port, config.link.baud);
+  std::unique_ptr<Transport> transport =
+      OpenSerialTransport(rig_server ? rig_server->port() : *options.port, config.link.baud);
   LinkEnvironment environment;
   environment.stop_requested = [&stop] { return stop.requested(); };
   BoardLink link(*transport, config.link, environment);
   // Declared after the link, so destroyed before it: from the handshake on, any way out of this
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
-
-  // Frames: a camera (newest frame wins), the rig's frame file, a video or image sequence, or
-  // the simulated rig rendered in lock-step.
-  std::unique_ptr<FrameSource> source;
-  std::unique_ptr<SyntheticScene> scene;
-  SimulatedRigSource* rendered = nullptr;
-  if (options.camera) {
-    FrameSourceSpec spec;
-    spec.camera = options.camera;
-    spec.capture = MergeCaptureOptions(options.capture_args,
-                                       tracking_config.capture.value_or(CameraSettings{}));
-    CameraSettingsReport accepted;
-    spec.capture_report = &accepted;
-    source = SourceForRun(OpenFrameSource(spec), FilePacing::kInCallersThread);  // Newest frame wins.
-    PrintCaptureReport(accepted);
-  } else if (options.rig_frames) {
-    source = std::make_unique<RigFileSource>(*options.rig_frames, options.fps);
-  } else if (options.input) {
-    FrameSourceSpec spec;
-    spec.input = *options.input;
-    spec.sequence_fps = options.fps;
-    source = OpenFrameSource(spec);
-    // An image sequence's every file is an input too (the pattern itself is not a file).
-    for (const std::string& file : source->files()) inputs.push_back({"--input", file});
-    CheckOutputsAreNotInputs(outputs, inputs);
-  } else {
-    SceneOptions scene_options;
-    scene_options.fps = options.fps;
-    RenderOptions render;
-    render.supersample = options.sim_supersample;
-    scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
-    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *scene, options.fps, duration_s);
-    rendered = rig_source.get();
-    source = std::move(rig_source);
-  }
+  ControlFrames frames =
+      OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
 
   TrackingSession tracking(tracking_config);
   ControlSink control(session, link, duration_s,
-                      /*stop_at_duration=*/rendered == nullptr || options.identify);
-  std::vector<CsvColumn> extra = control.columns();
+                      /*stop_at_duration=*/frames.rendered == nullptr || options.identify);
   std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
-  if (options.identify) {
-    extra.push_back(NumberColumn("identify_phase", [&experiment](const FrameResult&) {
-      return experiment && !experiment->samples().empty()
-                 ? std::optional<double>(experiment->samples().back().phase)
-                 : std::nullopt;
-    }));
-  }
-  if (rendered != nullptr) {
-    extra.push_back(NumberColumn("rig_true_angle_deg", [rendered](const FrameResult&) {
-      const std::optional<RigSnapshot>& truth = rendered->truth();
-      return truth ? std::optional<double>(truth->angle_deg) : std::nullopt;
-    }));
-    extra.push_back(NumberColumn("rig_pressure_kpa", [rendered](const FrameResult&) {
-      const std::optional<RigSnapshot>& truth = rendered->truth();
-      return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
-    }));
-  }
-  // The CSV is optional for an identification run (`softsight identify` without --csv).
-  std::optional<CsvSink> csv;
+  std::optional<CsvSink> csv;  // Optional for an identification (`softsight identify` without --csv).
   if (!options.csv_file.empty() || !options.identify) {
-    CsvColumnTable columns = TrackingColumns(tracking_config, extra);
+    CsvColumnTable columns = TrackingColumns(
+        tracking_config, ControlColumns(control, experiment, options.identify, frames.rendered));
     columns.insert_before("latency_row_ms", control.latency_column());
     csv.emplace(options.csv_file, std::move(columns));
   }
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
-  if (rig && rendered == nullptr) {
-    rig_clock.emplace(*rig);
-    sinks.push_back(&*rig_clock);
-  }
+  if (rig && frames.rendered == nullptr) sinks.push_back(&rig_clock.emplace(*rig));
   sinks.push_back(&control);  // Before the CSV: its columns read this frame's step.
   if (csv) sinks.push_back(&*csv);
 
@@ -499,129 +426,36 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   try {
     info = session.start();
   } catch (const StopRequested&) {
-    summary.stop_reason = StopSignalReason(stop.signal());
-    summary.stop_signal = stop.signal();
+    StoppedBySignal(stop, &summary);
     return summary;
   }
-  // Every frame carries one command; frames further apart than the board's watchdog allows
-  // would have the actuator vented between any two of them, silently. Refused, naming the rate.
-  if (const std::optional<double> fps = source->fps(); fps && *fps > 0.0) {
-    const double period_ms = 1000.0 / *fps;
-    // A fifth of the watchdog's time is left for the frame's own jitter and the answer.
-    const double longest_period_ms = 0.8 * info.watchdog_ms;
-    if (period_ms > longest_period_ms * (1.0 + 1e-9)) {
-      throw InputError("control: frames every " + ShortNumber(period_ms) + " ms (" +
-                       ShortNumber(*fps) + " fps) but the board's watchdog vents after " +
-                       std::to_string(info.watchdog_ms) + " ms without a command: use at least " +
-                       ShortNumber(1000.0 / longest_period_ms) +
-                       " fps; nothing sent but the handshake, vented");
-    }
-  }
-  if (const std::optional<double> asked = session.pressure_clamped_from()) {
-    // Said once, even with --quiet: the run does not do what the command line says.
-    std::fprintf(stderr,
-                 "control: --pressure-kpa %s is above the limit of %s kPa (control.controller."
-                 "max_kpa, at most the board's limit); sending %s kPa\n",
-                 ShortNumber(*asked).c_str(),
-                 ShortNumber(session.controller().options().max_kpa).c_str(),
-                 ShortNumber(session.pressure_target_kpa()).c_str());
-  }
-  if (options.identify) {
-    const double ceiling_kpa =
-        IdentificationCeiling(session.controller().options(), info.pressure_limit_kpa);
-    const double min_kpa = session.controller().options().min_kpa;
-    if (!(min_kpa < ceiling_kpa)) {
-      // Every setpoint would be raised to min_kpa, above the ceiling the experiment announces.
-      throw InputError("identify: control.controller.min_kpa " + ShortNumber(min_kpa) +
-                       " kPa is not below the experiment's ceiling of " + ShortNumber(ceiling_kpa) +
-                       " kPa (control.controller.max_kpa and the board's limit); vented");
-    }
-    experiment.emplace(options.identify_options, ceiling_kpa);
-    control.identify(&*experiment);
-    if (!options.quiet) {
-      std::fprintf(stderr,
-                   "identify: steps of %.3g kPa up to %.3g kPa and back, then a PRBS around a "
-                   "working point; vents and stops on lost markers, no response or a pressure "
-                   "above the ceiling\n",
-                   experiment->ceiling_kpa() / options.identify_options.levels,
-                   experiment->ceiling_kpa());
-    }
-  }
-  if (!options.quiet) {
-    std::fprintf(stderr,
-                 "control: %s: board protocol %d, pressure limit %.1f kPa, inner loop %d Hz, "
-                 "watchdog %d ms\n",
-                 transport->name().c_str(), info.protocol_version, info.pressure_limit_kpa,
-                 info.loop_hz, info.watchdog_ms);
-    const ControllerOptions& c = session.controller().options();
-    if (!options.identify) {  // The experiment runs open loop: the gains play no part.
-      std::fprintf(stderr,
-                   "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
-                   "bias %.3g kPa, ff %.3g kPa/deg, hysteresis %.3g kPa, lead %.3g s, output "
-                   "%.3g..%.3g kPa, slew %.3g kPa/s, hold %.3g s\n",
-                   c.kp_kpa_per_deg, c.ki_kpa_per_deg_s, c.kd_kpa_s_per_deg, c.bias_kpa,
-                   c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.min_kpa, c.max_kpa,
-                   c.max_rate_kpa_per_s, c.hold_s);
-    }
-  }
+  CheckFrameRateAgainstWatchdog(*frames.source, info);
+  if (options.identify) StartIdentification(options, session, info, &experiment, &control);
+  AnnounceRun(options, *transport, info, session);
 
   RunOptions run;
   run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
-  const auto collect = [&] {
-    summary = control.summary();
-    summary.link_rejected = link.stats().rejected_lines;
-    summary.resends = link.stats().resends;
-    if (limited_to_reach) summary.notes.push_back(*limited_to_reach);
-    const double max_kpa = session.controller().options().max_kpa;
-    if (control.longest_at_output_limit_s() > 1.0) {
-      summary.notes.push_back(
-          "the outer loop's output stayed at its limit (" + ShortNumber(max_kpa) + " kPa) for " +
-          FixedNumber(control.longest_at_output_limit_s(), 1) +
-          " s: the target may be beyond the actuator's reach (`softsight identify` measures it)");
-    }
-    if (session.duty_held_at_limit() > 0) {
-      summary.notes.push_back(
-          "valves held closed (duty 0) in " + std::to_string(session.duty_held_at_limit()) +
-          " frames: the pressure had reached control.controller.max_kpa (" +
-          ShortNumber(session.controller().options().max_kpa) + " kPa)");
-    }
-    if (session.watchdog_answers() > 0) {
-      summary.notes.push_back(
-          "the board's watchdog had vented in " + std::to_string(session.watchdog_answers()) +
-          " answers: commands came too far apart (a camera slower than the watchdog?)");
-    }
-    if (session.limit_answers() > 0) {
-      summary.notes.push_back("the board's pressure guard overrode the outputs in " +
-                              std::to_string(session.limit_answers()) +
-                              " answers: the pressure reached the board's limit");
-    }
-  };
-  RunSummary ran;
   try {
-    ran = RunPipeline(*source, tracking, sinks, run);
+    summary.run = RunPipeline(*frames.source, tracking, sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
-    collect();
-    summary.stop_reason = StopSignalReason(stop.signal());
-    summary.stop_signal = stop.signal();
+    CollectControlSummary(control, link, session, limited_to_reach, &summary);
+    StoppedBySignal(stop, &summary);
     session.stop();
     return summary;
   } catch (const std::exception&) {
     // The session's destructor sends STOP on the way out.
-    collect();
+    CollectControlSummary(control, link, session, limited_to_reach, &summary);
     summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
     throw;
   }
-  collect();
-  summary.latency_result_ms_median = ran.latency_result_ms_median;
-  summary.latency_result_ms_p99 = ran.latency_result_ms_p99;
-  summary.latency_done_ms_median = ran.latency_done_ms_median;
-  summary.latency_done_ms_p99 = ran.latency_done_ms_p99;
+  const RunSummary ran = summary.run;
+  CollectControlSummary(control, link, session, limited_to_reach, &summary);
+  summary.run = ran;
   if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
     session.stop();
     if (stop.requested()) {  // Not a failure: the caller says which signal and exits 130/143.
-      summary.stop_reason = StopSignalReason(stop.signal());
-      summary.stop_signal = stop.signal();
+      StoppedBySignal(stop, &summary);
       return summary;
     }
     throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
@@ -629,13 +463,15 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
-      summary.stop_reason = rendered != nullptr ? "duration reached" : "end of input";
+      summary.stop_reason = frames.rendered != nullptr ? "duration reached" : "end of input";
       break;
     case StopReason::kMaxFrames:
     case StopReason::kStopRequested:
-      summary.stop_reason =
-          control.done() ? "duration reached" : StopSignalReason(stop.signal());
-      if (!control.done()) summary.stop_signal = stop.signal();
+      if (control.done()) {
+        summary.stop_reason = "duration reached";
+      } else {
+        StoppedBySignal(stop, &summary);
+      }
       break;
     case StopReason::kError:
       // The session's destructor sends STOP on the way out.
@@ -643,17 +479,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       throw InputError(ran.error);
   }
   session.stop();  // Vent at the end of the run.
-  if (experiment) {
-    IdentifyOutcome outcome;
-    outcome.model = FitActuatorModel(*experiment);
-    const std::vector<IdentifySample>& samples = experiment->samples();
-    const double frame_period_s = (samples.back().time_s - samples.front().time_s) /
-                                  static_cast<double>(std::max<size_t>(1, samples.size() - 1));
-    outcome.tuned = TuneController(&outcome.model, config.controller, frame_period_s,
-                                   options.identify_options.closed_loop_s);
-    outcome.samples = experiment->samples();
-    summary.identified = std::move(outcome);
-  }
+  if (experiment) summary.identified = IdentifiedFrom(*experiment, config, options);
   if (!options.metrics_csv_file.empty()) {
     WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.steps));
   }
@@ -695,8 +521,8 @@ std::string FormatControlSummary(const ControlSummary& s) {
     std::snprintf(line, sizeof(line),
                   "latency from capture, median / p99: result %.3f / %.3f ms, serial command "
                   "%.3f / %.3f ms, CSV row %.3f / %.3f ms\n",
-                  s.latency_result_ms_median, s.latency_result_ms_p99, s.latency_command_ms_median,
-                  s.latency_command_ms_p99, s.latency_done_ms_median, s.latency_done_ms_p99);
+                  s.run.latency_result_ms_median, s.run.latency_result_ms_p99, s.latency_command_ms_median,
+                  s.latency_command_ms_p99, s.run.latency_done_ms_median, s.run.latency_done_ms_p99);
     out << line;
   }
   return out.str();

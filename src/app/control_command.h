@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "softsight/pipeline/summary.h"
+
 #include "control/identify.h"
 #include "control/step_metrics.h"
 #include "softsight/control/session.h"
@@ -80,12 +82,13 @@ struct ControlSummary {
   // SIGINT or SIGTERM when a signal stopped the run (stop_reason says so), else 0. An
   // identification a signal stopped returns without `identified` instead of throwing.
   int stop_signal = 0;
-  // Latency per frame from its capture (the camera's frame handed over; the simulated rig's frame
-  // rendered) to the tracker's result, to the serial command sent, and to every output written
-  // (the CSV row), ms: median and 99th percentile.
-  double latency_result_ms_median = 0.0, latency_result_ms_p99 = 0.0;
+  // The pipeline's own summary of the run (frames, found rates, timings; the latency per frame
+  // from its capture (the camera's frame handed over; the simulated rig's frame rendered) to the
+  // tracker's result and to every output written, the CSV row's from the CSV sink).
+  RunSummary run;
+  // From the capture to the serial command that frame's step sent, ms: median and 99th
+  // percentile (the controller's own figure).
   double latency_command_ms_median = 0.0, latency_command_ms_p99 = 0.0;
-  double latency_done_ms_median = 0.0, latency_done_ms_p99 = 0.0;
   // Angle mode: rise and settling time, overshoot and steady-state error of the last step to a
   // constant target, RMS error over the run (control/step_metrics.h).
   StepMetrics metrics;

@@ -1,0 +1,267 @@
+// The frame sources and sinks of `softsight control` (RunControl wires them): the rig's frame
+// file, the simulated rig rendered in lock-step, the sink that runs the controller on each
+// frame's angle, and the simulated board's clock driven by the frames. Private to the command.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "app/control_command.h"
+#include "softsight/control/board_link.h"
+#include "softsight/control/rig.h"
+#include "softsight/core/error.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/pipeline/sink.h"
+#include "softsight/pipeline/sinks.h"
+#include "softsight/sim/scene.h"
+
+namespace softsight::control_parts {
+
+// Frames of a rig running in another process (`softsight rig --pty --frames FILE`), which
+// rewrites FILE atomically (write + rename) at its frame rate: read it at `fps`, wall clock.
+class RigFileSource : public FrameSource {
+ public:
+  RigFileSource(std::string file, double fps) : file_(std::move(file)), fps_(fps) {}
+  bool read(Frame& frame) override {
+    const auto period = std::chrono::duration<double>(1.0 / fps_);
+    if (index_ == 0) start_ = std::chrono::steady_clock::now();
+    std::this_thread::sleep_until(start_ + std::chrono::duration_cast<
+                                               std::chrono::steady_clock::duration>(period * index_));
+    cv::Mat image = cv::imread(file_, cv::IMREAD_COLOR);
+    if (image.empty()) {
+      throw InputError(file_ + ": cannot read the rig's frame at frame " + std::to_string(index_) +
+                       " (is `softsight rig --frames " + file_ + "` running?)");
+    }
+    frame.image = image;
+    frame.index = index_;
+    frame.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    ++index_;
+    return true;
+  }
+  std::string description() const override { return "rig frames " + file_; }
+  std::optional<int64_t> frame_count() const override { return std::nullopt; }
+  std::optional<double> fps() const override { return fps_; }
+  bool is_live() const override { return true; }
+
+ private:
+  std::string file_;
+  double fps_;
+  int64_t index_ = 0;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// The simulated rig's camera: each frame renders the rig's current bend, then the rig advances by
+// one frame period, in lock-step with the loop (simulated time: as fast as it can). Ends after
+// `duration_s`.
+class SimulatedRigSource : public FrameSource {
+ public:
+  SimulatedRigSource(SimulatedRig& rig, SyntheticScene& scene, double fps, double duration_s)
+      : rig_(rig), scene_(scene), fps_(fps),
+        frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1) {}
+  bool read(Frame& frame) override {
+    if (index_ >= frames_) return false;
+    if (index_ > 0) rig_.advance(1.0 / fps_);
+    truth_ = rig_.snapshot();
+    const double t = static_cast<double>(index_) / fps_;
+    scene_.render_at_bend(truth_->bend_deg, t, static_cast<int>(index_), frame.image);
+    frame.index = index_++;
+    frame.time_s = t;
+    return true;
+  }
+  std::string description() const override { return "simulated rig"; }
+  std::optional<int64_t> frame_count() const override { return frames_; }
+  std::optional<double> fps() const override { return fps_; }
+  // The rig's state when the last frame was rendered.
+  const std::optional<RigSnapshot>& truth() const { return truth_; }
+
+ private:
+  SimulatedRig& rig_;
+  SyntheticScene& scene_;
+  double fps_;
+  int64_t frames_;
+  int64_t index_ = 0;
+  std::optional<RigSnapshot> truth_;
+};
+
+// The controller as a sink: one step per frame with the measured angle. Its columns (by name)
+// read the step of the frame being written, so it must come before the CSV sink.
+class ControlSink : public FrameSink {
+ public:
+  // With `stop_at_duration`, done() turns true once `duration_s` of frame time has passed (a
+  // camera or the rig's frame file, which have no end of their own).
+  ControlSink(ControlSession& session, const BoardLink& link, double duration_s,
+              bool stop_at_duration)
+      : session_(session), link_(link), duration_s_(duration_s),
+        stop_at_duration_(stop_at_duration) {}
+
+  // From then on each frame runs this experiment (open loop) instead of the closed loop, until
+  // it is done.
+  void identify(IdentificationExperiment* experiment) { experiment_ = experiment; }
+
+  void consume(const Frame& frame, const FrameResult& result) override {
+    if (experiment_ != nullptr) {
+      sample_ = StepIdentification(*experiment_, session_, frame.time_s,
+                                   result.measurement.angle_deg);
+      if (experiment_->done()) done_ = true;
+    } else {
+      sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+    }
+    // A command written for this frame: its latency from the frame's capture (absent when this
+    // step sent none).
+    const auto sent = link_.last_sent();
+    latency_command_ms_ =
+        sent >= frame.captured && frame.captured != std::chrono::steady_clock::time_point{}
+            ? std::optional<double>(
+                  std::chrono::duration<double, std::milli>(sent - frame.captured).count())
+            : std::nullopt;
+    if (latency_command_ms_) command_latencies_ms_.push_back(*latency_command_ms_);
+    ++frames_;
+    summary_.duration_s = sample_.time_s;
+    summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
+    summary_.board_rejected = sample_.board.board_rejected;
+    if (sample_.measured_deg) ++summary_.measured;
+    if (sample_.measured_deg && sample_.target_deg) {
+      const double e = *sample_.measured_deg - *sample_.target_deg;
+      sum_sq_ += e * e;
+      ++errors_;
+      summary_.final_error_deg = e;
+    }
+    if (sample_.target_deg) collect_step_point(*sample_.target_deg);
+    // Closed loop asking for max_kpa, frame after frame: a target the actuator may not reach.
+    const bool at_limit = experiment_ == nullptr && sample_.target_deg && sample_.setpoint_kpa &&
+                          *sample_.setpoint_kpa >= session_.controller().options().max_kpa - 1e-9;
+    if (!at_limit) {
+      at_limit_since_s_.reset();
+    } else {
+      if (!at_limit_since_s_) at_limit_since_s_ = sample_.time_s;
+      longest_at_limit_s_ = std::max(longest_at_limit_s_, sample_.time_s - *at_limit_since_s_);
+    }
+    if (stop_at_duration_ && sample_.time_s >= duration_s_) done_ = true;
+  }
+
+  bool done() const { return done_; }
+  // The longest stretch of frame time the closed loop spent asking for max_kpa.
+  double longest_at_output_limit_s() const { return longest_at_limit_s_; }
+
+  // The controller's CSV columns: target_deg, setpoint_kpa, board_pressure_kpa,
+  // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected.
+  std::vector<CsvColumn> columns() const {
+    const auto column = [this](const char* name, auto value) {
+      return NumberColumn(name, [this, value](const FrameResult&) -> std::optional<double> {
+        return value(sample_);
+      });
+    };
+    using S = const ControlSample&;
+    return {
+        column("target_deg", [](S s) { return s.target_deg; }),
+        column("setpoint_kpa", [](S s) { return s.setpoint_kpa; }),
+        column("board_pressure_kpa", [](S s) { return s.board.pressure_kpa; }),
+        column("board_setpoint_kpa", [](S s) { return s.board.setpoint_kpa; }),
+        column("duty", [](S s) { return s.board.duty; }),
+        column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
+        column("control_action",
+               [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
+        NumberColumn("link_rejected",
+                     [this](const FrameResult&) -> std::optional<double> {
+                       return static_cast<double>(link_.stats().rejected_lines);
+                     }),
+        column("board_rejected", [](S s) { return static_cast<double>(s.board.board_rejected); }),
+    };
+  }
+
+  // latency_command_ms: from the frame's capture to the serial command its step sent (goes
+  // between the CSV's latency_result_ms and latency_row_ms).
+  CsvColumn latency_column() const {
+    return NumberColumn("latency_command_ms",
+                        [this](const FrameResult&) { return latency_command_ms_; }, "%.3f");
+  }
+
+  // The figures so far (frames, errors, pressures); the link's counters are the caller's.
+  ControlSummary summary() const {
+    ControlSummary out = summary_;
+    out.frames = frames_;
+    std::vector<double> latencies = command_latencies_ms_;
+    SummariseTimes(latencies, &out.latency_command_ms_median, &out.latency_command_ms_p99);
+    if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
+    if (!step_points_.empty()) {
+      out.metrics = ComputeStepMetrics(step_points_);
+      out.metrics.rms_error_deg = out.rms_error_deg;  // Over the whole run, not the last step.
+    }
+    out.steps = ComputeEveryStepMetrics(run_points_);
+    // A target that moves (a ramp, a sine), not only jumps: how it is followed.
+    int changes = 0;
+    for (size_t k = 1; k < run_points_.size(); ++k) {
+      changes += run_points_[k].target_deg != run_points_[k - 1].target_deg;
+    }
+    if (changes > static_cast<int>(out.steps.size()) + 10) {
+      out.tracking = ComputeTrackingMetrics(run_points_);
+    }
+    return out;
+  }
+
+ private:
+  ControlSession& session_;
+  const BoardLink& link_;
+  double duration_s_;
+  bool stop_at_duration_;
+  // The frames since the target last jumped (with the one before the jump), for the step
+  // figures, at most kMaxStepPoints of them (an hour at 30 fps): a longer hold keeps its first
+  // hour, which is where a step settles.
+  static constexpr size_t kMaxStepPoints = 108000;
+  void collect_step_point(double target_deg) {
+    const TrackingPoint point{sample_.time_s, target_deg, sample_.measured_deg};
+    const StepMetricsOptions defaults;
+    if (!step_points_.empty() &&
+        std::abs(target_deg - step_points_.back().target_deg) > defaults.step_threshold_deg) {
+      const TrackingPoint before = step_points_.back();
+      step_points_.clear();
+      step_points_.push_back(before);
+    }
+    if (step_points_.size() < kMaxStepPoints) step_points_.push_back(point);
+    if (run_points_.size() < kMaxStepPoints) run_points_.push_back(point);
+  }
+
+  IdentificationExperiment* experiment_ = nullptr;
+  std::optional<double> at_limit_since_s_;  // Frame time the output reached max_kpa, while there.
+  double longest_at_limit_s_ = 0.0;
+  std::vector<TrackingPoint> step_points_;
+  // Every frame of the run (its first hour), for the figures of each step of a staircase and the
+  // tracking of a moving target.
+  std::vector<TrackingPoint> run_points_;
+  ControlSample sample_;
+  std::optional<double> latency_command_ms_;
+  std::vector<double> command_latencies_ms_;
+  ControlSummary summary_;
+  int64_t frames_ = 0;
+  double sum_sq_ = 0.0;
+  int64_t errors_ = 0;
+  bool done_ = false;
+};
+
+// A simulated board with frames from elsewhere (--simulate --input): its clock follows the
+// frames' timestamps, as it would follow the wall clock on a bench.
+class RigClockSink : public FrameSink {
+ public:
+  explicit RigClockSink(SimulatedRig& rig) : rig_(rig) {}
+  void consume(const Frame& frame, const FrameResult& result) override {
+    (void)result;
+    if (previous_s_ && frame.time_s > *previous_s_) rig_.advance(frame.time_s - *previous_s_);
+    previous_s_ = frame.time_s;
+  }
+
+ private:
+  SimulatedRig& rig_;
+  std::optional<double> previous_s_;
+};
+
+}  // namespace softsight::control_parts
