@@ -1,0 +1,205 @@
+#include "track/template_parts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace softsight::template_internal {
+
+std::string RectText(const cv::Rect& r) {
+  return cv::format("[%d, %d, %d, %d]", r.x, r.y, r.width, r.height);
+}
+
+cv::Point2d HalfSize(const cv::Size& size) {
+  return {(size.width - 1) / 2.0, (size.height - 1) / 2.0};
+}
+
+double PeakOffset(double l, double c, double r, bool v_shaped) {
+  if (!std::isfinite(l) || !std::isfinite(r)) return 0.0;
+  double d = 0.0;
+  if (v_shaped) {
+    const double slope = c - std::min(l, r);
+    if (slope > 0) d = (r - l) / (2.0 * slope);
+  } else {
+    const double curvature = 2.0 * c - l - r;
+    if (curvature > 0) d = (r - l) / (2.0 * curvature);
+  }
+  return std::clamp(d, -0.5, 0.5);
+}
+
+cv::Point2d SubPixel(const cv::Mat& sim, cv::Point best, bool v_shaped) {
+  cv::Point2d offset(0, 0);
+  const float* row = sim.ptr<float>(best.y);
+  if (best.x > 0 && best.x < sim.cols - 1) {
+    offset.x = PeakOffset(row[best.x - 1], row[best.x], row[best.x + 1], v_shaped);
+  }
+  if (best.y > 0 && best.y < sim.rows - 1) {
+    offset.y = PeakOffset(sim.at<float>(best.y - 1, best.x), row[best.x],
+                          sim.at<float>(best.y + 1, best.x), v_shaped);
+  }
+  return offset;
+}
+
+bool BestIn(const cv::Mat& sim, cv::Point* at) {
+  float best = -std::numeric_limits<float>::infinity();
+  bool any = false;
+  for (int y = 0; y < sim.rows; ++y) {
+    const float* s = sim.ptr<float>(y);
+    for (int x = 0; x < sim.cols; ++x) {
+      if (s[x] > best || (!any && !std::isnan(s[x]))) {
+        best = s[x];
+        *at = {x, y};
+        any = true;
+      }
+    }
+  }
+  return any;
+}
+
+bool RivalIn(const cv::Mat& sim, cv::Point best, int radius, cv::Point* at) {
+  float top = -std::numeric_limits<float>::infinity();
+  bool any = false;
+  for (int y = 0; y < sim.rows; ++y) {
+    const float* s = sim.ptr<float>(y);
+    for (int x = 0; x < sim.cols; ++x) {
+      if (std::abs(x - best.x) <= radius && std::abs(y - best.y) <= radius) continue;
+      const float v = s[x];
+      if (std::isnan(v) || (any && v <= top)) continue;
+      bool peak = true;
+      for (int dy = -1; dy <= 1 && peak; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if ((dx == 0 && dy == 0) || yy < 0 || xx < 0 || yy >= sim.rows || xx >= sim.cols) continue;
+          if (sim.at<float>(yy, xx) > v) {
+            peak = false;
+            break;
+          }
+        }
+      }
+      if (!peak) continue;
+      top = v;
+      *at = {x, y};
+      any = true;
+    }
+  }
+  return any;
+}
+
+cv::Mat RoundMask(const cv::Size& size) {
+  cv::Mat mask(size, CV_8UC1);
+  const cv::Point2d centre = HalfSize(size);
+  const double rx = size.width / 2.0, ry = size.height / 2.0;
+  for (int i = 0; i < size.height; ++i) {
+    for (int j = 0; j < size.width; ++j) {
+      const double u = (j - centre.x) / rx, v = (i - centre.y) / ry;
+      mask.at<uint8_t>(i, j) = u * u + v * v <= 1.0 ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
+double ZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+              cv::Mat& result, ZnccScratch& scratch) {
+  MatchZncc(image(cv::Rect(top_left, templ.size())), templ, result, scratch);
+  return result.at<float>(0, 0);  // NaN on a flat window: fails every comparison.
+}
+
+cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength) {
+  *strength = 0.0;
+  const cv::Point2d geometric = HalfSize(templ.size());
+  const int m = std::min({3, (templ.cols - 3) / 2, (templ.rows - 3) / 2});
+  if (m < 1) return geometric;
+  const cv::Rect inner_rect(m, m, templ.cols - 2 * m, templ.rows - 2 * m);
+  cv::Point2d c = geometric;
+  cv::Mat turned, zncc;
+  ZnccScratch scratch;
+  PreparedTemplate inner;
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    const cv::Matx23d turn(-1, 0, 2 * c.x, 0, -1, 2 * c.y);  // Its own inverse.
+    cv::warpAffine(templ, turned, turn, templ.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    if (!inner.Prepare(turned(inner_rect))) return geometric;
+    MatchZncc(templ, inner, zncc, scratch);
+    cv::Point best;
+    if (!BestIn(zncc, &best)) return geometric;
+    *strength = zncc.at<float>(best);
+    const cv::Point2d shift = cv::Point2d(best.x - m, best.y - m) + SubPixel(zncc, best, false);
+    c += 0.5 * shift;
+    if (std::abs(c.x - geometric.x) > m || std::abs(c.y - geometric.y) > m) return geometric;
+    if (cv::norm(shift) < 1e-3) break;
+  }
+  return c;
+}
+
+bool SplitLevels(const cv::Mat& gray, const cv::Mat& mask, double* low, double* high) {
+  int hist[256] = {0};
+  int n = 0;
+  for (int y = 0; y < gray.rows; ++y) {
+    const uint8_t* g = gray.ptr<uint8_t>(y);
+    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
+    for (int x = 0; x < gray.cols; ++x) {
+      if (m && !m[x]) continue;
+      ++hist[g[x]];
+      ++n;
+    }
+  }
+  if (n < 2) return false;
+  double total = 0;
+  for (int v = 0; v < 256; ++v) total += double{1.0} * v * hist[v];
+  double best = -1, sum0 = 0;
+  int n0 = 0;
+  for (int t = 0; t < 255; ++t) {
+    n0 += hist[t];
+    sum0 += double{1.0} * t * hist[t];
+    const int n1 = n - n0;
+    if (n0 == 0 || n1 == 0) continue;
+    const double m0 = sum0 / n0, m1 = (total - sum0) / n1;
+    const double between = double{1.0} * n0 * n1 * (m1 - m0) * (m1 - m0);
+    if (between > best) {
+      best = between;
+      *low = m0;
+      *high = m1;
+    }
+  }
+  return best > 0;
+}
+
+void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out) {
+  if (native.channels() == 1) {
+    out = native;
+  } else if (!projection.empty()) {
+    cv::transform(native, out, projection);
+  } else {
+    cv::cvtColor(native, out, cv::COLOR_BGR2GRAY);
+  }
+}
+
+cv::Mat ContrastProjection(const cv::Mat& bgr) {
+  const cv::Mat samples = bgr.clone().reshape(1, static_cast<int>(bgr.total()));
+  cv::Mat covariance, mean;
+  cv::calcCovarMatrix(samples, covariance, mean,
+                      cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE, CV_64F);
+  cv::Mat values, vectors;
+  cv::eigen(covariance, values, vectors);
+  cv::Vec3d axis(vectors.at<double>(0, 0), vectors.at<double>(0, 1), vectors.at<double>(0, 2));
+  const double l1 = std::abs(axis[0]) + std::abs(axis[1]) + std::abs(axis[2]);
+  if (!(l1 > 0)) return {};
+  if (axis[0] + axis[1] + axis[2] < 0) axis = -axis;  // Mostly positive: light stays light.
+  axis /= l1;
+  double offset = 0;
+  for (int c = 0; c < 3; ++c) offset -= 255.0 * std::min(0.0, axis[c]);
+  cv::Mat m = (cv::Mat_<float>(1, 4) << axis[0], axis[1], axis[2], offset);
+  return m;
+}
+
+bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
+                       BlobMeter* meter, cv::Point2d* anchor) {
+  *projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
+  cv::Mat gray;
+  BlobChannelOf(templ, *projection, gray);
+  return meter->Learn(gray, mask, anchor);
+}
+
+}  // namespace softsight::template_internal

@@ -1,0 +1,305 @@
+// The template tracker's parts that are not the tracker's state machine: its constants, the
+// similarity map's peaks (integer best, sub-pixel offset, the best rival), masks, the centre of
+// symmetry, and the marker's blob inside the template (BlobMeter: its foreground, which every
+// match is verified against). Private to track/; tests reach them here.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "track/match_kernels.h"
+#include "track/soft_centroid.h"
+
+namespace softsight::template_internal {
+
+inline constexpr int kMinTemplatePx = 3;           // Smaller templates have no sub-pixel neighbourhood.
+inline constexpr int kMinRungPx = 5;               // Smallest side of a scaled first template.
+inline constexpr int kMaxTemplateRowBytes = 2048;  // The SAD kernel's 16-bit accumulator limit.
+inline constexpr int kMinCoarseTemplatePx = 8;     // Coarsest pyramid template side.
+inline constexpr int kRefineMarginPx = 2;          // Search margin per pyramid level while refining.
+inline constexpr int kCandidates = 3;              // Coarse peaks refined to full resolution.
+inline constexpr int kMaxRecentre = 4;             // Re-centrings of the final window onto its peak.
+inline constexpr int kFineMarginPx = 3;            // First-template search around the working match.
+inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
+inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
+inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
+// A neighbouring rung replaces the current one only when its ZNCC is higher by this much, so
+// noise does not make the scale flicker between two rungs that fit equally.
+inline constexpr double kScaleHysteresis = 0.003;
+// Below this self-match of the turned template there is no centre of symmetry worth reporting.
+inline constexpr double kMinSymmetry = 0.5;
+
+inline constexpr double kNoRival = -std::numeric_limits<double>::infinity();
+
+std::string RectText(const cv::Rect& r);
+
+// Centre-of-template coordinates <-> top-left placement.
+cv::Point2d HalfSize(const cv::Size& size);
+
+// Peak offset in [-0.5, 0.5] from three samples of a similarity (higher is better) around its
+// integer maximum `c`. A parabola suits quadratic peaks (SSD, ZNCC); the equiangular fit suits
+// V-shaped ones (SAD), where a parabola would halve the offset.
+double PeakOffset(double l, double c, double r, bool v_shaped);
+
+// Sub-pixel offset of the peak at `best` of a similarity map, per axis.
+cv::Point2d SubPixel(const cv::Mat& sim, cv::Point best, bool v_shaped);
+
+// The highest non-NaN value of a CV_32F map; false when every value is NaN.
+bool BestIn(const cv::Mat& sim, cv::Point* at);
+
+// The highest local maximum of `sim` farther than `radius` (per axis) from `best`: a distinct
+// second place the template fits. A value on the map's edge counts when it is not below its
+// neighbours inside (it may be the slope of a peak just outside). False when there is none.
+bool RivalIn(const cv::Mat& sim, cv::Point best, int radius, cv::Point* at);
+
+// The ellipse inscribed in a template of `size` (pixel centres within it count).
+cv::Mat RoundMask(const cv::Size& size);
+
+// ZNCC of `templ` placed at `top_left` of `image` (one placement, by the vector kernel: the
+// scalar reference here was a tenth of the tracker's time).
+double ZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+              cv::Mat& result, ZnccScratch& scratch);
+
+// The point about which `templ` is most nearly point-symmetric, in template coordinates: the
+// template is matched (ZNCC) against its inner part turned by 180 degrees about a guess c; a
+// shift d between the two puts the centre of symmetry at c + d / 2. The guess starts at the
+// geometric centre and is refined by turning about the last estimate (sub-pixel, bilinear), so
+// the final shift is near zero, where the parabola fit of the peak has no pixel-locking bias.
+// `strength` gets the ZNCC of the self-match (1: perfectly symmetric). Falls back to the
+// geometric centre.
+cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength);
+
+// ---- Re-centring on the marker's blob ---------------------------------------------------------
+// A marker that is a blob (a dot, a disc: one compact region brighter or darker than what is
+// around it) is measured by its soft centroid in every frame: each pixel weighs by how much of it
+// is marker, (v - background) / (marker - background) clamped to [0, 1], with the two levels
+// split by Otsu's criterion in the patch at the match. Its centroid is the marker's centroid
+// whatever its shape, so it follows perspective, scale and rotation exactly, where a template's
+// fixed anchor carries the band's texture turning with the body.
+
+// Otsu split of the (masked) values of a one-channel patch: the two class means. False when the
+// patch has too little contrast to split.
+bool SplitLevels(const cv::Mat& gray, const cv::Mat& mask, double* low, double* high);
+
+inline constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker and background.
+// The blob at a match has at least this fraction of the learned blob's area (at the current
+// scale), and at most its inverse: a tilt to 60 degrees halves a disc's area.
+inline constexpr double kMinBlobAreaRatio = 0.4;
+// A match may move onto its blob by at least this much (px; more for larger templates).
+inline constexpr double kMinBlobShiftPx = 2.0;
+// A blob this close to where the match puts it agrees with the match (px).
+inline constexpr double kBlobAgreePx = 1.0;
+
+// The one channel a template's blob is measured in: native gray, or colour projected on its
+// axis (`projection`, see ContrastProjection; empty: luma).
+void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out);
+
+class BlobMeter {
+ public:
+  // Learns the marker's polarity from the selected template (one channel): true when its centre
+  // is a blob that lies wholly inside the template (mask), with `centroid` its soft centroid.
+  bool Learn(const cv::Mat& gray, const cv::Mat& mask, cv::Point2d* centroid) {
+    double low = 0, high = 0;
+    if (!SplitLevels(gray, mask, &low, &high) || high - low < kMinBlobContrast) return false;
+    const cv::Point centre(gray.cols / 2, gray.rows / 2);
+    bright_ = gray.at<uint8_t>(centre) > (low + high) / 2;
+    double area = 0;
+    if (!Measure(gray, mask, HalfSize(gray.size()), centroid, &area)) return false;
+    area_ = area;
+    return true;
+  }
+
+  // The soft centroid of the marker-side component nearest `guess` (patch coordinates), and its
+  // area in px (sum of weights). False when there is no such component within 2 px of the guess,
+  // when it touches the patch or mask border (not separated from its surroundings), or when the
+  // patch has too little contrast.
+  bool Measure(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
+               cv::Point2d* centroid, double* area) {
+    double low = 0, high = 0;
+    if (!Segment(gray, mask, guess, &low, &high)) return false;
+    const cv::Rect box = box_;
+    // The levels right at the blob: the marker's from its interior (pixels whose 4 neighbours are
+    // all in the component), the background's from a ring 3-4 px outside it. Otsu's class means
+    // would take them from the whole patch, where shading and texture of the surroundings differ
+    // from what is at the rim.
+    const cv::Rect grown = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
+                           cv::Rect(0, 0, gray.cols, gray.rows);
+    auto distance = [&](int x, int y) {  // Chebyshev distance to the component, capped at 5.
+      int best = 5;
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if (yy < 0 || xx < 0 || yy >= gray.rows || xx >= gray.cols || !label_.at<uint8_t>(yy, xx)) {
+            continue;
+          }
+          best = std::min(best, std::max(std::abs(dx), std::abs(dy)));
+        }
+      }
+      return best;
+    };
+    double fg_sum = 0, bg_sum = 0;
+    int fg_n = 0, bg_n = 0;
+    dist_.create(gray.size(), CV_8UC1);
+    for (int y = grown.y; y < grown.br().y; ++y) {
+      for (int x = grown.x; x < grown.br().x; ++x) {
+        const int d = label_.at<uint8_t>(y, x) ? 0 : distance(x, y);
+        dist_.at<uint8_t>(y, x) = static_cast<uint8_t>(d);
+        if (!IsInside(gray, mask, x, y)) continue;
+        if (d == 0 && label_.at<uint8_t>(y - 1, x) && label_.at<uint8_t>(y + 1, x) &&
+            label_.at<uint8_t>(y, x - 1) && label_.at<uint8_t>(y, x + 1)) {
+          fg_sum += gray.at<uint8_t>(y, x);
+          ++fg_n;
+        } else if (d == 3 || d == 4) {
+          bg_sum += gray.at<uint8_t>(y, x);
+          ++bg_n;
+        }
+      }
+    }
+    const double fg = fg_n > 0 ? fg_sum / fg_n : (bright_ ? high : low);
+    const double bg = bg_n > 0 ? bg_sum / bg_n : (bright_ ? low : high);
+    if (!(std::abs(fg - bg) >= kMinBlobContrast)) return false;
+    // Soft centroid over the component grown by 2 px (its anti-aliased rim), inside the mask.
+    double sw = 0, sx = 0, sy = 0;
+    for (int y = grown.y; y < grown.br().y; ++y) {
+      for (int x = grown.x; x < grown.br().x; ++x) {
+        if (!IsInside(gray, mask, x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
+        const double w = track_internal::Membership(&gray.at<uint8_t>(y, x), 1, &bg, &fg, 0.0, false);
+        sw += w;
+        sx += w * x;
+        sy += w * y;
+      }
+    }
+    if (!(sw > 0)) return false;
+    *centroid = {sx / sw, sy / sw};
+    *area = sw;
+    return true;
+  }
+
+  // The marker-side component nearest `guess`, as Measure finds it, with its binary centroid and
+  // pixel count: a quick check that the blob is there (a fraction of Measure's cost).
+  bool Locate(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
+              cv::Point2d* centroid, double* area) {
+    double low = 0, high = 0;
+    if (!Segment(gray, mask, guess, &low, &high)) return false;
+    const cv::Moments m = cv::moments(label_(box_), true);
+    if (!(m.m00 > 0)) return false;
+    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+    *area = m.m00;
+    return true;
+  }
+
+  double area() const { return area_; }  // At selection, px.
+
+ private:
+  // Splits the patch into its two classes (low, high: their levels) and fills the marker-side
+  // component nearest `guess` into label_ (box_). False without contrast, without such a
+  // component within 2 px, or when it reaches the patch's or mask's edge.
+  bool Segment(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess, double* low,
+               double* high) {
+    if (!SplitLevels(gray, mask, low, high) || *high - *low < kMinBlobContrast) return false;
+    const double threshold = (*low + *high) / 2;
+    const std::optional<cv::Point> seed = SeedNear(gray, mask, guess, threshold);
+    return seed && Fill(gray, mask, *seed, threshold);
+  }
+  bool IsInside(const cv::Mat& gray, const cv::Mat& mask, int x, int y) const {
+    return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
+           (mask.empty() || mask.at<uint8_t>(y, x));
+  }
+  bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
+    const double v = gray.at<uint8_t>(y, x);
+    return bright_ ? v > threshold : v < threshold;
+  }
+  // The marker-side pixel nearest `guess` at `threshold`, within 2 px (and a bit).
+  std::optional<cv::Point> SeedNear(const cv::Mat& gray, const cv::Mat& mask,
+                                    const cv::Point2d& guess, double threshold) const {
+    std::optional<cv::Point> seed;
+    double nearest = 8.0;  // Squared distance.
+    const int gx = static_cast<int>(std::lround(guess.x)), gy = static_cast<int>(std::lround(guess.y));
+    for (int y = gy - 2; y <= gy + 2; ++y) {
+      for (int x = gx - 2; x <= gx + 2; ++x) {
+        if (!IsInside(gray, mask, x, y) || !IsMarker(gray, x, y, threshold)) continue;
+        const double d = (x - guess.x) * (x - guess.x) + (y - guess.y) * (y - guess.y);
+        if (d <= nearest) {
+          nearest = d;
+          seed = cv::Point(x, y);
+        }
+      }
+    }
+    return seed;
+  }
+  // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
+  // box_). False when it reaches the patch's or the mask's edge: not separated there.
+  bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
+    label_.create(gray.size(), CV_8UC1);
+    label_.setTo(0);
+    stack_.clear();
+    stack_.push_back(seed);
+    label_.at<uint8_t>(seed) = 1;
+    box_ = cv::Rect(seed, cv::Size(1, 1));
+    while (!stack_.empty()) {
+      const cv::Point p = stack_.back();
+      stack_.pop_back();
+      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return false;
+      box_ |= cv::Rect(p, cv::Size(1, 1));
+      const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
+      for (const cv::Point& q : next) {
+        if (!IsInside(gray, mask, q.x, q.y)) return false;  // Reaches the mask's edge.
+        if (label_.at<uint8_t>(q) || !IsMarker(gray, q.x, q.y, threshold)) continue;
+        label_.at<uint8_t>(q) = 1;
+        stack_.push_back(q);
+      }
+    }
+    return true;
+  }
+
+  bool bright_ = true;
+  double area_ = 0;
+  cv::Mat label_, dist_;
+  cv::Rect box_;
+  std::vector<cv::Point> stack_;
+};
+
+// One match of a template in a searched region.
+struct Hit {
+  cv::Point top_left;          // Integer best placement in frame coordinates.
+  cv::Point2d offset{0, 0};    // Sub-pixel offset from it.
+  double similarity = 0;       // Map value at the integer best (higher is better), for ranking.
+  double score = 0;            // The reported score (see the header).
+  double zncc = 1;             // ZNCC at the same placement (= score for ZNCC).
+  double rival_zncc = kNoRival;  // ZNCC of the best distinct second peak in the region.
+  bool on_inner_edge = false;  // Best on a window edge that is not the frame's: may lie outside.
+};
+
+// The first template at one scale: a rung of the scale ladder.
+struct Rung {
+  bool tried = false;      // Preparation attempted (templ empty: this scale is impossible).
+  PreparedTemplate templ;  // Masked like the working template.
+  cv::Point2d anchor;      // The reported point, in this rung's template coordinates.
+};
+
+// The first template's measurement of the marker, in frame coordinates.
+struct Fix {
+  cv::Point2d centre;    // The matched rung's geometric centre (where the next search looks).
+  cv::Point2d reported;  // The rung's anchor: the position reported.
+  double zncc = 0;       // ZNCC with the first template at that scale.
+  double score = 0;      // The measure's score against it (see the header).
+};
+
+// The single channel that shows the template best: BGR projected on the template's principal
+// colour axis (the direction of largest colour variance, i.e. marker against band), with weights
+// of L1 norm 1 and an offset that keeps every value in 0..255. On a gray template (B = G = R, a
+// mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
+cv::Mat ContrastProjection(const cv::Mat& bgr);
+
+// The marker's blob in a selected template (its foreground): the channel it shows best
+// (`projection`: ContrastProjection on colour, else empty) and the blob learned in it. False
+// when the template shows none.
+bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
+                       BlobMeter* meter, cv::Point2d* anchor);
+
+}  // namespace softsight::template_internal

@@ -1,0 +1,131 @@
+// The template tracker (SAD, SSD or ZNCC; CreateTemplateTracker makes it): the search state
+// machine, the scale ladder and the working template. Private to track/; tests reach it here.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/track/template_tracker.h"
+#include "softsight/track/tracker.h"
+#include "track/match_kernels.h"
+#include "track/template_parts.h"
+
+namespace softsight::template_internal {
+
+class TemplateTracker final : public Tracker {
+ public:
+  explicit TemplateTracker(const TemplateParams& params) : params_(params) {
+    params_.image = params.image.clone();  // Own the pixels; the spec may change later.
+  }
+
+  void init(const cv::Mat& frame_bgr, const cv::Rect& hint) override;
+  bool start(const Frame& frame) override;
+  Observation update(const cv::Mat& frame_bgr) override;
+  void reset() override {
+    tracking_ = false;
+    last_centre_.reset();
+    velocity_px_ = {0, 0};
+    repeats_ = 0;
+    lost_frames_ = 0;
+  }
+
+ private:
+  bool adapts() const { return params_.update_rate > 0; }
+  // The template searched with: the updated one, or the first template at the current scale.
+  const PreparedTemplate& search_template() const {
+    return adapts() ? working_ : rungs_[rung_].templ;
+  }
+  void ToNative(const cv::Mat& frame, cv::Mat& out) const;
+  void ConvertAround(const cv::Mat& frame, const cv::Rect& rect);
+  void Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat& out);
+  // The one channel the blob is measured in: native gray, or colour projected on its axis.
+  void BlobChannel(const cv::Mat& native, cv::Mat& out) const {
+    BlobChannelOf(native, blob_projection_, out);
+  }
+  std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
+  // Whether `templ` (native) would show its marker's blob, as SetTemplate learns it; changes
+  // nothing.
+  bool ShowsAMarker(const cv::Mat& templ) const;
+  // A point of the selected template in a rung of `size`. Template coordinates scale about the
+  // pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
+  cv::Point2d ToRung(const cv::Point2d& p, const cv::Size& size) const {
+    return {(p.x + 0.5) * size.width / original_.cols - 0.5,
+            (p.y + 0.5) * size.height / original_.rows - 0.5};
+  }
+  cv::Mat MaskFor(const cv::Size& size) const {
+    return params_.round_mask ? RoundMask(size) : cv::Mat();
+  }
+  void SetTemplate(const cv::Mat& templ, const std::string& where);
+  const Rung* RungAt(int index);
+  void Similarity(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& sim);
+  double ScoreOf(double similarity) const;
+  bool Accept(const Hit& m) const;
+  cv::Rect WindowAround(const cv::Point2d& centre_px, const cv::Size& size, int margin_px) const;
+  std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
+                            bool find_rival);
+  std::optional<Hit> Refine(const cv::Mat& frame, cv::Point top_left);
+  std::optional<Hit> Acquire(const cv::Mat& frame);
+  std::optional<Fix> Measure(const cv::Mat& frame, const cv::Point2d& centre_px);
+  double RungZncc(const cv::Mat& frame, int index, const cv::Point2d& centre_px);
+  void UpdateScale(const cv::Mat& frame, const Fix& fix);
+  void UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px);
+  void RestoreWorkingTemplate();
+  void ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d& centre_px);
+  double rung_scale() const { return std::pow(kScaleStep, rung_ - kRungsBelow); }
+  Observation Lose(MarkerStatus why, int candidates = 0) {
+    tracking_ = false;  // Keep last_centre_: the next acquisition looks around it.
+    velocity_px_ = {0, 0};
+    repeats_ = 0;
+    ++lost_frames_;
+    return Observation::NotFound(why, candidates);
+  }
+
+  TemplateParams params_;
+  cv::Mat original_;                    // The selected template, native (gray or BGR).
+  cv::Point2d anchor_px_{0, 0};         // The reported point, in the selected template.
+  std::vector<Rung> rungs_;             // The scale ladder; [kRungsBelow] is the selection.
+  int rung_ = 0;                        // The current scale.
+  PreparedTemplate working_;            // The updated template (update_rate > 0).
+  cv::Mat working_f_;                   // Its CV_32F running blend.
+  cv::Mat working_mask_;                // Its mask (or empty), for its current size.
+  std::vector<PreparedTemplate> coarse_;  // Acquisition pyramid of the search template, [0] unused.
+  std::optional<cv::Point2d> last_centre_;  // Last known template centre (last match or hint).
+  cv::Point2d velocity_px_{0, 0};       // Per frame; zero unless the last two frames matched.
+  int repeats_ = 0;                     // Repeated frames in a row (track/repeated_frames.h).
+  // The footage was seen repeating frames: the next frame may show the marker where it was, or
+  // a step on, so the tracking window spans both.
+  bool footage_repeats_ = false;
+  bool tracking_ = false;               // The previous update found the marker (or the hint).
+  int lost_frames_ = 0;                 // Updates since the marker was last found.
+  // Distance to the nearest look-alike seen around the marker (at the selected scale), or
+  // infinity: re-acquisition never looks half of it away from the last position, so a marker
+  // covered beside its twin is lost, not swapped.
+  double look_alike_px_ = std::numeric_limits<double>::infinity();
+  bool scan_pending_ = false;           // Scan for look-alikes at the first match after a hint.
+
+  // Buffers reused from frame to frame.
+  cv::Mat region_, fine_, raw_, sim_, fine_sim_, rung_sim_, patch_, resized_, candidate_, shape_;
+  // The frame around the marker in the matched channel(s), converted once per update: the
+  // search, the measurement, the scale search and the template update each look at a window of
+  // it (they overlap; converting each on its own was a seventh of the tracker's time).
+  cv::Mat native_;
+  cv::Rect native_rect_;  // Where native_ lies in the frame; empty when not converted.
+  std::vector<cv::Mat> levels_;
+  std::vector<cv::Point> candidates_;
+  cv::Mat level_sim_;
+  cv::Mat projection_;  // Gray only: 1x4 BGR weights + offset, or empty for plain luma.
+  ZnccScratch zncc_;
+  // The marker's blob in the template: every match is verified against it (BlobShift).
+  BlobMeter blob_;
+  bool blob_ok_ = false;                // The template shows a blob (its foreground).
+  cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
+  cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
+  cv::Mat blob_native_, blob_gray_;
+};
+
+}  // namespace softsight::template_internal
