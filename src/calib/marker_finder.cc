@@ -554,16 +554,14 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
 
 namespace {
 
-MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& options,
-                            bool intensity) {
-  MarkerFinding finding;
-  finding.intensity = intensity;
+// ---- 1. Candidates: the colour tracker's own verdicts, band by band -----------------------------
+// Blobs that fitted a band (or, for colour, were refused for their shape alone: elongated), in
+// `search`; the larger blobs every band refused go to finding->rejected with the reason.
+std::vector<Candidate> FindCandidates(const cv::Mat& frame, const MarkerFinderOptions& options,
+                                      const cv::Rect& search, MarkerFinding* finding_out) {
+  MarkerFinding& finding = *finding_out;
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
-  const cv::Rect search = options.search_px ? (*options.search_px & frame_rect) : frame_rect;
-  if (search.empty()) throw InputError("the search region lies outside the frame");
   const cv::Rect2d search_area(search.x - 0.5, search.y - 0.5, search.width, search.height);
-
-  // ---- 1. Candidates: the colour tracker's own verdicts, band by band ----------------------------
   ColourParams probe;
   probe.min_area_px = options.min_area_px;
   probe.max_area_px = std::max(options.min_area_px + 1,
@@ -618,173 +616,202 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       finding.rejected.push_back({candidate.position_px, RadiusOf(candidate.area_px), why});
     }
   }
+  return fitting;
+}
+
+// ---- 2 + 3. A candidate's own ranges, verified by a tracker built from them ------------------------
+struct Verified {
+  FoundMarker marker;
+  int hue = 0;
+  CoreLooks looks;     // Medians over its core (colour markers).
+  bool twin = false;   // One of several alike blobs of its colour, told apart by its roi.
+  bool elongated = false;
+};
+struct LookAlike {
+  std::string colour;
+  int hue = 0;
+  double radius_px = 0;
+  size_t rejected_index = 0;  // Its entry in finding.rejected.
+};
+
+// Candidate `i` of `fitting` as a marker, or nullopt with its reason in finding->rejected (and,
+// when look-alikes of its colour made it ambiguous, in *ambiguous).
+std::optional<Verified> VerifyCandidate(const cv::Mat& frame, const MarkerFinderOptions& options,
+                                        const std::vector<Candidate>& fitting, size_t i,
+                                        MarkerFinding* finding_out,
+                                        std::vector<LookAlike>* ambiguous_out) {
+  MarkerFinding& finding = *finding_out;
+  std::vector<LookAlike>& ambiguous = *ambiguous_out;
+  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
+  const Candidate& c = fitting[i];
+  const double radius = RadiusOf(c.area_px);
+  auto reject = [&](const std::string& why) {
+    finding.rejected.push_back({c.position_px, radius, why});
+  };
+  // The roi: the click box, at least four radii, excluding every other candidate's centre.
+  double nearest = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < fitting.size(); ++j) {
+    if (j != i) nearest = std::min(nearest, cv::norm(fitting[j].position_px - c.position_px));
+  }
+  int side = std::max(options.roi_side_px, static_cast<int>(std::ceil(4 * radius)));
+  if (std::isfinite(nearest)) side = std::min(side, static_cast<int>(std::floor(1.3 * nearest)));
+  side = std::max(side, static_cast<int>(std::ceil(2 * radius)) + 3);
+
+  if (BorderDistance(c.position_px, frame.size()) < radius + 2) {
+    reject("cut by the frame border");
+    return std::nullopt;
+  }
+  const std::optional<double> edge = EdgeWidthPx(frame, c.position_px, radius);
+  if (!edge || *edge > std::max(kMaxEdgeWidthPx, kMaxEdgeWidthRadii * radius)) {
+    char why[96];
+    std::snprintf(why, sizeof(why), "soft edge (fades over %.1f px: a stain or shadow)",
+                  edge.value_or(0.0));
+    reject(edge ? why : "no edge (same colour around it)");
+    return std::nullopt;
+  }
+  MarkerSpec spec;
+  ColourParams& colour = spec.params.emplace<ColourParams>();
+  int hue = 0;
+  if (finding.intensity) {
+    cv::Mat gray;
+    cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+    const auto range = DotRange(gray, c.position_px, radius);
+    if (!range) {
+      reject("contrast (no clear level between the dot and its surroundings)");
+      return std::nullopt;
+    }
+    colour.gray = *range;
+    colour.roi = cv::Rect(cvRound(c.position_px.x) - side / 2,
+                          cvRound(c.position_px.y) - side / 2, side, side) & frame_rect;
+  } else {
+    HsvPickOptions picker = options.picker;
+    picker.radius_px = std::clamp(static_cast<int>(std::floor(0.6 * radius)), 1,
+                                  options.picker.radius_px);
+    std::string why;
+    const auto pick = PickMarkerColourAt(frame, c.position_px, picker, side, &why);
+    if (!pick) {
+      reject("colour pick: " + why);
+      return std::nullopt;
+    }
+    ApplyColourPick(*pick, &colour);
+    hue = pick->ranges.h.hue_centre();
+    if (c.elongated) {
+      const EllipseFit fit = FitMomentEllipse(frame, colour, c.position_px, 4 * radius + 4);
+      if (fit.fill < kMinEllipseFill || fit.minor_px < kMinStickerHalfWidthPx) {
+        char why[112];
+        std::snprintf(why, sizeof(why),
+                      "shape (not compact, nor an ellipse or a bar: fills %.2f of its ellipse, "
+                      "%.1f px wide)", fit.fill, 2 * fit.minor_px);
+        reject(why);
+        return std::nullopt;
+      }
+      colour.min_circularity = std::floor(100 * kStickerCircularity * c.circularity) / 100;
+    }
+  }
+  const double tolerance = std::max(1.0, kVerifyRadii * radius);
+  auto verify = [&](bool with_roi, Observation* observation) {
+    MarkerSpec probe_spec = spec;
+    probe_spec.name = "verify";
+    if (!with_roi) std::get<ColourParams>(probe_spec.params).roi.reset();
+    const auto tracker = CreateTracker(probe_spec);
+    Frame f;
+    f.image = frame;
+    tracker->start(f);
+    *observation = tracker->update(frame);
+    return observation->found() && cv::norm(*observation->position_px - c.position_px) <= tolerance;
+  };
+  Observation alone;
+  bool twin = false, needs_roi = c.elongated;
+  bool ok = verify(needs_roi, &alone);
+  if (!ok && c.elongated) {
+    reject(std::string("not verified in its roi (") + MarkerStatusName(alone.status()) + ")");
+    return std::nullopt;
+  }
+  if (ok && c.elongated) {
+    // Verified in its roi only, so it must be alone in the frame in another way: no other
+    // blob of its colour, of about its area, as elongated or rounder.
+    const int others = ElongatedLookAlikes(frame, colour, c);
+    if (others > 0) {
+      reject("ambiguous: " + std::to_string(others + 1) + " look-alikes of its colour and shape");
+      return std::nullopt;
+    }
+  }
+  if (!ok && (finding.intensity || options.search_px) &&
+      (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
+    // Identical dots, or look-alikes outside the search region: told apart by a roi each.
+    Observation inside;
+    ok = verify(true, &inside);
+    if (!ok) {
+      reject(std::string("not verified in its roi (") + MarkerStatusName(inside.status()) + ")");
+      return std::nullopt;
+    }
+    alone = inside;
+    needs_roi = true;
+  } else if (!ok && alone.status() == MarkerStatus::kAmbiguous) {
+    // Several blobs of its colour: identical markers (a dot on each of two carts, a row of
+    // pucks) when they are all alike, which is decided once all are seen; a roi tells them
+    // apart. Found in its roi, it is a twin until then.
+    Observation inside;
+    if (verify(true, &inside)) {
+      ok = twin = needs_roi = true;
+      alone = inside;
+    }
+  }
+  if (!ok) {
+    if (alone.status() == MarkerStatus::kAmbiguous) {
+      ambiguous.push_back({finding.intensity ? "dot" : HueName(hue), hue, radius,
+                           finding.rejected.size()});
+      reject("ambiguous: " + std::to_string(std::max(2, alone.candidates)) +
+             " look-alikes of its colour");
+    } else if (alone.found()) {
+      reject("its own ranges find another blob first, at " + Point(*alone.position_px));
+    } else {
+      reject(std::string("not found again with its own ranges (") +
+             MarkerStatusName(alone.status()) + ")");
+    }
+    return std::nullopt;
+  }
+  CoreLooks looks;
+  if (!finding.intensity) {
+    looks = CoreLooksOf(frame, c.position_px, radius);
+    // Tightened only once verified with the picked ranges, and kept only when the marker is
+    // still found with them: it steadies the tracking of a marker, never makes a blob one.
+    const MarkerSpec picked = spec;
+    const int picked_lo = colour.s.lo;
+    KeepSaturationAboveSurroundings(frame, c.position_px, radius, looks.saturation, &colour);
+    Observation tightened;
+    if (colour.s.lo != picked_lo && !verify(needs_roi, &tightened)) spec = picked;
+  }
+  Verified v;
+  v.marker.spec = spec;
+  v.marker.position_px = *alone.position_px;
+  v.marker.radius_px = radius;
+  v.marker.needs_roi = needs_roi;
+  v.hue = hue;
+  v.looks = looks;
+  v.twin = twin;
+  v.elongated = c.elongated;
+  return v;
+}
+
+MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& options,
+                            bool intensity) {
+  MarkerFinding finding;
+  finding.intensity = intensity;
+  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
+  const cv::Rect search = options.search_px ? (*options.search_px & frame_rect) : frame_rect;
+  if (search.empty()) throw InputError("the search region lies outside the frame");
+  const cv::Rect2d search_area(search.x - 0.5, search.y - 0.5, search.width, search.height);
+
+  std::vector<Candidate> fitting = FindCandidates(frame, options, search, &finding);
 
   // ---- 2 + 3. Each candidate's own ranges, verified by a tracker built from them ---------------------
-  struct Verified {
-    FoundMarker marker;
-    int hue = 0;
-    CoreLooks looks;     // Medians over its core (colour markers).
-    bool twin = false;   // One of several alike blobs of its colour, told apart by its roi.
-    bool elongated = false;
-  };
   std::vector<Verified> verified;
-  struct LookAlike {
-    std::string colour;
-    int hue = 0;
-    double radius_px = 0;
-    size_t rejected_index = 0;  // Its entry in finding.rejected.
-  };
   std::vector<LookAlike> ambiguous;
   for (size_t i = 0; i < fitting.size(); ++i) {
-    const Candidate& c = fitting[i];
-    const double radius = RadiusOf(c.area_px);
-    auto reject = [&](const std::string& why) {
-      finding.rejected.push_back({c.position_px, radius, why});
-    };
-    // The roi: the click box, at least four radii, excluding every other candidate's centre.
-    double nearest = std::numeric_limits<double>::infinity();
-    for (size_t j = 0; j < fitting.size(); ++j) {
-      if (j != i) nearest = std::min(nearest, cv::norm(fitting[j].position_px - c.position_px));
+    if (std::optional<Verified> v = VerifyCandidate(frame, options, fitting, i, &finding, &ambiguous)) {
+      verified.push_back(std::move(*v));
     }
-    int side = std::max(options.roi_side_px, static_cast<int>(std::ceil(4 * radius)));
-    if (std::isfinite(nearest)) side = std::min(side, static_cast<int>(std::floor(1.3 * nearest)));
-    side = std::max(side, static_cast<int>(std::ceil(2 * radius)) + 3);
-
-    if (BorderDistance(c.position_px, frame.size()) < radius + 2) {
-      reject("cut by the frame border");
-      continue;
-    }
-    const std::optional<double> edge = EdgeWidthPx(frame, c.position_px, radius);
-    if (!edge || *edge > std::max(kMaxEdgeWidthPx, kMaxEdgeWidthRadii * radius)) {
-      char why[96];
-      std::snprintf(why, sizeof(why), "soft edge (fades over %.1f px: a stain or shadow)",
-                    edge.value_or(0.0));
-      reject(edge ? why : "no edge (same colour around it)");
-      continue;
-    }
-    MarkerSpec spec;
-    ColourParams& colour = spec.params.emplace<ColourParams>();
-    int hue = 0;
-    if (finding.intensity) {
-      cv::Mat gray;
-      cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
-      const auto range = DotRange(gray, c.position_px, radius);
-      if (!range) {
-        reject("contrast (no clear level between the dot and its surroundings)");
-        continue;
-      }
-      colour.gray = *range;
-      colour.roi = cv::Rect(cvRound(c.position_px.x) - side / 2,
-                            cvRound(c.position_px.y) - side / 2, side, side) & frame_rect;
-    } else {
-      HsvPickOptions picker = options.picker;
-      picker.radius_px = std::clamp(static_cast<int>(std::floor(0.6 * radius)), 1,
-                                    options.picker.radius_px);
-      std::string why;
-      const auto pick = PickMarkerColourAt(frame, c.position_px, picker, side, &why);
-      if (!pick) {
-        reject("colour pick: " + why);
-        continue;
-      }
-      ApplyColourPick(*pick, &colour);
-      hue = pick->ranges.h.hue_centre();
-      if (c.elongated) {
-        const EllipseFit fit = FitMomentEllipse(frame, colour, c.position_px, 4 * radius + 4);
-        if (fit.fill < kMinEllipseFill || fit.minor_px < kMinStickerHalfWidthPx) {
-          char why[112];
-          std::snprintf(why, sizeof(why),
-                        "shape (not compact, nor an ellipse or a bar: fills %.2f of its ellipse, "
-                        "%.1f px wide)", fit.fill, 2 * fit.minor_px);
-          reject(why);
-          continue;
-        }
-        colour.min_circularity = std::floor(100 * kStickerCircularity * c.circularity) / 100;
-      }
-    }
-    const double tolerance = std::max(1.0, kVerifyRadii * radius);
-    auto verify = [&](bool with_roi, Observation* observation) {
-      MarkerSpec probe_spec = spec;
-      probe_spec.name = "verify";
-      if (!with_roi) std::get<ColourParams>(probe_spec.params).roi.reset();
-      const auto tracker = CreateTracker(probe_spec);
-      Frame f;
-      f.image = frame;
-      tracker->start(f);
-      *observation = tracker->update(frame);
-      return observation->found() && cv::norm(*observation->position_px - c.position_px) <= tolerance;
-    };
-    Observation alone;
-    bool twin = false, needs_roi = c.elongated;
-    bool ok = verify(needs_roi, &alone);
-    if (!ok && c.elongated) {
-      reject(std::string("not verified in its roi (") + MarkerStatusName(alone.status()) + ")");
-      continue;
-    }
-    if (ok && c.elongated) {
-      // Verified in its roi only, so it must be alone in the frame in another way: no other
-      // blob of its colour, of about its area, as elongated or rounder.
-      const int others = ElongatedLookAlikes(frame, colour, c);
-      if (others > 0) {
-        reject("ambiguous: " + std::to_string(others + 1) + " look-alikes of its colour and shape");
-        continue;
-      }
-    }
-    if (!ok && (finding.intensity || options.search_px) &&
-        (alone.status() == MarkerStatus::kAmbiguous || alone.found())) {
-      // Identical dots, or look-alikes outside the search region: told apart by a roi each.
-      Observation inside;
-      ok = verify(true, &inside);
-      if (!ok) {
-        reject(std::string("not verified in its roi (") + MarkerStatusName(inside.status()) + ")");
-        continue;
-      }
-      alone = inside;
-      needs_roi = true;
-    } else if (!ok && alone.status() == MarkerStatus::kAmbiguous) {
-      // Several blobs of its colour: identical markers (a dot on each of two carts, a row of
-      // pucks) when they are all alike, which is decided once all are seen; a roi tells them
-      // apart. Found in its roi, it is a twin until then.
-      Observation inside;
-      if (verify(true, &inside)) {
-        ok = twin = needs_roi = true;
-        alone = inside;
-      }
-    }
-    if (!ok) {
-      if (alone.status() == MarkerStatus::kAmbiguous) {
-        ambiguous.push_back({finding.intensity ? "dot" : HueName(hue), hue, radius,
-                             finding.rejected.size()});
-        reject("ambiguous: " + std::to_string(std::max(2, alone.candidates)) +
-               " look-alikes of its colour");
-      } else if (alone.found()) {
-        reject("its own ranges find another blob first, at " + Point(*alone.position_px));
-      } else {
-        reject(std::string("not found again with its own ranges (") +
-               MarkerStatusName(alone.status()) + ")");
-      }
-      continue;
-    }
-    CoreLooks looks;
-    if (!finding.intensity) {
-      looks = CoreLooksOf(frame, c.position_px, radius);
-      // Tightened only once verified with the picked ranges, and kept only when the marker is
-      // still found with them: it steadies the tracking of a marker, never makes a blob one.
-      const MarkerSpec picked = spec;
-      const int picked_lo = colour.s.lo;
-      KeepSaturationAboveSurroundings(frame, c.position_px, radius, looks.saturation, &colour);
-      Observation tightened;
-      if (colour.s.lo != picked_lo && !verify(needs_roi, &tightened)) spec = picked;
-    }
-    Verified v;
-    v.marker.spec = spec;
-    v.marker.position_px = *alone.position_px;
-    v.marker.radius_px = radius;
-    v.marker.needs_roi = needs_roi;
-    v.hue = hue;
-    v.looks = looks;
-    v.twin = twin;
-    v.elongated = c.elongated;
-    verified.push_back(v);
   }
   // The markers of one body are of one kind: beside round markers, an elongated blob is a patch
   // of the scene, not a sticker of theirs.
