@@ -16,6 +16,8 @@
 #include "app/commands.h"
 #include "softsight/core/error.h"
 #include "gui/live_options.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/tracking_session.h"
 
 namespace softsight {
@@ -96,30 +98,53 @@ constexpr double kMinMotionPx = 3.0;
 // The base of an actuator is clamped: over the frames that follow, it moves least. Returns true
 // when the last marker of the finding's order is the one that stays put (turn the order round),
 // false when the first is, nothing when the video does not show it; `note` says what was seen.
+// How far the two ends of the finding's order move from where init found them, over a run.
+class EndMotionSink : public FrameSink {
+ public:
+  explicit EndMotionSink(const MarkerFinding& finding) : finding_(finding) {}
+  void consume(const Frame& frame, const FrameResult& result) override {
+    (void)frame;
+    ++frames_;
+    const size_t last = finding_.markers.size() - 1;
+    const Observation& first = result.markers.front().observation;
+    const Observation& end = result.markers[last].observation;
+    if (!first.found() || !end.found()) return;
+    ++both_;
+    moved_first_ = std::max(moved_first_,
+                            cv::norm(*first.position_px - finding_.markers.front().position_px));
+    moved_last_ = std::max(moved_last_,
+                           cv::norm(*end.position_px - finding_.markers[last].position_px));
+  }
+  int64_t frames() const { return frames_; }
+  int64_t both() const { return both_; }  // Frames with both ends found.
+  double moved_first() const { return moved_first_; }
+  double moved_last() const { return moved_last_; }
+
+ private:
+  const MarkerFinding& finding_;
+  int64_t frames_ = 0, both_ = 0;
+  double moved_first_ = 0, moved_last_ = 0;
+};
+
 std::optional<bool> LastEndIsFixed(const InitOptions& options, const MarkerFinding& finding,
                                    std::string* note) {
   TrackingConfig config;
   for (const FoundMarker& m : finding.markers) config.markers.push_back(m.spec);
   std::unique_ptr<FrameSource> source = OpenFrameSource(options.source);
-  TrackingSession session(config);
   Frame frame;
   for (int64_t i = 0; i < options.frame; ++i) {
     if (!source->read(frame)) return std::nullopt;
   }
+  // The frames that follow, through the pipeline as `track` would run them.
+  TrackingSession session(config);
+  EndMotionSink motion(finding);
+  RunOptions run;
+  run.max_frames = kMotionFrames;
+  const RunSummary summary = RunPipeline(*source, session, {&motion}, run);
+  if (!summary.ok() && motion.frames() == 0) return std::nullopt;
   const size_t last = finding.markers.size() - 1;
-  double moved_first = 0, moved_last = 0;
-  int64_t both = 0, frames = 0;
-  for (; frames < kMotionFrames && source->read(frame); ++frames) {
-    const FrameResult& result = session.process(frame);
-    const Observation& first = result.markers.front().observation;
-    const Observation& end = result.markers[last].observation;
-    if (!first.found() || !end.found()) continue;
-    ++both;
-    moved_first = std::max(moved_first,
-                           cv::norm(*first.position_px - finding.markers.front().position_px));
-    moved_last = std::max(moved_last,
-                          cv::norm(*end.position_px - finding.markers[last].position_px));
-  }
+  const int64_t frames = motion.frames(), both = motion.both();
+  const double moved_first = motion.moved_first(), moved_last = motion.moved_last();
   char text[200];
   std::snprintf(text, sizeof(text), "over %lld frames from frame %lld, %s moved %.1f px and %s %.1f px",
                 static_cast<long long>(frames), static_cast<long long>(options.frame),
