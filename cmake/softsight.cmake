@@ -7,7 +7,7 @@
 # of all 20 took 33 s). Files batched together must not define the same name in an anonymous
 # namespace (or a `static` one); the targets below still do, and stay file by file until those
 # names are renamed or shared. A new clash shows as "redefinition of '...{anonymous}::NAME'".
-set(SOFTSIGHT_NOT_UNITY softsight_geometry_test softsight_track_test softsight_config_test softsight_io_test softsight_gui_test softsight_app_test)
+set(SOFTSIGHT_NOT_UNITY softsight_config_test softsight_io_test softsight_gui_test softsight_app_test)
 function(softsight_use_unity_build target)
   if(SOFTSIGHT_UNITY_BUILD AND NOT target IN_LIST SOFTSIGHT_NOT_UNITY)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)

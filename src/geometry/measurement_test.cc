@@ -1,3 +1,4 @@
+#include "geometry/geometry_test_util.h"
 #include "softsight/geometry/measurement.h"
 
 #include <cmath>
@@ -15,7 +16,7 @@ using ::testing::DoubleNear;
 using ::testing::HasSubstr;
 using ::testing::Optional;
 
-constexpr double kTol = 1e-9;
+using testing::kTol;
 
 MarkerObservation Seen(const std::string& name, double x, double y) {
   return {name, Observation{cv::Point2d(x, y), 1.0}};
@@ -30,10 +31,7 @@ MeasureOptions Triple() {
   return options;
 }
 
-cv::Point2d OnCircle(cv::Point2d centre, double radius, double angle_deg) {
-  const double a = angle_deg * std::numbers::pi / 180.0;
-  return centre + radius * cv::Point2d(std::cos(a), std::sin(a));
-}
+using testing::OnCircle;
 
 MarkerObservation SeenAt(const std::string& name, cv::Point2d p) { return Seen(name, p.x, p.y); }
 

@@ -1,3 +1,4 @@
+#include "geometry/geometry_test_util.h"
 #include "softsight/geometry/triangle.h"
 
 #include <cmath>
@@ -14,12 +15,9 @@ using ::testing::DoubleNear;
 using ::testing::Eq;
 using ::testing::Optional;
 
-constexpr double kTol = 1e-9;
+using testing::kTol;
 
-cv::Point2d OnCircle(cv::Point2d centre, double radius, double angle_deg) {
-  const double a = angle_deg * std::numbers::pi / 180.0;
-  return centre + radius * cv::Point2d(std::cos(a), std::sin(a));
-}
+using testing::OnCircle;
 
 TEST(TriangleTest, StraightIs180DegreesWithNoRadiusAndArcEqualToChord) {
   const TriangleMeasures m = MeasureTriangle({0, 0}, {50, 0}, {100, 0});
