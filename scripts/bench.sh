@@ -14,7 +14,8 @@ cd "$(dirname "$0")/.."
 WORK=${1:-bench_out}
 mkdir -p "$WORK"
 cmake --build build --target softsight softsight_speed_report softsight_colour_tracker_benchmark \
-  softsight_template_matching_benchmark softsight_frame_writer_benchmark >/dev/null
+  softsight_template_matching_benchmark softsight_frame_writer_benchmark \
+  softsight_tracking_session_benchmark >/dev/null
 S=build/src/app/softsight
 CFG=examples/markers.yaml
 PY=$(command -v python3)
@@ -126,6 +127,8 @@ build/src/track/softsight_colour_tracker_benchmark --benchmark_out_format=json -
 build/src/track/softsight_template_matching_benchmark --benchmark_out_format=json \
   --benchmark_filter='BM_(TrackWindowed|AcquireWholeFrame/2|SadVector/1|SadPlainScalar/1|SadAutoVectorisedLoop/1|BaselineWholeFrameMatchTemplate|GrayConversion)' \
   --benchmark_out="$WORK/template.json" >/dev/null 2>"$WORK/template.log"
+build/src/pipeline/softsight_tracking_session_benchmark --benchmark_out_format=json \
+  --benchmark_out="$WORK/session.json" >/dev/null 2>"$WORK/session.log"
 taskset -c 0 build/src/io/softsight_frame_writer_benchmark --benchmark_out_format=json \
   --benchmark_out="$WORK/writer.json" >/dev/null 2>"$WORK/writer.log"
 
@@ -193,4 +196,31 @@ for noise, label in ((0, "clean scene"), (4, "sensor noise sigma 4")):
     print(f"| lossless recording (HuffYUV) at 640x480, {label}: encode / decode, process CPU time "
           f"on one core | {he:.0f} / {hd:.0f} fps (FFV1 {fe:.0f} / {fd:.0f}: {he / fe:.1f}x / {hd / fd:.1f}x) "
           f"| | gray pass {wg:.3f} ms |")
+PYEOF
+
+# What TrackingSession costs beyond its trackers (issue 26, item 7): thread CPU time per frame,
+# each row beside the gray pass the session program measured in the same run.
+echo
+echo "TrackingSession per frame (thread CPU time, Google Benchmark):"
+echo
+"$PY" - "$WORK" <<'PYEOF'
+import json, os, sys
+with open(os.path.join(sys.argv[1], "session.json")) as f:
+    b = {x["name"]: x for x in json.load(f)["benchmarks"]}
+sizes = ("640/480", "1280/720")
+cpu = lambda name, s: b[f"{name}/{s}"]["cpu_ms_per_frame"]
+print("| what (3 colour markers) | 640x480 | 1280x720 | target |")
+print("| --- | --- | --- | --- |")
+def row(what, name, target):
+    cells = " | ".join(f"{cpu(name, s):.3f} ms ({cpu(name, s) / cpu('BM_GrayReference', s):.2f}x gray)"
+                       for s in sizes)
+    print(f"| {what} | {cells} | {target} |")
+row("BGR -> gray pass (reference)", "BM_GrayReference", "")
+row("the three colour trackers alone", "BM_Trackers3", "")
+row("`TrackingSession::process` whole", "BM_Session3", "<= 0.12 / 0.25 ms")
+row("of it: `FrameChangeDetector::observe`", "BM_FrameChange", "")
+over = " | ".join(f"{cpu('BM_Session3', s) - cpu('BM_Trackers3', s):.3f} ms "
+                  f"({(cpu('BM_Session3', s) - cpu('BM_Trackers3', s)) / cpu('BM_Trackers3', s):.2f}x the trackers)"
+                  for s in sizes)
+print(f"| the session's own checks (whole - trackers) | {over} | <= the trackers' time |")
 PYEOF

@@ -75,6 +75,35 @@ ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::ReadTextFile(dir.file("stderr.txt"))};
 }
 
+// `track` runs in the commands plugin, which must not load the live window's libraries (highgui
+// and its Qt: ~12 libraries and ~10 ms of every start-up; X11 comes with FFmpeg's hardware
+// decoders anyway): what the dynamic loader loaded
+// for `track --help` and for `live --help`, the GUI's plugin, which does.
+TEST(TrackCommand, LoadsVideoLibrariesButNoneOfTheLiveWindows) {
+  TempDir dir;
+  auto loaded = [&](const std::string& command) {
+    const std::string log = dir.file("loader.txt");
+    const int status = std::system(("LD_DEBUG=libs LD_DEBUG_OUTPUT=" + log + " " +
+                                    testing::SoftsightBinary() + " " + command + " > /dev/null")
+                                       .c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
+    // The loader writes its log to LD_DEBUG_OUTPUT.<pid>: the one file there is.
+    std::string text;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+      if (entry.path().filename().string().rfind("loader.txt.", 0) == 0) {
+        text += testing::ReadTextFile(entry.path().string());
+        std::filesystem::remove(entry.path());
+      }
+    }
+    return text;
+  };
+  const std::string track = loaded("track --help");
+  EXPECT_THAT(track, ::testing::HasSubstr("libopencv_videoio"));
+  EXPECT_THAT(track, ::testing::Not(::testing::HasSubstr("libopencv_highgui")));
+  EXPECT_THAT(track, ::testing::Not(::testing::HasSubstr("libQt5Widgets")));
+  EXPECT_THAT(loaded("live --help"), ::testing::HasSubstr("libopencv_highgui"));
+}
+
 // Camera settings with frames from a file: a --camera-* option cannot be carried out and is
 // refused before anything is written; a config's capture: section (a live recording saves one)
 // is said to be unused, and the run goes on.

@@ -2,15 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 
 namespace softsight {
 namespace {
 
-// Samples per cell side: cells of 8 x 8 samples (32 px at VGA) hold a marker or two.
-constexpr int kSamplesPerCell = 8;
-// About this many samples across the image's shorter side, whatever its resolution.
-constexpr int kSamplesAcross = 120;
 // A garbage cell stays "garbage" for at most this many frames before it is taken as the scene
 // (a finely textured object may really have come into view).
 constexpr int kGarbageMemory = 10;
@@ -28,60 +26,6 @@ constexpr double kGarbageFrameFraction = 0.1;
 // Another video of the same rig, lit otherwise, still differs where its actuator is (a quarter
 // of the cells in the tests).
 constexpr double kRelitChangedFraction = 0.08;
-
-}  // namespace
-
-void FrameChangeDetector::summarise(const cv::Mat& bgr, std::vector<Cell>& cells) {
-  cells.assign(static_cast<size_t>(cols_) * rows_, Cell());
-  std::vector<int>& counts = counts_;
-  counts.assign(cells.size(), 0);
-  const int half = step_ / 2;
-  for (int y = half; y < bgr.rows; y += step_) {
-    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
-    const cv::Vec3b* above = y - step_ >= 0 ? bgr.ptr<cv::Vec3b>(y - step_) : nullptr;
-    const int cy = std::min(y / cell_px_, rows_ - 1);
-    for (int x = half; x < bgr.cols; x += step_) {
-      const int cx = std::min(x / cell_px_, cols_ - 1);
-      Cell& cell = cells[static_cast<size_t>(cy) * cols_ + cx];
-      const cv::Vec3b p = row[x];
-      cell.b += p[0];
-      cell.g += p[1];
-      cell.r += p[2];
-      float texture = 0.0f;
-      int pairs = 0;
-      if (x - step_ >= 0) {
-        const cv::Vec3b q = row[x - step_];
-        texture += static_cast<float>(std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) +
-                                      std::abs(p[2] - q[2]));
-        ++pairs;
-      }
-      if (above != nullptr) {
-        const cv::Vec3b q = above[x];
-        texture += static_cast<float>(std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) +
-                                      std::abs(p[2] - q[2]));
-        ++pairs;
-      }
-      if (pairs > 0) cell.texture += texture / (3.0f * static_cast<float>(pairs));
-      ++counts[static_cast<size_t>(cy) * cols_ + cx];
-      // The sample's place in the cell's 8 x 8 grid (a border cell's extra samples are left out).
-      const int sx = (x - cx * cell_px_) / step_, sy = (y - cy * cell_px_) / step_;
-      if (sx < kSamplesPerCell && sy < kSamplesPerCell) {
-        cell.gray[static_cast<size_t>(sy * kSamplesPerCell + sx)] =
-            static_cast<uint8_t>((p[0] + p[1] + p[2]) / 3);
-      }
-    }
-  }
-  for (size_t i = 0; i < cells.size(); ++i) {
-    if (counts[i] == 0) continue;
-    const float n = static_cast<float>(counts[i]);
-    cells[i].b /= n;
-    cells[i].g /= n;
-    cells[i].r /= n;
-    cells[i].texture /= n;
-  }
-}
-
-namespace {
 
 // Correlation of two cells' samples, or 1 when either is too flat to tell (noise alone, whose
 // pattern changes from frame to frame, correlates with nothing).
@@ -127,16 +71,16 @@ cv::Vec3f FrameChangeDetector::row_gain(const std::vector<Cell>& now,
   constexpr float kDarkest = 24.0f;
   constexpr float kLeast = 1.0f / 3.0f, kMost = 3.0f;
   cv::Vec3f gain(1.0f, 1.0f, 1.0f);
-  const size_t first = static_cast<size_t>(row) * cols_;
+  const size_t first = static_cast<size_t>(row) * grid_.cols;
   for (int c = 0; c < 3; ++c) {
     ratios_.clear();
-    for (size_t i = first; i < first + static_cast<size_t>(cols_); ++i) {
+    for (size_t i = first; i < first + static_cast<size_t>(grid_.cols); ++i) {
       const float b = c == 0 ? before[i].b : c == 1 ? before[i].g : before[i].r;
       const float n = c == 0 ? now[i].b : c == 1 ? now[i].g : now[i].r;
       if (b >= kDarkest) ratios_.push_back(n / b);
     }
     // Half the row's cells at least must say: a change confined to a few cells is not the light.
-    if (ratios_.size() * 2 < static_cast<size_t>(cols_)) continue;  // cols_ >= 1: never empty.
+    if (ratios_.size() * 2 < static_cast<size_t>(grid_.cols)) continue;  // cols >= 1: never empty.
     auto middle = ratios_.begin() + static_cast<std::ptrdiff_t>(ratios_.size() / 2);
     std::nth_element(ratios_.begin(), middle, ratios_.end());
     if (*middle >= kLeast && *middle <= kMost) gain[c] = *middle;
@@ -153,10 +97,10 @@ bool FrameChangeDetector::Garbage(const Cell& now, const Cell& before) {
 double FrameChangeDetector::changed_between(const std::vector<Cell>& a,
                                             const std::vector<Cell>& b, bool relit) {
   int changed = 0;
-  for (int row = 0; row < rows_; ++row) {
+  for (int row = 0; row < grid_.rows; ++row) {
     const cv::Vec3f gain = relit ? row_gain(a, b, row) : cv::Vec3f(1.0f, 1.0f, 1.0f);
-    const size_t first = static_cast<size_t>(row) * cols_;
-    for (size_t i = first; i < first + static_cast<size_t>(cols_); ++i) {
+    const size_t first = static_cast<size_t>(row) * grid_.cols;
+    for (size_t i = first; i < first + static_cast<size_t>(grid_.cols); ++i) {
       changed += Changed(a[i], b[i], gain, relit) ? 1 : 0;
     }
   }
@@ -167,15 +111,12 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
   CV_Assert(bgr.type() == CV_8UC3);
   if (bgr.size() != size_ || !has_normal_) {
     size_ = bgr.size();
-    step_ = std::max(1, std::min(bgr.cols, bgr.rows) / kSamplesAcross);
-    cell_px_ = step_ * kSamplesPerCell;
-    cols_ = std::max(1, bgr.cols / cell_px_);
-    rows_ = std::max(1, bgr.rows / cell_px_);
-    summarise(bgr, now_);
+    grid_ = CellGrid::For(size_);
+    summariser_.summarise(bgr, grid_, now_);
     normal_ = now_;
     previous_ = now_;
     garbage_.assign(now_.size(), 0);
-    ratios_.reserve(static_cast<size_t>(cols_));
+    ratios_.reserve(static_cast<size_t>(grid_.cols));
     has_normal_ = true;
     whole_frame_changed_ = false;
     changed_fraction_ = 0.0;
@@ -183,7 +124,7 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     changed_run_ = 0;
     return;
   }
-  summarise(bgr, now_);
+  summariser_.summarise(bgr, grid_, now_);
   changed_fraction_ = changed_between(now_, normal_, false);
   int garbage_cells = 0;
   for (size_t i = 0; i < now_.size(); ++i) garbage_cells += Garbage(now_[i], normal_[i]) ? 1 : 0;
@@ -233,11 +174,11 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
 
 bool FrameChangeDetector::garbage_near(const cv::Point2d& image_px) const {
   if (!has_normal_ || !std::isfinite(image_px.x) || !std::isfinite(image_px.y)) return false;
-  const int cx = std::clamp(static_cast<int>(image_px.x / cell_px_), 0, cols_ - 1);
-  const int cy = std::clamp(static_cast<int>(image_px.y / cell_px_), 0, rows_ - 1);
-  for (int y = std::max(0, cy - 1); y <= std::min(rows_ - 1, cy + 1); ++y) {
-    for (int x = std::max(0, cx - 1); x <= std::min(cols_ - 1, cx + 1); ++x) {
-      if (garbage_[static_cast<size_t>(y) * cols_ + x] != 0) return true;
+  const int cx = std::clamp(static_cast<int>(image_px.x / grid_.cell_px), 0, grid_.cols - 1);
+  const int cy = std::clamp(static_cast<int>(image_px.y / grid_.cell_px), 0, grid_.rows - 1);
+  for (int y = std::max(0, cy - 1); y <= std::min(grid_.rows - 1, cy + 1); ++y) {
+    for (int x = std::max(0, cx - 1); x <= std::min(grid_.cols - 1, cx + 1); ++x) {
+      if (garbage_[static_cast<size_t>(y) * grid_.cols + x] != 0) return true;
     }
   }
   return false;

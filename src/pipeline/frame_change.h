@@ -2,9 +2,10 @@
 // flash. Trackers answer such frames with confident positions (a blob of the right colour is
 // somewhere in any picture), so the session must know before it believes them.
 //
-// The frame is summarised on a coarse grid of cells (a sample every few pixels, so it costs a
-// small fraction of one BGR->gray pass): per cell the mean colour and the texture (mean absolute
-// difference of neighbouring samples). Each frame is compared with the last frame judged normal:
+// The frame is summarised on a coarse grid of cells (a sample every few pixels,
+// pipeline/frame_summary.h, so it costs a fraction of one BGR->gray pass): per cell the mean
+// colour and the texture (mean absolute difference of neighbouring samples). Each frame is
+// compared with the last frame judged normal:
 //  - most cells changed at once (far more than the footage's usual frame-to-frame change): the
 //    whole frame changed. A change that persists (the light was switched on, the camera was
 //    bumped) becomes the new normal after a few frames. A change of the light alone is not a
@@ -21,11 +22,11 @@
 //    a stale copy of an earlier one; the whole frame is not believed for as long as it lasts.
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "pipeline/frame_summary.h"
 
 namespace softsight {
 
@@ -51,12 +52,7 @@ class FrameChangeDetector {
   double garbage_fraction() const { return garbage_fraction_; }
 
  private:
-  struct Cell {
-    float b = 0, g = 0, r = 0;  // Mean colour.
-    float texture = 0;          // Mean |difference| of horizontally and vertically adjacent samples.
-    std::array<uint8_t, 64> gray{};  // The cell's 8 x 8 samples, (b + g + r) / 3.
-  };
-  void summarise(const cv::Mat& bgr, std::vector<Cell>& cells);
+  using Cell = FrameCell;
   static bool Changed(const Cell& now, const Cell& before, const cv::Vec3f& gain, bool relit);
   static bool Garbage(const Cell& now, const Cell& before);
   // The per-channel gain that maps row `row` of `before` onto `now` (1 where it cannot tell).
@@ -65,11 +61,9 @@ class FrameChangeDetector {
   double changed_between(const std::vector<Cell>& a, const std::vector<Cell>& b, bool relit);
 
   cv::Size size_;             // Of the frames summarised so far.
-  int step_ = 1;              // Sample spacing in pixels.
-  int cell_px_ = 1;           // Cell side in pixels (kSamplesPerCell * step_).
-  int cols_ = 0, rows_ = 0;   // Cells per row and column.
+  CellGrid grid_;             // Their samples and cells.
+  FrameSummariser summariser_;
   std::vector<Cell> now_, normal_, previous_;  // Reused: no allocation per frame.
-  std::vector<int> counts_;                    // Samples per cell (summarise's scratch).
   std::vector<float> ratios_;                  // row_gain's scratch.
   std::vector<unsigned char> garbage_;         // Per cell: frames in a row it held garbage.
   bool has_normal_ = false;
