@@ -17,6 +17,7 @@ PACKAGES=(
   opencv-doc             # real sample images with known answers for the golden tests (chessboards, ...)
   clang libfuzzer-14-dev # fuzz targets (scripts/fuzz.sh): clang's libFuzzer with ASan + UBSan
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-opencv  # the Python package (python/), its tests and Dask batch runs
+  mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
 )
 
 missing=()
