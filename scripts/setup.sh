@@ -18,6 +18,7 @@ PACKAGES=(
   clang libfuzzer-14-dev # fuzz targets (scripts/fuzz.sh): clang's libFuzzer with ASan + UBSan
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-opencv  # the Python package (python/), its tests and Dask batch runs
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` (setup.py) and its check in a fresh virtual environment
+  mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
 )
 
 missing=()

@@ -9,8 +9,14 @@ The C++ library's API with numpy at the edges (docs/python.md has a tour):
 - ``track(input, config)``: a whole video, image sequence or built-in scene ("synth:bending"),
   its CSV's columns as numpy arrays (a Table: a dict with ``to_pandas()``), the same rows as
   ``softsight track`` writes.
+- ``frames(input, config)``: the same input and tracking, one FrameResult per frame, as a
+  generator (``for r in softsight.frames("run.avi", config): ...``).
 - ``geometry``, ``calib``, ``sim``: the measurements, calibration and the renderer with its
   exact truth, on numpy arrays. ``batch.track_many``: many inputs on a Dask cluster.
+
+``progress=`` (track, frames, batch.track_many): a callable ``progress(done, total)``, True (a
+tqdm bar when tqdm is installed, else a line on ``sys.stderr``) or False/None (silent, the
+default).
 
 Bad input raises ``InputError`` (a ValueError) with the CLI's one-line message.
 """
@@ -19,10 +25,11 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Optional, Union
+from typing import Generator, Optional, Union
 
-from . import _core
+from . import _core, _progress
 from ._core import Config, FrameResult, InputError, Marker, Session, calib, geometry, load_config, sim
+from ._progress import Progress
 from ._table import Table
 
 # The compiled submodules import as softsight.geometry, softsight.sim, softsight.calib too.
@@ -39,7 +46,9 @@ __all__ = [
     "Marker",
     "Session",
     "Table",
+    "batch",
     "calib",
+    "frames",
     "geometry",
     "load_config",
     "sim",
@@ -54,7 +63,7 @@ def track(
     input: PathLike,
     config: Union[Config, PathLike, dict],
     max_frames: Optional[int] = None,
-    progress: bool = False,
+    progress: Progress = False,
     *,
     csv: Optional[PathLike] = None,
     fps: float = 30.0,
@@ -65,9 +74,12 @@ def track(
     ``input`` is what ``softsight track --input`` takes: a video file, a folder of images, a
     printf pattern ("frames/%04d.png", timed at ``fps``) or a built-in scene ("synth:bending",
     "synth:wedge1", "synth:wedge4", "synth:bench", "synth:plate"). ``config`` is a Config, a
-    YAML path or a dict. ``max_frames`` stops early; ``progress`` prints a progress line on
-    stderr; ``csv`` also writes the CSV file, exactly as ``softsight track --csv`` does;
-    ``method`` overrides every marker's method (``--method``).
+    YAML path or a dict. ``max_frames`` stops early; ``csv`` also writes the CSV file, exactly as
+    ``softsight track --csv`` does; ``method`` overrides every marker's method (``--method``).
+    ``progress``: a callable ``progress(done, total)`` called after every frame (from the
+    thread running track, holding the GIL: keep it cheap; ``total`` is None when the input does
+    not know its length; an exception it raises ends the run and is raised here), True for a
+    tqdm bar (a line on ``sys.stderr`` without tqdm), False or None for none (the default).
 
     Returns a Table (a dict of numpy arrays, one per CSV column, in order: ``frame`` int64,
     ``<marker>_found`` bool, ``<marker>_status`` str, the rest float64 with NaN for an empty
@@ -78,12 +90,65 @@ def track(
     ``table`` attribute holds the rows before it (the CSV keeps them too, as the CLI's does).
     The GIL is released while frames are processed; Ctrl-C stops the run.
     """
-    columns, summary = _core._track(
-        input, config, max_frames, progress, None if csv is None else os.fspath(csv), fps, method
-    )
+    report = _progress.reporter(progress, "track", "frames")
+    try:
+        columns, summary = _core._track(
+            input, config, max_frames, report, None if csv is None else os.fspath(csv), fps, method
+        )
+    finally:
+        if report is not None:
+            report.close()
     table = Table(columns, summary)
     if summary["error"] is not None:
         error = InputError(summary["error"])
         error.table = table
         raise error
     return table
+
+
+def frames(
+    input: PathLike,
+    config: Union[Config, PathLike, dict],
+    max_frames: Optional[int] = None,
+    *,
+    fps: float = 30.0,
+    method: Optional[str] = None,
+    progress: Progress = False,
+) -> Generator[FrameResult, None, None]:
+    """Tracks ``input`` frame by frame: a generator of FrameResult, one per frame, in order.
+
+    ``input``, ``config``, ``max_frames``, ``fps``, ``method`` and ``progress`` are ``track``'s:
+    the frames come from the library's own reader (videos, image sequences, folders, built-in
+    scenes, with the same decode rules and checks), and each result holds the values of the row
+    ``track`` gives for that frame (``result.frame``, ``result.time_s``, every marker and
+    measurement), as ``Session.process`` returns them. The GIL is released while a frame is read
+    and tracked.
+
+    The input is opened here: a bad config or a missing input raises InputError at the call. A
+    frame that does not decode raises InputError from the loop, after the frames before it. The
+    input is let go of when the loop ends, breaks (the generator is closed when it is dropped)
+    or ``close()`` is called on the generator.
+    """
+    stream = _core._FrameStream(input, config, max_frames, fps, method)
+    return _frames(stream, _progress.reporter(progress, "frames", "frames"))
+
+
+def _frames(stream: "_core._FrameStream", report: Optional[_progress.Reporter]) -> Generator[FrameResult, None, None]:
+    try:
+        while True:
+            result = stream.next()
+            if result is None:
+                return
+            if report is not None:
+                report(stream.done, stream.total)
+            yield result
+    finally:  # The end, an error, or close(): the video is released now, not at garbage collection.
+        stream.close()
+        if report is not None:
+            report.close()
+
+
+# Imported with the package so ``softsight.batch`` is there after ``import softsight``, as the
+# stubs say; cheap, since Dask itself is only imported when track_many runs. Last: it imports
+# track from this module.
+from . import batch  # noqa: E402

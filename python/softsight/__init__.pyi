@@ -1,11 +1,11 @@
 # Type stubs for editors and type checkers: the public API of the softsight package.
 import os
-from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Generator, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
-from . import batch as batch
+from . import batch as batch  # Imported by __init__.py (Dask only when track_many runs).
 from . import calib as calib
 from . import geometry as geometry
 from . import sim as sim
@@ -15,6 +15,10 @@ __license__: str
 
 PathLike = Union[str, os.PathLike[str]]
 ConfigSource = Union["Config", PathLike, Mapping[str, Any]]
+# progress=: a callable progress(done, total) (total None when unknown), True (a tqdm bar, or a
+# line on sys.stderr) or False/None (silent).
+ProgressCallback = Callable[[int, Optional[int]], Any]
+Progress = Union[bool, None, ProgressCallback]
 
 class InputError(ValueError):
     """Bad input; the message is the CLI's one line naming the file, key or frame."""
@@ -116,11 +120,11 @@ class Session:
         index: Optional[int] = None,
     ) -> FrameResult: ...
 
-class Table(Dict[str, np.ndarray]):
+class Table(Dict[str, npt.NDArray[Any]]):
     """A run's columns as numpy arrays, in the CSV's order."""
     summary: Optional[Dict[str, Any]]
     def __init__(
-        self, columns: Mapping[str, np.ndarray], summary: Optional[Dict[str, Any]] = None
+        self, columns: Mapping[str, npt.NDArray[Any]], summary: Optional[Dict[str, Any]] = None
     ) -> None: ...
     @property
     def rows(self) -> int: ...
@@ -130,9 +134,18 @@ def track(
     input: PathLike,
     config: ConfigSource,
     max_frames: Optional[int] = None,
-    progress: bool = False,
+    progress: Progress = False,
     *,
     csv: Optional[PathLike] = None,
     fps: float = 30.0,
     method: Optional[str] = None,
 ) -> Table: ...
+def frames(
+    input: PathLike,
+    config: ConfigSource,
+    max_frames: Optional[int] = None,
+    *,
+    fps: float = 30.0,
+    method: Optional[str] = None,
+    progress: Progress = False,
+) -> Generator[FrameResult, None, None]: ...

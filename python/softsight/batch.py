@@ -9,12 +9,14 @@ error message; the others carry on. Needs Dask (Debian: python3-dask, python3-di
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 
-from . import InputError, load_config, track
+from . import InputError, _progress, load_config, track
+from ._progress import Progress
 from ._table import Table
 
 __all__ = ["track_many"]
@@ -56,6 +58,50 @@ def _track_one(path: str, config, csv: str, max_frames: Optional[int], fps: floa
         table = getattr(error, "table", None)
         row.update(ok=False, error=str(error), summary=None if table is None else table.summary)
     return row
+
+
+def _importing_the_main_script() -> bool:
+    """Whether this process is a spawned worker still importing the caller's script (Python's
+    multiprocessing marks that phase, and refuses to start processes during it, too)."""
+    import multiprocessing
+
+    return bool(getattr(multiprocessing.current_process(), "_inheriting", False))
+
+
+def _unguarded_main_line() -> Optional[int]:
+    """The line of the caller's script that calls track_many at import time, outside an
+    ``if __name__ == "__main__":`` block; None when the call is guarded or comes from no script
+    (a notebook, ``python -c``, a thread). Such a line runs again in every worker that Dask's
+    process workers import the script into."""
+    import ast
+    import inspect
+
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    frame = inspect.currentframe()
+    line = None
+    while frame is not None:  # The script's own top-level frame, if it is on the stack.
+        if frame.f_code.co_name == "<module>" and frame.f_globals.get("__name__") == "__main__":
+            line = frame.f_lineno
+        frame = frame.f_back
+    if line is None or not path:
+        return None
+    try:
+        tree = ast.parse(Path(path).read_text())
+    except (OSError, SyntaxError, ValueError):
+        return None  # Not readable as Python: nothing to say about it.
+
+    def is_main_guard(node: ast.AST) -> bool:
+        names = {n.id for n in ast.walk(node) if isinstance(n, ast.Name)}
+        texts = {n.value for n in ast.walk(node) if isinstance(n, ast.Constant)}
+        return "__name__" in names and "__main__" in texts
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and is_main_guard(node.test):
+            end = getattr(node, "end_lineno", None) or node.lineno
+            if node.lineno <= line <= end:
+                return None
+    return line
 
 
 def _failed(path: str, csv: str, error: BaseException) -> Dict[str, Any]:
@@ -100,6 +146,7 @@ def track_many(
     n_workers: int = 2,
     processes: bool = False,
     timeout_s: Optional[float] = None,
+    progress: Progress = False,
 ) -> Table:
     """Tracks every input of ``paths`` on a Dask cluster; one CSV per input in ``out_dir``.
 
@@ -109,6 +156,10 @@ def track_many(
     scheduler address ("tcp://host:8786"), or None for a LocalCluster of ``n_workers`` workers
     (threads in this process unless ``processes``; closed again at the end). ``max_frames``,
     ``fps`` and ``method`` are ``track``'s. ``timeout_s`` bounds the wait for each input.
+    ``processes=True`` starts the workers as new interpreters that import the calling script
+    again: that script must start its work under ``if __name__ == "__main__":`` (docs/python.md).
+    ``progress``: ``track``'s, counting inputs: ``progress(done, total)`` in this process as
+    each input's row comes in (in input order), True for a bar or line, False/None for none.
 
     Returns a Table (``to_pandas()`` for a DataFrame) with one row per input, in order: input,
     csv, ok, frames, stop_reason, error (the CLI's one-line message; "" when ok), found_<marker>
@@ -124,6 +175,23 @@ def track_many(
             "python3-dask python3-distributed; or pip install 'dask[distributed]')"
         ) from error
     checked = load_config(config, method=method)  # A bad config fails here, once.
+    if client is None and processes:  # Before anything is made or started.
+        # A script that calls track_many at import time, without the guard: each worker imports
+        # it again, starts a cluster of its own, dies and is restarted by Dask, over and over.
+        # Refused before any process starts (and, should a worker get here, there too).
+        guard = ("start the work under `if __name__ == \"__main__\":` (docs/python.md, 'Many "
+                 "videos on a Dask cluster')")
+        line = _unguarded_main_line()
+        if line is not None:
+            raise RuntimeError(
+                f"softsight.batch.track_many(processes=True): {sys.modules['__main__'].__file__} "
+                f"line {line} calls it when the script is imported, and every worker process "
+                f"imports it again: {guard}")
+        if _importing_the_main_script():
+            raise RuntimeError(
+                "softsight.batch.track_many(processes=True) ran while a worker process was "
+                f"importing the calling script: {guard}")
+    report = _progress.reporter(progress, "track_many", "inputs")  # A bad value too.
     inputs = [os.fspath(p) for p in paths]
     out = Path(os.fspath(out_dir))
     out.mkdir(parents=True, exist_ok=True)
@@ -148,7 +216,11 @@ def track_many(
             except Exception as error:  # A lost worker, a timeout: this input failed.
                 future.cancel()
                 rows.append(_failed(path, csv, error))
+            if report is not None:
+                report(len(rows), len(futures))
     finally:
+        if report is not None:
+            report.close()
         if own_client is not None:
             own_client.close()
         if own_cluster is not None:

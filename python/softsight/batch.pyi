@@ -2,7 +2,7 @@
 import os
 from typing import Any, Mapping, Optional, Sequence, Union
 
-from . import Config, Table
+from . import Config, Progress, Table
 
 def track_many(
     paths: Sequence[Union[str, os.PathLike[str]]],
@@ -16,4 +16,5 @@ def track_many(
     n_workers: int = 2,
     processes: bool = False,
     timeout_s: Optional[float] = None,
+    progress: Progress = False,
 ) -> Table: ...

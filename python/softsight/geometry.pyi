@@ -1,11 +1,11 @@
 # Type stubs: softsight.geometry (compiled). Points are (x, y) pairs or (N, 2) arrays; one point
 # gives a float or None, arrays give arrays with NaN where a value is undefined.
-from typing import Dict, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
-Point = Union[Tuple[float, float], Sequence[float], npt.NDArray[np.floating]]
+Point = Union[Tuple[float, float], Sequence[float], npt.NDArray[np.floating[Any]]]
 Points = Union[Point, npt.ArrayLike]
 Value = Union[Optional[float], npt.NDArray[np.float64]]
 

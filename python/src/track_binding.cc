@@ -1,8 +1,11 @@
 // softsight.track: a whole run (a video, an image sequence or a built-in scene) through the same
-// RunPipeline and CSV column table as `softsight track`, its columns returned as numpy arrays.
+// RunPipeline and CSV column table as `softsight track`, its columns returned as numpy arrays;
+// and softsight.frames' reader, the same source and session one frame at a time.
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 
@@ -54,35 +57,33 @@ class RowSink : public FrameSink {
   std::vector<size_t> ends_;
 };
 
-// "track: 120 / 300 frames" on stderr, a few times a second (progress=True).
-class ProgressLine : public FrameSink {
+// progress=: each processed frame reported to a Python callable progress(done, total) (total
+// None when the source does not know its length), holding the GIL only for the call. Never a
+// line on fd 2 from here: a notebook or contextlib.redirect_stderr only sees what Python writes to
+// sys.stderr, so the line and the tqdm bar are drawn in Python (softsight/_progress.py). An
+// exception from the callable is kept as the thread's Python error and ends the run.
+class ProgressCallback : public FrameSink {
  public:
+  explicit ProgressCallback(py::object callback) : callback_(std::move(callback)) {}
   void begin(const RunInfo& info) override { total_ = info.frame_count; }
   void consume(const Frame&, const FrameResult&) override {
-    ++frames_;
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_) return;
-    next_ = now + std::chrono::milliseconds(250);
-    print();
+    ++done_;
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    try {
+      callback_(done_, total_ ? py::object(py::int_(*total_)) : py::object(py::none()));
+    } catch (py::error_already_set& error) {
+      error.restore();  // Raised again by the caller once the run has ended.
+      failed_ = true;
+    }
   }
-  void end(const RunSummary&) override {
-    print();
-    std::fputc('\n', stderr);
-  }
+  bool failed() const { return failed_; }
 
  private:
-  void print() const {
-    if (total_) {
-      std::fprintf(stderr, "\rtrack: %lld / %lld frames", static_cast<long long>(frames_),
-                   static_cast<long long>(*total_));
-    } else {
-      std::fprintf(stderr, "\rtrack: %lld frames", static_cast<long long>(frames_));
-    }
-    std::fflush(stderr);
-  }
+  py::object callback_;
   std::optional<int64_t> total_;
-  int64_t frames_ = 0;
-  std::chrono::steady_clock::time_point next_{};
+  int64_t done_ = 0;
+  bool failed_ = false;
 };
 
 enum class Kind { kInt, kBool, kText, kNumber };
@@ -185,7 +186,7 @@ py::dict SummaryDict(const RunSummary& s) {
 // one during it ends the run and is the summary's "error" (the caller raises it with the rows
 // so far, as the CLI keeps the rows it wrote).
 py::tuple Track(const py::object& input, const py::object& config_source,
-                std::optional<int64_t> max_frames, bool progress,
+                std::optional<int64_t> max_frames, const py::object& progress,
                 const py::object& csv_path, double fps,
                 const std::optional<std::string>& method) {
   if (max_frames && *max_frames < 0) {
@@ -208,6 +209,8 @@ py::tuple Track(const py::object& input, const py::object& config_source,
   RunSummary summary;
   const CsvColumnTable table = TrackingColumns(config);
   RowSink rows(table);
+  std::optional<ProgressCallback> progress_sink;  // Made and destroyed holding the GIL.
+  if (!progress.is_none()) progress_sink.emplace(progress);
   bool interrupted = false;
   {
     py::gil_scoped_release release;
@@ -225,13 +228,13 @@ py::tuple Track(const py::object& input, const py::object& config_source,
       file.emplace(*csv, TrackingColumns(config));
       sinks.push_back(&*file);
     }
-    ProgressLine line;
-    if (progress) sinks.push_back(&line);
+    if (progress_sink) sinks.push_back(&*progress_sink);
     RunOptions run;
     run.max_frames = max_frames;
     // Ctrl-C in the interpreter's main thread ends the run (checked a few times a second).
     auto next_check = std::chrono::steady_clock::now();
     run.stop_requested = [&] {
+      if (progress_sink && progress_sink->failed()) return true;  // Its error is set: no more Python.
       const auto now = std::chrono::steady_clock::now();
       if (now < next_check) return false;
       next_check = now + std::chrono::milliseconds(200);
@@ -241,13 +244,105 @@ py::tuple Track(const py::object& input, const py::object& config_source,
     };
     summary = RunPipeline(*source, session, sinks, run);
   }
-  if (interrupted) throw py::error_already_set();
+  if (interrupted || (progress_sink && progress_sink->failed())) throw py::error_already_set();
   return py::make_tuple(Columns(rows, table, config), SummaryDict(summary));
 }
+
+// softsight.frames' reader: the frames of `input` through the library's own source (videos,
+// sequences, folders, built-in scenes, with track's decode rules) and one run's session, one
+// frame per next(), the GIL released while a frame is read and tracked. close() (or the end of
+// the input, or an error) releases the source, so a generator closed early lets go of the file.
+class FrameStream {
+ public:
+  FrameStream(const py::object& input, const py::object& config_source,
+              std::optional<int64_t> max_frames, double fps,
+              const std::optional<std::string>& method)
+      : max_frames_(max_frames) {
+    if (max_frames && *max_frames < 0) {
+      throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
+    }
+    TrackingConfig config = ResolveConfig(config_source, method);
+    FrameSourceSpec spec;
+    const std::optional<std::string> input_path = AsPath(input);
+    if (!input_path) {
+      throw py::type_error("input: a path (str, bytes or os.PathLike) or synth:NAME, got " +
+                           std::string(py::str(py::type::of(input).attr("__name__"))));
+    }
+    spec.input = *input_path;
+    spec.sequence_fps = fps;
+    py::gil_scoped_release release;
+    source_ = OpenFrameSource(spec);
+    session_ = std::make_unique<TrackingSession>(std::move(config));
+    RunOptions options;
+    options.max_frames = max_frames;
+    run_ = std::make_unique<PipelineRun>(*session_, DescribeRun(*source_, *session_, options));
+  }
+
+  // The next frame's result, or nothing at the end (of the input, or of max_frames). Throws
+  // InputError for an input with no frame at all, a frame that does not decode or a gray video
+  // with colour markers, as track() reports them; the stream is closed then.
+  std::optional<FrameResult> next() {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(mutex_);  // One frame at a time.
+    if (!source_) return std::nullopt;
+    try {
+      if (max_frames_ && run_->frames() >= *max_frames_) {
+        close_locked();
+        return std::nullopt;
+      }
+      frame_.captured = {};
+      if (!source_->read(frame_)) {
+        const std::string source = run_->summary().source;
+        const bool empty = run_->frames() == 0;
+        close_locked();
+        if (empty) throw InputError(NoFramesProblem(source));
+        return std::nullopt;
+      }
+      return run_->process(frame_);  // A copy: the session reuses its own for the next frame.
+    } catch (...) {
+      close_locked();
+      throw;
+    }
+  }
+
+  void close() {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    close_locked();
+  }
+  bool closed() const { return !source_; }
+  // The frames the run will have (max_frames when fewer), when the source knows its length.
+  std::optional<int64_t> total() const { return run_->info().frame_count; }
+  int64_t done() const { return run_->frames(); }
+
+ private:
+  void close_locked() {
+    source_.reset();  // The video file or the image sequence is let go of here.
+  }
+
+  std::optional<int64_t> max_frames_;
+  std::unique_ptr<FrameSource> source_;
+  std::unique_ptr<TrackingSession> session_;
+  std::unique_ptr<PipelineRun> run_;
+  Frame frame_;
+  std::mutex mutex_;
+};
 
 }  // namespace
 
 void BindTrack(py::module_& m) {
+  py::class_<FrameStream>(m, "_FrameStream",
+                          "softsight.frames' reader (use softsight.frames, which closes it).")
+      .def(py::init<const py::object&, const py::object&, std::optional<int64_t>, double,
+                    const std::optional<std::string>&>(),
+           py::arg("input"), py::arg("config"), py::arg("max_frames"), py::arg("fps"),
+           py::arg("method"))
+      .def("next", &FrameStream::next, "The next frame's FrameResult, or None at the end.")
+      .def("close", &FrameStream::close, "Releases the input (idempotent).")
+      .def_property_readonly("closed", &FrameStream::closed)
+      .def_property_readonly("total", &FrameStream::total)
+      .def_property_readonly("done", &FrameStream::done);
+
   m.def("_track", &Track, py::arg("input"), py::arg("config"), py::arg("max_frames"),
         py::arg("progress"), py::arg("csv"), py::arg("fps"), py::arg("method"),
         "softsight.track without the table: (columns dict, summary dict).");

@@ -124,3 +124,15 @@ def test_a_bad_camera_dict_is_an_input_error_naming_the_key():
                          (dict(good, camera_matrix=np.zeros((3, 3))), "focal lengths")):
         with pytest.raises(softsight.InputError, match=what):
             calib.undistort_points(points, broken)
+
+
+def test_softsight_batch_comes_with_the_package_without_importing_dask():
+    # The stubs promise softsight.batch after `import softsight`; Dask is only imported when
+    # track_many runs, so the import stays cheap.
+    import subprocess
+    import sys
+
+    code = "import sys, softsight; print(callable(softsight.batch.track_many), 'distributed' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=60)
+    assert out.stdout.split() == ["True", "False"]

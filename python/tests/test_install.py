@@ -24,6 +24,12 @@ def test_cmake_install_puts_an_importable_package_into_site_packages(tmp_path):
     assert not Path(INSTALL_DIR).is_absolute(), "the default install dir follows --prefix"
     assert (site / "softsight" / "__init__.py").exists()
     assert (site / "softsight" / "__init__.pyi").exists() and (site / "softsight" / "py.typed").exists()
+    # Every file of the package the build tree assembles is installed (a new module added to
+    # the package but not to python/CMakeLists.txt's list would be missing here).
+    built = {p.name for p in (Path(BUILD_DIR) / "python" / "softsight").iterdir()
+             if p.name != "__pycache__"}
+    installed = {p.name for p in (site / "softsight").iterdir()}
+    assert built - installed == set()
     code = ("import softsight, importlib.metadata as m; print(softsight.__file__); "
             "print(softsight.__version__, m.version('softsight'), m.metadata('softsight')['License'])")
     clean = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

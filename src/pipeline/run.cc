@@ -22,6 +22,11 @@ std::string GrayFrameProblem() {
          "gray-level range `gray: [lo, hi]` for white or black markers)";
 }
 
+std::string NoFramesProblem(const std::string& source) {
+  return source + ": no frames to read (an empty video or folder, a start past its end, or frames "
+                  "that cannot be decoded)";
+}
+
 RunInfo DescribeMarkers(const TrackingConfig& config) {
   RunInfo info;
   for (const MarkerSpec& spec : config.markers) info.marker_names.push_back(spec.name);
@@ -162,12 +167,9 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
       if (!source.read(frame)) {
         reason = StopReason::kEndOfInput;
         if (run.frames() == 0) {
-          // A file that ends before its first frame is a wrong input, not a run: a CSV of only a
-          // header, exit 0, would read as "tracked, nothing found".
+          // A file that ends before its first frame is a wrong input, not a run.
           reason = StopReason::kError;
-          error = run.summary().source +
-                  ": no frames to read (an empty video or folder, a start past its end, or frames "
-                  "that cannot be decoded)";
+          error = NoFramesProblem(run.summary().source);
         }
         break;
       }

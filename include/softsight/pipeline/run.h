@@ -89,6 +89,10 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
 // make gray frames an error, said with GrayFrameProblem() ("colour tracking needs colour (...)").
 bool NeedsColour(const TrackingConfig& config);
 std::string GrayFrameProblem();
+// The error of a run whose source (`source`: its description) ends before its first frame: a
+// CSV of only a header, exit 0, would read as "tracked, nothing found". RunPipeline's, and
+// that of a caller reading the source itself (softsight.frames in Python).
+std::string NoFramesProblem(const std::string& source);
 
 // What a run of `config` tells its sinks of the markers: their names, and whether measurements
 // come in millimetres. DescribeRun adds the source.
