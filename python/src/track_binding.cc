@@ -182,17 +182,14 @@ py::dict SummaryDict(const RunSummary& s) {
   return out;
 }
 
-// Returns (columns, summary); an InputError before the run (config, input, CSV path) is raised,
-// one during it ends the run and is the summary's "error" (the caller raises it with the rows
-// so far, as the CLI keeps the rows it wrote).
-py::tuple Track(const py::object& input, const py::object& config_source,
-                std::optional<int64_t> max_frames, const py::object& progress,
-                const py::object& csv_path, double fps,
-                const std::optional<std::string>& method) {
+void CheckMaxFrames(std::optional<int64_t> max_frames) {
   if (max_frames && *max_frames < 0) {
     throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
   }
-  const TrackingConfig config = ResolveConfig(config_source, method);
+}
+
+// What track() and frames() read: `input` (a path or synth:NAME), at `fps` for image sequences.
+FrameSourceSpec InputSpec(const py::object& input, double fps) {
   FrameSourceSpec spec;
   const std::optional<std::string> input_path = AsPath(input);
   if (!input_path) {
@@ -200,12 +197,25 @@ py::tuple Track(const py::object& input, const py::object& config_source,
                          std::string(py::str(py::type::of(input).attr("__name__"))));
   }
   spec.input = *input_path;
+  spec.sequence_fps = fps;
+  return spec;
+}
+
+// Returns (columns, summary); an InputError before the run (config, input, CSV path) is raised,
+// one during it ends the run and is the summary's "error" (the caller raises it with the rows
+// so far, as the CLI keeps the rows it wrote).
+py::tuple Track(const py::object& input, const py::object& config_source,
+                std::optional<int64_t> max_frames, const py::object& progress,
+                const py::object& csv_path, double fps,
+                const std::optional<std::string>& method) {
+  CheckMaxFrames(max_frames);
+  const TrackingConfig config = ResolveConfig(config_source, method);
+  const FrameSourceSpec spec = InputSpec(input, fps);
   std::optional<std::string> csv;
   if (!csv_path.is_none()) {
     csv = AsPath(csv_path);
     if (!csv) throw py::type_error("csv: a path (str, bytes or os.PathLike)");
   }
-  spec.sequence_fps = fps;
   RunSummary summary;
   const CsvColumnTable table = TrackingColumns(config);
   RowSink rows(table);
@@ -258,18 +268,9 @@ class FrameStream {
               std::optional<int64_t> max_frames, double fps,
               const std::optional<std::string>& method)
       : max_frames_(max_frames) {
-    if (max_frames && *max_frames < 0) {
-      throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
-    }
+    CheckMaxFrames(max_frames);
     TrackingConfig config = ResolveConfig(config_source, method);
-    FrameSourceSpec spec;
-    const std::optional<std::string> input_path = AsPath(input);
-    if (!input_path) {
-      throw py::type_error("input: a path (str, bytes or os.PathLike) or synth:NAME, got " +
-                           std::string(py::str(py::type::of(input).attr("__name__"))));
-    }
-    spec.input = *input_path;
-    spec.sequence_fps = fps;
+    const FrameSourceSpec spec = InputSpec(input, fps);
     py::gil_scoped_release release;
     source_ = OpenFrameSource(spec);
     session_ = std::make_unique<TrackingSession>(std::move(config));
