@@ -288,5 +288,56 @@ TEST(MarkerTracks, NoRunStartsFarAwayOrOnAnotherMarkersPlace) {
   }
 }
 
+
+// Two markers that jump by one translation together (the camera was bumped) are followed there;
+// one that jumps alone is not the camera.
+TEST(MarkerTracks, MarkersThatJumpTogetherByOneTranslationMoveTheirTracks) {
+  MarkerTracks tracks = TwoMovingTracks(10);
+  std::vector<MarkerObservation> m = Reports({cv::Point2d(100 + 30, 40), cv::Point2d(200 + 30, 40)});
+  ASSERT_TRUE(tracks.AnyJustLost(m));
+  const std::optional<cv::Point2d> shift = tracks.CommonShift(m);
+  ASSERT_TRUE(shift.has_value());
+  EXPECT_NEAR(shift->x, 30.0, 1e-6);
+  EXPECT_NEAR(shift->y, 40.0, 1e-6);
+  ASSERT_TRUE(tracks.FollowCamera(m, *shift));
+  const std::vector<MarkerCandidate> none;
+  const auto& d = tracks.associate(m, {&none, &none});
+  EXPECT_EQ(d[0].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_TRUE(m[0].observation.found() && m[1].observation.found());
+
+  MarkerTracks alone = TwoMovingTracks(10);
+  std::vector<MarkerObservation> one = Reports({cv::Point2d(100 + 30, 40), cv::Point2d(200, 0)});
+  EXPECT_FALSE(alone.CommonShift(one).has_value());
+  // A shift that explains no report does not move the tracks.
+  EXPECT_FALSE(alone.FollowCamera(one, {-300, 0}));
+}
+
+// A look-alike in view elsewhere when a marker is lost is another object: however far the
+// marker's reach grows while it is lost, it never takes it; a candidate that appears later
+// within the reach is taken.
+TEST(MarkerTracks, ALostMarkerNeverTakesAnObjectThatWasElsewhereWhenItWasLost) {
+  MarkerTracks tracks({5.0});
+  const std::vector<MarkerCandidate> none;
+  for (int f = 0; f < 10; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(100 + 20.0 * f, 100)});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+  }
+  // Lost at (300, 100) moving 20 px a frame; its tracker's report is a twin at (400, 100) that
+  // moves 10 px a frame: beyond reach when the marker is lost, within it a few frames later.
+  int believed = 0;
+  for (int f = 10; f < 30; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(400 + 10.0 * (f - 10), 100)});
+    const std::vector<MarkerCandidate> list = {
+        Candidate(*m[0].observation.position_px, CandidateVerdict::kChosen)};
+    tracks.associate(m, {&list});
+    believed += m[0].observation.found();
+    tracks.commit(m);
+  }
+  EXPECT_EQ(believed, 0);
+  EXPECT_EQ(tracks.others_excluded_for(0), 1u);
+}
+
 }  // namespace
 }  // namespace softsight

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstdlib>
 
+#include <opencv2/imgproc.hpp>
+
 namespace softsight {
 namespace {
 
@@ -125,6 +127,7 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     return;
   }
   summariser_.summarise(bgr, grid_, now_);
+  change_accepted_ = false;
   changed_fraction_ = changed_between(now_, normal_, false);
   int garbage_cells = 0;
   for (size_t i = 0; i < now_.size(); ++i) garbage_cells += Garbage(now_[i], normal_[i]) ? 1 : 0;
@@ -152,6 +155,8 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     alike_run_ = alike ? alike_run_ + 1 : 1;
     normal = alike_run_ >= kFramesToAcceptAChange || changed_run_ >= kLongestChangeRun;
     if (normal) {
+      before_change_ = normal_;
+      change_accepted_ = true;
       usual_fraction_ = std::max(usual_fraction_, changed_fraction_ / 3.0);
       changed_run_ = 0;
       alike_run_ = 0;
@@ -170,6 +175,52 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
     if (normal && !garbage) normal_[i] = now_[i];
   }
   std::swap(previous_, now_);
+}
+
+namespace {
+
+// The cells' gray samples laid out as the image they were sampled from (CV_32F).
+void SampleImage(const std::vector<FrameCell>& cells, const CellGrid& grid, cv::Mat& out) {
+  out.create(grid.rows * kSamplesPerCell, grid.cols * kSamplesPerCell, CV_32F);
+  for (int cy = 0; cy < grid.rows; ++cy) {
+    for (int cx = 0; cx < grid.cols; ++cx) {
+      const FrameCell& cell = cells[static_cast<size_t>(cy) * grid.cols + cx];
+      for (int y = 0; y < kSamplesPerCell; ++y) {
+        float* row = out.ptr<float>(cy * kSamplesPerCell + y) + cx * kSamplesPerCell;
+        for (int x = 0; x < kSamplesPerCell; ++x) row[x] = cell.gray[y * kSamplesPerCell + x];
+      }
+    }
+  }
+}
+
+// A phase correlation peak below this is no single clear translation (little texture, or the
+// actuator's own motion as large as the background's).
+constexpr double kMinShiftResponse = 0.15;
+// The share of cells that must have changed against the normal frame for the camera to have
+// moved.
+constexpr double kCameraMovedFraction = 0.5;
+
+}  // namespace
+
+std::optional<cv::Point2d> FrameChangeDetector::camera_shift_px() {
+  // Only a picture that changed as a whole moved with the camera: where a few cells changed,
+  // the largest textured thing that moved (a cart, the actuator) would pass for the camera.
+  if (!has_normal_ || !(change_accepted_ || changed_fraction_ >= kCameraMovedFraction)) {
+    return std::nullopt;
+  }
+  // observe() left this frame's summary in previous_ and the frame before's in now_.
+  SampleImage(change_accepted_ ? before_change_ : now_, grid_, samples_a_);
+  SampleImage(previous_, grid_, samples_b_);
+  if (window_.size() != samples_a_.size()) {
+    cv::createHanningWindow(window_, samples_a_.size(), CV_32F);
+  }
+  double response = 0.0;
+  const cv::Point2d shift = cv::phaseCorrelate(samples_a_, samples_b_, window_, &response);
+  if (!(response >= kMinShiftResponse) || !(cv::norm(shift) >= 1.0) ||
+      std::abs(shift.x) > samples_a_.cols / 4 || std::abs(shift.y) > samples_a_.rows / 4) {
+    return std::nullopt;
+  }
+  return shift * static_cast<double>(grid_.step);
 }
 
 bool FrameChangeDetector::garbage_near(const cv::Point2d& image_px) const {

@@ -20,8 +20,13 @@
 //    images a few): decoded garbage there; markers in or next to it are not trusted. Garbage in
 //    a tenth of the frame or more: the decoder lost its place, and the rest of the frame may be
 //    a stale copy of an earlier one; the whole frame is not believed for as long as it lasts.
+//
+// It also tells how far the camera moved: the translation between the summaries' gray samples
+// (phase correlation), of the last frame against this one, or across a change just accepted as
+// the new normal (a bumped camera), so the markers' tracks can follow the picture.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -46,6 +51,15 @@ class FrameChangeDetector {
   // The neighbourhood of `image_px` holds garbage (texture far beyond what it had).
   bool garbage_near(const cv::Point2d& image_px) const;
 
+  // How far the picture moved as a whole (the camera) since the frame before, in px: on the
+  // frame where a lasting change was just accepted as the new normal, since the last normal
+  // frame before that change. Absent when the picture did not change as a whole (half its cells
+  // or more: else what moved may be the largest moving thing in view, not the camera), when it
+  // cannot tell (too little texture, no clear single translation), or when the picture did not
+  // move by a sample or more. Computed on demand (a phase
+  // correlation of the summaries' samples: about 120 x 160 at any resolution).
+  std::optional<cv::Point2d> camera_shift_px();
+
   // Fraction of cells that changed against the last normal frame (for tests and tuning).
   double changed_fraction() const { return changed_fraction_; }
   // Fraction of cells holding garbage against the last normal frame (for tests and tuning).
@@ -64,6 +78,10 @@ class FrameChangeDetector {
   CellGrid grid_;             // Their samples and cells.
   FrameSummariser summariser_;
   std::vector<Cell> now_, normal_, previous_;  // Reused: no allocation per frame.
+  // The normal frame before a change that was accepted on this frame (for camera_shift_px).
+  std::vector<Cell> before_change_;
+  bool change_accepted_ = false;
+  cv::Mat samples_a_, samples_b_, window_;  // camera_shift_px's scratch.
   std::vector<float> ratios_;                  // row_gain's scratch.
   std::vector<unsigned char> garbage_;         // Per cell: frames in a row it held garbage.
   bool has_normal_ = false;

@@ -11,13 +11,19 @@ namespace {
 // The gate: a squared Mahalanobis distance of 16 is 4 sigma (2 degrees of freedom: a report
 // inside it by chance 1 time in 3000).
 constexpr double kGate2 = 16.0;
-// Candidates within this of each other are one blob seen by several trackers.
+// Candidates within this of each other are one blob seen by several trackers, or within this
+// fraction of the marker's size (two blobs of that size cannot lie closer than twice it; a
+// template's second peak is placed only to about a pixel, its centre not yet measured).
 constexpr double kSamePlacePx = 1.0;
+constexpr double kSamePlaceSizes = 0.5;
 // Costs (unitless): an allowed pair costs its distance2 / kGate2 (at most 1) plus a little of
 // the tracker's misfit; a first acquisition (no track yet) costs more than any allowed pair, so
 // a candidate a started track explains goes to that track; leaving a marker unassigned costs
 // more than both, so a marker takes a candidate whenever one is allowed.
 constexpr double kMisfitWeight = 0.05;
+// The misfit of a candidate in a marker's gate that its tracker did not list: worse than any the
+// tracker lists, so its own candidates come first.
+constexpr double kUnlistedMisfit = 2.0;
 constexpr double kFirstAcquisitionCost = 1.2;
 constexpr double kUnassignedCost = 1.5;
 // Rejected reports in a row, on one smooth motion, that restart a track: 0.1 s at 30 fps.
@@ -29,6 +35,12 @@ constexpr double kRunStepTolerance = 0.5;
 // speed: within twice the marker's size plus this many of its steps per frame since (counted up
 // to kReacquireFrames). A look-alike that stands still, or moves, far from there starts no run.
 constexpr double kRunStartSteps = 1.5;
+// Another object may go unseen this many frames and still be followed (a tracker that switched
+// from its window to the whole frame lists it again a frame later); longer, it is forgotten.
+constexpr int kOtherUnseenFrames = 1;
+// Its first step may be this many marker sizes plus the fastest marker's speed; later steps lie
+// within a size plus kRunStepTolerance of its step from where its constant velocity puts it.
+constexpr double kOtherFirstStepSizes = 3.0;
 
 double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
   const cv::Point2d ab = b - a;
@@ -68,6 +80,7 @@ MarkerTracks::MarkerTracks(std::vector<double> size_px, MotionModelOptions motio
 }
 
 void MarkerTracks::forget(size_t i) {
+  for (size_t o = 0; o < active_others_; ++o) others_[o].not_marker[i] = 0;
   Track& t = tracks_.at(i);
   t.motion.clear();
   t.pending_px.reset();
@@ -89,9 +102,10 @@ void MarkerTracks::skip() {
   for (Track& t : tracks_) t.predicted = false;
 }
 
-size_t MarkerTracks::pool(const cv::Point2d& p) {
+size_t MarkerTracks::pool(const cv::Point2d& p, double size_px) {
+  const double same_px = std::max(kSamePlacePx, kSamePlaceSizes * size_px);
   for (size_t k = 0; k < pooled_.size(); ++k) {
-    if (cv::norm(pooled_[k].position_px - p) <= kSamePlacePx) return k;
+    if (cv::norm(pooled_[k].position_px - p) <= same_px) return k;
   }
   pooled_.push_back({p});
   return pooled_.size() - 1;
@@ -121,7 +135,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
           index = c;
         }
       }
-      report_pooled_[i] = pool(*o.position_px);
+      report_pooled_[i] = pool(*o.position_px, size_px_[i]);
       entries_[i].push_back({*report_pooled_[i], index, misfit});
     }
     // The other candidates that fit the marker: the one the tracker did not choose (a twin it
@@ -130,11 +144,27 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     const std::vector<MarkerCandidate>& list = *candidates[i];
     for (size_t c = 0; c < list.size(); ++c) {
       if (!Fits(list[c].verdict)) continue;
-      const size_t k = pool(list[c].position_px);
+      const size_t k = pool(list[c].position_px, size_px_[i]);
       if (report_pooled_[i] && k == *report_pooled_[i]) continue;
       entries_[i].push_back({k, c, list[c].misfit});
     }
   }
+  // A candidate inside a started marker's gate proper (its prediction, not a coasting reach) that
+  // its tracker did not list (lost, or covered, this frame) is still that marker's to explain:
+  // it may take it (and stays not found: its tracker did not verify it), so a marker coasting
+  // with a wide reach does not take the place another marker was just predicted at.
+  for (size_t j = 0; j < markers.size(); ++j) {
+    const Track& t = tracks_[j];
+    if (!t.motion.started()) continue;
+    for (size_t k = 0; k < pooled_.size(); ++k) {
+      const cv::Point2d p = pooled_[k].position_px;
+      bool listed = false;
+      for (const Entry& e : entries_[j]) listed = listed || e.pooled == k;
+      if (listed || !InGate(j, p)) continue;
+      entries_[j].push_back({k, std::nullopt, kUnlistedMisfit});
+    }
+  }
+  MatchOthers();
   // The cost matrix.
   for (size_t i = 0; i < markers.size(); ++i) {
     cost_[i].assign(pooled_.size(), kForbidden);
@@ -149,22 +179,10 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
         }
         continue;
       }
+      if (!InReach(i, p) || IsOtherObject(i, e.pooled)) continue;
       const bool repeated = IsRepeat(t, p);
-      const double d2 = t.motion.distance2(p);
-      const double dist = cv::norm(p - t.motion.position());
-      // Inside the gate, or within what the marker covers in a frame at its speed plus its own
-      // size (it may stop or turn sharply within one frame: a bounce, a start).
-      bool inside = d2 <= kGate2 || dist <= size_px_[i] + cv::norm(t.motion.velocity()) || repeated;
-      if (!inside && t.misses > 0 && t.last_px) {
-        // Coasting: the marker may have stopped, slowed or kept going since it was last seen.
-        // Its reach is anywhere between where it was and where it would be now, plus the
-        // gate's radius.
-        inside = DistanceToSegment(p, *t.last_px, t.motion.position()) <=
-                 size_px_[i] + std::sqrt(kGate2) * t.motion.sigma_px();
-      }
-      if (!inside) continue;
-      cost_[i][e.pooled] =
-          (repeated ? 0.0 : std::min(d2, kGate2) / kGate2) + kMisfitWeight * std::min(e.misfit, 2.0);
+      cost_[i][e.pooled] = (repeated ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2) +
+                           kMisfitWeight * std::min(e.misfit, 2.0);
     }
   }
   const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
@@ -173,6 +191,8 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     tracks_[i].restart = false;
     if (assigned[i] < 0) {
       if (o.found()) {
+        // (A run may restart the track on an object followed as another one: the run's own
+        // start, near where the marker was last believed, is the evidence it is the marker.)
         if (tracks_[i].motion.started() && report_pooled_[i] &&
             ExtendsARejectedRun(i, *o.position_px)) {
           tracks_[i].restart = true;  // kKeep: the report stands, the track restarts on it.
@@ -201,7 +221,178 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
       o = Observation::NotFound(MarkerStatus::kImplausible);
     }
   }
+  FollowOthers(assigned);
   return decisions_;
+}
+
+bool MarkerTracks::AnyJustLost(const std::vector<MarkerObservation>& markers) {
+  CV_Assert(markers.size() == tracks_.size());
+  predict_all();
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    if (!t.motion.started() || t.misses > 0) continue;
+    const Observation& o = markers[i].observation;
+    if (!o.found() || !InGate(i, *o.position_px)) return true;
+  }
+  return false;
+}
+
+std::optional<cv::Point2d> MarkerTracks::CommonShift(
+    const std::vector<MarkerObservation>& markers) {
+  CV_Assert(markers.size() == tracks_.size());
+  predict_all();
+  cv::Point2d sum(0, 0);
+  int count = 0;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    if (!t.motion.started() || t.misses > 0) continue;
+    const Observation& o = markers[i].observation;
+    if (!o.found()) continue;
+    if (InGate(i, *o.position_px)) return std::nullopt;  // This one did not move with the rest.
+    sum += *o.position_px - t.motion.position();
+    ++count;
+  }
+  if (count < 2) return std::nullopt;
+  const cv::Point2d mean = sum * (1.0 / count);
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    const Observation& o = markers[i].observation;
+    if (!t.motion.started() || t.misses > 0 || !o.found()) continue;
+    if (cv::norm(*o.position_px - t.motion.position() - mean) > size_px_[i]) return std::nullopt;
+  }
+  return mean;
+}
+
+bool MarkerTracks::FollowCamera(const std::vector<MarkerObservation>& markers,
+                                const cv::Point2d& shift_px) {
+  CV_Assert(markers.size() == tracks_.size());
+  predict_all();
+  int gained = 0, lost = 0;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    const Observation& o = markers[i].observation;
+    if (!t.motion.started() || !o.found()) continue;
+    const bool before = InGate(i, *o.position_px);
+    const bool after = InGate(i, *o.position_px - shift_px);  // The track moved by the shift.
+    gained += !before && after;
+    lost += before && !after;
+  }
+  if (gained <= lost) return false;
+  for (Track& t : tracks_) {
+    if (!t.motion.started()) continue;
+    t.motion.shift(shift_px);
+    if (t.last_px) *t.last_px += shift_px;
+    if (t.pending_px) *t.pending_px += shift_px;
+  }
+  for (size_t o = 0; o < active_others_; ++o) others_[o].position_px += shift_px;
+  return true;
+}
+
+bool MarkerTracks::InGate(size_t i, const cv::Point2d& p) const {
+  const Track& t = tracks_[i];
+  // Inside the gate, or within what the marker covers in a frame at its speed plus its own size
+  // (it may stop or turn sharply within one frame: a bounce, a start).
+  return t.motion.distance2(p) <= kGate2 ||
+         cv::norm(p - t.motion.position()) <= size_px_[i] + cv::norm(t.motion.velocity()) ||
+         IsRepeat(t, p);
+}
+
+bool MarkerTracks::InReach(size_t i, const cv::Point2d& p) const {
+  const Track& t = tracks_[i];
+  if (InGate(i, p)) return true;
+  // Coasting: the marker may have stopped, slowed or kept going since it was last seen. Its
+  // reach is anywhere between where it was and where it would be now, plus the gate's radius.
+  return t.misses > 0 && t.last_px &&
+         DistanceToSegment(p, *t.last_px, t.motion.position()) <=
+             size_px_[i] + std::sqrt(kGate2) * t.motion.sigma_px();
+}
+
+// Which pooled candidate continues which followed object: nearest first, each at most once, an
+// object's next sighting within a size (plus half its step) of where its step puts it, its first
+// step within kOtherFirstStepSizes sizes plus the fastest marker's speed.
+void MarkerTracks::MatchOthers() {
+  pooled_other_.assign(pooled_.size(), std::nullopt);
+  if (active_others_ == 0) return;
+  double size = 0, speed = 0;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    size = std::max(size, size_px_[i]);
+    if (tracks_[i].motion.started()) speed = std::max(speed, cv::norm(tracks_[i].motion.velocity()));
+  }
+  other_pairs_.clear();
+  for (size_t o = 0; o < active_others_; ++o) {
+    const Other& other = others_[o];
+    const cv::Point2d step = other.step_px.value_or(cv::Point2d(0, 0)) * (1 + other.unseen);
+    const double radius = other.step_px
+                              ? size + kRunStepTolerance * cv::norm(step)
+                              : kOtherFirstStepSizes * size + speed * (1 + other.unseen);
+    for (size_t k = 0; k < pooled_.size(); ++k) {
+      const double d = cv::norm(pooled_[k].position_px - (other.position_px + step));
+      if (d <= radius) other_pairs_.push_back({d, k, o});
+    }
+  }
+  std::sort(other_pairs_.begin(), other_pairs_.end(),
+            [](const OtherPair& a, const OtherPair& b) { return a.distance_px < b.distance_px; });
+  other_seen_.assign(active_others_, 0);
+  for (const OtherPair& pair : other_pairs_) {
+    if (pooled_other_[pair.pooled] || other_seen_[pair.other]) continue;
+    pooled_other_[pair.pooled] = pair.other;
+    other_seen_[pair.other] = 1;
+  }
+}
+
+void MarkerTracks::FollowOthers(const std::vector<int>& assigned) {
+  pooled_taken_.assign(pooled_.size(), 0);
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (assigned[i] >= 0) pooled_taken_[static_cast<size_t>(assigned[i])] = 1;
+    if (tracks_[i].restart && report_pooled_[i]) pooled_taken_[*report_pooled_[i]] = 1;
+  }
+  // Every followed object goes unseen this frame unless a candidate no marker took continues it;
+  // one a marker took is that marker, not another object.
+  for (size_t o = 0; o < active_others_; ++o) ++others_[o].unseen;
+  for (size_t k = 0; k < pooled_.size(); ++k) {
+    const cv::Point2d p = pooled_[k].position_px;
+    if (pooled_other_[k]) {
+      Other& other = others_[*pooled_other_[k]];
+      if (pooled_taken_[k]) {
+        other.unseen = kOtherUnseenFrames + 1;  // Forgotten below.
+      } else {
+        other.step_px = (p - other.position_px) * (1.0 / other.unseen);
+        other.position_px = p;
+        other.unseen = 0;
+      }
+      continue;
+    }
+    if (pooled_taken_[k]) continue;
+    // A new object. Where marker i could not be in this frame (believed elsewhere, or just lost
+    // and this place beyond its reach), it is not marker i.
+    if (active_others_ == others_.size()) others_.emplace_back();
+    Other& other = others_[active_others_++];
+    other.position_px = p;
+    other.step_px.reset();
+    other.unseen = 0;
+    other.not_marker.assign(tracks_.size(), 0);
+    for (size_t i = 0; i < tracks_.size(); ++i) {
+      const Track& t = tracks_[i];
+      if (!t.motion.started()) continue;
+      const bool believed_elsewhere = assigned[i] >= 0;
+      const bool just_lost = assigned[i] < 0 && t.misses <= 1 && !InReach(i, p);
+      other.not_marker[i] = believed_elsewhere || just_lost;
+    }
+  }
+  // Forget the objects not seen for too long (their vectors stay for reuse).
+  for (size_t o = 0; o < active_others_;) {
+    if (others_[o].unseen > kOtherUnseenFrames) {
+      std::swap(others_[o], others_[--active_others_]);
+    } else {
+      ++o;
+    }
+  }
+}
+
+size_t MarkerTracks::others_excluded_for(size_t i) const {
+  size_t n = 0;
+  for (size_t o = 0; o < active_others_; ++o) n += others_[o].not_marker.at(i);
+  return n;
 }
 
 bool MarkerTracks::ExplainedByAnother(size_t i, const cv::Point2d& p) const {

@@ -20,6 +20,13 @@
 // own for kReacquireFrames frames in a row and no other marker's track explains any of them, the
 // track restarts on them (the first frames stay not believed). The run must also be able to have
 // left the marker's last believed place at its own speed: a look-alike elsewhere starts none.
+//
+// Candidates no marker takes are things of their own (a look-alike, a second cart's identical
+// dot), followed from frame to frame by their own constant velocity while they keep being seen.
+// One that was, in its first frame, where marker i could not be (marker i believed elsewhere in
+// that same frame, or just lost and the thing outside its reach) is another object for as long
+// as it is followed: marker i never takes it, however far its reach grows since. So a lost
+// marker is not re-acquired on a look-alike that was in view, elsewhere, when it was lost.
 #pragma once
 
 #include <cstdint>
@@ -62,6 +69,20 @@ class MarkerTracks {
   // The frame's believed reports (after every other check) update the tracks. Call once per
   // frame after associate().
   void commit(const std::vector<MarkerObservation>& markers);
+  // Whether a marker believed in the last frame has no report inside its gate in this one
+  // (`markers`: the trackers' reports, before associate()): the moment to ask whether the
+  // camera moved.
+  bool AnyJustLost(const std::vector<MarkerObservation>& markers);
+  // The one translation that every marker believed in the last frame made at once (each report
+  // this frame outside its gate, all of them within a marker's size of the same step from their
+  // predictions; two such markers at least): the camera moved, or the whole body at once, where
+  // the picture around it is too plain to tell (pipeline/frame_change.h). Absent otherwise.
+  std::optional<cv::Point2d> CommonShift(const std::vector<MarkerObservation>& markers);
+  // The camera moved the picture by `shift_px` since the last frame: every track (and every
+  // other object) moves with it, when that brings more of the markers' reports into their gates
+  // than it takes out (a shift that explains no report is not the markers' camera). Returns
+  // whether the tracks moved.
+  bool FollowCamera(const std::vector<MarkerObservation>& markers, const cv::Point2d& shift_px);
   // A frame in which nothing was believed (it changed as a whole): the tracks are predicted over
   // it, nothing else.
   void skip();
@@ -74,6 +95,9 @@ class MarkerTracks {
 
   // For tests: marker i's motion model.
   const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
+  // For tests: how many other objects are followed, and how many of them marker i may never take.
+  size_t others() const { return active_others_; }
+  size_t others_excluded_for(size_t i) const;
 
  private:
   struct Track {
@@ -97,11 +121,26 @@ class MarkerTracks {
   static bool IsRepeat(const Track& t, const cv::Point2d& p);
   // Whether a started track other than `i`'s could take a report at `p`.
   bool ExplainedByAnother(size_t i, const cv::Point2d& p) const;
+  // Whether `p` lies in marker i's gate proper: inside the Mahalanobis gate, within its size plus
+  // a frame's motion of its prediction, or a repeated frame.
+  bool InGate(size_t i, const cv::Point2d& p) const;
+  // Whether marker i's started track can be at `p` this frame: inside its gate, within its size
+  // plus a frame's motion, a repeated frame, or, while coasting, within reach of anywhere between
+  // where it was last seen and where it would be now.
+  bool InReach(size_t i, const cv::Point2d& p) const;
+  // Whether pooled candidate k is followed as another object that marker i may never take.
+  bool IsOtherObject(size_t i, size_t k) const {
+    return pooled_other_[k] && others_[*pooled_other_[k]].not_marker[i];
+  }
+  // Follows the candidates no marker took (see the file comment); `assigned`: the solver's.
+  void FollowOthers(const std::vector<int>& assigned);
+  void MatchOthers();
   // Marker i's report at `p` was rejected: true when it extends a run of rejected reports that
   // follows one smooth motion for kReacquireFrames frames (the track then restarts on it).
   bool ExtendsARejectedRun(size_t i, const cv::Point2d& p);
   void predict_all();
-  size_t pool(const cv::Point2d& p);
+  // The pooled candidate at `p` (a marker of about `size_px`), added when there is none.
+  size_t pool(const cv::Point2d& p, double size_px);
 
   std::vector<double> size_px_;
   std::vector<Track> tracks_;
@@ -119,6 +158,24 @@ class MarkerTracks {
   std::vector<double> unassigned_;
   std::vector<std::optional<size_t>> report_pooled_;
   MinimumCostAssignment solver_;
+
+  // Other objects (see the file comment): others_[0, active_others_) are followed; the rest are
+  // kept for reuse (their vectors keep their capacity).
+  struct Other {
+    cv::Point2d position_px;
+    std::optional<cv::Point2d> step_px;  // Between its last two sightings.
+    int unseen = 0;                      // Frames since it was last seen.
+    std::vector<uint8_t> not_marker;     // Per marker: 1 when that marker may never take it.
+  };
+  std::vector<Other> others_;
+  size_t active_others_ = 0;
+  std::vector<std::optional<size_t>> pooled_other_;  // Per pooled candidate: the other it is.
+  struct OtherPair {
+    double distance_px;
+    size_t pooled, other;
+  };
+  std::vector<OtherPair> other_pairs_;
+  std::vector<uint8_t> other_seen_, pooled_taken_;
 };
 
 }  // namespace softsight

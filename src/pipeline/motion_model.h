@@ -36,6 +36,11 @@ class MotionModel {
 
   // Advances the state by one frame (called once per frame, before gate/update).
   void predict();
+  // The picture moved by `shift_px` (the camera): the position moves with it, nothing else.
+  void shift(const cv::Point2d& shift_px) {
+    x_(0) += shift_px.x;
+    x_(1) += shift_px.y;
+  }
   // Folds a report of this frame in; `learn` adapts the acceleration to the innovation.
   void update(const cv::Point2d& position_px, bool learn = true);
 

@@ -120,6 +120,13 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     // Which candidate is which marker, for all markers at once with their motion: a report no
     // motion explains, or that another marker's track explains better, is not believed; a
     // candidate the tracker weighed but did not choose may be its marker.
+    // A marker believed a frame ago that now has no report where its motion puts it: if the
+    // whole picture moved (a bumped camera), the tracks move with it first.
+    if (tracks_->AnyJustLost(result_.markers)) {
+      std::optional<cv::Point2d> shift = frame_change_->camera_shift_px();
+      if (!shift) shift = tracks_->CommonShift(result_.markers);
+      if (shift) tracks_->FollowCamera(result_.markers, *shift);
+    }
     const std::vector<MarkerTracks::Decision>& decisions =
         tracks_->associate(result_.markers, candidate_lists_);
     for (size_t i = 0; i < trackers_.size(); ++i) {

@@ -79,6 +79,8 @@ OptionTable<TemplateParams> MakeTemplateTable() {
           .Doc("least ZNCC of the match with the first template at the current scale (drift guard)"),
       BoolOption<P>("template.scale_search", &P::scale_search)
           .Doc("follow the marker's size: the first template tried 5 % larger and smaller each frame"),
+      BoolOption<P>("template.turn_search", &P::turn_search)
+          .Doc("follow the marker's turning: the first template tried 5 deg turned either way each frame"),
   };
 }
 

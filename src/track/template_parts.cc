@@ -194,6 +194,30 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   return m;
 }
 
+void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_deg,
+                    const cv::Mat& shape, cv::Mat* out, cv::Mat* mask, cv::Matx23d* map) {
+  cv::Mat scaled = original;
+  if (size != original.size()) {
+    const bool smaller = size.area() < original.size().area();
+    cv::resize(original, scaled, size, 0, 0, smaller ? cv::INTER_AREA : cv::INTER_LINEAR);
+  }
+  if (turn_deg == 0.0) {
+    *out = scaled.clone();
+    *mask = shape.empty() ? cv::Mat() : shape.clone();
+    *map = cv::Matx23d(1, 0, 0, 0, 1, 0);
+    return;
+  }
+  // cv::getRotationMatrix2D turns a positive angle counter-clockwise on the screen: the minus
+  // keeps the header's convention.
+  const cv::Mat m = cv::getRotationMatrix2D(HalfSize(size), -turn_deg, 1.0);
+  *map = cv::Matx23d(m);
+  cv::warpAffine(scaled, *out, m, size, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  // What turned in from outside the template (or outside its round shape) does not count.
+  const cv::Mat inside = shape.empty() ? cv::Mat(size, CV_8UC1, cv::Scalar(255)) : shape;
+  cv::warpAffine(inside, *mask, m, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+  if (!shape.empty()) cv::bitwise_and(*mask, shape, *mask);
+}
+
 bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
                        BlobMeter* meter, cv::Point2d* anchor) {
   *projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();

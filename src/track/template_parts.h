@@ -29,8 +29,17 @@ inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring
 inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
 // A neighbouring rung replaces the current one only when its ZNCC is higher by this much, so
-// noise does not make the scale flicker between two rungs that fit equally.
+// noise does not make the scale (or the turn) flicker between two rungs that fit equally.
 inline constexpr double kScaleHysteresis = 0.003;
+// The ladder's second dimension: the first template turned about its centre, in steps of this
+// many degrees, all the way round (a sticker on a wheel, a marker on a body that turns). A step
+// this size costs a thin 28 px sticker about 0.95 of its ZNCC against itself.
+inline constexpr double kTurnStepDeg = 5.0;
+inline constexpr int kTurns = 72;  // 360 / kTurnStepDeg.
+// A turned rung replaces the current one only when its ZNCC is higher by this much: a disc fits
+// about as well turned as not (only the background around it changes), and flickering between
+// turns would move its reported point with each step; a sticker 5 degrees off loses far more.
+inline constexpr double kTurnHysteresis = 0.02;
 // Below this self-match of the turned template there is no centre of symmetry worth reporting.
 inline constexpr double kMinSymmetry = 0.5;
 
@@ -272,15 +281,24 @@ struct Hit {
   double score = 0;            // The reported score (see the header).
   double zncc = 1;             // ZNCC at the same placement (= score for ZNCC).
   double rival_zncc = kNoRival;  // ZNCC of the best distinct second peak in the region.
+  cv::Point rival_top_left;    // Its placement (when rival_zncc is finite).
   bool on_inner_edge = false;  // Best on a window edge that is not the frame's: may lie outside.
 };
 
-// The first template at one scale: a rung of the scale ladder.
+// The first template at one scale and turn: a rung of the ladder.
 struct Rung {
   bool tried = false;      // Preparation attempted (templ empty: this scale is impossible).
-  PreparedTemplate templ;  // Masked like the working template.
+  PreparedTemplate templ;  // Masked like the working template (turned: also to what turned in).
   cv::Point2d anchor;      // The reported point, in this rung's template coordinates.
+  cv::Point2d blob_anchor;  // The template's blob's centroid, likewise.
 };
+
+// The first template `original` scaled to `size` and turned by `turn_deg` about its centre (a
+// positive angle turns +x towards +y: clockwise on the screen, y pointing down), into `out`,
+// with its mask: `shape` (the round mask at `size`, or empty) cut to the pixels that come from
+// inside the template. `map` gets the transform from scaled to turned template coordinates.
+void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_deg,
+                    const cv::Mat& shape, cv::Mat* out, cv::Mat* mask, cv::Matx23d* map);
 
 // The first template's measurement of the marker, in frame coordinates.
 struct Fix {

@@ -32,5 +32,42 @@ TEST(TemplateParts, SymmetryCentreOfAnOffCentreDiscIsTheDiscsCentre) {
   EXPECT_NEAR(found.y, centre.y, 0.1);
 }
 
+// A quarter turn of a square template about its centre moves every pixel onto another one
+// exactly: the turned rung is cv::rotate's picture, and its anchor turns with it.
+TEST(TemplateParts, AQuarterTurnIsExactAndTurnsTheAnchorWithThePicture) {
+  cv::Mat templ(21, 21, CV_8UC1);
+  cv::randu(templ, 0, 256);
+  cv::Mat turned, mask, expected;
+  cv::Matx23d map;
+  TurnedTemplate(templ, templ.size(), 90.0, cv::Mat(), &turned, &mask, &map);
+  cv::rotate(templ, expected, cv::ROTATE_90_CLOCKWISE);  // +x towards +y on the screen.
+  EXPECT_EQ(cv::norm(turned, expected, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(mask), 21 * 21);
+  // The pixel at (x, y) = (17, 4) lands where cv::rotate puts it: (20 - 4, 17).
+  const cv::Point2d p(17, 4);
+  const cv::Point2d q(map(0, 0) * p.x + map(0, 1) * p.y + map(0, 2),
+                      map(1, 0) * p.x + map(1, 1) * p.y + map(1, 2));
+  EXPECT_NEAR(q.x, 16.0, 1e-9);
+  EXPECT_NEAR(q.y, 17.0, 1e-9);
+  EXPECT_EQ(turned.at<uint8_t>(17, 16), templ.at<uint8_t>(4, 17));
+}
+
+// A turned rectangle counts only what turned in from inside it (and inside its round shape).
+TEST(TemplateParts, ATurnedRectangleMasksWhatCameFromOutsideIt) {
+  const cv::Mat templ(11, 41, CV_8UC1, cv::Scalar(100));
+  cv::Mat turned, mask;
+  cv::Matx23d map;
+  TurnedTemplate(templ, templ.size(), 90.0, cv::Mat(), &turned, &mask, &map);
+  // Turned a quarter, the 41 x 11 band stands 11 wide and is cut to the 11 rows: an 11 x 11 core.
+  EXPECT_EQ(cv::countNonZero(mask), 11 * 11);
+  const cv::Mat round = RoundMask(templ.size());
+  TurnedTemplate(templ, templ.size(), 30.0, round, &turned, &mask, &map);
+  cv::Mat outside;
+  cv::bitwise_and(mask, ~round, outside);
+  EXPECT_EQ(cv::countNonZero(outside), 0);
+  EXPECT_GT(cv::countNonZero(mask), 0);
+  EXPECT_LT(cv::countNonZero(mask), cv::countNonZero(round));
+}
+
 }  // namespace
 }  // namespace softsight::template_internal

@@ -97,31 +97,44 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
     const cv::Point2d centre = SymmetryCentre(templ, &strength);
     if (strength >= kMinSymmetry) anchor_px_ = centre;
   }
-  rungs_.assign(kRungsBelow + 1 + kRungsAbove, Rung());  // Never resized: RungAt's references stay.
+  rungs_.clear();
   rung_ = kRungsBelow;
-  Rung& selected = rungs_[rung_];
+  turn_ = 0;
+  turn_step_ = 0;
+  Rung& selected = rungs_[RungKey(rung_, turn_)];
   selected.tried = true;
   selected.templ = std::move(first);
   selected.anchor = anchor_px_;
+  selected.blob_anchor = blob_anchor_px_;
   RestoreWorkingTemplate();
 }
 
-// The rung `index` of the ladder, prepared on first use; nullptr when that scale is impossible.
-const Rung* TemplateTracker::RungAt(int index) {
-  if (index < 0 || index >= static_cast<int>(rungs_.size())) return nullptr;
-  Rung& rung = rungs_[index];
+namespace {
+cv::Point2d Apply(const cv::Matx23d& m, const cv::Point2d& p) {
+  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
+}
+}  // namespace
+
+// The rung of the ladder at `scale` and `turn` (any whole number of steps: taken round the
+// circle), prepared on first use; nullptr when that scale is impossible.
+const Rung* TemplateTracker::RungAt(int scale, int turn) {
+  if (scale < 0 || scale > kRungsBelow + kRungsAbove) return nullptr;
+  turn = ((turn % kTurns) + kTurns) % kTurns;
+  Rung& rung = rungs_[RungKey(scale, turn)];
   if (!rung.tried) {
     rung.tried = true;
-    const double scale = std::pow(kScaleStep, index - kRungsBelow);
-    const cv::Size size(static_cast<int>(std::lround(original_.cols * scale)),
-                        static_cast<int>(std::lround(original_.rows * scale)));
+    const double factor = std::pow(kScaleStep, scale - kRungsBelow);
+    const cv::Size size(static_cast<int>(std::lround(original_.cols * factor)),
+                        static_cast<int>(std::lround(original_.rows * factor)));
     if (std::min(size.width, size.height) >= kMinRungPx &&
         static_cast<int>(size.area()) * original_.channels() <= kMaxTemplateValues &&
         size.width * original_.channels() <= kMaxTemplateRowBytes) {
-      cv::Mat scaled;
-      cv::resize(original_, scaled, size, 0, 0, scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
-      if (rung.templ.Prepare(scaled, MaskFor(size))) {
-        rung.anchor = ToRung(anchor_px_, size);
+      cv::Mat turned, mask;
+      cv::Matx23d map;
+      TurnedTemplate(original_, size, turn * kTurnStepDeg, MaskFor(size), &turned, &mask, &map);
+      if (rung.templ.Prepare(turned, mask)) {
+        rung.anchor = Apply(map, ToRung(anchor_px_, size));
+        rung.blob_anchor = Apply(map, ToRung(blob_anchor_px_, size));
       }
     }
   }
@@ -129,9 +142,10 @@ const Rung* TemplateTracker::RungAt(int index) {
 }
 
 void TemplateTracker::RestoreWorkingTemplate() {
-  const PreparedTemplate& rung = rungs_[rung_].templ;
+  const PreparedTemplate& rung = current().templ;
   working_.Prepare(rung.image(), rung.mask());
   working_mask_ = rung.mask().empty() ? cv::Mat() : rung.mask().clone();
+  working_key_ = RungKey(rung_, turn_);
   rung.image().convertTo(working_f_, CV_32F);
   coarse_.clear();
 }
@@ -342,6 +356,7 @@ std::optional<Hit> TemplateTracker::Search(const cv::Mat& frame, cv::Rect region
     m.rival_zncc = params_.measure == MatchMeasure::kZncc
                        ? sim_.at<float>(rival)
                        : ZnccAt(region_, rival, templ, shape_, zncc_);
+    m.rival_top_left = region.tl() + rival;
   }
   m.on_inner_edge =
       (best.x == 0 && region.x > 0) || (best.x == sim_.cols - 1 && region.br().x < frame.cols) ||
@@ -466,8 +481,9 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
   const int distinct = std::max(2, std::min(size.width, size.height) / 2);
   for (size_t i = 0; i < hits.size(); ++i) {
     const cv::Point d = hits[i].top_left - m.top_left;
-    if (std::abs(d.x) > distinct || std::abs(d.y) > distinct) {
-      m.rival_zncc = std::max(m.rival_zncc, hits[i].zncc);
+    if ((std::abs(d.x) > distinct || std::abs(d.y) > distinct) && hits[i].zncc > m.rival_zncc) {
+      m.rival_zncc = hits[i].zncc;
+      m.rival_top_left = hits[i].top_left;
     }
   }
   return m;
@@ -478,7 +494,7 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
 // still the marker). Empty when the first template's peak is not inside that window: the
 // working template and the first disagree about where the marker is.
 std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Point2d& centre_px) {
-  const Rung& rung = rungs_[rung_];
+  const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   const cv::Rect window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
@@ -519,10 +535,11 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   return fix;
 }
 
-// The best ZNCC of rung `index` within a pixel of being centred on `centre_px`; -inf when the
-// rung does not exist or does not fit in the frame there.
-double TemplateTracker::RungZncc(const cv::Mat& frame, int index, const cv::Point2d& centre_px) {
-  const Rung* rung = RungAt(index);
+// The best ZNCC of the rung at `scale` and `turn` within a pixel of being centred on
+// `centre_px`; -inf when the rung does not exist or does not fit in the frame there.
+double TemplateTracker::RungZncc(const cv::Mat& frame, int scale, int turn,
+                                 const cv::Point2d& centre_px) {
+  const Rung* rung = RungAt(scale, turn);
   if (!rung) return kNoRival;
   const cv::Size size = rung->templ.size();
   const cv::Rect window = WindowAround(centre_px, size, 1);
@@ -533,16 +550,58 @@ double TemplateTracker::RungZncc(const cv::Mat& frame, int index, const cv::Poin
   return BestIn(rung_sim_, &best) ? rung_sim_.at<float>(best) : kNoRival;
 }
 
-// Scale search: the neighbouring rungs of the ladder against the current one, at the match.
-void TemplateTracker::UpdateScale(const cv::Mat& frame, const Fix& fix) {
-  const double here = RungZncc(frame, rung_, fix.centre);
+// Scale and turn search: the neighbouring rungs of the ladder (one scale up and down, one turn
+// either way) against the current one, at the match; the best becomes current when it fits
+// better by the hysteresis. The turn found is the marker's spin from the last frame's.
+void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_turn) {
+  const double here = RungZncc(frame, rung_, turn_, fix.centre);
   if (!std::isfinite(here)) return;
-  const double smaller = RungZncc(frame, rung_ - 1, fix.centre);
-  const double larger = RungZncc(frame, rung_ + 1, fix.centre);
-  const int step = larger >= smaller ? 1 : -1;
-  if (std::max(smaller, larger) <= here + kScaleHysteresis) return;
-  rung_ += step;
-  if (!adapts()) coarse_.clear();  // The search template changed.
+  int scale = rung_, turn = turn_;
+  double best = here + kScaleHysteresis;
+  const auto consider = [&](int s, int t) {
+    const double zncc = RungZncc(frame, s, t, fix.centre);
+    if (zncc > best) {
+      best = zncc;
+      scale = s;
+      turn = t;
+    }
+  };
+  if (params_.scale_search) {
+    consider(rung_ + 1, turn_);  // Larger first: it wins a tie.
+    consider(rung_ - 1, turn_);
+  }
+  if (params_.turn_search) {
+    best = std::max(best, here + kTurnHysteresis);  // A turn must fit better by more.
+    consider(rung_, turn_ + 1);
+    consider(rung_, turn_ - 1);
+  }
+  turn = ((turn % kTurns) + kTurns) % kTurns;
+  if (params_.turn_search) {
+    int spin = turn - last_turn;  // Steps since the last match, the short way round.
+    if (spin > kTurns / 2) spin -= kTurns;
+    if (spin < -kTurns / 2) spin += kTurns;
+    turn_step_ = spin;
+  }
+  if (scale == rung_ && turn == turn_) return;
+  const bool turned = turn != turn_;
+  rung_ = scale;
+  turn_ = turn;
+  if (turned) {
+    TurnedTo();
+  } else if (!adapts()) {
+    coarse_.clear();  // The search template changed.
+  }
+}
+
+// The current turn changed: the working template, a blend of the patches the marker showed
+// turned as it was, starts again from the first template at the new turn (blending a turning
+// marker's patches smears it, and a search with that lost a sticker turning 5 degrees a frame).
+void TemplateTracker::TurnedTo() {
+  if (adapts()) {
+    RestoreWorkingTemplate();
+  } else {
+    coarse_.clear();
+  }
 }
 
 // How far to move the match onto the marker's blob (the template's foreground), so the position
@@ -555,7 +614,7 @@ void TemplateTracker::UpdateScale(const cv::Mat& frame, const Fix& fix) {
 // merged with its surroundings (it reaches the patch's edge), one whose area is far from the
 // learned blob's at this scale, or one farther than a quarter of the template.
 std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, const Fix& fix) {
-  const Rung& rung = rungs_[rung_];
+  const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   const cv::Rect at = WindowAround(fix.centre, size, 0);
   if ((at & cv::Rect(0, 0, frame.cols, frame.rows)) != at) return std::nullopt;
@@ -563,7 +622,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   BlobChannel(blob_native_, blob_gray_);
   // Where the template puts its blob (patch coordinates): the learned centroid at this rung.
   const cv::Point2d expected =
-      fix.centre - HalfSize(size) - cv::Point2d(at.tl()) + ToRung(blob_anchor_px_, size);
+      fix.centre - HalfSize(size) - cv::Point2d(at.tl()) + rung.blob_anchor;
   cv::Point2d centroid;
   double area = 0;
   if (!blob_.Locate(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
@@ -588,18 +647,22 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
 }
 
 void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px) {
-  const Rung& rung = rungs_[rung_];
+  const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   const cv::Rect around = WindowAround(centre_px, size, 2);
   if ((around & cv::Rect(0, 0, frame.cols, frame.rows)) != around) return;
   Native(frame, around, region_);
   // getRectSubPix centres the patch on its geometric centre, which centre_px is.
   cv::getRectSubPix(region_, size, centre_px - cv::Point2d(around.tl()), patch_, CV_32F);
-  if (working_f_.size() != size) {
-    // The scale changed: the running template follows it before the blend.
-    cv::resize(working_f_, resized_, size, 0, 0, cv::INTER_LINEAR);
-    std::swap(working_f_, resized_);
+  if (working_key_ != RungKey(rung_, turn_)) {
+    // The scale or turn changed: the running template follows its size and mask before the blend
+    // (its pixels follow a turn through the blend itself).
+    if (working_f_.size() != size) {
+      cv::resize(working_f_, resized_, size, 0, 0, cv::INTER_LINEAR);
+      std::swap(working_f_, resized_);
+    }
     working_mask_ = rung.templ.mask().empty() ? cv::Mat() : rung.templ.mask().clone();
+    working_key_ = RungKey(rung_, turn_);
   }
   cv::addWeighted(working_f_, 1.0 - params_.update_rate, patch_, params_.update_rate, 0.0,
                   working_f_);
@@ -615,9 +678,20 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
 
 Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   CV_Assert(frame_bgr.type() == CV_8UC3 || frame_bgr.type() == CV_8UC1);
+  weighed_.clear();
+  weighed_centres_.clear();
   if (rungs_.empty()) return Observation::NotFound(MarkerStatus::kNotStarted);  // No template.
   const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
   native_rect_ = cv::Rect();  // A new frame: nothing converted yet.
+  frame_ = frame_bgr;  // A header: adopt() verifies another candidate on this frame.
+  saved_ = State{last_centre_, velocity_px_, tracking_, repeats_, lost_frames_,
+                 rung_,        turn_,        turn_step_};
+  // A marker that spins (a sticker on a wheel) is looked for turned on as it turned last frame.
+  const int last_turn = turn_;
+  if (tracking_ && turn_step_ != 0 && RungAt(rung_, turn_ + turn_step_)) {
+    turn_ = ((turn_ + turn_step_) % kTurns + kTurns) % kTurns;
+    TurnedTo();
+  }
   std::optional<Hit> hit;
   if (tracking_) {
     cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
@@ -641,6 +715,17 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   }
   if (!hit) hit = Acquire(frame_bgr);
   if (!hit || !Accept(*hit)) return Lose(MarkerStatus::kLost);
+  const cv::Point2d matched = cv::Point2d(hit->top_left) + hit->offset +
+                              HalfSize(search_template().size());
+  // The places the tracker would take for its marker, for the session's association: the best
+  // match and a distinct second peak that passes min_zncc too (a look-alike: a twin the motion
+  // may tell apart where the scores cannot).
+  const bool rival_fits = hit->rival_zncc >= params_.min_zncc;
+  Weigh(matched, hit->zncc, CandidateVerdict::kFits);
+  if (rival_fits) {
+    Weigh(cv::Point2d(hit->rival_top_left) + HalfSize(search_template().size()), hit->rival_zncc,
+          CandidateVerdict::kFits);
+  }
   if (params_.ambiguity_margin > 0 && hit->rival_zncc >= hit->zncc - params_.ambiguity_margin) {
     return Lose(MarkerStatus::kAmbiguous, 2);
   }
@@ -648,8 +733,61 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     scan_pending_ = false;
     ScanForLookAlikes(frame_bgr, cv::Point2d(hit->top_left) + HalfSize(search_template().size()));
   }
-  const cv::Point2d matched = cv::Point2d(hit->top_left) + hit->offset +
-                              HalfSize(search_template().size());
+  Observation observation = Verify(frame_bgr, matched, hit->score, last_turn);
+  if (observation.found()) {
+    weighed_.front().verdict = CandidateVerdict::kChosen;
+    weighed_.front().position_px = *observation.position_px;
+  } else {
+    weighed_.front().verdict = CandidateVerdict::kShape;  // The first template or blob refused it.
+  }
+  return observation;
+}
+
+void TemplateTracker::Weigh(const cv::Point2d& centre_px, double zncc, CandidateVerdict verdict) {
+  const Rung& rung = current();
+  MarkerCandidate c;
+  // The point the match would report (the rung's anchor), to within the verification's shift.
+  c.position_px = centre_px - HalfSize(rung.templ.size()) + rung.anchor;
+  c.area_px = rung.templ.count();
+  c.circularity = 1.0;
+  c.misfit = std::clamp(1.0 - zncc, 0.0, 2.0);
+  c.verdict = verdict;
+  weighed_.push_back(c);
+  weighed_centres_.push_back(centre_px);
+}
+
+std::optional<Observation> TemplateTracker::adopt(size_t index) {
+  if (index >= weighed_.size() || frame_.empty()) return std::nullopt;
+  if (weighed_[index].verdict != CandidateVerdict::kFits &&
+      weighed_[index].verdict != CandidateVerdict::kChosen) {
+    return std::nullopt;
+  }
+  // Back to before the last update, then verify this candidate as if it had been the choice.
+  last_centre_ = saved_.last_centre;
+  velocity_px_ = saved_.velocity_px;
+  tracking_ = saved_.tracking;
+  repeats_ = saved_.repeats;
+  lost_frames_ = saved_.lost_frames;
+  rung_ = saved_.rung;
+  turn_ = saved_.turn;
+  turn_step_ = saved_.turn_step;
+  if (adapts()) RestoreWorkingTemplate();  // It may have blended in the other candidate.
+  native_rect_ = cv::Rect();
+  const Observation observation =
+      Verify(frame_, weighed_centres_[index], 1.0 - weighed_[index].misfit, turn_);
+  if (!observation.found()) return std::nullopt;
+  for (MarkerCandidate& c : weighed_) {
+    if (c.verdict == CandidateVerdict::kChosen) c.verdict = CandidateVerdict::kFits;
+  }
+  weighed_[index].verdict = CandidateVerdict::kChosen;
+  weighed_[index].position_px = *observation.position_px;
+  return observation;
+}
+
+// The first template's measurement at the working template's match `matched` (its centre), the
+// drift guard, the template's blob, then the tracker's state moves on to it.
+Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched,
+                                    double score, int last_turn) {
   const std::optional<Fix> fix = Measure(frame_bgr, matched);
   // SAD and SSD compare grey levels with the first template too: they do not cancel a change of
   // light, and a position they measure against a template the light has left is biased.
@@ -684,11 +822,11 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   last_centre_ = at.centre;
   tracking_ = true;
   lost_frames_ = 0;
-  if (params_.scale_search) UpdateScale(frame_bgr, at);
+  if (params_.scale_search || params_.turn_search) UpdatePose(frame_bgr, at, last_turn);
   if (adapts()) UpdateTemplate(frame_bgr, at.centre);
   Observation observation;
   observation.position_px = at.reported;
-  observation.score = hit->score;
+  observation.score = score;
   return observation;
 }
 

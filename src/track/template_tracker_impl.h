@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,10 +27,13 @@ class TemplateTracker final : public Tracker {
   void init(const cv::Mat& frame_bgr, const cv::Rect& hint) override;
   bool start(const Frame& frame) override;
   Observation update(const cv::Mat& frame_bgr) override;
+  const std::vector<MarkerCandidate>& candidates() const override { return weighed_; }
+  std::optional<Observation> adopt(size_t index) override;
   void reset() override {
     tracking_ = false;
     last_centre_.reset();
     velocity_px_ = {0, 0};
+    turn_step_ = 0;
     repeats_ = 0;
     lost_frames_ = 0;
   }
@@ -38,8 +42,10 @@ class TemplateTracker final : public Tracker {
   bool adapts() const { return params_.update_rate > 0; }
   // The template searched with: the updated one, or the first template at the current scale.
   const PreparedTemplate& search_template() const {
-    return adapts() ? working_ : rungs_[rung_].templ;
+    return adapts() ? working_ : current().templ;
   }
+  static int RungKey(int scale, int turn) { return scale * kTurns + turn; }
+  const Rung& current() const { return rungs_.at(RungKey(rung_, turn_)); }
   void ToNative(const cv::Mat& frame, cv::Mat& out) const;
   void ConvertAround(const cv::Mat& frame, const cv::Rect& rect);
   void Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat& out);
@@ -61,7 +67,7 @@ class TemplateTracker final : public Tracker {
     return params_.round_mask ? RoundMask(size) : cv::Mat();
   }
   void SetTemplate(const cv::Mat& templ, const std::string& where);
-  const Rung* RungAt(int index);
+  const Rung* RungAt(int scale, int turn);
   void Similarity(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& sim);
   double ScoreOf(double similarity) const;
   bool Accept(const Hit& m) const;
@@ -71,15 +77,22 @@ class TemplateTracker final : public Tracker {
   std::optional<Hit> Refine(const cv::Mat& frame, cv::Point top_left);
   std::optional<Hit> Acquire(const cv::Mat& frame);
   std::optional<Fix> Measure(const cv::Mat& frame, const cv::Point2d& centre_px);
-  double RungZncc(const cv::Mat& frame, int index, const cv::Point2d& centre_px);
-  void UpdateScale(const cv::Mat& frame, const Fix& fix);
+  double RungZncc(const cv::Mat& frame, int scale, int turn, const cv::Point2d& centre_px);
+  void UpdatePose(const cv::Mat& frame, const Fix& fix, int last_turn);
+  void TurnedTo();
   void UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px);
   void RestoreWorkingTemplate();
   void ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d& centre_px);
+  // Lists a place the template fits (its centre in the frame) among the candidates weighed.
+  void Weigh(const cv::Point2d& centre_px, double zncc, CandidateVerdict verdict);
+  // Verifies the match centred at `matched` and, when it holds, moves the tracker on to it.
+  Observation Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched, double score,
+                     int last_turn);
   double rung_scale() const { return std::pow(kScaleStep, rung_ - kRungsBelow); }
   Observation Lose(MarkerStatus why, int candidates = 0) {
     tracking_ = false;  // Keep last_centre_: the next acquisition looks around it.
     velocity_px_ = {0, 0};
+    turn_step_ = 0;
     repeats_ = 0;
     ++lost_frames_;
     return Observation::NotFound(why, candidates);
@@ -88,8 +101,14 @@ class TemplateTracker final : public Tracker {
   TemplateParams params_;
   cv::Mat original_;                    // The selected template, native (gray or BGR).
   cv::Point2d anchor_px_{0, 0};         // The reported point, in the selected template.
-  std::vector<Rung> rungs_;             // The scale ladder; [kRungsBelow] is the selection.
+  // The ladder: the first template at each scale (0 .. kRungsBelow + kRungsAbove; kRungsBelow is
+  // the selection's) and turn (0 .. kTurns - 1), prepared on first use (a map: the references
+  // RungAt hands out stay valid). The current rung always exists.
+  std::map<int, Rung> rungs_;
   int rung_ = 0;                        // The current scale.
+  int turn_ = 0;                        // The current turn, in kTurnStepDeg steps.
+  int turn_step_ = 0;                   // Turn steps between the last two matches (its spin).
+  int working_key_ = -1;                // The rung the working template's mask belongs to.
   PreparedTemplate working_;            // The updated template (update_rate > 0).
   cv::Mat working_f_;                   // Its CV_32F running blend.
   cv::Mat working_mask_;                // Its mask (or empty), for its current size.
@@ -107,6 +126,19 @@ class TemplateTracker final : public Tracker {
   // covered beside its twin is lost, not swapped.
   double look_alike_px_ = std::numeric_limits<double>::infinity();
   bool scan_pending_ = false;           // Scan for look-alikes at the first match after a hint.
+
+  // The candidates the last update weighed (the best match, a look-alike that fits too) with
+  // their template centres, the frame they were weighed on (a header) and the state before that
+  // update: adopt() verifies another of them as if it had been chosen.
+  std::vector<MarkerCandidate> weighed_;
+  std::vector<cv::Point2d> weighed_centres_;
+  cv::Mat frame_;
+  struct State {
+    std::optional<cv::Point2d> last_centre;
+    cv::Point2d velocity_px;
+    bool tracking = false;
+    int repeats = 0, lost_frames = 0, rung = 0, turn = 0, turn_step = 0;
+  } saved_;
 
   // Buffers reused from frame to frame.
   cv::Mat region_, fine_, raw_, sim_, fine_sim_, rung_sim_, patch_, resized_, candidate_, shape_;

@@ -16,6 +16,10 @@
 //              tracker never picks one of them;
 //   lost       nothing in the searched region fits (or the template's blob is not in the match);
 //   out_of_frame  the predicted window lies outside the image.
+// The places the tracker would take for its marker (its best match, and a distinct second peak
+// that passes min_zncc: a twin) are its candidates() for the session's association, which may
+// adopt() the other one when the motion says it is the marker (verified as the tracker's own
+// choice would be).
 // The reported position is the marker's centre, not the rectangle's: by default the template's
 // centre of point symmetry (a dot's centroid; found once, on the selected template), mapped into
 // the frame through the match with the first template at the current scale (report: centre
@@ -30,8 +34,10 @@
 //   - drift correction against the first template: the position is always measured with the first
 //     template (scaled), never with the updated one, so an updated template cannot carry the
 //     position away; an updated template that no longer resembles the first is discarded;
-//   - a scale search: the first template is kept on a ladder of scales (5 % apart); each frame the
-//     neighbouring rungs are tried and the best one becomes the scale (scale_search).
+//   - a scale and turn search: the first template is kept on a ladder of scales (5 % apart) and
+//     turns (5 degrees apart); each frame the neighbouring rungs are tried and the best one becomes
+//     the scale and turn (scale_search, turn_search); a marker that keeps turning is looked for
+//     turned on by its last spin.
 // A round mask (round, default on) matches only the ellipse inscribed in the template, so the
 // background in the rectangle's corners, which turns with the body, does not count.
 //
@@ -175,6 +181,15 @@ struct TemplateParams {
   // template follows a marker that approaches or recedes (0.4x .. 4x). Default true; false keeps
   // the selected size.
   bool scale_search = true;
+  // Turn search: the first template is also kept turned about its centre in 5 degree steps all
+  // the way round; each frame the turns one step either way are tried at the match (from where
+  // the marker's last spin carries it), and the better is kept when it fits better by a little,
+  // so the template follows a marker that turns (a sticker on a wheel, a marker on a bending body)
+  // and the drift guard compares the match with the first template as turned. Measured on a
+  // 28 x 8 px sticker on a rim turning 5 degrees a frame: without it a template box is lost
+  // after ~4 frames, the drift guard refusing the turned sticker. Default true; false keeps the
+  // selected orientation (a marker that must not be taken for a turned look-alike).
+  bool turn_search = true;
 
   // Returns true when every field is usable; otherwise false with `error` naming the field.
   bool Check(std::string* error) const;
