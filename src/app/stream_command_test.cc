@@ -150,7 +150,9 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
   EXPECT_EQ(copy[0], header);
   for (size_t r = 1; r < csv.size(); ++r) {
     for (size_t c = 0; c < header.size(); ++c) {
-      if (!IsTiming(header[c])) ExpectSameValue(csv[r][c], copy[r][c], "listened row " + std::to_string(r));
+      if (!IsTiming(header[c])) {
+        ExpectSameValue(csv[r][c], copy[r][c], "listened row " + std::to_string(r));
+      }
     }
   }
   EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("none dropped")));
@@ -186,7 +188,9 @@ TEST(Stream, StalledSubscriberLeavesTheRowsAndCountsDrops) {
   for (size_t r = 0; r < a.size(); ++r) {
     ASSERT_EQ(a[r].size(), b[r].size());
     for (size_t c = 0; c < a[r].size(); ++c) {
-      if (!IsTiming(a[0][c])) EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " " << a[0][c];
+      if (!IsTiming(a[0][c])) {
+        EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " " << a[0][c];
+      }
     }
   }
   EXPECT_EQ(summary.frames, 150);

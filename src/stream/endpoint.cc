@@ -23,6 +23,16 @@ void CheckScheme(const std::string& endpoint, const std::string& option) {
   if (!StartsWith(endpoint, "tcp://") && !StartsWith(endpoint, "ipc://")) {
     throw InputError(option + " " + endpoint + ": not an endpoint; " + kForms);
   }
+  if (!StartsWith(endpoint, "tcp://")) return;
+  // ZeroMQ takes a port beyond 65535 modulo 65536: another port than the one asked for.
+  const size_t colon = endpoint.rfind(':');
+  const std::string port = colon == std::string::npos ? "" : endpoint.substr(colon + 1);
+  const bool digits = !port.empty() && port.size() <= 5 &&
+                      port.find_first_not_of("0123456789") == std::string::npos;
+  if (port != "*" && (!digits || std::stoi(port) < 1 || std::stoi(port) > 65535)) {
+    throw InputError(option + " " + endpoint + ": the port must be 1..65535 (or * for any free "
+                     "one); " + kForms);
+  }
 }
 
 // Whether a program accepts connections on the unix socket at `path`.

@@ -185,8 +185,8 @@ void PublishSink::end(const RunSummary& summary) {
 }
 
 void PublishSink::report(RunSummary& summary) const {
-  std::string note = "--publish " + bound_endpoint_ + ": " + std::to_string(sent_) +
-                     " messages to " + std::to_string(subscriptions_seen_) + " subscriptions";
+  std::string note = "--publish " + bound_endpoint_ + ": messages sent " + std::to_string(sent_) +
+                     ", subscriptions " + std::to_string(subscriptions_seen_);
   if (dropped_ > 0) {
     note += "; " + std::to_string(dropped_) + " of them dropped for a subscriber too slow to read (its queue of " +
             std::to_string(options_.high_water_mark) + " was full)";
