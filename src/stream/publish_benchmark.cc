@@ -23,6 +23,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "softsight/config/config.h"
+#include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/scene.h"
