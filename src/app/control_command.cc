@@ -416,14 +416,14 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   std::optional<TargetFeed> feed;
   if (options.target_from) {
     target_source.emplace(*options.target_from);
-    feed.emplace(*target_source, TargetFeedOptionsFor(config, options.allow_saturation));
-    const std::optional<double> first =
-        feed->wait_first(options.target_wait_s, [&stop] { return stop.requested(); });
-    if (!first) {
+    feed.emplace(*options.target_from, TargetFeedOptionsFor(config, options.allow_saturation));
+    const ReceivedTargets arrived =
+        target_source->wait(options.target_wait_s, [&stop] { return stop.requested(); });
+    if (stop.requested()) {
       StoppedBySignal(stop, &summary);
       return summary;
     }
-    target.profile = TargetProfile::Constant(*first);
+    target.profile = TargetProfile::Constant(feed->first(arrived, options.target_wait_s));
   }
 
   std::unique_ptr<SimulatedRig> rig;
@@ -453,7 +453,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   columns.insert_before("latency_row_ms", control.latency_column());
   if (publish) publish->set_columns(columns);
   if (!options.csv_file.empty() || !options.identify) csv.emplace(options.csv_file, std::move(columns));
-  if (feed) control.follow(&*feed);
+  if (feed) control.follow(&*target_source, &*feed);
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
   if (rig && frames.rendered == nullptr) sinks.push_back(&rig_clock.emplace(*rig));

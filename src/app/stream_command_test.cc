@@ -2,8 +2,6 @@
 // (a raw record subscriber and `listen --csv`), a subscriber that stops reading, bad endpoints,
 // and `control --target-from` venting when its source falls silent. Every wait is a poll with a
 // bound; none needs a sleep to pass.
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -18,6 +16,7 @@
 
 #include "app/control_command.h"
 #include "app/listen_command.h"
+#include "app/program_test_util.h"
 #include "app/scene_markers_test_util.h"
 #include "app/track_command.h"
 #include "core/test_util.h"
@@ -27,7 +26,9 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::ProgramRun;
 using testing::ReadLines;
+using testing::RunBinary;
 using testing::ReadTextFile;
 using testing::SplitCsv;
 using testing::TempDir;
@@ -195,18 +196,6 @@ TEST(Stream, StalledSubscriberLeavesTheRowsAndCountsDrops) {
   }
   EXPECT_EQ(summary.frames, 150);
   EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("dropped for a subscriber too slow")));
-}
-
-struct ProgramRun {
-  int exit_code;
-  std::string stderr_text;
-};
-
-ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
-  const std::string command =
-      testing::SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ReadTextFile(dir.file("stderr.txt"))};
 }
 
 // A bad endpoint is one error line and exit 2, before anything is written; an ipc path that is

@@ -8,8 +8,8 @@
 
 namespace softsight {
 
-TargetFeed::TargetFeed(TargetSubscriber& source, TargetFeedOptions options)
-    : source_(source), options_(std::move(options)) {}
+TargetFeed::TargetFeed(std::string endpoint, TargetFeedOptions options)
+    : endpoint_(std::move(endpoint)), options_(std::move(options)) {}
 
 std::optional<double> TargetFeed::checked(double deg) {
   std::string problem;
@@ -46,29 +46,26 @@ void TargetFeed::take(const ReceivedTargets& received) {
   }
 }
 
-std::optional<double> TargetFeed::wait_first(double wait_s,
-                                             const std::function<bool()>& stop_requested) {
-  const ReceivedTargets first = source_.wait(wait_s, stop_requested);
-  take(first);
-  if (stop_requested && stop_requested()) return std::nullopt;
-  if (!first.newest_deg) {
-    throw InputError("--target-from " + source_.endpoint() + ": no target within " +
-                     ShortNumber(wait_s) + " s (--target-wait-s)" +
-                     (first.malformed > 0 ? "; " + std::to_string(first.malformed) +
-                                                " malformed messages, the first " +
-                                                first.first_problem
-                                          : std::string()) +
+double TargetFeed::first(const ReceivedTargets& arrived, double waited_s) {
+  take(arrived);
+  if (!arrived.newest_deg) {
+    throw InputError("--target-from " + endpoint_ + ": no target within " + ShortNumber(waited_s) +
+                     " s (--target-wait-s)" +
+                     (arrived.malformed > 0 ? "; " + std::to_string(arrived.malformed) +
+                                                  " malformed messages, the first " +
+                                                  arrived.first_problem
+                                            : std::string()) +
                      "; nothing sent to the board");
   }
   if (!requested_deg_) {
-    throw InputError("--target-from " + source_.endpoint() + ": the first target " +
-                     first_refusal_ + "; nothing sent to the board");
+    throw InputError("--target-from " + endpoint_ + ": the first target: " + first_refusal_ +
+                     "; nothing sent to the board");
   }
-  return requested_deg_;
+  return *requested_deg_;
 }
 
-std::optional<double> TargetFeed::at(double time_s) {
-  take(source_.poll());
+std::optional<double> TargetFeed::at(double time_s, const ReceivedTargets& arrived) {
+  take(arrived);
   if (!heard_at_s_ || heard_since_last_frame_) heard_at_s_ = time_s;
   heard_since_last_frame_ = false;
   const double dt = last_time_s_ ? std::max(0.0, time_s - *last_time_s_) : 0.0;
@@ -96,7 +93,7 @@ std::optional<double> TargetFeed::at(double time_s) {
 
 std::vector<std::string> TargetFeed::notes() const {
   std::vector<std::string> notes;
-  std::string line = "--target-from " + source_.endpoint() + ": " + std::to_string(received_) +
+  std::string line = "--target-from " + endpoint_ + ": " + std::to_string(received_) +
                      " target messages";
   if (refused_ > 0) {
     line += ", " + std::to_string(refused_) + " refused (kept the previous target; the first: " +

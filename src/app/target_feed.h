@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,17 +23,20 @@ struct TargetFeedOptions {
   double max_kpa = 0.0;             // ControllerOptions::max_kpa, for the reach.
 };
 
+// The checks only: what arrived comes from a TargetSubscriber (the caller polls it), so the rules
+// are tested without a socket.
 class TargetFeed {
  public:
-  TargetFeed(TargetSubscriber& source, TargetFeedOptions options);
+  // `endpoint` names the source in errors and notes.
+  TargetFeed(std::string endpoint, TargetFeedOptions options);
 
-  // Before the board is opened: waits at most `wait_s` for the first target and returns it,
-  // checked. Throws InputError naming the endpoint when none comes in time or the first is
-  // refused (nothing sent to the board yet). `stop_requested` ends the wait early (nullopt).
-  std::optional<double> wait_first(double wait_s, const std::function<bool()>& stop_requested);
-  // Per frame at `time_s` (the frame's timestamp): what arrived is checked, and the target the
-  // loop follows now is returned; nullopt when the source has been silent too long (vent).
-  std::optional<double> at(double time_s);
+  // Before the board is opened, what arrived while waiting (TargetSubscriber::wait, at most
+  // `waited_s`): the first target, checked. Throws InputError naming the endpoint when none came
+  // or the first was refused (nothing sent to the board yet).
+  double first(const ReceivedTargets& arrived, double waited_s);
+  // Per frame at `time_s` (the frame's timestamp), with what arrived since the last frame: the
+  // target the loop follows now, or nullopt when the source has been silent too long (vent).
+  std::optional<double> at(double time_s, const ReceivedTargets& arrived);
 
   // One line each: targets received and refused, the silences that vented.
   std::vector<std::string> notes() const;
@@ -45,7 +47,7 @@ class TargetFeed {
   std::optional<double> checked(double deg);
   void take(const ReceivedTargets& received);
 
-  TargetSubscriber& source_;
+  std::string endpoint_;
   TargetFeedOptions options_;
   std::optional<double> requested_deg_;  // The newest accepted target.
   std::optional<double> followed_deg_;   // What the loop follows (rate-limited).

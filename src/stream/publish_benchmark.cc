@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
+#include "pipeline/scene_config_test_util.h"
 #include "softsight/config/config.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
@@ -60,26 +61,6 @@ struct Scratch {
   }
   std::string file(const char* name) const { return (dir / name).string(); }
 };
-
-// The config of the rendered bending scene: red, blue and green, base to tip.
-TrackingConfig ThreeMarkerConfig() {
-  TrackingConfig config;
-  const char* names[] = {"red", "blue", "green"};
-  const HsvRange hues[] = {{170, 10}, {100, 130}, {45, 85}};
-  for (int i = 0; i < 3; ++i) {
-    MarkerSpec spec;
-    spec.name = names[i];
-    ColourParams& colour = std::get<ColourParams>(spec.params);
-    colour.h = hues[i];
-    colour.s = {80, 255};
-    colour.v = {40, 255};
-    config.markers.push_back(spec);
-  }
-  config.measure.base = "red";
-  config.measure.middle = "blue";
-  config.measure.tip = "green";
-  return config;
-}
 
 // A subscriber thread: receives every message, parses it (as a lab's script would), and notes
 // when each frame record arrived.
@@ -151,7 +132,7 @@ FrameResult SampleResult(const TrackingConfig& config) {
 void BM_CaptureToSubscriber(benchmark::State& state) {
   Scratch scratch;
   const bool tcp = state.range(0) == 1;
-  const TrackingConfig config = ThreeMarkerConfig();
+  const TrackingConfig config = testing::ThreeMarkerSceneConfig();
   CsvSink csv(scratch.file("run.csv"), TrackingColumns(config));
   PublishOptions options;
   options.endpoint = tcp ? "tcp://127.0.0.1:*" : "ipc://" + scratch.file("s.ipc");
@@ -220,7 +201,7 @@ const std::vector<cv::Mat>& Frames() {
 void BM_RunCost(benchmark::State& state) {
   Scratch scratch;
   const int subscribers = static_cast<int>(state.range(0));
-  const TrackingConfig config = ThreeMarkerConfig();
+  const TrackingConfig config = testing::ThreeMarkerSceneConfig();
   const std::vector<cv::Mat>& images = Frames();
   TrackingSession session(config);
   CsvSink csv(scratch.file("run.csv"), TrackingColumns(config));
