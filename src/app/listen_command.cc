@@ -166,7 +166,7 @@ CommandRunner SetupListenCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight listen tcp://localhost:5556\n"
       "  softsight listen tcp://rig-pc:5556 --csv remote.csv\n"
-      "  softsight listen ipc:///tmp/softsight.ipc --topic marker/tip --json");
+      "  softsight listen ipc:///tmp/softsight.ipc --topic marker/green --json");
   sub.add_option("endpoint", o->endpoint,
                  "Where the run publishes: tcp://HOST:PORT or ipc://PATH (its --publish, with * "
                  "replaced by its host name)")
