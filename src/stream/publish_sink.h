@@ -34,7 +34,7 @@ struct PublishOptions {
   // a socket, nor one another program listens on).
   std::string endpoint;
   // Messages queued per subscriber before further ones are dropped (ZMQ_SNDHWM). Default 1000:
-  // about 8 s of every topic of a 3-marker run at 30 fps. Range 1..1000000.
+  // about 6 s of every topic (5 a frame) of a 3-marker run at 30 fps. Range 1..1000000.
   int high_water_mark = 1000;
   // Before the first frame, wait until this many subscriptions to "hello" have arrived
   // (softsight listen and softsight.stream.subscribe each make one), so that they see every
