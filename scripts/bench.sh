@@ -15,7 +15,7 @@ WORK=${1:-bench_out}
 mkdir -p "$WORK"
 cmake --build build --target softsight softsight_speed_report softsight_colour_tracker_benchmark \
   softsight_template_matching_benchmark softsight_frame_writer_benchmark \
-  softsight_tracking_session_benchmark >/dev/null
+  softsight_tracking_session_benchmark softsight_publish_benchmark >/dev/null
 S=build/src/app/softsight
 CFG=examples/markers.yaml
 PY=$(command -v python3)
@@ -223,4 +223,33 @@ over = " | ".join(f"{cpu('BM_Session3', s) - cpu('BM_Trackers3', s):.3f} ms "
                   f"({(cpu('BM_Session3', s) - cpu('BM_Trackers3', s)) / cpu('BM_Trackers3', s):.2f}x the trackers)"
                   for s in sizes)
 print(f"| the session's own checks (whole - trackers) | {over} | <= the trackers' time |")
+PYEOF
+
+# The stream (--publish, issue 28): capture-to-subscriber latency beside the CSV row's, and the
+# run's own time per frame with 0, 1 and 10 subscribers beside a run without --publish.
+echo
+echo "The stream (--publish), load average $(cut -d' ' -f1-3 /proc/loadavg):"
+echo
+build/src/stream/softsight_publish_benchmark --benchmark_repetitions=5 \
+  --benchmark_report_aggregates_only=true --benchmark_out_format=json \
+  --benchmark_out="$WORK/publish.json" >/dev/null 2>"$WORK/publish.log"
+"$PY" - "$WORK" <<'PYEOF'
+import json, os, sys
+with open(os.path.join(sys.argv[1], "publish.json")) as f:
+    b = {x["name"]: x for x in json.load(f)["benchmarks"]}
+# Each figure: the median over 5 repetitions.
+print("| what | median | p99 | reference in the same run |")
+print("| --- | --- | --- | --- |")
+for arg, label in ((0, "ipc://"), (1, "tcp://127.0.0.1")):
+    r = b[f"BM_CaptureToSubscriber/{arg}/iterations:3000/real_time_median"]
+    print(f"| capture to a subscriber's receive, {label} | {r['subscriber_ms_median']:.3f} ms | "
+          f"{r['subscriber_ms_p99']:.3f} ms | CSV row {r['csv_row_ms_median']:.3f} / {r['csv_row_ms_p99']:.3f} ms; "
+          f"subscriber - row medians {r['subscriber_minus_row_ms_median']:.3f} ms (target <= 1 ms) |")
+base = b["BM_RunCost/-1/iterations:600/real_time_median"]
+for n in (0, 1, 10):
+    r = b[f"BM_RunCost/{n}/iterations:600/real_time_median"]
+    drops = f", {int(r['dropped'])} of {int(r['sent'])} messages dropped" if r.get("dropped") else ""
+    print(f"| the run's thread per frame (session + CSV + stream, 640x480, 3 markers), {n} subscribers{drops} | "
+          f"wall {r['real_time']:.3f} ms, CPU {r['cpu_time']:.3f} ms | | without --publish: wall "
+          f"{base['real_time']:.3f} ms, CPU {base['cpu_time']:.3f} ms |")
 PYEOF

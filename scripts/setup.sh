@@ -10,6 +10,7 @@ PACKAGES=(
   libyaml-cpp-dev        # configuration files
   libcli11-dev           # command-line parsing
   libserial-dev          # serial link to the pneumatic board
+  libzmq3-dev cppzmq-dev nlohmann-json3-dev  # --publish / listen / --target-from: ZeroMQ and its JSON records
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks
   xvfb xauth xdotool     # the live window's tests run under a virtual X server
@@ -19,6 +20,7 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-opencv  # the Python package (python/), its tests and Dask batch runs
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` (setup.py) and its check in a fresh virtual environment
   mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
+  python3-zmq            # softsight.stream.subscribe (the stream's Python end) and its test
 )
 
 missing=()

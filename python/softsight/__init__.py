@@ -13,6 +13,7 @@ The C++ library's API with numpy at the edges (docs/python.md has a tour):
   generator (``for r in softsight.frames("run.avi", config): ...``).
 - ``geometry``, ``calib``, ``sim``: the measurements, calibration and the renderer with its
   exact truth, on numpy arrays. ``batch.track_many``: many inputs on a Dask cluster.
+  ``stream.subscribe(address)``: a run's results as they happen (its ``--publish``).
 
 ``progress=`` (track, frames, batch.track_many): a callable ``progress(done, total)``, True (a
 tqdm bar when tqdm is installed, else a line on ``sys.stderr``) or False/None (silent, the
@@ -52,6 +53,7 @@ __all__ = [
     "geometry",
     "load_config",
     "sim",
+    "stream",
     "track",
     "__version__",
 ]
@@ -152,3 +154,4 @@ def _frames(stream: "_core._FrameStream", report: Optional[_progress.Reporter]) 
 # stubs say; cheap, since Dask itself is only imported when track_many runs. Last: it imports
 # track from this module.
 from . import batch  # noqa: E402
+from . import stream  # noqa: E402  (pyzmq only when subscribe() runs)

@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import batch as batch  # Imported by __init__.py (Dask only when track_many runs).
+from . import stream as stream  # Imported by __init__.py (pyzmq only when subscribe() runs).
 from . import calib as calib
 from . import geometry as geometry
 from . import sim as sim

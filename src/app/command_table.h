@@ -44,6 +44,8 @@ inline constexpr CommandInfo kCommandTable[] = {
      "commands"},
     {"rig", "Simulated pressure-control board + actuator on a pseudo-terminal (no hardware)",
      "commands"},
+    {"listen", "Receive the results a run publishes (--publish): print them or write a CSV",
+     "commands"},
     {"plot", "Draw angle, bending distance and arc length against time from a CSV (PNG or SVG)",
      "commands"},
     {"config", "Print every config key with its default and range (--doc), or check a config",

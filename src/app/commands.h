@@ -26,5 +26,6 @@ CommandRunner SetupCamerasCommand(CLI::App& sub);
 CommandRunner SetupConfigCommand(CLI::App& sub);
 CommandRunner SetupInitCommand(CLI::App& sub);
 CommandRunner SetupPickCommand(CLI::App& sub);
+CommandRunner SetupListenCommand(CLI::App& sub);
 
 }  // namespace softsight

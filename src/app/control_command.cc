@@ -14,6 +14,8 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/control_parts.h"
+#include "app/publish_options.h"
+#include "app/target_feed.h"
 #include "app/stop_request.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
@@ -60,6 +62,7 @@ void CheckOptions(const ControlOptions& o) {
   CheckOption("--duration-s", o.duration_s, 0.0, 7 * 86400.0, /*lo_open=*/true);  // A week.
   CheckOption("--fps", o.fps, 0.0, 1000.0, /*lo_open=*/true);
   CheckOption("--closed-loop-s", o.identify_options.closed_loop_s, 0.0, 100.0, /*lo_open=*/true);
+  CheckOption("--target-wait-s", o.target_wait_s, 0.0, 86400.0, /*lo_open=*/true);
   if (o.sim_supersample < 1 || o.sim_supersample > 8) {
     throw InputError("sim_supersample " + std::to_string(o.sim_supersample) + ": must be in 1..8");
   }
@@ -67,13 +70,16 @@ void CheckOptions(const ControlOptions& o) {
 
 ControlTarget MakeTarget(const ControlOptions& o) {
   const int chosen = (o.target_deg ? 1 : 0) + (o.profile_file ? 1 : 0) + (o.pressure_kpa ? 1 : 0) +
-                     (o.pwm ? 1 : 0);
+                     (o.pwm ? 1 : 0) + (o.target_from ? 1 : 0);
   if (chosen != 1) {
-    throw InputError(
-        "control: give exactly one of --target-deg, --profile, --pressure-kpa or --pwm");
+    throw InputError("control: give exactly one of --target-deg, --profile, --target-from, "
+                     "--pressure-kpa or --pwm");
   }
   ControlTarget target;
-  if (o.target_deg) {
+  if (o.target_from) {
+    // Replaced by the first target received (TargetFeed::wait_first) before the board opens.
+    target.profile = TargetProfile::Constant(180.0);
+  } else if (o.target_deg) {
     target.profile = TargetProfile::Constant(*o.target_deg);
   } else if (o.profile_file) {
     target.profile = TargetProfile::Load(*o.profile_file);
@@ -102,9 +108,10 @@ ControlTarget CheckedTarget(const ControlOptions& options) {
   }
   CheckOptions(options);
   if (!options.identify) return MakeTarget(options);
-  if (options.target_deg || options.profile_file || options.pressure_kpa || options.pwm) {
-    throw InputError("identify: no target option (--target-deg, --profile, --pressure-kpa, "
-                     "--pwm): the experiment chooses the pressures");
+  if (options.target_deg || options.profile_file || options.pressure_kpa || options.pwm ||
+      options.target_from) {
+    throw InputError("identify: no target option (--target-deg, --profile, --target-from, "
+                     "--pressure-kpa, --pwm): the experiment chooses the pressures");
   }
   ControlTarget target;
   target.mode = ControlMode::kPressure;
@@ -129,7 +136,10 @@ ControlConfig ControlConfigFor(const ControlOptions& options, const TrackingConf
 // to the reach (the returned note says so).
 std::optional<std::string> KeepTargetInReach(const ControlOptions& options,
                                              const ControlConfig& config, ControlTarget* target) {
-  if (target->mode != ControlMode::kAngle || options.identify) return std::nullopt;
+  // Targets from outside are checked one by one as they arrive (TargetFeed).
+  if (target->mode != ControlMode::kAngle || options.identify || options.target_from) {
+    return std::nullopt;
+  }
   const std::optional<std::string> problem =
       OutsideReach(config.model, target->profile.lowest_deg(), target->profile.highest_deg(),
                    config.controller.max_kpa);
@@ -149,6 +159,18 @@ std::optional<std::string> KeepTargetInReach(const ControlOptions& options,
                      FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)";
   if (!options.quiet) std::fprintf(stderr, "control: %s\n", note.c_str());
   return note;
+}
+
+// The checks of a target from outside: the controller's silence and rate settings, the model's
+// reach (as KeepTargetInReach's for a profile).
+TargetFeedOptions TargetFeedOptionsFor(const ControlConfig& config, bool allow_saturation) {
+  TargetFeedOptions feed;
+  feed.silence_s = config.controller.target_silence_s;
+  feed.max_rate_deg_per_s = config.controller.target_max_rate_deg_per_s;
+  feed.allow_saturation = allow_saturation;
+  feed.model = config.model;
+  feed.max_kpa = config.controller.max_kpa;
+  return feed;
 }
 
 double RunDuration(const ControlOptions& options, const ControlTarget& target) {
@@ -377,6 +399,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   std::vector<PathRole> outputs{{"--csv", options.csv_file},
                                 {"--metrics-csv", options.metrics_csv_file}};
   outputs.insert(outputs.end(), options.other_outputs.begin(), options.other_outputs.end());
+  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) outputs.push_back(*socket);
   std::vector<PathRole> inputs = ConfigInputs(tracking_config);
   if (options.profile_file) inputs.push_back({"--profile", *options.profile_file});
   if (options.input) inputs.push_back({"--input", *options.input});
@@ -385,6 +408,23 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   const ControlConfig config = ControlConfigFor(options, tracking_config);
   const std::optional<std::string> limited_to_reach = KeepTargetInReach(options, config, &target);
   const double duration_s = RunDuration(options, target);
+  // The stream's endpoint is taken before anything is written or sent: a bad one ends here.
+  const std::unique_ptr<PublishSink> publish = OpenPublishSink(options.publish, options.config_file);
+  // Ctrl-C and SIGTERM from here on: polled between frames and inside every wait for the board.
+  const StopRequest stop;
+  std::optional<TargetSubscriber> target_source;
+  std::optional<TargetFeed> feed;
+  if (options.target_from) {
+    target_source.emplace(*options.target_from);
+    feed.emplace(*options.target_from, TargetFeedOptionsFor(config, options.allow_saturation));
+    const ReceivedTargets arrived =
+        target_source->wait(options.target_wait_s, [&stop] { return stop.requested(); });
+    if (stop.requested()) {
+      StoppedBySignal(stop, &summary);
+      return summary;
+    }
+    target.profile = TargetProfile::Constant(feed->first(arrived, options.target_wait_s));
+  }
 
   std::unique_ptr<SimulatedRig> rig;
   std::unique_ptr<RigServer> rig_server;
@@ -392,8 +432,6 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     rig = std::make_unique<SimulatedRig>(config.rig);
     rig_server = std::make_unique<RigServer>(*rig);
   }
-  // Ctrl-C and SIGTERM from here on: polled between frames and inside every wait for the board.
-  const StopRequest stop;
   std::unique_ptr<Transport> transport =
       OpenSerialTransport(rig_server ? rig_server->port() : *options.port, config.link.baud);
   LinkEnvironment environment;
@@ -410,17 +448,29 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                       /*stop_at_duration=*/frames.rendered == nullptr || options.identify);
   std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
   std::optional<CsvSink> csv;  // Optional for an identification (`softsight identify` without --csv).
-  if (!options.csv_file.empty() || !options.identify) {
-    CsvColumnTable columns = TrackingColumns(
-        tracking_config, ControlColumns(control, experiment, options.identify, frames.rendered));
-    columns.insert_before("latency_row_ms", control.latency_column());
-    csv.emplace(options.csv_file, std::move(columns));
-  }
+  CsvColumnTable columns = TrackingColumns(
+      tracking_config, ControlColumns(control, experiment, options.identify, frames.rendered));
+  columns.insert_before("latency_row_ms", control.latency_column());
+  if (publish) publish->set_columns(columns);
+  if (!options.csv_file.empty() || !options.identify) csv.emplace(options.csv_file, std::move(columns));
+  if (feed) control.follow(&*target_source, &*feed);
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
   if (rig && frames.rendered == nullptr) sinks.push_back(&rig_clock.emplace(*rig));
-  sinks.push_back(&control);  // Before the CSV: its columns read this frame's step.
+  sinks.push_back(&control);  // Before the CSV and the stream: their columns read this frame's step.
   if (csv) sinks.push_back(&*csv);
+  if (publish) sinks.push_back(publish.get());
+  // What the stream and the target's source add to the summary's notes.
+  const auto add_notes = [&] {
+    if (feed) {
+      for (std::string& note : feed->notes()) summary.notes.push_back(std::move(note));
+    }
+    if (publish) {
+      RunSummary published;
+      publish->report(published);
+      for (std::string& note : published.notes) summary.notes.push_back(std::move(note));
+    }
+  };
 
   BoardInfo info;
   try {
@@ -440,17 +490,20 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
+    add_notes();
     StoppedBySignal(stop, &summary);
     session.stop();
     return summary;
   } catch (const std::exception&) {
     // The session's destructor sends STOP on the way out.
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
+    add_notes();
     summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
     throw;
   }
   const RunSummary ran = summary.run;
   CollectControlSummary(control, link, session, limited_to_reach, &summary);
+  add_notes();
   summary.run = ran;
   if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
     session.stop();
@@ -602,6 +655,16 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
   sub.add_option("--pressure-kpa", o->pressure_kpa,
                  "Open loop: hold this pressure setpoint (characterise an actuator)");
   sub.add_option("--pwm", o->pwm, "Open loop: this valve duty in -1..1 (> 0 inflate, < 0 vent)");
+  sub.add_option("--target-from", o->target_from,
+                 "Target angles from another program: a ZeroMQ endpoint it publishes on "
+                 "(tcp://HOST:5557, ipc://PATH), messages `target {\"angle_deg\": 120}`; checked "
+                 "as a profile (0..180, the model's reach), followed at most at "
+                 "controller.target_max_rate_deg_per_s, vented when silent longer than "
+                 "controller.target_silence_s (docs/stream.md)");
+  sub.add_option("--target-wait-s", o->target_wait_s,
+                 "With --target-from: the longest wait for the first target before the board is "
+                 "opened, seconds")
+      ->capture_default_str();
   sub.add_option("-o,--csv", o->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("--duration-s", o->duration_s,
                  "Run length in seconds (default: the profile's length + 2 s, else 10 s)");
@@ -621,7 +684,10 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                "Run a target beyond the identified actuator's reach (control.model) limited to "
                "that reach, instead of refusing it");
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
-  return [o, auto_tune, closed_loop_s] {
+  auto publish = std::make_shared<PublishArgs>();
+  AddPublishOptions(sub, publish.get());
+  return [o, auto_tune, closed_loop_s, publish] {
+    o->publish = publish->resolved();
     ControlOptions run = *o;
     if (*auto_tune) {
       ControlOptions identify = *o;
@@ -630,6 +696,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       identify.profile_file.reset();
       identify.pressure_kpa.reset();
       identify.pwm.reset();
+      identify.target_from.reset();
       identify.duration_s.reset();
       identify.metrics_csv_file.clear();
       identify.identify_options.closed_loop_s = *closed_loop_s;

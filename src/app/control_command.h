@@ -15,6 +15,7 @@
 #include "control/step_metrics.h"
 #include "softsight/control/session.h"
 #include "softsight/io/output_guard.h"
+#include "stream/publish_sink.h"
 
 namespace softsight {
 
@@ -38,6 +39,12 @@ struct ControlOptions {
   std::optional<std::string> profile_file;
   std::optional<double> pressure_kpa;
   std::optional<double> pwm;
+  // Or targets from another program (ZeroMQ SUB, app/target_feed.h): the run waits at most
+  // `target_wait_s` for the first before it opens the board.
+  std::optional<std::string> target_from;
+  double target_wait_s = 10.0;
+  // --publish: every frame's record (the CSV's columns) to subscribers as it happens.
+  std::optional<PublishOptions> publish;
   std::string csv_file;
   std::optional<double> duration_s;     // Default: the profile's length + 2 s, or 10 s.
   double fps = 30.0;                    // Frame rate of simulate / rig_frames.

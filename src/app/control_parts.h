@@ -17,6 +17,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/control_command.h"
+#include "app/target_feed.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
 #include "softsight/core/error.h"
@@ -107,12 +108,25 @@ class ControlSink : public FrameSink {
   // From then on each frame runs this experiment (open loop) instead of the closed loop, until
   // it is done.
   void identify(IdentificationExperiment* experiment) { experiment_ = experiment; }
+  // From then on each frame's target comes from `source`, checked by `feed` (control
+  // --target-from): the loop follows it, and vents while the feed says the source is silent.
+  void follow(TargetSubscriber* source, TargetFeed* feed) {
+    source_ = source;
+    feed_ = feed;
+  }
 
   void consume(const Frame& frame, const FrameResult& result) override {
     if (experiment_ != nullptr) {
       sample_ = StepIdentification(*experiment_, session_, frame.time_s,
                                    result.measurement.angle_deg);
       if (experiment_->done()) done_ = true;
+    } else if (feed_ != nullptr) {
+      if (const std::optional<double> target_deg = feed_->at(frame.time_s, source_->poll())) {
+        session_.set_angle_target(*target_deg);
+        sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+      } else {
+        sample_ = session_.vent(frame.time_s, result.measurement.angle_deg);
+      }
     } else {
       sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
     }
@@ -232,6 +246,8 @@ class ControlSink : public FrameSink {
   }
 
   IdentificationExperiment* experiment_ = nullptr;
+  TargetSubscriber* source_ = nullptr;
+  TargetFeed* feed_ = nullptr;
   std::optional<double> at_limit_since_s_;  // Frame time the output reached max_kpa, while there.
   double longest_at_limit_s_ = 0.0;
   std::vector<TrackingPoint> step_points_;

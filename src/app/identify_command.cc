@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/publish_options.h"
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
@@ -46,6 +47,7 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
   run.camera = options.camera;
   run.rig_frames = options.rig_frames;
   run.csv_file = options.csv_file;
+  run.publish = options.publish;
   run.fps = options.fps;
   run.sim_supersample = options.sim_supersample;
   run.duration_s = options.max_s;
@@ -114,7 +116,10 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   sub.add_option("--max-s", o->max_s, "Longest the experiment may take (default 600 s)");
   sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")->capture_default_str();
   sub.add_flag("-q,--quiet", o->quiet, "Only errors");
-  return [o] {
+  auto publish = std::make_shared<PublishArgs>();
+  AddPublishOptions(sub, publish.get());
+  return [o, publish] {
+    o->publish = publish->resolved();
     if (o->closed_loop_s && !(*o->closed_loop_s > 0.0 && *o->closed_loop_s <= 100.0)) {
       throw InputError("--closed-loop-s " + std::to_string(*o->closed_loop_s) +
                        ": must be a number in (0, 100]");

@@ -2,6 +2,8 @@
 // model fitted to it, gains from the model, all saved into a new config (never the input one).
 #pragma once
 
+#include "stream/publish_sink.h"
+
 #include <optional>
 #include <string>
 
@@ -12,6 +14,8 @@ namespace softsight {
 struct IdentifyCommandOptions {
   std::string config_file;    // Markers + `control:` section, read only.
   std::string output_file;    // The config to write: the input's, plus model: and the gains.
+  // --publish: every frame of the experiment to subscribers as it happens.
+  std::optional<PublishOptions> publish;
   bool simulate = false;      // The in-process simulated rig, rendered and tracked.
   std::optional<std::string> port;
   std::optional<int> camera;

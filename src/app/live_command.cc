@@ -8,10 +8,12 @@
 
 #include "app/capture_options.h"
 #include "app/commands.h"
+#include "app/publish_options.h"
 #include "softsight/core/error.h"
 #include "gui/live_window.h"
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {
@@ -29,6 +31,7 @@ struct LiveArgs {
   bool no_pace = false;
   bool no_trackbars = false;
   CaptureArgs capture;
+  PublishArgs publish;
 };
 
 // markers.yaml -> markers.live.yaml beside it: saving never overwrites the hand-written config.
@@ -85,6 +88,13 @@ int RunLive(const LiveArgs& args) {
   options.chart.window_s = args.window_s;
   options.scale_distance_mm = args.scale_distance_mm;
   if (std::string problem; !options.Check(&problem)) throw InputError("live options: " + problem);
+  // The stream sees every frame the window tracks (stepped and sought ones too, by their own
+  // frame numbers); its columns are those of the config as the window opens.
+  const std::unique_ptr<PublishSink> publish = OpenPublishSink(args.publish.resolved(), args.config);
+  if (publish) {
+    publish->set_columns(TrackingColumns(config));
+    options.sinks.push_back(publish.get());
+  }
   std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
             << " markers; press h in the window for help\n";
   LiveWindowOptions window;
@@ -92,7 +102,11 @@ int RunLive(const LiveArgs& args) {
   window.pace_files = !args.no_pace;
   FrameSourceOpener reopen;
   if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
-  const LiveRunResult run = RunLiveWindow(config, std::move(source), options, window, reopen);
+  LiveRunResult run = RunLiveWindow(config, std::move(source), options, window, reopen);
+  if (publish) {
+    publish->end(run.summary.run);
+    publish->report(run.summary.run);
+  }
   std::cerr << run.summary.Report();
   if (!run.last_recording.empty()) {
     std::cerr << "softsight live: last recording " << run.last_recording << ".*\n";
@@ -152,6 +166,7 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
                "Read a video file as fast as it decodes instead of at its frame rate");
   sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");
   AddCaptureOptions(sub, &args->capture);
+  AddPublishOptions(sub, &args->publish);
   return [args] { return RunLive(*args); };
 }
 

@@ -12,7 +12,7 @@ extern "C" __attribute__((visibility("default"))) int softsight_run_command(int 
       {"calibrate", SetupCalibrateCommand}, {"control", SetupControlCommand},
       {"identify", SetupIdentifyCommand}, {"rig", SetupRigCommand},
       {"plot", SetupPlotCommand},         {"config", SetupConfigCommand},
-      {"cameras", SetupCamerasCommand},
+      {"cameras", SetupCamerasCommand},   {"listen", SetupListenCommand},
   };
   return RunCommandLine(argc, argv, kCommands);
 }

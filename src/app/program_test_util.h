@@ -6,11 +6,24 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <string>
 
 #include "core/test_util.h"
 
 namespace softsight::testing {
+
+struct ProgramRun {
+  int exit_code;
+  std::string stderr_text;
+};
+
+// Runs `softsight ARGS` with its stderr in `dir`/stderr.txt; its exit code (-1: killed) and stderr.
+inline ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
+  const std::string command = SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ReadTextFile(dir.file("stderr.txt"))};
+}
 
 // Runs `softsight ARGS 2> stderr_file`, sends `signal` once `csv` holds `rows` lines (or when
 // the program has ended by itself), and returns the wait status. The commands install their

@@ -11,6 +11,7 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/progress.h"
+#include "app/publish_options.h"
 #include "app/stop_request.h"
 #include "app/track_many.h"
 #include "softsight/core/error.h"
@@ -41,6 +42,7 @@ void CheckOutputs(const TrackOptions& options, const TrackingConfig& config,
   std::vector<PathRole> outputs{{"--csv", options.csv_file}};
   if (options.annotated_file) outputs.push_back({"--annotated", *options.annotated_file});
   if (options.record_file) outputs.push_back({"--record", *options.record_file});
+  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) outputs.push_back(*socket);
   std::vector<PathRole> inputs = ConfigInputs(config);
   for (const std::string& file : source.files()) inputs.push_back({"--input", file});
   CheckOutputsAreNotInputs(outputs, inputs);
@@ -86,9 +88,16 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   if (!seams.open_source) source = SourceForRun(std::move(source), FilePacing::kReadAhead);
   TrackingSession session(config);
 
-  // Sinks in the order they see each frame; every output is opened (and checked) before the run.
+  // Sinks in the order they see each frame; every output is opened (and checked) before the run,
+  // the stream's endpoint first: a bad one is refused before the CSV is made.
+  const std::unique_ptr<PublishSink> publish = OpenPublishSink(options.publish, options.config_file);
   CsvSink csv(options.csv_file, TrackingColumns(config));
   std::vector<FrameSink*> sinks = {&csv};
+  if (publish) {
+    // Right after the CSV: each frame's record leaves as its row is written.
+    publish->set_columns(TrackingColumns(config));
+    sinks.push_back(publish.get());
+  }
   std::optional<VideoSink> annotated;
   if (options.annotated_file) {
     // MJPG keeps the file small: the annotated video is for people, not for measurement.
@@ -129,6 +138,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   auto jobs = std::make_shared<int>(DefaultJobs());
   auto capture = std::make_shared<CaptureArgs>();
   AddCaptureOptions(sub, capture.get());
+  auto publish = std::make_shared<PublishArgs>();
   sub.description(
       "Track the markers of a config in a video (or image sequence) and write one CSV row per\n"
       "frame: every marker's centroid, the bending angle, chord, sagitta, radius of curvature,\n"
@@ -136,7 +146,9 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight track --config examples/markers.yaml --input run.avi --csv run.csv\n"
       "  softsight track --config markers.yaml --camera 0 --csv bench.csv   (Ctrl-C stops)\n"
-      "  softsight track -c markers.yaml -i a.avi -i b.avi -i c.avi -o results/ --jobs 2");
+      "  softsight track -c markers.yaml -i a.avi -i b.avi -i c.avi -o results/ --jobs 2\n"
+      "  softsight track -c markers.yaml --camera 0 --csv run.csv --publish tcp://*:5556\n"
+      "      (and in another terminal: softsight listen tcp://localhost:5556)");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
@@ -178,7 +190,9 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       ->check(NumberIn(0, 1e15));
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
-  return [options, inputs, jobs, capture] {
+  AddPublishOptions(sub, publish.get());
+  return [options, inputs, jobs, capture, publish] {
+    options->publish = publish->resolved();
     const bool from_files = !inputs->empty() || !options->source.input.empty();
     if (!options->source.camera && from_files) {  // Neither: the missing input is said below.
       const std::string source = inputs->size() == 1   ? "the file " + inputs->front()

@@ -14,6 +14,7 @@
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/summary.h"
+#include "stream/publish_sink.h"
 
 namespace softsight {
 
@@ -29,6 +30,8 @@ struct TrackOptions {
   // camera run can be tracked again later and gives the same rows.
   std::optional<std::string> record_file;
   std::optional<int64_t> max_frames;
+  // --publish: every frame's record to subscribers as it happens (stream/publish_sink.h).
+  std::optional<PublishOptions> publish;
   bool quiet = false;                        // No progress bar, no summary.
   bool brief = false;                        // No progress bar, a one-line summary.
 };

@@ -63,17 +63,8 @@ RenderedClip RenderClip(const TempDir& dir, int frames, bool gray = false,
   return clip;
 }
 
-struct ProgramRun {
-  int exit_code;
-  std::string stderr_text;
-};
-
-ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
-  const std::string command =
-      testing::SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::ReadTextFile(dir.file("stderr.txt"))};
-}
+using testing::ProgramRun;
+using testing::RunBinary;
 
 // `track` runs in the commands plugin, which must not load the live window's libraries (highgui
 // and its Qt: ~12 libraries and ~10 ms of every start-up; X11 comes with FFmpeg's hardware

@@ -143,6 +143,11 @@ int RunTrackMany(const TrackManyOptions& options, std::ostream& report) {
                      ": with an output folder, give one input and a CSV file (-o run.csv) to "
                      "also write videos");
   }
+  if (common.publish) {
+    throw InputError("--publish " + common.publish->endpoint +
+                     ": with an output folder, give one input and a CSV file (-o run.csv) to "
+                     "also publish its results");
+  }
   if (common.source.camera) {
     throw InputError("--camera: with an output folder, give --input files (a camera run writes "
                      "one CSV: -o bench.csv)");

@@ -68,6 +68,16 @@ OptionTable<ControllerOptions> MakeController() {
           .Range(0, 60)
           .Unit("s")
           .Doc("vision lost: keep the last setpoint this long, then vent"),
+      DoubleOption<P>("target_silence_s", &P::target_silence_s)
+          .Range(0.01, 600)
+          .Unit("s")
+          .Doc("--target-from: the target's source silent this long (frames' clock) vents the "
+               "actuator until it sends again"),
+      DoubleOption<P>("target_max_rate_deg_per_s", &P::target_max_rate_deg_per_s)
+          .Range(0, 100000)
+          .Unit("deg/s")
+          .Doc("--target-from: the loop follows a new target at most this fast (a jump becomes "
+               "a ramp; 0: unlimited)"),
   };
 }
 

@@ -1,5 +1,7 @@
 #include "softsight/control/session.h"
 
+#include <cassert>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -141,6 +143,22 @@ ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
   sample.measured_deg = measured_deg;
   sample.action = ControllerOutput::Action::kTrack;
   sample.board = checked(send_pressure(setpoint_kpa, &sample.setpoint_kpa));
+  return sample;
+}
+
+void ControlSession::set_angle_target(double target_deg) {
+  assert(target_.mode == ControlMode::kAngle);
+  target_.profile = TargetProfile::Constant(target_deg);
+}
+
+ControlSample ControlSession::vent(double time_s, std::optional<double> measured_deg) {
+  if (!start_time_s_) start_time_s_ = time_s;
+  ControlSample sample;
+  sample.time_s = time_s - *start_time_s_;
+  sample.measured_deg = measured_deg;
+  sample.action = ControllerOutput::Action::kVent;
+  sample.board = checked(link_.stop());
+  controller_.reset();
   return sample;
 }
 

@@ -5,8 +5,10 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "softsight/calib/hsv_picker.h"
+#include "softsight/pipeline/sink.h"
 #include "gui/overlay.h"
 
 namespace softsight {
@@ -39,6 +41,10 @@ struct LiveOptions {
   StripChartOptions chart;
   HsvPickOptions picker;
   OverlayOptions overlay;  // base/middle/tip filled from the config by the window.
+  // Sinks of the program that see every frame the window tracks (`live --publish`: the stream),
+  // in the window's run (PipelineRun) from its first frame. Not owned; the caller ends them when
+  // RunLiveWindow returns, with its summary.
+  std::vector<FrameSink*> sinks;
 
   bool Check(std::string* error) const;
 };

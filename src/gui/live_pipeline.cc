@@ -5,11 +5,12 @@
 
 namespace softsight {
 
-LivePipeline::LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings)
+LivePipeline::LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings,
+                           std::vector<FrameSink*> sinks)
     : settings_(std::move(settings)), session_(std::make_unique<TrackingSession>(config)) {
   RunInfo info = DescribeMarkers(config);
   info.source = "live";
-  run_ = std::make_unique<PipelineRun>(*session_, std::move(info));
+  run_ = std::make_unique<PipelineRun>(*session_, std::move(info), std::move(sinks));
   in_run_ = std::make_unique<RecordingInRun>(*this);
   session_->set_edit_listener([this](const ConfigChange& change) {
     if (!recording_) return;

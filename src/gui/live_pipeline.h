@@ -35,8 +35,10 @@ struct LiveRecordingSettings {
 
 class LivePipeline {
  public:
-  // Builds the tracking session. Throws InputError on a bad config.
-  LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings);
+  // Builds the tracking session. `sinks` (not owned) see every processed frame from the first
+  // (LiveOptions::sinks). Throws InputError on a bad config.
+  LivePipeline(const TrackingConfig& config, LiveRecordingSettings settings,
+               std::vector<FrameSink*> sinks = {});
   ~LivePipeline();  // Closes a running recording (what it wrote stays).
 
   // The frames come from `source` (its description, rate and liveness, for the summary and the

@@ -119,5 +119,35 @@ TEST(LiveSummary, AFileRecordingWaitsForItsEncoderAndARecordingStillOpenIsCounte
   EXPECT_EQ(FramesInVideo(live.last_recording() + ".avi"), 13);
 }
 
+// What `live --publish` hands its stream: a program's sink in LiveOptions::sinks sees every frame
+// the window tracks, from the first, with the session's results.
+class CountingSink : public FrameSink {
+ public:
+  void begin(const RunInfo& info) override { markers = info.marker_names; }
+  void consume(const Frame& frame, const FrameResult& result) override {
+    indices.push_back(frame.index);
+    found += result.markers.at(0).observation.found() ? 1 : 0;
+  }
+  std::vector<std::string> markers;
+  std::vector<int64_t> indices;
+  int found = 0;
+};
+
+TEST(LiveSummary, AProgramsSinkSeesEveryTrackedFrame) {
+  CountingSink sink;
+  LiveOptions options;
+  options.sinks = {&sink};
+  LiveController live(testing::ThreeMarkerSceneConfig(), options);
+  live.describe_source(CameraStandIn());
+  SyntheticScene scene(SmallScene());
+  Feed(live, scene, 0, 12);
+  EXPECT_EQ(sink.markers, (std::vector<std::string>{"red", "blue", "green"}));
+  std::vector<int64_t> expected(12);
+  for (int i = 0; i < 12; ++i) expected[static_cast<size_t>(i)] = i;
+  EXPECT_EQ(sink.indices, expected);
+  EXPECT_EQ(sink.found, 12);
+  EXPECT_EQ(live.run_summary().run.frames, 12);
+}
+
 }  // namespace
 }  // namespace softsight

@@ -54,6 +54,14 @@ struct ControllerOptions {
   // Vision loss: keep the last setpoint (integral frozen) while the measurement has been missing
   // for at most this long (from the first frame without one), then vent. Default 0.5 s.
   double hold_s = 0.5;
+  // Targets from outside (`control --target-from`): a source silent for longer than this (since
+  // its last target, on the frames' clock) vents the actuator until it speaks again. Default
+  // 0.5 s: a few missed messages of a 10 Hz experiment script are not silence.
+  double target_silence_s = 0.5;
+  // How fast the loop's target may follow a target from outside, deg/s: a jump becomes a ramp
+  // at this rate; 0 = unlimited (the setpoint's own slew limit, max_rate_kpa_per_s, still holds).
+  // Default 0.
+  double target_max_rate_deg_per_s = 0.0;
 
   // Returns false and names the bad field in `error`.
   bool Check(std::string* error) const;

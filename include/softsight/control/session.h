@@ -65,6 +65,14 @@ class ControlSession {
   // Vents the actuator (end of run).
   BoardState stop();
 
+  // A target from outside (`control --target-from`), followed from the next step(): replaces
+  // the angle target with this constant one. Angle mode only (a debug assertion).
+  void set_angle_target(double target_deg);
+  // One frame with the actuator vented (the target's source went silent): the sample has no
+  // target and the action kVent; the outer loop starts afresh (reset) at the next step().
+  // Throws as step().
+  ControlSample vent(double time_s, std::optional<double> measured_deg);
+
   // The open-loop pressure target as given, when start() lowered it to max_kpa.
   std::optional<double> pressure_clamped_from() const { return pressure_clamped_from_; }
   // The pressure the open-loop target sends (after the clamp).

@@ -1,0 +1,194 @@
+#include "app/listen_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "app/cli_checks.h"
+#include "app/commands.h"
+#include "app/stop_request.h"
+#include "softsight/core/error.h"
+#include "softsight/core/format.h"
+#include "softsight/io/csv_writer.h"
+#include "stream/stream_format.h"
+#include "stream/subscriber.h"
+
+namespace softsight {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// The slice of each wait: how often Ctrl-C is noticed.
+constexpr int kPollSliceMs = 100;
+
+// A record's value as the CSV field: null -> empty, a number in its shortest exact form, a
+// string as it is (the publisher's rule, stream_format.h, read backwards).
+std::string FieldText(const Json& value) {
+  if (value.is_null()) return "";
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_boolean()) return value.get<bool>() ? "1" : "0";
+  return value.dump();
+}
+
+// The records as CSV rows: the columns are the first record's keys, in its order; each column
+// writes the current record's field (CsvWriter and the column table, as every CSV here).
+class RecordTable {
+ public:
+  explicit RecordTable(const Json& first) {
+    for (const auto& item : first.items()) {
+      const size_t i = table_.size();
+      table_.add({item.key(), [this, i](const FrameResult&, std::string& row) { row += fields_[i]; }});
+    }
+    fields_.resize(table_.size());
+  }
+  const CsvColumnTable& table() const { return table_; }
+  // The record's fields, by column name; a key the first record did not have is left out.
+  void set(const Json& record) {
+    for (size_t i = 0; i < table_.size(); ++i) {
+      const auto it = record.find(table_.column(i).name);
+      fields_[i] = it == record.end() ? std::string() : FieldText(*it);
+    }
+  }
+
+ private:
+  CsvColumnTable table_;
+  std::vector<std::string> fields_;
+};
+
+void CheckHello(const ListenOptions& options, const Json& hello) {
+  const auto version = hello.find("version");
+  if (hello.value("format", std::string()) != kStreamFormatName || version == hello.end() ||
+      !version->is_number_integer()) {
+    throw InputError("listen " + options.endpoint + ": the publisher's hello is not " +
+                     kStreamFormatName + "'s");
+  }
+  if (version->get<int>() != kStreamFormatVersion) {
+    throw InputError("listen " + options.endpoint + ": the publisher speaks " + kStreamFormatName +
+                     " version " + std::to_string(version->get<int>()) + "; this softsight reads version " +
+                     std::to_string(kStreamFormatVersion));
+  }
+}
+
+}  // namespace
+
+ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::ostream& err) {
+  if (options.topic.empty() || options.topic.find(' ') != std::string::npos) {
+    throw InputError("listen --topic '" + options.topic + "': give frame, measure or marker/NAME");
+  }
+  StreamSubscriber subscriber(options.endpoint, {kHelloTopic, options.topic, kEndTopic}, "listen");
+  std::unique_ptr<RecordTable> records;
+  std::unique_ptr<CsvWriter> csv;
+  std::string row;
+  std::optional<int64_t> last_frame;
+  ListenSummary summary;
+  auto heard = std::chrono::steady_clock::now();
+  while (!(options.count && summary.records >= *options.count)) {
+    if (options.stop_requested && options.stop_requested()) break;
+    const std::optional<StreamMessage> message = subscriber.receive(kPollSliceMs);
+    const auto now = std::chrono::steady_clock::now();
+    if (!message) {
+      if (options.timeout_s &&
+          std::chrono::duration<double>(now - heard).count() > *options.timeout_s) {
+        throw InputError("listen " + options.endpoint + ": nothing received for " +
+                         ShortNumber(*options.timeout_s) + " s (--timeout-s); is the run started "
+                         "with --publish at that endpoint?");
+      }
+      continue;
+    }
+    heard = now;
+    const Json body = Json::parse(message->body, nullptr, /*allow_exceptions=*/false);
+    if (body.is_discarded() || !body.is_object()) {
+      throw InputError("listen " + options.endpoint + ": a '" + message->topic +
+                       "' message is not a JSON object: \"" + message->body.substr(0, 60) + "\"");
+    }
+    if (message->topic == kHelloTopic) {
+      CheckHello(options, body);
+      if (summary.hellos++ == 0 && !options.quiet) {
+        err << "listen: " << body.value("source", std::string()) << ", config "
+            << body.value("config", std::string()) << " (digest "
+            << body.value("config_digest", std::string()) << "), "
+            << body.value("columns", Json::array()).size() << " columns, format version " << kStreamFormatVersion << "\n";
+      }
+      continue;
+    }
+    if (message->topic == kEndTopic) {
+      summary.ended = true;
+      summary.end_record = message->body;
+      if (!options.quiet) err << "listen: the run ended: " << message->body << "\n";
+      break;
+    }
+    if (message->topic != options.topic) continue;  // A longer topic with this prefix.
+    ++summary.records;
+    const auto frame = body.find("frame");
+    if (frame != body.end() && frame->is_number_integer()) {
+      const int64_t index = frame->get<int64_t>();
+      if (last_frame && index > *last_frame + 1) summary.frame_gaps += index - *last_frame - 1;
+      last_frame = index;
+    }
+    if (options.json) {
+      out << message->body << "\n" << std::flush;
+      continue;
+    }
+    if (!records) {
+      records = std::make_unique<RecordTable>(body);
+      if (!options.csv_file.empty()) {
+        csv = std::make_unique<CsvWriter>(options.csv_file, records->table());
+      } else {
+        out << records->table().header() << "\n";
+      }
+    }
+    records->set(body);
+    FrameResult named;  // Names the row in a write error.
+    named.frame_index = last_frame.value_or(summary.records - 1);
+    if (csv) {
+      csv->write(named);
+    } else {
+      records->table().append_row(named, row);
+      out << row << "\n" << std::flush;
+    }
+  }
+  if (!options.quiet && summary.frame_gaps > 0) {
+    err << "listen: " << summary.frame_gaps
+        << " frame numbers missing between records (dropped for this listener, or by the source)\n";
+  }
+  return summary;
+}
+
+CommandRunner SetupListenCommand(CLI::App& sub) {
+  auto o = std::make_shared<ListenOptions>();
+  sub.description(
+      "Receive the results a run publishes (track, live, control or identify with --publish):\n"
+      "print each frame's record as a CSV row, or write them to a CSV file, until the run ends.\n"
+      "The records have the run's CSV columns and values (docs/stream.md).\n"
+      "Examples:\n"
+      "  softsight listen tcp://localhost:5556\n"
+      "  softsight listen tcp://rig-pc:5556 --csv remote.csv\n"
+      "  softsight listen ipc:///tmp/softsight.ipc --topic marker/green --json");
+  sub.add_option("endpoint", o->endpoint,
+                 "Where the run publishes: tcp://HOST:PORT or ipc://PATH (its --publish, with * "
+                 "replaced by its host name)")
+      ->required();
+  sub.add_option("--topic", o->topic,
+                 "Which records: frame (every column), measure (the measurements), marker/NAME "
+                 "(one marker's columns)")
+      ->capture_default_str();
+  sub.add_option("-o,--csv", o->csv_file, "Write the records to this CSV instead of printing them");
+  sub.add_flag("--json", o->json, "Print each record's JSON as it came, one per line");
+  sub.add_option("--count", o->count, "Stop after this many records")->check(NumberIn(1, 1e15));
+  sub.add_option("--timeout-s", o->timeout_s,
+                 "Fail (exit 2) when nothing at all arrives for this many seconds (default: wait)")
+      ->check(NumberIn(1e-3, 1e9));
+  sub.add_flag("-q,--quiet", o->quiet, "Nothing on stderr but errors");
+  return [o] {
+    const StopRequest stop;
+    ListenOptions options = *o;
+    options.stop_requested = [&stop] { return stop.requested(); };
+    RunListen(options, std::cout, std::cerr);
+    return ExitCodeAfterStop(0);
+  };
+}
+
+}  // namespace softsight

@@ -1,0 +1,40 @@
+// `softsight listen ENDPOINT`: the receiving end of `--publish` on the command line. Prints each
+// record as a CSV row (or its JSON), or writes a CSV file through the CSV writer, until the run
+// ends (its "end" record), --count records, --timeout-s of silence or Ctrl-C.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+namespace softsight {
+
+struct ListenOptions {
+  std::string endpoint;              // tcp://HOST:PORT or ipc://PATH, as the run's --publish.
+  std::string topic = "frame";       // frame, measure, marker/<name> (docs/stream.md).
+  std::string csv_file;              // Write the records here; empty: print them.
+  bool json = false;                 // Print each record's JSON as it came, one per line.
+  std::optional<int64_t> count;      // Stop after this many records.
+  std::optional<double> timeout_s;   // Fail when nothing at all arrives for this long.
+  bool quiet = false;                // Nothing on stderr but errors.
+  // Polled every 100 ms: true stops listening (Ctrl-C; a test's own condition).
+  std::function<bool()> stop_requested;
+};
+
+struct ListenSummary {
+  int64_t records = 0;              // Of the topic, received.
+  int64_t hellos = 0;
+  int64_t frame_gaps = 0;           // Frame numbers missing between consecutive records.
+  bool ended = false;               // The run's "end" record arrived.
+  std::string end_record;           // Its JSON.
+};
+
+// Runs until one of the ends above. Records go to `out` (unless csv_file), the hello and the end
+// to `err` (unless quiet). Throws InputError: a malformed endpoint, a publisher of another
+// format version, a record that is not JSON, the timeout, an unwritable CSV (rows written before
+// stay).
+ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace softsight

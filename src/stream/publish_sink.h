@@ -1,0 +1,108 @@
+// `--publish ENDPOINT` (track, live, control, identify): every frame's result, as it happens, to
+// other programs on a ZeroMQ XPUB socket, in the records of stream/stream_format.h
+// (docs/stream.md). The program's own (not installed): libzmq stays out of the library.
+//
+// A slow or absent subscriber never slows the run: sends never block. Each subscriber has a
+// queue of `high_water_mark` messages; a message that would overflow a queue is counted as a
+// drop (the subscribers with room still get it), and the run's summary says how many.
+// An XPUB socket (not a PUB) sees each subscription arrive: a new subscriber to "hello" gets
+// the run's hello at once, however late it joins, and topics nobody asked for are not even
+// formatted.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "softsight/io/csv_columns.h"
+#include "softsight/pipeline/sink.h"
+#include "stream/stream_format.h"
+
+namespace zmq {
+class context_t;
+class socket_t;
+}  // namespace zmq
+
+namespace softsight {
+
+struct PublishOptions {
+  // Where subscribers connect: tcp://*:5556 (every interface), tcp://127.0.0.1:5556 (this
+  // machine only), ipc:///tmp/softsight.ipc (a socket file; never replaces a file that is not
+  // a socket, nor one another program listens on).
+  std::string endpoint;
+  // Messages queued per subscriber before further ones are dropped (ZMQ_SNDHWM). Default 1000:
+  // about 6 s of every topic (5 a frame) of a 3-marker run at 30 fps. Range 1..1000000.
+  int high_water_mark = 1000;
+  // Before the first frame, wait until this many subscriptions to "hello" have arrived
+  // (softsight listen and softsight.stream.subscribe each make one), so that they see every
+  // frame. 0 (default): start at once.
+  int wait_subscribers = 0;
+  // How long that wait may take, s; then the run stops with an error. Default 30.
+  double wait_timeout_s = 30.0;
+  // The hello's config_digest (Fnv1a64Hex of the config file's bytes) and config file name.
+  std::string config_digest;
+  std::string config_file;
+  // The kernel's send buffer per connection, bytes (ZMQ_SNDBUF); 0: the system's default. Tests
+  // make it small, so that a subscriber that stops reading fills its queue quickly.
+  int send_buffer_bytes = 0;
+
+  // Returns false and names the bad field.
+  bool Check(std::string* error) const;
+};
+
+class PublishSink : public FrameSink {
+ public:
+  // Binds at once: a malformed or busy endpoint throws InputError naming it (--publish ...),
+  // before the caller opens any output.
+  explicit PublishSink(PublishOptions options);
+  ~PublishSink() override;
+  PublishSink(const PublishSink&) = delete;
+  PublishSink& operator=(const PublishSink&) = delete;
+
+  // The columns of every record: the CSV's table (by value; the same closures write both).
+  // Before begin().
+  void set_columns(CsvColumnTable columns) { columns_ = std::move(columns); }
+
+  // Learns the markers (the topics), then waits for PublishOptions::wait_subscribers.
+  void begin(const RunInfo& info) override;
+  void consume(const Frame& frame, const FrameResult& result) override;
+  // The "end" record: frames, why the run stopped, messages sent and dropped.
+  void end(const RunSummary& summary) override;
+  // A note: the endpoint, messages sent, subscriptions seen and messages dropped.
+  void report(RunSummary& summary) const override;
+
+  // The endpoint as bound (a tcp port given as * is the one chosen).
+  const std::string& endpoint() const { return bound_endpoint_; }
+  int64_t sent() const { return sent_; }        // Messages handed to ZeroMQ.
+  int64_t dropped() const { return dropped_; }  // Of those, missed by at least one subscriber.
+  // Capture-to-send latency of every frame record sent, ms (for the benchmark).
+  const std::vector<double>& send_latencies_ms() const { return send_latency_ms_; }
+
+ private:
+  // Reads the subscriptions that arrived; a new one to "hello" gets the hello.
+  void read_subscriptions();
+  // Sends without blocking; a full queue counts a drop (the others still get the message).
+  void send(const std::string& message);
+  std::string hello() const;
+  bool wanted(const std::string& topic) const;
+
+  PublishOptions options_;
+  CsvColumnTable columns_;
+  RecordFormatter formatter_;
+  std::unique_ptr<zmq::context_t> context_;
+  std::unique_ptr<zmq::socket_t> socket_;
+  std::string bound_endpoint_;
+  RunInfo info_;
+  std::vector<TopicColumns> topics_;
+  std::vector<char> topic_wanted_;         // Per topic: some subscription matches it.
+  std::map<std::string, int> subscriptions_;  // Prefix -> how many subscribers asked for it.
+  int64_t subscriptions_seen_ = 0;
+  std::string message_;                    // Reused: no allocation per record once grown.
+  int64_t sent_ = 0, dropped_ = 0;
+  std::vector<double> send_latency_ms_;
+};
+
+}  // namespace softsight
