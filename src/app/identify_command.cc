@@ -68,6 +68,7 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
 
   if (!config.control) config.control.emplace();
   config.control->controller = found.tuned;
+  config.control->inner_loop = found.inner_loop;  // Also drops gains an older identify chose.
   config.control->model = found.model;
   std::string problem;
   if (!config.control->Check(&problem)) {

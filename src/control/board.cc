@@ -78,6 +78,8 @@ size_t Board::handle(const wire::Message& m, uint32_t now_ms) {
     // A new session starts from the safe state.
     mode_ = Mode::kIdle;
     loop_.reset();
+    // A host's gains last for its session only: the next one starts from the board's own.
+    loop_.set_gains(config_.kp_per_kpa, config_.ki_per_kpa_s);
     setpoint_pa_ = 0;
     command_duty_permille_ = 0;
     if (m.args[0] != wire::kProtocolVersion) {
@@ -110,6 +112,14 @@ size_t Board::handle(const wire::Message& m, uint32_t now_ms) {
       mode_ = Mode::kDuty;
       command_duty_permille_ = m.args[1];
       setpoint_pa_ = 0;
+      break;
+    case wire::MessageType::kSetGains:
+      if (m.args[1] < 0 || m.args[1] > wire::kMaxGainPermille || m.args[2] < 0 ||
+          m.args[2] > wire::kMaxGainPermille) {
+        return answer_error(seq, wire::kErrRange);
+      }
+      loop_.set_gains(static_cast<float>(m.args[1]) * 0.001f,
+                      static_cast<float>(m.args[2]) * 0.001f);
       break;
     case wire::MessageType::kStop:
       mode_ = Mode::kStopped;

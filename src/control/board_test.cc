@@ -36,6 +36,54 @@ wire::Message Send(Board& board, const std::string& line, uint32_t now_ms) {
   return m;
 }
 
+std::string GainLine(int32_t seq, int32_t kp_permille, int32_t ki_permille) {
+  wire::Message m;
+  m.type = wire::MessageType::kSetGains;
+  m.argc = 3;
+  m.args[0] = seq;
+  m.args[1] = kp_permille;
+  m.args[2] = ki_permille;
+  char buffer[wire::kLineBufferSize];
+  return std::string(buffer, wire::EncodeMessage(m, buffer, sizeof(buffer)));
+}
+
+// $GAIN (docs/protocol.md): the host's gains drive the loop until the next $HELLO; a gain out of
+// range, or before the handshake, is refused and changes nothing.
+TEST(Board, GainSetsTheInnerLoopForTheSessionAndHelloRestoresTheBoardsOwn) {
+  Board board{BoardConfig{}};
+  wire::Message m = Send(board, GainLine(1, 50, 120), 0);
+  ASSERT_EQ(m.type, wire::MessageType::kError);
+  EXPECT_EQ(m.args[1], wire::kErrNoHello);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.25f);
+
+  Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion), 0);
+  m = Send(board, GainLine(2, 50, 120), 0);
+  ASSERT_EQ(m.type, wire::MessageType::kState);
+  EXPECT_EQ(m.args[0], 2);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.05f);
+  EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.12f);
+  // The loop runs on them: 10 kPa of error asks 0.05 * 10 + one period of 0.12 * 10 kPa * 2 ms
+  // of duty (the board's own gains would ask 2.5: full inflation).
+  Send(board, Line(wire::MessageType::kSetPressure, 3, 20000), 0);
+  board.update(2, 10000);
+  EXPECT_EQ(board.duty_permille(), 502);
+
+  for (const auto& bad : {std::pair<int32_t, int32_t>{-1, 120}, {50, -1},
+                          {wire::kMaxGainPermille + 1, 120}, {50, wire::kMaxGainPermille + 1}}) {
+    m = Send(board, GainLine(4, bad.first, bad.second), 4);
+    ASSERT_EQ(m.type, wire::MessageType::kError) << bad.first << " " << bad.second;
+    EXPECT_EQ(m.args[1], wire::kErrRange);
+    EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.05f);
+    EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.12f);
+  }
+  m = Send(board, GainLine(5, wire::kMaxGainPermille, 0), 4);
+  EXPECT_EQ(m.type, wire::MessageType::kState) << "the largest gain the wire carries is taken";
+
+  Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion), 6);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.25f);
+  EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.5f);
+}
+
 TEST(Board, RequiresTheVersionedHandshake) {
   Board board{BoardConfig{}};
   wire::Message m = Send(board, Line(wire::MessageType::kSetPressure, 1, 20000), 0);

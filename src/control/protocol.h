@@ -36,6 +36,8 @@ enum class MessageType : uint8_t {
   kRead,         // $READ <seq>                        read state, changes nothing
   kStop,         // $STOP <seq>                        vent to the safe state
   kPing,         // $PING <seq>                        heartbeat, changes nothing
+  kSetGains,     // $GAIN <seq> <kp> <ki>              inner-loop gains, per-mille duty per kPa
+                 //                                    (kp) and per kPa*s (ki)
   // Board -> host.
   kHelloReply,   // $HI <version> <pressure_limit_pa> <loop_hz> <watchdog_ms>
   kState,        // $STATE <seq> <time_ms> <pressure_pa> <setpoint_pa> <duty_permille> <flags> <rejected>
@@ -57,8 +59,14 @@ enum StateFlag : uint16_t {
 enum ErrorCode : int32_t {
   kErrVersion = 1,    // $HELLO with another protocol version.
   kErrNoHello = 2,    // A command before a successful handshake.
-  kErrRange = 3,      // An argument outside its range (setpoint above the limit, |duty| > 1000).
+  kErrRange = 3,      // An argument outside its range (setpoint above the limit, |duty| > 1000,
+                      // a gain outside 0..kMaxGainPermille).
 };
+
+// The largest inner-loop gain $GAIN carries, per-mille duty per kPa (kp) or per kPa*s (ki): 1000
+// duty per kPa, a full valve swing for a pascal of error, is far beyond any useful loop. A gain
+// above it is a corrupted or mistyped value, refused with kErrRange.
+const int32_t kMaxGainPermille = 1000000;
 
 // Why a line was rejected. Rejected lines are counted and never acted on.
 enum class DecodeStatus : uint8_t {

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -63,6 +64,23 @@ constexpr double kMaxSensedPressureKpa = 2 * kMaxBoardPressureLimitKpa;
 // watchdog vents on its own when the commands stop.
 constexpr int kMaxStopMs = 1500;
 
+// The largest inner-loop gain the wire carries (duty per kPa, or per kPa*s): a full valve swing
+// for a pascal of error, far beyond any useful loop.
+constexpr double kMaxInnerGain = 1000.0;
+
+// Gains the host sets on the board's inner pressure loop for one session ($GAIN, right after the
+// handshake), when the board's own do not suit the plant: a tube between the valves and the
+// chamber delays the loop, and gains made for a short tube make it oscillate. `softsight
+// identify` measures the delay and chooses them. Absent (the default): the board's own gains.
+struct InnerLoopGains {
+  std::optional<double> kp_per_kpa;    // Valve duty per kPa of pressure error.
+  std::optional<double> ki_per_kpa_s;  // Valve duty per kPa*s.
+
+  bool given() const { return kp_per_kpa.has_value(); }
+  // Both or neither; each in [0, kMaxInnerGain]. False names the bad field in `error`.
+  bool Check(std::string* error) const;
+};
+
 // What the board said in its $HI answer.
 struct BoardInfo {
   int protocol_version = 0;
@@ -107,6 +125,11 @@ class BoardLink {
 
   BoardState set_pressure_kpa(double setpoint_kpa);
   BoardState set_duty(double duty);  // [-1, 1]; > 0 inflate, < 0 vent.
+  // The board's inner pressure loop gains for this session ($GAIN; a $HELLO restores the
+  // board's own): duty per kPa of error and per kPa*s, each in [0, kMaxInnerGain]. Throws
+  // InputError naming the port when the board refuses them, or when it answers READ but not
+  // GAIN: a firmware that predates the command.
+  BoardState set_inner_loop_gains(double kp_per_kpa, double ki_per_kpa_s);
   BoardState read_state();
   // Vent to the safe state (ignores stop requests; gives up after kMaxStopMs).
   BoardState stop();
@@ -129,7 +152,11 @@ class BoardLink {
       const std::string& line, bool honour_stop,
       const std::function<Verdict(const wire::Message&)>& classify, int64_t budget_ms = 0,
       uint64_t* rejected = nullptr, std::string* why = nullptr);
-  BoardState request(wire::MessageType type, int32_t value, const char* what);
+  // Sends `type` with its sequence number and `values`; the board's STATE. Throws InputError
+  // when the board refuses it, or after the retries; with `allow_silence`, a board that never
+  // answered (and said nothing rejected) gives nothing instead.
+  std::optional<BoardState> request(wire::MessageType type, std::initializer_list<int32_t> values,
+                                    const char* what, bool allow_silence = false);
   int64_t now_ms() const;
 
   Transport& transport_;
