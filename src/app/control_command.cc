@@ -294,8 +294,10 @@ void AnnounceRun(const ControlOptions& options, const Transport& transport, cons
   if (options.identify) return;  // The experiment runs open loop: the gains play no part.
   const InnerLoopGains& inner = config_inner_loop;
   if (inner.given()) {
-    std::fprintf(stderr, "control: inner loop gains sent: kp %.3g duty/kPa, ki %.3g duty/(kPa s) "
-                 "(control.inner_loop)\n", *inner.kp_per_kpa, *inner.ki_per_kpa_s);
+    std::fprintf(stderr,
+                 "control: inner loop gains sent: kp %.3g duty/kPa, ki %.3g duty/(kPa s), "
+                 "venting x %.3g (control.inner_loop)\n",
+                 inner.kp_per_kpa, inner.ki_per_kpa_s, inner.vent_scale);
   }
   const ControllerOptions& c = session.controller().options();
   std::fprintf(stderr,
@@ -555,8 +557,10 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
   }
   char inner[128] = "the board's own gains (a short tube)";
   if (found.inner_loop.given()) {
-    std::snprintf(inner, sizeof(inner), "kp %.3g duty/kPa, ki %.3g duty/(kPa s) for the tube",
-                  *found.inner_loop.kp_per_kpa, *found.inner_loop.ki_per_kpa_s);
+    std::snprintf(inner, sizeof(inner),
+                  "kp %.3g duty/kPa, ki %.3g duty/(kPa s), venting x %.3g for the tube",
+                  found.inner_loop.kp_per_kpa, found.inner_loop.ki_per_kpa_s,
+                  found.inner_loop.vent_scale);
   }
   char text[1536];
   std::snprintf(

@@ -59,16 +59,15 @@ bool LinkOptions::Check(std::string* error) const {
 
 bool InnerLoopGains::Check(std::string* error) const {
   // Each field's range is its row in control/control_options.cc; only the pairing here.
+  // Each field's range is its row in control/control_options.cc.
   if (const auto problem = CheckOptions(InnerLoopGainsTable(), *this)) return Fail(error, *problem);
-  if (kp_per_kpa.has_value() != ki_per_kpa_s.has_value()) {
-    return Fail(error, std::string(kp_per_kpa ? "ki_per_kpa_s" : "kp_per_kpa") +
-                           ": give both inner-loop gains or neither (neither: the board's own)");
-  }
   return true;
 }
 
 // The wire carries gains in per-mille; its limit and the host's are one.
 static_assert(kMaxInnerGain * 1000.0 == static_cast<double>(wire::kMaxGainPermille));
+static_assert(kMaxVentScale * 1000.0 == static_cast<double>(wire::kMaxVentPermille));
+static_assert(kMinVentScale * 1000.0 == 1.0);
 
 BoardLink::BoardLink(Transport& transport, LinkOptions options, LinkEnvironment environment)
     : transport_(transport), options_(options), environment_(std::move(environment)) {}
@@ -181,14 +180,18 @@ BoardState BoardLink::set_duty(double duty) {
                   "DUTY");
 }
 
-BoardState BoardLink::set_inner_loop_gains(double kp_per_kpa, double ki_per_kpa_s) {
+BoardState BoardLink::set_inner_loop_gains(double kp_per_kpa, double ki_per_kpa_s,
+                                           double vent_scale) {
   // Per-mille on the wire; a gain the wire cannot carry is the caller's bug (the config's
   // ranges keep it within kMaxInnerGain).
   const auto permille = [](double gain) {
     return static_cast<int32_t>(std::lround(std::clamp(gain, 0.0, kMaxInnerGain) * 1e3));
   };
   if (std::optional<BoardState> state =
-          request(wire::MessageType::kSetGains, {permille(kp_per_kpa), permille(ki_per_kpa_s)},
+          request(wire::MessageType::kSetGains,
+                  {permille(kp_per_kpa), permille(ki_per_kpa_s),
+                   static_cast<int32_t>(std::lround(
+                       std::clamp(vent_scale, kMinVentScale, kMaxVentScale) * 1e3))},
                   "GAIN", /*allow_silence=*/true)) {
     return *state;
   }

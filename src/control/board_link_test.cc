@@ -239,16 +239,17 @@ TEST(BoardLink, InnerLoopGainsGoOutAsGainAndAFirmwareWithoutItIsOneClearError) {
   FakeBoard fake;
   BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
   link.handshake();
-  link.set_inner_loop_gains(0.05, 0.12);
+  link.set_inner_loop_gains(0.05, 0.12, 0.333);
   const wire::Message sent = Decode(fake.written.back());
   ASSERT_EQ(sent.type, wire::MessageType::kSetGains);
   EXPECT_EQ(sent.args[1], 50);
   EXPECT_EQ(sent.args[2], 120);
+  EXPECT_EQ(sent.args[3], 333);
 
   fake.knows_gain = false;
   const int64_t before_ms = fake.now;
   try {
-    link.set_inner_loop_gains(0.05, 0.12);
+    link.set_inner_loop_gains(0.05, 0.12, 1.0);
     FAIL() << "an old firmware took GAIN";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith("serial port /dev/fake0: the board does not know "
@@ -347,18 +348,18 @@ TEST(ControlSession, TheInnerLoopGainsGoRightAfterTheHandshakeAndAnOldFirmwareSt
     EXPECT_EQ(fake.words().back(), "STOP") << "vented on the way out";
     for (const std::string& word : fake.words()) EXPECT_NE(word, "SETP");
   }
-  // Only one of the pair: refused before anything is sent.
+  // A gain out of range: refused before anything is sent.
   {
     FakeBoard fake;
     BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
     ControlSession session(ControllerOptions{}, link, Pressure(20.0));
-    InnerLoopGains half;
-    half.kp_per_kpa = 0.05;
+    InnerLoopGains bad = gains;
+    bad.vent_scale = 0.0;
     try {
-      session.set_inner_loop_gains(half);
-      FAIL() << "half a pair taken";
+      session.set_inner_loop_gains(bad);
+      FAIL() << "a vent scale of 0 taken";
     } catch (const InputError& e) {
-      EXPECT_THAT(e.what(), ::testing::StartsWith("control.inner_loop.ki_per_kpa_s: give both"));
+      EXPECT_THAT(e.what(), ::testing::StartsWith("control.inner_loop.vent_scale: "));
     }
     EXPECT_TRUE(fake.written.empty());
   }

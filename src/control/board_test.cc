@@ -36,13 +36,15 @@ wire::Message Send(Board& board, const std::string& line, uint32_t now_ms) {
   return m;
 }
 
-std::string GainLine(int32_t seq, int32_t kp_permille, int32_t ki_permille) {
+std::string GainLine(int32_t seq, int32_t kp_permille, int32_t ki_permille,
+                     int32_t vent_permille = 1000) {
   wire::Message m;
   m.type = wire::MessageType::kSetGains;
-  m.argc = 3;
+  m.argc = 4;
   m.args[0] = seq;
   m.args[1] = kp_permille;
   m.args[2] = ki_permille;
+  m.args[3] = vent_permille;
   char buffer[wire::kLineBufferSize];
   return std::string(buffer, wire::EncodeMessage(m, buffer, sizeof(buffer)));
 }
@@ -68,20 +70,32 @@ TEST(Board, GainSetsTheInnerLoopForTheSessionAndHelloRestoresTheBoardsOwn) {
   board.update(2, 10000);
   EXPECT_EQ(board.duty_permille(), 502);
 
-  for (const auto& bad : {std::pair<int32_t, int32_t>{-1, 120}, {50, -1},
-                          {wire::kMaxGainPermille + 1, 120}, {50, wire::kMaxGainPermille + 1}}) {
-    m = Send(board, GainLine(4, bad.first, bad.second), 4);
-    ASSERT_EQ(m.type, wire::MessageType::kError) << bad.first << " " << bad.second;
+  // Venting at a third of the duty: 10 kPa too much asks a third of 0.05 * 10 of venting (the
+  // integral of the period before and this period's cancel).
+  Send(board, GainLine(6, 50, 120, 333), 4);
+  Send(board, Line(wire::MessageType::kSetPressure, 7, 0), 4);
+  board.update(6, 10000);
+  EXPECT_EQ(board.duty_permille(), -167);
+  Send(board, GainLine(8, 50, 120), 6);
+
+  const int32_t kMaxGain = wire::kMaxGainPermille, kMaxVent = wire::kMaxVentPermille;
+  const int32_t bad[][3] = {{-1, 120, 1000},         {50, -1, 1000},       {kMaxGain + 1, 120, 1000},
+                            {50, kMaxGain + 1, 1000}, {50, 120, 0},        {50, 120, kMaxVent + 1}};
+  for (const auto& b : bad) {
+    m = Send(board, GainLine(4, b[0], b[1], b[2]), 4);
+    ASSERT_EQ(m.type, wire::MessageType::kError) << b[0] << " " << b[1] << " " << b[2];
     EXPECT_EQ(m.args[1], wire::kErrRange);
     EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.05f);
     EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.12f);
   }
-  m = Send(board, GainLine(5, wire::kMaxGainPermille, 0), 4);
-  EXPECT_EQ(m.type, wire::MessageType::kState) << "the largest gain the wire carries is taken";
+  EXPECT_FLOAT_EQ(board.vent_scale(), 1.0f);
+  m = Send(board, GainLine(5, wire::kMaxGainPermille, 0, wire::kMaxVentPermille), 4);
+  EXPECT_EQ(m.type, wire::MessageType::kState) << "the largest gains the wire carries are taken";
 
   Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion), 6);
   EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.25f);
   EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.5f);
+  EXPECT_FLOAT_EQ(board.vent_scale(), 1.0f);
 }
 
 TEST(Board, RequiresTheVersionedHandshake) {

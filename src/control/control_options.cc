@@ -91,12 +91,16 @@ OptionTable<InnerLoopGains> MakeInnerLoop() {
       DoubleOption<P>("kp_per_kpa", &P::kp_per_kpa)
           .Range(0, kMaxInnerGain)
           .Unit("duty/kPa")
-          .Doc("the board's pressure loop gain for this run, sent at the handshake (absent: the "
-               "board's own); identify sets it for a tube delay"),
+          .Doc("the board's pressure loop gain for this run, sent at the handshake with the two "
+               "below (0: the board's own gains, nothing sent); identify sets it for a tube"),
       DoubleOption<P>("ki_per_kpa_s", &P::ki_per_kpa_s)
           .Range(0, kMaxInnerGain)
           .Unit("duty/(kPa s)")
-          .Doc("the board's pressure loop integral gain for this run (with kp_per_kpa)"),
+          .Doc("the board's pressure loop integral gain for this run (with kp_per_kpa > 0)"),
+      DoubleOption<P>("vent_scale", &P::vent_scale)
+          .Range(kMinVentScale, kMaxVentScale)
+          .Doc("the loop's duty is multiplied by this when it vents, for a vent faster than the "
+               "pump (with kp_per_kpa > 0)"),
   };
 }
 
@@ -235,7 +239,7 @@ OptionTable<ActuatorModel> MakeModel() {
       row("inflate_kpa_per_s", &P::inflate_kpa_per_s, 0, 1e6, "kPa/s",
           "pressure rate at full inflation, near vented"),
       row("vent_kpa_per_s", &P::vent_kpa_per_s, 0, 1e6, "kPa/s",
-          "pressure rate at full venting (at about 40 % of the experiment's ceiling)"),
+          "pressure rate at full venting (at about a quarter of the experiment's ceiling)"),
       row("pressure_lag_s", &P::pressure_lag_s, 0, 100, "s",
           "inner loop setpoint -> sensed pressure: first-order lag"),
       row("pressure_dead_time_s", &P::pressure_dead_time_s, 0, 100, "s",

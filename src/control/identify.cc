@@ -17,7 +17,7 @@ std::string Seconds(double v) { return FixedNumber(v, 2) + " s"; }
 // The inner-loop probe inflates to this fraction of the ceiling: high enough for a few frames of
 // a rising pressure in a small chamber, low enough that what the tube still delivers after the
 // valves close stays under the ceiling.
-constexpr double kProbeFraction = 0.4;
+constexpr double kProbeFraction = 0.25;
 
 // Solves the 3x3 system a x = b (Cramer's rule); false when it is (nearly) singular.
 bool Solve3(const double a[3][3], const double b[3], double x[3]) {
@@ -614,7 +614,7 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
       m.dead_time_s + m.pressure_dead_time_s + 0.5 * frame_period_s;
   // Behind a tube the board's loop runs on the probe's gentle gains (no faster than the tube
   // lets it, and saturating on large steps): the outer loop is no faster than that inner loop.
-  const double inner_s = m.valve_dead_time_s > kShortTubeS ? m.pressure_lag_s : 0.0;
+  const double inner_s = m.valve_dead_time_s > kShortTubeS ? 3.0 * m.pressure_lag_s : 0.0;
   const double tau_c = closed_loop_s.value_or(
       std::max({measured_dead_s, 3.0 * frame_period_s, inner_s}));
   model->closed_loop_s = tau_c;

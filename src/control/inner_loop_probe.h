@@ -1,5 +1,6 @@
 // Measures the board's plant, valves to pressure sensor, open loop, before the identification's
-// pressure steps: full inflation from vented, the valves closed, full venting. From the board's
+// pressure steps: inflation from vented, the valves closed, venting (at a quarter duty; the rates
+// are scaled to full duty). From the board's
 // own clock in its answers (not the host's, so the serial line's latency is left out) it gives the
 // dead time between a valve command and the sensed pressure moving (a tube between the valves and
 // the chamber), and the pressure rates of full inflation and full venting.
@@ -20,7 +21,7 @@ namespace softsight {
 
 struct InnerLoopMeasurement {
   double dead_time_s = 0.0;        // From the valve command to the sensed pressure moving.
-  double inflate_kpa_per_s = 0.0;  // Full inflation, near vented.
+  double inflate_kpa_per_s = 0.0;  // Full inflation (duty 1), near vented.
   double vent_kpa_per_s = 0.0;     // Full venting (a positive rate) ...
   double vent_at_kpa = 0.0;        // ... at this pressure.
 };
@@ -31,24 +32,26 @@ constexpr double kShortTubeS = 0.015;
 
 // Gains for the board's PI loop behind the measured tube: nothing for a short one (the board's
 // own). The chamber is an integrator with dead time (duty -> pressure rate k), so Skogestad's SIMC
-// rule for it with the closed-loop time equal to the dead time: kp = 1 / (k (2 theta)), with k the
-// faster of the two rates (venting, taken in the middle of the range: an orifice's flow grows
-// with the square root of the pressure), so the loop is stable both ways (phase margin about
-// 60 deg). No integral: the chamber integrates already, so P alone holds a setpoint (the leak
-// leaves a few pascals), an integral sized for the slower inflation overshoots by 2 kPa at every
-// step behind a 50 ms tube, and the outer loop's integral removes what is left of the angle.
+// rule for it with the closed-loop time twice the dead time: kp = 1 / (k (3 theta)), with k
+// inflation's rate, and the venting duty scaled by inflation's rate over venting's (taken in the
+// middle of the range: an orifice's flow grows with the square root of the pressure), so the
+// loop has the same gain both ways (phase margin about 70 deg: with the closed-loop time equal to
+// the dead time the pressure overshot and the angle's step by 8-13 %). No integral: the chamber
+// integrates already, so P alone holds a setpoint (the leak leaves a few pascals), an integral
+// overshot by 2 kPa at every step behind a 50 ms tube, and the outer loop's integral removes
+// what is left of the angle.
 std::optional<InnerLoopGains> InnerLoopGainsFor(const InnerLoopMeasurement& m, double ceiling_kpa);
 
 // The longest the inflation or the venting may take before the probe gives up.
-constexpr double kProbeStageS = 3.0;
+constexpr double kProbeStageS = 5.0;
 
 class InnerLoopProbe {
  public:
   // Inflates to `probe_kpa` (sensed), closes the valves for a moment, vents to near 0.
   explicit InnerLoopProbe(double probe_kpa);
 
-  // The valve duty for the frame at `time_s` (+1 inflate, 0 closed, -1 vent); nothing once the
-  // probe is done. Throws IdentifyAbort when the pressure does not rise under full inflation (or
+  // The valve duty for the frame at `time_s` (> 0 inflate, 0 closed, < 0 vent); nothing once
+  // the probe is done. Throws IdentifyAbort when the pressure does not rise when inflating (or
   // fall when venting) within kProbeStageS.
   std::optional<double> next(double time_s);
   // The board's answer to that duty: its clock and its sensed pressure.

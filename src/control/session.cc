@@ -166,7 +166,8 @@ void ControlSession::set_inner_loop_gains(const InnerLoopGains& gains) {
 
 void ControlSession::send_inner_loop_gains() {
   if (!inner_loop_.given()) return;
-  checked(link_.set_inner_loop_gains(*inner_loop_.kp_per_kpa, *inner_loop_.ki_per_kpa_s));
+  checked(link_.set_inner_loop_gains(inner_loop_.kp_per_kpa, inner_loop_.ki_per_kpa_s,
+                                     inner_loop_.vent_scale));
 }
 
 BoardState ControlSession::stop() {

@@ -20,7 +20,7 @@ struct ActuatorModel {
   double hysteresis_deg = 0.0;
   double static_rms_deg = 0.0;   // RMS residual of the static fit.
   // Valves -> sensed pressure, open loop (the inner-loop probe): the delay of a tube between them,
-  // and the pressure rates of full inflation (near vented) and full venting (at about 40 % of the
+  // and the pressure rates of full inflation (near vented) and full venting (at about 25 % of the
   // experiment's ceiling).
   double valve_dead_time_s = 0.0;
   double inflate_kpa_per_s = 0.0;
