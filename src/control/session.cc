@@ -89,10 +89,7 @@ const BoardState& ControlSession::checked(const BoardState& state) {
 }
 
 ControlSample ControlSession::step(double time_s, std::optional<double> measured_deg) {
-  if (!start_time_s_) start_time_s_ = time_s;
-  ControlSample sample;
-  sample.time_s = time_s - *start_time_s_;
-  sample.measured_deg = measured_deg;
+  ControlSample sample = begin_sample(time_s, measured_deg);
   switch (target_.mode) {
     case ControlMode::kAngle: {
       const double target_deg = target_.profile.at(sample.time_s);
@@ -118,13 +115,18 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
   return sample;
 }
 
-ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
-                                            std::optional<double> measured_deg) {
+ControlSample ControlSession::begin_sample(double time_s, std::optional<double> measured_deg) {
   if (!start_time_s_) start_time_s_ = time_s;
   ControlSample sample;
   sample.time_s = time_s - *start_time_s_;
   sample.measured_deg = measured_deg;
   sample.action = ControllerOutput::Action::kTrack;
+  return sample;
+}
+
+ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
+                                            std::optional<double> measured_deg) {
+  ControlSample sample = begin_sample(time_s, measured_deg);
   sample.board = checked(send_pressure(setpoint_kpa, &sample.setpoint_kpa));
   return sample;
 }
@@ -148,11 +150,7 @@ void ControlSession::send_duty(double duty, ControlSample* sample) {
 
 ControlSample ControlSession::step_duty(double time_s, double duty,
                                         std::optional<double> measured_deg) {
-  if (!start_time_s_) start_time_s_ = time_s;
-  ControlSample sample;
-  sample.time_s = time_s - *start_time_s_;
-  sample.measured_deg = measured_deg;
-  sample.action = ControllerOutput::Action::kTrack;
+  ControlSample sample = begin_sample(time_s, measured_deg);
   send_duty(std::clamp(duty, -1.0, 1.0), &sample);
   return sample;
 }

@@ -89,6 +89,8 @@ class ControlSession {
  private:
   // Sends the setpoint clamped to [min_kpa, max_kpa]; `sent` receives the clamped value.
   BoardState send_pressure(double setpoint_kpa, std::optional<double>* sent);
+  // A frame's sample: its time since the first step, the angle, action kTrack.
+  ControlSample begin_sample(double time_s, std::optional<double> measured_deg);
   // Sends `duty`, or 0 (valves closed) when inflating would take the pressure to max_kpa.
   void send_duty(double duty, ControlSample* sample);
   void send_inner_loop_gains();
