@@ -135,5 +135,17 @@ TEST_F(Sketch, SpeaksVersion2WithACrcAndIgnoresTwoBitErrorsAnXorWouldPass) {
   EXPECT_EQ(Command(Line(wire::MessageType::kRead, 2)).args[6] - rejected_before, 2);  // Both.
 }
 
+TEST_F(Sketch, TakesTheHostsInnerLoopGainsTypedAsInTheReadme) {
+  Command(Line(wire::MessageType::kHello, wire::kProtocolVersion));
+  arduino_shim::SerialInput("$GAIN 2 73 0 335*4F8D\n");  // firmware/README.md, docs/protocol.md.
+  Run(1);
+  wire::Message m;
+  const std::string answer = arduino_shim::TakeSerialOutput();
+  ASSERT_FALSE(answer.empty());
+  ASSERT_EQ(wire::DecodeLine(answer.data(), answer.size() - 1, &m), wire::DecodeStatus::kOk);
+  EXPECT_EQ(m.type, wire::MessageType::kState);
+  EXPECT_EQ(m.args[0], 2);
+}
+
 }  // namespace
 }  // namespace softsight

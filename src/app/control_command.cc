@@ -128,6 +128,7 @@ ControlConfig ControlConfigFor(const ControlOptions& options, const TrackingConf
     config.controller = *options.controller;
   }
   if (options.model) config.model = *options.model;
+  if (options.inner_loop) config.inner_loop = *options.inner_loop;
   return config;
 }
 
@@ -297,7 +298,7 @@ void StartIdentification(const ControlOptions& options, const ControlSession& se
 // What the run is about to do: a pressure asked above the limit (said even with --quiet: the
 // run does not do what the command line says), the board, and the outer loop's gains.
 void AnnounceRun(const ControlOptions& options, const Transport& transport, const BoardInfo& info,
-                 const ControlSession& session) {
+                 const ControlSession& session, const InnerLoopGains& config_inner_loop) {
   if (const std::optional<double> asked = session.pressure_clamped_from()) {
     std::fprintf(stderr,
                  "control: --pressure-kpa %s is above the limit of %s kPa (control.controller."
@@ -313,6 +314,13 @@ void AnnounceRun(const ControlOptions& options, const Transport& transport, cons
                transport.name().c_str(), info.protocol_version, info.pressure_limit_kpa,
                info.loop_hz, info.watchdog_ms);
   if (options.identify) return;  // The experiment runs open loop: the gains play no part.
+  const InnerLoopGains& inner = config_inner_loop;
+  if (inner.given()) {
+    std::fprintf(stderr,
+                 "control: inner loop gains sent: kp %.3g duty/kPa, ki %.3g duty/(kPa s), "
+                 "venting x %.3g (control.inner_loop)\n",
+                 inner.kp_per_kpa, inner.ki_per_kpa_s, inner.vent_scale);
+  }
   const ControllerOptions& c = session.controller().options();
   std::fprintf(stderr,
                "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
@@ -368,6 +376,7 @@ IdentifyOutcome IdentifiedFrom(const IdentificationExperiment& experiment,
                                 static_cast<double>(std::max<size_t>(1, samples.size() - 1));
   outcome.tuned = TuneController(&outcome.model, config.controller, frame_period_s,
                                  options.identify_options.closed_loop_s);
+  outcome.inner_loop = experiment.inner_loop_gains();
   outcome.samples = samples;
   return outcome;
 }
@@ -440,6 +449,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // Declared after the link, so destroyed before it: from the handshake on, any way out of this
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
+  // An identification measures the plant first and chooses the board's gains itself.
+  if (!options.identify) session.set_inner_loop_gains(config.inner_loop);
   ControlFrames frames =
       OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
 
@@ -481,7 +492,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   CheckFrameRateAgainstWatchdog(*frames.source, info);
   if (options.identify) StartIdentification(options, session, info, &experiment, &control);
-  AnnounceRun(options, *transport, info, session);
+  AnnounceRun(options, *transport, info, session, config.inner_loop);
 
   RunOptions run;
   run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
@@ -597,7 +608,14 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
   if (m.saturation_kpa > 0.0) {
     std::snprintf(saturation, sizeof(saturation), "%.2f kPa", m.saturation_kpa);
   }
-  char text[1024];
+  char inner[128] = "the board's own gains (a short tube)";
+  if (found.inner_loop.given()) {
+    std::snprintf(inner, sizeof(inner),
+                  "kp %.3g duty/kPa, ki %.3g duty/(kPa s), venting x %.3g for the tube",
+                  found.inner_loop.kp_per_kpa, found.inner_loop.ki_per_kpa_s,
+                  found.inner_loop.vent_scale);
+  }
+  char text[1536];
   std::snprintf(
       text, sizeof(text),
       "identify: static map: straight %.1f deg, bend start %.2f kPa, slope %.3f deg/kPa, "
@@ -605,6 +623,8 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
       "%.1f..%.1f deg\n"
       "identify: dynamics: pressure lag %.3f s + dead time %.3f s (RMS %.2f kPa); bending lag "
       "%.3f s + dead time %.3f s (RMS %.2f deg)\n"
+      "identify: valves -> sensor: dead time %.3f s, full inflation %.1f kPa/s, full venting "
+      "%.1f kPa/s; board's inner loop: %s\n"
       "identify: gains (SIMC, closed-loop time %.3f s): kp %.3f kPa/deg, ki %.3f kPa/(deg s), "
       "bias %.2f kPa, ff %.4f kPa/deg, hysteresis %.2f kPa, lead %.3f s, integral band %.1f "
       "deg\n",
@@ -612,7 +632,8 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
       saturation,
       m.hysteresis_deg, m.static_rms_deg, m.valid_min_kpa, m.valid_max_kpa, m.valid_min_deg,
       m.valid_max_deg, m.pressure_lag_s, m.pressure_dead_time_s, m.pressure_rms_kpa, m.lag_s,
-      m.dead_time_s, m.dynamic_rms_deg, m.closed_loop_s, c.kp_kpa_per_deg, c.ki_kpa_per_deg_s,
+      m.dead_time_s, m.dynamic_rms_deg, m.valve_dead_time_s, m.inflate_kpa_per_s,
+      m.vent_kpa_per_s, inner, m.closed_loop_s, c.kp_kpa_per_deg, c.ki_kpa_per_deg_s,
       c.bias_kpa, c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.integral_band_deg);
   return text;
 }
@@ -713,6 +734,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       if (!o->quiet) std::cerr << FormatIdentifyOutcome(*found.identified);
       run.controller = found.identified->tuned;
       run.model = found.identified->model;  // Its reach is checked before the loop starts.
+      run.inner_loop = found.identified->inner_loop;
     } else if (closed_loop_s->has_value()) {
       throw InputError("control: --closed-loop-s needs --auto-tune");
     }

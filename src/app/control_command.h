@@ -57,6 +57,8 @@ struct ControlOptions {
   IdentifyOptions identify_options;
   // Replaces the config's control.controller (the gains `--auto-tune` found).
   std::optional<ControllerOptions> controller;
+  // Replaces the config's control.inner_loop (the board's gains `--auto-tune` chose).
+  std::optional<InnerLoopGains> inner_loop;
   // Replaces the config's control.model (what `--auto-tune` identified): its reach is checked.
   std::optional<ActuatorModel> model;
   // A target beyond the model's reach runs, limited to the reach, instead of being refused.
@@ -72,6 +74,7 @@ struct ControlOptions {
 struct IdentifyOutcome {
   ActuatorModel model;
   ControllerOptions tuned;                 // The config's controller with the gains from the model.
+  InnerLoopGains inner_loop;               // For the board's pressure loop (not given: its own).
   std::vector<IdentifySample> samples;     // Every frame of the experiment.
 };
 

@@ -70,6 +70,7 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
 
   if (!config.control) config.control.emplace();
   config.control->controller = found.tuned;
+  config.control->inner_loop = found.inner_loop;  // Also drops gains an older identify chose.
   config.control->model = found.model;
   std::string problem;
   if (!config.control->Check(&problem)) {
@@ -85,8 +86,10 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   auto o = std::make_shared<IdentifyCommandOptions>();
   sub.description(
       "Identify the actuator and tune the loop: a safe automatic experiment within the\n"
-      "configured pressure limits (pressure steps up and down, then a PRBS around a working\n"
-      "point), open loop, the camera measuring the angle. Fits the static map (bend start,\n"
+      "configured pressure limits (a valve probe, pressure steps up and down, then a PRBS\n"
+      "around a working point), open loop, the camera measuring the angle. The probe times the\n"
+      "valves: behind a tube (over 15 ms) the board's pressure loop gets gains for it (sent\n"
+      "with GAIN, written as control.inner_loop). Fits the static map (bend start,\n"
       "slope, saturation, hysteresis) and the dynamics (inner pressure loop and bending: lag +\n"
       "dead time), computes the outer-loop gains (SIMC PI, feed-forward from the static map,\n"
       "hysteresis compensation) and writes them with a `control: model:` section into a new\n"

@@ -35,7 +35,8 @@ float PressureLoop::update(int32_t setpoint_pa, int32_t pressure_pa) {
   if (!saturated_up && !saturated_down) {
     integral_ = Clamp(integral_ + config_.ki_per_kpa_s * error_kpa * dt_s, -1.0f, 1.0f);
   }
-  return Clamp(config_.kp_per_kpa * error_kpa + integral_, -1.0f, 1.0f);
+  const float duty = Clamp(config_.kp_per_kpa * error_kpa + integral_, -1.0f, 1.0f);
+  return duty < 0.0f ? Clamp(duty * vent_scale_, -1.0f, 0.0f) : duty;
 }
 
 Board::Board(const BoardConfig& config) : config_(config), loop_(config) {}
@@ -78,6 +79,8 @@ size_t Board::handle(const wire::Message& m, uint32_t now_ms) {
     // A new session starts from the safe state.
     mode_ = Mode::kIdle;
     loop_.reset();
+    // A host's gains last for its session only: the next one starts from the board's own.
+    loop_.set_gains(config_.kp_per_kpa, config_.ki_per_kpa_s, 1.0f);
     setpoint_pa_ = 0;
     command_duty_permille_ = 0;
     if (m.args[0] != wire::kProtocolVersion) {
@@ -110,6 +113,16 @@ size_t Board::handle(const wire::Message& m, uint32_t now_ms) {
       mode_ = Mode::kDuty;
       command_duty_permille_ = m.args[1];
       setpoint_pa_ = 0;
+      break;
+    case wire::MessageType::kSetGains:
+      if (m.args[1] < 0 || m.args[1] > wire::kMaxGainPermille || m.args[2] < 0 ||
+          m.args[2] > wire::kMaxGainPermille || m.args[3] < 1 ||
+          m.args[3] > wire::kMaxVentPermille) {
+        return answer_error(seq, wire::kErrRange);
+      }
+      loop_.set_gains(static_cast<float>(m.args[1]) * 0.001f,
+                      static_cast<float>(m.args[2]) * 0.001f,
+                      static_cast<float>(m.args[3]) * 0.001f);
       break;
     case wire::MessageType::kStop:
       mode_ = Mode::kStopped;

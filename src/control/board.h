@@ -23,6 +23,17 @@ class PressureLoop {
   // One period of 1 / loop_hz seconds. Returns the duty in [-1, 1].
   float update(int32_t setpoint_pa, int32_t pressure_pa);
   void reset() { integral_ = 0.0f; }
+  // New gains from the host ($GAIN); the integral (a duty) is kept, so the output does not jump.
+  // `vent_scale` multiplies the duty when it vents: a vent orifice faster than the pump would
+  // otherwise give the loop a higher gain one way than the other.
+  void set_gains(float kp_per_kpa, float ki_per_kpa_s, float vent_scale) {
+    config_.kp_per_kpa = kp_per_kpa;
+    config_.ki_per_kpa_s = ki_per_kpa_s;
+    vent_scale_ = vent_scale;
+  }
+  float kp_per_kpa() const { return config_.kp_per_kpa; }
+  float ki_per_kpa_s() const { return config_.ki_per_kpa_s; }
+  float vent_scale() const { return vent_scale_; }
   // Drops any integral that pushes towards inflation (used while the limit guard vents).
   void unwind_inflation() {
     if (integral_ > 0.0f) integral_ = 0.0f;
@@ -31,6 +42,7 @@ class PressureLoop {
  private:
   BoardConfig config_;
   float integral_ = 0.0f;
+  float vent_scale_ = 1.0f;
 };
 
 class Board {
@@ -54,7 +66,12 @@ class Board {
   int32_t setpoint_pa() const { return setpoint_pa_; }
   int32_t duty_permille() const { return duty_permille_; }
   int32_t pressure_pa() const { return pressure_pa_; }
+  // The board's own settings (as built; $GAIN changes the loop's gains, not these).
   const BoardConfig& config() const { return config_; }
+  // The inner loop's gains in use: the board's own until a $GAIN, again after each $HELLO.
+  float kp_per_kpa() const { return loop_.kp_per_kpa(); }
+  float ki_per_kpa_s() const { return loop_.ki_per_kpa_s(); }
+  float vent_scale() const { return loop_.vent_scale(); }
 
  private:
   size_t handle(const wire::Message& message, uint32_t now_ms);

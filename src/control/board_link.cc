@@ -57,6 +57,18 @@ bool LinkOptions::Check(std::string* error) const {
   return true;
 }
 
+bool InnerLoopGains::Check(std::string* error) const {
+  // Each field's range is its row in control/control_options.cc; only the pairing here.
+  // Each field's range is its row in control/control_options.cc.
+  if (const auto problem = CheckOptions(InnerLoopGainsTable(), *this)) return Fail(error, *problem);
+  return true;
+}
+
+// The wire carries gains in per-mille; its limit and the host's are one.
+static_assert(kMaxInnerGain * 1000.0 == static_cast<double>(wire::kMaxGainPermille));
+static_assert(kMaxVentScale * 1000.0 == static_cast<double>(wire::kMaxVentPermille));
+static_assert(kMinVentScale * 1000.0 == 1.0);
+
 BoardLink::BoardLink(Transport& transport, LinkOptions options, LinkEnvironment environment)
     : transport_(transport), options_(options), environment_(std::move(environment)) {}
 
@@ -159,27 +171,61 @@ BoardInfo BoardLink::handshake() {
 }
 
 BoardState BoardLink::set_pressure_kpa(double setpoint_kpa) {
-  return request(wire::MessageType::kSetPressure,
-                 static_cast<int32_t>(std::lround(setpoint_kpa * 1e3)), "SETP");
+  return *request(wire::MessageType::kSetPressure,
+                  {static_cast<int32_t>(std::lround(setpoint_kpa * 1e3))}, "SETP");
 }
 
 BoardState BoardLink::set_duty(double duty) {
-  return request(wire::MessageType::kSetDuty, static_cast<int32_t>(std::lround(duty * 1e3)),
-                 "DUTY");
+  return *request(wire::MessageType::kSetDuty, {static_cast<int32_t>(std::lround(duty * 1e3))},
+                  "DUTY");
 }
 
-BoardState BoardLink::read_state() { return request(wire::MessageType::kRead, 0, "READ"); }
-BoardState BoardLink::stop() { return request(wire::MessageType::kStop, 0, "STOP"); }
-BoardState BoardLink::heartbeat() { return request(wire::MessageType::kPing, 0, "PING"); }
+BoardState BoardLink::set_inner_loop_gains(double kp_per_kpa, double ki_per_kpa_s,
+                                           double vent_scale) {
+  // Per-mille on the wire; a gain the wire cannot carry is the caller's bug (the config's
+  // ranges keep it within kMaxInnerGain).
+  const auto permille = [](double gain) {
+    return static_cast<int32_t>(std::lround(std::clamp(gain, 0.0, kMaxInnerGain) * 1e3));
+  };
+  if (std::optional<BoardState> state =
+          request(wire::MessageType::kSetGains,
+                  {permille(kp_per_kpa), permille(ki_per_kpa_s),
+                   static_cast<int32_t>(std::lround(
+                       std::clamp(vent_scale, kMinVentScale, kMaxVentScale) * 1e3))},
+                  "GAIN", /*allow_silence=*/true)) {
+    return *state;
+  }
+  // Silence. A board that answers READ now is running but ignored GAIN: a firmware from before
+  // the command (it rejects an unknown word without an answer, docs/protocol.md).
+  const BoardState alive = read_state();
+  throw InputError(port_name() + ": the board does not know the GAIN command (no answer to " +
+                   std::to_string(options_.retries + 1) + " tries, though it answers READ; " +
+                   std::to_string(alive.board_rejected) +
+                   " lines rejected by it): its firmware predates inner-loop gains set by the "
+                   "host; update it (firmware/README.md), or remove control.inner_loop from the "
+                   "config to keep the board's own gains; vented");
+}
 
-BoardState BoardLink::request(wire::MessageType type, int32_t value, const char* what) {
+BoardState BoardLink::read_state() { return *request(wire::MessageType::kRead, {}, "READ"); }
+BoardState BoardLink::stop() { return *request(wire::MessageType::kStop, {}, "STOP"); }
+BoardState BoardLink::heartbeat() { return *request(wire::MessageType::kPing, {}, "PING"); }
+
+std::optional<BoardState> BoardLink::request(wire::MessageType type,
+                                             std::initializer_list<int32_t> values,
+                                             const char* what, bool allow_silence) {
   wire::Message command;
   command.type = type;
   command.argc = static_cast<uint8_t>(wire::ArgumentCount(type));
   const int32_t seq = next_seq_;
   next_seq_ = next_seq_ >= 999999 ? 1 : next_seq_ + 1;
   command.args[0] = seq;
-  command.args[1] = value;
+  std::string arguments;  // As sent, for an error message.
+  int i = 1;
+  for (const int32_t value : values) {
+    command.args[i++] = value;
+    arguments += ' ';
+    arguments += std::to_string(value);
+  }
   const bool is_stop = type == wire::MessageType::kStop;
   uint64_t rejected = 0;
   std::string why;
@@ -207,6 +253,7 @@ BoardState BoardLink::request(wire::MessageType type, int32_t value, const char*
                        std::to_string(rejected) + " lines from the board rejected (last: " + why +
                        "); check the board's firmware, baud rate and sensor");
     }
+    if (allow_silence) return std::nullopt;
     throw InputError(port_name() + ": no answer to " + what + " after " +
                      (is_stop ? std::to_string(kMaxStopMs) + " ms (the board's watchdog vents)"
                               : std::to_string(options_.retries + 1) + " tries of " +
@@ -215,8 +262,8 @@ BoardState BoardLink::request(wire::MessageType type, int32_t value, const char*
   }
   const wire::Message& m = *reply;
   if (m.type == wire::MessageType::kError) {
-    throw InputError(port_name() + ": the board refused " + std::string(what) + " " +
-                     std::to_string(value) + ": " + ErrorName(m.args[1]));
+    throw InputError(port_name() + ": the board refused " + std::string(what) + arguments + ": " +
+                     ErrorName(m.args[1]));
   }
   BoardState state;
   state.seq = m.args[0];

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "control/board.h"
@@ -41,8 +42,12 @@ class FakeBoard : public Transport {
  public:
   FakeBoard() : board_(BoardConfig{}) {}
 
-  void write_line(std::string_view line) override {
-    written.emplace_back(line);
+  void write_line(std::string_view line_in) override {
+    written.emplace_back(line_in);
+    std::string line(line_in);
+    // A firmware from before $GAIN rejects the word unanswered, as it rejects a corrupted line:
+    // the board below gets a line whose CRC does not match.
+    if (!knows_gain && line.rfind("$GAIN ", 0) == 0) line[4] = 'X';
     for (char c : line) {
       const size_t n = board_.receive(c, static_cast<uint32_t>(now));
       if (n == 0) continue;
@@ -96,6 +101,7 @@ class FakeBoard : public Transport {
 
   int64_t now = 0;
   int64_t latency_ms = 2;
+  bool knows_gain = true;
   int64_t chatter_period_ms = 0;
   int64_t chatter_until_ms = 60000;  // Bounded, so that a link that would wait for ever fails.
   std::function<std::string(const std::string&)> rewrite;
@@ -229,6 +235,35 @@ TEST(BoardLink, ABoardErrIsOneErrorNamingTheCommand) {
   }
 }
 
+TEST(BoardLink, InnerLoopGainsGoOutAsGainAndAFirmwareWithoutItIsOneClearError) {
+  FakeBoard fake;
+  BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+  link.handshake();
+  link.set_inner_loop_gains(0.05, 0.12, 0.333);
+  const wire::Message sent = Decode(fake.written.back());
+  ASSERT_EQ(sent.type, wire::MessageType::kSetGains);
+  EXPECT_EQ(sent.args[1], 50);
+  EXPECT_EQ(sent.args[2], 120);
+  EXPECT_EQ(sent.args[3], 333);
+
+  fake.knows_gain = false;
+  const int64_t before_ms = fake.now;
+  try {
+    link.set_inner_loop_gains(0.05, 0.12, 1.0);
+    FAIL() << "an old firmware took GAIN";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::StartsWith("serial port /dev/fake0: the board does not know "
+                                                "the GAIN command (no answer to 3 tries"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("update it (firmware/README.md), or remove "
+                                               "control.inner_loop"));
+  }
+  // Three tries of GAIN, then a READ that the board answered.
+  const std::vector<std::string> words = fake.words();
+  EXPECT_EQ(std::vector<std::string>(words.end() - 4, words.end()),
+            (std::vector<std::string>{"GAIN", "GAIN", "GAIN", "READ"}));
+  EXPECT_EQ(fake.now - before_ms, 3 * 100 + 2);
+}
+
 // ---- The session: STOP on every way out, the host's pressure clamp, the board's limit. ----
 
 ControlTarget Pressure(double kpa) {
@@ -285,6 +320,49 @@ TEST(ControlSession, ABoardReportingMoreThanItsLimitIsAFaultThatVents) {
         << e.what();
   }
   EXPECT_EQ(fake.words().back(), "STOP");
+}
+
+TEST(ControlSession, TheInnerLoopGainsGoRightAfterTheHandshakeAndAnOldFirmwareStopsTheRun) {
+  InnerLoopGains gains;
+  gains.kp_per_kpa = 0.05;
+  gains.ki_per_kpa_s = 0.12;
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+    session.set_inner_loop_gains(gains);
+    session.start();
+    session.step(0.0, std::nullopt);
+    session.stop();
+    EXPECT_EQ(fake.words(), (std::vector<std::string>{"HELLO", "GAIN", "SETP", "STOP"}));
+  }
+  {
+    FakeBoard fake;
+    fake.knows_gain = false;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    {
+      ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+      session.set_inner_loop_gains(gains);
+      EXPECT_THROW(session.start(), InputError);
+    }
+    EXPECT_EQ(fake.words().back(), "STOP") << "vented on the way out";
+    for (const std::string& word : fake.words()) EXPECT_NE(word, "SETP");
+  }
+  // A gain out of range: refused before anything is sent.
+  {
+    FakeBoard fake;
+    BoardLink link(fake, LinkOptions{}, SimulatedClock(fake));
+    ControlSession session(ControllerOptions{}, link, Pressure(20.0));
+    InnerLoopGains bad = gains;
+    bad.vent_scale = 0.0;
+    try {
+      session.set_inner_loop_gains(bad);
+      FAIL() << "a vent scale of 0 taken";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), ::testing::StartsWith("control.inner_loop.vent_scale: "));
+    }
+    EXPECT_TRUE(fake.written.empty());
+  }
 }
 
 TEST(ControlSession, SendsStopOnEveryWayOut) {

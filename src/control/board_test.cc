@@ -36,6 +36,68 @@ wire::Message Send(Board& board, const std::string& line, uint32_t now_ms) {
   return m;
 }
 
+std::string GainLine(int32_t seq, int32_t kp_permille, int32_t ki_permille,
+                     int32_t vent_permille = 1000) {
+  wire::Message m;
+  m.type = wire::MessageType::kSetGains;
+  m.argc = 4;
+  m.args[0] = seq;
+  m.args[1] = kp_permille;
+  m.args[2] = ki_permille;
+  m.args[3] = vent_permille;
+  char buffer[wire::kLineBufferSize];
+  return std::string(buffer, wire::EncodeMessage(m, buffer, sizeof(buffer)));
+}
+
+// $GAIN (docs/protocol.md): the host's gains drive the loop until the next $HELLO; a gain out of
+// range, or before the handshake, is refused and changes nothing.
+TEST(Board, GainSetsTheInnerLoopForTheSessionAndHelloRestoresTheBoardsOwn) {
+  Board board{BoardConfig{}};
+  wire::Message m = Send(board, GainLine(1, 50, 120), 0);
+  ASSERT_EQ(m.type, wire::MessageType::kError);
+  EXPECT_EQ(m.args[1], wire::kErrNoHello);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.25f);
+
+  Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion), 0);
+  m = Send(board, GainLine(2, 50, 120), 0);
+  ASSERT_EQ(m.type, wire::MessageType::kState);
+  EXPECT_EQ(m.args[0], 2);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.05f);
+  EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.12f);
+  // The loop runs on them: 10 kPa of error asks 0.05 * 10 + one period of 0.12 * 10 kPa * 2 ms
+  // of duty (the board's own gains would ask 2.5: full inflation).
+  Send(board, Line(wire::MessageType::kSetPressure, 3, 20000), 0);
+  board.update(2, 10000);
+  EXPECT_EQ(board.duty_permille(), 502);
+
+  // Venting at a third of the duty: 10 kPa too much asks a third of 0.05 * 10 of venting (the
+  // integral of the period before and this period's cancel).
+  Send(board, GainLine(6, 50, 120, 333), 4);
+  Send(board, Line(wire::MessageType::kSetPressure, 7, 0), 4);
+  board.update(6, 10000);
+  EXPECT_EQ(board.duty_permille(), -167);
+  Send(board, GainLine(8, 50, 120), 6);
+
+  const int32_t kMaxGain = wire::kMaxGainPermille, kMaxVent = wire::kMaxVentPermille;
+  const int32_t bad[][3] = {{-1, 120, 1000},         {50, -1, 1000},       {kMaxGain + 1, 120, 1000},
+                            {50, kMaxGain + 1, 1000}, {50, 120, 0},        {50, 120, kMaxVent + 1}};
+  for (const auto& b : bad) {
+    m = Send(board, GainLine(4, b[0], b[1], b[2]), 4);
+    ASSERT_EQ(m.type, wire::MessageType::kError) << b[0] << " " << b[1] << " " << b[2];
+    EXPECT_EQ(m.args[1], wire::kErrRange);
+    EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.05f);
+    EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.12f);
+  }
+  EXPECT_FLOAT_EQ(board.vent_scale(), 1.0f);
+  m = Send(board, GainLine(5, wire::kMaxGainPermille, 0, wire::kMaxVentPermille), 4);
+  EXPECT_EQ(m.type, wire::MessageType::kState) << "the largest gains the wire carries are taken";
+
+  Send(board, Line(wire::MessageType::kHello, wire::kProtocolVersion), 6);
+  EXPECT_FLOAT_EQ(board.kp_per_kpa(), 0.25f);
+  EXPECT_FLOAT_EQ(board.ki_per_kpa_s(), 0.5f);
+  EXPECT_FLOAT_EQ(board.vent_scale(), 1.0f);
+}
+
 TEST(Board, RequiresTheVersionedHandshake) {
   Board board{BoardConfig{}};
   wire::Message m = Send(board, Line(wire::MessageType::kSetPressure, 1, 20000), 0);

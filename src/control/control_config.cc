@@ -68,6 +68,7 @@ bool ControlConfig::Check(std::string* error) const {
   std::string problem;
   if (!controller.Check(&problem)) return Fail(error, "controller." + problem);
   if (!link.Check(&problem)) return Fail(error, "link." + problem);
+  if (!inner_loop.Check(&problem)) return Fail(error, "inner_loop." + problem);
   if (!rig.Check(&problem)) return Fail(error, "rig." + problem);
   if (!model.Check(&problem)) return Fail(error, "model." + problem);
   return true;

@@ -95,6 +95,25 @@ OptionTable<LinkOptions> MakeLink() {
   };
 }
 
+OptionTable<InnerLoopGains> MakeInnerLoop() {
+  using P = InnerLoopGains;
+  return {
+      DoubleOption<P>("kp_per_kpa", &P::kp_per_kpa)
+          .Range(0, kMaxInnerGain)
+          .Unit("duty/kPa")
+          .Doc("the board's pressure loop gain for this run, sent at the handshake with the two "
+               "below (0: the board's own gains, nothing sent); identify sets it for a tube"),
+      DoubleOption<P>("ki_per_kpa_s", &P::ki_per_kpa_s)
+          .Range(0, kMaxInnerGain)
+          .Unit("duty/(kPa s)")
+          .Doc("the board's pressure loop integral gain for this run (with kp_per_kpa > 0)"),
+      DoubleOption<P>("vent_scale", &P::vent_scale)
+          .Range(kMinVentScale, kMaxVentScale)
+          .Doc("the loop's duty is multiplied by this when it vents, for a vent faster than the "
+               "pump (with kp_per_kpa > 0)"),
+  };
+}
+
 // A board setting in kPa (the file) held in integer Pa (the board).
 Option<BoardConfig> KpaOption(const char* key, int32_t BoardConfig::*pa) {
   return CustomOption<BoardConfig>(
@@ -225,6 +244,12 @@ OptionTable<ActuatorModel> MakeModel() {
       row("hysteresis_deg", &P::hysteresis_deg, 0, 180, "deg",
           "static map: width between the up and down branches"),
       row("static_rms_deg", &P::static_rms_deg, 0, 180, "deg", "RMS residual of the static fit"),
+      row("valve_dead_time_s", &P::valve_dead_time_s, 0, 100, "s",
+          "valve command -> sensed pressure moving: the tube's delay (inner-loop probe)"),
+      row("inflate_kpa_per_s", &P::inflate_kpa_per_s, 0, 1e6, "kPa/s",
+          "pressure rate at full inflation, near vented"),
+      row("vent_kpa_per_s", &P::vent_kpa_per_s, 0, 1e6, "kPa/s",
+          "pressure rate at full venting (at about a quarter of the experiment's ceiling)"),
       row("pressure_lag_s", &P::pressure_lag_s, 0, 100, "s",
           "inner loop setpoint -> sensed pressure: first-order lag"),
       row("pressure_dead_time_s", &P::pressure_dead_time_s, 0, 100, "s",
@@ -250,6 +275,7 @@ OptionTable<ControlConfig> MakeControl() {
   OptionTable<P> table;
   AppendOptions(&table, "controller", &P::controller, ControllerOptionsTable());
   AppendOptions(&table, "link", &P::link, LinkOptionsTable());
+  AppendOptions(&table, "inner_loop", &P::inner_loop, InnerLoopGainsTable());
   AppendOptions(&table, "rig", &P::rig, RigOptionsTable());
   AppendOptions(&table, "model", &P::model, ModelOptionsTable());
   return table;
@@ -263,6 +289,10 @@ const OptionTable<ControllerOptions>& ControllerOptionsTable() {
 }
 const OptionTable<LinkOptions>& LinkOptionsTable() {
   static const OptionTable<LinkOptions> table = MakeLink();
+  return table;
+}
+const OptionTable<InnerLoopGains>& InnerLoopGainsTable() {
+  static const OptionTable<InnerLoopGains> table = MakeInnerLoop();
   return table;
 }
 const OptionTable<BoardConfig>& BoardConfigTable() {

@@ -10,6 +10,7 @@ namespace softsight {
 
 const OptionTable<ControllerOptions>& ControllerOptionsTable();
 const OptionTable<LinkOptions>& LinkOptionsTable();
+const OptionTable<InnerLoopGains>& InnerLoopGainsTable();
 const OptionTable<BoardConfig>& BoardConfigTable();  // in kPa where the board counts Pa
 const OptionTable<PlantOptions>& PlantOptionsTable();
 const OptionTable<RigOptions>& RigOptionsTable();    // with board.* and plant.*

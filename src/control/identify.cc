@@ -14,6 +14,11 @@ namespace {
 
 std::string Seconds(double v) { return FixedNumber(v, 2) + " s"; }
 
+// The inner-loop probe inflates to this fraction of the ceiling: high enough for a few frames of
+// a rising pressure in a small chamber, low enough that what the tube still delivers after the
+// valves close stays under the ceiling.
+constexpr double kProbeFraction = 0.25;
+
 // Solves the 3x3 system a x = b (Cramer's rule); false when it is (nearly) singular.
 bool Solve3(const double a[3][3], const double b[3], double x[3]) {
   auto det = [](const double m[3][3]) {
@@ -264,10 +269,13 @@ double IdentificationExperiment::next(double time_s, std::optional<double> angle
     case kBaseline:
       if (hold_complete(time_s)) {
         straight_deg_ = steady_point(true).angle_deg;
-        phase_ = kStepsUp;
-        level_ = 1;
-        start_hold(time_s, ceiling_kpa_ * level_ / options_.levels);
+        phase_ = kInnerLoop;
+        probe_.emplace(kProbeFraction * ceiling_kpa_);
+        probe(time_s);
       }
+      break;
+    case kInnerLoop:
+      probe(time_s);
       break;
     case kStepsUp:
       if (hold_complete(time_s)) {
@@ -325,13 +333,35 @@ double IdentificationExperiment::next(double time_s, std::optional<double> angle
     case kDone:
       break;
   }
-  samples_.back().setpoint_kpa = setpoint_kpa_;
-  return setpoint_kpa_;
+  samples_.back().setpoint_kpa = duty_ ? 0.0 : setpoint_kpa_;
+  samples_.back().duty = duty_;
+  return duty_ ? 0.0 : setpoint_kpa_;
 }
 
-void IdentificationExperiment::answered(double pressure_kpa) {
+void IdentificationExperiment::probe(double time_s) {
+  duty_ = probe_->next(time_s);
+  if (duty_) return;
+  inner_loop_ = probe_->measurement();
+  if (const std::optional<InnerLoopGains> gains = InnerLoopGainsFor(*inner_loop_, ceiling_kpa_)) {
+    inner_loop_gains_ = *gains;
+    gains_to_send_ = true;
+  }
+  phase_ = kStepsUp;
+  level_ = 1;
+  start_hold(time_s, ceiling_kpa_ * level_ / options_.levels);
+}
+
+std::optional<InnerLoopGains> IdentificationExperiment::take_gains_to_send() {
+  if (!gains_to_send_) return std::nullopt;
+  gains_to_send_ = false;
+  return inner_loop_gains_;
+}
+
+void IdentificationExperiment::answered(double pressure_kpa, int64_t board_time_ms) {
   if (samples_.empty()) return;
   samples_.back().pressure_kpa = pressure_kpa;
+  samples_.back().board_time_ms = board_time_ms;
+  if (probe_ && phase_ == kInnerLoop) probe_->answered(board_time_ms, pressure_kpa);
   if (pressure_kpa > ceiling_kpa_ + options_.over_ceiling_kpa) {
     throw IdentifyAbort("identify: the sensed pressure " + ShortNumber(pressure_kpa, 3) +
                         " kPa is above the experiment's ceiling of " + ShortNumber(ceiling_kpa_, 3) +
@@ -535,6 +565,11 @@ ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
   m.lag_s = bend_fit[0];
   m.dead_time_s = bend_fit[1];
   m.dynamic_rms_deg = std::sqrt(bend_fit[2] / static_cast<double>(t.size()));
+  if (const std::optional<InnerLoopMeasurement>& probe = experiment.inner_loop()) {
+    m.valve_dead_time_s = probe->dead_time_s;
+    m.inflate_kpa_per_s = probe->inflate_kpa_per_s;
+    m.vent_kpa_per_s = probe->vent_kpa_per_s;
+  }
   return m;
 }
 
@@ -545,8 +580,14 @@ double IdentificationCeiling(const ControllerOptions& controller, double board_l
 ControlSample StepIdentification(IdentificationExperiment& experiment, ControlSession& session,
                                  double time_s, std::optional<double> angle_deg) {
   const double setpoint_kpa = experiment.next(time_s, angle_deg);
-  const ControlSample sample = session.step_pressure(time_s, setpoint_kpa, angle_deg);
-  experiment.answered(sample.board.pressure_kpa);
+  // Gains the probe has just chosen reach the board before the first step that needs them.
+  if (const std::optional<InnerLoopGains> gains = experiment.take_gains_to_send()) {
+    session.set_inner_loop_gains(*gains);
+  }
+  const ControlSample sample =
+      experiment.duty() ? session.step_duty(time_s, *experiment.duty(), angle_deg)
+                        : session.step_pressure(time_s, setpoint_kpa, angle_deg);
+  experiment.answered(sample.board.pressure_kpa, sample.board.time_ms);
   return sample;
 }
 
@@ -571,7 +612,11 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
   // the actuator only once per frame.
   const double measured_dead_s =
       m.dead_time_s + m.pressure_dead_time_s + 0.5 * frame_period_s;
-  const double tau_c = closed_loop_s.value_or(std::max(measured_dead_s, 3.0 * frame_period_s));
+  // Behind a tube the board's loop runs on the probe's gentle gains (no faster than the tube
+  // lets it, and saturating on large steps): the outer loop is no faster than that inner loop.
+  const double inner_s = m.valve_dead_time_s > kShortTubeS ? 3.0 * m.pressure_lag_s : 0.0;
+  const double tau_c = closed_loop_s.value_or(
+      std::max({measured_dead_s, 3.0 * frame_period_s, inner_s}));
   model->closed_loop_s = tau_c;
   ControllerOptions c = base;
   c.kp_kpa_per_deg = std::clamp(tau / (k * (tau_c + theta)), 0.0, 100.0);

@@ -2,7 +2,9 @@
 //
 // The experiment (IdentificationExperiment) chooses one pressure setpoint per camera frame, open
 // loop, never above its ceiling:
-//   1. baseline: vented until the angle is steady (the straight angle);
+//   1. baseline: vented until the angle is steady (the straight angle), then the inner-loop probe
+//      (control/inner_loop_probe.h: full inflation, valves closed, full venting, open loop), whose
+//      tube delay decides the gains the board's pressure loop gets for the rest (InnerLoopGainsFor);
 //   2. steps up: `levels` equal pressure steps to the ceiling, each held until the angle is steady;
 //   3. steps down the same levels to 0 (the second branch of the hysteresis);
 //   4. PRBS: a pseudo-random binary sequence (31 bits of a 5-bit shift register) of +-amplitude
@@ -37,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "control/inner_loop_probe.h"
 #include "softsight/control/actuator_model.h"
 #include "softsight/control/controller.h"
 #include "softsight/control/session.h"
@@ -67,7 +70,9 @@ class IdentifyAbort : public InputError {
 struct IdentifySample {
   double time_s = 0.0;
   std::optional<double> angle_deg;  // Measured in this frame.
-  double setpoint_kpa = 0.0;        // Sent in this frame.
+  double setpoint_kpa = 0.0;        // Sent in this frame (0 while the probe drives the valves).
+  std::optional<double> duty;       // Sent in this frame instead, by the inner-loop probe.
+  int64_t board_time_ms = 0;        // The board's clock in its answer.
   double pressure_kpa = 0.0;        // The board's sensed pressure in its answer.
   int phase = 0;                    // IdentificationExperiment::Phase.
 };
@@ -80,18 +85,26 @@ struct StaticPoint {
 
 class IdentificationExperiment {
  public:
-  enum Phase { kBaseline = 0, kStepsUp = 1, kStepsDown = 2, kPrbs = 3, kDone = 4 };
+  // (kInnerLoop runs between the baseline and the steps; numbered last so that the numbers the
+  // CSV's identify_phase column had keep their meaning.)
+  enum Phase { kBaseline = 0, kStepsUp = 1, kStepsDown = 2, kPrbs = 3, kDone = 4, kInnerLoop = 5 };
 
   // `ceiling_kpa`: the highest setpoint the experiment sends (the caller takes it below the
   // controller's max_kpa and the board's limit). Throws InputError when it is not positive.
   IdentificationExperiment(const IdentifyOptions& options, double ceiling_kpa);
 
   // The setpoint to send for the frame at `time_s` whose angle is `angle_deg` (absent: markers
-  // not found). Throws IdentifyAbort. After the last phase: 0 and done().
+  // not found); while duty() is given, that valve duty is sent instead. Throws IdentifyAbort.
+  // After the last phase: 0 and done().
   double next(double time_s, std::optional<double> angle_deg);
-  // The board's answer to that setpoint (its sensed pressure). Throws IdentifyAbort when it is
-  // above the ceiling by more than over_ceiling_kpa.
-  void answered(double pressure_kpa);
+  // The valve duty of this frame while the inner-loop probe drives the valves, else nothing.
+  std::optional<double> duty() const { return duty_; }
+  // The gains for the board's inner loop the probe has just chosen, once (the caller sends them
+  // before this frame's command); nothing in every other frame.
+  std::optional<InnerLoopGains> take_gains_to_send();
+  // The board's answer to that command (its sensed pressure and its clock). Throws IdentifyAbort
+  // when the pressure is above the ceiling by more than over_ceiling_kpa.
+  void answered(double pressure_kpa, int64_t board_time_ms = 0);
 
   bool done() const { return phase_ == kDone; }
   Phase phase() const { return phase_; }
@@ -99,6 +112,9 @@ class IdentificationExperiment {
   const std::vector<IdentifySample>& samples() const { return samples_; }
   const std::vector<StaticPoint>& static_points() const { return static_points_; }
   std::optional<double> straight_deg() const { return straight_deg_; }
+  // What the probe measured, and the gains chosen from it (not given: the board's own).
+  const std::optional<InnerLoopMeasurement>& inner_loop() const { return inner_loop_; }
+  const InnerLoopGains& inner_loop_gains() const { return inner_loop_gains_; }
 
  private:
   // True once the current hold has lasted min_hold_s and the angle is steady (or max_hold_s).
@@ -106,6 +122,8 @@ class IdentificationExperiment {
   StaticPoint steady_point(bool up) const;
   void start_hold(double time_s, double setpoint_kpa);
   void start_prbs(double time_s);
+  // One frame of the inner-loop probe; on to the steps (in the same frame) when it is done.
+  void probe(double time_s);
 
   IdentifyOptions options_;
   double ceiling_kpa_;
@@ -118,6 +136,12 @@ class IdentificationExperiment {
   size_t hold_first_sample_ = 0;
   double setpoint_kpa_ = 0.0;
   int level_ = 0;
+  // The inner-loop probe.
+  std::optional<InnerLoopProbe> probe_;
+  std::optional<double> duty_;
+  std::optional<InnerLoopMeasurement> inner_loop_;
+  InnerLoopGains inner_loop_gains_;
+  bool gains_to_send_ = false;
   // PRBS.
   double prbs_start_s_ = 0.0;
   double prbs_centre_kpa_ = 0.0;

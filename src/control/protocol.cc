@@ -18,6 +18,7 @@ const CommandInfo kCommands[] = {
     {MessageType::kHello, "HELLO", 1, true},     {MessageType::kSetPressure, "SETP", 2, true},
     {MessageType::kSetDuty, "DUTY", 2, true},    {MessageType::kRead, "READ", 1, true},
     {MessageType::kStop, "STOP", 1, true},       {MessageType::kPing, "PING", 1, true},
+    {MessageType::kSetGains, "GAIN", 4, true},
     {MessageType::kHelloReply, "HI", 4, false},  {MessageType::kState, "STATE", 7, false},
     {MessageType::kError, "ERR", 2, false},
 };

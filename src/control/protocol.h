@@ -36,6 +36,9 @@ enum class MessageType : uint8_t {
   kRead,         // $READ <seq>                        read state, changes nothing
   kStop,         // $STOP <seq>                        vent to the safe state
   kPing,         // $PING <seq>                        heartbeat, changes nothing
+  kSetGains,     // $GAIN <seq> <kp> <ki> <vent>       inner-loop gains: per-mille duty per kPa
+                 //                                    (kp), per kPa*s (ki); venting's share of
+                 //                                    the duty in per-mille (vent)
   // Board -> host.
   kHelloReply,   // $HI <version> <pressure_limit_pa> <loop_hz> <watchdog_ms>
   kState,        // $STATE <seq> <time_ms> <pressure_pa> <setpoint_pa> <duty_permille> <flags> <rejected>
@@ -57,8 +60,19 @@ enum StateFlag : uint16_t {
 enum ErrorCode : int32_t {
   kErrVersion = 1,    // $HELLO with another protocol version.
   kErrNoHello = 2,    // A command before a successful handshake.
-  kErrRange = 3,      // An argument outside its range (setpoint above the limit, |duty| > 1000).
+  kErrRange = 3,      // An argument outside its range (setpoint above the limit, |duty| > 1000,
+                      // a gain outside 0..kMaxGainPermille, a vent share outside
+                      // 1..kMaxVentPermille).
 };
+
+// The largest inner-loop gain $GAIN carries, per-mille duty per kPa (kp) or per kPa*s (ki): 1000
+// duty per kPa, a full valve swing for a pascal of error, is far beyond any useful loop. A gain
+// above it is a corrupted or mistyped value, refused with kErrRange.
+const int32_t kMaxGainPermille = 1000000;
+// The venting share of $GAIN, per-mille of the loop's duty when it vents: 1..10000 (0.001..10).
+// A vent faster than the pump needs less duty for the same pressure rate; never 0, so the loop
+// can always vent.
+const int32_t kMaxVentPermille = 10000;
 
 // Why a line was rejected. Rejected lines are counted and never acted on.
 enum class DecodeStatus : uint8_t {

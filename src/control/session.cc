@@ -57,6 +57,7 @@ BoardInfo ControlSession::start() {
                      "); no setpoint sent, vented");
   }
   controller_.limit_max_kpa(info.pressure_limit_kpa);
+  send_inner_loop_gains();  // Before any setpoint: the loop starts with the gains for the plant.
   const double max_kpa = controller_.options().max_kpa;
   if (target_.mode == ControlMode::kPressure && target_.pressure_kpa > max_kpa) {
     pressure_clamped_from_ = target_.pressure_kpa;
@@ -90,10 +91,7 @@ const BoardState& ControlSession::checked(const BoardState& state) {
 }
 
 ControlSample ControlSession::step(double time_s, std::optional<double> measured_deg) {
-  if (!start_time_s_) start_time_s_ = time_s;
-  ControlSample sample;
-  sample.time_s = time_s - *start_time_s_;
-  sample.measured_deg = measured_deg;
+  ControlSample sample = begin_sample(time_s, measured_deg);
   switch (target_.mode) {
     case ControlMode::kAngle: {
       const double target_deg = target_.profile.at(sample.time_s);
@@ -113,35 +111,24 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
       break;
     case ControlMode::kDuty:
       sample.action = ControllerOutput::Action::kTrack;
-      // Open-loop inflation stops at the host's own limit, not only at the board's guard: while
-      // the sensed pressure is at max_kpa the valves stay closed (venting is always allowed).
-      sample.duty_command = target_.duty;
-      // The next frame's pressure is foreseen from the rise of the last frame that inflated: the
-      // valves close a frame early rather than one late.
-      if (target_.duty > 0.0 &&
-          last_pressure_kpa_ + inflate_rise_kpa_ >= controller_.options().max_kpa) {
-        sample.duty_command = 0.0;
-        ++duty_held_at_limit_;
-      }
-      {
-        const double before_kpa = last_pressure_kpa_;
-        sample.board = checked(link_.set_duty(*sample.duty_command));
-        if (*sample.duty_command > 0.0) {
-          inflate_rise_kpa_ = std::max(0.0, last_pressure_kpa_ - before_kpa);
-        }
-      }
+      send_duty(target_.duty, &sample);
       break;
   }
   return sample;
 }
 
-ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
-                                            std::optional<double> measured_deg) {
+ControlSample ControlSession::begin_sample(double time_s, std::optional<double> measured_deg) {
   if (!start_time_s_) start_time_s_ = time_s;
   ControlSample sample;
   sample.time_s = time_s - *start_time_s_;
   sample.measured_deg = measured_deg;
   sample.action = ControllerOutput::Action::kTrack;
+  return sample;
+}
+
+ControlSample ControlSession::step_pressure(double time_s, double setpoint_kpa,
+                                            std::optional<double> measured_deg) {
+  ControlSample sample = begin_sample(time_s, measured_deg);
   sample.board = checked(send_pressure(setpoint_kpa, &sample.setpoint_kpa));
   return sample;
 }
@@ -160,6 +147,43 @@ ControlSample ControlSession::vent(double time_s, std::optional<double> measured
   sample.board = checked(link_.stop());
   controller_.reset();
   return sample;
+}
+
+void ControlSession::send_duty(double duty, ControlSample* sample) {
+  // Open-loop inflation stops at the host's own limit, not only at the board's guard: while
+  // the sensed pressure is at max_kpa the valves stay closed (venting is always allowed).
+  sample->duty_command = duty;
+  // The next frame's pressure is foreseen from the rise of the last frame that inflated: the
+  // valves close a frame early rather than one late.
+  if (duty > 0.0 && last_pressure_kpa_ + inflate_rise_kpa_ >= controller_.options().max_kpa) {
+    sample->duty_command = 0.0;
+    ++duty_held_at_limit_;
+  }
+  const double before_kpa = last_pressure_kpa_;
+  sample->board = checked(link_.set_duty(*sample->duty_command));
+  if (*sample->duty_command > 0.0) {
+    inflate_rise_kpa_ = std::max(0.0, last_pressure_kpa_ - before_kpa);
+  }
+}
+
+ControlSample ControlSession::step_duty(double time_s, double duty,
+                                        std::optional<double> measured_deg) {
+  ControlSample sample = begin_sample(time_s, measured_deg);
+  send_duty(std::clamp(duty, -1.0, 1.0), &sample);
+  return sample;
+}
+
+void ControlSession::set_inner_loop_gains(const InnerLoopGains& gains) {
+  std::string problem;
+  if (!gains.Check(&problem)) throw InputError("control.inner_loop." + problem);
+  inner_loop_ = gains;
+  if (started_ && !stopped_) send_inner_loop_gains();
+}
+
+void ControlSession::send_inner_loop_gains() {
+  if (!inner_loop_.given()) return;
+  checked(link_.set_inner_loop_gains(inner_loop_.kp_per_kpa, inner_loop_.ki_per_kpa_s,
+                                     inner_loop_.vent_scale));
 }
 
 BoardState ControlSession::stop() {

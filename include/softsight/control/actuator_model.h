@@ -19,6 +19,12 @@ struct ActuatorModel {
   double saturation_kpa = 0.0;
   double hysteresis_deg = 0.0;
   double static_rms_deg = 0.0;   // RMS residual of the static fit.
+  // Valves -> sensed pressure, open loop (the inner-loop probe): the delay of a tube between them,
+  // and the pressure rates of full inflation (near vented) and full venting (at about 25 % of the
+  // experiment's ceiling).
+  double valve_dead_time_s = 0.0;
+  double inflate_kpa_per_s = 0.0;
+  double vent_kpa_per_s = 0.0;
   // Inner loop, pressure setpoint -> sensed pressure: first-order lag plus dead time.
   double pressure_lag_s = 0.0;
   double pressure_dead_time_s = 0.0;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -63,6 +64,30 @@ constexpr double kMaxSensedPressureKpa = 2 * kMaxBoardPressureLimitKpa;
 // watchdog vents on its own when the commands stop.
 constexpr int kMaxStopMs = 1500;
 
+// The largest inner-loop gain the wire carries (duty per kPa, or per kPa*s): a full valve swing
+// for a pascal of error, far beyond any useful loop.
+constexpr double kMaxInnerGain = 1000.0;
+// The range of the venting factor the wire carries.
+constexpr double kMinVentScale = 0.001;
+constexpr double kMaxVentScale = 10.0;
+
+// Gains the host sets on the board's inner pressure loop for one session ($GAIN, right after the
+// handshake), when the board's own do not suit the plant: a tube between the valves and the
+// chamber delays the loop, and gains made for a short tube make it oscillate. `softsight
+// identify` measures the delay and chooses them. kp_per_kpa 0 (the default): the board's own
+// gains, nothing sent.
+struct InnerLoopGains {
+  double kp_per_kpa = 0.0;    // Valve duty per kPa of pressure error; 0: the board's own gains.
+  double ki_per_kpa_s = 0.0;  // Valve duty per kPa*s.
+  // The duty is multiplied by this when the loop vents: a vent faster than the pump would
+  // otherwise give the loop more gain one way than the other. Default 1.
+  double vent_scale = 1.0;
+
+  bool given() const { return kp_per_kpa > 0.0; }
+  // Each in its range. False names the bad field in `error`.
+  bool Check(std::string* error) const;
+};
+
 // What the board said in its $HI answer.
 struct BoardInfo {
   int protocol_version = 0;
@@ -107,6 +132,12 @@ class BoardLink {
 
   BoardState set_pressure_kpa(double setpoint_kpa);
   BoardState set_duty(double duty);  // [-1, 1]; > 0 inflate, < 0 vent.
+  // The board's inner pressure loop gains for this session ($GAIN; a $HELLO restores the
+  // board's own): duty per kPa of error and per kPa*s, each in [0, kMaxInnerGain], and the
+  // factor of the duty when venting, in [kMinVentScale, kMaxVentScale]. Throws
+  // InputError naming the port when the board refuses them, or when it answers READ but not
+  // GAIN: a firmware that predates the command.
+  BoardState set_inner_loop_gains(double kp_per_kpa, double ki_per_kpa_s, double vent_scale);
   BoardState read_state();
   // Vent to the safe state (ignores stop requests; gives up after kMaxStopMs).
   BoardState stop();
@@ -129,7 +160,11 @@ class BoardLink {
       const std::string& line, bool honour_stop,
       const std::function<Verdict(const wire::Message&)>& classify, int64_t budget_ms = 0,
       uint64_t* rejected = nullptr, std::string* why = nullptr);
-  BoardState request(wire::MessageType type, int32_t value, const char* what);
+  // Sends `type` with its sequence number and `values`; the board's STATE. Throws InputError
+  // when the board refuses it, or after the retries; with `allow_silence`, a board that never
+  // answered (and said nothing rejected) gives nothing instead.
+  std::optional<BoardState> request(wire::MessageType type, std::initializer_list<int32_t> values,
+                                    const char* what, bool allow_silence = false);
   int64_t now_ms() const;
 
   Transport& transport_;

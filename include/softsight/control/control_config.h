@@ -1,5 +1,5 @@
 // Everything the `control:` section of a config sets (examples/rig.yaml documents every key):
-// the outer-loop gains, the serial link, the simulated rig, and the identified model.
+// the outer-loop gains, the serial link, the board's inner-loop gains, the simulated rig, and the identified model.
 #pragma once
 
 #include <string>
@@ -14,6 +14,7 @@ namespace softsight {
 struct ControlConfig {
   ControllerOptions controller;
   LinkOptions link;
+  InnerLoopGains inner_loop;  // Sent to the board at the handshake when given.
   RigOptions rig;  // Used by `softsight rig` and `softsight control --simulate` only.
   ActuatorModel model;  // Written by `softsight identify`; informative (the gains are above).
 

@@ -50,6 +50,11 @@ class ControlSession {
   ControlSession(const ControlSession&) = delete;
   ControlSession& operator=(const ControlSession&) = delete;
 
+  // Gains for the board's inner loop, sent by start() right after the handshake (and at once when
+  // the session has started: an identification that has just measured the plant). Not given:
+  // the board keeps its own. Throws InputError when they are unusable or the board refuses them.
+  void set_inner_loop_gains(const InnerLoopGains& gains);
+
   // Handshake; the controller's max_kpa is clamped to the board's limit, and so is an open-loop
   // pressure target (see pressure_clamped_from()). Throws InputError (after venting) when the
   // controller's min_kpa is not below the board's limit: every setpoint would be above it.
@@ -62,6 +67,9 @@ class ControlSession {
   // the same clamp to max_kpa and the same checks of the answer as step().
   ControlSample step_pressure(double time_s, double setpoint_kpa,
                               std::optional<double> measured_deg);
+  // One frame open loop at a valve duty chosen for this frame (an identification experiment),
+  // with the same hold at max_kpa as the duty mode of step().
+  ControlSample step_duty(double time_s, double duty, std::optional<double> measured_deg);
   // Vents the actuator (end of run).
   BoardState stop();
 
@@ -89,12 +97,18 @@ class ControlSession {
  private:
   // Sends the setpoint clamped to [min_kpa, max_kpa]; `sent` receives the clamped value.
   BoardState send_pressure(double setpoint_kpa, std::optional<double>* sent);
+  // A frame's sample: its time since the first step, the angle, action kTrack.
+  ControlSample begin_sample(double time_s, std::optional<double> measured_deg);
+  // Sends `duty`, or 0 (valves closed) when inflating would take the pressure to max_kpa.
+  void send_duty(double duty, ControlSample* sample);
+  void send_inner_loop_gains();
   // Throws (after venting) when the board says its pressure is above its own limit.
   const BoardState& checked(const BoardState& state);
 
   AngleController controller_;
   BoardLink& link_;
   ControlTarget target_;
+  InnerLoopGains inner_loop_;
   std::optional<double> start_time_s_;
   std::optional<double> pressure_clamped_from_;
   double board_limit_kpa_ = 0.0;
