@@ -600,6 +600,22 @@ class LiveFileTest : public LiveControllerTest {
     spec.input = path;
     return std::make_unique<PacedFrameSource>(OpenFrameSource(spec), clock.timing());
   }
+  // The options `live` runs a 30 fps file with (recordings at the file's rate).
+  LiveOptions FileOptions() const {
+    LiveOptions options = Options();
+    options.record_fps = 30.0;
+    return options;
+  }
+  // `track` on the last recording's raw video with its config gives the live CSV's text (found
+  // flags and positions included, timings left out): `rows` rows and the header.
+  void ExpectTrackReproduces(const LiveController& live, size_t rows) {
+    const std::string prefix = live.last_recording();
+    Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+    const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+    EXPECT_EQ(live_rows.size(), rows + 1);
+    EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+    fs::remove(dir_ / "again.csv");
+  }
 };
 
 TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrackReproduces) {
@@ -699,9 +715,7 @@ TEST_F(LiveFileTest, AOneRowRecordingAtTheEndAfterEditsReproducesUnderTrack) {
   const std::string video = WriteVideo(12);
   FakeClock clock;
   std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
-  LiveOptions options = Options();
-  options.record_fps = 30.0;
-  LiveController live(SceneConfig(), options);
+  LiveController live(SceneConfig(), FileOptions());
   LiveFeed feed(*source);
   while (feed.step(live)) {
   }
@@ -711,11 +725,7 @@ TEST_F(LiveFileTest, AOneRowRecordingAtTheEndAfterEditsReproducesUnderTrack) {
   live.on_event(UiEvent::Key('r'));
   ASSERT_TRUE(live.recording()) << live.message();
   live.on_event(UiEvent::Key('r'));
-  const std::string prefix = live.last_recording();
-  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
-  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
-  ASSERT_EQ(live_rows.size(), 2u);
-  EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+  ExpectTrackReproduces(live, 1);
 }
 
 TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfterTheReselection) {
@@ -1483,21 +1493,11 @@ TEST_F(LiveControllerTest, UndoRestoresTheMarkerAsItWasBeforeTheLastReselectionO
 // A recording reproduces under `track` (same rows, found flags and positions) when undo is among
 // its edits, whether it was started paused, after a method change, or at the end of the input.
 TEST_F(LiveFileTest, RecordingsWithUndoAmongTheEditsReproduceUnderTrackStartedPausedAtTheEndAfterAMethodChange) {
-  const auto reproduce = [&](LiveController& live, size_t rows) {
-    const std::string prefix = live.last_recording();
-    Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
-    const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
-    EXPECT_EQ(live_rows.size(), rows + 1);
-    EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
-    fs::remove(dir_ / "again.csv");
-  };
   const std::string video = WriteVideo(30);
   {  // Started paused, after a method change, a reselection and its undo; more while recording.
     FakeClock clock;
     std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
-    LiveOptions options = Options();
-    options.record_fps = 30.0;
-    LiveController live(SceneConfig(), options);
+    LiveController live(SceneConfig(), FileOptions());
     LiveFeed feed(*source);
     for (int i = 0; i < 10; ++i) ASSERT_TRUE(feed.step(live));
     live.on_event(UiEvent::Key(' '));
@@ -1518,14 +1518,12 @@ TEST_F(LiveFileTest, RecordingsWithUndoAmongTheEditsReproduceUnderTrackStartedPa
     live.on_event(UiEvent::Key('m'));  // A method change while recording: ssd.
     for (int i = 0; i < 2; ++i) ASSERT_TRUE(feed.step(live));
     live.on_event(UiEvent::Key('r'));
-    reproduce(live, 13);
+    ExpectTrackReproduces(live, 13);
   }
   {  // At the end: colour ranges moved (trackbar) and undone, a pick undone, one row recorded.
     FakeClock clock;
     std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
-    LiveOptions options = Options();
-    options.record_fps = 30.0;
-    LiveController live(SceneConfig(), options);
+    LiveController live(SceneConfig(), FileOptions());
     LiveFeed feed(*source);
     while (feed.step(live)) {
     }
@@ -1538,7 +1536,7 @@ TEST_F(LiveFileTest, RecordingsWithUndoAmongTheEditsReproduceUnderTrackStartedPa
     live.on_event(UiEvent::Key('r'));
     ASSERT_TRUE(live.recording()) << live.message();
     live.on_event(UiEvent::Key('r'));
-    reproduce(live, 1);
+    ExpectTrackReproduces(live, 1);
   }
 }
 
