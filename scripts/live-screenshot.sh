@@ -2,12 +2,12 @@
 # Makes docs/images/live-window.png, the live window as docs/live.md shows it: `softsight live` on
 # the demo's rendered video under a virtual display (Xvfb), driven with xdotool as a person would
 # (play, record a second, reselect the tip by a box, a range change that loses it for a while and
-# its undo, pause, zoom in on the middle marker with the wheel), then Xvfb's own framebuffer
+# pause, zoom in on the middle marker with +), then Xvfb's own framebuffer
 # (-fbdir, an XWD file) cropped to the window and written as PNG. No screenshot tool needed.
 # Usage: scripts/live-screenshot.sh [BUILD_DIR]   (default build; needs Xvfb and xdotool)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BIN="${1:-build}/src/app/softsight"
+BIN="$(realpath "${1:-build}")/src/app/softsight"
 OUT=docs/images/live-window.png
 work=$(mktemp -d)
 pids=()
@@ -21,14 +21,15 @@ trap cleanup EXIT
 video=$(ls "$work"/demo/*.avi | head -1)
 config=$(ls "$work"/demo/*.yaml | head -1)
 
-Xvfb :97 -screen 0 1280x900x24 -fbdir "$work" -nolisten tcp &
+# A display number Xvfb finds free (other users' displays are left alone).
+Xvfb -displayfd 3 -screen 0 1280x900x24 -fbdir "$work" -nolisten tcp 3>"$work/display" &
 pids+=($!)
-export DISPLAY=:97
-sleep 1
+for _ in $(seq 50); do [ -s "$work/display" ] && break; sleep 0.1; done
+export DISPLAY=":$(cat "$work/display")"
 (cd "$work" && exec "$BIN" live --input "$video" --config "$config" --no-trackbars \
    --record-prefix "$work/live" > "$work/live.log" 2>&1) &
 pids+=($!)
-xdotool search --sync --onlyvisible --name "softsight live" windowfocus --sync >/dev/null
+timeout 60 xdotool search --sync --onlyvisible --name "softsight live" windowfocus --sync >/dev/null
 key() { xdotool key "$@"; sleep 0.4; }
 sleep 2
 key r; sleep 1.5; key r                 # a recording: green along the timeline's top
@@ -39,10 +40,12 @@ sleep 1.5
 key space                                # paused
 win=$(xdotool search --onlyvisible --name "softsight live" | head -1)
 eval "$(xdotool getwindowgeometry --shell "$win")"
+X=0; Y=0  # Without a window manager the window is at the screen corner, undecorated.
+if [ -n "${SHOT_WHOLE_SCREEN:-}" ]; then WIDTH=1280; HEIGHT=900; fi
 # The middle marker (blue) in the window: where the log's last row says it is, else the middle.
 bx=$((WIDTH / 2)); by=$((HEIGHT / 3))
 xdotool mousemove $bx $by
-for _ in 1 2 3 4; do xdotool click 4; sleep 0.3; done
+for _ in 1 2 3 4; do xdotool key plus; sleep 0.3; done
 sleep 1.5
 python3 - "$work/Xvfb_screen0" "$OUT" "$X" "$Y" "$WIDTH" "$HEIGHT" <<'PY'
 import struct, sys, zlib

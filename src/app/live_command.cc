@@ -119,7 +119,7 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "stays and every key works. Rows keep the source's frame numbers after a seek.\n"
       "The timeline under the image shows where the frame is, where edits and recordings were\n"
       "made and where a marker was not found; click or drag on it to seek. { / } play slower /\n"
-      "faster (0.1x..4x); mouse wheel or + / - zoom at the pointer, right-drag pans, z shows the\n"
+      "faster (0.1x..4x); + / - zoom at the pointer, right-drag pans, z shows the\n"
       "whole image (clicks and boxes work zoomed); u undoes the last reselection or range change.\n"
       "v: mask view of the active marker (member pixels, candidate blobs with their verdicts,\n"
       "the searched region); there a click adds the clicked colours to the ranges, shift-click\n"

@@ -23,7 +23,7 @@ constexpr double kSpeeds[] = {0.1, 0.25, 0.5, 1.0, 2.0, 4.0};
 constexpr int kSpeedCount = static_cast<int>(std::size(kSpeeds));
 constexpr size_t kMaxQueuedRequests = 32;
 constexpr size_t kMaxUndo = 32;
-constexpr double kZoomStep = 1.25;  // Per wheel notch or + / - press.
+constexpr double kZoomStep = 1.25;  // Per + / - press.
 
 }  // namespace
 
@@ -684,9 +684,6 @@ void LiveController::handle(const UiEvent& event) {
     if (has_timeline_ && scrub(event, view)) return;
   }
   switch (event.type) {
-    case Type::kWheel:
-      if (in_image) zoom_at(at, std::pow(kZoomStep, event.value));
-      break;
     case Type::kPanDown:
       pan_from_ = at;
       break;

@@ -34,14 +34,13 @@ namespace softsight {
 class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
 
 struct UiEvent {
-  // kWheel: the mouse wheel (value: notches, positive away from the user); kPanDown / kPanMove:
-  // the right button pressed / moved with it held (pans a zoomed view).
-  enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar, kWheel, kPanDown, kPanMove };
+  // kPanDown / kPanMove: the right button pressed / moved with it held (pans a zoomed view).
+  enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar, kPanDown, kPanMove };
   Type type = Type::kKey;
   cv::Point2d position_px;  // Mouse events: canvas pixel (the scaled image is top left).
   int key = 0;              // kKey: the character ('q', ' ', '1') or 27 for Escape.
   int trackbar = 0;         // kTrackbar: index into kHsvTrackbars.
-  int value = 0;            // kTrackbar: new position; kWheel: notches.
+  int value = 0;            // kTrackbar: new position.
   bool shift = false;       // Mouse events: the shift key was held.
 
   static UiEvent Mouse(Type type, double x, double y, bool shift = false) {
@@ -50,9 +49,6 @@ struct UiEvent {
   static UiEvent Key(int key) { return {Type::kKey, {}, key, 0, 0, false}; }
   static UiEvent Trackbar(int index, int value) {
     return {Type::kTrackbar, {}, 0, index, value, false};
-  }
-  static UiEvent Wheel(double x, double y, int notches) {
-    return {Type::kWheel, {x, y}, 0, 0, notches, false};
   }
 };
 
@@ -95,7 +91,7 @@ inline constexpr std::array<LiveKey, 24> kLiveKeys = {{
     {'1', "1..9 active marker;  q / Esc quit"},
     {0, "drag a box: reselect; click: pick colour"},
     {0, "mask view: click adds colours, shift-click removes"},
-    {0, "wheel: zoom at the pointer; right-drag: pan"},
+    {0, "right-drag: pan a zoomed view"},
     {0, "timeline (under the image): click / drag seeks"},
 }};
 
@@ -143,7 +139,7 @@ class LiveController {
   const Timeline& timeline() const { return timeline_; }
   // The playing speed the window asks of a paced file (`{` / `}`: 0.1x .. 4x).
   double speed() const;
-  // The zoom and pan of the view (wheel, + / -, z, right-drag).
+  // The zoom and pan of the view (+ / -, z, right-drag).
   const ViewZoom& zoom() const { return zoom_; }
   // Edits `u` can undo.
   size_t undo_depth() const { return undo_.size(); }

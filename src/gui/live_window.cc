@@ -23,12 +23,8 @@ void OnMouse(int event, int x, int y, int flags, void* user) {
   auto* context = static_cast<CallbackContext*>(user);
   UiEvent::Type type;
   switch (event) {
-    case cv::EVENT_MOUSEWHEEL: {
-      // Notches of 120 (X11 buttons 4 and 5 come as +-120 through GTK and Qt).
-      const int delta = cv::getMouseWheelDelta(flags);
-      context->controller->on_event(UiEvent::Wheel(x, y, delta > 0 ? 1 : delta < 0 ? -1 : 0));
-      return;
-    }
+    // The wheel is not taken: OpenCV's Qt windows zoom their own view with it (and map the
+    // mouse through that zoom), which would zoom twice. + and - zoom the picture itself.
     case cv::EVENT_RBUTTONDOWN:
       type = UiEvent::Type::kPanDown;
       break;
