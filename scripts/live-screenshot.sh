@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Makes docs/images/live-window.png, the live window as docs/live.md shows it: `softsight live` on
 # the demo's rendered video under a virtual display (Xvfb), driven with xdotool as a person would
-# (play, record a second, reselect the tip by a box, a range change that loses it for a while and
-# pause, zoom in on the middle marker with +), then Xvfb's own framebuffer
-# (-fbdir, an XWD file) cropped to the window and written as PNG. No screenshot tool needed.
+# (play, record a second and a half, make the tip active and drag a box on background, which
+# loses it, pause, zoom in with + at the pointer), then Xvfb's own framebuffer (-fbdir, an XWD
+# file) cropped to the window and written as PNG. No screenshot tool needed. The keys are timed
+# with sleeps (this makes a picture; the tests wait for the window's stdout lines instead).
 # Usage: scripts/live-screenshot.sh [BUILD_DIR]   (default build; needs Xvfb and xdotool)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,8 +42,7 @@ key space                                # paused
 win=$(xdotool search --onlyvisible --name "softsight live" | head -1)
 eval "$(xdotool getwindowgeometry --shell "$win")"
 X=0; Y=0  # Without a window manager the window is at the screen corner, undecorated.
-if [ -n "${SHOT_WHOLE_SCREEN:-}" ]; then WIDTH=1280; HEIGHT=900; fi
-# The middle marker (blue) in the window: where the log's last row says it is, else the middle.
+# Near the middle marker (blue) at this point of the demo: the upper middle of the window.
 bx=$((WIDTH / 2)); by=$((HEIGHT / 3))
 xdotool mousemove $bx $by
 for _ in 1 2 3 4; do xdotool key plus; sleep 0.3; done
