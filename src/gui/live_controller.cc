@@ -16,6 +16,16 @@
 #include "gui/live_view.h"
 
 namespace softsight {
+namespace {
+
+// The playing speeds `{` and `}` step through (times the file's own rate).
+constexpr double kSpeeds[] = {0.1, 0.25, 0.5, 1.0, 2.0, 4.0};
+constexpr int kSpeedCount = static_cast<int>(std::size(kSpeeds));
+constexpr size_t kMaxQueuedRequests = 32;
+constexpr size_t kMaxUndo = 32;
+constexpr double kZoomStep = 1.25;  // Per + / - press.
+
+}  // namespace
 
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options,
                                std::function<void(int64_t index)> before_encode)
@@ -97,6 +107,10 @@ void LiveController::on_frame(const Frame& frame, SteadyClock::time_point captur
   frame_time_s_ = frame.time_s;
   // Tracked, counted and (while recording) recorded by the pipeline.
   const FrameResult& result = pipeline_->process(frame);
+  seeking_ = false;
+  if (has_timeline_) {
+    if (recording()) timeline_.mark(position_, Timeline::kRecorded);
+  }
   show(result);
   report_recording_failure();
   if (order != FrameOrder::kNext) {
@@ -125,7 +139,9 @@ void LiveController::redraw_annotated() {
 void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) const {
   OverlayStatus& status = overlay_status_;  // Reused: its vectors keep their storage.
   status.fps = meter_.fps();
+  // Slower than the video is said when the file plays slower than asked (`{` asks for less).
   status.speed = meter_.speed();
+  if (status.speed && *status.speed >= speed() * 0.9) status.speed = *status.speed / speed();
   status.latency_ms = meter_.latency_ms();
   const std::vector<MarkerSpec>& markers = config().markers;
   status.template_boxes.resize(markers.size());
@@ -150,9 +166,67 @@ void LiveController::on_end_of_input() {
 }
 
 std::optional<PlaybackRequest> LiveController::take_playback_request() {
-  std::optional<PlaybackRequest> request;
-  request.swap(playback_request_);
+  if (playback_requests_.empty()) return std::nullopt;
+  const PlaybackRequest request = playback_requests_.front();
+  playback_requests_.pop_front();
   return request;
+}
+
+bool LiveController::jump_pending() const {
+  return !playback_requests_.empty() &&
+         playback_requests_.front().kind != PlaybackRequest::Kind::kStepForward;
+}
+
+void LiveController::show_seeking() {
+  seeking_ = true;
+  dirty_ = true;
+}
+
+void LiveController::set_source_position(int64_t position, std::optional<int64_t> length) {
+  has_timeline_ = true;
+  position_ = position;
+  if (length && length != timeline_.length()) timeline_.set_length(*length);
+  timeline_.set_position(position);
+}
+
+double LiveController::speed() const { return kSpeeds[speed_step_]; }
+
+void LiveController::change_speed(int steps) {
+  speed_step_ = std::clamp(speed_step_ + steps, 0, kSpeedCount - 1);
+  meter_.restart();  // The rate measured at the old speed says nothing of the new one.
+  say("speed " + FixedNumber(speed(), speed() < 1 ? 2 : 0) + "x");
+}
+
+void LiveController::zoom_at(const cv::Point2d& image_px, double factor) {
+  if (frame_.empty()) return;
+  zoom_ = zoom_.about(image_px, factor, frame_.size());
+  dirty_ = true;
+}
+
+bool LiveController::scrub(const UiEvent& event, const LiveLayout& view) {
+  using Type = UiEvent::Type;
+  const cv::Point at(cvFloor(event.position_px.x), cvFloor(event.position_px.y));
+  if (event.type == Type::kMouseDown) scrubbing_ = view.timeline.contains(at);
+  if (!scrubbing_) return false;
+  if (event.type == Type::kMouseUp) scrubbing_ = false;
+  const int64_t target =
+      timeline_.position_at(event.position_px.x - view.timeline.x, view.timeline.width);
+  if (target == position_ && event.type != Type::kMouseDown) return true;
+  // A drag asks for many frames; only the newest one still matters.
+  if (!playback_requests_.empty() && playback_requests_.back().kind == PlaybackRequest::Kind::kSeekTo) {
+    playback_requests_.pop_back();
+  }
+  PlaybackRequest request;
+  request.kind = PlaybackRequest::Kind::kSeekTo;
+  request.position = target;
+  if (recording()) {
+    say("stop the recording first (r): a recording holds consecutive frames");
+    scrubbing_ = false;
+    return true;
+  }
+  playback_requests_.push_back(request);
+  dirty_ = true;
+  return true;
 }
 
 void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds) {
@@ -164,7 +238,11 @@ void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds
   if (kind == PlaybackRequest::Kind::kStepForward || kind == PlaybackRequest::Kind::kStepBack) {
     paused_ = true;
   }
-  playback_request_ = PlaybackRequest{kind, seconds};
+  if (playback_requests_.size() >= kMaxQueuedRequests) {
+    say("still seeking: key ignored");
+    return;
+  }
+  playback_requests_.push_back(PlaybackRequest{kind, seconds});
   dirty_ = true;
 }
 
@@ -231,6 +309,7 @@ void LiveController::apply_spec(int marker, const MarkerSpec& spec,
     say(e.what());
     return;
   }
+  if (has_timeline_) timeline_.mark(position_, Timeline::kEdit);
   if (marker == active_) ++hsv_revision_;
 }
 
@@ -245,6 +324,7 @@ void LiveController::click(const cv::Point2d& p) {
     say("colour pick for " + config().markers[marker].name + ": " + why);
     return;
   }
+  remember_for_undo(marker, "colour pick");
   active_ = marker;
   MarkerSpec spec = config().markers[marker];
   auto* colour = std::get_if<ColourParams>(&spec.params);
@@ -285,6 +365,7 @@ void LiveController::edit_range(const cv::Point2d& p, bool grow) {
     say(spec.name + ": " + why);
     return;
   }
+  remember_for_undo(active_, grow ? "added colours" : "removed colours");
   colour->h = ranges.h;
   colour->s = ranges.s;
   colour->v = ranges.v;
@@ -313,19 +394,71 @@ void LiveController::drag(const cv::Rect& dragged) {
     }
   }
   const int marker = count == 1 ? *inside : active_;
+  remember_for_undo(marker, "reselection");
   const MarkerSpec& spec = config().markers[marker];
   try {
     // The session remembers the selection in its config (the template's pixels, or the colour
     // search box), so that `s` saves it.
     show(session().reselect(spec.name, on_screen(), rect));
   } catch (const InputError& e) {
+    undo_.pop_back();  // Refused: nothing changed.
     say(e.what());
     return;
   }
+  if (has_timeline_) timeline_.mark(position_, Timeline::kEdit);
   if (active_ != marker) ++hsv_revision_;
   active_ = marker;
   say(spec.name + ": reselected in [" + std::to_string(rect.x) + ", " + std::to_string(rect.y) +
       ", " + std::to_string(rect.width) + ", " + std::to_string(rect.height) + "]");
+}
+
+void LiveController::remember_for_undo(int marker, const std::string& what, bool coalesce) {
+  if (coalesce && !undo_.empty() && undo_.back().coalescing && undo_.back().marker == marker) {
+    return;  // The same trackbar drag: undo goes back to before it began.
+  }
+  if (undo_.size() >= kMaxUndo) undo_.erase(undo_.begin());
+  UndoEntry entry{marker, config().markers[marker], colour_aside_[marker], what, coalesce};
+  auto* templ = std::get_if<TemplateParams>(&entry.spec.params);
+  if (templ && templ->image.empty() && templ->rect && marker < static_cast<int>(recording_cuts_.size()) &&
+      recording_cuts_[marker].first == *templ->rect) {
+    templ->image = recording_cuts_[marker].second;  // Cut when the recording started.
+  }
+  undo_.push_back(std::move(entry));
+}
+
+void LiveController::undo() {
+  if (undo_.empty()) {
+    say("nothing to undo (u undoes reselections and range changes)");
+    return;
+  }
+  UndoEntry entry = std::move(undo_.back());
+  undo_.pop_back();
+  if (auto* templ = std::get_if<TemplateParams>(&entry.spec.params)) {
+    if (templ->image.empty()) {
+      // A rectangle to cut on a frame that is no longer on screen: cutting it here would take
+      // whatever is there now, not the template.
+      say("cannot undo the " + entry.what + " of " + entry.spec.name + ": its template was cut " +
+          "from frame " + std::to_string(templ->template_frame) + " of the config, not live");
+      return;
+    }
+    // The old template, started where the marker is now (not where it was cut): the tracker
+    // then follows it from here, live and in `track` alike.
+    if (const auto position = position_of(entry.marker); position && !frame_.empty()) {
+      const cv::Size size = templ->image.size();
+      const cv::Rect here(cvRound(position->x - size.width / 2.0),
+                          cvRound(position->y - size.height / 2.0), size.width, size.height);
+      if ((here & cv::Rect(0, 0, frame_.cols, frame_.rows)) == here) {
+        templ->rect = here;
+        templ->template_frame = static_cast<int>(std::max<int64_t>(0, frame_index_));
+      }
+    }
+  }
+  colour_aside_[entry.marker] = entry.aside;
+  // The marker as it was, through the same respec every edit uses: a running recording logs it
+  // like any other edit, so `track` replays the undo too.
+  apply_spec(entry.marker, entry.spec, std::nullopt);
+  ++hsv_revision_;
+  say("undone: " + entry.what + " of " + entry.spec.name);
 }
 
 void LiveController::switch_method() {
@@ -364,6 +497,7 @@ void LiveController::set_hsv(int trackbar, int value) {
   HsvRange* ranges[3] = {&colour.h, &colour.s, &colour.v};
   int& field = trackbar % 2 == 0 ? ranges[trackbar / 2]->lo : ranges[trackbar / 2]->hi;
   if (field == value) return;  // The adapter moving its own trackbar: nothing changed.
+  remember_for_undo(active_, "range change", /*coalesce=*/true);
   field = value;
   colour.auto_bgr.reset();
   const std::string text = spec.name + ": h " + RangeText(colour.h) + " s " +
@@ -479,6 +613,12 @@ void LiveController::toggle_recording() {
     show(pipeline_->start_recording(
         again, boxes, options_.record_fps.value_or(meter_.fps().value_or(30.0)),
         [this](cv::Mat& canvas, const FrameResult& result) { draw_overlay(canvas, result); }));
+    // The recording's templates are cut from this frame (their configs say "rect on frame 0"):
+    // their pixels, for `u` to restore after the frame is gone.
+    recording_cuts_.assign(boxes.size(), {});
+    for (size_t i = 0; i < boxes.size(); ++i) {
+      if (boxes[i]) recording_cuts_[i] = {*boxes[i], again.image(*boxes[i]).clone()};
+    }
     ++hsv_revision_;
     say("recording to " + pipeline_->recording_prefix() + ".*");
     report_recording_failure();
@@ -491,6 +631,12 @@ Frame LiveController::on_screen() const { return Frame{frame_, frame_index_, fra
 
 void LiveController::show(const FrameResult& result) {
   last_result_ = result;
+  if (has_timeline_) {
+    // A frame tracked again (a reselection) may now find every marker: the mark follows.
+    const bool lost = std::any_of(result.markers.begin(), result.markers.end(),
+                                  [](const MarkerObservation& m) { return !m.observation.found(); });
+    timeline_.mark(position_, Timeline::kLost, lost);
+  }
   chart_.add(result);  // A frame measured again (re-tracked, reselected) replaces its sample.
   redraw_annotated();
   dirty_ = true;
@@ -504,7 +650,8 @@ void LiveController::set_screen(cv::Size screen_px) {
 LiveLayout LiveController::layout() const {
   const cv::Size image_size = frame_.empty() ? cv::Size(640, 480) : frame_.size();
   const int help_width = help_ ? HelpPanelWidth() : 0;
-  return ComputeLiveLayout(image_size, options_.chart.height_px, help_width, max_canvas_);
+  return ComputeLiveLayout(image_size, options_.chart.height_px, help_width, max_canvas_,
+                           StatusBandHeight(), has_timeline_, zoom_);
 }
 
 cv::Point2d LiveController::to_view(const cv::Point2d& image_px) const {
@@ -523,6 +670,8 @@ void LiveController::on_event(const UiEvent& event) {
 
 void LiveController::handle(const UiEvent& event) {
   using Type = UiEvent::Type;
+  // A trackbar drag is one edit for `u`; anything else in between starts a new one.
+  if (event.type != Type::kTrackbar && !undo_.empty()) undo_.back().coalescing = false;
   // The pointer works in image pixels: the canvas may show the image scaled down.
   const LiveLayout view = layout();
   const cv::Point2d at = view.to_image(event.position_px);
@@ -530,7 +679,22 @@ void LiveController::handle(const UiEvent& event) {
                                                       cvFloor(event.position_px.y))) &&
                         at.x >= -0.5 && at.y >= -0.5 && at.x < frame_.cols - 0.5 &&
                         at.y < frame_.rows - 0.5;
+  if (event.type == Type::kMouseDown || event.type == Type::kMouseMove ||
+      event.type == Type::kMouseUp) {
+    if (in_image) pointer_image_ = at;
+    if (has_timeline_ && scrub(event, view)) return;
+  }
   switch (event.type) {
+    case Type::kPanDown:
+      pan_from_ = at;
+      break;
+    case Type::kPanMove:
+      // The image point under the pointer at the press stays under it.
+      if (pan_from_ && !frame_.empty()) {
+        zoom_ = zoom_.panned(*pan_from_ - at, frame_.size());
+        dirty_ = true;
+      }
+      break;
     case Type::kMouseDown:
       if (pointer_->down(at, in_image)) dirty_ = true;
       break;
@@ -625,6 +789,29 @@ void LiveController::handle(const UiEvent& event) {
         case 'm':
           switch_method();
           break;
+        case 'u':
+          undo();
+          break;
+        case '}':
+          change_speed(+1);
+          break;
+        case '{':
+          change_speed(-1);
+          break;
+        case '+':
+        case '=':
+        case '-': {
+          // At the pointer when it is over the image, else at the middle of what is shown.
+          const cv::Point2d middle =
+              zoom_.origin_px + cv::Point2d(frame_.cols, frame_.rows) * (0.5 / zoom_.zoom) -
+              cv::Point2d(0.5, 0.5);
+          zoom_at(pointer_image_.value_or(middle), event.key == '-' ? 1 / kZoomStep : kZoomStep);
+          break;
+        }
+        case 'z':
+          zoom_ = {};
+          dirty_ = true;
+          break;
         case 'c':
           start_scale();
           break;
@@ -652,6 +839,7 @@ std::vector<std::string> LiveController::status_lines() const {
   if (paused_) state += "PAUSED  ";
   if (ended_) state += "END  ";
   if (loop_) state += "LOOP  ";
+  if (speed() != 1.0) state += FixedNumber(speed(), speed() < 1 ? 2 : 0) + "x  ";
   if (dropped_ > 0) state += "dropped " + std::to_string(dropped_) + "  ";
   state +=
       "active: " + config().markers[active_].name + " (" +
@@ -660,7 +848,11 @@ std::vector<std::string> LiveController::status_lines() const {
     state += "  " + FixedNumber(*scale, 4) + " mm/px";
   }
   lines.push_back(state);
-  if (!message_.empty()) lines.push_back(message_);
+  if (seeking_) {
+    lines.push_back("seeking...");
+  } else if (!message_.empty()) {
+    lines.push_back(message_);
+  }
   // The hint stays while picking, whatever other keys say meanwhile.
   if (scale_.active() && message_ != scale_.hint()) lines.push_back(scale_.hint());
   return lines;
@@ -681,6 +873,7 @@ const cv::Mat& LiveController::canvas() {
   state.press = pointer_->press();
   state.pointer = pointer_->pointer();
   state.chart = &chart_;
+  state.timeline = has_timeline_ ? &timeline_ : nullptr;
   dirty_ = false;
   return view_.compose(layout(), state);
 }

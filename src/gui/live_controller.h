@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <deque>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -24,6 +25,7 @@
 #include "gui/rate_meter.h"
 #include "gui/scale_clicks.h"
 #include "gui/strip_chart.h"
+#include "gui/timeline.h"
 #include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
 
@@ -32,7 +34,8 @@ namespace softsight {
 class LivePointer;    // gui/live_pointer.h: the mouse as clicks and drags.
 
 struct UiEvent {
-  enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar };
+  // kPanDown / kPanMove: the right button pressed / moved with it held (pans a zoomed view).
+  enum class Type { kMouseDown, kMouseMove, kMouseUp, kKey, kTrackbar, kPanDown, kPanMove };
   Type type = Type::kKey;
   cv::Point2d position_px;  // Mouse events: canvas pixel (the scaled image is top left).
   int key = 0;              // kKey: the character ('q', ' ', '1') or 27 for Escape.
@@ -65,7 +68,7 @@ struct LiveKey {
 // keys); each has an ASCII twin in kLiveKeys for keyboards and scripts without them.
 inline constexpr int kKeyLeft = 0xFF51, kKeyRight = 0xFF53, kKeyHome = 0xFF50, kKeyEnd = 0xFF57;
 // The keys, as the on-screen help (`h`) lists them (key 0: a line about the mouse).
-inline constexpr std::array<LiveKey, 19> kLiveKeys = {{
+inline constexpr std::array<LiveKey, 24> kLiveKeys = {{
     {'h', "help on / off"},
     {' ', "pause / resume (at the end: play from the start)"},
     {'.', "step 1 frame forward (pauses)"},
@@ -74,6 +77,8 @@ inline constexpr std::array<LiveKey, 19> kLiveKeys = {{
     {'[', "-1 s (also Left)"},
     {'<', "first frame (also Home)"},
     {'>', "last frame (also End)"},
+    {'}', "faster: 0.1x .. 4x ({ slower)"},
+    {'+', "zoom in at the pointer (- out, z whole image)"},
     {'l', "loop on / off"},
     {'0', "restart: first frame, trackers afresh, playing"},
     {'r', "record on / off (CSV, videos, config)"},
@@ -81,17 +86,21 @@ inline constexpr std::array<LiveKey, 19> kLiveKeys = {{
     {'b', "reset the bending-distance reference"},
     {'m', "switch method (colour, sad, ssd, zncc)"},
     {'c', "mm scale: click 2 points (Esc cancels)"},
+    {'u', "undo the last reselection or range change"},
     {'v', "mask view: active marker's pixels, blobs, window"},
     {'1', "1..9 active marker;  q / Esc quit"},
     {0, "drag a box: reselect; click: pick colour"},
     {0, "mask view: click adds colours, shift-click removes"},
+    {0, "right-drag: pan a zoomed view"},
+    {0, "timeline (under the image): click / drag seeks"},
 }};
 
 // What a transport key asks of the source; LiveFeed carries it out (a camera cannot).
 struct PlaybackRequest {
-  enum class Kind { kStepForward, kStepBack, kSeekSeconds, kStart, kEnd };
+  enum class Kind { kStepForward, kStepBack, kSeekSeconds, kSeekTo, kStart, kEnd };
   Kind kind = Kind::kStepForward;
-  double seconds = 0.0;  // kSeekSeconds: how far, negative backwards.
+  double seconds = 0.0;   // kSeekSeconds: how far, negative backwards.
+  int64_t position = 0;   // kSeekTo: the frame's position in the file (a timeline click).
 };
 
 // How a frame handed to the controller relates to the one before it.
@@ -117,8 +126,23 @@ class LiveController {
   void on_event(const UiEvent& event);
   // The source has ended: the last frame stays on screen, and every key still works.
   void on_end_of_input();
-  // The transport request of the last key, taken by the feed (once).
+  // The oldest transport request not yet carried out, taken by the feed (once). Keys pressed
+  // while a seek runs queue up behind it, in order (a timeline drag keeps only its newest seek).
   std::optional<PlaybackRequest> take_playback_request();
+  // A request that jumps (not a step forward) is waiting: the window shows the seeking hint
+  // (show_seeking) before the feed carries it out.
+  bool jump_pending() const;
+  void show_seeking();
+  // Where the frame about to be handed over is in a file (SeekableSource's position) and the
+  // file's length when known: the timeline. Cameras never call it (no timeline).
+  void set_source_position(int64_t position, std::optional<int64_t> length);
+  const Timeline& timeline() const { return timeline_; }
+  // The playing speed the window asks of a paced file (`{` / `}`: 0.1x .. 4x).
+  double speed() const;
+  // The zoom and pan of the view (+ / -, z, right-drag).
+  const ViewZoom& zoom() const { return zoom_; }
+  // Edits `u` can undo.
+  size_t undo_depth() const { return undo_.size(); }
   // A message from outside (the feed: "a camera cannot seek"), shown like the controller's own.
   void report(const std::string& message) { say(message); }
 
@@ -204,6 +228,14 @@ class LiveController {
   // and the scale hint.
   std::vector<std::string> status_lines() const;
   void select_marker(int index);
+  // Before a reselection or range change of `marker`: what `u` restores. `coalesce`: a trackbar
+  // drag is one edit however many steps the trackbar reports.
+  void remember_for_undo(int marker, const std::string& what, bool coalesce = false);
+  void undo();
+  void zoom_at(const cv::Point2d& image_px, double factor);
+  void change_speed(int steps);
+  // Mouse events on the timeline (scrubbing): true when the event was the timeline's.
+  bool scrub(const UiEvent& event, const LiveLayout& view);
   // A transport key: refused while recording (except a step forward), else queued for the feed.
   void request_playback(PlaybackRequest::Kind kind, double seconds = 0.0);
   void restart();
@@ -239,7 +271,26 @@ class LiveController {
   bool paused_ = false, help_ = false, quit_ = false, ended_ = false, loop_ = false;
   bool mask_view_ = false;
   cv::Mat hsv_patch_;  // Range edits: a reused buffer.
-  std::optional<PlaybackRequest> playback_request_;
+  std::deque<PlaybackRequest> playback_requests_;
+  bool seeking_ = false;  // The hint is on screen until the next frame.
+  Timeline timeline_;
+  bool has_timeline_ = false;  // A file: set_source_position was called.
+  int64_t position_ = -1;      // In the file, of the frame on screen.
+  bool scrubbing_ = false;     // The button went down on the timeline.
+  ViewZoom zoom_;
+  std::optional<cv::Point2d> pan_from_;      // Image pixel under the right button's press.
+  std::optional<cv::Point2d> pointer_image_;  // The pointer, image pixels: where keys zoom.
+  int speed_step_ = 3;  // Index into kSpeeds (1x).
+  struct UndoEntry {
+    int marker;
+    MarkerSpec spec;       // The marker as it was.
+    ColourParams aside;    // Its colour parameters set aside (a template marker's picks).
+    std::string what;
+    bool coalescing;       // A trackbar's edit: later steps of it join this entry.
+  };
+  std::vector<UndoEntry> undo_;
+  // Per marker, the box a recording's start cut its template from, and the pixels.
+  std::vector<std::pair<cv::Rect, cv::Mat>> recording_cuts_;
   int active_ = 0;
   int hsv_revision_ = 0;
   // Per marker (config order), the parameters of the method it does not use now: a marker is one

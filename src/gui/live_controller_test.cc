@@ -111,7 +111,7 @@ TEST_F(LiveControllerTest, TracksAndShowsTheOverlayAboveTheStripChart) {
   for (int i = 0; i < 5; ++i) truth = Feed(live, i);
   for (int m = 0; m < 3; ++m) ExpectAt(live, m, truth, 0.3);
   const cv::Mat& canvas = live.canvas();
-  EXPECT_EQ(canvas.size(), cv::Size(320, 240 + StripChartOptions{}.height_px));
+  EXPECT_EQ(canvas.size(), cv::Size(320, 240 + StatusBandHeight() + StripChartOptions{}.height_px));
   for (const MarkerTruth& marker : truth.markers) {
     // The overlay's ring around each marker, in canvas coordinates (= image coordinates).
     EXPECT_GE(RingPoints(canvas, *marker.centroid_px), 20) << marker.name;
@@ -600,6 +600,22 @@ class LiveFileTest : public LiveControllerTest {
     spec.input = path;
     return std::make_unique<PacedFrameSource>(OpenFrameSource(spec), clock.timing());
   }
+  // The options `live` runs a 30 fps file with (recordings at the file's rate).
+  LiveOptions FileOptions() const {
+    LiveOptions options = Options();
+    options.record_fps = 30.0;
+    return options;
+  }
+  // `track` on the last recording's raw video with its config gives the live CSV's text (found
+  // flags and positions included, timings left out): `rows` rows and the header.
+  void ExpectTrackReproduces(const LiveController& live, size_t rows) {
+    const std::string prefix = live.last_recording();
+    Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
+    const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
+    EXPECT_EQ(live_rows.size(), rows + 1);
+    EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+    fs::remove(dir_ / "again.csv");
+  }
 };
 
 TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrackReproduces) {
@@ -699,9 +715,7 @@ TEST_F(LiveFileTest, AOneRowRecordingAtTheEndAfterEditsReproducesUnderTrack) {
   const std::string video = WriteVideo(12);
   FakeClock clock;
   std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
-  LiveOptions options = Options();
-  options.record_fps = 30.0;
-  LiveController live(SceneConfig(), options);
+  LiveController live(SceneConfig(), FileOptions());
   LiveFeed feed(*source);
   while (feed.step(live)) {
   }
@@ -711,11 +725,7 @@ TEST_F(LiveFileTest, AOneRowRecordingAtTheEndAfterEditsReproducesUnderTrack) {
   live.on_event(UiEvent::Key('r'));
   ASSERT_TRUE(live.recording()) << live.message();
   live.on_event(UiEvent::Key('r'));
-  const std::string prefix = live.last_recording();
-  Track(prefix + ".yaml", prefix + ".raw.avi", (dir_ / "again.csv").string());
-  const std::vector<std::string> live_rows = CsvRowsWithoutTiming(prefix + ".csv");
-  ASSERT_EQ(live_rows.size(), 2u);
-  EXPECT_EQ(CsvRowsWithoutTiming((dir_ / "again.csv").string()), live_rows);
+  ExpectTrackReproduces(live, 1);
 }
 
 TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfterTheReselection) {
@@ -1147,14 +1157,16 @@ TEST_F(LivePlaybackTest, StepSeekStartEndLandOnTheSourcesFramesWithTheOverlayOnT
   Key(live, ',');
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 3);
-  Key(live, ']');  // +1 s = 30 frames.
+  const int64_t decoded = seekable_->frames_decoded();
+  Key(live, ']');  // +1 s = 30 frames: the file's own seek, not a decode of the frames between.
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 33);
-  const int64_t decoded = seekable_->frames_decoded();
-  Key(live, kKeyLeft);  // -1 s: frame 3 is no longer in the ring, the file is read again.
+  EXPECT_EQ(seekable_->direct_seeks(), 1);
+  EXPECT_EQ(seekable_->frames_decoded(), decoded + 1);
+  Key(live, kKeyLeft);  // -1 s: frame 3 is still in the ring, a copy.
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 3);
-  EXPECT_GT(seekable_->frames_decoded(), decoded);
+  EXPECT_EQ(seekable_->frames_decoded(), decoded + 1);
   Key(live, '>');  // End: the last frame, and the end of input at once (nothing follows it).
   ASSERT_TRUE(feed.step(live));
   ExpectShowing(live, 39);
@@ -1289,6 +1301,241 @@ TEST_F(LiveControllerTest, ACameraAnswersTransportKeysWithAMessage) {
   live.on_event(UiEvent::Key(','));
   EXPECT_FALSE(feed.step(live));
   EXPECT_NE(live.message().find("no stepping or seeking"), std::string::npos);
+}
+
+// The timeline under the picture, driven as a user does: a click on it seeks to the frame under
+// the pointer, a drag seeks once to where it is let go (the seeks on the way are replaced, not
+// queued), and it marks the frames where an edit was made, where a recording ran and where a
+// marker was not found (the mark follows a re-track: an undone range change clears it).
+TEST_F(LivePlaybackTest, TheTimelineSeeksByClickAndDragAndMarksEditsRecordingsAndLostMarkers) {
+  const std::string video = WriteVideo(40);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  ASSERT_EQ(live.timeline().length(), 40);  // The header's count, before reading to the end.
+  EXPECT_EQ(live.timeline().position(), 2);
+  const int width = 320;  // No screen given: the image and the timeline are unscaled.
+  const double bar_y = 240 + StatusBandHeight() + kTimelineHeightPx / 2.0;
+  const auto x_of = [&](int64_t frame) { return live.timeline().x_of(frame, width) + 0.2; };
+  Click(live, {x_of(20), bar_y});
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 20);
+
+  Key(live, ' ');  // Paused: only the drag's own seek can change the frame.
+  live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseDown, x_of(5), bar_y));
+  live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseMove, x_of(12), bar_y));
+  live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseMove, x_of(30), bar_y + 30));  // Off the bar.
+  live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseUp, x_of(30), bar_y + 30));
+  ASSERT_TRUE(feed.step(live));
+  ExpectShowing(live, 30);
+  EXPECT_FALSE(feed.step(live)) << "one seek for the whole drag";
+  EXPECT_EQ(live.undo_depth(), 0u) << "a drag on the timeline is no box on the image";
+
+  // Edits: a range change that loses red marks the frame lost; undoing it finds red again.
+  const int red_v_lo = live.active_hsv()[4];
+  live.on_event(UiEvent::Trackbar(4, 255));  // V lo of red: nothing is that bright.
+  live.on_event(UiEvent::Trackbar(4, 254));  // Still the same drag of the trackbar.
+  EXPECT_FALSE(live.last_result()->markers[0].observation.found());
+  EXPECT_TRUE(live.timeline().marked(30, Timeline::kLost));
+  EXPECT_TRUE(live.timeline().marked(30, Timeline::kEdit));
+  Key(live, 'u');
+  EXPECT_EQ(live.active_hsv()[4], red_v_lo) << "one undo takes back the whole trackbar drag";
+  EXPECT_TRUE(live.last_result()->markers[0].observation.found());
+  EXPECT_FALSE(live.timeline().marked(30, Timeline::kLost));
+  EXPECT_FALSE(live.timeline().marked(29, Timeline::kEdit));
+
+  // A recording marks its frames.
+  Key(live, 'r');
+  ASSERT_TRUE(live.recording());
+  Key(live, ' ');
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+  Key(live, 'r');
+  for (int frame = 31; frame <= 33; ++frame) EXPECT_TRUE(live.timeline().marked(frame, Timeline::kRecorded));
+  EXPECT_FALSE(live.timeline().marked(20, Timeline::kRecorded));
+
+  // Drawn under the picture: the cursor (white) at the frame on screen, the recorded stretch
+  // green along the bar's top, the edit yellow.
+  const cv::Mat canvas = live.canvas().clone();
+  const int bar_top = 240 + StatusBandHeight();
+  EXPECT_EQ(canvas.at<cv::Vec3b>(bar_top + 1, live.timeline().x_of(33, width)), cv::Vec3b(255, 255, 255));
+  EXPECT_EQ(canvas.at<cv::Vec3b>(bar_top + 1, live.timeline().x_of(31, width) - 2), cv::Vec3b(60, 200, 60));
+  EXPECT_EQ(canvas.at<cv::Vec3b>(bar_top + kTimelineHeightPx / 2, live.timeline().x_of(30, width)),
+            cv::Vec3b(0, 220, 255));
+  EXPECT_EQ(canvas.at<cv::Vec3b>(bar_top + 1, live.timeline().x_of(10, width)), cv::Vec3b(40, 40, 40));
+}
+
+// Keys pressed before a seek has been carried out queue up behind it and are carried out in
+// their order: none is lost.
+TEST_F(LivePlaybackTest, TransportKeysPressedDuringASeekAreQueuedInOrder) {
+  const std::string video = WriteVideo(40);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(feed.step(live));
+  Key(live, ' ');
+  Key(live, ']');  // 3 -> 33
+  EXPECT_TRUE(live.jump_pending());
+  const cv::Mat before = live.canvas().clone();
+  live.show_seeking();  // The window's hint while the seek runs.
+  EXPECT_GT(cv::norm(before, live.canvas(), cv::NORM_L1), 0.0);
+  Key(live, '[');  // -> 3
+  Key(live, '>');  // -> 39
+  Key(live, ',');  // -> 38
+  for (const int expected : {33, 3, 39, 38}) {
+    ASSERT_TRUE(feed.step(live));
+    ExpectShowing(live, expected);
+  }
+  EXPECT_FALSE(live.jump_pending());
+  EXPECT_FALSE(feed.step(live));
+}
+
+// `{` and `}` step the playing speed through 0.1x .. 4x; the paced file plays at it (the fake
+// clock's waits: frame periods divided by the speed), and the state line says it.
+TEST_F(LivePlaybackTest, SpeedKeysSetThePacedFilesRateFromATenthToFourTimes) {
+  const std::string video = WriteVideo(40);
+  Play(video);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source_, seekable_);
+  ASSERT_TRUE(feed.step(live));
+  Key(live, '}');
+  EXPECT_EQ(live.speed(), 2.0);
+  Key(live, '}');
+  Key(live, '}');
+  EXPECT_EQ(live.speed(), 4.0);  // The fastest.
+  const auto next_wait = [&] {
+    const auto before = clock_.now;
+    EXPECT_TRUE(feed.step(live));
+    clock_.now = clock_.waits.back();
+    return std::chrono::duration<double>(clock_.waits.back() - before).count();
+  };
+  next_wait();  // The new speed starts from the last frame shown.
+  EXPECT_NEAR(next_wait(), 1.0 / 30 / 4, 1e-6);
+  for (int i = 0; i < 8; ++i) Key(live, '{');
+  EXPECT_NEAR(live.speed(), 0.1, 1e-12);  // The slowest.
+  next_wait();
+  EXPECT_NEAR(next_wait(), 1.0 / 30 / 0.1, 1e-6);
+  EXPECT_NE(live.message().find("speed 0.10x"), std::string::npos) << live.message();
+}
+
+// Zoom about the pointer (+ / -), pan (right-drag), and every click or drag on the zoomed view
+// lands on the image pixels under it: a colour pick on blue and a reselection box.
+TEST_F(LiveControllerTest, ZoomedViewKeepsThePointedPixelAndClicksAndDragsMapThroughIt) {
+  LiveController live(SceneConfig(), Options());
+  SceneTruth truth;
+  for (int i = 0; i < 3; ++i) truth = Feed(live, i);
+  const cv::Point2d blue = *truth.markers[1].centroid_px;
+  const cv::Point2d pointer = live.to_view(blue);
+  live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseMove, pointer.x, pointer.y));
+  for (int i = 0; i < 9; ++i) live.on_event(UiEvent::Key(i % 2 == 0 ? '+' : '='));
+  EXPECT_NEAR(live.zoom().zoom, std::pow(1.25, 9.0), 1e-9);
+  // The pointed image point stays under the pointer (the image's edge allowing).
+  EXPECT_NEAR(live.to_view(blue).x, pointer.x, 1e-6);
+  EXPECT_NEAR(live.to_view(blue).y, pointer.y, 1e-6);
+  const double scale = live.to_view({1, 0}).x - live.to_view({0, 0}).x;
+  EXPECT_NEAR(scale, live.zoom().zoom, 1e-9);
+  // The canvas shows the image enlarged: blue's pixels around its centre.
+  const cv::Mat canvas = live.canvas().clone();
+  const cv::Vec3b shown = canvas.at<cv::Vec3b>(cvRound(pointer.y + 3 * scale), cvRound(pointer.x + 3 * scale));
+  EXPECT_GT(shown[0], shown[2] + 60) << "blue under the pointer, 3 image px off the centre";
+
+  // A click through the zoom picks blue's colour (the box around the image pixel clicked).
+  live.on_event(UiEvent::Key('3'));  // Active: green; the click goes to blue, found under it.
+  Click(live, live.to_view(blue + cv::Point2d(0.3, 0.3)));
+  const auto& colour = std::get<ColourParams>(live.config().markers[1].params);
+  ASSERT_TRUE(colour.roi) << live.message();
+  EXPECT_NEAR(colour.roi->x + colour.roi->width / 2.0, blue.x, 1.0);
+  EXPECT_NEAR(colour.roi->y + colour.roi->height / 2.0, blue.y, 1.0);
+  // A box dragged on the zoomed view, in image pixels.
+  Drag(live, live.to_view(blue - cv::Point2d(6, 6)), live.to_view(blue + cv::Point2d(7, 7)));
+  EXPECT_NE(live.message().find("blue: reselected in [" + std::to_string(cvRound(blue.x - 6)) + ", " +
+                                std::to_string(cvRound(blue.y - 6))),
+            std::string::npos)
+      << live.message();
+
+  // Right-drag pans by the image pixels the pointer moved over; z shows the whole image again.
+  const ViewZoom before = live.zoom();
+  live.on_event({UiEvent::Type::kPanDown, pointer, 0, 0, 0, false});
+  live.on_event({UiEvent::Type::kPanMove, pointer + cv::Point2d(scale * 4, 0), 0, 0, 0, false});
+  EXPECT_NEAR(live.zoom().origin_px.x, before.origin_px.x - 4, 1e-6);
+  live.on_event(UiEvent::Key('-'));
+  EXPECT_NEAR(live.zoom().zoom, before.zoom / 1.25, 1e-9);
+  live.on_event(UiEvent::Key('z'));
+  EXPECT_EQ(live.zoom().zoom, 1.0);
+  EXPECT_NEAR(live.to_view(blue).x, blue.x, 1e-9);
+}
+
+// `u` takes back the last reselection or range change, as the marker was; nothing left says so.
+TEST_F(LiveControllerTest, UndoRestoresTheMarkerAsItWasBeforeTheLastReselectionOrRangeChange) {
+  LiveController live(SceneConfig(), Options());
+  SceneTruth truth;
+  for (int i = 0; i < 3; ++i) truth = Feed(live, i);
+  live.on_event(UiEvent::Key('m'));  // sad: templates cut where the markers are.
+  const TemplateParams cut = std::get<TemplateParams>(live.config().markers[1].params);
+  const cv::Point2d blue = *truth.markers[1].centroid_px;
+  Drag(live, blue - cv::Point2d(9, 11), blue + cv::Point2d(12, 10));
+  ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
+  EXPECT_NE(*std::get<TemplateParams>(live.config().markers[1].params).rect, *cut.rect);
+  EXPECT_EQ(live.undo_depth(), 1u);
+  live.on_event(UiEvent::Key('u'));
+  EXPECT_NE(live.message().find("undone: reselection of blue"), std::string::npos) << live.message();
+  const TemplateParams back = std::get<TemplateParams>(live.config().markers[1].params);
+  EXPECT_EQ(*back.rect, *cut.rect);
+  EXPECT_EQ(cv::norm(back.image, cut.image, cv::NORM_INF), 0.0);
+  const SceneTruth next = Feed(live, 3);  // The old template tracks blue on.
+  ExpectAt(live, 1, next, 0.5);
+  live.on_event(UiEvent::Key('u'));
+  EXPECT_NE(live.message().find("nothing to undo"), std::string::npos);
+}
+
+// A recording reproduces under `track` (same rows, found flags and positions) when undo is among
+// its edits, whether it was started paused, after a method change, or at the end of the input.
+TEST_F(LiveFileTest, RecordingsWithUndoAmongTheEditsReproduceUnderTrackStartedPausedAtTheEndAfterAMethodChange) {
+  const std::string video = WriteVideo(30);
+  {  // Started paused, after a method change, a reselection and its undo; more while recording.
+    FakeClock clock;
+    std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+    LiveController live(SceneConfig(), FileOptions());
+    LiveFeed feed(*source);
+    for (int i = 0; i < 10; ++i) ASSERT_TRUE(feed.step(live));
+    live.on_event(UiEvent::Key(' '));
+    live.on_event(UiEvent::Key('m'));
+    const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+    Drag(live, blue - cv::Point2d(9, 11), blue + cv::Point2d(12, 10));
+    live.on_event(UiEvent::Key('u'));
+    ASSERT_NE(live.message().find("undone"), std::string::npos) << live.message();
+    live.on_event(UiEvent::Key('r'));
+    ASSERT_TRUE(live.recording()) << live.message();
+    live.on_event(UiEvent::Key(' '));
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(feed.step(live));
+    const cv::Point2d green = *live.last_result()->markers[2].observation.position_px;
+    Drag(live, green - cv::Point2d(10, 9), green + cv::Point2d(11, 12));
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+    live.on_event(UiEvent::Key('u'));
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(feed.step(live));
+    live.on_event(UiEvent::Key('m'));  // A method change while recording: ssd.
+    for (int i = 0; i < 2; ++i) ASSERT_TRUE(feed.step(live));
+    live.on_event(UiEvent::Key('r'));
+    ExpectTrackReproduces(live, 13);
+  }
+  {  // At the end: colour ranges moved (trackbar) and undone, a pick undone, one row recorded.
+    FakeClock clock;
+    std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+    LiveController live(SceneConfig(), FileOptions());
+    LiveFeed feed(*source);
+    while (feed.step(live)) {
+    }
+    ASSERT_TRUE(live.ended());
+    live.on_event(UiEvent::Trackbar(0, 100));
+    live.on_event(UiEvent::Key('u'));
+    Click(live, *live.last_result()->markers[2].observation.position_px);
+    live.on_event(UiEvent::Trackbar(5, 200));
+    live.on_event(UiEvent::Key('u'));
+    live.on_event(UiEvent::Key('r'));
+    ASSERT_TRUE(live.recording()) << live.message();
+    live.on_event(UiEvent::Key('r'));
+    ExpectTrackReproduces(live, 1);
+  }
 }
 
 TEST(LivePointer, ClicksWithinTheSlopDragsBeyondItAndNothingWithoutAPressInTheImage) {

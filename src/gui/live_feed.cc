@@ -10,7 +10,10 @@ LiveFeed::LiveFeed(FrameSource& source, SeekableSource* seekable)
 bool LiveFeed::read(LiveController& controller, FrameOrder order) {
   frame_.captured = {};
   if (!source_.read(frame_)) return false;
-  if (seekable_) shown_ = seekable_->position() - 1;
+  if (seekable_) {
+    shown_ = seekable_->position() - 1;
+    controller.set_source_position(shown_, seekable_->frame_count());
+  }
   ended_ = false;
   // A camera's frame carries its capture time (NewestFrameSource's thread); a played file's
   // capture is the moment it is due and read. The recording's latency_*_ms columns count from it.
@@ -71,6 +74,8 @@ bool LiveFeed::carry_out(const PlaybackRequest& request, LiveController& control
       const int64_t frames = std::llround(request.seconds * (fps > 0 ? fps : 30.0));
       return jump_to(std::max<int64_t>(0, shown_ + frames), controller);
     }
+    case Kind::kSeekTo:
+      return jump_to(request.position, controller);
     case Kind::kStart:
       return jump_to(0, controller);
     case Kind::kEnd: {
@@ -86,6 +91,7 @@ bool LiveFeed::carry_out(const PlaybackRequest& request, LiveController& control
 }
 
 bool LiveFeed::step(LiveController& controller) {
+  if (paced_) paced_->set_speed(controller.speed());
   if (const std::optional<PlaybackRequest> request = controller.take_playback_request()) {
     return carry_out(*request, controller);
   }

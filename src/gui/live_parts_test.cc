@@ -138,6 +138,49 @@ TEST(LiveView, StatusLinesAreSpacedByTheirHeightAndWrappedToTheImage) {
   }
 }
 
+// A long message is read whole: wrapped at spaces to the band's width, in the band under the
+// image (the picture keeps every pixel, so no marker is covered). The timeline sits under the
+// band, the chart under it.
+TEST(LiveView, ALongMessageWrapsInTheBandUnderTheImageNeverOverIt) {
+  const std::string message =
+      "the box [100, 31, 32, 32] holds no marker (nothing at its centre stands out from its "
+      "surroundings): drag it around a marker, with some background on every side";
+  int baseline = 0;
+  const std::vector<std::string> rows = WrapStatusLines({"PAUSED  active: red (sad)", message}, 320, 0.45);
+  ASSERT_GE(rows.size(), 4u);
+  std::string joined;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_LE(cv::getTextSize(rows[i], cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, &baseline).width, 320 - 16)
+        << rows[i];
+    joined += (i > 1 ? " " : "") + rows[i];
+  }
+  EXPECT_EQ(joined, message) << "wrapped at spaces, nothing lost";
+
+  const cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(100, 100, 100));
+  const StripChart chart;
+  Timeline timeline;
+  timeline.set_length(100);
+  timeline.set_position(50);
+  LiveViewState state;
+  state.frame = &frame;
+  state.annotated = &frame;
+  state.lines = {"PAUSED  active: red (sad)", message};
+  state.chart = &chart;
+  state.timeline = &timeline;
+  const LiveLayout layout =
+      ComputeLiveLayout(frame.size(), 180, 0, {}, StatusBandHeight(), /*timeline=*/true);
+  EXPECT_EQ(layout.status, cv::Rect(0, 240, 320, StatusBandHeight()));
+  EXPECT_EQ(layout.timeline, cv::Rect(0, 240 + StatusBandHeight(), 320, kTimelineHeightPx));
+  EXPECT_EQ(layout.chart.y, layout.timeline.br().y);
+  LiveView view;
+  const cv::Mat canvas = view.compose(layout, state).clone();
+  EXPECT_EQ(cv::norm(canvas(layout.image), frame, cv::NORM_INF), 0.0) << "nothing over the picture";
+  cv::Mat band_text;
+  cv::inRange(canvas(layout.status), cv::Scalar(200, 200, 200), cv::Scalar(255, 255, 255), band_text);
+  EXPECT_GT(cv::countNonZero(band_text), 200) << "the lines are in the band";
+  EXPECT_EQ(canvas.at<cv::Vec3b>(layout.timeline.y + 2, timeline.x_of(50, 320)), cv::Vec3b(255, 255, 255));
+}
+
 TEST(LiveView, TheFrameTheChartUnderItTheHelpBesideItAndTheDragBoxOrTheScalePoints) {
   const cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(100, 100, 100));
   const StripChart chart;

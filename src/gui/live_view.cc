@@ -23,6 +23,19 @@ const cv::Scalar kMaskRejectedColour(60, 60, 255), kMaskWindowColour(255, 255, 0
 
 }  // namespace
 
+static void ShowImage(const cv::Mat& image, const LiveLayout& view, cv::Mat& top) {
+  if (view.zoom.zoom == 1.0 && top.size() == image.size()) {
+    image.copyTo(top);
+  } else if (view.zoom.zoom == 1.0) {
+    cv::resize(image, top, top.size(), 0, 0, cv::INTER_AREA);
+  } else {
+    // Zoomed: the part shown, through the layout's own mapping (clicks map back through it).
+    // Enlarged pixels stay square blocks, so each one can be told apart and clicked.
+    cv::warpAffine(image, top, cv::Mat(view.view_from_image()), top.size(),
+                   view.scale_x() >= 1.0 ? cv::INTER_NEAREST : cv::INTER_LINEAR,
+                   cv::BORDER_CONSTANT);
+  }
+}
 
 const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& state) {
   canvas_.create(view.canvas, CV_8UC3);
@@ -34,17 +47,22 @@ const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& st
                 cv::LINE_AA);
   } else if (state.mask_view) {
     draw_mask_view(top, view, state);
-  } else if (view.image.size() == annotated.size()) {
-    // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
-    annotated.copyTo(top);
   } else {
-    cv::resize(annotated, top, view.image.size(), 0, 0, cv::INTER_AREA);
+    // Overlay status lines (recording, pause) live on the canvas only, not in recorded video.
+    ShowImage(annotated, view, top);
   }
   std::vector<std::string> lines = state.lines;
-  if (!lines.empty() && view.image.size() != view.image_px) {
-    lines.front() += "  view " + std::to_string(cvRound(100 * view.scale_x())) + "%";
+  if (!lines.empty() && (view.image.size() != view.image_px || view.zoom.zoom != 1.0)) {
+    lines.front() += (view.zoom.zoom != 1.0 ? "  zoom " : "  view ") +
+                     std::to_string(cvRound(100 * view.scale_x())) + "%";
   }
-  DrawStatusLines(top, lines, state.recording);
+  if (!view.status.empty()) {
+    cv::Mat band = canvas_(view.status);
+    band.setTo(cv::Scalar(28, 28, 28));
+    DrawStatusLines(band, lines, state.recording, kStatusRows);
+  } else {
+    DrawStatusLines(top, lines, state.recording);
+  }
   if (state.scale_mode) {
     for (const cv::Point2d& clicked : state.scale_points) {
       const cv::Point2d p = view.to_view(clicked);
@@ -63,6 +81,10 @@ const cv::Mat& LiveView::compose(const LiveLayout& view, const LiveViewState& st
     cv::rectangle(top, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)),
                   kDragColour, 1);
   }
+  if (state.timeline && !view.timeline.empty()) {
+    cv::Mat bar = canvas_(view.timeline);
+    state.timeline->draw(bar);
+  }
   cv::Mat bottom = canvas_(view.chart);
   state.chart->draw(bottom);
   if (!view.help.empty()) {
@@ -80,11 +102,7 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
   const bool has_mask = tracker.membership(frame, mask_);
   frame.convertTo(mask_image_, -1, 0.25, 0);
   if (has_mask) frame.copyTo(mask_image_, mask_);
-  if (mask_image_.size() == top.size()) {
-    mask_image_.copyTo(top);
-  } else {
-    cv::resize(mask_image_, top, top.size(), 0, 0, cv::INTER_AREA);
-  }
+  ShowImage(mask_image_, view, top);
   const double scale = view.scale_x();
   const double text = std::max(0.4, top.cols / 640.0 * 0.45);
   if (const std::optional<cv::Rect> region = tracker.search_region()) {
@@ -121,29 +139,75 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
 }
 
 
+// One size at every image size: the band's height is fixed.
+constexpr double kStatusTextScale = 0.45;
+
+int StatusBandHeight() {
+  int baseline = 0;
+  const int height = cv::getTextSize("Ag", kGuiFont, kStatusTextScale, kStatusOutline, &baseline).height;
+  return kStatusRows * (height + baseline + 4) + 4;
+}
+
+std::vector<std::string> WrapStatusLines(const std::vector<std::string>& lines, int width_px,
+                                         double text_scale, size_t* first_rows) {
+  std::vector<std::string> rows;
+  const int room = std::max(1, width_px - 16);  // 8 px margins.
+  const auto width_of = [text_scale](const std::string& text) {
+    int baseline = 0;
+    return cv::getTextSize(text, kGuiFont, text_scale, 1, &baseline).width + kStatusOutline;
+  };
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const size_t before = rows.size();
+    std::string row;
+    size_t start = 0;
+    const std::string& line = lines[i];
+    while (start <= line.size()) {
+      size_t end = line.find(' ', start);
+      if (end == std::string::npos) end = line.size();
+      const std::string word = line.substr(start, end - start);
+      const std::string joined = row.empty() ? word : row + " " + word;
+      if (!row.empty() && width_of(joined) > room) {
+        rows.push_back(row);
+        row = word;
+      } else {
+        row = joined;
+      }
+      start = end + 1;
+    }
+    rows.push_back(row);
+    if (i == 0 && first_rows) *first_rows = rows.size() - before;
+  }
+  return rows;
+}
+
 std::vector<cv::Point> PlaceStatusLines(cv::Size size, size_t count, double* text_scale) {
-  const double scale = std::max(0.4, size.width / 640.0 * 0.5);
+  const double scale = kStatusTextScale;
   *text_scale = scale;
   int baseline = 0;
   const int height = cv::getTextSize("Ag", kGuiFont, scale, kStatusOutline, &baseline).height;
   const int row_height = height + baseline + 4;  // Outlined rows never touch.
-  // One row per line, not wrapped: more rows would cover the markers at the image's bottom; a
-  // message longer than the image is also on stdout.
   std::vector<cv::Point> origins;
   int y = size.height - baseline - 4 - row_height * (static_cast<int>(count) - 1);
   for (size_t i = 0; i < count; ++i, y += row_height) origins.emplace_back(8, y);
   return origins;
 }
 
-void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red) {
+void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red,
+                     size_t max_rows) {
+  size_t red_rows = 0;
+  std::vector<std::string> rows = WrapStatusLines(lines, top.cols, kStatusTextScale, &red_rows);
+  if (max_rows > 0 && rows.size() > max_rows) {
+    rows.resize(max_rows);
+    rows.back() += " ...";
+  }
   double scale = 1;
-  const std::vector<cv::Point> origins = PlaceStatusLines(top.size(), lines.size(), &scale);
-  for (size_t i = 0; i < lines.size(); ++i) {
-    cv::putText(top, lines[i], origins[i], kGuiFont, scale, cv::Scalar(0, 0, 0), kStatusOutline,
+  const std::vector<cv::Point> origins = PlaceStatusLines(top.size(), rows.size(), &scale);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    cv::putText(top, rows[i], origins[i], kGuiFont, scale, cv::Scalar(0, 0, 0), kStatusOutline,
                 cv::LINE_AA);
-    cv::putText(top, lines[i], origins[i], kGuiFont, scale,
-                first_red && i == 0 ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255), 1,
-                cv::LINE_AA);
+    cv::putText(top, rows[i], origins[i], kGuiFont, scale,
+                first_red && i < red_rows ? cv::Scalar(80, 80, 255) : cv::Scalar(255, 255, 255),
+                1, cv::LINE_AA);
   }
 }
 

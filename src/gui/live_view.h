@@ -11,6 +11,7 @@
 
 #include "gui/live_layout.h"
 #include "gui/strip_chart.h"
+#include "gui/timeline.h"
 #include "softsight/core/format.h"
 #include "softsight/track/tracker.h"
 
@@ -29,6 +30,7 @@ struct LiveViewState {
   std::vector<cv::Point2d> scale_points;     // Image pixels.
   std::optional<cv::Point2d> press, pointer;  // The mouse, image pixels (drag box, scale line).
   const StripChart* chart = nullptr;
+  const Timeline* timeline = nullptr;  // A file's scrub bar; null for a camera.
 };
 
 class LiveView {
@@ -42,9 +44,22 @@ class LiveView {
   cv::Mat canvas_, mask_, mask_image_;  // Reused buffers: no allocation per frame.
 };
 
-// The lines at the bottom of the image, the first (the state line) in red when `first_red`
-// (recording).
-void DrawStatusLines(cv::Mat& top, const std::vector<std::string>& lines, bool first_red);
+// The status band under the image: kStatusRows rows of text, on a dark ground. Under the image,
+// not over it, so no message hides a marker at the image's bottom edge.
+inline constexpr int kStatusRows = 3;
+int StatusBandHeight();
+
+// The lines at the bottom of `area` (the band, or the image when there is none), the first (the
+// state line) in red when `first_red` (recording). A line wider than the area wraps at spaces
+// onto rows of its own; beyond `max_rows` (0: no limit) the last row shown ends in "..." (every
+// message is also on stdout).
+void DrawStatusLines(cv::Mat& area, const std::vector<std::string>& lines, bool first_red,
+                     size_t max_rows = 0);
+
+// `lines` wrapped at spaces to rows at most `width_px` wide at `text_scale` (outlined, as drawn),
+// and `first_rows` set to how many rows the first line took.
+std::vector<std::string> WrapStatusLines(const std::vector<std::string>& lines, int width_px,
+                                         double text_scale, size_t* first_rows = nullptr);
 
 // Where DrawStatusLines puts its `count` lines on an image of `size` (putText's baseline
 // origins): 8 px from the left, spaced by the outlined text's height at `text_scale`, the last at

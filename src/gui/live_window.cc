@@ -23,11 +23,17 @@ void OnMouse(int event, int x, int y, int flags, void* user) {
   auto* context = static_cast<CallbackContext*>(user);
   UiEvent::Type type;
   switch (event) {
+    // The wheel is not taken: OpenCV's Qt windows zoom their own view with it (and map the
+    // mouse through that zoom), which would zoom twice. + and - zoom the picture itself.
+    case cv::EVENT_RBUTTONDOWN:
+      type = UiEvent::Type::kPanDown;
+      break;
     case cv::EVENT_LBUTTONDOWN:
       type = UiEvent::Type::kMouseDown;
       break;
     case cv::EVENT_MOUSEMOVE:
-      type = UiEvent::Type::kMouseMove;
+      type = (flags & cv::EVENT_FLAG_RBUTTON) != 0 ? UiEvent::Type::kPanMove
+                                                   : UiEvent::Type::kMouseMove;
       break;
     case cv::EVENT_LBUTTONUP:
       type = UiEvent::Type::kMouseUp;
@@ -116,7 +122,22 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
   bool end_announced = false;
   controller.take_messages();  // Said while setting up: the terminal has the start-up lines.
   LiveFeed feed(source, seekable);
+  const auto forward_key = [&controller](int key) {
+    if (key < 0) return;
+    const int code = key & 0xFFFF;
+    if (code < 0x100 || code == kKeyLeft || code == kKeyRight || code == kKeyHome ||
+        code == kKeyEnd) {
+      controller.on_event(UiEvent::Key(code));
+    }
+  };
   while (!controller.quit_requested()) {
+    if (controller.jump_pending()) {
+      // A seek may decode for a while (a file without an index): say so on screen first. A key
+      // pressed meanwhile queues behind it.
+      controller.show_seeking();
+      cv::imshow(title, controller.canvas());
+      forward_key(cv::pollKey());
+    }
     // A paced file waits in read() until its frame is due (at most one frame period); a camera
     // returns its newest frame.
     const bool got = feed.step(controller);
@@ -130,13 +151,7 @@ int RunLiveLoop(LiveController& controller, FrameSource& source, const LiveWindo
       std::cout << "end of input" << std::endl;
       end_announced = true;
     }
-    if (key >= 0) {
-      const int code = key & 0xFFFF;
-      if (code < 0x100 || code == kKeyLeft || code == kKeyRight || code == kKeyHome ||
-          code == kKeyEnd) {
-        controller.on_event(UiEvent::Key(code));
-      }
-    }
+    forward_key(key);
     // What the window said (recording started, paused, saved ...) also goes to stdout, one
     // line each, for the terminal's scrollback and for scripts that drive the window.
     for (const std::string& said : controller.take_messages()) {

@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "gui/live_layout.h"
+#include "gui/live_view.h"  // StatusBandHeight
 #include "gui/live_test_util.h"
 #include "gui/overlay.h"
 #include "softsight/config/config.h"
@@ -339,7 +340,9 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
   std::string out;
   ASSERT_EQ(FocusLiveWindow(env, &out), 0) << out;
   // The layout the window uses for this frame on this screen (Xvfb puts the window at 0,0).
-  const LiveLayout layout = ComputeLiveLayout(scene.size, 180, 0, MaxCanvasForScreen({1366, 768}));
+  // A file: the status band and the timeline under the image.
+  const LiveLayout layout = ComputeLiveLayout(scene.size, 180, 0, MaxCanvasForScreen({1366, 768}),
+                                              StatusBandHeight(), /*timeline=*/true);
   ASSERT_LE(layout.canvas.width, 1366);
   ASSERT_LE(layout.canvas.height, 768);
   const auto expect_rings_on = [&](int index) {

@@ -32,7 +32,18 @@ void SeekableSource::remember(int64_t position, const Frame& frame) {
 
 bool SeekableSource::decode_next(Frame& frame) {
   if (length_ && decoded_ >= *length_) return false;
-  if (!source_->read(frame)) {
+  const bool after_direct_seek = landed_ == decoded_;
+  landed_ = -1;
+  bool got = false;
+  try {
+    got = source_->read(frame);
+  } catch (const InputError&) {
+    // A header that promised more frames than there are (the seek target is past the real end)
+    // looks like a truncated file from here; reading forward from the start tells which it is.
+    if (!after_direct_seek) throw;
+  }
+  if (!got) {
+    if (after_direct_seek) return read_forward_to(decoded_, frame);
     length_ = decoded_;
     return false;
   }
@@ -40,6 +51,15 @@ bool SeekableSource::decode_next(Frame& frame) {
   ++decoded_;
   ++decoded_total_;
   return true;
+}
+
+bool SeekableSource::read_forward_to(int64_t position, Frame& frame) {
+  source_ = reopen_();
+  decoded_ = 0;
+  while (decoded_ < position) {
+    if (!decode_next(scratch_)) return false;
+  }
+  return decode_next(frame);
 }
 
 bool SeekableSource::read(Frame& frame) {
@@ -51,10 +71,18 @@ bool SeekableSource::read(Frame& frame) {
     ++position_;
     return true;
   }
-  if (position_ < decoded_) {
-    // Behind the decoder and no longer in the ring: read again from the first frame.
-    source_ = reopen_();
-    decoded_ = 0;
+  // A few frames ahead, decoding through them costs what a seek does (FFmpeg's seek decodes
+  // from a key frame up to the target too); anywhere else the source's own seek, when it has
+  // one, and else reading again from the first frame.
+  const bool close_ahead = position_ >= decoded_ && position_ - decoded_ <= kReadThroughFrames;
+  if (!close_ahead) {
+    if (source_->seek_to(position_)) {
+      decoded_ = landed_ = position_;
+      ++direct_seeks_;
+    } else if (position_ < decoded_) {
+      source_ = reopen_();
+      decoded_ = 0;
+    }
   }
   while (decoded_ < position_) {
     if (!decode_next(scratch_)) {
@@ -62,8 +90,11 @@ bool SeekableSource::read(Frame& frame) {
       return false;
     }
   }
-  if (!decode_next(frame)) return false;
-  ++position_;
+  if (!decode_next(frame)) {
+    position_ = decoded_;
+    return false;
+  }
+  position_ = decoded_;
   return true;
 }
 
@@ -71,8 +102,11 @@ void SeekableSource::seek(int64_t position) { position_ = std::max<int64_t>(0, p
 
 bool SeekableSource::seek_last() {
   if (!length_) {
-    // Read to the end once (through the ring, so the last frames are cached for stepping back).
+    // The header's frame count, checked: its last frame must read and nothing may follow it
+    // (reading on from there, through the ring, finds the real end if the count was short).
     position_ = std::max(position_, decoded_);
+    const std::optional<int64_t> promised = source_->frame_count();
+    if (promised && *promised > 0 && *promised - 1 > position_) position_ = *promised - 1;
     while (read(scratch_)) {
     }
   }

@@ -3,13 +3,13 @@
 // `softsight live`. Every frame it delivers is the wrapped source's own Frame, index and
 // timestamp as that source numbers them, so rows after a seek still name the source's frames.
 //
-// How: the recently read frames are kept in a ring (a step back, or a second back, is a copy),
-// and a position outside it is reached by reopening the source and reading forward to it. That
-// is exact for every source (no keyframe or container-index guesswork, which OpenCV's
-// CAP_PROP_POS_FRAMES does on some codecs), at the cost of decoding up to the target: measured
-// 0.74-0.88 s to decode all of a 7 s (210-frame) 1280x720 HuffYUV clip on the idle 2-core
-// development machine; longer for long files. The end is found by reading to it once;
-// afterwards the length is known.
+// How: the recently read frames are kept in a ring (a step back, or a second back, is a copy).
+// A position outside it is reached by the wrapped source's own seek (FrameSource::seek_to: for a
+// video FFmpeg's, through the container's index, decoding from the key frame before the target;
+// measured exact for HuffYUV, FFV1 and MJPG in AVI and MKV, and 2-20 ms anywhere in a 10-minute
+// 640x480 file: docs/measurements.md), else by reopening the source and reading forward to it,
+// which is exact for every source but decodes everything before the target. The end is taken
+// from the header's frame count, checked by reading its last frame and finding nothing after it.
 #pragma once
 
 #include <cstdint>
@@ -55,6 +55,8 @@ class SeekableSource : public FrameSource {
   // Frames decoded from the wrapped source so far, reopenings included (for tests and --help's
   // figure of what a seek costs).
   int64_t frames_decoded() const { return decoded_total_; }
+  // Positions reached by the wrapped source's own seek so far.
+  int64_t direct_seeks() const { return direct_seeks_; }
 
  private:
   struct Slot {
@@ -64,6 +66,12 @@ class SeekableSource : public FrameSource {
   Slot* cached(int64_t position);
   void remember(int64_t position, const Frame& frame);
   bool decode_next(Frame& frame);  // The wrapped source's next frame (at decoded_).
+  // Reopens the source and reads forward to `position`: the way that works for every source.
+  bool read_forward_to(int64_t position, Frame& frame);
+
+  // Up to this many frames ahead, reading on is as cheap as a seek (which decodes from a key
+  // frame before the target up to it: OpenCV starts 16 frames before).
+  static constexpr int64_t kReadThroughFrames = 16;
 
   std::unique_ptr<FrameSource> source_;
   Opener reopen_;
@@ -72,6 +80,8 @@ class SeekableSource : public FrameSource {
   int64_t position_ = 0;    // Next frame to deliver.
   int64_t decoded_ = 0;     // Position of the wrapped source's next frame.
   int64_t decoded_total_ = 0;
+  int64_t landed_ = -1;  // Where the last direct seek put the source, until its frame is read.
+  int64_t direct_seeks_ = 0;
   std::optional<int64_t> length_;
   Frame scratch_;  // Frames read on the way to a seek target.
 };

@@ -125,6 +125,22 @@ class VideoFileSource : public FrameSource {
   std::optional<int64_t> frame_count() const override { return frame_count_; }
   std::optional<double> fps() const override { return fps_; }
 
+  bool seek_to(int64_t position) override {
+    // Damaged frames get no row, so positions no longer equal the decoder's frame numbers.
+    if (position < 0 || damaged_ > 0 || pending_error_) return false;
+    if (frame_count_ && position >= *frame_count_) return false;
+    // OpenCV's FFmpeg seek: av_seek_frame to a key frame at or before the target, then decoding
+    // forward to it by the frames' timestamps (exact for the intra-only codecs the recordings use,
+    // HuffYUV, FFV1, MJPG, in AVI and MKV: FrameSourceTest.SeekToShowsTheFrameReadingForwardShows).
+    if (!capture_.set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(position))) return false;
+    started_ = false;
+    have_current_ = have_next_ = false;
+    next_index_ = position;
+    decoded_ = position;  // As if read up to here: the truncation check counts from the start.
+    last_time_s_ = -1.0;
+    return true;
+  }
+
  private:
   struct Decoded {
     cv::Mat image;
@@ -280,6 +296,11 @@ class ImageSequenceSource : public FrameSource {
     for (const NumberedFile& file : files_) paths.push_back(file.path);
     return paths;
   }
+  bool seek_to(int64_t position) override {
+    if (position < 0 || position > static_cast<int64_t>(files_.size())) return false;
+    next_ = static_cast<size_t>(position);
+    return true;
+  }
 
  private:
   std::vector<NumberedFile> files_;
@@ -406,6 +427,11 @@ class SyntheticSource : public FrameSource {
   std::string description() const override { return description_; }
   std::optional<int64_t> frame_count() const override { return scene_.frame_count(); }
   std::optional<double> fps() const override { return scene_.options().fps; }
+  bool seek_to(int64_t position) override {
+    if (position < 0 || position > scene_.frame_count()) return false;
+    next_index_ = static_cast<int>(position);
+    return true;
+  }
 
  private:
   Scene scene_;

@@ -20,7 +20,7 @@ bool PacedFrameSource::read(Frame& frame) {
     anchor_time_s_ = frame.time_s;
   } else if (!paused_) {
     const auto due = *anchor_ + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(frame.time_s - anchor_time_s_));
+                                    std::chrono::duration<double>((frame.time_s - anchor_time_s_) / speed_));
     if (timing_.now() < due) timing_.sleep_until(due);
   }
   last_time_s_ = frame.time_s;
@@ -28,6 +28,15 @@ bool PacedFrameSource::read(Frame& frame) {
 }
 
 void PacedFrameSource::pause() { paused_ = true; }
+
+void PacedFrameSource::set_speed(double speed) {
+  if (!(speed > 0) || speed == speed_) return;
+  speed_ = speed;
+  if (!paused_ && last_time_s_) {
+    anchor_ = timing_.now();
+    anchor_time_s_ = *last_time_s_;
+  }
+}
 
 void PacedFrameSource::resume() {
   if (!paused_) return;

@@ -76,5 +76,28 @@ TEST(PacedFrameSource, PlaysAtTheFileRateWithoutDroppingAndAPauseIsNoGap) {
   EXPECT_NEAR(frame.time_s, 0.9, 1e-12) << "timestamps are the file's";
 }
 
+// At 0.5x a frame period of 0.1 s takes 0.2 s, at 4x 0.025 s; a change starts from the last
+// frame delivered (no jump, no burst to catch up).
+TEST(PacedFrameSource, SpeedScalesTheFramePeriodFromTheLastFrameOn) {
+  FakeClock clock;
+  PacedFrameSource source(std::make_unique<TenFrames>(), clock.timing());
+  Frame frame;
+  ASSERT_TRUE(source.read(frame));
+  ASSERT_TRUE(source.read(frame));
+  EXPECT_NEAR(clock.seconds(), 0.1, 1e-6);
+  source.set_speed(0.5);
+  ASSERT_TRUE(source.read(frame));
+  EXPECT_NEAR(clock.seconds(), 0.3, 1e-6);
+  ASSERT_TRUE(source.read(frame));
+  EXPECT_NEAR(clock.seconds(), 0.5, 1e-6);
+  clock.advance(1.0);  // Late: the change of speed does not make up for it with a burst.
+  source.set_speed(4.0);
+  ASSERT_TRUE(source.read(frame));
+  EXPECT_NEAR(clock.seconds(), 1.525, 1e-6);
+  EXPECT_EQ(frame.index, 4);
+  source.set_speed(0.0);  // Not a speed: ignored.
+  EXPECT_EQ(source.speed(), 4.0);
+}
+
 }  // namespace
 }  // namespace softsight

@@ -44,6 +44,18 @@ class FrameSource {
   // The files this source reads (a video; every file of an image sequence); none for cameras
   // and synthetic scenes. Outputs are checked against them before anything is written.
   virtual std::vector<std::string> files() const { return {}; }
+
+  // Makes the frame `position` frames after the first one (0-based, in the order read() returns
+  // them) the next one read() returns, without decoding the frames before it, when the source
+  // can do that exactly: a video through its container's index (FFmpeg's own seek, which decodes
+  // from the key frame before the target up to it), an image sequence, a rendered scene. Returns
+  // false, changing nothing, when it cannot (a camera; a video that has shown damaged frames, as
+  // its positions and frame numbers then differ; a position past the known end). A position
+  // beyond a too-long header count makes the next read() return false.
+  virtual bool seek_to(int64_t position) {
+    (void)position;
+    return false;
+  }
 };
 
 }  // namespace softsight

@@ -37,6 +37,10 @@ class PacedFrameSource : public FrameSource {
   void pause();
   void resume();
   bool paused() const { return paused_; }
+  // Plays at `speed` times the file's rate (0.5: half speed; > 0). The change starts from the
+  // last frame delivered, so there is no jump or burst.
+  void set_speed(double speed);
+  double speed() const { return speed_; }
 
   std::string description() const override { return source_->description(); }
   std::optional<int64_t> frame_count() const override { return source_->frame_count(); }
@@ -48,6 +52,7 @@ class PacedFrameSource : public FrameSource {
   std::unique_ptr<FrameSource> source_;
   Timing timing_;
   bool paused_ = false;
+  double speed_ = 1.0;
   // The clock: frame time `anchor_time_s_` is due at `anchor_`. Set by the first frame, moved by
   // resume() to the last delivered frame.
   std::optional<Clock::time_point> anchor_;
