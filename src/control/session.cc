@@ -139,10 +139,7 @@ void ControlSession::set_angle_target(double target_deg) {
 }
 
 ControlSample ControlSession::vent(double time_s, std::optional<double> measured_deg) {
-  if (!start_time_s_) start_time_s_ = time_s;
-  ControlSample sample;
-  sample.time_s = time_s - *start_time_s_;
-  sample.measured_deg = measured_deg;
+  ControlSample sample = begin_sample(time_s, measured_deg);
   sample.action = ControllerOutput::Action::kVent;
   sample.board = checked(link_.stop());
   controller_.reset();
