@@ -190,7 +190,7 @@ TrackingConfig EvaluateMethodConfig(const std::string& method,
       if (options.rect_centre) templ.report = TemplateReport::kRectCentre;
       if (options.square_mask) templ.round_mask = false;
     }
-    spec.params = ParamsForMethod(method, colour, templ);
+    spec.params = ParamsForMethod(method, {colour, templ});
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(scene);
