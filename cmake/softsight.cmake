@@ -5,11 +5,12 @@
 # compiled and optimised, once per batch instead of once per file. CLI11 is header-only: its code
 # was compiled again in each of the 20 command files (8-16 s of CPU each, 214 s in all; one batch
 # of all 20 took 33 s). Files batched together must not define the same name in an anonymous
-# namespace (or a `static` one); the targets below still do, and stay file by file until those
-# names are renamed or shared. A new clash shows as "redefinition of '...{anonymous}::NAME'".
-set(SOFTSIGHT_NOT_UNITY softsight_config_test softsight_io_test softsight_gui_test softsight_app_test)
+# namespace (or a `static` one): a helper two test files need lives in a shared test header
+# (core/test_util.h, app/program_test_util.h, ...), and one that only looks alike gets a name of
+# its own. A new clash shows as "redefinition of '...{anonymous}::NAME'". Every target is batched;
+# the gui library keeps live_window.cc out of its batches (src/gui/CMakeLists.txt says why).
 function(softsight_use_unity_build target)
-  if(SOFTSIGHT_UNITY_BUILD AND NOT target IN_LIST SOFTSIGHT_NOT_UNITY)
+  if(SOFTSIGHT_UNITY_BUILD)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
   endif()
 endfunction()

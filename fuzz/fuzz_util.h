@@ -12,12 +12,24 @@
 
 namespace softsight::fuzz {
 
-// A scratch file `name` in a folder made once per process and removed with what it holds when
-// the process ends normally (a fuzz run that finds a crash leaves it, beside the crash input).
+// A scratch file `name` in a folder made once per process. libFuzzer ends its process with
+// _Exit, which runs no destructor: scripts/fuzz.sh therefore names a folder of its own in
+// SOFTSIGHT_FUZZ_SCRATCH and removes it after the run (whatever way the run ends). Without it
+// (a harness run by hand) the folder is made in the temporary directory and removed only when
+// the process ends through exit().
 inline std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_t size) {
   struct Folder {
-    std::string path = "/tmp/softsight_fuzz_XXXXXX";
+    std::string path;
     Folder() {
+      const char* given = std::getenv("SOFTSIGHT_FUZZ_SCRATCH");
+      if (given != nullptr && *given != '\0') {
+        path = given;
+        std::error_code failed;
+        std::filesystem::create_directories(path, failed);
+        if (failed) std::abort();
+        return;
+      }
+      path = (std::filesystem::temp_directory_path() / "softsight_fuzz_XXXXXX").string();
       if (mkdtemp(path.data()) == nullptr) std::abort();
     }
     ~Folder() {

@@ -25,14 +25,19 @@ for t in "${TARGETS[@]}"; do BUILD_TARGETS+=("softsight_${t}_fuzzer"); done
 cmake --build build-sanitize --parallel "$(nproc)" --target "${BUILD_TARGETS[@]}"
 OUT=build-sanitize/fuzz-out
 mkdir -p "$OUT/crashes"
+# One scratch folder for the run: new corpus inputs (scratch/corpus) and the harnesses' input files
+# (scratch/files: libFuzzer ends with _Exit, so the harness cannot remove them itself). Removed
+# however the script ends.
+scratch="$(mktemp -d -t softsight_fuzz_run.XXXXXX)"
+trap 'rm -rf "$scratch"' EXIT
+export SOFTSIGHT_FUZZ_SCRATCH="$scratch/files"
 for t in "${TARGETS[@]}"; do
-  scratch="$(mktemp -d)"
+  rm -rf "$scratch/corpus" && mkdir -p "$scratch/corpus"
   echo "fuzz: $t (${FLAGS[*]})"
   # -timeout: an input that takes seconds is a hang, and fails like a crash.
   "build-sanitize/fuzz/softsight_${t}_fuzzer" "${FLAGS[@]}" -max_len=4096 -timeout=10 \
-    -rss_limit_mb=2048 -artifact_prefix="$OUT/crashes/${t}-" -print_final_stats=1 "$scratch" \
-    "fuzz/corpus/$t" 2> "$OUT/$t.log" || { tail -n 60 "$OUT/$t.log"; rm -rf "$scratch"; exit 1; }
+    -rss_limit_mb=2048 -artifact_prefix="$OUT/crashes/${t}-" -print_final_stats=1 "$scratch/corpus" \
+    "fuzz/corpus/$t" 2> "$OUT/$t.log" || { tail -n 60 "$OUT/$t.log"; exit 1; }
   grep -E "^stat::number_of_executed_units|^Done" "$OUT/$t.log" || true
-  rm -rf "$scratch"
 done
 echo "fuzz: ${#TARGETS[@]} targets, no crash"

@@ -14,6 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "calib/calibration_test_views.h"
+#include "core/test_util.h"
 #include "sim/opencv_samples.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
@@ -29,8 +30,8 @@ using ::testing::HasSubstr;
 class CalibrateCommandTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(fs::temp_directory_path() / ("softsight_calibrate_command_test_" + std::to_string(getpid())));
-    fs::remove_all(*dir_);
+    suite_dir_ = new testing::TempDir("calibrate_command");
+    dir_ = &suite_dir_->path();
     fs::create_directories(*dir_ / "views");
     const ChessboardRenderer renderer(testviews::Camera(), testviews::Pattern());
     for (const testviews::View& view : testviews::RenderViews(renderer, 10)) {
@@ -44,8 +45,9 @@ class CalibrateCommandTest : public ::testing::Test {
     cv::imwrite((*dir_ / "plane.png").string(), plane);
   }
   static void TearDownTestSuite() {
-    fs::remove_all(*dir_);
-    delete dir_;
+    delete suite_dir_;
+    suite_dir_ = nullptr;
+    dir_ = nullptr;
   }
 
   static CalibrateOptions CameraOptions() {
@@ -58,9 +60,11 @@ class CalibrateCommandTest : public ::testing::Test {
   }
 
   static constexpr double kPlaneDistanceMm = 560.0;
-  static fs::path* dir_;
+  static testing::TempDir* suite_dir_;  // Made in SetUpTestSuite, removed in TearDownTestSuite.
+  static const fs::path* dir_;
 };
-fs::path* CalibrateCommandTest::dir_ = nullptr;
+testing::TempDir* CalibrateCommandTest::suite_dir_ = nullptr;
+const fs::path* CalibrateCommandTest::dir_ = nullptr;
 
 TEST_F(CalibrateCommandTest, FolderOfViewsGivesTheCameraWithinOnePercent) {
   std::ostringstream report;

@@ -33,16 +33,12 @@ using testing::SplitCsv;
 using testing::TempDir;
 using testing::WriteTextFile;
 
-std::string Example() {
-  return testing::SourceDir() + "/examples/rig.yaml";
-}
-
 // The markers of examples/rig.yaml (the synthetic scene's); the control section stays at its
 // defaults, which are the example's values.
 const char* const kMarkers = testing::kSceneMarkersYaml;
 
 TEST(ControlConfig, ReadsTheExampleAndRejectsBadKeys) {
-  const ControlConfig config = LoadControlConfig(Example());
+  const ControlConfig config = LoadControlConfig(testing::RigExample());
   EXPECT_DOUBLE_EQ(config.controller.kp_kpa_per_deg, 0.25);
   EXPECT_DOUBLE_EQ(config.controller.hold_s, 0.5);
   EXPECT_EQ(config.link.baud, 115200);
@@ -194,7 +190,7 @@ TEST(ControlCommand, SimulatedStepSummaryGivesRiseSettlingOvershootSteadyStateAn
 
 TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
   ControlOptions options;
-  options.config_file = Example();
+  options.config_file = testing::RigExample();
   options.simulate = true;
   options.csv_file = "/nonexistent/x.csv";
   EXPECT_THROW(RunControl(options), InputError);  // No target.
@@ -210,7 +206,7 @@ TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {
 // option and where the frames come from, before a port is opened or a file written.
 TEST(ControlCommand, RefusesCameraSettingsWithoutACamera) {
   ControlOptions options;
-  options.config_file = Example();
+  options.config_file = testing::RigExample();
   options.simulate = true;
   options.target_deg = 120.0;
   options.csv_file = "/nonexistent/x.csv";
@@ -228,7 +224,7 @@ TEST(ControlCommand, RefusesNonFiniteAndOutOfRangeNumbersNamingTheOption) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   auto error_of = [](ControlOptions options) {
-    options.config_file = Example();
+    options.config_file = testing::RigExample();
     options.simulate = true;
     options.csv_file = "/nonexistent/never-written.csv";
     try {
@@ -272,7 +268,7 @@ TEST(ControlCommand, RefusesNonFiniteAndOutOfRangeNumbersNamingTheOption) {
   // Through the program: one line, exit code 2.
   TempDir dir;
   const std::string command = std::string("\"") + testing::SoftsightBinary() +
-                              "\" control --config " + Example() + " --simulate --pwm nan --csv " +
+                              "\" control --config " + testing::RigExample() + " --simulate --pwm nan --csv " +
                               dir.file("x.csv") + " 2> " + dir.file("err.txt");
   const int status = std::system(command.c_str());
   ASSERT_TRUE(WIFEXITED(status));

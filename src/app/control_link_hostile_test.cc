@@ -190,7 +190,6 @@ class HostileBoard {
   std::thread thread_;
 };
 
-const char* const kMarkers = testing::kSceneMarkersYaml;
 
 // The rendered actuator as the one frame `--rig-frames` keeps reading.
 void WriteFrame(const std::string& file) {
@@ -245,7 +244,7 @@ constexpr int kGoodAnswers = 4;  // HI and three frames.
 
 HostileRun RunAgainst(Hostility hostility) {
   testing::TempDir dir;
-  testing::WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  testing::WriteTextFile(dir.file("rig.yaml"), testing::kSceneMarkersYaml);
   WriteFrame(dir.file("frame.png"));
   HostileBoard board(hostility, kGoodAnswers);
   const pid_t pid = SpawnControl("--config " + dir.file("rig.yaml") + " --port " + board.port() +
@@ -349,7 +348,7 @@ TEST(HostileBoard, ABoardErrIsFollowedByStop) {
 
 TEST(HostileBoard, SigtermWhileTheBoardChattersStopsPromptlyAndVents) {
   testing::TempDir dir;
-  testing::WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  testing::WriteTextFile(dir.file("rig.yaml"), testing::kSceneMarkersYaml);
   WriteFrame(dir.file("frame.png"));
   // It chatters but answers STOP, so the run can end as interrupted rather than as a link error.
   HostileBoard board(Hostility::kChatter, kGoodAnswers, /*answer_stop=*/true);

@@ -19,10 +19,10 @@
 #include "app/progress.h"
 #include "app/scene_config.h"
 #include "app/truth_sink.h"
+#include "softsight/io/truth_csv.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
 #include "softsight/core/format.h"
-#include "softsight/io/csv_reader.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -190,7 +190,7 @@ TrackingConfig EvaluateMethodConfig(const std::string& method,
       if (options.rect_centre) templ.report = TemplateReport::kRectCentre;
       if (options.square_mask) templ.round_mask = false;
     }
-    spec.params = ParamsForMethod(method, colour, templ);
+    spec.params = ParamsForMethod(method, {colour, templ});
     config.markers.push_back(spec);
   }
   config.measure = SceneMeasureOptions(scene);
@@ -346,74 +346,17 @@ struct TruthTable {
 };
 
 TruthTable ReadTruthTable(const std::string& file, const TrackingConfig& config) {
-  const CsvTable table = ReadCsvTable(file);
-  const auto frame_column = table.find("frame");
-  if (!frame_column) {
-    throw InputError(file + ": no 'frame' column (the truth needs frame, and <name>_x, <name>_y "
-                     "per marker)");
-  }
-  struct Columns {
-    size_t x, y;
-    std::optional<size_t> visible;
-  };
+  std::vector<std::string> names;
+  for (const MarkerSpec& spec : config.markers) names.push_back(spec.name);
+  TruthCsv read = ReadTruthCsv(file, names);  // The columns `synth --truth` writes.
   TruthTable truth;
-  std::vector<Columns> columns;
-  for (size_t i = 0; i < config.markers.size(); ++i) {
-    const std::string& name = config.markers[i].name;
-    const auto x = table.find(name + "_x"), y = table.find(name + "_y");
-    if (!x || !y) {
-      truth.unmatched.push_back(name);
-      continue;
-    }
-    truth.config_index.push_back(i);
-    truth.names.push_back(name);
-    columns.push_back({*x, *y, table.find(name + "_visible")});
+  truth.config_index = std::move(read.wanted_index);
+  truth.names = std::move(read.markers);
+  truth.unmatched = std::move(read.missing);
+  for (SceneTruth& frame : read.frames) {
+    const int64_t index = frame.frame_index;
+    truth.by_frame.emplace(index, std::move(frame));
   }
-  if (truth.names.empty()) {
-    std::string have;
-    for (const std::string& c : table.columns) {
-      if (c.size() > 2 && c.compare(c.size() - 2, 2, "_x") == 0) {
-        have += (have.empty() ? "" : ", ") + c.substr(0, c.size() - 2);
-      }
-    }
-    throw InputError(file + ": no marker of the config has <name>_x and <name>_y columns here (the "
-                     "truth has: " + (have.empty() ? std::string("none") : have) + ")");
-  }
-  const auto angle_column = table.find("angle_deg");
-  const auto time_column = table.find("time_s");
-  for (size_t row = 0; row < table.row_count(); ++row) {
-    const std::optional<double>& frame = table.values[*frame_column][row];
-    if (!frame || *frame < 0 || *frame != std::floor(*frame)) {
-      throw InputError(file + ": line " + std::to_string(row + 2) +
-                       ": 'frame' must be a frame index (0, 1, 2, ...)");
-    }
-    SceneTruth t;
-    t.frame_index = static_cast<int64_t>(*frame);
-    if (time_column) t.time_s = table.values[*time_column][row].value_or(0.0);
-    for (size_t k = 0; k < columns.size(); ++k) {
-      MarkerTruth m;
-      m.name = truth.names[k];
-      const auto& x = table.values[columns[k].x][row];
-      const auto& y = table.values[columns[k].y][row];
-      if (x && y) m.centroid_px = cv::Point2d(*x, *y);
-      m.visible_fraction = m.centroid_px ? 1.0 : 0.0;
-      if (columns[k].visible) {
-        const auto& v = table.values[*columns[k].visible][row];
-        if (v && (*v < 0 || *v > 1)) {
-          throw InputError(file + ": line " + std::to_string(row + 2) + ": " + m.name +
-                           "_visible must lie within 0..1");
-        }
-        if (v && m.centroid_px) m.visible_fraction = *v;
-      }
-      t.markers.push_back(m);
-    }
-    if (angle_column) t.measurement.angle_deg = table.values[*angle_column][row];
-    if (!truth.by_frame.emplace(t.frame_index, std::move(t)).second) {
-      throw InputError(file + ": line " + std::to_string(row + 2) + ": frame " +
-                       std::to_string(static_cast<long long>(*frame)) + " is given twice");
-    }
-  }
-  if (truth.by_frame.empty()) throw InputError(file + ": no rows");
   return truth;
 }
 

@@ -116,8 +116,8 @@ TEST(EvaluateTest, WritesTheTableAsCsvAndMarkdown) {
   options.scene.frame_count = 5;
   options.methods = {"colour", "sad"};
   options.modes = {"gray", "colour"};
-  const fs::path csv = fs::path(::testing::TempDir()) /
-                       ("softsight_evaluate_" + std::to_string(getpid()) + ".csv");
+  const testing::TempDir dir;
+  const fs::path csv = dir.path() / "evaluate.csv";
   options.csv_file = csv.string();
   const EvaluateReport report = RunEvaluate(options);
   ASSERT_EQ(report.methods.size(), 3u);  // colour, sad gray, sad colour.
@@ -128,7 +128,6 @@ TEST(EvaluateTest, WritesTheTableAsCsvAndMarkdown) {
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 3);
-  fs::remove(csv);
 
   const std::string table = FormatEvaluateMarkdown(report);
   EXPECT_NE(table.find("| sad gray |"), std::string::npos) << table;

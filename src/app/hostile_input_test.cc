@@ -15,26 +15,17 @@
 #include <gtest/gtest.h>
 #include <opencv2/videoio.hpp>
 
+#include "app/program_test_util.h"
 #include "core/test_util.h"
 
 namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::ProgramRun;
+using testing::RunProgram;
 using testing::TempDir;
 
-struct ProgramRun {
-  int exit_code;
-  std::string stderr_text;
-};
-
-ProgramRun RunProgram(const std::string& args, const TempDir& dir) {
-  const std::string command = testing::SoftsightBinary() + " " + args + " > /dev/null 2> " +
-                              dir.file("stderr.txt") + " < /dev/null";
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-          testing::ReadTextFile(dir.file("stderr.txt"))};
-}
 
 void ExpectOneError(const ProgramRun& run, const std::string& what) {
   EXPECT_EQ(run.exit_code, 2) << run.stderr_text;

@@ -29,13 +29,12 @@ using testing::SplitCsv;
 using testing::TempDir;
 using testing::WriteTextFile;
 
-std::string Example() { return testing::SourceDir() + "/examples/rig.yaml"; }
 
 
 TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTheInput) {
   TempDir dir;
   const std::string input = dir.file("rig.yaml");
-  WriteTextFile(input, ReadTextFile(Example()));
+  WriteTextFile(input, ReadTextFile(testing::RigExample()));
   IdentifyCommandOptions o;
   o.config_file = input;
   o.output_file = dir.file("tuned.yaml");
@@ -47,7 +46,7 @@ TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTh
   const std::optional<IdentifyOutcome> ran = RunIdentify(o);
   ASSERT_TRUE(ran);
   const IdentifyOutcome& found = *ran;
-  EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));  // Never touched.
+  EXPECT_EQ(ReadTextFile(input), ReadTextFile(testing::RigExample()));  // Never touched.
 
   // The example's plant: 6 deg of bend per kPa, 0.4 deg of angle per degree of bend; lag 0.15 s.
   EXPECT_NEAR(found.model.slope_deg_per_kpa, 2.4, 0.24);
@@ -81,7 +80,7 @@ TEST(IdentifyCommand, SimulatedRigThroughTheTrackerWritesATunedConfigAndLeavesTh
 TEST(IdentifyCommand, RefusesToOverwriteTheInputConfig) {
   TempDir dir;
   const std::string input = dir.file("rig.yaml");
-  WriteTextFile(input, ReadTextFile(Example()));
+  WriteTextFile(input, ReadTextFile(testing::RigExample()));
   IdentifyCommandOptions o;
   o.config_file = input;
   o.simulate = true;
@@ -95,7 +94,7 @@ TEST(IdentifyCommand, RefusesToOverwriteTheInputConfig) {
       EXPECT_THAT(e.what(), HasSubstr("is the config " + input));
     }
   }
-  EXPECT_EQ(ReadTextFile(input), ReadTextFile(Example()));
+  EXPECT_EQ(ReadTextFile(input), ReadTextFile(testing::RigExample()));
   // Through the program: one line, exit code 2.
   const std::string command = std::string("\"") + testing::SoftsightBinary() +
                               "\" identify --config " + input + " --simulate -o " + input +
@@ -136,7 +135,7 @@ triple: [a, b, c]
 TEST(ControlCommand, AutoTuneIdentifiesThenRunsTheLoopWithTheGainsFound) {
   TempDir dir;
   ControlOptions o;
-  o.config_file = Example();
+  o.config_file = testing::RigExample();
   o.simulate = true;
   o.sim_supersample = 1;
   o.target_deg = 120.0;
@@ -175,7 +174,7 @@ TEST(ControlCommand, AutoTuneIdentifiesThenRunsTheLoopWithTheGainsFound) {
 // Without a model the run says the output stayed at its limit.
 TEST(ControlCommand, ATargetBeyondTheIdentifiedReachIsRefusedBeforeAnythingIsSent) {
   TempDir dir;
-  std::string stiff = ReadTextFile(Example());
+  std::string stiff = ReadTextFile(testing::RigExample());
   const size_t at = stiff.find("bend_deg_per_kpa: 6.0");
   ASSERT_NE(at, std::string::npos);
   stiff.replace(at, std::string("bend_deg_per_kpa: 6.0").size(), "bend_deg_per_kpa: 3.0");
@@ -244,7 +243,7 @@ TEST(ControlCommand, ATargetBeyondTheIdentifiedReachIsRefusedBeforeAnythingIsSen
 TEST(ControlCommand, AStaircaseGetsEveryStepsFiguresAndASineItsTrackingError) {
   TempDir dir;
   IdentifyCommandOptions identify;
-  identify.config_file = Example();
+  identify.config_file = testing::RigExample();
   identify.output_file = dir.file("tuned.yaml");
   identify.simulate = true;
   identify.sim_supersample = 1;
@@ -310,7 +309,7 @@ class PlantSweep : public ::testing::TestWithParam<Plant> {};
 TEST_P(PlantSweep, AfterIdentifyAStepSettlesQuicklyAndASineIsFollowed) {
   const Plant& plant = GetParam();
   TempDir dir;
-  std::string text = ReadTextFile(Example());
+  std::string text = ReadTextFile(testing::RigExample());
   const auto set = [&text](const std::string& key, const std::string& from, double value) {
     const size_t at = text.find(key + ": " + from);
     ASSERT_NE(at, std::string::npos) << key;
@@ -383,7 +382,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {
   TempDir dir;
-  WriteTextFile(dir.file("rig.yaml"), ReadTextFile(Example()));
+  WriteTextFile(dir.file("rig.yaml"), ReadTextFile(testing::RigExample()));
   const std::string csv = dir.file("ident.csv");
   const int status = testing::RunAndSignalOnceRowsAreWritten(
       "identify --config " + dir.file("rig.yaml") + " --simulate -o " + dir.file("tuned.yaml") +
@@ -408,7 +407,7 @@ TEST(ControlCommand, AutoTuneStoppedBySigtermDuringTheIdentificationExits143With
   TempDir dir;
   const std::string identify_csv = dir.file("run_identify.csv");
   const int status = testing::RunAndSignalOnceRowsAreWritten(
-      "control --config " + Example() + " --simulate --auto-tune --target-deg 120 --csv " +
+      "control --config " + testing::RigExample() + " --simulate --auto-tune --target-deg 120 --csv " +
           dir.file("run.csv"),
       identify_csv, 4, SIGTERM, dir.file("err.txt"));
   const std::string err = ReadTextFile(dir.file("err.txt"));

@@ -208,7 +208,7 @@ InitResult RunInit(const InitOptions& options) {
     // started. Identical markers and markers among look-alikes outside a search region keep theirs.
     for (FoundMarker& m : finding.markers) {
       if (!m.needs_roi && !finding.intensity && !finder.search_px) {
-        std::get<ColourParams>(m.spec.params).roi.reset();
+        m.spec.params.get<ColourParams>().roi.reset();
       }
     }
   }
@@ -284,7 +284,7 @@ TrackingConfig RunPick(const PickOptions& options) {
     if (options.base_config) {
       // A template marker becomes a colour marker: the pick is its colour.
       ColourParams colour;
-      if (const auto* had = std::get_if<ColourParams>(&config.markers[i].params)) colour = *had;
+      if (const auto* had = config.markers[i].params.get_if<ColourParams>()) colour = *had;
       ApplyColourPick(*pick, &colour);
       colour.roi_frame = roi_frame;
       config.markers[i].params = colour;
@@ -374,7 +374,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
       char line[256];
       std::snprintf(line, sizeof(line), "%zu %s at (%.2f, %.2f), radius %.1f px: ", i + 1,
                     m.spec.name.c_str(), m.position_px.x, m.position_px.y, m.radius_px);
-      std::cout << line << Describe(std::get<ColourParams>(m.spec.params)) << "\n";
+      std::cout << line << Describe(m.spec.params.get<ColourParams>()) << "\n";
     }
     if (result.config.measure.has_triple()) {
       std::cout << "triple: " << result.config.measure.base << ", "
@@ -427,7 +427,7 @@ CommandRunner SetupPickCommand(CLI::App& sub) {
     const TrackingConfig config = RunPick(options);
     for (size_t i = 0; i < options.at_px.size(); ++i) {
       const MarkerSpec& m = config.markers[i];
-      std::cout << m.name << ": " << Describe(std::get<ColourParams>(m.params)) << "\n";
+      std::cout << m.name << ": " << Describe(m.params.get<ColourParams>()) << "\n";
     }
     std::cout << "wrote " << options.config_out << "\n";
     return 0;

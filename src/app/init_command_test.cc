@@ -232,10 +232,10 @@ TEST(InitCommand, WhiteDotsOnGrayVideoGetAGrayRangeAndARoiEach) {
   EXPECT_TRUE(result.finding.intensity);
   ASSERT_EQ(result.config.markers.size(), 5u);
   for (const MarkerSpec& m : result.config.markers) {
-    EXPECT_TRUE(std::get<ColourParams>(m.params).gray && std::get<ColourParams>(m.params).roi) << m.name;
+    EXPECT_TRUE(m.params.get<ColourParams>().gray && m.params.get<ColourParams>().roi) << m.name;
   }
   EXPECT_EQ(result.config.measure.chain.size(), 5u);
-  for (const MarkerSpec& m : result.config.markers) EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, 0) << m.name;
+  for (const MarkerSpec& m : result.config.markers) EXPECT_EQ(m.params.get<ColourParams>().roi_frame, 0) << m.name;
 }
 
 // Identical dots need their rois, which hold where the dots are on the analysed frame: on a later
@@ -250,8 +250,8 @@ TEST(InitCommand, RoisFoundOnALaterFrameApplyFromThatFrame) {
   const InitResult result = RunInit(init);
   ASSERT_EQ(result.config.markers.size(), 5u);
   for (const MarkerSpec& m : result.config.markers) {
-    ASSERT_TRUE(std::get<ColourParams>(m.params).roi) << m.name;
-    EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, 12) << m.name;
+    ASSERT_TRUE(m.params.get<ColourParams>().roi) << m.name;
+    EXPECT_EQ(m.params.get<ColourParams>().roi_frame, 12) << m.name;
   }
   PlateScene truth_scene(PlateSceneOptions{});
   cv::Mat truth_image;
@@ -353,8 +353,8 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
     live.on_event(UiEvent::Key('1' + static_cast<int>(i)));
     live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseDown, clicks[i].x, clicks[i].y));
     live.on_event(UiEvent::Mouse(UiEvent::Type::kMouseUp, clicks[i].x, clicks[i].y));
-    const ColourParams& a = std::get<ColourParams>(picked.markers[i].params);
-    const ColourParams& b = std::get<ColourParams>(live.config().markers[i].params);
+    const ColourParams& a = picked.markers[i].params.get<ColourParams>();
+    const ColourParams& b = live.config().markers[i].params.get<ColourParams>();
     EXPECT_EQ(a.h.lo, b.h.lo);
     EXPECT_EQ(a.h.hi, b.h.hi);
     EXPECT_EQ(a.s.lo, b.s.lo);
@@ -373,10 +373,10 @@ TEST(PickCommand, GivesExactlyWhatAClickInLiveGives) {
   into.config_out = dir.file("updated.yaml");
   const TrackingConfig updated = RunPick(into);
   ASSERT_EQ(updated.markers.size(), 3u);
-  EXPECT_EQ(std::get<ColourParams>(updated.markers[0].params).h.lo, std::get<ColourParams>(picked.markers[0].params).h.lo);
-  EXPECT_EQ(std::get<ColourParams>(updated.markers[0].params).s.lo, std::get<ColourParams>(picked.markers[0].params).s.lo);
-  EXPECT_EQ(std::get<ColourParams>(updated.markers[1].params).h.lo, std::get<ColourParams>(start.markers[1].params).h.lo);
-  EXPECT_FALSE(std::get<ColourParams>(updated.markers[1].params).roi.has_value());
+  EXPECT_EQ(updated.markers[0].params.get<ColourParams>().h.lo, picked.markers[0].params.get<ColourParams>().h.lo);
+  EXPECT_EQ(updated.markers[0].params.get<ColourParams>().s.lo, picked.markers[0].params.get<ColourParams>().s.lo);
+  EXPECT_EQ(updated.markers[1].params.get<ColourParams>().h.lo, start.markers[1].params.get<ColourParams>().h.lo);
+  EXPECT_FALSE(updated.markers[1].params.get<ColourParams>().roi.has_value());
   EXPECT_EQ(updated.measure.base, start.measure.base);
   into.at_px = {clicks[0], clicks[1], clicks[2], clicks[0]};
   EXPECT_THROW(RunPick(into), InputError) << "more points than the config has markers";
@@ -423,7 +423,7 @@ TEST(PickCommand, APickAtALaterFrameTracksLikeLiveFromThatFrameAndNotBefore) {
   for (const SceneMarker& m : clip.scene.markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    std::get<ColourParams>(spec.params).h = {20, 30};
+    spec.params.get<ColourParams>().h = {20, 30};
     start.markers.push_back(spec);
   }
   start.measure = SceneMeasureOptions(clip.scene);
@@ -458,7 +458,7 @@ TEST(PickCommand, APickAtALaterFrameTracksLikeLiveFromThatFrameAndNotBefore) {
   for (const std::string& config : {dir.file("pick.yaml"), dir.file("live.yaml")}) {
     SCOPED_TRACE(config);
     const TrackingConfig saved = LoadTrackingConfig(config);
-    for (const MarkerSpec& m : saved.markers) EXPECT_EQ(std::get<ColourParams>(m.params).roi_frame, kPickFrame) << m.name;
+    for (const MarkerSpec& m : saved.markers) EXPECT_EQ(m.params.get<ColourParams>().roi_frame, kPickFrame) << m.name;
     TrackOptions track;
     track.config_file = config;
     track.source.input = clip.video;

@@ -1,5 +1,6 @@
-// Running the `softsight` program from the app's tests (test code only): a run interrupted by a
-// signal once its CSV has rows, as a user's Ctrl-C or a service manager's SIGTERM would.
+// Running the `softsight` program from the app's tests (test code only): a run and what it said
+// on stderr, and a run interrupted by a signal once its CSV has rows, as a user's Ctrl-C or a
+// service manager's SIGTERM would.
 #pragma once
 
 #include <signal.h>
@@ -13,14 +14,19 @@
 
 namespace softsight::testing {
 
+// examples/rig.yaml: the control examples' config (the synthetic scene's markers and a rig).
+inline std::string RigExample() { return SourceDir() + "/examples/rig.yaml"; }
+
+// How a run of the program ended: its exit code (-1 when a signal ended it) and its stderr.
 struct ProgramRun {
   int exit_code;
   std::string stderr_text;
 };
 
-// Runs `softsight ARGS` with its stderr in `dir`/stderr.txt; its exit code (-1: killed) and stderr.
-inline ProgramRun RunBinary(const std::string& args, const TempDir& dir) {
-  const std::string command = SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
+// Runs `softsight ARGS` with no input and its stdout discarded; stderr goes to a file in `dir`.
+inline ProgramRun RunProgram(const std::string& args, const TempDir& dir) {
+  const std::string command = SoftsightBinary() + " " + args + " > /dev/null 2> " +
+                              dir.file("stderr.txt") + " < /dev/null";
   const int status = std::system(command.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ReadTextFile(dir.file("stderr.txt"))};
 }

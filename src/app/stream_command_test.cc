@@ -28,7 +28,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::ProgramRun;
 using testing::ReadLines;
-using testing::RunBinary;
+using testing::RunProgram;
 using testing::ReadTextFile;
 using testing::SplitCsv;
 using testing::TempDir;
@@ -209,14 +209,14 @@ TEST(Stream, BadEndpointIsOneLineExit2AndNothingWritten) {
   for (const std::string& endpoint :
        {std::string("udp://1.2.3.4:5"), std::string("tcp://no.such.interface.invalid:5556"),
         "ipc://" + dir.file("keep.txt")}) {
-    const ProgramRun run = RunBinary(track + " --publish " + endpoint, dir);
+    const ProgramRun run = RunProgram(track + " --publish " + endpoint, dir);
     EXPECT_EQ(run.exit_code, 2) << endpoint;
     EXPECT_THAT(run.stderr_text, HasSubstr("--publish " + endpoint));
     EXPECT_EQ(std::count(run.stderr_text.begin(), run.stderr_text.end(), '\n'), 1) << run.stderr_text;
     EXPECT_FALSE(std::filesystem::exists(dir.file("out.csv"))) << endpoint;
   }
   EXPECT_EQ(ReadTextFile(dir.file("keep.txt")), "a lab's notes\n");
-  const ProgramRun listen = RunBinary("listen udp://1.2.3.4:5", dir);
+  const ProgramRun listen = RunProgram("listen udp://1.2.3.4:5", dir);
   EXPECT_EQ(listen.exit_code, 2);
   EXPECT_THAT(listen.stderr_text, HasSubstr("udp://1.2.3.4:5"));
 }

@@ -12,18 +12,11 @@
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/output_guard.h"
+#include "softsight/io/truth_csv.h"
 #include "softsight/sim/builtin_scenes.h"
 
 namespace softsight {
 namespace {
-
-void AppendNumber(std::string* line, const std::optional<double>& value) {
-  *line += ',';
-  if (!value) return;
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.6f", *value);
-  *line += buffer;
-}
 
 // Parses "x,y,w,h,first,last".
 Occluder ParseOccluder(const std::string& text) {
@@ -62,39 +55,6 @@ cv::Size ParseSize(const std::string& text) {
 
 }  // namespace
 
-std::string TruthCsvHeader(const SceneOptions& scene) {
-  std::vector<std::string> names;
-  for (const SceneMarker& m : scene.markers) names.push_back(m.name);
-  return TruthCsvHeader(names);
-}
-
-std::string TruthCsvHeader(const std::vector<std::string>& marker_names) {
-  std::string header = "frame,time_s,bend_deg";
-  for (const std::string& name : marker_names) {
-    header += "," + name + "_x," + name + "_y," + name + "_visible";
-  }
-  header += ",angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,tip_disp_px,centreline_radius_px";
-  return header;
-}
-
-std::string TruthCsvRow(const SceneTruth& truth) {
-  std::string line = std::to_string(truth.frame_index);
-  AppendNumber(&line, truth.time_s);
-  AppendNumber(&line, truth.bend_deg);
-  for (const MarkerTruth& m : truth.markers) {
-    AppendNumber(&line, m.centroid_px ? std::optional<double>(m.centroid_px->x) : std::nullopt);
-    AppendNumber(&line, m.centroid_px ? std::optional<double>(m.centroid_px->y) : std::nullopt);
-    AppendNumber(&line, m.visible_fraction);
-  }
-  const Measurement& r = truth.measurement;
-  for (const std::optional<double>& v :
-       {r.angle_deg, r.chord_px, r.sagitta_px, r.radius_px, r.arc_length_px, r.tip_disp_px,
-        truth.centreline_radius_px}) {
-    AppendNumber(&line, v);
-  }
-  return line;
-}
-
 std::string FormatSynthSummary(const SynthSummary& s, const SynthOptions& options) {
   char line[512];
   std::snprintf(line, sizeof(line),
@@ -129,12 +89,10 @@ SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* trut
                            {});
   FrameWriter sink({options.out, options.codec, fps});
   sink.open(size);  // Fails here, before the truth file is created.
-  std::ofstream truth_file;
-  if (options.truth_csv) {
-    truth_file.open(*options.truth_csv, std::ios::out | std::ios::trunc);
-    if (!truth_file) throw InputError(*options.truth_csv + ": cannot open for writing");
-    truth_file << TruthCsvHeader(marker_names) << "\n";
-  }
+  // The truth CSV's columns and writer are the ones `evaluate --truth` reads back with
+  // (io/truth_csv.h); each row is written whole as its frame is rendered.
+  std::optional<TruthCsvWriter> truth_csv;
+  if (options.truth_csv) truth_csv.emplace(*options.truth_csv, TruthColumns(marker_names));
 
   SynthSummary summary;
   summary.size = size;
@@ -148,17 +106,10 @@ SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* trut
     render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     sink.write(image, i);
     if (truths != nullptr) truths->push_back(truth);
-    if (truth_file.is_open()) {
-      truth_file << TruthCsvRow(truth) << "\n";
-      if (!truth_file) throw InputError(*options.truth_csv + ": write failed at frame " + std::to_string(i));
-    }
+    if (truth_csv) truth_csv->write(truth);
     ++summary.frames;
   }
   sink.close();
-  if (truth_file.is_open()) {
-    truth_file.close();
-    if (!truth_file) throw InputError(*options.truth_csv + ": write failed");
-  }
   summary.render_ms_mean = render_ms / std::max<int64_t>(1, summary.frames);
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

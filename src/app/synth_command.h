@@ -48,12 +48,7 @@ struct SynthSummary {
 // `truths` (optional) receives every frame's truth, in order.
 SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* truths = nullptr);
 
-// The truth CSV: frame, time_s, bend_deg, per marker <name>_x, <name>_y, <name>_visible (the
-// visible fraction, 0..1), then angle_deg, chord_px, sagitta_px, radius_px, arc_length_px,
-// tip_disp_px, centreline_radius_px. Absent values are empty fields.
-std::string TruthCsvHeader(const SceneOptions& scene);
-std::string TruthCsvHeader(const std::vector<std::string>& marker_names);
-std::string TruthCsvRow(const SceneTruth& truth);
+// The truth CSV (`--truth`) is io/truth_csv.h's: TruthColumns, read back by ReadTruthCsv.
 
 // One line for a person.
 std::string FormatSynthSummary(const SynthSummary& summary, const SynthOptions& options);

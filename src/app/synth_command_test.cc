@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
+#include "softsight/io/truth_csv.h"
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -23,37 +24,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A new empty folder `name`; every folder made so is removed when the test program ends.
-fs::path FreshDir(const std::string& name) {
-  struct Made {
-    std::vector<fs::path> folders;
-    ~Made() {
-      std::error_code ignored;
-      for (const fs::path& f : folders) fs::remove_all(f, ignored);
-    }
-  };
-  static Made made;
-  const fs::path dir = fs::path(::testing::TempDir()) / ("softsight_synth_" + std::to_string(getpid()) + "_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  made.folders.push_back(dir);
-  return dir;
-}
-
-std::vector<std::string> ReadLines(const fs::path& path) {
-  std::ifstream in(path);
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
-
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  for (std::string f; std::getline(in, f, ',');) fields.push_back(f);
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
+using testing::ReadLines;
+using testing::SplitCsv;
 
 SynthOptions SmallRun(const fs::path& out) {
   SynthOptions o;
@@ -70,7 +42,8 @@ SynthOptions SmallRun(const fs::path& out) {
 
 // The plate scene through the same command: gray lossless frames and the dots' truth.
 TEST(SynthCommandTest, PlateSceneWritesGrayFramesAndDotTruth) {
-  const fs::path dir = FreshDir("plate");
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   SynthOptions options = SmallRun(dir / "plate.avi");
   options.truth_csv = (dir / "truth.csv").string();
   PlateSceneOptions& plate = options.plate.emplace();
@@ -101,7 +74,8 @@ TEST(SynthCommandTest, PlateSceneWritesGrayFramesAndDotTruth) {
 // The video is lossless: what OpenCV reads back is exactly what the renderer drew, so accuracy
 // tests on video files measure the tracker, not the codec.
 TEST(SynthCommandTest, VideoReadsBackExactlyWithTruthCsv) {
-  const fs::path dir = FreshDir("video");
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   SynthOptions options = SmallRun(dir / "scene.avi");
   options.truth_csv = (dir / "truth.csv").string();
   options.occluders = {Occluder{cv::Rect2d(0, 0, 320, 240), 5, 5}};  // Frame 5: all hidden.
@@ -145,12 +119,22 @@ TEST(SynthCommandTest, VideoReadsBackExactlyWithTruthCsv) {
   EXPECT_EQ(hidden[4], "");
   EXPECT_EQ(std::stod(hidden[5]), 0.0);
   EXPECT_EQ(hidden[12], "");
-  // The rows are the scene's truth.
-  EXPECT_EQ(lines[4], TruthCsvRow(scene.render(3, expected)));
+  // The rows are the scene's truth, as `evaluate --truth` reads them back (to the 6 decimals).
+  const TruthCsv read = ReadTruthCsv(*options.truth_csv, {"red", "blue", "green"});
+  ASSERT_EQ(read.frames.size(), 8u);
+  const SceneTruth truth = scene.render(3, expected);
+  EXPECT_NEAR(read.frames[3].bend_deg, truth.bend_deg, 5e-7);
+  for (size_t m = 0; m < 3; ++m) {
+    ASSERT_TRUE(read.frames[3].markers[m].centroid_px) << m;
+    EXPECT_NEAR(read.frames[3].markers[m].centroid_px->x, truth.markers[m].centroid_px->x, 5e-7);
+    EXPECT_NEAR(read.frames[3].markers[m].centroid_px->y, truth.markers[m].centroid_px->y, 5e-7);
+  }
+  EXPECT_FALSE(read.frames[5].markers[0].centroid_px) << "hidden at frame 5";
 }
 
 TEST(SynthCommandTest, ImageSequenceIsLossless) {
-  const fs::path dir = FreshDir("images");
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   SynthOptions options = SmallRun(dir / "f_%03d.png");
   options.scene.kind = SceneKind::kWedge4;
   options.scene.frame_count = 3;
@@ -169,7 +153,8 @@ TEST(SynthCommandTest, ImageSequenceIsLossless) {
 }
 
 TEST(SynthCommandTest, BadInputIsOneLineInputError) {
-  const fs::path dir = FreshDir("bad");
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   auto expect_error = [](const SynthOptions& options, const std::string& needle) {
     try {
       RunSynth(options);
@@ -201,7 +186,8 @@ TEST(SynthCommandTest, BadInputIsOneLineInputError) {
 // Through the real program: an unknown scene is one line on stderr and exit code 2.
 TEST(SynthCommandTest, ProgramReportsBadSceneOnce) {
   const std::string binary = testing::SoftsightBinary();
-  const fs::path dir = FreshDir("program");
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   const fs::path err = dir / "stderr.txt";
   const std::string command = binary + " synth --scene spiral --out " +
                               (dir / "a.avi").string() + " 2>" + err.string();

@@ -18,6 +18,7 @@
 #include "gui/overlay.h"
 #include "softsight/io/run_source.h"
 #include "softsight/pipeline/run.h"
+#include "track/tracker_kind.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 
@@ -26,12 +27,8 @@ namespace {
 
 void CheckRunnable(const TrackingConfig& config, const TrackOptions& options) {
   for (const MarkerSpec& spec : config.markers) {
-    const auto* templ = std::get_if<TemplateParams>(&spec.params);
-    if (templ && templ->image.empty() && !templ->rect) {
-      throw InputError(options.config_file + ": marker '" + spec.name + "' uses template matching (" +
-                       TrackerMethodName(spec.params) +
-                       ") but has no template: give `template: {frame: 0, rect: [x, y, w, h]}` "
-                       "or `template: {file: marker.png}`");
+    if (const auto missing = spec.params.kind().missing_for_batch(spec.params)) {
+      throw InputError(options.config_file + ": marker '" + spec.name + "' " + *missing);
     }
   }
 }
@@ -64,7 +61,7 @@ TrackingConfig LoadTrackConfig(const TrackOptions& options) {
   TrackingConfig config = LoadTrackingConfig(options.config_file, options.method);
   if (options.template_colour) {
     for (MarkerSpec& spec : config.markers) {
-      if (auto* templ = std::get_if<TemplateParams>(&spec.params)) templ->colour = *options.template_colour;
+      if (auto* templ = spec.params.get_if<TemplateParams>()) templ->colour = *options.template_colour;
     }
   }
   CheckRunnable(config, options);

@@ -27,6 +27,8 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::ProgramRun;
+using testing::RunProgram;
 using testing::TempDir;
 
 // The scene's markers with a scale, so the millimetre columns are written too.
@@ -63,8 +65,6 @@ RenderedClip RenderClip(const TempDir& dir, int frames, bool gray = false,
   return clip;
 }
 
-using testing::ProgramRun;
-using testing::RunBinary;
 
 // `track` runs in the commands plugin, which must not load the live window's libraries (highgui
 // and its Qt: ~12 libraries and ~10 ms of every start-up; X11 comes with FFmpeg's hardware
@@ -103,7 +103,7 @@ TEST(TrackCommand, CameraSettingsWithAFileAreRefusedOnTheCommandLineAndNotedFrom
   const RenderedClip clip = RenderClip(dir, 3);
   testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
   const ProgramRun refused =
-      RunBinary("track --config " + dir.file("markers.yaml") + " --input " + clip.video +
+      RunProgram("track --config " + dir.file("markers.yaml") + " --input " + clip.video +
                     " --csv " + dir.file("a.csv") + " --camera-exposure 120",
                 dir);
   EXPECT_EQ(refused.exit_code, 2);
@@ -114,7 +114,7 @@ TEST(TrackCommand, CameraSettingsWithAFileAreRefusedOnTheCommandLineAndNotedFrom
 
   testing::WriteTextFile(dir.file("recorded.yaml"),
                          std::string(kConfig) + "capture:\n  exposure: 120\n");
-  const ProgramRun noted = RunBinary("track --config " + dir.file("recorded.yaml") + " --input " +
+  const ProgramRun noted = RunProgram("track --config " + dir.file("recorded.yaml") + " --input " +
                                          clip.video + " --csv " + dir.file("b.csv"),
                                      dir);
   EXPECT_EQ(noted.exit_code, 0) << noted.stderr_text;
@@ -273,7 +273,7 @@ TEST(TrackCommand, CorruptVideoExitsWithCodeTwoAndKeepsEveryRowWritten) {
     data.resize(data.size() * 2 / 3);
     std::ofstream(clip.video, std::ios::binary).write(data.data(), data.size());
   }
-  const ProgramRun run = RunBinary("track -q -c " + dir.file("markers.yaml") + " -i " + clip.video +
+  const ProgramRun run = RunProgram("track -q -c " + dir.file("markers.yaml") + " -i " + clip.video +
                                 " -o " + dir.file("out.csv"),
                             dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -386,7 +386,7 @@ TEST(TrackCommand, GrayVideoWithColourTrackingIsRefusedWithAHint) {
   TempDir dir;
   const RenderedClip clip = RenderClip(dir, 3, /*gray=*/true);
   testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
-  const ProgramRun run = RunBinary("track -c " + dir.file("markers.yaml") + " -i " + clip.video +
+  const ProgramRun run = RunProgram("track -c " + dir.file("markers.yaml") + " -i " + clip.video +
                                 " -o " + dir.file("out.csv"),
                             dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -398,15 +398,15 @@ TEST(TrackCommand, BadConfigAndMissingInputExitWithCodeTwo) {
   TempDir dir;
   testing::WriteTextFile(dir.file("bad.yaml"), "markers:\n  - name: red\n    hsv: {h: [0, 300]}\n");
   testing::WriteTextFile(dir.file("good.yaml"), kConfig);
-  ProgramRun run = RunBinary("track -c " + dir.file("bad.yaml") + " -i x.avi -o " + dir.file("o.csv"), dir);
+  ProgramRun run = RunProgram("track -c " + dir.file("bad.yaml") + " -i x.avi -o " + dir.file("o.csv"), dir);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.stderr_text, HasSubstr("bad.yaml:3"));
-  run = RunBinary("track -c " + dir.file("good.yaml") + " -i " + dir.file("none.avi") + " -o " +
+  run = RunProgram("track -c " + dir.file("good.yaml") + " -i " + dir.file("none.avi") + " -o " +
                       dir.file("o.csv"),
                   dir);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.stderr_text, HasSubstr("none.avi"));
-  run = RunBinary("track -c " + dir.file("good.yaml"), dir);
+  run = RunProgram("track -c " + dir.file("good.yaml"), dir);
   EXPECT_EQ(run.exit_code, 2) << "missing required options";
 }
 
@@ -468,7 +468,7 @@ class TrackRefuses : public ::testing::Test {
   }
   std::string config() const { return dir_.file("markers.yaml"); }
   ProgramRun Track(const std::string& args) {
-    return RunBinary("track -q -c " + config() + " " + args, dir_);
+    return RunProgram("track -q -c " + config() + " " + args, dir_);
   }
   // One error line naming `what`, exit code 2.
   void ExpectOneError(const ProgramRun& run, const std::string& what) {
@@ -549,7 +549,7 @@ TEST_F(TrackRefuses, OutputThatIsAnInputAndLeavesItUntouched) {
                          "   dt: d\n   data: [0., 0., 0., 0., 0.]\n");
   testing::WriteTextFile(dir_.file("with_camera.yaml"), kConfig + "camera: camera.yaml\n");
   const std::string camera_before = testing::ReadTextFile(dir_.file("camera.yaml"));
-  const ProgramRun run = RunBinary("track -q -c " + dir_.file("with_camera.yaml") + " -i " +
+  const ProgramRun run = RunProgram("track -q -c " + dir_.file("with_camera.yaml") + " -i " +
                                        clip_.video + " -o " + dir_.file("camera.yaml"),
                                    dir_);
   ExpectOneError(run, "camera.yaml");
@@ -566,7 +566,7 @@ TEST_F(TrackRefuses, ConfigWithRandomBytesOrAComplexKeyInOneEscapedLine) {
     std::string bytes(200, '\0');
     for (char& c : bytes) c = static_cast<char>(random() & 0xFF);
     testing::WriteTextFile(dir_.file("random.yaml"), bytes);
-    const ProgramRun run = RunBinary(
+    const ProgramRun run = RunProgram(
         "track -q -c " + dir_.file("random.yaml") + " -i " + clip_.video + " -o " + dir_.file("o.csv"),
         dir_);
     ExpectOneError(run, "random.yaml");
@@ -575,7 +575,7 @@ TEST_F(TrackRefuses, ConfigWithRandomBytesOrAComplexKeyInOneEscapedLine) {
     }
   }
   testing::WriteTextFile(dir_.file("key.yaml"), kConfig + "? [a, b]\n: 1\n");
-  ExpectOneError(RunBinary("track -q -c " + dir_.file("key.yaml") + " -i " + clip_.video + " -o " +
+  ExpectOneError(RunProgram("track -q -c " + dir_.file("key.yaml") + " -i " + clip_.video + " -o " +
                                dir_.file("o.csv"),
                            dir_),
                  "key.yaml:10:");
@@ -595,7 +595,7 @@ TEST(TrackCommand, SequenceWithAGapNumbersRowsByFileAndSaysSoInTheSummary) {
     std::snprintf(name, sizeof(name), "frames/%04d.png", i);
     cv::imwrite(dir.file(name), image);
   }
-  const ProgramRun run = RunBinary("track -c " + dir.file("markers.yaml") + " -i '" +
+  const ProgramRun run = RunProgram("track -c " + dir.file("markers.yaml") + " -i '" +
                                        dir.file("frames/%04d.png") + "' -o " + dir.file("o.csv"),
                                    dir);
   EXPECT_EQ(run.exit_code, 0) << run.stderr_text;

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "app/scene_markers_test_util.h"
+#include "app/program_test_util.h"
 #include "core/test_util.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/sim/scene.h"
@@ -23,9 +24,10 @@ namespace {
 
 using ::testing::HasSubstr;
 using ::testing::Not;
+using testing::ProgramRun;
+using testing::RunProgram;
 using testing::TempDir;
 
-const char* const kConfig = testing::kSceneMarkersYaml;
 
 // A short rendered bending clip (lossless), a different texture per seed.
 std::string RenderClip(const std::string& path, int frames, unsigned seed) {
@@ -45,17 +47,6 @@ std::string RenderClip(const std::string& path, int frames, unsigned seed) {
   return path;
 }
 
-struct ProgramRun {
-  int exit_code;
-  std::string stderr_text;
-};
-
-ProgramRun RunProgram(const std::string& args, const TempDir& dir) {
-  const std::string command =
-      testing::SoftsightBinary() + " " + args + " 2> " + dir.file("stderr.txt");
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing::ReadTextFile(dir.file("stderr.txt"))};
-}
 
 // Every column of a CSV but the timings (proc_ms, latency_*), which differ from run to run.
 std::vector<std::vector<std::string>> RowsWithoutTimings(const std::string& csv) {
@@ -85,7 +76,7 @@ TEST(TrackMany, CsvNamesComeFromTheInputsAndNeverClash) {
 
 TEST(TrackMany, JobsGiveTheCsvsOfSingleRunsAndAFailingInputDoesNotStopTheOthers) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
   std::vector<std::string> clips;
   for (unsigned seed = 1; seed <= 3; ++seed) {
     clips.push_back(RenderClip(dir.file("clip" + std::to_string(seed) + ".avi"), 12, seed));
@@ -135,7 +126,7 @@ TEST(TrackMany, JobsGiveTheCsvsOfSingleRunsAndAFailingInputDoesNotStopTheOthers)
 
 TEST(TrackMany, RefusesSeveralInputsIntoOneFileAndACsvThatIsAnInput) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
   const std::string clip = RenderClip(dir.file("a.avi"), 2, 1);
   const std::string config = " -c " + dir.file("markers.yaml");
   ProgramRun run = RunProgram("track" + config + " -i " + clip + " -i synth:bending -o " + dir.file("one.csv"), dir);
@@ -159,7 +150,7 @@ TEST(TrackMany, RefusesSeveralInputsIntoOneFileAndACsvThatIsAnInput) {
 // had already finished is kept whole, and the run exits 130 (128 + SIGINT).
 TEST(TrackMany, CtrlCStopsEveryJobExits130AndKeepsTheFinishedOutputs) {
   TempDir dir;
-  testing::WriteTextFile(dir.file("markers.yaml"), kConfig);
+  testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
   const std::string clip = RenderClip(dir.file("short.avi"), 12, 1);
   const std::string single = dir.file("single.csv");
   ASSERT_EQ(RunProgram("track -q -c " + dir.file("markers.yaml") + " -i " + clip + " -o " + single, dir)

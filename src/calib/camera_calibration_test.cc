@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/calibration_test_views.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/chessboard.h"
 
@@ -45,20 +46,6 @@ Errors CompareCorners(const std::vector<cv::Point2f>& found, const std::vector<c
 }
 
 // A file in one folder for the whole suite, removed when the test program ends.
-std::string TempPath(const std::string& name) {
-  struct Folder {
-    fs::path path =
-        fs::temp_directory_path() / ("softsight_calib_test_" + std::to_string(getpid()));
-    Folder() { fs::create_directories(path); }
-    ~Folder() {
-      std::error_code ignored;
-      fs::remove_all(path, ignored);
-    }
-  };
-  static const Folder folder;
-  return (folder.path / name).string();
-}
-
 // Rendering and calibrating is the slow part: done once for the whole suite.
 class CalibrationTest : public ::testing::Test {
  protected:
@@ -225,7 +212,8 @@ TEST_F(CalibrationTest, FrontoParallelPlaneScaleIsDistanceOverFocalLength) {
 }
 
 TEST_F(CalibrationTest, SavedCalibrationLoadsBackExactly) {
-  const std::string file = TempPath("camera.yaml");
+  const testing::TempDir dir;
+  const std::string file = dir.file("camera.yaml");
   SaveCameraCalibration(*result_, testviews::Spec(), file);
   const CameraIntrinsics loaded = LoadCameraIntrinsics(file);
   EXPECT_EQ(loaded.image_size, result_->camera.image_size);
@@ -243,17 +231,18 @@ TEST_F(CalibrationTest, SavedCalibrationLoadsBackExactly) {
 }
 
 TEST(CameraFileTest, BadFilesAreInputErrorsNamingFileAndKey) {
+  const testing::TempDir dir;
   EXPECT_THROW(
       {
         try {
-          LoadCameraIntrinsics(TempPath("does_not_exist.yaml"));
+          LoadCameraIntrinsics(dir.file("does_not_exist.yaml"));
         } catch (const InputError& e) {
           EXPECT_THAT(e.what(), HasSubstr("does_not_exist.yaml"));
           throw;
         }
       },
       InputError);
-  const std::string file = TempPath("no_matrix.yaml");
+  const std::string file = dir.file("no_matrix.yaml");
   std::ofstream(file) << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n";
   try {
     LoadCameraIntrinsics(file);
@@ -261,7 +250,7 @@ TEST(CameraFileTest, BadFilesAreInputErrorsNamingFileAndKey) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("camera_matrix: missing"));
   }
-  const std::string garbage = TempPath("garbage.yaml");
+  const std::string garbage = dir.file("garbage.yaml");
   std::ofstream(garbage) << "%YAML:1.0\n---\nimage_width: [unclosed\n";
   EXPECT_THROW(LoadCameraIntrinsics(garbage), InputError);
 }
@@ -271,7 +260,8 @@ TEST(PlaneFileTest, SavedPlaneLoadsBack) {
   plane.plane_mm_from_image = cv::Matx33d(0.2, 0.01, -3, 0.002, 0.21, 4, 1e-5, 2e-5, 1);
   plane.mm_per_px = 0.205;
   plane.rms_mm = 0.01;
-  const std::string file = TempPath("plane.yaml");
+  const testing::TempDir dir;
+  const std::string file = dir.file("plane.yaml");
   SavePlaneCalibration(plane, file);
   const PlaneCalibration loaded = LoadPlaneCalibration(file);
   for (int i = 0; i < 9; ++i) {
@@ -279,7 +269,7 @@ TEST(PlaneFileTest, SavedPlaneLoadsBack) {
   }
   EXPECT_DOUBLE_EQ(loaded.mm_per_px, 0.205);
 
-  const std::string singular = TempPath("singular_plane.yaml");
+  const std::string singular = dir.file("singular_plane.yaml");
   plane.plane_mm_from_image = cv::Matx33d(1, 2, 3, 2, 4, 6, 0, 0, 1);
   SavePlaneCalibration(plane, singular);
   EXPECT_THROW(LoadPlaneCalibration(singular), InputError);

@@ -712,7 +712,7 @@ std::optional<Verified> VerifyCandidate(const cv::Mat& frame, const MarkerFinder
   auto verify = [&](bool with_roi, Observation* observation) {
     MarkerSpec probe_spec = spec;
     probe_spec.name = "verify";
-    if (!with_roi) std::get<ColourParams>(probe_spec.params).roi.reset();
+    if (!with_roi) probe_spec.params.get<ColourParams>().roi.reset();
     const auto tracker = CreateTracker(probe_spec);
     Frame f;
     f.image = frame;
@@ -966,7 +966,7 @@ MarkerFinding FindMarkersAs(const cv::Mat& frame, const MarkerFinderOptions& opt
       if (same > 0) name += "_" + std::to_string(same + 1);
     }
     v.marker.spec.name = name;
-    ColourParams& colour = std::get<ColourParams>(v.marker.spec.params);
+    ColourParams& colour = v.marker.spec.params.get<ColourParams>();
     if (colour.roi) colour.roi_frame = static_cast<int>(options.frame_index);
     finding.markers.push_back(v.marker);
   }
@@ -1074,7 +1074,7 @@ cv::Mat DrawMarkerFinding(const cv::Mat& input, const MarkerFinding& finding) {
   }
   for (size_t i = 0; i < finding.markers.size(); ++i) {
     const FoundMarker& m = finding.markers[i];
-    const ColourParams& colour = std::get<ColourParams>(m.spec.params);
+    const ColourParams& colour = m.spec.params.get<ColourParams>();
     if (colour.roi) cv::rectangle(image, *colour.roi, roi_colour, 1);
     const cv::Point p(cvRound(m.position_px.x), cvRound(m.position_px.y));
     cv::circle(image, p, cvRound(m.radius_px) + 3, ok_colour, 2, cv::LINE_AA);

@@ -71,7 +71,7 @@ TEST(MarkerFinder, WhiteDotsOnColourFootageOfAGrayBenchAreFoundAndWrittenWithout
     double nearest = 1e9;
     for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
     EXPECT_LT(nearest, 0.5) << m.spec.name;
-    const ColourParams& colour = std::get<ColourParams>(m.spec.params);
+    const ColourParams& colour = m.spec.params.get<ColourParams>();
     EXPECT_TRUE(colour.gray && colour.roi) << m.spec.name;
   }
   EXPECT_FALSE(finding.measure.has_triple());

@@ -27,7 +27,7 @@ TEST(ConfigChanges, EveryKindIsWrittenAndReadBackInOrder) {
   TemplateParams templ;
   templ.rect = cv::Rect(40, 50, 23, 22);
   templ.min_zncc = 0.7;
-  sad.params = ParamsForMethod("sad", {}, templ);
+  sad.params = ParamsForMethod("sad", {templ});
   config.changes = {ConfigChange::Respec(sad), ConfigChange::Reselect("blue", {10, 20, 23, 22}),
                     ConfigChange::Retrack("red"), ConfigChange::ResetTipReference()};
   config.changes[0].after_frame = 3;
@@ -43,7 +43,7 @@ TEST(ConfigChanges, EveryKindIsWrittenAndReadBackInOrder) {
     EXPECT_EQ(back.changes[i].marker, config.changes[i].marker) << i;
   }
   EXPECT_EQ(TrackerMethodName(back.changes[0].spec.params), "sad");
-  const TemplateParams& back_templ = std::get<TemplateParams>(back.changes[0].spec.params);
+  const TemplateParams& back_templ = back.changes[0].spec.params.get<TemplateParams>();
   EXPECT_EQ(back_templ.rect, cv::Rect(40, 50, 23, 22));
   EXPECT_DOUBLE_EQ(back_templ.min_zncc, 0.7);
   EXPECT_EQ(back.changes[1].rect, cv::Rect(10, 20, 23, 22));

@@ -5,20 +5,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_sections.h"
+#include "config/kind_config_test_util.h"
 #include "config/yaml_map.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
 namespace {
-
-// One file per test: ctest runs the tests of this file in parallel.
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = testing::TempDir() + "/" +
-                           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
-                           name;
-  std::ofstream(path) << text;
-  return path;
-}
 
 ColourParams ReadFile(const std::string& path) {
   YamlMap marker(LoadYamlFile(path), path, "markers[0]");
@@ -28,18 +21,30 @@ ColourParams ReadFile(const std::string& path) {
   return params;
 }
 
-// The InputError message of reading `text`, or "" when it reads fine.
-std::string ErrorOf(const std::string& text) {
-  const std::string path = WriteTemp("bad_colour.yaml", text);
-  try {
-    ReadFile(path);
-  } catch (const InputError& e) {
-    return e.what();
+// Each test writes its files in a folder of its own, removed when the test ends.
+class ColourConfig : public ::testing::Test {
+ protected:
+  std::string WriteTemp(const std::string& name, const std::string& text) const {
+    const std::string path = dir_.file(name);
+    std::ofstream(path) << text;
+    return path;
   }
-  return "";
-}
 
-TEST(ColourConfig, ReadsEveryKey) {
+  // The InputError message of reading `text`, or "" when it reads fine.
+  std::string ErrorOf(const std::string& text) const {
+    const std::string path = WriteTemp("bad_colour.yaml", text);
+    try {
+      ReadFile(path);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+  const testing::TempDir dir_;
+};
+
+TEST_F(ColourConfig, ReadsEveryKey) {
   const std::string path = WriteTemp("colour.yaml",
                                      "hsv: {h: [170, 10], s: [80, 255], v: [40, 250]}\n"
                                      "filter: {type: median, ksize: 5}\n"
@@ -74,7 +79,7 @@ TEST(ColourConfig, ReadsEveryKey) {
   EXPECT_TRUE(p.Check(&problem)) << problem;
 }
 
-TEST(ColourConfig, AutoColourAndDefaults) {
+TEST_F(ColourConfig, AutoColourAndDefaults) {
   const ColourParams p = ReadFile(WriteTemp("auto.yaml", "auto_colour: [40, 40, 220]\n"));
   ASSERT_TRUE(p.auto_bgr);
   EXPECT_EQ(*p.auto_bgr, cv::Vec3b(40, 40, 220));
@@ -84,14 +89,14 @@ TEST(ColourConfig, AutoColourAndDefaults) {
   EXPECT_FALSE(p.roi);
 }
 
-TEST(ColourConfig, HueOutsideRangeNamesFileLineAndKey) {
+TEST_F(ColourConfig, HueOutsideRangeNamesFileLineAndKey) {
   const std::string error = ErrorOf("name: red\nhsv: {h: [200, 10], s: [80, 255]}\n");
   EXPECT_NE(error.find("bad_colour.yaml:2:"), std::string::npos) << error;
   EXPECT_NE(error.find("markers[0].hsv.h"), std::string::npos) << error;
   EXPECT_NE(error.find("200"), std::string::npos) << error;
 }
 
-TEST(ColourConfig, BadValuesAreErrorsNamingTheKey) {
+TEST_F(ColourConfig, BadValuesAreErrorsNamingTheKey) {
   struct Case {
     const char* yaml;
     const char* key;
@@ -120,7 +125,7 @@ TEST(ColourConfig, BadValuesAreErrorsNamingTheKey) {
   }
 }
 
-TEST(ColourConfig, WrittenParamsReadBackEqual) {
+TEST_F(ColourConfig, WrittenParamsReadBackEqual) {
   ColourParams p;
   p.h = {170, 10};
   p.s = {90, 250};

@@ -11,7 +11,7 @@
 #include "config/option_yaml.h"
 #include "config/yaml_map.h"
 #include "io/camera_options.h"
-#include "track/track_options.h"
+#include "track/tracker_kind.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -105,14 +105,14 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
   std::set<std::string> names;
   for (size_t i = 0; i < markers.size(); ++i) {
     YamlMap marker(markers[i], file, "markers[" + std::to_string(i) + "]");
-    std::string template_file;
-    std::optional<ColourParams> colour_aside;
-    MarkerSpec spec = ReadMarker(marker, method_override, &template_file, &colour_aside);
+    std::string image_file;
+    std::vector<MarkerParams> aside;
+    MarkerSpec spec = ReadMarker(marker, method_override, &image_file, &aside);
     if (!names.insert(spec.name).second) {
       marker.fail("name", "marker name '" + spec.name + "' is used twice");
     }
-    if (!template_file.empty()) config.template_files[spec.name] = template_file;
-    if (colour_aside) config.colour_aside[spec.name] = *colour_aside;
+    if (!image_file.empty()) config.template_files[spec.name] = image_file;
+    if (!aside.empty()) config.params_aside[spec.name] = std::move(aside);
     config.markers.push_back(std::move(spec));
   }
 
@@ -175,7 +175,7 @@ TrackingConfig ReadTrackingConfigNode(const YAML::Node& root, const std::string&
 }  // namespace
 
 MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
-                      std::string* template_file, std::optional<ColourParams>* colour_aside) {
+                      std::string* image_file, std::vector<MarkerParams>* aside) {
   MarkerSpec spec;
   spec.name = marker.string("name").value_or("");
   if (spec.name.empty()) marker.fail("name", "every marker needs a name");
@@ -195,41 +195,62 @@ MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_
       marker.fail("name", message);
     }
   }
-  const bool has_template = marker.has("template");
-  std::string method =
-      marker.choice("method", TrackerMethods()).value_or(DefaultTrackerMethod(has_template));
-  if (method_override) method = *method_override;
-  // Both methods' keys are read and checked (a typo or a bad value in either is an error), and
-  // the marker is the chosen method's parameters.
-  ColourParams colour;
-  TemplateSection templ;
-  ReadColourParams(marker, &colour);
-  ReadTemplateParams(marker, &templ);
-  marker.finish();
-  spec.params = ParamsForMethod(method, colour, templ.params);
-  *template_file = std::holds_alternative<TemplateParams>(spec.params) ? templ.file : "";
-  if (colour_aside != nullptr && std::holds_alternative<TemplateParams>(spec.params)) {
-    // Range-checked key by key above; the rules across fields are checked when it is used.
-    *colour_aside = colour;
+  // Unnamed, the method is the default one of the first kind the entry's keys claim (a
+  // `template:` key: zncc), else of the first kind.
+  const auto has_key = [&marker](const std::string& key) { return marker.has(key); };
+  const TrackerKind* unnamed = TrackerKinds().front();
+  for (const TrackerKind* kind : TrackerKinds()) {
+    if (kind->claims_unnamed(has_key)) {
+      unnamed = kind;
+      break;
+    }
   }
-
+  std::string method =
+      marker.choice("method", TrackerMethods()).value_or(unnamed->method_of(unnamed->defaults()));
+  if (method_override) method = *method_override;
+  const TrackerKind* chosen = KindOfMethod(method);  // Known: choice() and the override checked.
+  // Every kind's keys are read and checked (a typo or a bad value in any is an error), and the
+  // marker is the chosen method's parameters.
+  std::vector<KindSection> sections;
+  for (const TrackerKind* kind : TrackerKinds()) {
+    KindSection section{kind->defaults(), ""};
+    ReadKindParams(marker, &section);
+    sections.push_back(std::move(section));
+  }
+  marker.finish();
+  for (KindSection& section : sections) {
+    const TrackerKind& kind = section.params.kind();
+    if (&kind == chosen) {
+      spec.params = std::move(section.params);
+      kind.select_method(spec.params, method);
+      *image_file = section.image_file;
+    } else if (aside != nullptr && OptionsToYaml(KindSectionOptions(kind), section,
+                                                 {kind.defaults(), ""}).size() > 0) {
+      // Range-checked key by key above; the rules across fields are checked when it is used.
+      aside->push_back(std::move(section.params));
+    }
+  }
   std::string problem;
-  const bool ok = std::visit([&](const auto& params) { return params.Check(&problem); },
-                             spec.params);
-  if (!ok) throw InputError(marker.file() + ": marker '" + spec.name + "': " + problem);
+  if (!chosen->check(spec.params, &problem)) {
+    throw InputError(marker.file() + ": marker '" + spec.name + "': " + problem);
+  }
   return spec;
 }
 
-void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out,
-                 const ColourParams* colour_aside) {
+void WriteMarker(const MarkerSpec& spec, const std::string& image_file, YAML::Emitter& out,
+                 const std::vector<MarkerParams>* aside) {
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << spec.name;
   out << YAML::Key << "method" << YAML::Value << TrackerMethodName(spec.params);
-  if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
-    WriteColourParams(*colour, out);
-  } else {
-    if (colour_aside != nullptr) WriteColourParams(*colour_aside, out);
-    WriteTemplateParams({std::get<TemplateParams>(spec.params), template_file}, out);
+  // Kind by kind, in the registry's order: the marker's own keys, and those set aside.
+  for (const TrackerKind* kind : TrackerKinds()) {
+    if (&spec.params.kind() == kind) {
+      WriteKindParams({spec.params, image_file}, out);
+    } else if (aside != nullptr) {
+      for (const MarkerParams& params : *aside) {
+        if (&params.kind() == kind) WriteKindParams({params, ""}, out);
+      }
+    }
   }
   out << YAML::EndMap;
 }
@@ -264,9 +285,9 @@ void SaveTrackingConfig(const TrackingConfig& config, const std::string& file) {
   out << YAML::Key << "markers" << YAML::Value << YAML::BeginSeq;
   for (const MarkerSpec& spec : config.markers) {
     const auto file = config.template_files.find(spec.name);
-    const auto aside = config.colour_aside.find(spec.name);
+    const auto aside = config.params_aside.find(spec.name);
     WriteMarker(spec, file == config.template_files.end() ? "" : file->second, out,
-                aside == config.colour_aside.end() ? nullptr : &aside->second);
+                aside == config.params_aside.end() ? nullptr : &aside->second);
   }
   out << YAML::EndSeq;
   WriteMeasureOptions(config.measure, out);
@@ -331,11 +352,13 @@ std::string DocumentConfig() {
       "  - name: red                             # required: letters, digits, '_' or '-'; prefixes "
       "its CSV columns\n"
       "    method: colour                        # " + methods +
-      " (default: colour, or zncc with a template key)\n"
-      "    # ---- colour tracking\n";
-  doc += DescribeOptions(ColourParamsOptions(), 4);
-  doc += "    # ---- template matching (method sad, ssd or zncc)\n";
-  doc += DescribeOptions(TemplateSectionOptions(), 4);
+      " (default: colour, or zncc with a template key)\n";
+  for (const TrackerKind* kind : TrackerKinds()) {
+    std::string kind_methods;
+    for (const std::string& m : kind->methods()) kind_methods += (kind_methods.empty() ? "" : ", ") + m;
+    doc += "    # ---- " + kind->name() + " (method " + kind_methods + ")\n";
+    doc += DescribeKindKeys(*kind, 4);
+  }
   doc += "# ---- measurements (triple and chain name markers above)\n";
   doc += DescribeOptions(MeasureOptionsTable(), 0);
   doc +=

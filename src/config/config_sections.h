@@ -7,45 +7,46 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/option_table.h"
 #include "config/yaml_map.h"
 #include "softsight/control/control_config.h"
 #include "softsight/geometry/measurement.h"
-#include "softsight/track/colour_tracker.h"
-#include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
+#include "track/tracker_kind.h"
 
 namespace softsight {
 
-// colour_config.cc: a marker's colour keys (hsv, auto_colour, filter, morphology, blob, roi, ...).
-void ReadColourParams(YamlMap& marker, ColourParams* params);
-void WriteColourParams(const ColourParams& params, YAML::Emitter& out);
-
-// template_config.cc: a marker's `template:` key and matching options, and the image file the
-// template may come from (`template.file`): the file is the config's business, not the
-// tracker's, so it is kept here beside the parameters (its pixels go into params.image).
-struct TemplateSection {
-  TemplateParams params;
-  std::string file;  // `template.file` as written, relative to the config file; "" when none.
+// marker_config.cc: a marker's keys of one kind (track/tracker_kind.h): the kind's option rows and,
+// for a kind that holds an image, the key naming the image file. The file is the config's
+// business, not the tracker's, so its name is kept here beside the parameters (its pixels go
+// into the parameters).
+struct KindSection {
+  MarkerParams params;     // Of the kind whose keys these are.
+  std::string image_file;  // The image file key's value as written (relative to the config file).
 };
-// TemplateParams' option table (track/track_options.h) plus template.file.
-const OptionTable<TemplateSection>& TemplateSectionOptions();
-// Reads the keys into `section`; a newly named file is read into section->params.image.
-void ReadTemplateParams(YamlMap& marker, TemplateSection* section);
-void WriteTemplateParams(const TemplateSection& section, YAML::Emitter& out);
+// The kind's option rows plus its image file key (a table per kind, made once).
+const OptionTable<KindSection>& KindSectionOptions(const TrackerKind& kind);
+// Reads the keys of section->params' kind from `marker` into `section` and checks them; a newly
+// named image file is read into the parameters. Throws InputError naming file, line and key.
+void ReadKindParams(YamlMap& marker, KindSection* section);
+// The keys of `section` that differ from its kind's defaults.
+void WriteKindParams(const KindSection& section, YAML::Emitter& out);
+// Every key of `kind` as commented YAML with its default, unit and range (`config --doc`).
+std::string DescribeKindKeys(const TrackerKind& kind, int indent);
 
-// config.cc: one entry of `markers:`: its name, method (`method_override` replaces it) and that
-// method's keys (the other method's keys are read and checked too: a marker is one method's
-// parameters). `template_file` gets the marker's template.file ("" when none); `colour_aside`
-// (may be null), for a template marker, its colour keys (kept for the colour method).
+// config.cc: one entry of `markers:`: its name, method (`method_override` replaces it) and the
+// keys of every kind (all are read and checked: a typo or a bad value in any is an error); the
+// marker is the method's kind's parameters. `image_file` gets its kind's image file key ("" when
+// none); `aside` (may be null), its parameters of the other kinds whose keys the entry gives
+// (a template marker's colour keys, kept for a switch to the colour method).
 MarkerSpec ReadMarker(YamlMap& marker, const std::optional<std::string>& method_override,
-                      std::string* template_file, std::optional<ColourParams>* colour_aside = nullptr);
-// The same keys back: name, method, and the keys of the marker's parameters that differ from the
-// defaults (`template_file` as template.file for a template marker; `colour_aside`, when given
-// for a template marker, as its colour keys).
-void WriteMarker(const MarkerSpec& spec, const std::string& template_file, YAML::Emitter& out,
-                 const ColourParams* colour_aside = nullptr);
+                      std::string* image_file, std::vector<MarkerParams>* aside = nullptr);
+// The same keys back: name, method, the keys of the marker's parameters (and of `aside`, when
+// given) that differ from the defaults, with `image_file` as its kind's image file key.
+void WriteMarker(const MarkerSpec& spec, const std::string& image_file, YAML::Emitter& out,
+                 const std::vector<MarkerParams>* aside = nullptr);
 
 // metric_config.cc: top-level scale_mm_per_px / plane keys.
 void ReadMetricModel(YamlMap& top, MetricModel* metric);

@@ -35,11 +35,11 @@ TEST(Config, LoadsTheDocumentedExample) {
   ASSERT_EQ(config.markers.size(), 3u);
   EXPECT_EQ(config.markers[0].name, "red");
   EXPECT_EQ(TrackerMethodName(config.markers[0].params), "colour");
-  EXPECT_EQ(std::get<ColourParams>(config.markers[0].params).h.lo, 170);
-  EXPECT_EQ(std::get<ColourParams>(config.markers[0].params).h.hi, 10);
-  ASSERT_TRUE(std::get<ColourParams>(config.markers[0].params).roi.has_value());
-  EXPECT_EQ(*std::get<ColourParams>(config.markers[0].params).roi, cv::Rect(150, 300, 40, 40));
-  EXPECT_FALSE(std::get<ColourParams>(config.markers[1].params).roi.has_value());
+  EXPECT_EQ(config.markers[0].params.get<ColourParams>().h.lo, 170);
+  EXPECT_EQ(config.markers[0].params.get<ColourParams>().h.hi, 10);
+  ASSERT_TRUE(config.markers[0].params.get<ColourParams>().roi.has_value());
+  EXPECT_EQ(*config.markers[0].params.get<ColourParams>().roi, cv::Rect(150, 300, 40, 40));
+  EXPECT_FALSE(config.markers[1].params.get<ColourParams>().roi.has_value());
   EXPECT_EQ(config.measure.base, "red");
   EXPECT_EQ(config.measure.middle, "blue");
   EXPECT_EQ(config.measure.tip, "green");
@@ -66,8 +66,8 @@ TEST(Config, SavedConfigLoadsBackToTheSameValues) {
     EXPECT_EQ(again.markers[i].name, original.markers[i].name);
     EXPECT_EQ(TrackerMethodName(again.markers[i].params),
               TrackerMethodName(original.markers[i].params));
-    const ColourParams& a = std::get<ColourParams>(again.markers[i].params);
-    const ColourParams& b = std::get<ColourParams>(original.markers[i].params);
+    const ColourParams& a = again.markers[i].params.get<ColourParams>();
+    const ColourParams& b = original.markers[i].params.get<ColourParams>();
     EXPECT_EQ(a.h.lo, b.h.lo);
     EXPECT_EQ(a.h.hi, b.h.hi);
     EXPECT_EQ(a.s.lo, b.s.lo);
@@ -89,20 +89,22 @@ TEST(Config, ATemplateMarkersColourKeysAreKeptForTheColourMethod) {
     hsv: {h: [100, 130], s: [80, 255], v: [40, 255]}
 )");
   const TrackingConfig original = LoadTrackingConfig(dir.file("markers.yaml"));
-  ASSERT_EQ(original.colour_aside.size(), 1u) << "a colour marker has none";
-  EXPECT_EQ(original.colour_aside.at("red").h.lo, 160);
-  EXPECT_EQ(original.colour_aside.at("red").v.lo, 50);
+  ASSERT_EQ(original.params_aside.size(), 1u) << "a colour marker has none";
+  ASSERT_EQ(original.params_aside.at("red").size(), 1u) << "its colour keys, no other kind's";
+  const ColourParams& b = original.params_aside.at("red")[0].get<ColourParams>();
+  EXPECT_EQ(b.h.lo, 160);
+  EXPECT_EQ(b.v.lo, 50);
   SaveTrackingConfig(original, dir.file("saved.yaml"));
   const TrackingConfig again = LoadTrackingConfig(dir.file("saved.yaml"));
   EXPECT_EQ(TrackerMethodName(again.markers[0].params), "zncc");
-  ASSERT_EQ(again.colour_aside.count("red"), 1u);
-  const ColourParams& a = again.colour_aside.at("red");
-  const ColourParams& b = original.colour_aside.at("red");
+  ASSERT_EQ(again.params_aside.count("red"), 1u);
+  ASSERT_EQ(again.params_aside.at("red").size(), 1u);
+  const ColourParams& a = again.params_aside.at("red")[0].get<ColourParams>();
   EXPECT_EQ((std::array<int, 6>{a.h.lo, a.h.hi, a.s.lo, a.s.hi, a.v.lo, a.v.hi}),
             (std::array<int, 6>{b.h.lo, b.h.hi, b.s.lo, b.s.hi, b.v.lo, b.v.hi}));
   // --method colour uses them.
   const TrackingConfig colour = LoadTrackingConfig(dir.file("saved.yaml"), "colour");
-  EXPECT_EQ(std::get<ColourParams>(colour.markers[0].params).h.lo, 160);
+  EXPECT_EQ(colour.markers[0].params.get<ColourParams>().h.lo, 160);
 }
 
 TEST(Config, UnknownKeyIsNamedWithFileAndLine) {
@@ -187,7 +189,7 @@ TEST(Config, ShippedMarkerExamplesLoad) {
   EXPECT_TRUE(config.measure.metric.scale_mm_per_px.has_value());
   const TrackingConfig templates = LoadTrackingConfig(dir + "markers_template.yaml");
   ASSERT_EQ(templates.markers.size(), 5u);
-  EXPECT_EQ(std::get<TemplateParams>(templates.markers[0].params).rect, cv::Rect(388, 367, 25, 25));
+  EXPECT_EQ(templates.markers[0].params.get<TemplateParams>().rect, cv::Rect(388, 367, 25, 25));
   EXPECT_EQ(TrackerMethodName(templates.markers[4].params), "zncc");
 }
 

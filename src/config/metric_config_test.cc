@@ -1,5 +1,3 @@
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
@@ -7,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "config/config_sections.h"
+#include "core/test_util.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 
@@ -16,54 +15,45 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// One folder for the whole suite, removed when the test program ends.
-fs::path TempDir() {
-  struct Folder {
-    fs::path path = fs::temp_directory_path() /
-                    ("softsight_metric_config_test_" + std::to_string(getpid()));
-    Folder() { fs::create_directories(path); }
-    ~Folder() {
-      std::error_code ignored;
-      fs::remove_all(path, ignored);
-    }
-  };
-  static const Folder folder;
-  return folder.path;
-}
-
-// Reads the metric keys of `yaml` as if it were the config file `name` in TempDir().
-MetricModel Read(const std::string& yaml, const std::string& name = "config.yaml") {
-  const std::string file = (TempDir() / name).string();
-  std::ofstream(file) << yaml;
-  YamlMap top(LoadYamlFile(file), file, "");
-  MetricModel metric;
-  ReadMetricModel(top, &metric);
-  return metric;
-}
-
-std::string ErrorOf(const std::string& yaml) {
-  try {
-    Read(yaml);
-  } catch (const InputError& e) {
-    return e.what();
+// Each test reads its config in a folder of its own, removed when the test ends.
+class MetricConfigTest : public ::testing::Test {
+ protected:
+  // Reads the metric keys of `yaml` as if it were the config file `name` in dir_.
+  MetricModel Read(const std::string& yaml, const std::string& name = "config.yaml") {
+    const std::string file = dir_.file(name);
+    std::ofstream(file) << yaml;
+    YamlMap top(LoadYamlFile(file), file, "");
+    MetricModel metric;
+    ReadMetricModel(top, &metric);
+    return metric;
   }
-  return "(no error)";
-}
 
-TEST(MetricConfigTest, NoKeysMeansNoMetric) { EXPECT_TRUE(Read("other: 1\n").empty()); }
+  std::string ErrorOf(const std::string& yaml) {
+    try {
+      Read(yaml);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
 
-TEST(MetricConfigTest, ScaleKey) {
+  const testing::TempDir dir_;
+};
+
+TEST_F(MetricConfigTest, NoKeysMeansNoMetric) { EXPECT_TRUE(Read("other: 1\n").empty()); }
+
+TEST_F(MetricConfigTest, ScaleKey) {
   const MetricModel m = Read("scale_mm_per_px: 0.2\n");
   ASSERT_TRUE(m.scale_mm_per_px.has_value());
   EXPECT_DOUBLE_EQ(*m.scale_mm_per_px, 0.2);
   EXPECT_FALSE(m.plane_mm_from_image.has_value());
 }
 
-TEST(MetricConfigTest, PlaneFileIsReadBesideTheConfig) {
+TEST_F(MetricConfigTest, PlaneFileIsReadBesideTheConfig) {
   PlaneCalibration plane;
   plane.plane_mm_from_image = cv::Matx33d(0.2, 0.01, -3, 0.002, 0.21, 4, 1e-5, 2e-5, 1);
-  fs::create_directories(TempDir() / "sub");
-  SavePlaneCalibration(plane, (TempDir() / "sub" / "plane.yaml").string());
+  fs::create_directories(dir_.path() / "sub");
+  SavePlaneCalibration(plane, (dir_.path() / "sub" / "plane.yaml").string());
   const MetricModel m = Read("plane: sub/plane.yaml\n");
   ASSERT_TRUE(m.plane_mm_from_image.has_value());
   for (int i = 0; i < 9; ++i) {
@@ -71,14 +61,14 @@ TEST(MetricConfigTest, PlaneFileIsReadBesideTheConfig) {
   }
 }
 
-TEST(MetricConfigTest, MissingPlaneFileNamesConfigLineAndKey) {
+TEST_F(MetricConfigTest, MissingPlaneFileNamesConfigLineAndKey) {
   const std::string error = ErrorOf("a: 1\nplane: nowhere.yaml\n");
   EXPECT_THAT(error, HasSubstr("config.yaml:2:"));
   EXPECT_THAT(error, HasSubstr("plane"));
   EXPECT_THAT(error, HasSubstr("nowhere.yaml"));
 }
 
-TEST(MetricConfigTest, ScaleFromTwoPoints) {
+TEST_F(MetricConfigTest, ScaleFromTwoPoints) {
   const MetricModel m = Read("scale_from_points: {a: [10, 10], b: [310, 410], distance_mm: 100}\n");
   ASSERT_TRUE(m.scale_mm_per_px.has_value());
   EXPECT_DOUBLE_EQ(*m.scale_mm_per_px, 0.2);
@@ -93,7 +83,7 @@ TEST(MetricConfigTest, ScaleFromTwoPoints) {
               HasSubstr("scale_from_points.c: unknown key"));
 }
 
-TEST(MetricConfigTest, BadValuesAndConflictsAreErrors) {
+TEST_F(MetricConfigTest, BadValuesAndConflictsAreErrors) {
   EXPECT_THAT(ErrorOf("scale_mm_per_px: 0\n"), HasSubstr("config.yaml:1: scale_mm_per_px"));
   EXPECT_THAT(ErrorOf("scale_mm_per_px: fast\n"), HasSubstr("expected a number"));
   EXPECT_THAT(ErrorOf("scale_mm_per_px: 0.2\nplane_mm_from_image: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"),
@@ -103,7 +93,7 @@ TEST(MetricConfigTest, BadValuesAndConflictsAreErrors) {
   EXPECT_THAT(ErrorOf("plane_mm_from_image: [1, 2, 3]\n"), HasSubstr("list of 9 numbers"));
 }
 
-TEST(MetricConfigTest, ScalePointsAreWrittenAsPointsAndReadBackToTheSameScale) {
+TEST_F(MetricConfigTest, ScalePointsAreWrittenAsPointsAndReadBackToTheSameScale) {
   MetricModel original;
   original.scale_points = MetricModel::ScalePoints{{101.25, 40.0 / 3}, {250.5, 77.125}, 50};
   original.scale_mm_per_px = ScaleFromTwoPoints(original.scale_points->a_px,
@@ -122,7 +112,7 @@ TEST(MetricConfigTest, ScalePointsAreWrittenAsPointsAndReadBackToTheSameScale) {
   EXPECT_EQ(again.scale_points->b_px, original.scale_points->b_px);
 }
 
-TEST(MetricConfigTest, WrittenModelReadsBackExactly) {
+TEST_F(MetricConfigTest, WrittenModelReadsBackExactly) {
   for (const bool plane : {false, true}) {
     MetricModel original;
     if (plane) {

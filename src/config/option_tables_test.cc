@@ -11,6 +11,7 @@
 #include "softsight/config/config.h"
 #include "geometry/measure_options.h"
 #include "config/config_sections.h"
+#include "config/kind_config_test_util.h"
 #include "config/config_test_util.h"
 #include "config/option_table_test_util.h"
 #include "track/track_options.h"
@@ -94,10 +95,10 @@ TEST(OptionTables, TheCaptureSectionRoundTripsThroughAConfigFile) {
   capture.exposure = 156;
   capture.white_balance_k = 4600;
   config.capture = capture;
-  const std::string file = ::testing::TempDir() + "/softsight_capture_round_trip.yaml";
+  const testing::TempDir dir;
+  const std::string file = dir.file("capture_round_trip.yaml");
   SaveTrackingConfig(config, file);
   const TrackingConfig again = LoadTrackingConfig(file);
-  std::remove(file.c_str());
   ASSERT_TRUE(again.capture);
   EXPECT_EQ(*again.capture, capture);
 }
@@ -183,7 +184,7 @@ TEST(OptionTables, GeneratedDocumentationIsAConfigThatReadsBackToTheDefaults) {
   ASSERT_EQ(config.markers.size(), 1u);
   const ColourParams colour_defaults;
   for (const auto& o : ColourParamsOptions()) {
-    EXPECT_EQ(o.get(std::get<ColourParams>(config.markers[0].params)), o.get(colour_defaults))
+    EXPECT_EQ(o.get(config.markers[0].params.get<ColourParams>()), o.get(colour_defaults))
         << o.key;
     EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;
   }
@@ -191,7 +192,7 @@ TEST(OptionTables, GeneratedDocumentationIsAConfigThatReadsBackToTheDefaults) {
   const TrackingConfig as_template = LoadTrackingConfig(file, "zncc");
   const TemplateSection template_defaults;
   EXPECT_TRUE(as_template.template_files.empty());
-  const TemplateSection read{std::get<TemplateParams>(as_template.markers[0].params), ""};
+  const TemplateSection read{as_template.markers[0].params.get<TemplateParams>(), ""};
   for (const auto& o : TemplateSectionOptions()) {
     EXPECT_EQ(o.get(read), o.get(template_defaults)) << o.key;
     EXPECT_THAT(doc, HasSubstr(o.key.substr(o.key.rfind('.') + 1) + ":")) << o.key;

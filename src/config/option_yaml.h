@@ -53,11 +53,10 @@ void ReadOptions(YamlMap& map, const OptionTable<T>& table, T* object) {
   for (const auto& [prefix, m] : sections) m.finish();
 }
 
-// The options of `object` that differ from a default-constructed T (and apply to it), as a YAML
-// mapping: what a saved config needs to read back to the same struct.
+// The options of `object` that differ from `defaults` (a default-constructed T unless given) and
+// apply to it, as a YAML mapping: what a saved config needs to read back to the same struct.
 template <typename T>
-YAML::Node OptionsToYaml(const OptionTable<T>& table, const T& object) {
-  const T defaults{};
+YAML::Node OptionsToYaml(const OptionTable<T>& table, const T& object, const T& defaults = T{}) {
   YAML::Node root(YAML::NodeType::Map);
   for (const Option<T>& option : table) {
     if (option.applies && !option.applies(object)) continue;
@@ -70,8 +69,9 @@ YAML::Node OptionsToYaml(const OptionTable<T>& table, const T& object) {
 
 // Emits each key of OptionsToYaml into the mapping `out` is writing.
 template <typename T>
-void WriteOptions(const OptionTable<T>& table, const T& object, YAML::Emitter& out) {
-  const YAML::Node node = OptionsToYaml(table, object);
+void WriteOptions(const OptionTable<T>& table, const T& object, YAML::Emitter& out,
+                  const T& defaults = T{}) {
+  const YAML::Node node = OptionsToYaml(table, object, defaults);
   for (auto it = node.begin(); it != node.end(); ++it) {
     out << YAML::Key << it->first.Scalar() << YAML::Value << it->second;
   }

@@ -49,7 +49,7 @@ TEST(TemplateConfig, ReadsEveryKeyAndWritesThemBack) {
                                     SaveTrackingConfig(config, dir.file("saved.yaml"));
                                     return LoadTrackingConfig(dir.file("saved.yaml"));
                                   }()}) {
-    const TemplateParams& t = std::get<TemplateParams>(c.markers[0].params);
+    const TemplateParams& t = c.markers[0].params.get<TemplateParams>();
     EXPECT_EQ(TrackerMethodName(c.markers[0].params), "ssd");
     EXPECT_EQ(t.measure, MatchMeasure::kSsd);
     EXPECT_EQ(t.template_frame, 3);
@@ -78,7 +78,7 @@ TEST(TemplateConfig, TemplateWithoutMethodMeansZnccAndDefaultsStay) {
                          "markers:\n  - name: red\n    template: {rect: [10, 20, 21, 21]}\n");
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
   EXPECT_EQ(TrackerMethodName(config.markers[0].params), "zncc");
-  const TemplateParams& t = std::get<TemplateParams>(config.markers[0].params);
+  const TemplateParams& t = config.markers[0].params.get<TemplateParams>();
   const TemplateParams defaults;
   EXPECT_FALSE(t.colour);
   EXPECT_EQ(t.template_frame, 0);
@@ -95,7 +95,7 @@ TEST(TemplateConfig, ImageFileIsRelativeToTheConfig) {
                          "markers:\n  - name: red\n    method: sad\n"
                          "    template: {file: marker.png}\n");
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
-  const TemplateParams& t = std::get<TemplateParams>(config.markers[0].params);
+  const TemplateParams& t = config.markers[0].params.get<TemplateParams>();
   ASSERT_EQ(t.image.size(), image.size());
   EXPECT_EQ(t.image.type(), CV_8UC3);
   EXPECT_EQ(cv::norm(t.image, image, cv::NORM_INF), 0.0);
@@ -105,7 +105,7 @@ TEST(TemplateConfig, ImageFileIsRelativeToTheConfig) {
   SaveTrackingConfig(config, dir.file("saved.yaml"));
   const TrackingConfig saved = LoadTrackingConfig(dir.file("saved.yaml"));
   EXPECT_EQ(saved.template_files.at("red"), "marker.png");
-  EXPECT_EQ(cv::norm(std::get<TemplateParams>(saved.markers[0].params).image, image,
+  EXPECT_EQ(cv::norm(saved.markers[0].params.get<TemplateParams>().image, image,
                      cv::NORM_INF), 0.0);
   EXPECT_FALSE(t.rect.has_value());
 }
@@ -120,7 +120,7 @@ TEST(TemplateConfig, ImageWithRectIsWhereItWasSelectedAndMustBeItsSize) {
                          "markers:\n  - name: red\n    method: zncc\n"
                          "    template: {file: marker.png, frame: 12, rect: [40, 50, 23, 21]}\n");
   const TrackingConfig config = LoadTrackingConfig(dir.file("markers.yaml"));
-  const TemplateParams& t = std::get<TemplateParams>(config.markers[0].params);
+  const TemplateParams& t = config.markers[0].params.get<TemplateParams>();
   EXPECT_EQ(t.image.size(), image.size());
   EXPECT_EQ(t.rect, cv::Rect(40, 50, 23, 21));
   EXPECT_EQ(t.template_frame, 12);

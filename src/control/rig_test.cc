@@ -19,6 +19,7 @@
 
 #include "control/protocol.h"
 #include "control/rig_test_util.h"
+#include "core/test_util.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/session.h"
 #include "softsight/core/error.h"
@@ -462,7 +463,8 @@ TEST(Handshake, ASecondHostOnThePortIsRefusedAndTheFirstGoesOn) {
 }
 
 TEST(Handshake, APathThatIsNoTerminalIsOneErrorNamingWhatItIs) {
-  const std::string file = ::testing::TempDir() + "softsight_not_a_port.txt";
+  const testing::TempDir dir;
+  const std::string file = dir.file("not_a_port.txt");
   std::FILE* f = std::fopen(file.c_str(), "w");
   ASSERT_NE(f, nullptr);
   std::fclose(f);
@@ -476,7 +478,6 @@ TEST(Handshake, APathThatIsNoTerminalIsOneErrorNamingWhatItIs) {
           << e.what();
     }
   }
-  std::remove(file.c_str());
 }
 
 }  // namespace

@@ -116,8 +116,12 @@ inline bool Fail(std::string* error, const std::string& problem) {
 //   blob:
 //     min_area: 12        # px; >= 1. Smaller blobs are specks.
 // `indent` spaces precede every line (to nest a table under a parent key).
+// `defaults` gives each option's default (for a T whose default-constructed value is not its
+// defaults: a MarkerParams holds one kind's, given by the kind).
 template <typename T>
 std::string DescribeOptions(const OptionTable<T>& table, int indent = 0);
+template <typename T>
+std::string DescribeOptions(const OptionTable<T>& table, int indent, const T& defaults);
 
 // Moves an option table of a part (e.g. BoardConfig) under `prefix` of its owner (RigOptions),
 // reached through `part` (a member pointer or a T& -> Part& function).
@@ -363,7 +367,11 @@ std::string DescribeOptionSpecs(const std::vector<const OptionSpec*>& specs,
 
 template <typename T>
 std::string DescribeOptions(const OptionTable<T>& table, int indent) {
-  const T defaults{};
+  return DescribeOptions(table, indent, T{});
+}
+
+template <typename T>
+std::string DescribeOptions(const OptionTable<T>& table, int indent, const T& defaults) {
   std::vector<const OptionSpec*> specs;
   std::vector<std::optional<OptionValue>> values;
   for (const Option<T>& option : table) {

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "track/tracker_kind.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/core/format.h"
@@ -24,6 +25,21 @@ constexpr int kSpeedCount = static_cast<int>(std::size(kSpeeds));
 constexpr size_t kMaxQueuedRequests = 32;
 constexpr size_t kMaxUndo = 32;
 constexpr double kZoomStep = 1.25;  // Per + / - press.
+// Puts `params` in `aside` in place of the set of its kind there.
+void SetAside(std::vector<MarkerParams>& aside, const MarkerParams& params) {
+  for (MarkerParams& kept : aside) {
+    if (&kept.kind() == &params.kind()) {
+      kept = params;
+      return;
+    }
+  }
+  aside.push_back(params);
+}
+
+// Removes the set of `kind` from `aside` (it is the marker's own now).
+void TakeFromAside(std::vector<MarkerParams>& aside, const TrackerKind& kind) {
+  std::erase_if(aside, [&kind](const MarkerParams& kept) { return &kept.kind() == &kind; });
+}
 
 }  // namespace
 
@@ -45,14 +61,11 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
       config, LiveRecordingSettings{options_.record_prefix, std::move(before_encode)},
       options_.sinks);
   for (const MarkerSpec& spec : config.markers) {
-    const auto* colour = std::get_if<ColourParams>(&spec.params);
-    const auto* templ = std::get_if<TemplateParams>(&spec.params);
-    // A template marker's colour keys in the file are its colour method's parameters.
-    const auto aside = config.colour_aside.find(spec.name);
-    colour_aside_.push_back(colour ? *colour
-                                   : aside != config.colour_aside.end() ? aside->second
-                                                                        : ColourParams{});
-    template_aside_.push_back(templ ? *templ : TemplateParams{});
+    // Its keys of other kinds in the file (a template marker's colour keys) are those methods'
+    // parameters.
+    const auto aside = config.params_aside.find(spec.name);
+    aside_.push_back(aside != config.params_aside.end() ? aside->second
+                                                        : std::vector<MarkerParams>{});
   }
   say("press h for help");
 }
@@ -146,10 +159,8 @@ void LiveController::draw_overlay(cv::Mat& image, const FrameResult& result) con
   const std::vector<MarkerSpec>& markers = config().markers;
   status.template_boxes.resize(markers.size());
   for (size_t i = 0; i < markers.size(); ++i) {
-    const auto* templ = std::get_if<TemplateParams>(&markers[i].params);
-    std::optional<cv::Size> size;
-    if (templ && !templ->image.empty()) size = templ->image.size();
-    if (templ && !size && templ->rect) size = templ->rect->size();
+    // The box its kind draws around it (a template's size).
+    const std::optional<cv::Size> size = markers[i].params.kind().drawn_box(markers[i].params);
     if (size) {
       status.template_boxes[i] =
           OverlayStatus::TemplateBox{*size, TrackerMethodName(markers[i].params)};
@@ -327,14 +338,14 @@ void LiveController::click(const cv::Point2d& p) {
   remember_for_undo(marker, "colour pick");
   active_ = marker;
   MarkerSpec spec = config().markers[marker];
-  auto* colour = std::get_if<ColourParams>(&spec.params);
+  auto* colour = spec.params.get_if<ColourParams>();
   if (colour) {
     // The colour tracker looks for the marker around the click first.
     ApplyColourPick(*pick, colour);
     apply_spec(marker, spec, pick->roi);
   } else {
     // A template marker keeps its template; the ranges are kept for the colour method.
-    ApplyColourPick(*pick, &colour_aside_[marker]);
+    ApplyColourPick(*pick, &colour_set_aside(marker));
   }
   ++hsv_revision_;
   const std::string ranges = pick->ranges.gray
@@ -347,7 +358,7 @@ void LiveController::click(const cv::Point2d& p) {
 void LiveController::edit_range(const cv::Point2d& p, bool grow) {
   if (frame_.empty()) return;
   MarkerSpec spec = config().markers[active_];
-  auto* colour = std::get_if<ColourParams>(&spec.params);
+  auto* colour = spec.params.get_if<ColourParams>();
   if (!colour || colour->gray) {
     say(spec.name + ": ranges are edited for colour markers (m switches the method)");
     return;
@@ -417,8 +428,8 @@ void LiveController::remember_for_undo(int marker, const std::string& what, bool
     return;  // The same trackbar drag: undo goes back to before it began.
   }
   if (undo_.size() >= kMaxUndo) undo_.erase(undo_.begin());
-  UndoEntry entry{marker, config().markers[marker], colour_aside_[marker], what, coalesce};
-  auto* templ = std::get_if<TemplateParams>(&entry.spec.params);
+  UndoEntry entry{marker, config().markers[marker], aside_[marker], what, coalesce};
+  auto* templ = entry.spec.params.get_if<TemplateParams>();
   if (templ && templ->image.empty() && templ->rect && marker < static_cast<int>(recording_cuts_.size()) &&
       recording_cuts_[marker].first == *templ->rect) {
     templ->image = recording_cuts_[marker].second;  // Cut when the recording started.
@@ -433,7 +444,7 @@ void LiveController::undo() {
   }
   UndoEntry entry = std::move(undo_.back());
   undo_.pop_back();
-  if (auto* templ = std::get_if<TemplateParams>(&entry.spec.params)) {
+  if (auto* templ = entry.spec.params.get_if<TemplateParams>()) {
     if (templ->image.empty()) {
       // A rectangle to cut on a frame that is no longer on screen: cutting it here would take
       // whatever is there now, not the template.
@@ -453,7 +464,7 @@ void LiveController::undo() {
       }
     }
   }
-  colour_aside_[entry.marker] = entry.aside;
+  aside_[entry.marker] = entry.aside;
   // The marker as it was, through the same respec every edit uses: a running recording logs it
   // like any other edit, so `track` replays the undo too.
   apply_spec(entry.marker, entry.spec, std::nullopt);
@@ -469,13 +480,11 @@ void LiveController::switch_method() {
       current == methods.end() || current + 1 == methods.end() ? methods.front() : *(current + 1);
   for (int i = 0; i < static_cast<int>(config().markers.size()); ++i) {
     MarkerSpec spec = config().markers[i];
-    // The set in use now is set aside, to come back to; the other one comes back.
-    if (const auto* colour = std::get_if<ColourParams>(&spec.params)) {
-      colour_aside_[i] = *colour;
-    } else {
-      template_aside_[i] = std::get<TemplateParams>(spec.params);
-    }
-    spec.params = ParamsForMethod(next, colour_aside_[i], template_aside_[i]);
+    // The set in use now is set aside, to come back to; the next method's kind's set comes back
+    // (the same set when the method is of the same kind: sad -> ssd).
+    SetAside(aside_[i], spec.params);
+    spec.params = ParamsForMethod(next, aside_[i]);
+    TakeFromAside(aside_[i], spec.params.kind());
     std::optional<cv::Rect> hint;
     if (const auto position = position_of(i); position && !frame_.empty()) {
       hint = box_around(*position);
@@ -492,8 +501,8 @@ void LiveController::set_hsv(int trackbar, int value) {
   value = std::clamp(value, 0, kHsvTrackbars[trackbar].max);
   MarkerSpec spec = config().markers[active_];
   // A template marker's ranges are the ones set aside for its colour method.
-  auto* own = std::get_if<ColourParams>(&spec.params);
-  ColourParams& colour = own ? *own : colour_aside_[active_];
+  auto* own = spec.params.get_if<ColourParams>();
+  ColourParams& colour = own ? *own : colour_set_aside(active_);
   HsvRange* ranges[3] = {&colour.h, &colour.s, &colour.v};
   int& field = trackbar % 2 == 0 ? ranges[trackbar / 2]->lo : ranges[trackbar / 2]->hi;
   if (field == value) return;  // The adapter moving its own trackbar: nothing changed.
@@ -507,8 +516,18 @@ void LiveController::set_hsv(int trackbar, int value) {
 }
 
 ColourParams LiveController::colour_of(int marker) const {
-  const auto* own = std::get_if<ColourParams>(&config().markers[marker].params);
-  return own ? *own : colour_aside_[marker];
+  if (const auto* own = config().markers[marker].params.get_if<ColourParams>()) return *own;
+  for (const MarkerParams& params : aside_[marker]) {
+    if (const auto* colour = params.get_if<ColourParams>()) return *colour;
+  }
+  return ColourParams{};
+}
+
+ColourParams& LiveController::colour_set_aside(int marker) {
+  for (MarkerParams& params : aside_[marker]) {
+    if (auto* colour = params.get_if<ColourParams>()) return *colour;
+  }
+  return aside_[marker].emplace_back(ColourParams{}).get<ColourParams>();
 }
 
 std::array<int, 6> LiveController::active_hsv() const {
@@ -520,15 +539,13 @@ void LiveController::save_config() {
   const std::string path =
       options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
   try {
-    // The session's config, and each template marker's colour parameters as the window keeps
-    // them (ranges picked or moved while it matched templates), so that loading the file and
-    // switching back to colour finds them again.
+    // The session's config, and each marker's parameters of its other kinds as the window
+    // keeps them (ranges picked or moved while it matched templates), so that loading the file
+    // and switching method finds them again.
     TrackingConfig saved = config();
-    saved.colour_aside.clear();
+    saved.params_aside.clear();
     for (size_t i = 0; i < saved.markers.size(); ++i) {
-      if (std::holds_alternative<TemplateParams>(saved.markers[i].params)) {
-        saved.colour_aside[saved.markers[i].name] = colour_aside_[i];
-      }
+      if (!aside_[i].empty()) saved.params_aside[saved.markers[i].name] = aside_[i];
     }
     SaveLiveConfig(saved, path);
     say("saved " + path);

@@ -243,8 +243,10 @@ class LiveController {
   std::optional<cv::Point2d> position_of(int marker) const;
   cv::Rect box_around(const cv::Point2d& p) const;
   void apply_spec(int marker, const MarkerSpec& spec, const std::optional<cv::Rect>& hint);
-  // Marker `marker`'s colour parameters: its own for a colour marker, else those set aside.
+  // Marker `marker`'s colour parameters (what the HSV trackbars and range edits show and change):
+  // its own for a colour marker, else those set aside for the colour method.
   ColourParams colour_of(int marker) const;
+  ColourParams& colour_set_aside(int marker);
   void redraw_annotated();
   void draw_overlay(cv::Mat& image, const FrameResult& result) const;
   // The frame on screen, as the session saw it (no copy of the pixels).
@@ -284,7 +286,8 @@ class LiveController {
   struct UndoEntry {
     int marker;
     MarkerSpec spec;       // The marker as it was.
-    ColourParams aside;    // Its colour parameters set aside (a template marker's picks).
+    std::vector<MarkerParams> aside;  // Its other kinds' parameters set aside (a template
+                                      // marker's colour picks).
     std::string what;
     bool coalescing;       // A trackbar's edit: later steps of it join this entry.
   };
@@ -293,11 +296,11 @@ class LiveController {
   std::vector<std::pair<cv::Rect, cv::Mat>> recording_cuts_;
   int active_ = 0;
   int hsv_revision_ = 0;
-  // Per marker (config order), the parameters of the method it does not use now: a marker is one
-  // method's parameters (MarkerSpec), so a colour pick on a template marker, and the template of a
-  // marker switched to colour, are kept here for `m` to switch back to.
-  std::vector<ColourParams> colour_aside_;
-  std::vector<TemplateParams> template_aside_;
+  // Per marker (config order), its parameters of the kinds it does not use now, at most one set
+  // per kind: a marker is one kind's parameters (MarkerSpec), so a colour pick on a template
+  // marker, and the template of a marker switched to colour, are kept here for `m` to switch
+  // back to (and `s` saves them: TrackingConfig::params_aside).
+  std::vector<std::vector<MarkerParams>> aside_;
   std::unique_ptr<LivePointer> pointer_;
   ScaleClicks scale_;
   std::string message_;

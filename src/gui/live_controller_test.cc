@@ -14,6 +14,7 @@
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/range_edit.h"
+#include "core/test_util.h"
 #include "gui/live_test_util.h"
 #include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
@@ -41,13 +42,7 @@ class LiveControllerTest : public ::testing::Test {
  protected:
   LiveControllerTest() {
     scene_ = std::make_unique<SyntheticScene>(testing::LiveTestScene(60, 120));
-    dir_ = fs::temp_directory_path() /
-           ("softsight_live_test_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
   }
-  ~LiveControllerTest() override { fs::remove_all(dir_); }
 
   // Renders frame `index`, feeds it to the controller and returns its truth.
   SceneTruth Feed(LiveController& live, int index) {
@@ -102,7 +97,8 @@ class LiveControllerTest : public ::testing::Test {
   }
 
   std::unique_ptr<SyntheticScene> scene_;
-  fs::path dir_;
+  const testing::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 TEST_F(LiveControllerTest, TracksAndShowsTheOverlayAboveTheStripChart) {
@@ -123,7 +119,7 @@ TEST_F(LiveControllerTest, TracksAndShowsTheOverlayAboveTheStripChart) {
 
 TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   TrackingConfig config = SceneConfig();
-  std::get<ColourParams>(config.markers[1].params).h = {140, 160};  // Wrong: nothing in the scene has this hue.
+  config.markers[1].params.get<ColourParams>().h = {140, 160};  // Wrong: nothing in the scene has this hue.
   LiveController live(config, Options());
   SceneTruth truth = Feed(live, 0);
   ASSERT_FALSE(live.last_result()->markers[1].observation.found());
@@ -132,7 +128,7 @@ TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   EXPECT_EQ(live.active_marker(), 1);
   const int revision = live.hsv_revision();
   Click(live, *truth.markers[1].centroid_px);
-  const HsvRange h = std::get<ColourParams>(live.config().markers[1].params).h;
+  const HsvRange h = live.config().markers[1].params.get<ColourParams>().h;
   EXPECT_LT(h.lo, h.hi);
   EXPECT_LE(h.lo, 105);  // The blue marker's hue is about 107.
   EXPECT_GE(h.hi, 109);
@@ -146,9 +142,9 @@ TEST_F(LiveControllerTest, ClickCalibratesTheActiveMarkersColour) {
   // Saving writes what the click did; loading it gives the same ranges.
   live.on_event(UiEvent::Key('s'));
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.lo, h.lo);
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.hi, h.hi);
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).s.lo, std::get<ColourParams>(live.config().markers[1].params).s.lo);
+  EXPECT_EQ(saved.markers[1].params.get<ColourParams>().h.lo, h.lo);
+  EXPECT_EQ(saved.markers[1].params.get<ColourParams>().h.hi, h.hi);
+  EXPECT_EQ(saved.markers[1].params.get<ColourParams>().s.lo, live.config().markers[1].params.get<ColourParams>().s.lo);
 }
 
 TEST_F(LiveControllerTest, ClickOnAFoundMarkerPicksThatMarker) {
@@ -156,19 +152,19 @@ TEST_F(LiveControllerTest, ClickOnAFoundMarkerPicksThatMarker) {
   const SceneTruth truth = Feed(live, 0);
   Click(live, *truth.markers[2].centroid_px);  // Green, while red is active.
   EXPECT_EQ(live.active_marker(), 2);
-  const HsvRange h = std::get<ColourParams>(live.config().markers[2].params).h;
+  const HsvRange h = live.config().markers[2].params.get<ColourParams>().h;
   EXPECT_LE(h.lo, 60);
   EXPECT_GE(h.hi, 60);
   // A click on the grey background changes nothing and says why.
-  const HsvRange before = std::get<ColourParams>(live.config().markers[2].params).h;
+  const HsvRange before = live.config().markers[2].params.get<ColourParams>().h;
   Click(live, {5, 5});
   EXPECT_NE(live.message().find("not a coloured marker"), std::string::npos) << live.message();
-  EXPECT_EQ(std::get<ColourParams>(live.config().markers[2].params).h.lo, before.lo);
+  EXPECT_EQ(live.config().markers[2].params.get<ColourParams>().h.lo, before.lo);
 }
 
 TEST_F(LiveControllerTest, DragSelectsATemplateForTheMarkerInTheBox) {
   TrackingConfig config = SceneConfig();
-  for (MarkerSpec& spec : config.markers) spec.params = ParamsForMethod("zncc", {}, {});  // No templates yet.
+  for (MarkerSpec& spec : config.markers) spec.params = ParamsForMethod("zncc", {});  // No templates yet.
   LiveController live(config, Options());
   SceneTruth truth = Feed(live, 0);
   for (int m = 0; m < 3; ++m) EXPECT_FALSE(live.last_result()->markers[m].observation.found());
@@ -177,8 +173,8 @@ TEST_F(LiveControllerTest, DragSelectsATemplateForTheMarkerInTheBox) {
   const cv::Point2d red = *truth.markers[0].centroid_px;
   Drag(live, red - cv::Point2d(14, 14), red + cv::Point2d(14, 14));
   EXPECT_NE(live.message().find("red: reselected"), std::string::npos) << live.message();
-  ASSERT_TRUE(std::get<TemplateParams>(live.config().markers[0].params).rect);
-  EXPECT_EQ(std::get<TemplateParams>(live.config().markers[0].params).rect->width, 28);
+  ASSERT_TRUE(live.config().markers[0].params.get<TemplateParams>().rect);
+  EXPECT_EQ(live.config().markers[0].params.get<TemplateParams>().rect->width, 28);
   live.on_event(UiEvent::Key('3'));
   const cv::Point2d green = *truth.markers[2].centroid_px;
   Drag(live, green + cv::Point2d(14, 14), green - cv::Point2d(14, 14));  // Any direction.
@@ -231,7 +227,7 @@ TEST_F(LiveControllerTest, KeysPauseHelpSelectAndQuit) {
   live.on_event(UiEvent::Trackbar(0, 45));  // H lo of green: unchanged.
   EXPECT_EQ(live.hsv_revision(), revision);
   live.on_event(UiEvent::Trackbar(5, 200));  // V hi.
-  EXPECT_EQ(std::get<ColourParams>(live.config().markers[2].params).v.hi, 200);
+  EXPECT_EQ(live.config().markers[2].params.get<ColourParams>().v.hi, 200);
   EXPECT_EQ(live.active_hsv()[5], 200);
 
   EXPECT_FALSE(live.quit_requested());
@@ -279,8 +275,8 @@ TEST_F(LiveControllerTest, SwitchingBackToColourRestoresTheRangesPickedWhileMatc
   EXPECT_NE(picked, (std::array<int, 6>{95, 125, 80, 255, 40, 255})) << "the pick's own ranges";
   for (int k = 0; k < 3; ++k) live.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
   ASSERT_EQ(TrackerMethodName(live.config().markers[1].params), "colour");
-  EXPECT_EQ(RangesOf(std::get<ColourParams>(live.config().markers[1].params)), picked);
-  const ColourParams& red = std::get<ColourParams>(live.config().markers[0].params);
+  EXPECT_EQ(RangesOf(live.config().markers[1].params.get<ColourParams>()), picked);
+  const ColourParams& red = live.config().markers[0].params.get<ColourParams>();
   EXPECT_EQ(red.h.lo, 170);  // Not picked: the config's ranges.
   EXPECT_EQ(red.h.hi, 10);
   SceneTruth truth;
@@ -300,11 +296,12 @@ TEST_F(LiveControllerTest, RangesPickedWhileMatchingTemplatesAreSavedAndComeBack
   }
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
   ASSERT_EQ(TrackerMethodName(saved.markers[1].params), "sad");
-  ASSERT_EQ(saved.colour_aside.count("blue"), 1u);
-  EXPECT_EQ(RangesOf(saved.colour_aside.at("blue")), picked);
+  ASSERT_EQ(saved.params_aside.count("blue"), 1u);
+  ASSERT_EQ(saved.params_aside.at("blue").size(), 1u);
+  EXPECT_EQ(RangesOf(saved.params_aside.at("blue")[0].get<ColourParams>()), picked);
   // The same file with --method colour tracks blue with the picked ranges.
   const TrackingConfig as_colour = LoadTrackingConfig((dir_ / "saved.yaml").string(), "colour");
-  EXPECT_EQ(std::get<ColourParams>(as_colour.markers[1].params).h.lo, picked[0]);
+  EXPECT_EQ(as_colour.markers[1].params.get<ColourParams>().h.lo, picked[0]);
 
   LiveController again(saved, Options());
   SceneTruth truth;
@@ -313,7 +310,7 @@ TEST_F(LiveControllerTest, RangesPickedWhileMatchingTemplatesAreSavedAndComeBack
   EXPECT_EQ(again.active_hsv(), picked) << "the trackbars show the saved colour ranges";
   for (int k = 0; k < 3; ++k) again.on_event(UiEvent::Key('m'));  // ssd, zncc, colour
   ASSERT_EQ(TrackerMethodName(again.config().markers[1].params), "colour");
-  EXPECT_EQ(RangesOf(std::get<ColourParams>(again.config().markers[1].params)), picked);
+  EXPECT_EQ(RangesOf(again.config().markers[1].params.get<ColourParams>()), picked);
   for (int i = 6; i < 9; ++i) truth = Feed(again, i);
   ExpectAt(again, 1, truth, 0.5);
 }
@@ -689,10 +686,10 @@ TEST_F(LiveFileTest, ARecordingStartedAfterPausedEditsReproducesUnderTrack) {
   live.on_event(UiEvent::Key('m'));  // colour -> sad
   ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "sad");
   // A box on empty background is refused, saying why; the active marker keeps its template.
-  const cv::Rect before = *std::get<TemplateParams>(live.config().markers[0].params).rect;
+  const cv::Rect before = *live.config().markers[0].params.get<TemplateParams>().rect;
   Drag(live, {20, 20}, {44, 44});
   EXPECT_NE(live.message().find("holds no marker"), std::string::npos) << live.message();
-  EXPECT_EQ(*std::get<TemplateParams>(live.config().markers[0].params).rect, before);
+  EXPECT_EQ(*live.config().markers[0].params.get<TemplateParams>().rect, before);
   // A box around blue, off its centre: blue's template is re-cut.
   const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
   Drag(live, blue - cv::Point2d(9, 11), blue + cv::Point2d(12, 10));
@@ -757,9 +754,9 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
     EXPECT_TRUE(fs::exists(dir_ / ("saved." + std::string(marker) + ".png"))) << marker;
   }
   const TrackingConfig reloaded = LoadTrackingConfig(saved);
-  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[0].params).template_frame, 7);
-  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[1].params).template_frame, 12);
-  EXPECT_EQ(std::get<TemplateParams>(reloaded.markers[1].params).rect->size(), cv::Size(23, 22));
+  EXPECT_EQ(reloaded.markers[0].params.get<TemplateParams>().template_frame, 7);
+  EXPECT_EQ(reloaded.markers[1].params.get<TemplateParams>().template_frame, 12);
+  EXPECT_EQ(reloaded.markers[1].params.get<TemplateParams>().rect->size(), cv::Size(23, 22));
 
   Track(saved, video, (dir_ / "tracked.csv").string());
   const CsvTable table = ReadCsvTable((dir_ / "tracked.csv").string());
@@ -822,8 +819,8 @@ TEST_F(LiveFileTest, HsvRangesChangedWithTrackbarsAreSavedAndTrackReproducesThem
   while (feed.step(live)) shown.push_back(*live.last_result());
   live.on_event(UiEvent::Key('s'));
   const TrackingConfig saved = LoadTrackingConfig((dir_ / "saved.yaml").string());
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.lo, 92);
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[1].params).h.hi, 128);
+  EXPECT_EQ(saved.markers[1].params.get<ColourParams>().h.lo, 92);
+  EXPECT_EQ(saved.markers[1].params.get<ColourParams>().h.hi, 128);
   Track((dir_ / "saved.yaml").string(), video, (dir_ / "tracked.csv").string());
   ExpectTrackShowsTheSame((dir_ / "tracked.csv").string(), shown, 6);
 }
@@ -915,7 +912,7 @@ TEST_F(LiveControllerTest, WhilePausedARangeChangeRetracksTheFrameOnScreenAtOnce
 
 TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRangeRetrackingAtOnce) {
   TrackingConfig config = SceneConfig();
-  std::get<ColourParams>(config.markers[1].params).h = {117, 125};  // Blue (hue 112 here) is outside its range.
+  config.markers[1].params.get<ColourParams>().h = {117, 125};  // Blue (hue 112 here) is outside its range.
   LiveController live(config, Options());
   SceneTruth truth;
   for (int i = 0; i < 4; ++i) truth = Feed(live, i);
@@ -945,8 +942,8 @@ TEST_F(LiveControllerTest, MaskViewShowsTheMembersAndClicksGrowAndShrinkTheRange
   ASSERT_TRUE(live.last_result()->measurement.angle_deg.has_value());
   EXPECT_EQ(live.chart().newest(0), live.last_result()->measurement.angle_deg);
   EXPECT_EQ(live.chart().size(), 4u);
-  EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.lo, 112);
-  EXPECT_EQ(std::get<ColourParams>(live.config().markers[1].params).h.hi, 125);
+  EXPECT_EQ(live.config().markers[1].params.get<ColourParams>().h.lo, 112);
+  EXPECT_EQ(live.config().markers[1].params.get<ColourParams>().h.hi, 125);
   {
     const cv::Mat canvas = live.canvas();
     EXPECT_EQ(canvas.at<cv::Vec3b>(cv::Point(blue)), frame.at<cv::Vec3b>(cv::Point(blue)));
@@ -1059,7 +1056,8 @@ TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRight
   const SceneOptions options = testing::LiveTest720pScene(10);
   SyntheticScene scene(options);
   LiveOptions live_options;
-  live_options.save_config_path = (fs::temp_directory_path() / "softsight_fit_test.yaml").string();
+  const testing::TempDir dir;
+  live_options.save_config_path = dir.file("fit.yaml");
   LiveController live(SceneConfig(), live_options);
   live.set_screen({1366, 768});
   Frame frame;
@@ -1094,16 +1092,16 @@ TEST(LiveControllerOnAScreen, A720pFrameFitsALaptopScreenAndClicksSelectTheRight
   live.on_event(UiEvent::Mouse(Type::kMouseUp, std::round(on_canvas.x), std::round(on_canvas.y)));
   EXPECT_EQ(live.active_marker(), 1);
   const MarkerSpec& spec = live.config().markers[1];
-  ASSERT_TRUE(std::get<ColourParams>(spec.params).roi) << live.message();
-  const cv::Point2d centre(std::get<ColourParams>(spec.params).roi->x + std::get<ColourParams>(spec.params).roi->width / 2.0,
-                           std::get<ColourParams>(spec.params).roi->y + std::get<ColourParams>(spec.params).roi->height / 2.0);
+  ASSERT_TRUE(spec.params.get<ColourParams>().roi) << live.message();
+  const cv::Point2d centre(spec.params.get<ColourParams>().roi->x + spec.params.get<ColourParams>().roi->width / 2.0,
+                           spec.params.get<ColourParams>().roi->y + spec.params.get<ColourParams>().roi->height / 2.0);
   // Rounding the click to a canvas pixel moves it by up to half a canvas pixel, and the box is
   // cut around the nearest image pixel.
   const double scale = live.to_view({1, 0}).x - live.to_view({0, 0}).x;
   EXPECT_NEAR(centre.x, blue.x, 0.5 / scale + 1.0) << live.message();
   EXPECT_NEAR(centre.y, blue.y, 0.5 / scale + 1.0);
-  EXPECT_LT(std::get<ColourParams>(spec.params).h.lo, 107);  // Blue's hue, about 107.
-  EXPECT_GT(std::get<ColourParams>(spec.params).h.hi, 107);
+  EXPECT_LT(spec.params.get<ColourParams>().h.lo, 107);  // Blue's hue, about 107.
+  EXPECT_GT(spec.params.get<ColourParams>().h.hi, 107);
 }
 
 class LivePlaybackTest : public LiveFileTest {
@@ -1442,7 +1440,7 @@ TEST_F(LiveControllerTest, ZoomedViewKeepsThePointedPixelAndClicksAndDragsMapThr
   // A click through the zoom picks blue's colour (the box around the image pixel clicked).
   live.on_event(UiEvent::Key('3'));  // Active: green; the click goes to blue, found under it.
   Click(live, live.to_view(blue + cv::Point2d(0.3, 0.3)));
-  const auto& colour = std::get<ColourParams>(live.config().markers[1].params);
+  const auto& colour = live.config().markers[1].params.get<ColourParams>();
   ASSERT_TRUE(colour.roi) << live.message();
   EXPECT_NEAR(colour.roi->x + colour.roi->width / 2.0, blue.x, 1.0);
   EXPECT_NEAR(colour.roi->y + colour.roi->height / 2.0, blue.y, 1.0);
@@ -1471,15 +1469,15 @@ TEST_F(LiveControllerTest, UndoRestoresTheMarkerAsItWasBeforeTheLastReselectionO
   SceneTruth truth;
   for (int i = 0; i < 3; ++i) truth = Feed(live, i);
   live.on_event(UiEvent::Key('m'));  // sad: templates cut where the markers are.
-  const TemplateParams cut = std::get<TemplateParams>(live.config().markers[1].params);
+  const TemplateParams cut = live.config().markers[1].params.get<TemplateParams>();
   const cv::Point2d blue = *truth.markers[1].centroid_px;
   Drag(live, blue - cv::Point2d(9, 11), blue + cv::Point2d(12, 10));
   ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
-  EXPECT_NE(*std::get<TemplateParams>(live.config().markers[1].params).rect, *cut.rect);
+  EXPECT_NE(*live.config().markers[1].params.get<TemplateParams>().rect, *cut.rect);
   EXPECT_EQ(live.undo_depth(), 1u);
   live.on_event(UiEvent::Key('u'));
   EXPECT_NE(live.message().find("undone: reselection of blue"), std::string::npos) << live.message();
-  const TemplateParams back = std::get<TemplateParams>(live.config().markers[1].params);
+  const TemplateParams back = live.config().markers[1].params.get<TemplateParams>();
   EXPECT_EQ(*back.rect, *cut.rect);
   EXPECT_EQ(cv::norm(back.image, cut.image, cv::NORM_INF), 0.0);
   const SceneTruth next = Feed(live, 3);  // The old template tracks blue on.

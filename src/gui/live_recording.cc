@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "track/tracker_kind.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
 
@@ -79,22 +80,17 @@ void LiveRecording::log(ConfigChange change) {
   change.after_frame = std::max<int64_t>(0, frames_ - 1);
   // A start frame the window set (a reselection's, in the source's numbers) is already behind:
   // the new tracker starts on the next frame, live and in `track` alike.
-  if (auto* colour = std::get_if<ColourParams>(&change.spec.params);
-      colour && change.kind == ConfigChange::Kind::kRespec) {
-    colour->roi_frame = static_cast<int>(std::min<int64_t>(colour->roi_frame, change.after_frame));
-  }
-  auto* templ_params = std::get_if<TemplateParams>(&change.spec.params);
-  if (templ_params && change.kind == ConfigChange::Kind::kRespec) {
-    TemplateParams& templ = *templ_params;
-    templ.template_frame =
-        static_cast<int>(std::min<int64_t>(templ.template_frame, change.after_frame));
-    if (!templ.image.empty()) {
+  if (change.kind == ConfigChange::Kind::kRespec) {
+    MarkerParams& params = change.spec.params;
+    params.kind().start_by(params, change.after_frame);
+    // Pixels the parameters hold (a template cut live) go to an image file beside the config.
+    if (const cv::Mat* image = params.kind().image(params)) {
       const std::filesystem::path yaml(prefix_ + ".yaml");
       const std::string name = yaml.stem().string() + "." +
                                std::to_string(saved_.changes.size() + 1) + "." +
                                change.spec.name + ".png";
       const std::string path = (yaml.parent_path() / name).string();
-      if (!cv::imwrite(path, templ.image)) {
+      if (!cv::imwrite(path, *image)) {
         throw InputError(path + ": cannot write the template image");
       }
       change.template_file = name;  // Relative to the config, as the reader resolves it.
@@ -111,17 +107,11 @@ TrackingConfig RecordingStartConfig(const TrackingConfig& config,
   start.changes.clear();
   for (size_t i = 0; i < start.markers.size() && i < boxes.size(); ++i) {
     if (!boxes[i]) continue;
+    // The recording's frame 0 is the frame on screen: the marker starts there, in its box (a
+    // template is cut from that frame, so no image file holds it).
     MarkerSpec& spec = start.markers[i];
-    if (auto* templ = std::get_if<TemplateParams>(&spec.params)) {
-      templ->rect = *boxes[i];
-      templ->template_frame = 0;
-      templ->image = cv::Mat();
-      start.template_files.erase(spec.name);
-    } else {
-      ColourParams& colour = std::get<ColourParams>(spec.params);
-      colour.roi = *boxes[i];
-      colour.roi_frame = 0;  // The recording's frame 0 is the frame on screen.
-    }
+    spec.params.kind().start_in(spec.params, *boxes[i]);
+    start.template_files.erase(spec.name);
   }
   return start;
 }
@@ -136,11 +126,11 @@ TrackingConfig WithTemplateImages(const TrackingConfig& config, const std::strin
   TrackingConfig saved = config;
   const std::filesystem::path file(path);
   for (const MarkerSpec& spec : saved.markers) {
-    const auto* templ = std::get_if<TemplateParams>(&spec.params);
-    if (!templ || templ->image.empty()) continue;
+    const cv::Mat* image = spec.params.kind().image(spec.params);
+    if (image == nullptr) continue;
     const std::string name = file.stem().string() + "." + spec.name + ".png";
     const std::string image_path = (file.parent_path() / name).string();
-    if (!cv::imwrite(image_path, templ->image)) {
+    if (!cv::imwrite(image_path, *image)) {
       throw InputError(image_path + ": cannot write the template image");
     }
     // Relative to the config, as the reader resolves it. A template selected live keeps its rect

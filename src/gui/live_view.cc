@@ -129,7 +129,7 @@ void LiveView::draw_mask_view(cv::Mat& top, const LiveLayout& view, const LiveVi
     cv::putText(top, label, origin, kGuiFont, text * 0.8, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(top, label, origin, kGuiFont, text * 0.8, colour, 1, cv::LINE_AA);
   }
-  const auto* c = std::get_if<ColourParams>(&state.active->params);  // A mask is a colour's.
+  const auto* c = state.active->params.get_if<ColourParams>();  // A mask is a colour's.
   const std::string title =
       "MASK " + state.active->name +
       (has_mask && c ? ": h " + RangeText(c->h) + " s " + RangeText(c->s) + " v " + RangeText(c->v)

@@ -307,7 +307,7 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   std::this_thread::sleep_for(200ms);
   const TrackingConfig picked = LoadTrackingConfig(saved);
   ASSERT_EQ(picked.markers.size(), 3u);
-  const HsvRange h = std::get<ColourParams>(picked.markers[1].params).h;
+  const HsvRange h = picked.markers[1].params.get<ColourParams>().h;
   EXPECT_TRUE(h.lo != 95 || h.hi != 125) << "the click did not change blue's range";
   EXPECT_LT(h.lo, 107);  // Blue's hue, about 107.
   EXPECT_GT(h.hi, 107);
@@ -376,9 +376,9 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
   ASSERT_TRUE(WaitForOutput(live_, "live: saved", 20s, &output)) << output;
   const TrackingConfig picked = LoadTrackingConfig((dir_ / "markers.live.yaml").string());
   const MarkerSpec& spec = picked.markers[1];
-  ASSERT_TRUE(std::get<ColourParams>(spec.params).roi);
-  const cv::Point2d centre(std::get<ColourParams>(spec.params).roi->x + std::get<ColourParams>(spec.params).roi->width / 2.0,
-                           std::get<ColourParams>(spec.params).roi->y + std::get<ColourParams>(spec.params).roi->height / 2.0);
+  ASSERT_TRUE(spec.params.get<ColourParams>().roi);
+  const cv::Point2d centre(spec.params.get<ColourParams>().roi->x + spec.params.get<ColourParams>().roi->width / 2.0,
+                           spec.params.get<ColourParams>().roi->y + spec.params.get<ColourParams>().roi->height / 2.0);
   EXPECT_NEAR(centre.x, truth[9].markers[1].centroid_px->x, 0.5 / layout.scale_x() + 1.0);
   EXPECT_NEAR(centre.y, truth[9].markers[1].centroid_px->y, 0.5 / layout.scale_y() + 1.0);
   ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;

@@ -1,6 +1,7 @@
 // The live window's seekable source on an image sequence whose numbering starts at 5: every
 // frame it returns after a seek is the sequence's own (index from the file's number).
 #include "gui/seekable_source.h"
+#include "core/test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -15,9 +16,8 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(SeekableSource, SeeksInAnImageSequenceKeepingItsFileNumbersInsideAndOutsideTheRing) {
-  const fs::path dir = fs::temp_directory_path() / "softsight_seekable_source_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
   for (int n = 5; n < 15; ++n) {
     // Each image's grey level says which file it is.
     cv::imwrite((dir / cv::format("f%d.png", n)).string(),
@@ -59,7 +59,6 @@ TEST(SeekableSource, SeeksInAnImageSequenceKeepingItsFileNumbersInsideAndOutside
   EXPECT_FALSE(source.read(frame));
   source.seek(25);
   EXPECT_FALSE(source.read(frame));
-  fs::remove_all(dir);
 }
 
 // FFmpeg's own seek (through the container's index) is what makes a seek in a long file fast;

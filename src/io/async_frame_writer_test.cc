@@ -17,7 +17,7 @@ namespace {
 using testing::TempDir;
 
 // Frame `i`: a textured image that differs from every other frame everywhere.
-cv::Mat NumberedFrame(int i) {
+cv::Mat TexturedNumberedFrame(int i) {
   cv::Mat image(96, 128, CV_8UC3);
   cv::RNG rng(static_cast<uint64_t>(i) + 1);
   rng.fill(image, cv::RNG::UNIFORM, 0, 256);
@@ -49,7 +49,7 @@ TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExac
     for (int i = 0; i < 40; ++i) {
       cv::Mat* slot = writer.acquire();
       ASSERT_NE(slot, nullptr) << "never dropped";
-      NumberedFrame(i).copyTo(*slot);
+      TexturedNumberedFrame(i).copyTo(*slot);
       writer.commit(i);
     }
     writer.close();
@@ -59,7 +59,7 @@ TEST(AsyncFrameWriter, AFileRecordingWaitsForTheEncoderAndKeepsEveryFrameBitExac
   ASSERT_EQ(frames.size(), 40u);
   for (int i = 0; i < 40; ++i) {
     EXPECT_EQ(frames[i].index, i);
-    EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
+    EXPECT_TRUE(SameImage(frames[i].image, TexturedNumberedFrame(i))) << "frame " << i;
   }
 }
 
@@ -76,7 +76,7 @@ TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLose
       for (int i = 0; i < 5; ++i) {
         cv::Mat* slot = writer.acquire();
         ASSERT_NE(slot, nullptr) << "never dropped";
-        NumberedFrame(i).copyTo(*slot);
+        TexturedNumberedFrame(i).copyTo(*slot);
         writer.commit(i);
       }
     });
@@ -92,7 +92,7 @@ TEST(AsyncFrameWriter, AWaitingWriterCountsTheFramesThatHeldUpThePipelineAndLose
   const std::vector<Frame> frames = ReadBack(path);
   ASSERT_EQ(frames.size(), 5u);
   for (int i = 0; i < 5; ++i) {
-    EXPECT_TRUE(SameImage(frames[i].image, NumberedFrame(i))) << "frame " << i;
+    EXPECT_TRUE(SameImage(frames[i].image, TexturedNumberedFrame(i))) << "frame " << i;
   }
 }
 

@@ -2,23 +2,23 @@
 
 #include <chrono>
 #include <cstdio>
-#include <stdexcept>
 #include <utility>
 
 namespace softsight {
-namespace {
 
-void AppendNumber(std::string& row, const std::optional<double>& value, const char* format) {
+void AppendCsvNumber(std::string& row, const std::optional<double>& value, const char* format) {
   if (!value) return;
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, *value);
   row += buffer;
 }
 
+namespace {
+
 // A measurement field, 4 decimals as the contract has always had.
 CsvColumn MeasurementColumn(std::string name, std::optional<double> Measurement::*member) {
   return {std::move(name), [member](const FrameResult& r, std::string& row) {
-            AppendNumber(row, r.measurement.*member, "%.4f");
+            AppendCsvNumber(row, r.measurement.*member, "%.4f");
           }};
 }
 
@@ -31,54 +31,6 @@ std::optional<double> MillisecondsSince(std::chrono::steady_clock::time_point ca
 
 }  // namespace
 
-CsvColumn NumberColumn(std::string name,
-                       std::function<std::optional<double>(const FrameResult&)> value,
-                       const char* format) {
-  return {std::move(name), [value = std::move(value), format](const FrameResult& r,
-                                                              std::string& row) {
-            AppendNumber(row, value(r), format);
-          }};
-}
-
-void CsvColumnTable::add(CsvColumn column) { columns_.push_back(std::move(column)); }
-
-void CsvColumnTable::insert_before(const std::string& before, CsvColumn column) {
-  const std::optional<size_t> at = find(before);
-  if (!at) throw std::logic_error("CsvColumnTable: no column '" + before + "'");
-  columns_.insert(columns_.begin() + static_cast<std::ptrdiff_t>(*at), std::move(column));
-}
-
-std::optional<size_t> CsvColumnTable::find(const std::string& name) const {
-  for (size_t i = 0; i < columns_.size(); ++i) {
-    if (columns_[i].name == name) return i;
-  }
-  return std::nullopt;
-}
-
-std::vector<std::string> CsvColumnTable::names() const {
-  std::vector<std::string> names;
-  names.reserve(columns_.size());
-  for (const CsvColumn& column : columns_) names.push_back(column.name);
-  return names;
-}
-
-std::string CsvColumnTable::header() const {
-  std::string line;
-  for (size_t i = 0; i < columns_.size(); ++i) {
-    if (i > 0) line += ',';
-    line += columns_[i].name;
-  }
-  return line;
-}
-
-void CsvColumnTable::append_row(const FrameResult& result, std::string& row) const {
-  row.clear();
-  for (size_t i = 0; i < columns_.size(); ++i) {
-    if (i > 0) row += ',';
-    columns_[i].append(result, row);
-  }
-}
-
 CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, bool metric,
                                const std::vector<CsvColumn>& extra,
                                const std::vector<std::string>& inner_angle_markers) {
@@ -87,24 +39,24 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
                row += std::to_string(r.frame_index);
              }});
   table.add({"time_s", [](const FrameResult& r, std::string& row) {
-               AppendNumber(row, r.time_s, "%.6f");
+               AppendCsvNumber(row, r.time_s, "%.6f");
              }});
   for (size_t i = 0; i < marker_names.size(); ++i) {
     const std::string& name = marker_names[i];
     // Per-marker columns read markers[i]: the session reports every marker in config order.
     table.add({name + "_x", [i](const FrameResult& r, std::string& row) {
                  const Observation& o = r.markers.at(i).observation;
-                 if (o.found()) AppendNumber(row, o.position_px->x, "%.4f");
+                 if (o.found()) AppendCsvNumber(row, o.position_px->x, "%.4f");
                }});
     table.add({name + "_y", [i](const FrameResult& r, std::string& row) {
                  const Observation& o = r.markers.at(i).observation;
-                 if (o.found()) AppendNumber(row, o.position_px->y, "%.4f");
+                 if (o.found()) AppendCsvNumber(row, o.position_px->y, "%.4f");
                }});
     table.add({name + "_found", [i](const FrameResult& r, std::string& row) {
                  row += r.markers.at(i).observation.found() ? '1' : '0';
                }});
     table.add({name + "_score", [i](const FrameResult& r, std::string& row) {
-                 AppendNumber(row, r.markers.at(i).observation.score, "%.4f");
+                 AppendCsvNumber(row, r.markers.at(i).observation.score, "%.4f");
                }});
     // Why the marker has no position (or "found"): a word, never a number.
     table.add({name + "_status", [i](const FrameResult& r, std::string& row) {
@@ -121,7 +73,7 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
     table.add({"angle_" + inner_angle_markers[k] + "_deg",
                [k](const FrameResult& r, std::string& row) {
                  const auto& angles = r.measurement.inner_angle_deg;
-                 if (k < angles.size()) AppendNumber(row, angles[k], "%.4f");
+                 if (k < angles.size()) AppendCsvNumber(row, angles[k], "%.4f");
                }});
   }
   if (metric) {
@@ -137,14 +89,14 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
   // controller's command) is in it. Timings, like proc_ms: they differ from run to run.
   table.add({"latency_result_ms", [](const FrameResult& r, std::string& row) {
                const bool stamped = r.captured != std::chrono::steady_clock::time_point{};
-               AppendNumber(row, stamped ? std::optional<double>(r.latency_result_ms) : std::nullopt,
+               AppendCsvNumber(row, stamped ? std::optional<double>(r.latency_result_ms) : std::nullopt,
                             "%.3f");
              }});
   table.add({"latency_row_ms", [](const FrameResult& r, std::string& row) {
-               AppendNumber(row, MillisecondsSince(r.captured), "%.3f");
+               AppendCsvNumber(row, MillisecondsSince(r.captured), "%.3f");
              }});
   table.add({"proc_ms", [](const FrameResult& r, std::string& row) {
-               AppendNumber(row, r.proc_ms, "%.4f");
+               AppendCsvNumber(row, r.proc_ms, "%.4f");
              }});
   return table;
 }

@@ -12,50 +12,39 @@
 
 namespace softsight {
 
-CsvWriter::CsvWriter(const std::string& path, CsvColumnTable columns)
-    : path_(path), columns_(std::move(columns)) {
+CsvFile::CsvFile(const std::string& path, std::string header) : path_(path) {
   // Opened without O_TRUNC: the file is emptied only once this writer holds its lock, so a
   // second program naming a CSV another one is writing is refused and leaves it intact.
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
   if (fd_ < 0) {
     throw InputError(EscapeForMessage(path) + ": cannot write CSV (" + std::strerror(errno) + ")");
   }
-  row_ = columns_.header();
   try {
     LockOutputOrThrow(fd_, path);
     struct stat info {};
     if (::fstat(fd_, &info) == 0 && S_ISREG(info.st_mode) && ::ftruncate(fd_, 0) != 0) {
       throw InputError(EscapeForMessage(path) + ": cannot empty it (" + std::strerror(errno) + ")");
     }
-    put(std::nullopt);
+    put(header, std::nullopt);
   } catch (...) {
     ::close(fd_);
     throw;
   }
 }
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& marker_names,
-                     bool metric)
-    : CsvWriter(path, TrackingColumns(marker_names, metric)) {}
-
-CsvWriter::~CsvWriter() {
+CsvFile::~CsvFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-void CsvWriter::write(const FrameResult& result) {
-  columns_.append_row(result, row_);
-  put(result.frame_index);
-}
-
-void CsvWriter::put(std::optional<int64_t> frame_index) {
+void CsvFile::put(std::string& line, std::optional<int64_t> frame_index) {
   // One write() of the whole line with its newline. When it fails (disk full, a file-size limit
   // with SIGXFSZ ignored, an I/O error) or writes only part of the line, the file is cut back to
   // the last complete row, so a reader never sees half a row.
-  row_ += '\n';
+  line += '\n';
   size_t written = 0;
   int error = 0;
-  while (written < row_.size()) {
-    const ssize_t n = ::write(fd_, row_.data() + written, row_.size() - written);
+  while (written < line.size()) {
+    const ssize_t n = ::write(fd_, line.data() + written, line.size() - written);
     if (n > 0) {
       written += static_cast<size_t>(n);
     } else if (n < 0 && errno == EINTR) {
@@ -66,7 +55,7 @@ void CsvWriter::put(std::optional<int64_t> frame_index) {
     }
   }
   if (error == 0) {
-    committed_bytes_ += static_cast<off_t>(row_.size());
+    committed_bytes_ += static_cast<off_t>(line.size());
     return;
   }
   if (written > 0) {

@@ -37,7 +37,7 @@ std::string WriteVideo(const TempDir& dir, int frames) {
 }
 
 // Reads until the end; returns the frames read (rethrows the source's error).
-int ReadAll(FrameSource& source) {
+int CountFramesToTheEnd(FrameSource& source) {
   Frame frame;
   int read = 0;
   while (source.read(frame)) ++read;
@@ -79,7 +79,7 @@ TEST(VideoFileSource, TruncatedFileIsAnErrorNamingTheFile) {
   Damage(path, /*truncate=*/true);
   try {
     auto source = OpenFrameSource({path, {}, 30.0});
-    ReadAll(*source);
+    CountFramesToTheEnd(*source);
     FAIL() << "a truncated video was read without an error";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr(path));
@@ -92,7 +92,7 @@ TEST(VideoFileSource, FrameThatFailsToDecodeIsAnError) {
   const std::string path = WriteVideo(dir, 40);
   Damage(path, /*truncate=*/false);
   auto source = OpenFrameSource({path, {}, 30.0});
-  EXPECT_THROW(ReadAll(*source), InputError);
+  EXPECT_THROW(CountFramesToTheEnd(*source), InputError);
 }
 
 // Frames that differ from each other everywhere a little and in one place a lot: a textured
@@ -120,11 +120,6 @@ std::string WriteFrames(const std::string& path, const char* fourcc,
   return path;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
-
 void WriteBytes(const std::string& path, const std::string& data) {
   std::ofstream(path, std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
 }
@@ -146,7 +141,7 @@ TEST(VideoFileSource, TruncatedVideoReturnsOnlyWholeFramesOfTheRightIndex) {
   TempDir dir;
   const std::vector<cv::Mat> originals = DistinctFrames(40);
   for (const char* codec : {"FFV1", "MJPG"}) {
-    const std::string full = ReadBytes(WriteFrames(dir.file("full.avi"), codec, originals));
+    const std::string full = testing::ReadTextFile(WriteFrames(dir.file("full.avi"), codec, originals));
     for (double cut = 0.20; cut < 0.70; cut += 0.02) {
       const std::string path = dir.file("cut.avi");
       WriteBytes(path, full.substr(0, static_cast<size_t>(cut * full.size())));
@@ -177,7 +172,7 @@ TEST(VideoFileSource, TruncatedVideoReturnsOnlyWholeFramesOfTheRightIndex) {
 TEST(VideoFileSource, FramesTheDecoderFoundDamagedAreLeftOutAndReported) {
   TempDir dir;
   const std::vector<cv::Mat> originals = DistinctFrames(40);
-  std::string data = ReadBytes(WriteFrames(dir.file("clip.avi"), "MJPG", originals));
+  std::string data = testing::ReadTextFile(WriteFrames(dir.file("clip.avi"), "MJPG", originals));
   std::mt19937 random(5);
   for (int flip = 0; flip < 20; ++flip) {
     const size_t at = data.size() * 4 / 10 + random() % (data.size() / 5);
@@ -256,7 +251,7 @@ TEST(ImageSequenceSource, PrintfPatternStartingAtOne) {
     cv::imwrite(dir.file(name), MakeFrame(i));
   }
   auto source = OpenFrameSource({dir.file("f%03d.png"), {}, 30.0});
-  EXPECT_EQ(ReadAll(*source), 3);
+  EXPECT_EQ(CountFramesToTheEnd(*source), 3);
 }
 
 TEST(ImageSequenceSource, PatternWithAGapKeepsEachFilesNumberAndSaysSo) {

@@ -42,10 +42,17 @@ const std::vector<cv::Mat>& Frames(int noise_sigma) {
   return frames;
 }
 
+// The encoded videos, each rewritten by every timed iteration, are the run's scratch: removed
+// after each benchmark, so a run leaves nothing in the temporary folder.
 std::string PathFor(const char* codec, int noise_sigma) {
   return (std::filesystem::temp_directory_path() /
           ("softsight_bench_" + std::string(codec) + std::to_string(noise_sigma) + ".avi"))
       .string();
+}
+
+void RemoveVideo(const char* codec, int noise_sigma) {
+  std::error_code ignored;
+  std::filesystem::remove(PathFor(codec, noise_sigma), ignored);
 }
 
 void Write(const char* codec, int noise_sigma) {
@@ -60,6 +67,7 @@ void BM_Encode(benchmark::State& state) {
   const int noise = static_cast<int>(state.range(1));
   Frames(noise);
   for (auto _ : state) Write(codec, noise);
+  RemoveVideo(codec, noise);
   state.SetItemsProcessed(state.iterations() * kFrames);  // items/s = frames per second.
   state.SetLabel(codec);
 }
@@ -76,6 +84,7 @@ void BM_Decode(benchmark::State& state) {
     cv::VideoCapture video(PathFor(codec, noise), cv::CAP_FFMPEG);
     while (video.read(frame)) ++frames;
   }
+  RemoveVideo(codec, noise);
   state.SetItemsProcessed(frames);
   state.SetLabel(codec);
 }

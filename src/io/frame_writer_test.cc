@@ -23,7 +23,7 @@ cv::Mat Pattern(int seed) {
   return image;
 }
 
-std::string ErrorOf(const FrameWriterOptions& options) {
+std::string OpenError(const FrameWriterOptions& options) {
   try {
     FrameWriter writer(options);
   } catch (const InputError& e) {
@@ -131,7 +131,7 @@ TEST(FrameWriter, ImagePatternNamesEachFileByTheFrameIndex) {
 TEST(FrameWriter, ImagePatternIsNeverAPrintfFormat) {
   TempDir dir;
   for (const char* bad : {"f%s.png", "f%n.png", "f%099d.png", "f%5d.png", "f%x.png", "f%ld.png"}) {
-    EXPECT_THAT(ErrorOf({dir.file(bad), "", 30.0}), HasSubstr(bad));
+    EXPECT_THAT(OpenError({dir.file(bad), "", 30.0}), HasSubstr(bad));
   }
   const cv::Mat frame = Pattern(3);
   {
@@ -145,11 +145,11 @@ TEST(FrameWriter, ImagePatternIsNeverAPrintfFormat) {
 
 TEST(FrameWriter, BadOutputsAreRefusedBeforeAnyFrame) {
   TempDir dir;
-  EXPECT_THAT(ErrorOf({dir.file("none/raw.avi"), "", 30.0}), HasSubstr("does not exist"));
-  EXPECT_THAT(ErrorOf({dir.file("raw.xyz"), "", 30.0}), HasSubstr("unknown video type"));
-  EXPECT_THAT(ErrorOf({dir.file("raw.avi"), "h265", 30.0}), HasSubstr("h265"));
-  EXPECT_THAT(ErrorOf({dir.file("f%d%d.png"), "", 30.0}), HasSubstr("more than one number"));
-  EXPECT_THAT(ErrorOf({dir.file("raw.avi"), "", 0.0}), HasSubstr("frame rate"));
+  EXPECT_THAT(OpenError({dir.file("none/raw.avi"), "", 30.0}), HasSubstr("does not exist"));
+  EXPECT_THAT(OpenError({dir.file("raw.xyz"), "", 30.0}), HasSubstr("unknown video type"));
+  EXPECT_THAT(OpenError({dir.file("raw.avi"), "h265", 30.0}), HasSubstr("h265"));
+  EXPECT_THAT(OpenError({dir.file("f%d%d.png"), "", 30.0}), HasSubstr("more than one number"));
+  EXPECT_THAT(OpenError({dir.file("raw.avi"), "", 0.0}), HasSubstr("frame rate"));
 }
 
 TEST(FrameWriter, AFrameOfAnotherSizeIsAnErrorNamingTheFrame) {

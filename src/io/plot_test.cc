@@ -11,6 +11,7 @@
 #include <regex>
 #include <sstream>
 
+#include "core/test_util.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -20,14 +21,6 @@ namespace fs = std::filesystem;
 
 class PlotTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("softsight_plot_test_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
 
   // Writes a tracking CSV with the design document's columns for markers red, blue, green.
@@ -70,7 +63,8 @@ class PlotTest : public ::testing::Test {
     return path;
   }
 
-  fs::path dir_;
+  const testing::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 // True when some pixel within `radius` of `p` has colour `bgr` (within `tolerance` per channel).

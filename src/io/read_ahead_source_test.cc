@@ -47,11 +47,6 @@ std::string WriteNumberedVideo(const std::string& path, const std::string& codec
   return path;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
-
 // What a reader saw: per frame its index, time and the number it shows; then how it ended.
 struct Reading {
   std::vector<int64_t> indices;
@@ -119,7 +114,7 @@ TEST(ReadAheadSource, ImageSequenceKeepsItsNumbersAndNote) {
 TEST(ReadAheadSource, TruncatedOrDamagedFileEndsLikeAnUnthreadedRead) {
   TempDir dir;
   for (const char* codec : {"hfyu", "mjpg"}) {
-    const std::string full = ReadBytes(WriteNumberedVideo(dir.file("full.avi"), codec, 40));
+    const std::string full = testing::ReadTextFile(WriteNumberedVideo(dir.file("full.avi"), codec, 40));
     for (double cut : {0.3, 0.55, 0.8}) {
       for (bool zeroed : {false, true}) {
         std::string data = full;
@@ -153,9 +148,9 @@ TEST(ReadAheadSource, TruncatedOrDamagedFileEndsLikeAnUnthreadedRead) {
 }
 
 // Frames whose pixel (0, 0) carries the index; throws at `fail_at`; endless with count < 0.
-class CountingSource : public FrameSource {
+class IndexInPixelSource : public FrameSource {
  public:
-  explicit CountingSource(int count, int fail_at = -1) : count_(count), fail_at_(fail_at) {}
+  explicit IndexInPixelSource(int count, int fail_at = -1) : count_(count), fail_at_(fail_at) {}
   bool read(Frame& frame) override {
     if (next_ == fail_at_) throw InputError("counting: frame " + std::to_string(next_) + " is bad");
     if (count_ >= 0 && next_ >= count_) return false;
@@ -179,7 +174,7 @@ class CountingSource : public FrameSource {
 };
 
 TEST(ReadAheadSource, ErrorComesAfterTheFramesBeforeItAndOnce) {
-  ReadAheadSource source(std::make_unique<CountingSource>(10, /*fail_at=*/3), 4);
+  ReadAheadSource source(std::make_unique<IndexInPixelSource>(10, /*fail_at=*/3), 4);
   Frame frame;
   for (int i = 0; i < 3; ++i) {
     ASSERT_TRUE(source.read(frame));
@@ -192,7 +187,7 @@ TEST(ReadAheadSource, ErrorComesAfterTheFramesBeforeItAndOnce) {
 }
 
 TEST(ReadAheadSource, AFrameKeptByTheReaderIsNeverOverwritten) {
-  ReadAheadSource source(std::make_unique<CountingSource>(600), 2);
+  ReadAheadSource source(std::make_unique<IndexInPixelSource>(600), 2);
   Frame frame;
   std::vector<cv::Mat> kept;  // Shallow copies, as a sink that keeps frames would hold them.
   for (int i = 0; i < 600; ++i) {
@@ -208,7 +203,7 @@ TEST(ReadAheadSource, AFrameKeptByTheReaderIsNeverOverwritten) {
 TEST(ReadAheadSource, StopsWithAFullQueueOfAnEndlessSource) {
   // The decoder waits on a full queue; destroying the source (a Ctrl-C ending the run) must stop
   // it at once rather than wait for the end of a stream that never ends.
-  auto source = std::make_unique<ReadAheadSource>(std::make_unique<CountingSource>(-1), 2);
+  auto source = std::make_unique<ReadAheadSource>(std::make_unique<IndexInPixelSource>(-1), 2);
   Frame frame;
   ASSERT_TRUE(source->read(frame));
   EXPECT_FALSE(source->frame_count().has_value());

@@ -74,14 +74,14 @@ std::vector<SceneScore> TrackScene(const DotScene& scene, const TrackingConfig& 
 
 MarkerSpec YellowDot(const std::string& name, const cv::Rect& roi) {
   MarkerSpec spec = testing::ColourMarker(name, {20, 40});
-  std::get<ColourParams>(spec.params).roi = roi;
+  spec.params.get<ColourParams>().roi = roi;
   return spec;
 }
 
 MarkerSpec WhiteDot(const std::string& name, const cv::Rect& roi) {
   MarkerSpec spec;
   spec.name = name;
-  ColourParams& colour = std::get<ColourParams>(spec.params);
+  ColourParams& colour = spec.params.get<ColourParams>();
   colour.gray = HsvRange{185, 255};
   colour.roi = roi;
   return spec;
@@ -261,7 +261,7 @@ TEST(AssociationScenes, ADiscPartlyCoveredByAPaddleIsFoundAtItsCentreOrNotAtAll)
                     {70, 70, 70}});
   const DotScene scene(options, shapes, covers);
   MarkerSpec spec = testing::ColourMarker("red", {170, 10});
-  std::get<ColourParams>(spec.params).roi = scene.roi(0);
+  spec.params.get<ColourParams>().roi = scene.roi(0);
   TrackingConfig config;
   config.markers = {spec};
   TrackingSession session(config);
@@ -295,7 +295,7 @@ TEST(AssociationScenes, APalePuckWithAHighlightIsFound) {
                     [](double t) { return DotPose{{200 + 2.0 * t, 200 + 40 * std::sin(t / 15)}}; }});
   const DotScene scene(options, shapes);
   MarkerSpec spec = testing::ColourMarker("puck", {50, 70});
-  ColourParams& colour = std::get<ColourParams>(spec.params);
+  ColourParams& colour = spec.params.get<ColourParams>();
   colour.s = {40, 255};
   colour.v = {120, 255};
   colour.roi = scene.roi(0);
@@ -326,8 +326,8 @@ DotScene TurningRim() {
 TEST(AssociationScenes, AnElongatedStickerOnATurningRimIsFollowed) {
   const DotScene scene = TurningRim();
   MarkerSpec spec = testing::ColourMarker("sticker", {10, 30});
-  std::get<ColourParams>(spec.params).roi = scene.roi(2);
-  std::get<ColourParams>(spec.params).min_circularity = 0.2;
+  spec.params.get<ColourParams>().roi = scene.roi(2);
+  spec.params.get<ColourParams>().min_circularity = 0.2;
   TrackingConfig config;
   config.markers = {spec};
   const int count = 144;  // Two turns.
@@ -366,7 +366,7 @@ TEST(AssociationScenes, InitTakesTheCartsIdenticalDotsAsTwoMarkersThatKeepTheirI
   std::vector<size_t> shape_of;
   for (const FoundMarker& m : finding.markers) {
     EXPECT_TRUE(m.needs_roi);
-    ASSERT_TRUE(std::get<ColourParams>(m.spec.params).roi.has_value());
+    ASSERT_TRUE(m.spec.params.get<ColourParams>().roi.has_value());
     const size_t dot = NearestShape(scene, m.position_px, {2, 3});
     EXPECT_LT(cv::norm(m.position_px - *scene.truth(dot, 0)), 0.5);
     shape_of.push_back(dot);
@@ -435,7 +435,7 @@ TEST(AssociationScenes, InitTakesTheRimsElongatedStickerAndItIsFollowed) {
   }();
   ASSERT_EQ(finding.markers.size(), 1u);
   EXPECT_LT(cv::norm(finding.markers[0].position_px - *scene.truth(2, 0)), 0.5);
-  EXPECT_LT(std::get<ColourParams>(config.markers[0].params).min_circularity, 0.5);
+  EXPECT_LT(config.markers[0].params.get<ColourParams>().min_circularity, 0.5);
   const int count = 144;  // Two turns.
   const SceneScore s = TrackScene(scene, config, {2}, count, 1.5)[0];
   EXPECT_EQ(s.wrong, 0) << s.first_wrong;
@@ -450,8 +450,8 @@ constexpr const char* kTemplateMethods[] = {"zncc", "ssd", "sad"};
 MarkerSpec TemplateDot(const std::string& name, const std::string& method, const cv::Rect& rect) {
   MarkerSpec spec;
   spec.name = name;
-  spec.params = ParamsForMethod(method, {}, {});
-  std::get<TemplateParams>(spec.params).rect = rect;
+  spec.params = ParamsForMethod(method, {});
+  spec.params.get<TemplateParams>().rect = rect;
   return spec;
 }
 
@@ -557,7 +557,7 @@ TEST(AssociationScenes, ATemplateOnAStickerTurningWithAWheelFollowsItAllTheWayRo
     const SceneScore s = TrackScene(scene, config, {2}, count, 1.5)[0];
     EXPECT_EQ(s.wrong, 0) << s.first_wrong;
     EXPECT_GE(s.found, count - 3);
-    std::get<TemplateParams>(config.markers[0].params).turn_search = false;
+    config.markers[0].params.get<TemplateParams>().turn_search = false;
     const SceneScore fixed = TrackScene(scene, config, {2}, count, 1.5)[0];
     EXPECT_EQ(fixed.wrong, 0) << fixed.first_wrong;
     EXPECT_LT(fixed.found, count / 2);

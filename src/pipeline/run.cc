@@ -7,12 +7,12 @@
 #include <opencv2/core.hpp>
 
 #include "softsight/core/error.h"
+#include "track/tracker_kind.h"
 
 namespace softsight {
 bool NeedsColour(const TrackingConfig& config) {
   for (const MarkerSpec& spec : config.markers) {
-    const auto* templ = std::get_if<TemplateParams>(&spec.params);
-    if (templ ? templ->colour : std::get<ColourParams>(spec.params).NeedsColour()) return true;
+    if (spec.params.kind().needs_colour(spec.params)) return true;
   }
   return false;
 }

@@ -13,7 +13,7 @@ namespace softsight::testing {
 inline MarkerSpec ColourMarker(const std::string& name, HsvRange hue) {
   MarkerSpec spec;
   spec.name = name;
-  ColourParams& colour = std::get<ColourParams>(spec.params);
+  ColourParams& colour = spec.params.get<ColourParams>();
   colour.h = hue;
   colour.s = {80, 255};
   colour.v = {40, 255};

@@ -11,23 +11,16 @@
 #include "pipeline/marker_plausibility.h"
 #include "pipeline/marker_tracks.h"
 #include "softsight/core/error.h"
+#include "track/tracker_kind.h"
 
 namespace softsight {
 namespace {
 
-// About the marker's radius, from what the config says of its size: the unit of how far it may
-// move beyond its predicted position in one frame. A template or ROI rectangle is drawn around
-// the marker; the colour tracker's window is at least 4 marker radii (its documented minimum).
+// About the marker's radius, from what the config says of its size (its kind knows: a template or
+// roi rectangle drawn around it, a search window): the unit of how far it may move beyond its
+// predicted position in one frame.
 double MarkerSizePx(const MarkerSpec& spec) {
-  double size = 0.0;
-  if (const auto* templ = std::get_if<TemplateParams>(&spec.params)) {
-    if (templ->rect) size = 0.5 * std::max(templ->rect->width, templ->rect->height);
-    if (!templ->image.empty()) size = 0.5 * std::max(templ->image.cols, templ->image.rows);
-  } else if (const ColourParams& colour = std::get<ColourParams>(spec.params); colour.roi) {
-    size = 0.5 * std::max(colour.roi->width, colour.roi->height);
-  } else if (colour.window_px > 0) {
-    size = 0.25 * colour.window_px;
-  }
+  const double size = spec.params.kind().size_hint_px(spec.params);
   return std::clamp(size > 0.0 ? size : 16.0, 4.0, 64.0);
 }
 
@@ -260,22 +253,12 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     tracks_->forget(i);
     // ... nor another marker's last position there (the person may have swapped two markers).
     std::fill(believed_px_.begin(), believed_px_.end(), std::nullopt);
-    // Saved configs must reproduce what the mouse did: the template's own pixels (a rectangle
-    // on the config's template frame would cut whatever is there, not this marker), which a
-    // saved config writes as an image file beside itself, with where and on which frame it was
-    // selected, so that `track` starts it there and then, as here.
-    const int frame_index = static_cast<int>(std::max<int64_t>(0, frame.index));
-    if (auto* templ = std::get_if<TemplateParams>(&config_.markers[i].params)) {
-      templ->rect = rect;
-      templ->template_frame = frame_index;
-      templ->image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
-      config_.template_files.erase(marker);  // The file holds the old template.
-    } else {
-      // The roi holds from this frame on: at frame 0 the marker was elsewhere.
-      ColourParams& colour = std::get<ColourParams>(config_.markers[i].params);
-      colour.roi = rect;
-      colour.roi_frame = frame_index;
-    }
+    // Saved configs must reproduce what the mouse did (the marker's kind says how: a template's
+    // own pixels, cut here, or a colour marker's roi from this frame), so that `track` starts it
+    // there and then, as here. A template file held the old template.
+    MarkerParams& params = config_.markers[i].params;
+    params.kind().remember_selection(params, frame, rect);
+    config_.template_files.erase(marker);
     // The selection's frame is tracked by the new tracker at once, as `track` tracks a template's
     // reference frame: the window shows the new result now, and the tracker has seen the frames
     // it would have seen in `track`. The other markers already saw this frame; the joint checks
@@ -322,10 +305,11 @@ void TrackingSession::respec(const MarkerSpec& spec) {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (config_.markers[i].name != spec.name) continue;
     trackers_[i] = CreateTracker(spec);
-    // A template file names the pixels it was read into; a spec without them is no longer it.
-    const auto* before = std::get_if<TemplateParams>(&config_.markers[i].params);
-    const auto* after = std::get_if<TemplateParams>(&spec.params);
-    if (!before || !after || before->image.data != after->image.data) {
+    // An image file names the pixels it was read into; a spec without them is no longer it.
+    const MarkerParams& before = config_.markers[i].params;
+    const cv::Mat* image_before = before.kind().image(before);
+    const cv::Mat* image_after = spec.params.kind().image(spec.params);
+    if (!image_before || !image_after || image_before->data != image_after->data) {
       config_.template_files.erase(spec.name);
     }
     config_.markers[i] = spec;

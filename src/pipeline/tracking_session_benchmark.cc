@@ -80,7 +80,7 @@ TrackingConfig ThreeMarkerConfig() {
   for (int i = 0; i < 3; ++i) {
     MarkerSpec spec;
     spec.name = names[i];
-    ColourParams& colour = std::get<ColourParams>(spec.params);
+    ColourParams& colour = spec.params.get<ColourParams>();
     colour.h = hues[i];
     colour.s = {80, 255};
     colour.v = {40, 255};

@@ -69,9 +69,9 @@ TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
   const Clip clip = Render(5);
   TrackingConfig config = ThreeMarkerSceneConfig();
   const cv::Point2d blue = *clip.truth[2].markers[1].centroid_px;
-  config.markers[1].params = ParamsForMethod("zncc", {}, {});
-  std::get<TemplateParams>(config.markers[1].params).template_frame = 2;
-  std::get<TemplateParams>(config.markers[1].params).rect = cv::Rect(static_cast<int>(blue.x) - 12,
+  config.markers[1].params = ParamsForMethod("zncc", {});
+  config.markers[1].params.get<TemplateParams>().template_frame = 2;
+  config.markers[1].params.get<TemplateParams>().rect = cv::Rect(static_cast<int>(blue.x) - 12,
                                           static_cast<int>(blue.y) - 12, 25, 25);
   TrackingSession session(config);
   for (int i = 0; i < 5; ++i) {
@@ -86,7 +86,7 @@ TEST(TrackingSession, ReselectIsRecordedInTheConfigSoASavedConfigReproducesIt) {
   TrackingSession session(ThreeMarkerSceneConfig());
   session.process(clip.frames[0]);
   session.reselect("blue", clip.frames[0], cv::Rect(10, 20, 30, 40));
-  EXPECT_EQ(std::get<ColourParams>(session.config().markers[1].params).roi, cv::Rect(10, 20, 30, 40));
+  EXPECT_EQ(session.config().markers[1].params.get<ColourParams>().roi, cv::Rect(10, 20, 30, 40));
   EXPECT_THROW(session.reselect("yellow", clip.frames[0], cv::Rect(0, 0, 5, 5)),
                InputError);
 }
@@ -105,7 +105,7 @@ TEST(TrackingSession, TellsItsEditListenerOfEachEditWithTheFrameItFollows) {
   session.process(clip.frames[0]);
   session.process(clip.frames[1]);
   MarkerSpec spec = session.config().markers[0];
-  std::get<ColourParams>(spec.params).h = {5, 25};
+  spec.params.get<ColourParams>().h = {5, 25};
   session.respec(spec);
   session.reselect("blue", clip.frames[1], cv::Rect(10, 20, 30, 40));
   EXPECT_THROW(session.reselect("yellow", clip.frames[1], cv::Rect(0, 0, 5, 5)), InputError);
@@ -117,7 +117,7 @@ TEST(TrackingSession, TellsItsEditListenerOfEachEditWithTheFrameItFollows) {
   ASSERT_EQ(heard.size(), 5u);
   EXPECT_EQ(heard[0].kind, ConfigChange::Kind::kRespec);
   EXPECT_EQ(heard[0].spec.name, spec.name);
-  EXPECT_EQ(std::get<ColourParams>(heard[0].spec.params).h.hi, 25);
+  EXPECT_EQ(heard[0].spec.params.get<ColourParams>().h.hi, 25);
   EXPECT_EQ(heard[0].after_frame, 1);
   EXPECT_EQ(heard[1].kind, ConfigChange::Kind::kReselect);
   EXPECT_EQ(heard[1].marker, "blue");
@@ -140,7 +140,7 @@ TEST(TrackingSession, AColourPickAtALaterFrameIsSavedWithItsFrameAndTrackReprodu
   constexpr int kPickFrame = 10;
   const Clip clip = Render(14, {}, /*stretch=*/3);
   TrackingConfig config = ThreeMarkerSceneConfig();
-  std::get<ColourParams>(config.markers[2].params).h = {20, 30};  // green's ranges are wrong (yellow) until the pick
+  config.markers[2].params.get<ColourParams>().h = {20, 30};  // green's ranges are wrong (yellow) until the pick
   TrackingSession live(config);
   std::vector<std::optional<cv::Point2d>> live_green(clip.frames.size());
   for (int i = 0; i < static_cast<int>(clip.frames.size()); ++i) {
@@ -150,20 +150,20 @@ TEST(TrackingSession, AColourPickAtALaterFrameIsSavedWithItsFrameAndTrackReprodu
       const auto pick = PickMarkerColourAt(clip.frames[i].image, at, HsvPickOptions{}, 32);
       ASSERT_TRUE(pick.has_value());
       MarkerSpec spec = live.config().markers[2];
-      ApplyColourPick(*pick, &std::get<ColourParams>(spec.params));
+      ApplyColourPick(*pick, &spec.params.get<ColourParams>());
       live.respec(spec);
       result = &live.reselect("green", clip.frames[i], pick->roi);
     }
     live_green[i] = result->markers[2].observation.position_px;
   }
-  EXPECT_EQ(std::get<ColourParams>(live.config().markers[2].params).roi_frame, kPickFrame);
+  EXPECT_EQ(live.config().markers[2].params.get<ColourParams>().roi_frame, kPickFrame);
   const cv::Point2d at_pick = *clip.truth[kPickFrame].markers[2].centroid_px;
   ASSERT_GT(cv::norm(at_pick - *clip.truth[0].markers[2].centroid_px), 30.0);
 
   testing::TempDir dir;
   SaveTrackingConfig(live.config(), dir.file("live.yaml"));
   const TrackingConfig saved = LoadTrackingConfig(dir.file("live.yaml"));
-  EXPECT_EQ(std::get<ColourParams>(saved.markers[2].params).roi_frame, kPickFrame);
+  EXPECT_EQ(saved.markers[2].params.get<ColourParams>().roi_frame, kPickFrame);
   TrackingSession track(saved);
   for (int i = 0; i < static_cast<int>(clip.frames.size()); ++i) {
     const Observation& green = track.process(clip.frames[i]).markers[2].observation;

@@ -505,7 +505,7 @@ TEST(TrackerRegistry, BuildsColourTrackersAndRejectsBadSpecs) {
   EXPECT_EQ(methods.front(), "colour");
 
   try {
-    ParamsForMethod("telepathy", {}, {});
+    ParamsForMethod("telepathy", {});
     FAIL() << "unknown method accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("telepathy"), std::string::npos);

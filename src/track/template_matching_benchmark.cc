@@ -227,8 +227,8 @@ std::vector<std::unique_ptr<Tracker>> MakeTrackers(const std::string& method, bo
   for (const cv::Rect& rect : scene.rects) {
     MarkerSpec spec;
     spec.name = std::string("marker");
-    spec.params = ParamsForMethod(method, {}, {});
-    std::get<TemplateParams>(spec.params).colour = colour;
+    spec.params = ParamsForMethod(method, {});
+    spec.params.get<TemplateParams>().colour = colour;
     trackers.push_back(CreateTracker(spec));
     trackers.back()->init(scene.frames[0], rect);
   }

@@ -85,8 +85,8 @@ Stats Track(const Sequence& sequence, const std::string& method, bool colour,
   for (const MarkerTruth& marker : sequence.truth[0].markers) {
     MarkerSpec spec;
     spec.name = marker.name;
-    spec.params = ParamsForMethod(method, {}, params);
-    std::get<TemplateParams>(spec.params).colour = colour;
+    spec.params = ParamsForMethod(method, {params});
+    spec.params.get<TemplateParams>().colour = colour;
     trackers.push_back(CreateTracker(spec));
     const cv::Rect rect = RectAround(*marker.centroid_px, kTemplatePx);
     trackers.back()->init(sequence.frames[0], rect);
@@ -138,9 +138,9 @@ TEST(TemplateTrackerTest, FirstMatchOnTheSelectionFrameIsExact) {
       SCOPED_TRACE(std::string(method) + (colour ? " colour" : " gray"));
       MarkerSpec spec;
       spec.name = "blue";
-      spec.params = ParamsForMethod(method, {}, {});
-      std::get<TemplateParams>(spec.params).colour = colour;
-      std::get<TemplateParams>(spec.params).report = TemplateReport::kRectCentre;
+      spec.params = ParamsForMethod(method, {});
+      spec.params.get<TemplateParams>().colour = colour;
+      spec.params.get<TemplateParams>().report = TemplateReport::kRectCentre;
       const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
       const cv::Rect rect(205, 186, 25, 29);
       tracker->init(sequence.frames[0], rect);
@@ -210,9 +210,9 @@ TEST(TemplateTrackerTest, ContrastProjectionEqualsLumaOnAGrayScene) {
   }
   MarkerSpec spec;
   spec.name = "blue";
-  spec.params = ParamsForMethod("zncc", {}, {});
+  spec.params = ParamsForMethod("zncc", {});
   MarkerSpec luma = spec;
-  std::get<TemplateParams>(luma.params).contrast_gray = false;
+  luma.params.get<TemplateParams>().contrast_gray = false;
   const std::unique_ptr<Tracker> a = CreateTracker(spec);
   const std::unique_ptr<Tracker> b = CreateTracker(luma);
   const cv::Rect rect = RectAround(*sequence.truth[0].markers[1].centroid_px, kTemplatePx);
@@ -295,15 +295,15 @@ TEST(TemplateTrackerTest, WindowedSearchEqualsFullFrameSearch) {
     SCOPED_TRACE(method + (colour ? " colour" : " gray"));
     MarkerSpec windowed;
     windowed.name = "green";
-    windowed.params = ParamsForMethod(method, {}, {});
-    std::get<TemplateParams>(windowed.params).colour = colour;
+    windowed.params = ParamsForMethod(method, {});
+    windowed.params.get<TemplateParams>().colour = colour;
     // Both see the same single disc here; the ambiguity check (a distinct second peak) would
     // look at different regions, so it is off for this comparison of the searches themselves.
-    std::get<TemplateParams>(windowed.params).ambiguity_margin = 0;
+    windowed.params.get<TemplateParams>().ambiguity_margin = 0;
     MarkerSpec full = windowed;
-    std::get<TemplateParams>(full.params).search_margin_px = 4096;  // The "window" is the whole frame.
-    std::get<TemplateParams>(full.params).acquire_radius_px = 0;
-    std::get<TemplateParams>(full.params).pyramid_levels = 1;
+    full.params.get<TemplateParams>().search_margin_px = 4096;  // The "window" is the whole frame.
+    full.params.get<TemplateParams>().acquire_radius_px = 0;
+    full.params.get<TemplateParams>().pyramid_levels = 1;
     const std::unique_ptr<Tracker> a = CreateTracker(windowed);
     const std::unique_ptr<Tracker> b = CreateTracker(full);
     const cv::Rect rect =
@@ -329,8 +329,8 @@ TEST(TemplateTrackerTest, RecalibrationReplacesTheTemplate) {
   const Sequence& sequence = Rendered("clean");
   MarkerSpec spec;
   spec.name = "m";
-  spec.params = ParamsForMethod("zncc", {}, {});
-  std::get<TemplateParams>(spec.params).colour = true;
+  spec.params = ParamsForMethod("zncc", {});
+  spec.params.get<TemplateParams>().colour = true;
   const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
   const auto& truth0 = sequence.truth[0].markers;
   tracker->init(sequence.frames[0], RectAround(*truth0[0].centroid_px, kTemplatePx));
@@ -356,10 +356,10 @@ TEST(TemplateTrackerTest, TemplateImageIsFoundOnTheWholeFrame) {
   for (bool colour : {false, true}) {
     MarkerSpec spec;
     spec.name = "green";
-    spec.params = ParamsForMethod("zncc", {}, {});
-    std::get<TemplateParams>(spec.params).colour = colour;
-    std::get<TemplateParams>(spec.params).image = sequence.frames[12](rect).clone();  // As if read from marker.png.
-    std::get<TemplateParams>(spec.params).report = TemplateReport::kRectCentre;
+    spec.params = ParamsForMethod("zncc", {});
+    spec.params.get<TemplateParams>().colour = colour;
+    spec.params.get<TemplateParams>().image = sequence.frames[12](rect).clone();  // As if read from marker.png.
+    spec.params.get<TemplateParams>().report = TemplateReport::kRectCentre;
     const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
     tracker->init(sequence.frames[12], cv::Rect());
     const Observation o = tracker->update(sequence.frames[12]);
@@ -414,9 +414,9 @@ TEST(TemplateTrackerTest, CentreOfSymmetryGivesTheMarkerCentroid) {
   ASSERT_GT(cv::norm(RectCentre(rect) - truth), 0.3);
   MarkerSpec spec;
   spec.name = "green";
-  spec.params = ParamsForMethod("zncc", {}, {});
-  std::get<TemplateParams>(spec.params).colour = true;
-  std::get<TemplateParams>(spec.params).report = TemplateReport::kSymmetry;
+  spec.params = ParamsForMethod("zncc", {});
+  spec.params.get<TemplateParams>().colour = true;
+  spec.params.get<TemplateParams>().report = TemplateReport::kSymmetry;
   const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
   tracker->init(sequence.frames[0], rect);
   const Observation o = tracker->update(sequence.frames[0]);
@@ -514,7 +514,7 @@ TEST(TemplateTrackerTest, LookAlikeNeighbourIsNeverTakenForACoveredMarker) {
     SCOPED_TRACE(method);
     MarkerSpec spec;
     spec.name = "left_dot";
-    spec.params = ParamsForMethod(method, {}, {});
+    spec.params = ParamsForMethod(method, {});
     const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
     int found = 0, wrong = 0, covered_reported = 0;
     for (int i = 0; i < 40; ++i) {
@@ -548,7 +548,7 @@ TEST(TemplateTrackerTest, FootageThatRepeatsFramesIsTrackedThroughTheJumps) {
     SCOPED_TRACE(method);
     MarkerSpec spec;
     spec.name = "dot";
-    spec.params = ParamsForMethod(method, {}, {});
+    spec.params = ParamsForMethod(method, {});
     const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
     int found = 0, wrong = 0;
     double x = 20.3;
@@ -575,8 +575,8 @@ TEST(TemplateTrackerTest, TwoLookAlikesInTheSearchedRegionAreAmbiguous) {
   const cv::Mat selection = TwoDots(a, b, 7.0);
   MarkerSpec spec;
   spec.name = "left_dot";
-  spec.params = ParamsForMethod("zncc", {}, {});
-  std::get<TemplateParams>(spec.params).image = selection(RectAround(a, 21)).clone();  // A template image: no position yet.
+  spec.params = ParamsForMethod("zncc", {});
+  spec.params.get<TemplateParams>().image = selection(RectAround(a, 21)).clone();  // A template image: no position yet.
   const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
   tracker->init(selection, cv::Rect());
   const Observation o = tracker->update(selection);
@@ -584,14 +584,14 @@ TEST(TemplateTrackerTest, TwoLookAlikesInTheSearchedRegionAreAmbiguous) {
   EXPECT_EQ(o.status(), MarkerStatus::kAmbiguous);
   EXPECT_EQ(o.candidates, 2);
   // With the check off the whole-frame best is one of the two, a guess: that is what it prevents.
-  std::get<TemplateParams>(spec.params).ambiguity_margin = 0;
+  spec.params.get<TemplateParams>().ambiguity_margin = 0;
   const std::unique_ptr<Tracker> guessing = CreateTracker(spec);
   guessing->init(selection, cv::Rect());
   const Observation guess = guessing->update(selection);
   ASSERT_TRUE(guess.found());
   EXPECT_LT(std::min(cv::norm(*guess.position_px - a), cv::norm(*guess.position_px - b)), 0.3);
   // A dragged rectangle says which one is meant: the first update looks there only.
-  const std::unique_ptr<Tracker> dragged = CreateTracker(MarkerSpec{"left_dot", ParamsForMethod("zncc", {}, {})});
+  const std::unique_ptr<Tracker> dragged = CreateTracker(MarkerSpec{"left_dot", ParamsForMethod("zncc", {})});
   dragged->init(selection, RectAround(b, 21));
   const Observation right = dragged->update(selection);
   ASSERT_TRUE(right.found());
@@ -618,7 +618,7 @@ PlateFigures TrackPlate(const std::string& method, TemplateParams params = {}) {
   for (const MarkerTruth& m : truth[0].markers) {
     MarkerSpec spec;
     spec.name = m.name;
-    spec.params = ParamsForMethod(method, {}, params);
+    spec.params = ParamsForMethod(method, {params});
     trackers.push_back(CreateTracker(spec));
     trackers.back()->init(frames[0], RectAround(*m.centroid_px, 25));
   }

@@ -52,7 +52,7 @@ cv::Rect RectAround(const cv::Point2d& centre, int side) {
 MarkerSpec SpecFor(const std::string& method, const std::string& name = "m") {
   MarkerSpec spec;
   spec.name = name;
-  spec.params = ParamsForMethod(method, {}, {});
+  spec.params = ParamsForMethod(method, {});
   return spec;
 }
 
@@ -72,7 +72,7 @@ TEST(TrackerRegistry, EveryMethodIsBuiltByItsNameAndTheDefaultsAreRegistered) {
     EXPECT_NE(CreateTracker(SpecFor(method)), nullptr) << method;
   }
   try {
-    ParamsForMethod("optical_flow", {}, {});
+    ParamsForMethod("optical_flow", {});
     FAIL() << "an unknown method must be refused";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("optical_flow"), std::string::npos) << e.what();
@@ -92,14 +92,14 @@ TEST(TrackerRegistry, MethodNamesAndParametersMapOneToOne) {
   templ.colour = true;
   templ.min_zncc = 0.7;
   for (const std::string& method : TrackerMethods()) {
-    const MarkerParams params = ParamsForMethod(method, colour, templ);
+    const MarkerParams params = ParamsForMethod(method, {colour, templ});
     EXPECT_EQ(TrackerMethodName(params), method);
-    EXPECT_EQ(std::holds_alternative<TemplateParams>(params), IsTemplateMethod(method)) << method;
-    if (const auto* t = std::get_if<TemplateParams>(&params)) {
+    EXPECT_EQ(params.holds<TemplateParams>(), IsTemplateMethod(method)) << method;
+    if (const auto* t = params.get_if<TemplateParams>()) {
       EXPECT_TRUE(t->colour) << method;
       EXPECT_DOUBLE_EQ(t->min_zncc, 0.7) << method;
     } else {
-      EXPECT_EQ(std::get<ColourParams>(params).window_px, 40);
+      EXPECT_EQ(params.get<ColourParams>().window_px, 40);
     }
   }
   EXPECT_EQ(TrackerMethodName(MarkerSpec{}.params), "colour");
@@ -114,7 +114,7 @@ TEST(TrackerRegistry, TemplateTrackerStartsItselfOnItsTemplateFrame) {
     if (!IsTemplateMethod(method)) continue;
     for (size_t m = 0; m < s.truth[0].markers.size(); ++m) {
       MarkerSpec spec = SpecFor(method, s.truth[0].markers[m].name);
-      TemplateParams& templ = std::get<TemplateParams>(spec.params);
+      TemplateParams& templ = spec.params.get<TemplateParams>();
       templ.template_frame = kTemplateFrame;
       templ.rect = RectAround(*s.truth[kTemplateFrame].markers[m].centroid_px, kTemplatePx);
       const auto tracker = CreateTracker(spec);
@@ -144,7 +144,7 @@ TEST(TrackerRegistry, TemplateTrackerFromAnImageStartsOnTheFirstFrame) {
   const Sequence& s = Rendered();
   const size_t m = 1;
   MarkerSpec spec = SpecFor(DefaultTrackerMethod(true));
-  TemplateParams& templ = std::get<TemplateParams>(spec.params);
+  TemplateParams& templ = spec.params.get<TemplateParams>();
   templ.colour = true;
   templ.image =
       s.frames[0].image(RectAround(*s.truth[0].markers[m].centroid_px, kTemplatePx)).clone();
@@ -161,7 +161,7 @@ TEST(TrackerRegistry, ColourTrackerStartsOnItsFirstFrameWithinItsRoi) {
   const Sequence& s = Rendered();
   MarkerSpec spec = SpecFor(DefaultTrackerMethod(false));
   // Every colour is a marker: what is found depends only on where the tracker may look.
-  ColourParams& colour = std::get<ColourParams>(spec.params);
+  ColourParams& colour = spec.params.get<ColourParams>();
   colour.h = {0, 179};
   colour.s = {80, 255};
   colour.v = {40, 255};

@@ -65,10 +65,11 @@ struct TrackingConfig {
   // are the marker's TemplateParams::image; a template selected anew has no file until a saver
   // (the live window's `s`) writes one.
   std::map<std::string, std::string> template_files;
-  // Marker name -> the colour parameters a template marker keeps for the colour method: its
-  // colour keys in the file (HSV ranges picked in the live window while it matched templates),
-  // which a switch to colour (`m` in live, `--method colour`) uses. Colour markers have none.
-  std::map<std::string, ColourParams> colour_aside;
+  // Marker name -> its parameters of the kinds other than its own whose keys the file gives (a
+  // template marker's colour keys: HSV ranges picked in the live window while it matched
+  // templates), which a switch of method (`m` in live, `--method colour`) uses. At most one per
+  // kind; a marker whose file gives no other kind's keys has none.
+  std::map<std::string, std::vector<MarkerParams>> params_aside;
   MeasureOptions measure;              // Triple, chain, tip reference, metric model.
   // Lens model from `softsight calibrate` (the `camera:` key, relative to the config file).
   // Trackers work on the frames as recorded; measurements use undistorted marker positions.

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "softsight/core/types.h"
@@ -16,31 +17,56 @@
 
 namespace softsight {
 
-class CsvWriter {
+// The file side of a CSV writer: opens and locks the file (output_guard.h: a file another
+// program is writing is refused and left intact), empties it, and writes whole lines.
+class CsvFile {
  public:
-  // Opens `path` and writes the header. Throws InputError naming the file when it can't.
-  CsvWriter(const std::string& path, CsvColumnTable columns);
-  // The tracking columns (TrackingColumns(marker_names, metric)).
-  CsvWriter(const std::string& path, const std::vector<std::string>& marker_names, bool metric);
-  ~CsvWriter();
-  CsvWriter(const CsvWriter&) = delete;
-  CsvWriter& operator=(const CsvWriter&) = delete;
+  // Opens `path` and writes `header`. Throws InputError naming the file when it can't.
+  CsvFile(const std::string& path, std::string header);
+  ~CsvFile();
+  CsvFile(const CsvFile&) = delete;
+  CsvFile& operator=(const CsvFile&) = delete;
 
-  // Writes one row. Throws InputError naming the file and frame when the write fails.
-  void write(const FrameResult& result);
-
+  // Writes `line` and a newline in one write(); `frame_index` names the row in the error. Throws
+  // InputError naming the file and frame when the write fails. `line` is the caller's reused
+  // buffer (the newline is appended to it).
+  void put(std::string& line, std::optional<int64_t> frame_index);
   const std::string& path() const { return path_; }
-  const CsvColumnTable& columns() const { return columns_; }
 
  private:
-  // Writes row_ (plus the newline); frame_index names the row in the error.
-  void put(std::optional<int64_t> frame_index);
-
   std::string path_;
-  CsvColumnTable columns_;
   int fd_ = -1;
   off_t committed_bytes_ = 0;  // File size after the last complete row.
+};
+
+// One row per `Row` (which has a frame_index, naming the row in an error), from a column table.
+template <typename Row>
+class BasicCsvWriter {
+ public:
+  BasicCsvWriter(const std::string& path, BasicCsvColumnTable<Row> columns)
+      : columns_(std::move(columns)), file_(path, columns_.header()) {}
+
+  // Writes one row. Throws InputError naming the file and frame when the write fails.
+  void write(const Row& row_data) {
+    columns_.append_row(row_data, row_);
+    file_.put(row_, row_data.frame_index);
+  }
+  const std::string& path() const { return file_.path(); }
+  const BasicCsvColumnTable<Row>& columns() const { return columns_; }
+
+ private:
+  BasicCsvColumnTable<Row> columns_;
+  CsvFile file_;
   std::string row_;  // Reused buffer: no allocation per row once it has grown.
+};
+
+class CsvWriter : public BasicCsvWriter<FrameResult> {
+ public:
+  CsvWriter(const std::string& path, CsvColumnTable columns)
+      : BasicCsvWriter(path, std::move(columns)) {}
+  // The tracking columns (TrackingColumns(marker_names, metric)).
+  CsvWriter(const std::string& path, const std::vector<std::string>& marker_names, bool metric)
+      : BasicCsvWriter(path, TrackingColumns(marker_names, metric)) {}
 };
 
 }  // namespace softsight

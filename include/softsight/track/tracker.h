@@ -9,7 +9,10 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <variant>
+#include <type_traits>
+#include <typeindex>
+#include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -92,11 +95,90 @@ class Tracker {
   virtual std::optional<cv::Rect> search_region() const;
 };
 
-// A marker's tracking parameters: one of the methods' parameter sets. ColourParams: colour (or
-// gray-level) thresholding; TemplateParams: template matching, whose measure (sad, ssd, zncc) and
-// gray/colour choice it carries. The other method's parameters are not part of a marker: the live
-// window remembers them while a person switches methods.
-using MarkerParams = std::variant<ColourParams, TemplateParams>;
+class TrackerKind;  // What a kind of marker is to the program (src/track/tracker_kind.h).
+
+namespace tracker_detail {
+// The registered kind whose parameter set is of `type`. A type no kind registered is a
+// programming error: it throws std::logic_error.
+const TrackerKind& KindOfParams(std::type_index type);
+}  // namespace tracker_detail
+
+// A marker's tracking parameters: the parameter set of one kind of marker. Built in: ColourParams
+// (colour or gray-level thresholding) and TemplateParams (template matching, whose measure, sad,
+// ssd or zncc, and gray/colour choice it carries); a kind registered in src/track/ adds its own
+// set (src/track/tracker_kind.h). A value: copies are independent. What differs between kinds
+// (checks, YAML keys, what a tracker needs from a frame, how a person selects the marker) is
+// asked of kind(), so only src/track/ tells kinds apart; code that edits one kind's own fields
+// (the live window's colour ranges) asks for that set by type with get_if<P>().
+class MarkerParams {
+ public:
+  MarkerParams();  // ColourParams' defaults.
+  // Any registered kind's parameter set (implicit, so `spec.params = colour;` reads as it says).
+  template <typename P,
+            typename = std::enable_if_t<!std::is_same_v<std::decay_t<P>, MarkerParams>>>
+  MarkerParams(P params)  // NOLINT(google-explicit-constructor)
+      : kind_(&tracker_detail::KindOfParams(typeid(std::decay_t<P>))),
+        value_(std::make_unique<Value<std::decay_t<P>>>(std::move(params))) {}
+  MarkerParams(const MarkerParams& other)
+      : kind_(other.kind_), value_(other.value_ ? other.value_->clone() : nullptr) {}
+  MarkerParams(MarkerParams&&) noexcept = default;
+  MarkerParams& operator=(const MarkerParams& other) {
+    if (this != &other) *this = MarkerParams(other);
+    return *this;
+  }
+  MarkerParams& operator=(MarkerParams&&) noexcept = default;
+
+  // The kind these parameters are of.
+  const TrackerKind& kind() const { return *kind_; }
+
+  template <typename P>
+  bool holds() const {
+    return value_ != nullptr && value_->type() == std::type_index(typeid(P));
+  }
+  // The parameter set when it is a P, else null.
+  template <typename P>
+  const P* get_if() const {
+    return holds<P>() ? &static_cast<const Value<P>&>(*value_).params : nullptr;
+  }
+  template <typename P>
+  P* get_if() {
+    return holds<P>() ? &static_cast<Value<P>&>(*value_).params : nullptr;
+  }
+  // The parameter set, which must be a P (std::bad_cast otherwise).
+  template <typename P>
+  const P& get() const {
+    if (const P* params = get_if<P>()) return *params;
+    throw std::bad_cast();
+  }
+  template <typename P>
+  P& get() {
+    if (P* params = get_if<P>()) return *params;
+    throw std::bad_cast();
+  }
+  // Replaces the parameters with a default P and returns it.
+  template <typename P>
+  P& emplace() {
+    *this = MarkerParams(P{});
+    return get<P>();
+  }
+
+ private:
+  struct Holder {
+    virtual ~Holder() = default;
+    virtual std::unique_ptr<Holder> clone() const = 0;
+    virtual std::type_index type() const = 0;
+  };
+  template <typename P>
+  struct Value final : Holder {
+    explicit Value(P p) : params(std::move(p)) {}
+    std::unique_ptr<Holder> clone() const override { return std::make_unique<Value>(params); }
+    std::type_index type() const override { return typeid(P); }
+    P params;
+  };
+
+  const TrackerKind* kind_;
+  std::unique_ptr<Holder> value_;
+};
 
 // Everything needed to build the tracker of one marker.
 struct MarkerSpec {
@@ -115,10 +197,10 @@ std::vector<std::string> TrackerMethods();
 // The name of the method `params` select ("colour", or the template's measure: "sad", ...).
 std::string TrackerMethodName(const MarkerParams& params);
 
-// The parameters of `method`: `colour` for the colour method, else `templ` with the method's
-// measure. Throws InputError listing the methods when `method` is not one of them.
-MarkerParams ParamsForMethod(const std::string& method, const ColourParams& colour,
-                             const TemplateParams& templ);
+// The parameters of `method`: the first of `known` of the method's kind (else that kind's
+// defaults) with the method selected (a template's measure). Throws InputError listing the
+// methods when `method` is not one of them.
+MarkerParams ParamsForMethod(const std::string& method, const std::vector<MarkerParams>& known);
 
 // The method of a marker whose config names none: template matching (zncc) when it has a
 // template, else colour.
