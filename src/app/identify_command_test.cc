@@ -304,6 +304,10 @@ struct Plant {
   double tube_s;
 };
 
+// The plant's name is all a test name needs (gtest would print the bytes of the struct,
+// pointer included: ctest's list of tests would change with every link).
+void PrintTo(const Plant& plant, std::ostream* os) { *os << plant.name; }
+
 class PlantSweep : public ::testing::TestWithParam<Plant> {};
 
 TEST_P(PlantSweep, AfterIdentifyAStepSettlesQuicklyAndASineIsFollowed) {

@@ -52,7 +52,7 @@ TrackOptions BendingRun(const TempDir& dir, const std::string& csv, int64_t fram
 }
 
 // The CSV as rows of fields, header first.
-std::vector<std::vector<std::string>> ReadCsv(const std::string& path) {
+std::vector<std::vector<std::string>> ReadCsvCells(const std::string& path) {
   std::vector<std::vector<std::string>> rows;
   for (const std::string& line : ReadLines(path)) rows.push_back(SplitCsv(line));
   return rows;
@@ -125,7 +125,7 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
   EXPECT_EQ((*hello)["format"], "softsight-stream");
   EXPECT_EQ((*hello)["config_digest"].get<std::string>().size(), 16u);
 
-  const std::vector<std::vector<std::string>> csv = ReadCsv(options.csv_file);
+  const std::vector<std::vector<std::string>> csv = ReadCsvCells(options.csv_file);
   ASSERT_EQ(summary.frames, 90);
   ASSERT_EQ(csv.size(), 91u);
   const std::vector<std::string>& header = csv[0];
@@ -146,7 +146,7 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
   EXPECT_TRUE(heard.ended);
   EXPECT_EQ(heard.records, 90);
   EXPECT_EQ(heard.frame_gaps, 0);
-  const std::vector<std::vector<std::string>> copy = ReadCsv(listen.csv_file);
+  const std::vector<std::vector<std::string>> copy = ReadCsvCells(listen.csv_file);
   ASSERT_EQ(copy.size(), csv.size());
   EXPECT_EQ(copy[0], header);
   for (size_t r = 1; r < csv.size(); ++r) {
@@ -182,8 +182,8 @@ TEST(Stream, StalledSubscriberLeavesTheRowsAndCountsDrops) {
   stalled.connect(publish.endpoint);
   const RunSummary summary = RunTrack(options);
 
-  const auto a = ReadCsv(plain.csv_file);
-  const auto b = ReadCsv(options.csv_file);
+  const auto a = ReadCsvCells(plain.csv_file);
+  const auto b = ReadCsvCells(options.csv_file);
   ASSERT_EQ(a.size(), 151u);
   ASSERT_EQ(b.size(), a.size());
   for (size_t r = 0; r < a.size(); ++r) {
@@ -251,7 +251,7 @@ TEST(Stream, TargetFromVentsWhenTheSourceFallsSilent) {
   targets.send(zmq::str_buffer("target {\"angle_deg\": 150}"));
   const ControlSummary summary = controlled.get();
 
-  const auto csv = ReadCsv(options.csv_file);
+  const auto csv = ReadCsvCells(options.csv_file);
   ASSERT_GT(csv.size(), 50u);
   const auto column = [&](const std::string& name) {
     return static_cast<size_t>(std::find(csv[0].begin(), csv[0].end(), name) - csv[0].begin());

@@ -37,6 +37,10 @@ struct PlantCase {
   double sine_rms_deg = 2.0;
 };
 
+// The case's name is all a test name needs (gtest would print the struct's bytes, pointer
+// included: ctest's list of tests would change with every link).
+void PrintTo(const PlantCase& c, std::ostream* os) { *os << c.name; }
+
 RigOptions RigFor(const PlantCase& c) {
   RigOptions rig;
   rig.plant.bend_deg_per_kpa = c.bend_deg_per_kpa;
