@@ -405,8 +405,26 @@ void LiveController::drag(const cv::Rect& dragged) {
     }
   }
   const int marker = count == 1 ? *inside : active_;
-  remember_for_undo(marker, "reselection");
   const MarkerSpec& spec = config().markers[marker];
+  // A box in which the marker's own tracker finds nothing (empty background, or a colour the
+  // marker's range does not take) would leave the marker lost: it is refused and the marker
+  // stays as it was. (A template box with no marker in it is refused by its tracker's init.)
+  try {
+    const Frame frame = on_screen();
+    std::unique_ptr<Tracker> trial = CreateTracker(spec);
+    trial->init(frame.image, rect);
+    if (!trial->update(frame.image).found()) {
+      say(spec.name + ": the box [" + std::to_string(rect.x) + ", " + std::to_string(rect.y) +
+          ", " + std::to_string(rect.width) + ", " + std::to_string(rect.height) +
+          "] holds nothing its tracker takes for the marker; drag it around the marker (or "
+          "click the marker first to pick its colour)");
+      return;
+    }
+  } catch (const InputError& e) {
+    say(e.what());
+    return;
+  }
+  remember_for_undo(marker, "reselection");
   try {
     // The session remembers the selection in its config (the template's pixels, or the colour
     // search box), so that `s` saves it.

@@ -667,6 +667,31 @@ TEST_F(LiveFileTest, PausedFileStopsAndRecordingRowsAreTheSourcesFramesThatTrack
   EXPECT_EQ(again, live_rows);
 }
 
+// A box dragged on empty background while the active marker tracks by colour is refused: the
+// marker is not lost, and keeps being found where it is.
+TEST_F(LiveFileTest, AColourBoxOnBackgroundIsRefusedAndTheMarkerKeepsItsPlace) {
+  const std::string video = WriteVideo(12);
+  FakeClock clock;
+  std::unique_ptr<PacedFrameSource> source = PlayFile(video, clock);
+  LiveController live(SceneConfig(), Options());
+  LiveFeed feed(*source);
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(feed.step(live));
+  live.on_event(UiEvent::Key(' '));
+  ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "colour");
+  const cv::Point2d red = *live.last_result()->markers[0].observation.position_px;
+  Drag(live, {20, 20}, {44, 44});
+  EXPECT_NE(live.message().find("holds nothing its tracker takes"), std::string::npos)
+      << live.message();
+  EXPECT_FALSE(live.config().markers[0].params.get<ColourParams>().roi.has_value() &&
+               *live.config().markers[0].params.get<ColourParams>().roi == cv::Rect(20, 20, 24, 24));
+  ASSERT_TRUE(live.last_result()->markers[0].observation.found());
+  EXPECT_EQ(*live.last_result()->markers[0].observation.position_px, red);
+  // A box around the marker is taken.
+  Drag(live, red - cv::Point2d(12, 12), red + cv::Point2d(12, 12));
+  EXPECT_NE(live.message().find("reselected"), std::string::npos) << live.message();
+  EXPECT_TRUE(live.last_result()->markers[0].observation.found());
+}
+
 // A recording started after edits made while paused (every marker switched to SAD, a box dragged
 // on empty background and refused, a box dragged around a marker) reproduces under `track`: the
 // recording starts from a session built afresh from its config, not one that keeps what it
