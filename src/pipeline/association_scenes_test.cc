@@ -557,10 +557,12 @@ TEST(AssociationScenes, ATemplateOnAStickerTurningWithAWheelFollowsItAllTheWayRo
     const SceneScore s = TrackScene(scene, config, {2}, count, 1.5)[0];
     EXPECT_EQ(s.wrong, 0) << s.first_wrong;
     EXPECT_GE(s.found, count - 3);
+    // Without it, a third of a turn shows the loss (2-4 of 48 found; 4-10 of 144 before).
     config.markers[0].params.get<TemplateParams>().turn_search = false;
-    const SceneScore fixed = TrackScene(scene, config, {2}, count, 1.5)[0];
+    const int third = count / 3;
+    const SceneScore fixed = TrackScene(scene, config, {2}, third, 1.5)[0];
     EXPECT_EQ(fixed.wrong, 0) << fixed.first_wrong;
-    EXPECT_LT(fixed.found, count / 2);
+    EXPECT_LT(fixed.found, third / 2);
   }
 }
 
