@@ -173,8 +173,9 @@ class DotScene {
         const double a = pose.angle_deg * CV_PI / 180.0;
         const cv::Point2d off(shape.highlight_offset.x * radii.width,
                               shape.highlight_offset.y * radii.height);
-        const cv::Point2d c = pose.centre_px + cv::Point2d(off.x * std::cos(a) - off.y * std::sin(a),
-                                                           off.x * std::sin(a) + off.y * std::cos(a));
+        const cv::Point2d turned(off.x * std::cos(a) - off.y * std::sin(a),
+                                 off.x * std::sin(a) + off.y * std::cos(a));
+        const cv::Point2d c = pose.centre_px + turned;
         out->push_back(EllipseDrawing(c, radii * shape.highlight_fraction, pose.angle_deg,
                                       *shape.highlight_bgr));
       }
@@ -188,8 +189,9 @@ class DotScene {
       d.br = cv::Point(cvRound((r.x + r.width + 0.5) * kSs) - 1,
                        cvRound((r.y + r.height + 0.5) * kSs) - 1);
       d.bgr = cv::Scalar(cover.bgr);
-      d.reach = cv::Rect(cv::Point(cvFloor(d.tl.x / double(kSs)) - 1, cvFloor(d.tl.y / double(kSs)) - 1),
-                         cv::Point(cvFloor(d.br.x / double(kSs)) + 2, cvFloor(d.br.y / double(kSs)) + 2));
+      const auto out_px = [](int big) { return cvFloor(big / static_cast<double>(kSs)); };
+      d.reach = cv::Rect(cv::Point(out_px(d.tl.x) - 1, out_px(d.tl.y) - 1),
+                         cv::Point(out_px(d.br.x) + 2, out_px(d.br.y) + 2));
       out->push_back(d);
     }
   }
@@ -214,8 +216,8 @@ class DotScene {
     }
     const cv::Rect frame_rect(cv::Point(0, 0), options_.size);
     for (cv::Rect& r : *out) r &= frame_rect;
-    out->erase(std::remove_if(out->begin(), out->end(), [](const cv::Rect& r) { return r.empty(); }),
-               out->end());
+    const auto empty = [](const cv::Rect& r) { return r.empty(); };
+    out->erase(std::remove_if(out->begin(), out->end(), empty), out->end());
   }
 
   void MakeBackground() {
