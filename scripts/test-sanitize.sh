@@ -1,8 +1,15 @@
 #!/usr/bin/env bash
-# The whole test suite again, built with AddressSanitizer + UBSan in build-sanitize/ (clang, -O1;
-# README's second, optional test command; CI runs it after scripts/test.sh). Any memory error,
-# leak (system libraries in scripts/sanitizer/lsan.supp aside) or undefined behaviour fails the
-# test that caused it. The same tree holds the fuzz targets (scripts/fuzz.sh), built here too.
+# The suite again with AddressSanitizer + UBSan (clang, -O1; README's second, optional test
+# command; CI runs it after scripts/test.sh). Any memory error, leak (system libraries in
+# scripts/sanitizer/lsan.supp aside) or undefined behaviour fails the test that caused it.
+# One instrumented tree, build-sanitize/, holds the program, the fuzz targets (scripts/fuzz.sh)
+# and the tests of the modules that take outside input (scripts/sanitizer/configure.sh lists
+# them). Two runs:
+#   1. those modules' tests, instrumented;
+#   2. the plain tree's end-to-end tests of every command (ctest label `app`: hostile configs,
+#      videos, CSVs, boards over a pseudo-terminal, signals) against the instrumented program,
+#      so the commands run instrumented without compiling their tests a second time (they run the
+#      program; their own code is the harness). Needs the plain tree: built first if absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -10,18 +17,35 @@ source scripts/sanitizer/env.sh
 source scripts/sanitizer/configure.sh
 ConfigureSanitizeTree "$@"
 cmake --build build-sanitize --parallel "$(nproc)"
-# The renderer draws the same pictures with clang as with GCC (each random draw in its own
-# statement), so the golden pixel hashes and the noise-4 textured bench run here too.
-# Left to the plain suite (scripts/test.sh runs every test): 14 of the 16 identification runs on
-# simulated plants, the same code on other plant parameters, 8-10 s each under ASan; the shipped
-# plant's two runs stay. (A parameterised test's name goes on with "  # GetParam() = ...".)
-# Likewise the three longest template scenes of the association tests (60-110 s each under ASan:
-# 144-200 frames of template matching on other footage); the template code they run is run
-# here by the template tracker's tests and the other association scenes (the rim's sticker
-# turning under a box mostly of tyre, the carts).
-SKIP='^Identify/Plants\..*/(big_laggy|big_stiff|mid|stiff_fast|stiff_slow|weak_fast|weak_slow) '
-SKIP+='|^AssociationScenes\.(ATemplateOnAStickerTurningWithAWheelFollowsItAllTheWayRound|'
-SKIP+='TemplateMarkersOnAMovingPlateAreFollowedOrLostNeverSwapped|'
-SKIP+='ATemplateMarkerIsNotTakenForIdenticalDotsComingIntoView)$'
-cd build-sanitize
-ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -E "$SKIP"
+if [ ! -x build/src/app/softsight_app_test ]; then scripts/build.sh; fi
+
+# Left to the plain suite: the same code on more frames, more parameters or more commands, run
+# here by shorter tests (a parameterised test's name goes on with "  # GetParam() = ..."):
+#  - the association scenes (tens to hundreds of frames of rendered footage each, 5-110 s under
+#    ASan; the session's association code runs here in the pipeline module's other tests and in
+#    every end-to-end `track` run);
+#  - the accuracy and equivalence sweeps of the trackers (the soft centroid against the textbook's
+#    on hundreds of positions, the HSV kernel on every colour, windowed against whole-frame
+#    search) whose code the trackers' other tests run;
+#  - the identification runs on simulated plants but the shipped plant's, and the ten-plant sweep
+#    of `identify` followed by `control` (10-15 s each under ASan);
+#  - of the end-to-end tests, those that measure how well a command tracks (init, pick, evaluate,
+#    synth, track-many's jobs, the camera seam, one pipeline for three commands); every refusal,
+#    hostile input, board and signal test runs against the instrumented program.
+LONG='^AssociationScenes\.'
+LONG+='|^ColourVerification\.SoftCentroidAccuracyAgainstBinaryAndTextbook$'
+LONG+='|^ColourKernels\.VectorHsvTestIsOpenCvsForEveryColour$'
+LONG+='|^TemplateTrackerTest\.WindowedSearchEqualsFullFrameSearch$'
+LONG+='|^ColourTrackerScene\.WindowedEqualsWholeFrameAndCoarseEqualsFullResolution$'
+LONG+='|^Identify/Plants\..*/(big_laggy|big_stiff|mid|stiff_fast|stiff_slow|weak_fast|weak_slow'
+LONG+='|fast_tube|shipped_tube) '
+LONG+='|^TenPlants/PlantSweep\.'
+LONG+='|^(TrackMany|InitCommand|InitSweep|PickCommand|OnePipeline|EvaluateTest|EvaluateVideo)\.'
+LONG+='|^(SynthCommandTest|TrackCamera)\.'
+start=$SECONDS
+(cd build-sanitize && ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -E "$LONG")
+echo "sanitize: instrumented tests done in $((SECONDS - start)) s"
+start=$SECONDS
+(cd build && SOFTSIGHT_BINARY="$PWD/../build-sanitize/src/app/softsight" \
+   ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -L '^app$' -E "$LONG")
+echo "sanitize: end-to-end tests against the instrumented program done in $((SECONDS - start)) s"

@@ -6,6 +6,12 @@
 # ASan means nothing), no Python module (an instrumented module cannot be loaded by the plain
 # interpreter), no public-header compile check (the plain build has it; it finds nothing at run
 # time). No -Werror: the plain build (scripts/test.sh) holds warnings at zero.
+# The tests built instrumented: the modules that take outside input (configs, videos, CSVs, board
+# answers, the stream) or hold the trackers' and the session's pixel arithmetic. The commands'
+# end-to-end tests are not rebuilt: scripts/test-sanitize.sh runs the plain tree's against the
+# instrumented program. The renderer, calibration, geometry and the live window run instrumented
+# inside the program and the tests above, and plainly in scripts/test.sh.
+SANITIZE_TEST_MODULES="core;config;io;control;stream;track;pipeline;firmware"
 ConfigureSanitizeTree() {
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
@@ -13,5 +19,6 @@ ConfigureSanitizeTree() {
     -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
     -DSOFTSIGHT_SANITIZE=ON -DSOFTSIGHT_FUZZ=ON -DSOFTSIGHT_BUILD_BENCHMARKS=OFF \
     -DSOFTSIGHT_BUILD_PYTHON=OFF -DSOFTSIGHT_CHECK_PUBLIC_HEADERS=OFF -DSOFTSIGHT_WERROR=OFF \
+    -DSOFTSIGHT_TEST_MODULES="$SANITIZE_TEST_MODULES" \
     "$@" >/dev/null
 }
