@@ -18,7 +18,6 @@ cv::Mat DistortionMat(const std::vector<double>& distortion) {
   return cv::Mat(distortion, /*copyData=*/true).reshape(1, 1);
 }
 
-
 cv::FileStorage OpenForReading(const std::string& file) {
   // Checked first: FileStorage would also log its own error line for a missing file.
   std::error_code ignored;

@@ -62,8 +62,8 @@ class GoldenStereoPairs : public ::testing::Test {
   static void SetUpTestSuite() {
     pairs_ = new std::vector<SamplePair>();
     for (const char* number : kPairNumbers) {
-      SamplePair pair{std::string("left") + number + ".jpg", std::string("right") + number + ".jpg",
-                      {}, {}};
+      SamplePair pair{
+          std::string("left") + number + ".jpg", std::string("right") + number + ".jpg", {}, {}};
       for (const std::string* name : {&pair.left_name, &pair.right_name}) {
         if (!samples::OpenCvSample(*name)) {
           missing_ = new std::string(*name);
@@ -169,7 +169,8 @@ TEST_F(GoldenStereoPairs, BaselineAndRotationAgreeWithOpenCvsStereoCalibrate) {
   const DirectStereo sample = CallStereoCalibrate(clean_left, clean_right);
   EXPECT_NEAR(stereo.baseline_mm() / sample.baseline_mm, 1.0, 0.01);
   EXPECT_LT(RotationDifferenceDeg(stereo.R, sample.R), 0.3);
-  std::cout << "[ figures  ] baseline " << stereo.baseline_mm() << " mm; cv::stereoCalibrate on the "
+  std::cout << "[ figures  ] baseline " << stereo.baseline_mm()
+            << " mm; cv::stereoCalibrate on the "
             << "same corners " << direct.baseline_mm << " mm, rotation "
             << RotationDifferenceDeg(stereo.R, direct.R) << " deg apart; OpenCV's sample detection "
             << sample.baseline_mm << " mm, " << RotationDifferenceDeg(stereo.R, sample.R)
@@ -265,10 +266,10 @@ TEST_F(GoldenStereoPairs, APairWithTheBoardInOneViewOnlyAndAMismatchedPairAreLef
                            cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))),
             StereoPairStatus::kLeftOnly);
   // Two views of different moments: the board is in both, but they do not fit the rig.
-  EXPECT_EQ(calibrator.add_corners("left03.jpg", FindChessboard((*pairs_)[2].left, grid),
-                                   "right09.jpg", FindChessboard((*pairs_)[8].right, grid),
-                                   cv::Size(640, 480)),
-            StereoPairStatus::kUsed);
+  EXPECT_EQ(
+      calibrator.add_corners("left03.jpg", FindChessboard((*pairs_)[2].left, grid), "right09.jpg",
+                             FindChessboard((*pairs_)[8].right, grid), cv::Size(640, 480)),
+      StereoPairStatus::kUsed);
   const StereoCalibrationResult result = calibrator.calibrate();
   ASSERT_EQ(result.pairs.size(), std::size(kPairNumbers) + 2);
   EXPECT_EQ(result.pairs[std::size(kPairNumbers)].status, StereoPairStatus::kLeftOnly);

@@ -62,7 +62,10 @@ bool StereoCalibration::Check(std::string* error) const {
   const std::pair<const char*, cv::Mat> matrices[] = {
       {"camera_matrix_left", cv::Mat(left.camera_matrix)},
       {"camera_matrix_right", cv::Mat(right.camera_matrix)},
-      {"R", cv::Mat(R)}, {"T", cv::Mat(T)}, {"F", cv::Mat(F)}, {"P1", cv::Mat(P1)},
+      {"R", cv::Mat(R)},
+      {"T", cv::Mat(T)},
+      {"F", cv::Mat(F)},
+      {"P1", cv::Mat(P1)},
       {"P2", cv::Mat(P2)}};
   for (const auto& [name, m] : matrices) {
     if (!Finite(m)) {
@@ -125,8 +128,7 @@ StereoCalibrator::StereoCalibrator(StereoCalibrationOptions options)
 }
 
 StereoPairStatus StereoCalibrator::add(const std::string& left_name, const cv::Mat& left_image,
-                                       const std::string& right_name,
-                                       const cv::Mat& right_image) {
+                                       const std::string& right_name, const cv::Mat& right_image) {
   if (left_image.empty()) throw InputError(left_name + ": empty image");
   if (right_image.empty()) throw InputError(right_name + ": empty image");
   if (left_image.size() != right_image.size()) {
@@ -146,8 +148,9 @@ StereoPairStatus StereoCalibrator::add_corners(
   if (image_size_.empty()) {
     image_size_ = image_size;
   } else if (image_size != image_size_) {
-    throw InputError(left_name + ": image is " + SizeText(image_size) + " but the first pair's are " +
-                     SizeText(image_size_) + "; calibrate one resolution at a time");
+    throw InputError(left_name + ": image is " + SizeText(image_size) +
+                     " but the first pair's are " + SizeText(image_size_) +
+                     "; calibrate one resolution at a time");
   }
   if (left_corners && right_corners) {
     // findChessboardCorners may start a board at either end (a 180 degree turn of the grid),
@@ -236,8 +239,8 @@ StereoCalibrationResult StereoCalibrator::calibrate() const {
       throw InputError("only " + std::to_string(kept.size()) + " of " +
                        std::to_string(both.size()) +
                        " pairs with the board in both views fit together (reprojection error "
-                       "below " + std::to_string(limit) + " px), need at least " +
-                       std::to_string(min_views) +
+                       "below " +
+                       std::to_string(limit) + " px), need at least " + std::to_string(min_views) +
                        ": were the pairs taken at the same moment, and do left and right match?");
     }
     used = std::move(kept);
@@ -274,9 +277,11 @@ void SaveStereoCalibration(const StereoCalibrationResult& result, const Chessboa
   fs << "rms_px" << s.rms_px;
   fs << "baseline_mm" << s.baseline_mm();
   fs << "pairs_used" << result.pairs_used();
-  fs << "pairs" << "[";
+  fs << "pairs"
+     << "[";
   for (const StereoPairReport& pair : result.pairs) {
-    fs << "{" << "left" << pair.left_name << "right" << pair.right_name << "status"
+    fs << "{"
+       << "left" << pair.left_name << "right" << pair.right_name << "status"
        << StereoPairStatusName(pair.status);
     if (pair.left_rms_px) fs << "left_rms_px" << *pair.left_rms_px;
     if (pair.right_rms_px) fs << "right_rms_px" << *pair.right_rms_px;

@@ -44,11 +44,11 @@ class RenderedStereoPairs : public ::testing::Test {
     look.supersample = 2;
     const ChessboardRenderer left(rig_->left, RigPattern(), look);
     const ChessboardRenderer right(rig_->right, RigPattern(), look);
-    const double poses[][6] = {
-        {300, 0, 0, 0, 0, 0},      {280, 25, 0, 5, -15, 10},  {280, -25, 0, -5, 15, -10},
-        {290, 0, 25, 10, 10, 15},  {290, 0, -25, -10, -10, -15}, {320, 20, 20, 15, -20, -15},
-        {320, -20, 20, -15, 20, 15}, {320, 20, -20, 3, 20, -15}, {260, -20, -20, -3, -5, 10},
-        {340, 30, 10, 0, 0, 20}};
+    const double poses[][6] = {{300, 0, 0, 0, 0, 0},         {280, 25, 0, 5, -15, 10},
+                               {280, -25, 0, -5, 15, -10},   {290, 0, 25, 10, 10, 15},
+                               {290, 0, -25, -10, -10, -15}, {320, 20, 20, 15, -20, -15},
+                               {320, -20, 20, -15, 20, 15},  {320, 20, -20, 3, 20, -15},
+                               {260, -20, -20, -3, -5, 10},  {340, 30, 10, 0, 0, 20}};
     for (const auto& p : poses) {
       const BoardPose pose = LookAtBoard(RigPattern(), p[0], p[1], p[2], p[3], p[4], p[5]);
       cv::Mat l, r;
@@ -101,8 +101,9 @@ TEST_F(RenderedStereoPairs, RecoversTheRigsPoseAndLenses) {
 
 TEST_F(RenderedStereoPairs, FileRoundTripKeepsTheRig) {
   const StereoCalibrationResult result = Calibrate();
-  const std::string file =
-      (std::filesystem::temp_directory_path() / ("softsight_stereo_" + std::to_string(::getpid()) + ".yaml")).string();
+  const std::string file = (std::filesystem::temp_directory_path() /
+                            ("softsight_stereo_" + std::to_string(::getpid()) + ".yaml"))
+                               .string();
   SaveStereoCalibration(result, Options().camera.board, file);
   const StereoCalibration loaded = LoadStereoCalibration(file);
   std::filesystem::remove(file);
@@ -129,8 +130,9 @@ TEST_F(RenderedStereoPairs, TooFewPairsWithTheBoardInBothViewsIsAnError) {
 }
 
 TEST(StereoCalibrationFileTest, AMissingKeyIsNamed) {
-  const std::string file =
-      (std::filesystem::temp_directory_path() / ("softsight_stereo_bad_" + std::to_string(::getpid()) + ".yaml")).string();
+  const std::string file = (std::filesystem::temp_directory_path() /
+                            ("softsight_stereo_bad_" + std::to_string(::getpid()) + ".yaml"))
+                               .string();
   {
     cv::FileStorage fs(file, cv::FileStorage::WRITE);
     fs << "image_width" << 640 << "image_height" << 480;
@@ -140,7 +142,8 @@ TEST(StereoCalibrationFileTest, AMissingKeyIsNamed) {
     LoadStereoCalibration(file);
     FAIL() << "loaded a file without the right camera";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(file + ": camera_matrix_right: missing"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find(file + ": camera_matrix_right: missing"),
+              std::string::npos)
         << e.what();
   }
   std::filesystem::remove(file);

@@ -76,9 +76,9 @@ Triangulator::Triangulator(StereoCalibration stereo, TriangulationOptions option
   left_projection_ = stereo_.left.camera_matrix * identity;
   const cv::Matx33d& r = stereo_.R;
   const cv::Vec3d& t = stereo_.T;
-  right_projection_ = stereo_.right.camera_matrix *
-                      cv::Matx34d(r(0, 0), r(0, 1), r(0, 2), t[0], r(1, 0), r(1, 1), r(1, 2), t[1],
-                                  r(2, 0), r(2, 1), r(2, 2), t[2]);
+  right_projection_ =
+      stereo_.right.camera_matrix * cv::Matx34d(r(0, 0), r(0, 1), r(0, 2), t[0], r(1, 0), r(1, 1),
+                                                r(1, 2), t[1], r(2, 0), r(2, 1), r(2, 2), t[2]);
 }
 
 cv::Point2d Triangulator::undistort_left(const cv::Point2d& raw_px) const {
@@ -93,9 +93,8 @@ cv::Point2d Triangulator::undistort_left(const cv::Point2d& raw_px) const {
 cv::Point2d Triangulator::undistort_right(const cv::Point2d& raw_px) const {
   cv::Point2d out;
   cv::undistortPoints(cv::Mat(1, 1, CV_64FC2, const_cast<cv::Point2d*>(&raw_px)),
-                      cv::Mat(1, 1, CV_64FC2, &out), stereo_.right.camera_matrix,
-                      right_distortion_, cv::noArray(), stereo_.right.camera_matrix,
-                      kUndistortCriteria);
+                      cv::Mat(1, 1, CV_64FC2, &out), stereo_.right.camera_matrix, right_distortion_,
+                      cv::noArray(), stereo_.right.camera_matrix, kUndistortCriteria);
   return out;
 }
 
@@ -150,11 +149,10 @@ StereoPoint Triangulator::triangulate(const std::optional<cv::Point2d>& left_px,
 
   static const cv::Matx33d kIdentity = cv::Matx33d::eye();
   static const cv::Vec3d kZero(0, 0, 0);
-  const View views[2] = {
-      {stereo_.left.camera_matrix, kIdentity, kZero, l,
-       left_sigma_px.value_or(options_.position_sigma_px)},
-      {stereo_.right.camera_matrix, stereo_.R, stereo_.T, r,
-       right_sigma_px.value_or(options_.position_sigma_px)}};
+  const View views[2] = {{stereo_.left.camera_matrix, kIdentity, kZero, l,
+                          left_sigma_px.value_or(options_.position_sigma_px)},
+                         {stereo_.right.camera_matrix, stereo_.R, stereo_.T, r,
+                          right_sigma_px.value_or(options_.position_sigma_px)}};
 
   // Gauss-Newton on the weighted reprojection error: the linear solution minimises an
   // algebraic error that weights the two views by their depths, not by their pixels.

@@ -28,7 +28,8 @@ TEST(TriangulatorTest, ExactProjectionsGiveTheExactPoint) {
   const Triangulator triangulator(CalibrationOfRig(rig));
   for (const cv::Point3d truth : {cv::Point3d(0, 0, 300), cv::Point3d(-40, 30, 250),
                                   cv::Point3d(55, -35, 380), cv::Point3d(10, 60, 200)}) {
-    const StereoPoint p = triangulator.triangulate(ProjectLeft(rig, truth), ProjectRight(rig, truth));
+    const StereoPoint p =
+        triangulator.triangulate(ProjectLeft(rig, truth), ProjectRight(rig, truth));
     ASSERT_TRUE(p.found()) << truth;
     EXPECT_LT(cv::norm(*p.position_mm - truth), 1e-6) << truth;
     EXPECT_LT(*p.epipolar_px, 1e-6);
@@ -159,12 +160,14 @@ SceneErrors MeasureScene(const StereoScene& scene, int first_plane_frame) {
       ++angles;
     }
     if (index < first_plane_frame || !shape.out_of_plane_deg || !shape.angle_deg) continue;
-    errors.worst_out_of_plane_error_deg = std::max(
-        errors.worst_out_of_plane_error_deg, std::abs(*shape.out_of_plane_deg - truth.plane_tilt_deg));
+    errors.worst_out_of_plane_error_deg =
+        std::max(errors.worst_out_of_plane_error_deg,
+                 std::abs(*shape.out_of_plane_deg - truth.plane_tilt_deg));
     errors.worst_3d_angle_error_deg =
         std::max(errors.worst_3d_angle_error_deg, std::abs(*shape.angle_deg - truth.angle_deg));
     if (tracked_left[0] && tracked_left[1] && tracked_left[2]) {
-      const std::optional<double> flat = AngleAtMiddleDeg(*tracked_left[0], *tracked_left[1], *tracked_left[2]);
+      const std::optional<double> flat =
+          AngleAtMiddleDeg(*tracked_left[0], *tracked_left[1], *tracked_left[2]);
       if (flat) {
         errors.worst_2d_angle_error_deg =
             std::max(errors.worst_2d_angle_error_deg, std::abs(*flat - truth.angle_deg));
@@ -191,7 +194,8 @@ TEST(StereoSceneTriangulationTest, MarkersAndTheAngleIn3dAtThreeHundredMillimetr
             << errors.angle_rms_deg << " deg RMS\n";
 }
 
-TEST(StereoSceneTriangulationTest, ABendThirtyDegreesOutOfTheImagePlaneIsMeasuredWhereOneCameraIsNot) {
+TEST(StereoSceneTriangulationTest,
+     ABendThirtyDegreesOutOfTheImagePlaneIsMeasuredWhereOneCameraIsNot) {
   // Bent 60 to 100 degrees in a plane tilted 30 degrees: the 3D angle and the plane's tilt
   // within 0.5 degrees, while the angle the left camera sees is off by more.
   StereoSceneOptions options;
@@ -202,8 +206,9 @@ TEST(StereoSceneTriangulationTest, ABendThirtyDegreesOutOfTheImagePlaneIsMeasure
   EXPECT_LT(errors.worst_out_of_plane_error_deg, 0.5);
   EXPECT_LT(errors.worst_3d_angle_error_deg, 0.5);
   EXPECT_GT(errors.worst_2d_angle_error_deg, 0.5);
-  std::cout << "[ figures  ] 30 deg out of plane: plane tilt error " << errors.worst_out_of_plane_error_deg
-            << " deg, 3D angle error " << errors.worst_3d_angle_error_deg << " deg, one camera's 2D angle error "
+  std::cout << "[ figures  ] 30 deg out of plane: plane tilt error "
+            << errors.worst_out_of_plane_error_deg << " deg, 3D angle error "
+            << errors.worst_3d_angle_error_deg << " deg, one camera's 2D angle error "
             << errors.worst_2d_angle_error_deg << " deg\n";
 }
 

@@ -77,7 +77,8 @@ std::optional<PlaneFit3d> FitPlane3d(const std::vector<cv::Point3d>& points) {
 
   PlaneFit3d plane;
   plane.centroid = centroid;
-  plane.normal = cv::normalize(cv::Vec3d(eigenvectors(2, 0), eigenvectors(2, 1), eigenvectors(2, 2)));
+  plane.normal =
+      cv::normalize(cv::Vec3d(eigenvectors(2, 0), eigenvectors(2, 1), eigenvectors(2, 2)));
   const cv::Vec3d orientation = Vec(points[1] - points[0]).cross(Vec(points.back() - points[0]));
   if (orientation.dot(plane.normal) < 0) plane.normal = -plane.normal;
   plane.rms_residual =
@@ -148,10 +149,12 @@ Shape3d MeasureShape3d(const std::vector<std::optional<cv::Point3d>>& chain,
     shape.plane_normal = circle->normal;
     shape.radius = circle->radius;
     shape.arc_length = ArcLength3d(*circle, found);
-    if (reference_normal) shape.out_of_plane_deg = AngleBetweenPlanesDeg(circle->normal, *reference_normal);
+    if (reference_normal)
+      shape.out_of_plane_deg = AngleBetweenPlanesDeg(circle->normal, *reference_normal);
   } else if (const std::optional<PlaneFit3d> plane = FitPlane3d(found)) {
     shape.plane_normal = plane->normal;
-    if (reference_normal) shape.out_of_plane_deg = AngleBetweenPlanesDeg(plane->normal, *reference_normal);
+    if (reference_normal)
+      shape.out_of_plane_deg = AngleBetweenPlanesDeg(plane->normal, *reference_normal);
   }
   if (tip && tip_reference) shape.tip_disp = cv::norm(*tip - *tip_reference);
   return shape;

@@ -12,8 +12,8 @@ namespace softsight {
 namespace {
 
 using ::testing::DoubleNear;
-using ::testing::Optional;
 using testing::kTol;
+using ::testing::Optional;
 
 // A point on a circle of `radius` about `centre` in the plane spanned by unit vectors u and v.
 cv::Point3d OnCircle3d(const cv::Point3d& centre, const cv::Vec3d& u, const cv::Vec3d& v,
@@ -40,7 +40,8 @@ TEST(Shape3dTest, AngleAtMiddleIsTheTriangleAngleInAnyOrientation) {
   EXPECT_THAT(AngleAtMiddle3dDeg(middle + cv::Point3d(a[0], a[1], a[2]), middle,
                                  middle + cv::Point3d(b[0], b[1], b[2])),
               Optional(DoubleNear(90.0, kTol)));
-  EXPECT_THAT(AngleAtMiddle3dDeg({0, 0, 0}, {1, 1, 1}, {2, 2, 2}), Optional(DoubleNear(180.0, kTol)));
+  EXPECT_THAT(AngleAtMiddle3dDeg({0, 0, 0}, {1, 1, 1}, {2, 2, 2}),
+              Optional(DoubleNear(180.0, kTol)));
   EXPECT_EQ(AngleAtMiddle3dDeg({1, 2, 3}, {1, 2, 3}, {5, 5, 5}), std::nullopt);
 }
 
@@ -48,7 +49,8 @@ TEST(Shape3dTest, PlaneOfPointsOnATiltedCircleHasTheTiltedNormal) {
   cv::Vec3d u, v, n;
   TiltedPlane(30.0, u, v, n);
   std::vector<cv::Point3d> points;
-  for (double a : {200.0, 240.0, 280.0, 320.0}) points.push_back(OnCircle3d({5, 8, 310}, u, v, 60, a));
+  for (double a : {200.0, 240.0, 280.0, 320.0})
+    points.push_back(OnCircle3d({5, 8, 310}, u, v, 60, a));
   const std::optional<PlaneFit3d> plane = FitPlane3d(points);
   ASSERT_TRUE(plane.has_value());
   EXPECT_NEAR(std::abs(plane->normal.dot(n)), 1.0, kTol);
@@ -84,7 +86,8 @@ TEST(Shape3dTest, CircleFitRecoversRadiusCentreAndArcLengthOfATiltedArc) {
   EXPECT_NEAR(cv::norm(circle->centre - centre), 0.0, 1e-7);
   EXPECT_NEAR(circle->rms_residual, 0.0, 1e-7);
   // 200 degrees of arc: past a half circle, so the major arc.
-  EXPECT_THAT(ArcLength3d(*circle, points), Optional(DoubleNear(45.0 * 200.0 * std::numbers::pi / 180.0, 1e-6)));
+  EXPECT_THAT(ArcLength3d(*circle, points),
+              Optional(DoubleNear(45.0 * 200.0 * std::numbers::pi / 180.0, 1e-6)));
 }
 
 TEST(Shape3dTest, MeasureShapeOfAThreeMarkerChainBentOutOfTheImagePlane) {
@@ -101,7 +104,8 @@ TEST(Shape3dTest, MeasureShapeOfAThreeMarkerChainBentOutOfTheImagePlane) {
   EXPECT_THAT(shape.angle_deg, Optional(DoubleNear(120.0, 1e-9)));
   EXPECT_THAT(shape.out_of_plane_deg, Optional(DoubleNear(30.0, 1e-7)));
   EXPECT_THAT(shape.radius, Optional(DoubleNear(50.0, 1e-7)));
-  EXPECT_THAT(shape.arc_length, Optional(DoubleNear(50.0 * 120.0 * std::numbers::pi / 180.0, 1e-6)));
+  EXPECT_THAT(shape.arc_length,
+              Optional(DoubleNear(50.0 * 120.0 * std::numbers::pi / 180.0, 1e-6)));
   EXPECT_THAT(shape.tip_disp, Optional(DoubleNear(5.0, kTol)));
 
   // The middle marker lost: no angle, no plane from two points, the tip still moves.

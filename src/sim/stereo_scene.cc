@@ -119,7 +119,8 @@ StereoSceneTruth StereoScene::truth(int index) const {
   StereoSceneTruth truth;
   truth.index = index;
   truth.bend_deg = o.max_bend_deg * t;
-  const double tilt_deg = o.plane_tilt_start_deg + (o.plane_tilt_end_deg - o.plane_tilt_start_deg) * t;
+  const double tilt_deg =
+      o.plane_tilt_start_deg + (o.plane_tilt_end_deg - o.plane_tilt_start_deg) * t;
 
   // The bending direction: perpendicular to the straight direction, turned `tilt` from the
   // image-parallel direction towards the camera's axis.
@@ -139,10 +140,10 @@ StereoSceneTruth StereoScene::truth(int index) const {
   const cv::Vec3d base = ToVec(o.base_mm);
   for (const StereoMarker& marker : o.markers) {
     const double s = marker.body_fraction * o.length_mm;
-    const cv::Vec3d p =
-        curvature > 0 ? base + (std::sin(curvature * s) / curvature) * d0 +
-                            ((1.0 - std::cos(curvature * s)) / curvature) * bend_direction
-                      : base + s * d0;
+    const cv::Vec3d p = curvature > 0
+                            ? base + (std::sin(curvature * s) / curvature) * d0 +
+                                  ((1.0 - std::cos(curvature * s)) / curvature) * bend_direction
+                            : base + s * d0;
     StereoMarkerTruth m;
     m.name = marker.name;
     m.position_mm = ToPoint(p);
@@ -199,11 +200,10 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
                             cv::saturate_cast<int>(p.y * (1 << kShift)));
     }
     const double depth = (rotation * ToVec(o.base_mm) + translation)[2];
-    const int thickness =
-        std::max(1, static_cast<int>(std::lround(o.body_width_mm * camera.camera_matrix(0, 0) / depth)));
-    cv::polylines(image, polyline, false,
-                  cv::Scalar(o.body_bgr[0], o.body_bgr[1], o.body_bgr[2]), thickness, cv::LINE_AA,
-                  kShift);
+    const int thickness = std::max(
+        1, static_cast<int>(std::lround(o.body_width_mm * camera.camera_matrix(0, 0) / depth)));
+    cv::polylines(image, polyline, false, cv::Scalar(o.body_bgr[0], o.body_bgr[1], o.body_bgr[2]),
+                  thickness, cv::LINE_AA, kShift);
   }
 
   // The markers: flat discs in the bending plane's orientation. Each sub-sample's ray (through
@@ -224,7 +224,8 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
     }
     std::vector<cv::Point2d> rim_px;
     cv::projectPoints(rim, cv::Vec3d(), cv::Vec3d(), camera.camera_matrix, distortion, rim_px);
-    const cv::Rect2d bounds = cv::boundingRect(std::vector<cv::Point2f>(rim_px.begin(), rim_px.end()));
+    const cv::Rect2d bounds =
+        cv::boundingRect(std::vector<cv::Point2f>(rim_px.begin(), rim_px.end()));
     const cv::Rect box = cv::Rect(static_cast<int>(std::floor(bounds.x)) - 2,
                                   static_cast<int>(std::floor(bounds.y)) - 2,
                                   static_cast<int>(std::ceil(bounds.width)) + 5,
@@ -243,9 +244,9 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
       }
     }
     std::vector<cv::Point2d> rays;
-    cv::undistortPoints(samples, rays, camera.camera_matrix, distortion, cv::noArray(),
-                        cv::noArray(),
-                        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+    cv::undistortPoints(
+        samples, rays, camera.camera_matrix, distortion, cv::noArray(), cv::noArray(),
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
     const double plane_offset = normal.dot(centre);
     const double r2 = o.marker_radius_mm * o.marker_radius_mm;
     const cv::Vec3b colour = o.markers[m].bgr;

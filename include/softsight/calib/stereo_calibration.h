@@ -56,11 +56,11 @@ struct StereoCalibrationOptions {
 
 // What happened to one pair of views.
 enum class StereoPairStatus {
-  kUsed,           // The board in both views, and the pair fits the others.
-  kLeftOnly,       // The board was found in the left view only.
-  kRightOnly,      // ... in the right view only.
-  kNeither,        // ... in neither view.
-  kOutlier,        // Found in both, but its reprojection error does not fit the other pairs.
+  kUsed,       // The board in both views, and the pair fits the others.
+  kLeftOnly,   // The board was found in the left view only.
+  kRightOnly,  // ... in the right view only.
+  kNeither,    // ... in neither view.
+  kOutlier,    // Found in both, but its reprojection error does not fit the other pairs.
 };
 // "used", "left_only", "right_only", "neither", "outlier".
 const char* StereoPairStatusName(StereoPairStatus status);

@@ -35,7 +35,7 @@ std::optional<double> AngleBetweenPlanesDeg(const cv::Vec3d& normal_a, const cv:
 
 struct CircleFit3d {
   cv::Point3d centre;
-  cv::Vec3d normal;           // The plane the circle lies in (unit).
+  cv::Vec3d normal;  // The plane the circle lies in (unit).
   double radius = 0.0;
   double rms_residual = 0.0;  // RMS distance of the points from the circle, in 3D.
 };
@@ -46,16 +46,17 @@ std::optional<CircleFit3d> FitCircle3d(const std::vector<cv::Point3d>& points);
 
 // Length along `circle` from the first to the last point through the others in order (as
 // ArcLengthThroughPoints, after projecting the points into the circle's plane).
-std::optional<double> ArcLength3d(const CircleFit3d& circle, const std::vector<cv::Point3d>& points);
+std::optional<double> ArcLength3d(const CircleFit3d& circle,
+                                  const std::vector<cv::Point3d>& points);
 
 // What a frame's 3D markers give.
 struct Shape3d {
-  std::optional<double> angle_deg;          // At the chain's middle marker.
-  std::optional<cv::Vec3d> plane_normal;    // The bending plane (all found markers).
-  std::optional<double> out_of_plane_deg;   // Bending plane vs the reference plane.
-  std::optional<double> radius;             // 3D circle fit through all found markers.
-  std::optional<double> arc_length;         // Along that circle, base to tip.
-  std::optional<double> tip_disp;           // Tip from its reference position.
+  std::optional<double> angle_deg;         // At the chain's middle marker.
+  std::optional<cv::Vec3d> plane_normal;   // The bending plane (all found markers).
+  std::optional<double> out_of_plane_deg;  // Bending plane vs the reference plane.
+  std::optional<double> radius;            // 3D circle fit through all found markers.
+  std::optional<double> arc_length;        // Along that circle, base to tip.
+  std::optional<double> tip_disp;          // Tip from its reference position.
 };
 
 // `chain`: the markers base to tip (3 or more), absent where not found. The angle needs the

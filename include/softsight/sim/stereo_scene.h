@@ -21,7 +21,7 @@ namespace softsight {
 struct StereoRig {
   CameraModel left, right;
   cv::Matx33d R = cv::Matx33d::eye();  // right_from_left.
-  cv::Vec3d T{-100, 0, 0};             // right_from_left (mm); the right camera 100 mm to the right.
+  cv::Vec3d T{-100, 0, 0};  // right_from_left (mm); the right camera 100 mm to the right.
 };
 
 // Two 640x480 webcams (f 600 px, mild barrel distortion, slightly different lenses), side by
@@ -61,12 +61,11 @@ struct StereoSceneOptions {
   // sees an ellipse), centred on the centre line.
   double marker_radius_mm = 3.0;
   double body_width_mm = 12.0;
-  std::vector<StereoMarker> markers = {{"red", {40, 40, 220}, 0.1},
-                                       {"blue", {220, 90, 40}, 0.5},
-                                       {"green", {60, 200, 60}, 0.9}};
+  std::vector<StereoMarker> markers = {
+      {"red", {40, 40, 220}, 0.1}, {"blue", {220, 90, 40}, 0.5}, {"green", {60, 200, 60}, 0.9}};
   cv::Vec3b body_bgr{200, 200, 205};
   cv::Vec3b background_bgr{105, 110, 115};
-  int supersample = 4;  // Sub-samples per pixel side for the markers' edges (1..16).
+  int supersample = 4;       // Sub-samples per pixel side for the markers' edges (1..16).
   double noise_sigma = 0.0;  // Gaussian sensor noise, grey levels.
   uint64_t seed = 7;
 
@@ -76,19 +75,19 @@ struct StereoSceneOptions {
 
 struct StereoMarkerTruth {
   std::string name;
-  cv::Point3d position_mm;    // The disc's centre.
+  cv::Point3d position_mm;        // The disc's centre.
   cv::Point2d left_px, right_px;  // Its projection (raw pixels) in each view.
 };
 
 struct StereoSceneTruth {
   int index = 0;
-  double bend_deg = 0.0;              // Total turning of the centre line.
-  double plane_tilt_deg = 0.0;        // The bending plane vs the left camera's image plane.
-  cv::Vec3d plane_normal;             // Unit normal of the bending plane.
+  double bend_deg = 0.0;        // Total turning of the centre line.
+  double plane_tilt_deg = 0.0;  // The bending plane vs the left camera's image plane.
+  cv::Vec3d plane_normal;       // Unit normal of the bending plane.
   std::vector<StereoMarkerTruth> markers;
   // From the true 3D centres (base, middle, tip: the first, middle and last marker).
-  double angle_deg = 0.0;             // At the middle marker, in 3D.
-  std::optional<double> radius_mm;    // Of the centre line (absent when straight).
+  double angle_deg = 0.0;           // At the middle marker, in 3D.
+  std::optional<double> radius_mm;  // Of the centre line (absent when straight).
 };
 
 class StereoScene {
