@@ -55,6 +55,7 @@ __all__ = [
     "sim",
     "stream",
     "track",
+    "track_stereo",
     "__version__",
 ]
 
@@ -106,6 +107,41 @@ def track(
         error.table = table
         raise error
     return table
+
+
+def track_stereo(
+    left: PathLike,
+    right: PathLike,
+    config: Union[Config, PathLike, dict],
+    stereo: PathLike,
+    max_frames: Optional[int] = None,
+    *,
+    right_config: Union[Config, PathLike, dict, None] = None,
+    frame_offset: int = 0,
+    max_epipolar_px: float = 2.0,
+    reference_plane: str = "image",
+    fps: float = 30.0,
+) -> Table:
+    """Tracks the markers of ``config`` in two views of a calibrated pair of cameras and returns
+    the columns ``softsight track-stereo`` writes (docs/stereo.md).
+
+    ``left`` and ``right`` are videos, folders of images or printf patterns; ``stereo`` is the
+    file of ``softsight calibrate --left ... --right ...``. Right frame ``i + frame_offset`` is
+    paired with left frame ``i``. ``right_config``: the right view's markers when they need other
+    colours or rois (the same names). A marker has ``<m>_X/_Y/_Z`` (mm, the first camera's frame)
+    only when both views found it and the pair passed the epipolar check (``max_epipolar_px``);
+    ``<m>_status`` says why not. ``reference_plane``: "image" or "first" (what the out-of-plane
+    angle is measured against).
+
+    Returns a Table (``frame`` and ``right_frame`` int64, ``<m>_status`` str, the rest float64,
+    NaN for an empty field); ``table.summary`` has ``pairs``, ``found`` and ``epipolar`` (per
+    marker) and ``baseline_mm``. Raises InputError with the CLI's message for bad input.
+    """
+    columns, summary = _core._track_stereo(
+        left, right, config, stereo, max_frames, right_config, frame_offset, max_epipolar_px,
+        reference_plane, fps
+    )
+    return Table(columns, summary)
 
 
 def frames(

@@ -141,6 +141,19 @@ def track(
     fps: float = 30.0,
     method: Optional[str] = None,
 ) -> Table: ...
+def track_stereo(
+    left: PathLike,
+    right: PathLike,
+    config: ConfigSource,
+    stereo: PathLike,
+    max_frames: Optional[int] = None,
+    *,
+    right_config: Optional[ConfigSource] = None,
+    frame_offset: int = 0,
+    max_epipolar_px: float = 2.0,
+    reference_plane: str = "image",
+    fps: float = 30.0,
+) -> Table: ...
 def frames(
     input: PathLike,
     config: ConfigSource,

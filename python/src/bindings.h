@@ -22,6 +22,7 @@ void BindTrack(py::module_& m);
 void BindGeometry(py::module_& m);
 void BindSim(py::module_& m);
 void BindCalib(py::module_& m);
+void BindStereo(py::module_& m);
 
 // A config as Python holds it: the library's config and where it came from (a path or a dict),
 // which is what a pickle carries (a Dask worker reloads it, with the same checks).

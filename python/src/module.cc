@@ -40,4 +40,5 @@ PYBIND11_MODULE(_core, m) {
   softsight::python::BindGeometry(m);
   softsight::python::BindSim(m);
   softsight::python::BindCalib(m);
+  softsight::python::BindStereo(m);
 }

@@ -3,25 +3,26 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <optional>
 #include <set>
+#include <sstream>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "app/commands.h"
 #include "io/sequence_pattern.h"
 #include "softsight/calib/camera_calibration.h"
+#include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
+#include "softsight/io/output_guard.h"
 
 namespace softsight {
 namespace fs = std::filesystem;
 namespace {
-
-using ViewCallback = std::function<void(const std::string& name, const cv::Mat& image)>;
 
 bool IsImageFile(const fs::path& path) {
   static const std::set<std::string> kExtensions = {".png", ".jpg", ".jpeg", ".bmp", ".tif",
@@ -39,54 +40,105 @@ cv::Mat ReadImage(const std::string& file) {
   return image;
 }
 
+// The views of one input, read one at a time (a video is never held in memory): a folder (its
+// image files in name order), a numbered pattern (every file it names, in number order, whatever
+// the first number and gaps), one image, or a video (every `step`-th frame). `option` names the
+// input in messages ("--input", "--left").
+class ViewSequence {
+ public:
+  ViewSequence(const std::string& input, const std::string& option, int step)
+      : option_(option), step_(step) {
+    std::error_code error;
+    if (fs::is_directory(input, error)) {
+      std::vector<fs::path> files;
+      for (const fs::directory_entry& entry : fs::directory_iterator(input)) {
+        if (entry.is_regular_file() && IsImageFile(entry.path())) files.push_back(entry.path());
+      }
+      if (files.empty())
+        throw InputError(option + " " + input + ": the folder holds no image files");
+      std::sort(files.begin(), files.end());
+      for (const fs::path& file : files)
+        files_.push_back({file.filename().string(), file.string()});
+      return;
+    }
+    if (input.find('%') != std::string::npos && !fs::exists(input, error)) {
+      // Parsed, never handed to printf: "%s" in the user's text must not be a format. A gap
+      // (OpenCV's left01 .. left14 has no left10) is not the end: every file is a view, named by
+      // its file, and the report says which numbers were missing.
+      const std::vector<NumberedFile> files = ListSequenceFiles(ParseSequencePattern(input));
+      if (files.empty()) throw InputError(option + " " + input + ": no file matches the pattern");
+      for (const NumberedFile& file : files) {
+        files_.push_back({fs::path(file.path).filename().string(), file.path});
+      }
+      if (const std::optional<std::string> gaps = DescribeNumberingGaps(files)) {
+        note_ =
+            option + " " + input + ": " + *gaps + "; every file found is a view, named by its file";
+      }
+      return;
+    }
+    if (!fs::is_regular_file(input, error)) {
+      throw InputError(option + " " + input + ": no such file or folder");
+    }
+    if (IsImageFile(input)) {
+      files_.push_back({fs::path(input).filename().string(), input});
+      return;
+    }
+    video_.open(input);
+    if (!video_.isOpened()) {
+      throw InputError(option + " " + input + ": cannot open as a video (and it is no image)");
+    }
+    video_file_ = input;
+  }
 
-// Every view in `input`: a folder (its image files in name order), a numbered pattern (every
-// file it names, in number order, whatever the first number and gaps) or a video (every
-// `step`-th frame). Returns what the report should say about the input (gaps in a pattern's
-// numbering), if anything.
-std::optional<std::string> ForEachView(const std::string& input, int step,
-                                       const ViewCallback& callback) {
-  std::error_code error;
-  if (fs::is_directory(input, error)) {
-    std::vector<fs::path> files;
-    for (const fs::directory_entry& entry : fs::directory_iterator(input)) {
-      if (entry.is_regular_file() && IsImageFile(entry.path())) files.push_back(entry.path());
+  // The next view; false at the end.
+  bool next(std::string& name, cv::Mat& image) {
+    if (!video_.isOpened()) {
+      if (next_file_ >= files_.size()) return false;
+      const NamedFile& file = files_[next_file_++];
+      name = file.name;
+      image = ReadImage(file.path);
+      return true;
     }
-    if (files.empty()) throw InputError("--input " + input + ": the folder holds no image files");
-    std::sort(files.begin(), files.end());
-    for (const fs::path& file : files) callback(file.filename().string(), ReadImage(file.string()));
-    return std::nullopt;
-  }
-  if (input.find('%') != std::string::npos && !fs::exists(input, error)) {
-    // Parsed, never handed to printf: "%s" in the user's text must not be a format. A gap
-    // (OpenCV's left01 .. left14 has no left10) is not the end: every file is a view, named by
-    // its file, and the report says which numbers were missing.
-    const std::vector<NumberedFile> files = ListSequenceFiles(ParseSequencePattern(input));
-    if (files.empty()) throw InputError("--input " + input + ": no file matches the pattern");
-    for (const NumberedFile& file : files) {
-      callback(fs::path(file.path).filename().string(), ReadImage(file.path));
+    // Every step-th frame; the ones between are read and dropped (grab would not decode
+    // them, but a video's frames must be read in order anyway).
+    for (; video_.read(image); ++frame_index_) {
+      if (frame_index_ % step_ == 0) {
+        name = "frame " + std::to_string(frame_index_++);
+        return true;
+      }
     }
-    const std::optional<std::string> gaps = DescribeNumberingGaps(files);
-    if (!gaps) return std::nullopt;
-    return "--input " + input + ": " + *gaps + "; every file found is a view, named by its file";
+    return false;
   }
-  if (!fs::is_regular_file(input, error)) {
-    throw InputError("--input " + input + ": no such file or folder");
+
+  bool is_video() const { return video_.isOpened() || !video_file_.empty(); }
+  // Absent for a video (its length is only known at its end).
+  std::optional<size_t> file_count() const {
+    if (is_video()) return std::nullopt;
+    return files_.size();
   }
-  if (IsImageFile(input)) {
-    callback(fs::path(input).filename().string(), ReadImage(input));
-    return std::nullopt;
+  // What the report should say about the input (gaps in a pattern's numbering), if anything.
+  const std::optional<std::string>& note() const { return note_; }
+  // The files read, for the output guard.
+  std::vector<PathRole> inputs() const {
+    std::vector<PathRole> roles;
+    if (is_video()) roles.push_back({option_, video_file_});
+    for (const NamedFile& file : files_) roles.push_back({option_, file.path});
+    return roles;
   }
-  cv::VideoCapture video(input);
-  if (!video.isOpened()) {
-    throw InputError("--input " + input + ": cannot open as a video (and it is no image)");
-  }
-  cv::Mat frame;
-  for (int index = 0; video.read(frame); ++index) {
-    if (index % step == 0) callback("frame " + std::to_string(index), frame);
-  }
-  return std::nullopt;
-}
+
+ private:
+  struct NamedFile {
+    std::string name, path;
+  };
+  std::string option_;
+  int step_ = 1;
+  std::vector<NamedFile> files_;
+  size_t next_file_ = 0;
+  cv::VideoCapture video_;
+  std::string video_file_;
+  int frame_index_ = 0;
+  std::optional<std::string> note_;
+};
 
 ChessboardSpec BoardFrom(const CalibrateOptions& options) {
   ChessboardSpec board;
@@ -105,10 +157,11 @@ CalibrateSummary CalibrateCameraMode(const CalibrateOptions& options, const Ches
   calibration.board = board;
   calibration.estimate_k3 = options.estimate_k3;
   ChessboardCalibrator calibrator(calibration);
-  const std::optional<std::string> input_note =
-      ForEachView(*options.input, options.step, [&](const std::string& name, const cv::Mat& image) {
-        calibrator.add(name, image);
-      });
+  ViewSequence views(*options.input, "--input", options.step);
+  std::string name;
+  cv::Mat image;
+  while (views.next(name, image)) calibrator.add(name, image);
+  const std::optional<std::string>& input_note = views.note();
   const CalibrationResult result = calibrator.calibrate();
   SaveCameraCalibration(result, board, options.out_file);
 
@@ -169,19 +222,149 @@ CalibrateSummary CalibratePlaneMode(const CalibrateOptions& options, const Chess
   return summary;
 }
 
+std::string PairName(const StereoPairReport& pair) {
+  return pair.left_name + " + " + pair.right_name;
+}
+
+CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const ChessboardSpec& board,
+                                     std::ostream& report) {
+  ViewSequence left(*options.left, "--left", options.step);
+  ViewSequence right(*options.right, "--right", options.step);
+  if (left.file_count() && right.file_count() && *left.file_count() != *right.file_count()) {
+    throw InputError("--left has " + std::to_string(*left.file_count()) + " images but --right " +
+                     std::to_string(*right.file_count()) +
+                     ": the views are paired one to one in order, so each needs its partner");
+  }
+  std::vector<PathRole> inputs = left.inputs();
+  for (PathRole& role : right.inputs()) inputs.push_back(std::move(role));
+  CheckOutputsAreNotInputs(
+      {{"--out", options.out_file}, {"--picture", options.picture_file.value_or("")}}, inputs);
+
+  StereoCalibrationOptions calibration;
+  calibration.camera.board = board;
+  calibration.camera.estimate_k3 = options.estimate_k3;
+  StereoCalibrator calibrator(calibration);
+  std::string left_name, right_name;
+  cv::Mat left_image, right_image, picture_left, picture_right;
+  std::string picture_pair;
+  std::optional<std::string> length_note;
+  while (true) {
+    const bool have_left = left.next(left_name, left_image);
+    const bool have_right = right.next(right_name, right_image);
+    if (!have_left || !have_right) {
+      if (have_left || have_right) {
+        length_note = std::string(have_left ? "--right" : "--left") +
+                      " ended first: the other's views after " +
+                      (have_left ? left_name : right_name) + " have no partner and were not used";
+      }
+      break;
+    }
+    const StereoPairStatus status = calibrator.add(left_name, left_image, right_name, right_image);
+    if (status == StereoPairStatus::kUsed && picture_left.empty() && options.picture_file) {
+      picture_left = left_image.clone();
+      picture_right = right_image.clone();
+      picture_pair = left_name + " + " + right_name;
+    }
+  }
+  const StereoCalibrationResult result = calibrator.calibrate();
+  SaveStereoCalibration(result, board, options.out_file);
+
+  CalibrateSummary summary;
+  summary.pairs = static_cast<int>(result.pairs.size());
+  summary.pairs_used = result.pairs_used();
+  summary.baseline_mm = result.stereo.baseline_mm();
+  summary.rms_px = result.stereo.rms_px;
+  summary.fx_px = result.stereo.left.camera_matrix(0, 0);
+  summary.fy_px = result.stereo.left.camera_matrix(1, 1);
+  for (const ViewSequence* views : {&left, &right}) {
+    if (views->note()) report << *views->note() << "\n";
+  }
+  if (length_note) report << *length_note << "\n";
+  report << std::fixed << std::setprecision(2);
+  report << "board " << options.chessboard << " (" << board.square_mm
+         << " mm squares) in both views of " << summary.pairs_used << " of " << summary.pairs
+         << " pairs (" << result.stereo.left.image_size.width << "x"
+         << result.stereo.left.image_size.height << ")\n";
+  report << std::setprecision(3);
+  for (const StereoPairReport& pair : result.pairs) {
+    if (pair.status == StereoPairStatus::kUsed) {
+      report << "  " << PairName(pair) << ": " << *pair.left_rms_px << " / " << *pair.right_rms_px
+             << " px\n";
+      continue;
+    }
+    std::string why;
+    switch (pair.status) {
+      case StereoPairStatus::kLeftOnly: why = "board in the left view only"; break;
+      case StereoPairStatus::kRightOnly: why = "board in the right view only"; break;
+      case StereoPairStatus::kNeither: why = "board in neither view"; break;
+      case StereoPairStatus::kOutlier: {
+        std::ostringstream text;
+        text << std::fixed << std::setprecision(3) << "does not fit the other pairs ("
+             << *pair.left_rms_px << " / " << *pair.right_rms_px
+             << " px: did the board move between the two pictures?)";
+        why = text.str();
+        break;
+      }
+      case StereoPairStatus::kUsed: break;
+    }
+    report << "  " << PairName(pair) << ": left out, " << why << "\n";
+    summary.left_out.push_back(PairName(pair) + ": " + StereoPairStatusName(pair.status));
+  }
+  const StereoCalibration& s = result.stereo;
+  cv::Vec3d rotation;
+  cv::Rodrigues(s.R, rotation);
+  report << std::setprecision(2) << "left camera: fx " << s.left.camera_matrix(0, 0) << " px, RMS "
+         << result.left_rms_px << " px; right camera: fx " << s.right.camera_matrix(0, 0)
+         << " px, RMS " << result.right_rms_px << " px\n";
+  report << "baseline " << s.baseline_mm() << " mm, cameras turned "
+         << cv::norm(rotation) * 180.0 / CV_PI << " deg apart; stereo reprojection RMS "
+         << std::setprecision(3) << s.rms_px << " px"
+         << (s.rms_px > 1.0 ? " (high: were the pairs taken at the same moment?)" : "") << "\n";
+  report << "wrote " << options.out_file << "\n";
+  if (options.picture_file) {
+    const cv::Mat picture = DrawRectifiedPair(s, picture_left, picture_right);
+    bool written = false;
+    try {
+      written = cv::imwrite(*options.picture_file, picture);
+    } catch (const cv::Exception&) {
+    }
+    if (!written) {
+      throw InputError(
+          "--picture " + *options.picture_file +
+          ": cannot write (use an image extension such as .png, in a writable folder)");
+    }
+    report << "wrote " << *options.picture_file << " (" << picture_pair
+           << " rectified: each point of the scene should lie on one line in both halves)\n";
+  }
+  report.unsetf(std::ios::floatfield);
+  return summary;
+}
+
 }  // namespace
 
 CalibrateSummary RunCalibrate(const CalibrateOptions& options, std::ostream& report) {
-  if (options.input.has_value() == options.plane_image.has_value()) {
-    throw InputError("give either --input FRAMES (camera calibration) or --plane IMAGE (scale in "
-                     "the actuator's plane)");
+  const bool stereo = options.left.has_value() || options.right.has_value();
+  if (stereo && options.left.has_value() != options.right.has_value()) {
+    throw InputError(std::string("--") + (options.left ? "right" : "left") +
+                     ": stereo calibration needs both --left and --right views");
   }
+  if (static_cast<int>(options.input.has_value()) +
+          static_cast<int>(options.plane_image.has_value()) + static_cast<int>(stereo) !=
+      1) {
+    throw InputError(
+        "give one of --input FRAMES (camera calibration), --plane IMAGE (scale in "
+        "the actuator's plane) or --left FRAMES --right FRAMES (two cameras)");
+  }
+  if (options.picture_file && !stereo)
+    throw InputError("--picture is used with --left and --right only");
   if (options.camera_file && !options.plane_image) {
     throw InputError("--camera is used with --plane only");
   }
   if (options.out_file.empty()) throw InputError("--out: give the file to write");
-  if (options.step < 1) throw InputError("--step: must be >= 1, got " + std::to_string(options.step));
+  if (options.step < 1)
+    throw InputError("--step: must be >= 1, got " + std::to_string(options.step));
   const ChessboardSpec board = BoardFrom(options);
+  if (stereo) return CalibrateStereoMode(options, board, report);
   return options.input ? CalibrateCameraMode(options, board, report)
                        : CalibratePlaneMode(options, board, report);
 }
@@ -194,7 +377,10 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub) {
       "  softsight calibrate --input shots/ --chessboard 9x6 --square-mm 25 --out camera.yaml\n"
       "  softsight calibrate --plane board_on_table.png --camera camera.yaml --chessboard 9x6 "
       "--square-mm 25 --out plane.yaml\n"
-      "Then put `camera: camera.yaml` and `plane: plane.yaml` in the tracking config.\n"
+      "  softsight calibrate --left left/ --right right/ --chessboard 9x6 --square-mm 25 "
+      "--out stereo.yaml --picture epipolar.png\n"
+      "Then put `camera: camera.yaml` and `plane: plane.yaml` in the tracking config; a\n"
+      "stereo.yaml is for `track-stereo` (docs/stereo.md).\n"
       "Take 10-20 views of the board filling much of the frame at different tilts and\n"
       "positions, including the image corners.");
   auto* input = sub.add_option("--input", options->input,
@@ -204,6 +390,17 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub) {
                                "One image of the chessboard lying flat in the actuator's plane: "
                                "writes the image-to-millimetre homography instead");
   input->excludes(plane);
+  auto* left =
+      sub.add_option("--left", options->left,
+                     "Two cameras: the first camera's chessboard views (folder, pattern or "
+                     "video), paired one to one in order with --right's");
+  auto* right = sub.add_option("--right", options->right,
+                               "Two cameras: the second camera's views of the same moments");
+  left->excludes(input)->excludes(plane);
+  right->excludes(input)->excludes(plane);
+  sub.add_option("--picture", options->picture_file,
+                 "With --left/--right: write the first pair rectified side by side with epipolar "
+                 "lines (PNG)");
   sub.add_option("--camera", options->camera_file,
                  "With --plane: the camera file from an earlier `calibrate --input` run, used to "
                  "remove lens distortion")
@@ -214,7 +411,8 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub) {
   sub.add_option("--square-mm", options->square_mm, "Side of one printed square in millimetres")
       ->required();
   sub.add_option("--out", options->out_file, "File to write (OpenCV YAML)")->required();
-  sub.add_option("--step", options->step, "Video input: use every N-th frame (default 1)");
+  sub.add_option("--step", options->step,
+                 "Video input: use every N-th frame (default 1; with two videos, both)");
   sub.add_flag("--k3", options->estimate_k3,
                "Also estimate the k3 radial term (wide-angle lenses only)");
   return [options] {

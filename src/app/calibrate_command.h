@@ -1,5 +1,6 @@
-// `softsight calibrate`: camera intrinsics and distortion from chessboard views, or the
-// homography from image pixels to millimetres in the actuator's plane.
+// `softsight calibrate`: camera intrinsics and distortion from chessboard views, the homography
+// from image pixels to millimetres in the actuator's plane, or a stereo rig (two cameras) from
+// pairs of chessboard views.
 #pragma once
 
 #include <iosfwd>
@@ -18,9 +19,15 @@ struct CalibrateOptions {
   // Plane mode: the camera file from camera mode, to undistort the board's corners (without it
   // the lens is assumed distortion-free).
   std::optional<std::string> camera_file;
+  // Stereo mode: the two cameras' views of the board at the same moments, each a folder, a
+  // numbered pattern or a video; paired one to one in order (file order, or frame index).
+  std::optional<std::string> left, right;
+  // Stereo mode: a picture of the first used pair, rectified side by side with horizontal lines
+  // (a point of the scene must lie on one line in both halves).
+  std::optional<std::string> picture_file;
   std::string chessboard;           // Inner corners, "9x6".
   double square_mm = 0.0;           // Side of one printed square in mm.
-  std::string out_file;             // camera.yaml or plane.yaml (OpenCV FileStorage YAML).
+  std::string out_file;             // camera.yaml, plane.yaml or stereo.yaml (OpenCV YAML).
   int step = 1;                     // Video input: use every step-th frame (neighbours repeat).
   bool estimate_k3 = false;         // Also fit k3 (wide-angle lenses).
 };
@@ -32,6 +39,10 @@ struct CalibrateSummary {
   double fx_px = 0.0, fy_px = 0.0;      // Camera mode: focal lengths.
   double mm_per_px = 0.0;               // Plane mode: scale at the board's centre.
   double rms_mm = 0.0;                  // Plane mode: homography residual on the corners.
+  int pairs = 0;                        // Stereo mode: pairs looked at ...
+  int pairs_used = 0;                   // ... and used.
+  std::vector<std::string> left_out;    // Stereo mode: "left03.jpg + right03.jpg: outlier".
+  double baseline_mm = 0.0;             // Stereo mode.
 };
 
 // Does the work and prints the report to `report`. Throws InputError for bad input (missing

@@ -195,7 +195,7 @@ TEST_F(CalibrateCommandTest, BadInputIsOneLineNamingTheCulprit) {
 
   options = CameraOptions();
   options.plane_image = (*dir_ / "plane.png").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("either --input"));
+  EXPECT_THAT(ErrorOf(options), HasSubstr("give one of --input"));
 
   fs::create_directories(*dir_ / "empty");
   options = CameraOptions();

@@ -20,6 +20,7 @@ CommandRunner SetupSynthCommand(CLI::App& sub);
 CommandRunner SetupEvaluateCommand(CLI::App& sub);
 CommandRunner SetupDemoCommand(CLI::App& sub);
 CommandRunner SetupCalibrateCommand(CLI::App& sub);
+CommandRunner SetupTrackStereoCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
 CommandRunner SetupCamerasCommand(CLI::App& sub);

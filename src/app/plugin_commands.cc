@@ -13,6 +13,7 @@ extern "C" __attribute__((visibility("default"))) int softsight_run_command(int 
       {"identify", SetupIdentifyCommand}, {"rig", SetupRigCommand},
       {"plot", SetupPlotCommand},         {"config", SetupConfigCommand},
       {"cameras", SetupCamerasCommand},   {"listen", SetupListenCommand},
+      {"track-stereo", SetupTrackStereoCommand},
   };
   return RunCommandLine(argc, argv, kCommands);
 }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <filesystem>
 #include <limits>
 #include <regex>
@@ -10,88 +9,20 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/calibration_internals.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
-namespace {
 
-std::string SizeText(const cv::Size& size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
-
-cv::Mat DistortionMat(const std::vector<double>& distortion) {
-  if (distortion.empty()) return cv::Mat();
-  return cv::Mat(distortion, /*copyData=*/true).reshape(1, 1);
-}
-
-// Undistortion of points is iterative; OpenCV's default of 5 iterations is not enough near the
-// image corners of a wide lens.
-const cv::TermCriteria kUndistortCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50,
-                                          1e-10);
-
-cv::FileStorage OpenForReading(const std::string& file) {
-  // Checked first: FileStorage would also log its own error line for a missing file.
-  std::error_code ignored;
-  const std::filesystem::file_status status = std::filesystem::status(file, ignored);
-  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot open (no such file)");
-  if (!std::filesystem::is_regular_file(status)) {
-    throw InputError(file + ": not a regular file (expected an OpenCV YAML/XML file)");
-  }
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(file, cv::FileStorage::READ)) {
-      throw InputError(file + ": cannot open (missing or not an OpenCV YAML/XML file)");
-    }
-  } catch (const cv::Exception& e) {
-    throw InputError(file + ": not a valid OpenCV YAML file (" + e.err + ")");
-  }
-  return fs;
-}
-
-cv::FileStorage OpenForWriting(const std::string& file) {
-  cv::FileStorage fs;
-  try {
-    if (fs.open(file, cv::FileStorage::WRITE)) return fs;
-  } catch (const cv::Exception&) {
-  }
-  throw InputError(file + ": cannot write (check the folder exists and is writable)");
-}
-
-cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std::string& key,
-                   int rows, int cols) {
-  cv::Mat m;
-  try {
-    fs[key] >> m;
-  } catch (const cv::Exception&) {
-    throw InputError(file + ": " + key + ": not a matrix");
-  }
-  if (m.empty()) throw InputError(file + ": " + key + ": missing");
-  if ((rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols) || m.channels() != 1) {
-    throw InputError(file + ": " + key + ": expected a " + std::to_string(rows) + "x" +
-                     std::to_string(cols) + " matrix, got " + std::to_string(m.rows) + "x" +
-                     std::to_string(m.cols));
-  }
-  m.convertTo(m, CV_64F);
-  if (!cv::checkRange(m)) throw InputError(file + ": " + key + ": has a non-finite entry");
-  return m;
-}
-
-int ReadPositiveInt(const cv::FileStorage& fs, const std::string& file, const std::string& key) {
-  const cv::FileNode node = fs[key];
-  if (node.empty() || !node.isInt() || static_cast<int>(node) <= 0) {
-    throw InputError(file + ": " + key + ": missing or not a positive integer");
-  }
-  return static_cast<int>(node);
-}
-
-std::string Now() {
-  const std::time_t t = std::time(nullptr);
-  char text[64];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return text;
-}
-
-}  // namespace
+using calib_internal::CalibrateFromCorners;
+using calib_internal::DistortionMat;
+using calib_internal::kUndistortCriteria;
+using calib_internal::Now;
+using calib_internal::OpenForReading;
+using calib_internal::OpenForWriting;
+using calib_internal::ReadMatrix;
+using calib_internal::ReadPositiveInt;
+using calib_internal::SizeText;
 
 bool ChessboardSpec::Check(std::string* error) const {
   if (inner_corners.width < 2 || inner_corners.height < 2) {
@@ -206,17 +137,8 @@ CalibrationResult ChessboardCalibrator::calibrate() const {
         " images, need at least " + std::to_string(options_.min_views) +
         " (--chessboard counts INNER corners; the whole board must be in view)");
   }
-  const std::vector<std::vector<cv::Point3f>> object_points(
-      image_corners_.size(), ChessboardObjectPoints(options_.board));
-  cv::Mat camera_matrix, distortion;
-  std::vector<cv::Mat> rvecs, tvecs;
-  const int flags = options_.estimate_k3 ? 0 : cv::CALIB_FIX_K3;
   CalibrationResult result;
-  result.rms_px = cv::calibrateCamera(object_points, image_corners_, image_size_, camera_matrix,
-                                      distortion, rvecs, tvecs, flags);
-  result.camera.image_size = image_size_;
-  result.camera.camera_matrix = cv::Matx33d(camera_matrix);
-  distortion.reshape(1, 1).copyTo(result.camera.distortion);
+  result.rms_px = CalibrateFromCorners(options_, image_size_, image_corners_, result.camera);
   result.used = used_;
   result.not_found = not_found_;
   return result;

@@ -115,6 +115,9 @@ OptionTable<ColourParams> MakeColourTable() {
                         {"soft", ColourParams::Centroid::kSoft},
                         {"binary", ColourParams::Centroid::kBinary}})
           .Doc("soft: edge pixels weighted by membership (sub-pixel); binary: the paper's mask"),
+      BoolOption<P>("rim_fit", &P::rim_fit)
+          .Doc("a round marker seen smaller than learned is placed by the circle of its size "
+               "through its visible rim (false: markers moving in depth, two cameras)"),
       DoubleOption<P>("ambiguity_margin", &P::ambiguity_margin)
           .Range(0, 10)
           .Doc("a runner-up within this misfit of the best makes the marker ambiguous (not found)"),

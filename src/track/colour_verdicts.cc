@@ -118,7 +118,8 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
 }
 
 std::optional<double> ColourTracker::rim_radius_px() const {
-  if (!model_ || model_->circularity < kMinRimCircularity || model_->area_px < kMinRimArea) {
+  if (!params_.rim_fit || !model_ || model_->circularity < kMinRimCircularity ||
+      model_->area_px < kMinRimArea) {
     return std::nullopt;
   }
   // The centres of a disc's edge pixels lie half a pixel inside its outline.

@@ -74,6 +74,12 @@ struct ColourParams {
   // kBinary: the paper's centroid of the binary mask (exact for hard-edged, unblurred markers).
   enum class Centroid { kSoft, kBinary };
   Centroid centroid = Centroid::kSoft;
+  // A round marker seen smaller than its learned area is taken as partly hidden and placed by
+  // the circle of its learned size through its visible rim (default true: a finger or a clamp
+  // over part of it does not pull it off). False: always the centroid of what is seen, for
+  // markers whose apparent size changes by itself: moving in depth or turning away from the
+  // camera (two cameras, track-stereo), where the circle of the old size lands up to 1 px off.
+  bool rim_fit = true;
 
   // ---- Verification ------------------------------------------------------------------------------
   // Each candidate gets a misfit: 0 is a perfect fit, each criterion (area, shape, colour,

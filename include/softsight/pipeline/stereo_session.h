@@ -1,0 +1,89 @@
+// Two cameras, one actuator: each view is tracked by its own TrackingSession, the markers are
+// matched across the views by name, every pair is checked against the epipolar constraint and
+// triangulated (calib/triangulation.h), and the 3D shape is measured (geometry/shape3d.h).
+// A marker is found in 3D only when both views found it and the pair is verified; otherwise its
+// status says why (never a point from an unverified pair).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/calib/stereo_calibration.h"
+#include "softsight/calib/triangulation.h"
+#include "softsight/config/config.h"
+#include "softsight/core/types.h"
+#include "softsight/geometry/shape3d.h"
+#include "softsight/io/csv_columns.h"
+
+namespace softsight {
+
+struct StereoOptions {
+  TriangulationOptions triangulation;
+  // What the out-of-plane angle is measured against: the first camera's image plane (default:
+  // a bend seen face on reads 0), or the bending plane of the first frame where it is defined
+  // (three found markers not on a line): how far the bend has turned since.
+  enum class ReferencePlane { kImage, kFirstFrame };
+  ReferencePlane reference_plane = ReferencePlane::kImage;
+
+  bool Check(std::string* error) const;
+};
+
+// "image" or "first"; throws InputError naming `what` and listing the choices.
+StereoOptions::ReferencePlane ParseReferencePlane(const std::string& text, const std::string& what);
+
+struct StereoMarkerResult {
+  std::string name;
+  Observation left, right;  // Each view's own observation (raw pixels).
+  StereoPoint point;        // The verified 3D point, or why there is none.
+  // "found", "epipolar", "behind", or the first view that did not find the marker and why
+  // ("left_lost", "right_covered", ...).
+  std::string status;
+};
+
+struct StereoFrameResult {
+  int64_t frame_index = 0;                  // The left view's frame.
+  int64_t right_frame_index = 0;            // The right view's frame paired with it.
+  double time_s = 0.0;                      // The left view's.
+  std::vector<StereoMarkerResult> markers;  // In the left config's order.
+  // In millimetres, the first camera's frame: the chain's angle, plane, circle and tip.
+  Shape3d shape;
+  // What each camera alone measures (eq. 7 on its image positions), for comparison.
+  std::optional<double> left_angle_deg, right_angle_deg;
+  double proc_ms = 0.0;
+};
+
+class StereoSession {
+ public:
+  // `left` and `right` configure each view's markers (colours may look different through two
+  // cameras; rois differ); every marker of `left` must be in `right` by name. The chain measured
+  // is left.measure's chain, else its triple. Throws InputError naming what is wrong.
+  StereoSession(const TrackingConfig& left, const TrackingConfig& right,
+                const StereoCalibration& stereo, const StereoOptions& options = {});
+  ~StereoSession();
+  StereoSession(StereoSession&&) noexcept;
+  StereoSession& operator=(StereoSession&&) noexcept;
+
+  // Tracks both frames and measures in 3D. Throws InputError when a frame's size is not the
+  // calibrated one (naming the view).
+  const StereoFrameResult& process(const Frame& left, const Frame& right);
+
+  std::vector<std::string> marker_names() const;
+  const Triangulator& triangulator() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The stereo CSV's columns: frame, right_frame, time_s; per marker <m>_X, <m>_Y, <m>_Z (mm,
+// first camera's frame), <m>_sigma_mm, <m>_epipolar_px, <m>_status; then angle_deg (3D),
+// out_of_plane_deg, plane_nx, plane_ny, plane_nz, radius_mm, arc_length_mm, tip_disp_mm,
+// angle_left_deg, angle_right_deg, proc_ms. Absent values are empty fields.
+BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names);
+
+}  // namespace softsight

@@ -1,0 +1,142 @@
+// softsight.track_stereo: two views of a calibrated pair of cameras through the same
+// StereoSession and CSV column table as `softsight track-stereo`, the columns returned as numpy
+// arrays (docs/stereo.md).
+#include <cstdlib>
+#include <limits>
+#include <memory>
+
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "softsight/calib/stereo_calibration.h"
+#include "softsight/core/error.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/io/output_guard.h"
+#include "softsight/pipeline/stereo_session.h"
+
+namespace softsight::python {
+namespace {
+
+std::string StereoPath(const py::object& value, const char* what) {
+  const std::optional<std::string> path = AsPath(value);
+  if (!path) throw py::type_error(std::string(what) + ": a path (str, bytes or os.PathLike)");
+  return *path;
+}
+
+// The rows as the CLI's CSV has them, then one numpy array per column: frame and right_frame
+// int64, <marker>_status str, every other column float64 (NaN for an empty field).
+py::dict StereoColumnsDict(const BasicCsvColumnTable<StereoFrameResult>& table,
+                           const std::vector<std::string>& rows) {
+  const size_t n = rows.size();
+  py::module_ np = py::module_::import("numpy");
+  py::dict out;
+  std::vector<std::vector<std::string>> fields(table.size(), std::vector<std::string>(n));
+  for (size_t r = 0; r < n; ++r) {
+    size_t start = 0;
+    for (size_t c = 0; c < table.size(); ++c) {
+      const size_t end = std::min(rows[r].find(',', start), rows[r].size());
+      fields[c][r] = rows[r].substr(start, end - start);
+      start = end + 1;
+    }
+  }
+  for (size_t c = 0; c < table.size(); ++c) {
+    const std::string& name = table.column(c).name;
+    const bool text = name.size() > 7 && name.compare(name.size() - 7, 7, "_status") == 0;
+    if (text) {
+      py::list values(n);
+      for (size_t r = 0; r < n; ++r) values[r] = py::str(fields[c][r]);
+      out[py::str(name)] = np.attr("array")(values, py::arg("dtype") = "U");
+    } else if (name == "frame" || name == "right_frame") {
+      py::array_t<int64_t> values(n);
+      for (size_t r = 0; r < n; ++r)
+        values.mutable_data()[r] = std::strtoll(fields[c][r].c_str(), nullptr, 10);
+      out[py::str(name)] = values;
+    } else {
+      py::array_t<double> values(n);
+      for (size_t r = 0; r < n; ++r) {
+        values.mutable_data()[r] = fields[c][r].empty()
+                                       ? std::numeric_limits<double>::quiet_NaN()
+                                       : std::strtod(fields[c][r].c_str(), nullptr);
+      }
+      out[py::str(name)] = values;
+    }
+  }
+  return out;
+}
+
+py::tuple TrackStereo(const py::object& left, const py::object& right, const py::object& config,
+                      const py::object& stereo, std::optional<int64_t> max_frames,
+                      const py::object& right_config, int64_t frame_offset, double max_epipolar_px,
+                      const std::string& reference_plane, double fps) {
+  if (max_frames && *max_frames < 0) {
+    throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
+  }
+  const TrackingConfig left_config = ResolveConfig(config, std::nullopt);
+  const TrackingConfig other_config =
+      right_config.is_none() ? left_config : ResolveConfig(right_config, std::nullopt);
+  const StereoCalibration calibration = LoadStereoCalibration(StereoPath(stereo, "stereo"));
+  StereoOptions options;
+  options.triangulation.max_epipolar_px = max_epipolar_px;
+  options.reference_plane = ParseReferencePlane(reference_plane, "reference_plane");
+  FrameSourceSpec left_spec, right_spec;
+  left_spec.input = StereoPath(left, "left");
+  right_spec.input = StereoPath(right, "right");
+  left_spec.sequence_fps = right_spec.sequence_fps = fps;
+
+  std::vector<std::string> rows;
+  int64_t pairs = 0;
+  py::dict found, epipolar;
+  std::vector<int64_t> found_count, epipolar_count;
+  std::vector<std::string> names;
+  {
+    py::gil_scoped_release release;
+    const std::unique_ptr<FrameSource> left_source = OpenFrameSource(left_spec);
+    const std::unique_ptr<FrameSource> right_source = OpenFrameSource(right_spec);
+    StereoSession session(left_config, other_config, calibration, options);
+    names = session.marker_names();
+    found_count.assign(names.size(), 0);
+    epipolar_count.assign(names.size(), 0);
+    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names);
+    Frame left_frame, right_frame;
+    FrameSource& ahead = frame_offset > 0 ? *right_source : *left_source;
+    for (int64_t skipped = 0; skipped < std::abs(frame_offset); ++skipped) {
+      if (!ahead.read(frame_offset > 0 ? right_frame : left_frame)) {
+        throw InputError("frame_offset " + std::to_string(frame_offset) + ": " +
+                         ahead.description() + " has only " + std::to_string(skipped) + " frames");
+      }
+    }
+    std::string row;
+    while (!max_frames || pairs < *max_frames) {
+      if (!left_source->read(left_frame) || !right_source->read(right_frame)) break;
+      const StereoFrameResult& result = session.process(left_frame, right_frame);
+      table.append_row(result, row);
+      rows.push_back(row);
+      ++pairs;
+      for (size_t i = 0; i < result.markers.size(); ++i) {
+        if (result.markers[i].point.found()) ++found_count[i];
+        if (result.markers[i].point.status == StereoStatus::kEpipolar) ++epipolar_count[i];
+      }
+    }
+  }
+  for (size_t i = 0; i < names.size(); ++i) {
+    found[py::str(names[i])] = found_count[i];
+    epipolar[py::str(names[i])] = epipolar_count[i];
+  }
+  py::dict summary;
+  summary["pairs"] = pairs;
+  summary["found"] = found;
+  summary["epipolar"] = epipolar;
+  summary["baseline_mm"] = calibration.baseline_mm();
+  return py::make_tuple(StereoColumnsDict(StereoColumns(names), rows), summary);
+}
+
+}  // namespace
+
+void BindStereo(py::module_& m) {
+  m.def("_track_stereo", &TrackStereo, py::arg("left"), py::arg("right"), py::arg("config"),
+        py::arg("stereo"), py::arg("max_frames"), py::arg("right_config"), py::arg("frame_offset"),
+        py::arg("max_epipolar_px"), py::arg("reference_plane"), py::arg("fps"),
+        "softsight.track_stereo without the table: (columns dict, summary dict).");
+}
+
+}  // namespace softsight::python

@@ -1,0 +1,97 @@
+"""softsight.track_stereo: the same columns as `softsight track-stereo`, and exact 3D on a rig whose
+geometry is known by construction.
+
+Both views are the built-in bending scene (the same frames). The right camera of the rig sits
+100 mm to the right with its principal point 200 px further right, so one pixel in both views is a
+point at Z = f B / 200 px = 300 mm: the actuator lies in the plane Z = 300 mm, parallel to the
+image, and its 3D angle is exactly the angle one camera measures.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softsight
+from conftest import run_cli
+
+STEREO_YAML = """%YAML:1.0
+---
+image_width: 640
+image_height: 480
+camera_matrix_left: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 600., 0., 320., 0., 600., 240., 0., 0., 1. ]
+distortion_left: !!opencv-matrix
+   rows: 1
+   cols: 5
+   dt: d
+   data: [ 0., 0., 0., 0., 0. ]
+camera_matrix_right: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 600., 0., 520., 0., 600., 240., 0., 0., 1. ]
+distortion_right: !!opencv-matrix
+   rows: 1
+   cols: 5
+   dt: d
+   data: [ 0., 0., 0., 0., 0. ]
+R: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]
+T: !!opencv-matrix
+   rows: 3
+   cols: 1
+   dt: d
+   data: [ -100., 0., 0. ]
+"""
+
+
+@pytest.fixture
+def stereo_yaml(tmp_path) -> Path:
+    path = tmp_path / "stereo.yaml"
+    path.write_text(STEREO_YAML)
+    return path
+
+
+def test_track_stereo_gives_the_cli_columns_and_exact_3d(markers_yaml, stereo_yaml, tmp_path):
+    table = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                                   max_frames=6)
+    csv_path = tmp_path / "run3d.csv"
+    run_cli("track-stereo", "-c", str(markers_yaml), "--left", "synth:bending", "--right",
+            "synth:bending", "--stereo", str(stereo_yaml), "--csv", str(csv_path),
+            "--max-frames", "6")
+    with open(csv_path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert list(table) == list(rows[0])
+    assert len(table["frame"]) == len(rows) == 6
+    assert table.summary["pairs"] == 6
+    for name in ("red", "blue", "green"):
+        assert list(table[f"{name}_status"]) == ["found"] * 6
+        assert table.summary["found"][name] == 6
+        np.testing.assert_allclose(table[f"{name}_Z"], 300.0, atol=1e-3)
+        np.testing.assert_allclose(table[f"{name}_X"], [float(r[f"{name}_X"]) for r in rows])
+    # In a plane parallel to the image the 3D angle is the 2D one, and the plane is the image's.
+    np.testing.assert_allclose(table["angle_deg"], table["angle_left_deg"], atol=1e-3)
+    out_of_plane = table["out_of_plane_deg"]
+    defined = ~np.isnan(out_of_plane)  # Not while the three markers are exactly on a line.
+    assert defined.sum() >= 3
+    np.testing.assert_allclose(out_of_plane[defined], 0.0, atol=1e-3)
+    assert table["frame"].dtype == np.int64
+
+
+def test_bad_input_gives_the_cli_message(markers_yaml, stereo_yaml, tmp_path):
+    with pytest.raises(softsight.InputError, match="missing.yaml: cannot open"):
+        softsight.track_stereo("synth:bending", "synth:bending", markers_yaml,
+                               tmp_path / "missing.yaml")
+    with pytest.raises(softsight.InputError, match="reference_plane: expected image"):
+        softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                               reference_plane="sideways")

@@ -1,0 +1,101 @@
+#include "calib/calibration_internals.h"
+
+#include <ctime>
+#include <filesystem>
+
+#include <opencv2/calib3d.hpp>
+
+#include "softsight/core/error.h"
+
+namespace softsight::calib_internal {
+
+std::string SizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+cv::Mat DistortionMat(const std::vector<double>& distortion) {
+  if (distortion.empty()) return cv::Mat();
+  return cv::Mat(distortion, /*copyData=*/true).reshape(1, 1);
+}
+
+cv::FileStorage OpenForReading(const std::string& file) {
+  // Checked first: FileStorage would also log its own error line for a missing file.
+  std::error_code ignored;
+  const std::filesystem::file_status status = std::filesystem::status(file, ignored);
+  if (!std::filesystem::exists(status)) throw InputError(file + ": cannot open (no such file)");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(file + ": not a regular file (expected an OpenCV YAML/XML file)");
+  }
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(file, cv::FileStorage::READ)) {
+      throw InputError(file + ": cannot open (missing or not an OpenCV YAML/XML file)");
+    }
+  } catch (const cv::Exception& e) {
+    throw InputError(file + ": not a valid OpenCV YAML file (" + e.err + ")");
+  }
+  return fs;
+}
+
+cv::FileStorage OpenForWriting(const std::string& file) {
+  cv::FileStorage fs;
+  try {
+    if (fs.open(file, cv::FileStorage::WRITE)) return fs;
+  } catch (const cv::Exception&) {
+  }
+  throw InputError(file + ": cannot write (check the folder exists and is writable)");
+}
+
+cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std::string& key,
+                   int rows, int cols) {
+  cv::Mat m;
+  try {
+    fs[key] >> m;
+  } catch (const cv::Exception&) {
+    throw InputError(file + ": " + key + ": not a matrix");
+  }
+  if (m.empty()) throw InputError(file + ": " + key + ": missing");
+  if ((rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols) || m.channels() != 1) {
+    throw InputError(file + ": " + key + ": expected a " + std::to_string(rows) + "x" +
+                     std::to_string(cols) + " matrix, got " + std::to_string(m.rows) + "x" +
+                     std::to_string(m.cols));
+  }
+  m.convertTo(m, CV_64F);
+  if (!cv::checkRange(m)) throw InputError(file + ": " + key + ": has a non-finite entry");
+  return m;
+}
+
+int ReadPositiveInt(const cv::FileStorage& fs, const std::string& file, const std::string& key) {
+  const cv::FileNode node = fs[key];
+  if (node.empty() || !node.isInt() || static_cast<int>(node) <= 0) {
+    throw InputError(file + ": " + key + ": missing or not a positive integer");
+  }
+  return static_cast<int>(node);
+}
+
+std::string Now() {
+  const std::time_t t = std::time(nullptr);
+  char text[64];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return text;
+}
+
+double CalibrateFromCorners(const CalibrationOptions& options, const cv::Size& image_size,
+                            const std::vector<std::vector<cv::Point2f>>& corners,
+                            CameraIntrinsics& camera, std::vector<double>* per_view_rms_px) {
+  const std::vector<std::vector<cv::Point3f>> object_points(corners.size(),
+                                                            ChessboardObjectPoints(options.board));
+  cv::Mat camera_matrix, distortion, std_intrinsics, std_extrinsics, per_view;
+  std::vector<cv::Mat> rvecs, tvecs;
+  const int flags = options.estimate_k3 ? 0 : cv::CALIB_FIX_K3;
+  const double rms_px =
+      cv::calibrateCamera(object_points, corners, image_size, camera_matrix, distortion, rvecs,
+                          tvecs, std_intrinsics, std_extrinsics, per_view, flags);
+  camera.image_size = image_size;
+  camera.camera_matrix = cv::Matx33d(camera_matrix);
+  distortion.reshape(1, 1).copyTo(camera.distortion);
+  if (per_view_rms_px != nullptr) per_view.reshape(1, 1).copyTo(*per_view_rms_px);
+  return rms_px;
+}
+
+}  // namespace softsight::calib_internal

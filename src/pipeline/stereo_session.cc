@@ -1,0 +1,208 @@
+#include "softsight/pipeline/stereo_session.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "softsight/core/error.h"
+#include "softsight/pipeline/tracking_session.h"
+
+namespace softsight {
+namespace {
+
+std::string SizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// The markers measured in 3D, base to tip: the chain, else the triple, else none.
+std::vector<std::string> ChainOf(const MeasureOptions& measure) {
+  if (!measure.chain.empty()) return measure.chain;
+  if (measure.has_triple()) return {measure.base, measure.middle, measure.tip};
+  return {};
+}
+
+const Observation* FindObservation(const FrameResult& result, const std::string& name) {
+  for (const MarkerObservation& m : result.markers) {
+    if (m.name == name) return &m.observation;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+bool StereoOptions::Check(std::string* error) const { return triangulation.Check(error); }
+
+StereoOptions::ReferencePlane ParseReferencePlane(const std::string& text,
+                                                  const std::string& what) {
+  if (text == "image") return StereoOptions::ReferencePlane::kImage;
+  if (text == "first") return StereoOptions::ReferencePlane::kFirstFrame;
+  throw InputError(what +
+                   ": expected image (the first camera's image plane) or first (the "
+                   "first frame's bending plane), got '" +
+                   text + "'");
+}
+
+struct StereoSession::Impl {
+  Impl(const TrackingConfig& left_config, const TrackingConfig& right_config,
+       const StereoCalibration& stereo, const StereoOptions& options)
+      : left(left_config),
+        right(right_config),
+        triangulator(stereo, options.triangulation),
+        options(options) {
+    for (const MarkerSpec& spec : left_config.markers) {
+      bool in_right = false;
+      for (const MarkerSpec& other : right_config.markers)
+        in_right = in_right || other.name == spec.name;
+      if (!in_right) {
+        throw InputError("marker '" + spec.name +
+                         "' is in the left view's config but not in the right view's: the "
+                         "views' markers are matched by name");
+      }
+      names.push_back(spec.name);
+    }
+    for (const std::string& name : ChainOf(left_config.measure)) {
+      for (size_t i = 0; i < names.size(); ++i) {
+        if (names[i] == name) chain_index.push_back(i);
+      }
+    }
+    result.markers.resize(names.size());
+    for (size_t i = 0; i < names.size(); ++i) result.markers[i].name = names[i];
+    chain.resize(chain_index.size());
+  }
+
+  TrackingSession left, right;
+  Triangulator triangulator;
+  StereoOptions options;
+  std::vector<std::string> names;
+  std::vector<size_t> chain_index;  // The chain's markers' indices in `names`, base to tip.
+  std::vector<std::optional<cv::Point3d>> chain;  // Reused per frame.
+  std::optional<cv::Vec3d> reference_normal;
+  std::optional<cv::Point3d> tip_reference;
+  StereoFrameResult result;
+};
+
+StereoSession::StereoSession(const TrackingConfig& left, const TrackingConfig& right,
+                             const StereoCalibration& stereo, const StereoOptions& options) {
+  std::string error;
+  if (!options.Check(&error)) throw InputError("stereo: " + error);
+  impl_ = std::make_unique<Impl>(left, right, stereo, options);
+  if (options.reference_plane == StereoOptions::ReferencePlane::kImage) {
+    impl_->reference_normal = cv::Vec3d(0, 0, 1);
+  }
+}
+
+StereoSession::~StereoSession() = default;
+StereoSession::StereoSession(StereoSession&&) noexcept = default;
+StereoSession& StereoSession::operator=(StereoSession&&) noexcept = default;
+
+std::vector<std::string> StereoSession::marker_names() const { return impl_->names; }
+const Triangulator& StereoSession::triangulator() const { return impl_->triangulator; }
+
+const StereoFrameResult& StereoSession::process(const Frame& left_frame, const Frame& right_frame) {
+  Impl& s = *impl_;
+  const cv::Size calibrated = s.triangulator.stereo().left.image_size;
+  if (left_frame.image.size() != calibrated || right_frame.image.size() != calibrated) {
+    const bool left_bad = left_frame.image.size() != calibrated;
+    throw InputError(std::string(left_bad ? "left" : "right") + " frame " +
+                     std::to_string(left_bad ? left_frame.index : right_frame.index) + " is " +
+                     SizeText(left_bad ? left_frame.image.size() : right_frame.image.size()) +
+                     " but the stereo calibration is for " + SizeText(calibrated) + " images");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const FrameResult& left = s.left.process(left_frame);
+  const FrameResult& right = s.right.process(right_frame);
+  StereoFrameResult& out = s.result;
+  out.frame_index = left.frame_index;
+  out.right_frame_index = right.frame_index;
+  out.time_s = left.time_s;
+  out.left_angle_deg = left.measurement.angle_deg;
+  out.right_angle_deg = right.measurement.angle_deg;
+  for (size_t i = 0; i < s.names.size(); ++i) {
+    StereoMarkerResult& m = out.markers[i];
+    const Observation* l = FindObservation(left, m.name);
+    const Observation* r = FindObservation(right, m.name);
+    m.left = l != nullptr ? *l : Observation::NotFound(MarkerStatus::kLost);
+    m.right = r != nullptr ? *r : Observation::NotFound(MarkerStatus::kLost);
+    m.point = s.triangulator.triangulate(m.left.position_px, m.right.position_px);
+    if (m.point.status != StereoStatus::kMissing) {
+      m.status = StereoStatusName(m.point.status);
+    } else if (!m.left.found()) {
+      m.status = std::string("left_") + MarkerStatusName(m.left.status());
+    } else {
+      m.status = std::string("right_") + MarkerStatusName(m.right.status());
+    }
+  }
+  for (size_t k = 0; k < s.chain_index.size(); ++k) {
+    s.chain[k] = out.markers[s.chain_index[k]].point.position_mm;
+  }
+  if (!s.tip_reference && !s.chain.empty() && s.chain.back()) s.tip_reference = s.chain.back();
+  out.shape = MeasureShape3d(s.chain, s.reference_normal, s.tip_reference);
+  if (!s.reference_normal && out.shape.plane_normal) {
+    // The first frame with a bending plane is the reference from now on (its own angle: 0).
+    s.reference_normal = out.shape.plane_normal;
+    out.shape.out_of_plane_deg = 0.0;
+  }
+  out.proc_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names) {
+  using Row = StereoFrameResult;
+  using Column = BasicCsvColumn<Row>;
+  BasicCsvColumnTable<Row> table;
+  table.add(Column{"frame",
+                   [](const Row& r, std::string& row) { row += std::to_string(r.frame_index); }});
+  table.add(Column{"right_frame", [](const Row& r, std::string& row) {
+                     row += std::to_string(r.right_frame_index);
+                   }});
+  table.add(NumberColumn<Row>(
+      "time_s", [](const Row& r) { return r.time_s; }, "%.6f"));
+  for (size_t i = 0; i < marker_names.size(); ++i) {
+    const std::string& name = marker_names[i];
+    const auto coordinate = [i](int axis) {
+      return [i, axis](const Row& r) -> std::optional<double> {
+        const std::optional<cv::Point3d>& p = r.markers[i].point.position_mm;
+        if (!p) return std::nullopt;
+        return axis == 0 ? p->x : axis == 1 ? p->y : p->z;
+      };
+    };
+    table.add(NumberColumn<Row>(name + "_X", coordinate(0), "%.4f"));
+    table.add(NumberColumn<Row>(name + "_Y", coordinate(1), "%.4f"));
+    table.add(NumberColumn<Row>(name + "_Z", coordinate(2), "%.4f"));
+    table.add(NumberColumn<Row>(
+        name + "_sigma_mm", [i](const Row& r) { return r.markers[i].point.sigma_mm; }, "%.4f"));
+    table.add(NumberColumn<Row>(
+        name + "_epipolar_px", [i](const Row& r) { return r.markers[i].point.epipolar_px; },
+        "%.3f"));
+    table.add(Column{name + "_status",
+                     [i](const Row& r, std::string& row) { row += r.markers[i].status; }});
+  }
+  table.add(NumberColumn<Row>(
+      "angle_deg", [](const Row& r) { return r.shape.angle_deg; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "out_of_plane_deg", [](const Row& r) { return r.shape.out_of_plane_deg; }, "%.4f"));
+  for (int axis = 0; axis < 3; ++axis) {
+    table.add(NumberColumn<Row>(
+        std::string("plane_n") + "xyz"[axis],
+        [axis](const Row& r) -> std::optional<double> {
+          if (!r.shape.plane_normal) return std::nullopt;
+          return (*r.shape.plane_normal)[axis];
+        },
+        "%.6f"));
+  }
+  table.add(NumberColumn<Row>(
+      "radius_mm", [](const Row& r) { return r.shape.radius; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "arc_length_mm", [](const Row& r) { return r.shape.arc_length; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "tip_disp_mm", [](const Row& r) { return r.shape.tip_disp; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "angle_left_deg", [](const Row& r) { return r.left_angle_deg; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "angle_right_deg", [](const Row& r) { return r.right_angle_deg; }, "%.4f"));
+  table.add(NumberColumn<Row>(
+      "proc_ms", [](const Row& r) { return r.proc_ms; }, "%.3f"));
+  return table;
+}
+
+}  // namespace softsight
