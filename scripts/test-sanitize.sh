@@ -6,8 +6,9 @@
 # and the tests of the modules that take outside input (scripts/sanitizer/configure.sh lists
 # them). Two runs:
 #   1. those modules' tests, instrumented;
-#   2. the plain tree's end-to-end tests of every command (ctest label `app`: hostile configs,
-#      videos, CSVs, boards over a pseudo-terminal, signals) against the instrumented program,
+#   2. the plain tree's end-to-end tests of every command (ctest labels app and app_stereo:
+#      hostile configs, videos, CSVs, boards over a pseudo-terminal, signals) against the
+#      instrumented program,
 #      so the commands run instrumented without compiling their tests a second time (they run the
 #      program; their own code is the harness). Needs the plain tree: built first if absent.
 set -euo pipefail
@@ -30,8 +31,8 @@ if [ ! -x build/src/app/softsight_app_test ]; then scripts/build.sh; fi
 #  - the identification runs on simulated plants but the shipped plant's, and the ten-plant sweep
 #    of `identify` followed by `control` (10-15 s each under ASan);
 #  - of the end-to-end tests, those that measure how well a command tracks (init, pick, evaluate,
-#    synth, track-many's jobs, the camera seam, one pipeline for three commands); every refusal,
-#    hostile input, board and signal test runs against the instrumented program.
+#    synth, track-many's jobs, the camera seam, one pipeline for three commands, two cameras);
+#    every refusal, hostile input, board and signal test runs against the instrumented program.
 LONG='^AssociationScenes\.'
 LONG+='|^ColourVerification\.SoftCentroidAccuracyAgainstBinaryAndTextbook$'
 LONG+='|^ColourKernels\.VectorHsvTestIsOpenCvsForEveryColour$'
@@ -42,10 +43,12 @@ LONG+='|fast_tube|shipped_tube) '
 LONG+='|^TenPlants/PlantSweep\.'
 LONG+='|^(TrackMany|InitCommand|InitSweep|PickCommand|OnePipeline|EvaluateTest|EvaluateVideo)\.'
 LONG+='|^(SynthCommandTest|TrackCamera)\.'
+LONG+='|^TrackStereoCommandTest\.(MarkersAndAngles|WithTheRimFit|WithoutTheOffset|MarkersSwapped)'
+LONG+='|^CalibrateStereoCommandTest\.TwoFolders'
 start=$SECONDS
 (cd build-sanitize && ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -E "$LONG")
 echo "sanitize: instrumented tests done in $((SECONDS - start)) s"
 start=$SECONDS
 (cd build && SOFTSIGHT_BINARY="$PWD/../build-sanitize/src/app/softsight" \
-   ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -L '^app$' -E "$LONG")
+   ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -L '^app(_stereo)?$' -E "$LONG")
 echo "sanitize: end-to-end tests against the instrumented program done in $((SECONDS - start)) s"
