@@ -450,7 +450,10 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
   // An identification measures the plant first and chooses the board's gains itself.
-  if (!options.identify) session.set_inner_loop_gains(config.inner_loop);
+  if (!options.identify) {
+    session.set_inner_loop_gains(config.inner_loop);
+    session.set_model(config.model);
+  }
   ControlFrames frames =
       OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
 
