@@ -679,6 +679,14 @@ ControllerOptions TuneController(ActuatorModel* model, const ControllerOptions& 
   // model_inverse: false. It corrects the model's error over the closed-loop time.
   c.model_inverse = true;
   c.model_correction_s = std::clamp(tau_c, 0.001, 10.0);
+  // Its setpoint leads the pressure by up to 1/g at full duty (the error at which the board's
+  // duty saturates) and must come back in one frame when the model says stop, on top of the
+  // pressure's own rate: a slower slew limit would hold it on (overshoot).
+  if (m.pressure_duty_per_kpa > 0.0) {
+    const double swing = 1.0 / (m.pressure_duty_per_kpa * frame_period_s) +
+                         std::max(m.inflate_kpa_per_s, m.vent_kpa_per_s);
+    c.max_rate_kpa_per_s = std::clamp(std::max(c.max_rate_kpa_per_s, swing), 1.0, 1000.0);
+  }
   return c;
 }
 

@@ -10,6 +10,14 @@ namespace {
 
 constexpr double kStepS = 0.001;  // The model's integration step.
 
+// The side of the play to push on (+1: more bend) for its output to reach `wanted` from `play`;
+// `last` when it is there.
+double Branch(double wanted, double play, double last) {
+  if (wanted > play + 0.01) return 1.0;
+  if (wanted < play - 0.01) return -1.0;
+  return last;
+}
+
 }  // namespace
 
 ModelLoop::ModelLoop(const ActuatorModel& m, double vent_scale, const ControllerOptions& options)
@@ -142,19 +150,15 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
     return wanted(t) + tau_b_ * (wanted(t + hd) - wanted(t - hd)) / (2.0 * hd);
   };
 
-  // The hysteresis branch: the direction the bend is asked to move (or the side of a step).
   const double reach_t = time_s + frame + look;
   const double gap = wanted(time_s) - state_.d;
-  const double slope = led(reach_t + hd) - led(reach_t - hd);
-  if (std::abs(gap) > kJumpDeg) {
-    direction_ = gap > 0.0 ? 1.0 : -1.0;
-  } else if (std::abs(slope) > 1e-6) {
-    direction_ = slope > 0.0 ? 1.0 : -1.0;
-  }
 
   // The model when this frame's setpoint starts to act.
   State acting = state_;
   advance(&acting, time_s + theta_p_, [this](double t) { return sent_at(t); });
+  // The hysteresis branch: the play's output must move towards what the lag is to be fed, so
+  // its input is half the width beyond it that way (the play operator's exact inverse).
+  direction_ = Branch(led(reach_t), acting.play, direction_);
   const auto pressure_after = [&](double u) {
     State s = acting;
     advance(&s, time_s + theta_p_ + frame, [u](double) { return u; });
@@ -175,10 +179,13 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
     State s = state_;
     double last = bang;
     double last_t = time_s + frame;
+    double branch = dir;
     const auto command = [&](double t) {
       if (t < time_s) return sent_at(t);
       if (t < time_s + frame) return bang;
-      const double want = static_pressure(wanted(t + look), dir);
+      const double bend = wanted(t + look);
+      branch = Branch(bend, s.play, branch);
+      const double want = static_pressure(bend, branch);
       if (max_rate_ > 0.0) {
         const double step = max_rate_ * std::max(0.0, t - last_t);
         last = std::clamp(want, last - step, last + step);
