@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <cstdio>
+#include <cstdlib>
 
 namespace softsight {
 namespace {
@@ -170,7 +172,7 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
   if (std::abs(gap) > kJumpDeg) {
     // Catching up with a step: full pressure (or none) this frame, if switching to the target's
     // pressure next frame leaves no overshoot in the model.
-    const double dir = direction_;
+    const double dir = gap > 0.0 ? 1.0 : -1.0;
     // Full duty through the frame, the setpoint no further than that from the pressure (1/g: the
     // error at which the loop's duty saturates), so that switching back takes one frame.
     const double bang =
@@ -204,6 +206,7 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
       t = next;
       if (t >= time_s + frame) over = std::max(over, dir * (s.d - wanted(t + theta_b_)));
     }
+    if (std::getenv("SOFTSIGHT_DEBUG_MODEL")) std::fprintf(stderr, "t %.3f gap %.2f p %.2f play %.2f d %.2f bang %.2f over %.3f corr %.2f\n", time_s, gap, state_.p, state_.play, state_.d, bang, over, correction_);
     if (over <= kOvershootDeg) {
       setpoint = bang;
       full = true;
