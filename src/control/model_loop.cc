@@ -4,8 +4,6 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 namespace softsight {
 namespace {
@@ -158,9 +156,16 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
   // The model when this frame's setpoint starts to act.
   State acting = state_;
   advance(&acting, time_s + theta_p_, [this](double t) { return sent_at(t); });
-  // The hysteresis branch: the play's output must move towards what the lag is to be fed, so
-  // its input is half the width beyond it that way (the play operator's exact inverse).
-  direction_ = Branch(led(reach_t), acting.play, direction_);
+  // What the lag is to be fed: the led target, plus the model's own gap to the target closed
+  // over three frames or twice the dead times (the lag alone would close it over its time
+  // constant: a laggy bend left behind where it could not relax fast enough stayed behind for a
+  // half cycle).
+  const double catch_up_s = std::max(3.0 * frame, 2.0 * look);
+  const double behind = wanted(time_s + theta_p_ + theta_b_) - acting.d;
+  const double aim = led(reach_t) + tau_b_ * behind / catch_up_s;
+  // The hysteresis branch: the play's output must move towards that, so its input is half the
+  // width beyond it that way (the play operator's exact inverse).
+  direction_ = Branch(aim, acting.play, direction_);
   const auto pressure_after = [&](double u) {
     State s = acting;
     advance(&s, time_s + theta_p_ + frame, [u](double) { return u; });
@@ -206,14 +211,13 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
       t = next;
       if (t >= time_s + frame) over = std::max(over, dir * (s.d - wanted(t + theta_b_)));
     }
-    if (std::getenv("SOFTSIGHT_DEBUG_MODEL")) std::fprintf(stderr, "t %.3f gap %.2f p %.2f play %.2f d %.2f bang %.2f over %.3f corr %.2f\n", time_s, gap, state_.p, state_.play, state_.d, bang, over, correction_);
     if (over <= kOvershootDeg) {
       setpoint = bang;
       full = true;
     }
   }
   if (!full) {
-    const double goal = std::max(0.0, std::min(p0_ + (led(reach_t) + direction_ * half_) / k_,
+    const double goal = std::max(0.0, std::min(p0_ + (aim + direction_ * half_) / k_,
                                                std::max(p0_, sat_)));
     if (pressure_after(hi_kpa) <= goal) {
       setpoint = hi_kpa;
