@@ -288,6 +288,62 @@ TEST_P(Plants, TheGainsFromTheModelSettleAStepAndFollowASine) {
 
 PlantCase Shipped() { return PlantCase{"shipped", 6.0, 20, 0.15, 3.0, 1}; }
 
+// The model-based loop given the plant's true model (from its parameters, not identified): what
+// is left of the error is the loop's own (the camera's noise, the frame's hold, the board's
+// integral and dead band the model leaves out). A 0.5 Hz sine of 20 deg and a 40 deg step.
+TEST(ModelBasedLoop, WithThePlantsTrueModelFollowsASineAndStepsWithoutOvershoot) {
+  for (const double tube_s : {0.0, 0.05}) {
+    PlantCase c = Shipped();
+    c.tube_s = tube_s;
+    const RigOptions rig = RigFor(c);
+    const double angle_per_bend = 0.5 * rig.end_marker_span;
+    ActuatorModel truth;
+    truth.straight_deg = 180.0;
+    truth.bend_start_kpa = rig.plant.bend_start_kpa;
+    truth.slope_deg_per_kpa = angle_per_bend * rig.plant.bend_deg_per_kpa;
+    truth.hysteresis_deg = angle_per_bend * rig.plant.hysteresis_deg;
+    truth.lag_s = rig.plant.bend_lag_s;
+    // The chamber: p_atm / V times the pump's free flow, and the vent's flow at 10 kPa.
+    const double per_l_per_min = 101.325 / (rig.plant.chamber_volume_ml * 1e-3) / 60.0;
+    truth.inflate_kpa_per_s = per_l_per_min * rig.plant.pump_flow_l_per_min;
+    truth.vent_kpa_per_s = per_l_per_min * rig.plant.vent_flow_l_per_min;
+    truth.vent_at_kpa = 10.0;
+    // The board's loop: its own P gain, or behind the tube gains for it (the probe's rule from
+    // the true rates and delay); the tube's delay is the loop's dead time.
+    InnerLoopGains gains;
+    if (tube_s > 0.0) {
+      InnerLoopMeasurement m;
+      m.dead_time_s = tube_s;
+      m.inflate_kpa_per_s = truth.inflate_kpa_per_s;
+      m.vent_kpa_per_s = truth.vent_kpa_per_s;
+      m.vent_at_kpa = truth.vent_at_kpa;
+      gains = *InnerLoopGainsFor(m, 40.0);
+    }
+    truth.pressure_duty_per_kpa = gains.given() ? gains.kp_per_kpa : rig.board.kp_per_kpa;
+    truth.pressure_duty_dead_time_s = tube_s;
+    ControllerOptions loop = ControllerFor(c);
+    loop.model_inverse = true;
+    loop.model_correction_s = 0.1;
+    loop.max_rate_kpa_per_s = 1000.0;
+
+    Bench bench(rig, c.seed);
+    std::vector<TrackingPoint> sine =
+        bench.control(loop, TargetProfile::Parse("step 150\nhold 2\nsine 150 20 0.5 6\n", "s"),
+                      8.0, gains, truth);
+    sine.erase(sine.begin(), sine.begin() + static_cast<long>(2 * kCameraFps));
+    const double sine_rms = *ComputeStepMetrics(sine).rms_error_deg;
+    Vent(bench.rig());
+    const StepMetrics step =
+        ComputeStepMetrics(bench.control(loop, TargetProfile::Constant(140.0), 3.0, gains, truth));
+    std::printf("model-based, true model, tube %.2f s: sine RMS %.2f deg, step %s\n", tube_s,
+                sine_rms, FormatStepMetrics(step).c_str());
+    EXPECT_LT(sine_rms, tube_s > 0.0 ? 0.8 : 0.5);
+    ASSERT_TRUE(step.settling_1deg_s) << FormatStepMetrics(step);
+    EXPECT_LT(*step.settling_1deg_s, 1.0) << FormatStepMetrics(step);
+    EXPECT_LT(*step.overshoot_percent, 2.0) << FormatStepMetrics(step);
+  }
+}
+
 // Runs the experiment expecting it to stop with an error; returns the error.
 template <typename Error>
 std::string ExpectAbort(Bench& bench, const ControllerOptions& controller,
