@@ -10,8 +10,10 @@
 // the model is driven by what was sent).
 //
 // Each frame's setpoint: the bend the target asks for at the frame's end plus the dead times
-// (the profile is known ahead: the look-ahead compensates them), led by the bending lag, with
-// half the hysteresis by its direction, through the static map's inverse to a pressure; then
+// (the profile is known ahead: the look-ahead compensates them), led by the bending lag, plus
+// the model's gap to the target closed over three frames (or twice the dead times), with half
+// the hysteresis on the side the model's play must move, through the static map's inverse to a
+// pressure; then
 // the setpoint that takes the model's pressure there by the frame's end (bisection through the
 // pump- and vent-limited inner loop). While the model lags the target by more than kJumpDeg
 // (after a step), full pressure or none instead, as long as the model predicts that switching
