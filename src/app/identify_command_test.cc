@@ -302,6 +302,10 @@ struct Plant {
   double tube_s;
 };
 
+// The plant's name is all a test name needs (gtest would print the bytes of the struct,
+// pointer included: ctest's list of tests would change with every link).
+void PrintTo(const Plant& plant, std::ostream* os) { *os << plant.name; }
+
 // The sine's 20 deg at 0.5 Hz around 155 deg.
 constexpr double kSineAmplitudeDeg = 20.0;
 constexpr double kSineHz = 0.5;
