@@ -322,6 +322,13 @@ void AnnounceRun(const ControlOptions& options, const Transport& transport, cons
                  inner.kp_per_kpa, inner.ki_per_kpa_s, inner.vent_scale);
   }
   const ControllerOptions& c = session.controller().options();
+  if (session.controller().model_based()) {
+    std::fprintf(stderr,
+                 "control: outer loop model-based (control.model inverted, its error low-passed "
+                 "over %.3g s), output %.3g..%.3g kPa, slew %.3g kPa/s, hold %.3g s\n",
+                 c.model_correction_s, c.min_kpa, c.max_kpa, c.max_rate_kpa_per_s, c.hold_s);
+    return;
+  }
   std::fprintf(stderr,
                "control: outer loop kp %.3g kPa/deg, ki %.3g kPa/(deg s), kd %.3g kPa s/deg, "
                "bias %.3g kPa, ff %.3g kPa/deg, hysteresis %.3g kPa, lead %.3g s, output "
@@ -450,7 +457,10 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);
   // An identification measures the plant first and chooses the board's gains itself.
-  if (!options.identify) session.set_inner_loop_gains(config.inner_loop);
+  if (!options.identify) {
+    session.set_inner_loop_gains(config.inner_loop);
+    session.set_model(config.model);
+  }
   ControlFrames frames =
       OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
 
@@ -621,19 +631,23 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
       "identify: static map: straight %.1f deg, bend start %.2f kPa, slope %.3f deg/kPa, "
       "saturation %s, hysteresis %.2f deg (RMS residual %.2f deg), valid %.1f..%.1f kPa, "
       "%.1f..%.1f deg\n"
-      "identify: dynamics: pressure lag %.3f s + dead time %.3f s (RMS %.2f kPa); bending lag "
-      "%.3f s + dead time %.3f s (RMS %.2f deg)\n"
+      "identify: dynamics: pressure lag %.3f s + dead time %.3f s (RMS %.2f kPa), as the board "
+      "runs it %.3f duty/kPa + dead time %.3f s (RMS %.2f kPa); bending lag %.3f s + dead time "
+      "%.3f s (RMS %.2f deg)\n"
       "identify: valves -> sensor: dead time %.3f s, full inflation %.1f kPa/s, full venting "
       "%.1f kPa/s; board's inner loop: %s\n"
-      "identify: gains (SIMC, closed-loop time %.3f s): kp %.3f kPa/deg, ki %.3f kPa/(deg s), "
+      "identify: loop: model-based (model_inverse: %s), its error low-passed over %.3f s; the PI "
+      "for model_inverse false (SIMC): kp %.3f kPa/deg, ki %.3f kPa/(deg s), "
       "bias %.2f kPa, ff %.4f kPa/deg, hysteresis %.2f kPa, lead %.3f s, integral band %.1f "
       "deg\n",
       m.straight_deg, m.bend_start_kpa, m.slope_deg_per_kpa,
       saturation,
       m.hysteresis_deg, m.static_rms_deg, m.valid_min_kpa, m.valid_max_kpa, m.valid_min_deg,
-      m.valid_max_deg, m.pressure_lag_s, m.pressure_dead_time_s, m.pressure_rms_kpa, m.lag_s,
+      m.valid_max_deg, m.pressure_lag_s, m.pressure_dead_time_s, m.pressure_rms_kpa,
+      m.pressure_duty_per_kpa, m.pressure_duty_dead_time_s, m.pressure_duty_rms_kpa, m.lag_s,
       m.dead_time_s, m.dynamic_rms_deg, m.valve_dead_time_s, m.inflate_kpa_per_s,
-      m.vent_kpa_per_s, inner, m.closed_loop_s, c.kp_kpa_per_deg, c.ki_kpa_per_deg_s,
+      m.vent_kpa_per_s, inner, c.model_inverse ? "true" : "false", c.model_correction_s,
+      c.kp_kpa_per_deg, c.ki_kpa_per_deg_s,
       c.bias_kpa, c.ff_kpa_per_deg, c.hysteresis_kpa, c.ff_lead_s, c.integral_band_deg);
   return text;
 }

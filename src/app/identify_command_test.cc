@@ -5,9 +5,11 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,6 +18,7 @@
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/control/rig.h"
 #include "softsight/core/format.h"
 
 namespace softsight {
@@ -288,25 +291,43 @@ TEST(ControlCommand, AStaircaseGetsEveryStepsFiguresAndASineItsTrackingError) {
 
 // The range of plants a lab meets (issue 23): total bending 3-10 deg/kPa, chamber 10-60 ml,
 // bending lag 0.05-0.4 s, hysteresis 1-6 deg, and two behind a 50 ms tube between the valves and
-// the chamber. After `identify`, a step from straight to 140 deg settles within +-1 deg and
-// overshoots less than 5 %, and a 0.5 Hz sine of 20 deg around 155 deg is followed within
-// `sine_rms_deg`. Each case prints its row of docs/control.md's table ("PlantSweep row:";
-// scripts/plant_sweep_table.sh collects them). Issue 23 asks < 2 s and <= 2 deg everywhere; the
-// cases that miss it say by how much, and why (docs/control.md, "What the plants reach"):
-// the stiff, big, laggy corner is pump-limited (a perfect controller settles in 1.91 s and
-// follows the sine with 15.0 deg RMS at best); the big chamber's and the tube plants' sines are
-// the controller's shortfall (not physics), held here at what this code reaches.
+// the chamber. After `identify` (its config runs the model-based loop), a step from straight to
+// 140 deg settles within +-1 deg in under 2 s with under 5 % overshoot, and a 0.5 Hz sine of
+// 20 deg around 155 deg is followed within 2 deg RMS: issue 23's figures, on every plant but
+// one sine, which no controller can follow (PumpLimitedSineRms below). Each case prints its
+// row of docs/control.md's table ("PlantSweep row:"; scripts/plant_sweep_table.sh collects them).
 struct Plant {
   const char* name;
   double bend_deg_per_kpa, chamber_ml, lag_s, hysteresis_deg;
-  double settle_within_s;
-  double sine_rms_deg;
   double tube_s;
 };
 
 // The plant's name is all a test name needs (gtest would print the bytes of the struct,
 // pointer included: ctest's list of tests would change with every link).
 void PrintTo(const Plant& plant, std::ostream* os) { *os << plant.name; }
+
+// The sine's 20 deg at 0.5 Hz around 155 deg.
+constexpr double kSineAmplitudeDeg = 20.0;
+constexpr double kSineHz = 0.5;
+
+// The least RMS error with which any controller can follow the sine on `plant`, from the pump
+// alone (0 when the pump does not forbid 2 deg). The pressure rises at most at the pump's free
+// rate p_atm Q / V (less towards its stall pressure; venting is taken as instant), so over a
+// period its first harmonic is at most 2 Q p_atm / (V w) (a sawtooth rising at that rate); the
+// play and the static map's flat part never make the bend move faster than the pressure, and
+// the bending lag divides the harmonic by |1 + i w lag|. The angle's harmonic at the sine's
+// frequency is then at most A = 0.5 * span * bend/kPa * that, and the error's own harmonic at
+// that frequency alone is (20 - A) / sqrt(2) RMS when A < 20.
+double PumpLimitedSineRms(const Plant& plant) {
+  const PlantOptions pump;  // The example rig's pump and vent (not changed by the sweep).
+  const double w = 2.0 * std::numbers::pi * kSineHz;
+  const double rise_kpa_per_s =
+      101.325 * pump.pump_flow_l_per_min / 60.0 / (plant.chamber_ml * 1e-3);
+  const double angle_per_kpa = 0.5 * RigOptions{}.end_marker_span * plant.bend_deg_per_kpa;
+  const double harmonic_deg = 2.0 * angle_per_kpa * rise_kpa_per_s /
+                              (w * std::sqrt(1.0 + (w * plant.lag_s) * (w * plant.lag_s)));
+  return std::max(0.0, (kSineAmplitudeDeg - harmonic_deg) / std::sqrt(2.0));
+}
 
 class PlantSweep : public ::testing::TestWithParam<Plant> {};
 
@@ -364,24 +385,31 @@ TEST_P(PlantSweep, AfterIdentifyAStepSettlesQuicklyAndASineIsFollowed) {
               plant.tube_s > 0.0 ? (", tube " + ShortNumber(plant.tube_s) + " s").c_str() : "",
               *run.metrics.settling_1deg_s, *run.metrics.overshoot_percent,
               *followed.tracking->rms_error_deg);
-  EXPECT_LE(*run.metrics.settling_1deg_s, plant.settle_within_s) << FormatStepMetrics(run.metrics);
+  EXPECT_LT(*run.metrics.settling_1deg_s, 2.0) << FormatStepMetrics(run.metrics);
   EXPECT_LT(*run.metrics.overshoot_percent, 5.0) << FormatStepMetrics(run.metrics);
-  EXPECT_LE(*followed.tracking->rms_error_deg, plant.sine_rms_deg)
-      << FormatControlSummary(followed);
+  const double impossible_below_deg = PumpLimitedSineRms(plant);
+  if (impossible_below_deg <= 2.0) {
+    EXPECT_LE(*followed.tracking->rms_error_deg, 2.0) << FormatControlSummary(followed);
+  } else {
+    // The pump cannot move this plant 20 deg at 0.5 Hz (the stiff, big, laggy corner: 4.7 deg
+    // RMS at least): the figure cannot be met. The loop must not do worse than that bound
+    // allows by more than it does now (18.3 deg: it follows the sine late, see
+    // docs/control.md "What the plants reach"); held here at 4.2 times the bound.
+    EXPECT_GT(*followed.tracking->rms_error_deg, impossible_below_deg);
+    EXPECT_LE(*followed.tracking->rms_error_deg, 4.2 * impossible_below_deg)
+        << FormatControlSummary(followed);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     TenPlants, PlantSweep,
-    ::testing::Values(Plant{"example", 6, 20, 0.15, 3, 1.5, 2.0, 0.0},
-                      Plant{"stiff", 3, 20, 0.15, 3, 1.5, 2.0, 0.0},
-                      Plant{"soft", 10, 20, 0.15, 3, 1.5, 2.0, 0.0},
-                      Plant{"quick", 6, 10, 0.05, 1, 1.5, 2.0, 0.0},
-                      Plant{"big", 6, 60, 0.15, 3, 1.5, 4.0, 0.0},
-                      Plant{"laggy", 6, 20, 0.40, 6, 1.5, 2.0, 0.0},
-                      Plant{"stiff_big_laggy", 3, 60, 0.40, 6, 2.4, 16.5, 0.0},
-                      Plant{"soft_small_quick", 10, 10, 0.05, 1, 1.5, 2.0, 0.0},
-                      Plant{"example_tube", 6, 20, 0.15, 3, 2.0, 3.6, 0.05},
-                      Plant{"laggy_tube", 6, 20, 0.40, 6, 2.0, 5.8, 0.05}),
+    ::testing::Values(Plant{"example", 6, 20, 0.15, 3, 0.0}, Plant{"stiff", 3, 20, 0.15, 3, 0.0},
+                      Plant{"soft", 10, 20, 0.15, 3, 0.0}, Plant{"quick", 6, 10, 0.05, 1, 0.0},
+                      Plant{"big", 6, 60, 0.15, 3, 0.0}, Plant{"laggy", 6, 20, 0.40, 6, 0.0},
+                      Plant{"stiff_big_laggy", 3, 60, 0.40, 6, 0.0},
+                      Plant{"soft_small_quick", 10, 10, 0.05, 1, 0.0},
+                      Plant{"example_tube", 6, 20, 0.15, 3, 0.05},
+                      Plant{"laggy_tube", 6, 20, 0.40, 6, 0.05}),
     [](const ::testing::TestParamInfo<Plant>& info) { return std::string(info.param.name); });
 
 TEST(IdentifyCommand, CtrlCDuringTheExperimentVentsWritesNothingAndExits130) {

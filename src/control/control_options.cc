@@ -64,6 +64,15 @@ OptionTable<ControllerOptions> MakeController() {
           .Range(0, 100000)
           .Unit("kPa/s")
           .Doc("setpoint slew limit, protects the silicone on target steps (0: unlimited)"),
+      BoolOption<P>("model_inverse", &P::model_inverse)
+          .Doc("model-based loop: the identified model (control.model) inverted as the "
+               "feed-forward, with the profile's look-ahead over the dead times, corrected by the "
+               "measured model error; false: the PI with the ff_* terms above"),
+      DoubleOption<P>("model_correction_s", &P::model_correction_s)
+          .Range(0.001, 10)
+          .Unit("s")
+          .Doc("model-based loop: low-pass time of the model error it corrects (the feedback's "
+               "speed)"),
       DoubleOption<P>("hold_s", &P::hold_s)
           .Range(0, 60)
           .Unit("s")
@@ -249,13 +258,22 @@ OptionTable<ActuatorModel> MakeModel() {
       row("inflate_kpa_per_s", &P::inflate_kpa_per_s, 0, 1e6, "kPa/s",
           "pressure rate at full inflation, near vented"),
       row("vent_kpa_per_s", &P::vent_kpa_per_s, 0, 1e6, "kPa/s",
-          "pressure rate at full venting (at about a quarter of the experiment's ceiling)"),
+          "pressure rate at full venting, at vent_at_kpa"),
+      row("vent_at_kpa", &P::vent_at_kpa, 0, 1000, "kPa",
+          "the pressure full venting's rate was measured at (it grows with sqrt(p))"),
       row("pressure_lag_s", &P::pressure_lag_s, 0, 100, "s",
           "inner loop setpoint -> sensed pressure: first-order lag"),
       row("pressure_dead_time_s", &P::pressure_dead_time_s, 0, 100, "s",
           "inner loop: dead time"),
       row("pressure_rms_kpa", &P::pressure_rms_kpa, 0, 1000, "kPa",
           "RMS residual of the inner-loop fit"),
+      row("pressure_duty_per_kpa", &P::pressure_duty_per_kpa, 0, 1000, "duty/kPa",
+          "inner loop as the board runs it: duty = g * pressure error, saturating at full duty, "
+          "times the probe's rates (0: not fitted)"),
+      row("pressure_duty_dead_time_s", &P::pressure_duty_dead_time_s, 0, 100, "s",
+          "that inner-loop model's dead time"),
+      row("pressure_duty_rms_kpa", &P::pressure_duty_rms_kpa, 0, 1000, "kPa",
+          "RMS residual of that fit"),
       row("lag_s", &P::lag_s, 0, 100, "s", "sensed pressure -> angle: first-order lag"),
       row("dead_time_s", &P::dead_time_s, 0, 100, "s",
           "sensed pressure -> angle: dead time (camera and tracker included)"),

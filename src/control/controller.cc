@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "control/control_options.h"
+#include "control/model_loop.h"
 
 namespace softsight {
 
@@ -23,6 +24,19 @@ bool ControllerOptions::Check(std::string* error) const {
 
 AngleController::AngleController(const ControllerOptions& options) : options_(options) {
   assert(options_.Check(nullptr));
+}
+
+AngleController::~AngleController() = default;
+
+void AngleController::set_model(const ActuatorModel& model, double vent_scale) {
+  model_loop_.reset();
+  if (options_.model_inverse && model.identified()) {
+    model_loop_ = std::make_unique<ModelLoop>(model, vent_scale, options_);
+  }
+}
+
+void AngleController::observe_pressure(double pressure_kpa) {
+  if (model_loop_) model_loop_->observe_pressure(pressure_kpa);
 }
 
 void AngleController::limit_max_kpa(double max_kpa) {
@@ -44,10 +58,29 @@ void AngleController::reset() {
   derivative_deg_per_s_ = 0.0;
   setpoint_kpa_ = 0.0;
   vented_ = true;
+  if (model_loop_) model_loop_->reset();
+}
+
+double AngleController::model_setpoint(double time_s, double target_deg,
+                                       std::optional<double> measured_deg,
+                                       const Preview& preview, double dt_s) {
+  // Within the output limits and the slew limit from the last setpoint.
+  double lo = options_.min_kpa, hi = options_.max_kpa;
+  if (options_.max_rate_kpa_per_s > 0.0 && dt_s > 0.0) {
+    const double step = options_.max_rate_kpa_per_s * dt_s;
+    lo = std::clamp(setpoint_kpa_ - step, lo, hi);
+    hi = std::clamp(setpoint_kpa_ + step, lo, hi);
+  }
+  const double setpoint =
+      std::clamp(model_loop_->update(time_s, measured_deg, target_deg, preview, lo, hi), lo, hi);
+  model_loop_->sent(setpoint);
+  setpoint_kpa_ = setpoint;
+  return setpoint;
 }
 
 ControllerOutput AngleController::update(double time_s, double target_deg_in,
-                                         std::optional<double> measured_deg) {
+                                         std::optional<double> measured_deg,
+                                         const Preview& preview) {
   double target_deg = target_deg_in;  // Becomes the reference (below) when it is ramped.
   const double dt_s = last_time_s_ ? std::max(0.0, time_s - *last_time_s_) : 0.0;
   last_time_s_ = time_s;
@@ -61,12 +94,16 @@ ControllerOutput AngleController::update(double time_s, double target_deg_in,
     if (!vented_ && time_s - *loss_start_s_ <= options_.hold_s + 1e-9) {
       out.action = ControllerOutput::Action::kHold;
       out.setpoint_kpa = setpoint_kpa_;
+      // The model-based loop runs on its model meanwhile (its pressure is the board's sensed
+      // one): a setpoint held in the middle of a step would overshoot it.
+      if (model_loop_) out.setpoint_kpa = model_setpoint(time_s, target_deg, std::nullopt, preview, dt_s);
       return out;
     }
     vented_ = true;
     integral_kpa_ = 0.0;
     setpoint_kpa_ = 0.0;
     reference_deg_.reset();
+    if (model_loop_) model_loop_->reset();
     out.action = ControllerOutput::Action::kVent;
     return out;
   }
@@ -74,6 +111,11 @@ ControllerOutput AngleController::update(double time_s, double target_deg_in,
   loss_start_s_.reset();
   vented_ = false;
   out.error_deg = *measured_deg - target_deg;
+  if (model_loop_) {
+    out.action = ControllerOutput::Action::kTrack;
+    out.setpoint_kpa = model_setpoint(time_s, target_deg, measured_deg, preview, dt_s);
+    return out;
+  }
   // With a feed-forward the slew limit shapes the reference too: the loop follows a reference
   // that moves towards the target at most as fast as the slew limit lets the feed-forward move
   // (max_rate / ff deg/s), starting where the actuator is. So P and I act on the error from a

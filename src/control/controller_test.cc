@@ -103,6 +103,44 @@ TEST(AngleController, HoldsThenVentsOnVisionLoss) {
   EXPECT_EQ(fresh.update(0.0, 120.0, std::nullopt).action, ControllerOutput::Action::kVent);
 }
 
+// The model-based loop runs only with model_inverse and an identified model; otherwise the
+// controller is the PI, frame for frame.
+TEST(AngleController, TheModelBasedLoopNeedsTheOptionAndAModel) {
+  ActuatorModel model;
+  model.straight_deg = 180.0;
+  model.bend_start_kpa = 3.0;
+  model.slope_deg_per_kpa = 2.4;
+  model.lag_s = 0.15;
+  model.inflate_kpa_per_s = 80.0;
+  model.vent_kpa_per_s = 150.0;
+  model.vent_at_kpa = 10.0;
+  model.pressure_duty_per_kpa = 0.25;
+  ControllerOptions pi;
+  ControllerOptions flagged = pi;
+  flagged.model_inverse = true;
+  AngleController plain(pi), unmodelled(flagged), off(pi), on(flagged);
+  off.set_model(model);
+  unmodelled.set_model(ActuatorModel{});  // Not identified.
+  on.set_model(model);
+  EXPECT_FALSE(off.model_based());
+  EXPECT_FALSE(unmodelled.model_based());
+  EXPECT_TRUE(on.model_based());
+  for (int k = 0; k < 30; ++k) {
+    const double t = k / 30.0, measured = 180.0 - k;
+    const double expected = plain.update(t, 150.0, measured).setpoint_kpa;
+    EXPECT_DOUBLE_EQ(off.update(t, 150.0, measured).setpoint_kpa, expected) << k;
+    EXPECT_DOUBLE_EQ(unmodelled.update(t, 150.0, measured).setpoint_kpa, expected) << k;
+  }
+  // A step from straight: the model-based loop asks for full duty at once, a setpoint at least
+  // 1/g (the error at which the board's duty saturates) above the vented chamber, but no more
+  // than 1/g above what the pump gives in that frame (so it can come back in one), where the
+  // PI's slew limit holds its first setpoint at 0.
+  const ControllerOutput first = on.update(0.0, 150.0, 180.0);
+  EXPECT_EQ(AngleController(pi).update(0.0, 150.0, 180.0).setpoint_kpa, 0.0);
+  EXPECT_GE(first.setpoint_kpa, 1.0 / model.pressure_duty_per_kpa);
+  EXPECT_LE(first.setpoint_kpa, model.inflate_kpa_per_s / 30.0 + 1.0 / model.pressure_duty_per_kpa);
+}
+
 TEST(AngleController, CheckNamesTheBadField) {
   ControllerOptions o;
   std::string error;

@@ -32,9 +32,7 @@ struct PlantCase {
   double limit_kpa = 50.0;  // A weak actuator needs a higher pressure for the same bend.
   double pump_l_per_min = 1.0;
   double tube_s = 0.0;  // Between the valves and the chamber.
-  // Issue 23's figure, but big_laggy's 2.06 deg (its 55 ml, 0.4 s lag; not the pump: a perfect
-  // controller follows with 0.04 deg) is the controller's shortfall, held here at what it reaches.
-  double sine_rms_deg = 2.0;
+  double sine_rms_deg = 2.0;  // Issue 23's figure, for every plant here.
 };
 
 // The case's name is all a test name needs (gtest would print the struct's bytes, pointer
@@ -97,11 +95,13 @@ class Bench {
 
   // The closed loop; returns the true angle against the target at every frame.
   std::vector<TrackingPoint> control(const ControllerOptions& controller, const TargetProfile& p,
-                                     double seconds, const InnerLoopGains& inner_loop = {}) {
+                                     double seconds, const InnerLoopGains& inner_loop = {},
+                                     const ActuatorModel& model = {}) {
     ControlTarget target;
     target.profile = p;
     ControlSession session(controller, link_, target);
     session.set_inner_loop_gains(inner_loop);
+    session.set_model(model);  // For the model-based loop (model_inverse), as `control` does.
     session.start();
     std::vector<TrackingPoint> out;
     for (int k = 0; k <= std::lround(seconds * kCameraFps); ++k) {
@@ -202,11 +202,14 @@ TEST_P(Plants, IdentificationRecoversTheStaticSlopeAndTheLag) {
   // loop behind a tube only.
   ASSERT_TRUE(id.probe);
   std::printf("probe %-10s tube %.3f s: dead time %.4f s, inflation %.1f kPa/s, venting %.1f kPa/s "
-              "at %.1f kPa; board gains %s kp %.4f ki %.4f vent %.3f\n",
+              "at %.1f kPa; board gains %s kp %.4f ki %.4f vent %.3f; inner loop fitted: lag %.3f "
+              "s (RMS %.2f kPa), duty %.3f/kPa dead %.3f s (RMS %.2f kPa)\n",
               c.name, c.tube_s, id.probe->dead_time_s, id.probe->inflate_kpa_per_s,
               id.probe->vent_kpa_per_s, id.probe->vent_at_kpa,
               id.inner_loop.given() ? "sent" : "own", id.inner_loop.kp_per_kpa,
-              id.inner_loop.ki_per_kpa_s, id.inner_loop.vent_scale);
+              id.inner_loop.ki_per_kpa_s, id.inner_loop.vent_scale, model.pressure_lag_s,
+              model.pressure_rms_kpa, model.pressure_duty_per_kpa, model.pressure_duty_dead_time_s,
+              model.pressure_duty_rms_kpa);
   EXPECT_NEAR(id.probe->dead_time_s, c.tube_s + 0.001, 0.008);
   EXPECT_EQ(id.inner_loop.given(), c.tube_s > 0.0);
   // The chamber's rate at full inflation: p_atm / V * pump flow (at 0 kPa, less what the pump
@@ -214,6 +217,19 @@ TEST_P(Plants, IdentificationRecoversTheStaticSlopeAndTheLag) {
   const double inflate_kpa_per_s =
       101.325 / (c.chamber_ml * 1e-3) * c.pump_l_per_min / 60.0;
   EXPECT_NEAR(id.probe->inflate_kpa_per_s, inflate_kpa_per_s, 0.1 * inflate_kpa_per_s);
+  // The inner loop as the board runs it: its P gain (the rig's board: 0.25 duty/kPa, plus an
+  // integral the model leaves out; behind a tube the gain sent, which the tube's delay inside
+  // the loop makes look up to half as large again; the weak plants' pump, working at up to 40
+  // kPa of its 120 kPa stall, gives less than the probe's rate near vented: a smaller gain).
+  const double board_kp = id.inner_loop.given() ? id.inner_loop.kp_per_kpa : 0.25;
+  EXPECT_GT(model.pressure_duty_per_kpa, 0.5 * board_kp) << c.name;
+  EXPECT_LT(model.pressure_duty_per_kpa, 1.5 * board_kp) << c.name;
+  EXPECT_NEAR(model.vent_at_kpa, id.probe->vent_at_kpa, 1e-12);
+  // A large chamber is pump-limited on the PRBS's steps: the saturating model explains them,
+  // the linear lag does not.
+  if (c.chamber_ml >= 50) {
+    EXPECT_LT(model.pressure_duty_rms_kpa, 0.5 * model.pressure_rms_kpa) << c.name;
+  }
   // The gains by the documented rule.
   EXPECT_NEAR(id.tuned.ff_kpa_per_deg, 1.0 / model.slope_deg_per_kpa, 1e-12);
   EXPECT_GT(id.tuned.kp_kpa_per_deg, 0.0);
@@ -228,7 +244,7 @@ INSTANTIATE_TEST_SUITE_P(
                       PlantCase{"stiff_slow", 10.0, 60, 0.40, 6.0, 3},
                       PlantCase{"stiff_fast", 10.0, 10, 0.05, 6.0, 4},
                       PlantCase{"weak_slow", 3.0, 30, 0.40, 3.0, 5, 70.0},
-                      PlantCase{"big_laggy", 6.0, 55, 0.40, 6.0, 6, 50.0, 1.0, 0.0, 2.2},
+                      PlantCase{"big_laggy", 6.0, 55, 0.40, 6.0, 6, 50.0, 1.0, 0.0},
                       PlantCase{"mid", 4.5, 40, 0.10, 1.0, 7},
                       PlantCase{"big_stiff", 8.0, 50, 0.25, 4.0, 8},
                       // A 50 ms tube between the valves and the chamber (the board's own gains
@@ -246,17 +262,21 @@ TEST_P(Plants, TheGainsFromTheModelSettleAStepAndFollowASine) {
   const Identified id = IdentifyPlant(c, bench);
   Vent(bench.rig());
   const StepMetrics step =
-      ComputeStepMetrics(bench.control(id.tuned, TargetProfile::Constant(120.0), 4.0, id.inner_loop));
+      ComputeStepMetrics(bench.control(id.tuned, TargetProfile::Constant(120.0), 4.0, id.inner_loop,
+                                       id.model));
   Vent(bench.rig());
   const TargetProfile sine_profile =
       TargetProfile::Parse("step 140\nhold 2\nsine 140 20 0.25 8\n", "sine.txt");
-  std::vector<TrackingPoint> sine = bench.control(id.tuned, sine_profile, 10.0, id.inner_loop);
+  std::vector<TrackingPoint> sine =
+      bench.control(id.tuned, sine_profile, 10.0, id.inner_loop, id.model);
   sine.erase(sine.begin(), sine.begin() + static_cast<long>(2 * kCameraFps));  // The sine only.
   const StepMetrics sine_metrics = ComputeStepMetrics(sine);
-  std::printf("loop %-10s kp %.3f ki %.3f lead %.3f s | step 180 -> 120: rise %.2f s, settling "
+  // The tuned loop is the model-based one (the model inverted, its error corrected).
+  EXPECT_TRUE(id.tuned.model_inverse);
+  std::printf("loop %-10s model-based | step 180 -> 120: rise %.2f s, settling "
               "+-1 deg %.2f s, +-2 deg %.2f s, overshoot %.1f %%, steady-state %+.2f deg | sine "
               "140 +- 20 deg 0.25 Hz: RMS %.2f deg\n",
-              c.name, id.tuned.kp_kpa_per_deg, id.tuned.ki_kpa_per_deg_s, id.tuned.ff_lead_s,
+              c.name,
               step.rise_time_s.value_or(99), step.settling_1deg_s.value_or(99),
               step.settling_2deg_s.value_or(99), step.overshoot_percent.value_or(99),
               step.steady_state_error_deg.value_or(99), sine_metrics.rms_error_deg.value_or(99));
@@ -267,6 +287,62 @@ TEST_P(Plants, TheGainsFromTheModelSettleAStepAndFollowASine) {
 }
 
 PlantCase Shipped() { return PlantCase{"shipped", 6.0, 20, 0.15, 3.0, 1}; }
+
+// The model-based loop given the plant's true model (from its parameters, not identified): what
+// is left of the error is the loop's own (the camera's noise, the frame's hold, the board's
+// integral and dead band the model leaves out). A 0.5 Hz sine of 20 deg and a 40 deg step.
+TEST(ModelBasedLoop, WithThePlantsTrueModelFollowsASineAndStepsWithoutOvershoot) {
+  for (const double tube_s : {0.0, 0.05}) {
+    PlantCase c = Shipped();
+    c.tube_s = tube_s;
+    const RigOptions rig = RigFor(c);
+    const double angle_per_bend = 0.5 * rig.end_marker_span;
+    ActuatorModel truth;
+    truth.straight_deg = 180.0;
+    truth.bend_start_kpa = rig.plant.bend_start_kpa;
+    truth.slope_deg_per_kpa = angle_per_bend * rig.plant.bend_deg_per_kpa;
+    truth.hysteresis_deg = angle_per_bend * rig.plant.hysteresis_deg;
+    truth.lag_s = rig.plant.bend_lag_s;
+    // The chamber: p_atm / V times the pump's free flow, and the vent's flow at 10 kPa.
+    const double per_l_per_min = 101.325 / (rig.plant.chamber_volume_ml * 1e-3) / 60.0;
+    truth.inflate_kpa_per_s = per_l_per_min * rig.plant.pump_flow_l_per_min;
+    truth.vent_kpa_per_s = per_l_per_min * rig.plant.vent_flow_l_per_min;
+    truth.vent_at_kpa = 10.0;
+    // The board's loop: its own P gain, or behind the tube gains for it (the probe's rule from
+    // the true rates and delay); the tube's delay is the loop's dead time.
+    InnerLoopGains gains;
+    if (tube_s > 0.0) {
+      InnerLoopMeasurement m;
+      m.dead_time_s = tube_s;
+      m.inflate_kpa_per_s = truth.inflate_kpa_per_s;
+      m.vent_kpa_per_s = truth.vent_kpa_per_s;
+      m.vent_at_kpa = truth.vent_at_kpa;
+      gains = *InnerLoopGainsFor(m, 40.0);
+    }
+    truth.pressure_duty_per_kpa = gains.given() ? gains.kp_per_kpa : rig.board.kp_per_kpa;
+    truth.pressure_duty_dead_time_s = tube_s;
+    ControllerOptions loop = ControllerFor(c);
+    loop.model_inverse = true;
+    loop.model_correction_s = 0.1;
+    loop.max_rate_kpa_per_s = 1000.0;
+
+    Bench bench(rig, c.seed);
+    std::vector<TrackingPoint> sine =
+        bench.control(loop, TargetProfile::Parse("step 150\nhold 2\nsine 150 20 0.5 6\n", "s"),
+                      8.0, gains, truth);
+    sine.erase(sine.begin(), sine.begin() + static_cast<long>(2 * kCameraFps));
+    const double sine_rms = *ComputeStepMetrics(sine).rms_error_deg;
+    Vent(bench.rig());
+    const StepMetrics step =
+        ComputeStepMetrics(bench.control(loop, TargetProfile::Constant(140.0), 3.0, gains, truth));
+    std::printf("model-based, true model, tube %.2f s: sine RMS %.2f deg, step %s\n", tube_s,
+                sine_rms, FormatStepMetrics(step).c_str());
+    EXPECT_LT(sine_rms, tube_s > 0.0 ? 0.8 : 0.5);
+    ASSERT_TRUE(step.settling_1deg_s) << FormatStepMetrics(step);
+    EXPECT_LT(*step.settling_1deg_s, 1.0) << FormatStepMetrics(step);
+    EXPECT_LT(*step.overshoot_percent, 2.0) << FormatStepMetrics(step);
+  }
+}
 
 // Runs the experiment expecting it to stop with an error; returns the error.
 template <typename Error>

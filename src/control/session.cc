@@ -96,12 +96,18 @@ ControlSample ControlSession::step(double time_s, std::optional<double> measured
     case ControlMode::kAngle: {
       const double target_deg = target_.profile.at(sample.time_s);
       sample.target_deg = target_deg;
-      const ControllerOutput out = controller_.update(time_s, target_deg, measured_deg);
+      // The profile is known ahead: the model-based loop looks ahead over the dead times.
+      const TargetProfile& profile = target_.profile;
+      const double now_s = sample.time_s;
+      const ControllerOutput out = controller_.update(
+          time_s, target_deg, measured_deg,
+          [&profile, now_s](double ahead_s) { return profile.at(now_s + ahead_s); });
       sample.action = out.action;
       if (out.action == ControllerOutput::Action::kVent) {
         sample.board = checked(link_.stop());
       } else {
         sample.board = checked(send_pressure(out.setpoint_kpa, &sample.setpoint_kpa));
+        controller_.observe_pressure(sample.board.pressure_kpa);
       }
       break;
     }
@@ -175,6 +181,10 @@ void ControlSession::set_inner_loop_gains(const InnerLoopGains& gains) {
   if (!gains.Check(&problem)) throw InputError("control.inner_loop." + problem);
   inner_loop_ = gains;
   if (started_ && !stopped_) send_inner_loop_gains();
+}
+
+void ControlSession::set_model(const ActuatorModel& model) {
+  controller_.set_model(model, inner_loop_.given() ? inner_loop_.vent_scale : 1.0);
 }
 
 void ControlSession::send_inner_loop_gains() {

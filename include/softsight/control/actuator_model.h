@@ -25,10 +25,19 @@ struct ActuatorModel {
   double valve_dead_time_s = 0.0;
   double inflate_kpa_per_s = 0.0;
   double vent_kpa_per_s = 0.0;
+  double vent_at_kpa = 0.0;  // The pressure vent_kpa_per_s was measured at (an orifice: ~sqrt(p)).
   // Inner loop, pressure setpoint -> sensed pressure: first-order lag plus dead time.
   double pressure_lag_s = 0.0;
   double pressure_dead_time_s = 0.0;
   double pressure_rms_kpa = 0.0;  // RMS residual of that fit.
+  // The same, as the board's loop works: a valve duty proportional to the pressure error,
+  // saturating at full duty, times the probe's rates (inflation; venting ~ sqrt(p), times the
+  // loop's vent scale): dp/dt = clamp(g (setpoint(t - dead) - p), -1, 1) * rate. A large chamber
+  // is pump-limited on a large step, which a linear lag cannot say. The model-based loop
+  // (ControllerOptions::model_inverse) inverts this one.
+  double pressure_duty_per_kpa = 0.0;  // g; 0: not fitted.
+  double pressure_duty_dead_time_s = 0.0;
+  double pressure_duty_rms_kpa = 0.0;  // RMS residual of that fit.
   // Bending, sensed pressure -> angle: the static map (with its hysteresis) through a first-order
   // lag plus dead time (the camera's and the tracker's delay are in the dead time).
   double lag_s = 0.0;

@@ -6,8 +6,12 @@
 // bend more, and a positive error asks for more pressure. All gains are therefore >= 0.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
+
+#include "softsight/control/actuator_model.h"
 
 namespace softsight {
 
@@ -51,6 +55,22 @@ struct ControllerOptions {
   // Setpoint slew limit, kPa/s; 0 = unlimited. Default 60: protects the silicone on target steps.
   // With a feed-forward it also ramps the reference the loop follows (max_rate / ff deg/s).
   double max_rate_kpa_per_s = 60.0;
+  // Model-based loop (what `softsight identify` writes): instead of the PI and the ff_* terms,
+  // the identified model (AngleController::set_model) inverted as the feed-forward, and the
+  // model's error (measured angle - the model's angle for the sensed pressures), low-passed over
+  // model_correction_s, taken off the target it inverts (internal model control). Per frame:
+  //   bend wanted       = (straight - target) at the frame's end plus the dead times (the
+  //                       profile's look-ahead), led by the bending lag (its rate times lag_s),
+  //                       +- half the hysteresis by its direction, - the model error
+  //   pressure wanted   = the static map's inverse of that bend
+  //   setpoint          = the one that brings the model's inner loop (from the board's sensed
+  //                       pressure, pump- and vent-limited) to that pressure by the frame's end
+  // and, while the model lags the target by more than a degree (a step), full pressure (or
+  // none) as long as the model predicts no overshoot when it switches to the target's pressure
+  // the frame after (the fastest approach the pump allows). Output limits and the slew limit
+  // hold as for the PI; the model sees the setpoint as sent, so nothing winds up. Default off.
+  bool model_inverse = false;
+  double model_correction_s = 0.1;
   // Vision loss: keep the last setpoint (integral frozen) while the measurement has been missing
   // for at most this long (from the first frame without one), then vent. Default 0.5 s.
   double hold_s = 0.5;
@@ -77,12 +97,31 @@ struct ControllerOutput {
   std::optional<double> error_deg;    // measured - target, when measured.
 };
 
+class ModelLoop;  // control/model_loop.h
+
 class AngleController {
  public:
   explicit AngleController(const ControllerOptions& options);
+  ~AngleController();
+  AngleController(const AngleController&) = delete;
+  AngleController& operator=(const AngleController&) = delete;
+
+  // The target `ahead_s` after the current frame's (a profile's future): the model-based loop's
+  // look-ahead. Without one the target is taken to stay where it is.
+  using Preview = std::function<double(double ahead_s)>;
+
+  // The identified actuator the model-based loop (options.model_inverse) inverts, and the vent
+  // scale of the board's pressure loop (InnerLoopGains::vent_scale when the host sends gains,
+  // else 1). Without an identified model (or with model_inverse off) the PI runs.
+  void set_model(const ActuatorModel& model, double vent_scale = 1.0);
+  bool model_based() const { return model_loop_ != nullptr; }
 
   // One frame at `time_s` (monotonic). `measured_deg` absent = the tracker lost a marker.
-  ControllerOutput update(double time_s, double target_deg, std::optional<double> measured_deg);
+  ControllerOutput update(double time_s, double target_deg, std::optional<double> measured_deg,
+                          const Preview& preview = {});
+  // The board's sensed pressure in its answer to the last setpoint (the pressure when it
+  // arrived): the model-based loop's pressure from then on.
+  void observe_pressure(double pressure_kpa);
   void reset();
 
   double integral_kpa() const { return integral_kpa_; }
@@ -91,6 +130,10 @@ class AngleController {
   void limit_max_kpa(double max_kpa);
 
  private:
+  // The model-based loop's setpoint (measured_deg absent: markers lost, the model runs on).
+  double model_setpoint(double time_s, double target_deg, std::optional<double> measured_deg,
+                        const Preview& preview, double dt_s);
+
   ControllerOptions options_;
   std::optional<double> last_time_s_;
   std::optional<double> loss_start_s_;  // First frame of the current vision loss.
@@ -104,6 +147,7 @@ class AngleController {
   double derivative_deg_per_s_ = 0.0;
   double setpoint_kpa_ = 0.0;
   bool vented_ = true;
+  std::unique_ptr<ModelLoop> model_loop_;
 };
 
 }  // namespace softsight

@@ -54,6 +54,10 @@ class ControlSession {
   // the session has started: an identification that has just measured the plant). Not given:
   // the board keeps its own. Throws InputError when they are unusable or the board refuses them.
   void set_inner_loop_gains(const InnerLoopGains& gains);
+  // The identified actuator for the model-based loop (ControllerOptions::model_inverse; its
+  // vent scale is the inner-loop gains' when they are given: call after set_inner_loop_gains).
+  // Nothing changes without model_inverse or an identified model.
+  void set_model(const ActuatorModel& model);
 
   // Handshake; the controller's max_kpa is clamped to the board's limit, and so is an open-loop
   // pressure target (see pressure_clamped_from()). Throws InputError (after venting) when the
