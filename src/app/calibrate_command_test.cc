@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "app/calibrate_test_util.h"
 #include "calib/calibration_test_views.h"
 #include "core/test_util.h"
 #include "sim/opencv_samples.h"
@@ -164,59 +165,49 @@ TEST_F(CalibrateCommandTest, OpenCvsSampleChessboardsThroughAPatternAreAllThirte
   EXPECT_THAT(report.str(), HasSubstr("found in 13 of 13 images"));
 }
 
-std::string ErrorOf(const CalibrateOptions& options) {
-  std::ostringstream report;
-  try {
-    RunCalibrate(options, report);
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-    return message;
-  }
-  return "(no error)";
-}
+using testing::CalibrateErrorOf;
 
 TEST_F(CalibrateCommandTest, BadInputIsOneLineNamingTheCulprit) {
   CalibrateOptions options = CameraOptions();
   options.input = (*dir_ / "no_such_folder").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("no_such_folder: no such file or folder"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("no_such_folder: no such file or folder"));
 
   options = CameraOptions();
   options.chessboard = "9*6";
-  EXPECT_THAT(ErrorOf(options), HasSubstr("--chessboard: expected inner corners"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("--chessboard: expected inner corners"));
 
   options = CameraOptions();
   options.chessboard = "7x5";  // Wrong count: the board is found nowhere.
-  EXPECT_THAT(ErrorOf(options), HasSubstr("found in 0 of 11 images"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("found in 0 of 11 images"));
 
   options = CameraOptions();
   options.square_mm = 0;
-  EXPECT_THAT(ErrorOf(options), HasSubstr("--square-mm"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("--square-mm"));
 
   options = CameraOptions();
   options.plane_image = (*dir_ / "plane.png").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("give one of --input"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("give one of --input"));
 
   fs::create_directories(*dir_ / "empty");
   options = CameraOptions();
   options.input = (*dir_ / "empty").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("holds no image files"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("holds no image files"));
 
   const std::string corrupt = (*dir_ / "corrupt" / "a.png").string();
   fs::create_directories(*dir_ / "corrupt");
   std::ofstream(corrupt) << "not a png";
   options.input = (*dir_ / "corrupt").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("a.png: cannot read"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("a.png: cannot read"));
 
   options = CameraOptions();
   options.input.reset();
   options.plane_image = (*dir_ / "views" / "blank.png").string();
   options.out_file = (*dir_ / "plane_blank.yaml").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("blank.png: the 9x6 chessboard was not found"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("blank.png: the 9x6 chessboard was not found"));
 
   options.plane_image = (*dir_ / "plane.png").string();
   options.camera_file = (*dir_ / "missing_camera.yaml").string();
-  EXPECT_THAT(ErrorOf(options), HasSubstr("missing_camera.yaml: cannot open"));
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("missing_camera.yaml: cannot open"));
 }
 
 }  // namespace

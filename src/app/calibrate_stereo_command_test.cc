@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/calibrate_command.h"
+#include "app/calibrate_test_util.h"
 #include "core/test_util.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
@@ -69,15 +70,7 @@ class CalibrateStereoCommandTest : public ::testing::Test {
     return options;
   }
   static std::string ErrorOf(const CalibrateOptions& options) {
-    std::ostringstream report;
-    try {
-      RunCalibrate(options, report);
-    } catch (const InputError& e) {
-      const std::string message = e.what();
-      EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-      return message;
-    }
-    return "(no error)";
+    return testing::CalibrateErrorOf(options);
   }
   static testing::TempDir* dir_;
 };
