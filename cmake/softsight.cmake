@@ -69,10 +69,45 @@ function(softsight_reuse_test_pch target)
   target_precompile_headers(${target} REUSE_FROM softsight_test_pch)
 endfunction()
 
+# The tests' main(): GoogleTest's, plus SOFTSIGHT_TEST_EXCLUDE (src/core/test_main.cc).
+function(softsight_test_main_library)
+  if(NOT TARGET softsight_test_main)
+    add_library(softsight_test_main STATIC ${PROJECT_SOURCE_DIR}/src/core/test_main.cc)
+    target_link_libraries(softsight_test_main PUBLIC GTest::gtest)
+  endif()
+endfunction()
+
+# Registers a test executable with ctest: one entry per test suite (or per 8 of its tests), all
+# labelled `label`, found after the executable is built (cmake/discover_test_suites.cmake says
+# why: one process per TEST cost more CPU in starting than most tests take).
+function(softsight_discover_test_suites target label)
+  set(base "${CMAKE_CURRENT_BINARY_DIR}/${target}")
+  add_custom_command(
+    TARGET ${target} POST_BUILD
+    BYPRODUCTS "${base}_suites.cmake"
+    COMMAND "${CMAKE_COMMAND}"
+            -D "TEST_EXECUTABLE=$<TARGET_FILE:${target}>"
+            -D "CTEST_FILE=${base}_suites.cmake"
+            -D "LABEL=${label}"
+            -D "WORKING_DIR=${CMAKE_CURRENT_BINARY_DIR}"
+            -D "MAX_PER_ENTRY=8"
+            -D "DISCOVERY_TIMEOUT=60"
+            -P "${PROJECT_SOURCE_DIR}/cmake/discover_test_suites.cmake"
+    VERBATIM)
+  file(WRITE "${base}_include.cmake"
+    "if(EXISTS \"${base}_suites.cmake\")\n"
+    "  include(\"${base}_suites.cmake\")\n"
+    "else()\n"
+    "  add_test(${target}_NOT_BUILT ${target}_NOT_BUILT)\n"
+    "endif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${base}_include.cmake")
+endfunction()
+
 # softsight_add_test(<module> SOURCES ... DEPS ...)
-# One GoogleTest executable per module (softsight_<module>_test), every TEST registered with ctest
-# with the ctest label <module> (`ctest -L io`). SOFTSIGHT_TEST_MODULES, when set, lists the
-# modules whose tests are built (the instrumented tree builds only some: scripts/test-sanitize.sh).
+# One GoogleTest executable per module (softsight_<module>_test), its tests registered with ctest
+# by suite (softsight_discover_test_suites) with the ctest label <module> (`ctest -L io`).
+# SOFTSIGHT_TEST_MODULES, when set, lists the modules whose tests are built (the instrumented
+# tree builds only some: scripts/test-sanitize.sh).
 function(softsight_add_test module)
   if(NOT SOFTSIGHT_BUILD_TESTS)
     return()
@@ -85,14 +120,15 @@ function(softsight_add_test module)
   add_executable(${target} ${ARG_SOURCES})
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
   # Test code may use any OpenCV module (writing fixtures, reading images), whatever its module links.
+  softsight_test_main_library()
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} ${OpenCV_LIBS} GTest::gtest GTest::gmock
-                                          GTest::gtest_main)
+                                          softsight_test_main)
   # End-to-end tests find the program and the repository through these (env vars of the same
   # names override them).
   softsight_test_definitions(${target})
   softsight_use_unity_build(${target})
   softsight_reuse_test_pch(${target})
-  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS ${module})
+  softsight_discover_test_suites(${target} ${module})
 endfunction()
 
 # softsight_add_benchmark(<name> SOURCES ... DEPS ...)
