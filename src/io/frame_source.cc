@@ -4,9 +4,12 @@
 #include <cctype>
 #include <cmath>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -41,33 +44,64 @@ void ToBgr(const cv::Mat& decoded, cv::Mat& bgr) {
 
 // Which packets of a video are key frames (decodable on their own), read on demand from a second,
 // demux-only capture (no decoding: OpenCV's raw mode), in step with the frames asked about. A
-// file OpenCV cannot read that way is taken as all key frames (damage stays in its frame).
+// file OpenCV cannot read that way is taken as all key frames (damage stays in its frame), and
+// so is a codec that has no other kind (`intra_only`: nothing is read twice).
 class KeyFrameIndex {
  public:
-  explicit KeyFrameIndex(const std::string& path) : path_(path) {}
-  // The first key frame after `index`, counted as the decoder counts frames; INT64_MAX when the
-  // stream has none after it (the damage lasts to the end).
+  KeyFrameIndex(const std::string& path, bool intra_only) : path_(path), intra_only_(intra_only) {}
+  // Whether frame `index` (counted as the decoder counts frames) is a key frame; true when the
+  // container cannot say.
+  bool is_key(int64_t index) {
+    if (!read_to(index)) return true;
+    return flags_[static_cast<size_t>(index)];
+  }
+  // The first key frame after `index`; INT64_MAX when the stream has none after it (the damage
+  // lasts to the end).
   int64_t next_after(int64_t index) {
-    if (!opened_) {
-      opened_ = true;
-      usable_ = raw_.open(path_, cv::CAP_FFMPEG, {cv::CAP_PROP_FORMAT, -1}) && raw_.isOpened();
-    }
-    if (!usable_) return index + 1;
-    while (true) {
-      if (last_key_ > index) return last_key_;
-      if (!raw_.grab()) return std::numeric_limits<int64_t>::max();
-      const int64_t packet = packets_++;
-      if (raw_.get(cv::CAP_PROP_LRF_HAS_KEY_FRAME) != 0.0) last_key_ = packet;
+    for (int64_t i = index + 1;; ++i) {
+      if (!read_to(i)) return usable_ ? std::numeric_limits<int64_t>::max() : index + 1;
+      if (flags_[static_cast<size_t>(i)]) return i;
     }
   }
 
  private:
+  // Demuxes packets up to `index`; false when the index (or the stream) cannot say.
+  bool read_to(int64_t index) {
+    if (!opened_) {
+      opened_ = true;
+      usable_ = !intra_only_ && raw_.open(path_, cv::CAP_FFMPEG, {cv::CAP_PROP_FORMAT, -1}) &&
+                raw_.isOpened();
+    }
+    if (!usable_) return false;
+    while (static_cast<int64_t>(flags_.size()) <= index) {
+      if (ended_ || !raw_.grab()) {
+        ended_ = true;
+        return false;
+      }
+      flags_.push_back(raw_.get(cv::CAP_PROP_LRF_HAS_KEY_FRAME) != 0.0);
+    }
+    return true;
+  }
+
   std::string path_;
+  bool intra_only_;
   cv::VideoCapture raw_;
-  bool opened_ = false, usable_ = false;
-  int64_t packets_ = 0;
-  int64_t last_key_ = -1;
+  bool opened_ = false, usable_ = false, ended_ = false;
+  std::vector<bool> flags_;  // Per packet read so far: a key frame.
 };
+
+// Codecs whose every frame is a key frame (FourCC as FFmpeg reports it through OpenCV).
+bool IntraOnlyCodec(double fourcc_property) {
+  const auto fourcc = static_cast<uint32_t>(fourcc_property);
+  char code[5] = {static_cast<char>(fourcc & 0xff), static_cast<char>((fourcc >> 8) & 0xff),
+                  static_cast<char>((fourcc >> 16) & 0xff), static_cast<char>((fourcc >> 24) & 0xff),
+                  0};
+  static const char* kIntraOnly[] = {"HFYU", "FFVH", "FFV1", "MJPG", "mjpg", "AVRn", "MJPA",
+                                     "png ", "MPNG", "UYVY", "YUY2", "Y800", "I420", "BGR ",
+                                     "RGB ", "utvd", "ULRG", "ULY0", "ULY2", "M8RG", "M8Y0"};
+  return std::any_of(std::begin(kIntraOnly), std::end(kIntraOnly),
+                     [&](const char* c) { return std::string_view(code, 4) == c; });
+}
 
 // A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
 // - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) is damaged: it gets
@@ -89,6 +123,7 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
+    key_frames_ = std::make_unique<KeyFrameIndex>(path, IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC)));
   }
 
   bool read(Frame& frame) override {
@@ -158,6 +193,7 @@ class VideoFileSource : public FrameSource {
     }
     frame.index = current_.index;
     frame.time_s = current_.time_s;
+    frame.key_frame = key_frames_->is_key(current_.index);
     std::swap(current_, next_);
     have_current_ = have_next_;
     return true;
@@ -187,7 +223,7 @@ class VideoFileSource : public FrameSource {
         ++damaged_;
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
         // in every frame decoded from this one, silently, until the next key frame.
-        suspect_until_ = std::max(suspect_until_, key_frames_.next_after(index));
+        suspect_until_ = std::max(suspect_until_, key_frames_->next_after(index));
         continue;
       }
       if (index < suspect_until_) {
@@ -238,7 +274,7 @@ class VideoFileSource : public FrameSource {
   int64_t decoded_ = 0;     // Frames the decoder returned, damaged ones included.
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
-  KeyFrameIndex key_frames_{path_};
+  std::unique_ptr<KeyFrameIndex> key_frames_;
   int64_t suspect_until_ = 0;           // Frames before this index follow a damaged one.
   int64_t predicted_from_damaged_ = 0;  // Left out for that reason.
   double last_time_s_ = -1.0;

@@ -242,6 +242,29 @@ TEST(VideoFileSource, FramesTheDecoderFoundDamagedAreLeftOutAndReported) {
   EXPECT_EQ(indices, expected);
 }
 
+// Each frame says whether it was decoded on its own: MPEG-4 as OpenCV writes it has a key frame
+// every 12th frame, whose damage (or the frames' before it) the frames after it do not repeat;
+// in an intra-only codec (HuffYUV, MJPG) every frame is one.
+TEST(VideoFileSource, FramesSayWhetherTheyAreKeyFrames) {
+  TempDir dir;
+  const std::vector<cv::Mat> frames = DistinctFrames(40);
+  for (const char* fourcc : {"mp4v", "HFYU", "MJPG"}) {
+    const std::string path = WriteFrames(dir.file(std::string("v_") + fourcc +
+                                                  (fourcc[0] == 'm' ? ".mp4" : ".avi")),
+                                         fourcc, frames);
+    auto source = OpenFrameSource({path});
+    Frame frame;
+    int read = 0;
+    while (source->read(frame)) {
+      const bool predicted_codec = fourcc[0] == 'm';
+      EXPECT_EQ(frame.key_frame, !predicted_codec || frame.index % 12 == 0)
+          << fourcc << " frame " << frame.index;
+      ++read;
+    }
+    EXPECT_EQ(read, 40) << fourcc;
+  }
+}
+
 TEST(VideoFileSource, MissingOrNonVideoFileIsAnError) {
   TempDir dir;
   try {

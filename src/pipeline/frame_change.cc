@@ -109,7 +109,7 @@ double FrameChangeDetector::changed_between(const std::vector<Cell>& a,
   return a.empty() ? 0.0 : static_cast<double>(changed) / static_cast<double>(a.size());
 }
 
-void FrameChangeDetector::observe(const cv::Mat& bgr) {
+void FrameChangeDetector::observe(const cv::Mat& bgr, bool key_frame) {
   CV_Assert(bgr.type() == CV_8UC3);
   if (bgr.size() != size_ || !has_normal_) {
     size_ = bgr.size();
@@ -151,9 +151,14 @@ void FrameChangeDetector::observe(const cv::Mat& bgr) {
   } else if (changed_fraction_ > threshold) {
     // Frames that look alike (a change that stays) count towards accepting it.
     const bool alike = changed_run_ > 0 && changed_between(now_, previous_, false) < 0.5 * threshold;
+    // A change that begins in a predicted frame, or in a key frame, may be the decoder's damage,
+    // which every frame up to the next key frame repeats: it must be seen in a key frame after
+    // the one it began in (in a camera's or an intra-only video's frames, the next frame).
+    key_frame_in_run_ = changed_run_ > 0 && (key_frame_in_run_ || key_frame);
     ++changed_run_;
     alike_run_ = alike ? alike_run_ + 1 : 1;
-    normal = alike_run_ >= kFramesToAcceptAChange || changed_run_ >= kLongestChangeRun;
+    normal = (alike_run_ >= kFramesToAcceptAChange || changed_run_ >= kLongestChangeRun) &&
+             key_frame_in_run_;
     if (normal) {
       before_change_ = normal_;
       change_accepted_ = true;

@@ -15,7 +15,10 @@
 //    textured cell still correlates), and at most a few cells changed (where the actuator
 //    moved), it is believed: a flickering lamp, the camera's exposure, a rolling shutter's bands
 //    under mains light. A frame from another video of the same rig, lit otherwise, still differs
-//    where its actuator is.
+//    where its actuator is. In a video that predicts frames from earlier ones (MPEG-4, H.264),
+//    a change is accepted only once a key frame after the one it began in shows it: the
+//    decoder's silent damage (a flipped bit in a key frame) lasts exactly up to the next key
+//    frame and looks like a lasting change until then.
 //  - a cell whose texture exploded (random bytes are ~85 grey levels between neighbours, camera
 //    images a few): decoded garbage there; markers in or next to it are not trusted. Garbage in
 //    a tenth of the frame or more: the decoder lost its place, and the rest of the frame may be
@@ -42,8 +45,10 @@ class FrameChangeDetector {
   static constexpr int kFramesToAcceptAChange = 3;
 
   // Compares `bgr` (CV_8UC3) with the last normal frame; call once per frame, before the
-  // queries below. A frame of another size starts afresh (it is taken as normal).
-  void observe(const cv::Mat& bgr);
+  // queries below. A frame of another size starts afresh (it is taken as normal). `key_frame`:
+  // Frame::key_frame (a video that predicts frames repeats a damaged picture up to its next key
+  // frame, so a lasting change is accepted only once a later key frame shows it).
+  void observe(const cv::Mat& bgr, bool key_frame = true);
 
   // The frame changed all at once, or is largely decoded garbage: nothing found in it can be
   // trusted.
@@ -91,6 +96,7 @@ class FrameChangeDetector {
   double usual_fraction_ = 0.0;  // Running mean of changed_fraction_ over normal frames.
   int changed_run_ = 0;          // Consecutive frames that changed against the normal one.
   int alike_run_ = 0;            // ... of which the last ones looked like each other.
+  bool key_frame_in_run_ = false;  // ... of which one after the first was a key frame.
 };
 
 }  // namespace softsight

@@ -95,7 +95,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
     if (!initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
   }
-  frame_change_->observe(frame.image);
+  frame_change_->observe(frame.image, frame.key_frame);
   if (frame_change_->whole_frame_changed()) {
     // Nothing in this frame is believed, and the trackers do not see it: their windows, motion
     // and learned models stay as they were in the last believable frame.

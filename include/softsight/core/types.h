@@ -28,6 +28,12 @@ struct Frame {
   // file's: when it was decoded. Left at the epoch by a source, RunPipeline stamps it when
   // read() returns.
   std::chrono::steady_clock::time_point captured{};
+  // Decoded on its own: every frame of a camera, an image sequence or an intra-only codec
+  // (HuffYUV, FFV1, MJPG), and the key frames of a codec that predicts frames from earlier ones
+  // (MPEG-4, H.264). A predicted frame repeats any damage of the frames it was decoded from,
+  // silently, up to the next key frame: the session accepts a lasting change of the whole
+  // picture (a bumped camera) only once a key frame shows it too.
+  bool key_frame = true;
 };
 
 // Why a marker has (or has no) position in a frame: the per-marker `<name>_status` CSV column.
