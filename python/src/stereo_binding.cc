@@ -87,16 +87,17 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   int64_t pairs = 0;
   py::dict found, epipolar;
   std::vector<int64_t> found_count, epipolar_count;
-  std::vector<std::string> names;
+  std::vector<std::string> names, segments;
   {
     py::gil_scoped_release release;
     const std::unique_ptr<FrameSource> left_source = OpenFrameSource(left_spec);
     const std::unique_ptr<FrameSource> right_source = OpenFrameSource(right_spec);
     StereoSession session(left_config, other_config, calibration, options);
     names = session.marker_names();
+    segments = session.segment_names();
     found_count.assign(names.size(), 0);
     epipolar_count.assign(names.size(), 0);
-    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names);
+    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names, segments);
     Frame left_frame, right_frame;
     FrameSource& ahead = frame_offset > 0 ? *right_source : *left_source;
     for (int64_t skipped = 0; skipped < std::abs(frame_offset); ++skipped) {
@@ -127,7 +128,7 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   summary["found"] = found;
   summary["epipolar"] = epipolar;
   summary["baseline_mm"] = calibration.baseline_mm();
-  return py::make_tuple(StereoColumnsDict(StereoColumns(names), rows), summary);
+  return py::make_tuple(StereoColumnsDict(StereoColumns(names, segments), rows), summary);
 }
 
 }  // namespace
