@@ -17,6 +17,7 @@
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_reader.h"
+#include "softsight/io/plot.h"
 #include "softsight/sim/stereo_scene.h"
 
 namespace softsight {
@@ -127,6 +128,12 @@ TEST_F(TrackStereoCommandTest, MarkersAndAnglesIn3dMatchTheTruth) {
             << " deg RMS; the left camera's 2D angle off by up to " << worst_single_camera_error_deg
             << " deg\n";
   EXPECT_FALSE(value("tip_disp_mm", 0).value_or(1.0) > 1e-9);  // The first tip is the reference.
+
+  // `softsight plot` on it: the 3D angle with each camera's, and the out-of-plane angle.
+  const PlotLayout layout = ComputePlotLayout(table, PlotOptions{});
+  ASSERT_GE(layout.panels.size(), 2u);
+  EXPECT_EQ(layout.panels[0].series.size(), 3u);
+  EXPECT_EQ(layout.panels[1].y_label, "out-of-plane angle [deg]");
 }
 
 TEST_F(TrackStereoCommandTest, WithTheRimFitAMarkerMovingAwayIsPlacedOffAndTheRunSaysSo) {
