@@ -206,8 +206,12 @@ TEST(TrackStereoSideBySideTest, OneSideBySideVideoGivesTheRowsOfTheTwoVideos) {
   const StereoScene scene(MakeStereoRig(), options);
   WriteRigAndMarkers(dir, scene.rig());
   {
-    FrameWriter left({dir.file("left.avi")}), right({dir.file("right.avi")}),
-        both({dir.file("both.avi")});
+    const auto video = [&dir](const char* name) {
+      FrameWriterOptions options;
+      options.path = dir.file(name);
+      return options;
+    };
+    FrameWriter left(video("left.avi")), right(video("right.avi")), both(video("both.avi"));
     cv::Mat l, r, wide;
     for (int i = 0; i < options.frame_count; ++i) {
       scene.render(i, l, r);
