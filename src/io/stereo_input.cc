@@ -192,6 +192,10 @@ class SideBySide : public StereoInput {
 
   bool read(FramePair& pair) override {
     pair.pair_dt_ms.reset();
+    // Let go of the last halves first: the decoded frame's buffer is then the source's alone to
+    // reuse (a read-ahead source gives up a buffer still shared, and allocates a new one).
+    pair.left.image.release();
+    pair.right.image.release();
     if (!source_->read(full_)) return false;
     const cv::Mat& image = full_.image;
     if (image.cols % 2 != 0) {

@@ -147,12 +147,16 @@ TEST(PairByIndexTest, TheOffsetDropsTheEarlierViewsFirstFrames) {
   }
 }
 
-// One wide frame per read, its columns numbered in its pixels.
+// One wide frame per read, its columns numbered in its pixels; it counts the reads whose buffer
+// was still shared with somebody (the halves of the last frame) and so could not be reused.
 class WideFrames : public FrameSource {
  public:
-  explicit WideFrames(int width) : width_(width) {}
+  explicit WideFrames(int width, int* shared_buffers = nullptr)
+      : width_(width), shared_buffers_(shared_buffers) {}
   bool read(Frame& frame) override {
     if (next_ == 2) return false;
+    if (shared_buffers_ != nullptr && frame.image.u != nullptr && frame.image.u->refcount > 1)
+      ++*shared_buffers_;
     frame.image.create(3, width_, CV_8UC3);
     for (int x = 0; x < width_; ++x)
       frame.image.col(x).setTo(cv::Scalar(x % 256, next_, 7));
@@ -165,11 +169,14 @@ class WideFrames : public FrameSource {
   std::optional<double> fps() const override { return 2.0; }
 
  private:
-  int width_, next_ = 0;
+  int width_;
+  int* shared_buffers_;
+  int next_ = 0;
 };
 
 TEST(SideBySideTest, EachHalfIsAViewIntoTheDecodedFrame) {
-  auto input = SplitSideBySide(std::make_unique<WideFrames>(20));
+  int shared_buffers = 0;
+  auto input = SplitSideBySide(std::make_unique<WideFrames>(20, &shared_buffers));
   FramePair pair;
   ASSERT_TRUE(input->read(pair));
   ASSERT_TRUE(input->read(pair));
@@ -183,6 +190,8 @@ TEST(SideBySideTest, EachHalfIsAViewIntoTheDecodedFrame) {
   EXPECT_EQ(pair.left.index, 1);
   EXPECT_EQ(pair.right.time_s, 0.5);
   EXPECT_FALSE(input->read(pair));
+  EXPECT_TRUE(pair.left.image.empty());  // The halves do not outlive the end.
+  EXPECT_EQ(shared_buffers, 0);  // Each read could reuse the decoded frame's buffer.
 
   auto odd = SplitSideBySide(std::make_unique<WideFrames>(21));
   try {
