@@ -99,6 +99,9 @@ struct OffsetCase {
   int offset;
   bool flash;
 };
+void PrintTo(const OffsetCase& c, std::ostream* os) {
+  *os << "offset " << c.offset << (c.flash ? " with a flash" : " from the motion");
+}
 
 class TrackStereoOffsetTest : public ::testing::TestWithParam<OffsetCase> {};
 
