@@ -45,6 +45,8 @@ LONG+='|^(TrackMany|InitCommand|InitSweep|PickCommand|OnePipeline|EvaluateTest|E
 LONG+='|^(SynthCommandTest|TrackCamera)\.'
 LONG+='|^TrackStereoCommandTest\.(MarkersAndAngles|WithTheRimFit|WithoutTheOffset|MarkersSwapped)'
 LONG+='|^CalibrateStereoCommandTest\.TwoFolders'
+LONG+='|^(TrackStereoSideBySideTest|TrackStereoCamerasTest|TrackStereoChainTest)\.'
+LONG+='|^Offsets/TrackStereoOffsetTest\.'
 start=$SECONDS
 (cd build-sanitize && ctest --output-on-failure --parallel "$(nproc)" --timeout 480 -E "$LONG")
 echo "sanitize: instrumented tests done in $((SECONDS - start)) s"
