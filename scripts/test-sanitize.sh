@@ -51,6 +51,10 @@ done
 LONG+=':TrackStereoCommandTest.MarkersAndAngles*:TrackStereoCommandTest.WithTheRimFit*'
 LONG+=':TrackStereoCommandTest.WithoutTheOffset*:TrackStereoCommandTest.MarkersSwapped*'
 LONG+=':CalibrateStereoCommandTest.TwoFolders*'
+for suite in TrackStereoSideBySideTest TrackStereoCamerasTest TrackStereoChainTest \
+             Offsets/TrackStereoOffsetTest; do
+  LONG+=":$suite.*"
+done
 export SOFTSIGHT_TEST_EXCLUDE="$LONG"
 start=$SECONDS
 (cd build-sanitize && ctest --output-on-failure --parallel "$(nproc)" --timeout 480)

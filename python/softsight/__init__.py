@@ -127,7 +127,7 @@ def track_stereo(
 
     ``left`` and ``right`` are videos, folders of images or printf patterns; ``stereo`` is the
     file of ``softsight calibrate --left ... --right ...``. Right frame ``i + frame_offset`` is
-    paired with left frame ``i``. ``right_config``: the right view's markers when they need other
+    paired with left frame ``i`` (0 by default: unlike the CLI, the offset is not searched for). ``right_config``: the right view's markers when they need other
     colours or rois (the same names). A marker has ``<m>_X/_Y/_Z`` (mm, the first camera's frame)
     only when both views found it and the pair passed the epipolar check (``max_epipolar_px``);
     ``<m>_status`` says why not. ``reference_plane``: "image" or "first" (what the out-of-plane

@@ -12,6 +12,7 @@
 #include "softsight/core/error.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/output_guard.h"
+#include "softsight/io/stereo_input.h"
 #include "softsight/pipeline/stereo_session.h"
 
 namespace softsight::python {
@@ -87,28 +88,22 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   int64_t pairs = 0;
   py::dict found, epipolar;
   std::vector<int64_t> found_count, epipolar_count;
-  std::vector<std::string> names;
+  std::vector<std::string> names, segments;
   {
     py::gil_scoped_release release;
-    const std::unique_ptr<FrameSource> left_source = OpenFrameSource(left_spec);
-    const std::unique_ptr<FrameSource> right_source = OpenFrameSource(right_spec);
+    const std::unique_ptr<StereoInput> input = PairByIndex(
+        OpenFrameSource(left_spec), OpenFrameSource(right_spec), frame_offset, "frame_offset");
     StereoSession session(left_config, other_config, calibration, options);
     names = session.marker_names();
+    segments = session.segment_names();
     found_count.assign(names.size(), 0);
     epipolar_count.assign(names.size(), 0);
-    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names);
-    Frame left_frame, right_frame;
-    FrameSource& ahead = frame_offset > 0 ? *right_source : *left_source;
-    for (int64_t skipped = 0; skipped < std::abs(frame_offset); ++skipped) {
-      if (!ahead.read(frame_offset > 0 ? right_frame : left_frame)) {
-        throw InputError("frame_offset " + std::to_string(frame_offset) + ": " +
-                         ahead.description() + " has only " + std::to_string(skipped) + " frames");
-      }
-    }
+    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names, segments);
+    FramePair pair;
     std::string row;
     while (!max_frames || pairs < *max_frames) {
-      if (!left_source->read(left_frame) || !right_source->read(right_frame)) break;
-      const StereoFrameResult& result = session.process(left_frame, right_frame);
+      if (!input->read(pair)) break;
+      const StereoFrameResult& result = session.process(pair);
       table.append_row(result, row);
       rows.push_back(row);
       ++pairs;
@@ -127,7 +122,7 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   summary["found"] = found;
   summary["epipolar"] = epipolar;
   summary["baseline_mm"] = calibration.baseline_mm();
-  return py::make_tuple(StereoColumnsDict(StereoColumns(names), rows), summary);
+  return py::make_tuple(StereoColumnsDict(StereoColumns(names, segments), rows), summary);
 }
 
 }  // namespace

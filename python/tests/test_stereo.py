@@ -68,7 +68,7 @@ def test_track_stereo_gives_the_cli_columns_and_exact_3d(markers_yaml, stereo_ya
     csv_path = tmp_path / "run3d.csv"
     run_cli("track-stereo", "-c", str(markers_yaml), "--left", "synth:bending", "--right",
             "synth:bending", "--stereo", str(stereo_yaml), "--csv", str(csv_path),
-            "--max-frames", "6")
+            "--max-frames", "6", "--frame-offset", "0")
     with open(csv_path, newline="") as f:
         rows = list(csv.DictReader(f))
     assert list(table) == list(rows[0])

@@ -23,7 +23,8 @@ CommandRunner SetupPlotCommand(CLI::App& sub) {
   sub.description(
       "Draw CSVs of `softsight track`, `live` or `control` against time: stacked panels of the\n"
       "angle [deg], bending distance (tip displacement) and arc length (mm when the CSV has the\n"
-      "_mm columns, else px); a `control` CSV adds target vs measured angle, pressure and duty.\n"
+      "_mm columns, else px); a `control` CSV adds target vs measured angle, pressure and duty;\n"
+      "a `track-stereo` CSV the 3D angle beside each camera's own and the out-of-plane angle.\n"
       "Several CSVs are overlaid in one colour each, a --truth CSV (softsight synth --truth) in\n"
       "black. --panels adds the radius of curvature and each marker's x and y. A y axis never\n"
       "spans less than --min-span-px / -deg / -mm, so a steady value's sub-pixel noise is not\n"
@@ -31,7 +32,7 @@ CommandRunner SetupPlotCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight plot run.csv -o run.png\n"
       "  softsight plot colour.csv zncc.csv --truth truth.csv --panels angle,radius,xy -o cmp.svg");
-  sub.add_option("csv", args->csvs, "One or more CSVs written by `softsight track`, `live` or `control`")
+  sub.add_option("csv", args->csvs, "One or more CSVs written by `softsight track`, `live`, `control` or `track-stereo`")
       ->required();
   sub.add_option("-o,--out", args->out, "Output figure: .png, .jpg (raster) or .svg (vector)")
       ->required();

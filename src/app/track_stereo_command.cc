@@ -1,6 +1,7 @@
 #include "app/track_stereo_command.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -11,8 +12,11 @@
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_writer.h"
+#include "softsight/io/frame_offset.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/output_guard.h"
+#include "softsight/io/run_source.h"
+#include "softsight/io/stereo_input.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/track/colour_tracker.h"
 #include "track/tracker_kind.h"
@@ -39,11 +43,143 @@ std::optional<double> Median(std::vector<double>& values) {
 
 }  // namespace
 
-TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report) {
+namespace {
+
+void CheckOptions(const TrackStereoOptions& options) {
   if (options.csv_file.empty()) throw InputError("--csv: give the file to write");
   if (options.max_frames && *options.max_frames < 0) {
     throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
   }
+}
+
+FrameSourceSpec SpecOf(const std::string& input, double fps) {
+  FrameSourceSpec spec;
+  spec.input = input;
+  spec.sequence_fps = fps;
+  return spec;
+}
+
+// A source as a run reads it: a camera in its own thread (newest frame), a file decoded ahead.
+std::unique_ptr<FrameSource> Open(const FrameSourceSpec& spec) {
+  return SourceForRun(OpenFrameSource(spec), FilePacing::kReadAhead);
+}
+
+// Finds the frame offset from a flash or the motion (io/frame_offset.h), reports it, or refuses
+// in one line.
+int64_t FindFrameOffset(const TrackStereoOptions& options, const FrameSourceSpec& left_spec,
+                        const FrameSourceSpec& right_spec, std::ostream& report) {
+  FrameOffsetOptions offset_options;
+  offset_options.max_offset_frames = options.max_offset_frames;
+  std::string error;
+  if (!offset_options.Check(&error)) throw InputError("--max-offset-frames: " + error);
+  // The frames the run can use, and the offset's worth beyond them.
+  std::optional<int64_t> frames;
+  if (options.max_frames) frames = *options.max_frames + options.max_offset_frames;
+  const SyncSignal left = MeasureSyncSignal(*OpenFrameSource(left_spec), frames);
+  const SyncSignal right = MeasureSyncSignal(*OpenFrameSource(right_spec), frames);
+  const FrameOffsetEstimate estimate = EstimateFrameOffset(left, right, offset_options);
+  if (!estimate.offset_frames) {
+    throw InputError("cannot find the frame offset between --left and --right within +-" +
+                     std::to_string(options.max_offset_frames) + " frames: " + estimate.refusal +
+                     "; pass --frame-offset N");
+  }
+  const int64_t offset = *estimate.offset_frames;
+  report << "frame offset " << offset << " (right frame = left frame "
+         << (offset >= 0 ? "+ " : "- ") << std::abs(offset) << "), found from ";
+  report << std::fixed << std::setprecision(3);
+  if (estimate.method == FrameOffsetEstimate::Method::kFlash) {
+    report << "a flash: left frame " << *estimate.left_flash_frame << ", right frame "
+           << *estimate.right_flash_frame << " (brightness steps " << std::setprecision(1)
+           << estimate.left_flash_step << " and " << estimate.right_flash_step
+           << " grey levels)\n";
+  } else {
+    report << "the motion: correlation " << *estimate.peak_correlation;
+    if (estimate.second_correlation) {
+      report << ", next best peak " << *estimate.second_correlation << " at offset "
+             << *estimate.second_offset;
+    } else {
+      report << ", no other peak";
+    }
+    report << " (searched +-" << options.max_offset_frames << ")\n";
+  }
+  report.unsetf(std::ios::floatfield);
+  report << std::setprecision(6);
+  return offset;
+}
+
+// The pairs the options ask for, the offset found when it is needed.
+std::unique_ptr<StereoInput> OpenStereoInput(const TrackStereoOptions& options,
+                                             TrackStereoSummary& summary, std::ostream& report) {
+  const bool cameras = options.left_camera || options.right_camera;
+  const bool files = !options.left_input.empty() || !options.right_input.empty();
+  if (int(cameras) + int(files) + int(options.side_by_side.has_value()) != 1) {
+    throw InputError(
+        "give the two views one way: --left and --right, --side-by-side, or --left-camera and "
+        "--right-camera");
+  }
+  if (options.pair_by != "index" && options.pair_by != "time") {
+    throw InputError("--pair-by: expected index or time, got '" + options.pair_by + "'");
+  }
+  const bool by_time = options.pair_by == "time" || cameras;
+  if (!std::isfinite(options.time_offset_ms)) throw InputError("--time-offset-ms: must be finite");
+  if (by_time && options.frame_offset) {
+    throw InputError("--frame-offset pairs by index; with --pair-by time give --time-offset-ms");
+  }
+  if (options.side_by_side) {
+    if (options.frame_offset.value_or(0) != 0 || options.pair_by == "time") {
+      throw InputError("--side-by-side: both views are in one frame (no --frame-offset or "
+                       "--pair-by time)");
+    }
+    return SplitSideBySide(Open(SpecOf(*options.side_by_side, options.sequence_fps)));
+  }
+  if (cameras) {
+    if (!options.left_camera || !options.right_camera) {
+      throw InputError("--left-camera and --right-camera: give both");
+    }
+    FrameSourceSpec left, right;
+    left.camera = options.left_camera;
+    right.camera = options.right_camera;
+    TimePairingOptions pairing;
+    pairing.clock = TimePairingOptions::Clock::kCaptureTime;
+    pairing.time_offset_ms = options.time_offset_ms;
+    return PairByTime(Open(left),
+                      Open(right), pairing);
+  }
+  if (options.left_input.empty() || options.right_input.empty()) {
+    throw InputError(std::string(options.left_input.empty() ? "--left" : "--right") +
+                     ": give both views' videos (or --side-by-side)");
+  }
+  const FrameSourceSpec left_spec = SpecOf(options.left_input, options.sequence_fps);
+  const FrameSourceSpec right_spec =
+      SpecOf(options.right_input, options.right_sequence_fps.value_or(options.sequence_fps));
+  if (by_time) {
+    TimePairingOptions pairing;
+    pairing.time_offset_ms = options.time_offset_ms;
+    return PairByTime(Open(left_spec), Open(right_spec), pairing);
+  }
+  const int64_t offset = options.frame_offset
+                             ? *options.frame_offset
+                             : FindFrameOffset(options, left_spec, right_spec, report);
+  summary.frame_offset = offset;
+  return PairByIndex(Open(left_spec), Open(right_spec), offset,
+                     "--frame-offset");
+}
+
+}  // namespace
+
+TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report) {
+  CheckOptions(options);
+  TrackStereoSummary summary;
+  const std::unique_ptr<StereoInput> input = OpenStereoInput(options, summary, report);
+  const std::optional<int64_t> offset = summary.frame_offset;
+  summary = RunTrackStereo(options, *input, report);
+  summary.frame_offset = offset;
+  return summary;
+}
+
+TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
+                                  std::ostream& report) {
+  CheckOptions(options);
   const TrackingConfig left_config = LoadStereoViewConfig(options.config_file);
   const TrackingConfig right_config =
       options.right_config_file ? LoadStereoViewConfig(*options.right_config_file) : left_config;
@@ -55,20 +191,12 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
   std::string error;
   if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
 
-  FrameSourceSpec left_spec, right_spec;
-  left_spec.input = options.left_input;
-  right_spec.input = options.right_input;
-  left_spec.sequence_fps = right_spec.sequence_fps = options.sequence_fps;
-  const std::unique_ptr<FrameSource> left = OpenFrameSource(left_spec);
-  const std::unique_ptr<FrameSource> right = OpenFrameSource(right_spec);
-
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
     for (PathRole& role : ConfigInputs(right_config)) inputs.push_back(std::move(role));
   }
   inputs.push_back({"--stereo", options.stereo_file});
-  for (const std::string& file : left->files()) inputs.push_back({"--left", file});
-  for (const std::string& file : right->files()) inputs.push_back({"--right", file});
+  for (const std::string& file : input.files()) inputs.push_back({"an input", file});
   CheckOutputsAreNotInputs({{"--csv", options.csv_file}}, inputs);
 
   // Markers move in depth before two cameras: seen smaller than learned, a colour marker with the
@@ -88,34 +216,26 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
 
-  // The offset: the first |offset| frames of the view that started earlier have no partner.
-  Frame left_frame, right_frame;
-  FrameSource& ahead = options.frame_offset > 0 ? *right : *left;
-  for (int64_t skipped = 0; skipped < std::abs(options.frame_offset); ++skipped) {
-    if (!ahead.read(options.frame_offset > 0 ? right_frame : left_frame)) {
-      throw InputError("--frame-offset " + std::to_string(options.frame_offset) + ": " +
-                       ahead.description() + " has only " + std::to_string(skipped) + " frames");
-    }
-  }
-
-  BasicCsvWriter<StereoFrameResult> csv(options.csv_file, StereoColumns(names));
+  BasicCsvWriter<StereoFrameResult> csv(options.csv_file,
+                                        StereoColumns(names, session.segment_names()));
   TrackStereoSummary summary;
   summary.found.assign(names.size(), {"", 0});
   summary.epipolar.assign(names.size(), {"", 0});
   for (size_t i = 0; i < names.size(); ++i)
     summary.found[i].first = summary.epipolar[i].first = names[i];
   std::vector<double> sigmas, epipolar_distances;
-  std::optional<std::string> ended;
+  FramePair pair;
+  bool by_time = false;
   while (!options.max_frames || summary.pairs < *options.max_frames) {
-    const bool have_left = left->read(left_frame);
-    const bool have_right = have_left && right->read(right_frame);
-    if (!have_left || !have_right) {
-      if (have_left) ended = right->description() + " ended first";
-      break;
-    }
-    const StereoFrameResult& result = session.process(left_frame, right_frame);
+    if (!input.read(pair)) break;
+    const StereoFrameResult& result = session.process(pair);
     csv.write(result);
     ++summary.pairs;
+    if (result.pair_dt_ms) {
+      by_time = true;
+      summary.max_abs_pair_dt_ms =
+          std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
+    }
     for (size_t i = 0; i < result.markers.size(); ++i) {
       const StereoPoint& p = result.markers[i].point;
       if (p.found()) {
@@ -128,10 +248,26 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
   }
   summary.median_sigma_mm = Median(sigmas);
   summary.median_epipolar_px = Median(epipolar_distances);
+  summary.left_unpaired = input.left_unpaired();
+  summary.right_unpaired = input.right_unpaired();
 
-  report << summary.pairs << " pairs of frames (right frame = left frame "
-         << (options.frame_offset >= 0 ? "+ " : "- ") << std::abs(options.frame_offset) << ")";
-  if (ended) report << "; " << *ended;
+  report << summary.pairs << " pairs of frames";
+  if (by_time) {
+    report << " (paired by time; left out without a partner within half a frame interval: "
+           << summary.left_unpaired << " left, " << summary.right_unpaired << " right frames";
+    if (summary.max_abs_pair_dt_ms) {
+      report << "; pairing error up to " << std::fixed << std::setprecision(1)
+             << *summary.max_abs_pair_dt_ms << " ms";
+    }
+    report << ")";
+  } else if (summary.left_unpaired > 0 || summary.right_unpaired > 0) {
+    const int64_t offset = summary.right_unpaired - summary.left_unpaired;
+    report << " (right frame = left frame " << (offset >= 0 ? "+ " : "- ") << std::abs(offset)
+           << ")";
+  } else {
+    report << " (right frame = left frame + 0)";
+  }
+  if (const std::optional<std::string> ended = input.ended_first()) report << "; " << *ended;
   report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
   for (size_t i = 0; i < names.size(); ++i) {
     report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
@@ -166,24 +302,47 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       "  softsight calibrate --left cal/left/ --right cal/right/ --chessboard 9x6 --square-mm 25 "
       "--out stereo.yaml\n"
       "  softsight track-stereo -c markers.yaml --left left.avi --right right.avi "
-      "--stereo stereo.yaml --csv run3d.csv");
+      "--stereo stereo.yaml --csv run3d.csv\n"
+      "Without --frame-offset the offset between the two videos is found from a flash or the\n"
+      "motion (and refused when unclear); --pair-by time pairs frames by their timestamps.");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
   sub.add_option("--right-config", options->right_config_file,
                  "The right view's marker config, when its colours or rois differ (same names)")
       ->check(CLI::ExistingFile);
-  sub.add_option("--left", options->left_input, "The first camera's video (or image sequence)")
-      ->required();
-  sub.add_option("--right", options->right_input, "The second camera's video (or image sequence)")
-      ->required();
+  sub.add_option("--left", options->left_input, "The first camera's video (or image sequence)");
+  sub.add_option("--right", options->right_input,
+                 "The second camera's video (or image sequence)");
+  sub.add_option("--side-by-side", options->side_by_side,
+                 "Instead of --left/--right: one video, the first camera in the left half of each "
+                 "frame, the second in the right half");
+  sub.add_option("--left-camera", options->left_camera,
+                 "Instead of --left/--right: two live cameras (V4L2 indices), paired by capture "
+                 "time")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--right-camera", options->right_camera, "The second live camera")
+      ->check(CLI::NonNegativeNumber);
   sub.add_option("--stereo", options->stereo_file,
                  "The rig from `softsight calibrate --left ... --right ...`")
       ->required();
   sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("--frame-offset", options->frame_offset,
                  "Pair left frame i with right frame i + N (the right camera started N frames "
-                 "earlier; negative: later)");
+                 "earlier; negative: later). Not given: found from a flash or the motion, or "
+                 "refused");
+  sub.add_option("--max-offset-frames", options->max_offset_frames,
+                 "Without --frame-offset: search offsets up to this many frames either way")
+      ->capture_default_str()
+      ->check(NumberIn(0, 100000));
+  sub.add_option("--pair-by", options->pair_by,
+                 "index (frame i with frame i + offset) or time (each frame with the other "
+                 "view's nearest in time, within half a frame interval; CSV column pair_dt_ms)")
+      ->capture_default_str();
+  sub.add_option("--time-offset-ms", options->time_offset_ms,
+                 "With --pair-by time: the right view's clock minus the left one's (ms)")
+      ->capture_default_str()
+      ->check(NumberIn(-1e9, 1e9));
   sub.add_option("--max-epipolar-px", options->max_epipolar_px,
                  "A pair farther than this from its epipolar line is not believed (status "
                  "epipolar)")
@@ -195,6 +354,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--fps", options->sequence_fps, "Frame rate of image sequences")
       ->capture_default_str()
+      ->check(NumberIn(1e-3, 1e6));
+  sub.add_option("--right-fps", options->right_sequence_fps,
+                 "Frame rate of the right image sequence, when it differs from --fps")
       ->check(NumberIn(1e-3, 1e6));
   sub.add_option("--max-frames", options->max_frames, "Stop after this many pairs")
       ->check(NumberIn(0, 1e15));

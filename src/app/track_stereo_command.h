@@ -12,19 +12,35 @@
 
 namespace softsight {
 
+class StereoInput;
+
 struct TrackStereoOptions {
   std::string config_file;                       // Markers (and the triple or chain).
   std::optional<std::string> right_config_file;  // The right view's, when its rois differ.
   std::string left_input, right_input;           // Videos, image folders or patterns.
+  // Instead of left_input and right_input: one video, the first camera in the left half of each
+  // frame, the second in the right half.
+  std::optional<std::string> side_by_side;
+  // Instead of left_input and right_input: two live cameras (V4L2 indices), paired by the time
+  // each frame was captured.
+  std::optional<int> left_camera, right_camera;
   std::string stereo_file;                       // From `calibrate --left --right`.
   std::string csv_file;
-  // The right view's frame paired with left frame i is i + frame_offset (the right camera
-  // started recording frame_offset frames earlier; negative: later).
-  int64_t frame_offset = 0;
+  // Pairing by index: the right view's frame paired with left frame i is i + frame_offset (the
+  // right camera started recording frame_offset frames earlier; negative: later). Absent: found
+  // from a flash or the motion (io/frame_offset.h) within +-max_offset_frames, or refused.
+  std::optional<int64_t> frame_offset;
+  int64_t max_offset_frames = 60;
+  // "index" (frame i with frame i + frame_offset) or "time" (each frame with the other view's
+  // nearest in time, within half a frame interval; io/stereo_input.h).
+  std::string pair_by = "index";
+  // Pairing by time: the right view's clock minus the left one's (ms).
+  double time_offset_ms = 0.0;
   double max_epipolar_px = 2.0;           // See TriangulationOptions.
   std::string reference_plane = "image";  // "image" or "first" (StereoOptions).
   std::optional<int64_t> max_frames;
   double sequence_fps = 30.0;  // Image sequences' frame rate.
+  std::optional<double> right_sequence_fps;  // The right image sequence's, when it differs.
 };
 
 struct TrackStereoSummary {
@@ -33,10 +49,20 @@ struct TrackStereoSummary {
   std::vector<std::pair<std::string, int64_t>> found, epipolar;
   std::optional<double> median_sigma_mm;     // Over the found points.
   std::optional<double> median_epipolar_px;  // Over the pairs both views found.
+  // Pairing: the offset used (by index), and frames of each view left without a partner (by
+  // time: none within the tolerance; by index: the earlier view's first frames).
+  std::optional<int64_t> frame_offset;
+  int64_t left_unpaired = 0, right_unpaired = 0;
+  std::optional<double> max_abs_pair_dt_ms;  // By time: the worst pairing error.
 };
 
 // Runs the whole job and prints its report. Throws InputError for bad input (config, stereo
-// file, videos, offset, outputs that are inputs) or a frame of the wrong size.
+// file, videos, offset, outputs that are inputs), a frame of the wrong size, or an offset that
+// cannot be found (one line: pass --frame-offset).
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report);
+// The same on pairs from `input` (any two sources: cameras, stand-ins in tests); the options'
+// inputs, offset and pairing are not used.
+TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
+                                  std::ostream& report);
 
 }  // namespace softsight

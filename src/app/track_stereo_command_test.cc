@@ -11,11 +11,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/scene_markers_test_util.h"
+#include "app/stereo_test_util.h"
 #include "app/track_stereo_command.h"
 #include "calib/stereo_test_util.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_reader.h"
+#include "softsight/io/plot.h"
 #include "softsight/sim/stereo_scene.h"
 
 namespace softsight {
@@ -23,38 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-// The scene's markers as a config for two cameras: without the rim fit (the markers move in
-// depth, so each view sees them change size; colour_tracker.h).
-std::string StereoMarkersYaml() {
-  std::string yaml = testing::kSceneMarkersYaml;
-  for (size_t at = yaml.find("    hsv:"); at != std::string::npos; at = yaml.find("    hsv:", at)) {
-    at = yaml.find('\n', at) + 1;
-    yaml.insert(at, "    rim_fit: false\n");
-  }
-  return yaml;
-}
-
-// Each row's fields by column name (status columns are words).
-std::vector<std::map<std::string, std::string>> ReadRows(const std::string& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  for (std::stringstream s(line); std::getline(s, line, ',');) header.push_back(line);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    std::map<std::string, std::string> row;
-    std::stringstream s(line);
-    for (const std::string& name : header) {
-      std::string field;
-      std::getline(s, field, ',');
-      row[name] = field;
-    }
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
+using testing::ReadRows;
+using testing::StereoMarkersYaml;
 
 class TrackStereoCommandTest : public ::testing::Test {
  protected:
@@ -156,6 +128,12 @@ TEST_F(TrackStereoCommandTest, MarkersAndAnglesIn3dMatchTheTruth) {
             << " deg RMS; the left camera's 2D angle off by up to " << worst_single_camera_error_deg
             << " deg\n";
   EXPECT_FALSE(value("tip_disp_mm", 0).value_or(1.0) > 1e-9);  // The first tip is the reference.
+
+  // `softsight plot` on it: the 3D angle with each camera's, and the out-of-plane angle.
+  const PlotLayout layout = ComputePlotLayout(table, PlotOptions{});
+  ASSERT_GE(layout.panels.size(), 2u);
+  EXPECT_EQ(layout.panels[0].series.size(), 3u);
+  EXPECT_EQ(layout.panels[1].y_label, "out-of-plane angle [deg]");
 }
 
 TEST_F(TrackStereoCommandTest, WithTheRimFitAMarkerMovingAwayIsPlacedOffAndTheRunSaysSo) {

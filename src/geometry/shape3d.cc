@@ -129,6 +129,32 @@ std::optional<double> ArcLength3d(const CircleFit3d& circle,
   return ArcLengthThroughPoints(flat, InPlane(points, circle.centre, u, v));
 }
 
+void MeasureSegments3d(const std::vector<std::optional<cv::Point3d>>& chain,
+                       std::vector<Segment3d>* segments) {
+  segments->resize(chain.size() >= 3 ? chain.size() - 2 : 0);
+  for (size_t k = 0; k < segments->size(); ++k) {
+    Segment3d& segment = (*segments)[k];
+    segment = Segment3d{};
+    const std::optional<cv::Point3d>&a = chain[k], &b = chain[k + 1], &c = chain[k + 2];
+    if (!a || !b || !c) continue;
+    const cv::Vec3d u = *a - *b, v = *c - *b;
+    const double nu = cv::norm(u), nv = cv::norm(v);
+    if (!(nu > 0) || !(nv > 0)) continue;
+    // The angle at the middle, theta: an inscribed angle, so the arc through the middle spans
+    // 2 pi - 2 theta of the circle, whose radius is |ac| / (2 sin theta) (law of sines).
+    const double theta = std::atan2(cv::norm(u.cross(v)), u.dot(v));
+    segment.angle_deg = theta * kRadToDeg;
+    const double sin_theta = std::sin(theta);
+    if (sin_theta < 1e-12) {
+      // On a line: straight through the middle (folded back on itself: no circle either).
+      if (theta > std::numbers::pi / 2) segment.arc_length = nu + nv;
+      continue;
+    }
+    segment.radius = cv::norm(*c - *a) / (2.0 * sin_theta);
+    segment.arc_length = *segment.radius * (2.0 * std::numbers::pi - 2.0 * theta);
+  }
+}
+
 Shape3d MeasureShape3d(const std::vector<std::optional<cv::Point3d>>& chain,
                        const std::optional<cv::Vec3d>& reference_normal,
                        const std::optional<cv::Point3d>& tip_reference) {

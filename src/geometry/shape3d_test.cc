@@ -117,5 +117,66 @@ TEST(Shape3dTest, MeasureShapeOfAThreeMarkerChainBentOutOfTheImagePlane) {
   EXPECT_THAT(partial.tip_disp, Optional(DoubleNear(5.0, kTol)));
 }
 
+TEST(Shape3dTest, SegmentsOfAChainWithTwoCurvaturesEachGiveTheirOwnCircle) {
+  // Five markers in a tilted plane: the first three on a circle of radius 40 (30 deg apart),
+  // the last three on one of radius 90 (20 deg apart), sharing the middle marker: each inner
+  // marker's triple lies on one circle, except the one that straddles both.
+  cv::Vec3d u, v, n;
+  TiltedPlane(35.0, u, v, n);
+  const cv::Point3d centre_a(0, 0, 300);
+  std::vector<std::optional<cv::Point3d>> chain;
+  for (double a : {0.0, 30.0, 60.0}) chain.push_back(OnCircle3d(centre_a, u, v, 40.0, a));
+  // A circle of radius 90 through chain[2], tangent-free: centre on the line from chain[2]
+  // through centre_a, beyond it.
+  const cv::Point3d joint = *chain[2];
+  const cv::Point3d centre_b = joint + (centre_a - joint) * (90.0 / 40.0);
+  const cv::Point3d r0 = joint - centre_b;
+  // Angles on the second circle measured from the joint's direction.
+  const cv::Vec3d e1 = cv::normalize(cv::Vec3d(r0.x, r0.y, r0.z));
+  const cv::Vec3d e2 = n.cross(e1);
+  for (double a : {20.0, 40.0}) {
+    const double t = a * std::numbers::pi / 180.0;
+    const cv::Vec3d p = 90.0 * (std::cos(t) * e1 + std::sin(t) * e2);
+    chain.push_back(centre_b + cv::Point3d(p[0], p[1], p[2]));
+  }
+  std::vector<Segment3d> segments;
+  MeasureSegments3d(chain, &segments);
+  ASSERT_EQ(segments.size(), 3u);
+  EXPECT_THAT(segments[0].radius, Optional(DoubleNear(40.0, 1e-9)));
+  EXPECT_THAT(segments[0].arc_length, Optional(DoubleNear(40.0 * std::numbers::pi / 3, 1e-9)));
+  // An inscribed angle: 180 - half the arc's 60 deg.
+  EXPECT_THAT(segments[0].angle_deg, Optional(DoubleNear(150.0, 1e-9)));
+  EXPECT_THAT(segments[2].radius, Optional(DoubleNear(90.0, 1e-9)));
+  EXPECT_THAT(segments[2].arc_length, Optional(DoubleNear(90.0 * 40.0 * std::numbers::pi / 180, 1e-9)));
+  ASSERT_TRUE(segments[1].radius.has_value());  // Straddles both: between the two.
+  EXPECT_GT(*segments[1].radius, 40.0);
+  EXPECT_LT(*segments[1].radius, 90.0);
+  // The same triples through the general 3D circle fit (the reference): the same figures.
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const std::vector<cv::Point3d> triple = {*chain[k], *chain[k + 1], *chain[k + 2]};
+    const std::optional<CircleFit3d> circle = FitCircle3d(triple);
+    ASSERT_TRUE(circle.has_value());
+    EXPECT_THAT(segments[k].radius, Optional(DoubleNear(circle->radius, 1e-6 * circle->radius)));
+    EXPECT_THAT(segments[k].arc_length,
+                Optional(DoubleNear(*ArcLength3d(*circle, triple), 1e-6 * circle->radius)));
+  }
+
+  // A missing marker empties the two segments it belongs to; a straight triple has no radius.
+  chain[3].reset();
+  chain.push_back(cv::Point3d(0, 0, 0));
+  MeasureSegments3d(chain, &segments);
+  ASSERT_EQ(segments.size(), 4u);
+  EXPECT_TRUE(segments[0].radius.has_value());
+  EXPECT_FALSE(segments[1].arc_length.has_value());
+  EXPECT_FALSE(segments[2].angle_deg.has_value());
+  const std::vector<std::optional<cv::Point3d>> straight = {
+      cv::Point3d(0, 0, 300), cv::Point3d(3, 4, 300), cv::Point3d(9, 12, 300)};
+  MeasureSegments3d(straight, &segments);
+  ASSERT_EQ(segments.size(), 1u);
+  EXPECT_FALSE(segments[0].radius.has_value());
+  EXPECT_THAT(segments[0].arc_length, Optional(DoubleNear(15.0, kTol)));
+  EXPECT_THAT(segments[0].angle_deg, Optional(DoubleNear(180.0, kTol)));
+}
+
 }  // namespace
 }  // namespace softsight

@@ -419,10 +419,12 @@ class CameraSource : public FrameSource {
       throw InputError("camera " + std::to_string(index_) + ": frame " +
                        std::to_string(next_index_) + " could not be captured (unplugged?)");
     }
+    // Capture time on this machine's steady clock: two cameras read by one program share it
+    // (pairing by time, stereo_input.h).
+    frame.captured = std::chrono::steady_clock::now();
     ToBgr(decoded_, frame.image);
     frame.index = next_index_++;
-    frame.time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    frame.time_s = std::chrono::duration<double>(frame.captured - start_).count();
     return true;
   }
 

@@ -119,8 +119,8 @@ PlotPanel MakePanel(std::string y_label) {
   return panel;
 }
 
-const char* const kPanelKinds[] = {"angle", "bending", "arc", "radius", "xy", "control"};
-const char* const kDefaultPanels[] = {"angle", "bending", "arc", "control"};
+const char* const kPanelKinds[] = {"angle", "plane", "bending", "arc", "radius", "xy", "control"};
+const char* const kDefaultPanels[] = {"angle", "plane", "bending", "arc", "control"};
 // The live overlay's "straight" (gui/overlay.h, ReadsStraight): a radius of this many arc lengths
 // or more is mostly centroid noise and grows without bound as the actuator straightens, so the
 // radius panel leaves it out (a gap) rather than let it set the axis.
@@ -192,9 +192,28 @@ void AddPanels(const std::string& kind, const PlotData& data, const Legend& lege
       const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
       if (target) panel.series.push_back(Series(legend.label(t, "target"), *target, kTarget, t));
       if (model) panel.series.push_back(Series(legend.label(t, "model"), *model, kTarget, t));
+      // A track-stereo CSV: the 3D angle beside what each camera alone measures.
+      const auto left = table.find("angle_left_deg"), right = table.find("angle_right_deg");
       if (angle) {
-        const std::string quantity = legend.single() ? (target || model ? "measured" : "angle") : "";
+        const std::string quantity =
+            legend.single() ? (target || model ? "measured" : left ? "3D" : "angle") : "";
         panel.series.push_back(Series(legend.label(t, quantity), *angle, legend.colour(t, kMeasured), t));
+      }
+      if (left && legend.single()) {
+        panel.series.push_back(Series("left camera", *left, kPalette[0], t));
+        if (right) panel.series.push_back(Series("right camera", *right, kPalette[1], t));
+      }
+    }
+    if (!panel.series.empty()) panels->push_back(panel);
+  } else if (kind == "plane") {
+    // track-stereo: the bending plane's angle out of the reference plane.
+    PlotPanel panel = MakePanel("out-of-plane angle [deg]");
+    panel.unit = "deg";
+    for (size_t t = 0; t < data.table_count(); ++t) {
+      const auto column = data.table(t).find("out_of_plane_deg");
+      if (column) {
+        panel.series.push_back(Series(legend.label(t, legend.single() ? "out of plane" : ""),
+                                      *column, legend.colour(t, kArc), t));
       }
     }
     if (!panel.series.empty()) panels->push_back(panel);
@@ -206,7 +225,23 @@ void AddPanels(const std::string& kind, const PlotData& data, const Legend& lege
     // Empty fields (a straight actuator has no radius) are gaps, as everywhere.
     AddLengthPanel(data, legend, "radius", "radius of curvature", kMeasured, panels);
   } else if (kind == "xy") {
-    // The markers of the first run, in its column order: one panel for x, one for y each.
+    // The markers of the first run, in its column order: one panel for x, one for y each; a
+    // track-stereo CSV's markers in 3D (<m>_X, _Y, _Z, mm): one panel per coordinate.
+    for (const std::string& column : first.columns) {
+      if (column.size() < 3 || column.compare(column.size() - 2, 2, "_X") != 0) continue;
+      const std::string name = column.substr(0, column.size() - 2);
+      if (!first.find(name + "_Y") || !first.find(name + "_Z")) continue;
+      for (const char* axis : {"_X", "_Y", "_Z"}) {
+        PlotPanel panel = MakePanel(name + " " + (axis + 1) + " [mm]");
+        panel.unit = "mm";
+        for (size_t t = 0; t < data.table_count(); ++t) {
+          const auto c = data.table(t).find(name + axis);
+          if (c) panel.series.push_back(Series(legend.label(t, legend.single() ? name + " " + (axis + 1) : ""),
+                                         *c, legend.colour(t, kMeasured), t));
+        }
+        panels->push_back(panel);
+      }
+    }
     for (const std::string& column : first.columns) {
       if (column.size() < 3 || column.compare(column.size() - 2, 2, "_x") != 0) continue;
       const std::string name = column.substr(0, column.size() - 2);
@@ -281,6 +316,7 @@ std::vector<PlotPanel> ChoosePanels(const PlotData& data, const PlotOptions& opt
                        (kind == "xy" ? std::string("<name>_x and <name>_y")
                         : kind == "radius" ? std::string("radius_px")
                         : kind == "angle" ? std::string("angle_deg")
+                        : kind == "plane" ? std::string("out_of_plane_deg, from track-stereo")
                         : kind == "bending" ? std::string("tip_disp_px")
                         : kind == "arc" ? std::string("arc_length_px")
                                         : std::string("pressure or duty columns")) +
@@ -393,7 +429,7 @@ std::optional<double> PlotSeriesValue(const CsvTable& table, const PlotSeries& s
   return v;
 }
 
-const char* PlotPanelNames() { return "angle, bending, arc, radius, xy, control"; }
+const char* PlotPanelNames() { return "angle, plane, bending, arc, radius, xy, control"; }
 
 PlotLayout ComputePlotLayout(const CsvTable& table, const PlotOptions& options) {
   return ComputePlotLayout(PlotData{{table}, std::nullopt}, options);

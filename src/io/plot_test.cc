@@ -295,6 +295,65 @@ TEST_F(PlotTest, ControllerColumnsAddTargetAndPressurePanels) {
   }
 }
 
+// A track-stereo CSV: the 3D angle with each camera's own in one panel, the out-of-plane angle
+// in its own, the lengths in mm, and (asked for) each marker's X, Y and Z.
+TEST_F(PlotTest, TrackStereoColumnsGiveThe3dAngleAndTheOutOfPlanePanel) {
+  const std::string csv = Path("run3d.csv");
+  {
+    std::ofstream out(csv);
+    out << "frame,right_frame,time_s,pair_dt_ms,red_X,red_Y,red_Z,red_sigma_mm,red_epipolar_px,"
+           "red_status,angle_deg,out_of_plane_deg,plane_nx,plane_ny,plane_nz,radius_mm,"
+           "arc_length_mm,tip_disp_mm,angle_left_deg,angle_right_deg,proc_ms\n";
+    for (int i = 0; i < 21; ++i) {
+      const double t = i * 0.1;
+      out << i << "," << i + 3 << "," << t << ",," << 10 + t << "," << 20 << "," << 300 - t
+          << ",0.05,0.1,found," << kLinearAngle(t) << "," << 30 - 5 * t << ",0,0.5,0.86,"
+          << 60 << "," << kLinearArc(t) << "," << kLinearTip(t) << "," << kLinearAngle(t) - 2
+          << "," << kLinearAngle(t) + 1 << ",2.5\n";
+    }
+  }
+  const CsvTable table = ReadCsvTable(csv);
+  const PlotLayout layout = ComputePlotLayout(table, PlotOptions{});
+  ASSERT_EQ(layout.panels.size(), 4u);
+  const PlotPanel& angle = layout.panels[0];
+  ASSERT_EQ(angle.series.size(), 3u);
+  EXPECT_EQ(angle.series[0].label, "3D");
+  EXPECT_EQ(table.columns[angle.series[0].column], "angle_deg");
+  EXPECT_EQ(angle.series[1].label, "left camera");
+  EXPECT_EQ(table.columns[angle.series[2].column], "angle_right_deg");
+  const PlotPanel& plane = layout.panels[1];
+  EXPECT_EQ(plane.y_label, "out-of-plane angle [deg]");
+  EXPECT_EQ(table.columns[plane.series[0].column], "out_of_plane_deg");
+  EXPECT_EQ(layout.panels[2].y_label, "bending distance [mm]");
+  EXPECT_EQ(layout.panels[3].y_label, "arc length [mm]");
+
+  // The out-of-plane curve is drawn where the data says: 30 deg at t = 0, 25 at t = 1.
+  WritePlot(csv, Path("run3d.png"));
+  const cv::Mat image = cv::imread(Path("run3d.png"));
+  for (double t : {0.0, 1.0, 1.6}) {
+    EXPECT_TRUE(ColourNear(image, plane.to_pixel(t, 30 - 5 * t), plane.series[0].bgr, 1)) << t;
+  }
+
+  PlotOptions xyz;
+  xyz.panels = {"xy", "plane"};
+  const PlotLayout markers = ComputePlotLayout(table, xyz);
+  ASSERT_EQ(markers.panels.size(), 4u);
+  EXPECT_EQ(markers.panels[0].y_label, "red X [mm]");
+  EXPECT_EQ(markers.panels[2].y_label, "red Z [mm]");
+  EXPECT_EQ(table.columns[markers.panels[2].series[0].column], "red_Z");
+
+  // A 2D CSV has no out-of-plane angle: asking for it names the column.
+  const std::string flat = WriteCsv("flat.csv", 5, 0.1, kLinearAngle, kLinearTip, kLinearArc, false);
+  PlotOptions plane_only;
+  plane_only.panels = {"plane"};
+  try {
+    ComputePlotLayout(ReadCsvTable(flat), plane_only);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("out_of_plane_deg"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(PlotTest, BadInputIsOneLineNamingTheFile) {
   auto expect_error = [](const std::function<void()>& call, const std::string& needle) {
     try {

@@ -67,6 +67,9 @@ struct StereoSession::Impl {
     result.markers.resize(names.size());
     for (size_t i = 0; i < names.size(); ++i) result.markers[i].name = names[i];
     chain.resize(chain_index.size());
+    if (chain_index.size() > 3) {
+      for (size_t k = 1; k + 1 < chain_index.size(); ++k) segment_names.push_back(names[chain_index[k]]);
+    }
   }
 
   TrackingSession left, right;
@@ -74,6 +77,7 @@ struct StereoSession::Impl {
   StereoOptions options;
   std::vector<std::string> names;
   std::vector<size_t> chain_index;  // The chain's markers' indices in `names`, base to tip.
+  std::vector<std::string> segment_names;  // Inner markers, with more than 3 in the chain.
   std::vector<std::optional<cv::Point3d>> chain;  // Reused per frame.
   std::optional<cv::Vec3d> reference_normal;
   std::optional<cv::Point3d> tip_reference;
@@ -95,6 +99,13 @@ StereoSession::StereoSession(StereoSession&&) noexcept = default;
 StereoSession& StereoSession::operator=(StereoSession&&) noexcept = default;
 
 std::vector<std::string> StereoSession::marker_names() const { return impl_->names; }
+std::vector<std::string> StereoSession::segment_names() const { return impl_->segment_names; }
+
+const StereoFrameResult& StereoSession::process(const FramePair& pair) {
+  process(pair.left, pair.right);
+  impl_->result.pair_dt_ms = pair.pair_dt_ms;
+  return impl_->result;
+}
 const Triangulator& StereoSession::triangulator() const { return impl_->triangulator; }
 
 const StereoFrameResult& StereoSession::process(const Frame& left_frame, const Frame& right_frame) {
@@ -114,6 +125,7 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
   out.frame_index = left.frame_index;
   out.right_frame_index = right.frame_index;
   out.time_s = left.time_s;
+  out.pair_dt_ms.reset();
   out.left_angle_deg = left.measurement.angle_deg;
   out.right_angle_deg = right.measurement.angle_deg;
   for (size_t i = 0; i < s.names.size(); ++i) {
@@ -136,6 +148,7 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
   }
   if (!s.tip_reference && !s.chain.empty() && s.chain.back()) s.tip_reference = s.chain.back();
   out.shape = MeasureShape3d(s.chain, s.reference_normal, s.tip_reference);
+  if (!s.segment_names.empty()) MeasureSegments3d(s.chain, &out.segments);
   if (!s.reference_normal && out.shape.plane_normal) {
     // The first frame with a bending plane is the reference from now on (its own angle: 0).
     s.reference_normal = out.shape.plane_normal;
@@ -146,7 +159,8 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
   return out;
 }
 
-BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names) {
+BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names,
+                                                     const std::vector<std::string>& segment_names) {
   using Row = StereoFrameResult;
   using Column = BasicCsvColumn<Row>;
   BasicCsvColumnTable<Row> table;
@@ -157,6 +171,8 @@ BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::stri
                    }});
   table.add(NumberColumn<Row>(
       "time_s", [](const Row& r) { return r.time_s; }, "%.6f"));
+  table.add(NumberColumn<Row>(
+      "pair_dt_ms", [](const Row& r) { return r.pair_dt_ms; }, "%.3f"));
   for (size_t i = 0; i < marker_names.size(); ++i) {
     const std::string& name = marker_names[i];
     const auto coordinate = [i](int axis) {
@@ -196,6 +212,32 @@ BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::stri
       "arc_length_mm", [](const Row& r) { return r.shape.arc_length; }, "%.4f"));
   table.add(NumberColumn<Row>(
       "tip_disp_mm", [](const Row& r) { return r.shape.tip_disp; }, "%.4f"));
+  for (size_t k = 0; k < segment_names.size(); ++k) {
+    const auto segment = [k](const Row& r) -> const Segment3d* {
+      return k < r.segments.size() ? &r.segments[k] : nullptr;
+    };
+    table.add(NumberColumn<Row>(
+        "angle_" + segment_names[k] + "_deg",
+        [segment](const Row& r) -> std::optional<double> {
+          const Segment3d* s = segment(r);
+          return s != nullptr ? s->angle_deg : std::nullopt;
+        },
+        "%.4f"));
+    table.add(NumberColumn<Row>(
+        "radius_" + segment_names[k] + "_mm",
+        [segment](const Row& r) -> std::optional<double> {
+          const Segment3d* s = segment(r);
+          return s != nullptr ? s->radius : std::nullopt;
+        },
+        "%.4f"));
+    table.add(NumberColumn<Row>(
+        "arc_length_" + segment_names[k] + "_mm",
+        [segment](const Row& r) -> std::optional<double> {
+          const Segment3d* s = segment(r);
+          return s != nullptr ? s->arc_length : std::nullopt;
+        },
+        "%.4f"));
+  }
   table.add(NumberColumn<Row>(
       "angle_left_deg", [](const Row& r) { return r.left_angle_deg; }, "%.4f"));
   table.add(NumberColumn<Row>(

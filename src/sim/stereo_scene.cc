@@ -96,6 +96,23 @@ bool StereoSceneOptions::Check(std::string* error) const {
       return false;
     }
   }
+  if (!bend_deg_per_frame.empty()) {
+    if (bend_deg_per_frame.size() != static_cast<size_t>(frame_count)) {
+      *error = "bend_deg_per_frame: " + std::to_string(bend_deg_per_frame.size()) +
+               " values for " + std::to_string(frame_count) + " frames";
+      return false;
+    }
+    for (double bend : bend_deg_per_frame) {
+      if (!(bend >= 0 && bend <= 300)) {
+        *error = "bend_deg_per_frame: each must be in [0, 300], got " + std::to_string(bend);
+        return false;
+      }
+    }
+  }
+  if (flash_length_frames < 0 || !(flash_gray >= 0 && flash_gray <= 255)) {
+    *error = "flash_length_frames: must be >= 0, flash_gray in [0, 255]";
+    return false;
+  }
   if (supersample < 1 || supersample > 16) {
     *error = "supersample: must be 1..16, got " + std::to_string(supersample);
     return false;
@@ -118,7 +135,10 @@ StereoSceneTruth StereoScene::truth(int index) const {
   const double t = o.frame_count > 1 ? static_cast<double>(index) / (o.frame_count - 1) : 0.0;
   StereoSceneTruth truth;
   truth.index = index;
-  truth.bend_deg = o.max_bend_deg * t;
+  truth.bend_deg = o.bend_deg_per_frame.empty()
+                       ? o.max_bend_deg * t
+                       : o.bend_deg_per_frame[static_cast<size_t>(
+                             std::clamp(index, 0, static_cast<int>(o.bend_deg_per_frame.size()) - 1))];
   const double tilt_deg =
       o.plane_tilt_start_deg + (o.plane_tilt_end_deg - o.plane_tilt_start_deg) * t;
 
@@ -269,6 +289,11 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
         }
       }
     }
+  }
+
+  if (o.flash_frame && index >= *o.flash_frame &&
+      (o.flash_length_frames == 0 || index < *o.flash_frame + o.flash_length_frames)) {
+    image += cv::Scalar::all(o.flash_gray);  // Saturating.
   }
 
   if (o.noise_sigma > 0) {

@@ -59,6 +59,21 @@ struct Shape3d {
   std::optional<double> tip_disp;          // Tip from its reference position.
 };
 
+// One hinge of a chain: the circle through three consecutive markers (per-segment curvature of
+// a multi-segment actuator).
+struct Segment3d {
+  std::optional<double> angle_deg;   // At the middle one of the three (eq. 7 in 3D).
+  std::optional<double> radius;      // Their circumcircle; absent when they are on a line.
+  std::optional<double> arc_length;  // First to last through the middle along that circle;
+                                     // the two distances added when on a line.
+};
+
+// For each inner marker chain[k] (k = 1 .. N-2) the circle through chain[k-1], chain[k] and
+// chain[k+1], into `segments` (resized to N-2, or emptied for fewer than 3 markers; no
+// allocation once its capacity is reached). A segment with a missing marker has no values.
+void MeasureSegments3d(const std::vector<std::optional<cv::Point3d>>& chain,
+                       std::vector<Segment3d>* segments);
+
 // `chain`: the markers base to tip (3 or more), absent where not found. The angle needs the
 // first, the middle (index size / 2) and the last; plane and circle need 3 found markers;
 // the out-of-plane angle needs `reference_normal` (e.g. the first frame's bending plane, or

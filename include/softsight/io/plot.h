@@ -1,6 +1,6 @@
 // Plots of softsight CSVs against time, as in the paper's Figure 4: stacked panels for the angle,
-// the bending distance (tip displacement) and the arc length, plus the controller's columns when
-// the CSV has them (target vs measured angle, pressure, valve duty); on request the radius of
+// the bending distance (tip displacement) and the arc length, plus the out-of-plane angle of a
+// track-stereo CSV and the controller's columns when the CSV has them (target vs measured angle, pressure, valve duty); on request the radius of
 // curvature and each marker's x and y. Several runs are overlaid (one colour each) with a truth
 // CSV (synth's, the same column names) in black. A y axis never spans less than the minimum span
 // of its unit, so a steady value's sub-pixel noise is not blown up to the panel's height.
@@ -24,10 +24,12 @@ struct PlotOptions {
   int width_px = 1000;        // Figure width. Narrower than ~400 leaves no room for tick labels.
   int panel_height_px = 240;  // Height of each stacked panel, including its label strip.
   std::string title;          // Shown on top; empty: the CSVs' file names.
-  // Panels, top to bottom: "angle", "bending" (tip displacement), "arc" (arc length), "radius"
-  // (radius of curvature), "xy" (each marker's x and y, one panel each), "control" (pressures,
-  // duty). Empty (default): angle, bending, arc and control, each when the CSV has its columns;
-  // a panel asked for by name whose columns no CSV has is an error.
+  // Panels, top to bottom: "angle" (a track-stereo CSV's 3D angle with each camera's own),
+  // "plane" (track-stereo's out-of-plane angle), "bending" (tip displacement), "arc" (arc
+  // length), "radius" (radius of curvature), "xy" (each marker's x and y, or X, Y and Z in 3D,
+  // one panel each), "control" (pressures, duty). Empty (default): angle, plane, bending, arc
+  // and control, each when the CSV has its columns; a panel asked for by name whose columns no
+  // CSV has is an error.
   std::vector<std::string> panels;
   // Smallest span of a y axis, per unit: values that vary less are shown in an axis this tall,
   // centred on them. Defaults: 2 px (20x the colour tracker's ~0.1 px precision), 1 deg,

@@ -19,6 +19,7 @@
 #include "softsight/core/types.h"
 #include "softsight/geometry/shape3d.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/io/stereo_input.h"
 
 namespace softsight {
 
@@ -49,9 +50,14 @@ struct StereoFrameResult {
   int64_t frame_index = 0;                  // The left view's frame.
   int64_t right_frame_index = 0;            // The right view's frame paired with it.
   double time_s = 0.0;                      // The left view's.
+  // Paired by time: the right frame's time minus the left one's (ms), the pairing error.
+  std::optional<double> pair_dt_ms;
   std::vector<StereoMarkerResult> markers;  // In the left config's order.
   // In millimetres, the first camera's frame: the chain's angle, plane, circle and tip.
   Shape3d shape;
+  // A chain of more than 3 markers: the circle through each inner marker and its two
+  // neighbours (StereoSession::segment_names), in chain order. Empty otherwise.
+  std::vector<Segment3d> segments;
   // What each camera alone measures (eq. 7 on its image positions), for comparison.
   std::optional<double> left_angle_deg, right_angle_deg;
   double proc_ms = 0.0;
@@ -71,8 +77,13 @@ class StereoSession {
   // Tracks both frames and measures in 3D. Throws InputError when a frame's size is not the
   // calibrated one (naming the view).
   const StereoFrameResult& process(const Frame& left, const Frame& right);
+  // The same for a pair from a StereoInput (its pairing error goes into the result).
+  const StereoFrameResult& process(const FramePair& pair);
 
   std::vector<std::string> marker_names() const;
+  // The chain's inner markers, whose segments StereoFrameResult::segments holds (a chain of
+  // more than 3 markers; else none).
+  std::vector<std::string> segment_names() const;
   const Triangulator& triangulator() const;
 
  private:
@@ -80,10 +91,14 @@ class StereoSession {
   std::unique_ptr<Impl> impl_;
 };
 
-// The stereo CSV's columns: frame, right_frame, time_s; per marker <m>_X, <m>_Y, <m>_Z (mm,
-// first camera's frame), <m>_sigma_mm, <m>_epipolar_px, <m>_status; then angle_deg (3D),
-// out_of_plane_deg, plane_nx, plane_ny, plane_nz, radius_mm, arc_length_mm, tip_disp_mm,
-// angle_left_deg, angle_right_deg, proc_ms. Absent values are empty fields.
-BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names);
+// The stereo CSV's columns: frame, right_frame, time_s, pair_dt_ms; per marker <m>_X, <m>_Y,
+// <m>_Z (mm, first camera's frame), <m>_sigma_mm, <m>_epipolar_px, <m>_status; then angle_deg
+// (3D), out_of_plane_deg, plane_nx, plane_ny, plane_nz, radius_mm, arc_length_mm, tip_disp_mm;
+// per segment (inner marker <s> of a chain of more than 3) angle_<s>_deg, radius_<s>_mm,
+// arc_length_<s>_mm; then angle_left_deg, angle_right_deg, proc_ms. Absent values are empty
+// fields.
+BasicCsvColumnTable<StereoFrameResult> StereoColumns(
+    const std::vector<std::string>& marker_names,
+    const std::vector<std::string>& segment_names = {});
 
 }  // namespace softsight

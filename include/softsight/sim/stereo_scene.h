@@ -52,6 +52,10 @@ struct StereoSceneOptions {
   // Total turning of the centre line, from 0 at frame 0 to max_bend_deg at the last frame
   // (linear in the frame index).
   double max_bend_deg = 90.0;
+  // When not empty: the bend of each frame (deg, frame_count values), instead of the linear
+  // ramp to max_bend_deg: motion that starts, stops and changes speed (what finding the offset
+  // between two cameras' videos correlates), or none at all.
+  std::vector<double> bend_deg_per_frame;
   // The bending plane contains the straight direction; it is turned this much about it out of
   // the image-parallel plane (0: the bend is seen face on, 90: edge on), at frame 0 and at the
   // last frame (linear between: a turning, i.e. twisting, actuator).
@@ -67,6 +71,12 @@ struct StereoSceneOptions {
   cv::Vec3b background_bgr{105, 110, 115};
   int supersample = 4;       // Sub-samples per pixel side for the markers' edges (1..16).
   double noise_sigma = 0.0;  // Gaussian sensor noise, grey levels.
+  // A flash: from frame `flash_frame` on, for `flash_length_frames` frames (0: to the end: a
+  // lamp switched on), every pixel of both views is `flash_gray` grey levels brighter
+  // (saturating). Absent: no flash.
+  std::optional<int> flash_frame;
+  int flash_length_frames = 1;
+  double flash_gray = 60.0;
   uint64_t seed = 7;
 
   // False with a one-line message naming the bad field.
