@@ -506,6 +506,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
 
   RunOptions run;
   run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
+  run.check_key_frame_groups = false;  // The loop acts on each frame as it comes.
   try {
     summary.run = RunPipeline(*frames.source, tracking, sinks, run);
   } catch (const StopRequested&) {

@@ -252,7 +252,9 @@ TEST(VideoFileSource, FramesSayWhetherTheyAreKeyFrames) {
     const std::string path = WriteFrames(dir.file(std::string("v_") + fourcc +
                                                   (fourcc[0] == 'm' ? ".mp4" : ".avi")),
                                          fourcc, frames);
-    auto source = OpenFrameSource({path});
+    FrameSourceSpec spec;
+    spec.input = path;
+    auto source = OpenFrameSource(spec);
     Frame frame;
     int read = 0;
     while (source->read(frame)) {

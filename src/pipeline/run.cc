@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/key_frame_groups.h"
 #include "softsight/core/error.h"
 #include "track/tracker_kind.h"
 
@@ -53,7 +54,8 @@ PipelineRun::PipelineRun(TrackingSession& session, RunInfo info, std::vector<Fra
       info_(std::move(info)),
       sinks_(std::move(sinks)),
       needs_colour_(NeedsColour(session.config())),
-      start_(std::chrono::steady_clock::now()) {
+      start_(std::chrono::steady_clock::now()),
+      deliver_([this](const Frame& frame, const FrameResult& result) { deliver(frame, result); }) {
   summary_.source = info_.source;
   for (const std::string& name : info_.marker_names) summary_.markers.push_back({name, 0});
   if (info_.frame_count) {
@@ -85,11 +87,13 @@ void PipelineRun::leave(FrameSink& sink) {
   joined_.erase(std::remove(joined_.begin(), joined_.end(), &sink), joined_.end());
 }
 
+PipelineRun::~PipelineRun() = default;
+
 const FrameResult& PipelineRun::process(Frame& frame) {
   if (frame.captured == std::chrono::steady_clock::time_point{}) {
     frame.captured = std::chrono::steady_clock::now();
   }
-  if (summary_.frames == 0) {
+  if (processed_ == 0) {
     if (needs_colour_ && IsGrayscale(frame.image)) {
       throw InputError(summary_.source + ": the video is grayscale, but " + GrayFrameProblem());
     }
@@ -98,6 +102,16 @@ const FrameResult& PipelineRun::process(Frame& frame) {
     summary_.first_index = frame.index;
   }
   const FrameResult& result = session_.process(frame);
+  ++processed_;
+  if (key_frame_groups_) {
+    key_frame_groups_->add(frame, result, deliver_);
+  } else {
+    deliver(frame, result);
+  }
+  return result;
+}
+
+void PipelineRun::deliver(const Frame& frame, const FrameResult& result) {
   for (size_t i = 0; i < result.markers.size(); ++i) {
     summary_.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
   }
@@ -112,7 +126,10 @@ const FrameResult& PipelineRun::process(Frame& frame) {
           .count());
   ++summary_.frames;
   summary_.last_index = frame.index;
-  return result;
+}
+
+void PipelineRun::check_key_frame_groups() {
+  if (!key_frame_groups_) key_frame_groups_ = std::make_unique<KeyFrameGroups>();
 }
 
 RunSummary PipelineRun::summary() const {
@@ -130,8 +147,22 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
                                std::string error) {
   CV_Assert(!finished_);
   finished_ = true;
+  if (key_frame_groups_) {
+    // The last group has no key frame after it: it goes on unchecked.
+    try {
+      key_frame_groups_->flush(deliver_);
+    } catch (const InputError& e) {
+      if (error.empty()) error = e.what();
+      reason = StopReason::kError;
+    }
+    if (key_frame_groups_->demoted() > 0) {
+      notes.push_back(std::to_string(key_frame_groups_->demoted()) +
+                      " marker-frames not believed: moved by damage the decoder did not report, "
+                      "undone at the next key frame");
+    }
+  }
   // An empty source, or a stop before the first frame: the sinks still see begin() and end().
-  if (summary_.frames == 0 && reason != StopReason::kError) begin_sinks();
+  if (processed_ == 0 && reason != StopReason::kError) begin_sinks();
   RunSummary summary = this->summary();
   summary.stop_reason = reason;
   summary.dropped = dropped;
@@ -145,6 +176,7 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
 RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options) {
   PipelineRun run(session, DescribeRun(source, session, options), sinks);
+  if (options.check_key_frame_groups) run.check_key_frame_groups();
   const auto notes = [&source] {
     std::vector<std::string> notes;
     if (const std::optional<std::string> note = source.note()) notes.push_back(*note);

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,12 +19,20 @@
 
 namespace softsight {
 
+class KeyFrameGroups;
+
 struct RunOptions {
   // Stop after this many processed frames (absent: until the source ends). Must be >= 0.
   std::optional<int64_t> max_frames;
   // Polled before each frame is read; true ends the run cleanly with kStopRequested (every sink
   // still gets end()). Empty: never. Called from the running thread: make it cheap (a flag).
   std::function<bool()> stop_requested;
+  // A video that predicts frames (MPEG-4, H.264): each group of frames reaches the sinks only
+  // after its next key frame was tracked, so that a marker the decoder's silent damage moved is
+  // reported implausible instead of found (src/pipeline/key_frame_groups.h; frames of cameras,
+  // image sequences and intra-only videos are not delayed). Off for a loop that acts on each
+  // frame as it comes (`control`): it cannot wait for the next key frame.
+  bool check_key_frame_groups = true;
 };
 
 // One run, frame by frame: RunPipeline's work per frame and its summary, for a caller whose own
@@ -34,6 +43,9 @@ class PipelineRun {
   // `info` as DescribeRun gives it (frame_size is set from the first frame). `sinks` begin at
   // the first frame and end in finish(). The session must outlive the run.
   PipelineRun(TrackingSession& session, RunInfo info, std::vector<FrameSink*> sinks = {});
+  ~PipelineRun();
+  PipelineRun(const PipelineRun&) = delete;
+  PipelineRun& operator=(const PipelineRun&) = delete;
   // Before the first frame: the source the frames come from (its description, rate, whether it
   // is live, its frame count), for the sinks' begin() and the summary.
   void describe_source(const FrameSource& source);
@@ -47,8 +59,12 @@ class PipelineRun {
   // leaving it (its owner ends it); leave() of a sink not in the run does nothing.
   void join(FrameSink& sink);
   void leave(FrameSink& sink);
+  // From now on, hold a predicted video's frames until the next key frame shows whether the
+  // decoder damaged them (RunOptions::check_key_frame_groups); process() still returns each
+  // frame's result at once, the sinks get it when its group is checked.
+  void check_key_frame_groups();
   const RunInfo& info() const { return info_; }
-  int64_t frames() const { return summary_.frames; }  // Processed so far.
+  int64_t frames() const { return processed_; }  // Processed so far (the sinks may lag).
 
   // The summary so far: frames, found counts, timings, the first and last source index. Why the
   // run stopped and the source's drops are finish()'s.
@@ -61,6 +77,8 @@ class PipelineRun {
 
  private:
   void begin_sinks();
+  // A result reaches the summary and the sinks.
+  void deliver(const Frame& frame, const FrameResult& result);
 
   TrackingSession& session_;
   RunInfo info_;
@@ -70,8 +88,11 @@ class PipelineRun {
   bool needs_colour_;
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_;
-  RunSummary summary_;
+  RunSummary summary_;  // Its frames: those the sinks have had.
+  int64_t processed_ = 0;
   std::vector<double> proc_ms_, latency_result_ms_, latency_done_ms_;
+  std::unique_ptr<KeyFrameGroups> key_frame_groups_;  // Set by check_key_frame_groups().
+  std::function<void(const Frame&, const FrameResult&)> deliver_;
 };
 
 // Runs the pipeline. Pacing is the source's business (a camera decorator drops stale frames, a

@@ -1,0 +1,81 @@
+// A video that predicts frames from earlier ones (MPEG-4, H.264) repeats damage the decoder did
+// not notice (a flipped bit that still decodes: a key frame whose macroblocks slid 16 px, a
+// patch copied to the wrong place) in every frame up to its next key frame, which is decoded
+// afresh. No check of one frame can tell such a picture from a real one (a slid picture looks
+// like a bumped camera), but the next key frame can: the damage ends exactly there. A marker
+// that the damage moved by D comes back by -D at the key frame, after moving by +D where the
+// damage began; real motion does not jump to and fro exactly at a key frame.
+//
+// So a run over such a video holds each group of frames (a key frame and the predicted frames
+// after it) until the next key frame has been tracked, checks every marker across that key
+// frame, and only then hands the group on. A marker whose position at the key frame jumps
+// back by what it jumped at an earlier frame of the group (both far beyond the group's own
+// motion noise) is not believed from that earlier frame to the end of the group: its
+// observation becomes `implausible` and the frame's measurements, which used it, absent.
+// Frames of a camera, an image sequence or an intra-only video are all key frames: they pass
+// straight through.
+//
+// What it cannot see: damage that grows over several frames (no single jump where it began),
+// and damage in the last group of the video (no key frame after it).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "softsight/core/types.h"
+
+namespace softsight {
+
+class KeyFrameGroups {
+ public:
+  // A held frame handed on, in source order.
+  using Release = std::function<void(const Frame& frame, const FrameResult& result)>;
+
+  // Groups that would hold more than `max_held_bytes` of images are handed on unchecked as the
+  // limit is reached (counted in unchecked_frames()).
+  explicit KeyFrameGroups(size_t max_held_bytes = size_t{512} << 20)
+      : max_held_bytes_(max_held_bytes) {}
+
+  // The next frame and its result: held, or handed on (with any group this frame ends) through
+  // `release` before add() returns.
+  void add(const Frame& frame, const FrameResult& result, const Release& release);
+  // The end of the run: the held group, unchecked (no key frame follows it).
+  void flush(const Release& release);
+
+  // Marker-frames found to be the decoder's damage and reported implausible instead.
+  int64_t demoted() const { return demoted_; }
+  // Frames handed on without a check: groups over the memory limit, and the last group.
+  int64_t unchecked_frames() const { return unchecked_frames_; }
+
+ private:
+  struct Held {
+    Frame frame;
+    FrameResult result;
+  };
+  // Demotes, in the held group, what the key frame `next` shows to be damage.
+  void check(const FrameResult& next);
+  void hold(const Frame& frame, const FrameResult& result);
+  void release_held(const Release& release, bool checked);
+
+  size_t max_held_bytes_;
+  bool predicted_seen_ = false;  // Until a predicted frame comes, every frame passes through.
+  std::vector<Held> held_;       // Slots reused across groups: their images keep their buffers.
+  size_t count_ = 0;             // held_[0, count_) is the open group.
+  size_t held_bytes_ = 0;
+  // The last frame handed on (the step into a group's first frame starts there).
+  int64_t tail_index_ = -1;
+  std::vector<std::optional<cv::Point2d>> tail_px_;
+  // check()'s scratch, per marker.
+  std::vector<int64_t> indices_;
+  std::vector<cv::Point2d> points_, residuals_;
+  std::vector<double> scratch_;
+  int64_t demoted_ = 0;
+  int64_t unchecked_frames_ = 0;
+};
+
+}  // namespace softsight

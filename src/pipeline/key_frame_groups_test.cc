@@ -1,0 +1,152 @@
+#include "pipeline/key_frame_groups.h"
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace softsight {
+namespace {
+
+constexpr int kKeyFrameInterval = 12;
+
+// Three markers moving 2 px per frame to the right (with a little jitter, as a tracker's
+// positions have), in a video with a key frame every 12th frame. `damage(index, marker)` adds
+// the displacement of a damaged picture.
+struct Track {
+  template <typename Damage>
+  std::vector<FrameResult> results(int frames, Damage damage) const {
+    std::vector<FrameResult> out;
+    for (int i = 0; i < frames; ++i) {
+      FrameResult r;
+      r.frame_index = i;
+      for (int m = 0; m < 3; ++m) {
+        MarkerObservation o;
+        o.name = "m" + std::to_string(m);
+        const double jitter = 0.2 * std::sin(1.7 * i + m);
+        o.observation.position_px = cv::Point2d(100 + 2.0 * i + jitter, 100 + 50 * m) + damage(i, m);
+        r.markers.push_back(o);
+      }
+      r.measurement.angle_deg = 150.0;
+      out.push_back(r);
+    }
+    return out;
+  }
+};
+
+struct Released {
+  std::vector<int64_t> order;
+  std::vector<FrameResult> results;
+};
+
+// Runs `results` through the check; every frame's release is recorded.
+Released CheckGroups(const std::vector<FrameResult>& results, bool predicted, KeyFrameGroups& groups) {
+  Released released;
+  const KeyFrameGroups::Release release = [&](const Frame& frame, const FrameResult& result) {
+    EXPECT_EQ(frame.index, result.frame_index);
+    released.order.push_back(frame.index);
+    released.results.push_back(result);
+  };
+  Frame frame;
+  frame.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  for (const FrameResult& result : results) {
+    frame.index = result.frame_index;
+    frame.key_frame = !predicted || result.frame_index % kKeyFrameInterval == 0;
+    groups.add(frame, result, release);
+  }
+  groups.flush(release);
+  return released;
+}
+
+void ExpectEveryFrameOnceInOrder(const Released& released, int frames) {
+  ASSERT_EQ(static_cast<int>(released.order.size()), frames);
+  for (int i = 0; i < frames; ++i) EXPECT_EQ(released.order[i], i);
+}
+
+TEST(KeyFrameGroups, AMarkerMovedFromMidGroupToTheKeyFrameIsNotBelievedThere) {
+  // Frames 28-35 slid 16 px (one macroblock) for markers 0 and 1; key frame 36 is clean.
+  const auto damage = [](int i, int m) {
+    return i >= 28 && i < 36 && m < 2 ? cv::Point2d(-16, 0) : cv::Point2d(0, 0);
+  };
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(Track{}.results(60, damage), true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (int i = 0; i < 60; ++i) {
+    const bool damaged = i >= 28 && i < 36;
+    for (int m = 0; m < 3; ++m) {
+      const Observation& o = released.results[i].markers[m].observation;
+      EXPECT_EQ(o.found(), !(damaged && m < 2)) << "frame " << i << " marker " << m;
+      if (!o.found()) {
+        EXPECT_EQ(o.status(), MarkerStatus::kImplausible);
+      }
+    }
+    EXPECT_EQ(released.results[i].measurement.angle_deg.has_value(), !damaged) << i;
+  }
+  EXPECT_EQ(groups.demoted(), 2 * 8);
+}
+
+TEST(KeyFrameGroups, ADamagedKeyFrameLeavesItsWholeGroupNotBelieved) {
+  const auto damage = [](int i, int) {
+    return i >= 24 && i < 36 ? cv::Point2d(16, -16) : cv::Point2d(0, 0);
+  };
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(Track{}.results(60, damage), true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (int i = 0; i < 60; ++i) {
+    const bool damaged = i >= 24 && i < 36;
+    for (int m = 0; m < 3; ++m) {
+      EXPECT_EQ(released.results[i].markers[m].observation.found(), !damaged) << i << " " << m;
+    }
+  }
+  EXPECT_EQ(groups.demoted(), 3 * 12);
+}
+
+TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
+  // A puck bouncing at key frame 36 (2 px per frame to the right, then 6 to the left), and a
+  // camera bumped by 16 px at frame 30 that stays bumped: nothing jumps back.
+  const auto motion = [](int i, int m) {
+    if (m == 0) return i >= 36 ? cv::Point2d(-8.0 * (i - 35), 0) : cv::Point2d(0, 0);
+    return i >= 30 ? cv::Point2d(16, 0) : cv::Point2d(0, 0);
+  };
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(Track{}.results(60, motion), true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (const FrameResult& r : released.results) {
+    for (const MarkerObservation& m : r.markers) EXPECT_TRUE(m.observation.found()) << r.frame_index;
+  }
+  EXPECT_EQ(groups.demoted(), 0);
+}
+
+TEST(KeyFrameGroups, FramesThatAreAllKeyFramesPassStraightThrough) {
+  // A camera's or an intra-only video's frames: each is handed on within its own add().
+  const auto damage = [](int i, int) {
+    return i >= 24 && i < 36 ? cv::Point2d(16, 0) : cv::Point2d(0, 0);
+  };
+  const std::vector<FrameResult> results = Track{}.results(40, damage);
+  KeyFrameGroups groups;
+  Frame frame;
+  frame.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  int released = 0;
+  for (const FrameResult& result : results) {
+    frame.index = result.frame_index;
+    groups.add(frame, result, [&](const Frame& f, const FrameResult& r) {
+      EXPECT_EQ(f.index, frame.index) << "handed on later than its own add()";
+      EXPECT_EQ(r.markers[0].observation.position_px, result.markers[0].observation.position_px);
+      ++released;
+    });
+  }
+  EXPECT_EQ(released, 40);
+  EXPECT_EQ(groups.demoted(), 0);
+  EXPECT_EQ(groups.unchecked_frames(), 0);
+}
+
+TEST(KeyFrameGroups, AGroupOverTheMemoryLimitGoesOnUncheckedInOrder) {
+  const auto none = [](int, int) { return cv::Point2d(0, 0); };
+  KeyFrameGroups groups(/*max_held_bytes=*/4 * 4 * 3 * 5);  // Five of the test's frames.
+  const Released released = CheckGroups(Track{}.results(30, none), true, groups);
+  ExpectEveryFrameOnceInOrder(released, 30);
+  EXPECT_GT(groups.unchecked_frames(), 0);
+}
+
+}  // namespace
+}  // namespace softsight
