@@ -149,7 +149,9 @@ endfunction()
 # A public header is a promise: a library user has include/ (and OpenCV) on the path, never src/.
 # Compiles every header in include/softsight/ on its own, in one translation unit per header, with
 # exactly that include path, so a public header that includes a private one (or forgets one of
-# its own includes) fails the build.
+# softsight's headers it uses) fails the build. OpenCV's core and the standard headers the public
+# headers use come precompiled: parsing them was ~1.9 s of each 2.6 s check (114 s of CPU for
+# the 48 headers); a header that forgot one of those would still compile here.
 function(softsight_check_public_headers)
   file(GLOB_RECURSE headers CONFIGURE_DEPENDS RELATIVE ${PROJECT_SOURCE_DIR}/include
        ${PROJECT_SOURCE_DIR}/include/softsight/*.h)
@@ -163,4 +165,6 @@ function(softsight_check_public_headers)
   add_library(softsight_public_headers OBJECT ${sources})
   target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include)
   target_include_directories(softsight_public_headers SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
+  target_precompile_headers(softsight_public_headers PRIVATE
+    <opencv2/core.hpp> <string> <optional> <vector> <cstdint> <memory> <functional> <chrono>)
 endfunction()

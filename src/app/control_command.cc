@@ -141,24 +141,40 @@ std::optional<std::string> KeepTargetInReach(const ControlOptions& options,
   if (target->mode != ControlMode::kAngle || options.identify || options.target_from) {
     return std::nullopt;
   }
-  const std::optional<std::string> problem =
-      OutsideReach(config.model, target->profile.lowest_deg(), target->profile.highest_deg(),
-                   config.controller.max_kpa);
-  if (!problem) return std::nullopt;
   const std::string what = options.profile_file
                                ? "--profile " + EscapeForMessage(*options.profile_file)
                                : "--target-deg " + ShortNumber(target->profile.at(0.0));
-  if (!options.allow_saturation) {
-    throw InputError(what + ": " + *problem +
-                     "; nothing sent (--allow-saturation runs it with the target limited to the "
-                     "reach)");
+  std::vector<std::string> notes;
+  // Too fast (a ramp or sine the pump cannot follow): refused the same way; run as given with
+  // --allow-saturation, the actuator falling behind (docs/control.md, "Reach").
+  if (const std::optional<std::string> too_fast = OutsideRateReach(config.model, target->profile)) {
+    if (!options.allow_saturation) {
+      throw InputError(what + ": " + *too_fast +
+                       "; nothing sent (--allow-saturation runs it as given, the actuator "
+                       "falling behind)");
+    }
+    notes.push_back(what + ": " + *too_fast + "; run as given (--allow-saturation)");
   }
-  const ActuatorReach reach = ReachOf(config.model, config.controller.max_kpa);
-  target->profile = target->profile.ClampedTo(reach.most_bent_deg, reach.straightest_deg);
-  std::string note = what + ": " + *problem + "; the target was limited to " +
-                     FixedNumber(reach.most_bent_deg, 1) + ".." +
-                     FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)";
-  if (!options.quiet) std::fprintf(stderr, "control: %s\n", note.c_str());
+  if (const std::optional<std::string> problem =
+          OutsideReach(config.model, target->profile.lowest_deg(), target->profile.highest_deg(),
+                       config.controller.max_kpa)) {
+    if (!options.allow_saturation) {
+      throw InputError(what + ": " + *problem +
+                       "; nothing sent (--allow-saturation runs it with the target limited to the "
+                       "reach)");
+    }
+    const ActuatorReach reach = ReachOf(config.model, config.controller.max_kpa);
+    target->profile = target->profile.ClampedTo(reach.most_bent_deg, reach.straightest_deg);
+    notes.push_back(what + ": " + *problem + "; the target was limited to " +
+                    FixedNumber(reach.most_bent_deg, 1) + ".." +
+                    FixedNumber(reach.straightest_deg, 1) + " deg (--allow-saturation)");
+  }
+  if (notes.empty()) return std::nullopt;
+  std::string note = notes.front();
+  for (size_t i = 1; i < notes.size(); ++i) note += "; " + notes[i];
+  if (!options.quiet) {
+    for (const std::string& n : notes) std::fprintf(stderr, "control: %s\n", n.c_str());
+  }
   return note;
 }
 

@@ -1,6 +1,9 @@
 #include "softsight/control/control_config.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
 
 #include "control/control_options.h"
 #include "core/option_table.h"
@@ -59,6 +62,61 @@ std::optional<std::string> OutsideReach(const ActuatorModel& model, double lowes
   if (highest_deg > reach.straightest_deg + tolerance_deg) {
     return FixedNumber(highest_deg, 1) + " deg is straighter than the actuator gets when vented (" +
            FixedNumber(reach.straightest_deg, 1) + " deg; control.model: " + range + ")";
+  }
+  return std::nullopt;
+}
+
+namespace {
+// The identified rates are estimates: a segment is refused only past this share of its bound.
+constexpr double kRateReachTolerance = 1.2;
+}  // namespace
+
+double MaxSineAmplitudeDeg(const ActuatorModel& model, double frequency_hz) {
+  if (!model.identified() || model.inflate_kpa_per_s <= 0.0 || model.slope_deg_per_kpa <= 0.0 ||
+      frequency_hz <= 0.0) {
+    return std::numeric_limits<double>::infinity();
+  }
+  const double w = 2.0 * std::numbers::pi * frequency_hz;
+  return 2.0 * model.slope_deg_per_kpa * model.inflate_kpa_per_s /
+         (w * std::sqrt(1.0 + (w * model.lag_s) * (w * model.lag_s)));
+}
+
+std::optional<std::string> OutsideRateReach(const ActuatorModel& model,
+                                            const TargetProfile& profile) {
+  if (!model.identified() || model.inflate_kpa_per_s <= 0.0 || model.slope_deg_per_kpa <= 0.0) {
+    return std::nullopt;
+  }
+  for (const TargetProfile::Segment& s : profile.segments()) {
+    const std::string when = "at " + FixedNumber(s.start_s, 1) + " s";
+    if (s.kind == TargetProfile::Segment::Kind::kRamp && s.duration_s > 0.0) {
+      const double rate_deg_per_s = std::abs(s.to_deg - s.from_deg) / s.duration_s;
+      const bool bending = s.to_deg < s.from_deg;  // 180 is straight: bending lowers the angle.
+      const double kpa_per_s = bending ? model.inflate_kpa_per_s : model.vent_kpa_per_s;
+      if (kpa_per_s <= 0.0) continue;
+      const double most_deg_per_s = model.slope_deg_per_kpa * kpa_per_s;
+      if (rate_deg_per_s > kRateReachTolerance * most_deg_per_s) {
+        return "the ramp " + when + " (" + FixedNumber(s.from_deg, 1) + " to " +
+               FixedNumber(s.to_deg, 1) + " deg at " + FixedNumber(rate_deg_per_s, 1) +
+               " deg/s) is faster than the actuator: the " + (bending ? "pump raises" : "vent lowers") +
+               " the pressure at most " + FixedNumber(kpa_per_s, 1) + " kPa/s, " +
+               FixedNumber(most_deg_per_s, 1) + " deg/s (control.model)";
+      }
+    } else if (s.kind == TargetProfile::Segment::Kind::kSine && s.frequency_hz > 0.0) {
+      const double most_deg = MaxSineAmplitudeDeg(model, s.frequency_hz);
+      if (std::abs(s.amplitude_deg) <= kRateReachTolerance * most_deg) continue;
+      // The highest frequency at which this swing is within the bound (it falls with frequency).
+      double low = 0.0, high = s.frequency_hz;
+      for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (low + high);
+        (MaxSineAmplitudeDeg(model, mid) >= std::abs(s.amplitude_deg) ? low : high) = mid;
+      }
+      return "the sine " + when + " (" + FixedNumber(std::abs(s.amplitude_deg), 1) + " deg at " +
+             ShortNumber(s.frequency_hz) + " Hz) is faster than the actuator: the pump raises the "
+             "pressure at most " + FixedNumber(model.inflate_kpa_per_s, 1) + " kPa/s, so at " +
+             ShortNumber(s.frequency_hz) + " Hz it swings at most " + FixedNumber(most_deg, 1) +
+             " deg, and " + FixedNumber(std::abs(s.amplitude_deg), 1) + " deg only up to " +
+             FixedNumber(low, 2) + " Hz (control.model)";
+    }
   }
   return std::nullopt;
 }

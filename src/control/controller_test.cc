@@ -1,6 +1,8 @@
 #include "softsight/control/controller.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -268,6 +270,42 @@ ActuatorModel StiffPlant() {
   m.valid_min_deg = 130.25;
   m.valid_max_deg = 180.0;
   return m;
+}
+
+// Speed is part of reach: the pump raises the pressure at most inflate_kpa_per_s, the vent lowers
+// it at most vent_kpa_per_s. With 1.2 deg/kPa, a 10 kPa/s pump and a 0.4 s bending lag, a sine
+// at 0.5 Hz swings at most 2 * 1.2 * 10 / (pi * sqrt(1 + (0.4 pi)^2)) = 4.757 deg; ramps bend at
+// most 12 deg/s and straighten at most 1.2 * 20 = 24 deg/s. Only 20 % past the bound is refused.
+TEST(ActuatorReach, ARampOrSineFasterThanThePumpIsNamedWithWhatTheActuatorCanDo) {
+  ActuatorModel m = StiffPlant();
+  m.inflate_kpa_per_s = 10.0;
+  m.vent_kpa_per_s = 20.0;
+  m.lag_s = 0.4;
+  const double w = std::numbers::pi;
+  const double bound = 2.0 * 1.2 * 10.0 / (w * std::sqrt(1.0 + 0.16 * w * w));
+  EXPECT_NEAR(MaxSineAmplitudeDeg(m, 0.5), bound, 1e-12);
+  EXPECT_NEAR(bound, 4.757, 0.001);
+  const auto profile = [](const std::string& text) { return TargetProfile::Parse(text, "test"); };
+  EXPECT_FALSE(OutsideRateReach(m, profile("step 160\nsine 160 5.7 0.5 4\n")));  // 1.19x.
+  EXPECT_EQ(OutsideRateReach(m, profile("step 160\nhold 1\nsine 160 20 0.5 4\n")),
+            std::optional<std::string>(
+                "the sine at 1.0 s (20.0 deg at 0.5 Hz) is faster than the actuator: the pump "
+                "raises the pressure at most 10.0 kPa/s, so at 0.5 Hz it swings at most 4.8 deg, "
+                "and 20.0 deg only up to 0.17 Hz (control.model)"));
+  // At the frequency named, the swing is what the bound allows (w^2 (1 + 0.16 w^2) = 1.44).
+  EXPECT_NEAR(MaxSineAmplitudeDeg(m, 0.17485), 20.0, 0.01);
+  // Ramps: bending at 15 deg/s (over 1.2 x 12) is refused, straightening at 28 deg/s is not.
+  EXPECT_THAT(OutsideRateReach(m, profile("ramp 165 1\n")).value_or(""),
+              ::testing::HasSubstr("the ramp at 0.0 s (180.0 to 165.0 deg at 15.0 deg/s) is faster "
+                                   "than the actuator: the pump raises the pressure at most 10.0 "
+                                   "kPa/s, 12.0 deg/s"));
+  EXPECT_FALSE(OutsideRateReach(m, profile("step 140\nramp 168 1\n")));
+  EXPECT_TRUE(OutsideRateReach(m, profile("step 140\nramp 170 1\n")));
+  // Steps take the time they take; a model without the rates reaches everything.
+  EXPECT_FALSE(OutsideRateReach(m, profile("step 135\nstep 178\n")));
+  ActuatorModel no_rates = m;
+  no_rates.inflate_kpa_per_s = 0.0;
+  EXPECT_FALSE(OutsideRateReach(no_rates, profile("sine 160 20 5 4\n")));
 }
 
 TEST(ActuatorReach, ATargetBeyondTheIdentifiedRangeIsNamedWithThePressureItNeeds) {

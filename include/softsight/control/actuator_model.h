@@ -6,6 +6,8 @@
 #include <optional>
 #include <string>
 
+#include "softsight/control/profile.h"
+
 namespace softsight {
 
 struct ActuatorModel {
@@ -77,5 +79,20 @@ ActuatorReach ReachOf(const ActuatorModel& model, double max_kpa);
 // need about 48.4 kPa". A model not identified reaches everything.
 std::optional<std::string> OutsideReach(const ActuatorModel& model, double lowest_deg,
                                         double highest_deg, double max_kpa);
+
+// Nothing when the actuator can move as fast as every ramp and sine of `profile` asks; else the
+// first segment it cannot follow, in one line with what it can do. The pump raises the pressure
+// at most inflate_kpa_per_s and the vent lowers it at most vent_kpa_per_s, so a ramp bends at
+// most slope * inflate deg/s (straightens at most slope * vent), and a sine's swing at angular
+// frequency w is at most 2 slope inflate / (w sqrt(1 + (w lag)^2)) deg (the first harmonic of a
+// sawtooth rising at the pump's rate, vented at once, behind the bending lag): a bound no
+// controller beats. The identified rates carry error: only a segment asking 20 % more than the
+// bound is refused. Steps are never refused (they take the time they take). A model not
+// identified, or without the rates, reaches everything.
+std::optional<std::string> OutsideRateReach(const ActuatorModel& model,
+                                            const TargetProfile& profile);
+// The largest sine swing (deg) the actuator can follow at `frequency_hz` (the bound above);
+// infinite for a model without the rates.
+double MaxSineAmplitudeDeg(const ActuatorModel& model, double frequency_hz);
 
 }  // namespace softsight
