@@ -132,14 +132,20 @@ function(softsight_add_test module)
 endfunction()
 
 # softsight_add_benchmark(<name> SOURCES ... DEPS ...)
-# A Google Benchmark program (softsight_<name>_benchmark). Benchmarks never run as tests.
+# A Google Benchmark program (softsight_<name>_benchmark). Benchmarks never run as tests, and
+# are not part of the default build (47 s of CPU that scripts/test.sh and CI do not need): the
+# target softsight_benchmarks builds them all (scripts/bench.sh does).
 function(softsight_add_benchmark name)
   if(NOT SOFTSIGHT_BUILD_BENCHMARKS)
     return()
   endif()
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   set(target softsight_${name}_benchmark)
-  add_executable(${target} ${ARG_SOURCES})
+  add_executable(${target} EXCLUDE_FROM_ALL ${ARG_SOURCES})
+  if(NOT TARGET softsight_benchmarks)
+    add_custom_target(softsight_benchmarks)
+  endif()
+  add_dependencies(softsight_benchmarks ${target})
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} ${OpenCV_LIBS} benchmark::benchmark
                                           benchmark::benchmark_main)

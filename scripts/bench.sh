@@ -13,9 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 WORK=${1:-bench_out}
 mkdir -p "$WORK"
-cmake --build build --target softsight softsight_speed_report softsight_colour_tracker_benchmark \
-  softsight_template_matching_benchmark softsight_frame_writer_benchmark \
-  softsight_tracking_session_benchmark softsight_publish_benchmark >/dev/null
+cmake --build build --target softsight softsight_speed_report softsight_benchmarks >/dev/null
 S=build/src/app/softsight
 CFG=examples/markers.yaml
 PY=$(command -v python3)
