@@ -2,9 +2,12 @@
 // known pose into two image sequences, tracked by `track-stereo` with the rig's exact
 // calibration file; the CSV is read back against the renderer's 3D truth.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <sys/wait.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -271,7 +274,7 @@ TEST_F(TrackStereoCommandTest, InTheBenchBoardsFrameMarkersMatchTheTruthAndTheSh
   std::cout << "[ figures  ] track-stereo --bench-board: board fit " << *summary.bench_board_rms_mm
             << " mm RMS; markers in the board's frame " << rms
             << " mm RMS from the truth; bending plane normal within " << worst_normal_deg
-            << " deg\n";
+            << " deg\n[ report   ] " << report.str().substr(0, report.str().find('\n') + 1);
 
   // The stereo file's own board (9x6 of 25 mm here) is not the one on the bench: refused by the
   // fit's residual, before anything is written.
@@ -286,6 +289,7 @@ TEST_F(TrackStereoCommandTest, InTheBenchBoardsFrameMarkersMatchTheTruthAndTheSh
                                     ": the triangulated corners fit a flat 9x6 board of 25.00 mm "
                                     "squares to"));
     EXPECT_THAT(e.what(), HasSubstr("(limit 2.00)"));
+    std::cout << "[ refusal  ] " << e.what() << "\n";
   }
   EXPECT_FALSE(fs::exists(options.csv_file));
 }
@@ -303,6 +307,19 @@ TEST_F(TrackStereoCommandTest, ABenchBoardImageWithoutTheBoardIsRefusedNamingThe
     EXPECT_THAT(e.what(), HasSubstr(options.bench_board[0] +
                                     ": the 9x6 chessboard (inner corners) was not found"));
   }
+  EXPECT_FALSE(fs::exists(options.csv_file));
+  // The program: one line naming the file, exit code 2.
+  const std::string cli = testing::SoftsightBinary() + " track-stereo -c " + options.config_file +
+                          " --left " + options.left_input + " --right " + options.right_input +
+                          " --frame-offset 3 --stereo " + options.stereo_file + " --csv " +
+                          options.csv_file + " --bench-board " + options.bench_board[0] + " " +
+                          options.bench_board[1] + " 2> " + dir_->file("bench_err.txt");
+  EXPECT_EQ(WEXITSTATUS(std::system(cli.c_str())), 2);
+  const std::string err = testing::ReadTextFile(dir_->file("bench_err.txt"));
+  EXPECT_THAT(err, HasSubstr(options.bench_board[0] + ": the 9x6 chessboard (inner corners) was "
+                             "not found"));
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  std::cout << "[ refusal  ] " << err;
   EXPECT_FALSE(fs::exists(options.csv_file));
   options.bench_board = {dir_->file("missing_left.png"), dir_->file("right/003.png")};
   EXPECT_THROW(
