@@ -210,12 +210,29 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
 
 }  // namespace
 
+namespace {
+
+// The run on `input`; `bench` is the bench board's frame when already located.
+TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
+                       std::ostream& report, std::optional<BoardFrame> bench);
+
+}  // namespace
+
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report) {
   CheckOptions(options);
+  // The bench board first: a refusal should not wait for the frame offset to be found.
+  std::optional<BoardFrame> bench;
+  if (!options.bench_board.empty()) {
+    TriangulationOptions triangulation;
+    triangulation.max_epipolar_px = options.max_epipolar_px;
+    std::string error;
+    if (!triangulation.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+    bench = FindBenchBoard(options, LoadStereoCalibration(options.stereo_file), triangulation);
+  }
   TrackStereoSummary summary;
   const std::unique_ptr<StereoInput> input = OpenStereoInput(options, summary, report);
   const std::optional<int64_t> offset = summary.frame_offset;
-  summary = RunTrackStereo(options, *input, report);
+  summary = Run(options, *input, report, bench);
   summary.frame_offset = offset;
   return summary;
 }
@@ -223,6 +240,13 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
                                   std::ostream& report) {
   CheckOptions(options);
+  return Run(options, input, report, std::nullopt);
+}
+
+namespace {
+
+TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
+                       std::ostream& report, std::optional<BoardFrame> bench) {
   const TrackingConfig left_config = LoadStereoViewConfig(options.config_file);
   const TrackingConfig right_config =
       options.right_config_file ? LoadStereoViewConfig(*options.right_config_file) : left_config;
@@ -233,9 +257,8 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
       ParseReferencePlane(options.reference_plane, "--reference-plane");
   std::string error;
   if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
-  std::optional<BoardFrame> bench;
   if (!options.bench_board.empty()) {
-    bench = FindBenchBoard(options, stereo, stereo_options.triangulation);
+    if (!bench) bench = FindBenchBoard(options, stereo, stereo_options.triangulation);
     const cv::Vec3d o = bench->origin_mm;
     report << std::fixed << std::setprecision(1) << "bench board " << options.bench_board[0]
            << " / " << options.bench_board[1] << ": " << bench->corners
@@ -357,6 +380,8 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
   report.unsetf(std::ios::floatfield);
   return summary;
 }
+
+}  // namespace
 
 CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
   auto options = std::make_shared<TrackStereoOptions>();

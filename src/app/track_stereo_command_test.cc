@@ -308,10 +308,11 @@ TEST_F(TrackStereoCommandTest, ABenchBoardImageWithoutTheBoardIsRefusedNamingThe
                                     ": the 9x6 chessboard (inner corners) was not found"));
   }
   EXPECT_FALSE(fs::exists(options.csv_file));
-  // The program: one line naming the file, exit code 2.
+  // The program: one line naming the file, exit code 2, before the frame offset is searched for
+  // (no --frame-offset here: the board is looked at first).
   const std::string cli = testing::SoftsightBinary() + " track-stereo -c " + options.config_file +
                           " --left " + options.left_input + " --right " + options.right_input +
-                          " --frame-offset 3 --stereo " + options.stereo_file + " --csv " +
+                          " --stereo " + options.stereo_file + " --csv " +
                           options.csv_file + " --bench-board " + options.bench_board[0] + " " +
                           options.bench_board[1] + " 2> " + dir_->file("bench_err.txt");
   EXPECT_EQ(WEXITSTATUS(std::system(cli.c_str())), 2);
