@@ -121,6 +121,37 @@ TEST_F(RenderedBenchBoard, PoseMatchesTheTruthWhicheverWayTheBoardIsTurned) {
   }
 }
 
+TEST_F(RenderedBenchBoard, ABoardWithDarkSquaresAtBothEndsStartsNearestTheTopLeft) {
+  // 8x6 inner corners: 9x7 squares, dark at both ends of the diagonal. The colour cannot tell
+  // the ends apart; the origin is the end nearer the left view's top-left corner: the board's
+  // own origin when it lies the right way round, its far corner (axes turned 180 deg about Z)
+  // when it lies the other way round.
+  ChessboardPattern pattern = BenchPattern();
+  pattern.inner_corners = cv::Size(8, 6);
+  ChessboardSpec spec = BenchSpec();
+  spec.inner_corners = pattern.inner_corners;
+  const StereoRig rig = MakeStereoRig();
+  ChessboardLook look;
+  look.supersample = 2;
+  const Triangulator triangulator = ExactRig();
+  for (const double roll : {0.0, 180.0}) {
+    const BoardPose pose = LookAtBoard(pattern, 300, 40, 0, roll);
+    cv::Mat left, right;
+    ChessboardRenderer(rig.left, pattern, look).render(pose, left);
+    ChessboardRenderer(rig.right, pattern, look).render(RightBoardPose(rig, pose), right);
+    const BoardFrame frame =
+        LocateBenchBoard(triangulator, spec, "left.png", left, "right.png", right);
+    cv::Matx33d rotation = BenchPoseRotation(pose);
+    cv::Vec3d origin = pose.tvec;
+    if (roll == 180.0) {
+      origin = rotation * cv::Vec3d(7 * 20.0, 5 * 20.0, 0.0) + pose.tvec;
+      rotation = rotation * cv::Matx33d(-1, 0, 0, 0, -1, 0, 0, 0, 1);
+    }
+    EXPECT_LT(BenchRotationErrorDeg(frame.rotation, rotation), 0.1) << "roll " << roll;
+    EXPECT_LT(cv::norm(frame.origin_mm - origin), 0.5) << "roll " << roll;
+  }
+}
+
 TEST_F(RenderedBenchBoard, RefusesAMissingBoardOrAWrongSquareNamingTheFiles) {
   const Triangulator triangulator = ExactRig();
   cv::Mat left, right;
