@@ -198,7 +198,7 @@ ChessboardSpec BenchBoardSpec(const TrackStereoOptions& options) {
 
 // Finds the bench board in its two images and fits its frame, or refuses in one line.
 BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibration& stereo,
-                            const TriangulationOptions& triangulation) {
+                          const TriangulationOptions& triangulation) {
   const ChessboardSpec board = BenchBoardSpec(options);
   const std::string& left_file = options.bench_board[0];
   const std::string& right_file = options.bench_board[1];
@@ -207,10 +207,6 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
   return LocateBenchBoard(Triangulator(stereo, triangulation), board, left_file, left, right_file,
                           right);
 }
-
-}  // namespace
-
-namespace {
 
 // The run on `input`; `bench` is the bench board's frame when already located.
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
