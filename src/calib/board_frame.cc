@@ -13,7 +13,8 @@
 namespace softsight {
 
 cv::Point3d BoardFrame::to_board(const cv::Point3d& camera_mm) const {
-  const cv::Vec3d p = rotation.t() * (cv::Vec3d(camera_mm.x, camera_mm.y, camera_mm.z) - origin_mm);
+  const cv::Vec3d p =
+      rotation.t() * (cv::Vec3d(camera_mm.x, camera_mm.y, camera_mm.z) - origin_mm);
   return {p[0], p[1], p[2]};
 }
 
@@ -105,8 +106,11 @@ std::optional<double> PatchLevel(const cv::Mat& gray, const cv::Point2d& at, int
 bool StartsAtTheOtherEnd(const cv::Mat& image, const std::vector<cv::Point2f>& corners,
                          const cv::Size& inner) {
   std::vector<cv::Point2f> grid;
-  for (int r = 0; r < inner.height; ++r)
-    for (int c = 0; c < inner.width; ++c) grid.emplace_back(static_cast<float>(c), static_cast<float>(r));
+  for (int r = 0; r < inner.height; ++r) {
+    for (int c = 0; c < inner.width; ++c) {
+      grid.emplace_back(static_cast<float>(c), static_cast<float>(r));
+    }
+  }
   const cv::Matx33d homography(cv::findHomography(grid, corners, 0));
   const auto image_of = [&](double c, double r) {
     const cv::Vec3d p = homography * cv::Vec3d(c, r, 1.0);
