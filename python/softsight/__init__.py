@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Generator, Optional, Union
+from typing import Generator, Optional, Tuple, Union
 
 from . import _core, _progress
 from ._core import Config, FrameResult, InputError, Marker, Session, calib, geometry, load_config, sim
@@ -121,6 +121,9 @@ def track_stereo(
     max_epipolar_px: float = 2.0,
     reference_plane: str = "image",
     fps: float = 30.0,
+    bench_board: Optional[Tuple[PathLike, PathLike]] = None,
+    chessboard: Optional[str] = None,
+    square_mm: Optional[float] = None,
 ) -> Table:
     """Tracks the markers of ``config`` in two views of a calibrated pair of cameras and returns
     the columns ``softsight track-stereo`` writes (docs/stereo.md).
@@ -131,7 +134,10 @@ def track_stereo(
     colours or rois (the same names). A marker has ``<m>_X/_Y/_Z`` (mm, the first camera's frame)
     only when both views found it and the pair passed the epipolar check (``max_epipolar_px``);
     ``<m>_status`` says why not. ``reference_plane``: "image" or "first" (what the out-of-plane
-    angle is measured against).
+    angle is measured against). ``bench_board=(left_image, right_image)``: one pair of pictures
+    of the chessboard lying on the bench; ``<m>_X/_Y/_Z`` and ``plane_n*`` are then in the board's
+    frame (``--bench-board``; the board from ``chessboard="9x6"`` and ``square_mm``, else the
+    stereo file's; ``table.summary`` adds ``bench_board_rms_mm`` and ``bench_board_origin_mm``).
 
     Returns a Table (``frame`` and ``right_frame`` int64, ``<m>_status`` str, the rest float64,
     NaN for an empty field); ``table.summary`` has ``pairs``, ``found`` and ``epipolar`` (per
@@ -139,7 +145,7 @@ def track_stereo(
     """
     columns, summary = _core._track_stereo(
         left, right, config, stereo, max_frames, right_config, frame_offset, max_epipolar_px,
-        reference_plane, fps
+        reference_plane, fps, bench_board, chessboard, square_mm
     )
     return Table(columns, summary)
 

@@ -153,6 +153,9 @@ def track_stereo(
     max_epipolar_px: float = 2.0,
     reference_plane: str = "image",
     fps: float = 30.0,
+    bench_board: Optional[Tuple[PathLike, PathLike]] = None,
+    chessboard: Optional[str] = None,
+    square_mm: Optional[float] = None,
 ) -> Table: ...
 def frames(
     input: PathLike,

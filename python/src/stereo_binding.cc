@@ -5,9 +5,11 @@
 #include <limits>
 #include <memory>
 
+#include <opencv2/imgcodecs.hpp>
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_source.h"
@@ -65,10 +67,39 @@ py::dict StereoColumnsDict(const BasicCsvColumnTable<StereoFrameResult>& table,
   return out;
 }
 
+// The bench board's frame (`track-stereo --bench-board`): the board from `chessboard` and
+// `square_mm`, else the stereo file's.
+BoardFrame BenchFrame(const py::object& bench_board, const std::optional<std::string>& chessboard,
+                      std::optional<double> square_mm, const std::string& stereo_file,
+                      const StereoCalibration& calibration,
+                      const TriangulationOptions& triangulation) {
+  const py::sequence images = bench_board.cast<py::sequence>();
+  if (images.size() != 2) {
+    throw InputError("bench_board: give two images, the left and the right view of the board");
+  }
+  const std::string left_file = StereoPath(images[0], "bench_board");
+  const std::string right_file = StereoPath(images[1], "bench_board");
+  const std::optional<ChessboardSpec> stored = LoadStereoCalibrationBoard(stereo_file);
+  if ((!chessboard || !square_mm) && !stored) {
+    throw InputError("bench_board: " + stereo_file +
+                     " does not say which board it was calibrated with; give chessboard and "
+                     "square_mm");
+  }
+  ChessboardSpec board = stored.value_or(ChessboardSpec{});
+  if (chessboard) board.inner_corners = ParseChessboardSize(*chessboard, "chessboard");
+  if (square_mm) board.square_mm = *square_mm;
+  const cv::Mat left_image = cv::imread(left_file, cv::IMREAD_COLOR);
+  const cv::Mat right_image = cv::imread(right_file, cv::IMREAD_COLOR);
+  return LocateBenchBoard(Triangulator(calibration, triangulation), board, left_file, left_image,
+                          right_file, right_image);
+}
+
 py::tuple TrackStereo(const py::object& left, const py::object& right, const py::object& config,
                       const py::object& stereo, std::optional<int64_t> max_frames,
                       const py::object& right_config, int64_t frame_offset, double max_epipolar_px,
-                      const std::string& reference_plane, double fps) {
+                      const std::string& reference_plane, double fps,
+                      const py::object& bench_board, const std::optional<std::string>& chessboard,
+                      std::optional<double> square_mm) {
   if (max_frames && *max_frames < 0) {
     throw InputError("max_frames: " + std::to_string(*max_frames) + " must be >= 0");
   }
@@ -79,6 +110,15 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   StereoOptions options;
   options.triangulation.max_epipolar_px = max_epipolar_px;
   options.reference_plane = ParseReferencePlane(reference_plane, "reference_plane");
+  if (bench_board.is_none() && (chessboard || square_mm)) {
+    throw InputError(std::string(chessboard ? "chessboard" : "square_mm") +
+                     " describes the bench_board board; give bench_board=(left, right)");
+  }
+  std::optional<BoardFrame> bench;
+  if (!bench_board.is_none()) {
+    bench = BenchFrame(bench_board, chessboard, square_mm, StereoPath(stereo, "stereo"),
+                       calibration, options.triangulation);
+  }
   FrameSourceSpec left_spec, right_spec;
   left_spec.input = StereoPath(left, "left");
   right_spec.input = StereoPath(right, "right");
@@ -101,10 +141,15 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
     const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names, segments);
     FramePair pair;
     std::string row;
+    StereoFrameResult in_board;
     while (!max_frames || pairs < *max_frames) {
       if (!input->read(pair)) break;
       const StereoFrameResult& result = session.process(pair);
-      table.append_row(result, row);
+      if (bench) {
+        in_board = result;
+        ExpressInBoardFrame(*bench, in_board);
+      }
+      table.append_row(bench ? in_board : result, row);
       rows.push_back(row);
       ++pairs;
       for (size_t i = 0; i < result.markers.size(); ++i) {
@@ -122,6 +167,11 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   summary["found"] = found;
   summary["epipolar"] = epipolar;
   summary["baseline_mm"] = calibration.baseline_mm();
+  if (bench) {
+    summary["bench_board_rms_mm"] = bench->rms_mm;
+    summary["bench_board_origin_mm"] =
+        py::make_tuple(bench->origin_mm[0], bench->origin_mm[1], bench->origin_mm[2]);
+  }
   return py::make_tuple(StereoColumnsDict(StereoColumns(names, segments), rows), summary);
 }
 
@@ -131,6 +181,7 @@ void BindStereo(py::module_& m) {
   m.def("_track_stereo", &TrackStereo, py::arg("left"), py::arg("right"), py::arg("config"),
         py::arg("stereo"), py::arg("max_frames"), py::arg("right_config"), py::arg("frame_offset"),
         py::arg("max_epipolar_px"), py::arg("reference_plane"), py::arg("fps"),
+        py::arg("bench_board"), py::arg("chessboard"), py::arg("square_mm"),
         "softsight.track_stereo without the table: (columns dict, summary dict).");
 }
 

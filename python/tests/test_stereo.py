@@ -95,3 +95,47 @@ def test_bad_input_gives_the_cli_message(markers_yaml, stereo_yaml, tmp_path):
     with pytest.raises(softsight.InputError, match="reference_plane: expected image"):
         softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
                                reference_plane="sideways")
+
+
+def _write_pgm(path: Path, image: np.ndarray) -> None:
+    with open(path, "wb") as f:
+        f.write(b"P5\n%d %d\n255\n" % (image.shape[1], image.shape[0]) + image.tobytes())
+
+
+def test_bench_board_puts_the_markers_in_the_boards_frame(markers_yaml, stereo_yaml, tmp_path):
+    # A 9x6 board (10x7 squares of 40 px = 20 mm at 300 mm, dark square at the top-left) drawn
+    # facing the rig in the plane Z = 300 mm: one picture serves both views (see the rig above).
+    # Its frame is the camera's turned by nothing, with the origin at its first inner corner,
+    # pixel (159.5, 139.5): (-80.25, -50.25, 300) mm.
+    board = np.full((480, 640), 110, np.uint8)
+    board[80:400, 100:540] = 230
+    for i in range(10):
+        for j in range(7):
+            if (i + j) % 2 == 0:
+                board[100 + 40 * j:140 + 40 * j, 120 + 40 * i:160 + 40 * i] = 25
+    _write_pgm(tmp_path / "bench.pgm", board)
+    _write_pgm(tmp_path / "blank.pgm", np.full((480, 640), 110, np.uint8))
+    bench = (tmp_path / "bench.pgm", tmp_path / "bench.pgm")
+
+    camera = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                                    max_frames=4)
+    table = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                                   max_frames=4, bench_board=bench, chessboard="9x6",
+                                   square_mm=20.0)
+    assert table.summary["bench_board_rms_mm"] < 0.05
+    np.testing.assert_allclose(table.summary["bench_board_origin_mm"], (-80.25, -50.25, 300.0),
+                               atol=0.05)
+    for name in ("red", "blue", "green"):
+        np.testing.assert_allclose(table[f"{name}_X"], camera[f"{name}_X"] + 80.25, atol=0.05)
+        np.testing.assert_allclose(table[f"{name}_Y"], camera[f"{name}_Y"] + 50.25, atol=0.05)
+        np.testing.assert_allclose(table[f"{name}_Z"], 0.0, atol=0.05)
+    for column in ("angle_deg", "radius_mm", "arc_length_mm", "tip_disp_mm"):
+        np.testing.assert_array_equal(table[column], camera[column])
+
+    with pytest.raises(softsight.InputError, match="blank.pgm: the 9x6 chessboard"):
+        softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                               bench_board=(tmp_path / "blank.pgm", bench[1]),
+                               chessboard="9x6", square_mm=20.0)
+    with pytest.raises(softsight.InputError, match="does not say which board"):
+        softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                               bench_board=bench)

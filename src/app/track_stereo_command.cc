@@ -6,8 +6,11 @@
 #include <iostream>
 #include <memory>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
@@ -47,6 +50,13 @@ namespace {
 
 void CheckOptions(const TrackStereoOptions& options) {
   if (options.csv_file.empty()) throw InputError("--csv: give the file to write");
+  if (!options.bench_board.empty() && options.bench_board.size() != 2) {
+    throw InputError("--bench-board: give two images, the left and the right view of the board");
+  }
+  if (options.bench_board.empty() && (!options.chessboard.empty() || options.square_mm)) {
+    throw InputError(std::string(options.chessboard.empty() ? "--square-mm" : "--chessboard") +
+                     " describes the --bench-board board; give --bench-board LEFT RIGHT");
+  }
   if (options.max_frames && *options.max_frames < 0) {
     throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
   }
@@ -165,14 +175,60 @@ std::unique_ptr<StereoInput> OpenStereoInput(const TrackStereoOptions& options,
                      "--frame-offset");
 }
 
+// The board of --bench-board: --chessboard and --square-mm, else the stereo file's.
+ChessboardSpec BenchBoardSpec(const TrackStereoOptions& options) {
+  const std::optional<ChessboardSpec> stored = LoadStereoCalibrationBoard(options.stereo_file);
+  if ((options.chessboard.empty() || !options.square_mm) && !stored) {
+    throw InputError("--bench-board: " + options.stereo_file +
+                     " does not say which board it was calibrated with; give --chessboard WxH "
+                     "--square-mm S");
+  }
+  ChessboardSpec board = stored.value_or(ChessboardSpec{});
+  if (!options.chessboard.empty()) {
+    board.inner_corners = ParseChessboardSize(options.chessboard, "--chessboard");
+  }
+  if (options.square_mm) {
+    if (!(std::isfinite(*options.square_mm) && *options.square_mm > 0.0)) {
+      throw InputError("--square-mm: must be the printed square's side in mm (> 0)");
+    }
+    board.square_mm = *options.square_mm;
+  }
+  return board;
+}
+
+// Finds the bench board in its two images and fits its frame, or refuses in one line.
+BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibration& stereo,
+                          const TriangulationOptions& triangulation) {
+  const ChessboardSpec board = BenchBoardSpec(options);
+  const std::string& left_file = options.bench_board[0];
+  const std::string& right_file = options.bench_board[1];
+  const cv::Mat left = cv::imread(left_file, cv::IMREAD_COLOR);
+  const cv::Mat right = cv::imread(right_file, cv::IMREAD_COLOR);
+  return LocateBenchBoard(Triangulator(stereo, triangulation), board, left_file, left, right_file,
+                          right);
+}
+
+// The run on `input`; `bench` is the bench board's frame when already located.
+TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
+                       std::ostream& report, std::optional<BoardFrame> bench);
+
 }  // namespace
 
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report) {
   CheckOptions(options);
+  // The bench board first: a refusal should not wait for the frame offset to be found.
+  std::optional<BoardFrame> bench;
+  if (!options.bench_board.empty()) {
+    TriangulationOptions triangulation;
+    triangulation.max_epipolar_px = options.max_epipolar_px;
+    std::string error;
+    if (!triangulation.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+    bench = FindBenchBoard(options, LoadStereoCalibration(options.stereo_file), triangulation);
+  }
   TrackStereoSummary summary;
   const std::unique_ptr<StereoInput> input = OpenStereoInput(options, summary, report);
   const std::optional<int64_t> offset = summary.frame_offset;
-  summary = RunTrackStereo(options, *input, report);
+  summary = Run(options, *input, report, bench);
   summary.frame_offset = offset;
   return summary;
 }
@@ -180,6 +236,13 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
                                   std::ostream& report) {
   CheckOptions(options);
+  return Run(options, input, report, std::nullopt);
+}
+
+namespace {
+
+TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
+                       std::ostream& report, std::optional<BoardFrame> bench) {
   const TrackingConfig left_config = LoadStereoViewConfig(options.config_file);
   const TrackingConfig right_config =
       options.right_config_file ? LoadStereoViewConfig(*options.right_config_file) : left_config;
@@ -190,6 +253,17 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
       ParseReferencePlane(options.reference_plane, "--reference-plane");
   std::string error;
   if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+  if (!options.bench_board.empty()) {
+    if (!bench) bench = FindBenchBoard(options, stereo, stereo_options.triangulation);
+    const cv::Vec3d o = bench->origin_mm;
+    report << std::fixed << std::setprecision(1) << "bench board " << options.bench_board[0]
+           << " / " << options.bench_board[1] << ": " << bench->corners
+           << " corners, fitted to " << std::setprecision(3) << bench->rms_mm << " mm RMS (max "
+           << bench->max_mm << " mm); its origin at (" << std::setprecision(1) << o[0] << ", "
+           << o[1] << ", " << o[2] << ") mm in the first camera's frame\n";
+    report.unsetf(std::ios::floatfield);
+    report << std::setprecision(6);
+  }
 
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
@@ -197,6 +271,7 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
   }
   inputs.push_back({"--stereo", options.stereo_file});
   for (const std::string& file : input.files()) inputs.push_back({"an input", file});
+  for (const std::string& file : options.bench_board) inputs.push_back({"--bench-board", file});
   CheckOutputsAreNotInputs({{"--csv", options.csv_file}}, inputs);
 
   // Markers move in depth before two cameras: seen smaller than learned, a colour marker with the
@@ -223,13 +298,19 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
   summary.epipolar.assign(names.size(), {"", 0});
   for (size_t i = 0; i < names.size(); ++i)
     summary.found[i].first = summary.epipolar[i].first = names[i];
+  if (bench) summary.bench_board_rms_mm = bench->rms_mm;
   std::vector<double> sigmas, epipolar_distances;
   FramePair pair;
+  StereoFrameResult in_board;
   bool by_time = false;
   while (!options.max_frames || summary.pairs < *options.max_frames) {
     if (!input.read(pair)) break;
     const StereoFrameResult& result = session.process(pair);
-    csv.write(result);
+    if (bench) {
+      in_board = result;
+      ExpressInBoardFrame(*bench, in_board);
+    }
+    csv.write(bench ? in_board : result);
     ++summary.pairs;
     if (result.pair_dt_ms) {
       by_time = true;
@@ -284,10 +365,19 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
   }
   if (summary.median_sigma_mm)
     report << "; 3D uncertainty: median " << *summary.median_sigma_mm << " mm";
-  report << "\nwrote " << options.csv_file << "\n";
+  report << "\nwrote " << options.csv_file;
+  if (bench) {
+    report << ": <m>_X/_Y/_Z and plane_n* in the bench board's frame (origin at its first inner "
+              "corner, X along its first row, Y along its columns, Z into the bench)";
+  } else {
+    report << ": <m>_X/_Y/_Z in the first camera's frame";
+  }
+  report << "\n";
   report.unsetf(std::ios::floatfield);
   return summary;
 }
+
+}  // namespace
 
 CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
   auto options = std::make_shared<TrackStereoOptions>();
@@ -304,7 +394,11 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       "  softsight track-stereo -c markers.yaml --left left.avi --right right.avi "
       "--stereo stereo.yaml --csv run3d.csv\n"
       "Without --frame-offset the offset between the two videos is found from a flash or the\n"
-      "motion (and refused when unclear); --pair-by time pairs frames by their timestamps.");
+      "motion (and refused when unclear); --pair-by time pairs frames by their timestamps.\n"
+      "--bench-board LEFT RIGHT (one pair of images of the chessboard lying on the bench) puts\n"
+      "the 3D coordinates in the board's frame instead of the first camera's:\n"
+      "  softsight track-stereo -c markers.yaml --left left.avi --right right.avi "
+      "--stereo stereo.yaml --bench-board bench_left.png bench_right.png --csv run3d.csv");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
@@ -352,6 +446,16 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
                  "The out-of-plane angle against: image (the first camera's image plane) or first "
                  "(the first frame's bending plane)")
       ->capture_default_str();
+  sub.add_option("--bench-board", options->bench_board,
+                 "LEFT RIGHT: one pair of images of the chessboard lying on the bench; the 3D "
+                 "coordinates are then in the board's frame (origin at its first inner corner, X "
+                 "along its first row, Y along its columns, Z into the bench) instead of the "
+                 "first camera's")
+      ->expected(2);
+  sub.add_option("--chessboard", options->chessboard,
+                 "The --bench-board board's inner corners WxH (default: the --stereo file's)");
+  sub.add_option("--square-mm", options->square_mm,
+                 "The --bench-board board's square side in mm (default: the --stereo file's)");
   sub.add_option("--fps", options->sequence_fps, "Frame rate of image sequences")
       ->capture_default_str()
       ->check(NumberIn(1e-3, 1e6));

@@ -41,6 +41,13 @@ struct TrackStereoOptions {
   std::optional<int64_t> max_frames;
   double sequence_fps = 30.0;  // Image sequences' frame rate.
   std::optional<double> right_sequence_fps;  // The right image sequence's, when it differs.
+  // Empty, or one pair of images (left, right) of the chessboard lying on the bench: the 3D
+  // coordinates are then in the board's frame (calib/board_frame.h) instead of the first
+  // camera's. The board: `chessboard` ("9x6", inner corners) and `square_mm`, each taken from
+  // the stereo file when not given.
+  std::vector<std::string> bench_board;
+  std::string chessboard;
+  std::optional<double> square_mm;
 };
 
 struct TrackStereoSummary {
@@ -54,6 +61,8 @@ struct TrackStereoSummary {
   std::optional<int64_t> frame_offset;
   int64_t left_unpaired = 0, right_unpaired = 0;
   std::optional<double> max_abs_pair_dt_ms;  // By time: the worst pairing error.
+  // With a bench board: its fit's RMS residual (mm), the coordinates in its frame.
+  std::optional<double> bench_board_rms_mm;
 };
 
 // Runs the whole job and prints its report. Throws InputError for bad input (config, stereo

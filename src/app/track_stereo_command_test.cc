@@ -2,12 +2,16 @@
 // known pose into two image sequences, tracked by `track-stereo` with the rig's exact
 // calibration file; the CSV is read back against the renderer's 3D truth.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include <sys/wait.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/scene_markers_test_util.h"
@@ -187,6 +191,160 @@ TEST_F(TrackStereoCommandTest, MarkersSwappedInOneViewAreRefusedByTheEpipolarChe
   EXPECT_EQ(rows[0].at("angle_deg"), "");
   EXPECT_THAT(report.str(),
               HasSubstr("red: found in 3D in 0 of 4 (4 refused by the epipolar check)"));
+}
+
+// The calibration board laid once on the bench, seen by both cameras: the markers' coordinates
+// come out in its frame. The renderer's board pose is the truth: each true marker position is
+// carried into the board's frame the same way, and the frame-independent measurements must not
+// change at all.
+TEST_F(TrackStereoCommandTest, InTheBenchBoardsFrameMarkersMatchTheTruthAndTheShapeIsUnchanged) {
+  ChessboardPattern pattern;
+  pattern.inner_corners = cv::Size(9, 6);
+  pattern.square_mm = 20.0;
+  pattern.margin_mm = 15.0;
+  const BoardPose pose = LookAtBoard(pattern, 320, 40, 0, 10, 0, 10);
+  ChessboardLook look;
+  look.supersample = 2;
+  cv::Mat left, right;
+  ChessboardRenderer(scene_->rig().left, pattern, look).render(pose, left);
+  ChessboardRenderer(scene_->rig().right, pattern, look)
+      .render(RightBoardPose(scene_->rig(), pose), right);
+  cv::imwrite(dir_->file("bench_left.png"), left);
+  cv::imwrite(dir_->file("bench_right.png"), right);
+  cv::Matx33d board_rotation;
+  cv::Rodrigues(pose.rvec, board_rotation);
+  const auto true_in_board = [&](const cv::Point3d& p) {
+    const cv::Vec3d q = board_rotation.t() * (cv::Vec3d(p.x, p.y, p.z) - pose.tvec);
+    return cv::Point3d(q[0], q[1], q[2]);
+  };
+
+  TrackStereoOptions camera_options = Options();
+  camera_options.csv_file = dir_->file("camera_frame.csv");
+  std::ostringstream camera_report;
+  RunTrackStereo(camera_options, camera_report);
+  EXPECT_THAT(camera_report.str(), HasSubstr("<m>_X/_Y/_Z in the first camera's frame"));
+
+  TrackStereoOptions options = Options();
+  options.csv_file = dir_->file("bench_frame.csv");
+  options.bench_board = {dir_->file("bench_left.png"), dir_->file("bench_right.png")};
+  options.chessboard = "9x6";
+  options.square_mm = 20.0;
+  std::ostringstream report;
+  const TrackStereoSummary summary = RunTrackStereo(options, report);
+  ASSERT_TRUE(summary.bench_board_rms_mm.has_value());
+  EXPECT_LT(*summary.bench_board_rms_mm, 0.3);
+  EXPECT_THAT(report.str(), HasSubstr("bench board " + options.bench_board[0] + " / " +
+                                      options.bench_board[1] + ": 54 corners, fitted to"));
+  EXPECT_THAT(report.str(), HasSubstr("<m>_X/_Y/_Z and plane_n* in the bench board's frame"));
+
+  const auto camera_rows = ReadRows(camera_options.csv_file);
+  const auto rows = ReadRows(options.csv_file);
+  const CsvTable table = ReadCsvTable(options.csv_file);
+  ASSERT_EQ(rows.size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(camera_rows.size(), rows.size());
+  const auto value = [&](const std::string& column, size_t row) {
+    return *table.values[*table.find(column)][row];
+  };
+  double position_sq = 0;
+  int positions = 0;
+  double worst_normal_deg = 0;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    for (const char* column : {"angle_deg", "out_of_plane_deg", "radius_mm", "arc_length_mm",
+                               "tip_disp_mm", "angle_left_deg", "angle_right_deg"}) {
+      EXPECT_EQ(rows[r].at(column), camera_rows[r].at(column)) << column << ", frame " << r;
+    }
+    for (const StereoMarkerTruth& m : truths_[r].markers) {
+      ASSERT_EQ(rows[r].at(m.name + "_status"), "found") << "frame " << r;
+      EXPECT_EQ(rows[r].at(m.name + "_sigma_mm"), camera_rows[r].at(m.name + "_sigma_mm"));
+      const cv::Point3d p(value(m.name + "_X", r), value(m.name + "_Y", r),
+                          value(m.name + "_Z", r));
+      position_sq += std::pow(cv::norm(p - true_in_board(m.position_mm)), 2);
+      ++positions;
+    }
+    if (r >= 6) {  // The bending plane is well defined.
+      const cv::Vec3d n(value("plane_nx", r), value("plane_ny", r), value("plane_nz", r));
+      const cv::Vec3d truth = board_rotation.t() * truths_[r].plane_normal;
+      worst_normal_deg = std::max(
+          worst_normal_deg, std::acos(std::min(1.0, std::abs(n.dot(truth)))) * 180.0 / CV_PI);
+    }
+  }
+  const double rms = std::sqrt(position_sq / positions);
+  EXPECT_LT(rms, 0.2);
+  EXPECT_LT(worst_normal_deg, 0.5);
+  std::cout << "[ figures  ] track-stereo --bench-board: board fit " << *summary.bench_board_rms_mm
+            << " mm RMS; markers in the board's frame " << rms
+            << " mm RMS from the truth; bending plane normal within " << worst_normal_deg
+            << " deg\n[ report   ] " << report.str().substr(0, report.str().find('\n') + 1);
+
+  // The stereo file's own board (9x6 of 25 mm here) is not the one on the bench: refused by the
+  // fit's residual, before anything is written.
+  options.chessboard.clear();
+  options.square_mm.reset();
+  options.csv_file = dir_->file("refused.csv");
+  try {
+    RunTrackStereo(options, report);
+    ADD_FAILURE() << "a board of the wrong size was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("bench_left.png / " + options.bench_board[1] +
+                                    ": the triangulated corners fit a flat 9x6 board of 25.00 mm "
+                                    "squares to"));
+    EXPECT_THAT(e.what(), HasSubstr("(limit 2.00)"));
+    std::cout << "[ refusal  ] " << e.what() << "\n";
+  }
+  EXPECT_FALSE(fs::exists(options.csv_file));
+}
+
+TEST_F(TrackStereoCommandTest, ABenchBoardImageWithoutTheBoardIsRefusedNamingTheFile) {
+  TrackStereoOptions options = Options();
+  options.bench_board = {dir_->file("left/000.png"), dir_->file("right/003.png")};
+  options.csv_file = dir_->file("no_board.csv");
+  std::ostringstream report;
+  try {
+    RunTrackStereo(options, report);
+    ADD_FAILURE() << "no board, yet accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    EXPECT_THAT(e.what(), HasSubstr(options.bench_board[0] +
+                                    ": the 9x6 chessboard (inner corners) was not found"));
+  }
+  EXPECT_FALSE(fs::exists(options.csv_file));
+  // The program: one line naming the file, exit code 2, before the frame offset is searched for
+  // (no --frame-offset here: the board is looked at first).
+  const std::string cli = testing::SoftsightBinary() + " track-stereo -c " + options.config_file +
+                          " --left " + options.left_input + " --right " + options.right_input +
+                          " --stereo " + options.stereo_file + " --csv " +
+                          options.csv_file + " --bench-board " + options.bench_board[0] + " " +
+                          options.bench_board[1] + " 2> " + dir_->file("bench_err.txt");
+  EXPECT_EQ(WEXITSTATUS(std::system(cli.c_str())), 2);
+  const std::string err = testing::ReadTextFile(dir_->file("bench_err.txt"));
+  EXPECT_THAT(err, HasSubstr(options.bench_board[0] + ": the 9x6 chessboard (inner corners) was "
+                             "not found"));
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  std::cout << "[ refusal  ] " << err;
+  EXPECT_FALSE(fs::exists(options.csv_file));
+  options.bench_board = {dir_->file("missing_left.png"), dir_->file("right/003.png")};
+  EXPECT_THROW(
+      {
+        try {
+          RunTrackStereo(options, report);
+        } catch (const InputError& e) {
+          EXPECT_THAT(e.what(), HasSubstr("missing_left.png: cannot read the image"));
+          throw;
+        }
+      },
+      InputError);
+  options = Options();
+  options.square_mm = 20.0;
+  EXPECT_THROW(
+      {
+        try {
+          RunTrackStereo(options, report);
+        } catch (const InputError& e) {
+          EXPECT_THAT(e.what(), HasSubstr("--square-mm describes the --bench-board board"));
+          throw;
+        }
+      },
+      InputError);
 }
 
 TEST_F(TrackStereoCommandTest, BadInputIsOneLineNamingTheCulprit) {

@@ -317,6 +317,20 @@ StereoCalibration LoadStereoCalibration(const std::string& file) {
   return s;
 }
 
+std::optional<ChessboardSpec> LoadStereoCalibrationBoard(const std::string& file) {
+  cv::FileStorage fs = OpenForReading(file);
+  if (fs["board_width"].empty() || fs["board_height"].empty() || fs["square_size_mm"].empty()) {
+    return std::nullopt;
+  }
+  ChessboardSpec board;
+  board.inner_corners = cv::Size(ReadPositiveInt(fs, file, "board_width"),
+                                 ReadPositiveInt(fs, file, "board_height"));
+  board.square_mm = static_cast<double>(fs["square_size_mm"]);
+  std::string error;
+  if (!board.Check(&error)) throw InputError(file + ": the board: " + error);
+  return board;
+}
+
 cv::Mat DrawRectifiedPair(const StereoCalibration& stereo, const cv::Mat& left_image,
                           const cv::Mat& right_image, int spacing_px) {
   CV_Assert(spacing_px > 0);

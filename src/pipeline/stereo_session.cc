@@ -159,6 +159,19 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
   return out;
 }
 
+void ExpressInBoardFrame(const BoardFrame& frame, StereoFrameResult& result) {
+  for (StereoMarkerResult& marker : result.markers) {
+    StereoPoint& point = marker.point;
+    if (point.position_mm) point.position_mm = frame.to_board(*point.position_mm);
+    if (point.covariance_mm2) {
+      point.covariance_mm2 = frame.covariance_to_board(*point.covariance_mm2);
+    }
+  }
+  if (result.shape.plane_normal) {
+    result.shape.plane_normal = frame.direction_to_board(*result.shape.plane_normal);
+  }
+}
+
 BasicCsvColumnTable<StereoFrameResult> StereoColumns(const std::vector<std::string>& marker_names,
                                                      const std::vector<std::string>& segment_names) {
   using Row = StereoFrameResult;

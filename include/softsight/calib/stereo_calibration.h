@@ -122,6 +122,9 @@ class StereoCalibrator {
 void SaveStereoCalibration(const StereoCalibrationResult& result, const ChessboardSpec& board,
                            const std::string& file);
 StereoCalibration LoadStereoCalibration(const std::string& file);
+// The board the rig was calibrated with (board_width, board_height, square_size_mm), absent when
+// the file does not store it. Throws InputError naming the file when it stores a bad one.
+std::optional<ChessboardSpec> LoadStereoCalibrationBoard(const std::string& file);
 
 // Both images rectified side by side (left | right) with horizontal lines every `spacing_px`:
 // on a good calibration each point of the scene lies on the same line in both halves. BGR.

@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/calib/triangulation.h"
 #include "softsight/config/config.h"
@@ -90,6 +91,12 @@ class StereoSession {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Expresses a frame's 3D results in a board's frame (calib/board_frame.h) instead of the first
+// camera's: each found marker's position and covariance, and the bending plane's normal. The
+// angles, radii, arc lengths, the tip displacement and the out-of-plane angle do not depend on
+// the frame and are left as they are.
+void ExpressInBoardFrame(const BoardFrame& frame, StereoFrameResult& result);
 
 // The stereo CSV's columns: frame, right_frame, time_s, pair_dt_ms; per marker <m>_X, <m>_Y,
 // <m>_Z (mm, first camera's frame), <m>_sigma_mm, <m>_epipolar_px, <m>_status; then angle_deg
