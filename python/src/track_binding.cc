@@ -266,8 +266,7 @@ class FrameStream {
  public:
   FrameStream(const py::object& input, const py::object& config_source,
               std::optional<int64_t> max_frames, double fps,
-              const std::optional<std::string>& method)
-      : max_frames_(max_frames) {
+              const std::optional<std::string>& method) {
     CheckMaxFrames(max_frames);
     TrackingConfig config = ResolveConfig(config_source, method);
     const FrameSourceSpec spec = InputSpec(input, fps);
@@ -276,30 +275,24 @@ class FrameStream {
     session_ = std::make_unique<TrackingSession>(std::move(config));
     RunOptions options;
     options.max_frames = max_frames;
-    run_ = std::make_unique<PipelineRun>(*session_, DescribeRun(*source_, *session_, options));
+    stream_ = std::make_unique<RunStream>(*source_, *session_, options);
   }
 
-  // The next frame's result, or nothing at the end (of the input, or of max_frames). Throws
+  // The next frame's result, or nothing at the end (of the input, or of max_frames). A predicted
+  // video's results come once their key-frame group is checked, as track()'s rows do. Throws
   // InputError for an input with no frame at all, a frame that does not decode or a gray video
-  // with colour markers, as track() reports them; the stream is closed then.
+  // with colour markers, as track() reports them, after the results before it; the input is
+  // released when the run ends.
   std::optional<FrameResult> next() {
     py::gil_scoped_release release;
     const std::lock_guard<std::mutex> lock(mutex_);  // One frame at a time.
-    if (!source_) return std::nullopt;
+    if (closed_) return std::nullopt;
     try {
-      if (max_frames_ && run_->frames() >= *max_frames_) {
-        close_locked();
-        return std::nullopt;
-      }
-      frame_.captured = {};
-      if (!source_->read(frame_)) {
-        const std::string source = run_->summary().source;
-        const bool empty = run_->frames() == 0;
-        close_locked();
-        if (empty) throw InputError(NoFramesProblem(source));
-        return std::nullopt;
-      }
-      return run_->process(frame_);  // A copy: the session reuses its own for the next frame.
+      std::optional<FrameResult> result = stream_->next();
+      // The run has ended: the file is let go of at once (the stream's held results remain).
+      if (stream_->ended()) source_.reset();
+      if (!result) closed_ = true;
+      return result;
     } catch (...) {
       close_locked();
       throw;
@@ -311,21 +304,21 @@ class FrameStream {
     const std::lock_guard<std::mutex> lock(mutex_);
     close_locked();
   }
-  bool closed() const { return !source_; }
+  bool closed() const { return closed_; }
   // The frames the run will have (max_frames when fewer), when the source knows its length.
-  std::optional<int64_t> total() const { return run_->info().frame_count; }
-  int64_t done() const { return run_->frames(); }
+  std::optional<int64_t> total() const { return stream_->info().frame_count; }
+  int64_t done() const { return stream_->returned(); }
 
  private:
   void close_locked() {
+    closed_ = true;   // The stream is not asked again: its source is gone.
     source_.reset();  // The video file or the image sequence is let go of here.
   }
 
-  std::optional<int64_t> max_frames_;
   std::unique_ptr<FrameSource> source_;
   std::unique_ptr<TrackingSession> session_;
-  std::unique_ptr<PipelineRun> run_;
-  Frame frame_;
+  std::unique_ptr<RunStream> stream_;
+  bool closed_ = false;
   std::mutex mutex_;
 };
 

@@ -64,6 +64,25 @@ def test_every_frame_of_a_video_has_the_values_of_tracks_row(bending_video, mark
     assert assert_frames_match_track(bending_video, markers_yaml) == 24
 
 
+def test_a_predicted_video_gives_tracks_rows_after_its_key_frame_check(bending_video,
+                                                                       markers_yaml, tmp_path):
+    # MPEG-4 (a key frame every 12th frame as OpenCV writes it): frames() holds each group until
+    # the next key frame is tracked, as track() does, and yields the same values in order.
+    reader = cv2.VideoCapture(str(bending_video))
+    mp4 = tmp_path / "bending.mp4"
+    writer = cv2.VideoWriter(str(mp4), cv2.VideoWriter_fourcc(*"mp4v"), 30.0, (640, 480))
+    while True:
+        ok, image = reader.read()
+        if not ok:
+            break
+        writer.write(image)
+    writer.release()
+    assert assert_frames_match_track(mp4, markers_yaml) == 24
+    gen = softsight.frames(mp4, markers_yaml)
+    assert [next(gen).frame for _ in range(3)] == [0, 1, 2]
+    gen.close()
+
+
 def test_a_rendered_scene_and_an_image_folder_too(markers_yaml, tmp_path):
     table = softsight.track("synth:bending", markers_yaml, max_frames=6)
     results = list(softsight.frames("synth:bending", markers_yaml, max_frames=6))

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -217,6 +218,79 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
     throw;
   }
   return run.finish(reason, source.dropped_frames(), notes(), std::move(error));
+}
+
+// Collects the results the run delivers (after their key-frame group was checked) for next().
+class RunStream::Queue : public FrameSink {
+ public:
+  void consume(const Frame& frame, const FrameResult& result) override {
+    (void)frame;
+    results.push_back(result);
+  }
+  std::deque<FrameResult> results;
+};
+
+RunStream::RunStream(FrameSource& source, TrackingSession& session, const RunOptions& options)
+    : source_(source), options_(options), queue_(std::make_unique<Queue>()) {
+  run_ = std::make_unique<PipelineRun>(session, DescribeRun(source, session, options),
+                                       std::vector<FrameSink*>{queue_.get()});
+  if (options.check_key_frame_groups) run_->check_key_frame_groups();
+  summary_ = run_->summary();
+}
+
+RunStream::~RunStream() = default;
+
+const RunInfo& RunStream::info() const { return run_->info(); }
+
+std::optional<FrameResult> RunStream::next() {
+  if (queue_->results.empty() && !ended_) fill();
+  if (!queue_->results.empty()) {
+    FrameResult result = std::move(queue_->results.front());
+    queue_->results.pop_front();
+    ++returned_;
+    return result;
+  }
+  // Every result is out: now the error that ended the run, once.
+  if (!summary_.error.empty()) {
+    std::string error;
+    std::swap(error, summary_.error);
+    throw InputError(error);
+  }
+  return std::nullopt;
+}
+
+void RunStream::fill() {
+  try {
+    while (queue_->results.empty()) {
+      if (options_.max_frames && run_->frames() >= *options_.max_frames) {
+        return end(StopReason::kMaxFrames, {});
+      }
+      if (options_.stop_requested && options_.stop_requested()) {
+        return end(StopReason::kStopRequested, {});
+      }
+      frame_.captured = {};
+      if (!source_.read(frame_)) {
+        // A file that ends before its first frame is a wrong input, not a run.
+        if (run_->frames() == 0) return end(StopReason::kError, NoFramesProblem(summary_.source));
+        return end(StopReason::kEndOfInput, {});
+      }
+      run_->process(frame_);
+    }
+  } catch (const InputError& e) {
+    end(StopReason::kError, e.what());
+  } catch (const std::exception& e) {
+    end(StopReason::kError, e.what());
+    summary_.error.clear();
+    throw;
+  }
+}
+
+void RunStream::end(StopReason reason, std::string error) {
+  std::vector<std::string> notes;
+  if (const std::optional<std::string> note = source_.note()) notes.push_back(*note);
+  ended_ = true;
+  // Hands on the held group (unchecked: no key frame follows it) before the error is thrown.
+  summary_ = run_->finish(reason, source_.dropped_frames(), std::move(notes), std::move(error));
 }
 
 }  // namespace softsight

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <gmock/gmock.h>
+#include <opencv2/imgproc.hpp>
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
@@ -327,6 +328,114 @@ TEST(RunPipeline, GrayFramesForColourTrackingAreAnErrorNamingTheSource) {
   EXPECT_THAT(summary.error, HasSubstr("video gray.avi"));
   EXPECT_THAT(summary.error, HasSubstr("grayscale"));
   EXPECT_TRUE(sink.indices.empty());
+}
+
+// A predicted video (a key frame every 12th) whose frames 28-35 the decoder silently slid 16 px
+// to the left (a macroblock), as a flipped bit does; frame 40 does not decode.
+class SlidPredictedFrames : public FrameSource {
+ public:
+  explicit SlidPredictedFrames(int frames) : scene_(SmallScene(frames)) {}
+  bool read(Frame& frame) override {
+    if (next_ == 40) throw InputError("clip.mp4: frame 40 cannot be decoded");
+    if (next_ >= scene_.options().frame_count) return false;
+    truth_.push_back(scene_.render(next_, frame.image));
+    if (next_ >= 28 && next_ < 36) {
+      const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, -16, 0, 1, 0);
+      cv::warpAffine(frame.image.clone(), frame.image, shift, frame.image.size(),
+                     cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+    }
+    frame.index = next_;
+    frame.time_s = next_ / 30.0;
+    frame.key_frame = next_ % 12 == 0;
+    ++next_;
+    return true;
+  }
+  std::string description() const override { return "clip.mp4"; }
+  std::optional<int64_t> frame_count() const override { return scene_.options().frame_count; }
+  std::optional<double> fps() const override { return 30.0; }
+  const std::vector<SceneTruth>& truth() const { return truth_; }
+
+ private:
+  SyntheticScene scene_;
+  int next_ = 0;
+  std::vector<SceneTruth> truth_;
+};
+
+TEST(RunStream, PullsRunPipelinesCheckedResultsThenItsError) {
+  SlidPredictedFrames pushed_source(60);
+  TrackingSession pushed_session(ThreeMarkerSceneConfig());
+  RecordingSink sink;
+  const RunSummary pushed = RunPipeline(pushed_source, pushed_session, {&sink});
+  ASSERT_EQ(pushed.stop_reason, StopReason::kError);
+
+  SlidPredictedFrames source(60);
+  TrackingSession session(ThreeMarkerSceneConfig());
+  RunStream stream(source, session);
+  std::vector<FrameResult> pulled;
+  std::string error;
+  try {
+    while (std::optional<FrameResult> result = stream.next()) pulled.push_back(*result);
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  EXPECT_EQ(error, pushed.error) << "the error comes after every result before it";
+  EXPECT_EQ(error, "clip.mp4: frame 40 cannot be decoded");
+  EXPECT_TRUE(stream.ended());
+  EXPECT_FALSE(stream.next()) << "the error is thrown once";
+  ASSERT_EQ(pulled.size(), sink.indices.size());
+  ASSERT_EQ(pulled.size(), 40u);
+  EXPECT_EQ(stream.returned(), 40);
+  EXPECT_EQ(stream.summary().frames, pushed.frames);
+  EXPECT_EQ(stream.summary().notes, pushed.notes);
+  // Frames 28-35, three markers each: the key frame's check, not the tracker, refused them.
+  EXPECT_THAT(pushed.notes, ::testing::Contains(HasSubstr("24 marker-frames not believed")));
+  int slid_found = 0;
+  for (size_t f = 0; f < pulled.size(); ++f) {
+    EXPECT_EQ(pulled[f].frame_index, sink.indices[f]);
+    for (size_t m = 0; m < 3; ++m) {
+      const Observation& o = pulled[f].markers[m].observation;
+      EXPECT_EQ(o.found(), sink.found[f][m]) << "frame " << f << " marker " << m;
+      if (!o.found()) continue;
+      // Found means at the true place: the slid frames' markers are not believed.
+      const cv::Point2d truth = *source.truth()[f].markers[m].centroid_px;
+      EXPECT_LT(cv::norm(*o.position_px - truth), 3.0) << "frame " << f << " marker " << m;
+      slid_found += f >= 28 && f < 36;
+    }
+  }
+  EXPECT_EQ(slid_found, 0);
+  int clean_found = 0;
+  for (size_t f = 0; f < 28; ++f) {
+    for (size_t m = 0; m < 3; ++m) clean_found += pulled[f].markers[m].observation.found();
+  }
+  EXPECT_EQ(clean_found, 28 * 3) << "the frames before the damage are tracked";
+}
+
+TEST(RunStream, AnInputWithoutFramesIsAnErrorAndMaxFramesEndsIt) {
+  class NoFrames : public FrameSource {
+   public:
+    bool read(Frame&) override { return false; }
+    std::string description() const override { return "empty.avi"; }
+    std::optional<int64_t> frame_count() const override { return 0; }
+    std::optional<double> fps() const override { return std::nullopt; }
+  } empty;
+  TrackingSession session(ThreeMarkerSceneConfig());
+  RunStream stream(empty, session);
+  try {
+    stream.next();
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("empty.avi: no frames to read"));
+  }
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
+  TrackingSession again(ThreeMarkerSceneConfig());
+  RunOptions options;
+  options.max_frames = 4;
+  RunStream four(*source, again, options);
+  int count = 0;
+  while (four.next()) ++count;
+  EXPECT_EQ(count, 4);
+  EXPECT_EQ(four.summary().stop_reason, StopReason::kMaxFrames);
+  EXPECT_EQ(four.info().frame_count, 4);
 }
 
 TEST(CsvSink, WritesOneCompleteRowPerFrameWithTheSourceIndex) {

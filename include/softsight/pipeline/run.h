@@ -105,6 +105,45 @@ class PipelineRun {
 RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options = {});
 
+// RunPipeline turned inside out, for a caller that pulls one result at a time (Python's
+// softsight.frames): the same reading, max_frames, stop request, grayscale check and key-frame
+// check (a predicted video's results come out once their group is checked, so next() may read
+// several frames before it returns one), without sinks. The source and the session must outlive
+// the stream while it runs; once ended() the source is not read again (it may be closed).
+class RunStream {
+ public:
+  RunStream(FrameSource& source, TrackingSession& session, const RunOptions& options = {});
+  ~RunStream();
+  RunStream(const RunStream&) = delete;
+  RunStream& operator=(const RunStream&) = delete;
+
+  // The next frame's result, in source order, or nothing once the run has ended. An InputError
+  // (a frame that does not decode, an input without frames, a gray video for colour markers)
+  // is thrown after every result before it has been returned; the run has ended then.
+  std::optional<FrameResult> next();
+  bool ended() const { return ended_; }
+  const RunInfo& info() const;
+  int64_t returned() const { return returned_; }  // Results next() has returned.
+  // The run's summary; complete (why it stopped, notes such as demoted marker-frames) once
+  // ended() is true.
+  const RunSummary& summary() const { return summary_; }
+
+ private:
+  class Queue;
+  // Reads and processes until a result is queued or the run ends.
+  void fill();
+  void end(StopReason reason, std::string error);
+
+  FrameSource& source_;
+  RunOptions options_;
+  std::unique_ptr<Queue> queue_;
+  std::unique_ptr<PipelineRun> run_;
+  Frame frame_;
+  bool ended_ = false;
+  int64_t returned_ = 0;
+  RunSummary summary_;
+};
+
 // Whether a run of `config` needs colour frames: a marker whose colour range accepts gray pixels
 // (a gray-level range, white or black dots) is tracked on gray video as well; only the others
 // make gray frames an error, said with GrayFrameProblem() ("colour tracking needs colour (...)").
