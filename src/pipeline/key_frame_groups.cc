@@ -1,6 +1,8 @@
 #include "pipeline/key_frame_groups.h"
 
 #include <algorithm>
+#include <limits>
+#include <optional>
 
 namespace softsight {
 
@@ -25,11 +27,7 @@ void KeyFrameGroups::add(const Frame& frame, const FrameResult& result, const Re
   if (!frame.key_frame) predicted_seen_ = true;
   if (!predicted_seen_) {
     release(frame, result);
-    tail_index_ = result.frame_index;
-    tail_px_.resize(result.markers.size());
-    for (size_t m = 0; m < result.markers.size(); ++m) {
-      tail_px_[m] = result.markers[m].observation.position_px;
-    }
+    remember(result);
     return;
   }
   if (frame.key_frame && count_ > 0) {
@@ -41,7 +39,13 @@ void KeyFrameGroups::add(const Frame& frame, const FrameResult& result, const Re
   hold(frame, result);
 }
 
-void KeyFrameGroups::flush(const Release& release) { release_held(release, /*checked=*/false); }
+void KeyFrameGroups::flush(const Release& release, bool damaged) {
+  if (damaged && count_ > 0 && predicted_seen_) {
+    // The damage the run ended with may be in this group too, and no key frame follows it.
+    for (size_t m = 0; m < held_[0].result.markers.size(); ++m) check_unverified(m);
+  }
+  release_held(release, /*checked=*/false);
+}
 
 void KeyFrameGroups::hold(const Frame& frame, const FrameResult& result) {
   if (count_ == held_.size()) held_.emplace_back();
@@ -56,83 +60,133 @@ void KeyFrameGroups::hold(const Frame& frame, const FrameResult& result) {
 }
 
 void KeyFrameGroups::release_held(const Release& release, bool checked) {
-  for (size_t i = 0; i < count_; ++i) release(held_[i].frame, held_[i].result);
-  if (count_ > 0) {
-    const FrameResult& last = held_[count_ - 1].result;
-    tail_index_ = last.frame_index;
-    tail_px_.resize(last.markers.size());
-    for (size_t m = 0; m < last.markers.size(); ++m) {
-      tail_px_[m] = last.markers[m].observation.position_px;
-    }
+  for (size_t i = 0; i < count_; ++i) {
+    release(held_[i].frame, held_[i].result);
+    remember(held_[i].result);
   }
   if (!checked) unchecked_frames_ += static_cast<int64_t>(count_);
   count_ = 0;
   held_bytes_ = 0;
 }
 
+void KeyFrameGroups::remember(const FrameResult& result) {
+  if (tail_.size() < result.markers.size()) tail_.resize(result.markers.size());
+  for (size_t m = 0; m < result.markers.size(); ++m) {
+    const Observation& o = result.markers[m].observation;
+    tail_[m] = o.found() ? std::optional<Anchor>(Anchor{result.frame_index, *o.position_px})
+                         : std::nullopt;
+  }
+}
+
+// The marker's track through the held group: its position in the frame before the group (when
+// it was found there and believed), the group's frames that found it, and `key`, the key frame after it, when given.
+// Fills indices_, points_ and residuals_ (each step's departure from the track's median
+// velocity); returns the jump threshold, or nothing when the track is too short to know the
+// group's own motion.
+std::optional<double> KeyFrameGroups::track(size_t m, const Observation* key, int64_t key_index) {
+  indices_.clear();
+  points_.clear();
+  if (m < tail_.size() && tail_[m]) {
+    indices_.push_back(tail_[m]->index);
+    points_.push_back(tail_[m]->px);
+  }
+  for (size_t i = 0; i < count_; ++i) {
+    const Observation& o = held_[i].result.markers[m].observation;
+    if (!o.found()) continue;
+    indices_.push_back(held_[i].result.frame_index);
+    points_.push_back(*o.position_px);
+  }
+  if (key) {
+    indices_.push_back(key_index);
+    points_.push_back(*key->position_px);
+  }
+  const size_t n = points_.size();
+  if (n < 4) return std::nullopt;  // Too few steps to know the group's own motion.
+  // The group's motion: the median velocity per frame; each step's residual from it.
+  scratch_.clear();
+  for (size_t k = 1; k < n; ++k) {
+    scratch_.push_back((points_[k].x - points_[k - 1].x) / double(indices_[k] - indices_[k - 1]));
+  }
+  const double vx = MedianOf(scratch_);
+  scratch_.clear();
+  for (size_t k = 1; k < n; ++k) {
+    scratch_.push_back((points_[k].y - points_[k - 1].y) / double(indices_[k] - indices_[k - 1]));
+  }
+  const double vy = MedianOf(scratch_);
+  residuals_.assign(n, cv::Point2d(0, 0));
+  scratch_.clear();
+  for (size_t k = 1; k < n; ++k) {
+    const double frames = double(indices_[k] - indices_[k - 1]);
+    residuals_[k] = points_[k] - points_[k - 1] - cv::Point2d(vx * frames, vy * frames);
+    scratch_.push_back(cv::norm(residuals_[k]));
+  }
+  return std::max(kMinJumpPx, kNoiseFactor * MedianOf(scratch_));
+}
+
+void KeyFrameGroups::demote_from(size_t m, int64_t first_damaged) {
+  for (size_t i = 0; i < count_; ++i) {
+    FrameResult& held = held_[i].result;
+    Observation& o = held.markers[m].observation;
+    if (held.frame_index < first_damaged || !o.found()) continue;
+    o = Observation::NotFound(MarkerStatus::kImplausible);
+    held.measurement = Measurement{};  // Measured with the damaged marker.
+    ++demoted_;
+  }
+}
+
 void KeyFrameGroups::check(const FrameResult& next) {
   for (size_t m = 0; m < next.markers.size(); ++m) {
-    if (!next.markers[m].observation.found()) continue;
-    // The marker's track: the frame before the group, the group, the key frame after it.
-    indices_.clear();
-    points_.clear();
-    if (tail_index_ >= 0 && m < tail_px_.size() && tail_px_[m]) {
-      indices_.push_back(tail_index_);
-      points_.push_back(*tail_px_[m]);
+    const Observation& key = next.markers[m].observation;
+    if (!key.found()) {
+      // The key frame cannot vouch for the group: its tracker refused what it saw there as a
+      // jump, or the marker is not there at all.
+      check_unverified(m);
+      continue;
     }
-    for (size_t i = 0; i < count_; ++i) {
-      const Observation& o = held_[i].result.markers[m].observation;
-      if (!o.found()) continue;
-      indices_.push_back(held_[i].result.frame_index);
-      points_.push_back(*o.position_px);
-    }
-    indices_.push_back(next.frame_index);
-    points_.push_back(*next.markers[m].observation.position_px);
+    const std::optional<double> threshold = track(m, &key, next.frame_index);
+    if (!threshold) continue;
     const size_t n = points_.size();
-    if (n < 4) continue;  // Too few steps to know the group's own motion.
-    // The group's motion: the median velocity per frame; each step's residual from it.
-    scratch_.clear();
-    for (size_t k = 1; k < n; ++k) {
-      scratch_.push_back((points_[k].x - points_[k - 1].x) / double(indices_[k] - indices_[k - 1]));
-    }
-    const double vx = MedianOf(scratch_);
-    scratch_.clear();
-    for (size_t k = 1; k < n; ++k) {
-      scratch_.push_back((points_[k].y - points_[k - 1].y) / double(indices_[k] - indices_[k - 1]));
-    }
-    const double vy = MedianOf(scratch_);
-    residuals_.assign(n, cv::Point2d(0, 0));
-    scratch_.clear();
-    for (size_t k = 1; k < n; ++k) {
-      const double frames = double(indices_[k] - indices_[k - 1]);
-      residuals_[k] = points_[k] - points_[k - 1] - cv::Point2d(vx * frames, vy * frames);
-      scratch_.push_back(cv::norm(residuals_[k]));
-    }
-    const double threshold = std::max(kMinJumpPx, kNoiseFactor * MedianOf(scratch_));
     const cv::Point2d back = residuals_[n - 1];
     const double back_px = cv::norm(back);
-    if (back_px <= threshold) continue;
+    if (back_px <= *threshold) continue;
     // Where the damage began: the step the jump back undoes best.
     std::optional<size_t> onset;
     double best = kUndoTolerance * back_px;
     for (size_t k = 1; k + 1 < n; ++k) {
       const double undone = cv::norm(residuals_[k] + back);
-      if (cv::norm(residuals_[k]) > threshold && undone < best) {
+      if (cv::norm(residuals_[k]) > *threshold && undone < best) {
         best = undone;
         onset = k;
       }
     }
     if (!onset) continue;  // A real change of motion at the key frame (a bounce): believed.
-    const int64_t first_damaged = indices_[*onset];
-    for (size_t i = 0; i < count_; ++i) {
-      FrameResult& held = held_[i].result;
-      Observation& o = held.markers[m].observation;
-      if (held.frame_index < first_damaged || !o.found()) continue;
-      o = Observation::NotFound(MarkerStatus::kImplausible);
-      held.measurement = Measurement{};  // Measured with the damaged marker.
-      ++demoted_;
+    demote_from(m, indices_[*onset]);
+  }
+}
+
+void KeyFrameGroups::check_unverified(size_t m) {
+  const bool anchored = m < tail_.size() && tail_[m];
+  if (!anchored) {
+    // Not in the frame before the group (or not believed there), and not at the key frame after
+    // it: nothing ties the group's positions to the marker's (a key frame the damage moved it
+    // in, or the group after such a group).
+    demote_from(m, std::numeric_limits<int64_t>::min());
+    return;
+  }
+  const std::optional<double> threshold = track(m, nullptr, 0);
+  if (!threshold) return;
+  // Without a key frame to undo it, a jump in the group is not told from real motion: the
+  // marker is believed up to the biggest one and not after it.
+  std::optional<size_t> onset;
+  double biggest = *threshold;
+  for (size_t k = 1; k < points_.size(); ++k) {
+    const double jump = cv::norm(residuals_[k]);
+    if (jump > biggest) {
+      biggest = jump;
+      onset = k;
     }
   }
+  if (onset) demote_from(m, indices_[*onset]);
 }
 
 }  // namespace softsight

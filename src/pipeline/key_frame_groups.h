@@ -15,8 +15,15 @@
 // Frames of a camera, an image sequence or an intra-only video are all key frames: they pass
 // straight through.
 //
+// When the key frame cannot vouch for a marker (its tracker refused what it saw there, or the
+// marker is not there), a jump in the group is not believed either, from the jump on; and a
+// marker not found (or not believed) in the frame before the group and not found at the key
+// frame after it is not believed anywhere in the group (nothing ties those positions to the marker: a key frame the
+// damage moved it in). The last group of a run that ended with damage (the decoder reported it,
+// the file was cut) is checked the same way, as no key frame follows it.
+//
 // What it cannot see: damage that grows over several frames (no single jump where it began),
-// and damage in the last group of the video (no key frame after it).
+// and damage in the last group of a video the decoder did not complain about.
 #pragma once
 
 #include <cstddef>
@@ -44,8 +51,10 @@ class KeyFrameGroups {
   // The next frame and its result: held, or handed on (with any group this frame ends) through
   // `release` before add() returns.
   void add(const Frame& frame, const FrameResult& result, const Release& release);
-  // The end of the run: the held group, unchecked (no key frame follows it).
-  void flush(const Release& release);
+  // The end of the run: the held group, unchecked (no key frame follows it). A run that ended
+  // with damage (`damaged`: the decoder reported it, or the file was cut) does not believe a
+  // marker's jump in that group, nor a marker the frame before the group did not have.
+  void flush(const Release& release, bool damaged = false);
 
   // Marker-frames found to be the decoder's damage and reported implausible instead.
   int64_t demoted() const { return demoted_; }
@@ -59,6 +68,11 @@ class KeyFrameGroups {
   };
   // Demotes, in the held group, what the key frame `next` shows to be damage.
   void check(const FrameResult& next);
+  // A marker the key frame after the group does not show: a jump in the group is not believed.
+  void check_unverified(size_t marker);
+  std::optional<double> track(size_t marker, const Observation* key, int64_t key_index);
+  void demote_from(size_t marker, int64_t first_damaged);
+  void remember(const FrameResult& released);
   void hold(const Frame& frame, const FrameResult& result);
   void release_held(const Release& release, bool checked);
 
@@ -67,9 +81,13 @@ class KeyFrameGroups {
   std::vector<Held> held_;       // Slots reused across groups: their images keep their buffers.
   size_t count_ = 0;             // held_[0, count_) is the open group.
   size_t held_bytes_ = 0;
-  // The last frame handed on (the step into a group's first frame starts there).
-  int64_t tail_index_ = -1;
-  std::vector<std::optional<cv::Point2d>> tail_px_;
+  // Per marker, its position in the last frame handed on, when found and believed there (a
+  // group's track starts there).
+  struct Anchor {
+    int64_t index;
+    cv::Point2d px;
+  };
+  std::vector<std::optional<Anchor>> tail_;
   // check()'s scratch, per marker.
   std::vector<int64_t> indices_;
   std::vector<cv::Point2d> points_, residuals_;

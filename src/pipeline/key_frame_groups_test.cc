@@ -40,7 +40,8 @@ struct Released {
 };
 
 // Runs `results` through the check; every frame's release is recorded.
-Released CheckGroups(const std::vector<FrameResult>& results, bool predicted, KeyFrameGroups& groups) {
+Released CheckGroups(const std::vector<FrameResult>& results, bool predicted, KeyFrameGroups& groups,
+                     bool ended_damaged = false) {
   Released released;
   const KeyFrameGroups::Release release = [&](const Frame& frame, const FrameResult& result) {
     EXPECT_EQ(frame.index, result.frame_index);
@@ -54,8 +55,17 @@ Released CheckGroups(const std::vector<FrameResult>& results, bool predicted, Ke
     frame.key_frame = !predicted || result.frame_index % kKeyFrameInterval == 0;
     groups.add(frame, result, release);
   }
-  groups.flush(release);
+  groups.flush(release, ended_damaged);
   return released;
+}
+
+// The tracker did not find `marker` in frames [first, last].
+void Hide(std::vector<FrameResult>& results, int marker, int first, int last,
+          MarkerStatus why = MarkerStatus::kLost) {
+  for (int i = first; i <= last; ++i) {
+    results[static_cast<size_t>(i)].markers[static_cast<size_t>(marker)].observation =
+        Observation::NotFound(why);
+  }
 }
 
 void ExpectEveryFrameOnceInOrder(const Released& released, int frames) {
@@ -115,6 +125,62 @@ TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
     for (const MarkerObservation& m : r.markers) EXPECT_TRUE(m.observation.found()) << r.frame_index;
   }
   EXPECT_EQ(groups.demoted(), 0);
+}
+
+TEST(KeyFrameGroups, AJumpMidGroupIsNotBelievedWhenTheKeyFrameDoesNotShowTheMarker) {
+  // Marker 0 slid 16 px from frame 28; at key frame 36 its tracker refused the jump back (or
+  // lost it): nothing after frame 28 vouches for it. Marker 1 is hidden at the key frame too
+  // but did not jump: believed. Marker 2 is seen at the key frame, where it did not move.
+  const auto damage = [](int i, int m) {
+    return i >= 28 && i < 36 && m == 0 ? cv::Point2d(-16, 0) : cv::Point2d(0, 0);
+  };
+  std::vector<FrameResult> results = Track{}.results(60, damage);
+  Hide(results, 0, 36, 37, MarkerStatus::kImplausible);
+  Hide(results, 1, 36, 36);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (int i = 0; i < 60; ++i) {
+    const bool hidden0 = i == 36 || i == 37;
+    EXPECT_EQ(released.results[i].markers[0].observation.found(), i < 28 || (i > 37))
+        << "frame " << i << (hidden0 ? " (hidden)" : "");
+    EXPECT_EQ(released.results[i].markers[1].observation.found(), i != 36) << "frame " << i;
+    EXPECT_TRUE(released.results[i].markers[2].observation.found()) << "frame " << i;
+  }
+  EXPECT_EQ(groups.demoted(), 8);
+}
+
+TEST(KeyFrameGroups, AMarkerNeitherJustBeforeItsGroupNorAfterItIsNotBelievedInIt) {
+  // Marker 2 is not in frame 23 (before the group 24-35) nor at key frame 36: its positions in
+  // the group, however steady, are tied to nothing (a key frame the damage moved it in).
+  std::vector<FrameResult> results = Track{}.results(60, [](int, int) { return cv::Point2d(); });
+  Hide(results, 2, 20, 23);
+  Hide(results, 2, 36, 40);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  for (int i = 24; i < 36; ++i) {
+    EXPECT_FALSE(released.results[i].markers[2].observation.found()) << "frame " << i;
+    EXPECT_TRUE(released.results[i].markers[1].observation.found()) << "frame " << i;
+  }
+  EXPECT_EQ(groups.demoted(), 12);
+}
+
+TEST(KeyFrameGroups, TheLastGroupOfARunEndedByDamageDoesNotBelieveAJump) {
+  // Frames 48-59 are the last group: no key frame follows. Marker 0 jumps 16 px at frame 52.
+  const auto jump = [](int i, int m) {
+    return i >= 52 && m == 0 ? cv::Point2d(16, 0) : cv::Point2d(0, 0);
+  };
+  for (const bool damaged : {false, true}) {
+    KeyFrameGroups groups;
+    const Released released = CheckGroups(Track{}.results(60, jump), true, groups, damaged);
+    ExpectEveryFrameOnceInOrder(released, 60);
+    for (int i = 48; i < 60; ++i) {
+      EXPECT_EQ(released.results[i].markers[0].observation.found(), !damaged || i < 52)
+          << "frame " << i << (damaged ? ", run ended by damage" : ", clean end");
+      EXPECT_TRUE(released.results[i].markers[1].observation.found()) << "frame " << i;
+    }
+    EXPECT_EQ(groups.demoted(), damaged ? 8 : 0);
+  }
 }
 
 TEST(KeyFrameGroups, FramesThatAreAllKeyFramesPassStraightThrough) {

@@ -151,7 +151,7 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
   if (key_frame_groups_) {
     // The last group has no key frame after it: it goes on unchecked.
     try {
-      key_frame_groups_->flush(deliver_);
+      key_frame_groups_->flush(deliver_, reason == StopReason::kError);
     } catch (const InputError& e) {
       if (error.empty()) error = e.what();
       reason = StopReason::kError;
