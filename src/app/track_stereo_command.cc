@@ -60,6 +60,12 @@ void CheckOptions(const TrackStereoOptions& options) {
   if (options.max_frames && *options.max_frames < 0) {
     throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
   }
+  if (ParseReferencePlane(options.reference_plane, "--reference-plane") ==
+          StereoOptions::ReferencePlane::kBoard &&
+      options.bench_board.empty()) {
+    throw InputError("--reference-plane board: the bench board's plane; give --bench-board LEFT "
+                     "RIGHT (one pair of images of the board lying on the bench)");
+  }
 }
 
 FrameSourceSpec SpecOf(const std::string& input, double fps) {
@@ -251,10 +257,11 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   stereo_options.triangulation.max_epipolar_px = options.max_epipolar_px;
   stereo_options.reference_plane =
       ParseReferencePlane(options.reference_plane, "--reference-plane");
-  std::string error;
-  if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
   if (!options.bench_board.empty()) {
     if (!bench) bench = FindBenchBoard(options, stereo, stereo_options.triangulation);
+    // Its Z axis in the first camera's frame (kBoard's reference; unused otherwise).
+    stereo_options.board_normal =
+        cv::Vec3d(bench->rotation(0, 2), bench->rotation(1, 2), bench->rotation(2, 2));
     const cv::Vec3d o = bench->origin_mm;
     report << std::fixed << std::setprecision(1) << "bench board " << options.bench_board[0]
            << " / " << options.bench_board[1] << ": " << bench->corners
@@ -264,6 +271,8 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     report.unsetf(std::ios::floatfield);
     report << std::setprecision(6);
   }
+  std::string error;
+  if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
 
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
@@ -372,6 +381,9 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   } else {
     report << ": <m>_X/_Y/_Z in the first camera's frame";
   }
+  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
+    report << "; out_of_plane_deg against the bench board's plane";
+  }
   report << "\n";
   report.unsetf(std::ios::floatfield);
   return summary;
@@ -443,8 +455,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->capture_default_str()
       ->check(NumberIn(1e-3, 1e3));
   sub.add_option("--reference-plane", options->reference_plane,
-                 "The out-of-plane angle against: image (the first camera's image plane) or first "
-                 "(the first frame's bending plane)")
+                 "The out-of-plane angle against: image (the first camera's image plane), first "
+                 "(the first frame's bending plane) or board (the --bench-board's plane: the "
+                 "bench)")
       ->capture_default_str();
   sub.add_option("--bench-board", options->bench_board,
                  "LEFT RIGHT: one pair of images of the chessboard lying on the bench; the 3D "

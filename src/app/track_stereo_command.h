@@ -37,7 +37,8 @@ struct TrackStereoOptions {
   // Pairing by time: the right view's clock minus the left one's (ms).
   double time_offset_ms = 0.0;
   double max_epipolar_px = 2.0;           // See TriangulationOptions.
-  std::string reference_plane = "image";  // "image" or "first" (StereoOptions).
+  // "image", "first" or "board" (StereoOptions; board needs bench_board).
+  std::string reference_plane = "image";
   std::optional<int64_t> max_frames;
   double sequence_fps = 30.0;  // Image sequences' frame rate.
   std::optional<double> right_sequence_fps;  // The right image sequence's, when it differs.
