@@ -82,8 +82,9 @@ std::unique_ptr<FrameSource> Open(const FrameSourceSpec& spec) {
 
 // Finds the frame offset from a flash or the motion (io/frame_offset.h), reports it, or refuses
 // in one line.
-int64_t FindFrameOffset(const TrackStereoOptions& options, const FrameSourceSpec& left_spec,
-                        const FrameSourceSpec& right_spec, std::ostream& report) {
+int64_t FindAndReportFrameOffset(const TrackStereoOptions& options,
+                                 const FrameSourceSpec& left_spec,
+                                 const FrameSourceSpec& right_spec, std::ostream& report) {
   FrameOffsetOptions offset_options;
   offset_options.max_offset_frames = options.max_offset_frames;
   std::string error;
@@ -91,36 +92,10 @@ int64_t FindFrameOffset(const TrackStereoOptions& options, const FrameSourceSpec
   // The frames the run can use, and the offset's worth beyond them.
   std::optional<int64_t> frames;
   if (options.max_frames) frames = *options.max_frames + options.max_offset_frames;
-  const SyncSignal left = MeasureSyncSignal(*OpenFrameSource(left_spec), frames);
-  const SyncSignal right = MeasureSyncSignal(*OpenFrameSource(right_spec), frames);
-  const FrameOffsetEstimate estimate = EstimateFrameOffset(left, right, offset_options);
-  if (!estimate.offset_frames) {
-    throw InputError("cannot find the frame offset between --left and --right within +-" +
-                     std::to_string(options.max_offset_frames) + " frames: " + estimate.refusal +
-                     "; pass --frame-offset N");
-  }
-  const int64_t offset = *estimate.offset_frames;
-  report << "frame offset " << offset << " (right frame = left frame "
-         << (offset >= 0 ? "+ " : "- ") << std::abs(offset) << "), found from ";
-  report << std::fixed << std::setprecision(3);
-  if (estimate.method == FrameOffsetEstimate::Method::kFlash) {
-    report << "a flash: left frame " << *estimate.left_flash_frame << ", right frame "
-           << *estimate.right_flash_frame << " (brightness steps " << std::setprecision(1)
-           << estimate.left_flash_step << " and " << estimate.right_flash_step
-           << " grey levels)\n";
-  } else {
-    report << "the motion: correlation " << *estimate.peak_correlation;
-    if (estimate.second_correlation) {
-      report << ", next best peak " << *estimate.second_correlation << " at offset "
-             << *estimate.second_offset;
-    } else {
-      report << ", no other peak";
-    }
-    report << " (searched +-" << options.max_offset_frames << ")\n";
-  }
-  report.unsetf(std::ios::floatfield);
-  report << std::setprecision(6);
-  return offset;
+  const FrameOffsetEstimate estimate = FindFrameOffset(
+      *OpenFrameSource(left_spec), *OpenFrameSource(right_spec), offset_options, frames);
+  report << DescribeFrameOffset(estimate, offset_options) << "\n";
+  return *estimate.offset_frames;
 }
 
 // The pairs the options ask for, the offset found when it is needed.
@@ -175,7 +150,7 @@ std::unique_ptr<StereoInput> OpenStereoInput(const TrackStereoOptions& options,
   }
   const int64_t offset = options.frame_offset
                              ? *options.frame_offset
-                             : FindFrameOffset(options, left_spec, right_spec, report);
+                             : FindAndReportFrameOffset(options, left_spec, right_spec, report);
   summary.frame_offset = offset;
   return PairByIndex(Open(left_spec), Open(right_spec), offset,
                      "--frame-offset");
