@@ -10,6 +10,7 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/publish_options.h"
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
@@ -21,6 +22,7 @@
 #include "softsight/io/run_source.h"
 #include "softsight/io/stereo_input.h"
 #include "softsight/pipeline/stereo_session.h"
+#include "softsight/pipeline/summary.h"
 #include "softsight/track/colour_tracker.h"
 #include "track/tracker_kind.h"
 
@@ -256,7 +258,14 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   inputs.push_back({"--stereo", options.stereo_file});
   for (const std::string& file : input.files()) inputs.push_back({"an input", file});
   for (const std::string& file : options.bench_board) inputs.push_back({"--bench-board", file});
-  CheckOutputsAreNotInputs({{"--csv", options.csv_file}}, inputs);
+  std::vector<PathRole> outputs = {{"--csv", options.csv_file}};
+  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) {
+    outputs.push_back(*socket);
+  }
+  CheckOutputsAreNotInputs(outputs, inputs);
+  // Bound now: a bad endpoint is refused before any output is made.
+  const std::unique_ptr<PublishSink> publish =
+      OpenPublishSink(options.publish, options.config_file);
 
   // Markers move in depth before two cameras: seen smaller than learned, a colour marker with the
   // rim fit is taken as partly hidden and placed by a circle of its old size (up to 1 px off,
@@ -275,8 +284,19 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
 
-  BasicCsvWriter<StereoFrameResult> csv(options.csv_file,
-                                        StereoColumns(names, session.segment_names()));
+  const BasicCsvColumnTable<StereoFrameResult> columns =
+      StereoColumns(names, session.segment_names());
+  BasicCsvWriter<StereoFrameResult> csv(options.csv_file, columns);
+  std::string published_row;
+  if (publish) {
+    publish->set_row_columns(columns.names(),
+                             {"_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status"});
+    RunInfo info;
+    info.source = input.description();
+    info.live = options.left_camera.has_value();
+    info.marker_names = names;
+    publish->begin(info);
+  }
   TrackStereoSummary summary;
   summary.found.assign(names.size(), {"", 0});
   summary.epipolar.assign(names.size(), {"", 0});
@@ -287,29 +307,55 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   FramePair pair;
   StereoFrameResult in_board;
   bool by_time = false;
-  while (!options.max_frames || summary.pairs < *options.max_frames) {
-    if (!input.read(pair)) break;
-    const StereoFrameResult& result = session.process(pair);
-    if (bench) {
-      in_board = result;
-      ExpressInBoardFrame(*bench, in_board);
-    }
-    csv.write(bench ? in_board : result);
-    ++summary.pairs;
-    if (result.pair_dt_ms) {
-      by_time = true;
-      summary.max_abs_pair_dt_ms =
-          std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
-    }
-    for (size_t i = 0; i < result.markers.size(); ++i) {
-      const StereoPoint& p = result.markers[i].point;
-      if (p.found()) {
-        ++summary.found[i].second;
-        sigmas.push_back(*p.sigma_mm);
+  RunSummary run;  // For the stream's end record and its note.
+  run.source = input.description();
+  try {
+    while (!options.max_frames || summary.pairs < *options.max_frames) {
+      if (!input.read(pair)) break;
+      const StereoFrameResult& result = session.process(pair);
+      if (bench) {
+        in_board = result;
+        ExpressInBoardFrame(*bench, in_board);
       }
-      if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
-      if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
+      csv.write(bench ? in_board : result);
+      if (publish) {
+        columns.append_row(bench ? in_board : result, published_row);
+        publish->publish_row(published_row);
+      }
+      ++summary.pairs;
+      if (result.pair_dt_ms) {
+        by_time = true;
+        summary.max_abs_pair_dt_ms =
+            std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
+      }
+      for (size_t i = 0; i < result.markers.size(); ++i) {
+        const StereoPoint& p = result.markers[i].point;
+        if (p.found()) {
+          ++summary.found[i].second;
+          sigmas.push_back(*p.sigma_mm);
+        }
+        if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
+        if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
+      }
     }
+  } catch (const InputError& e) {
+    // The subscribers learn that the run ended, and why; the error itself is reported once,
+    // where it is handled.
+    if (publish) {
+      run.frames = summary.pairs;
+      run.stop_reason = StopReason::kError;
+      run.error = e.what();
+      publish->end(run);
+    }
+    throw;
+  }
+  if (publish) {
+    run.frames = summary.pairs;
+    run.stop_reason = options.max_frames && summary.pairs >= *options.max_frames
+                          ? StopReason::kMaxFrames
+                          : StopReason::kEndOfInput;
+    publish->end(run);
+    publish->report(run);
   }
   summary.median_sigma_mm = Median(sigmas);
   summary.median_epipolar_px = Median(epipolar_distances);
@@ -360,6 +406,7 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     report << "; out_of_plane_deg against the bench board's plane";
   }
   report << "\n";
+  for (const std::string& note : run.notes) report << "note: " << note << "\n";
   report.unsetf(std::ios::floatfield);
   return summary;
 }
@@ -452,7 +499,10 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->check(NumberIn(1e-3, 1e6));
   sub.add_option("--max-frames", options->max_frames, "Stop after this many pairs")
       ->check(NumberIn(0, 1e15));
-  return [options] {
+  auto publish = std::make_shared<PublishArgs>();
+  AddPublishOptions(sub, publish.get());
+  return [options, publish] {
+    options->publish = publish->resolved();
     RunTrackStereo(*options, std::cout);
     return 0;
   };

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "stream/publish_sink.h"
+
 namespace softsight {
 
 class StereoInput;
@@ -49,6 +51,9 @@ struct TrackStereoOptions {
   std::vector<std::string> bench_board;
   std::string chessboard;
   std::optional<double> square_mm;
+  // --publish: every pair's row (the CSV's columns) to subscribers as it happens
+  // (stream/publish_sink.h; topics frame, measure, marker/<name> with <name>_X ... _status).
+  std::optional<PublishOptions> publish;
 };
 
 struct TrackStereoSummary {

@@ -5,12 +5,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include <sys/wait.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -24,6 +26,7 @@
 #include "softsight/io/csv_reader.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/stereo_scene.h"
+#include "stream/subscriber.h"
 
 namespace softsight {
 namespace {
@@ -374,6 +377,88 @@ TEST_F(TrackStereoCommandTest, AgainstTheBenchBoardsPlaneTheOutOfPlaneAngleIsThe
   const std::string err = testing::ReadTextFile(dir_->file("board_err.txt"));
   EXPECT_THAT(err, HasSubstr("--reference-plane board: the bench board's plane"));
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(options.csv_file));
+}
+
+// `--publish`: while track-stereo runs, a subscriber gets every pair's row with the CSV's
+// columns and values (topic frame), a marker's 3D columns (marker/<name>) and the run's end.
+TEST_F(TrackStereoCommandTest, PublishSendsEveryRowWithTheCsvsColumnsAsItHappens) {
+  TrackStereoOptions options = Options();
+  options.csv_file = dir_->file("published.csv");
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir_->file("stereo.ipc");
+  publish.wait_subscribers = 1;  // Connected before the first pair: it gets every one.
+  options.publish = publish;
+  StreamSubscriber records(publish.endpoint, {"hello", "frame", "marker/green", "end"}, "test");
+  std::ostringstream report;
+  auto run = std::async(std::launch::async, [&] { return RunTrackStereo(options, report); });
+  std::optional<nlohmann::ordered_json> hello, end;
+  std::vector<nlohmann::ordered_json> frames, green;
+  for (int waits = 0; !end && waits < 600;) {
+    const std::optional<StreamMessage> message = records.receive(100);
+    if (!message) {
+      ++waits;  // At most a minute of silence in all.
+      continue;
+    }
+    const nlohmann::ordered_json body = nlohmann::ordered_json::parse(message->body);
+    if (message->topic == "hello") hello = body;
+    if (message->topic == "frame") frames.push_back(body);
+    if (message->topic == "marker/green") green.push_back(body);
+    if (message->topic == "end") end = body;
+  }
+  const TrackStereoSummary summary = run.get();
+  ASSERT_TRUE(end.has_value()) << "no end record";
+  ASSERT_TRUE(hello.has_value());
+  EXPECT_EQ((*end)["frames"], kFrames);
+  EXPECT_EQ((*end)["stop_reason"], "end of input");
+  EXPECT_THAT(report.str(), HasSubstr("note: --publish " + publish.endpoint));
+  EXPECT_THAT(report.str(), HasSubstr("none dropped"));
+
+  std::ifstream csv(options.csv_file);
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = testing::SplitCsv(line);
+  EXPECT_EQ((*hello)["columns"].get<std::vector<std::string>>(), header);
+  EXPECT_EQ((*hello)["markers"].get<std::vector<std::string>>(),
+            (std::vector<std::string>{"red", "blue", "green"}));
+  ASSERT_EQ(frames.size(), static_cast<size_t>(summary.pairs));
+  ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames));
+  for (size_t r = 0; r < frames.size(); ++r) {
+    ASSERT_TRUE(static_cast<bool>(std::getline(csv, line)));
+    const std::vector<std::string> fields = testing::SplitCsv(line);
+    std::vector<std::string> keys;
+    for (const auto& item : frames[r].items()) keys.push_back(item.key());
+    ASSERT_EQ(keys, header) << "record " << r;
+    for (size_t c = 0; c < header.size(); ++c) {
+      const nlohmann::ordered_json& value = frames[r][header[c]];
+      if (fields[c].empty()) {
+        EXPECT_TRUE(value.is_null()) << header[c] << ", record " << r;
+      } else if (value.is_string()) {
+        EXPECT_EQ(value.get<std::string>(), fields[c]) << header[c] << ", record " << r;
+      } else {
+        EXPECT_EQ(value.get<double>(), std::stod(fields[c])) << header[c] << ", record " << r;
+      }
+    }
+  }
+  ASSERT_EQ(green.size(), frames.size());
+  std::vector<std::string> green_keys;
+  for (const auto& item : green[0].items()) green_keys.push_back(item.key());
+  EXPECT_EQ(green_keys, (std::vector<std::string>{"frame", "time_s", "green_X", "green_Y",
+                                                  "green_Z", "green_sigma_mm",
+                                                  "green_epipolar_px", "green_status"}));
+  EXPECT_EQ(green.back()["green_Z"], frames.back()["green_Z"]);
+
+  // A bad endpoint: one line naming it, before any output is made.
+  options.csv_file = dir_->file("not_published.csv");
+  options.publish->endpoint = "tcp://nowhere";
+  options.publish->wait_subscribers = 0;
+  try {
+    RunTrackStereo(options, report);
+    ADD_FAILURE() << "a bad endpoint was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--publish"));
+    EXPECT_THAT(e.what(), HasSubstr("tcp://nowhere"));
+  }
   EXPECT_FALSE(fs::exists(options.csv_file));
 }
 
