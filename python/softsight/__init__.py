@@ -117,7 +117,8 @@ def track_stereo(
     max_frames: Optional[int] = None,
     *,
     right_config: Union[Config, PathLike, dict, None] = None,
-    frame_offset: int = 0,
+    frame_offset: Optional[int] = None,
+    max_offset_frames: int = 60,
     max_epipolar_px: float = 2.0,
     reference_plane: str = "image",
     fps: float = 30.0,
@@ -130,22 +131,31 @@ def track_stereo(
 
     ``left`` and ``right`` are videos, folders of images or printf patterns; ``stereo`` is the
     file of ``softsight calibrate --left ... --right ...``. Right frame ``i + frame_offset`` is
-    paired with left frame ``i`` (0 by default: unlike the CLI, the offset is not searched for). ``right_config``: the right view's markers when they need other
-    colours or rois (the same names). A marker has ``<m>_X/_Y/_Z`` (mm, the first camera's frame)
-    only when both views found it and the pair passed the epipolar check (``max_epipolar_px``);
-    ``<m>_status`` says why not. ``reference_plane``: "image" or "first" (what the out-of-plane
-    angle is measured against). ``bench_board=(left_image, right_image)``: one pair of pictures
-    of the chessboard lying on the bench; ``<m>_X/_Y/_Z`` and ``plane_n*`` are then in the board's
-    frame (``--bench-board``; the board from ``chessboard="9x6"`` and ``square_mm``, else the
-    stereo file's; ``table.summary`` adds ``bench_board_rms_mm`` and ``bench_board_origin_mm``).
+    paired with left frame ``i``; ``frame_offset=None`` (the default) finds the offset as
+    ``track-stereo`` does without ``--frame-offset``: from a flash, else the motion, within
+    ``max_offset_frames`` either way (both inputs are read once more for it), and raises
+    InputError ("cannot find the frame offset between left and right ...; pass frame_offset=N")
+    when it is not clear (a repeating motion, a still scene). ``right_config``: the right view's
+    markers when they need other colours or rois (the same names). A marker has ``<m>_X/_Y/_Z``
+    (mm, the first camera's frame) only when both views found it and the pair passed the
+    epipolar check (``max_epipolar_px``); ``<m>_status`` says why not. ``reference_plane``:
+    "image", "first" or "board" (what the out-of-plane angle is measured against; "board" needs
+    ``bench_board``). ``bench_board=(left_image, right_image)``: one pair of pictures of the
+    chessboard lying on the bench; ``<m>_X/_Y/_Z`` and ``plane_n*`` are then in the board's frame
+    (``--bench-board``; the board from ``chessboard="9x6"`` and ``square_mm``, else the stereo
+    file's; ``table.summary`` adds ``bench_board_rms_mm`` and ``bench_board_origin_mm``).
 
     Returns a Table (``frame`` and ``right_frame`` int64, ``<m>_status`` str, the rest float64,
     NaN for an empty field); ``table.summary`` has ``pairs``, ``found`` and ``epipolar`` (per
-    marker) and ``baseline_mm``. Raises InputError with the CLI's message for bad input.
+    marker), ``baseline_mm``, ``frame_offset`` (the offset used), ``frame_offset_method``
+    ("given", "flash" or "motion"), ``frame_offset_correlation`` and
+    ``frame_offset_next_correlation`` (the motion's r at the offset and at the next best peak, else
+    None) and ``frame_offset_report`` (the CLI's line, None when given). Raises InputError with
+    the CLI's message for bad input.
     """
     columns, summary = _core._track_stereo(
-        left, right, config, stereo, max_frames, right_config, frame_offset, max_epipolar_px,
-        reference_plane, fps, bench_board, chessboard, square_mm
+        left, right, config, stereo, max_frames, right_config, frame_offset, max_offset_frames,
+        max_epipolar_px, reference_plane, fps, bench_board, chessboard, square_mm
     )
     return Table(columns, summary)
 

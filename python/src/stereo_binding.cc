@@ -12,6 +12,7 @@
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
+#include "softsight/io/frame_offset.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/io/stereo_input.h"
@@ -96,7 +97,8 @@ BoardFrame BenchFrame(const py::object& bench_board, const std::optional<std::st
 
 py::tuple TrackStereo(const py::object& left, const py::object& right, const py::object& config,
                       const py::object& stereo, std::optional<int64_t> max_frames,
-                      const py::object& right_config, int64_t frame_offset, double max_epipolar_px,
+                      const py::object& right_config, std::optional<int64_t> frame_offset,
+                      int64_t max_offset_frames, double max_epipolar_px,
                       const std::string& reference_plane, double fps,
                       const py::object& bench_board, const std::optional<std::string>& chessboard,
                       std::optional<double> square_mm) {
@@ -114,15 +116,37 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
     throw InputError(std::string(chessboard ? "chessboard" : "square_mm") +
                      " describes the bench_board board; give bench_board=(left, right)");
   }
+  if (options.reference_plane == StereoOptions::ReferencePlane::kBoard && bench_board.is_none()) {
+    throw InputError("reference_plane board: the bench board's plane; give bench_board=(left, "
+                     "right) (one pair of images of the board lying on the bench)");
+  }
+  FrameOffsetOptions offset_options;
+  offset_options.max_offset_frames = max_offset_frames;
+  std::string error;
+  if (!frame_offset && !offset_options.Check(&error)) throw InputError(error);
   std::optional<BoardFrame> bench;
   if (!bench_board.is_none()) {
     bench = BenchFrame(bench_board, chessboard, square_mm, StereoPath(stereo, "stereo"),
                        calibration, options.triangulation);
+    options.board_normal =
+        cv::Vec3d(bench->rotation(0, 2), bench->rotation(1, 2), bench->rotation(2, 2));
   }
   FrameSourceSpec left_spec, right_spec;
   left_spec.input = StereoPath(left, "left");
   right_spec.input = StereoPath(right, "right");
   left_spec.sequence_fps = right_spec.sequence_fps = fps;
+  // Not given: found from a flash or the motion, as `track-stereo` does without --frame-offset
+  // (within max_offset_frames; the frames the run can use and the range beyond them).
+  std::optional<FrameOffsetEstimate> found_offset;
+  if (!frame_offset) {
+    py::gil_scoped_release release;
+    std::optional<int64_t> frames;
+    if (max_frames) frames = *max_frames + max_offset_frames;
+    found_offset = FindFrameOffset(*OpenFrameSource(left_spec), *OpenFrameSource(right_spec),
+                                   offset_options, frames,
+                                   FrameOffsetNames{"left and right", "frame_offset=N"});
+    frame_offset = found_offset->offset_frames;
+  }
 
   std::vector<std::string> rows;
   int64_t pairs = 0;
@@ -132,7 +156,7 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   {
     py::gil_scoped_release release;
     const std::unique_ptr<StereoInput> input = PairByIndex(
-        OpenFrameSource(left_spec), OpenFrameSource(right_spec), frame_offset, "frame_offset");
+        OpenFrameSource(left_spec), OpenFrameSource(right_spec), *frame_offset, "frame_offset");
     StereoSession session(left_config, other_config, calibration, options);
     names = session.marker_names();
     segments = session.segment_names();
@@ -167,6 +191,25 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
   summary["found"] = found;
   summary["epipolar"] = epipolar;
   summary["baseline_mm"] = calibration.baseline_mm();
+  // The offset used and where it came from: "given", "flash" or "motion" (with the motion's
+  // correlation at the offset and at the next best peak, None when there is none).
+  summary["frame_offset"] = *frame_offset;
+  summary["frame_offset_method"] =
+      found_offset ? FrameOffsetMethodName(found_offset->method) : "given";
+  py::object correlation = py::none(), next_correlation = py::none();
+  if (found_offset && found_offset->method == FrameOffsetEstimate::Method::kMotion) {
+    correlation = py::float_(*found_offset->peak_correlation);
+    if (found_offset->second_correlation) {
+      next_correlation = py::float_(*found_offset->second_correlation);
+    }
+  }
+  summary["frame_offset_correlation"] = correlation;
+  summary["frame_offset_next_correlation"] = next_correlation;
+  if (found_offset) {
+    summary["frame_offset_report"] = DescribeFrameOffset(*found_offset, offset_options);
+  } else {
+    summary["frame_offset_report"] = py::none();
+  }
   if (bench) {
     summary["bench_board_rms_mm"] = bench->rms_mm;
     summary["bench_board_origin_mm"] =
@@ -180,7 +223,7 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
 void BindStereo(py::module_& m) {
   m.def("_track_stereo", &TrackStereo, py::arg("left"), py::arg("right"), py::arg("config"),
         py::arg("stereo"), py::arg("max_frames"), py::arg("right_config"), py::arg("frame_offset"),
-        py::arg("max_epipolar_px"), py::arg("reference_plane"), py::arg("fps"),
+        py::arg("max_offset_frames"), py::arg("max_epipolar_px"), py::arg("reference_plane"), py::arg("fps"),
         py::arg("bench_board"), py::arg("chessboard"), py::arg("square_mm"),
         "softsight.track_stereo without the table: (columns dict, summary dict).");
 }

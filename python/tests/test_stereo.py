@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import softsight
-from conftest import run_cli
+from conftest import cli_error, run_cli
 
 STEREO_YAML = """%YAML:1.0
 ---
@@ -63,8 +63,10 @@ def stereo_yaml(tmp_path) -> Path:
 
 
 def test_track_stereo_gives_the_cli_columns_and_exact_3d(markers_yaml, stereo_yaml, tmp_path):
+    # The same scene in both views, started together (a smooth sweep: the motion alone would not
+    # tell the offset, see the refusal test below).
     table = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
-                                   max_frames=6)
+                                   max_frames=6, frame_offset=0)
     csv_path = tmp_path / "run3d.csv"
     run_cli("track-stereo", "-c", str(markers_yaml), "--left", "synth:bending", "--right",
             "synth:bending", "--stereo", str(stereo_yaml), "--csv", str(csv_path),
@@ -118,10 +120,10 @@ def test_bench_board_puts_the_markers_in_the_boards_frame(markers_yaml, stereo_y
     bench = (tmp_path / "bench.pgm", tmp_path / "bench.pgm")
 
     camera = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
-                                    max_frames=4)
+                                    max_frames=4, frame_offset=0)
     table = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
-                                   max_frames=4, bench_board=bench, chessboard="9x6",
-                                   square_mm=20.0)
+                                   max_frames=4, frame_offset=0, bench_board=bench,
+                                   chessboard="9x6", square_mm=20.0)
     assert table.summary["bench_board_rms_mm"] < 0.05
     np.testing.assert_allclose(table.summary["bench_board_origin_mm"], (-80.25, -50.25, 300.0),
                                atol=0.05)
@@ -139,3 +141,118 @@ def test_bench_board_puts_the_markers_in_the_boards_frame(markers_yaml, stereo_y
     with pytest.raises(softsight.InputError, match="does not say which board"):
         softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
                                bench_board=bench)
+
+
+def test_reference_plane_board_measures_against_the_bench_board(markers_yaml, stereo_yaml,
+                                                                tmp_path):
+    # The board of the test above, facing the rig like the bend: the bend lies in the board's
+    # plane (0 degrees where the plane is defined). Without a bench board: refused.
+    board = np.full((480, 640), 110, np.uint8)
+    board[80:400, 100:540] = 230
+    for i in range(10):
+        for j in range(7):
+            if (i + j) % 2 == 0:
+                board[100 + 40 * j:140 + 40 * j, 120 + 40 * i:160 + 40 * i] = 25
+    _write_pgm(tmp_path / "bench.pgm", board)
+    bench = (tmp_path / "bench.pgm", tmp_path / "bench.pgm")
+    table = softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                                   max_frames=6, frame_offset=0, bench_board=bench,
+                                   chessboard="9x6", square_mm=20.0, reference_plane="board")
+    out_of_plane = table["out_of_plane_deg"]
+    defined = ~np.isnan(out_of_plane)
+    assert defined.sum() >= 3
+    np.testing.assert_allclose(out_of_plane[defined], 0.0, atol=0.05)
+    with pytest.raises(softsight.InputError,
+                       match="reference_plane board: the bench board's plane; give bench_board"):
+        softsight.track_stereo("synth:bending", "synth:bending", markers_yaml, stereo_yaml,
+                               reference_plane="board")
+
+
+def _write_ppm(path: Path, bgr: np.ndarray) -> None:
+    rgb = np.ascontiguousarray(bgr[:, :, ::-1])
+    with open(path, "wb") as f:
+        f.write(b"P6\n%d %d\n255\n" % (rgb.shape[1], rgb.shape[0]) + rgb.tobytes())
+
+
+def _jerky_walk(count: int, seed: int = 3) -> list:
+    """Scene frames of the bending scene visited at speeds that change every 2-7 frames: a bend
+    that starts, stops and reverses (what the offset is found from)."""
+    rng = np.random.default_rng(seed)
+    frame, speed, left, walk = 60, 0, 0, []
+    for _ in range(count):
+        if left <= 0:
+            speed = int(rng.choice([0, 0, 3, 6, 9, -4, -8]))
+            left = int(rng.integers(2, 8))
+        left -= 1
+        frame = int(np.clip(frame + speed, 0, 299))
+        walk.append(frame)
+    return walk
+
+
+def _two_videos(tmp_path: Path, walk: list, offset: int, count: int) -> tuple:
+    """Two folders of the bending scene along `walk`: right frame i shows moment i, left frame i
+    shows moment i + offset (the right camera started `offset` frames earlier)."""
+    scene = softsight.sim.Scene("bending", frames=300)
+    rendered: dict = {}
+    folders = (tmp_path / "left", tmp_path / "right")
+    for folder in folders:
+        folder.mkdir()
+    for i in range(count):
+        for folder, moment in ((folders[0], i + offset), (folders[1], i)):
+            frame = walk[moment]
+            if frame not in rendered:
+                rendered[frame] = scene.render(frame)[0]
+            _write_ppm(folder / f"{i:03d}.ppm", rendered[frame])
+    return folders
+
+
+def test_without_frame_offset_the_offset_is_found_like_the_cli(markers_yaml, stereo_yaml,
+                                                              tmp_path):
+    left, right = _two_videos(tmp_path, _jerky_walk(41), 5, 36)
+    table = softsight.track_stereo(left, right, markers_yaml, stereo_yaml)
+    summary = table.summary
+    assert summary["frame_offset"] == 5
+    assert summary["frame_offset_method"] == "motion"
+    assert summary["frame_offset_correlation"] > 0.99
+    assert summary["frame_offset_next_correlation"] is None or (
+        summary["frame_offset_next_correlation"] < summary["frame_offset_correlation"] - 0.15)
+    assert summary["pairs"] == 31
+    np.testing.assert_array_equal(table["right_frame"], table["frame"] + 5)
+    for name in ("red", "blue", "green"):
+        assert list(table[f"{name}_status"]) == ["found"] * 31
+        np.testing.assert_allclose(table[f"{name}_Z"], 300.0, atol=1e-3)
+    # The program says the same line; the offset given by hand gives the same columns.
+    result = run_cli("track-stereo", "-c", str(markers_yaml), "--left", str(left), "--right",
+                     str(right), "--stereo", str(stereo_yaml), "--csv", str(tmp_path / "a.csv"))
+    assert summary["frame_offset_report"] in result.stdout
+    given = softsight.track_stereo(left, right, markers_yaml, stereo_yaml, frame_offset=5)
+    assert given.summary["frame_offset"] == 5
+    assert given.summary["frame_offset_method"] == "given"
+    assert given.summary["frame_offset_correlation"] is None
+    assert given.summary["frame_offset_report"] is None
+    for column in table:
+        if column != "proc_ms":
+            np.testing.assert_array_equal(table[column], given[column])
+
+
+def test_a_repeating_motion_is_refused_with_the_clis_message(markers_yaml, stereo_yaml,
+                                                            tmp_path):
+    # A swing with a period of 8 frames: offsets 8 frames apart fit alike.
+    walk = [int(round(150 + 60 * np.sin(2 * np.pi * t / 8))) for t in range(39)]
+    left, right = _two_videos(tmp_path, walk, 3, 36)
+    with pytest.raises(softsight.InputError) as error:
+        softsight.track_stereo(left, right, markers_yaml, stereo_yaml)
+    message = str(error.value)
+    assert message.startswith("cannot find the frame offset between left and right within +-60 "
+                              "frames: two offsets fit the motion alike")
+    assert message.endswith("; pass frame_offset=N")
+    cli = cli_error("track-stereo", "-c", str(markers_yaml), "--left", str(left), "--right",
+                    str(right), "--stereo", str(stereo_yaml), "--csv", str(tmp_path / "r.csv"))
+    assert cli == (message.replace("between left and right", "between --left and --right")
+                   .replace("frame_offset=N", "--frame-offset N"))
+    assert not (tmp_path / "r.csv").exists()
+    # Given, the same videos track; a bad range names the argument.
+    assert softsight.track_stereo(left, right, markers_yaml, stereo_yaml,
+                                  frame_offset=3).summary["pairs"] == 33
+    with pytest.raises(softsight.InputError, match="max_offset_frames: must be in"):
+        softsight.track_stereo(left, right, markers_yaml, stereo_yaml, max_offset_frames=-1)

@@ -10,6 +10,7 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/publish_options.h"
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
@@ -21,6 +22,7 @@
 #include "softsight/io/run_source.h"
 #include "softsight/io/stereo_input.h"
 #include "softsight/pipeline/stereo_session.h"
+#include "softsight/pipeline/summary.h"
 #include "softsight/track/colour_tracker.h"
 #include "track/tracker_kind.h"
 
@@ -60,6 +62,12 @@ void CheckOptions(const TrackStereoOptions& options) {
   if (options.max_frames && *options.max_frames < 0) {
     throw InputError("--max-frames " + std::to_string(*options.max_frames) + ": must be 0 or more");
   }
+  if (ParseReferencePlane(options.reference_plane, "--reference-plane") ==
+          StereoOptions::ReferencePlane::kBoard &&
+      options.bench_board.empty()) {
+    throw InputError("--reference-plane board: the bench board's plane; give --bench-board LEFT "
+                     "RIGHT (one pair of images of the board lying on the bench)");
+  }
 }
 
 FrameSourceSpec SpecOf(const std::string& input, double fps) {
@@ -76,8 +84,9 @@ std::unique_ptr<FrameSource> Open(const FrameSourceSpec& spec) {
 
 // Finds the frame offset from a flash or the motion (io/frame_offset.h), reports it, or refuses
 // in one line.
-int64_t FindFrameOffset(const TrackStereoOptions& options, const FrameSourceSpec& left_spec,
-                        const FrameSourceSpec& right_spec, std::ostream& report) {
+int64_t FindAndReportFrameOffset(const TrackStereoOptions& options,
+                                 const FrameSourceSpec& left_spec,
+                                 const FrameSourceSpec& right_spec, std::ostream& report) {
   FrameOffsetOptions offset_options;
   offset_options.max_offset_frames = options.max_offset_frames;
   std::string error;
@@ -85,36 +94,10 @@ int64_t FindFrameOffset(const TrackStereoOptions& options, const FrameSourceSpec
   // The frames the run can use, and the offset's worth beyond them.
   std::optional<int64_t> frames;
   if (options.max_frames) frames = *options.max_frames + options.max_offset_frames;
-  const SyncSignal left = MeasureSyncSignal(*OpenFrameSource(left_spec), frames);
-  const SyncSignal right = MeasureSyncSignal(*OpenFrameSource(right_spec), frames);
-  const FrameOffsetEstimate estimate = EstimateFrameOffset(left, right, offset_options);
-  if (!estimate.offset_frames) {
-    throw InputError("cannot find the frame offset between --left and --right within +-" +
-                     std::to_string(options.max_offset_frames) + " frames: " + estimate.refusal +
-                     "; pass --frame-offset N");
-  }
-  const int64_t offset = *estimate.offset_frames;
-  report << "frame offset " << offset << " (right frame = left frame "
-         << (offset >= 0 ? "+ " : "- ") << std::abs(offset) << "), found from ";
-  report << std::fixed << std::setprecision(3);
-  if (estimate.method == FrameOffsetEstimate::Method::kFlash) {
-    report << "a flash: left frame " << *estimate.left_flash_frame << ", right frame "
-           << *estimate.right_flash_frame << " (brightness steps " << std::setprecision(1)
-           << estimate.left_flash_step << " and " << estimate.right_flash_step
-           << " grey levels)\n";
-  } else {
-    report << "the motion: correlation " << *estimate.peak_correlation;
-    if (estimate.second_correlation) {
-      report << ", next best peak " << *estimate.second_correlation << " at offset "
-             << *estimate.second_offset;
-    } else {
-      report << ", no other peak";
-    }
-    report << " (searched +-" << options.max_offset_frames << ")\n";
-  }
-  report.unsetf(std::ios::floatfield);
-  report << std::setprecision(6);
-  return offset;
+  const FrameOffsetEstimate estimate = FindFrameOffset(
+      *OpenFrameSource(left_spec), *OpenFrameSource(right_spec), offset_options, frames);
+  report << DescribeFrameOffset(estimate, offset_options) << "\n";
+  return *estimate.offset_frames;
 }
 
 // The pairs the options ask for, the offset found when it is needed.
@@ -169,7 +152,7 @@ std::unique_ptr<StereoInput> OpenStereoInput(const TrackStereoOptions& options,
   }
   const int64_t offset = options.frame_offset
                              ? *options.frame_offset
-                             : FindFrameOffset(options, left_spec, right_spec, report);
+                             : FindAndReportFrameOffset(options, left_spec, right_spec, report);
   summary.frame_offset = offset;
   return PairByIndex(Open(left_spec), Open(right_spec), offset,
                      "--frame-offset");
@@ -251,10 +234,11 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   stereo_options.triangulation.max_epipolar_px = options.max_epipolar_px;
   stereo_options.reference_plane =
       ParseReferencePlane(options.reference_plane, "--reference-plane");
-  std::string error;
-  if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
   if (!options.bench_board.empty()) {
     if (!bench) bench = FindBenchBoard(options, stereo, stereo_options.triangulation);
+    // Its Z axis in the first camera's frame (kBoard's reference; unused otherwise).
+    stereo_options.board_normal =
+        cv::Vec3d(bench->rotation(0, 2), bench->rotation(1, 2), bench->rotation(2, 2));
     const cv::Vec3d o = bench->origin_mm;
     report << std::fixed << std::setprecision(1) << "bench board " << options.bench_board[0]
            << " / " << options.bench_board[1] << ": " << bench->corners
@@ -264,6 +248,8 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     report.unsetf(std::ios::floatfield);
     report << std::setprecision(6);
   }
+  std::string error;
+  if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
 
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
@@ -272,7 +258,14 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   inputs.push_back({"--stereo", options.stereo_file});
   for (const std::string& file : input.files()) inputs.push_back({"an input", file});
   for (const std::string& file : options.bench_board) inputs.push_back({"--bench-board", file});
-  CheckOutputsAreNotInputs({{"--csv", options.csv_file}}, inputs);
+  std::vector<PathRole> outputs = {{"--csv", options.csv_file}};
+  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) {
+    outputs.push_back(*socket);
+  }
+  CheckOutputsAreNotInputs(outputs, inputs);
+  // Bound now: a bad endpoint is refused before any output is made.
+  const std::unique_ptr<PublishSink> publish =
+      OpenPublishSink(options.publish, options.config_file);
 
   // Markers move in depth before two cameras: seen smaller than learned, a colour marker with the
   // rim fit is taken as partly hidden and placed by a circle of its old size (up to 1 px off,
@@ -291,8 +284,19 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
 
-  BasicCsvWriter<StereoFrameResult> csv(options.csv_file,
-                                        StereoColumns(names, session.segment_names()));
+  const BasicCsvColumnTable<StereoFrameResult> columns =
+      StereoColumns(names, session.segment_names());
+  BasicCsvWriter<StereoFrameResult> csv(options.csv_file, columns);
+  std::string published_row;
+  if (publish) {
+    publish->set_row_columns(columns.names(),
+                             {"_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status"});
+    RunInfo info;
+    info.source = input.description();
+    info.live = options.left_camera.has_value();
+    info.marker_names = names;
+    publish->begin(info);
+  }
   TrackStereoSummary summary;
   summary.found.assign(names.size(), {"", 0});
   summary.epipolar.assign(names.size(), {"", 0});
@@ -303,29 +307,55 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   FramePair pair;
   StereoFrameResult in_board;
   bool by_time = false;
-  while (!options.max_frames || summary.pairs < *options.max_frames) {
-    if (!input.read(pair)) break;
-    const StereoFrameResult& result = session.process(pair);
-    if (bench) {
-      in_board = result;
-      ExpressInBoardFrame(*bench, in_board);
-    }
-    csv.write(bench ? in_board : result);
-    ++summary.pairs;
-    if (result.pair_dt_ms) {
-      by_time = true;
-      summary.max_abs_pair_dt_ms =
-          std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
-    }
-    for (size_t i = 0; i < result.markers.size(); ++i) {
-      const StereoPoint& p = result.markers[i].point;
-      if (p.found()) {
-        ++summary.found[i].second;
-        sigmas.push_back(*p.sigma_mm);
+  RunSummary run;  // For the stream's end record and its note.
+  run.source = input.description();
+  try {
+    while (!options.max_frames || summary.pairs < *options.max_frames) {
+      if (!input.read(pair)) break;
+      const StereoFrameResult& result = session.process(pair);
+      if (bench) {
+        in_board = result;
+        ExpressInBoardFrame(*bench, in_board);
       }
-      if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
-      if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
+      csv.write(bench ? in_board : result);
+      if (publish) {
+        columns.append_row(bench ? in_board : result, published_row);
+        publish->publish_row(published_row);
+      }
+      ++summary.pairs;
+      if (result.pair_dt_ms) {
+        by_time = true;
+        summary.max_abs_pair_dt_ms =
+            std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
+      }
+      for (size_t i = 0; i < result.markers.size(); ++i) {
+        const StereoPoint& p = result.markers[i].point;
+        if (p.found()) {
+          ++summary.found[i].second;
+          sigmas.push_back(*p.sigma_mm);
+        }
+        if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
+        if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
+      }
     }
+  } catch (const InputError& e) {
+    // The subscribers learn that the run ended, and why; the error itself is reported once,
+    // where it is handled.
+    if (publish) {
+      run.frames = summary.pairs;
+      run.stop_reason = StopReason::kError;
+      run.error = e.what();
+      publish->end(run);
+    }
+    throw;
+  }
+  if (publish) {
+    run.frames = summary.pairs;
+    run.stop_reason = options.max_frames && summary.pairs >= *options.max_frames
+                          ? StopReason::kMaxFrames
+                          : StopReason::kEndOfInput;
+    publish->end(run);
+    publish->report(run);
   }
   summary.median_sigma_mm = Median(sigmas);
   summary.median_epipolar_px = Median(epipolar_distances);
@@ -372,7 +402,11 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   } else {
     report << ": <m>_X/_Y/_Z in the first camera's frame";
   }
+  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
+    report << "; out_of_plane_deg against the bench board's plane";
+  }
   report << "\n";
+  for (const std::string& note : run.notes) report << "note: " << note << "\n";
   report.unsetf(std::ios::floatfield);
   return summary;
 }
@@ -443,8 +477,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->capture_default_str()
       ->check(NumberIn(1e-3, 1e3));
   sub.add_option("--reference-plane", options->reference_plane,
-                 "The out-of-plane angle against: image (the first camera's image plane) or first "
-                 "(the first frame's bending plane)")
+                 "The out-of-plane angle against: image (the first camera's image plane), first "
+                 "(the first frame's bending plane) or board (the --bench-board's plane: the "
+                 "bench)")
       ->capture_default_str();
   sub.add_option("--bench-board", options->bench_board,
                  "LEFT RIGHT: one pair of images of the chessboard lying on the bench; the 3D "
@@ -464,7 +499,10 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->check(NumberIn(1e-3, 1e6));
   sub.add_option("--max-frames", options->max_frames, "Stop after this many pairs")
       ->check(NumberIn(0, 1e15));
-  return [options] {
+  auto publish = std::make_shared<PublishArgs>();
+  AddPublishOptions(sub, publish.get());
+  return [options, publish] {
+    options->publish = publish->resolved();
     RunTrackStereo(*options, std::cout);
     return 0;
   };

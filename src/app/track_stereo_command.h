@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "stream/publish_sink.h"
+
 namespace softsight {
 
 class StereoInput;
@@ -37,7 +39,8 @@ struct TrackStereoOptions {
   // Pairing by time: the right view's clock minus the left one's (ms).
   double time_offset_ms = 0.0;
   double max_epipolar_px = 2.0;           // See TriangulationOptions.
-  std::string reference_plane = "image";  // "image" or "first" (StereoOptions).
+  // "image", "first" or "board" (StereoOptions; board needs bench_board).
+  std::string reference_plane = "image";
   std::optional<int64_t> max_frames;
   double sequence_fps = 30.0;  // Image sequences' frame rate.
   std::optional<double> right_sequence_fps;  // The right image sequence's, when it differs.
@@ -48,6 +51,9 @@ struct TrackStereoOptions {
   std::vector<std::string> bench_board;
   std::string chessboard;
   std::optional<double> square_mm;
+  // --publish: every pair's row (the CSV's columns) to subscribers as it happens
+  // (stream/publish_sink.h; topics frame, measure, marker/<name> with <name>_X ... _status).
+  std::optional<PublishOptions> publish;
 };
 
 struct TrackStereoSummary {

@@ -5,12 +5,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include <sys/wait.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -20,9 +22,11 @@
 #include "calib/stereo_test_util.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/geometry/shape3d.h"
 #include "softsight/io/csv_reader.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/stereo_scene.h"
+#include "stream/subscriber.h"
 
 namespace softsight {
 namespace {
@@ -79,6 +83,28 @@ class TrackStereoCommandTest : public ::testing::Test {
     options.csv_file = dir_->file("run3d.csv");
     options.frame_offset = kRightLead;
     return options;
+  }
+  // Renders the 9x6 board of 20 mm at `pose` (the left camera's) into `<name>_left.png` and
+  // `<name>_right.png`; returns the two files.
+  static std::vector<std::string> WriteBenchBoard(const std::string& name, const BoardPose& pose) {
+    ChessboardLook look;
+    look.supersample = 2;
+    cv::Mat left, right;
+    ChessboardRenderer(scene_->rig().left, BenchPattern(), look).render(pose, left);
+    ChessboardRenderer(scene_->rig().right, BenchPattern(), look)
+        .render(RightBoardPose(scene_->rig(), pose), right);
+    const std::vector<std::string> files = {dir_->file(name + "_left.png"),
+                                            dir_->file(name + "_right.png")};
+    cv::imwrite(files[0], left);
+    cv::imwrite(files[1], right);
+    return files;
+  }
+  static ChessboardPattern BenchPattern() {
+    ChessboardPattern pattern;
+    pattern.inner_corners = cv::Size(9, 6);
+    pattern.square_mm = 20.0;
+    pattern.margin_mm = 15.0;
+    return pattern;
   }
   static testing::TempDir* dir_;
   static StereoScene* scene_;
@@ -198,19 +224,8 @@ TEST_F(TrackStereoCommandTest, MarkersSwappedInOneViewAreRefusedByTheEpipolarChe
 // carried into the board's frame the same way, and the frame-independent measurements must not
 // change at all.
 TEST_F(TrackStereoCommandTest, InTheBenchBoardsFrameMarkersMatchTheTruthAndTheShapeIsUnchanged) {
-  ChessboardPattern pattern;
-  pattern.inner_corners = cv::Size(9, 6);
-  pattern.square_mm = 20.0;
-  pattern.margin_mm = 15.0;
-  const BoardPose pose = LookAtBoard(pattern, 320, 40, 0, 10, 0, 10);
-  ChessboardLook look;
-  look.supersample = 2;
-  cv::Mat left, right;
-  ChessboardRenderer(scene_->rig().left, pattern, look).render(pose, left);
-  ChessboardRenderer(scene_->rig().right, pattern, look)
-      .render(RightBoardPose(scene_->rig(), pose), right);
-  cv::imwrite(dir_->file("bench_left.png"), left);
-  cv::imwrite(dir_->file("bench_right.png"), right);
+  const BoardPose pose = LookAtBoard(BenchPattern(), 320, 40, 0, 10, 0, 10);
+  WriteBenchBoard("bench", pose);
   cv::Matx33d board_rotation;
   cv::Rodrigues(pose.rvec, board_rotation);
   const auto true_in_board = [&](const cv::Point3d& p) {
@@ -290,6 +305,159 @@ TEST_F(TrackStereoCommandTest, InTheBenchBoardsFrameMarkersMatchTheTruthAndTheSh
                                     "squares to"));
     EXPECT_THAT(e.what(), HasSubstr("(limit 2.00)"));
     std::cout << "[ refusal  ] " << e.what() << "\n";
+  }
+  EXPECT_FALSE(fs::exists(options.csv_file));
+}
+
+// `--reference-plane board`: the out-of-plane angle against the bench board's plane. The bend
+// leans 30 degrees out of the image plane; each board is posed at another angle to it, and the
+// renderer's bending-plane normal and board pose give the true angle between the two planes.
+TEST_F(TrackStereoCommandTest, AgainstTheBenchBoardsPlaneTheOutOfPlaneAngleIsTheTrueOne) {
+  struct Board {
+    std::string name;
+    BoardPose pose;
+  };
+  const std::vector<Board> boards = {
+      {"tilted_x", LookAtBoard(BenchPattern(), 320, 40, 0, 10, 0, 10)},   // 52.6 deg to the bend.
+      {"tilted_y", LookAtBoard(BenchPattern(), 310, 0, -35, -5, 0, 0)},   // 5.7 deg.
+      {"steep", LookAtBoard(BenchPattern(), 300, -45, 40, 20, 0, 10)}};  // 74.9 deg.
+  // The bending plane from three markers is good to 0.4 deg (the test above: its normal), the
+  // board's to 0.03 deg (calib/board_frame_test.cc): the tolerance is the bend's.
+  double worst_deg = 0, error_sq = 0;
+  int angles = 0;
+  for (const Board& board : boards) {
+    TrackStereoOptions options = Options();
+    options.csv_file = dir_->file("board_plane_" + board.name + ".csv");
+    options.bench_board = WriteBenchBoard(board.name, board.pose);
+    options.chessboard = "9x6";
+    options.square_mm = 20.0;
+    options.reference_plane = "board";
+    std::ostringstream report;
+    RunTrackStereo(options, report);
+    EXPECT_THAT(report.str(), HasSubstr("out_of_plane_deg against the bench board's plane"));
+    cv::Matx33d board_rotation;
+    cv::Rodrigues(board.pose.rvec, board_rotation);
+    const cv::Vec3d board_normal(board_rotation(0, 2), board_rotation(1, 2), board_rotation(2, 2));
+    const CsvTable table = ReadCsvTable(options.csv_file);
+    const std::vector<std::optional<double>>& measured =
+        table.values[*table.find("out_of_plane_deg")];
+    ASSERT_EQ(measured.size(), static_cast<size_t>(kFrames));
+    double truth_deg = 0;
+    for (size_t r = 6; r < measured.size(); ++r) {  // The bending plane is well defined.
+      truth_deg = *AngleBetweenPlanesDeg(truths_[r].plane_normal, board_normal);
+      ASSERT_TRUE(measured[r].has_value()) << board.name << ", frame " << r;
+      EXPECT_NEAR(*measured[r], truth_deg, 0.5) << board.name << ", frame " << r;
+      worst_deg = std::max(worst_deg, std::abs(*measured[r] - truth_deg));
+      error_sq += std::pow(*measured[r] - truth_deg, 2);
+      ++angles;
+    }
+    std::cout << "[ figures  ] --reference-plane board (" << board.name << "): true angle "
+              << truth_deg << " deg, measured " << *measured.back() << " deg\n";
+  }
+  std::cout << "[ figures  ] --reference-plane board: error " << std::sqrt(error_sq / angles)
+            << " deg RMS, worst " << worst_deg << " deg\n";
+
+  // Without a bench board there is no board's plane: one line, exit code 2, nothing written.
+  TrackStereoOptions options = Options();
+  options.reference_plane = "board";
+  options.csv_file = dir_->file("no_bench.csv");
+  std::ostringstream report;
+  try {
+    RunTrackStereo(options, report);
+    ADD_FAILURE() << "--reference-plane board without --bench-board was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--reference-plane board: the bench board's plane; give "
+                                    "--bench-board LEFT RIGHT"));
+  }
+  const std::string cli = testing::SoftsightBinary() + " track-stereo -c " + options.config_file +
+                          " --left " + options.left_input + " --right " + options.right_input +
+                          " --stereo " + options.stereo_file + " --csv " + options.csv_file +
+                          " --reference-plane board 2> " + dir_->file("board_err.txt");
+  EXPECT_EQ(WEXITSTATUS(std::system(cli.c_str())), 2);
+  const std::string err = testing::ReadTextFile(dir_->file("board_err.txt"));
+  EXPECT_THAT(err, HasSubstr("--reference-plane board: the bench board's plane"));
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(options.csv_file));
+}
+
+// `--publish`: while track-stereo runs, a subscriber gets every pair's row with the CSV's
+// columns and values (topic frame), a marker's 3D columns (marker/<name>) and the run's end.
+TEST_F(TrackStereoCommandTest, PublishSendsEveryRowWithTheCsvsColumnsAsItHappens) {
+  TrackStereoOptions options = Options();
+  options.csv_file = dir_->file("published.csv");
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir_->file("stereo.ipc");
+  publish.wait_subscribers = 1;  // Connected before the first pair: it gets every one.
+  options.publish = publish;
+  StreamSubscriber records(publish.endpoint, {"hello", "frame", "marker/green", "end"}, "test");
+  std::ostringstream report;
+  auto run = std::async(std::launch::async, [&] { return RunTrackStereo(options, report); });
+  std::optional<nlohmann::ordered_json> hello, end;
+  std::vector<nlohmann::ordered_json> frames, green;
+  for (int waits = 0; !end && waits < 600;) {
+    const std::optional<StreamMessage> message = records.receive(100);
+    if (!message) {
+      ++waits;  // At most a minute of silence in all.
+      continue;
+    }
+    const nlohmann::ordered_json body = nlohmann::ordered_json::parse(message->body);
+    if (message->topic == "hello") hello = body;
+    if (message->topic == "frame") frames.push_back(body);
+    if (message->topic == "marker/green") green.push_back(body);
+    if (message->topic == "end") end = body;
+  }
+  const TrackStereoSummary summary = run.get();
+  ASSERT_TRUE(end.has_value()) << "no end record";
+  ASSERT_TRUE(hello.has_value());
+  EXPECT_EQ((*end)["frames"], kFrames);
+  EXPECT_EQ((*end)["stop_reason"], "end of input");
+  EXPECT_THAT(report.str(), HasSubstr("note: --publish " + publish.endpoint));
+  EXPECT_THAT(report.str(), HasSubstr("none dropped"));
+
+  std::ifstream csv(options.csv_file);
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = testing::SplitCsv(line);
+  EXPECT_EQ((*hello)["columns"].get<std::vector<std::string>>(), header);
+  EXPECT_EQ((*hello)["markers"].get<std::vector<std::string>>(),
+            (std::vector<std::string>{"red", "blue", "green"}));
+  ASSERT_EQ(frames.size(), static_cast<size_t>(summary.pairs));
+  ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames));
+  for (size_t r = 0; r < frames.size(); ++r) {
+    ASSERT_TRUE(static_cast<bool>(std::getline(csv, line)));
+    const std::vector<std::string> fields = testing::SplitCsv(line);
+    std::vector<std::string> keys;
+    for (const auto& item : frames[r].items()) keys.push_back(item.key());
+    ASSERT_EQ(keys, header) << "record " << r;
+    for (size_t c = 0; c < header.size(); ++c) {
+      const nlohmann::ordered_json& value = frames[r][header[c]];
+      if (fields[c].empty()) {
+        EXPECT_TRUE(value.is_null()) << header[c] << ", record " << r;
+      } else if (value.is_string()) {
+        EXPECT_EQ(value.get<std::string>(), fields[c]) << header[c] << ", record " << r;
+      } else {
+        EXPECT_EQ(value.get<double>(), std::stod(fields[c])) << header[c] << ", record " << r;
+      }
+    }
+  }
+  ASSERT_EQ(green.size(), frames.size());
+  std::vector<std::string> green_keys;
+  for (const auto& item : green[0].items()) green_keys.push_back(item.key());
+  EXPECT_EQ(green_keys, (std::vector<std::string>{"frame", "time_s", "green_X", "green_Y",
+                                                  "green_Z", "green_sigma_mm",
+                                                  "green_epipolar_px", "green_status"}));
+  EXPECT_EQ(green.back()["green_Z"], frames.back()["green_Z"]);
+
+  // A bad endpoint: one line naming it, before any output is made.
+  options.csv_file = dir_->file("not_published.csv");
+  options.publish->endpoint = "tcp://nowhere";
+  options.publish->wait_subscribers = 0;
+  try {
+    RunTrackStereo(options, report);
+    ADD_FAILURE() << "a bad endpoint was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--publish"));
+    EXPECT_THAT(e.what(), HasSubstr("tcp://nowhere"));
   }
   EXPECT_FALSE(fs::exists(options.csv_file));
 }

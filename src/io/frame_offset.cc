@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "softsight/core/error.h"
 #include "softsight/core/types.h"
 #include "softsight/io/frame_source.h"
 
@@ -195,6 +196,57 @@ FrameOffsetEstimate EstimateFrameOffset(const SyncSignal& left, const SyncSignal
   }
   estimate.offset_frames = estimate.peak_offset;
   return estimate;
+}
+
+FrameOffsetEstimate FindFrameOffset(FrameSource& left, FrameSource& right,
+                                    const FrameOffsetOptions& options,
+                                    std::optional<int64_t> max_frames,
+                                    const FrameOffsetNames& names) {
+  const std::string range = "within +-" + std::to_string(options.max_offset_frames) + " frames";
+  std::string error;
+  if (!options.Check(&error)) {
+    throw InputError("cannot find the frame offset between " + names.inputs + ": " + error);
+  }
+  const SyncSignal left_signal = MeasureSyncSignal(left, max_frames);
+  const SyncSignal right_signal = MeasureSyncSignal(right, max_frames);
+  FrameOffsetEstimate estimate = EstimateFrameOffset(left_signal, right_signal, options);
+  if (!estimate.offset_frames) {
+    throw InputError("cannot find the frame offset between " + names.inputs + " " + range +
+                     ": " + estimate.refusal + "; pass " + names.option);
+  }
+  return estimate;
+}
+
+std::string DescribeFrameOffset(const FrameOffsetEstimate& estimate,
+                                const FrameOffsetOptions& options) {
+  const int64_t offset = estimate.offset_frames.value_or(0);
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "frame offset %lld (right frame = left frame %c %lld), found from ",
+                static_cast<long long>(offset), offset >= 0 ? '+' : '-',
+                static_cast<long long>(std::abs(offset)));
+  std::string line = text;
+  if (estimate.method == FrameOffsetEstimate::Method::kFlash) {
+    std::snprintf(text, sizeof(text),
+                  "a flash: left frame %lld, right frame %lld (brightness steps %.1f and %.1f "
+                  "grey levels)",
+                  static_cast<long long>(estimate.left_flash_frame.value_or(-1)),
+                  static_cast<long long>(estimate.right_flash_frame.value_or(-1)),
+                  estimate.left_flash_step, estimate.right_flash_step);
+    return line + text;
+  }
+  std::snprintf(text, sizeof(text), "the motion: correlation %.3f",
+                estimate.peak_correlation.value_or(0.0));
+  line += text;
+  if (estimate.second_correlation) {
+    std::snprintf(text, sizeof(text), ", next best peak %.3f at offset %lld",
+                  *estimate.second_correlation,
+                  static_cast<long long>(estimate.second_offset.value_or(0)));
+    line += text;
+  } else {
+    line += ", no other peak";
+  }
+  return line + " (searched +-" + std::to_string(options.max_offset_frames) + ")";
 }
 
 }  // namespace softsight

@@ -29,15 +29,29 @@ const Observation* FindObservation(const FrameResult& result, const std::string&
 
 }  // namespace
 
-bool StereoOptions::Check(std::string* error) const { return triangulation.Check(error); }
+bool StereoOptions::Check(std::string* error) const {
+  if (reference_plane == ReferencePlane::kBoard) {
+    if (!board_normal) {
+      *error = "reference_plane: board needs board_normal (a bench board's plane)";
+      return false;
+    }
+    const double length = cv::norm(*board_normal);
+    if (!(std::isfinite(length) && length > 0.0)) {
+      *error = "board_normal: must be a finite, non-zero vector";
+      return false;
+    }
+  }
+  return triangulation.Check(error);
+}
 
 StereoOptions::ReferencePlane ParseReferencePlane(const std::string& text,
                                                   const std::string& what) {
   if (text == "image") return StereoOptions::ReferencePlane::kImage;
   if (text == "first") return StereoOptions::ReferencePlane::kFirstFrame;
+  if (text == "board") return StereoOptions::ReferencePlane::kBoard;
   throw InputError(what +
-                   ": expected image (the first camera's image plane) or first (the "
-                   "first frame's bending plane), got '" +
+                   ": expected image (the first camera's image plane), first (the first "
+                   "frame's bending plane) or board (the bench board's plane), got '" +
                    text + "'");
 }
 
@@ -91,6 +105,8 @@ StereoSession::StereoSession(const TrackingConfig& left, const TrackingConfig& r
   impl_ = std::make_unique<Impl>(left, right, stereo, options);
   if (options.reference_plane == StereoOptions::ReferencePlane::kImage) {
     impl_->reference_normal = cv::Vec3d(0, 0, 1);
+  } else if (options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
+    impl_->reference_normal = cv::normalize(*options.board_normal);
   }
 }
 

@@ -78,7 +78,7 @@ std::string PublishSink::hello() const {
       info_.frame_count ? nlohmann::ordered_json(*info_.frame_count) : nlohmann::ordered_json();
   hello["live"] = info_.live;
   hello["markers"] = info_.marker_names;
-  hello["columns"] = columns_.names();
+  hello["columns"] = row_names_.empty() ? columns_.names() : row_names_;
   nlohmann::ordered_json topics = nlohmann::ordered_json::array();
   topics.push_back(kHelloTopic);
   for (const TopicColumns& topic : topics_) topics.push_back(topic.topic);
@@ -130,7 +130,9 @@ void PublishSink::send(const std::string& message) {
 
 void PublishSink::begin(const RunInfo& info) {
   info_ = info;
-  topics_ = StreamTopics(columns_, info.marker_names);
+  topics_ = row_names_.empty()
+                ? StreamTopics(columns_, info.marker_names)
+                : StreamTopics(row_names_, info.marker_names, row_marker_suffixes_);
   topic_wanted_.assign(topics_.size(), 0);
   if (info.frame_count) {
     send_latency_ms_.reserve(static_cast<size_t>(std::clamp<int64_t>(*info.frame_count, 0, int64_t{1} << 22)));
@@ -170,6 +172,30 @@ void PublishSink::consume(const Frame& frame, const FrameResult& result) {
                                      std::chrono::steady_clock::now() - result.captured)
                                      .count());
     }
+  }
+}
+
+void PublishSink::set_row_columns(std::vector<std::string> names,
+                                  std::vector<std::string> marker_suffixes) {
+  row_names_ = std::move(names);
+  row_marker_suffixes_ = std::move(marker_suffixes);
+}
+
+void PublishSink::publish_row(std::string_view csv_row) {
+  read_subscriptions();
+  row_fields_.clear();
+  for (size_t start = 0;;) {
+    const size_t comma = csv_row.find(',', start);
+    row_fields_.push_back(csv_row.substr(start, comma == std::string_view::npos
+                                                    ? std::string_view::npos
+                                                    : comma - start));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  for (size_t i = 0; i < topics_.size(); ++i) {
+    if (!topic_wanted_[i]) continue;
+    FormatRecord(topics_[i], row_names_, row_fields_, message_);
+    send(message_);
   }
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "softsight/io/csv_columns.h"
@@ -65,6 +66,13 @@ class PublishSink : public FrameSink {
   // The columns of every record: the CSV's table (by value; the same closures write both).
   // Before begin().
   void set_columns(CsvColumnTable columns) { columns_ = std::move(columns); }
+  // Instead, rows of another table (track-stereo's StereoColumns), published by publish_row():
+  // its column names, and the suffixes of a marker's columns (its marker/<name> topic). Before
+  // begin().
+  void set_row_columns(std::vector<std::string> names, std::vector<std::string> marker_suffixes);
+  // One row of that table as its CSV text (fields separated by commas; no field holds one):
+  // the records of the topics someone subscribed to. Between begin() and end().
+  void publish_row(std::string_view csv_row);
 
   // Learns the markers (the topics), then waits for PublishOptions::wait_subscribers.
   void begin(const RunInfo& info) override;
@@ -92,6 +100,10 @@ class PublishSink : public FrameSink {
   PublishOptions options_;
   CsvColumnTable columns_;
   RecordFormatter formatter_;
+  // set_row_columns(): the table's names (empty: `columns_` is the table) and marker suffixes;
+  // publish_row()'s fields, reused.
+  std::vector<std::string> row_names_, row_marker_suffixes_;
+  std::vector<std::string_view> row_fields_;
   std::unique_ptr<zmq::context_t> context_;
   std::unique_ptr<zmq::socket_t> socket_;
   std::string bound_endpoint_;

@@ -1,7 +1,9 @@
 #include "stream/stream_format.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 
 namespace softsight {
 namespace {
@@ -37,14 +39,23 @@ bool IsJsonNumber(std::string_view s) {
 
 std::vector<TopicColumns> StreamTopics(const CsvColumnTable& table,
                                        const std::vector<std::string>& marker_names) {
-  const std::vector<std::string> names = table.names();
+  return StreamTopics(table.names(), marker_names, {"_x", "_y", "_found", "_score", "_status"});
+}
+
+std::vector<TopicColumns> StreamTopics(const std::vector<std::string>& names,
+                                       const std::vector<std::string>& marker_names,
+                                       const std::vector<std::string>& marker_suffixes) {
+  const auto find = [&names](const std::string& name) -> std::optional<size_t> {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) return std::nullopt;
+    return static_cast<size_t>(it - names.begin());
+  };
   std::vector<bool> of_a_marker(names.size(), false);
   std::vector<TopicColumns> markers;
-  static constexpr std::string_view kMarkerSuffixes[] = {"_x", "_y", "_found", "_score", "_status"};
   for (const std::string& marker : marker_names) {
     TopicColumns topic{kMarkerTopicPrefix + marker, {}};
-    for (std::string_view suffix : kMarkerSuffixes) {
-      if (const auto at = table.find(marker + std::string(suffix))) {
+    for (const std::string& suffix : marker_suffixes) {
+      if (const auto at = find(marker + suffix)) {
         topic.columns.push_back(*at);
         of_a_marker[*at] = true;
       }
@@ -54,7 +65,7 @@ std::vector<TopicColumns> StreamTopics(const CsvColumnTable& table,
   // Every record says which frame it is: frame and time_s lead the partial ones.
   std::vector<size_t> when;
   for (const char* key : {"frame", "time_s"}) {
-    if (const auto at = table.find(key)) when.push_back(*at);
+    if (const auto at = find(key)) when.push_back(*at);
   }
   TopicColumns frame{kFrameTopic, {}};
   TopicColumns measure{kMeasureTopic, when};
@@ -116,6 +127,22 @@ void RecordFormatter::format(const TopicColumns& topic, const FrameResult& resul
     field_.clear();
     column.append(result, field_);
     AppendJsonValue(field_, message);
+  }
+  message += '}';
+}
+
+void FormatRecord(const TopicColumns& topic, const std::vector<std::string>& names,
+                  const std::vector<std::string_view>& fields, std::string& message) {
+  message.clear();
+  message += topic.topic;
+  message += " {";
+  bool first = true;
+  for (const size_t i : topic.columns) {
+    if (!first) message += ',';
+    first = false;
+    AppendJsonString(names[i], message);
+    message += ':';
+    AppendJsonValue(i < fields.size() ? fields[i] : std::string_view(), message);
   }
   message += '}';
 }

@@ -39,6 +39,11 @@ struct TopicColumns {
 // A marker's columns are the table's "<name>_x", "_y", "_found", "_score", "_status".
 std::vector<TopicColumns> StreamTopics(const CsvColumnTable& table,
                                        const std::vector<std::string>& marker_names);
+// The same for any table's column names, a marker's columns being "<name><suffix>" for each of
+// `marker_suffixes` (track-stereo's: "_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status").
+std::vector<TopicColumns> StreamTopics(const std::vector<std::string>& column_names,
+                                       const std::vector<std::string>& marker_names,
+                                       const std::vector<std::string>& marker_suffixes);
 
 // Appends `field` (a CSV field's text) as a JSON value by the rule above.
 void AppendJsonValue(std::string_view field, std::string& out);
@@ -56,6 +61,11 @@ class RecordFormatter {
   const CsvColumnTable& table_;
   std::string field_;
 };
+
+// Sets `message` to "<topic> {"<column>": value, ...}" for `topic`'s columns, from a row's field
+// texts (`fields[i]` is column `names[i]`'s, as the CSV has it).
+void FormatRecord(const TopicColumns& topic, const std::vector<std::string>& names,
+                  const std::vector<std::string_view>& fields, std::string& message);
 
 // The 64-bit FNV-1a digest of `bytes` as 16 hex digits: the hello's config_digest (the config
 // file's bytes), so a subscriber can tell two runs' configs apart. Not a cryptographic hash.

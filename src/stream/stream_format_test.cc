@@ -77,6 +77,27 @@ TEST(StreamFormat, ARecordIsTheTopicAndAJsonObjectOfTheRowsFields) {
   EXPECT_EQ(record.size(), table.size());
 }
 
+TEST(StreamFormat, AnyTablesRowBecomesRecordsByColumnNameAndMarkerSuffix) {
+  // track-stereo's kind of table: its own marker columns, rows given as the CSV's field texts.
+  const std::vector<std::string> names = {"frame", "right_frame", "time_s", "tip_X", "tip_Z",
+                                          "tip_status", "angle_deg", "proc_ms"};
+  const std::vector<TopicColumns> topics =
+      StreamTopics(names, {"tip"}, {"_X", "_Y", "_Z", "_status"});
+  ASSERT_EQ(topics.size(), 3u);
+  EXPECT_EQ(topics[1].topic, "measure");
+  EXPECT_EQ(topics[1].columns, (std::vector<size_t>{0, 2, 1, 6, 7}));
+  EXPECT_EQ(topics[2].topic, "marker/tip");
+  EXPECT_EQ(topics[2].columns, (std::vector<size_t>{0, 2, 3, 4, 5}));
+  const std::vector<std::string_view> fields = {"4", "9", "0.133333", "-1.2500", "",
+                                                "right_lost", "", "0.250"};
+  std::string message;
+  FormatRecord(topics[2], names, fields, message);
+  EXPECT_EQ(message, "marker/tip {\"frame\":4,\"time_s\":0.133333,\"tip_X\":-1.2500,"
+                     "\"tip_Z\":null,\"tip_status\":\"right_lost\"}");
+  FormatRecord(topics[0], names, fields, message);
+  EXPECT_EQ(nlohmann::ordered_json::parse(message.substr(6)).size(), names.size());
+}
+
 TEST(StreamFormat, DigestIsFnv1a64) {
   EXPECT_EQ(Fnv1a64Hex(""), "cbf29ce484222325");
   EXPECT_EQ(Fnv1a64Hex("a"), "af63dc4c8601ec8c");

@@ -92,4 +92,27 @@ FrameOffsetEstimate EstimateFrameOffset(const SyncSignal& left, const SyncSignal
 // "flash", "motion".
 const char* FrameOffsetMethodName(FrameOffsetEstimate::Method method);
 
+// What a refusal calls the two inputs and the setting that gives the offset by hand: the
+// program's options by default, a library call's own argument names otherwise.
+struct FrameOffsetNames {
+  std::string inputs = "--left and --right";
+  std::string option = "--frame-offset N";
+};
+
+// Reads both sources (to their end, or `max_frames` frames each) and estimates the offset.
+// Returns an estimate with an offset, or throws InputError in one line: "cannot find the frame
+// offset between <inputs> within +-<max_offset_frames> frames: <refusal>; pass <option>" (also
+// for options that fail Check()). Throws what the sources' read() throws.
+FrameOffsetEstimate FindFrameOffset(FrameSource& left, FrameSource& right,
+                                    const FrameOffsetOptions& options,
+                                    std::optional<int64_t> max_frames,
+                                    const FrameOffsetNames& names = {});
+
+// One line (no newline) for an estimate with an offset: "frame offset 5 (right frame = left
+// frame + 5), found from the motion: correlation 1.000, next best peak 0.635 at offset -15
+// (searched +-60)", or "... found from a flash: left frame 20, right frame 13 (brightness steps
+// 60.0 and 60.0 grey levels)".
+std::string DescribeFrameOffset(const FrameOffsetEstimate& estimate,
+                                const FrameOffsetOptions& options);
+
 }  // namespace softsight

@@ -27,15 +27,20 @@ namespace softsight {
 struct StereoOptions {
   TriangulationOptions triangulation;
   // What the out-of-plane angle is measured against: the first camera's image plane (default:
-  // a bend seen face on reads 0), or the bending plane of the first frame where it is defined
-  // (three found markers not on a line): how far the bend has turned since.
-  enum class ReferencePlane { kImage, kFirstFrame };
+  // a bend seen face on reads 0), the bending plane of the first frame where it is defined
+  // (three found markers not on a line): how far the bend has turned since, or a bench board's
+  // plane (`board_normal`): how far the bend leans out of the bench.
+  enum class ReferencePlane { kImage, kFirstFrame, kBoard };
   ReferencePlane reference_plane = ReferencePlane::kImage;
+  // kBoard: the board's normal in the first camera's frame (BoardFrame::rotation's third column,
+  // calib/board_frame.h), any non-zero length; its sign does not matter. Absent by default;
+  // required by kBoard, not used otherwise.
+  std::optional<cv::Vec3d> board_normal;
 
   bool Check(std::string* error) const;
 };
 
-// "image" or "first"; throws InputError naming `what` and listing the choices.
+// "image", "first" or "board"; throws InputError naming `what` and listing the choices.
 StereoOptions::ReferencePlane ParseReferencePlane(const std::string& text, const std::string& what);
 
 struct StereoMarkerResult {
