@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "app/control_command.h"
+#include "app/identify_command.h"
 #include "app/program_test_util.h"
 #include "app/stereo_test_util.h"
 #include "calib/stereo_test_util.h"
@@ -203,6 +204,35 @@ TEST(ControlStereo, PairsRefusedByTheEpipolarCheckAreNotMeasurements) {
     EXPECT_EQ(*Field(row, "control_action"), 2.0);  // Vented: never a measurement to act on.
     EXPECT_LT(*Field(row, "rig_pressure_kpa"), 0.5);
   }
+}
+
+// `identify --stereo`: the experiment measures the 3D angle, so the model it fits is the
+// actuator's (the plant bends 0.4 x 6 deg/kPa of angle with a 0.15 s lag, the example's), and
+// the model-based loop it writes settles the 3D step as PlantSweep's example plant does.
+TEST(ControlStereo, IdentifyThroughTwoCamerasThenTheModelBasedLoop) {
+  TempDir dir;
+  ControlOptions step = StereoStep(dir, 120.0, "tuned3d.csv");
+  IdentifyCommandOptions identify;
+  identify.config_file = step.config_file;
+  identify.output_file = dir.file("tuned.yaml");
+  identify.simulate = true;
+  identify.quiet = true;
+  identify.stereo = step.stereo;
+  const std::optional<IdentifyOutcome> found = RunIdentify(identify);
+  ASSERT_TRUE(found);
+  EXPECT_NEAR(found->model.slope_deg_per_kpa, 2.4, 0.1 * 2.4);
+  EXPECT_NEAR(found->model.lag_s, 0.15, 0.3 * 0.15);
+
+  step.config_file = identify.output_file;
+  const ControlSummary run = RunControl(step);
+  ASSERT_TRUE(run.metrics.settling_1deg_s && run.metrics.overshoot_percent);
+  std::printf("ControlStereo after identify --stereo: slope %.3f deg/kPa, lag %.3f s; step to 120 "
+              "deg settles +-1 deg in %.2f s, overshoot %.1f %%\n",
+              found->model.slope_deg_per_kpa, found->model.lag_s, *run.metrics.settling_1deg_s,
+              *run.metrics.overshoot_percent);
+  EXPECT_LT(*run.metrics.settling_1deg_s, 2.0) << FormatStepMetrics(run.metrics);
+  EXPECT_LT(*run.metrics.overshoot_percent, 5.0) << FormatStepMetrics(run.metrics);
+  EXPECT_NEAR(SettledTrueAngle(ReadRows(step.csv_file)), 120.0, 1.0);
 }
 
 // Bad options: one error line naming what is wrong, exit code 2, before the board is opened.
