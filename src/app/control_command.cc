@@ -746,10 +746,10 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       "--csv run.csv\n"
       "Two cameras (--stereo): the loop closes on the 3D angle, a pair not verified in both views\n"
       "counting as a lost marker; the CSV has the track-stereo columns and the controller's:\n"
-      "  softsight control --config examples/rig.yaml --simulate --stereo builtin "
-      "--target-deg 140 --csv run3d.csv\n"
+      "  softsight control --config examples/rig_stereo.yaml --simulate --stereo builtin "
+      "--target-deg 120 --csv run3d.csv\n"
       "  softsight control --config rig.yaml --stereo stereo.yaml --left-camera 0 --right-camera 2 "
-      "--port /dev/ttyACM0 --target-deg 140 --csv run3d.csv");
+      "--port /dev/ttyACM0 --target-deg 120 --csv run3d.csv");
   sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), see "
                  "examples/rig.yaml")
       ->required()

@@ -26,18 +26,19 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::ReadRows;
-using testing::StereoMarkersYaml;
 using testing::TempDir;
 
 using Rows = std::vector<std::map<std::string, std::string>>;
 
-// A step from straight to `target_deg` on the example rig's plant and gains (the config's
-// control section at its defaults), the simulated pair built in, the bend 30 deg out of the
-// first camera's image plane.
+// examples/rig_stereo.yaml: the markers without the rim fit, the loop at its defaults (the
+// example rig's plant and gains).
+std::string RigStereoExample() { return testing::SourceDir() + "/examples/rig_stereo.yaml"; }
+
+// A step from straight to `target_deg` with examples/rig_stereo.yaml, the simulated pair built
+// in, the bend 30 deg out of the first camera's image plane.
 ControlOptions StereoStep(const TempDir& dir, double target_deg, const std::string& csv) {
-  std::ofstream(dir.file("rig.yaml")) << StereoMarkersYaml();
   ControlOptions options;
-  options.config_file = dir.file("rig.yaml");
+  options.config_file = RigStereoExample();
   options.simulate = true;
   options.target_deg = target_deg;
   options.duration_s = 3.0;
@@ -238,7 +239,6 @@ TEST(ControlStereo, IdentifyThroughTwoCamerasThenTheModelBasedLoop) {
 // Bad options: one error line naming what is wrong, exit code 2, before the board is opened.
 TEST(ControlStereo, BadOptionsGiveOneErrorLineAndExit2) {
   TempDir dir;
-  std::ofstream(dir.file("rig.yaml")) << StereoMarkersYaml();
   // A pair calibrated at another image size than the simulated cameras'.
   StereoRig small = MakeStereoRig();
   for (CameraModel* camera : {&small.left, &small.right}) {
@@ -249,7 +249,7 @@ TEST(ControlStereo, BadOptionsGiveOneErrorLineAndExit2) {
   StereoCalibrationResult small_rig;
   small_rig.stereo = testing::CalibrationOfRig(small);
   SaveStereoCalibration(small_rig, ChessboardSpec{}, dir.file("small.yaml"));
-  const std::string base = "control --config " + dir.file("rig.yaml") +
+  const std::string base = "control --config " + RigStereoExample() +
                            " --target-deg 140 --duration-s 1 --csv " + dir.file("run.csv") + " ";
   struct Case {
     std::string args, message;
