@@ -38,9 +38,9 @@ using control_parts::ControlSink;
 using control_parts::RigClockSink;
 using control_parts::RigFileSource;
 using control_parts::SimulatedRigSource;
-using control_parts::SimulatedStereoRigInput;
 using control_parts::OpenStereoPairs;
 using control_parts::OpenStereoSession;
+using control_parts::SimulatedStereoRigInput;
 using control_parts::RunStereoControl;
 using control_parts::StereoControlColumns;
 using control_parts::StereoControlFrames;
@@ -527,7 +527,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   const bool rendered = frames.rendered != nullptr || (pairs && pairs->rendered != nullptr);
 
-  TrackingSession tracking(tracking_config);
+  std::optional<TrackingSession> tracking;  // One camera's (two: the pairs' StereoSession).
+  if (!pairs) tracking.emplace(tracking_config);
   ControlSink control(session, link, duration_s,
                       /*stop_at_duration=*/!rendered || options.identify);
   std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
@@ -585,7 +586,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   try {
     summary.run = pairs ? RunStereoControl(*pairs->input, *pairs->session, pairs->angle, control,
                                            stereo_csv ? &*stereo_csv : nullptr, run.stop_requested)
-                        : RunPipeline(*frames.source, tracking, sinks, run);
+                        : RunPipeline(*frames.source, *tracking, sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
