@@ -14,6 +14,7 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/control_parts.h"
+#include "app/control_stereo.h"
 #include "app/publish_options.h"
 #include "app/target_feed.h"
 #include "app/stop_request.h"
@@ -37,6 +38,12 @@ using control_parts::ControlSink;
 using control_parts::RigClockSink;
 using control_parts::RigFileSource;
 using control_parts::SimulatedRigSource;
+using control_parts::OpenStereoPairs;
+using control_parts::OpenStereoSession;
+using control_parts::SimulatedStereoRigInput;
+using control_parts::RunStereoControl;
+using control_parts::StereoControlColumns;
+using control_parts::StereoControlFrames;
 
 // The longest identification experiment: far more than the steps and the PRBS take.
 constexpr double kMaxIdentifyS = 600.0;
@@ -99,7 +106,15 @@ ControlTarget MakeTarget(const ControlOptions& o) {
 ControlTarget CheckedTarget(const ControlOptions& options) {
   const int sources =
       (options.camera ? 1 : 0) + (options.rig_frames ? 1 : 0) + (options.input ? 1 : 0);
-  if (sources > 1 || (sources == 0 && !options.simulate)) {
+  if (options.stereo && sources > 0) {
+    throw InputError("control --stereo: the frames come from --left-camera and --right-camera "
+                     "(or the simulated rig with --simulate), not --camera, --rig-frames or "
+                     "--input");
+  }
+  if (options.stereo && options.publish) {
+    throw InputError("control --stereo: --publish is not offered with two cameras yet");
+  }
+  if (!options.stereo && (sources > 1 || (sources == 0 && !options.simulate))) {
     throw InputError("control: give one frame source: --camera, --rig-frames or --input (or "
                      "none with --simulate, which renders the simulated rig)");
   }
@@ -244,35 +259,57 @@ ControlFrames OpenControlFrames(const ControlOptions& options, const TrackingCon
 }
 
 // The CSV's columns beyond tracking: the controller's, the experiment's phase, and the
-// simulated rig's truth (what the actuator really did).
-std::vector<CsvColumn> ControlColumns(const ControlSink& control,
-                                      const std::optional<IdentificationExperiment>& experiment,
-                                      bool identify, const SimulatedRigSource* rendered) {
-  std::vector<CsvColumn> extra = control.columns();
+// simulated rig's truth (what the actuator really did; `truth` the rendering source's, null
+// for frames from elsewhere). Rows of one camera (FrameResult) or two (StereoFrameResult).
+template <typename Row>
+std::vector<BasicCsvColumn<Row>> ControlColumns(
+    const ControlSink& control, const std::optional<IdentificationExperiment>& experiment,
+    bool identify, const std::optional<RigSnapshot>* truth) {
+  std::vector<BasicCsvColumn<Row>> extra = control.columns<Row>();
   if (identify) {
-    extra.push_back(NumberColumn("identify_phase", [&experiment](const FrameResult&) {
+    extra.push_back(NumberColumn<Row>("identify_phase", [&experiment](const Row&) {
       return experiment && !experiment->samples().empty()
                  ? std::optional<double>(experiment->samples().back().phase)
                  : std::nullopt;
     }));
   }
-  if (rendered != nullptr) {
-    extra.push_back(NumberColumn("rig_true_angle_deg", [rendered](const FrameResult&) {
-      const std::optional<RigSnapshot>& truth = rendered->truth();
-      return truth ? std::optional<double>(truth->angle_deg) : std::nullopt;
+  if (truth != nullptr) {
+    extra.push_back(NumberColumn<Row>("rig_true_angle_deg", [truth](const Row&) {
+      return *truth ? std::optional<double>((*truth)->angle_deg) : std::nullopt;
     }));
-    extra.push_back(NumberColumn("rig_pressure_kpa", [rendered](const FrameResult&) {
-      const std::optional<RigSnapshot>& truth = rendered->truth();
-      return truth ? std::optional<double>(truth->pressure_kpa) : std::nullopt;
+    extra.push_back(NumberColumn<Row>("rig_pressure_kpa", [truth](const Row&) {
+      return *truth ? std::optional<double>((*truth)->pressure_kpa) : std::nullopt;
     }));
   }
   return extra;
 }
 
+// Two cameras' CSV (control_stereo.h): the stereo columns, then the angle the loop was given
+// (measured_deg: the 3D angle_deg, or one camera's with --stereo-angle), the controller's, and
+// with the simulated pair the true bending plane's tilt out of the first camera's image plane.
+BasicCsvColumnTable<StereoFrameResult> StereoCsvColumns(
+    const ControlSink& control, const std::optional<IdentificationExperiment>& experiment,
+    bool identify, const StereoControlFrames& pairs) {
+  using Row = StereoFrameResult;
+  std::vector<BasicCsvColumn<Row>> extra{NumberColumn<Row>(
+      "measured_deg", [&control](const Row&) { return control.measured_deg(); })};
+  const std::optional<RigSnapshot>* truth =
+      pairs.rendered != nullptr ? &pairs.rendered->truth() : nullptr;
+  for (BasicCsvColumn<Row>& column : ControlColumns<Row>(control, experiment, identify, truth)) {
+    extra.push_back(std::move(column));
+  }
+  if (const SimulatedStereoRigInput* rendered = pairs.rendered) {
+    extra.push_back(NumberColumn<Row>("rig_true_out_of_plane_deg", [rendered](const Row&) {
+      const std::optional<StereoSceneTruth>& scene = rendered->scene_truth();
+      return scene ? std::optional<double>(scene->plane_tilt_deg) : std::nullopt;
+    }));
+  }
+  return StereoControlColumns(*pairs.session, std::move(extra), control.latency_column<Row>());
+}
+
 // Every frame carries one command; frames further apart than the board's watchdog allows would
 // have the actuator vented between any two of them, silently. Refused, naming the rate.
-void CheckFrameRateAgainstWatchdog(const FrameSource& source, const BoardInfo& info) {
-  const std::optional<double> fps = source.fps();
+void CheckFrameRateAgainstWatchdog(const std::optional<double>& fps, const BoardInfo& info) {
   if (!fps || !(*fps > 0.0)) return;
   const double period_ms = 1000.0 / *fps;
   // A fifth of the watchdog's time is left for the frame's own jitter and the answer.
@@ -420,7 +457,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
 
   ControlTarget target = CheckedTarget(options);
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
-  if (!options.camera) {
+  if (!options.camera && !(options.stereo && options.stereo->left_camera)) {
     RefuseCaptureWithoutCamera(options.capture_args, tracking_config.capture, options.config_file,
                                options.input        ? "the file " + *options.input
                                : options.rig_frames ? "the rig's frames " + *options.rig_frames
@@ -436,6 +473,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (options.profile_file) inputs.push_back({"--profile", *options.profile_file});
   if (options.input) inputs.push_back({"--input", *options.input});
   if (options.rig_frames) inputs.push_back({"--rig-frames", *options.rig_frames});
+  // Two cameras: the calibration and both views' markers, checked before the port is opened.
+  std::optional<StereoControlFrames> pairs;
+  if (options.stereo) pairs = OpenStereoSession(options, tracking_config, &inputs);
   CheckOutputsAreNotInputs(outputs, inputs);
   const ControlConfig config = ControlConfigFor(options, tracking_config);
   const std::optional<std::string> limited_to_reach = KeepTargetInReach(options, config, &target);
@@ -477,23 +517,43 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     session.set_inner_loop_gains(config.inner_loop);
     session.set_model(config.model);
   }
-  ControlFrames frames =
-      OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
+  // One camera (a FrameSource through a TrackingSession), or two (pairs through a
+  // StereoSession): either way the controller is handed one angle per frame.
+  ControlFrames frames;
+  if (pairs) {
+    OpenStereoPairs(options, tracking_config, rig.get(), duration_s, &*pairs);
+  } else {
+    frames = OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
+  }
+  const bool rendered = frames.rendered != nullptr || (pairs && pairs->rendered != nullptr);
 
-  TrackingSession tracking(tracking_config);
+  std::optional<TrackingSession> tracking;  // One camera's (two: the pairs' StereoSession).
+  if (!pairs) tracking.emplace(tracking_config);
   ControlSink control(session, link, duration_s,
-                      /*stop_at_duration=*/frames.rendered == nullptr || options.identify);
+                      /*stop_at_duration=*/!rendered || options.identify);
   std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
-  std::optional<CsvSink> csv;  // Optional for an identification (`softsight identify` without --csv).
-  CsvColumnTable columns = TrackingColumns(
-      tracking_config, ControlColumns(control, experiment, options.identify, frames.rendered));
-  columns.insert_before("latency_row_ms", control.latency_column());
-  if (publish) publish->set_columns(columns);
-  if (!options.csv_file.empty() || !options.identify) csv.emplace(options.csv_file, std::move(columns));
+  // Optional for an identification (`softsight identify` without --csv).
+  const bool write_csv = !options.csv_file.empty() || !options.identify;
+  std::optional<CsvSink> csv;
+  std::optional<BasicCsvWriter<StereoFrameResult>> stereo_csv;
+  if (pairs) {
+    if (write_csv) {
+      stereo_csv.emplace(options.csv_file,
+                         StereoCsvColumns(control, experiment, options.identify, *pairs));
+    }
+  } else {
+    CsvColumnTable columns = TrackingColumns(
+        tracking_config,
+        ControlColumns<FrameResult>(control, experiment, options.identify,
+                                    frames.rendered ? &frames.rendered->truth() : nullptr));
+    columns.insert_before("latency_row_ms", control.latency_column());
+    if (publish) publish->set_columns(columns);
+    if (write_csv) csv.emplace(options.csv_file, std::move(columns));
+  }
   if (feed) control.follow(&*target_source, &*feed);
   std::optional<RigClockSink> rig_clock;
   std::vector<FrameSink*> sinks;
-  if (rig && frames.rendered == nullptr) sinks.push_back(&rig_clock.emplace(*rig));
+  if (rig && !rendered) sinks.push_back(&rig_clock.emplace(*rig));
   sinks.push_back(&control);  // Before the CSV and the stream: their columns read this frame's step.
   if (csv) sinks.push_back(&*csv);
   if (publish) sinks.push_back(publish.get());
@@ -516,7 +576,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     StoppedBySignal(stop, &summary);
     return summary;
   }
-  CheckFrameRateAgainstWatchdog(*frames.source, info);
+  CheckFrameRateAgainstWatchdog(pairs ? pairs->fps : frames.source->fps(), info);
   if (options.identify) StartIdentification(options, session, info, &experiment, &control);
   AnnounceRun(options, *transport, info, session, config.inner_loop);
 
@@ -524,7 +584,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
   run.check_key_frame_groups = false;  // The loop acts on each frame as it comes.
   try {
-    summary.run = RunPipeline(*frames.source, tracking, sinks, run);
+    summary.run = pairs ? RunStereoControl(*pairs->input, *pairs->session, pairs->angle, control,
+                                           stereo_csv ? &*stereo_csv : nullptr, run.stop_requested)
+                        : RunPipeline(*frames.source, *tracking, sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
@@ -554,7 +616,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
-      summary.stop_reason = frames.rendered != nullptr ? "duration reached" : "end of input";
+      summary.stop_reason = rendered ? "duration reached" : "end of input";
       break;
     case StopReason::kMaxFrames:
     case StopReason::kStopRequested:
@@ -682,7 +744,13 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight control --config examples/rig.yaml --simulate --target-deg 120 --csv run.csv\n"
       "  softsight control --config rig.yaml --port /dev/ttyACM0 --camera 0 --profile steps.txt "
-      "--csv run.csv");
+      "--csv run.csv\n"
+      "Two cameras (--stereo): the loop closes on the 3D angle, a pair not verified in both views\n"
+      "counting as a lost marker; the CSV has the track-stereo columns and the controller's:\n"
+      "  softsight control --config examples/rig_stereo.yaml --simulate --stereo builtin "
+      "--target-deg 120 --csv run3d.csv\n"
+      "  softsight control --config rig.yaml --stereo stereo.yaml --left-camera 0 --right-camera 2 "
+      "--port /dev/ttyACM0 --target-deg 120 --csv run3d.csv");
   sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), see "
                  "examples/rig.yaml")
       ->required()
@@ -738,8 +806,11 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
   auto publish = std::make_shared<PublishArgs>();
   AddPublishOptions(sub, publish.get());
-  return [o, auto_tune, closed_loop_s, publish] {
+  auto stereo = std::make_shared<ControlStereoOptions>();
+  control_parts::AddControlStereoOptions(sub, stereo.get());
+  return [o, auto_tune, closed_loop_s, publish, stereo, &sub] {
     o->publish = publish->resolved();
+    o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);
     ControlOptions run = *o;
     if (*auto_tune) {
       ControlOptions identify = *o;

@@ -15,9 +15,30 @@
 #include "control/step_metrics.h"
 #include "softsight/control/session.h"
 #include "softsight/io/output_guard.h"
+#include "softsight/sim/stereo_scene.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
+
+// Two cameras: the loop closes on the angle measured in 3D (docs/control.md "Two cameras").
+struct ControlStereoOptions {
+  // The pair's calibration (`softsight calibrate --left ... --right ...`), or "builtin" with
+  // `simulate`: the simulated pair's own (sim/stereo_scene.h MakeStereoRig, exact).
+  std::string stereo_file;
+  std::optional<std::string> right_config_file;  // The right view's markers when its rois differ.
+  // Two live cameras (V4L2 indices), paired by capture time; none with `simulate`, which renders
+  // both views of the simulated rig through the simulated pair.
+  std::optional<int> left_camera, right_camera;
+  // The angle the loop is given: "3d" (default: from the markers verified in both views), or
+  // "left" / "right", what that camera alone measures on its image (to compare, not to use).
+  std::string angle = "3d";
+  double max_epipolar_px = 2.0;  // A pair farther from its epipolar line is not believed.
+  // The simulated actuator's bending plane, turned this far out of the first camera's image
+  // plane (deg, 0..80): what one camera's angle gets wrong.
+  double sim_tilt_deg = 30.0;
+  // Markers the simulated pair does not see in one view for a stretch of frames (tests).
+  std::vector<StereoHiddenMarker> sim_hidden;
+};
 
 struct ControlOptions {
   std::string config_file;              // Markers + `control:` section (examples/rig.yaml).
@@ -49,6 +70,8 @@ struct ControlOptions {
   std::optional<double> duration_s;     // Default: the profile's length + 2 s, or 10 s.
   double fps = 30.0;                    // Frame rate of simulate / rig_frames.
   int sim_supersample = 2;              // Renderer supersampling in simulate (speed vs fidelity).
+  // Two cameras instead of one (none of camera, rig_frames, input then).
+  std::optional<ControlStereoOptions> stereo;
   bool quiet = false;
   // Identification instead of a target (`softsight identify`, `control --auto-tune`): the
   // experiment of control/identify.h runs open loop until it is done, then the model is fitted

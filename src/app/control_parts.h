@@ -115,20 +115,27 @@ class ControlSink : public FrameSink {
     feed_ = feed;
   }
 
+  // One frame tracked by one camera: its angle is the measurement.
   void consume(const Frame& frame, const FrameResult& result) override {
+    step(frame, result.measurement.angle_deg);
+  }
+
+  // One step of the loop on `frame`'s time with the angle measured for it, wherever it came from
+  // (one camera's tracking, two cameras' 3D angle); absent: no measurement this frame (the
+  // controller holds, then vents: ControllerOptions::hold_s).
+  void step(const Frame& frame, std::optional<double> measured_deg) {
     if (experiment_ != nullptr) {
-      sample_ = StepIdentification(*experiment_, session_, frame.time_s,
-                                   result.measurement.angle_deg);
+      sample_ = StepIdentification(*experiment_, session_, frame.time_s, measured_deg);
       if (experiment_->done()) done_ = true;
     } else if (feed_ != nullptr) {
       if (const std::optional<double> target_deg = feed_->at(frame.time_s, source_->poll())) {
         session_.set_angle_target(*target_deg);
-        sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+        sample_ = session_.step(frame.time_s, measured_deg);
       } else {
-        sample_ = session_.vent(frame.time_s, result.measurement.angle_deg);
+        sample_ = session_.vent(frame.time_s, measured_deg);
       }
     } else {
-      sample_ = session_.step(frame.time_s, result.measurement.angle_deg);
+      sample_ = session_.step(frame.time_s, measured_deg);
     }
     // A command written for this frame: its latency from the frame's capture (absent when this
     // step sent none).
@@ -168,10 +175,12 @@ class ControlSink : public FrameSink {
   double longest_at_output_limit_s() const { return longest_at_limit_s_; }
 
   // The controller's CSV columns: target_deg, setpoint_kpa, board_pressure_kpa,
-  // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected.
-  std::vector<CsvColumn> columns() const {
+  // board_setpoint_kpa, duty, board_flags, control_action, link_rejected, board_rejected; for
+  // rows of one camera's results (FrameResult) or two cameras' (StereoFrameResult).
+  template <typename Row = FrameResult>
+  std::vector<BasicCsvColumn<Row>> columns() const {
     const auto column = [this](const char* name, auto value) {
-      return NumberColumn(name, [this, value](const FrameResult&) -> std::optional<double> {
+      return NumberColumn<Row>(name, [this, value](const Row&) -> std::optional<double> {
         return value(sample_);
       });
     };
@@ -185,20 +194,23 @@ class ControlSink : public FrameSink {
         column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
         column("control_action",
                [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
-        NumberColumn("link_rejected",
-                     [this](const FrameResult&) -> std::optional<double> {
-                       return static_cast<double>(link_.stats().rejected_lines);
-                     }),
+        NumberColumn<Row>("link_rejected",
+                          [this](const Row&) -> std::optional<double> {
+                            return static_cast<double>(link_.stats().rejected_lines);
+                          }),
         column("board_rejected", [](S s) { return static_cast<double>(s.board.board_rejected); }),
     };
   }
 
   // latency_command_ms: from the frame's capture to the serial command its step sent (goes
   // between the CSV's latency_result_ms and latency_row_ms).
-  CsvColumn latency_column() const {
-    return NumberColumn("latency_command_ms",
-                        [this](const FrameResult&) { return latency_command_ms_; }, "%.3f");
+  template <typename Row = FrameResult>
+  BasicCsvColumn<Row> latency_column() const {
+    return NumberColumn<Row>(
+        "latency_command_ms", [this](const Row&) { return latency_command_ms_; }, "%.3f");
   }
+  // The angle the loop was given for the frame being written (the measurement of step()).
+  std::optional<double> measured_deg() const { return sample_.measured_deg; }
 
   // The figures so far (frames, errors, pressures); the link's counters are the caller's.
   ControlSummary summary() const {

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/control_stereo.h"
 #include "app/publish_options.h"
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
@@ -46,6 +47,7 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
   run.port = options.port;
   run.camera = options.camera;
   run.rig_frames = options.rig_frames;
+  run.stereo = options.stereo;
   run.csv_file = options.csv_file;
   run.publish = options.publish;
   run.fps = options.fps;
@@ -97,7 +99,9 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
       "not respond or the pressure goes above the ceiling. See docs/control.md.\n"
       "Examples:\n"
       "  softsight identify --config examples/rig.yaml --simulate -o tuned.yaml --csv ident.csv\n"
-      "  softsight identify --config rig.yaml --port /dev/ttyACM0 --camera 0 -o tuned.yaml");
+      "  softsight identify --config rig.yaml --port /dev/ttyACM0 --camera 0 -o tuned.yaml\n"
+      "  softsight identify --config rig.yaml --port /dev/ttyACM0 --stereo stereo.yaml "
+      "--left-camera 0 --right-camera 2 -o tuned.yaml   (the 3D angle)");
   sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), read only")
       ->required()
       ->check(CLI::ExistingFile);
@@ -121,8 +125,11 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", o->quiet, "Only errors");
   auto publish = std::make_shared<PublishArgs>();
   AddPublishOptions(sub, publish.get());
-  return [o, publish] {
+  auto stereo = std::make_shared<ControlStereoOptions>();
+  control_parts::AddControlStereoOptions(sub, stereo.get());
+  return [o, publish, stereo, &sub] {
     o->publish = publish->resolved();
+    o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);
     if (o->closed_loop_s && !(*o->closed_loop_s > 0.0 && *o->closed_loop_s <= 100.0)) {
       throw InputError("--closed-loop-s " + std::to_string(*o->closed_loop_s) +
                        ": must be a number in (0, 100]");

@@ -20,6 +20,8 @@ struct IdentifyCommandOptions {
   std::optional<std::string> port;
   std::optional<int> camera;
   std::optional<std::string> rig_frames;
+  // Two cameras: the experiment measures the 3D angle (control's --stereo; no camera, rig_frames).
+  std::optional<ControlStereoOptions> stereo;
   std::string csv_file;       // Every frame of the experiment (optional).
   std::string model_csv_file; // Measured against the fitted model, per frame (optional).
   double fps = 30.0;          // Of --simulate and --rig-frames.

@@ -27,7 +27,6 @@
 #include "track/tracker_kind.h"
 
 namespace softsight {
-namespace {
 
 TrackingConfig LoadStereoViewConfig(const std::string& file) {
   TrackingConfig config = LoadTrackingConfig(file);
@@ -38,6 +37,8 @@ TrackingConfig LoadStereoViewConfig(const std::string& file) {
   }
   return config;
 }
+
+namespace {
 
 std::optional<double> Median(std::vector<double>& values) {
   if (values.empty()) return std::nullopt;

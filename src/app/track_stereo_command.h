@@ -15,6 +15,11 @@
 namespace softsight {
 
 class StereoInput;
+struct TrackingConfig;
+
+// One view's marker config (LoadTrackingConfig), every marker ready for a run without the mouse
+// (a template marker with its template); throws InputError naming the file and marker.
+TrackingConfig LoadStereoViewConfig(const std::string& file);
 
 struct TrackStereoOptions {
   std::string config_file;                       // Markers (and the triple or chain).

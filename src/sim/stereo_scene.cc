@@ -109,6 +109,14 @@ bool StereoSceneOptions::Check(std::string* error) const {
       }
     }
   }
+  for (const StereoHiddenMarker& h : hidden) {
+    const bool known = std::any_of(markers.begin(), markers.end(),
+                                   [&](const StereoMarker& m) { return m.name == h.name; });
+    if (!known || (h.view != 0 && h.view != 1) || h.frames < 1) {
+      *error = "hidden: " + h.name + ": must name a marker, view 0 or 1, frames >= 1";
+      return false;
+    }
+  }
   if (flash_length_frames < 0 || !(flash_gray >= 0 && flash_gray <= 255)) {
     *error = "flash_length_frames: must be >= 0, flash_gray in [0, 255]";
     return false;
@@ -133,12 +141,21 @@ StereoScene::StereoScene(StereoRig rig, StereoSceneOptions options)
 StereoSceneTruth StereoScene::truth(int index) const {
   const StereoSceneOptions& o = options_;
   const double t = o.frame_count > 1 ? static_cast<double>(index) / (o.frame_count - 1) : 0.0;
+  return truth_at_bend(o.bend_deg_per_frame.empty()
+                           ? o.max_bend_deg * t
+                           : o.bend_deg_per_frame[static_cast<size_t>(std::clamp(
+                                 index, 0, static_cast<int>(o.bend_deg_per_frame.size()) - 1))],
+                       index);
+}
+
+StereoSceneTruth StereoScene::truth_at_bend(double bend_deg, int index) const {
+  const StereoSceneOptions& o = options_;
+  const double t =
+      o.frame_count > 1 ? std::clamp(static_cast<double>(index) / (o.frame_count - 1), 0.0, 1.0)
+                        : 0.0;
   StereoSceneTruth truth;
   truth.index = index;
-  truth.bend_deg = o.bend_deg_per_frame.empty()
-                       ? o.max_bend_deg * t
-                       : o.bend_deg_per_frame[static_cast<size_t>(
-                             std::clamp(index, 0, static_cast<int>(o.bend_deg_per_frame.size()) - 1))];
+  truth.bend_deg = std::clamp(bend_deg, 0.0, 300.0);
   const double tilt_deg =
       o.plane_tilt_start_deg + (o.plane_tilt_end_deg - o.plane_tilt_start_deg) * t;
 
@@ -181,7 +198,12 @@ StereoSceneTruth StereoScene::truth(int index) const {
 }
 
 StereoSceneTruth StereoScene::render(int index, cv::Mat& left, cv::Mat& right) const {
-  const StereoSceneTruth t = truth(index);
+  return render_at_bend(truth(index).bend_deg, index, left, right);
+}
+
+StereoSceneTruth StereoScene::render_at_bend(double bend_deg, int index, cv::Mat& left,
+                                             cv::Mat& right) const {
+  const StereoSceneTruth t = truth_at_bend(bend_deg, index);
   draw(rig_.left, cv::Matx33d::eye(), cv::Vec3d(0, 0, 0), t, index, 0, left);
   draw(rig_.right, rig_.R, rig_.T, t, index, 1, right);
   return t;
@@ -232,6 +254,12 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
   const int s = o.supersample;
   const cv::Vec3d normal = rotation * truth.plane_normal;
   for (size_t m = 0; m < truth.markers.size(); ++m) {
+    const auto covers = [&](const StereoHiddenMarker& h) {
+      return h.name == truth.markers[m].name && h.view == view && index >= h.first_frame &&
+             index < h.first_frame + h.frames;
+    };
+    const bool hidden = std::any_of(o.hidden.begin(), o.hidden.end(), covers);
+    if (hidden) continue;
     const cv::Vec3d centre = rotation * ToVec(truth.markers[m].position_mm) + translation;
     cv::Vec3d u = normal.cross(cv::Vec3d(0, 0, 1));
     if (cv::norm(u) < 1e-9) u = cv::Vec3d(1, 0, 0);

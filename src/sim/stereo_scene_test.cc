@@ -92,5 +92,39 @@ TEST(StereoSceneTest, UnusableOptionsAreRefusedByName) {
   }
 }
 
+// The simulated control rig's frames: an explicit bend renders exactly what the time profile's
+// frame of that bend does; a marker hidden in one view is missing there only, for its frames.
+TEST(StereoSceneTest, AnExplicitBendAndAMarkerHiddenInOneView) {
+  StereoSceneOptions options;
+  options.frame_count = 5;
+  options.max_bend_deg = 80.0;
+  options.hidden = {{"green", 1, 2, 2}};
+  const StereoScene scene(MakeStereoRig(), options);
+  cv::Mat left, right, left_at, right_at;
+  const StereoSceneTruth profile = scene.render(1, left, right);
+  const StereoSceneTruth at = scene.render_at_bend(20.0, 1, left_at, right_at);
+  EXPECT_DOUBLE_EQ(at.bend_deg, profile.bend_deg);
+  EXPECT_DOUBLE_EQ(at.angle_deg, profile.angle_deg);
+  EXPECT_EQ(cv::norm(left, left_at, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(right, right_at, cv::NORM_INF), 0.0);
+  EXPECT_DOUBLE_EQ(scene.truth_at_bend(400.0, 0).bend_deg, 300.0);  // Clamped.
+
+  // Whether the pixel at the marker's projected centre has the marker's colour.
+  const auto drawn = [&](const cv::Mat& image, const cv::Point2d& at_px, size_t marker) {
+    const cv::Vec3b pixel = image.at<cv::Vec3b>(static_cast<int>(std::lround(at_px.y)),
+                                                static_cast<int>(std::lround(at_px.x)));
+    return cv::norm(cv::Vec3d(pixel) - cv::Vec3d(options.markers[marker].bgr)) < 10.0;
+  };
+  for (int index = 0; index < 5; ++index) {
+    const StereoSceneTruth truth = scene.render_at_bend(60.0, index, left, right);
+    const bool hidden = index == 2 || index == 3;
+    EXPECT_TRUE(drawn(left, truth.markers[2].left_px, 2)) << index;
+    EXPECT_EQ(drawn(right, truth.markers[2].right_px, 2), !hidden) << index;
+    EXPECT_TRUE(drawn(right, truth.markers[1].right_px, 1)) << index;
+  }
+  options.hidden = {{"purple", 0, 0, 1}};
+  EXPECT_THROW(StereoScene(MakeStereoRig(), options), InputError);
+}
+
 }  // namespace
 }  // namespace softsight

@@ -42,6 +42,15 @@ struct StereoMarker {
   double body_fraction = 0.0;  // 0 = base, 1 = tip.
 };
 
+// A marker covered in one view for a stretch of frames (a hand or a tube in front of one camera):
+// not drawn in that view; the other view and the truth are unchanged.
+struct StereoHiddenMarker {
+  std::string name;     // One of StereoSceneOptions::markers.
+  int view = 1;         // 0: the left (first) camera, 1: the right one.
+  int first_frame = 0;  // From this frame index on ...
+  int frames = 1;       // ... for this many frames (>= 1).
+};
+
 struct StereoSceneOptions {
   int frame_count = 30;
   // The base of the actuator (mm, left camera's frame) and its straight direction (unit after
@@ -67,6 +76,7 @@ struct StereoSceneOptions {
   double body_width_mm = 12.0;
   std::vector<StereoMarker> markers = {
       {"red", {40, 40, 220}, 0.1}, {"blue", {220, 90, 40}, 0.5}, {"green", {60, 200, 60}, 0.9}};
+  std::vector<StereoHiddenMarker> hidden;
   cv::Vec3b body_bgr{200, 200, 205};
   cv::Vec3b background_bgr{105, 110, 115};
   int supersample = 4;       // Sub-samples per pixel side for the markers' edges (1..16).
@@ -109,6 +119,11 @@ class StereoScene {
   StereoSceneTruth render(int index, cv::Mat& left, cv::Mat& right) const;
   // The truth alone (no drawing).
   StereoSceneTruth truth(int index) const;
+  // The actuator at an explicit bend (the simulated control rig's), clamped to [0, 300] deg;
+  // `index` selects the plane's tilt, the hidden markers, the flash and the noise as for frame
+  // `index` (past the last frame: as for the last).
+  StereoSceneTruth render_at_bend(double bend_deg, int index, cv::Mat& left, cv::Mat& right) const;
+  StereoSceneTruth truth_at_bend(double bend_deg, int index) const;
 
   const StereoRig& rig() const { return rig_; }
   const StereoSceneOptions& options() const { return options_; }

@@ -1,0 +1,290 @@
+#include "app/control_stereo.h"
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+
+#include "app/capture_options.h"
+#include "app/cli_checks.h"
+#include "app/track_stereo_command.h"
+#include "softsight/calib/stereo_calibration.h"
+#include "softsight/core/error.h"
+#include "softsight/core/format.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/io/run_source.h"
+#include "softsight/track/colour_tracker.h"
+
+namespace softsight::control_parts {
+namespace {
+
+constexpr const char* kBuiltinStereo = "builtin";
+
+// The simulated pair's calibration, exactly as it renders (no calibration error).
+StereoCalibration CalibrationOf(const StereoRig& rig) {
+  StereoCalibration stereo;
+  stereo.left = {rig.left.image_size, rig.left.camera_matrix, rig.left.distortion};
+  stereo.right = {rig.right.image_size, rig.right.camera_matrix, rig.right.distortion};
+  stereo.R = rig.R;
+  stereo.T = rig.T;
+  CompleteStereoCalibration(stereo);
+  return stereo;
+}
+
+std::string SizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+std::unique_ptr<FrameSource> OpenCamera(int index, const ControlOptions& options,
+                                        const TrackingConfig& config) {
+  FrameSourceSpec spec;
+  spec.camera = index;
+  spec.capture =
+      MergeCaptureOptions(options.capture_args, config.capture.value_or(CameraSettings{}));
+  CameraSettingsReport accepted;
+  spec.capture_report = &accepted;
+  std::unique_ptr<FrameSource> source = SourceForRun(OpenFrameSource(spec), FilePacing::kReadAhead);
+  PrintCaptureReport(accepted);
+  return source;
+}
+
+}  // namespace
+
+StereoAngle ParseStereoAngle(const std::string& text) {
+  if (text == "3d") return StereoAngle::k3d;
+  if (text == "left") return StereoAngle::kLeft;
+  if (text == "right") return StereoAngle::kRight;
+  throw InputError("--stereo-angle " + EscapeForMessage(text) + ": expected 3d, left or right");
+}
+
+std::optional<double> StereoMeasuredAngle(const StereoFrameResult& result, StereoAngle angle) {
+  switch (angle) {
+    case StereoAngle::k3d: return result.shape.angle_deg;
+    case StereoAngle::kLeft: return result.left_angle_deg;
+    case StereoAngle::kRight: return result.right_angle_deg;
+  }
+  return std::nullopt;
+}
+
+SimulatedStereoRigInput::SimulatedStereoRigInput(SimulatedRig& rig, const StereoScene& scene,
+                                                 double fps, double duration_s)
+    : rig_(rig), scene_(scene), fps_(fps),
+      frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1) {}
+
+bool SimulatedStereoRigInput::read(FramePair& pair) {
+  if (index_ >= frames_) return false;
+  if (index_ > 0) rig_.advance(1.0 / fps_);
+  truth_ = rig_.snapshot();
+  const double t = static_cast<double>(index_) / fps_;
+  scene_truth_ = scene_.render_at_bend(truth_->bend_deg, static_cast<int>(index_),
+                                       pair.left.image, pair.right.image);
+  for (Frame* frame : {&pair.left, &pair.right}) {
+    frame->index = index_;
+    frame->time_s = t;
+    frame->captured = std::chrono::steady_clock::now();
+  }
+  pair.pair_dt_ms.reset();
+  ++index_;
+  return true;
+}
+
+StereoControlFrames OpenStereoSession(const ControlOptions& options,
+                                      const TrackingConfig& left_config,
+                                      std::vector<PathRole>* inputs) {
+  const ControlStereoOptions& o = *options.stereo;
+  StereoControlFrames frames;
+  frames.angle = ParseStereoAngle(o.angle);
+  const bool cameras = o.left_camera || o.right_camera;
+  if (options.simulate && cameras) {
+    throw InputError("--simulate --stereo: the simulated rig is rendered into both views; "
+                     "give no --left-camera / --right-camera");
+  }
+  if (!options.simulate && !(o.left_camera && o.right_camera)) {
+    throw InputError("--stereo: give both --left-camera and --right-camera (or "
+                     "--simulate)");
+  }
+  if (!(o.sim_tilt_deg >= 0.0 && o.sim_tilt_deg <= 80.0)) {
+    throw InputError("--sim-tilt-deg " + ShortNumber(o.sim_tilt_deg) + ": must be in [0, 80]");
+  }
+
+  StereoCalibration calibration;
+  const StereoRig simulated_pair = MakeStereoRig();
+  if (o.stereo_file == kBuiltinStereo) {
+    if (!options.simulate) {
+      throw InputError("--stereo builtin: the simulated pair's calibration is for --simulate; "
+                       "give the file of `softsight calibrate --left ... --right ...`");
+    }
+    calibration = CalibrationOf(simulated_pair);
+  } else {
+    try {
+      calibration = LoadStereoCalibration(o.stereo_file);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--stereo ") + e.what());
+    }
+    inputs->push_back({"--stereo", o.stereo_file});
+    if (options.simulate && calibration.left.image_size != simulated_pair.left.image_size) {
+      throw InputError("--stereo " + o.stereo_file + ": calibrated for " +
+                       SizeText(calibration.left.image_size) +
+                       " images, but the simulated cameras give " +
+                       SizeText(simulated_pair.left.image_size) +
+                       " (--stereo builtin: the simulated pair's own calibration)");
+    }
+  }
+  TrackingConfig right_config = left_config;
+  if (o.right_config_file) {
+    right_config = LoadStereoViewConfig(*o.right_config_file);
+    for (PathRole& role : ConfigInputs(right_config)) inputs->push_back(std::move(role));
+    inputs->push_back({"--right-config", *o.right_config_file});
+  }
+  // Markers move in depth before two cameras: a colour marker with the rim fit is placed by a
+  // circle of its learned size when seen smaller (docs/stereo.md). Said, not overridden.
+  std::string rim_fitted;
+  for (const MarkerSpec& spec : left_config.markers) {
+    const auto* colour = spec.params.get_if<ColourParams>();
+    if (colour != nullptr && colour->rim_fit) {
+      rim_fitted += (rim_fitted.empty() ? "" : ", ") + spec.name;
+    }
+  }
+  if (!rim_fitted.empty() && !options.quiet) {
+    std::cerr << "control: note: " << rim_fitted << " use the rim fit (rim_fit: true); for "
+              << "markers moving in depth set rim_fit: false (docs/stereo.md)\n";
+  }
+  StereoOptions stereo_options;
+  stereo_options.triangulation.max_epipolar_px = o.max_epipolar_px;
+  std::string error;
+  if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+  frames.session =
+      std::make_unique<StereoSession>(left_config, right_config, calibration, stereo_options);
+  return frames;
+}
+
+void OpenStereoPairs(const ControlOptions& options, const TrackingConfig& left_config,
+                     SimulatedRig* rig, double duration_s, StereoControlFrames* frames_out) {
+  const ControlStereoOptions& o = *options.stereo;
+  StereoControlFrames& frames = *frames_out;
+  if (options.simulate) {
+    const StereoRig simulated_pair = MakeStereoRig();
+    StereoSceneOptions scene;
+    scene.plane_tilt_start_deg = scene.plane_tilt_end_deg = o.sim_tilt_deg;
+    scene.supersample = options.sim_supersample;
+    scene.hidden = o.sim_hidden;
+    frames.scene = std::make_unique<StereoScene>(simulated_pair, scene);
+    auto input =
+        std::make_unique<SimulatedStereoRigInput>(*rig, *frames.scene, options.fps, duration_s);
+    frames.rendered = input.get();
+    frames.input = std::move(input);
+    frames.fps = options.fps;
+  } else {
+    TimePairingOptions pairing;
+    pairing.clock = TimePairingOptions::Clock::kCaptureTime;
+    frames.input = PairByTime(OpenCamera(*o.left_camera, options, left_config),
+                              OpenCamera(*o.right_camera, options, left_config), pairing);
+  }
+}
+
+BasicCsvColumnTable<StereoFrameResult> StereoControlColumns(
+    const StereoSession& session, std::vector<BasicCsvColumn<StereoFrameResult>> extra,
+    BasicCsvColumn<StereoFrameResult> latency) {
+  BasicCsvColumnTable<StereoFrameResult> columns =
+      StereoColumns(session.marker_names(), session.segment_names());
+  for (BasicCsvColumn<StereoFrameResult>& column : extra) {
+    columns.insert_before("proc_ms", std::move(column));
+  }
+  columns.insert_before("proc_ms", std::move(latency));
+  return columns;
+}
+
+RunSummary RunStereoControl(StereoInput& input, StereoSession& session, StereoAngle angle,
+                            ControlSink& control, BasicCsvWriter<StereoFrameResult>* csv,
+                            const std::function<bool()>& stop_requested) {
+  using Clock = std::chrono::steady_clock;
+  RunSummary summary;
+  summary.source = input.description();
+  for (const std::string& name : session.marker_names()) summary.markers.push_back({name, 0});
+  std::vector<double> proc_ms, result_ms, done_ms;
+  const auto ms_since = [](Clock::time_point from) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - from).count();
+  };
+  const Clock::time_point start = Clock::now();
+  FramePair pair;
+  try {
+    while (true) {
+      if ((stop_requested && stop_requested()) || control.done()) {
+        summary.stop_reason = StopReason::kStopRequested;
+        break;
+      }
+      if (!input.read(pair)) {
+        summary.stop_reason = StopReason::kEndOfInput;
+        break;
+      }
+      if (pair.left.captured == Clock::time_point{}) pair.left.captured = Clock::now();
+      const StereoFrameResult& result = session.process(pair);
+      result_ms.push_back(ms_since(pair.left.captured));
+      const std::optional<double> measured_deg = StereoMeasuredAngle(result, angle);
+      control.step(pair.left, measured_deg);
+      if (csv != nullptr) csv->write(result);
+      done_ms.push_back(ms_since(pair.left.captured));
+      proc_ms.push_back(result.proc_ms);
+      if (!summary.first_index) summary.first_index = result.frame_index;
+      summary.last_index = result.frame_index;
+      ++summary.frames;
+      if (measured_deg) ++summary.measured;
+      for (size_t i = 0; i < result.markers.size() && i < summary.markers.size(); ++i) {
+        if (result.markers[i].point.found()) ++summary.markers[i].found;
+      }
+    }
+  } catch (const InputError& e) {
+    summary.stop_reason = StopReason::kError;
+    summary.error = e.what();
+  }
+  summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
+  SummariseTimes(result_ms, &summary.latency_result_ms_median, &summary.latency_result_ms_p99);
+  SummariseTimes(done_ms, &summary.latency_done_ms_median, &summary.latency_done_ms_p99);
+  return summary;
+}
+
+void AddControlStereoOptions(CLI::App& sub, ControlStereoOptions* args) {
+  sub.add_option("--stereo", args->stereo_file,
+                 "Two cameras: close the loop on the 3D angle. The pair's calibration from "
+                 "`softsight calibrate --left ... --right ...`, or `builtin` with --simulate (the "
+                 "simulated pair of docs/stereo.md, the actuator bending out of the image plane)");
+  sub.add_option("--left-camera", args->left_camera,
+                 "With --stereo: the first camera (V4L2 index), paired with the second by capture "
+                 "time")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--right-camera", args->right_camera, "With --stereo: the second camera")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--right-config", args->right_config_file,
+                 "With --stereo: the right view's marker config, when its colours or rois differ "
+                 "(same names)")
+      ->check(CLI::ExistingFile);
+  sub.add_option("--stereo-angle", args->angle,
+                 "With --stereo: the angle the loop closes on: 3d (verified in both views), or "
+                 "left / right (that camera's own 2D angle, to compare)")
+      ->capture_default_str();
+  sub.add_option("--max-epipolar-px", args->max_epipolar_px,
+                 "With --stereo: a pair farther than this from its epipolar line is not believed "
+                 "(a lost marker to the loop)")
+      ->capture_default_str()
+      ->check(NumberIn(1e-3, 1e3));
+  sub.add_option("--sim-tilt-deg", args->sim_tilt_deg,
+                 "With --simulate --stereo: the simulated actuator's bending plane, turned this "
+                 "far out of the first camera's image plane (deg)")
+      ->capture_default_str()
+      ->check(NumberIn(0, 80));
+}
+
+std::optional<ControlStereoOptions> StereoOptionsGiven(const CLI::App& sub,
+                                                       const ControlStereoOptions& args) {
+  if (sub.count("--stereo") > 0) return args;
+  for (const char* option : {"--left-camera", "--right-camera", "--right-config", "--stereo-angle",
+                             "--max-epipolar-px", "--sim-tilt-deg"}) {
+    if (sub.count(option) > 0) {
+      throw InputError(std::string(option) + " is for two cameras: give --stereo FILE (or "
+                       "--stereo builtin with --simulate)");
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace softsight::control_parts
