@@ -180,6 +180,35 @@ TEST(DrawOverlayTest, LostMarkerIsFlaggedInRedAndNotDrawn) {
   EXPECT_FALSE(ColourWithin(frame, OnCircle(centre, 80, 340), overlay_colour::kMarker, 13));
 }
 
+TEST(DrawOverlayTest, AFoundMarkerNotBelievedIsCrossedOutInRedWithWhy) {
+  // The stereo window: blue was found in this view but its pair failed the epipolar check.
+  cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  const FrameResult result = ThreeMarkers(true);
+  OverlayStatus status;
+  status.refused = {"", "epipolar"};  // Missing entries (green): believed.
+  OverlayOptions options = Triple();
+  options.show_measurements = false;
+  DrawOverlay(frame, result, options, status);
+  const cv::Point2d blue = *result.markers[1].observation.position_px;
+  int yellow_ring = 0;
+  for (double deg = 0; deg < 360; deg += 30) {
+    yellow_ring += ColourWithin(frame, OnCircle(blue, 12, deg), overlay_colour::kMarker, 1);
+    EXPECT_TRUE(ColourWithin(frame, OnCircle(blue, 12, deg), overlay_colour::kLost, 1)) << deg;
+  }
+  EXPECT_EQ(yellow_ring, 0) << "drawn as found";
+  // The slanted cross through the centroid, and the reason beside it.
+  EXPECT_TRUE(ColourWithin(frame, blue + cv::Point2d(5, 5), overlay_colour::kLost, 1));
+  EXPECT_TRUE(ColourWithin(frame, blue + cv::Point2d(-5, 5), overlay_colour::kLost, 1));
+  EXPECT_GT(CountColour(frame(cv::Rect(cvRound(blue.x) + 15, cvRound(blue.y) - 30, 120, 25)),
+                        overlay_colour::kLost, 60),
+            30);
+  // The believed markers keep their yellow rings.
+  for (int i : {0, 2}) {
+    EXPECT_TRUE(ColourWithin(frame, OnCircle(*result.markers[i].observation.position_px, 12, 90),
+                             overlay_colour::kMarker, 1));
+  }
+}
+
 TEST(DrawOverlayTest, OptionsCheckNamesTheField) {
   OverlayOptions options;
   std::string error;
