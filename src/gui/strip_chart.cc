@@ -89,7 +89,9 @@ void StripChart::add(double time_s, std::initializer_list<std::optional<double>>
 void StripChart::clear() { samples_.clear(); }
 
 double StripChart::x_of(double time_s) const {
-  return x_left_ + (time_s - (t_right_ - options_.window_s)) / options_.window_s * x_width_;
+  // The newest sample on the lane's last column (x_left_ + x_width_ is past it: clipped).
+  return x_left_ +
+         (time_s - (t_right_ - options_.window_s)) / options_.window_s * (x_width_ - 1);
 }
 
 double StripChart::y_of(int i, double value) const {
