@@ -57,7 +57,8 @@ void StereoWindow::show_and_poll(int wait_ms) {
   }
   cv::imshow(options_.title, view_.canvas());
   const std::string said = keys_.press(cv::waitKeyEx(std::max(1, wait_ms)));
-  if (!said.empty()) std::cout << "window: " << said << std::endl;
+  // Said on stdout too, with the pair on screen (scripts and the test under Xvfb read it).
+  if (!said.empty()) std::cout << "window: " << said << " at frame " << shown_frame_ << std::endl;
   if (!keys_.quit && cv::getWindowProperty(options_.title, cv::WND_PROP_VISIBLE) < 1) {
     keys_.quit = true;  // Closed by the user.
     std::cout << "window: closed" << std::endl;
@@ -67,6 +68,7 @@ void StereoWindow::show_and_poll(int wait_ms) {
 void StereoWindow::consume(const FramePair& pair, const StereoFrameResult& result,
                            const FrameResult& left, const FrameResult& right) {
   view_.add(result);
+  shown_frame_ = result.frame_index;
   view_.compose(pair, result, left, right, keys_.paused ? "PAUSED (space: play, .: next pair)" : "");
   int wait_ms = 1;
   if (options_.pace && !keys_.paused) {

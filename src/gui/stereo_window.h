@@ -7,6 +7,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -57,6 +58,7 @@ class StereoWindow : public StereoSink {
   StereoView view_;
   StereoWindowKeys keys_;
   bool open_ = false;
+  int64_t shown_frame_ = 0;  // The left frame of the pair on screen.
   // Pacing: the wall time at which the pair of time `media_start_s_` was shown.
   std::optional<Clock::time_point> wall_start_;
   double media_start_s_ = 0.0;
