@@ -495,9 +495,10 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
   sub.add_flag("--window", options->window,
                "Show both views side by side with their overlay and a strip chart of the 3D, "
                "each camera's and the out-of-plane angle while tracking (needs a display)");
-  sub.add_flag_callback("--no-pace", [options] { options->pace = false; },
-               "With --window: play recorded inputs as fast as they are tracked instead of at "
-               "their frame rate");
+  sub.add_flag_callback(
+      "--no-pace", [options] { options->pace = false; },
+      "With --window: play recorded inputs as fast as they are tracked instead of at their frame "
+      "rate");
   sub.add_option("--chart-seconds", options->chart_seconds,
                  "With --window: the strip chart's time span, seconds")
       ->capture_default_str()
