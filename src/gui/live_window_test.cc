@@ -534,8 +534,8 @@ class TrackStereoWindowTest : public LiveWindowTest {
     options.frame_count = kFrames;
     options.max_bend_deg = 90.0;
     scene_ = std::make_unique<StereoScene>(MakeStereoRig(), options);
-    // 2 fps: played at its pace, the window is on screen for 6 s, time to press keys (also
-    // under the sanitizers).
+    // 2 fps: played at its pace, the window is on screen for 6 s, time to press keys on a
+    // loaded machine too (the pause ends the wait).
     FrameWriterOptions left_video, right_video;
     left_video.path = (dir_ / "left.avi").string();
     right_video.path = (dir_ / "right.avi").string();
