@@ -3,8 +3,9 @@
 // The program itself (main.cc) is a small launcher that links no OpenCV: `softsight --version`
 // and `softsight --help` answer from this table alone, in a few milliseconds. A command is run
 // by the plugin beside the program that holds it (loaded with dlopen): softsight_commands.so
-// for every command but `live`, softsight_live.so for `live`, the only one that needs the GUI's
-// libraries (highgui and its Qt/GTK and X11), which therefore load only for it.
+// for every command but `live`, softsight_live.so for `live` (and `track-stereo --window`), the
+// only ones that need the GUI's libraries (highgui and its Qt/GTK and X11), which therefore load
+// only for them.
 #pragma once
 
 #include <cstring>
@@ -27,7 +28,8 @@ inline constexpr CommandInfo kCommandTable[] = {
     {"demo", "Render the built-in demo scene, track it and write a CSV (start here)", "commands"},
     {"track", "Track markers in a video or image sequence and write per-frame measurements",
      "commands"},
-    {"track-stereo", "Track markers in two cameras' videos and write 3D positions and angles",
+    {"track-stereo",
+     "Track markers in two cameras' videos and write 3D positions and angles (--window: watch)",
      "commands"},
     {"init", "Find the markers in a frame by themselves and write a config (no GUI)", "commands"},
     {"pick", "Write a config with the colours at given pixels, as clicks in `live` give them",
@@ -53,6 +55,32 @@ inline constexpr CommandInfo kCommandTable[] = {
     {"config", "Print every config key with its default and range (--doc), or check a config",
      "commands"},
 };
+
+// A command that runs in another plugin when given a flag: `track-stereo --window` opens the
+// stereo window, so it runs in the live plugin, which holds a `track-stereo` of its own (the
+// same options and run, with the window).
+struct PluginByFlag {
+  const char* command;
+  const char* flag;
+  const char* plugin;
+};
+inline constexpr PluginByFlag kPluginsByFlag[] = {{"track-stereo", "--window", "live"}};
+
+// The plugin that runs `command` with these arguments (argv as main() got it).
+inline const char* PluginFor(const CommandInfo& command, int argc, char** argv) {
+  for (const PluginByFlag& by_flag : kPluginsByFlag) {
+    if (std::strcmp(by_flag.command, command.name) != 0) continue;
+    const size_t length = std::strlen(by_flag.flag);
+    for (int i = 1; i < argc; ++i) {
+      if (std::strcmp(argv[i], "--") == 0) break;
+      if (std::strncmp(argv[i], by_flag.flag, length) == 0 &&
+          (argv[i][length] == '\0' || argv[i][length] == '=')) {
+        return by_flag.plugin;
+      }
+    }
+  }
+  return command.plugin;
+}
 
 inline const CommandInfo* FindCommand(const char* name) {
   for (const CommandInfo& command : kCommandTable) {

@@ -21,6 +21,9 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub);
 CommandRunner SetupDemoCommand(CLI::App& sub);
 CommandRunner SetupCalibrateCommand(CLI::App& sub);
 CommandRunner SetupTrackStereoCommand(CLI::App& sub);
+// `track-stereo` in the live plugin, where `track-stereo --window` runs (app/command_table.h):
+// the same command, with the stereo window (app/track_stereo_window.cc).
+CommandRunner SetupTrackStereoWindowCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
 CommandRunner SetupCamerasCommand(CLI::App& sub);

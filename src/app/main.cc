@@ -43,8 +43,9 @@ std::vector<std::filesystem::path> PluginCandidates(const char* plugin) {
 }
 
 int RunPlugin(const CommandInfo& command, int argc, char** argv) {
+  const char* plugin_name = PluginFor(command, argc, argv);
   std::string why;
-  for (const std::filesystem::path& path : PluginCandidates(command.plugin)) {
+  for (const std::filesystem::path& path : PluginCandidates(plugin_name)) {
     if (!std::filesystem::exists(path)) continue;
     void* plugin = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (plugin == nullptr) {
@@ -58,9 +59,9 @@ int RunPlugin(const CommandInfo& command, int argc, char** argv) {
     }
     return entry(argc, argv);  // The plugin stays loaded until the process ends.
   }
-  if (why.empty()) why = PluginCandidates(command.plugin).front().string() + " not found";
+  if (why.empty()) why = PluginCandidates(plugin_name).front().string() + " not found";
   std::cerr << "softsight " << command.name << ": error: cannot load the program's "
-            << command.plugin << " plugin: " << EscapeForMessage(why)
+            << plugin_name << " plugin: " << EscapeForMessage(why)
             << " (it is installed beside the softsight program)\n";
   return 1;
 }

@@ -93,6 +93,10 @@ TEST(TrackCommand, LoadsVideoLibrariesButNoneOfTheLiveWindows) {
   EXPECT_THAT(track, ::testing::Not(::testing::HasSubstr("libopencv_highgui")));
   EXPECT_THAT(track, ::testing::Not(::testing::HasSubstr("libQt5Widgets")));
   EXPECT_THAT(loaded("live --help"), ::testing::HasSubstr("libopencv_highgui"));
+  // track-stereo likewise; with --window it runs in the live plugin, which has its window.
+  EXPECT_THAT(loaded("track-stereo --help"),
+              ::testing::Not(::testing::HasSubstr("libopencv_highgui")));
+  EXPECT_THAT(loaded("track-stereo --window --help"), ::testing::HasSubstr("libopencv_highgui"));
 }
 
 // Camera settings with frames from a file: a --camera-* option cannot be carried out and is

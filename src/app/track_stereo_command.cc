@@ -194,11 +194,13 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
 
 // The run on `input`; `bench` is the bench board's frame when already located.
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
-                       std::ostream& report, std::optional<BoardFrame> bench);
+                       std::ostream& report, std::optional<BoardFrame> bench,
+                       const StereoRunHooks& hooks);
 
 }  // namespace
 
-TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report) {
+TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report,
+                                  const StereoRunHooks& hooks) {
   CheckOptions(options);
   // The bench board first: a refusal should not wait for the frame offset to be found.
   std::optional<BoardFrame> bench;
@@ -212,21 +214,22 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
   TrackStereoSummary summary;
   const std::unique_ptr<StereoInput> input = OpenStereoInput(options, summary, report);
   const std::optional<int64_t> offset = summary.frame_offset;
-  summary = Run(options, *input, report, bench);
+  summary = Run(options, *input, report, bench, hooks);
   summary.frame_offset = offset;
   return summary;
 }
 
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
-                                  std::ostream& report) {
+                                  std::ostream& report, const StereoRunHooks& hooks) {
   CheckOptions(options);
-  return Run(options, input, report, std::nullopt);
+  return Run(options, input, report, std::nullopt, hooks);
 }
 
 namespace {
 
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
-                       std::ostream& report, std::optional<BoardFrame> bench) {
+                       std::ostream& report, std::optional<BoardFrame> bench,
+                       const StereoRunHooks& hooks) {
   const TrackingConfig left_config = LoadStereoViewConfig(options.config_file);
   const TrackingConfig right_config =
       options.right_config_file ? LoadStereoViewConfig(*options.right_config_file) : left_config;
@@ -310,18 +313,27 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   bool by_time = false;
   RunSummary run;  // For the stream's end record and its note.
   run.source = input.description();
+  for (StereoSink* sink : hooks.sinks) sink->begin(left_config, right_config);
   try {
     while (!options.max_frames || summary.pairs < *options.max_frames) {
+      if (hooks.stop_requested && hooks.stop_requested()) {
+        summary.stopped = true;
+        break;
+      }
       if (!input.read(pair)) break;
       const StereoFrameResult& result = session.process(pair);
       if (bench) {
         in_board = result;
         ExpressInBoardFrame(*bench, in_board);
       }
-      csv.write(bench ? in_board : result);
+      const StereoFrameResult& row = bench ? in_board : result;
+      csv.write(row);
       if (publish) {
-        columns.append_row(bench ? in_board : result, published_row);
+        columns.append_row(row, published_row);
         publish->publish_row(published_row);
+      }
+      for (StereoSink* sink : hooks.sinks) {
+        sink->consume(pair, row, session.left_result(), session.right_result());
       }
       ++summary.pairs;
       if (result.pair_dt_ms) {
@@ -352,7 +364,8 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   }
   if (publish) {
     run.frames = summary.pairs;
-    run.stop_reason = options.max_frames && summary.pairs >= *options.max_frames
+    run.stop_reason = summary.stopped ? StopReason::kStopRequested
+                      : options.max_frames && summary.pairs >= *options.max_frames
                           ? StopReason::kMaxFrames
                           : StopReason::kEndOfInput;
     publish->end(run);
@@ -379,7 +392,11 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   } else {
     report << " (right frame = left frame + 0)";
   }
-  if (const std::optional<std::string> ended = input.ended_first()) report << "; " << *ended;
+  if (summary.stopped) {
+    report << "; stopped from the window";
+  } else if (const std::optional<std::string> ended = input.ended_first()) {
+    report << "; " << *ended;
+  }
   report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
   for (size_t i = 0; i < names.size(); ++i) {
     report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
@@ -415,6 +432,10 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
 }  // namespace
 
 CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
+  return SetupTrackStereoCommand(sub, nullptr);
+}
+
+CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_window) {
   auto options = std::make_shared<TrackStereoOptions>();
   sub.description(
       "Track the markers in two synchronised videos of a calibrated pair of cameras and write\n"
@@ -433,7 +454,15 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       "--bench-board LEFT RIGHT (one pair of images of the chessboard lying on the bench) puts\n"
       "the 3D coordinates in the board's frame instead of the first camera's:\n"
       "  softsight track-stereo -c markers.yaml --left left.avi --right right.avi "
-      "--stereo stereo.yaml --bench-board bench_left.png bench_right.png --csv run3d.csv");
+      "--stereo stereo.yaml --bench-board bench_left.png bench_right.png --csv run3d.csv\n"
+      "--window shows both views side by side while the CSV is written: each marker's ring (a\n"
+      "red slanted cross with why when it is not found in 3D: epipolar, right_lost ...), the\n"
+      "status of the pair, and a strip chart of the 3D angle beside each camera's own, and of\n"
+      "the out-of-plane angle. Keys: space pause / resume, . one pair (paused), q or Esc stop\n"
+      "(the CSV keeps the pairs so far). Recorded inputs play at their frame rate (--no-pace:\n"
+      "as fast as they are tracked); the window closes at the end of the input:\n"
+      "  softsight track-stereo -c markers.yaml --left-camera 0 --right-camera 2 "
+      "--stereo stereo.yaml --csv live3d.csv --window");
   sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
       ->required()
       ->check(CLI::ExistingFile);
@@ -500,11 +529,34 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
       ->check(NumberIn(1e-3, 1e6));
   sub.add_option("--max-frames", options->max_frames, "Stop after this many pairs")
       ->check(NumberIn(0, 1e15));
+  sub.add_flag("--window", options->window,
+               "Show both views side by side with their overlay and a strip chart of the 3D, "
+               "each camera's and the out-of-plane angle while tracking (needs a display)");
+  sub.add_flag_callback(
+      "--no-pace", [options] { options->pace = false; },
+      "With --window: play recorded inputs as fast as they are tracked instead of at their frame "
+      "rate");
+  sub.add_option("--chart-seconds", options->chart_seconds,
+                 "With --window: the strip chart's time span, seconds")
+      ->capture_default_str()
+      ->check(NumberIn(0.2, 3600));
   auto publish = std::make_shared<PublishArgs>();
   AddPublishOptions(sub, publish.get());
-  return [options, publish] {
+  return [options, publish, open_window] {
     options->publish = publish->resolved();
-    RunTrackStereo(*options, std::cout);
+    if (!options->window) {
+      RunTrackStereo(*options, std::cout);
+      return 0;
+    }
+    if (open_window == nullptr) {
+      // The launcher runs `track-stereo --window` in the live plugin; this one has no GUI.
+      throw InputError("--window: this build's track-stereo has no window (softsight_live.so)");
+    }
+    const StereoWindowRun window = open_window(*options);
+    StereoRunHooks hooks;
+    hooks.sinks = {window.sink.get()};
+    hooks.stop_requested = window.stop_requested;
+    RunTrackStereo(*options, std::cout, hooks);
     return 0;
   };
 }

@@ -4,17 +4,21 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "app/commands.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
 
 class StereoInput;
+class StereoSink;
 struct TrackingConfig;
 
 // One view's marker config (LoadTrackingConfig), every marker ready for a run without the mouse
@@ -59,6 +63,21 @@ struct TrackStereoOptions {
   // --publish: every pair's row (the CSV's columns) to subscribers as it happens
   // (stream/publish_sink.h; topics frame, measure, marker/<name> with <name>_X ... _status).
   std::optional<PublishOptions> publish;
+  // `--window`: both views side by side with their overlay and a strip chart of the 3D angle,
+  // each camera's and the out-of-plane angle, while the CSV is written as without it (the
+  // window runs in the live plugin, app/track_stereo_window.cc). `pace`: recorded inputs play
+  // at their frame rate in it (cameras come at theirs); false: as fast as they are tracked.
+  bool window = false;
+  bool pace = true;
+  double chart_seconds = 10.0;  // The strip chart's time span.
+};
+
+// What a run feeds besides the CSV, and what may end it early: the stereo window.
+struct StereoRunHooks {
+  std::vector<StereoSink*> sinks;  // Not owned; each sees every pair after its CSV row.
+  // Polled before each pair is read: true ends the run there, as the end of the input would
+  // (the window's q, Escape or close). Empty: never.
+  std::function<bool()> stop_requested;
 };
 
 struct TrackStereoSummary {
@@ -74,15 +93,30 @@ struct TrackStereoSummary {
   std::optional<double> max_abs_pair_dt_ms;  // By time: the worst pairing error.
   // With a bench board: its fit's RMS residual (mm), the coordinates in its frame.
   std::optional<double> bench_board_rms_mm;
+  bool stopped = false;  // Ended by StereoRunHooks::stop_requested before the input did.
 };
 
 // Runs the whole job and prints its report. Throws InputError for bad input (config, stereo
 // file, videos, offset, outputs that are inputs), a frame of the wrong size, or an offset that
 // cannot be found (one line: pass --frame-offset).
-TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report);
+TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostream& report,
+                                  const StereoRunHooks& hooks = {});
 // The same on pairs from `input` (any two sources: cameras, stand-ins in tests); the options'
 // inputs, offset and pairing are not used.
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
-                                  std::ostream& report);
+                                  std::ostream& report, const StereoRunHooks& hooks = {});
+
+// The stereo window for a run with --window, and how the run learns that it was closed. Made
+// by the live plugin (the only one that loads the GUI's libraries): `track-stereo --window` runs
+// there (app/command_table.h). Throws InputError when there is no display.
+struct StereoWindowRun {
+  std::unique_ptr<StereoSink> sink;
+  std::function<bool()> stop_requested;
+};
+using StereoWindowOpener = StereoWindowRun (*)(const TrackStereoOptions& options);
+
+// The command line of `track-stereo`; `open_window` makes the window for --window (null: none,
+// the commands plugin).
+CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_window);
 
 }  // namespace softsight

@@ -21,6 +21,7 @@
 #include "softsight/io/csv_reader.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/stereo_session.h"
 #include "softsight/sim/stereo_scene.h"
 
 namespace softsight {
@@ -256,6 +257,89 @@ TEST(TrackStereoSideBySideTest, OneSideBySideVideoGivesTheRowsOfTheTwoVideos) {
   side_by_side.left_input.clear();
   side_by_side.frame_offset = 2;
   EXPECT_THROW(RunTrackStereo(side_by_side, report), InputError);
+}
+
+// What the stereo window (--window) is fed: each pair after its CSV row, as that row has it, with
+// the two halves of a side-by-side video as the views and each view's own tracking; and its stop
+// (q) ends the run after the pairs so far.
+TEST(TrackStereoSinkTest, EachPairReachesTheSinksAsItsRowAndAStopEndsTheRun) {
+  const TempDir dir;
+  StereoSceneOptions options;
+  options.frame_count = 6;
+  const StereoScene scene(MakeStereoRig(), options);
+  WriteRigAndMarkers(dir, scene.rig());
+  std::vector<StereoSceneTruth> truths;
+  {
+    FrameWriterOptions video;
+    video.path = dir.file("both.avi");
+    FrameWriter both(video);
+    cv::Mat l, r, wide;
+    for (int i = 0; i < options.frame_count; ++i) {
+      truths.push_back(scene.render(i, l, r));
+      cv::hconcat(l, r, wide);
+      both.write(wide, i);
+    }
+  }
+  struct Seen : StereoSink {
+    int begun = 0;
+    std::vector<cv::Size> left_sizes, right_sizes;
+    std::vector<std::optional<double>> angles, left_angles;
+    std::vector<std::vector<std::string>> left_markers;
+    std::vector<cv::Point2d> blue_left_px;
+    void begin(const TrackingConfig& left, const TrackingConfig& right) override {
+      begun += left.markers.size() == 3 && right.markers.size() == 3;
+    }
+    void consume(const FramePair& pair, const StereoFrameResult& result, const FrameResult& left,
+                 const FrameResult& right) override {
+      left_sizes.push_back(pair.left.image.size());
+      right_sizes.push_back(pair.right.image.size());
+      angles.push_back(result.shape.angle_deg);
+      left_angles.push_back(left.measurement.angle_deg);
+      std::vector<std::string> names;
+      for (const MarkerObservation& m : left.markers) names.push_back(m.name);
+      left_markers.push_back(names);
+      blue_left_px.push_back(left.markers[1].observation.position_px.value_or(cv::Point2d()));
+      EXPECT_EQ(right.markers.size(), 3u);
+    }
+  } seen;
+  TrackStereoOptions run;
+  run.config_file = dir.file("markers.yaml");
+  run.side_by_side = dir.file("both.avi");
+  run.stereo_file = dir.file("stereo.yaml");
+  run.csv_file = dir.file("run.csv");
+  StereoRunHooks hooks;
+  hooks.sinks = {&seen};
+  std::ostringstream report;
+  const TrackStereoSummary all = RunTrackStereo(run, report, hooks);
+  EXPECT_EQ(all.pairs, options.frame_count);
+  EXPECT_FALSE(all.stopped);
+  EXPECT_EQ(seen.begun, 1);
+  const CsvTable table = ReadCsvTable(run.csv_file);
+  ASSERT_EQ(seen.angles.size(), static_cast<size_t>(options.frame_count));
+  for (int i = 0; i < options.frame_count; ++i) {
+    EXPECT_EQ(seen.left_sizes[i], cv::Size(640, 480));
+    EXPECT_EQ(seen.right_sizes[i], cv::Size(640, 480));
+    ASSERT_TRUE(seen.angles[i]);
+    // The CSV's 4 decimals of the value the sink had.
+    EXPECT_NEAR(*seen.angles[i], *table.values[*table.find("angle_deg")][i], 1e-4) << i;
+    // The left view's own measurement is the row's angle_left_deg.
+    ASSERT_TRUE(seen.left_angles[i]);
+    EXPECT_NEAR(*seen.left_angles[i], *table.values[*table.find("angle_left_deg")][i], 1e-4) << i;
+    EXPECT_EQ(seen.left_markers[i], (std::vector<std::string>{"red", "blue", "green"}));
+    EXPECT_LT(cv::norm(seen.blue_left_px[i] - truths[i].markers[1].left_px), 0.5) << i;
+  }
+
+  // A stop asked for after 3 pairs: 3 rows, said so.
+  Seen stopped;
+  hooks.sinks = {&stopped};
+  hooks.stop_requested = [&stopped] { return stopped.angles.size() >= 3; };
+  run.csv_file = dir.file("stopped.csv");
+  report.str("");
+  const TrackStereoSummary three = RunTrackStereo(run, report, hooks);
+  EXPECT_EQ(three.pairs, 3);
+  EXPECT_TRUE(three.stopped);
+  EXPECT_THAT(report.str(), HasSubstr("stopped from the window"));
+  EXPECT_EQ(ReadRows(run.csv_file).size(), 3u);
 }
 
 // A live camera's stand-in: frame k is the scene at capture time start_ms + k * 1000 / fps,

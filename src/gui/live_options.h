@@ -13,10 +13,11 @@
 
 namespace softsight {
 
-// The scrolling strip chart under the live image: angle, bending distance and arc length.
+// The scrolling strip chart under the live image (the live window: angle, bending distance, arc
+// length and radius; the stereo window: the 3D and each camera's angle, the out-of-plane angle).
 struct StripChartOptions {
   double window_s = 10.0;  // Time span shown, seconds. Longer shows slower trends, less detail.
-  int height_px = 220;     // Height of the whole chart (four lanes) under the image.
+  int height_px = 220;     // Height of the whole chart (all its lanes) under the image.
   bool Check(std::string* error) const;
 };
 

@@ -20,6 +20,8 @@ namespace softsight {
 // True when a window can be opened (an X display answers, or a Wayland socket is named);
 // otherwise false with `why` saying what is missing.
 bool HaveDisplay(std::string* why);
+// The default X screen's size in pixels (XWayland too); empty when no X server answers.
+cv::Size ScreenSize();
 
 struct LiveWindowOptions {
   std::string title = "softsight live";

@@ -24,7 +24,12 @@
 #include "gui/live_view.h"  // StatusBandHeight
 #include "gui/live_test_util.h"
 #include "gui/overlay.h"
+#include "app/stereo_test_util.h"
+#include "calib/stereo_test_util.h"
+#include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
+#include "softsight/io/frame_writer.h"
+#include "softsight/sim/stereo_scene.h"
 #include "softsight/io/csv_reader.h"
 #include "softsight/sim/scene.h"
 
@@ -515,6 +520,131 @@ TEST_F(LiveWindowTest, PlotCommandWritesTheFigure) {
       RunProcess({binary_, "plot", (dir_ / "missing.csv").string(), "-o", "x.png"}, {}, &output),
       2);
   EXPECT_NE(output.find("missing.csv"), std::string::npos) << output;
+}
+
+// `track-stereo --window` on a pair of rendered videos: both views side by side with their
+// overlay on the real screen, space pauses (the run waits), q stops; at the end of the input or
+// --max-frames the window closes by itself, and the CSV is the one written without the window.
+class TrackStereoWindowTest : public LiveWindowTest {
+ protected:
+  static constexpr int kFrames = 12;
+  void SetUp() override {
+    LiveWindowTest::SetUp();
+    StereoSceneOptions options;
+    options.frame_count = kFrames;
+    options.max_bend_deg = 90.0;
+    scene_ = std::make_unique<StereoScene>(MakeStereoRig(), options);
+    // 2 fps: played at its pace, the window is on screen for 6 s, time to press keys on a
+    // loaded machine too (the pause ends the wait).
+    FrameWriterOptions left_video, right_video;
+    left_video.path = (dir_ / "left.avi").string();
+    right_video.path = (dir_ / "right.avi").string();
+    left_video.fps = right_video.fps = 2.0;
+    FrameWriter left_writer(left_video), right_writer(right_video);
+    cv::Mat left, right;
+    for (int i = 0; i < kFrames; ++i) {
+      truths_.push_back(scene_->render(i, left, right));
+      left_writer.write(left, i);
+      right_writer.write(right, i);
+    }
+    left_writer.close();
+    right_writer.close();
+    StereoCalibrationResult rig;
+    rig.stereo = testing::CalibrationOfRig(scene_->rig());
+    SaveStereoCalibration(rig, ChessboardSpec{}, (dir_ / "stereo.yaml").string());
+    std::ofstream((dir_ / "markers.yaml").string()) << testing::StereoMarkersYaml();
+  }
+  std::vector<std::string> Command(const std::string& csv) const {
+    return {binary_,          "track-stereo",  "-c",
+            (dir_ / "markers.yaml").string(), "--left", (dir_ / "left.avi").string(),
+            "--right",        (dir_ / "right.avi").string(), "--stereo",
+            (dir_ / "stereo.yaml").string(),  "--frame-offset", "0",
+            "--csv",          (dir_ / csv).string()};
+  }
+  // The CSV's rows without proc_ms (the last column: timing).
+  std::vector<std::string> Rows(const std::string& csv) const {
+    std::ifstream in(dir_ / csv);
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line.substr(0, line.rfind(',')));
+    return rows;
+  }
+  std::unique_ptr<StereoScene> scene_;
+  std::vector<StereoSceneTruth> truths_;
+};
+
+TEST_F(TrackStereoWindowTest, ClosesByItselfAtTheEndOrMaxFramesWithTheSameCsvAsWithout) {
+  std::string output;
+  ASSERT_EQ(RunProcess(Command("plain.csv"), {}, &output), 0) << output;
+  const std::vector<std::string> plain = Rows("plain.csv");
+  ASSERT_EQ(plain.size(), kFrames + 1u) << output;
+
+  // A screen tall enough for two 640x480 views, the status band and the chart at full size.
+  const std::string display = StartXvfb("1400x900x24");
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  // To the end of the input, unpaced: the window closes by itself, the CSV is the same.
+  output.clear();
+  std::vector<std::string> windowed = Command("window.csv");
+  windowed.insert(windowed.end(), {"--window", "--no-pace"});
+  ASSERT_EQ(RunProcess(windowed, env, &output), 0) << output;
+  EXPECT_NE(output.find("12 pairs of frames"), std::string::npos) << output;
+  EXPECT_EQ(Rows("window.csv"), plain);
+  // --max-frames: as many rows, the first ones.
+  output.clear();
+  windowed = Command("max.csv");
+  windowed.insert(windowed.end(), {"--window", "--no-pace", "--max-frames", "5"});
+  ASSERT_EQ(RunProcess(windowed, env, &output), 0) << output;
+  EXPECT_EQ(Rows("max.csv"), std::vector<std::string>(plain.begin(), plain.begin() + 6));
+}
+
+TEST_F(TrackStereoWindowTest, BothViewsOnScreenAndSpacePausesAndQStops) {
+  const std::string display = StartXvfb("1400x900x24");
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  // Paced at 2 fps: pause once the window is up, look at it, then stop it with q.
+  std::vector<std::string> paced = Command("stopped.csv");
+  paced.push_back("--window");
+  live_ = Spawn(paced, env, true);
+  ASSERT_GT(live_.pid, 0);
+  std::string output, xdotool_output;
+  ASSERT_EQ(RunProcess({"xdotool", "search", "--sync", "--onlyvisible", "--name",
+                        "softsight track-stereo", "windowfocus", "--sync", "key", "space"},
+                       env, &xdotool_output),
+            0)
+      << xdotool_output;
+  ASSERT_TRUE(WaitForOutput(live_, "window: paused at frame ", 20s, &output)) << output;
+  const size_t at = output.find("window: paused at frame ") + 24;
+  const int paused = std::stoi(output.substr(at));
+  ASSERT_GE(paused, 0);
+  ASSERT_LT(paused, kFrames) << "ended before the pause";
+  std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
+  const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+  ASSERT_FALSE(screen.empty()) << "cannot read Xvfb's screen file";
+  // The window at the screen's top-left (no window manager), the views at full size side by
+  // side: each marker's ring around its true position in each view of the paused pair.
+  for (const StereoMarkerTruth& m : truths_[paused].markers) {
+    EXPECT_GE(RingPoints(screen, m.left_px), 20) << m.name << " left, frame " << paused;
+    EXPECT_GE(RingPoints(screen, m.right_px + cv::Point2d(640, 0)), 20)
+        << m.name << " right, frame " << paused;
+  }
+  // The chart under the views: its dark background.
+  EXPECT_LT(cv::mean(screen(cv::Rect(0, 480 + StatusBandHeight(), 1280, 200)))[0], 70);
+  // Paused, the run waited: q stops it after the pair on screen.
+  ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &xdotool_output), 0) << xdotool_output;
+  WaitForOutput(live_, "stopped from the window", 20s, &output);
+  EXPECT_EQ(WaitExit(live_, 20s), 0) << output;
+  EXPECT_NE(output.find("stopped from the window"), std::string::npos) << output;
+  // The rows up to the pair paused on, each pair's frames, all markers found in 3D.
+  const std::vector<std::map<std::string, std::string>> rows =
+      testing::ReadRows((dir_ / "stopped.csv").string());
+  ASSERT_EQ(rows.size(), paused + 1u);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].at("frame"), std::to_string(i));
+    EXPECT_EQ(rows[i].at("right_frame"), std::to_string(i));
+    for (const char* marker : {"red", "blue", "green"}) {
+      EXPECT_EQ(rows[i].at(std::string(marker) + "_status"), "found") << marker << " " << i;
+    }
+  }
 }
 
 }  // namespace

@@ -127,9 +127,18 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
   const Measurement& m = result.measurement;
 
   // The text block first, so that markers moving under it stay visible.
-  std::string lost;
-  for (const MarkerObservation& marker : result.markers) {
-    if (!marker.observation.found()) lost += (lost.empty() ? "" : ", ") + marker.name;
+  std::string lost, refused;
+  const auto refusal = [&](size_t index) -> const std::string* {
+    return index < status.refused.size() && !status.refused[index].empty() ? &status.refused[index]
+                                                                           : nullptr;
+  };
+  for (size_t i = 0; i < result.markers.size(); ++i) {
+    const MarkerObservation& marker = result.markers[i];
+    if (!marker.observation.found()) {
+      lost += (lost.empty() ? "" : ", ") + marker.name;
+    } else if (const std::string* why = refusal(i)) {
+      refused += (refused.empty() ? "" : ", ") + marker.name + " (" + *why + ")";
+    }
   }
   if (options.show_measurements) {
     std::vector<std::pair<std::string, cv::Scalar>> lines;
@@ -170,6 +179,7 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
       lines.emplace_back(buffer, overlay_colour::kLost);
     }
     if (!lost.empty()) lines.emplace_back("LOST: " + lost, overlay_colour::kLost);
+    if (!refused.empty()) lines.emplace_back("NOT BELIEVED: " + refused, overlay_colour::kLost);
     for (const std::string& note : status.notes) lines.emplace_back(note, overlay_colour::kText);
 
     // Darken the block behind the text so it reads on any background.
@@ -215,6 +225,20 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
     if (!marker.observation.found()) continue;
     const cv::Point2d p = *marker.observation.position_px;
     const int r = options.marker_ring_px;
+    const size_t index = static_cast<size_t>(&marker - result.markers.data());
+    if (const std::string* why = refusal(index)) {
+      // Found here, not believed: the lost colour, a slanted cross through a thin ring, and why.
+      cv::circle(frame_bgr, Fixed(p), r << kSubPixelShift, overlay_colour::kLost, 1, cv::LINE_AA,
+                 kSubPixelShift);
+      const cv::Point2d d(r * 0.7, r * 0.7), e(r * 0.7, -r * 0.7);
+      cv::line(frame_bgr, Fixed(p - d), Fixed(p + d), overlay_colour::kLost, ring_thickness,
+               cv::LINE_AA, kSubPixelShift);
+      cv::line(frame_bgr, Fixed(p - e), Fixed(p + e), overlay_colour::kLost, ring_thickness,
+               cv::LINE_AA, kSubPixelShift);
+      OutlinedText(frame_bgr, marker.name + ": " + *why,
+                   cv::Point(cvRound(p.x) + r + 3, cvRound(p.y) - r), scale, overlay_colour::kLost);
+      continue;
+    }
     cv::circle(frame_bgr, Fixed(p), r << kSubPixelShift, overlay_colour::kMarker, ring_thickness,
                cv::LINE_AA, kSubPixelShift);
     const cv::Point2d dx(r / 2.0, 0), dy(0, r / 2.0);
@@ -226,7 +250,6 @@ void DrawOverlay(cv::Mat& frame_bgr, const FrameResult& result, const OverlayOpt
                  overlay_colour::kMarker);
     // A template marker: the template's box where it matched, and the match's score (the
     // paper's display of SAD, SSD and ZNCC).
-    const size_t index = static_cast<size_t>(&marker - result.markers.data());
     if (index < status.template_boxes.size() && status.template_boxes[index]) {
       const OverlayStatus::TemplateBox& box = *status.template_boxes[index];
       const cv::Point2d half(box.size_px.width / 2.0, box.size_px.height / 2.0);

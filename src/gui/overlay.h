@@ -60,6 +60,11 @@ struct OverlayStatus {
     std::string method;  // "sad", "ssd", "zncc".
   };
   std::vector<std::optional<TemplateBox>> template_boxes;
+  // Markers this view found but that are not believed (by index in result.markers; empty
+  // entries and missing ones: believed), with why: the stereo window's markers not found in 3D
+  // ("epipolar", "right_lost", ...). Each is drawn in the lost colour with a slanted cross and
+  // its reason instead of the found marker's ring, and listed as not believed in the text block.
+  std::vector<std::string> refused;
 };
 
 // True when the radius is too large against the arc length to be told from a straight

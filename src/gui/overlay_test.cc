@@ -180,6 +180,35 @@ TEST(DrawOverlayTest, LostMarkerIsFlaggedInRedAndNotDrawn) {
   EXPECT_FALSE(ColourWithin(frame, OnCircle(centre, 80, 340), overlay_colour::kMarker, 13));
 }
 
+TEST(DrawOverlayTest, AFoundMarkerNotBelievedIsCrossedOutInRedWithWhy) {
+  // The stereo window: blue was found in this view but its pair failed the epipolar check.
+  cv::Mat frame(320, 320, CV_8UC3, cv::Scalar(90, 90, 90));
+  const FrameResult result = ThreeMarkers(true);
+  OverlayStatus status;
+  status.refused = {"", "epipolar"};  // Missing entries (green): believed.
+  OverlayOptions options = Triple();
+  options.show_measurements = false;
+  DrawOverlay(frame, result, options, status);
+  const cv::Point2d blue = *result.markers[1].observation.position_px;
+  int yellow_ring = 0;
+  for (double deg = 0; deg < 360; deg += 30) {
+    yellow_ring += ColourWithin(frame, OnCircle(blue, 12, deg), overlay_colour::kMarker, 1);
+    EXPECT_TRUE(ColourWithin(frame, OnCircle(blue, 12, deg), overlay_colour::kLost, 1)) << deg;
+  }
+  EXPECT_EQ(yellow_ring, 0) << "drawn as found";
+  // The slanted cross through the centroid, and the reason beside it.
+  EXPECT_TRUE(ColourWithin(frame, blue + cv::Point2d(5, 5), overlay_colour::kLost, 1));
+  EXPECT_TRUE(ColourWithin(frame, blue + cv::Point2d(-5, 5), overlay_colour::kLost, 1));
+  EXPECT_GT(CountColour(frame(cv::Rect(cvRound(blue.x) + 15, cvRound(blue.y) - 30, 120, 25)),
+                        overlay_colour::kLost, 60),
+            30);
+  // The believed markers keep their yellow rings.
+  for (int i : {0, 2}) {
+    EXPECT_TRUE(ColourWithin(frame, OnCircle(*result.markers[i].observation.position_px, 12, 90),
+                             overlay_colour::kMarker, 1));
+  }
+}
+
 TEST(DrawOverlayTest, OptionsCheckNamesTheField) {
   OverlayOptions options;
   std::string error;
@@ -277,6 +306,39 @@ TEST(StripChartTest, ValueLabelsAreNotClippedWhateverTheirWidth) {
       EXPECT_LE(text.y + text.height, area.rows);
     }
   }
+}
+
+TEST(StripChartTest, LanesOfSeveralCurvesShareTheirAxis) {
+  // The stereo window's chart: the 3D angle with each camera's, then the out-of-plane angle.
+  const cv::Scalar a3d(255, 255, 255), left(0, 200, 0), right(200, 0, 200), tilt(0, 140, 255);
+  StripChart chart(StripChartOptions{.window_s = 10.0, .height_px = 160},
+                   {{"angle", "deg", {{"3D", a3d}, {"left", left}, {"right", right}}, false},
+                    {"out of plane", "deg", {{"", tilt}}, false}});
+  ASSERT_EQ(chart.lane_count(), 2);
+  for (int i = 0; i < 60; ++i) {
+    const double t = i / 10.0;
+    // Each camera sees the bend foreshortened; the right camera lost a marker for 2..3 s.
+    chart.add(t, {60.0 + 5 * t, 50.0 + 5 * t, (t >= 2 && t < 3) ? std::nullopt
+                                                                  : std::optional(40.0 + 5 * t),
+                  20.0 + 2 * t});
+  }
+  cv::Mat area(160, 500, CV_8UC3);
+  chart.draw(area);
+  EXPECT_EQ(chart.lane(0).label, "angle [deg]");
+  EXPECT_EQ(chart.lane(1).label, "out of plane [deg]");
+  // One axis for the three curves: all of them inside it.
+  EXPECT_LE(chart.lane(0).y_min, 40.0);
+  EXPECT_GE(chart.lane(0).y_max, 60.0 + 5 * 5.9);
+  EXPECT_EQ(chart.newest(0), 60.0 + 5 * 5.9);
+  EXPECT_EQ(chart.newest(3), 20.0 + 2 * 5.9);
+  for (double t : {1.0, 4.0, 5.5}) {
+    EXPECT_TRUE(ColourWithin(area, {chart.x_of(t), chart.y_of(0, 60.0 + 5 * t)}, a3d, 1)) << t;
+    EXPECT_TRUE(ColourWithin(area, {chart.x_of(t), chart.y_of(0, 50.0 + 5 * t)}, left, 1)) << t;
+    EXPECT_TRUE(ColourWithin(area, {chart.x_of(t), chart.y_of(0, 40.0 + 5 * t)}, right, 1)) << t;
+    EXPECT_TRUE(ColourWithin(area, {chart.x_of(t), chart.y_of(1, 20.0 + 2 * t)}, tilt, 1)) << t;
+  }
+  // The right camera's gap stays a gap.
+  EXPECT_FALSE(ColourWithin(area, {chart.x_of(2.5), chart.y_of(0, 40.0 + 5 * 2.5)}, right, 2));
 }
 
 TEST(DrawOverlayTest, TheTextNamesTheFrameAndItsTime) {

@@ -39,26 +39,49 @@ bool StripChartOptions::Check(std::string* error) const {
   return true;
 }
 
-StripChart::StripChart(StripChartOptions options) : options_(options) {
+StripChart::StripChart(StripChartOptions options)
+    : StripChart(options, {{"angle", "deg", {{"", kColours[0]}}, false},
+                           {"bending dist", "px", {{"", kColours[1]}}, true},
+                           {"arc length", "px", {{"", kColours[2]}}, true},
+                           {"radius", "px", {{"", kColours[3]}}, true}}) {}
+
+StripChart::StripChart(StripChartOptions options, std::vector<LaneSpec> lanes)
+    : options_(options), specs_(std::move(lanes)) {
   std::string error;
   CV_Assert(options_.Check(&error));
+  int series = 0;
+  for (const LaneSpec& lane : specs_) {
+    CV_Assert(!lane.series.empty());
+    first_series_.push_back(series);
+    series += static_cast<int>(lane.series.size());
+  }
+  CV_Assert(!specs_.empty() && series <= static_cast<int>(kMaxSeries));
+  lanes_.resize(specs_.size());
 }
 
 void StripChart::add(const FrameResult& result) {
-  if (!samples_.empty() && result.time_s < samples_.back().time_s) samples_.clear();
-  if (!samples_.empty() && result.time_s == samples_.back().time_s) samples_.pop_back();
   const Measurement& m = result.measurement;
   const bool metric = m.tip_disp_mm.has_value() || m.arc_length_mm.has_value();
   // A radius too large to tell from straight is a gap, as the overlay reads it "straight": its
   // thousands of px would flatten the lane.
   std::optional<double> radius = metric ? m.radius_mm : m.radius_px;
   if (ReadsStraight(m)) radius.reset();
-  Sample sample{result.time_s,
-                {m.angle_deg, metric ? m.tip_disp_mm : m.tip_disp_px,
-                 metric ? m.arc_length_mm : m.arc_length_px, radius},
-                metric};
-  samples_.push_back(sample);
-  while (!samples_.empty() && samples_.front().time_s < result.time_s - options_.window_s) {
+  add(result.time_s,
+      {m.angle_deg, metric ? m.tip_disp_mm : m.tip_disp_px,
+       metric ? m.arc_length_mm : m.arc_length_px, radius},
+      metric);
+}
+
+void StripChart::add(double time_s, std::initializer_list<std::optional<double>> values,
+                     bool metric) {
+  CV_Assert(values.size() <= kMaxSeries);
+  if (!samples_.empty() && time_s < samples_.back().time_s) samples_.clear();
+  if (!samples_.empty() && time_s == samples_.back().time_s) samples_.pop_back();
+  Sample& sample = samples_.emplace_back();
+  sample.time_s = time_s;
+  sample.metric = metric;
+  std::copy(values.begin(), values.end(), sample.values.begin());
+  while (!samples_.empty() && samples_.front().time_s < time_s - options_.window_s) {
     samples_.pop_front();
   }
 }
@@ -66,34 +89,42 @@ void StripChart::add(const FrameResult& result) {
 void StripChart::clear() { samples_.clear(); }
 
 double StripChart::x_of(double time_s) const {
-  return x_left_ + (time_s - (t_right_ - options_.window_s)) / options_.window_s * x_width_;
+  // The newest sample on the lane's last column (x_left_ + x_width_ is past it: clipped).
+  return x_left_ +
+         (time_s - (t_right_ - options_.window_s)) / options_.window_s * (x_width_ - 1);
+}
+
+double StripChart::y_of(int i, double value) const {
+  const Lane& lane = lanes_[i];
+  return lane.rect.y + (lane.y_max - value) / (lane.y_max - lane.y_min) * (lane.rect.height - 1);
 }
 
 void StripChart::draw(cv::Mat& area) const {
   CV_Assert(area.type() == CV_8UC3);
   area.setTo(kBackground);
   const bool metric = !samples_.empty() && samples_.back().metric;
-  const char* unit = metric ? "mm" : "px";
-  const std::string names[kLanes] = {"angle [deg]", std::string("bending dist [") + unit + "]",
-                                     std::string("arc length [") + unit + "]",
-                                     std::string("radius [") + unit + "]"};
-  const int lane_height = area.rows / kLanes;
+  const int lanes = lane_count();
+  const int lane_height = area.rows / lanes;
   t_right_ = samples_.empty() ? 0.0 : samples_.back().time_s;
 
   // The value ranges and tick labels of all lanes first: the left margin is as wide as the
   // widest label (a 5-digit arc length or a negative distance is not cut off).
-  std::vector<double> ticks[kLanes];
-  std::vector<std::string> tick_text[kLanes];
+  std::vector<std::vector<double>> ticks(lanes);
+  std::vector<std::vector<std::string>> tick_text(lanes);
   int label_width = 0, baseline = 0;
   const int text_height = cv::getTextSize("0", kGuiFont, kFontScale, 1, &baseline).height;
-  for (int i = 0; i < kLanes; ++i) {
+  for (int i = 0; i < lanes; ++i) {
+    const LaneSpec& spec = specs_[i];
     Lane& lane = lanes_[i];
-    lane.label = names[i];
+    lane.label = spec.name + " [" + (spec.length && metric ? "mm" : spec.unit) + "]";
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    const int first = first_series_[i], end = first + static_cast<int>(spec.series.size());
     for (const Sample& s : samples_) {
-      if (s.values[i]) {
-        lo = std::min(lo, *s.values[i]);
-        hi = std::max(hi, *s.values[i]);
+      for (int k = first; k < end; ++k) {
+        if (s.values[k]) {
+          lo = std::min(lo, *s.values[k]);
+          hi = std::max(hi, *s.values[k]);
+        }
       }
     }
     if (lo > hi) {
@@ -125,17 +156,16 @@ void StripChart::draw(cv::Mat& area) const {
   x_width_ = std::max(1, area.cols - left - kRight);
 
   std::vector<cv::Point> run;
-  for (int i = 0; i < kLanes; ++i) {
+  for (int i = 0; i < lanes; ++i) {
+    const LaneSpec& spec = specs_[i];
     Lane& lane = lanes_[i];
     lane.rect = cv::Rect(left, i * lane_height + 3, static_cast<int>(x_width_), lane_height - 6);
-    const double lo = lane.y_min, hi = lane.y_max;
     const cv::Rect& r = lane.rect;
-    auto y_of = [&](double v) { return r.y + (hi - v) / (hi - lo) * (r.height - 1); };
 
     cv::rectangle(area, r, kGridColour, 1);
     lane.tick_labels.clear();
     for (size_t k = 0; k < ticks[i].size(); ++k) {
-      const int y = cvRound(y_of(ticks[i][k]));
+      const int y = cvRound(y_of(i, ticks[i][k]));
       cv::line(area, {r.x, y}, {r.x + r.width - 1, y}, kGridColour, 1);
       // Centred on its grid line, but kept inside the lane (a tick at the lane's edge).
       const int text_y = std::clamp(y + text_height / 2, r.y + text_height, r.y + r.height - 1);
@@ -145,38 +175,56 @@ void StripChart::draw(cv::Mat& area) const {
                   cv::LINE_AA);
       lane.tick_labels.emplace_back(text_x, text_y - text_height, width, text_height + baseline);
     }
-    // Current value in the lane's label, so the chart reads without the overlay.
-    std::string label = names[i];
-    if (!samples_.empty()) {
-      char value[32];
-      if (samples_.back().values[i]) {
-        std::snprintf(value, sizeof(value), "  %.1f", *samples_.back().values[i]);
-      } else {
-        std::snprintf(value, sizeof(value), "  --");
+    // Current values in the lane's label, so the chart reads without the overlay: after the
+    // label, each curve's (named when the lane has several) in its colour.
+    const int first = first_series_[i];
+    const int count = static_cast<int>(spec.series.size());
+    cv::Point at(r.x + 6, r.y + 14);
+    for (int k = 0; k < count; ++k) {
+      std::string text = k == 0 ? lane.label : "";
+      if (!samples_.empty()) {
+        char value[32];
+        const std::optional<double>& v = samples_.back().values[first + k];
+        if (v) {
+          std::snprintf(value, sizeof(value), "%.1f", *v);
+        } else {
+          std::snprintf(value, sizeof(value), "--");
+        }
+        text += "  ";
+        if (count > 1) text += spec.series[k].name + " ";
+        text += value;
+      } else if (count > 1) {
+        text += "  " + spec.series[k].name;
       }
-      label += value;
+      cv::putText(area, text, at, kGuiFont, kFontScale, spec.series[k].colour, 1, cv::LINE_AA);
+      at.x += cv::getTextSize(text, kGuiFont, kFontScale, 1, &baseline).width;
     }
-    cv::putText(area, label, {r.x + 6, r.y + 14}, kGuiFont, kFontScale, kColours[i], 1, cv::LINE_AA);
 
     cv::Mat lane_area = area(r);
-    run.clear();
-    auto flush = [&] {
-      if (run.size() == 1) {
-        cv::circle(lane_area, run[0], 2 << kSubPixelShift, kColours[i], cv::FILLED, cv::LINE_AA, kSubPixelShift);
-      } else if (run.size() > 1) {
-        cv::polylines(lane_area, run, false, kColours[i], 1, cv::LINE_AA, kSubPixelShift);
-      }
+    // The first curve last, on top of the others.
+    for (int k = count - 1; k >= 0; --k) {
+      const cv::Scalar& colour = spec.series[k].colour;
       run.clear();
-    };
-    for (const Sample& s : samples_) {
-      if (!s.values[i]) {
-        flush();
-        continue;
+      auto flush = [&] {
+        if (run.size() == 1) {
+          cv::circle(lane_area, run[0], 2 << kSubPixelShift, colour, cv::FILLED, cv::LINE_AA,
+                     kSubPixelShift);
+        } else if (run.size() > 1) {
+          cv::polylines(lane_area, run, false, colour, 1, cv::LINE_AA, kSubPixelShift);
+        }
+        run.clear();
+      };
+      for (const Sample& s : samples_) {
+        const std::optional<double>& v = s.values[first + k];
+        if (!v) {
+          flush();
+          continue;
+        }
+        run.emplace_back(cvRound((x_of(s.time_s) - r.x) * (1 << kSubPixelShift)),
+                         cvRound((y_of(i, *v) - r.y) * (1 << kSubPixelShift)));
       }
-      run.emplace_back(cvRound((x_of(s.time_s) - r.x) * (1 << kSubPixelShift)),
-                       cvRound((y_of(*s.values[i]) - r.y) * (1 << kSubPixelShift)));
+      flush();
     }
-    flush();
   }
   char span[32];
   std::snprintf(span, sizeof(span), "last %g s", options_.window_s);

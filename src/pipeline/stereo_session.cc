@@ -96,6 +96,9 @@ struct StereoSession::Impl {
   std::optional<cv::Vec3d> reference_normal;
   std::optional<cv::Point3d> tip_reference;
   StereoFrameResult result;
+  FrameResult no_result;  // The views' results before the first pair.
+  const FrameResult* left_result = &no_result;
+  const FrameResult* right_result = &no_result;
 };
 
 StereoSession::StereoSession(const TrackingConfig& left, const TrackingConfig& right,
@@ -123,6 +126,8 @@ const StereoFrameResult& StereoSession::process(const FramePair& pair) {
   return impl_->result;
 }
 const Triangulator& StereoSession::triangulator() const { return impl_->triangulator; }
+const FrameResult& StereoSession::left_result() const { return *impl_->left_result; }
+const FrameResult& StereoSession::right_result() const { return *impl_->right_result; }
 
 const StereoFrameResult& StereoSession::process(const Frame& left_frame, const Frame& right_frame) {
   Impl& s = *impl_;
@@ -137,6 +142,8 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
   const auto start = std::chrono::steady_clock::now();
   const FrameResult& left = s.left.process(left_frame);
   const FrameResult& right = s.right.process(right_frame);
+  s.left_result = &left;
+  s.right_result = &right;
   StereoFrameResult& out = s.result;
   out.frame_index = left.frame_index;
   out.right_frame_index = right.frame_index;

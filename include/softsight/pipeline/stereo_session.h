@@ -91,10 +91,33 @@ class StereoSession {
   // more than 3 markers; else none).
   std::vector<std::string> segment_names() const;
   const Triangulator& triangulator() const;
+  // Each view's own tracking of the last pair: its markers (in its config's order, raw pixels)
+  // and what that camera alone measures; what the stereo window draws on each view. Empty
+  // before the first pair; valid until the next process().
+  const FrameResult& left_result() const;
+  const FrameResult& right_result() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// Where each pair's results go besides the CSV (the stereo window): a sink only consumes; the
+// data flows one way, pairs -> StereoSession -> every sink, in the order given, from the thread
+// that runs the loop, pair by pair.
+class StereoSink {
+ public:
+  virtual ~StereoSink() = default;
+  // Once, before the first pair: each view's config (the markers an overlay's triangle joins).
+  virtual void begin(const TrackingConfig& left, const TrackingConfig& right) {
+    (void)left;
+    (void)right;
+  }
+  // Every pair tracked, after its CSV row: the frames as read (no overlay), the row's results,
+  // and each view's own tracking (StereoSession::left_result / right_result). May throw
+  // InputError: the run stops with it.
+  virtual void consume(const FramePair& pair, const StereoFrameResult& result,
+                       const FrameResult& left, const FrameResult& right) = 0;
 };
 
 // Expresses a frame's 3D results in a board's frame (calib/board_frame.h) instead of the first
