@@ -11,6 +11,7 @@
 #include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/publish_options.h"
+#include "app/stop_request.h"
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
@@ -393,7 +394,7 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     report << " (right frame = left frame + 0)";
   }
   if (summary.stopped) {
-    report << "; stopped from the window";
+    report << "; " << (hooks.stop_reason ? hooks.stop_reason() : "stopped from the window");
   } else if (const std::optional<std::string> ended = input.ended_first()) {
     report << "; " << *ended;
   }
@@ -544,20 +545,27 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
   AddPublishOptions(sub, publish.get());
   return [options, publish, open_window] {
     options->publish = publish->resolved();
-    if (!options->window) {
-      RunTrackStereo(*options, std::cout);
-      return 0;
-    }
-    if (open_window == nullptr) {
-      // The launcher runs `track-stereo --window` in the live plugin; this one has no GUI.
-      throw InputError("--window: this build's track-stereo has no window (softsight_live.so)");
-    }
-    const StereoWindowRun window = open_window(*options);
+    // Ctrl-C or SIGTERM ends the run between pairs with every row written and the summary;
+    // the exit code then says so (130 / 143).
+    const StopRequest stop;
     StereoRunHooks hooks;
-    hooks.sinks = {window.sink.get()};
-    hooks.stop_requested = window.stop_requested;
+    hooks.stop_reason = [&stop]() -> std::string {
+      return stop.signal() != 0 ? StopSignalReason(stop.signal()) : "stopped from the window";
+    };
+    std::optional<StereoWindowRun> window;
+    if (options->window) {
+      if (open_window == nullptr) {
+        // The launcher runs `track-stereo --window` in the live plugin; this one has no GUI.
+        throw InputError("--window: this build's track-stereo has no window (softsight_live.so)");
+      }
+      window = open_window(*options);
+      hooks.sinks = {window->sink.get()};
+    }
+    hooks.stop_requested = [&stop, &window] {
+      return stop.requested() || (window && window->stop_requested && window->stop_requested());
+    };
     RunTrackStereo(*options, std::cout, hooks);
-    return 0;
+    return ExitCodeAfterStop(0);
   };
 }
 

@@ -76,8 +76,11 @@ struct TrackStereoOptions {
 struct StereoRunHooks {
   std::vector<StereoSink*> sinks;  // Not owned; each sees every pair after its CSV row.
   // Polled before each pair is read: true ends the run there, as the end of the input would
-  // (the window's q, Escape or close). Empty: never.
+  // (the window's q, Escape or close; Ctrl-C). Empty: never.
   std::function<bool()> stop_requested;
+  // What stopped it, for the summary line ("stopped by Ctrl-C (SIGINT)"). Empty: "stopped from
+  // the window".
+  std::function<std::string()> stop_reason;
 };
 
 struct TrackStereoSummary {

@@ -16,6 +16,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "app/program_test_util.h"
 #include "app/scene_markers_test_util.h"
 #include "app/stereo_test_util.h"
 #include "app/track_stereo_command.h"
@@ -513,6 +514,29 @@ TEST_F(TrackStereoCommandTest, ABenchBoardImageWithoutTheBoardIsRefusedNamingThe
         }
       },
       InputError);
+}
+
+// Ctrl-C between pairs: every row written is whole, the summary says why it stopped, and the
+// exit code is 130 (128 + SIGINT), as for `track`. The built-in scene in both views gives 300
+// pairs (its markers fail the epipolar check there, but every pair still gets its row).
+TEST_F(TrackStereoCommandTest, CtrlCStopsBetweenPairsWithEveryRowCompleteAndExitCode130) {
+  const std::string csv = dir_->file("interrupted.csv");
+  const int status = testing::RunAndSignalOnceRowsAreWritten(
+      "track-stereo -c " + dir_->file("markers.yaml") +
+          " --left synth:bending --right synth:bending --frame-offset 0 --stereo " +
+          dir_->file("stereo.yaml") + " --csv " + csv + " > " + dir_->file("interrupted.txt"),
+      csv, 6, SIGINT, dir_->file("interrupted_err.txt"));
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly";
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_THAT(testing::ReadTextFile(dir_->file("interrupted.txt")),
+              HasSubstr("stopped by Ctrl-C (SIGINT)"));
+  const std::vector<std::string> lines = testing::ReadLines(csv);
+  ASSERT_GE(lines.size(), 6u);
+  ASSERT_LT(lines.size(), 301u) << "the run ended before the interrupt arrived";
+  const size_t columns = testing::SplitCsv(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i) {
+    EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << "row " << i;
+  }
 }
 
 TEST_F(TrackStereoCommandTest, BadInputIsOneLineNamingTheCulprit) {
