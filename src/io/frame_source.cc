@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <string_view>
+#include <thread>
 #include <variant>
 #include <vector>
 
@@ -123,7 +124,13 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
-    key_frames_ = std::make_unique<KeyFrameIndex>(path, IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC)));
+    const bool intra_only = IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
+    key_frames_ = std::make_unique<KeyFrameIndex>(path, intra_only);
+    // OpenCV gives FFmpeg's decoder one thread per processor (4.6's API does not say how many).
+    if (!intra_only) {
+      decoder_lag_frames_ =
+          std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
+    }
   }
 
   bool read(Frame& frame) override {
@@ -222,8 +229,11 @@ class VideoFileSource : public FrameSource {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
-        // in every frame decoded from this one, silently, until the next key frame.
-        suspect_until_ = std::max(suspect_until_, key_frames_->next_after(index));
+        // in every frame decoded from the damaged one, silently, until the next key frame; and
+        // its frame threads decode up to decoder_lag_frames_ frames past the one read() returns
+        // and complain from there, so the damaged frame is this one or one of those.
+        suspect_until_ =
+            std::max(suspect_until_, key_frames_->next_after(index + decoder_lag_frames_));
         continue;
       }
       if (index < suspect_until_) {
@@ -275,6 +285,10 @@ class VideoFileSource : public FrameSource {
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
   std::unique_ptr<KeyFrameIndex> key_frames_;
+  // How many frames a predicting codec's frame threads may be decoding past the one read()
+  // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
+  // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).
+  int64_t decoder_lag_frames_ = 0;
   int64_t suspect_until_ = 0;           // Frames before this index follow a damaged one.
   int64_t predicted_from_damaged_ = 0;  // Left out for that reason.
   double last_time_s_ = -1.0;

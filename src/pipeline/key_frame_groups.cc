@@ -14,6 +14,10 @@ constexpr double kMinJumpPx = 3.0;
 constexpr double kNoiseFactor = 6.0;
 // The jump back at the key frame must undo the earlier one to within this share of its size.
 constexpr double kUndoTolerance = 0.5;
+// A group's track starts at the marker's last believed position when it is in one of this many
+// frames handed on last (a marker hidden for a frame or two still ties the group to its past;
+// frames the decoder left out do not count).
+constexpr int kAnchorFrames = 3;
 
 double MedianOf(std::vector<double>& values) {
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -73,9 +77,16 @@ void KeyFrameGroups::remember(const FrameResult& result) {
   if (tail_.size() < result.markers.size()) tail_.resize(result.markers.size());
   for (size_t m = 0; m < result.markers.size(); ++m) {
     const Observation& o = result.markers[m].observation;
-    tail_[m] = o.found() ? std::optional<Anchor>(Anchor{result.frame_index, *o.position_px})
-                         : std::nullopt;
+    if (o.found()) {
+      tail_[m] = Anchor{result.frame_index, *o.position_px, 1};
+    } else if (tail_[m] && ++tail_[m]->frames_since > kAnchorFrames) {
+      tail_[m].reset();
+    }
   }
+}
+
+const KeyFrameGroups::Anchor* KeyFrameGroups::anchor(size_t m) const {
+  return m < tail_.size() && tail_[m] ? &*tail_[m] : nullptr;
 }
 
 // The marker's track through the held group: its position in the frame before the group (when
@@ -86,9 +97,10 @@ void KeyFrameGroups::remember(const FrameResult& result) {
 std::optional<double> KeyFrameGroups::track(size_t m, const Observation* key, int64_t key_index) {
   indices_.clear();
   points_.clear();
-  if (m < tail_.size() && tail_[m]) {
-    indices_.push_back(tail_[m]->index);
-    points_.push_back(tail_[m]->px);
+  const Anchor* before = anchor(m);
+  if (before) {
+    indices_.push_back(before->index);
+    points_.push_back(before->px);
   }
   for (size_t i = 0; i < count_; ++i) {
     const Observation& o = held_[i].result.markers[m].observation;
@@ -159,14 +171,24 @@ void KeyFrameGroups::check(const FrameResult& next) {
         onset = k;
       }
     }
-    if (!onset) continue;  // A real change of motion at the key frame (a bounce): believed.
-    demote_from(m, indices_[*onset]);
+    if (onset) {
+      demote_from(m, indices_[*onset]);
+      continue;
+    }
+    // A group that jumps away from the marker's past at its own key frame and back at the next
+    // one is the picture of a damaged key frame, even when the damage also changed how the
+    // marker moves in it (so the jumps do not cancel). Real motion does not jump exactly at
+    // two key frames in a row; a single change of motion at a key frame (a bounce) is believed.
+    const bool entered_at_key_frame =
+        anchor(m) != nullptr && indices_[1] == held_[0].result.frame_index;
+    if (entered_at_key_frame && cv::norm(residuals_[1]) > *threshold) {
+      demote_from(m, std::numeric_limits<int64_t>::min());
+    }
   }
 }
 
 void KeyFrameGroups::check_unverified(size_t m) {
-  const bool anchored = m < tail_.size() && tail_[m];
-  if (!anchored) {
+  if (!anchor(m)) {
     // Not in the frame before the group (or not believed there), and not at the key frame after
     // it: nothing ties the group's positions to the marker's (a key frame the damage moved it
     // in, or the group after such a group).

@@ -15,15 +15,24 @@
 // Frames of a camera, an image sequence or an intra-only video are all key frames: they pass
 // straight through.
 //
-// When the key frame cannot vouch for a marker (its tracker refused what it saw there, or the
-// marker is not there), a jump in the group is not believed either, from the jump on; and a
-// marker not found (or not believed) in the frame before the group and not found at the key
-// frame after it is not believed anywhere in the group (nothing ties those positions to the marker: a key frame the
-// damage moved it in). The last group of a run that ended with damage (the decoder reported it,
-// the file was cut) is checked the same way, as no key frame follows it.
+// A damaged key frame can also change how the marker moves through its group (the predicted
+// frames carry the damage on with their own motion), so the jump back at the next key frame
+// does not undo the jump in: a marker that jumps away from its past exactly at the group's key
+// frame and jumps again at the next one is not believed anywhere in the group. A single change
+// of motion at a key frame (a bounce) is believed.
 //
-// What it cannot see: damage that grows over several frames (no single jump where it began),
-// and damage in the last group of a video the decoder did not complain about.
+// The marker's past is its last believed position in the last few frames handed on (it may be
+// hidden in the frame just before the group). When the key frame cannot vouch for a marker (its
+// tracker refused what it saw there, or the marker is not there), a jump in the group is not
+// believed either, from the jump on; and a marker with no such past and not found at the key
+// frame after the group is not believed anywhere in the group (nothing ties those positions to
+// the marker: a key frame the damage moved it in). The last group of a run that ended with
+// damage (the decoder reported it, the file was cut) is checked the same way, as no key frame
+// follows it.
+//
+// What it cannot see: damage that grows over several frames (no single jump where it began), a
+// damaged group whose own motion is so erratic that its jumps are within its scatter, and damage
+// in the last group of a video the decoder did not complain about.
 #pragma once
 
 #include <cstddef>
@@ -81,13 +90,15 @@ class KeyFrameGroups {
   std::vector<Held> held_;       // Slots reused across groups: their images keep their buffers.
   size_t count_ = 0;             // held_[0, count_) is the open group.
   size_t held_bytes_ = 0;
-  // Per marker, its position in the last frame handed on, when found and believed there (a
-  // group's track starts there).
+  // Per marker, its position in the last frame handed on that found and believed it, while that
+  // is one of the last few frames handed on (a group's track starts there).
   struct Anchor {
     int64_t index;
     cv::Point2d px;
+    int frames_since;  // Frames handed on since and including it.
   };
   std::vector<std::optional<Anchor>> tail_;
+  const Anchor* anchor(size_t marker) const;
   // check()'s scratch, per marker.
   std::vector<int64_t> indices_;
   std::vector<cv::Point2d> points_, residuals_;

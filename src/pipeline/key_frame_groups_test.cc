@@ -111,6 +111,27 @@ TEST(KeyFrameGroups, ADamagedKeyFrameLeavesItsWholeGroupNotBelieved) {
   EXPECT_EQ(groups.demoted(), 3 * 12);
 }
 
+TEST(KeyFrameGroups, ADamagedKeyFrameThatAlsoStoppedTheMarkerLeavesItsGroupNotBelieved) {
+  // Key frame 24 was decoded 16 px off for marker 0, and the frames predicted from it left the
+  // marker standing still while it really moved on: the jump at key frame 36 does not undo the
+  // one at 24. Marker 0 is also hidden in frame 23, just before the group: the group is tied to
+  // the marker's past by frame 22.
+  const auto damage = [](int i, int m) {
+    return i >= 24 && i < 36 && m == 0 ? cv::Point2d(16 - 2.0 * (i - 24), -16) : cv::Point2d(0, 0);
+  };
+  std::vector<FrameResult> results = Track{}.results(60, damage);
+  Hide(results, 0, 23, 23, MarkerStatus::kCovered);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (int i = 0; i < 60; ++i) {
+    const bool damaged = i >= 24 && i < 36;
+    EXPECT_EQ(released.results[i].markers[0].observation.found(), !damaged && i != 23) << i;
+    EXPECT_TRUE(released.results[i].markers[1].observation.found()) << i;
+  }
+  EXPECT_EQ(groups.demoted(), 12);
+}
+
 TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
   // A puck bouncing at key frame 36 (2 px per frame to the right, then 6 to the left), and a
   // camera bumped by 16 px at frame 30 that stays bumped: nothing jumps back.
