@@ -156,7 +156,13 @@ void KeyFrameGroups::check(const FrameResult& next) {
       continue;
     }
     const std::optional<double> threshold = track(m, &key, next.frame_index);
-    if (!threshold) continue;
+    if (!threshold) {
+      // Found in too few of the group's frames to know its motion there: nothing to check
+      // those positions against (after damage the tracker often finds a marker only here and
+      // there in a group, each time somewhere else).
+      demote_from(m, std::numeric_limits<int64_t>::min());
+      continue;
+    }
     const size_t n = points_.size();
     const cv::Point2d back = residuals_[n - 1];
     const double back_px = cv::norm(back);
@@ -196,7 +202,10 @@ void KeyFrameGroups::check_unverified(size_t m) {
     return;
   }
   const std::optional<double> threshold = track(m, nullptr, 0);
-  if (!threshold) return;
+  if (!threshold) {
+    demote_from(m, std::numeric_limits<int64_t>::min());  // Too few positions to check: as above.
+    return;
+  }
   // Without a key frame to undo it, a jump in the group is not told from real motion: the
   // marker is believed up to the biggest one and not after it.
   std::optional<size_t> onset;

@@ -26,9 +26,11 @@
 // tracker refused what it saw there, or the marker is not there), a jump in the group is not
 // believed either, from the jump on; and a marker with no such past and not found at the key
 // frame after the group is not believed anywhere in the group (nothing ties those positions to
-// the marker: a key frame the damage moved it in). The last group of a run that ended with
-// damage (the decoder reported it, the file was cut) is checked the same way, as no key frame
-// follows it.
+// the marker: a key frame the damage moved it in). A marker found in too few of the group's
+// frames to know its motion there (after damage a tracker often finds it only here and there)
+// is not believed in them either: there is nothing to check them against. The last group of a
+// run that ended with damage (the decoder reported it, the file was cut) is checked the same
+// way, as no key frame follows it.
 //
 // What it cannot see: damage that grows over several frames (no single jump where it began), a
 // damaged group whose own motion is so erratic that its jumps are within its scatter, and damage

@@ -132,6 +132,28 @@ TEST(KeyFrameGroups, ADamagedKeyFrameThatAlsoStoppedTheMarkerLeavesItsGroupNotBe
   EXPECT_EQ(groups.demoted(), 12);
 }
 
+TEST(KeyFrameGroups, AMarkerFoundInTooFewFramesOfItsGroupToCheckIsNotBelievedThere) {
+  // Marker 0 is found in frames 30 and 31 only of the group 24-35 (the tracker refused the rest
+  // of the damaged group) and at key frame 36; marker 1, found just before its group 36-47, is
+  // found in frames 42 and 43 only, and not at key frame 48. Two positions tell nothing of the
+  // group's motion: neither is believed.
+  std::vector<FrameResult> results = Track{}.results(60, [](int i, int m) {
+    return (m == 0 && i >= 24 && i < 36) || (m == 1 && i >= 36 && i < 48) ? cv::Point2d(16, 16)
+                                                                           : cv::Point2d(0, 0);
+  });
+  Hide(results, 0, 20, 29, MarkerStatus::kImplausible);
+  Hide(results, 0, 32, 35, MarkerStatus::kImplausible);
+  Hide(results, 1, 36, 41, MarkerStatus::kLost);
+  Hide(results, 1, 44, 48, MarkerStatus::kLost);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  ExpectEveryFrameOnceInOrder(released, 60);
+  for (const int i : {30, 31}) EXPECT_FALSE(released.results[i].markers[0].observation.found()) << i;
+  for (const int i : {42, 43}) EXPECT_FALSE(released.results[i].markers[1].observation.found()) << i;
+  EXPECT_TRUE(released.results[36].markers[0].observation.found()) << "the key frame is its own";
+  EXPECT_EQ(groups.demoted(), 4);
+}
+
 TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
   // A puck bouncing at key frame 36 (2 px per frame to the right, then 6 to the left), and a
   // camera bumped by 16 px at frame 30 that stays bumped: nothing jumps back.
