@@ -187,10 +187,38 @@ void KeyFrameGroups::check(const FrameResult& next) {
     // two key frames in a row; a single change of motion at a key frame (a bounce) is believed.
     const bool entered_at_key_frame =
         anchor(m) != nullptr && indices_[1] == held_[0].result.frame_index;
-    if (entered_at_key_frame && cv::norm(residuals_[1]) > *threshold) {
+    if (entered_at_key_frame && jumps_at_both_ends(*threshold)) {
       demote_from(m, std::numeric_limits<int64_t>::min());
     }
   }
+}
+
+// Whether the track's first step (into the group's key frame) and its last (to the next key
+// frame) are both jumps. Judged against the group's own frames when it has enough of them
+// (their motion and scatter, which the two jumps would otherwise inflate: a damaged group's
+// track is short and erratic), else against `threshold`, the whole track's.
+bool KeyFrameGroups::jumps_at_both_ends(double threshold) {
+  const size_t n = points_.size();
+  if (n < 5) return cv::norm(residuals_[1]) > threshold && cv::norm(residuals_[n - 1]) > threshold;
+  // Steps 2 .. n-2 lie inside the group.
+  cv::Point2d velocity;
+  scratch_.clear();
+  for (size_t k = 2; k + 1 < n; ++k) {
+    scratch_.push_back((points_[k].x - points_[k - 1].x) / double(indices_[k] - indices_[k - 1]));
+  }
+  velocity.x = MedianOf(scratch_);
+  scratch_.clear();
+  for (size_t k = 2; k + 1 < n; ++k) {
+    scratch_.push_back((points_[k].y - points_[k - 1].y) / double(indices_[k] - indices_[k - 1]));
+  }
+  velocity.y = MedianOf(scratch_);
+  const auto residual = [&](size_t k) {
+    return cv::norm(points_[k] - points_[k - 1] - velocity * double(indices_[k] - indices_[k - 1]));
+  };
+  scratch_.clear();
+  for (size_t k = 2; k + 1 < n; ++k) scratch_.push_back(residual(k));
+  const double inner = std::max(kMinJumpPx, kNoiseFactor * MedianOf(scratch_));
+  return residual(1) > inner && residual(n - 1) > inner;
 }
 
 void KeyFrameGroups::check_unverified(size_t m) {

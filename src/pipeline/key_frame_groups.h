@@ -18,8 +18,10 @@
 // A damaged key frame can also change how the marker moves through its group (the predicted
 // frames carry the damage on with their own motion), so the jump back at the next key frame
 // does not undo the jump in: a marker that jumps away from its past exactly at the group's key
-// frame and jumps again at the next one is not believed anywhere in the group. A single change
-// of motion at a key frame (a bounce) is believed.
+// frame and jumps again at the next one is not believed anywhere in the group. The two jumps
+// are judged against the group's own frames (their motion and scatter without the jumps, which
+// would swamp them in a damaged group's short, erratic track). A single change of motion at a
+// key frame (a bounce) is believed.
 //
 // The marker's past is its last believed position in the last few frames handed on (it may be
 // hidden in the frame just before the group). When the key frame cannot vouch for a marker (its
@@ -33,8 +35,8 @@
 // way, as no key frame follows it.
 //
 // What it cannot see: damage that grows over several frames (no single jump where it began), a
-// damaged group whose own motion is so erratic that its jumps are within its scatter, and damage
-// in the last group of a video the decoder did not complain about.
+// damaged group whose own frames scatter as much as its jumps, and damage in the last group of a
+// video the decoder did not complain about.
 #pragma once
 
 #include <cstddef>
@@ -81,6 +83,7 @@ class KeyFrameGroups {
   void check(const FrameResult& next);
   // A marker the key frame after the group does not show: a jump in the group is not believed.
   void check_unverified(size_t marker);
+  bool jumps_at_both_ends(double threshold);
   std::optional<double> track(size_t marker, const Observation* key, int64_t key_index);
   void demote_from(size_t marker, int64_t first_damaged);
   void remember(const FrameResult& released);

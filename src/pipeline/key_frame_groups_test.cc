@@ -154,6 +154,35 @@ TEST(KeyFrameGroups, AMarkerFoundInTooFewFramesOfItsGroupToCheckIsNotBelievedThe
   EXPECT_EQ(groups.demoted(), 4);
 }
 
+TEST(KeyFrameGroups, ADamagedKeyFrameWhoseGroupMovesErraticallyIsNotBelieved) {
+  // Marker 0's track through a bit-flipped MPEG-4 clip: it moves down 3.7 px per frame; key frame
+  // 84 was decoded with damage, and in its group the tracker found the marker only in frames 84,
+  // 85, 89 and 91, 16-35 px off and drifting left; key frame 96 shows it on its way again. With
+  // so few frames, the two jumps would swamp the group's own scatter if it were measured with
+  // them.
+  std::vector<FrameResult> results = Track{}.results(108, [](int, int) { return cv::Point2d(); });
+  const auto place = [&](int i, cv::Point2d p) {
+    results[static_cast<size_t>(i)].markers[0].observation.position_px = p;
+  };
+  for (int i = 0; i < 108; ++i) {
+    place(i, cv::Point2d(415.2, 294.0) + (i - 82) * cv::Point2d(-0.764, 3.729));
+  }
+  place(84, {397.7, 309.6});
+  place(85, {395.8, 311.1});
+  place(89, {385.9, 311.2});
+  place(91, {382.0, 310.9});
+  for (const int i : {83, 86, 87, 88, 90, 92, 93, 94, 95}) Hide(results, 0, i, i, MarkerStatus::kLost);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  ExpectEveryFrameOnceInOrder(released, 108);
+  for (const int i : {84, 85, 89, 91}) {
+    EXPECT_FALSE(released.results[i].markers[0].observation.found()) << i;
+  }
+  EXPECT_TRUE(released.results[82].markers[0].observation.found());
+  EXPECT_TRUE(released.results[96].markers[0].observation.found());
+  EXPECT_EQ(groups.demoted(), 4);
+}
+
 TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
   // A puck bouncing at key frame 36 (2 px per frame to the right, then 6 to the left), and a
   // camera bumped by 16 px at frame 30 that stays bumped: nothing jumps back.
@@ -167,6 +196,22 @@ TEST(KeyFrameGroups, RealMotionThatChangesAtAKeyFrameIsBelieved) {
   for (const FrameResult& r : released.results) {
     for (const MarkerObservation& m : r.markers) EXPECT_TRUE(m.observation.found()) << r.frame_index;
   }
+  EXPECT_EQ(groups.demoted(), 0);
+}
+
+TEST(KeyFrameGroups, FastOscillationIsBelieved) {
+  // Markers swinging 40 px back and forth, one cycle in 15, 24 and 40 frames (a group of 12
+  // frames sees most of a cycle): their speed changes within every group and at every key frame,
+  // and marker 0 is hidden now and then.
+  std::vector<FrameResult> results = Track{}.results(120, [](int i, int m) {
+    const double period = m == 0 ? 15.0 : m == 1 ? 24.0 : 40.0;
+    return cv::Point2d(-2.0 * i + 40.0 * std::sin(2 * M_PI * i / period),
+                       25.0 * std::cos(2 * M_PI * i / period));
+  });
+  for (const int i : {11, 23, 30, 31, 47, 59, 60, 71, 83, 95}) Hide(results, 0, i, i);
+  KeyFrameGroups groups;
+  const Released released = CheckGroups(results, true, groups);
+  ExpectEveryFrameOnceInOrder(released, 120);
   EXPECT_EQ(groups.demoted(), 0);
 }
 
