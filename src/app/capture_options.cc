@@ -26,8 +26,14 @@ void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
     if (!option.unit.empty()) help += " [" + option.unit + "]";
     help += "; " + OptionRangeText(option) + " (config: capture." + option.key + ")";
     // The map's nodes stay where they are: the option writes into its own entry.
+    // Read as text and checked by MergeCaptureOptions (one message for the flag and the config
+    // key alike); the help names the kind of value.
+    const char* type_name = option.kind == OptionKind::kInt      ? "INT"
+                            : option.kind == OptionKind::kDouble ? "FLOAT"
+                                                                 : "TEXT";
     sub.add_option(FlagOf(option.key), (*args)[option.key], help)
-        ->group("Camera settings (with --camera N only)");
+        ->type_name(type_name)
+        ->group("Camera settings (when the frames come from a camera)");
   }
 }
 

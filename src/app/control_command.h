@@ -42,8 +42,9 @@ struct ControlStereoOptions {
 
 struct ControlOptions {
   std::string config_file;              // Markers + `control:` section (examples/rig.yaml).
-  // Where the board is: a serial device (/dev/ttyACM0, /dev/pts/N), or `simulate` for an
-  // in-process simulated rig behind a real pseudo-terminal, advanced in lock-step with the frames.
+  // Where the board is: a serial device (/dev/ttyACM0, /dev/pts/N); or, with `simulate` (and no
+  // port), an in-process simulated rig behind a real pseudo-terminal, advanced in lock-step with
+  // the frames.
   std::optional<std::string> port;
   bool simulate = false;
   // Frames: a camera index, a file the rig rewrites (`rig --frames`), or a video / image
