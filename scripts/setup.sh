@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev          # image processing, video I/O, calibration, GUI (OpenCV 4.6)
   libavutil-dev          # FFmpeg's log (OpenCV decodes with FFmpeg): which frames a decoder found damaged
+  libavcodec-dev libavformat-dev  # FFmpeg's own marks of the frames it concealed damage in
   libyaml-cpp-dev        # configuration files
   libcli11-dev           # command-line parsing
   libserial-dev          # serial link to the pneumatic board

@@ -1,9 +1,11 @@
 #include "io/decoder_log.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdarg>
 #include <cstdio>
 #include <mutex>
+#include <vector>
 
 extern "C" {
 #include <libavutil/log.h>
@@ -17,9 +19,16 @@ namespace {
 std::atomic<uint64_t> g_error_count{0};
 std::mutex g_last_error_mutex;
 std::string g_last_error;
+std::mutex g_ignored_mutex;
+std::vector<const void*> g_ignored;  // A DecodeProbe's contexts: a few at most.
+
+bool Ignored(const void* context) {
+  std::lock_guard<std::mutex> lock(g_ignored_mutex);
+  return std::find(g_ignored.begin(), g_ignored.end(), context) != g_ignored.end();
+}
 
 extern "C" void OnDecoderLog(void* context, int level, const char* format, va_list args) {
-  if (level > AV_LOG_ERROR) return;
+  if (level > AV_LOG_ERROR || Ignored(context)) return;
   char text[256];
   std::vsnprintf(text, sizeof(text), format, args);
   std::string message = text;
@@ -44,6 +53,13 @@ void CaptureDecoderErrors() {
 }
 
 uint64_t DecoderErrorCount() { return g_error_count.load(); }
+
+void IgnoreDecoderLogsFrom(const void* context, bool ignore) {
+  std::lock_guard<std::mutex> lock(g_ignored_mutex);
+  const auto found = std::find(g_ignored.begin(), g_ignored.end(), context);
+  if (ignore && found == g_ignored.end()) g_ignored.push_back(context);
+  if (!ignore && found != g_ignored.end()) g_ignored.erase(found);
+}
 
 std::string LastDecoderError() {
   std::lock_guard<std::mutex> lock(g_last_error_mutex);

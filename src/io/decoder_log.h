@@ -20,4 +20,8 @@ uint64_t DecoderErrorCount();
 // The last error message (one line, escaped), for reports.
 std::string LastDecoderError();
 
+// Messages logged with `context` (an AVFormatContext or AVCodecContext of a DecodeProbe) are not
+// counted (ignore = true) from now on, or counted again (false, before the context is freed).
+void IgnoreDecoderLogsFrom(const void* context, bool ignore);
+
 }  // namespace softsight

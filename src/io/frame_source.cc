@@ -19,6 +19,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "io/camera_options.h"
+#include "io/decode_probe.h"
 #include "io/decoder_log.h"
 #include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
@@ -124,10 +125,10 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
-    const bool intra_only = IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
-    key_frames_ = std::make_unique<KeyFrameIndex>(path, intra_only);
+    predicted_ = !IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
+    key_frames_ = std::make_unique<KeyFrameIndex>(path, !predicted_);
     // OpenCV gives FFmpeg's decoder one thread per processor (4.6's API does not say how many).
-    if (!intra_only) {
+    if (predicted_) {
       decoder_lag_frames_ =
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
     }
@@ -175,6 +176,10 @@ class VideoFileSource : public FrameSource {
     // forward to it by the frames' timestamps (exact for the intra-only codecs the recordings use,
     // HuffYUV, FFV1, MJPG, in AVI and MKV: FrameSourceTest.SeekToShowsTheFrameReadingForwardShows).
     if (!capture_.set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(position))) return false;
+    // The probe decodes from the start: a seek would wait for it to get there. From here on the
+    // decoder's log alone tells damage.
+    probe_.reset();
+    probe_abandoned_ = true;
     started_ = false;
     have_current_ = have_next_ = false;
     next_index_ = position;
@@ -208,6 +213,7 @@ class VideoFileSource : public FrameSource {
 
   // Decodes the next undamaged frame into `out`; false at the end of the stream.
   bool decode(Decoded& out) {
+    if (predicted_ && !probe_ && !probe_abandoned_) probe_ = std::make_unique<DecodeProbe>(path_);
     while (true) {
       const uint64_t errors_before = DecoderErrorCount();
       if (!capture_.read(out.image) || out.image.empty()) {
@@ -225,7 +231,8 @@ class VideoFileSource : public FrameSource {
       }
       ++decoded_;
       const int64_t index = next_index_++;
-      if (DecoderErrorCount() != errors_before) {
+      const bool concealed = probe_ && probe_->concealed(index).value_or(false);
+      if (DecoderErrorCount() != errors_before || concealed) {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
@@ -256,7 +263,10 @@ class VideoFileSource : public FrameSource {
     std::string text = lead + " " + std::to_string(damaged_) + " frame" +
                        (damaged_ == 1 ? "" : "s") + " the decoder found damaged " +
                        (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
-                       std::to_string(first_damaged_) + ", decoder: " + LastDecoderError() + ")";
+                       std::to_string(first_damaged_) + ", decoder: " +
+                       (LastDecoderError().empty() ? std::string("concealed damage")
+                                                   : LastDecoderError()) +
+                       ")";
     if (predicted_from_damaged_ > 0) {
       text += ", and " + std::to_string(predicted_from_damaged_) +
               " decoded from them up to the next key frame";
@@ -285,6 +295,10 @@ class VideoFileSource : public FrameSource {
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
   std::unique_ptr<KeyFrameIndex> key_frames_;
+  bool predicted_ = false;  // The codec predicts frames from earlier ones (not intra-only).
+  // Which frames the decoder concealed damage in (predicting codecs; until a seek).
+  std::unique_ptr<DecodeProbe> probe_;
+  bool probe_abandoned_ = false;
   // How many frames a predicting codec's frame threads may be decoding past the one read()
   // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
   // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).

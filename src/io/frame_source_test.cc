@@ -1,6 +1,8 @@
 #include "softsight/io/frame_source.h"
 
+#include <algorithm>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -11,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/test_util.h"
+#include "io/decode_probe.h"
 #include "io/decoder_log.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/plate_scene.h"
@@ -245,6 +248,58 @@ TEST(VideoFileSource, FramesTheDecoderFoundDamagedAreLeftOutAndReported) {
 // Each frame says whether it was decoded on its own: MPEG-4 as OpenCV writes it has a key frame
 // every 12th frame, whose damage (or the frames' before it) the frames after it do not repeat;
 // in an intra-only codec (HuffYUV, MJPG) every frame is one.
+// The second decoding that marks the frames FFmpeg concealed damage in (io/decode_probe.h).
+TEST(DecodeProbe, MarksNoFrameOfACleanVideoAndSaysWhereTheVideoEnds) {
+  TempDir dir;
+  const std::string path = WriteFrames(dir.file("clean.mp4"), "mp4v", DistinctFrames(30));
+  DecodeProbe probe(path);
+  for (int64_t i = 0; i < 30; ++i) EXPECT_EQ(probe.concealed(i), std::optional<bool>(false)) << i;
+  EXPECT_EQ(probe.concealed(30), std::nullopt) << "past the last frame the probe cannot say";
+  EXPECT_EQ(probe.concealed(-1), std::nullopt);
+  DecodeProbe missing(dir.file("none.mp4"));
+  EXPECT_EQ(missing.concealed(0), std::nullopt);
+}
+
+TEST(DecodeProbe, MarksTheSameFramesOfADamagedVideoEveryTimeAndLogsNothingOfItsOwn) {
+  TempDir dir;
+  std::string data =
+      testing::ReadTextFile(WriteFrames(dir.file("clip.mp4"), "mp4v", DistinctFrames(40)));
+  std::mt19937 random(3);
+  for (int flip = 0; flip < 20; ++flip) {
+    const size_t at = data.size() / 10 + random() % (data.size() * 8 / 10);
+    data[at] = static_cast<char>(data[at] ^ (1 << (random() % 8)));
+  }
+  const std::string path = dir.file("flipped.mp4");
+  WriteBytes(path, data);
+  CaptureDecoderErrors();
+  const uint64_t errors_before = DecoderErrorCount();
+  std::vector<std::vector<bool>> runs;
+  for (int run = 0; run < 3; ++run) {
+    DecodeProbe probe(path);
+    std::vector<bool> marks;
+    for (int64_t i = 0;; ++i) {
+      const std::optional<bool> concealed = probe.concealed(i);
+      if (!concealed) break;
+      marks.push_back(*concealed);
+    }
+    runs.push_back(marks);
+  }
+  EXPECT_EQ(DecoderErrorCount(), errors_before) << "the probe's own complaints were counted";
+  ASSERT_GT(runs[0].size(), 20u);
+  EXPECT_EQ(runs[1], runs[0]);
+  EXPECT_EQ(runs[2], runs[0]);
+  EXPECT_GT(std::count(runs[0].begin(), runs[0].end(), true), 0) << "choose flips that do damage";
+}
+
+TEST(DecodeProbe, StopsWhenDroppedMidFile) {
+  TempDir dir;
+  const std::string path = WriteFrames(dir.file("clean.mp4"), "mp4v", DistinctFrames(60));
+  for (int i = 0; i < 5; ++i) {
+    DecodeProbe probe(path);
+    EXPECT_EQ(probe.concealed(1), std::optional<bool>(false));
+  }  // Each destructor returns: the thread stopped between packets.
+}
+
 TEST(VideoFileSource, FramesSayWhetherTheyAreKeyFrames) {
   TempDir dir;
   const std::vector<cv::Mat> frames = DistinctFrames(40);
