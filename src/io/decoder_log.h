@@ -1,7 +1,8 @@
 // FFmpeg's decoders say when a frame's data is broken ("huffman table decode error", "overread
 // 8") only through av_log, which OpenCV's VideoCapture neither returns nor exposes. This captures
 // those messages for the video sources instead of letting them print mid-progress-bar, so a frame
-// the decoder complained about is known as damaged.
+// the decoder complained about is known as damaged. (Which frame a complaint belongs to is
+// uncertain when the decoder runs frame threads; io/decode_probe.h gives exact per-frame marks.)
 #pragma once
 
 #include <cstdint>

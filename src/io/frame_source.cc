@@ -117,6 +117,14 @@ class VideoFileSource : public FrameSource {
  public:
   explicit VideoFileSource(const std::string& path) : path_(path) {
     if (!fs::exists(path)) throw InputError(path + ": no such video file");
+    // A pipe or a device can be read only once, and the file is read more than once (its key
+    // frames, the decoder's damage marks): a second reader would take frames from the first.
+    std::error_code ignored;
+    if (!fs::is_regular_file(path, ignored)) {
+      throw InputError(path +
+                       ": not a regular file (a pipe or a device); save the video to a file first, "
+                       "or use --camera for a camera");
+    }
     CaptureDecoderErrors();
     if (!capture_.open(path, cv::CAP_FFMPEG) || !capture_.isOpened()) {
       throw InputError(path + ": cannot open as a video (unsupported, truncated or corrupt file)");

@@ -6,6 +6,8 @@
 #include <random>
 #include <set>
 
+#include <sys/stat.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -332,6 +334,21 @@ TEST(VideoFileSource, MissingOrNonVideoFileIsAnError) {
   }
   testing::WriteTextFile(dir.file("notes.avi"), "this is not a video");
   EXPECT_THROW(OpenFrameSource({dir.file("notes.avi"), {}, 30.0}), InputError);
+}
+
+// A pipe would be read by the decoder and, in part, by the source's second readers (the key
+// frame index, the damage probe), each taking frames from the other: refused before it is opened
+// (opening a pipe nobody writes to would block).
+TEST(VideoFileSource, PipeIsRefusedWithoutBeingOpened) {
+  TempDir dir;
+  const std::string pipe = dir.file("stream.avi");
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  try {
+    OpenFrameSource({pipe, {}, 30.0});
+    FAIL() << "a pipe was accepted as a video file";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("stream.avi: not a regular file"));
+  }
 }
 
 TEST(ImageSequenceSource, FolderIsReadInNameOrderAtTheGivenRate) {

@@ -1,10 +1,12 @@
-// A video that predicts frames from earlier ones (MPEG-4, H.264) repeats damage the decoder did
-// not notice (a flipped bit that still decodes: a key frame whose macroblocks slid 16 px, a
-// patch copied to the wrong place) in every frame up to its next key frame, which is decoded
-// afresh. No check of one frame can tell such a picture from a real one (a slid picture looks
-// like a bumped camera), but the next key frame can: the damage ends exactly there. A marker
-// that the damage moved by D comes back by -D at the key frame, after moving by +D where the
-// damage began; real motion does not jump to and fro exactly at a key frame.
+// A video that predicts frames from earlier ones (MPEG-4, H.264) repeats damage in every frame
+// up to its next key frame, which is decoded afresh. The video source leaves out the frames the
+// decoder complained about or concealed damage in and the ones after them (io/decode_probe.h);
+// this is for damage the decoder neither reported nor concealed (a flipped bit that still
+// decodes: a key frame whose macroblocks slid 16 px, a patch copied to the wrong place). No check
+// of one frame can tell such a picture from a real one (a slid picture looks like a bumped
+// camera), but the next key frame can: the damage ends exactly there. A marker that the damage
+// moved by D comes back by -D at the key frame, after moving by +D where the damage began; real
+// motion does not jump to and fro exactly at a key frame.
 //
 // So a run over such a video holds each group of frames (a key frame and the predicted frames
 // after it) until the next key frame has been tracked, checks every marker across that key
@@ -36,7 +38,7 @@
 //
 // What it cannot see: damage that grows over several frames (no single jump where it began), a
 // damaged group whose own frames scatter as much as its jumps, and damage in the last group of a
-// video the decoder did not complain about.
+// video the decoder did not complain about or conceal damage in.
 #pragma once
 
 #include <cstddef>
