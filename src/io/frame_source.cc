@@ -133,12 +133,13 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
-    predicted_ = !IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
-    key_frames_ = std::make_unique<KeyFrameIndex>(path, !predicted_);
+    const bool intra_only = IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
+    key_frames_ = std::make_unique<KeyFrameIndex>(path, intra_only);
     // OpenCV gives FFmpeg's decoder one thread per processor (4.6's API does not say how many).
-    if (predicted_) {
+    if (!intra_only) {
       decoder_lag_frames_ =
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
+      probe_ = std::make_unique<DecodeProbe>(path);
     }
   }
 
@@ -187,7 +188,6 @@ class VideoFileSource : public FrameSource {
     // The probe decodes from the start: a seek would wait for it to get there. From here on the
     // decoder's log alone tells damage.
     probe_.reset();
-    probe_abandoned_ = true;
     started_ = false;
     have_current_ = have_next_ = false;
     next_index_ = position;
@@ -221,7 +221,6 @@ class VideoFileSource : public FrameSource {
 
   // Decodes the next undamaged frame into `out`; false at the end of the stream.
   bool decode(Decoded& out) {
-    if (predicted_ && !probe_ && !probe_abandoned_) probe_ = std::make_unique<DecodeProbe>(path_);
     while (true) {
       const uint64_t errors_before = DecoderErrorCount();
       if (!capture_.read(out.image) || out.image.empty()) {
@@ -268,13 +267,12 @@ class VideoFileSource : public FrameSource {
   // "<lead> 3 damaged frames left out (first: frame 16, decoder: mjpeg: ...)", or "".
   std::string damage_summary(const std::string& lead) const {
     if (damaged_ == 0) return "";
+    const std::string last_error = LastDecoderError();
     std::string text = lead + " " + std::to_string(damaged_) + " frame" +
                        (damaged_ == 1 ? "" : "s") + " the decoder found damaged " +
                        (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
                        std::to_string(first_damaged_) + ", decoder: " +
-                       (LastDecoderError().empty() ? std::string("concealed damage")
-                                                   : LastDecoderError()) +
-                       ")";
+                       (last_error.empty() ? "concealed damage" : last_error) + ")";
     if (predicted_from_damaged_ > 0) {
       text += ", and " + std::to_string(predicted_from_damaged_) +
               " decoded from them up to the next key frame";
@@ -303,10 +301,8 @@ class VideoFileSource : public FrameSource {
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
   std::unique_ptr<KeyFrameIndex> key_frames_;
-  bool predicted_ = false;  // The codec predicts frames from earlier ones (not intra-only).
-  // Which frames the decoder concealed damage in (predicting codecs; until a seek).
+  // Which frames the decoder concealed damage in (predicting codecs; none after a seek).
   std::unique_ptr<DecodeProbe> probe_;
-  bool probe_abandoned_ = false;
   // How many frames a predicting codec's frame threads may be decoding past the one read()
   // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
   // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).

@@ -247,9 +247,6 @@ TEST(VideoFileSource, FramesTheDecoderFoundDamagedAreLeftOutAndReported) {
   EXPECT_EQ(indices, expected);
 }
 
-// Each frame says whether it was decoded on its own: MPEG-4 as OpenCV writes it has a key frame
-// every 12th frame, whose damage (or the frames' before it) the frames after it do not repeat;
-// in an intra-only codec (HuffYUV, MJPG) every frame is one.
 // The second decoding that marks the frames FFmpeg concealed damage in (io/decode_probe.h).
 TEST(DecodeProbe, MarksNoFrameOfACleanVideoAndSaysWhereTheVideoEnds) {
   TempDir dir;
@@ -302,6 +299,9 @@ TEST(DecodeProbe, StopsWhenDroppedMidFile) {
   }  // Each destructor returns: the thread stopped between packets.
 }
 
+// Each frame says whether it was decoded on its own: MPEG-4 as OpenCV writes it has a key frame
+// every 12th frame, whose damage (or the frames' before it) the frames after it do not repeat;
+// in an intra-only codec (HuffYUV, MJPG) every frame is one.
 TEST(VideoFileSource, FramesSayWhetherTheyAreKeyFrames) {
   TempDir dir;
   const std::vector<cv::Mat> frames = DistinctFrames(40);
