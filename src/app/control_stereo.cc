@@ -135,19 +135,6 @@ StereoControlFrames OpenStereoSession(const ControlOptions& options,
     for (PathRole& role : ConfigInputs(right_config)) inputs->push_back(std::move(role));
     inputs->push_back({"--right-config", *o.right_config_file});
   }
-  // Markers move in depth before two cameras: a colour marker with the rim fit is placed by a
-  // circle of its learned size when seen smaller (docs/stereo.md). Said, not overridden.
-  std::string rim_fitted;
-  for (const MarkerSpec& spec : left_config.markers) {
-    const auto* colour = spec.params.get_if<ColourParams>();
-    if (colour != nullptr && colour->rim_fit) {
-      rim_fitted += (rim_fitted.empty() ? "" : ", ") + spec.name;
-    }
-  }
-  if (!rim_fitted.empty() && !options.quiet) {
-    std::cerr << "control: note: " << rim_fitted << " use the rim fit (rim_fit: true); for "
-              << "markers moving in depth set rim_fit: false (docs/stereo.md)\n";
-  }
   StereoOptions stereo_options;
   stereo_options.triangulation.max_epipolar_px = o.max_epipolar_px;
   std::string error;

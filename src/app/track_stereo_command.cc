@@ -272,20 +272,6 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   const std::unique_ptr<PublishSink> publish =
       OpenPublishSink(options.publish, options.config_file);
 
-  // Markers move in depth before two cameras: seen smaller than learned, a colour marker with the
-  // rim fit is taken as partly hidden and placed by a circle of its old size (up to 1 px off,
-  // 2 mm in depth at 300 mm; docs/stereo.md). Said, not overridden: the config decides.
-  std::string rim_fitted;
-  for (const MarkerSpec& spec : left_config.markers) {
-    const auto* colour = spec.params.get_if<ColourParams>();
-    if (colour != nullptr && colour->rim_fit)
-      rim_fitted += (rim_fitted.empty() ? "" : ", ") + spec.name;
-  }
-  if (!rim_fitted.empty()) {
-    report << "note: " << rim_fitted << " use the rim fit (rim_fit: true); for markers moving in "
-           << "depth set rim_fit: false (docs/stereo.md)\n";
-  }
-
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
 

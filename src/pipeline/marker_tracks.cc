@@ -41,6 +41,11 @@ constexpr int kOtherUnseenFrames = 1;
 // Its first step may be this many marker sizes plus the fastest marker's speed; later steps lie
 // within a size plus kRunStepTolerance of its step from where its constant velocity puts it.
 constexpr double kOtherFirstStepSizes = 3.0;
+// A report that does not continue its marker's track must lie within this many sigma of where
+// the body puts it (4 sigma in 2 degrees of freedom: 1 time in 3000 by chance) ...
+constexpr double kBodyGateSigmas = 4.0;
+// ... and no closer than this is ever asked of it (px): sub-pixel noise is not a contradiction.
+constexpr double kBodyGateMinPx = 1.5;
 
 double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
   const cv::Point2d ab = b - a;
@@ -66,7 +71,7 @@ bool Fits(CandidateVerdict v) {
 }  // namespace
 
 MarkerTracks::MarkerTracks(std::vector<double> size_px, MotionModelOptions motion)
-    : size_px_(std::move(size_px)) {
+    : size_px_(std::move(size_px)), body_(size_px_.size()) {
   for (size_t i = 0; i < size_px_.size(); ++i) {
     Track track;
     track.motion = MotionModel(motion);
@@ -77,6 +82,10 @@ MarkerTracks::MarkerTracks(std::vector<double> size_px, MotionModelOptions motio
   cost_.resize(size_px_.size());
   unassigned_.resize(size_px_.size());
   report_pooled_.resize(size_px_.size());
+  anchor_px_.resize(size_px_.size());
+  believed_px_.resize(size_px_.size());
+  body_prediction_.resize(size_px_.size());
+  learn_from_.resize(size_px_.size());
 }
 
 void MarkerTracks::forget(size_t i) {
@@ -88,6 +97,8 @@ void MarkerTracks::forget(size_t i) {
   t.last_px.reset();
   t.repeats = 0;
   t.misses = 0;
+  body_.forget(i);
+  body_prediction_[i].reset();
 }
 
 void MarkerTracks::predict_all() {
@@ -95,6 +106,41 @@ void MarkerTracks::predict_all() {
     if (!t.predicted) t.motion.predict();
     t.predicted = true;
   }
+}
+
+void MarkerTracks::predict_from_body(const std::vector<MarkerObservation>& markers) {
+  for (size_t j = 0; j < markers.size(); ++j) {
+    const Track& t = tracks_[j];
+    const Observation& o = markers[j].observation;
+    anchor_px_[j].reset();
+    if (t.motion.started() && t.misses == 0 && o.found() && InGate(j, *o.position_px)) {
+      anchor_px_[j] = *o.position_px;
+    }
+  }
+  for (size_t i = 0; i < markers.size(); ++i) {
+    const Track& t = tracks_[i];
+    body_prediction_[i] = t.motion.started() ? body_.predict(i, anchor_px_, t.misses + 1)
+                                             : std::nullopt;
+  }
+}
+
+namespace {
+
+double BodyGatePx(const BodyConstellation::Prediction& p) {
+  return std::max(kBodyGateMinPx, kBodyGateSigmas * p.sigma_px);
+}
+
+}  // namespace
+
+bool MarkerTracks::BodyAllows(size_t i, const cv::Point2d& p) const {
+  const std::optional<BodyConstellation::Prediction>& b = body_prediction_[i];
+  return !b || cv::norm(p - b->position_px) <= BodyGatePx(*b);
+}
+
+bool MarkerTracks::BodyVouches(size_t i, const cv::Point2d& p) const {
+  const std::optional<BodyConstellation::Prediction>& b = body_prediction_[i];
+  // Only a tolerance tighter than the marker's size tells it from a look-alike beside it.
+  return b && BodyGatePx(*b) <= size_px_[i] && cv::norm(p - b->position_px) <= BodyGatePx(*b);
 }
 
 void MarkerTracks::skip() {
@@ -165,6 +211,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     }
   }
   MatchOthers();
+  predict_from_body(markers);
   // The cost matrix.
   for (size_t i = 0; i < markers.size(); ++i) {
     cost_[i].assign(pooled_.size(), kForbidden);
@@ -179,10 +226,23 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
         }
         continue;
       }
-      if (!InReach(i, p) || IsOtherObject(i, e.pooled)) continue;
-      const bool repeated = IsRepeat(t, p);
-      cost_[i][e.pooled] = (repeated ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2) +
-                           kMisfitWeight * std::min(e.misfit, 2.0);
+      if (IsOtherObject(i, e.pooled)) continue;
+      double fit = 0.0;
+      if (t.misses == 0 && InGate(i, p)) {
+        // The track goes on: its motion judges the report.
+        fit = IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
+      } else if (BodyVouches(i, p)) {
+        // Re-acquired, or jumped with its body (a shaken plate): where the others put it.
+        const BodyConstellation::Prediction& b = *body_prediction_[i];
+        const double d = cv::norm(p - b.position_px) / BodyGatePx(b);
+        fit = d * d;
+      } else if (InReach(i, p) && BodyAllows(i, p)) {
+        // Re-acquired within its motion's reach, and not where the body says it cannot be.
+        fit = std::min(t.motion.distance2(p), kGate2) / kGate2;
+      } else {
+        continue;
+      }
+      cost_[i][e.pooled] = fit + kMisfitWeight * std::min(e.misfit, 2.0);
     }
   }
   const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
@@ -207,6 +267,11 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     }
     tracks_[i].pending_px.reset();
     const size_t k = static_cast<size_t>(assigned[i]);
+    {
+      const cv::Point2d p = pooled_[k].position_px;
+      decisions_[i].vouched_by_body =
+          tracks_[i].motion.started() && !(tracks_[i].misses == 0 && InGate(i, p)) && BodyVouches(i, p);
+    }
     if (report_pooled_[i] && k == *report_pooled_[i]) {
       tracks_[i].repeated = IsRepeat(tracks_[i], *o.position_px);
       continue;  // kKeep.
@@ -411,8 +476,11 @@ bool MarkerTracks::ExplainedByAnother(size_t i, const cv::Point2d& p) const {
 
 bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
   Track& t = tracks_[i];
-  // A look-alike another marker's track could take is that marker's business, not a run.
-  if (ExplainedByAnother(i, p)) {
+  // A look-alike another marker's track could take is that marker's business, not a run; nor is
+  // one where an arrangement checked by more anchors than it needs says the marker cannot be (one
+  // its anchors fit exactly may have bent: an actuator's tip beyond its two neighbours).
+  const std::optional<BodyConstellation::Prediction>& body = body_prediction_[i];
+  if (ExplainedByAnother(i, p) || (body && !body->exact && !BodyAllows(i, p))) {
     t.pending_px.reset();
     return false;
   }
@@ -447,6 +515,17 @@ bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
 
 void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
   CV_Assert(markers.size() == tracks_.size());
+  // The body remembers this frame's arrangement; a marker that continued its track teaches how
+  // far it moves against its body in a frame.
+  for (size_t i = 0; i < markers.size(); ++i) {
+    const Observation& o = markers[i].observation;
+    believed_px_[i] = o.found() ? o.position_px : std::nullopt;
+    learn_from_[i] = o.found() && tracks_[i].motion.started() && tracks_[i].misses == 0
+                         ? body_prediction_[i]
+                         : std::nullopt;
+    body_prediction_[i].reset();
+  }
+  body_.remember(believed_px_, learn_from_);
   for (size_t i = 0; i < markers.size(); ++i) {
     Track& t = tracks_[i];
     if (!t.predicted) t.motion.predict();

@@ -36,6 +36,7 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/assignment.h"
+#include "pipeline/body_constellation.h"
 #include "pipeline/motion_model.h"
 #include "softsight/core/types.h"
 #include "softsight/track/tracker.h"
@@ -53,6 +54,9 @@ class MarkerTracks {
     };
     Action action = Action::kKeep;
     size_t candidate = 0;
+    // The marker was re-acquired (or jumped) where the other markers' arrangement puts it, within
+    // a tolerance tighter than its size: the body vouches for it, whatever its own motion said.
+    bool vouched_by_body = false;
   };
 
   // `size_px[i]`: about marker i's radius. A report within it of the prediction is always inside
@@ -92,6 +96,12 @@ class MarkerTracks {
   // Whether this frame's report of marker i restarts its track (a run of its tracker's own
   // reports the gate had rejected): its motion before is no evidence against it.
   bool restarting(size_t i) const { return tracks_.at(i).restart; }
+
+  // Marker i's position predicted this frame from the other markers' arrangement
+  // (pipeline/body_constellation.h); absent when too few of them were believed with it.
+  const std::optional<BodyConstellation::Prediction>& body_prediction(size_t i) const {
+    return body_prediction_.at(i);
+  }
 
   // For tests: marker i's motion model.
   const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
@@ -139,11 +149,22 @@ class MarkerTracks {
   // follows one smooth motion for kReacquireFrames frames (the track then restarts on it).
   bool ExtendsARejectedRun(size_t i, const cv::Point2d& p);
   void predict_all();
+  // Where the body puts marker i this frame (see body_constellation.h), from the markers whose
+  // reports continue their tracks inside their gates.
+  void predict_from_body(const std::vector<MarkerObservation>& markers);
+  // Whether a report at `p` that does not continue marker i's track (a re-acquisition, or a jump
+  // out of its gate) lies where the body puts it (always true when the body says nothing), and
+  // whether the body alone vouches for it.
+  bool BodyAllows(size_t i, const cv::Point2d& p) const;
+  bool BodyVouches(size_t i, const cv::Point2d& p) const;
   // The pooled candidate at `p` (a marker of about `size_px`), added when there is none.
   size_t pool(const cv::Point2d& p, double size_px);
 
   std::vector<double> size_px_;
   std::vector<Track> tracks_;
+  BodyConstellation body_;
+  std::vector<std::optional<cv::Point2d>> anchor_px_, believed_px_;
+  std::vector<std::optional<BodyConstellation::Prediction>> body_prediction_, learn_from_;
   std::vector<Decision> decisions_;
   // Per frame, reused: the pooled candidates, each marker's (pooled index, tracker index,
   // misfit) entries, the cost matrix and the report's pooled index per marker.

@@ -123,6 +123,9 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     const std::vector<MarkerTracks::Decision>& decisions =
         tracks_->associate(result_.markers, candidate_lists_);
     for (size_t i = 0; i < trackers_.size(); ++i) {
+      // Where the other markers' arrangement puts it: its own motion before (a jump with its
+      // body, or a stretch lost) is no evidence against it; the arrangement still judges it.
+      if (decisions[i].vouched_by_body) plausibility_->forget(i);
       switch (decisions[i].action) {
         case MarkerTracks::Decision::Action::kKeep:
           // A track restarted on its tracker's own run of reports: the motion the plausibility

@@ -352,6 +352,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     }
     rim_points_.assign(edge_points_.begin(), edge_points_.end());
     blob->rim = FitRimOfRadius(rim_points_, *radius);
+    // A whole marker seen at a slant (an ellipse narrower than the learned disc) fits the circle
+    // along part of its edge too; the rest of its edge bulges outwards where a cut's is straight
+    // or pushed in. Its centroid is its centre.
+    if (blob->rim) {
+      const std::optional<double> bulge =
+          OffRimBulgePx(rim_points_, *blob->rim, *radius, kRimInlierPx, &off_rim_);
+      if (bulge && *bulge > kMaxCutBulgePx) blob->rim.reset();
+    }
     if (const std::optional<cv::Point2d> centre = RimCentre(*blob)) {
       blob->centroid_px = *centre;
       blob->rim_placed = true;

@@ -227,6 +227,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Point> points_;
   std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.
   std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
+  std::vector<std::pair<double, cv::Point2d>> off_rim_;  // Scratch of OffRimBulgePx.
 };
 
 }  // namespace softsight

@@ -81,6 +81,11 @@ constexpr double kMinRimArea = 28.0;
 constexpr double kWholeRimFraction = 0.97;
 constexpr double kMinRimArcDeg = 170.0;
 constexpr double kMaxRimRmsPx = 0.5;
+// The rim fit's inlier tolerance (px; FitRimOfRadius's default) and how far the edge off the
+// circle may bulge outwards and still be a cut (px): a chord of pixels is straight to about half
+// a pixel; an ellipse's arc bulges by its sagitta, several pixels for a disc seen at a slant.
+constexpr double kRimInlierPx = 0.75;
+constexpr double kMaxCutBulgePx = 1.0;
 // Adaptation while tracking only from frames where the marker's shape is within kAdaptShape of
 // the learned one (a partial cover changes it; growth and tilt change it slowly); the reference
 // area stays within kAdaptMinRange..kAdaptMaxRange times the first one. A jump in area is not

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace softsight {
 namespace {
@@ -84,6 +85,47 @@ std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, do
   for (size_t k = 1; k < angles.size(); ++k) largest_gap = std::max(largest_gap, angles[k] - angles[k - 1]);
   fit.arc_deg = (2 * CV_PI - largest_gap) * 180.0 / CV_PI;
   return fit;
+}
+
+std::optional<double> OffRimBulgePx(const std::vector<cv::Point2d>& edge_px, const RimFit& fit,
+                                    double radius_px, double inlier_px,
+                                    std::vector<std::pair<double, cv::Point2d>>* scratch) {
+  // The off-circle points by their angle around the centre.
+  scratch->clear();
+  for (const cv::Point2d& p : edge_px) {
+    const cv::Point2d d = p - fit.centre_px;
+    // Inside the circle: what a cut (or a slant) left of the disc. A stray pixel outside it is
+    // neither.
+    if (cv::norm(d) >= radius_px - inlier_px) continue;
+    scratch->emplace_back(std::atan2(d.y, d.x), p);
+  }
+  if (scratch->size() < 3) return std::nullopt;
+  std::sort(scratch->begin(), scratch->end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  // They span one arc of angles: its ends are either side of the largest gap between neighbours
+  // (the gap that holds the rim on the circle).
+  size_t last = scratch->size() - 1, first = 0;
+  double gap = (*scratch)[0].first + 2 * CV_PI - (*scratch)[last].first;
+  for (size_t k = 1; k < scratch->size(); ++k) {
+    const double g = (*scratch)[k].first - (*scratch)[k - 1].first;
+    if (g > gap) {
+      gap = g;
+      first = k;
+      last = k - 1;
+    }
+  }
+  const cv::Point2d a = (*scratch)[first].second, b = (*scratch)[last].second;
+  const cv::Point2d ab = b - a;
+  const double len = cv::norm(ab);
+  if (len < 1.0) return std::nullopt;
+  // The outward normal of the chord: towards the middle of the arc the points span (away from
+  // the centre; the chord may pass through the centre itself).
+  const double mid = (*scratch)[first].first + (2 * CV_PI - gap) / 2;
+  cv::Point2d n(ab.y / len, -ab.x / len);
+  if (n.dot(cv::Point2d(std::cos(mid), std::sin(mid))) < 0) n = -n;
+  double bulge = -std::numeric_limits<double>::infinity();
+  for (const auto& [angle, p] : *scratch) bulge = std::max(bulge, n.dot(p - a));
+  return bulge;
 }
 
 }  // namespace softsight

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -24,5 +25,15 @@ struct RimFit {
 // Deterministic (candidate circles from pairs of points taken in a fixed order).
 std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, double radius_px,
                                      double inlier_px = 0.75);
+
+// How far the edge that is not on the fitted circle bulges outwards (px) beyond the straight line
+// joining its two ends. A disc cut by a straight edge leaves a chord (0); a finger or a paddle
+// pushes the edge inwards (negative); a whole marker seen in perspective (an ellipse narrower than
+// the learned disc) has a convex arc there, bulging by its sagitta: it is not partly hidden, and
+// the circle through part of its edge is not its centre. `scratch` is reused. Absent when fewer
+// than three edge points lie inside the circle, off it.
+std::optional<double> OffRimBulgePx(const std::vector<cv::Point2d>& edge_px, const RimFit& fit,
+                                    double radius_px, double inlier_px,
+                                    std::vector<std::pair<double, cv::Point2d>>* scratch);
 
 }  // namespace softsight

@@ -53,5 +53,49 @@ TEST(RimFit, TooFewPointsOrNoRadiusGiveNoFit) {
   EXPECT_FALSE(FitRimOfRadius(CutDiscEdge({40, 40}, 10, 60), 0.0));
 }
 
+// The edge pixels of a filled ellipse (semi-axes `a` across, `b` down) at `centre`.
+std::vector<cv::Point2d> EllipseEdge(const cv::Point2d& centre, double a, double b) {
+  cv::Mat mask(80, 80, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < mask.rows; ++y) {
+    for (int x = 0; x < mask.cols; ++x) {
+      const double u = (x - centre.x) / a, v = (y - centre.y) / b;
+      if (u * u + v * v <= 1.0) mask.at<uchar>(y, x) = 255;
+    }
+  }
+  std::vector<cv::Point2d> edge;
+  for (int y = 1; y + 1 < mask.rows; ++y) {
+    for (int x = 1; x + 1 < mask.cols; ++x) {
+      if (mask.at<uchar>(y, x) && (!mask.at<uchar>(y, x - 1) || !mask.at<uchar>(y, x + 1) ||
+                                   !mask.at<uchar>(y - 1, x) || !mask.at<uchar>(y + 1, x))) {
+        edge.emplace_back(x, y);
+      }
+    }
+  }
+  return edge;
+}
+
+TEST(RimFit, ACutLeavesAStraightEdgeOffTheCircleAndASlantedDiscABulgingOne) {
+  std::vector<std::pair<double, cv::Point2d>> scratch;
+  // A disc cut by a straight edge: what is off the circle is the chord.
+  const cv::Point2d centre(40.3, 39.6);
+  for (const double cut : {45.0, 40.3}) {
+    const std::vector<cv::Point2d> edge = CutDiscEdge(centre, 10, cut);
+    const std::optional<RimFit> fit = FitRimOfRadius(edge, 9.5);
+    ASSERT_TRUE(fit);
+    const std::optional<double> bulge = OffRimBulgePx(edge, *fit, 9.5, 0.75, &scratch);
+    ASSERT_TRUE(bulge) << "cut " << cut;
+    EXPECT_LT(*bulge, 1.0) << "cut " << cut;
+  }
+  // The same disc seen at a slant (ViSP's mire-2 dots: 17 x 12 px where the disc was 17 x 17): a
+  // circle of the disc's radius fits its ends and one side, the other side bulges by pixels.
+  const std::vector<cv::Point2d> slanted = EllipseEdge(centre, 8.5, 6.0);
+  const std::optional<RimFit> fit = FitRimOfRadius(slanted, 8.4);
+  if (fit) {
+    const std::optional<double> bulge = OffRimBulgePx(slanted, *fit, 8.4, 0.75, &scratch);
+    ASSERT_TRUE(bulge);
+    EXPECT_GT(*bulge, 2.0);
+  }
+}
+
 }  // namespace
 }  // namespace softsight

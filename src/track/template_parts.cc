@@ -133,39 +133,6 @@ cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength) {
   return c;
 }
 
-bool SplitLevels(const cv::Mat& gray, const cv::Mat& mask, double* low, double* high) {
-  int hist[256] = {0};
-  int n = 0;
-  for (int y = 0; y < gray.rows; ++y) {
-    const uint8_t* g = gray.ptr<uint8_t>(y);
-    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
-    for (int x = 0; x < gray.cols; ++x) {
-      if (m && !m[x]) continue;
-      ++hist[g[x]];
-      ++n;
-    }
-  }
-  if (n < 2) return false;
-  double total = 0;
-  for (int v = 0; v < 256; ++v) total += double{1.0} * v * hist[v];
-  double best = -1, sum0 = 0;
-  int n0 = 0;
-  for (int t = 0; t < 255; ++t) {
-    n0 += hist[t];
-    sum0 += double{1.0} * t * hist[t];
-    const int n1 = n - n0;
-    if (n0 == 0 || n1 == 0) continue;
-    const double m0 = sum0 / n0, m1 = (total - sum0) / n1;
-    const double between = double{1.0} * n0 * n1 * (m1 - m0) * (m1 - m0);
-    if (between > best) {
-      best = between;
-      *low = m0;
-      *high = m1;
-    }
-  }
-  return best > 0;
-}
-
 void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out) {
   if (native.channels() == 1) {
     out = native;
@@ -218,9 +185,46 @@ void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_d
   if (!shape.empty()) cv::bitwise_and(*mask, shape, *mask);
 }
 
+cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask) {
+  // Candidates: the box's principal colour axis (marker against band, when they dominate the
+  // box), luma, and the axis from the colour of the box's edge to the colour at its centre (a
+  // yellow dot on a green cart over a blue backdrop: the principal axis is cart against
+  // backdrop, in which the dot hardly differs from its cart).
+  const cv::Point c(bgr.cols / 2, bgr.rows / 2);
+  const cv::Rect centre = cv::Rect(c.x - 1, c.y - 1, 3, 3) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  cv::Mat border_mask(bgr.size(), CV_8UC1, cv::Scalar(255));
+  if (bgr.cols > 2 && bgr.rows > 2) border_mask(cv::Rect(1, 1, bgr.cols - 2, bgr.rows - 2)).setTo(0);
+  const cv::Scalar inner = cv::mean(bgr(centre)), edge = cv::mean(bgr, border_mask);
+  cv::Vec3d axis(inner[0] - edge[0], inner[1] - edge[1], inner[2] - edge[2]);
+  cv::Mat towards_centre;
+  if (const double l1 = std::abs(axis[0]) + std::abs(axis[1]) + std::abs(axis[2]); l1 > 0) {
+    axis /= l1;
+    double offset = 0;
+    for (int k = 0; k < 3; ++k) offset -= 255.0 * std::min(0.0, axis[k]);
+    towards_centre = (cv::Mat_<float>(1, 4) << axis[0], axis[1], axis[2], offset);
+  }
+  const cv::Mat principal = ContrastProjection(bgr);
+  const cv::Mat candidates[] = {principal, cv::Mat(), towards_centre};
+  // The one in which the marker at the centre is most isolated from its surroundings (see
+  // BlobMeter::isolation); the principal axis when none shows a blob there.
+  cv::Mat best = principal, gray;
+  double best_isolation = -1;
+  for (size_t k = 0; k < 3; ++k) {
+    if (k == 2 && towards_centre.empty()) continue;
+    BlobChannelOf(bgr, candidates[k], gray);
+    BlobMeter trial;
+    cv::Point2d centroid;
+    if (trial.Learn(gray, mask, &centroid) && trial.isolation() > best_isolation) {
+      best_isolation = trial.isolation();
+      best = candidates[k];
+    }
+  }
+  return best;
+}
+
 bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
                        BlobMeter* meter, cv::Point2d* anchor) {
-  *projection = templ.channels() == 3 ? ContrastProjection(templ) : cv::Mat();
+  *projection = templ.channels() == 3 ? MarkerProjection(templ, mask) : cv::Mat();
   cv::Mat gray;
   BlobChannelOf(templ, *projection, gray);
   return meter->Learn(gray, mask, anchor);

@@ -4,6 +4,7 @@
 // match is verified against). Private to track/; tests reach them here.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -86,14 +87,10 @@ cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength);
 // ---- Re-centring on the marker's blob ---------------------------------------------------------
 // A marker that is a blob (a dot, a disc: one compact region brighter or darker than what is
 // around it) is measured by its soft centroid in every frame: each pixel weighs by how much of it
-// is marker, (v - background) / (marker - background) clamped to [0, 1], with the two levels
-// split by Otsu's criterion in the patch at the match. Its centroid is the marker's centroid
+// is marker, (v - background) / (marker - background) clamped to [0, 1], the blob cut from its
+// surroundings half way between its own level and the level at which it would join them. Its centroid is the marker's centroid
 // whatever its shape, so it follows perspective, scale and rotation exactly, where a template's
 // fixed anchor carries the band's texture turning with the body.
-
-// Otsu split of the (masked) values of a one-channel patch: the two class means. False when the
-// patch has too little contrast to split.
-bool SplitLevels(const cv::Mat& gray, const cv::Mat& mask, double* low, double* high);
 
 inline constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker and background.
 // The blob at a match has at least this fraction of the learned blob's area (at the current
@@ -111,17 +108,34 @@ void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& ou
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
-  // is a blob that lies wholly inside the template (mask), with `centroid` its soft centroid.
+  // is a blob that lies wholly inside the template (mask), with `centroid` its soft centroid. The
+  // polarity is the one in which the centre stands out more from what surrounds it (a bright
+  // dot, or a dark one, on a band that may itself be brighter or darker than the background).
   bool Learn(const cv::Mat& gray, const cv::Mat& mask, cv::Point2d* centroid) {
-    double low = 0, high = 0;
-    if (!SplitLevels(gray, mask, &low, &high) || high - low < kMinBlobContrast) return false;
-    const cv::Point centre(gray.cols / 2, gray.rows / 2);
-    bright_ = gray.at<uint8_t>(centre) > (low + high) / 2;
+    const cv::Point2d centre = HalfSize(gray.size());
+    double best = -1;
+    bool best_bright = true;
+    for (const bool bright : {true, false}) {
+      bright_ = bright;
+      double low = 0, high = 0;
+      if (Segment(gray, mask, centre, &low, &high) && high - low > best) {
+        best = high - low;
+        best_bright = bright;
+      }
+    }
+    if (best < 0) return false;
+    bright_ = best_bright;
     double area = 0;
-    if (!Measure(gray, mask, HalfSize(gray.size()), centroid, &area)) return false;
+    if (!Measure(gray, mask, centre, centroid, &area)) return false;
     area_ = area;
     return true;
   }
+
+  // How much the learned blob stands out, after Learn: the levels between it and the level at
+  // which it would join its surroundings, as a fraction of the patch's whole range of levels (a
+  // channel in which a shadow beside the marker is nearly as dark as the marker scores less than
+  // one in which only the marker differs).
+  double isolation() const { return range_ > 0 ? contrast_ / range_ : 0.0; }
 
   // The soft centroid of the marker-side component nearest `guess` (patch coordinates), and its
   // area in px (sum of weights). False when there is no such component within 2 px of the guess,
@@ -133,7 +147,7 @@ class BlobMeter {
     if (!Segment(gray, mask, guess, &low, &high)) return false;
     const cv::Rect box = box_;
     // The levels right at the blob: the marker's from its interior (pixels whose 4 neighbours are
-    // all in the component), the background's from a ring 3-4 px outside it. Otsu's class means
+    // all in the component), the background's from a ring 3-4 px outside it. Levels of the patch
     // would take them from the whole patch, where shading and texture of the surroundings differ
     // from what is at the rim.
     const cv::Rect grown = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
@@ -205,15 +219,91 @@ class BlobMeter {
   double area() const { return area_; }  // At selection, px.
 
  private:
-  // Splits the patch into its two classes (low, high: their levels) and fills the marker-side
-  // component nearest `guess` into label_ (box_). False without contrast, without such a
-  // component within 2 px, or when it reaches the patch's or mask's edge.
+  // The marker-side component around `guess`, isolated from the patch's edge: from the most
+  // marker-like pixel within 2 px of the guess, the level at which it would join the patch's (or
+  // the mask's) edge is the lowest (bright marker) level on the best path out: the pass. The
+  // component is cut half way between the marker's own level (its core) and the pass, so a dot on
+  // a band over a background (a yellow dot on a green cart on a dark table) is the dot, not the
+  // band: a single split of the patch's levels would cut between band and background.
+  // `low`/`high` get the background's and marker's levels (for a dark marker, the other way
+  // round). False when the marker does not stand out by kMinBlobContrast from its pass.
   bool Segment(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess, double* low,
                double* high) {
-    if (!SplitLevels(gray, mask, low, high) || *high - *low < kMinBlobContrast) return false;
-    const double threshold = (*low + *high) / 2;
-    const std::optional<cv::Point> seed = SeedNear(gray, mask, guess, threshold);
-    return seed && Fill(gray, mask, *seed, threshold);
+    const std::optional<cv::Point> seed = ExtremeNear(gray, mask, guess);
+    if (!seed) return false;
+    // A priority flood from the seed, most marker-like first (256 buckets of marker-likeness):
+    // the first edge pixel it takes sets the pass.
+    for (auto& bucket : buckets_) bucket.clear();
+    visited_.create(gray.size(), CV_8UC1);
+    visited_.setTo(0);
+    const auto likeness = [&](int x, int y) {
+      const int v = gray.at<uint8_t>(y, x);
+      return bright_ ? v : 255 - v;
+    };
+    int level = likeness(seed->x, seed->y);
+    buckets_[level].push_back(*seed);
+    visited_.at<uint8_t>(*seed) = 1;
+    core_.clear();
+    int pass = -1;
+    while (pass < 0) {
+      while (level >= 0 && buckets_[level].empty()) --level;
+      if (level < 0) break;
+      const cv::Point p = buckets_[level].back();
+      buckets_[level].pop_back();
+      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) {
+        pass = level;
+        break;
+      }
+      if (core_.size() < kCoreSamples) core_.push_back(level);
+      const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
+      for (const cv::Point& q : next) {
+        if (visited_.at<uint8_t>(q)) continue;
+        visited_.at<uint8_t>(q) = 1;
+        if (!IsInside(gray, mask, q.x, q.y)) {
+          pass = std::min(level, 255);  // The mask's edge: the flood leaves here at this level.
+          break;
+        }
+        const int l = likeness(q.x, q.y);
+        buckets_[std::min(l, level)].push_back(q);  // A path's level is its least marker-like.
+      }
+    }
+    if (pass < 0 || core_.empty()) return false;
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(gray, &lo, &hi, nullptr, nullptr, mask.empty() ? cv::noArray() : mask);
+    range_ = hi - lo;
+    // The marker's own level: the median of its most marker-like pixels (robust to one glint).
+    std::nth_element(core_.begin(), core_.begin() + core_.size() / 2, core_.end());
+    const int core = core_[core_.size() / 2];
+    contrast_ = core - pass;
+    if (contrast_ < kMinBlobContrast) return false;
+    const double cut = (core + pass) / 2.0;
+    const double marker_level = bright_ ? core : 255 - core;
+    const double pass_level = bright_ ? pass : 255 - pass;
+    *low = std::min(marker_level, pass_level);
+    *high = std::max(marker_level, pass_level);
+    return Fill(gray, mask, *seed, bright_ ? cut : 255 - cut);
+  }
+  // The most marker-like pixel within 2 px of `guess` (the nearest of equals).
+  std::optional<cv::Point> ExtremeNear(const cv::Mat& gray, const cv::Mat& mask,
+                                       const cv::Point2d& guess) const {
+    std::optional<cv::Point> seed;
+    int best = -1;
+    double nearest = 0;
+    const int gx = static_cast<int>(std::lround(guess.x)), gy = static_cast<int>(std::lround(guess.y));
+    for (int y = gy - 2; y <= gy + 2; ++y) {
+      for (int x = gx - 2; x <= gx + 2; ++x) {
+        if (!IsInside(gray, mask, x, y)) continue;
+        const int v = gray.at<uint8_t>(y, x);
+        const int l = bright_ ? v : 255 - v;
+        const double d = (x - guess.x) * (x - guess.x) + (y - guess.y) * (y - guess.y);
+        if (l > best || (l == best && d < nearest)) {
+          best = l;
+          nearest = d;
+          seed = cv::Point(x, y);
+        }
+      }
+    }
+    return seed;
   }
   bool IsInside(const cv::Mat& gray, const cv::Mat& mask, int x, int y) const {
     return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
@@ -222,24 +312,6 @@ class BlobMeter {
   bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
     const double v = gray.at<uint8_t>(y, x);
     return bright_ ? v > threshold : v < threshold;
-  }
-  // The marker-side pixel nearest `guess` at `threshold`, within 2 px (and a bit).
-  std::optional<cv::Point> SeedNear(const cv::Mat& gray, const cv::Mat& mask,
-                                    const cv::Point2d& guess, double threshold) const {
-    std::optional<cv::Point> seed;
-    double nearest = 8.0;  // Squared distance.
-    const int gx = static_cast<int>(std::lround(guess.x)), gy = static_cast<int>(std::lround(guess.y));
-    for (int y = gy - 2; y <= gy + 2; ++y) {
-      for (int x = gx - 2; x <= gx + 2; ++x) {
-        if (!IsInside(gray, mask, x, y) || !IsMarker(gray, x, y, threshold)) continue;
-        const double d = (x - guess.x) * (x - guess.x) + (y - guess.y) * (y - guess.y);
-        if (d <= nearest) {
-          nearest = d;
-          seed = cv::Point(x, y);
-        }
-      }
-    }
-    return seed;
   }
   // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
@@ -266,11 +338,17 @@ class BlobMeter {
     return true;
   }
 
+  // The marker's level is the median of its this many most marker-like pixels.
+  static constexpr size_t kCoreSamples = 9;
   bool bright_ = true;
   double area_ = 0;
-  cv::Mat label_, dist_;
+  double contrast_ = 0;
+  double range_ = 0;
+  cv::Mat label_, dist_, visited_;
   cv::Rect box_;
   std::vector<cv::Point> stack_;
+  std::array<std::vector<cv::Point>, 256> buckets_;
+  std::vector<int> core_;
 };
 
 // One match of a template in a searched region.
@@ -314,8 +392,14 @@ struct Fix {
 // mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
 cv::Mat ContrastProjection(const cv::Mat& bgr);
 
+// The single channel a selected box (BGR, with the template's `mask`) shows its marker in best:
+// of the principal colour axis (ContrastProjection), luma (an empty matrix) and the axis from the
+// box's edge colour to its centre's, the one in which the blob at the centre is most isolated
+// from its surroundings (BlobMeter::isolation). The principal axis when none shows a blob.
+cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask);
+
 // The marker's blob in a selected template (its foreground): the channel it shows best
-// (`projection`: ContrastProjection on colour, else empty) and the blob learned in it. False
+// (`projection`: MarkerProjection on colour, else empty) and the blob learned in it. False
 // when the template shows none.
 bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
                        BlobMeter* meter, cv::Point2d* anchor);
