@@ -23,60 +23,74 @@ constexpr double kRelativeClipSigmas = 4.0;
 // marker's distance from the anchor (1 sigma: a turn of 9 degrees, or 15 % nearer the camera).
 constexpr double kOneAnchorTurn = 0.15;
 
-// The least-squares similarity (z' = a z + b in complex numbers) taking `from` to `to`: two
-// anchors, or anchors along one line. Returns false when `from` has no extent.
+// Weighted centroids of `from` and `to`.
+void WeightedMeans(const std::vector<cv::Point2d>& from, const std::vector<cv::Point2d>& to,
+                   const std::vector<double>& w, cv::Point2d* mf, cv::Point2d* mt, double* sw) {
+  *mf = cv::Point2d(0, 0);
+  *mt = cv::Point2d(0, 0);
+  *sw = 0;
+  for (size_t k = 0; k < from.size(); ++k) {
+    *mf += w[k] * from[k];
+    *mt += w[k] * to[k];
+    *sw += w[k];
+  }
+  *mf *= 1.0 / *sw;
+  *mt *= 1.0 / *sw;
+}
+
+// The RMS residual of `transform` over the pairs, weighted, per coordinate, with `params` of the
+// 2n coordinates spent on the fit (0 when none are left to check it).
+double ResidualRms(const std::vector<cv::Point2d>& from, const std::vector<cv::Point2d>& to,
+                   const std::vector<double>& w, const cv::Matx23d& t, int params) {
+  const double n = static_cast<double>(from.size());
+  if (2 * n <= params) return 0.0;
+  double ss = 0, sw = 0;
+  for (size_t k = 0; k < from.size(); ++k) {
+    const cv::Point2d p(t(0, 0) * from[k].x + t(0, 1) * from[k].y + t(0, 2),
+                        t(1, 0) * from[k].x + t(1, 1) * from[k].y + t(1, 2));
+    const cv::Point2d r = p - to[k];
+    ss += w[k] * r.dot(r);
+    sw += w[k];
+  }
+  return std::sqrt(ss / sw * n / (2 * n - params));
+}
+
+// The weighted least-squares similarity (z' = a z + b in complex numbers) taking `from` to `to`:
+// two anchors, or anchors along one line. Returns false when `from` has no extent.
 bool FitSimilarity(const std::vector<cv::Point2d>& from, const std::vector<cv::Point2d>& to,
-                   cv::Matx23d* transform, double* residual_rms) {
-  const size_t n = from.size();
-  cv::Point2d mf(0, 0), mt(0, 0);
-  for (size_t k = 0; k < n; ++k) {
-    mf += from[k];
-    mt += to[k];
-  }
-  mf *= 1.0 / static_cast<double>(n);
-  mt *= 1.0 / static_cast<double>(n);
+                   const std::vector<double>& w, cv::Matx23d* transform, double* residual_rms) {
+  cv::Point2d mf, mt;
+  double sw = 0;
+  WeightedMeans(from, to, w, &mf, &mt, &sw);
   double sxx = 0, re = 0, im = 0;
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < from.size(); ++k) {
     const cv::Point2d f = from[k] - mf, t = to[k] - mt;
-    sxx += f.dot(f);
-    re += f.x * t.x + f.y * t.y;
-    im += f.x * t.y - f.y * t.x;
+    sxx += w[k] * f.dot(f);
+    re += w[k] * (f.x * t.x + f.y * t.y);
+    im += w[k] * (f.x * t.y - f.y * t.x);
   }
-  if (sxx < 1.0) return false;  // The anchors are at one place: no rotation or scale to fit.
+  if (sxx < 1e-6 * sw) return false;  // The anchors are at one place: nothing to turn or scale.
   const double a = re / sxx, b = im / sxx;
   *transform = cv::Matx23d(a, -b, mt.x - (a * mf.x - b * mf.y), b, a, mt.y - (b * mf.x + a * mf.y));
-  double ss = 0;
-  for (size_t k = 0; k < n; ++k) {
-    const cv::Point2d p(a * from[k].x - b * from[k].y + (*transform)(0, 2),
-                        b * from[k].x + a * from[k].y + (*transform)(1, 2));
-    const cv::Point2d r = p - to[k];
-    ss += r.dot(r);
-  }
-  // Two anchors fit any similarity exactly: their residual says nothing (the relative-motion
-  // term carries the uncertainty then). With more, the residual's degrees of freedom are 2n - 4.
-  *residual_rms = n > 2 ? std::sqrt(ss / static_cast<double>(2 * n - 4)) : 0.0;
+  *residual_rms = ResidualRms(from, to, w, *transform, 4);
   return true;
 }
 
-// The least-squares affine transform taking `from` to `to` (three anchors or more, spread in two
-// directions: a plate seen in changing perspective is affine to a good approximation, a
-// similarity is not). Returns false when the anchors are too close to one line to fix it.
+// The weighted least-squares affine transform taking `from` to `to` (three anchors or more,
+// spread in two directions: a plate seen in changing perspective is affine to a good
+// approximation, a similarity is not). Returns false when the anchors are too close to one line
+// to fix it.
 bool FitAffine(const std::vector<cv::Point2d>& from, const std::vector<cv::Point2d>& to,
-               cv::Matx23d* transform, double* residual_rms) {
-  const size_t n = from.size();
-  if (n < 3) return false;
-  cv::Point2d mf(0, 0), mt(0, 0);
-  for (size_t k = 0; k < n; ++k) {
-    mf += from[k];
-    mt += to[k];
-  }
-  mf *= 1.0 / static_cast<double>(n);
-  mt *= 1.0 / static_cast<double>(n);
+               const std::vector<double>& w, cv::Matx23d* transform, double* residual_rms) {
+  if (from.size() < 3) return false;
+  cv::Point2d mf, mt;
+  double sw = 0;
+  WeightedMeans(from, to, w, &mf, &mt, &sw);
   cv::Matx22d s = cv::Matx22d::zeros(), c = cv::Matx22d::zeros();
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < from.size(); ++k) {
     const cv::Vec2d f(from[k].x - mf.x, from[k].y - mf.y), t(to[k].x - mt.x, to[k].y - mt.y);
-    s += f * f.t();
-    c += t * f.t();
+    s += w[k] * (f * f.t());
+    c += w[k] * (t * f.t());
   }
   // The spread's smaller axis against its larger (eigenvalues of s): below kMinSpreadRatio the
   // anchors lie along a line (an actuator's markers), and the affine's shear is a guess.
@@ -84,16 +98,11 @@ bool FitAffine(const std::vector<cv::Point2d>& from, const std::vector<cv::Point
   const double tr = s(0, 0) + s(1, 1), det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
   const double disc = std::sqrt(std::max(0.0, tr * tr / 4 - det));
   const double lmax = tr / 2 + disc, lmin = tr / 2 - disc;
-  if (lmax < 1.0 || lmin < kMinSpreadRatio * kMinSpreadRatio * lmax) return false;
+  if (lmax <= 0 || lmin < kMinSpreadRatio * kMinSpreadRatio * lmax) return false;
   const cv::Matx22d a = c * s.inv();
   const cv::Vec2d b = cv::Vec2d(mt.x, mt.y) - a * cv::Vec2d(mf.x, mf.y);
   *transform = cv::Matx23d(a(0, 0), a(0, 1), b[0], a(1, 0), a(1, 1), b[1]);
-  double ss = 0;
-  for (size_t k = 0; k < n; ++k) {
-    const cv::Vec2d p = a * cv::Vec2d(from[k].x, from[k].y) + b;
-    ss += (p[0] - to[k].x) * (p[0] - to[k].x) + (p[1] - to[k].y) * (p[1] - to[k].y);
-  }
-  *residual_rms = n > 3 ? std::sqrt(ss / static_cast<double>(2 * n - 6)) : 0.0;
+  *residual_rms = ResidualRms(from, to, w, *transform, 6);
   return true;
 }
 
@@ -110,16 +119,19 @@ std::optional<BodyConstellation::Prediction> BodyConstellation::predict(
   if (!has_snapshot_.at(i) || !snapshot_[i][i]) return std::nullopt;
   from_.clear();
   to_.clear();
+  weight_.clear();
   for (size_t j = 0; j < anchors_px.size(); ++j) {
     if (j == i || !anchors_px[j] || !snapshot_[i][j]) continue;
     from_.push_back(*snapshot_[i][j]);
     to_.push_back(*anchors_px[j]);
+    // An anchor that moves against the body (an actuator's bending tip) says less of where the
+    // body is than one that keeps its place on it: weighted by its own uncertainty.
+    const double r = relative_of(j);
+    weight_.push_back(1.0 / (kReportSigmaPx * kReportSigmaPx + r * r));
   }
   if (from_.empty()) return std::nullopt;
   const double gap = static_cast<double>(std::max(1, frames_since));
-  const double relative = relative_samples_[i] >= kRelativeSamplesToTrust
-                              ? relative_px_[i]
-                              : std::max(relative_px_[i], kRelativeUntrustedPx);
+  const double relative = relative_of(i);
   const cv::Point2d s = *snapshot_[i][i];
   Prediction p;
   p.anchors = static_cast<int>(from_.size());
@@ -135,9 +147,9 @@ std::optional<BodyConstellation::Prediction> BodyConstellation::predict(
   cv::Matx23d t;
   double residual = 0.0;
   bool exact = false;
-  if (FitAffine(from_, to_, &t, &residual)) {
+  if (FitAffine(from_, to_, weight_, &t, &residual)) {
     exact = from_.size() == 3;
-  } else if (FitSimilarity(from_, to_, &t, &residual)) {
+  } else if (FitSimilarity(from_, to_, weight_, &t, &residual)) {
     exact = from_.size() == 2;
   } else {
     return std::nullopt;
@@ -160,6 +172,12 @@ std::optional<BodyConstellation::Prediction> BodyConstellation::predict(
                          lever * lever * residual * residual + gap * gap * relative * relative);
   p.exact = exact;
   return p;
+}
+
+double BodyConstellation::relative_of(size_t i) const {
+  return relative_samples_[i] >= kRelativeSamplesToTrust
+             ? relative_px_[i]
+             : std::max(relative_px_[i], kRelativeUntrustedPx);
 }
 
 void BodyConstellation::remember(const std::vector<std::optional<cv::Point2d>>& believed_px,

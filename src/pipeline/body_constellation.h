@@ -7,13 +7,15 @@
 //
 // For each marker, the constellation remembers the positions of every marker believed in the
 // last frame in which it was believed itself (its snapshot). The prediction of marker i in a new
-// frame is the snapshot's position of i carried by the similarity transform (rotation, scale,
-// translation: the body's motion and its distance to the camera) that best takes the snapshot's
+// frame is the snapshot's position of i carried by the transform that best takes the snapshot's
 // positions of the anchors (markers believed in this frame, inside their own motion gates) to
-// where they are now. Its uncertainty is the fit's residual (a body that deformed, or tilted in
-// perspective, fits a similarity less well) plus how far the marker itself usually moves
-// against its body per frame (learned while it is tracked: a bending actuator's tip moves
-// against its base; a plate's dots never do), over the frames since its snapshot.
+// where they are now, each anchor weighted by how still it keeps on the body: affine from three
+// anchors or more (the body's motion, its distance to the camera and its tilt in perspective), a
+// similarity from two or from anchors along one line, a translation from one (wide: the body may
+// have turned about it). Its uncertainty is the fit's residual carried out to the marker (a body
+// that deformed fits less well), the anchors' own noise, and how far the marker itself moves
+// against its body per frame (learned while it is tracked: a bending actuator's tip moves against
+// its base; a plate's dots never do) times the frames since its snapshot.
 #pragma once
 
 #include <cstddef>
@@ -68,8 +70,11 @@ class BodyConstellation {
   // Per marker: running RMS of its prediction's miss in consecutive frames (px).
   std::vector<double> relative_px_;
   std::vector<int> relative_samples_;
+  // How far marker i moves against its body per frame (px, 1 sigma), as far as it is known.
+  double relative_of(size_t i) const;
   // Scratch for the fit (reused).
   mutable std::vector<cv::Point2d> from_, to_;
+  mutable std::vector<double> weight_;
 };
 
 }  // namespace softsight

@@ -226,19 +226,24 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
         }
         continue;
       }
-      if (IsOtherObject(i, e.pooled)) continue;
+      const bool continues = t.misses == 0 && InGate(i, p);
+      const double motion_fit =
+          IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
       double fit = 0.0;
-      if (t.misses == 0 && InGate(i, p)) {
-        // The track goes on: its motion judges the report.
-        fit = IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
-      } else if (BodyVouches(i, p)) {
-        // Re-acquired, or jumped with its body (a shaken plate): where the others put it.
+      if (BodyVouches(i, p)) {
+        // Where the others put it (re-acquired, or jumped with its body: a shaken plate). That
+        // outweighs having been followed as another object meanwhile.
         const BodyConstellation::Prediction& b = *body_prediction_[i];
         const double d = cv::norm(p - b.position_px) / BodyGatePx(b);
-        fit = d * d;
+        fit = continues ? std::min(motion_fit, d * d) : d * d;
+      } else if (IsOtherObject(i, e.pooled)) {
+        continue;
+      } else if (continues) {
+        // The track goes on: its motion judges the report.
+        fit = motion_fit;
       } else if (InReach(i, p) && BodyAllows(i, p)) {
         // Re-acquired within its motion's reach, and not where the body says it cannot be.
-        fit = std::min(t.motion.distance2(p), kGate2) / kGate2;
+        fit = motion_fit;
       } else {
         continue;
       }

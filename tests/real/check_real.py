@@ -32,16 +32,16 @@ CASES = {
         what='ViSP mire-2: 501 real 384x288 gray frames, a hand-held plate with 5 white dots over '
              'clutter (reference: ViSP vpDot2)',
         input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5,
-        configs=[('colour', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 96.0),
+        configs=[('colour', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 99.0),
                  ('zncc', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 80.0)]),
     'cube': dict(
         what='ViSP cube: 80 real gray frames, 12 white dots on a cube face, other faces\' dots come '
              'into view (reference: ViSP vpDot2)',
         input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5,
-        configs=[('hand', {f'd{k}': f'd{k}' for k in range(12)}, 'd0,d3,d6', 68.0),
+        configs=[('hand', {f'd{k}': f'd{k}' for k in range(12)}, 'd0,d3,d6', 99.0),
                  ('zncc', {f'd{k}': f'd{k}' for k in range(12)}, 'd0,d3,d6', 99.0),
                  ('init_roi', {'d0': 'dot0', 'd11': 'dot1', 'd10': 'dot2', 'd9': 'dot3'},
-                  'd0,d10,d9', 78.0),
+                  'd0,d10,d9', 99.0),
                  # examples/markers.yaml's gray range with no roi: twelve identical dots and no
                  # way to tell them apart; nothing may be reported.
                  ('mistake', {f'd{k}': f'd{k}' for k in range(12)}, '', 0.0)]),
