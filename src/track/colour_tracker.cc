@@ -289,7 +289,7 @@ void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
   m.area_px = std::clamp(m.area_px + r * (blob.area_px - m.area_px),
                          kAdaptMinRange * m.first_area_px, kAdaptMaxRange * m.first_area_px);
   m.circularity += r * (blob.circularity - m.circularity);
-  if (blob.measured) m.colour += r * (blob.core_colour - m.colour);
+  if (blob.measured && !blob.shaded) m.colour += r * (blob.core_colour - m.colour);
 }
 
 Observation ColourTracker::report(const Choice& choice) {
@@ -344,8 +344,22 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     size_t best_index = 0;
     double best_dist = std::numeric_limits<double>::infinity();
     double nearest_partial = std::numeric_limits<double>::infinity();
-    for (const ColourBlob& b : blobs_) {
-      const auto [verdict, misfit] = judge(b);
+    for (ColourBlob& b : blobs_) {
+      auto [verdict, misfit] = judge(b);
+      const double d = cv::norm(b.centroid_px - predicted);
+      // In a shadow (a hand or a tool between the light and the marker, a dim side of the bench):
+      // a blob where the marker should be that fits it in everything but brightness (its tint,
+      // size, shape and contrast) is the marker darkened, not a darker look-alike that happens to
+      // stand exactly there. Colour only: a gray marker has nothing but its brightness.
+      if (verdict == CandidateVerdict::kColour && !gray_ && model_ &&
+          d <= ref_radius + cv::norm(velocity_px_) + 1.0) {
+        const auto [shaded, shaded_misfit] = judge(b, true);
+        if (shaded == CandidateVerdict::kFits) {
+          verdict = shaded;
+          misfit = shaded_misfit + kShadowMisfit;
+          b.shaded = true;
+        }
+      }
       candidates_.push_back(candidate(b, verdict, misfit));
       // What is left of a covered marker: of its colour, smaller than it (often a sliver, so of
       // any shape), and within its own radius (plus one frame's motion) of where it should be.
@@ -353,7 +367,6 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
       const bool smaller = (verdict == CandidateVerdict::kSize ||
                             verdict == CandidateVerdict::kShape) &&
                            model_ && b.area_px < model_->area_px;
-      const double d = cv::norm(b.centroid_px - predicted);
       if ((smaller || verdict == CandidateVerdict::kPartial) && model_ &&
           d <= ref_radius + cv::norm(velocity_px_) + 1.0) {
         partly_seen_ = true;

@@ -46,6 +46,9 @@ struct ColourBlob {
   // marker partly covered shows the centroid's shift towards what is left of it.
   double asymmetry_px = 0;
   bool measured = false;           // The colour statistics below are set.
+  // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
+  // marker should be): its colour is not the marker's under the usual light, and is not learned.
+  bool shaded = false;
   // Mean colour (B, G, R, or the gray level in [0]) of the blob's core (2 px inside its edge, or
   // the whole blob when that is empty) and of its surroundings (a ring 3-4 px outside, pixels of
   // other blobs excluded), with their RMS spread (over channels).

@@ -117,6 +117,10 @@ constexpr double kRivalStillPx = 0.5;
 constexpr int kRelearnAfterFrames = 15;
 // How near, in learned radii (plus one per frame lost): it may have moved while it was lost.
 constexpr double kRelearnRadii = 6.0;
+// A blob where the tracked marker should be (within its radius plus a frame's motion) that fits
+// it in everything but brightness is the marker in a shadow, taken at once; its misfit is raised
+// by this, so the marker at its own brightness wins where both are in view.
+constexpr double kShadowMisfit = 1.0;
 
 // ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
 constexpr int kAutoHueTolerance = 12;        // hue units (2 degrees each)
