@@ -158,6 +158,8 @@ CalibrateSummary CalibrateCameraMode(const CalibrateOptions& options, const Ches
   calibration.estimate_k3 = options.estimate_k3;
   ChessboardCalibrator calibrator(calibration);
   ViewSequence views(*options.input, "--input", options.step);
+  // Before any work: the calibration must not land on a picture, the video or a link to them.
+  CheckOutputsAreNotInputs({{"--out", options.out_file}}, views.inputs());
   std::string name;
   cv::Mat image;
   while (views.next(name, image)) calibrator.add(name, image);
@@ -197,6 +199,10 @@ CalibrateSummary CalibrateCameraMode(const CalibrateOptions& options, const Ches
 
 CalibrateSummary CalibratePlaneMode(const CalibrateOptions& options, const ChessboardSpec& board,
                                     std::ostream& report) {
+  // Before any work: the scale must not replace the picture or the camera's intrinsics.
+  CheckOutputsAreNotInputs({{"--out", options.out_file}},
+                           {{"--plane", *options.plane_image},
+                            {"--camera", options.camera_file.value_or("")}});
   std::optional<CameraIntrinsics> camera;
   if (options.camera_file) camera = LoadCameraIntrinsics(*options.camera_file);
   const std::string& image_file = *options.plane_image;
@@ -237,6 +243,16 @@ CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const Ches
   }
   std::vector<PathRole> inputs = left.inputs();
   for (PathRole& role : right.inputs()) inputs.push_back(std::move(role));
+  // The same views on both sides calibrate two cameras at one place (baseline 0).
+  for (const PathRole& l : left.inputs()) {
+    for (const PathRole& r : right.inputs()) {
+      std::error_code ec;
+      if (fs::equivalent(l.path, r.path, ec)) {
+        throw InputError("--left and --right: " + EscapeForMessage(l.path) +
+                         " is a view of both cameras; give each camera's own views");
+      }
+    }
+  }
   CheckOutputsAreNotInputs(
       {{"--out", options.out_file}, {"--picture", options.picture_file.value_or("")}}, inputs);
 

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -208,6 +209,51 @@ TEST_F(CalibrateCommandTest, BadInputIsOneLineNamingTheCulprit) {
   options.plane_image = (*dir_ / "plane.png").string();
   options.camera_file = (*dir_ / "missing_camera.yaml").string();
   EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("missing_camera.yaml: cannot open"));
+}
+
+std::string FileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST_F(CalibrateCommandTest, NoInputIsOverwrittenAndAFailedWriteIsAnErrorThatKeepsTheOldFile) {
+  // --out naming one of the views: refused before any work, the picture as it was.
+  const fs::path view = *fs::directory_iterator(*dir_ / "views");
+  const std::string before = FileBytes(view);
+  CalibrateOptions options = CameraOptions();
+  options.out_file = view.string();
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("refusing to overwrite an input"));
+  EXPECT_EQ(FileBytes(view), before);
+  // ... or a link to it.
+  const fs::path link = *dir_ / "link_to_view.png";
+  fs::remove(link);
+  fs::create_symlink(view, link);
+  options.out_file = link.string();
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("refusing to overwrite an input"));
+  EXPECT_EQ(FileBytes(view), before);
+
+  // The plane's scale written over the camera's intrinsics it reads: refused, intrinsics kept.
+  std::ostringstream report;
+  RunCalibrate(CameraOptions(), report);
+  const fs::path camera = *dir_ / "camera.yaml";
+  const std::string intrinsics = FileBytes(camera);
+  options = CameraOptions();
+  options.input.reset();
+  options.plane_image = (*dir_ / "plane.png").string();
+  options.camera_file = camera.string();
+  options.out_file = camera.string();
+  EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("refusing to overwrite an input"));
+  EXPECT_EQ(FileBytes(camera), intrinsics);
+
+  // A write that fails (a full disk) is an error naming the file, never "wrote".
+  if (fs::exists("/dev/full")) {
+    options = CameraOptions();
+    options.out_file = "/dev/full";
+    EXPECT_THAT(CalibrateErrorOf(options), HasSubstr("/dev/full: cannot write it"));
+  }
+  // The calibration lands whole or not at all: written beside it, then renamed over it.
+  EXPECT_FALSE(fs::exists(camera.string() + ".part"));
+  EXPECT_THAT(FileBytes(camera), HasSubstr("camera_matrix"));
 }
 
 }  // namespace

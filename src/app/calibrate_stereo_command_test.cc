@@ -116,6 +116,12 @@ TEST_F(CalibrateStereoCommandTest, BadInputIsOneLineNamingTheCulprit) {
   options.right = dir_->file("short");
   EXPECT_THAT(ErrorOf(options), HasSubstr("--left has 9 images but --right 1"));
 
+  // One folder of views given as both cameras': two cameras at one place (baseline 0).
+  options = Options();
+  options.right = options.left;
+  EXPECT_THAT(ErrorOf(options), HasSubstr("is a view of both cameras"));
+  EXPECT_FALSE(fs::exists(options.out_file));
+
   // The output guard: never write over an input.
   options = Options();
   options.picture_file = dir_->file("right/03.png");

@@ -121,6 +121,12 @@ TEST_F(InputsKeptTest, ControlNeverWritesOverTheConfigProfileOrVideo) {
                 "refusing to overwrite an input");
 }
 
+TEST_F(InputsKeptTest, TheRigNeverPaintsItsFramesOverItsConfig) {
+  // `rig --frames` names the picture it keeps rewriting: its own config was turned into a PNG.
+  ExpectRefused("rig --pty --config " + config_ + " --frames " + config_,
+                "refusing to overwrite an input");
+}
+
 TEST_F(InputsKeptTest, OneNameForTwoOutputsIsRefusedBeforeTheRun) {
   const std::string x = dir_.file("x.csv");
   ExpectRefused("control --config " + config_ + " --simulate --target-deg 120 --csv " + x +

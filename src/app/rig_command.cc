@@ -10,6 +10,7 @@
 
 #include "app/commands.h"
 #include "app/stop_request.h"
+#include "softsight/io/output_guard.h"
 #include "softsight/control/rig.h"
 #include "softsight/core/error.h"
 #include "softsight/config/control_config.h"
@@ -57,6 +58,11 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   if (options.disconnect_after_replies && *options.disconnect_after_replies < 1) {
     throw InputError("--disconnect-after-replies " +
                      std::to_string(*options.disconnect_after_replies) + ": must be at least 1");
+  }
+  // The picture written must not replace the config it was started with.
+  if (options.frames_file) {
+    CheckOutputsAreNotInputs({{"--frames", *options.frames_file}},
+                             {{"--config", options.config_file.value_or("")}});
   }
   const ControlConfig config =
       options.config_file ? LoadControlConfig(*options.config_file) : ControlConfig{};

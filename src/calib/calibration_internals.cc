@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "softsight/core/error.h"
+#include "softsight/core/file_write.h"
 
 namespace softsight::calib_internal {
 
@@ -38,12 +39,15 @@ cv::FileStorage OpenForReading(const std::string& file) {
 }
 
 cv::FileStorage OpenForWriting(const std::string& file) {
-  cv::FileStorage fs;
-  try {
-    if (fs.open(file, cv::FileStorage::WRITE)) return fs;
-  } catch (const cv::Exception&) {
-  }
-  throw InputError(file + ": cannot write (check the folder exists and is writable)");
+  // Built in memory, in the format the file's name asks for (XML or JSON by extension, else
+  // YAML), and written whole by FinishWriting.
+  const std::string ext = std::filesystem::path(file).extension().string();
+  const std::string format = ext == ".xml" || ext == ".json" || ext == ".yml" ? ext : ".yaml";
+  return cv::FileStorage(format, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+}
+
+void FinishWriting(cv::FileStorage& fs, const std::string& file) {
+  WriteWholeFileOrThrow(file, fs.releaseAndGetString());
 }
 
 cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std::string& key,

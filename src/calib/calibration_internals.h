@@ -20,9 +20,12 @@ cv::Mat DistortionMat(const std::vector<double>& distortion);
 inline const cv::TermCriteria kUndistortCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
                                                  50, 1e-10);
 
-// Throw InputError naming the file (missing, not a file, not OpenCV YAML, not writable).
+// Throw InputError naming the file (missing, not a file, not OpenCV YAML).
 cv::FileStorage OpenForReading(const std::string& file);
+// A storage for `file` built in memory; FinishWriting writes it whole (core/file_write.h): a
+// failure leaves the file that was there, never a cut one, and is an InputError naming it.
 cv::FileStorage OpenForWriting(const std::string& file);
+void FinishWriting(cv::FileStorage& fs, const std::string& file);
 // A finite rows x cols matrix (0: any), as CV_64F; InputError naming file and key otherwise.
 cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std::string& key,
                    int rows, int cols);

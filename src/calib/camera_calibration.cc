@@ -19,6 +19,7 @@ using calib_internal::DistortionMat;
 using calib_internal::kUndistortCriteria;
 using calib_internal::Now;
 using calib_internal::OpenForReading;
+using calib_internal::FinishWriting;
 using calib_internal::OpenForWriting;
 using calib_internal::ReadMatrix;
 using calib_internal::ReadPositiveInt;
@@ -160,6 +161,7 @@ void SaveCameraCalibration(const CalibrationResult& result, const ChessboardSpec
   fs << "views_not_found" << "[";
   for (const std::string& name : result.not_found) fs << name;
   fs << "]";
+  FinishWriting(fs, file);
 }
 
 CameraIntrinsics LoadCameraIntrinsics(const std::string& file) {
@@ -290,6 +292,7 @@ void SavePlaneCalibration(const PlaneCalibration& plane, const std::string& file
   fs << "board_width" << plane.board.inner_corners.width;
   fs << "board_height" << plane.board.inner_corners.height;
   fs << "square_size_mm" << plane.board.square_mm;
+  FinishWriting(fs, file);
 }
 
 PlaneCalibration LoadPlaneCalibration(const std::string& file) {

@@ -15,6 +15,7 @@ using calib_internal::CalibrateFromCorners;
 using calib_internal::DistortionMat;
 using calib_internal::Now;
 using calib_internal::OpenForReading;
+using calib_internal::FinishWriting;
 using calib_internal::OpenForWriting;
 using calib_internal::ReadMatrix;
 using calib_internal::ReadPositiveInt;
@@ -81,6 +82,24 @@ bool StereoCalibration::Check(std::string* error) const {
   if (!(cv::norm(T) > 0)) {
     *error = "T: the cameras are at the same place (baseline 0): no depth from two views";
     return false;
+  }
+  // A baseline no bench has (beyond 100 m) is a corrupt file: its depths overflow to inf/nan.
+  constexpr double kMaxBaselineMm = 1e5;
+  if (!(cv::norm(T) <= kMaxBaselineMm)) {
+    *error = "T: a baseline of " + std::to_string(cv::norm(T)) +
+             " mm (more than 100 m between the cameras): not a calibration of a bench";
+    return false;
+  }
+  for (const auto& [name, d] : {std::pair{"distortion_left", &left.distortion},
+                                std::pair{"distortion_right", &right.distortion}}) {
+    for (const double k : *d) {
+      // Lens distortion coefficients beyond 1e3 map every point outside the image.
+      if (!(std::isfinite(k) && std::abs(k) <= 1e3)) {
+        *error = std::string(name) + ": a coefficient of " + std::to_string(k) +
+                 " (no lens distorts beyond 1e3): a corrupt file";
+        return false;
+      }
+    }
   }
   return true;
 }
@@ -288,6 +307,7 @@ void SaveStereoCalibration(const StereoCalibrationResult& result, const Chessboa
     fs << "}";
   }
   fs << "]";
+  FinishWriting(fs, file);
 }
 
 StereoCalibration LoadStereoCalibration(const std::string& file) {

@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
@@ -113,6 +114,29 @@ TEST_F(RenderedStereoPairs, FileRoundTripKeepsTheRig) {
   EXPECT_EQ(loaded.right.distortion, result.stereo.right.distortion);
   EXPECT_LT(cv::norm(loaded.P2 - result.stereo.P2), 1e-6);
   EXPECT_NEAR(loaded.rms_px, result.stereo.rms_px, 1e-12);
+}
+
+TEST_F(RenderedStereoPairs, ABaselineOrADistortionNoBenchHasIsRefusedOnLoading) {
+  // A rig file edited or corrupted to a 1e300 mm baseline gave "baseline inf mm" and nan depths.
+  const StereoCalibrationResult good = Calibrate();
+  const std::string file = (std::filesystem::temp_directory_path() /
+                            ("softsight_stereo_far_" + std::to_string(::getpid()) + ".yaml"))
+                               .string();
+  StereoCalibrationResult far = good;
+  far.stereo.T = cv::Vec3d(1e300, 0, 0);
+  StereoCalibrationResult warped = good;
+  warped.stereo.left.distortion[0] = 1e10;
+  for (const auto& [result, named] : {std::pair{&far, ": T: a baseline of"},
+                                      std::pair{&warped, ": distortion_left: a coefficient of"}}) {
+    SaveStereoCalibration(*result, Options().camera.board, file);
+    try {
+      LoadStereoCalibration(file);
+      ADD_FAILURE() << "loaded a rig with " << named;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr(file + named));
+    }
+  }
+  std::filesystem::remove(file);
 }
 
 TEST_F(RenderedStereoPairs, TooFewPairsWithTheBoardInBothViewsIsAnError) {

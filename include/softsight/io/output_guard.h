@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "softsight/core/file_write.h"  // LockOutputOrThrow, WriteWholeFileOrThrow
+
 namespace softsight {
 
 struct PathRole {
@@ -26,15 +28,5 @@ struct PathRole {
 // Empty output paths stand for "not written" and are skipped.
 void CheckOutputsAreNotInputs(const std::vector<PathRole>& outputs,
                               const std::vector<PathRole>& inputs);
-
-// An open file descriptor of an output, locked for the writer alone (flock, exclusive). Throws
-// InputError naming `path` when another process holds the lock: the other writer's file is
-// left as it is. Call before truncating the file.
-void LockOutputOrThrow(int fd, const std::string& path);
-
-// Writes `text` as the whole content of `path`, through a temporary file beside it renamed over
-// it, so a failure (disk full, a killed process) leaves the old file or nothing, never half.
-// Throws InputError naming the file.
-void WriteWholeFileOrThrow(const std::string& path, const std::string& text);
 
 }  // namespace softsight
