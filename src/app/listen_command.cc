@@ -186,7 +186,11 @@ CommandRunner SetupListenCommand(CLI::App& sub) {
     const StopRequest stop;
     ListenOptions options = *o;
     options.stop_requested = [&stop] { return stop.requested(); };
-    RunListen(options, std::cout, std::cerr);
+    const ListenSummary summary = RunListen(options, std::cout, std::cerr);
+    if (stop.requested() && !options.quiet) {
+      std::cerr << "listen: " << StopSignalReason(stop.signal()) << " after " << summary.records
+                << " records\n";
+    }
     return ExitCodeAfterStop(0);
   };
 }

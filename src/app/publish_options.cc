@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "app/cli_checks.h"
+#include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "stream/stream_format.h"
 
@@ -47,6 +48,7 @@ std::unique_ptr<PublishSink> OpenPublishSink(const std::optional<PublishOptions>
   std::ostringstream bytes;
   bytes << in.rdbuf();
   options.config_digest = Fnv1a64Hex(bytes.str());
+  options.stop_requested = AnyStopRequested;  // Ctrl-C ends --publish-wait's wait.
   return std::make_unique<PublishSink>(std::move(options));
 }
 

@@ -18,6 +18,8 @@ extern "C" void OnStopSignal(int signal) {
 
 }  // namespace
 
+bool AnyStopRequested() { return g_stop_signal != 0; }
+
 StopRequest::StopRequest() {
   g_stop_signal = 0;
   previous_int_ = std::signal(SIGINT, OnStopSignal);

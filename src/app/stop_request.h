@@ -30,6 +30,10 @@ class StopRequest {
   Handler previous_term_;
 };
 
+// Whether the living StopRequest has caught a signal (false while none lives): for waits deep in
+// a library (a publisher waiting for its subscribers) that cannot hold the instance.
+bool AnyStopRequested();
+
 // For a summary: "stopped by Ctrl-C (SIGINT)", "stopped by SIGTERM".
 std::string StopSignalReason(int signal);
 

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <filesystem>
 #include <cmath>
+#include <csignal>
 #include <future>
 #include <sstream>
 
@@ -219,6 +220,23 @@ TEST(Stream, BadEndpointIsOneLineExit2AndNothingWritten) {
   const ProgramRun listen = RunProgram("listen udp://1.2.3.4:5", dir);
   EXPECT_EQ(listen.exit_code, 2);
   EXPECT_THAT(listen.stderr_text, HasSubstr("udp://1.2.3.4:5"));
+}
+
+// Ctrl-C or SIGTERM while a run waits for its subscribers (--publish-wait): the run stops as
+// any stop asks (exit 128 + signal, "stopped by"), not "internal error: Interrupted system call".
+TEST(Stream, ASignalDuringThePublishWaitStopsTheRunAsAskedNotAsAnError) {
+  TempDir dir;
+  WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
+  const std::string csv = dir.file("run.csv");
+  const int status = testing::RunAndSignalOnceRowsAreWritten(
+      "track -c " + dir.file("markers.yaml") + " -i synth:bending -o " + csv +
+          " --publish ipc://" + dir.file("w.ipc") + " --publish-wait 1 --publish-wait-s 120",
+      csv, 1, SIGTERM, dir.file("err.txt"));
+  const std::string err = ReadTextFile(dir.file("err.txt"));
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_THAT(err, HasSubstr("stopped by SIGTERM"));
+  EXPECT_THAT(err, ::testing::Not(HasSubstr("error")));
 }
 
 // `control --target-from`: the first target arrives, then the source says nothing more. The loop

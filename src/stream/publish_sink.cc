@@ -1,6 +1,7 @@
 #include "stream/publish_sink.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -147,6 +148,7 @@ void PublishSink::begin(const RunInfo& info) {
     return count;
   };
   while (hello_subscribers() < options_.wait_subscribers) {
+    if (options_.stop_requested && options_.stop_requested()) return;
     if (std::chrono::steady_clock::now() >= deadline) {
       throw InputError("--publish " + options_.endpoint + ": " +
                        std::to_string(hello_subscribers()) + " of " +
@@ -155,7 +157,11 @@ void PublishSink::begin(const RunInfo& info) {
                        " s (--publish-wait); start them first, or give --publish-wait 0");
     }
     zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
-    zmq::poll(&item, 1, std::chrono::milliseconds(kWaitPollMs));
+    try {
+      zmq::poll(&item, 1, std::chrono::milliseconds(kWaitPollMs));
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR) throw;  // A signal: the loop asks whether to stop.
+    }
     read_subscriptions();
   }
 }

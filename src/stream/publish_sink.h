@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,9 @@ struct PublishOptions {
   int wait_subscribers = 0;
   // How long that wait may take, s; then the run stops with an error. Default 30.
   double wait_timeout_s = 30.0;
+  // Asked while waiting: true ends the wait at once (Ctrl-C, SIGTERM), and the run then stops
+  // before its first frame as a stop asks. Empty: never.
+  std::function<bool()> stop_requested;
   // The hello's config_digest (Fnv1a64Hex of the config file's bytes) and config file name.
   std::string config_digest;
   std::string config_file;

@@ -1,5 +1,6 @@
 #include "stream/subscriber.h"
 
+#include <cerrno>
 #include <chrono>
 
 #include <zmq.hpp>
@@ -23,11 +24,18 @@ StreamSubscriber::~StreamSubscriber() = default;
 
 std::optional<StreamMessage> StreamSubscriber::receive(int timeout_ms) {
   zmq::message_t message;
-  if (timeout_ms > 0) {
-    zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
-    if (zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) == 0) return std::nullopt;
+  try {
+    if (timeout_ms > 0) {
+      zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
+      if (zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) == 0) return std::nullopt;
+    }
+    if (!socket_->recv(message, zmq::recv_flags::dontwait)) return std::nullopt;
+  } catch (const zmq::error_t& e) {
+    // A signal (Ctrl-C, SIGTERM) interrupted the wait: nothing received; the caller asks
+    // whether to stop.
+    if (e.num() == EINTR) return std::nullopt;
+    throw;
   }
-  if (!socket_->recv(message, zmq::recv_flags::dontwait)) return std::nullopt;
   const std::string text = message.to_string();
   const size_t space = text.find(' ');
   if (space == std::string::npos) return StreamMessage{text, ""};
