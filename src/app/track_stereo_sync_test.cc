@@ -160,6 +160,56 @@ INSTANTIATE_TEST_SUITE_P(Offsets, TrackStereoOffsetTest,
                                   std::to_string(std::abs(info.param.offset));
                          });
 
+TEST(TrackStereoRatesTest, TwoFrameRatesArePairedByTimeNotByIndex) {
+  // The left view at 30 fps, the right one every other frame at 15 fps (hostile trial D4: paired
+  // by index, 32 marker-frames were found up to 27.7 mm off in depth, and the offset search
+  // answered a confident wrong offset). Paired by time, every pair is one moment.
+  const TempDir dir;
+  StereoSceneOptions scene_options;
+  scene_options.frame_count = 24;
+  scene_options.bend_deg_per_frame = JerkyBend(scene_options.frame_count);
+  const StereoScene scene(MakeStereoRig(), scene_options);
+  WriteRigAndMarkers(dir, scene.rig());
+  fs::create_directories(dir.path() / "left");
+  fs::create_directories(dir.path() / "right");
+  std::vector<StereoSceneTruth> truths;
+  cv::Mat left, right;
+  char name[32];
+  for (int t = 0; t < scene_options.frame_count; ++t) {
+    truths.push_back(scene.render(t, left, right));
+    std::snprintf(name, sizeof(name), "left/%03d.png", t);
+    cv::imwrite(dir.file(name), left);
+    if (t % 2 == 0) {
+      std::snprintf(name, sizeof(name), "right/%03d.png", t / 2);
+      cv::imwrite(dir.file(name), right);
+    }
+  }
+  TrackStereoOptions options = FolderRun(dir);
+  options.left_input = dir.file("left/%03d.png");
+  options.right_input = dir.file("right/%03d.png");
+  options.sequence_fps = 30;
+  options.right_sequence_fps = 15;
+  std::ostringstream report;
+  const TrackStereoSummary summary = RunTrackStereo(options, report);
+  EXPECT_THAT(report.str(), HasSubstr("30 fps and the right at 15 fps: paired by time"));
+  EXPECT_FALSE(summary.frame_offset.has_value()) << "no offset searched between two rates";
+  const auto rows = ReadRows(dir.file("run3d.csv"));
+  ASSERT_FALSE(rows.empty());
+  int points = 0;
+  for (const auto& row : rows) {
+    EXPECT_NE(row.at("pair_dt_ms"), "");  // Paired by time.
+    const StereoSceneTruth& truth = truths.at(static_cast<size_t>(std::stoi(row.at("frame"))));
+    for (const StereoMarkerTruth& m : truth.markers) {
+      if (row.at(m.name + "_status") != "found") continue;
+      const cv::Point3d p(std::stod(row.at(m.name + "_X")), std::stod(row.at(m.name + "_Y")),
+                          std::stod(row.at(m.name + "_Z")));
+      EXPECT_LT(cv::norm(p - m.position_mm), 1.0) << m.name << " in frame " << row.at("frame");
+      ++points;
+    }
+  }
+  EXPECT_GE(points, 3 * static_cast<int>(rows.size()) / 2);
+}
+
 TEST(TrackStereoOffsetRefusalTest, ARepeatingMotionIsRefusedWithExitCode2) {
   // A swing with a period of 8 frames: offsets 4 frames apart fit alike. One line, naming the
   // option that settles it; the program exits with 2 and writes no CSV.
