@@ -152,7 +152,7 @@ void BindSession(py::module_& m) {
   py::class_<MarkerObservation>(m, "Marker", R"doc(
 One marker in one frame. ``x``, ``y`` are None when it was not found (never a stale or guessed
 position); ``status`` says why: found, lost, ambiguous, implausible, covered, out_of_frame,
-not_started (the CSV's <name>_status).)doc")
+not_started, stale (the CSV's <name>_status).)doc")
       .def_readonly("name", &MarkerObservation::name)
       .def_property_readonly(
           "x",

@@ -119,6 +119,7 @@ TEST_F(CalibrateStereoCommandTest, BadInputIsOneLineNamingTheCulprit) {
   // One folder of views given as both cameras': two cameras at one place (baseline 0).
   options = Options();
   options.right = options.left;
+  options.out_file = dir_->file("one_place.yaml");
   EXPECT_THAT(ErrorOf(options), HasSubstr("is a view of both cameras"));
   EXPECT_FALSE(fs::exists(options.out_file));
 

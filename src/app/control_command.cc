@@ -401,6 +401,13 @@ void CollectControlSummary(const ControlSink& control, const BoardLink& link,
   summary->link_rejected = link.stats().rejected_lines;
   summary->resends = link.stats().resends;
   if (limited_to_reach) summary->notes.push_back(*limited_to_reach);
+  if (control.stale_frames() > 0) {
+    summary->notes.push_back(
+        "the camera repeated its last picture in " + std::to_string(control.stale_frames()) +
+        " of " + std::to_string(summary->frames) +
+        " frames (markers `stale`: a frozen camera or a stalled frame relay): no new measurement "
+        "there, so the loop held, then vented");
+  }
   const double max_kpa = session.controller().options().max_kpa;
   if (control.longest_at_output_limit_s() > 1.0) {
     summary->notes.push_back(

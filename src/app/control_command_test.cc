@@ -6,11 +6,14 @@
 #include <poll.h>
 #include <sys/syscall.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 
 #include <gmock/gmock.h>
@@ -409,6 +412,69 @@ TEST(ControlCommand, PortDisappearsMidRunOneErrorExitNonZeroCsvIntactRigVents) {
   EXPECT_THAT(rig_err, HasSubstr("rig: stopped by SIGTERM after"));
   // After its summary: 128 + SIGTERM, as for a process the signal killed.
   EXPECT_TRUE(WIFEXITED(rig_status) && WEXITSTATUS(rig_status) == 143) << rig_err;
+}
+
+TEST(ControlCommand, AFrozenCameraIsNoMeasurementTheLoopHoldsThenVents) {
+  // Hostile trial D18: the rig's frames file stops changing (a copy of one frame: a camera whose
+  // driver hands out its last buffer, a relay that stalled). Every repeated picture is `stale`,
+  // not a measurement: the loop holds, then vents, and says why; it never pumps to max_kpa on the
+  // frozen angle.
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  std::string port;
+  const std::string live = dir.file("live.png"), frozen = dir.file("frozen.png");
+  int rig_stderr = -1;
+  const pid_t rig = StartRig("--frames " + live + " --fps 20 --duration-s 30", "", &port,
+                             &rig_stderr);
+  ASSERT_GT(rig, 0);
+  std::filesystem::copy_file(live, frozen);  // Written before the rig serves.
+  const std::string command = std::string("\"") + testing::SoftsightBinary() +
+                              "\" control --config " + dir.file("rig.yaml") + " --port " + port +
+                              " --rig-frames " + frozen + " --fps 20 --target-deg 120 --csv " +
+                              dir.file("run.csv") + " --duration-s 1.5 2> " + dir.file("ctl.err");
+  const int status = std::system(command.c_str());
+  kill(rig, SIGTERM);
+  std::string rig_err;
+  ReadUntil(rig_stderr, "", &rig_err);
+  close(rig_stderr);
+  int rig_status = 0;
+  waitpid(rig, &rig_status, 0);
+
+  const std::string err = ReadTextFile(dir.file("ctl.err"));
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_THAT(err, HasSubstr("the camera repeated its last picture in "));
+  EXPECT_THAT(err, HasSubstr("held, then vented"));
+  // The board never pressurised on the frozen angle (the rest of the run: the rig vented).
+  const size_t at = err.find("max board pressure ");
+  ASSERT_NE(at, std::string::npos) << err;
+  EXPECT_LT(std::stod(err.substr(at + std::strlen("max board pressure "))), 5.0) << err;
+  const std::vector<std::string> lines = ReadLines(dir.file("run.csv"));
+  ASSERT_GT(lines.size(), 3u);
+  EXPECT_THAT(lines[0], HasSubstr("red_status"));
+  EXPECT_THAT(lines.back(), HasSubstr("stale"));
+}
+
+TEST(ControlCommand, RigFramesThatAreAPipeAreOneErrorNotAHang) {
+  // Hostile trial D8: a FIFO as --rig-frames blocked open() deaf to Ctrl-C and SIGTERM.
+  TempDir dir;
+  WriteTextFile(dir.file("rig.yaml"), kMarkers);
+  ASSERT_EQ(::mkfifo(dir.file("fifo.png").c_str(), 0600), 0);
+  std::string port;
+  int rig_stderr = -1;
+  const pid_t rig = StartRig("--frames " + dir.file("live.png") + " --duration-s 30", "", &port,
+                             &rig_stderr);
+  ASSERT_GT(rig, 0);
+  const testing::ProgramRun run = testing::RunProgram(
+      "control --config " + dir.file("rig.yaml") + " --port " + port + " --rig-frames " +
+          dir.file("fifo.png") + " --target-deg 120 --csv " + dir.file("x.csv"),
+      dir);
+  kill(rig, SIGTERM);
+  std::string rig_err;
+  ReadUntil(rig_stderr, "", &rig_err);
+  close(rig_stderr);
+  waitpid(rig, nullptr, 0);
+  EXPECT_EQ(run.exit_code, 2) << run.stderr_text;
+  EXPECT_THAT(run.stderr_text, HasSubstr("fifo.png: not a regular file"));
 }
 
 TEST(ControlCommand, CtrlCVentsPrintsTheSummaryAndExits130) {

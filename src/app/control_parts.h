@@ -3,9 +3,15 @@
 // frame's angle, and the simulated board's clock driven by the frames. Private to the command.
 #pragma once
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -38,11 +44,16 @@ class RigFileSource : public FrameSource {
     if (index_ == 0) start_ = std::chrono::steady_clock::now();
     std::this_thread::sleep_until(start_ + std::chrono::duration_cast<
                                                std::chrono::steady_clock::duration>(period * index_));
-    cv::Mat image = cv::imread(file_, cv::IMREAD_COLOR);
+    ReadBytes();
+    const cv::Mat image = cv::imdecode(bytes_, cv::IMREAD_COLOR);
     if (image.empty()) {
       throw InputError(file_ + ": cannot read the rig's frame at frame " + std::to_string(index_) +
                        " (is `softsight rig --frames " + file_ + "` running?)");
     }
+    // The rig rewrites its file every frame with a new picture (its camera has sensor noise): the
+    // very bytes of the last read are a relay that stalled, not a new measurement.
+    frame.repeated = index_ > 0 && bytes_ == last_bytes_;
+    last_bytes_.swap(bytes_);
     frame.image = image;
     frame.index = index_;
     frame.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -55,10 +66,42 @@ class RigFileSource : public FrameSource {
   bool is_live() const override { return true; }
 
  private:
+  // The file's bytes into bytes_. Opened without blocking and checked to be a regular file
+  // before reading: a pipe (or a file swapped for one mid-run) would block open() and read()
+  // deaf to Ctrl-C, with the board left to its watchdog.
+  void ReadBytes() {
+    const int fd = ::open(file_.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+      throw InputError(file_ + ": cannot read the rig's frame at frame " + std::to_string(index_) +
+                       " (" + std::strerror(errno) + "; is `softsight rig --frames " + file_ +
+                       "` running?)");
+    }
+    struct stat info {};
+    if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+      ::close(fd);
+      throw InputError(file_ + ": not a regular file (a pipe or a device?) at frame " +
+                       std::to_string(index_) + ": --rig-frames reads the picture file that "
+                       "`softsight rig --frames` rewrites");
+    }
+    bytes_.resize(static_cast<size_t>(info.st_size));
+    size_t got = 0;
+    while (got < bytes_.size()) {
+      const ssize_t n = ::read(fd, bytes_.data() + got, bytes_.size() - got);
+      if (n > 0) {
+        got += static_cast<size_t>(n);
+      } else if (n == 0 || errno != EINTR) {
+        break;
+      }
+    }
+    ::close(fd);
+    bytes_.resize(got);
+  }
+
   std::string file_;
   double fps_;
   int64_t index_ = 0;
   std::chrono::steady_clock::time_point start_;
+  std::vector<uchar> bytes_, last_bytes_;
 };
 
 // The simulated rig's camera: each frame renders the rig's current bend, then the rig advances by
@@ -117,8 +160,11 @@ class ControlSink : public FrameSink {
 
   // One frame tracked by one camera: its angle is the measurement.
   void consume(const Frame& frame, const FrameResult& result) override {
+    if (frame.repeated) ++stale_frames_;
     step(frame, result.measurement.angle_deg);
   }
+  // Frames the camera repeated (Frame::repeated): no new measurement, the loop held, then vented.
+  int64_t stale_frames() const { return stale_frames_; }
 
   // One step of the loop on `frame`'s time with the angle measured for it, wherever it came from
   // (one camera's tracking, two cameras' 3D angle); absent: no measurement this frame (the
@@ -236,6 +282,7 @@ class ControlSink : public FrameSink {
   }
 
  private:
+  int64_t stale_frames_ = 0;
   ControlSession& session_;
   const BoardLink& link_;
   double duration_s_;

@@ -19,6 +19,12 @@
 namespace softsight {
 namespace {
 
+// Grey levels, 1 sigma: a good webcam in lab light.
+constexpr double kRigCameraNoise = 1.0;
+
+}  // namespace
+namespace {
+
 const char* ModeName(BoardMode mode) {
   switch (mode) {
     case BoardMode::kIdle: return "idle (vented)";
@@ -75,7 +81,11 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
     scene_options.fps = options.fps;
     RenderOptions render;
     render.supersample = options.supersample;
-    scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
+    // A camera's sensor noise: every frame is a new picture, as from a real camera, so a reader
+    // can tell a frame the rig wrote from the last one read again (control: a stalled relay).
+    NoiseOptions noise;
+    noise.sigma = kRigCameraNoise;
+    scene = std::make_unique<SyntheticScene>(scene_options, noise, render);
     const RigSnapshot s = rig.snapshot();
     scene->render_at_bend(s.bend_deg, s.time_s, 0, image);
     WriteAtomically(*options.frames_file, image);  // A first frame before anyone connects.

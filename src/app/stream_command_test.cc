@@ -217,6 +217,9 @@ TEST(Stream, BadEndpointIsOneLineExit2AndNothingWritten) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("out.csv"))) << endpoint;
   }
   EXPECT_EQ(ReadTextFile(dir.file("keep.txt")), "a lab's notes\n");
+  // A host name is this machine's address (ZeroMQ binds to interfaces and addresses only).
+  const ProgramRun localhost = RunProgram(track + " --publish tcp://localhost:*", dir);
+  EXPECT_EQ(localhost.exit_code, 0) << localhost.stderr_text;
   const ProgramRun listen = RunProgram("listen udp://1.2.3.4:5", dir);
   EXPECT_EQ(listen.exit_code, 2);
   EXPECT_THAT(listen.stderr_text, HasSubstr("udp://1.2.3.4:5"));

@@ -12,6 +12,7 @@ const char* MarkerStatusName(MarkerStatus status) {
     case MarkerStatus::kCovered: return "covered";
     case MarkerStatus::kOutOfFrame: return "out_of_frame";
     case MarkerStatus::kNotStarted: return "not_started";
+    case MarkerStatus::kStale: return "stale";
   }
   return "lost";
 }

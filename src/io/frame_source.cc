@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -429,6 +430,16 @@ std::unique_ptr<FrameSource> OpenPattern(const std::string& pattern, double fps)
   return std::make_unique<ImageSequenceSource>(std::move(files), "images " + pattern, fps);
 }
 
+// Whether two pictures are the same bytes; stops at the first row that differs.
+bool SamePicture(const cv::Mat& a, const cv::Mat& b) {
+  if (a.empty() || a.size() != b.size() || a.type() != b.type()) return false;
+  const size_t row_bytes = static_cast<size_t>(a.cols) * a.elemSize();
+  for (int y = 0; y < a.rows; ++y) {
+    if (std::memcmp(a.ptr(y), b.ptr(y), row_bytes) != 0) return false;
+  }
+  return true;
+}
+
 class CameraSource : public FrameSource {
  public:
   CameraSource(int index, const CameraSettings& settings, CameraSettingsReport* report)
@@ -455,6 +466,11 @@ class CameraSource : public FrameSource {
     // (pairing by time, stereo_input.h).
     frame.captured = std::chrono::steady_clock::now();
     ToBgr(decoded_, frame.image);
+    // A sensor's noise makes every real picture differ from the last somewhere in its first rows
+    // (the comparison stops there); the very same picture is a driver handing out its last
+    // buffer again: no new measurement (Frame::repeated).
+    frame.repeated = SamePicture(last_, frame.image);
+    frame.image.copyTo(last_);
     frame.index = next_index_++;
     frame.time_s = std::chrono::duration<double>(frame.captured - start_).count();
     return true;
@@ -475,6 +491,7 @@ class CameraSource : public FrameSource {
   std::string note_;
   cv::VideoCapture capture_;
   cv::Mat decoded_;
+  cv::Mat last_;  // The last picture, to tell a repeated one.
   int64_t next_index_ = 0;
   std::chrono::steady_clock::time_point start_;
 };

@@ -95,6 +95,26 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
     if (!initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
   }
+  if (frame.repeated) {
+    // The live source handed out its last picture again: nothing in it is a new measurement.
+    // The trackers do not see it; the tracks are predicted over it, as over a lost frame.
+    for (size_t i = 0; i < trackers_.size(); ++i) {
+      if (initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kStale);
+    }
+    tracks_->skip();
+    for (size_t i = 0; i < result_.markers.size(); ++i) previous_px_[i].reset();
+    measure(frame);
+    result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
+                      cv::getTickFrequency();
+    result_.captured = frame.captured;
+    result_.latency_result_ms =
+        frame.captured == std::chrono::steady_clock::time_point{}
+            ? 0.0
+            : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                        frame.captured)
+                  .count();
+    return result_;
+  }
   frame_change_->observe(frame.image, frame.key_frame);
   if (frame_change_->whole_frame_changed()) {
     // Nothing in this frame is believed, and the trackers do not see it: their windows, motion

@@ -65,6 +65,32 @@ TEST(TrackingSession, TracksEveryMarkerAndMeasuresLikeTheTruth) {
   }
 }
 
+TEST(TrackingSession, ARepeatedLivePictureIsStaleNotAMeasurementAndTrackingGoesOnAfterIt) {
+  // A frozen camera hands out its last picture again (Frame::repeated): every marker is `stale`,
+  // no angle is measured, and the next new picture is tracked as before.
+  const Clip clip = Render(8);
+  TrackingSession session(ThreeMarkerSceneConfig());
+  for (size_t i = 0; i < clip.frames.size(); ++i) {
+    Frame frame = clip.frames[i];
+    const bool frozen = i == 3 || i == 4;
+    if (frozen) {
+      frame = clip.frames[2];
+      frame.index = static_cast<int64_t>(i);
+      frame.repeated = true;
+    }
+    const FrameResult& result = session.process(frame);
+    for (const MarkerObservation& m : result.markers) {
+      if (frozen) {
+        EXPECT_EQ(m.observation.status(), MarkerStatus::kStale) << "frame " << i;
+      } else {
+        EXPECT_TRUE(m.observation.found()) << m.name << " in frame " << i;
+      }
+    }
+    EXPECT_EQ(result.measurement.angle_deg.has_value(), !frozen) << "frame " << i;
+  }
+  EXPECT_STREQ(MarkerStatusName(MarkerStatus::kStale), "stale");
+}
+
 TEST(TrackingSession, TemplateMarkerIsNotFoundBeforeItsTemplateFrame) {
   const Clip clip = Render(5);
   TrackingConfig config = ThreeMarkerSceneConfig();

@@ -1,5 +1,7 @@
 #include "stream/endpoint.h"
 
+#include <arpa/inet.h>
+#include <netdb.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -7,6 +9,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 
 #include "softsight/core/error.h"
 
@@ -65,6 +68,28 @@ void CheckIpcPath(const std::string& endpoint, const std::string& option) {
   }
 }
 
+// tcp://HOST:PORT with HOST resolved to one of this machine's IPv4 addresses (localhost ->
+// 127.0.0.1); absent when HOST does not resolve.
+std::optional<std::string> ResolvedTcp(const std::string& endpoint) {
+  const size_t start = std::strlen("tcp://");
+  const size_t colon = endpoint.rfind(':');
+  if (colon == std::string::npos || colon <= start) return std::nullopt;
+  const std::string host = endpoint.substr(start, colon - start);
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(host.c_str(), nullptr, &hints, &found) != 0 || found == nullptr) {
+    return std::nullopt;
+  }
+  char text[INET_ADDRSTRLEN] = {};
+  const auto* address = reinterpret_cast<const sockaddr_in*>(found->ai_addr);
+  const bool ok = ::inet_ntop(AF_INET, &address->sin_addr, text, sizeof(text)) != nullptr;
+  ::freeaddrinfo(found);
+  if (!ok) return std::nullopt;
+  return "tcp://" + std::string(text) + endpoint.substr(colon);
+}
+
 }  // namespace
 
 std::string BindOrThrow(zmq::socket_t& socket, const std::string& endpoint,
@@ -74,8 +99,21 @@ std::string BindOrThrow(zmq::socket_t& socket, const std::string& endpoint,
   try {
     socket.bind(endpoint);
   } catch (const zmq::error_t& e) {
+    // ZeroMQ binds to an interface's name or an address, not to a host name: tcp://localhost:P
+    // is this machine's loopback address, resolved here.
+    std::optional<std::string> resolved;
+    if (e.num() == ENODEV && StartsWith(endpoint, "tcp://")) resolved = ResolvedTcp(endpoint);
+    if (resolved) {
+      try {
+        socket.bind(*resolved);
+        return socket.get(zmq::sockopt::last_endpoint);
+      } catch (const zmq::error_t&) {
+      }
+    }
     const std::string why = e.num() == EADDRINUSE ? "the address is in use (another run?)"
-                            : e.num() == ENODEV   ? "no such network interface"
+                            : e.num() == ENODEV   ? "no such network interface or host name "
+                                                    "here (give an interface, or an address such "
+                                                    "as 127.0.0.1)"
                                                   : e.what();
     throw InputError(option + " " + endpoint + ": cannot listen there: " + why + "; " + kForms);
   }

@@ -34,6 +34,11 @@ struct Frame {
   // silently, up to the next key frame: the session accepts a lasting change of the whole
   // picture (a bumped camera) only once a key frame shows it too.
   bool key_frame = true;
+  // The source delivered the very picture it delivered before (a frozen camera whose driver
+  // keeps handing out its last buffer, a frame relay that stalled): not a new measurement. The
+  // session reports every marker `stale` in it, so a control loop holds, then vents, as when the
+  // markers are lost. Live sources set it; a recording's repeated frames are its own business.
+  bool repeated = false;
 };
 
 // Why a marker has (or has no) position in a frame: the per-marker `<name>_status` CSV column.
@@ -47,9 +52,11 @@ enum class MarkerStatus : uint8_t {
   kCovered,      // The marker is where expected but too little of it is visible to measure.
   kOutOfFrame,   // The marker's expected position lies outside the image.
   kNotStarted,   // The tracker has nothing to look for yet (its template frame is still ahead).
+  kStale,        // The live source repeated its last picture (Frame::repeated): no new measurement.
 };
 
-// "found", "lost", "ambiguous", "implausible", "covered", "out_of_frame", "not_started".
+// "found", "lost", "ambiguous", "implausible", "covered", "out_of_frame", "not_started",
+// "stale".
 const char* MarkerStatusName(MarkerStatus status);
 
 // What one tracker says about its marker in one frame. A marker that was not found has no

@@ -31,7 +31,7 @@ class MarkerStatusSummary {
   std::vector<std::string> lines() const;
 
  private:
-  static constexpr size_t kStatusCount = static_cast<size_t>(MarkerStatus::kNotStarted) + 1;
+  static constexpr size_t kStatusCount = static_cast<size_t>(MarkerStatus::kStale) + 1;
   struct Run {
     int64_t first = 0, last = 0;
     int candidates = 0;  // The most candidates seen in the run (kAmbiguous only).
