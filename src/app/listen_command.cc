@@ -60,15 +60,50 @@ class RecordTable {
 
 void CheckHello(const ListenOptions& options, const Json& hello) {
   const auto version = hello.find("version");
-  if (hello.value("format", std::string()) != kStreamFormatName || version == hello.end() ||
-      !version->is_number_integer()) {
+  const auto format = hello.find("format");
+  if (format == hello.end() || !format->is_string() || *format != kStreamFormatName ||
+      version == hello.end() || !version->is_number_integer()) {
     throw InputError("listen " + options.endpoint + ": the publisher's hello is not " +
                      kStreamFormatName + "'s");
   }
-  if (version->get<int>() != kStreamFormatVersion) {
+  // As sent: a version beyond an int is not read modulo 2^32 (4294967297 is not 1).
+  const bool same = version->is_number_unsigned()
+                        ? version->get<uint64_t>() == static_cast<uint64_t>(kStreamFormatVersion)
+                        : version->get<int64_t>() == kStreamFormatVersion;
+  if (!same) {
     throw InputError("listen " + options.endpoint + ": the publisher speaks " + kStreamFormatName +
-                     " version " + std::to_string(version->get<int>()) + "; this softsight reads version " +
+                     " version " + version->dump() + "; this softsight reads version " +
                      std::to_string(kStreamFormatVersion));
+  }
+  for (const char* key : {"source", "config", "config_digest"}) {
+    const auto it = hello.find(key);
+    if (it != hello.end() && !it->is_string()) {
+      throw InputError("listen " + options.endpoint + ": the publisher's hello has a " + key +
+                       " that is not text (" + it->dump().substr(0, 40) + ")");
+    }
+  }
+  const auto columns = hello.find("columns");
+  if (columns != hello.end() && !columns->is_array()) {
+    throw InputError("listen " + options.endpoint + ": the publisher's hello has columns that are "
+                     "not a list");
+  }
+}
+
+// A record's field as softsight publishes them: a number, true/false, null, or a word (a status)
+// without a CSV separator, quote or line break. Anything else would forge or shift rows of the
+// CSV written from it: refused, naming the field.
+void CheckRecordFields(const ListenOptions& options, const std::string& topic, const Json& record) {
+  for (const auto& item : record.items()) {
+    const Json& v = item.value();
+    const bool plain_text =
+        v.is_string() && v.get_ref<const std::string&>().find_first_of(",\"\r\n") == std::string::npos;
+    if (!(v.is_number() || v.is_boolean() || v.is_null() || plain_text)) {
+      throw InputError("listen " + options.endpoint + ": a '" + topic + "' record's field \"" +
+                       item.key().substr(0, 40) + "\" is " +
+                       (v.is_string() ? "text with a comma, quote or line break"
+                                      : std::string("not a number or a word (") + v.type_name() + ")") +
+                       ": not softsight's stream");
+    }
   }
 }
 
@@ -121,6 +156,13 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
       break;
     }
     if (message->topic != options.topic) continue;  // A longer topic with this prefix.
+    if (summary.hellos == 0) {
+      // Every run greets each new subscriber before its records: a record before any hello is
+      // not from a softsight run (or from one this listener cannot check).
+      ++summary.before_hello;
+      continue;
+    }
+    CheckRecordFields(options, message->topic, body);
     ++summary.records;
     const auto frame = body.find("frame");
     if (frame != body.end() && frame->is_number_integer()) {
@@ -149,6 +191,10 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
       records->table().append_row(named, row);
       out << row << "\n" << std::flush;
     }
+  }
+  if (!options.quiet && summary.before_hello > 0) {
+    err << "listen: " << summary.before_hello
+        << " records before the publisher's hello were left out (not checked as softsight's)\n";
   }
   if (!options.quiet && summary.frame_gaps > 0) {
     err << "listen: " << summary.frame_gaps

@@ -27,6 +27,7 @@ struct ListenSummary {
   int64_t records = 0;              // Of the topic, received.
   int64_t hellos = 0;
   int64_t frame_gaps = 0;           // Frame numbers missing between consecutive records.
+  int64_t before_hello = 0;         // Records that came before any hello: left out.
   bool ended = false;               // The run's "end" record arrived.
   std::string end_record;           // Its JSON.
 };

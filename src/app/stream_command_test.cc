@@ -242,6 +242,66 @@ TEST(Stream, ASignalDuringThePublishWaitStopsTheRunAsAskedNotAsAnError) {
   EXPECT_THAT(err, ::testing::Not(HasSubstr("error")));
 }
 
+// What `listen` makes of a hostile or broken publisher (hostile trial D13): `messages` repeated
+// until listen returns; its error, or "" when it ended normally.
+std::string ListenTo(const std::vector<std::string>& messages, const TempDir& dir,
+                     const std::string& csv = "", ListenSummary* summary = nullptr) {
+  zmq::context_t context;
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  const std::string endpoint = "ipc://" + dir.file("hostile.ipc");
+  pub.bind(endpoint);
+  ListenOptions listen;
+  listen.endpoint = endpoint;
+  listen.csv_file = csv;
+  listen.count = 2;
+  listen.quiet = true;
+  std::ostringstream out, err;
+  auto listened = std::async(std::launch::async, [&] { return RunListen(listen, out, err); });
+  // Sent over and over until listen has what it takes (a subscription needs a moment to arrive;
+  // the loop's pace decides nothing).
+  while (listened.wait_for(std::chrono::milliseconds(5)) != std::future_status::ready) {
+    for (const std::string& m : messages) pub.send(zmq::buffer(m), zmq::send_flags::dontwait);
+  }
+  try {
+    const ListenSummary got = listened.get();
+    if (summary) *summary = got;
+    return "";
+  } catch (const InputError& e) {
+    return e.what();
+  }
+}
+
+TEST(Stream, ListenRefusesWhatNoSoftsightRunSendsAndNeverForgesACsvRow) {
+  TempDir dir;
+  const std::string hello =
+      R"(hello {"format":"softsight-stream","version":1,"source":"x","config":"c.yaml",)"
+      R"("config_digest":"0","columns":["frame","time_s","red_status"]})";
+  // A number where the hello has text: one error line, not "internal error: type_error".
+  EXPECT_THAT(ListenTo({R"(hello {"format":"softsight-stream","version":1,"source":5})"}, dir),
+              HasSubstr("hello has a source that is not text"));
+  // A version beyond an int is not read modulo 2^32.
+  EXPECT_THAT(ListenTo({R"(hello {"format":"softsight-stream","version":4294967297})"}, dir),
+              HasSubstr("version 4294967297"));
+  // A status with a line break or a comma would forge or shift rows: refused, the CSV unwritten
+  // past its rows so far.
+  const std::string csv = dir.file("l.csv");
+  EXPECT_THAT(ListenTo({hello, R"(frame {"frame":0,"time_s":0,"red_status":"found\n666,1e9,evil"})"},
+                       dir, csv),
+              HasSubstr("\"red_status\" is text with a comma"));
+  if (std::filesystem::exists(csv)) {
+    for (const std::string& line : ReadLines(csv)) EXPECT_THAT(line, ::testing::Not(HasSubstr("evil")));
+  }
+  // Records before any hello are left out (counted), the ones after it taken.
+  ListenSummary summary;
+  EXPECT_EQ(ListenTo({R"(frame {"frame":0,"time_s":0,"red_status":"found"})", hello,
+                      R"(frame {"frame":1,"time_s":0.1,"red_status":"found"})"},
+                     dir, "", &summary),
+            "");
+  EXPECT_EQ(summary.records, 2);
+  EXPECT_GT(summary.before_hello, 0);
+}
+
 // `control --target-from`: the first target arrives, then the source says nothing more. The loop
 // follows it, and once the source has been silent for controller.target_silence_s (0.5 s of the
 // frames' clock) it vents, frame after frame, and says so in the summary.
