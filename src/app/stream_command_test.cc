@@ -160,6 +160,41 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
   EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("none dropped")));
 }
 
+// Hostile trial D2: a peer that cancels subscriptions it never made (every topic, over and over)
+// while a listener follows the run: the listener still gets every record.
+TEST(Stream, HostilePeersChangeNothing) {
+  TempDir dir;
+  TrackOptions options = BendingRun(dir, "run.csv", 60);
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir.file("h.ipc");
+  publish.wait_subscribers = 1;
+  options.publish = publish;
+
+  zmq::context_t context;
+  zmq::socket_t hostile(context, zmq::socket_type::xsub);
+  hostile.set(zmq::sockopt::linger, 0);
+  hostile.connect(publish.endpoint);
+  ListenOptions listen;
+  listen.endpoint = publish.endpoint;
+  listen.quiet = true;
+  listen.timeout_s = 60.0;
+  std::ostringstream listen_out, listen_err;
+  auto listened = std::async(std::launch::async, [&] { return RunListen(listen, listen_out, listen_err); });
+  auto tracked = std::async(std::launch::async, [&] { return RunTrack(options); });
+  // Cancels of every topic (XSUB: a leading 0 byte), sent until the run ends.
+  while (tracked.wait_for(std::chrono::milliseconds(2)) != std::future_status::ready) {
+    for (const char* topic : {"", "frame ", "hello ", "end ", "frame", "f"}) {
+      (void)hostile.send(zmq::buffer(std::string(1, '\0') + topic), zmq::send_flags::dontwait);
+    }
+  }
+  const RunSummary summary = tracked.get();
+  const ListenSummary heard = listened.get();
+  EXPECT_EQ(summary.frames, 60);
+  EXPECT_TRUE(heard.ended);
+  EXPECT_EQ(heard.records, 60) << "every record reached the listener";
+  EXPECT_EQ(heard.frame_gaps, 0);
+}
+
 // A subscriber that stops reading (here: never reads) fills its queue; the run goes on with the
 // same rows as a run without a stream, and the drops are counted in its summary.
 TEST(Stream, StalledSubscriberLeavesTheRowsAndCountsDrops) {

@@ -23,6 +23,10 @@ constexpr int kLingerMs = 1000;
 // The wait for subscribers polls the socket this often (to send each new one the hello).
 constexpr int kWaitPollMs = 50;
 
+// The largest subscription message read (bytes), and the most distinct prefixes remembered.
+constexpr int kMaxSubscriptionBytes = 1024;
+constexpr size_t kMaxSubscriptionPrefixes = 4096;
+
 bool Matches(const std::string& prefix, const std::string& topic) {
   // A message is "<topic> {...}": a subscription matches when it is a prefix of that.
   const std::string head = topic + ' ';
@@ -56,9 +60,14 @@ PublishSink::PublishSink(PublishOptions options)
   socket_->set(zmq::sockopt::sndhwm, options_.high_water_mark);
   socket_->set(zmq::sockopt::linger, kLingerMs);
   if (options_.send_buffer_bytes > 0) socket_->set(zmq::sockopt::sndbuf, options_.send_buffer_bytes);
-  // Every subscription and unsubscription reaches read_subscriptions(), also a second subscriber
-  // to a topic someone already has (it needs its own hello).
-  socket_->set(zmq::sockopt::xpub_verboser, 1);
+  // Every subscription reaches read_subscriptions(), also a second subscriber to a topic someone
+  // already has (it needs its own hello). Cancellations are not read: ZeroMQ passes on a cancel
+  // from a peer that never subscribed as readily as a real one, and one shared count would let
+  // any peer stop the topics of all (ZeroMQ's own filter is per subscriber, and stays right).
+  socket_->set(zmq::sockopt::xpub_verbose, 1);
+  // A subscription is a topic's prefix, a few bytes: a larger message from a peer is dropped
+  // with its connection (a 6 MB subscription grew the publisher by 200 MB).
+  socket_->set(zmq::sockopt::maxmsgsize, int64_t{kMaxSubscriptionBytes});
   // A full queue refuses the message (counted) instead of losing it silently; send() then hands
   // it to the subscribers with room.
   socket_->set(zmq::sockopt::xpub_nodrop, 1);
@@ -101,15 +110,18 @@ void PublishSink::read_subscriptions() {
     if (message.size() == 0) continue;
     const auto* bytes = static_cast<const char*>(message.data());
     const std::string prefix(bytes + 1, message.size() - 1);
-    if (bytes[0] == 1) {
-      ++subscriptions_[prefix];
-      ++subscriptions_seen_;
-      send_hello = send_hello || Matches(prefix, kHelloTopic);
-    } else if (bytes[0] == 0) {
-      const auto it = subscriptions_.find(prefix);
-      if (it != subscriptions_.end() && --it->second <= 0) subscriptions_.erase(it);
+    if (bytes[0] != 1) continue;  // A cancellation (see the constructor).
+    ++subscriptions_seen_;
+    send_hello = send_hello || Matches(prefix, kHelloTopic);
+    // Distinct prefixes are remembered up to a bound (what the run's topics can match is a few
+    // hundred): a flood of distinct ones costs the loop nothing more.
+    const auto it = subscriptions_.find(prefix);
+    if (it != subscriptions_.end()) {
+      ++it->second;
+    } else if (subscriptions_.size() < kMaxSubscriptionPrefixes) {
+      subscriptions_.emplace(prefix, 1);
+      changed = true;
     }
-    changed = true;
   }
   if (changed) {
     topic_wanted_.assign(topics_.size(), 0);

@@ -114,7 +114,8 @@ class PublishSink : public FrameSink {
   RunInfo info_;
   std::vector<TopicColumns> topics_;
   std::vector<char> topic_wanted_;         // Per topic: some subscription matches it.
-  std::map<std::string, int> subscriptions_;  // Prefix -> how many subscribers asked for it.
+  // Prefix -> how many subscriptions asked for it (cancellations are not counted: see the .cc).
+  std::map<std::string, int> subscriptions_;
   int64_t subscriptions_seen_ = 0;
   std::string message_;                    // Reused: no allocation per record once grown.
   int64_t sent_ = 0, dropped_ = 0;
