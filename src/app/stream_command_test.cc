@@ -21,6 +21,7 @@
 #include "app/scene_markers_test_util.h"
 #include "app/track_command.h"
 #include "core/test_util.h"
+#include "stream/publish_sink.h"
 #include "stream/subscriber.h"
 
 namespace softsight {
@@ -158,6 +159,28 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
     }
   }
   EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("none dropped")));
+}
+
+// Hostile trial D15: two runs started together on one ipc:// path both bound (ZeroMQ replaces a
+// socket file), and one published to nobody. A lock beside the path decides, whatever the timing;
+// the run leaves neither the socket file nor the lock behind.
+TEST(Stream, OneIpcPathIsOneRunsAndNothingOfItStaysBehind) {
+  TempDir dir;
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir.file("one.ipc");
+  {
+    PublishSink first(publish);
+    try {
+      PublishSink second(publish);
+      ADD_FAILURE() << "two publishers bound one path";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("another program publishes on"));
+    }
+    EXPECT_TRUE(std::filesystem::exists(dir.file("one.ipc")));
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("one.ipc")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("one.ipc.lock")));
+  PublishSink again(publish);  // Free again.
 }
 
 // Hostile trial D2: a peer that cancels subscriptions it never made (every topic, over and over)

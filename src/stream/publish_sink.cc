@@ -1,5 +1,9 @@
 #include "stream/publish_sink.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -71,10 +75,48 @@ PublishSink::PublishSink(PublishOptions options)
   // A full queue refuses the message (counted) instead of losing it silently; send() then hands
   // it to the subscribers with room.
   socket_->set(zmq::sockopt::xpub_nodrop, 1);
-  bound_endpoint_ = BindOrThrow(*socket_, options_.endpoint, "--publish");
+  // A socket file is claimed with a lock beside it before the bind: ZeroMQ replaces a socket
+  // file when it binds, so two runs started together on one path both bound, and one published to
+  // nobody. The lock makes the second one's refusal certain, not a matter of timing.
+  if (options_.endpoint.rfind("ipc://", 0) == 0) {
+    const std::string path = options_.endpoint.substr(6);
+    if (!path.empty() && path != "*" && path[0] != '@') {
+      lock_path_ = path + ".lock";
+      // Removed at the end only when this run made it: a file of that name is someone's.
+      lock_fd_ = ::open(lock_path_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+      lock_made_ = lock_fd_ >= 0;
+      if (!lock_made_) lock_fd_ = ::open(lock_path_.c_str(), O_RDONLY | O_CLOEXEC);
+      if (lock_fd_ >= 0 && ::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+        if (lock_made_) ::unlink(lock_path_.c_str());
+        ::close(lock_fd_);
+        lock_fd_ = -1;
+        throw InputError("--publish " + options_.endpoint + ": another program publishes on " +
+                         path + " (another softsight run?); choose another path");
+      }
+    }
+  }
+  try {
+    bound_endpoint_ = BindOrThrow(*socket_, options_.endpoint, "--publish");
+  } catch (...) {
+    if (lock_fd_ >= 0) {
+      if (lock_made_) ::unlink(lock_path_.c_str());
+      ::close(lock_fd_);
+    }
+    throw;
+  }
+  ipc_path_ = lock_path_.empty() ? "" : options_.endpoint.substr(6);
 }
 
-PublishSink::~PublishSink() = default;
+PublishSink::~PublishSink() {
+  // The socket first (its queued messages get their linger), then the socket file and the lock:
+  // nothing of the run is left on the disk.
+  socket_.reset();
+  if (!ipc_path_.empty()) ::unlink(ipc_path_.c_str());
+  if (lock_fd_ >= 0) {
+    if (lock_made_) ::unlink(lock_path_.c_str());
+    ::close(lock_fd_);
+  }
+}
 
 std::string PublishSink::hello() const {
   nlohmann::ordered_json hello;

@@ -111,6 +111,10 @@ class PublishSink : public FrameSink {
   std::unique_ptr<zmq::context_t> context_;
   std::unique_ptr<zmq::socket_t> socket_;
   std::string bound_endpoint_;
+  // ipc:// only: the socket file (removed at the end) and the lock held beside it while bound.
+  std::string ipc_path_, lock_path_;
+  int lock_fd_ = -1;
+  bool lock_made_ = false;
   RunInfo info_;
   std::vector<TopicColumns> topics_;
   std::vector<char> topic_wanted_;         // Per topic: some subscription matches it.
