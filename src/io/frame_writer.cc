@@ -89,7 +89,9 @@ FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(option
   }
 }
 
-FrameWriter::~FrameWriter() { close(); }
+FrameWriter::~FrameWriter() {
+  if (video_.isOpened()) video_.release();  // Unchecked: a caller that cares called close().
+}
 
 void FrameWriter::open(cv::Size size) {
   size_ = size;
@@ -126,7 +128,26 @@ void FrameWriter::write(const cv::Mat& image_bgr, int64_t index) {
 }
 
 void FrameWriter::close() {
-  if (video_.isOpened()) video_.release();
+  if (!video_.isOpened()) return;
+  video_.release();
+  // FFmpeg reports no write error (a full disk, a file size limit): the finished file is read
+  // back, and one that does not hold every frame written is an error, never a silent cut video.
+  if (written_ == 0) return;
+  cv::VideoCapture check;
+  double frames = -1.0;
+  try {
+    if (check.open(options_.path, cv::CAP_FFMPEG)) frames = check.get(cv::CAP_PROP_FRAME_COUNT);
+  } catch (const cv::Exception&) {
+    frames = -1.0;
+  }
+  // A Matroska file's count comes from its duration: within a frame of the truth.
+  const double tolerance = Lower(fs::path(options_.path).extension().string()) == ".mkv" ? 1.0 : 0.0;
+  if (!(frames + tolerance >= static_cast<double>(written_))) {
+    throw InputError(options_.path + ": the video holds " +
+                     (frames >= 0 ? std::to_string(static_cast<int64_t>(frames)) : std::string("no")) +
+                     " of the " + std::to_string(written_) +
+                     " frames written (a full disk, or a file size limit?)");
+  }
 }
 
 }  // namespace softsight

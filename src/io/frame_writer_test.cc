@@ -1,5 +1,11 @@
 #include "softsight/io/frame_writer.h"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -169,4 +175,36 @@ TEST(FrameWriter, AFrameOfAnotherSizeIsAnErrorNamingTheFrame) {
 }
 
 }  // namespace
+// A video cut by a file-size limit (ulimit -f; a full disk does the same): FFmpeg says nothing,
+// the file holds a fraction of the frames. Closing reads it back and says so, naming the file.
+// Run in a child process, which alone gets the limit.
+TEST(FrameWriter, AVideoCutByAFullDiskIsAnErrorAtClose) {
+  TempDir dir;
+  const std::string path = dir.file("cut.avi");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);  // As main() does: the write fails with EFBIG instead.
+    constexpr rlim_t kLimitBytes = 200 * 1024;
+    const rlimit limit{kLimitBytes, kLimitBytes};
+    if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(3);
+    cv::Mat image(480, 640, CV_8UC3);
+    try {
+      FrameWriter writer({path, "", 30.0});
+      for (int i = 0; i < 10; ++i) {
+        cv::randu(image, 0, 255);  // Noise: HuffYUV cannot shrink it, 10 frames pass the limit.
+        writer.write(image, i);
+      }
+      writer.close();
+    } catch (const InputError& e) {
+      _exit(std::string(e.what()).find("cut.avi: the video holds") != std::string::npos ? 0 : 4);
+    }
+    _exit(5);  // Not noticed.
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
 }  // namespace softsight

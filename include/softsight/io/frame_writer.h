@@ -41,7 +41,9 @@ class FrameWriter {
   // Writes one 8-bit BGR image; `index` names the file of an image pattern. Every image must have
   // the size of the first. Throws InputError naming the file and frame on failure.
   void write(const cv::Mat& image_bgr, int64_t index);
-  // Finishes the video (also done by the destructor).
+  // Finishes the video and checks it holds every frame written (FFmpeg reports no write error):
+  // throws InputError naming the file when it does not (a full disk, a file size limit). The
+  // destructor finishes it without the check.
   void close();
 
   // "HuffYUV video (lossless)", "PNG images (lossless)", ...
