@@ -251,7 +251,10 @@ ControlFrames OpenControlFrames(const ControlOptions& options, const TrackingCon
     RenderOptions render;
     render.supersample = options.sim_supersample;
     frames.scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
-    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *frames.scene, options.fps, duration_s);
+    // With targets from another program the simulation keeps the real time's pace: that
+    // program's messages come in real time, and their silence is judged on the frames' clock.
+    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *frames.scene, options.fps,
+                                                           duration_s, options.target_from.has_value());
     frames.rendered = rig_source.get();
     frames.source = std::move(rig_source);
   }
