@@ -103,17 +103,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     }
     tracks_->skip();
     for (size_t i = 0; i < result_.markers.size(); ++i) previous_px_[i].reset();
-    measure(frame);
-    result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
-                      cv::getTickFrequency();
-    result_.captured = frame.captured;
-    result_.latency_result_ms =
-        frame.captured == std::chrono::steady_clock::time_point{}
-            ? 0.0
-            : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                        frame.captured)
-                  .count();
-    return result_;
+    return finish(frame, start);
   }
   frame_change_->observe(frame.image, frame.key_frame);
   if (frame_change_->whole_frame_changed()) {
@@ -202,8 +192,12 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       believed_frame_[i] = frame.index;
     }
   }
+  return finish(frame, start);
+}
+
+const FrameResult& TrackingSession::finish(const Frame& frame, int64_t start_ticks) {
   measure(frame);
-  result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start) /
+  result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start_ticks) /
                     cv::getTickFrequency();
   result_.captured = frame.captured;
   result_.latency_result_ms =

@@ -98,6 +98,8 @@ class TrackingSession {
   EditListener edit_listener_;
   int64_t last_frame_ = -1;  // The index of the frame process() saw last.
   void measure(const Frame& frame);  // result_.measurement from result_.markers.
+  // The frame's measurement, timing and latency, then the live edits made after it.
+  const FrameResult& finish(const Frame& frame, int64_t start_ticks);
   // The config's recorded live edits (config.changes) due after `frame`, the frame just processed.
   void apply_changes(const Frame& frame);
   size_t next_change_ = 0;  // The first of config_.changes not yet applied.
