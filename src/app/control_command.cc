@@ -251,12 +251,13 @@ ControlFrames OpenControlFrames(const ControlOptions& options, const TrackingCon
     RenderOptions render;
     render.supersample = options.sim_supersample;
     frames.scene = std::make_unique<SyntheticScene>(scene_options, NoiseOptions{}, render);
+    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *frames.scene, options.fps, duration_s);
+    frames.rendered = rig_source.get();
     // With targets from another program the simulation keeps the real time's pace: that
     // program's messages come in real time, and their silence is judged on the frames' clock.
-    auto rig_source = std::make_unique<SimulatedRigSource>(*rig, *frames.scene, options.fps,
-                                                           duration_s, options.target_from.has_value());
-    frames.rendered = rig_source.get();
-    frames.source = std::move(rig_source);
+    frames.source = SourceForRun(std::move(rig_source), options.target_from
+                                                            ? FilePacing::kRealTime
+                                                            : FilePacing::kInCallersThread);
   }
   return frames;
 }

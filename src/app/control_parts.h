@@ -109,21 +109,11 @@ class RigFileSource : public FrameSource {
 // `duration_s`.
 class SimulatedRigSource : public FrameSource {
  public:
-  // `real_time`: each frame waits for its simulated time on the wall clock (targets from another
-  // program come in real time; their silence is judged on the frames' clock).
-  SimulatedRigSource(SimulatedRig& rig, SyntheticScene& scene, double fps, double duration_s,
-                     bool real_time = false)
+  SimulatedRigSource(SimulatedRig& rig, SyntheticScene& scene, double fps, double duration_s)
       : rig_(rig), scene_(scene), fps_(fps),
-        frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1),
-        real_time_(real_time) {}
+        frames_(static_cast<int64_t>(std::floor(duration_s * fps + 1e-9)) + 1) {}
   bool read(Frame& frame) override {
     if (index_ >= frames_) return false;
-    if (real_time_) {
-      if (index_ == 0) start_ = std::chrono::steady_clock::now();
-      std::this_thread::sleep_until(
-          start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                       std::chrono::duration<double>(static_cast<double>(index_) / fps_)));
-    }
     if (index_ > 0) rig_.advance(1.0 / fps_);
     truth_ = rig_.snapshot();
     const double t = static_cast<double>(index_) / fps_;
@@ -143,8 +133,6 @@ class SimulatedRigSource : public FrameSource {
   SyntheticScene& scene_;
   double fps_;
   int64_t frames_;
-  bool real_time_;
-  std::chrono::steady_clock::time_point start_;
   int64_t index_ = 0;
   std::optional<RigSnapshot> truth_;
 };
@@ -294,7 +282,6 @@ class ControlSink : public FrameSink {
   }
 
  private:
-  int64_t stale_frames_ = 0;
   ControlSession& session_;
   const BoardLink& link_;
   double duration_s_;
@@ -333,6 +320,7 @@ class ControlSink : public FrameSink {
   double sum_sq_ = 0.0;
   int64_t errors_ = 0;
   bool done_ = false;
+  int64_t stale_frames_ = 0;  // Frames the camera repeated (see stale_frames()).
 };
 
 // A simulated board with frames from elsewhere (--simulate --input): its clock follows the

@@ -22,9 +22,6 @@ namespace {
 // Grey levels, 1 sigma: a good webcam in lab light.
 constexpr double kRigCameraNoise = 1.0;
 
-}  // namespace
-namespace {
-
 const char* ModeName(BoardMode mode) {
   switch (mode) {
     case BoardMode::kIdle: return "idle (vented)";

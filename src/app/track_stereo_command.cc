@@ -147,37 +147,31 @@ std::unique_ptr<StereoInput> OpenStereoInput(const TrackStereoOptions& options,
   const FrameSourceSpec left_spec = SpecOf(options.left_input, options.sequence_fps);
   const FrameSourceSpec right_spec =
       SpecOf(options.right_input, options.right_sequence_fps.value_or(options.sequence_fps));
+  TimePairingOptions pairing;
+  pairing.time_offset_ms = options.time_offset_ms;
+  if (by_time) return PairByTime(Open(left_spec), Open(right_spec), pairing);
   // Frame i with frame i + offset is one moment only when both views run at one rate: a 30 fps
   // and a 15 fps view paired by index drift apart (the 3D points of every pair but the first are
   // of two moments), and the offset search between them finds a confident wrong offset. Two
   // rates are paired by time unless --frame-offset says to pair by index all the same.
-  bool rates_differ = false;
-  if (!by_time) {
-    const std::optional<double> left_fps = Open(left_spec)->fps();
-    const std::optional<double> right_fps = Open(right_spec)->fps();
-    rates_differ = left_fps && right_fps &&
-                   std::abs(*left_fps - *right_fps) > 1e-3 * std::max(*left_fps, *right_fps);
-    if (rates_differ) {
-      report << "note: the left view runs at " << ShortNumber(*left_fps) << " fps and the right at "
-             << ShortNumber(*right_fps) << " fps: "
-             << (options.frame_offset
-                     ? "paired by index all the same, as --frame-offset asks (--pair-by time "
-                       "pairs the frames of one moment)\n"
-                     : "paired by time (each left frame with the right frame nearest in time); "
-                       "--frame-offset N pairs by index instead\n");
-    }
-  }
-  if (by_time || (rates_differ && !options.frame_offset)) {
-    TimePairingOptions pairing;
-    pairing.time_offset_ms = options.time_offset_ms;
-    return PairByTime(Open(left_spec), Open(right_spec), pairing);
+  std::unique_ptr<FrameSource> left = Open(left_spec), right = Open(right_spec);
+  const std::optional<double> left_fps = left->fps(), right_fps = right->fps();
+  if (left_fps && right_fps &&
+      std::abs(*left_fps - *right_fps) > 1e-3 * std::max(*left_fps, *right_fps)) {
+    report << "note: the left view runs at " << ShortNumber(*left_fps) << " fps and the right at "
+           << ShortNumber(*right_fps) << " fps: "
+           << (options.frame_offset
+                   ? "paired by index all the same, as --frame-offset asks (--pair-by time "
+                     "pairs the frames of one moment)\n"
+                   : "paired by time (each left frame with the right frame nearest in time); "
+                     "--frame-offset N pairs by index instead\n");
+    if (!options.frame_offset) return PairByTime(std::move(left), std::move(right), pairing);
   }
   const int64_t offset = options.frame_offset
                              ? *options.frame_offset
                              : FindAndReportFrameOffset(options, left_spec, right_spec, report);
   summary.frame_offset = offset;
-  return PairByIndex(Open(left_spec), Open(right_spec), offset,
-                     "--frame-offset");
+  return PairByIndex(std::move(left), std::move(right), offset, "--frame-offset");
 }
 
 // The board of --bench-board: --chessboard and --square-mm, else the stereo file's.

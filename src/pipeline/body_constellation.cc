@@ -208,8 +208,4 @@ void BodyConstellation::forget(size_t i) {
   for (auto& row : snapshot_) row[i].reset();
 }
 
-void BodyConstellation::clear() {
-  for (size_t i = 0; i < snapshot_.size(); ++i) forget(i);
-}
-
 }  // namespace softsight

@@ -57,8 +57,6 @@ class BodyConstellation {
 
   // Marker i starts afresh (re-selected, or the video jumped): no snapshot.
   void forget(size_t i);
-  // Every marker starts afresh.
-  void clear();
 
   // For tests: how far marker i was learned to move against its body per frame (px, 1 sigma).
   double relative_motion_px(size_t i) const { return relative_px_.at(i); }

@@ -113,7 +113,7 @@ void MarkerTracks::predict_from_body(const std::vector<MarkerObservation>& marke
     const Track& t = tracks_[j];
     const Observation& o = markers[j].observation;
     anchor_px_[j].reset();
-    if (t.motion.started() && t.misses == 0 && o.found() && InGate(j, *o.position_px)) {
+    if (t.motion.started() && o.found() && Continues(j, *o.position_px)) {
       anchor_px_[j] = *o.position_px;
     }
   }
@@ -226,7 +226,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
         }
         continue;
       }
-      const bool continues = t.misses == 0 && InGate(i, p);
+      const bool continues = Continues(i, p);
       const double motion_fit =
           IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
       double fit = 0.0;
@@ -275,7 +275,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     {
       const cv::Point2d p = pooled_[k].position_px;
       decisions_[i].vouched_by_body =
-          tracks_[i].motion.started() && !(tracks_[i].misses == 0 && InGate(i, p)) && BodyVouches(i, p);
+          tracks_[i].motion.started() && !Continues(i, p) && BodyVouches(i, p);
     }
     if (report_pooled_[i] && k == *report_pooled_[i]) {
       tracks_[i].repeated = IsRepeat(tracks_[i], *o.position_px);

@@ -97,12 +97,6 @@ class MarkerTracks {
   // reports the gate had rejected): its motion before is no evidence against it.
   bool restarting(size_t i) const { return tracks_.at(i).restart; }
 
-  // Marker i's position predicted this frame from the other markers' arrangement
-  // (pipeline/body_constellation.h); absent when too few of them were believed with it.
-  const std::optional<BodyConstellation::Prediction>& body_prediction(size_t i) const {
-    return body_prediction_.at(i);
-  }
-
   // For tests: marker i's motion model.
   const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
   // For tests: how many other objects are followed, and how many of them marker i may never take.
@@ -134,6 +128,11 @@ class MarkerTracks {
   // Whether `p` lies in marker i's gate proper: inside the Mahalanobis gate, within its size plus
   // a frame's motion of its prediction, or a repeated frame.
   bool InGate(size_t i, const cv::Point2d& p) const;
+  // Whether a report at `p` continues marker i's track: believed in the last frame, and `p` in
+  // its gate proper.
+  bool Continues(size_t i, const cv::Point2d& p) const {
+    return tracks_[i].misses == 0 && InGate(i, p);
+  }
   // Whether marker i's started track can be at `p` this frame: inside its gate, within its size
   // plus a frame's motion, a repeated frame, or, while coasting, within reach of anywhere between
   // where it was last seen and where it would be now.

@@ -87,9 +87,7 @@ PublishSink::PublishSink(PublishOptions options)
       lock_made_ = lock_fd_ >= 0;
       if (!lock_made_) lock_fd_ = ::open(lock_path_.c_str(), O_RDONLY | O_CLOEXEC);
       if (lock_fd_ >= 0 && ::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-        if (lock_made_) ::unlink(lock_path_.c_str());
-        ::close(lock_fd_);
-        lock_fd_ = -1;
+        release_lock();
         throw InputError("--publish " + options_.endpoint + ": another program publishes on " +
                          path + " (another softsight run?); choose another path");
       }
@@ -98,10 +96,7 @@ PublishSink::PublishSink(PublishOptions options)
   try {
     bound_endpoint_ = BindOrThrow(*socket_, options_.endpoint, "--publish");
   } catch (...) {
-    if (lock_fd_ >= 0) {
-      if (lock_made_) ::unlink(lock_path_.c_str());
-      ::close(lock_fd_);
-    }
+    release_lock();
     throw;
   }
   ipc_path_ = lock_path_.empty() ? "" : options_.endpoint.substr(6);
@@ -112,10 +107,14 @@ PublishSink::~PublishSink() {
   // nothing of the run is left on the disk.
   socket_.reset();
   if (!ipc_path_.empty()) ::unlink(ipc_path_.c_str());
-  if (lock_fd_ >= 0) {
-    if (lock_made_) ::unlink(lock_path_.c_str());
-    ::close(lock_fd_);
-  }
+  release_lock();
+}
+
+void PublishSink::release_lock() {
+  if (lock_fd_ < 0) return;
+  if (lock_made_) ::unlink(lock_path_.c_str());
+  ::close(lock_fd_);
+  lock_fd_ = -1;
 }
 
 std::string PublishSink::hello() const {

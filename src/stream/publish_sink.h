@@ -115,6 +115,8 @@ class PublishSink : public FrameSink {
   std::string ipc_path_, lock_path_;
   int lock_fd_ = -1;
   bool lock_made_ = false;
+  // Lets go of the lock beside an ipc:// path (and removes it when this run made it).
+  void release_lock();
   RunInfo info_;
   std::vector<TopicColumns> topics_;
   std::vector<char> topic_wanted_;         // Per topic: some subscription matches it.

@@ -88,9 +88,10 @@ cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength);
 // A marker that is a blob (a dot, a disc: one compact region brighter or darker than what is
 // around it) is measured by its soft centroid in every frame: each pixel weighs by how much of it
 // is marker, (v - background) / (marker - background) clamped to [0, 1], the blob cut from its
-// surroundings half way between its own level and the level at which it would join them. Its centroid is the marker's centroid
-// whatever its shape, so it follows perspective, scale and rotation exactly, where a template's
-// fixed anchor carries the band's texture turning with the body.
+// surroundings half way between its own level and the level at which it would join them. Its
+// centroid is the marker's centroid whatever its shape, so it follows perspective, scale and
+// rotation exactly, where a template's fixed anchor carries the band's texture turning with the
+// body.
 
 inline constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker and background.
 // The blob at a match has at least this fraction of the learned blob's area (at the current
@@ -128,6 +129,9 @@ class BlobMeter {
     double area = 0;
     if (!Measure(gray, mask, centre, centroid, &area)) return false;
     area_ = area;
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(gray, &lo, &hi, nullptr, nullptr, mask.empty() ? cv::noArray() : mask);
+    range_ = hi - lo;
     return true;
   }
 
@@ -260,7 +264,7 @@ class BlobMeter {
         if (visited_.at<uint8_t>(q)) continue;
         visited_.at<uint8_t>(q) = 1;
         if (!IsInside(gray, mask, q.x, q.y)) {
-          pass = std::min(level, 255);  // The mask's edge: the flood leaves here at this level.
+          pass = level;  // The mask's edge: the flood leaves here at this level.
           break;
         }
         const int l = likeness(q.x, q.y);
@@ -268,9 +272,6 @@ class BlobMeter {
       }
     }
     if (pass < 0 || core_.empty()) return false;
-    double lo = 0, hi = 0;
-    cv::minMaxLoc(gray, &lo, &hi, nullptr, nullptr, mask.empty() ? cv::noArray() : mask);
-    range_ = hi - lo;
     // The marker's own level: the median of its most marker-like pixels (robust to one glint).
     std::nth_element(core_.begin(), core_.begin() + core_.size() / 2, core_.end());
     const int core = core_[core_.size() / 2];
