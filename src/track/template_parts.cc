@@ -133,6 +133,17 @@ cv::Point2d SymmetryCentre(const cv::Mat& templ, double* strength) {
   return c;
 }
 
+cv::Point2d MarkerSymmetryCentre(const cv::Mat& templ, const cv::Point2d& blob_centre,
+                                 double blob_area, double* strength) {
+  const double reach = std::sqrt(std::max(blob_area, 0.0) / CV_PI) + 2.0;
+  const cv::Rect around =
+      cv::Rect(cv::Point(cvRound(blob_centre.x - reach), cvRound(blob_centre.y - reach)),
+               cv::Point(cvRound(blob_centre.x + reach) + 1, cvRound(blob_centre.y + reach) + 1)) &
+      cv::Rect(0, 0, templ.cols, templ.rows);
+  if (around.width < 7 || around.height < 7) return SymmetryCentre(templ, strength);
+  return SymmetryCentre(templ(around), strength) + cv::Point2d(around.tl());
+}
+
 void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out) {
   if (native.channels() == 1) {
     out = native;

@@ -32,6 +32,26 @@ TEST(TemplateParts, SymmetryCentreOfAnOffCentreDiscIsTheDiscsCentre) {
   EXPECT_NEAR(found.y, centre.y, 0.1);
 }
 
+// A disc near one side of a box that also holds a band's bright edge above it and a dark groove
+// below (a marker near an actuator's edge): the box's centre of symmetry is pulled off the
+// disc, the marker's own is on it.
+TEST(TemplateParts, MarkerSymmetryCentreIgnoresWhatElseTheBoxHolds) {
+  cv::Mat templ(33, 33, CV_8UC1, cv::Scalar(90));
+  cv::rectangle(templ, cv::Rect(0, 0, 33, 5), cv::Scalar(250), cv::FILLED);
+  cv::rectangle(templ, cv::Rect(4, 28, 6, 5), cv::Scalar(20), cv::FILLED);
+  const cv::Point2d centre(16.25, 16.5);
+  cv::circle(templ, cv::Point(cvRound(centre.x * 256), cvRound(centre.y * 256)), 7 * 256,
+             cv::Scalar(200), cv::FILLED, cv::LINE_AA, 8);
+  double box_strength = 0.0, strength = 0.0;
+  const cv::Point2d box = SymmetryCentre(templ, &box_strength);
+  EXPECT_GT(cv::norm(box - centre), 0.3) << "the box alone would do: the test shows nothing";
+  const cv::Point2d found =
+      MarkerSymmetryCentre(templ, centre + cv::Point2d(0.3, -0.2), CV_PI * 49, &strength);
+  EXPECT_GT(strength, kMinSymmetry);
+  EXPECT_NEAR(found.x, centre.x, 0.1);
+  EXPECT_NEAR(found.y, centre.y, 0.1);
+}
+
 // A quarter turn of a square template about its centre moves every pixel onto another one
 // exactly: the turned rung is cv::rotate's picture, and its anchor turns with it.
 TEST(TemplateParts, AQuarterTurnIsExactAndTurnsTheAnchorWithThePicture) {

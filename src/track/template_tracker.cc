@@ -94,7 +94,9 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
     // The turned template is matched unmasked: a mask shrunk with it would cut the rim of a
     // disc, which is what carries its position.
     double strength = 0.0;
-    const cv::Point2d centre = SymmetryCentre(templ, &strength);
+    const cv::Point2d centre =
+        blob_ok_ ? MarkerSymmetryCentre(templ, blob_anchor_px_, blob_.area(), &strength)
+                 : SymmetryCentre(templ, &strength);
     if (strength >= kMinSymmetry) anchor_px_ = centre;
   }
   rungs_.clear();

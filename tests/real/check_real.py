@@ -64,11 +64,7 @@ CASES = {
              'top face\'s centre)',
         input='video.avi', args=[], tol=1.5,
         configs=[('pick', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 98.0),
-                 # Known limit: a ZNCC box's blob includes the dome's shaded flank below each
-                 # marker (the template is matched in one gray channel), which puts it 0.5-1 px
-                 # below the top face's centre; held here at its own tolerance until fixed.
-                 ('zncc', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 97.0,
-                  2.5)]),
+                 ('zncc', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 97.0)]),
 }
 
 
@@ -193,10 +189,11 @@ def main():
                 continue
             angle = (f"{median(s['angle']):.2f} / {max(s['angle']):.2f} deg ({len(s['angle'])} frames)"
                      if s['angle'] else '-')
+            spread = (f"{median(s['errors']):.2f} / {rms(s['errors']):.2f}" if s['errors'] else '-')
             if a.markdown:
                 print(f"| {name} | {s['config']} | {s['found']}/{s['visible']} = {s['rate']:.1f} % "
                       f"({s['floor']:g} %) | {s['wrong']} (> {s['tol']:g} px) | "
-                      f"{median(s['errors']):.2f} / {rms(s['errors']):.2f} | {angle} |")
+                      f"{spread} | {angle} |")
             else:
                 verdict = 'FAIL' if s['problems'] else 'ok'
                 print(f"{verdict} {name} {s['config']}: found {s['found']}/{s['visible']} "

@@ -20,8 +20,9 @@
 // that passes min_zncc: a twin) are its candidates() for the session's association, which may
 // adopt() the other one when the motion says it is the marker (verified as the tracker's own
 // choice would be).
-// The reported position is the marker's centre, not the rectangle's: by default the template's
-// centre of point symmetry (a dot's centroid; found once, on the selected template), mapped into
+// The reported position is the marker's centre, not the rectangle's: by default the marker's
+// centre of point symmetry (a dot's centroid; found once, on the selected template, in the square
+// around its blob, so what else the box holds does not pull it), mapped into
 // the frame through the match with the first template at the current scale (report: centre
 // measures the blob's centroid in every frame instead). A dragged rectangle
 // is centred on the marker only to the nearest pixel; report: rect_centre gives the rectangle's
@@ -102,8 +103,10 @@ struct TemplateParams {
   // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a
   // faster unmasked ZNCC kernel).
   bool round_mask = true;
-  // Which point is reported (see the contract above). Default kSymmetry: the template's centre
-  // of point symmetry (a dot's or disc's centroid), carried by the match with the first template;
+  // Which point is reported (see the contract above). Default kSymmetry: the marker's centre
+  // of point symmetry (a dot's or disc's centroid; measured on the square around the template's
+  // blob where it shows one, else on the whole template), carried by the match with the first
+  // template, and moved onto the blob's centroid where the two disagree by more than 0.75 px;
   // a template without a clear one (self-match of the turned template below 0.5) reports its
   // rectangle's centre. kCentre: when the selected template shows a blob (one compact region
   // brighter or darker than what is around it, wholly inside the template), its soft centroid,
