@@ -169,6 +169,14 @@ not_started, stale (the CSV's <name>_status).)doc")
           },
           "Centroid row in pixels, or None.")
       .def_property_readonly(
+          "sigma_px",
+          [](const MarkerObservation& o) -> py::object {
+            if (!o.observation.found()) return py::none();
+            return Optional(o.observation.sigma_px);
+          },
+          "The position's standard uncertainty along each axis in pixels (a found marker lies "
+          "within 3 sigma of its true centre), or None.")
+      .def_property_readonly(
           "found", [](const MarkerObservation& o) { return o.observation.found(); },
           "Whether the marker was found (verified) in this frame.")
       .def_property_readonly(

@@ -37,6 +37,7 @@ def test_process_on_videocapture_frames_matches_the_cli_csv(bending_video, marke
         for m in r.markers:
             got[f"{m.name}_x"].append(field(m.x))
             got[f"{m.name}_y"].append(field(m.y))
+            got[f"{m.name}_sigma_px"].append(field(m.sigma_px))
             got[f"{m.name}_found"].append("1" if m.found else "0")
             got[f"{m.name}_score"].append(field(m.score))
             got[f"{m.name}_status"].append(m.status)

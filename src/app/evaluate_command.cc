@@ -136,6 +136,9 @@ MethodResult ResultOf(const Run& run, const TruthScore& score, const RunSummary&
   out.centroid_max_px = score.centroid_max_px;
   out.centroid_p95_px = score.centroid_p95_px;
   out.wrong_finds = score.wrong_finds;
+  out.with_sigma = score.with_sigma;
+  out.within_3_sigma = score.within_3_sigma;
+  out.beyond_5_sigma = score.beyond_5_sigma;
   out.precision_rms_px = score.precision_rms_px;
   out.precision_max_px = score.precision_max_px;
   out.angle_rms_deg = score.angle_rms_deg;
@@ -295,20 +298,25 @@ std::string FormatEvaluateMarkdown(const EvaluateReport& report) {
   out << report.conditions << "\n\n"
       << "| method | centroid RMS (px) | centroid p95 (px) | centroid max (px) | "
          "precision RMS (px) | precision max (px) | misses / visible | wrong (> 3 px) | "
-         "false / hidden | angle RMS (deg) | median (ms) | p99 (ms) |\n"
-      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+         "false / hidden | within 3 sigma / beyond 5 | angle RMS (deg) | median (ms) | p99 (ms) |\n"
+      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
   for (const MethodResult& m : report.methods) {
     out << "| " << m.label() << " | " << FormatOptional(m.centroid_rms_px, 3) << " | "
         << FormatOptional(m.centroid_p95_px, 3) << " | " << FormatOptional(m.centroid_max_px, 3)
         << " | " << FormatOptional(m.precision_rms_px, 3) << " | "
         << FormatOptional(m.precision_max_px, 3) << " | " << m.misses << " / " << m.visible
         << " | " << m.wrong_finds << " | " << m.false_reports << " / " << m.hidden << " | "
-        << FormatOptional(m.angle_rms_deg, 3) << " | " << FixedNumber(m.proc_ms_median, 3)
+        << (m.with_sigma > 0 ? FixedNumber(100.0 * m.within_3_sigma / m.with_sigma, 1) + " % / " +
+                                   std::to_string(m.beyond_5_sigma)
+                             : std::string("-"))
+        << " | " << FormatOptional(m.angle_rms_deg, 3) << " | " << FixedNumber(m.proc_ms_median, 3)
         << " | " << FixedNumber(m.proc_ms_p99, 3) << " |\n";
   }
   out << "\nCentroid: |tracked - true| over found, visible (>= 50%) marker-frames. Precision: the "
          "same after removing each marker's constant offset measured on its first found frame "
-         "(frame 0). Wrong: found farther than 3 px from the truth. Times: tracking + measurement of all markers per frame.\n";
+         "(frame 0). Wrong: found farther than 3 px from the truth. Sigma: the share of found "
+         "positions whose error along both axes is within 3 of their reported sigma_px, and the "
+         "count beyond 5. Times: tracking + measurement of all markers per frame.\n";
   return out.str();
 }
 
@@ -317,7 +325,8 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
   if (!out) throw InputError(file + ": cannot write the CSV (check the folder and permissions)");
   out << "method,mode,frames,visible,found,misses,hidden,false_reports,centroid_rms_px,"
          "centroid_max_px,precision_rms_px,precision_max_px,angle_rms_deg,angle_frames,"
-         "proc_ms_median,proc_ms_p99,centroid_p95_px,wrong_finds\n";
+         "proc_ms_median,proc_ms_p99,centroid_p95_px,wrong_finds,with_sigma,within_3_sigma,"
+         "beyond_5_sigma\n";
   const auto field = [](const std::optional<double>& value) {
     return value ? FixedNumber(*value, 6) : std::string();
   };
@@ -328,7 +337,8 @@ void WriteEvaluateCsv(const EvaluateReport& report, const std::string& file) {
         << field(m.precision_rms_px) << "," << field(m.precision_max_px) << ","
         << field(m.angle_rms_deg) << "," << m.angle_frames << ","
         << FixedNumber(m.proc_ms_median, 6) << "," << FixedNumber(m.proc_ms_p99, 6) << ","
-        << field(m.centroid_p95_px) << "," << m.wrong_finds << "\n";
+        << field(m.centroid_p95_px) << "," << m.wrong_finds << "," << m.with_sigma << ","
+        << m.within_3_sigma << "," << m.beyond_5_sigma << "\n";
   }
   out.flush();
   if (!out) throw InputError(file + ": writing the CSV failed (disk full?)");

@@ -63,6 +63,8 @@ struct MethodResult {
   std::optional<double> centroid_max_px;
   std::optional<double> centroid_p95_px;  // 95th percentile of the same errors.
   int64_t wrong_finds = 0;          // Found farther than kWrongFindPx (3 px) from the truth.
+  // The reported sigma against the errors (TruthScore): hits with one, within 3, beyond 5.
+  int64_t with_sigma = 0, within_3_sigma = 0, beyond_5_sigma = 0;
   // Precision: the same error after subtracting, per marker, the constant offset (tracked - true)
   // measured on the first frame where the marker was found and visible (frame 0 normally): what
   // remains once the half-pixel placement of a dragged template is taken out.

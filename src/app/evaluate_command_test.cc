@@ -75,6 +75,26 @@ TEST(EvaluateTest, ColourIsSubPixelWithoutMissesAndZnccColourKeepsEveryMarker) {
   EXPECT_GE(zncc.proc_ms_p99, zncc.proc_ms_median);
 }
 
+// Every found position carries its sigma, and the sigma is calibrated: on a noisy, blurred
+// scene at least 99 % of the found positions lie within 3 sigma of the truth along both axes and
+// none beyond 5 (tests/real/check_real.py checks the same on real and physically rendered
+// footage).
+TEST(EvaluateTest, EveryFoundPositionCarriesACalibratedSigma) {
+  EvaluateOptions options = SmallScene();
+  options.noise.sigma = 6;
+  options.noise.blur_sigma_px = 1;
+  options.methods = {"colour", "sad", "zncc"};
+  options.modes = {"gray", "colour"};
+  const EvaluateReport report = RunEvaluate(options);
+  SCOPED_TRACE(FormatEvaluateMarkdown(report));
+  for (const MethodResult& m : report.methods) {
+    EXPECT_GT(m.found_visible, 100) << m.label();
+    EXPECT_EQ(m.with_sigma, m.found_visible) << m.label();
+    EXPECT_GE(m.within_3_sigma, 0.99 * m.with_sigma) << m.label();
+    EXPECT_EQ(m.beyond_5_sigma, 0) << m.label();
+  }
+}
+
 TEST(EvaluateTest, FullyOccludedMarkerIsNeverReported) {
   EvaluateOptions options = SmallScene();
   options.scene.frame_count = 30;

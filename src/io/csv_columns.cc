@@ -52,6 +52,10 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
                  const Observation& o = r.markers.at(i).observation;
                  if (o.found()) AppendCsvNumber(row, o.position_px->y, "%.4f");
                }});
+    table.add({name + "_sigma_px", [i](const FrameResult& r, std::string& row) {
+                 const Observation& o = r.markers.at(i).observation;
+                 if (o.found()) AppendCsvNumber(row, o.sigma_px, "%.4f");
+               }});
     table.add({name + "_found", [i](const FrameResult& r, std::string& row) {
                  row += r.markers.at(i).observation.found() ? '1' : '0';
                }});

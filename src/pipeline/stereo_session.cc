@@ -157,7 +157,8 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
     const Observation* r = FindObservation(right, m.name);
     m.left = l != nullptr ? *l : Observation::NotFound(MarkerStatus::kLost);
     m.right = r != nullptr ? *r : Observation::NotFound(MarkerStatus::kLost);
-    m.point = s.triangulator.triangulate(m.left.position_px, m.right.position_px);
+    m.point = s.triangulator.triangulate(m.left.position_px, m.right.position_px,
+                                         m.left.sigma_px, m.right.sigma_px);
     if (m.point.status != StereoStatus::kMissing) {
       m.status = StereoStatusName(m.point.status);
     } else if (!m.left.found()) {

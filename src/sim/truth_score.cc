@@ -46,6 +46,14 @@ void TruthScorer::add(const SceneTruth& truth, const FrameResult& result) {
         squared_ += absolute * absolute;
         errors_.push_back(absolute);
         if (absolute > kWrongFindPx) ++counts_.wrong_finds;
+        if (observation.sigma_px && *observation.sigma_px > 0) {
+          // Along each axis, in units of the position's sigma: within 3 when both axes are.
+          const double normalised =
+              std::max(std::abs(error.x), std::abs(error.y)) / *observation.sigma_px;
+          ++counts_.with_sigma;
+          counts_.within_3_sigma += normalised <= 3.0;
+          counts_.beyond_5_sigma += normalised > 5.0;
+        }
         precise_squared_ += precise * precise;
         max_ = std::max(max_, absolute);
         precise_max_ = std::max(precise_max_, precise);

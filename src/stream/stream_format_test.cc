@@ -48,8 +48,9 @@ TEST(StreamFormat, TopicsSplitTheColumnsByMarkerAndMeasurement) {
                                       "radius_px", "arc_length_px", "tip_disp_px",
                                       "latency_result_ms", "latency_row_ms", "proc_ms"}));
   EXPECT_EQ(topics[3].topic, "marker/tip");
-  EXPECT_EQ(names(topics[3]), (std::vector<std::string>{"frame", "time_s", "tip_x", "tip_y",
-                                                        "tip_found", "tip_score", "tip_status"}));
+  EXPECT_EQ(names(topics[3]),
+            (std::vector<std::string>{"frame", "time_s", "tip_x", "tip_y", "tip_sigma_px",
+                                      "tip_found", "tip_score", "tip_status"}));
 }
 
 TEST(StreamFormat, ARecordIsTheTopicAndAJsonObjectOfTheRowsFields) {

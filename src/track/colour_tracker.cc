@@ -14,6 +14,7 @@
 #include "softsight/core/error.h"
 #include "track/colour_tracker_impl.h"
 #include "track/colour_tracker_parts.h"
+#include "track/position_sigma.h"
 #include "track/track_options.h"
 
 namespace softsight {
@@ -292,6 +293,21 @@ void ColourTracker::learn(const ColourBlob& blob, bool tracking) {
   if (blob.measured && !blob.shaded) m.colour += r * (blob.core_colour - m.colour);
 }
 
+namespace {
+BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
+  BlobEvidence evidence;
+  evidence.area_px = blob.area_px;
+  if (blob.measured) {
+    evidence.noise_levels = 0.5 * (blob.core_sigma + blob.ring_sigma);
+    evidence.contrast_levels = blob.contrast * (blob.core_sigma + blob.ring_sigma + 2.0);
+    evidence.excess_asymmetry_px = blob.asymmetry_px - model.asymmetry_px;
+  }
+  evidence.rim_placed = blob.rim_placed;
+  if (blob.rim_placed) evidence.area_px = std::max(blob.area_px, model.area_px);
+  return evidence;
+}
+}  // namespace
+
 Observation ColourTracker::report(const Choice& choice) {
   if (!choice.blob && choice.hold) {
     ++held_frames_;
@@ -320,6 +336,7 @@ Observation ColourTracker::report(const Choice& choice) {
   Observation obs;
   obs.position_px = blob.centroid_px;
   obs.score = blob.area_px / model_->area_px;
+  obs.sigma_px = BlobCentroidSigmaPx(EvidenceOf(blob, *model_));
   return obs;
 }
 

@@ -10,6 +10,7 @@
 #include "softsight/core/error.h"
 #include "softsight/track/tracker.h"
 #include "track/match_kernels.h"
+#include "track/position_sigma.h"
 #include "track/template_parts.h"
 #include "track/template_tracker_impl.h"
 #include "track/repeated_frames.h"
@@ -829,6 +830,10 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   Observation observation;
   observation.position_px = at.reported;
   observation.score = score;
+  BlobEvidence blob;
+  if (blob_ok_) blob.area_px = blob_.area() * rung_scale() * rung_scale();
+  const cv::Size size = current().templ.size();
+  observation.sigma_px = TemplateMatchSigmaPx(fix->zncc, size.width, size.height, blob);
   return observation;
 }
 

@@ -6,7 +6,8 @@ user runs it) and scored against the case's reference.csv (frame, marker, x, y, 
 stored frames' pixels, pixel centres at whole numbers). A case passes when no config reports a
 marker found farther from the reference than the case's tolerance, no marker is reported found
 where the reference says it is absent, and every config finds at least its floor of the visible
-marker-frames. The floors are the found rates measured when they were set, rounded down: a change
+marker-frames, and the positions' reported sigma (`<marker>_sigma_px`, the reference's own
+uncertainty added) holds: none beyond 5 sigma, at least 99 % within 3 sigma. The floors are the found rates measured when they were set, rounded down: a change
 that loses finds shows here; one that gains them should raise the floor (docs/measurements.md).
 
 usage: check_real.py --softsight PROGRAM [--case NAME ...] [--markdown] [--keep DIR]
@@ -31,13 +32,13 @@ CASES = {
     'mire2': dict(
         what='ViSP mire-2: 501 real 384x288 gray frames, a hand-held plate with 5 white dots over '
              'clutter (reference: ViSP vpDot2)',
-        input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5,
+        input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5, ref_sigma=0.1,
         configs=[('colour', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 99.0),
                  ('zncc', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 80.0)]),
     'cube': dict(
         what='ViSP cube: 80 real gray frames, 12 white dots on a cube face, other faces\' dots come '
              'into view (reference: ViSP vpDot2)',
-        input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5,
+        input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5, ref_sigma=0.1,
         configs=[('hand', {f'd{k}': f'd{k}' for k in range(12)}, 'd0,d3,d6', 99.0),
                  ('zncc', {f'd{k}': f'd{k}' for k in range(12)}, 'd0,d3,d6', 99.0),
                  ('init_roi', {'d0': 'dot0', 'd11': 'dot1', 'd10': 'dot2', 'd9': 'dot3'},
@@ -48,7 +49,7 @@ CASES = {
     'twocarts': dict(
         what='OSP Tracker: two carts with identical yellow dots, 30-60 px a frame (reference: the '
              'Tracker project\'s points)',
-        input='two-carts.mp4', args=[], tol=3.0,
+        input='two-carts.mp4', args=[], tol=3.0, ref_sigma=0.5,
         configs=[('pick', {'cart1': 'green', 'cart2': 'green_2'}, '', 93.0),
                  ('pick_cart1', {'cart1': 'green'}, '', 93.0),
                  ('auto', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 93.0),
@@ -56,19 +57,19 @@ CASES = {
                  ('mistake', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 16.0)]),
     'balltoss': dict(
         what='OSP Tracker: a white ball thrown over black cloth (reference: hand clicks)',
-        input='BallToss_new_BallToss.mp4', args=[], tol=3.0,
+        input='BallToss_new_BallToss.mp4', args=[], tol=3.0, ref_sigma=1.0,
         configs=[('ball', {'ball': 'ball'}, '', 81.0)]),
     'blender-bench': dict(
         what='A physically based render (Blender Cycles, not this project\'s renderer) of a '
              'ribbed silicone actuator with domed markers on a bench; MJPG (exact truth: each '
              'top face\'s centre)',
-        input='video.avi', args=[], tol=1.5,
+        input='video.avi', args=[], tol=1.5, ref_sigma=0.0,
         configs=[('pick', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 98.0),
                  ('zncc', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 97.0)]),
 }
 
 
-def score(track_csv, reference_csv, tol, name_map, triple):
+def score(track_csv, reference_csv, tol, name_map, triple, ref_sigma):
     """Scores one CSV: per marker found/visible, wrong (> tol), false-while-absent, distances."""
     with open(track_csv, newline='') as f:
         rows = {int(r['frame']): r for r in csv.DictReader(f)}
@@ -77,7 +78,8 @@ def score(track_csv, reference_csv, tol, name_map, triple):
     by_frame = {}
     for r in ref:
         by_frame.setdefault(int(r['frame']), {})[r['marker']] = r
-    s = dict(visible=0, found=0, wrong=0, absent=0, false=0, errors=[], worst=None, angle=[])
+    s = dict(visible=0, found=0, wrong=0, absent=0, false=0, errors=[], worst=None, angle=[],
+             normalised=[])
     for r in ref:
         if r['marker'] not in name_map:
             continue
@@ -94,6 +96,12 @@ def score(track_csv, reference_csv, tol, name_map, triple):
         s['found'] += 1
         d = math.hypot(float(row[f'{name}_x']) - float(r['x']), float(row[f'{name}_y']) - float(r['y']))
         s['errors'].append(d)
+        # The error along each axis in units of the position's sigma (the reference's own
+        # uncertainty added): "within 3 sigma" means both axes are.
+        if row.get(f'{name}_sigma_px', '') != '':
+            sigma = math.hypot(float(row[f'{name}_sigma_px']), ref_sigma)
+            s['normalised'].append(max(abs(float(row[f'{name}_x']) - float(r['x'])),
+                                       abs(float(row[f'{name}_y']) - float(r['y']))) / sigma)
         if d > tol:
             s['wrong'] += 1
             if s['worst'] is None or d > s['worst'][0]:
@@ -132,7 +140,8 @@ def run_case(program, name, case, keep):
             results.append(dict(config=cfg, failed=f'track exited {done.returncode}: {last}'))
             ok = False
             continue
-        s = score(csv_path, os.path.join(folder, 'reference.csv'), tol, name_map, triple)
+        s = score(csv_path, os.path.join(folder, 'reference.csv'), tol, name_map, triple,
+                  case['ref_sigma'])
         s.update(config=cfg, tol=tol, floor=floor)
         s['rate'] = 100.0 * s['found'] / max(1, s['visible'])
         problems = []
@@ -142,6 +151,14 @@ def run_case(program, name, case, keep):
                             f"{marker} in frame {frame})")
         if s['false']:
             problems.append(f"{s['false']} reported found where the reference says absent")
+        # The reported sigma is calibrated: none beyond 5 sigma, and (where there are enough finds
+        # to say) at least 99 % within 3 sigma.
+        n = s['normalised']
+        if any(v > 5 for v in n):
+            problems.append(f"{sum(v > 5 for v in n)} found positions beyond 5 sigma of the reference")
+        if len(n) >= 100 and sum(v <= 3 for v in n) < 0.99 * len(n):
+            problems.append(f"only {100.0 * sum(v <= 3 for v in n) / len(n):.1f} % of found positions "
+                            "within 3 sigma of the reference (< 99 %)")
         if s['rate'] < floor:
             problems.append(f"found {s['rate']:.1f} % < floor {floor:g} %")
         s['problems'] = problems
@@ -178,8 +195,8 @@ def main():
         return 2
     all_ok = True
     if a.markdown:
-        print('| case | config | found (floor) | wrong (> tol) | median / RMS px | angle error median / max |')
-        print('| --- | --- | --- | --- | --- | --- |')
+        print('| case | config | found (floor) | wrong (> tol) | median / RMS px | within 3 sigma / beyond 5 | angle error median / max |')
+        print('| --- | --- | --- | --- | --- | --- | --- |')
     for name in a.case or list(CASES):
         ok, results = run_case(program, name, CASES[name], a.keep)
         all_ok = all_ok and ok
@@ -190,16 +207,19 @@ def main():
             angle = (f"{median(s['angle']):.2f} / {max(s['angle']):.2f} deg ({len(s['angle'])} frames)"
                      if s['angle'] else '-')
             spread = (f"{median(s['errors']):.2f} / {rms(s['errors']):.2f}" if s['errors'] else '-')
+            n = s['normalised']
+            coverage = (f"{100.0 * sum(v <= 3 for v in n) / len(n):.1f} % / {sum(v > 5 for v in n)}"
+                        if n else '-')
             if a.markdown:
                 print(f"| {name} | {s['config']} | {s['found']}/{s['visible']} = {s['rate']:.1f} % "
                       f"({s['floor']:g} %) | {s['wrong']} (> {s['tol']:g} px) | "
-                      f"{spread} | {angle} |")
+                      f"{spread} | {coverage} | {angle} |")
             else:
                 verdict = 'FAIL' if s['problems'] else 'ok'
                 print(f"{verdict} {name} {s['config']}: found {s['found']}/{s['visible']} "
                       f"({s['rate']:.1f} %, floor {s['floor']:g} %), wrong (> {s['tol']:g} px) "
                       f"{s['wrong']}, median {median(s['errors']):.2f} px, RMS {rms(s['errors']):.2f} px, "
-                      f"angle error {angle}" + ''.join(f'\n    {p}' for p in s['problems']))
+                      f"within 3 sigma / beyond 5 sigma {coverage}, angle error {angle}" + ''.join(f'\n    {p}' for p in s['problems']))
     return 0 if all_ok else 1
 
 

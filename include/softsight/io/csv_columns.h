@@ -2,7 +2,8 @@
 // that writes its field for a frame (the row), so header and rows cannot disagree, and callers
 // add columns by name (the controller's), never by position. The tracking columns are the stable
 // contract other programs rely on (README "CSV columns"):
-//   frame, time_s, per marker <name>_x, <name>_y, <name>_found, <name>_score, <name>_status,
+//   frame, time_s, per marker <name>_x, <name>_y, <name>_sigma_px, <name>_found, <name>_score,
+//   <name>_status,
 //   angle_deg, chord_px, sagitta_px, radius_px, arc_length_px, tip_disp_px,
 //   angle_<name>_deg per inner marker of the chain (none without a chain),
 //   chord_mm, sagitta_mm, radius_mm, arc_length_mm, tip_disp_mm (only with a metric model),

@@ -45,6 +45,12 @@ struct TruthScore {
   std::optional<double> centroid_max_px;
   std::optional<double> centroid_p95_px;  // 95th percentile (nearest rank) of the same errors.
   int64_t wrong_finds = 0;                // Hits farther than kWrongFindPx from the truth.
+  // The hits' reported uncertainty (Observation::sigma_px) against their errors: hits with a
+  // sigma, those whose error along both axes is within 3 sigma, and those beyond 5 sigma on
+  // either axis. A calibrated sigma keeps at least 99 % within 3 and none beyond 5.
+  int64_t with_sigma = 0;
+  int64_t within_3_sigma = 0;
+  int64_t beyond_5_sigma = 0;
   // The same after subtracting, per marker, the constant offset (tracked - true) of its first
   // hit: what remains once the half-pixel placement of a dragged template is taken out.
   std::optional<double> precision_rms_px;

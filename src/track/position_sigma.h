@@ -1,0 +1,36 @@
+// The standard uncertainty of a reported marker position: Observation::sigma_px, the CSV's
+// `<marker>_sigma_px`. One number per position, the 1-sigma error along each image axis, so a
+// reader can weigh positions (the stereo triangulation does) and "found" is a number: a found
+// marker lies within 3 sigma of its true centre (measured: docs/measurements.md, "Uncertainty").
+//
+// The error of a centroid has a part that noise makes (it shrinks with the marker's size and its
+// contrast) and a part that no amount of averaging removes: what the segmentation or the match
+// takes for the marker is not exactly the marker (a domed marker's shaded flank, the soft band's
+// levels, the template's surroundings changing with the pose). The second part grows with the
+// marker's size and dominates on real footage; its constants are calibrated on the scenes with
+// truth (rendered, physically rendered and real; see tests/real/check_real.py's coverage).
+#pragma once
+
+namespace softsight {
+
+// What a blob's segmentation tells about how well its centroid is placed.
+struct BlobEvidence {
+  double area_px = 0;          // The blob's area.
+  double noise_levels = 0;     // RMS spread of the marker's and its surroundings' levels.
+  double contrast_levels = 0;  // Marker against surroundings, same units (0: unknown).
+  // How much more asymmetric the blob is than the marker when whole (a part covered, cut, or
+  // smeared by motion), px.
+  double excess_asymmetry_px = 0;
+  bool rim_placed = false;     // The centre is a circle fitted to part of the rim.
+};
+
+// Per axis, px: a colour blob's (or a template's blob's) centroid.
+double BlobCentroidSigmaPx(const BlobEvidence& blob);
+
+// Per axis, px: a template match's position, from its correlation with the first template
+// (`zncc`, 1 = identical), the template's size and, when the position was put on the template's
+// blob, that blob's evidence (area 0: no blob).
+double TemplateMatchSigmaPx(double zncc, double template_width_px, double template_height_px,
+                            const BlobEvidence& blob);
+
+}  // namespace softsight

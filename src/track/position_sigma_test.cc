@@ -1,0 +1,45 @@
+// The position's sigma grows with what makes a position less certain, each term on its own.
+#include "track/position_sigma.h"
+
+#include <gtest/gtest.h>
+
+namespace softsight {
+namespace {
+
+BlobEvidence Disc(double radius_px) {
+  BlobEvidence blob;
+  blob.area_px = 3.14159265 * radius_px * radius_px;
+  blob.noise_levels = 3;
+  blob.contrast_levels = 120;
+  return blob;
+}
+
+TEST(PositionSigma, ABlobsSigmaGrowsWithSizeNoisePartialViewAndARimFit) {
+  const double base = BlobCentroidSigmaPx(Disc(8));
+  EXPECT_GT(base, 0.05);  // Never below the floor...
+  EXPECT_LT(base, 0.5);   // ... and well under a pixel for a clear, whole 16 px disc.
+  EXPECT_GT(BlobCentroidSigmaPx(Disc(16)), base);
+  BlobEvidence noisy = Disc(8);
+  noisy.noise_levels = 60;
+  noisy.contrast_levels = 20;
+  EXPECT_GT(BlobCentroidSigmaPx(noisy), base + 0.1);
+  BlobEvidence cut = Disc(8);
+  cut.excess_asymmetry_px = 2;
+  EXPECT_GT(BlobCentroidSigmaPx(cut), base + 0.5);
+  BlobEvidence rim = Disc(8);
+  rim.rim_placed = true;
+  EXPECT_GT(BlobCentroidSigmaPx(rim), base);
+}
+
+TEST(PositionSigma, AMatchsSigmaGrowsAsTheMatchFitsLess) {
+  const BlobEvidence none;
+  const double good = TemplateMatchSigmaPx(0.99, 31, 31, none);
+  EXPECT_GT(good, 0.05);
+  EXPECT_LT(good, 0.5);
+  EXPECT_GT(TemplateMatchSigmaPx(0.8, 31, 31, none), good + 0.3);
+  EXPECT_GT(TemplateMatchSigmaPx(0.99, 61, 61, none), good);
+  EXPECT_GE(TemplateMatchSigmaPx(0.99, 31, 31, Disc(8)), good);
+}
+
+}  // namespace
+}  // namespace softsight
