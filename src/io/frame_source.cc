@@ -93,23 +93,35 @@ class KeyFrameIndex {
   std::vector<bool> flags_;  // Per packet read so far: a key frame.
 };
 
-// Codecs whose every frame is a key frame (FourCC as FFmpeg reports it through OpenCV).
-bool IntraOnlyCodec(double fourcc_property) {
+// The FourCC as FFmpeg reports it through OpenCV, as its four characters.
+std::string FourCcText(double fourcc_property) {
   const auto fourcc = static_cast<uint32_t>(fourcc_property);
-  char code[5] = {static_cast<char>(fourcc & 0xff), static_cast<char>((fourcc >> 8) & 0xff),
-                  static_cast<char>((fourcc >> 16) & 0xff), static_cast<char>((fourcc >> 24) & 0xff),
-                  0};
+  return {static_cast<char>(fourcc & 0xff), static_cast<char>((fourcc >> 8) & 0xff),
+          static_cast<char>((fourcc >> 16) & 0xff), static_cast<char>((fourcc >> 24) & 0xff)};
+}
+
+// Codecs whose every frame is a key frame.
+bool IntraOnlyCodec(double fourcc_property) {
+  const std::string code = FourCcText(fourcc_property);
   static const char* kIntraOnly[] = {"HFYU", "FFVH", "FFV1", "MJPG", "mjpg", "AVRn", "MJPA",
                                      "png ", "MPNG", "UYVY", "YUY2", "Y800", "I420", "BGR ",
                                      "RGB ", "utvd", "ULRG", "ULY0", "ULY2", "M8RG", "M8Y0"};
   return std::any_of(std::begin(kIntraOnly), std::end(kIntraOnly),
-                     [&](const char* c) { return std::string_view(code, 4) == c; });
+                     [&](const char* c) { return code == c; });
+}
+
+// Motion JPEG (each frame a JPEG), whose decoder conceals a frame's desynchronised data silently.
+bool MotionJpegCodec(double fourcc_property) {
+  const std::string code = FourCcText(fourcc_property);
+  return code == "MJPG" || code == "mjpg" || code == "AVRn" || code == "MJPA";
 }
 
 // A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
-// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) is damaged: it gets
-//   no row (its garbage would be measured as if it were real), later frames keep their numbers,
-//   and the end of the run reports how many there were;
+// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice), or marked as
+//   concealed (DecodeProbe), is damaged: it gets no row (its garbage would be measured as if it
+//   were real), later frames keep their numbers, and the end of the run reports how many there
+//   were. Motion JPEG's decoder conceals damage without a mark: a frame whose coded data does
+//   not fill its picture (io/jpeg_scan.h, checked by the probe) is damaged too;
 // - a file cut short: the last frame decoded before the cut may be half a frame or a stale copy
 //   of an earlier one (FFmpeg's frame threads hand back an old buffer when the last packet is
 //   cut), so frames are read one ahead, and when the stream ends short of the header's frame
@@ -134,13 +146,19 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
-    const bool intra_only = IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
+    const double fourcc = capture_.get(cv::CAP_PROP_FOURCC);
+    const bool intra_only = IntraOnlyCodec(fourcc);
     key_frames_ = std::make_unique<KeyFrameIndex>(path, intra_only);
     // OpenCV gives FFmpeg's decoder one thread per processor (4.6's API does not say how many).
     if (!intra_only) {
       decoder_lag_frames_ =
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
       probe_ = std::make_unique<DecodeProbe>(path);
+    }
+    if (MotionJpegCodec(fourcc)) {
+      // Its packets' data checked, not decoded (io/jpeg_scan.h): a damaged frame is its own.
+      probe_ = std::make_unique<DecodeProbe>(path);
+      concealed_damage_ = "a JPEG whose coded data does not fill its picture";
     }
   }
 
@@ -240,6 +258,7 @@ class VideoFileSource : public FrameSource {
       ++decoded_;
       const int64_t index = next_index_++;
       const bool concealed = probe_ && probe_->concealed(index).value_or(false);
+      if (concealed) damage_kind_ = concealed_damage_;
       if (DecoderErrorCount() != errors_before || concealed) {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
@@ -273,7 +292,7 @@ class VideoFileSource : public FrameSource {
                        (damaged_ == 1 ? "" : "s") + " the decoder found damaged " +
                        (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
                        std::to_string(first_damaged_) + ", decoder: " +
-                       (last_error.empty() ? "concealed damage" : last_error) + ")";
+                       (last_error.empty() ? damage_kind_ : last_error) + ")";
     if (predicted_from_damaged_ > 0) {
       text += ", and " + std::to_string(predicted_from_damaged_) +
               " decoded from them up to the next key frame";
@@ -302,8 +321,12 @@ class VideoFileSource : public FrameSource {
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
   std::unique_ptr<KeyFrameIndex> key_frames_;
-  // Which frames the decoder concealed damage in (predicting codecs; none after a seek).
+  // Which frames the decoder concealed damage in (predicting codecs and Motion JPEG; none after
+  // a seek).
   std::unique_ptr<DecodeProbe> probe_;
+  // What the probe's mark means, and the kind of concealed damage seen last, for the report.
+  std::string concealed_damage_ = "concealed damage";
+  std::string damage_kind_;
   // How many frames a predicting codec's frame threads may be decoding past the one read()
   // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
   // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).
