@@ -1,5 +1,6 @@
 // The checks for damage an intra-only decoder conceals (issue 44, D9 and D10): a JPEG whose
-// entropy-coded data does not fill its picture (io/jpeg_scan.h).
+// entropy-coded data does not fill its picture (io/jpeg_scan.h), and a band of rows from the
+// frame's edge whose colours all moved at once (io/damaged_band.h).
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -8,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "io/damaged_band.h"
 #include "io/jpeg_scan.h"
 
 namespace softsight {
@@ -124,6 +126,48 @@ TEST(JpegScanCheck, WhatItCannotWalkIsUnchecked) {
   }();
   EXPECT_EQ(check.check(png.data(), png.size()), JpegScanCheck::Verdict::kUnchecked);
   EXPECT_EQ(check.check(nullptr, 0), JpegScanCheck::Verdict::kUnchecked);
+}
+
+// The pictures' check: a band from an edge whose colours all moved against the frame before.
+TEST(DamagedBand, ABandOfRowsOffsetFromTheEdgeIsDamageAndMotionOrLightIsNot) {
+  DamagedBand band;
+  EXPECT_FALSE(band.damaged(Scene(0)));  // The first frame has nothing to compare with.
+  EXPECT_FALSE(band.damaged(Scene(2))) << "the markers moved";
+  EXPECT_FALSE(band.damaged(Scene(4)));
+  // The rows from 150 down, 6 levels darker in blue: a HuffYUV residual gone wrong (decoded
+  // bottom-up, so it is the top that goes wrong there; MJPG, the bottom).
+  cv::Mat damaged = Scene(6);
+  damaged.rowRange(150, 240) -= cv::Scalar(6, 0, 0);
+  EXPECT_TRUE(band.damaged(damaged));
+  // The next frame differs from the damaged one by the same band: it is compared with the last
+  // clean frame too, and is not damaged.
+  EXPECT_FALSE(band.damaged(Scene(8)));
+  cv::Mat top = Scene(10);
+  top.rowRange(0, 70) += cv::Scalar(0, 0, 9);
+  EXPECT_TRUE(band.damaged(top));
+  EXPECT_FALSE(band.damaged(Scene(12)));
+  // The exposure: all rows brighter at once.
+  cv::Mat brighter = Scene(14) + cv::Scalar::all(8);
+  EXPECT_FALSE(band.damaged(brighter));
+  // A rolling shutter under mains light: the gain varies smoothly along the rows.
+  for (int frame = 0; frame < 6; ++frame) {
+    cv::Mat flicker = Scene(14);
+    for (int y = 0; y < flicker.rows; ++y) {
+      const double gain = 1.0 + 0.15 * std::sin(y / 25.0 + 1.3 * frame);
+      flicker.row(y).convertTo(flicker.row(y), -1, gain);
+    }
+    EXPECT_FALSE(band.damaged(flicker)) << "flicker frame " << frame;
+  }
+}
+
+TEST(DamagedBand, AFrameTheDecoderReportedIsNotComparedWith) {
+  DamagedBand band;
+  EXPECT_FALSE(band.damaged(Scene(0)));
+  cv::Mat garbage(240, 320, CV_8UC3);
+  cv::randu(garbage, 0, 256);
+  EXPECT_TRUE(band.damaged(garbage, /*known_damaged=*/true));
+  EXPECT_FALSE(band.damaged(Scene(2))) << "compared with the frame before the garbage";
+  EXPECT_FALSE(band.damaged(cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)))) << "not BGR: unchecked";
 }
 
 }  // namespace

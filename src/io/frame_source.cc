@@ -20,6 +20,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "io/camera_options.h"
+#include "io/damaged_band.h"
 #include "io/decode_probe.h"
 #include "io/decoder_log.h"
 #include "io/sequence_pattern.h"
@@ -120,8 +121,10 @@ bool MotionJpegCodec(double fourcc_property) {
 // - a frame its decoder logged an error for (a corrupt JPEG, a broken slice), or marked as
 //   concealed (DecodeProbe), is damaged: it gets no row (its garbage would be measured as if it
 //   were real), later frames keep their numbers, and the end of the run reports how many there
-//   were. Motion JPEG's decoder conceals damage without a mark: a frame whose coded data does
-//   not fill its picture (io/jpeg_scan.h, checked by the probe) is damaged too;
+//   were. Intra-only decoders conceal damage without a mark: a Motion JPEG frame whose coded
+//   data does not fill its picture (io/jpeg_scan.h, checked by the probe), and an intra-only
+//   frame with a band of rows from its edge whose colours all moved at once
+//   (io/damaged_band.h), are damaged too;
 // - a file cut short: the last frame decoded before the cut may be half a frame or a stale copy
 //   of an earlier one (FFmpeg's frame threads hand back an old buffer when the last packet is
 //   cut), so frames are read one ahead, and when the stream ends short of the header's frame
@@ -155,6 +158,7 @@ class VideoFileSource : public FrameSource {
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
       probe_ = std::make_unique<DecodeProbe>(path);
     }
+    if (intra_only) damaged_band_.emplace();
     if (MotionJpegCodec(fourcc)) {
       // Its packets' data checked, not decoded (io/jpeg_scan.h): a damaged frame is its own.
       probe_ = std::make_unique<DecodeProbe>(path);
@@ -207,6 +211,7 @@ class VideoFileSource : public FrameSource {
     // The probe decodes from the start: a seek would wait for it to get there. From here on the
     // decoder's log alone tells damage.
     probe_.reset();
+    if (damaged_band_) damaged_band_->reset();
     started_ = false;
     have_current_ = have_next_ = false;
     next_index_ = position;
@@ -258,8 +263,12 @@ class VideoFileSource : public FrameSource {
       ++decoded_;
       const int64_t index = next_index_++;
       const bool concealed = probe_ && probe_->concealed(index).value_or(false);
+      const bool reported = DecoderErrorCount() != errors_before || concealed;
+      // Told of every frame, so that the next one is compared with this one.
+      const bool band = damaged_band_ && damaged_band_->damaged(out.image, reported);
       if (concealed) damage_kind_ = concealed_damage_;
-      if (DecoderErrorCount() != errors_before || concealed) {
+      if (band && !reported) damage_kind_ = kDamagedBand;
+      if (reported || band) {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
@@ -324,9 +333,13 @@ class VideoFileSource : public FrameSource {
   // Which frames the decoder concealed damage in (predicting codecs and Motion JPEG; none after
   // a seek).
   std::unique_ptr<DecodeProbe> probe_;
+  // Intra-only codecs: damage concealed from one row on (io/damaged_band.h).
+  std::optional<DamagedBand> damaged_band_;
   // What the probe's mark means, and the kind of concealed damage seen last, for the report.
   std::string concealed_damage_ = "concealed damage";
   std::string damage_kind_;
+  static constexpr const char* kDamagedBand =
+      "a band of rows from the frame's edge whose colours all moved at once (concealed damage)";
   // How many frames a predicting codec's frame threads may be decoding past the one read()
   // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
   // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).
