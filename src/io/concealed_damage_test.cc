@@ -115,6 +115,21 @@ TEST(JpegScanCheck, FlipsThatPutTheCodesOutOfStepAreFound) {
   }
 }
 
+// OpenCV's own MJPEG writer cuts the last bytes off some frames (its 32-bit flush); decoders fill
+// them with zeros, in the corner MCU alone. Data running out earlier is damage.
+TEST(JpegScanCheck, DataCutShortInTheLastMcuOnlyPasses) {
+  const std::vector<uint8_t> clean = Jpeg(Scene());
+  ASSERT_EQ(clean[clean.size() - 2], 0xFF);  // EOI.
+  std::vector<uint8_t> cut = clean;
+  cut.erase(cut.end() - 4, cut.end() - 2);
+  JpegScanCheck check;
+  EXPECT_EQ(check.check(cut.data(), cut.size()), JpegScanCheck::Verdict::kWhole);
+  std::vector<uint8_t> half = clean;
+  half.erase(half.begin() + static_cast<std::ptrdiff_t>((ScanStart(clean) + clean.size()) / 2),
+             half.end() - 2);
+  EXPECT_EQ(check.check(half.data(), half.size()), JpegScanCheck::Verdict::kDamaged);
+}
+
 TEST(JpegScanCheck, WhatItCannotWalkIsUnchecked) {
   JpegScanCheck check;
   const std::vector<uint8_t> progressive = Jpeg(Scene(), {cv::IMWRITE_JPEG_PROGRESSIVE, 1});

@@ -150,13 +150,17 @@ JpegScanCheck::Verdict JpegScanCheck::walk_scan(const uint8_t* jpeg, size_t size
             if (k > 64) return Verdict::kDamaged;  // Past the block's 64 coefficients.
             reader.skip(bits);
           }
-          if (reader.overread()) return Verdict::kDamaged;
+          // Data that runs out before the last MCU is out of step. In the last MCU it may be the
+          // encoder's: OpenCV's own MJPEG writer cuts the last bytes off one frame in ten (its
+          // 32-bit flush), which decoders fill with zeros, in the picture's corner MCU alone.
+          if (reader.overread() && mcu + 1 < total) return Verdict::kDamaged;
         }
       }
     }
-    // An intact interval ends within its last byte (the rest is padding).
+    // An intact interval ends within its last byte (the rest is padding), or in the last MCU
+    // past it (above).
     const int64_t spare = static_cast<int64_t>(segment_.size()) * 8 - reader.consumed();
-    if (spare < 0 || spare >= 8) return Verdict::kDamaged;
+    if (spare >= 8) return Verdict::kDamaged;
     if (mcu < total) {
       if (at + 1 >= size || jpeg[at + 1] != 0xD0 + next_restart) return Verdict::kDamaged;
       next_restart = (next_restart + 1) & 7;
