@@ -184,8 +184,9 @@ class VideoFileSource : public FrameSource {
       have_next_ = false;
       return emit(frame);
     }
-    if (!have_next_ && frame_count_ && decoded_ < *frame_count_) {
-      // Truncated: `current_` was decoded from the last, cut packet.
+    if (!have_next_ && frame_count_ && decoded_ < *frame_count_ && !last_decoded_left_out_) {
+      // Truncated: `current_` was decoded from the last, cut packet (unless the frame decoded
+      // from it was left out as damaged already: then the error comes after this good one).
       throw InputError(path_ + ": only " + std::to_string(decoded_) + " of the " +
                        std::to_string(*frame_count_) +
                        " frames its header lists could be decoded (truncated or corrupt file); "
@@ -277,12 +278,15 @@ class VideoFileSource : public FrameSource {
         // and complain from there, so the damaged frame is this one or one of those.
         suspect_until_ =
             std::max(suspect_until_, key_frames_->next_after(index + decoder_lag_frames_));
+        last_decoded_left_out_ = true;
         continue;
       }
       if (index < suspect_until_) {
         ++predicted_from_damaged_;
+        last_decoded_left_out_ = true;
         continue;
       }
+      last_decoded_left_out_ = false;
       out.index = index;
       const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
       // Container timestamps when the demuxer has them; the nominal rate otherwise.
@@ -329,6 +333,7 @@ class VideoFileSource : public FrameSource {
   int64_t decoded_ = 0;     // Frames the decoder returned, damaged ones included.
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
+  bool last_decoded_left_out_ = false;  // The last frame the decoder returned was damaged.
   std::unique_ptr<KeyFrameIndex> key_frames_;
   // Which frames the decoder concealed damage in (predicting codecs and Motion JPEG; none after
   // a seek).
