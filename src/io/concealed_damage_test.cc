@@ -183,6 +183,13 @@ TEST(DamagedBand, AFrameTheDecoderReportedIsNotComparedWith) {
   EXPECT_TRUE(band.damaged(garbage, /*known_damaged=*/true));
   EXPECT_FALSE(band.damaged(Scene(2))) << "compared with the frame before the garbage";
   EXPECT_FALSE(band.damaged(cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)))) << "not BGR: unchecked";
+  // A damaged first frame is no frame to compare with.
+  DamagedBand fresh;
+  EXPECT_TRUE(fresh.damaged(garbage, /*known_damaged=*/true));
+  EXPECT_FALSE(fresh.damaged(Scene(0)));
+  cv::Mat top = Scene(2);
+  top.rowRange(0, 70) += cv::Scalar(0, 0, 9);
+  EXPECT_TRUE(fresh.damaged(top)) << "compared with the first clean frame";
 }
 
 }  // namespace

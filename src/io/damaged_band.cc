@@ -138,9 +138,12 @@ bool DamagedBand::damaged(const cv::Mat& bgr, bool known_damaged) {
     return false;
   }
   sample(bgr, now_);
-  if (known_damaged && has_previous_ && now_.size() == previous_.size()) {
-    previous_damaged_ = true;
-    cv::swap(previous_, now_);
+  if (known_damaged) {
+    // Compared with by the next frame only as a damaged one (with no frame before it, not at all).
+    if (has_previous_ && now_.size() == previous_.size()) {
+      previous_damaged_ = true;
+      cv::swap(previous_, now_);
+    }
     return true;
   }
   if (!has_previous_ || now_.size() != previous_.size()) {
