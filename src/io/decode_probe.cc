@@ -6,6 +6,7 @@ extern "C" {
 }
 
 #include "io/decoder_log.h"
+#include "io/jpeg_scan.h"
 
 namespace softsight {
 namespace {
@@ -43,6 +44,21 @@ std::optional<bool> DecodeProbe::concealed(int64_t index) {
   return concealed_[static_cast<size_t>(index)];
 }
 
+void DecodeProbe::check_jpeg_packets(AVFormatContext* format, AVPacket* packet, int stream) {
+  JpegScanCheck check;
+  while (!stop_ && av_read_frame(format, packet) >= 0) {
+    if (packet->stream_index == stream) {
+      const bool damaged =
+          check.check(packet->data, static_cast<size_t>(packet->size)) ==
+          JpegScanCheck::Verdict::kDamaged;
+      std::lock_guard<std::mutex> lock(mutex_);
+      concealed_.push_back(damaged);
+      progressed_.notify_all();
+    }
+    av_packet_unref(packet);
+  }
+}
+
 void DecodeProbe::run(const std::string& path) {
   CaptureDecoderErrors();
   {
@@ -61,7 +77,11 @@ void DecodeProbe::run(const std::string& path) {
     if (d.codec != nullptr) IgnoreDecoderLogsFrom(d.codec, true);
     d.packet = av_packet_alloc();
     d.frame = av_frame_alloc();
-    bool ok = d.codec != nullptr && d.packet != nullptr && d.frame != nullptr &&
+    // Each MJPEG packet is one whole JPEG, and its decoder conceals a desynchronised scan
+    // without a mark: the packets' entropy-coded data is checked instead of decoded.
+    const bool jpeg_packets = decoder != nullptr && decoder->id == AV_CODEC_ID_MJPEG;
+    if (jpeg_packets && d.packet != nullptr) check_jpeg_packets(d.format, d.packet, stream);
+    bool ok = !jpeg_packets && d.codec != nullptr && d.packet != nullptr && d.frame != nullptr &&
               avcodec_parameters_to_context(d.codec, d.format->streams[stream]->codecpar) >= 0;
     if (ok) {
       d.codec->thread_count = 1;  // Each mark belongs to its frame, the same in every run.

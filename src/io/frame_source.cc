@@ -20,6 +20,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "io/camera_options.h"
+#include "io/damaged_band.h"
 #include "io/decode_probe.h"
 #include "io/decoder_log.h"
 #include "io/sequence_pattern.h"
@@ -93,23 +94,37 @@ class KeyFrameIndex {
   std::vector<bool> flags_;  // Per packet read so far: a key frame.
 };
 
-// Codecs whose every frame is a key frame (FourCC as FFmpeg reports it through OpenCV).
-bool IntraOnlyCodec(double fourcc_property) {
+// The FourCC as FFmpeg reports it through OpenCV, as its four characters.
+std::string FourCcText(double fourcc_property) {
   const auto fourcc = static_cast<uint32_t>(fourcc_property);
-  char code[5] = {static_cast<char>(fourcc & 0xff), static_cast<char>((fourcc >> 8) & 0xff),
-                  static_cast<char>((fourcc >> 16) & 0xff), static_cast<char>((fourcc >> 24) & 0xff),
-                  0};
+  return {static_cast<char>(fourcc & 0xff), static_cast<char>((fourcc >> 8) & 0xff),
+          static_cast<char>((fourcc >> 16) & 0xff), static_cast<char>((fourcc >> 24) & 0xff)};
+}
+
+// Codecs whose every frame is a key frame.
+bool IntraOnlyCodec(double fourcc_property) {
+  const std::string code = FourCcText(fourcc_property);
   static const char* kIntraOnly[] = {"HFYU", "FFVH", "FFV1", "MJPG", "mjpg", "AVRn", "MJPA",
                                      "png ", "MPNG", "UYVY", "YUY2", "Y800", "I420", "BGR ",
                                      "RGB ", "utvd", "ULRG", "ULY0", "ULY2", "M8RG", "M8Y0"};
   return std::any_of(std::begin(kIntraOnly), std::end(kIntraOnly),
-                     [&](const char* c) { return std::string_view(code, 4) == c; });
+                     [&](const char* c) { return code == c; });
+}
+
+// Motion JPEG (each frame a JPEG), whose decoder conceals a frame's desynchronised data silently.
+bool MotionJpegCodec(double fourcc_property) {
+  const std::string code = FourCcText(fourcc_property);
+  return code == "MJPG" || code == "mjpg" || code == "AVRn" || code == "MJPA";
 }
 
 // A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
-// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) is damaged: it gets
-//   no row (its garbage would be measured as if it were real), later frames keep their numbers,
-//   and the end of the run reports how many there were;
+// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice), or marked as
+//   concealed (DecodeProbe), is damaged: it gets no row (its garbage would be measured as if it
+//   were real), later frames keep their numbers, and the end of the run reports how many there
+//   were. Intra-only decoders conceal damage without a mark: a Motion JPEG frame whose coded
+//   data does not fill its picture (io/jpeg_scan.h, checked by the probe), and an intra-only
+//   frame with a band of rows from its edge whose colours all moved at once
+//   (io/damaged_band.h), are damaged too;
 // - a file cut short: the last frame decoded before the cut may be half a frame or a stale copy
 //   of an earlier one (FFmpeg's frame threads hand back an old buffer when the last packet is
 //   cut), so frames are read one ahead, and when the stream ends short of the header's frame
@@ -134,13 +149,20 @@ class VideoFileSource : public FrameSource {
     if (count > 0) frame_count_ = static_cast<int64_t>(count);
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     if (fps > 0 && fps < 100000) fps_ = fps;
-    const bool intra_only = IntraOnlyCodec(capture_.get(cv::CAP_PROP_FOURCC));
+    const double fourcc = capture_.get(cv::CAP_PROP_FOURCC);
+    const bool intra_only = IntraOnlyCodec(fourcc);
     key_frames_ = std::make_unique<KeyFrameIndex>(path, intra_only);
     // OpenCV gives FFmpeg's decoder one thread per processor (4.6's API does not say how many).
     if (!intra_only) {
       decoder_lag_frames_ =
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
       probe_ = std::make_unique<DecodeProbe>(path);
+    }
+    if (intra_only) damaged_band_.emplace();
+    if (MotionJpegCodec(fourcc)) {
+      // Its packets' data checked, not decoded (io/jpeg_scan.h): a damaged frame is its own.
+      probe_ = std::make_unique<DecodeProbe>(path);
+      concealed_damage_ = "a JPEG whose coded data does not fill its picture";
     }
   }
 
@@ -162,8 +184,9 @@ class VideoFileSource : public FrameSource {
       have_next_ = false;
       return emit(frame);
     }
-    if (!have_next_ && frame_count_ && decoded_ < *frame_count_) {
-      // Truncated: `current_` was decoded from the last, cut packet.
+    if (!have_next_ && frame_count_ && decoded_ < *frame_count_ && !last_decoded_left_out_) {
+      // Truncated: `current_` was decoded from the last, cut packet (unless the frame decoded
+      // from it was left out as damaged already: then the error comes after this good one).
       throw InputError(path_ + ": only " + std::to_string(decoded_) + " of the " +
                        std::to_string(*frame_count_) +
                        " frames its header lists could be decoded (truncated or corrupt file); "
@@ -189,6 +212,7 @@ class VideoFileSource : public FrameSource {
     // The probe decodes from the start: a seek would wait for it to get there. From here on the
     // decoder's log alone tells damage.
     probe_.reset();
+    if (damaged_band_) damaged_band_->reset();
     started_ = false;
     have_current_ = have_next_ = false;
     next_index_ = position;
@@ -240,7 +264,12 @@ class VideoFileSource : public FrameSource {
       ++decoded_;
       const int64_t index = next_index_++;
       const bool concealed = probe_ && probe_->concealed(index).value_or(false);
-      if (DecoderErrorCount() != errors_before || concealed) {
+      const bool reported = DecoderErrorCount() != errors_before || concealed;
+      // Told of every frame, so that the next one is compared with this one.
+      const bool band = damaged_band_ && damaged_band_->damaged(out.image, reported);
+      if (concealed) damage_kind_ = concealed_damage_;
+      if (band && !reported) damage_kind_ = kDamagedBand;
+      if (reported || band) {
         if (damaged_ == 0) first_damaged_ = index;
         ++damaged_;
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
@@ -249,12 +278,15 @@ class VideoFileSource : public FrameSource {
         // and complain from there, so the damaged frame is this one or one of those.
         suspect_until_ =
             std::max(suspect_until_, key_frames_->next_after(index + decoder_lag_frames_));
+        last_decoded_left_out_ = true;
         continue;
       }
       if (index < suspect_until_) {
         ++predicted_from_damaged_;
+        last_decoded_left_out_ = true;
         continue;
       }
+      last_decoded_left_out_ = false;
       out.index = index;
       const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
       // Container timestamps when the demuxer has them; the nominal rate otherwise.
@@ -273,7 +305,7 @@ class VideoFileSource : public FrameSource {
                        (damaged_ == 1 ? "" : "s") + " the decoder found damaged " +
                        (damaged_ == 1 ? "is" : "are") + " left out (first: frame " +
                        std::to_string(first_damaged_) + ", decoder: " +
-                       (last_error.empty() ? "concealed damage" : last_error) + ")";
+                       (last_error.empty() ? damage_kind_ : last_error) + ")";
     if (predicted_from_damaged_ > 0) {
       text += ", and " + std::to_string(predicted_from_damaged_) +
               " decoded from them up to the next key frame";
@@ -301,9 +333,18 @@ class VideoFileSource : public FrameSource {
   int64_t decoded_ = 0;     // Frames the decoder returned, damaged ones included.
   int64_t damaged_ = 0;
   int64_t first_damaged_ = 0;
+  bool last_decoded_left_out_ = false;  // The last frame the decoder returned was damaged.
   std::unique_ptr<KeyFrameIndex> key_frames_;
-  // Which frames the decoder concealed damage in (predicting codecs; none after a seek).
+  // Which frames the decoder concealed damage in (predicting codecs and Motion JPEG; none after
+  // a seek).
   std::unique_ptr<DecodeProbe> probe_;
+  // Intra-only codecs: damage concealed from one row on (io/damaged_band.h).
+  std::optional<DamagedBand> damaged_band_;
+  // What the probe's mark means, and the kind of concealed damage seen last, for the report.
+  std::string concealed_damage_ = "concealed damage";
+  std::string damage_kind_;
+  static constexpr const char* kDamagedBand =
+      "a band of rows from the frame's edge whose colours all moved at once (concealed damage)";
   // How many frames a predicting codec's frame threads may be decoding past the one read()
   // returns (0 for intra-only codecs, whose complaints this source takes as the frame's own, as
   // FramesTheDecoderFoundDamagedAreLeftOutAndReported checks for MJPG).
