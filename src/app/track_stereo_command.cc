@@ -373,6 +373,10 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                       : options.max_frames && summary.pairs >= *options.max_frames
                           ? StopReason::kMaxFrames
                           : StopReason::kEndOfInput;
+    // The report's words for a stop (below), in the end record too.
+    if (summary.stopped) {
+      run.stop_detail = hooks.stop_reason ? hooks.stop_reason() : "stopped from the window";
+    }
     publish->end(run);
     publish->report(run);
   }
