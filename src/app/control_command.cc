@@ -594,6 +594,20 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   RunOptions run;
   run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
   run.check_key_frame_groups = false;  // The loop acts on each frame as it comes.
+  // Why the loop stopped, in the summary's words; the stream's end record says the same.
+  run.describe_stop = [&](StopReason reason) -> std::string {
+    switch (reason) {
+      case StopReason::kEndOfInput:
+        return rendered ? "duration reached" : "end of input";
+      case StopReason::kMaxFrames:
+      case StopReason::kStopRequested:
+        if (control.done()) return "duration reached";
+        return stop.signal() != 0 ? StopSignalReason(stop.signal()) : std::string();
+      case StopReason::kError:
+        return "";
+    }
+    return "";
+  };
   try {
     summary.run = pairs ? RunStereoControl(*pairs->input, *pairs->session, pairs->angle, control,
                                            stereo_csv ? &*stereo_csv : nullptr, run.stop_requested)
@@ -627,12 +641,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   switch (ran.stop_reason) {
     case StopReason::kEndOfInput:
-      summary.stop_reason = rendered ? "duration reached" : "end of input";
+      summary.stop_reason = run.describe_stop(ran.stop_reason);
       break;
     case StopReason::kMaxFrames:
     case StopReason::kStopRequested:
       if (control.done()) {
-        summary.stop_reason = "duration reached";
+        summary.stop_reason = run.describe_stop(ran.stop_reason);
       } else {
         StoppedBySignal(stop, &summary);
       }

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -24,13 +25,59 @@ using Json = nlohmann::ordered_json;
 // The slice of each wait: how often Ctrl-C is noticed.
 constexpr int kPollSliceMs = 100;
 
-// A record's value as the CSV field: null -> empty, a number in its shortest exact form, a
-// string as it is (the publisher's rule, stream_format.h, read backwards).
-std::string FieldText(const Json& value) {
+// The text of each number among a record's own fields (the object's first level), as the
+// message has it: the publisher sends the CSV's field ("1.0000"), and a parsed double would print
+// as "1.0", so `listen --csv` would differ from the run's CSV. nlohmann's SAX interface hands
+// over a float's text; an integer's text is its value's.
+class RecordNumberTexts : public nlohmann::json_sax<Json> {
+ public:
+  // Fills `texts` (field name -> the number's text); false when the body does not parse.
+  static bool Read(const std::string& body, std::map<std::string, std::string>& texts) {
+    texts.clear();
+    RecordNumberTexts reader(texts);
+    return Json::sax_parse(body, &reader, nlohmann::json::input_format_t::json, /*strict=*/true,
+                           /*ignore_comments=*/false);
+  }
+
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t value) override {
+    return keep(std::to_string(value));
+  }
+  bool number_unsigned(number_unsigned_t value) override {
+    return keep(std::to_string(value));
+  }
+  bool number_float(number_float_t, const string_t& text) override { return keep(text); }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return ++depth_, true; }
+  bool key(string_t& name) override { return key_ = name, true; }
+  bool end_object() override { return --depth_, true; }
+  bool start_array(std::size_t) override { return ++depth_, true; }
+  bool end_array() override { return --depth_, true; }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  explicit RecordNumberTexts(std::map<std::string, std::string>& texts) : texts_(texts) {}
+  bool keep(const std::string& text) {
+    if (depth_ == 1) texts_[key_] = text;
+    return true;
+  }
+  std::map<std::string, std::string>& texts_;
+  std::string key_;
+  int depth_ = 0;
+};
+
+// A record's value as the CSV field: null -> empty, a number as the message wrote it (`text`,
+// the CSV's own digits), a string as it is (the publisher's rule, stream_format.h, read
+// backwards).
+std::string FieldText(const Json& value, const std::string* text) {
   if (value.is_null()) return "";
   if (value.is_string()) return value.get<std::string>();
   if (value.is_boolean()) return value.get<bool>() ? "1" : "0";
-  return value.dump();
+  return text != nullptr ? *text : value.dump();
 }
 
 // The records as CSV rows: the columns are the first record's keys, in its order; each column
@@ -46,10 +93,15 @@ class RecordTable {
   }
   const CsvColumnTable& table() const { return table_; }
   // The record's fields, by column name; a key the first record did not have is left out.
-  void set(const Json& record) {
+  // `numbers`: the record's numbers as the message wrote them (RecordNumberTexts).
+  void set(const Json& record, const std::map<std::string, std::string>& numbers) {
     for (size_t i = 0; i < table_.size(); ++i) {
-      const auto it = record.find(table_.column(i).name);
-      fields_[i] = it == record.end() ? std::string() : FieldText(*it);
+      const std::string& name = table_.column(i).name;
+      const auto it = record.find(name);
+      const auto text = numbers.find(name);
+      fields_[i] = it == record.end()
+                       ? std::string()
+                       : FieldText(*it, text != numbers.end() ? &text->second : nullptr);
     }
   }
 
@@ -117,6 +169,7 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
   std::unique_ptr<RecordTable> records;
   std::unique_ptr<CsvWriter> csv;
   std::string row;
+  std::map<std::string, std::string> numbers;  // Reused per record.
   std::optional<int64_t> last_frame;
   ListenSummary summary;
   auto heard = std::chrono::steady_clock::now();
@@ -182,7 +235,8 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
         out << records->table().header() << "\n";
       }
     }
-    records->set(body);
+    RecordNumberTexts::Read(message->body, numbers);
+    records->set(body, numbers);
     FrameResult named;  // Names the row in a write error.
     named.frame_index = last_frame.value_or(summary.records - 1);
     if (csv) {

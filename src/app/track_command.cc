@@ -119,11 +119,12 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   RunOptions run;
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
+  run.describe_stop = [&stop](StopReason reason) {
+    return reason == StopReason::kStopRequested && stop.signal() != 0 ? StopSignalReason(stop.signal())
+                                                                      : std::string();
+  };
   // The sinks add their own figures (CSV row latency, encoder errors and waits): FrameSink::report.
   summary = RunPipeline(*source, session, sinks, run);
-  if (summary.stop_reason == StopReason::kStopRequested && stop.signal() != 0) {
-    summary.stop_detail = StopSignalReason(stop.signal());
-  }
   if (!summary.ok()) throw InputError(summary.error);
   return summary;
 }

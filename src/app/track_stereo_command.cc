@@ -210,7 +210,7 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
 // The run on `input`; `bench` is the bench board's frame when already located.
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                        std::ostream& report, std::optional<BoardFrame> bench,
-                       const StereoRunHooks& hooks);
+                       const StereoRunHooks& hooks, std::optional<int64_t> frame_offset);
 
 }  // namespace
 
@@ -229,22 +229,21 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, std::ostrea
   TrackStereoSummary summary;
   const std::unique_ptr<StereoInput> input = OpenStereoInput(options, summary, report);
   const std::optional<int64_t> offset = summary.frame_offset;
-  summary = Run(options, *input, report, bench, hooks);
-  summary.frame_offset = offset;
+  summary = Run(options, *input, report, bench, hooks, offset);
   return summary;
 }
 
 TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput& input,
                                   std::ostream& report, const StereoRunHooks& hooks) {
   CheckOptions(options);
-  return Run(options, input, report, std::nullopt, hooks);
+  return Run(options, input, report, std::nullopt, hooks, std::nullopt);
 }
 
 namespace {
 
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                        std::ostream& report, std::optional<BoardFrame> bench,
-                       const StereoRunHooks& hooks) {
+                       const StereoRunHooks& hooks, std::optional<int64_t> frame_offset) {
   const TrackingConfig left_config = LoadStereoViewConfig(options.config_file);
   const TrackingConfig right_config =
       options.right_config_file ? LoadStereoViewConfig(*options.right_config_file) : left_config;
@@ -303,10 +302,13 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     publish->begin(info);
   }
   TrackStereoSummary summary;
+  summary.frame_offset = frame_offset;
   summary.found.assign(names.size(), {"", 0});
   summary.epipolar.assign(names.size(), {"", 0});
+  summary.timing.assign(names.size(), {"", 0});
   for (size_t i = 0; i < names.size(); ++i)
-    summary.found[i].first = summary.epipolar[i].first = names[i];
+    summary.found[i].first = summary.epipolar[i].first = summary.timing[i].first = names[i];
+  std::vector<double> lags;
   if (bench) summary.bench_board_rms_mm = bench->rms_mm;
   std::vector<double> sigmas, epipolar_distances;
   FramePair pair;
@@ -342,8 +344,10 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
         summary.max_abs_pair_dt_ms =
             std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
       }
+      if (result.lag_frames) lags.push_back(*result.lag_frames);
       for (size_t i = 0; i < result.markers.size(); ++i) {
         const StereoPoint& p = result.markers[i].point;
+        if (p.status == StereoStatus::kTiming) ++summary.timing[i].second;
         if (p.found()) {
           ++summary.found[i].second;
           sigmas.push_back(*p.sigma_mm);
@@ -369,11 +373,24 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                       : options.max_frames && summary.pairs >= *options.max_frames
                           ? StopReason::kMaxFrames
                           : StopReason::kEndOfInput;
+    // The report's words for a stop (below), in the end record too.
+    if (summary.stopped) {
+      run.stop_detail = hooks.stop_reason ? hooks.stop_reason() : "stopped from the window";
+    }
     publish->end(run);
     publish->report(run);
   }
   summary.median_sigma_mm = Median(sigmas);
   summary.median_epipolar_px = Median(epipolar_distances);
+  summary.lagging_pairs = static_cast<int64_t>(lags.size());
+  summary.median_lag_frames = Median(lags);
+  // One wrong offset lags by one amount all along; two frame rates or a dropped frame by a
+  // changing one (no single offset then pairs one moment).
+  bool one_lag = false;
+  if (lags.size() >= 4) {
+    std::sort(lags.begin(), lags.end());
+    one_lag = lags[lags.size() * 3 / 4] - lags[lags.size() / 4] <= 0.5;
+  }
   summary.left_unpaired = input.left_unpaired();
   summary.right_unpaired = input.right_unpaired();
 
@@ -402,8 +419,16 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   for (size_t i = 0; i < names.size(); ++i) {
     report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
            << summary.pairs;
-    if (summary.epipolar[i].second > 0) {
-      report << " (" << summary.epipolar[i].second << " refused by the epipolar check)";
+    if (summary.epipolar[i].second > 0 || summary.timing[i].second > 0) {
+      report << " (";
+      if (summary.epipolar[i].second > 0) {
+        report << summary.epipolar[i].second << " refused by the epipolar check";
+      }
+      if (summary.timing[i].second > 0) {
+        report << (summary.epipolar[i].second > 0 ? ", " : "") << summary.timing[i].second
+               << " by the pairing check (timing)";
+      }
+      report << ")";
     }
     report << "\n";
   }
@@ -426,6 +451,28 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   }
   report << "\n";
   for (const std::string& note : run.notes) report << "note: " << note << "\n";
+  if (summary.median_lag_frames) {
+    // A moving marker's right point lies where the marker was some frames before or after: on
+    // its epipolar line while it moves along the line, at a wrong depth. Said once, with what
+    // would pair one moment.
+    const double lag = *summary.median_lag_frames;
+    report << "note: in " << summary.lagging_pairs << " of " << summary.pairs
+           << " pairs the markers' motion says the right frame is about " << std::fixed
+           << std::setprecision(1) << std::abs(lag) << " frames " << (lag > 0 ? "later" : "earlier")
+           << " than the left one (moving markers there: status timing, not found in 3D)";
+    if (summary.frame_offset && one_lag) {
+      const int64_t better = *summary.frame_offset - std::llround(lag);
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: try --frame-offset " << better;
+    } else if (summary.frame_offset) {
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: leave --frame-offset out to have it found from the motion (two "
+                "frame rates: --pair-by time)";
+    } else {
+      report << "; the two views are not paired at one moment (their clocks or --time-offset-ms?)";
+    }
+    report << "\n";
+  }
   report.unsetf(std::ios::floatfield);
   return summary;
 }
@@ -444,7 +491,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
       "pair of frames: the angle at the middle marker, the bending plane and its angle out of\n"
       "the reference plane, radius and arc length of the 3D circle, tip displacement.\n"
       "A marker is found in 3D only when both views found it and the pair passes the\n"
-      "epipolar check (docs/stereo.md).\n"
+      "epipolar check and the pairing check (the markers' motion says both frames are of one\n"
+      "moment; else a moving marker's status is timing and a note names the offset to try;\n"
+      "docs/stereo.md).\n"
       "Example:\n"
       "  softsight calibrate --left cal/left/ --right cal/right/ --chessboard 9x6 --square-mm 25 "
       "--out stereo.yaml\n"

@@ -85,8 +85,13 @@ struct StereoRunHooks {
 
 struct TrackStereoSummary {
   int64_t pairs = 0;  // Pairs of frames tracked (CSV rows).
-  // Per marker: pairs found in 3D, and pairs refused by the epipolar check.
-  std::vector<std::pair<std::string, int64_t>> found, epipolar;
+  // Per marker: pairs found in 3D, pairs refused by the epipolar check, and pairs refused by the
+  // pairing check (status timing: the views' frames not of one moment).
+  std::vector<std::pair<std::string, int64_t>> found, epipolar, timing;
+  // The pairs whose markers' motion said the views' frames are not of one moment, and the
+  // median lag they showed (right frames; positive: the right frame is later).
+  int64_t lagging_pairs = 0;
+  std::optional<double> median_lag_frames;
   std::optional<double> median_sigma_mm;     // Over the found points.
   std::optional<double> median_epipolar_px;  // Over the pairs both views found.
   // Pairing: the offset used (by index), and frames of each view left without a partner (by

@@ -29,6 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::ReadRows;
 using testing::StereoMarkersYaml;
 using testing::TempDir;
@@ -208,6 +209,63 @@ TEST(TrackStereoRatesTest, TwoFrameRatesArePairedByTimeNotByIndex) {
     }
   }
   EXPECT_GE(points, 3 * static_cast<int>(rows.size()) / 2);
+}
+
+// A deliberately wrong --frame-offset (hostile trial D4): a marker moving along its epipolar line
+// stays on the line and only its depth comes out wrong, so the epipolar check lets such pairs
+// through (there: 6 pairs with an out-of-plane angle of 80-85 deg where the truth was 0). The
+// markers' motion across their lines shows the lag: those points are refused (status timing),
+// the run's note names the offset that pairs one moment, and the right offset loses no point.
+TEST(TrackStereoPairingCheckTest, AWrongFrameOffsetShowsAndItsMovingPointsAreNotBelieved) {
+  constexpr int kTrueOffset = 5;
+  const TempDir dir;
+  StereoSceneOptions scene_options;
+  scene_options.frame_count = 60 + kTrueOffset;
+  scene_options.bend_deg_per_frame = JerkyBend(scene_options.frame_count);
+  const StereoScene scene(MakeStereoRig(), scene_options);
+  WriteRigAndMarkers(dir, scene.rig());
+  const std::vector<StereoSceneTruth> truths = RenderFolders(scene, dir, kTrueOffset, 0, 60);
+  struct Count {
+    int found = 0, off = 0, timing = 0;
+  };
+  const auto run = [&](int64_t offset, std::string* report_text) {
+    TrackStereoOptions options = FolderRun(dir);
+    options.frame_offset = offset;
+    std::ostringstream report;
+    RunTrackStereo(options, report);
+    *report_text = report.str();
+    Count count;
+    for (const auto& row : ReadRows(dir.file("run3d.csv"))) {
+      const StereoSceneTruth& truth =
+          truths.at(static_cast<size_t>(std::stoi(row.at("frame")) + kTrueOffset));
+      for (const StereoMarkerTruth& m : truth.markers) {
+        const std::string& status = row.at(m.name + "_status");
+        count.timing += status == "timing" ? 1 : 0;
+        if (status != "found") continue;
+        ++count.found;
+        const cv::Point3d p(std::stod(row.at(m.name + "_X")), std::stod(row.at(m.name + "_Y")),
+                            std::stod(row.at(m.name + "_Z")));
+        count.off += cv::norm(p - m.position_mm) > 1.0 ? 1 : 0;
+      }
+    }
+    return count;
+  };
+  std::string report;
+  const Count right = run(kTrueOffset, &report);
+  EXPECT_EQ(right.timing, 0) << report;
+  EXPECT_EQ(right.off, 0) << report;
+  EXPECT_THAT(report, Not(HasSubstr("timing")));
+  for (const int64_t wrong : {int64_t{2}, int64_t{8}}) {
+    const Count count = run(wrong, &report);
+    std::printf("--frame-offset %lld (right: %d): %d found, %d more than 1 mm off, %d timing; "
+                "right offset: %d found\n",
+                static_cast<long long>(wrong), kTrueOffset, count.found, count.off, count.timing,
+                right.found);
+    EXPECT_GT(count.timing, 0) << report;
+    EXPECT_LE(count.off, 10) << report;
+    EXPECT_THAT(report, HasSubstr("the frame offset " + std::to_string(wrong) + " looks wrong"))
+        << report;
+  }
 }
 
 TEST(TrackStereoOffsetRefusalTest, ARepeatingMotionIsRefusedWithExitCode2) {

@@ -61,6 +61,7 @@ const char* StereoStatusName(StereoStatus status) {
     case StereoStatus::kMissing: return "missing";
     case StereoStatus::kEpipolar: return "epipolar";
     case StereoStatus::kBehind: return "behind";
+    case StereoStatus::kTiming: return "timing";
   }
   return "?";
 }
@@ -103,6 +104,16 @@ double Triangulator::epipolar_distance_px(const cv::Point2d& left_px,
   const cv::Point2d l = undistort_left(left_px), r = undistort_right(right_px);
   const cv::Vec3d line = stereo_.F * cv::Vec3d(l.x, l.y, 1.0);
   return std::abs(line.dot(cv::Vec3d(r.x, r.y, 1.0))) / std::hypot(line[0], line[1]);
+}
+
+double Triangulator::signed_epipolar_distance_px(const cv::Point2d& left_px,
+                                                 const cv::Point2d& right_px,
+                                                 cv::Vec2d* line_normal) const {
+  const cv::Point2d l = undistort_left(left_px), r = undistort_right(right_px);
+  const cv::Vec3d line = stereo_.F * cv::Vec3d(l.x, l.y, 1.0);
+  const double norm = std::hypot(line[0], line[1]);
+  *line_normal = cv::Vec2d(line[0] / norm, line[1] / norm);
+  return line.dot(cv::Vec3d(r.x, r.y, 1.0)) / norm;
 }
 
 cv::Point2d Triangulator::project_left(const cv::Point3d& point_mm) const {

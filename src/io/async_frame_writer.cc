@@ -1,6 +1,7 @@
 #include "softsight/io/async_frame_writer.h"
 
 #include <algorithm>
+#include <exception>
 #include <utility>
 
 namespace softsight {
@@ -16,9 +17,22 @@ AsyncFrameWriter::AsyncFrameWriter(FrameWriterOptions options, size_t capacity,
 }
 
 AsyncFrameWriter::~AsyncFrameWriter() {
+  if (std::uncaught_exceptions() > uncaught_at_start_) {
+    // Left by an exception: the video is abandoned (FrameWriter::discard), the output left as it
+    // was; what is queued is not waited for.
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closing_ = true;
+      abandoned_ = true;
+    }
+    queued_cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    writer_.discard();
+    return;
+  }
   try {
     close();
-  } catch (...) {  // Reported by the caller's own close(), or lost with a run that threw.
+  } catch (...) {  // Reported by the caller's own close(); the cut video was removed.
   }
 }
 
@@ -30,7 +44,7 @@ void AsyncFrameWriter::encode_loop() {
     {
       std::unique_lock<std::mutex> lock(mutex_);
       queued_cv_.wait(lock, [this] { return count_ > 0 || closing_; });
-      if (count_ == 0) break;  // Closing, and everything queued is written.
+      if (count_ == 0 || abandoned_) break;  // Closing, and everything queued is written.
       slot = &ring_[head_];    // Stays queued (not reused by acquire()) until written.
     }
     try {
@@ -79,8 +93,11 @@ void AsyncFrameWriter::close() {
   }
   queued_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (error_) {
+    writer_.discard();  // A frame could not be written: the video is not put in place.
+    std::rethrow_exception(std::exchange(error_, nullptr));
+  }
   writer_.close();
-  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
 }
 
 }  // namespace softsight

@@ -1,7 +1,15 @@
 #include "softsight/io/frame_writer.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
 #include <filesystem>
 #include <vector>
 
@@ -9,6 +17,7 @@
 
 #include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
+#include "softsight/core/file_write.h"
 
 namespace softsight {
 namespace {
@@ -87,16 +96,54 @@ FrameWriter::FrameWriter(FrameWriterOptions options) : options_(std::move(option
     throw InputError("codec '" + options_.codec + "' for " + path +
                      ": unknown (choose ffv1, hfyu, mjpg or mp4v)");
   }
+  struct stat info {};
+  const bool device = ::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode);
+  // A device (/dev/null) cannot be replaced by a rename: written in place.
+  const fs::path output(path);
+  writing_path_ = device ? path
+                         : (output.parent_path() /
+                            ("." + output.filename().string() + ".part" + output.extension().string()))
+                               .string();
+  // Made now (not truncated: another run's may be in it) and locked, so a second writer of this
+  // video is refused before it cuts the first one's file; FFmpeg truncates it when it opens.
+  lock_fd_ = ::open(writing_path_.c_str(), O_WRONLY | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0666);
+  if (lock_fd_ < 0) {
+    throw InputError(path + ": cannot write the video (" + std::strerror(errno) + ")");
+  }
+  try {
+    LockOutputOrThrow(lock_fd_, path);
+  } catch (...) {
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw;
+  }
 }
 
 FrameWriter::~FrameWriter() {
-  if (video_.isOpened()) video_.release();  // Unchecked: a caller that cares called close().
+  // Left by an exception: the video is abandoned. Left in order: finished as close() does (a cut
+  // video is then removed, its error lost: a caller that cares calls close()).
+  if (std::uncaught_exceptions() > uncaught_at_start_) {
+    discard();
+    return;
+  }
+  try {
+    close();
+  } catch (...) {  // close() removed the temporary file.
+  }
+}
+
+void FrameWriter::discard() {
+  if (video_.isOpened()) video_.release();
+  if (lock_fd_ < 0) return;
+  if (writing_path_ != options_.path) ::unlink(writing_path_.c_str());
+  ::close(lock_fd_);
+  lock_fd_ = -1;
 }
 
 void FrameWriter::open(cv::Size size) {
   size_ = size;
   if (images_ || video_.isOpened()) return;
-  video_.open(options_.path, cv::CAP_FFMPEG, fourcc_, options_.fps, size, true);
+  video_.open(writing_path_, cv::CAP_FFMPEG, fourcc_, options_.fps, size, true);
   if (!video_.isOpened()) {
     throw InputError(options_.path + ": cannot open for writing as " + format_ +
                      " (check the folder is writable and the codec fits the container)");
@@ -128,26 +175,41 @@ void FrameWriter::write(const cv::Mat& image_bgr, int64_t index) {
 }
 
 void FrameWriter::close() {
-  if (!video_.isOpened()) return;
+  if (!video_.isOpened()) {
+    discard();  // No frame, no video: nothing to put in place.
+    return;
+  }
   video_.release();
   // FFmpeg reports no write error (a full disk, a file size limit): the finished file is read
   // back, and one that does not hold every frame written is an error, never a silent cut video.
-  if (written_ == 0) return;
-  cv::VideoCapture check;
-  double frames = -1.0;
-  try {
-    if (check.open(options_.path, cv::CAP_FFMPEG)) frames = check.get(cv::CAP_PROP_FRAME_COUNT);
-  } catch (const cv::Exception&) {
+  double frames = static_cast<double>(written_);
+  if (written_ > 0) {
+    cv::VideoCapture check;
     frames = -1.0;
+    try {
+      if (check.open(writing_path_, cv::CAP_FFMPEG)) frames = check.get(cv::CAP_PROP_FRAME_COUNT);
+    } catch (const cv::Exception&) {
+      frames = -1.0;
+    }
   }
   // A Matroska file's count comes from its duration: within a frame of the truth.
   const double tolerance = Lower(fs::path(options_.path).extension().string()) == ".mkv" ? 1.0 : 0.0;
   if (!(frames + tolerance >= static_cast<double>(written_))) {
+    discard();
     throw InputError(options_.path + ": the video holds " +
                      (frames >= 0 ? std::to_string(static_cast<int64_t>(frames)) : std::string("no")) +
                      " of the " + std::to_string(written_) +
-                     " frames written (a full disk, or a file size limit?)");
+                     " frames written (a full disk, or a file size limit?); left as it was");
   }
+  if (writing_path_ != options_.path &&
+      std::rename(writing_path_.c_str(), options_.path.c_str()) != 0) {
+    const int error = errno;
+    discard();
+    throw InputError(options_.path + ": cannot put the finished video in place (" +
+                     std::strerror(error) + ")");
+  }
+  ::close(lock_fd_);  // The lock goes with the finished file.
+  lock_fd_ = -1;
 }
 
 }  // namespace softsight

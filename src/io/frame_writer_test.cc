@@ -179,8 +179,10 @@ TEST(FrameWriter, AFrameOfAnotherSizeIsAnErrorNamingTheFrame) {
 // the file holds a fraction of the frames. Closing reads it back and says so, naming the file.
 // Run in a child process, which alone gets the limit.
 TEST(FrameWriter, AVideoCutByAFullDiskIsAnErrorAtClose) {
+  namespace fs = std::filesystem;
   TempDir dir;
   const std::string path = dir.file("cut.avi");
+  testing::WriteTextFile(path, "the previous run's video");
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
@@ -205,6 +207,48 @@ TEST(FrameWriter, AVideoCutByAFullDiskIsAnErrorAtClose) {
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
   EXPECT_EQ(WEXITSTATUS(status), 0);
+  // The cut video never took the output's name: the older file is intact, no temporary is left.
+  EXPECT_EQ(testing::ReadTextFile(path), "the previous run's video");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+}
+
+// A video is written beside its output and renamed into place only when whole: a writer left by
+// an exception (a run that failed mid-way) abandons its video and an older file of the name is
+// left as it was; a finished one replaces it. No temporary file stays behind either way.
+TEST(FrameWriter, AnOutputIsReplacedOnlyByAFinishedVideo) {
+  namespace fs = std::filesystem;
+  TempDir dir;
+  const std::string path = dir.file("run.avi");
+  testing::WriteTextFile(path, "the previous run's video");
+  const std::vector<cv::Mat> frames = RenderedFrames();
+  const auto files_in_folder = [&dir] {
+    return std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator());
+  };
+  try {
+    FrameWriter writer({path, "", 25.0});
+    writer.write(frames[0], 0);
+    writer.write(frames[1], 1);
+    EXPECT_EQ(files_in_folder(), 2) << "the temporary file beside the output";
+    EXPECT_EQ(testing::ReadTextFile(path), "the previous run's video") << "not touched yet";
+    throw InputError("the run failed at frame 2");
+  } catch (const InputError&) {
+  }
+  EXPECT_EQ(testing::ReadTextFile(path), "the previous run's video");
+  EXPECT_EQ(files_in_folder(), 1);
+
+  {
+    FrameWriter writer({path, "", 25.0});
+    for (size_t i = 0; i < frames.size(); ++i) writer.write(frames[i], static_cast<int64_t>(i));
+    writer.close();
+  }
+  ExpectReadsBackBitExact(path, frames);
+  EXPECT_EQ(files_in_folder(), 1);
+
+  // A writer that made no frame makes no file.
+  const std::string never = dir.file("never.avi");
+  FrameWriter({never, "", 25.0}).close();
+  EXPECT_FALSE(fs::exists(never));
+  EXPECT_EQ(files_in_folder(), 1);
 }
 
 }  // namespace softsight

@@ -169,6 +169,7 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
   summary.dropped = dropped;
   summary.notes = std::move(notes);
   summary.error = std::move(error);
+  if (describe_stop_) summary.stop_detail = describe_stop_(reason);
   for (size_t i = 0; i < begun_; ++i) sinks_[i]->end(summary);
   for (size_t i = 0; i < begun_; ++i) sinks_[i]->report(summary);
   return summary;
@@ -178,6 +179,7 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options) {
   PipelineRun run(session, DescribeRun(source, session, options), sinks);
   if (options.check_key_frame_groups) run.check_key_frame_groups();
+  run.describe_stop_with(options.describe_stop);
   const auto notes = [&source] {
     std::vector<std::string> notes;
     if (const std::optional<std::string> note = source.note()) notes.push_back(*note);

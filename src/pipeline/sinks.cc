@@ -1,8 +1,5 @@
 #include "softsight/pipeline/sinks.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <string>
@@ -69,50 +66,19 @@ void CsvSink::consume(const Frame& frame, const FrameResult& result) {
 }
 
 
-namespace {
-
-// The lock of a video file this run writes, when the file exists: taken before the encoder
-// truncates an existing file (another run's recording is refused, not cut), and again once the
-// encoder has made a new one. -1 for an image pattern or a file not there yet; devices and FIFOs
-// are opened without blocking and not locked (LockOutputOrThrow).
-int LockVideoFileIfItExists(const std::string& path) {
-  if (path.find('%') != std::string::npos) return -1;
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return -1;  // Not made yet, or the encoder names what is wrong with the path.
-  try {
-    LockOutputOrThrow(fd, path);
-  } catch (...) {
-    ::close(fd);
-    throw;
-  }
-  return fd;
-}
-
-}  // namespace
-
 VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> fps,
                      FrameDrawer draw, std::function<void(int64_t index)> before_encode)
     : fps_(fps), draw_(std::move(draw)), before_encode_(std::move(before_encode)) {
   options_.path = std::move(path);
   options_.codec = std::move(codec);
   options_.fps = fps.value_or(30.0);
-  lock_fd_ = LockVideoFileIfItExists(options_.path);
-  // Checks path and codec now.
+  // Checks path and codec now, and locks the video (FrameWriter): a second run writing it is
+  // refused here.
   capacity_ = kQueuedFrames;
-  try {
-    writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
-    if (lock_fd_ < 0) lock_fd_ = LockVideoFileIfItExists(options_.path);
-  } catch (...) {
-    if (lock_fd_ >= 0) ::close(lock_fd_);
-    throw;
-  }
+  writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
 }
 
-VideoSink::~VideoSink() {
-  writer_.reset();  // Finished (and the file closed) before its lock goes.
-  if (lock_fd_ >= 0) ::close(lock_fd_);
-}
-
+VideoSink::~VideoSink() = default;
 
 void VideoSink::begin(const RunInfo& info) {
   live_ = info.live;
@@ -127,7 +93,6 @@ void VideoSink::begin(const RunInfo& info) {
     writer_ = std::make_unique<AsyncFrameWriter>(options_, capacity_, before_encode_);
   }
   if (!info.frame_size.empty()) writer_->open(info.frame_size);
-  if (lock_fd_ < 0) lock_fd_ = LockVideoFileIfItExists(options_.path);
 }
 
 void VideoSink::consume(const Frame& frame, const FrameResult& result) {

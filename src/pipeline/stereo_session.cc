@@ -1,7 +1,9 @@
 #include "softsight/pipeline/stereo_session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 
 #include "softsight/core/error.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -28,6 +30,122 @@ const Observation* FindObservation(const FrameResult& result, const std::string&
 }
 
 }  // namespace
+
+// Whether the two views' frames of a pair are of one moment, from the markers' own motion. The
+// epipolar check cannot see a wrong pairing of a marker moving along its epipolar line: the
+// right view's point stays on the line and only the depth comes out wrong (a wrong
+// --frame-offset: up to 38 mm, and out-of-plane angles of 80-90 deg where the truth is 0).
+// But when the right frames are `lag` frames later than the left ones' moments, the right point
+// of right frame j lies where the marker was at right frame j - lag, and its signed distance from
+// the epipolar line is the motion across the line between the two: d_j ~= n_j . (R_j - R_{j-lag}).
+// Every lag within kMaxLagFrames is fitted so to the last pairs of every marker (each marker with
+// its own constant: a calibration's offset from the line is not motion); a lag other than 0 that
+// explains the distances far better than 0 does, beyond the points' noise, says the pairs are not
+// of one moment. From then on (until 0 fits again) only a marker at rest is believed: one whose
+// point moved in either view over the last frames by more than a quarter of the epipolar limit is
+// not (kTiming): the views show it at two places of its path, its depth off by as much as it moved
+// along the line. The first pairs of a run, before any marker has moved across its line, cannot
+// be judged.
+class StereoPairingCheck {
+ public:
+  explicit StereoPairingCheck(size_t markers) : markers_(markers) {}
+
+  // Marker `i`'s pair (raw pixels; both views found it), the right one from right frame
+  // `right_frame`: adds its evidence; returns how far the marker moved in either view over the
+  // last frames (px, the largest of the spans back to each of them), when it was found there.
+  std::optional<double> add(const Triangulator& triangulator, size_t i, const cv::Point2d& left_px,
+                            const cv::Point2d& right_px, int64_t right_frame) {
+    Marker& m = markers_[i];
+    if (!m.history.empty() && m.last_right_frame + 1 != right_frame) {
+      // A repeated right frame (paired by time) adds nothing; a gap starts the history again.
+      if (m.last_right_frame == right_frame) return m.last_motion;
+      m.history.clear();
+    }
+    Entry entry;
+    entry.left_px = left_px;
+    entry.right_px = right_px;
+    entry.distance = triangulator.signed_epipolar_distance_px(left_px, right_px, &entry.normal);
+    std::optional<double> motion;
+    if (!m.history.empty()) {
+      motion = 0.0;
+      const size_t first = m.history.size() > kRecentFrames ? m.history.size() - kRecentFrames : 0;
+      for (size_t k = first; k < m.history.size(); ++k) {
+        motion = std::max({*motion, cv::norm(right_px - m.history[k].right_px),
+                           cv::norm(left_px - m.history[k].left_px)});
+      }
+    }
+    m.history.push_back(entry);
+    if (m.history.size() > kWindowPairs + 2 * kMaxLagFrames) m.history.pop_front();
+    m.last_right_frame = right_frame;
+    m.last_motion = motion;
+    return motion;
+  }
+  // The marker was not seen in both views: its motion is unknown until it is again.
+  void lose(size_t i) { markers_[i].history.clear(); }
+
+  // Updates the verdict with the evidence so far and returns it: the lag of the right frames (in
+  // the right view's frames; positive: the right frame is later than the left one's moment)
+  // while the pairs are judged not of one moment, else none.
+  std::optional<double> update(double sigma_px) {
+    // Per candidate lag: the squared residuals (about each marker's own mean) and their count,
+    // over the pairs whose partner frame is in the history.
+    std::vector<double> sse(2 * kMaxLagFrames + 1, 0.0), count(sse.size(), 0.0);
+    for (const Marker& m : markers_) {
+      const int size = static_cast<int>(m.history.size());
+      for (int lag = -kMaxLagFrames; lag <= kMaxLagFrames; ++lag) {
+        const int first = std::max(0, lag), last = std::min(size, size + lag);
+        if (last - first < 3) continue;
+        double sum = 0.0, sum_sq = 0.0;
+        for (int j = first; j < last; ++j) {
+          const Entry& e = m.history[static_cast<size_t>(j)];
+          const cv::Point2d step = e.right_px - m.history[static_cast<size_t>(j - lag)].right_px;
+          const double residual = e.distance - (step.x * e.normal[0] + step.y * e.normal[1]);
+          sum += residual;
+          sum_sq += residual * residual;
+        }
+        const size_t k = static_cast<size_t>(lag + kMaxLagFrames);
+        sse[k] += sum_sq - sum * sum / (last - first);
+        count[k] += last - first - 1;  // One degree of freedom for the marker's mean.
+      }
+    }
+    std::optional<int> best;
+    double best_mean = 0.0;
+    for (int lag = -kMaxLagFrames; lag <= kMaxLagFrames; ++lag) {
+      const size_t k = static_cast<size_t>(lag + kMaxLagFrames);
+      if (count[k] < 3.0) continue;
+      if (!best || sse[k] / count[k] < best_mean) {
+        best = lag;
+        best_mean = sse[k] / count[k];
+      }
+    }
+    const size_t zero = kMaxLagFrames;
+    if (!best || count[zero] < 3.0) return lag_;
+    const double at_zero = sse[zero] / count[zero], noise = sigma_px * sigma_px;
+    if (*best != 0 && at_zero > 9.0 * noise && best_mean < 0.25 * at_zero) {
+      lag_ = *best;
+    } else if (*best == 0 || at_zero <= 4.0 * noise) {
+      lag_.reset();  // Of one moment (again).
+    }
+    return lag_;
+  }
+
+ private:
+  static constexpr int kMaxLagFrames = 8;
+  static constexpr size_t kWindowPairs = 30;
+  static constexpr size_t kRecentFrames = 8;
+  struct Entry {
+    cv::Point2d left_px, right_px;
+    double distance = 0.0;  // Signed distance of the right point from its epipolar line (px).
+    cv::Vec2d normal;       // That line's unit normal.
+  };
+  struct Marker {
+    std::deque<Entry> history;  // Contiguous right frames, oldest first.
+    int64_t last_right_frame = 0;
+    std::optional<double> last_motion;
+  };
+  std::vector<Marker> markers_;
+  std::optional<double> lag_;
+};
 
 bool StereoOptions::Check(std::string* error) const {
   if (reference_plane == ReferencePlane::kBoard) {
@@ -61,7 +179,8 @@ struct StereoSession::Impl {
       : left(left_config),
         right(right_config),
         triangulator(stereo, options.triangulation),
-        options(options) {
+        options(options),
+        pairing(left_config.markers.size()) {
     for (const MarkerSpec& spec : left_config.markers) {
       bool in_right = false;
       for (const MarkerSpec& other : right_config.markers)
@@ -89,6 +208,8 @@ struct StereoSession::Impl {
   TrackingSession left, right;
   Triangulator triangulator;
   StereoOptions options;
+  StereoPairingCheck pairing;
+  std::vector<std::optional<double>> recent_motion_px;  // Per marker, reused per frame.
   std::vector<std::string> names;
   std::vector<size_t> chain_index;  // The chain's markers' indices in `names`, base to tip.
   std::vector<std::string> segment_names;  // Inner markers, with more than 3 in the chain.
@@ -159,6 +280,27 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
     m.right = r != nullptr ? *r : Observation::NotFound(MarkerStatus::kLost);
     m.point = s.triangulator.triangulate(m.left.position_px, m.right.position_px,
                                          m.left.sigma_px, m.right.sigma_px);
+    s.recent_motion_px.resize(s.names.size());
+    s.recent_motion_px[i].reset();
+    if (m.point.epipolar_px) {
+      s.recent_motion_px[i] = s.pairing.add(s.triangulator, i, *m.left.position_px,
+                                             *m.right.position_px, right.frame_index);
+    } else {
+      s.pairing.lose(i);
+    }
+  }
+  // Noise of a point's distance from its line: both views' centroids.
+  const double sigma_px = std::sqrt(2.0) * s.triangulator.options().position_sigma_px;
+  out.lag_frames = s.pairing.update(sigma_px);
+  for (size_t i = 0; i < s.names.size(); ++i) {
+    StereoMarkerResult& m = out.markers[i];
+    if (out.lag_frames && m.point.found() && s.recent_motion_px[i] &&
+        *s.recent_motion_px[i] > 0.25 * s.triangulator.options().max_epipolar_px) {
+      m.point = StereoPoint{};
+      m.point.status = StereoStatus::kTiming;
+      m.point.epipolar_px = s.triangulator.epipolar_distance_px(*m.left.position_px,
+                                                                *m.right.position_px);
+    }
     if (m.point.status != StereoStatus::kMissing) {
       m.status = StereoStatusName(m.point.status);
     } else if (!m.left.found()) {

@@ -30,6 +30,10 @@ void SummariseTimes(std::vector<double>& times_ms, double* median_ms, double* p9
   *p99_ms = times_ms[p99];
 }
 
+std::string RunSummary::stop_text() const {
+  return stop_detail.empty() ? StopReasonName(stop_reason) : stop_detail;
+}
+
 double RunSummary::found_rate(size_t i) const {
   return frames > 0 ? static_cast<double>(markers.at(i).found) / static_cast<double>(frames)
                     : 0.0;
@@ -58,8 +62,7 @@ std::string RunSummary::FullReport() const {
   std::string out;
   char line[384];
   std::snprintf(line, sizeof(line), "frames: %lld from %s in %.2f s (%s)\n",
-                static_cast<long long>(frames), source.c_str(), wall_s,
-                stop_detail.empty() ? StopReasonName(stop_reason) : stop_detail.c_str());
+                static_cast<long long>(frames), source.c_str(), wall_s, stop_text().c_str());
   out += line;
   if (first_index && last_index) {
     std::snprintf(line, sizeof(line), "source frames %lld..%lld, %lld dropped by the source\n",

@@ -262,7 +262,7 @@ void PublishSink::end(const RunSummary& summary) {
   read_subscriptions();
   nlohmann::ordered_json end;
   end["frames"] = summary.frames;
-  end["stop_reason"] = StopReasonName(summary.stop_reason);
+  end["stop_reason"] = summary.stop_text();  // The printed summary's words (RunOptions::describe_stop).
   end["error"] = summary.error;
   end["sent"] = sent_ + 1;  // This record too.
   end["dropped"] = dropped_;

@@ -38,8 +38,12 @@ enum class StereoStatus {
   kMissing,   // Not found in one view or both (no pair to verify).
   kEpipolar,  // Found in both, but the pair breaks the epipolar constraint.
   kBehind,    // The rays meet behind a camera: not one object either.
+  // On the epipolar line, but the two views' motions say their frames are not of one moment (a
+  // wrong --frame-offset): moving along the epipolar line, the point's depth would be off
+  // (StereoSession's pairing check; the triangulator never sets it).
+  kTiming,
 };
-// "found", "missing", "epipolar", "behind".
+// "found", "missing", "epipolar", "behind", "timing".
 const char* StereoStatusName(StereoStatus status);
 
 struct StereoPoint {
@@ -70,6 +74,10 @@ class Triangulator {
   // Distance of the right point from the left point's epipolar line, both raw pixels
   // (undistorted here), in undistorted pixels of the right camera.
   double epipolar_distance_px(const cv::Point2d& left_px, const cv::Point2d& right_px) const;
+  // The same, signed, with the line's unit normal in the right image (the side the distance is
+  // counted positive towards): how far a motion of the right point moves it across the line.
+  double signed_epipolar_distance_px(const cv::Point2d& left_px, const cv::Point2d& right_px,
+                                     cv::Vec2d* line_normal) const;
 
   // A point (mm, first camera's frame) to raw (distorted) pixels of each camera.
   cv::Point2d project_left(const cv::Point3d& point_mm) const;

@@ -32,7 +32,9 @@ class AsyncFrameWriter {
   // index; a test holds the encoder there to fill the queue.
   AsyncFrameWriter(FrameWriterOptions options, size_t capacity = 8,
                    std::function<void(int64_t index)> before_encode = {});
-  ~AsyncFrameWriter();  // Finishes what is queued (close()), errors swallowed.
+  // Finishes what is queued (close()), errors swallowed; left by an exception, abandons the
+  // video instead (FrameWriter::discard), the output left as it was.
+  ~AsyncFrameWriter();
   AsyncFrameWriter(const AsyncFrameWriter&) = delete;
   AsyncFrameWriter& operator=(const AsyncFrameWriter&) = delete;
 
@@ -44,7 +46,8 @@ class AsyncFrameWriter {
   cv::Mat* acquire();
   // Queues the buffer acquire() returned, as the frame with this index.
   void commit(int64_t index);
-  // Encodes everything queued, then closes the file; rethrows the encoder's error, if any.
+  // Encodes everything queued, then closes the file (FrameWriter::close: into place when whole);
+  // rethrows the encoder's error, if any (the video then abandoned).
   void close();
 
   const std::string& path() const { return path_; }
@@ -69,6 +72,8 @@ class AsyncFrameWriter {
   std::vector<Slot> ring_;  // Queued: ring_[head_] .. count_ of them; the next free follows.
   size_t head_ = 0, count_ = 0;
   bool closing_ = false, done_ = false;
+  bool abandoned_ = false;  // Destroyed by an exception: what is queued is dropped.
+  int uncaught_at_start_ = std::uncaught_exceptions();
   std::exception_ptr error_;
   int64_t queued_ = 0;
   std::atomic<int64_t> waited_{0};

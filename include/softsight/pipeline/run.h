@@ -33,6 +33,11 @@ struct RunOptions {
   // image sequences and intra-only videos are not delayed). Off for a loop that acts on each
   // frame as it comes (`control`): it cannot wait for the next key frame.
   bool check_key_frame_groups = true;
+  // Why the run stopped in the words of the command that runs it ("duration reached", "stopped
+  // by SIGINT"; empty: StopReasonName's), asked once as it ends and kept in
+  // RunSummary::stop_detail before the sinks' end(): the stream's end record and the printed
+  // summary then say the same. Empty: none.
+  std::function<std::string(StopReason)> describe_stop;
 };
 
 // One run, frame by frame: RunPipeline's work per frame and its summary, for a caller whose own
@@ -74,6 +79,10 @@ class PipelineRun {
   // frame without an error still begins and ends its sinks.
   RunSummary finish(StopReason reason, int64_t dropped = 0, std::vector<std::string> notes = {},
                     std::string error = {});
+  // RunOptions::describe_stop, for finish().
+  void describe_stop_with(std::function<std::string(StopReason)> describe) {
+    describe_stop_ = std::move(describe);
+  }
 
  private:
   void begin_sinks();
@@ -87,6 +96,7 @@ class PipelineRun {
   std::vector<FrameSink*> joined_;  // Begun and ended by their owners.
   bool needs_colour_;
   bool finished_ = false;
+  std::function<std::string(StopReason)> describe_stop_;
   std::chrono::steady_clock::time_point start_;
   RunSummary summary_;  // Its frames: those the sinks have had.
   int64_t processed_ = 0;

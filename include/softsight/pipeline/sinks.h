@@ -62,8 +62,9 @@ class VideoSink : public FrameSink {
  public:
   // Checks the path and codec at once (FrameWriter). `fps` absent: the source's, else 30.
   // `before_encode` (tests): AsyncFrameWriter's hook on the encoding thread.
-  // A video file is locked (flock) while it is written: a second writer of it is refused with
-  // InputError before it truncates anything.
+  // A video is written beside its output and renamed into place when whole (FrameWriter), its
+  // temporary file locked (flock) meanwhile: a second writer of it is refused with InputError
+  // before it truncates anything.
   VideoSink(std::string path, std::string codec, std::optional<double> fps, FrameDrawer draw = {},
             std::function<void(int64_t index)> before_encode = {});
   ~VideoSink() override;
@@ -94,7 +95,6 @@ class VideoSink : public FrameSink {
   std::unique_ptr<AsyncFrameWriter> writer_;
   std::optional<std::string> error_;
   bool live_ = false;  // RunInfo::live: a camera's run.
-  int lock_fd_ = -1;  // Holds the file's lock while this sink lives (-1: a pattern or device).
 };
 
 }  // namespace softsight

@@ -47,7 +47,7 @@ struct StereoMarkerResult {
   std::string name;
   Observation left, right;  // Each view's own observation (raw pixels).
   StereoPoint point;        // The verified 3D point, or why there is none.
-  // "found", "epipolar", "behind", or the first view that did not find the marker and why
+  // "found", "epipolar", "behind", "timing" (StereoStatus::kTiming), or the first view that did not find the marker and why
   // ("left_lost", "right_covered", ...).
   std::string status;
 };
@@ -58,6 +58,10 @@ struct StereoFrameResult {
   double time_s = 0.0;                      // The left view's.
   // Paired by time: the right frame's time minus the left one's (ms), the pairing error.
   std::optional<double> pair_dt_ms;
+  // When the markers' motion over the last pairs says the right view's frames are not of the
+  // left one's moment: by how many right frames the right one is later (negative: earlier).
+  // Moving markers are then not found in 3D (status "timing"). Absent: no sign of it.
+  std::optional<double> lag_frames;
   std::vector<StereoMarkerResult> markers;  // In the left config's order.
   // In millimetres, the first camera's frame: the chain's angle, plane, circle and tip.
   Shape3d shape;

@@ -60,6 +60,8 @@ struct RunSummary {
 
   // Fraction of processed frames in which marker `i` was found (0 without frames).
   double found_rate(size_t i) const;
+  // Why it stopped, as the summary says it: stop_detail, else StopReasonName(stop_reason).
+  std::string stop_text() const;
   // Whether the run ended without an error.
   bool ok() const { return stop_reason != StopReason::kError; }
 
