@@ -631,7 +631,7 @@ def main():
     # where something moves (plus a margin for shadows and blur) is rendered: the bench and the
     # wall do not change, and the same seed gives the same sampling noise there, so the pasted
     # part has no seam. post.py pastes each part onto the plate.
-    t = time.time()
+    t, cpu = time.time(), time.process_time()
     if a.look is not None:
         scene.frame_set(a.look)
         scene.render.filepath = os.path.join(a.out, 'look.png')
@@ -647,7 +647,8 @@ def main():
         r.border_min_y, r.border_max_y = 1 - y1 / HEIGHT, 1 - y0 / HEIGHT
         r.filepath = os.path.join(a.out, 'frames', f'{f:04d}.png')
         bpy.ops.render.render(write_still=True)
-    print(f'PBR_TIMING scene={a.scene} frames={frames} seconds={time.time() - t:.1f}')
+    print(f'PBR_TIMING scene={a.scene} frames={frames} seconds={time.time() - t:.1f} '
+          f'cpu_seconds={time.process_time() - cpu:.1f}')
 
 
 main()
