@@ -287,8 +287,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
 
   // Pass 1: core colour, ring colour (overall and per sector).
   cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
+  cv::Matx33d core_outer = cv::Matx33d::zeros(), ring_outer = cv::Matx33d::zeros();
   std::array<cv::Vec3d, kSectors> sector_sum{};
   std::array<int, kSectors> sector_n{};
+  // Per quarter of the ring: sums and second moments, for the contrast (see below).
+  constexpr int kQuarters = 4;
+  std::array<cv::Vec3d, kQuarters> quarter_sum{};
+  std::array<cv::Matx33d, kQuarters> quarter_outer{};
+  std::array<double, kQuarters> quarter_n{};
   double core_n = 0, ring_n = 0;
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
@@ -301,6 +307,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
         for (int k = 0; k < channels; ++k) {
           core_sum[k] += c[k];
           core_sq[k] += c[k] * c[k];
+          for (int l = 0; l < k; ++l) core_outer(k, l) += c[k] * c[l];
         }
         core_n += 1;
       } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
@@ -309,7 +316,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
           ring_sum[k] += c[k];
           ring_sq[k] += c[k] * c[k];
           sector_sum[sector][k] += c[k];
+          for (int l = 0; l < k; ++l) ring_outer(k, l) += c[k] * c[l];
         }
+        const int quarter = sector * kQuarters / kSectors;
+        for (int k = 0; k < channels; ++k) {
+          quarter_sum[quarter][k] += c[k];
+          for (int l = 0; l <= k; ++l) quarter_outer[quarter](k, l) += c[k] * c[l];
+        }
+        quarter_n[quarter] += 1;
         ++sector_n[sector];
         ring_n += 1;
       }
@@ -326,10 +340,52 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   blob->core_px = pure_core ? static_cast<int>(core_n) : 0;
   blob->core_sigma = std::sqrt(core_var);
   blob->ring_sigma = std::sqrt(ring_var);
+  // The contrast is judged against each quarter of the ring on its own, along the colour axis
+  // that separates the marker from that quarter, with that quarter's spread along it: a marker
+  // at an actuator's edge has a bright band on one side and the body's shaded ribs on the other,
+  // and the spread of the two together (or shading across the ring, which spreads it along grey
+  // while a dim saturated marker differs in chroma) would hide a marker a person sees plainly.
+  // The median over the quarters: a patch of background texture stands out from few of them.
   const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
   const double axis2 = axis.dot(axis);
-  blob->contrast = std::sqrt(axis2) /
-                   (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  const auto spread_along = [&](const cv::Vec3d& direction, const cv::Matx33d& second,
+                                const cv::Vec3d& mean, double n) {
+    const double length = std::sqrt(direction.dot(direction));
+    if (!(length > 0) || !(n > 0)) return 0.0;
+    const cv::Vec3d u = direction / length;
+    double variance = 0;
+    for (int k = 0; k < channels; ++k) {
+      for (int l = 0; l < channels; ++l) {
+        const double moment = (k >= l ? second(k, l) : second(l, k)) / n;
+        variance += u[k] * u[l] * (moment - mean[k] * mean[l]);
+      }
+    }
+    return std::sqrt(std::max(0.0, variance));
+  };
+  cv::Matx33d core_second = core_outer;
+  for (int k = 0; k < channels; ++k) core_second(k, k) = core_sq[k];
+  std::array<double, kQuarters> quarter_contrast{};
+  int quarters = 0;
+  for (int q = 0; q < kQuarters; ++q) {
+    if (quarter_n[q] < 3) continue;
+    const cv::Vec3d mean = quarter_sum[q] / quarter_n[q];
+    const cv::Vec3d direction = blob->core_colour - mean;
+    const double core_along = spread_along(direction, core_second, blob->core_colour, core_n);
+    const double ring_along = spread_along(direction, quarter_outer[q], mean, quarter_n[q]);
+    quarter_contrast[quarters++] = std::sqrt(direction.dot(direction)) /
+                                   (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
+  }
+  blob->whole_ring_contrast =
+      std::sqrt(axis2) /
+      (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  if (quarters == 0) {
+    blob->contrast = blob->whole_ring_contrast;
+  } else {
+    std::sort(quarter_contrast.begin(), quarter_contrast.begin() + quarters);
+    blob->contrast = quarters % 2 ? quarter_contrast[quarters / 2]
+                                  : 0.5 * (quarter_contrast[quarters / 2 - 1] +
+                                           quarter_contrast[quarters / 2]);
+  }
   blob->measured = true;
   // A round marker partly hidden: the circle of its radius through its edge (not where the
   // frame cuts it).

@@ -299,7 +299,7 @@ BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
   evidence.area_px = blob.area_px;
   if (blob.measured) {
     evidence.noise_levels = 0.5 * (blob.core_sigma + blob.ring_sigma);
-    evidence.contrast_levels = blob.contrast * (blob.core_sigma + blob.ring_sigma + 2.0);
+    evidence.contrast_levels = cv::norm(blob.core_colour - blob.ring_colour);
     evidence.excess_asymmetry_px = blob.asymmetry_px - model.asymmetry_px;
   }
   evidence.rim_placed = blob.rim_placed;

@@ -57,9 +57,15 @@ struct ColourBlob {
   // the background. 0 for a blob too small to have any (its colour is then the whole blob's).
   int core_px = 0;
   double core_sigma = 0, ring_sigma = 0;
-  // |core - ring| / (core_sigma + ring_sigma + 2): how clearly the blob stands out from what
-  // surrounds it. A printed or painted marker scores far above a patch of background texture.
+  // How clearly the blob stands out from what surrounds it: per quarter of the ring,
+  // |core - quarter| / (core spread / 2 + quarter spread + 2), the spreads measured along the
+  // colour axis core - quarter; the median over the quarters. A printed or painted marker scores far above a patch of background texture.
   double contrast = 0;
+  // The same against the whole ring at once, its spread over every channel: stricter where the
+  // surroundings vary (shading, an edge beside the marker). What a whole-frame search with nothing
+  // learned and no roi needs (init): there nobody showed the marker, and a patch of texture that
+  // differs from part of its surroundings must not pass.
+  double whole_ring_contrast = 0;
   // For a blob smaller than a round marker's learned area (set with the colour statistics): the
   // circle of the marker's radius fitted to its edge (track/rim_fit.h), whose centre is the
   // marker's when what is left of it shows enough of its rim (see RimCentre).

@@ -90,6 +90,9 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
   }
   // Contrast to its own surroundings.
   if (!(b.contrast >= kMinContrast)) return {CandidateVerdict::kContrast, kInf};
+  if (!model_ && !acquire_roi_ && !(b.whole_ring_contrast >= kMinContrast)) {
+    return {CandidateVerdict::kContrast, kInf};
+  }
   misfit += kMinContrast / b.contrast;
   // Colour against the learned core colour, or the nominal one.
   const std::optional<cv::Vec3d> reference =
