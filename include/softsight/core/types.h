@@ -67,7 +67,7 @@ struct Observation {
   // The position's standard uncertainty along each image axis, px (set with position_px): from
   // the marker's size, contrast and noise, a partial view, the match's fit. A found marker lies
   // within 3 sigma of its true centre (docs/measurements.md, "Uncertainty").
-  std::optional<double> sigma_px;
+  std::optional<double> sigma_px{};
   // Why there is no position (ignored while position_px is set): see status().
   MarkerStatus not_found_reason = MarkerStatus::kLost;
   // With kAmbiguous: how many candidates fitted about equally (for the summary's "2 candidates").
