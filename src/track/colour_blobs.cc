@@ -381,7 +381,11 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   if (quarters == 0) {
     blob->contrast = blob->whole_ring_contrast;
   } else {
-    std::sort(quarter_contrast.begin(), quarter_contrast.begin() + quarters);
+    for (int a = 1; a < quarters; ++a) {  // At most four: insertion.
+      for (int b = a; b > 0 && quarter_contrast[b - 1] > quarter_contrast[b]; --b) {
+        std::swap(quarter_contrast[b - 1], quarter_contrast[b]);
+      }
+    }
     blob->contrast = quarters % 2 ? quarter_contrast[quarters / 2]
                                   : 0.5 * (quarter_contrast[quarters / 2 - 1] +
                                            quarter_contrast[quarters / 2]);

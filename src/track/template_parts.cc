@@ -233,6 +233,53 @@ cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask) {
   return best;
 }
 
+namespace {
+cv::Vec3d Chromaticity(const cv::Vec3d& bgr) {
+  return bgr / (bgr[0] + bgr[1] + bgr[2] + kChromaDarkLevels);
+}
+}  // namespace
+
+bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out) {
+  if (bgr.type() != CV_8UC3 || bgr.cols < 5 || bgr.rows < 5) return false;
+  cv::Vec3d centre(0, 0, 0), edge(0, 0, 0);
+  int centre_n = 0, edge_n = 0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3d c = Chromaticity(cv::Vec3d(row[x][0], row[x][1], row[x][2]));
+      if (std::abs(2 * x - (bgr.cols - 1)) <= 2 && std::abs(2 * y - (bgr.rows - 1)) <= 2) {
+        centre += c;
+        ++centre_n;
+      } else if (x == 0 || y == 0 || x == bgr.cols - 1 || y == bgr.rows - 1) {
+        edge += c;
+        ++edge_n;
+      }
+    }
+  }
+  if (centre_n == 0 || edge_n == 0) return false;
+  const cv::Vec3d axis = centre / centre_n - edge / edge_n;
+  const double span = std::sqrt(axis.dot(axis));
+  if (!(span >= kMinChromaSpan)) return false;
+  out->background = edge / edge_n;
+  out->axis = axis / span;
+  out->span = span;
+  return true;
+}
+
+void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  out.create(bgr.size(), CV_8UC1);
+  const double scale = 160.0 / chroma.span;
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3d c = Chromaticity(cv::Vec3d(row[x][0], row[x][1], row[x][2]));
+      o[x] = cv::saturate_cast<uint8_t>(40.0 + scale * (c - chroma.background).dot(chroma.axis));
+    }
+  }
+}
+
 bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
                        BlobMeter* meter, cv::Point2d* anchor) {
   *projection = templ.channels() == 3 ? MarkerProjection(templ, mask) : cv::Mat();

@@ -410,6 +410,28 @@ cv::Mat ContrastProjection(const cv::Mat& bgr);
 // from its surroundings (BlobMeter::isolation). The principal axis when none shows a blob.
 cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask);
 
+// ---- The marker's colour, for its blob --------------------------------------------------------
+// On colour footage a template's blob is measured in the marker's chromaticity (each pixel's BGR
+// over its sum), projected on the axis from the box's edge to its centre. A light from one side
+// shades a domed marker from bright to dark across its face: in any gray channel its blob's
+// centroid moves 2-4 px towards the lit flank (a physically rendered bench), while the
+// chromaticity hardly changes with the light's strength. Dark pixels' chromaticity is noise: the
+// sum is damped by kChromaDarkLevels.
+struct ChromaAxis {
+  cv::Vec3d background;  // Chromaticity of the box's edge.
+  cv::Vec3d axis;        // Unit vector from it towards the marker's (the box's centre).
+  double span = 0;       // The marker's distance along the axis.
+};
+inline constexpr double kChromaDarkLevels = 30.0;
+// Below this span the marker's colour is the background's (a white dot on grey): no axis.
+inline constexpr double kMinChromaSpan = 0.05;
+// The axis of `bgr` (a selected template, 8-bit BGR); false when its centre's chromaticity does
+// not differ from its edge's.
+bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out);
+// One 8-bit channel: the background at 40, the marker at 200.
+void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
+
+
 // The marker's blob in a selected template (its foreground): the channel it shows best
 // (`projection`: MarkerProjection on colour, else empty) and the blob learned in it. False
 // when the template shows none.

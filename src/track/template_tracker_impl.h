@@ -66,7 +66,10 @@ class TemplateTracker final : public Tracker {
   cv::Mat MaskFor(const cv::Size& size) const {
     return params_.round_mask ? RoundMask(size) : cv::Mat();
   }
-  void SetTemplate(const cv::Mat& templ, const std::string& where);
+  // `selection_bgr`: the template as selected in colour (empty on gray footage), in which its
+  // blob is measured when the marker's colour differs from its surroundings' (ChromaAxis).
+  void SetTemplate(const cv::Mat& templ, const std::string& where,
+                   const cv::Mat& selection_bgr = cv::Mat());
   const Rung* RungAt(int scale, int turn);
   void Similarity(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& sim);
   double ScoreOf(double similarity) const;
@@ -155,6 +158,11 @@ class TemplateTracker final : public Tracker {
   // The marker's blob in the template: every match is verified against it (BlobShift).
   BlobMeter blob_;
   bool blob_ok_ = false;                // The template shows a blob (its foreground).
+  bool chroma_ok_ = false;              // ... measured in its chromaticity (chroma_).
+  ChromaAxis chroma_;
+  // The blob's centroid, measured in every frame, is the reported point (report: centre, or a
+  // blob measured in its chromaticity).
+  bool blob_reported_ = false;
   cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;

@@ -183,7 +183,10 @@ TEST(TemplateTrackerTest, GrayTemplatesTrackToATenthOfAPixel) {
   }
 }
 
-TEST(TemplateTrackerTest, LumaGrayIsLessAccurateThanTheContrastProjection) {
+// Matched in luma, the green disc hardly differs from the band: the match misses frames the
+// contrast projection keeps. (Where found, both report the disc's blob measured in its
+// chromaticity, equally accurate.)
+TEST(TemplateTrackerTest, LumaGrayMatchesLessReliablyThanTheContrastProjection) {
   TemplateParams luma;
   luma.contrast_gray = false;
   for (const char* method : kMethods) {
@@ -194,7 +197,7 @@ TEST(TemplateTrackerTest, LumaGrayIsLessAccurateThanTheContrastProjection) {
     SCOPED_TRACE(what);
     EXPECT_LE(plain.rms_px, 0.25);
     EXPECT_LE(plain.max_px, 1.3);
-    EXPECT_GT(plain.rms_px, projected.rms_px);
+    EXPECT_GT(plain.missed, projected.missed);
   }
 }
 

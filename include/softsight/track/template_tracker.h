@@ -103,7 +103,10 @@ struct TemplateParams {
   // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a
   // faster unmasked ZNCC kernel).
   bool round_mask = true;
-  // Which point is reported (see the contract above). Default kSymmetry: the marker's centre
+  // Which point is reported (see the contract above). Default kSymmetry: on colour footage where
+  // the marker stands out more in its chromaticity than in the matched channel, its blob's soft
+  // centroid in that chromaticity, measured in every frame (shading does not move it); else the
+  // marker's centre
   // of point symmetry (a dot's or disc's centroid; measured on the square around the template's
   // blob where it shows one, else on the whole template), carried by the match with the first
   // template, and moved onto the blob's centroid where the two disagree by more than 0.75 px;
