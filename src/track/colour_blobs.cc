@@ -287,14 +287,13 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
 
   // Pass 1: core colour, ring colour (overall and per sector).
   cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
-  cv::Matx33d core_outer = cv::Matx33d::zeros(), ring_outer = cv::Matx33d::zeros();
+  // Second moments (lower triangle) of the core and of each quarter of the ring (four sectors
+  // each), for the contrast (see below).
+  constexpr int kQuarters = 4;
+  cv::Matx33d core_outer = cv::Matx33d::zeros();
+  std::array<cv::Matx33d, kQuarters> quarter_outer{};
   std::array<cv::Vec3d, kSectors> sector_sum{};
   std::array<int, kSectors> sector_n{};
-  // Per quarter of the ring: sums and second moments, for the contrast (see below).
-  constexpr int kQuarters = 4;
-  std::array<cv::Vec3d, kQuarters> quarter_sum{};
-  std::array<cv::Matx33d, kQuarters> quarter_outer{};
-  std::array<double, kQuarters> quarter_n{};
   double core_n = 0, ring_n = 0;
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
@@ -307,23 +306,18 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
         for (int k = 0; k < channels; ++k) {
           core_sum[k] += c[k];
           core_sq[k] += c[k] * c[k];
-          for (int l = 0; l < k; ++l) core_outer(k, l) += c[k] * c[l];
+          for (int l = 0; l <= k; ++l) core_outer(k, l) += c[k] * c[l];
         }
         core_n += 1;
       } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
+        cv::Matx33d& outer = quarter_outer[sector * kQuarters / kSectors];
         for (int k = 0; k < channels; ++k) {
           ring_sum[k] += c[k];
           ring_sq[k] += c[k] * c[k];
           sector_sum[sector][k] += c[k];
-          for (int l = 0; l < k; ++l) ring_outer(k, l) += c[k] * c[l];
+          for (int l = 0; l <= k; ++l) outer(k, l) += c[k] * c[l];
         }
-        const int quarter = sector * kQuarters / kSectors;
-        for (int k = 0; k < channels; ++k) {
-          quarter_sum[quarter][k] += c[k];
-          for (int l = 0; l <= k; ++l) quarter_outer[quarter](k, l) += c[k] * c[l];
-        }
-        quarter_n[quarter] += 1;
         ++sector_n[sector];
         ring_n += 1;
       }
@@ -362,16 +356,20 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     }
     return std::sqrt(std::max(0.0, variance));
   };
-  cv::Matx33d core_second = core_outer;
-  for (int k = 0; k < channels; ++k) core_second(k, k) = core_sq[k];
   std::array<double, kQuarters> quarter_contrast{};
   int quarters = 0;
   for (int q = 0; q < kQuarters; ++q) {
-    if (quarter_n[q] < 3) continue;
-    const cv::Vec3d mean = quarter_sum[q] / quarter_n[q];
+    cv::Vec3d sum(0, 0, 0);
+    int n = 0;
+    for (int i = q * kSectors / kQuarters; i < (q + 1) * kSectors / kQuarters; ++i) {
+      sum += sector_sum[i];
+      n += sector_n[i];
+    }
+    if (n < 3) continue;
+    const cv::Vec3d mean = sum / n;
     const cv::Vec3d direction = blob->core_colour - mean;
-    const double core_along = spread_along(direction, core_second, blob->core_colour, core_n);
-    const double ring_along = spread_along(direction, quarter_outer[q], mean, quarter_n[q]);
+    const double core_along = spread_along(direction, core_outer, blob->core_colour, core_n);
+    const double ring_along = spread_along(direction, quarter_outer[q], mean, n);
     quarter_contrast[quarters++] = std::sqrt(direction.dot(direction)) /
                                    (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
   }
