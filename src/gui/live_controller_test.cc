@@ -1586,3 +1586,40 @@ TEST(LivePointer, ClicksWithinTheSlopDragsBeyondItAndNothingWithoutAPressInTheIm
 
 }  // namespace
 }  // namespace softsight
+
+namespace softsight {
+namespace {
+
+// The case a bench user met: paused on frame 250 of synth's scene, switched to ZNCC (templates cut
+// where the colour markers were), then seeked on. A jump searches every frame afresh, and in
+// gray the three discs look alike: each template must still find its own disc, by its colour.
+TEST(LiveSeek, AfterASwitchToZnccEachSeekFindsEveryMarkerOnItsOwnDisc) {
+  SyntheticScene scene{SceneOptions{}};
+  LiveController live(testing::LiveTestConfig(), LiveOptions{});
+  const auto show = [&](int index, FrameOrder order) {
+    Frame frame;
+    SceneTruth truth = scene.render(index, frame.image);
+    frame.index = index;
+    frame.time_s = truth.time_s;
+    live.on_frame(frame, SteadyClock::now(), order);
+    return truth;
+  };
+  for (int i = 0; i < 3; ++i) show(i, FrameOrder::kNext);
+  live.on_event(UiEvent::Key(' '));  // Pause.
+  show(250, FrameOrder::kJump);
+  for (int k = 0; k < 3; ++k) live.on_event(UiEvent::Key('m'));  // colour -> sad -> ssd -> zncc
+  ASSERT_EQ(live.message(), "method: zncc");
+  for (int target : {279, 260, 120, 299, 10}) {
+    const SceneTruth truth = show(target, FrameOrder::kJump);
+    for (int m = 0; m < 3; ++m) {
+      const Observation& o = live.last_result()->markers[m].observation;
+      ASSERT_TRUE(o.found()) << truth.markers[m].name << " in frame " << target << ": "
+                             << MarkerStatusName(o.status());
+      EXPECT_LT(cv::norm(*o.position_px - *truth.markers[m].centroid_px), 0.5)
+          << truth.markers[m].name << " in frame " << target;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace softsight

@@ -280,6 +280,31 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
   }
 }
 
+bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv::Vec3d* chroma) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  const double r = std::max(radius, 1.0);
+  const cv::Rect box(static_cast<int>(std::floor(centre.x - r)),
+                     static_cast<int>(std::floor(centre.y - r)),
+                     static_cast<int>(std::ceil(2 * r)) + 2, static_cast<int>(std::ceil(2 * r)) + 2);
+  if ((box & cv::Rect(0, 0, bgr.cols, bgr.rows)) != box) return false;
+  cv::Vec3d sum(0, 0, 0);
+  int n = 0;
+  for (int y = box.y; y < box.br().y; ++y) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    for (int x = box.x; x < box.br().x; ++x) {
+      const double dx = x - centre.x, dy = y - centre.y;
+      if (dx * dx + dy * dy > r * r) continue;
+      sum += cv::Vec3d(row[x][0], row[x][1], row[x][2]);
+      ++n;
+    }
+  }
+  if (n == 0) return false;
+  const double total = sum[0] + sum[1] + sum[2];
+  if (!(total >= kDarkCoreLevels * n)) return false;
+  *chroma = sum / total;
+  return true;
+}
+
 bool LearnTemplateBlob(const cv::Mat& templ, const cv::Mat& mask, cv::Mat* projection,
                        BlobMeter* meter, cv::Point2d* anchor) {
   *projection = templ.channels() == 3 ? MarkerProjection(templ, mask) : cv::Mat();

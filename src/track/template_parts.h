@@ -432,6 +432,24 @@ bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out);
 void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
 
 
+// The colour of a marker's core: the chromaticity (B, G, R over their sum) of the mean colour of
+// a disc of `radius` px at `centre` in `bgr` (8-bit BGR). A match in one channel is blind to hue:
+// three discs of one size look alike to a gray template, and only their colour tells the green
+// one it was cut around from the blue one. False when the disc leaves the image or is too dark
+// for its colour to mean anything (a mean of B + G + R under kDarkCoreLevels).
+inline constexpr double kDarkCoreLevels = 60.0;
+bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv::Vec3d* chroma);
+// Chromaticity distance beyond which a place shows another marker's colour, not this one's. The
+// lights a template meets after it was cut move a core's chromaticity by up to about 0.06 (white
+// under a warm side light); markers a person tells apart by colour lie 0.3-0.6 apart.
+inline constexpr double kOtherColourDistance = 0.15;
+// A match whose core shows the marker's own colour (within this distance) is a second, independent
+// piece of evidence: it is accepted down to min_zncc - kColourZnccAllowance. A marker smeared by
+// fast motion or turned against its template matches its template's gray levels less well
+// (0.72-0.79 for a blurred tip that a person sees plainly) while its colour stays its own.
+inline constexpr double kSameColourDistance = 0.06;
+inline constexpr double kColourZnccAllowance = 0.1;
+
 // The marker's blob in a selected template (its foreground): the channel it shows best
 // (`projection`: MarkerProjection on colour, else empty) and the blob learned in it. False
 // when the template shows none.

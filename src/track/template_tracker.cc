@@ -108,6 +108,15 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
       chroma_ok_ = true;
     }
   }
+  core_colour_.reset();
+  if (!selection_bgr.empty() && selection_bgr.size() == templ.size()) {
+    // The blob's core, or a sixth of the box around its centre without a blob.
+    const cv::Point2d core = blob_ok_ ? blob_anchor_px_ : HalfSize(templ.size());
+    core_radius_px_ = std::max(1.5, blob_ok_ ? 0.6 * std::sqrt(blob_.area() / CV_PI)
+                                             : std::min(templ.cols, templ.rows) / 6.0);
+    cv::Vec3d chroma;
+    if (CoreColour(selection_bgr, core, core_radius_px_, &chroma)) core_colour_ = chroma;
+  }
   blob_reported_ = blob_ok_ && (params_.report == TemplateReport::kCentre ||
                                 (chroma_ok_ && params_.report == TemplateReport::kSymmetry));
   if (blob_reported_) anchor_px_ = blob_anchor_px_;
@@ -340,8 +349,8 @@ double TemplateTracker::ScoreOf(double similarity) const {
   return similarity;
 }
 
-bool TemplateTracker::Accept(const Hit& m) const {
-  if (!(m.zncc >= params_.min_zncc)) return false;
+bool TemplateTracker::Accept(const Hit& m, bool colour_agrees) const {
+  if (!(m.zncc >= params_.min_zncc - (colour_agrees ? kColourZnccAllowance : 0.0))) return false;
   switch (params_.measure) {
     case MatchMeasure::kSad: return m.score <= params_.max_sad;
     case MatchMeasure::kSsd: return m.score <= params_.max_ssd;
@@ -469,7 +478,9 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
   std::vector<cv::Point>& candidates = candidates_;
   candidates.clear();
   const cv::Size coarse = pyramid(top).size();
-  for (int k = 0; k < kCandidates; ++k) {
+  // A colour tells look-alikes apart: more peaks are refined, those of another colour dropped.
+  const int peaks = core_colour_ && frame.type() == CV_8UC3 ? 2 * kCandidates : kCandidates;
+  for (int k = 0; k < peaks; ++k) {
     cv::Point at;
     if (!BestIn(sim_, &at)) break;
     candidates.push_back(at);
@@ -479,7 +490,7 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
         .setTo(std::numeric_limits<float>::quiet_NaN());
   }
   std::vector<Hit> hits;
-  hits.reserve(kCandidates);
+  hits.reserve(peaks);
   for (cv::Point p : candidates) {
     int level = top;  // The level `p` is in.
     for (int l = top - 1; l >= 1; --l) {
@@ -496,7 +507,9 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
       level = l;
     }
     std::optional<Hit> m = Refine(frame, region.tl() + p * (1 << level));
-    if (m) hits.push_back(*m);
+    if (m && !OtherColourAt(frame, cv::Point2d(m->top_left) + m->offset + HalfSize(size))) {
+      hits.push_back(*m);
+    }
   }
   if (hits.empty()) return std::nullopt;
   size_t best = 0;
@@ -676,6 +689,28 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   return shift;
 }
 
+std::optional<double> TemplateTracker::ColourDistanceAt(const cv::Mat& frame,
+                                                       const cv::Point2d& centre_px) const {
+  if (!core_colour_ || frame.type() != CV_8UC3) return std::nullopt;
+  const Rung& rung = current();
+  const cv::Point2d core = centre_px - HalfSize(rung.templ.size()) + rung.blob_anchor;
+  cv::Vec3d chroma;
+  if (!CoreColour(frame, core, core_radius_px_ * rung_scale(), &chroma)) return std::nullopt;
+  const cv::Vec3d d = chroma - *core_colour_;
+  return std::sqrt(d.dot(d));
+}
+
+bool TemplateTracker::ColourAgreesAt(const cv::Mat& frame, const Hit& hit) const {
+  const std::optional<double> distance = ColourDistanceAt(
+      frame, cv::Point2d(hit.top_left) + hit.offset + HalfSize(search_template().size()));
+  return distance && *distance <= kSameColourDistance;
+}
+
+bool TemplateTracker::OtherColourAt(const cv::Mat& frame, const cv::Point2d& centre_px) const {
+  const std::optional<double> distance = ColourDistanceAt(frame, centre_px);
+  return distance && *distance > kOtherColourDistance;
+}
+
 void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px) {
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
@@ -741,10 +776,23 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     hit = Search(frame_bgr, window, search_template(), true);
     // Moving faster than the window (its best is on the window's edge, or is no match at all
     // because the marker left it): acquire.
-    if (hit && (hit->on_inner_edge || !Accept(*hit))) hit.reset();
+    if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit)))) {
+      hit.reset();
+    }
   }
   if (!hit) hit = Acquire(frame_bgr);
-  if (!hit || !Accept(*hit)) return Lose(MarkerStatus::kLost);
+  if (!hit || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit))) return Lose(MarkerStatus::kLost);
+  // Of another colour than the marker: a look-alike (a blue disc for the green one's gray
+  // template), not the marker; a rival of another colour is no rival.
+  const auto centre_of = [&](cv::Point top_left) {
+    return cv::Point2d(top_left) + HalfSize(search_template().size());
+  };
+  if (hit->rival_zncc >= params_.min_zncc && OtherColourAt(frame_bgr, centre_of(hit->rival_top_left))) {
+    hit->rival_zncc = kNoRival;
+  }
+  if (OtherColourAt(frame_bgr, centre_of(hit->top_left) + hit->offset)) {
+    return Lose(MarkerStatus::kLost);
+  }
   const cv::Point2d matched = cv::Point2d(hit->top_left) + hit->offset +
                               HalfSize(search_template().size());
   // The places the tracker would take for its marker, for the session's association: the best

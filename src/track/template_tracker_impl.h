@@ -54,6 +54,13 @@ class TemplateTracker final : public Tracker {
     BlobChannelOf(native, blob_projection_, out);
   }
   std::optional<cv::Point2d> BlobShift(const cv::Mat& frame, const Fix& fix);
+  // The template placed with its centre at `centre_px` shows another colour than the marker's
+  // core (core_colour_) there; false when that colour is unknown or cannot be judged.
+  bool OtherColourAt(const cv::Mat& frame, const cv::Point2d& centre_px) const;
+  // The hit's core shows the marker's colour (within kSameColourDistance).
+  bool ColourAgreesAt(const cv::Mat& frame, const Hit& hit) const;
+  // The chromaticity distance of the core at `centre_px` from the marker's; empty when unknown.
+  std::optional<double> ColourDistanceAt(const cv::Mat& frame, const cv::Point2d& centre_px) const;
   // Whether `templ` (native) would show its marker's blob, as SetTemplate learns it; changes
   // nothing.
   bool ShowsAMarker(const cv::Mat& templ) const;
@@ -73,7 +80,9 @@ class TemplateTracker final : public Tracker {
   const Rung* RungAt(int scale, int turn);
   void Similarity(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& sim);
   double ScoreOf(double similarity) const;
-  bool Accept(const Hit& m) const;
+  // The match passes the measure's thresholds; with `colour_agrees` (its core shows the
+  // marker's colour) min_zncc is lowered by kColourZnccAllowance.
+  bool Accept(const Hit& m, bool colour_agrees = false) const;
   cv::Rect WindowAround(const cv::Point2d& centre_px, const cv::Size& size, int margin_px) const;
   std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
                             bool find_rival);
@@ -164,6 +173,10 @@ class TemplateTracker final : public Tracker {
   // blob measured in its chromaticity).
   bool blob_reported_ = false;
   cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
+  // The colour of the marker's core in the selection (CoreColour), when it was cut from a colour
+  // frame: a place of another colour is not the marker, however well it matches.
+  std::optional<cv::Vec3d> core_colour_;
+  double core_radius_px_ = 0.0;  // The core disc's radius, in the selected template.
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;
 };

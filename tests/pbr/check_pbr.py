@@ -39,7 +39,7 @@ CASES = {
         configs=[('pick', 99.0, None),
                  # 19 marker-frames were 1.5-2.5 px off before the template's blob was measured in
                  # the marker's chromaticity (the gray blob took in the dome's shaded flank)
-                 ('zncc', 97.0, None)]),
+                 ('zncc', 99.0, None)]),
     'side': dict(
         what='dim warm side light, highlights on the domes, MJPG',
         # pick found nothing here (0 %) until the contrast was judged per quarter of the ring
@@ -49,23 +49,29 @@ CASES = {
                  ('zncc', 99.0, None)]),
     'distractors': dict(
         what='red screwdriver, red, green and blue caps and parts of the markers\' colours in view',
+        # zncc: 93.5 % before a match whose core shows the marker's colour was accepted down to
+        # a ZNCC of 0.7 (the moving green, 0.72-0.79 in gray)
         configs=[('pick', 98.0, None),
-                 ('zncc', 93.0, None)]),
+                 ('zncc', 99.0, None)]),
     'finger': dict(
         what='a finger covers the middle marker for 10 frames',
         # pick: green (fully visible, never covered) is still `lost` in 18 of 36 frames: its
         # contrast against the bright band and the lit silicone around it is near the limit (was
         # 0 of 36, and blue 1 of 24, before the contrast was judged per quarter of the ring)
         configs=[('pick', 81.0, None),
-                 ('zncc', 96.0, None)]),
+                 ('zncc', 98.0, None)]),
     'fastblur': dict(
         what='fast bend (tip up to 23 px a frame), motion blur, H.264',
         configs=[('pick', 97.0, 'pick reports the blurred tip 1.5-2.1 px off in 3 frames (the fastest)'),
-                 ('zncc', 89.0, None)]),
+                 # zncc: 89.8 % before the colour of the match's core counted as evidence (the
+                 # blurred tip scores 0.72-0.79 in gray)
+                 ('zncc', 99.0, None)]),
     'wedge': dict(
         what='4-segment wedge, 5 markers (red, yellow, green, blue, magenta) on a wooden bench, from above',
+        # zncc: magenta is lost in 17 of 36 frames while the last segment turns 80 degrees
+        # against its template (its box holds the segment's edges, which turn with it)
         configs=[('pick', 99.0, None),
-                 ('zncc', 87.0, None)]),
+                 ('zncc', 90.0, None)]),
     'whitedots': dict(
         what='white domed dots on a dark actuator',
         configs=[('achromatic', 99.0, None), ('pick', 99.0, None), ('zncc', 99.0, None)]),

@@ -3,8 +3,11 @@
 // The contract. One template per marker, cut from a rectangle on a reference frame (init's hint)
 // or given as an image. update() reports the marker's position only when the match is verified;
 // otherwise Observation::NotFound says why:
-//   found      the best match passes the measure's threshold (min_zncc, and max_sad / max_ssd),
-//              no distinct second peak in the searched region comes within ambiguity_margin of
+//   found      the best match passes the measure's threshold (min_zncc, and max_sad / max_ssd;
+//              0.1 below min_zncc when the match's core shows the marker's own colour), shows
+//              the colour of the marker's core when the template was cut from a colour frame (a
+//              gray template of a green disc is never found on the blue one), no distinct second
+//              peak of the marker's colour in the searched region comes within ambiguity_margin of
 //              it (ZNCC), the matched patch is still consistent with the FIRST template at
 //              the current scale (ZNCC >= drift_min_zncc), and, when the selected template shows
 //              a blob (a dot or sticker standing out from what is around it: its foreground),
@@ -138,7 +141,9 @@ struct TemplateParams {
 
   // ---- Verification: a best match worse than these is "not found" ----------------------------
   // Default 0.8: the paper's "realistic match". Higher rejects more partly covered markers and
-  // more frames under blur or lighting change. SAD and SSD matches must pass it too (one ZNCC at
+  // more frames under blur or lighting change. A match whose core shows the marker's own colour
+  // (a template cut from a colour frame) passes 0.1 lower: its colour is a second piece of
+  // evidence, and a blurred or turning marker matches its gray levels less well. SAD and SSD matches must pass it too (one ZNCC at
   // the best placement, a shape check): grey-level closeness alone accepts smooth background
   // patches once the light has changed.
   double min_zncc = 0.8;
