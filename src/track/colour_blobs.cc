@@ -295,6 +295,20 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   std::array<cv::Vec3d, kSectors> sector_sum{};
   std::array<int, kSectors> sector_n{};
   double core_n = 0, ring_n = 0;
+  // The same in chromaticity (colour only): the core's and each quarter's sum and second moments.
+  const bool chromatic = channels == 3;
+  cv::Vec3d core_chroma_sum(0, 0, 0);
+  cv::Matx33d core_chroma_outer = cv::Matx33d::zeros();
+  std::array<cv::Vec3d, kQuarters> quarter_chroma_sum{};
+  std::array<cv::Matx33d, kQuarters> quarter_chroma_outer{};
+  const auto add_chroma = [](const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
+    const double scale = 1.0 / (c[0] + c[1] + c[2] + kChromaDarkLevels);
+    const cv::Vec3d chroma(c[0] * scale, c[1] * scale, c[2] * scale);
+    sum += chroma;
+    for (int k = 0; k < 3; ++k) {
+      for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];
+    }
+  };
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
@@ -308,6 +322,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
           core_sq[k] += c[k] * c[k];
           for (int l = 0; l <= k; ++l) core_outer(k, l) += c[k] * c[l];
         }
+        if (chromatic) add_chroma(c, core_chroma_sum, core_chroma_outer);
         core_n += 1;
       } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
@@ -317,6 +332,10 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
           ring_sq[k] += c[k] * c[k];
           sector_sum[sector][k] += c[k];
           for (int l = 0; l <= k; ++l) outer(k, l) += c[k] * c[l];
+        }
+        if (chromatic) {
+          const int quarter = sector * kQuarters / kSectors;
+          add_chroma(c, quarter_chroma_sum[quarter], quarter_chroma_outer[quarter]);
         }
         ++sector_n[sector];
         ring_n += 1;
@@ -343,13 +362,13 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
   const double axis2 = axis.dot(axis);
   const auto spread_along = [&](const cv::Vec3d& direction, const cv::Matx33d& second,
-                                const cv::Vec3d& mean, double n) {
+                                const cv::Vec3d& mean, double n, int dims) {
     const double length = std::sqrt(direction.dot(direction));
     if (!(length > 0) || !(n > 0)) return 0.0;
     const cv::Vec3d u = direction / length;
     double variance = 0;
-    for (int k = 0; k < channels; ++k) {
-      for (int l = 0; l < channels; ++l) {
+    for (int k = 0; k < dims; ++k) {
+      for (int l = 0; l < dims; ++l) {
         const double moment = (k >= l ? second(k, l) : second(l, k)) / n;
         variance += u[k] * u[l] * (moment - mean[k] * mean[l]);
       }
@@ -368,10 +387,30 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     if (n < 3) continue;
     const cv::Vec3d mean = sum / n;
     const cv::Vec3d direction = blob->core_colour - mean;
-    const double core_along = spread_along(direction, core_outer, blob->core_colour, core_n);
-    const double ring_along = spread_along(direction, quarter_outer[q], mean, n);
-    quarter_contrast[quarters++] = std::sqrt(direction.dot(direction)) /
-                                   (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
+    const double core_along =
+        spread_along(direction, core_outer, blob->core_colour, core_n, channels);
+    const double ring_along = spread_along(direction, quarter_outer[q], mean, n, channels);
+    double contrast = std::sqrt(direction.dot(direction)) /
+                      (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
+    if (chromatic) {
+      // A marker differs from its surroundings in chroma where light and texture vary them in
+      // brightness: a dim blue dome beside the shaded ribs and lit band of a side-lit body, a
+      // green one on speckled silicone. Their dark and bright pixels spread the levels along the
+      // marker's direction, not its chromaticity.
+      const cv::Vec3d core_chroma = core_chroma_sum / core_n;
+      const cv::Vec3d ring_chroma = quarter_chroma_sum[q] / n;
+      const cv::Vec3d chroma_direction = core_chroma - ring_chroma;
+      const double chroma_distance = std::sqrt(chroma_direction.dot(chroma_direction));
+      if (chroma_distance >= kMinChromaContrastSpan) {
+        const double core_chroma_along =
+            spread_along(chroma_direction, core_chroma_outer, core_chroma, core_n, 3);
+        const double ring_chroma_along =
+            spread_along(chroma_direction, quarter_chroma_outer[q], ring_chroma, n, 3);
+        contrast = std::max(contrast, chroma_distance / (kCoreSigmaWeight * core_chroma_along +
+                                                         ring_chroma_along + kChromaNoiseFloor));
+      }
+    }
+    quarter_contrast[quarters++] = contrast;
   }
   blob->whole_ring_contrast =
       std::sqrt(axis2) /

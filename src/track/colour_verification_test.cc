@@ -373,5 +373,54 @@ TEST(ColourVerification, SoftCentroidAccuracyAgainstBinaryAndTextbook) {
   EXPECT_LT(noise.soft, noise.binary);
 }
 
+// ---- A marker that differs in chroma from surroundings that vary in brightness --------------------
+
+// A dim green disc on speckled silicone: dark and bright specks spread the ring's levels along
+// the disc's own direction (it is darker than the mean), so by levels alone it hardly stands out
+// (contrast about 1.5), while a person sees a green disc on grey specks: its chromaticity is
+// the difference. Found in every frame, at its centre.
+TEST(ColourVerification, ADimDiscOnSpeckledSurroundingsStandsOutByItsChroma) {
+  const cv::Point2d centre(80.3, 60.6);
+  ColourParams params;
+  params.h = {45, 75};
+  params.s = {80, 255};
+  params.v = {40, 255};
+  params.roi = cv::Rect(64, 44, 33, 33);
+  ColourTracker tracker(params);
+  cv::RNG rng(7);
+  int found = 0;
+  double worst_px = 0;
+  for (int frame = 0; frame < 10; ++frame) {
+    cv::Mat image(120, 160, CV_8UC3);
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const bool speck = rng.uniform(0.0, 1.0) < 0.4;  // Grey specks on a pale beige.
+        const double level = speck ? rng.uniform(40.0, 70.0) : rng.uniform(190.0, 235.0);
+        image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(level * 0.92),
+                                              cv::saturate_cast<uchar>(level * 0.97),
+                                              cv::saturate_cast<uchar>(level));
+      }
+    }
+    cv::Mat disc = cv::Mat::zeros(image.size(), CV_8U);
+    cv::circle(disc, cv::Point(cvRound(centre.x * 16), cvRound(centre.y * 16)), 9 * 16, 255,
+               cv::FILLED, cv::LINE_8, 4);
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        if (!disc.at<uchar>(y, x)) continue;
+        const double gain = rng.uniform(0.7, 1.3);  // A mottled pigment.
+        image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(60 * gain),
+                                              cv::saturate_cast<uchar>(120 * gain),
+                                              cv::saturate_cast<uchar>(50 * gain));
+      }
+    }
+    const Observation o = tracker.update(image);
+    if (!o.found()) continue;
+    ++found;
+    worst_px = std::max(worst_px, cv::norm(*o.position_px - centre));
+  }
+  EXPECT_EQ(found, 10);
+  EXPECT_LT(worst_px, 0.5);
+}
+
 }  // namespace
 }  // namespace softsight

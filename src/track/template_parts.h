@@ -447,7 +447,10 @@ inline constexpr double kOtherColourDistance = 0.15;
 // piece of evidence: it is accepted down to min_zncc - kColourZnccAllowance. A marker smeared by
 // fast motion or turned against its template matches its template's gray levels less well
 // (0.72-0.79 for a blurred tip that a person sees plainly) while its colour stays its own.
+// Only a coloured marker's (one whose core lies kMinCoreChroma or more from grey): every grey
+// place agrees with a white dot's colour.
 inline constexpr double kSameColourDistance = 0.06;
+inline constexpr double kMinCoreChroma = 0.06;
 inline constexpr double kColourZnccAllowance = 0.1;
 
 // The marker's blob in a selected template (its foreground): the channel it shows best

@@ -701,6 +701,10 @@ std::optional<double> TemplateTracker::ColourDistanceAt(const cv::Mat& frame,
 }
 
 bool TemplateTracker::ColourAgreesAt(const cv::Mat& frame, const Hit& hit) const {
+  // A grey marker's colour is every grey place's: agreeing with it says nothing.
+  if (!core_colour_) return false;
+  const cv::Vec3d from_grey = *core_colour_ - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
+  if (std::sqrt(from_grey.dot(from_grey)) < kMinCoreChroma) return false;
   const std::optional<double> distance = ColourDistanceAt(
       frame, cv::Point2d(hit.top_left) + hit.offset + HalfSize(search_template().size()));
   return distance && *distance <= kSameColourDistance;
