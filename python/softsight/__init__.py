@@ -85,7 +85,7 @@ def track(
     tqdm bar (a line on ``sys.stderr`` without tqdm), False or None for none (the default).
 
     Returns a Table (a dict of numpy arrays, one per CSV column, in order: ``frame`` int64,
-    ``<marker>_found`` bool, ``<marker>_status`` str, the rest float64 with NaN for an empty
+    ``<marker>_found`` bool, ``<marker>_status`` and ``<marker>_track`` str, the rest float64 with NaN for an empty
     field) holding the same values as the CLI's CSV; ``table.summary`` has the run's summary.
 
     Raises InputError with the CLI's message for a bad config, a missing or corrupt input or an

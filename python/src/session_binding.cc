@@ -188,6 +188,10 @@ not_started, stale (the CSV's <name>_status).)doc")
           [](const MarkerObservation& o) { return MarkerStatusName(o.observation.status()); },
           "Why the marker has (or has no) position.")
       .def_property_readonly(
+          "track", [](const MarkerObservation& o) { return TrackStateName(o.track); },
+          "Where the marker's track stands (the CSV's <name>_track): tentative (found, the first "
+          "report of its track), confirmed, coasting (not found, still predicted), or lost.")
+      .def_property_readonly(
           "candidates", [](const MarkerObservation& o) { return o.observation.candidates; },
           "With status 'ambiguous': how many candidates fitted about equally.")
       .def("__repr__", [](const MarkerObservation& o) {

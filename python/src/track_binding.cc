@@ -103,6 +103,7 @@ py::dict Columns(const RowSink& rows, const CsvColumnTable& table, const Trackin
   for (const MarkerSpec& spec : config.markers) {
     found.insert(spec.name + "_found");
     status.insert(spec.name + "_status");
+    status.insert(spec.name + "_track");
   }
   const size_t n = rows.rows();
   std::vector<std::pair<const char*, size_t>> fields;

@@ -41,6 +41,7 @@ def test_process_on_videocapture_frames_matches_the_cli_csv(bending_video, marke
             got[f"{m.name}_found"].append("1" if m.found else "0")
             got[f"{m.name}_score"].append(field(m.score))
             got[f"{m.name}_status"].append(m.status)
+            got[f"{m.name}_track"].append(m.track)
         for name in ("angle_deg", "chord_px", "sagitta_px", "radius_px", "arc_length_px",
                      "tip_disp_px", "chord_mm", "sagitta_mm", "radius_mm", "arc_length_mm",
                      "tip_disp_mm"):

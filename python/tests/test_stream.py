@@ -71,7 +71,7 @@ def test_one_marker_topic_has_only_its_columns(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     assert [list(r.keys()) for r in records] == [
         ["frame", "time_s", "green_x", "green_y", "green_sigma_px", "green_found", "green_score",
-         "green_status"]] * 5
+         "green_status", "green_track"]] * 5
 
 
 def test_to_dataframe_says_what_it_needs_without_pandas() -> None:

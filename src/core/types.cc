@@ -17,4 +17,14 @@ const char* MarkerStatusName(MarkerStatus status) {
   return "lost";
 }
 
+const char* TrackStateName(TrackState state) {
+  switch (state) {
+    case TrackState::kLost: return "lost";
+    case TrackState::kTentative: return "tentative";
+    case TrackState::kConfirmed: return "confirmed";
+    case TrackState::kCoasting: return "coasting";
+  }
+  return "lost";
+}
+
 }  // namespace softsight

@@ -66,6 +66,10 @@ CsvColumnTable TrackingColumns(const std::vector<std::string>& marker_names, boo
     table.add({name + "_status", [i](const FrameResult& r, std::string& row) {
                  row += MarkerStatusName(r.markers.at(i).observation.status());
                }});
+    // What the session believes of the marker over time (tentative, confirmed, coasting, lost).
+    table.add({name + "_track", [i](const FrameResult& r, std::string& row) {
+                 row += TrackStateName(r.markers.at(i).track);
+               }});
   }
   table.add(MeasurementColumn("angle_deg", &Measurement::angle_deg));
   table.add(MeasurementColumn("chord_px", &Measurement::chord_px));

@@ -30,11 +30,15 @@ std::vector<std::string> SplitFields(const std::string& line) {
   return fields;
 }
 
-// A marker's status column holds words ("found", "lost"): no number to read.
+// A marker's status and track columns hold words ("found", "confirmed"): no number to read.
 bool IsTextColumn(const std::string& column) {
-  const std::string suffix = "_status";
-  return column.size() >= suffix.size() &&
-         column.compare(column.size() - suffix.size(), suffix.size(), suffix) == 0;
+  for (const std::string suffix : {"_status", "_track"}) {
+    if (column.size() >= suffix.size() &&
+        column.compare(column.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ FrameResult TwoMarkers(bool second_found) {
   FrameResult result;
   result.frame_index = 7;
   result.time_s = 0.25;
-  result.markers.push_back({"red", {cv::Point2d(10.5, 20.25), 0.97, 0.125}});
+  result.markers.push_back({"red", {cv::Point2d(10.5, 20.25), 0.97, 0.125}, TrackState::kConfirmed});
   result.markers.push_back(
       {"blue", second_found ? Observation{cv::Point2d(1, 2), 0.5} : Observation{}});
   result.measurement.angle_deg = 135.0;
@@ -39,8 +39,8 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
   TempDir dir;
   { CsvWriter csv(dir.file("a.csv"), {"red", "blue"}, /*metric=*/false); }
   EXPECT_EQ(testing::ReadLines(dir.file("a.csv")).at(0),
-            "frame,time_s,red_x,red_y,red_sigma_px,red_found,red_score,red_status,blue_x,blue_y,"
-            "blue_sigma_px,blue_found,blue_score,blue_status,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,"
+            "frame,time_s,red_x,red_y,red_sigma_px,red_found,red_score,red_status,red_track,blue_x,"
+            "blue_y,blue_sigma_px,blue_found,blue_score,blue_status,blue_track,angle_deg,chord_px,sagitta_px,radius_px,arc_length_px,"
             "tip_disp_px,latency_result_ms,latency_row_ms,proc_ms");
   {
     CsvWriter csv(dir.file("b.csv"),
@@ -50,7 +50,8 @@ TEST(CsvWriter, HeaderFollowsTheDocumentedContract) {
                                   })}));
   }
   EXPECT_EQ(testing::ReadLines(dir.file("b.csv")).at(0),
-            "frame,time_s,red_x,red_y,red_sigma_px,red_found,red_score,red_status,angle_deg,chord_px,"
+            "frame,time_s,red_x,red_y,red_sigma_px,red_found,red_score,red_status,red_track,angle_deg,"
+            "chord_px,"
             "sagitta_px,"
             "radius_px,arc_length_px,tip_disp_px,chord_mm,sagitta_mm,radius_mm,arc_length_mm,"
             "tip_disp_mm,target_deg,latency_result_ms,latency_row_ms,proc_ms");
@@ -65,7 +66,7 @@ TEST(CsvWriter, MissingValuesAreEmptyFieldsAndRowsAreFlushedImmediately) {
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_THAT(testing::SplitCsv(lines[1]),
               ElementsAre("7", "0.250000", "10.5000", "20.2500", "0.1250", "1", "0.9700", "found",
-                          "", "", "", "0", "", "lost", "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
+                          "confirmed", "", "", "", "0", "", "lost", "lost", "135.0000", "100.0000", "", "", "", "", "20.0000", "", "", "", "",
                           "", "", "0.1250"));  // No capture time: no latency.
 }
 

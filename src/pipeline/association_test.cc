@@ -200,6 +200,34 @@ TEST(MarkerTracks, AJumpNoMotionExplainsIsNotBelievedButAMarkerBackWithinItsReac
   EXPECT_EQ(tracks.associate(back, {&none})[0].action, MarkerTracks::Decision::Action::kKeep);
 }
 
+// One state per marker: tentative on its track's first report, confirmed from the second,
+// coasting while unseen (a skipped frame too) for up to kCoastFrames, then lost; forgotten (a
+// seek, a re-selection) it is lost at once.
+TEST(MarkerTracks, EachMarkerHasOneTrackStateThatFollowsItsReports) {
+  MarkerTracks tracks({6.0});
+  const std::vector<MarkerCandidate> none;
+  const auto frame = [&](std::optional<cv::Point2d> at) {
+    std::vector<MarkerObservation> m = Reports({at});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+    return tracks.state(0);
+  };
+  EXPECT_EQ(tracks.state(0), TrackState::kLost);  // Never seen.
+  EXPECT_EQ(frame(cv::Point2d(100, 100)), TrackState::kTentative);
+  EXPECT_EQ(frame(cv::Point2d(104, 100)), TrackState::kConfirmed);
+  EXPECT_EQ(frame(cv::Point2d(108, 100)), TrackState::kConfirmed);
+  tracks.skip();  // A frame nothing was believed in (it changed as a whole).
+  EXPECT_EQ(tracks.state(0), TrackState::kCoasting);
+  EXPECT_EQ(frame(cv::Point2d(116, 100)), TrackState::kConfirmed);  // Where its motion took it.
+  for (int f = 1; f <= kCoastFrames; ++f) {
+    ASSERT_EQ(frame(std::nullopt), TrackState::kCoasting) << f << " frames unseen";
+  }
+  EXPECT_EQ(frame(std::nullopt), TrackState::kLost);
+  EXPECT_EQ(TrackStateName(TrackState::kCoasting), std::string("coasting"));
+  tracks.forget(0);
+  EXPECT_EQ(tracks.state(0), TrackState::kLost);
+}
+
 TEST(MarkerTracks, ARepeatedFrameIsBelievedAndTheStepAfterItIsExpected) {
   MarkerTracks tracks({4.0});
   const std::vector<MarkerCandidate> none;

@@ -144,6 +144,7 @@ bool MarkerTracks::BodyVouches(size_t i, const cv::Point2d& p) const {
 }
 
 void MarkerTracks::skip() {
+  skipped_ = true;
   predict_all();
   for (Track& t : tracks_) t.predicted = false;
 }
@@ -518,8 +519,19 @@ bool MarkerTracks::ExtendsARejectedRun(size_t i, const cv::Point2d& p) {
   return true;
 }
 
+TrackState MarkerTracks::state(size_t i) const {
+  const Track& t = tracks_.at(i);
+  if (!t.motion.started()) return TrackState::kLost;
+  if (t.misses == 0 && !skipped_) {
+    return t.motion.updates() == 0 ? TrackState::kTentative : TrackState::kConfirmed;
+  }
+  // A skipped frame (nothing believed in it) counts as a miss.
+  return t.misses + (skipped_ ? 1 : 0) <= kCoastFrames ? TrackState::kCoasting : TrackState::kLost;
+}
+
 void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
   CV_Assert(markers.size() == tracks_.size());
+  skipped_ = false;
   // The body remembers this frame's arrangement; a marker that continued its track teaches how
   // far it moves against its body in a frame.
   for (size_t i = 0; i < markers.size(); ++i) {

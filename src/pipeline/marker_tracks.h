@@ -93,6 +93,9 @@ class MarkerTracks {
   // Marker i starts afresh (re-selected, re-specified, or the video jumped): no motion.
   void forget(size_t i);
 
+  // Where marker i's track stands after this frame's commit() (or skip()).
+  TrackState state(size_t i) const;
+
   // Whether this frame's report of marker i restarts its track (a run of its tracker's own
   // reports the gate had rejected): its motion before is no evidence against it.
   bool restarting(size_t i) const { return tracks_.at(i).restart; }
@@ -161,6 +164,7 @@ class MarkerTracks {
 
   std::vector<double> size_px_;
   std::vector<Track> tracks_;
+  bool skipped_ = false;  // The last frame was skip()ped, not commit()ted.
   BodyConstellation body_;
   std::vector<std::optional<cv::Point2d>> anchor_px_, believed_px_;
   std::vector<std::optional<BodyConstellation::Prediction>> body_prediction_, learn_from_;

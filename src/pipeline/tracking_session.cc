@@ -196,6 +196,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
 }
 
 const FrameResult& TrackingSession::finish(const Frame& frame, int64_t start_ticks) {
+  for (size_t i = 0; i < result_.markers.size(); ++i) result_.markers[i].track = tracks_->state(i);
   measure(frame);
   result_.proc_ms = 1000.0 * static_cast<double>(cv::getTickCount() - start_ticks) /
                     cv::getTickFrequency();
@@ -290,6 +291,8 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
       believed_px_[i] = previous_px_[i];
       believed_frame_[i] = frame.index;
     }
+    // A new track: it starts on this report at the next frame's association.
+    result_.markers[i].track = previous_px_[i] ? TrackState::kTentative : TrackState::kLost;
     measure(frame);
     edited(ConfigChange::Reselect(marker, rect));
     return result_;
@@ -311,6 +314,7 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
       result_.markers[i].observation = trackers_[i]->update(frame.image);
     }
     previous_px_[i] = result_.markers[i].observation.position_px;
+    result_.markers[i].track = previous_px_[i] ? TrackState::kTentative : TrackState::kLost;
     measure(frame);
     edited(ConfigChange::Retrack(marker));
     return result_;

@@ -39,7 +39,7 @@ bool IsJsonNumber(std::string_view s) {
 
 std::vector<TopicColumns> StreamTopics(const CsvColumnTable& table,
                                        const std::vector<std::string>& marker_names) {
-  return StreamTopics(table.names(), marker_names, {"_x", "_y", "_sigma_px", "_found", "_score", "_status"});
+  return StreamTopics(table.names(), marker_names, {"_x", "_y", "_sigma_px", "_found", "_score", "_status", "_track"});
 }
 
 std::vector<TopicColumns> StreamTopics(const std::vector<std::string>& names,

@@ -36,7 +36,8 @@ struct TopicColumns {
 };
 
 // The topics of a run: frame, measure, then marker/<name> per marker (in `marker_names` order).
-// A marker's columns are the table's "<name>_x", "_y", "_sigma_px", "_found", "_score", "_status".
+// A marker's columns are the table's "<name>_x", "_y", "_sigma_px", "_found", "_score", "_status",
+// "_track".
 std::vector<TopicColumns> StreamTopics(const CsvColumnTable& table,
                                        const std::vector<std::string>& marker_names);
 // The same for any table's column names, a marker's columns being "<name><suffix>" for each of

@@ -50,7 +50,7 @@ TEST(StreamFormat, TopicsSplitTheColumnsByMarkerAndMeasurement) {
   EXPECT_EQ(topics[3].topic, "marker/tip");
   EXPECT_EQ(names(topics[3]),
             (std::vector<std::string>{"frame", "time_s", "tip_x", "tip_y", "tip_sigma_px",
-                                      "tip_found", "tip_score", "tip_status"}));
+                                      "tip_found", "tip_score", "tip_status", "tip_track"}));
 }
 
 TEST(StreamFormat, ARecordIsTheTopicAndAJsonObjectOfTheRowsFields) {

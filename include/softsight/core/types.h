@@ -84,10 +84,28 @@ struct Observation {
   }
 };
 
+// Where a marker's track stands after a frame: the per-marker `<name>_track` CSV column. One
+// state per marker, kept by the session's association (its motion model: position, velocity and
+// their covariance); the status says what this frame's report was, the track what the session
+// believes of the marker over time.
+enum class TrackState : uint8_t {
+  kLost,       // No track: never found yet, forgotten (a seek, a re-selection), or unseen too long.
+  kTentative,  // Found in this frame, the first report of its track: its velocity is unknown.
+  kConfirmed,  // Found in this frame, continuing a track of two reports or more.
+  kCoasting,   // Not found in this frame, but still predicted: a re-acquisition must lie where a
+               // plausible motion since it was last found puts it (for up to kCoastFrames).
+};
+// Frames a track coasts unseen before it is lost (a second at 30 fps).
+inline constexpr int kCoastFrames = 30;
+
+// "lost", "tentative", "confirmed", "coasting".
+const char* TrackStateName(TrackState state);
+
 // A named observation, as the pipeline hands it to measurement and sinks.
 struct MarkerObservation {
   std::string name;
   Observation observation;
+  TrackState track = TrackState::kLost;  // Set by the session after the frame's association.
 };
 
 // One frame's measurements. Absent where undefined (a marker missing, a straight actuator has
