@@ -130,8 +130,8 @@ void CheckHello(const ListenOptions& options, const Json& hello) {
   for (const char* key : {"source", "config", "config_digest"}) {
     const auto it = hello.find(key);
     if (it != hello.end() && !it->is_string()) {
-      throw InputError("listen " + options.endpoint + ": the publisher's hello has a " + key +
-                       " that is not text (" + it->dump().substr(0, 40) + ")");
+      throw InputError("listen " + options.endpoint + ": the publisher's hello has " +
+                       WithArticle(key) + " that is not text (" + it->dump().substr(0, 40) + ")");
     }
   }
   const auto columns = hello.find("columns");
