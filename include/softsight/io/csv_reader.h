@@ -11,9 +11,9 @@ namespace softsight {
 
 // A CSV read into columns of optional numbers (an empty field, "nan" or "inf" is absent).
 struct CsvTable {
-  std::string source;                                      // File name, for messages and the title.
-  std::vector<std::string> columns;                        // Header names, in file order.
-  std::vector<std::vector<std::optional<double>>> values;  // values[column][row].
+  std::string source{};                                      // File name, for messages, title.
+  std::vector<std::string> columns{};                        // Header names, in file order.
+  std::vector<std::vector<std::optional<double>>> values{};  // values[column][row].
 
   size_t row_count() const { return values.empty() ? 0 : values.front().size(); }
   std::optional<size_t> find(const std::string& column) const;
