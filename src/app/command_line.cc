@@ -13,6 +13,7 @@
 
 #include "app/cli_checks.h"
 #include "app/command_table.h"
+#include "app/help_format.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
@@ -24,6 +25,8 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
   // writer reports after cutting the file back to its last complete row, not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{kProgramDescription};
+  app.name("softsight");  // Not argv[0], the path it was started by: "Usage: softsight track".
+  app.formatter(TerminalHelpFormatter());  // Before the commands: they take the app's.
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("softsight ") + kVersion);
   std::map<const CLI::App*, CommandRunner> runners;

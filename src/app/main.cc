@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/command_table.h"
+#include "app/help_format.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
@@ -69,6 +70,8 @@ int RunPlugin(const CommandInfo& command, int argc, char** argv) {
 // No command given: --help and --version, or the usage error, from the table alone.
 int RunWithoutCommand(int argc, char** argv) {
   CLI::App app{kProgramDescription};
+  app.name("softsight");  // Not argv[0], the path it was started by: "Usage: softsight track".
+  app.formatter(TerminalHelpFormatter());  // Before the commands: they take the app's.
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("softsight ") + kVersion);
   for (const CommandInfo& command : kCommandTable) app.add_subcommand(command.name, command.summary);
