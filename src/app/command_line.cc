@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "app/cli_checks.h"
 #include "app/command_table.h"
 #include "app/help_format.h"
+#include "app/unknown_word.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
@@ -42,6 +44,12 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
+    // A mistyped option first: CLI11 reports a required option the typo left out before the
+    // word it did not know ("--config is required" for --confg).
+    if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
+      std::cerr << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
+      return kInputErrorExitCode;
+    }
     // One line like every other error, naming the command it was for.
     const std::vector<CLI::App*> parsed = app.get_subcommands();
     const std::string command =

@@ -1,5 +1,6 @@
-// The command line's own rough edges (issue 47): help wrapped to the terminal. In process,
-// against the commands' real options, each case takes microseconds.
+// The command line's own rough edges (issue 47): a mistyped word named with the nearest one, help
+// wrapped to the terminal. In process, against the commands' real options:
+// parsing fails before a command runs, so each case takes microseconds.
 #include <unistd.h>
 
 #include <cstdlib>
@@ -14,11 +15,14 @@
 #include "app/command_table.h"
 #include "app/commands.h"
 #include "app/help_format.h"
+#include "app/program_test_util.h"
+#include "app/unknown_word.h"
 #include "core/test_util.h"
 
 namespace softsight {
 namespace {
 
+using ::testing::HasSubstr;
 using testing::TempDir;
 
 // Every command of the commands plugin (plugin_commands.cc; `live` is the live plugin's own).
@@ -34,6 +38,74 @@ const std::vector<CommandSetup>& PluginCommands() {
       {"track-stereo", SetupTrackStereoCommand},
   };
   return commands;
+}
+
+struct ParsedLine {
+  int exit_code;
+  std::string stderr_text;
+};
+
+// RunCommandLine on `words` (after the program's name), its stderr captured.
+ParsedLine RunWords(std::vector<std::string> words) {
+  words.insert(words.begin(), "softsight");
+  std::vector<char*> argv;
+  for (std::string& word : words) argv.push_back(word.data());
+  ::testing::internal::CaptureStderr();
+  const int exit_code =
+      RunCommandLine(static_cast<int>(argv.size()), argv.data(), PluginCommands());
+  return {exit_code, ::testing::internal::GetCapturedStderr()};
+}
+
+TEST(EditDistance, CountsInsertionsDeletionsSubstitutionsAndSwaps) {
+  EXPECT_EQ(EditDistance("track", "track"), 0u);
+  EXPECT_EQ(EditDistance("trak", "track"), 1u);
+  EXPECT_EQ(EditDistance("trakc", "track"), 1u) << "two neighbours swapped are one edit";
+  EXPECT_EQ(EditDistance("kitten", "sitting"), 3u);
+  EXPECT_EQ(EditDistance("", "abc"), 3u);
+}
+
+TEST(NearestWord, OffersOnlyWhatIsCloseForItsLength) {
+  const std::vector<std::string> commands = {"track", "track-stereo", "plot", "listen", "live"};
+  EXPECT_EQ(NearestWord("trak", commands), "track");
+  EXPECT_EQ(NearestWord("trak-sterio", commands), "track-stereo");
+  EXPECT_EQ(NearestWord("PLOT", commands), "plot") << "case is no edit";
+  EXPECT_EQ(NearestWord("lsten", commands), "listen");
+  EXPECT_EQ(NearestWord("xyz", commands), std::nullopt);
+  EXPECT_EQ(NearestWord("pl", commands), std::nullopt) << "2 edits are too many for 2 letters";
+  const std::vector<std::string> options = {"--config", "--camera", "--input", "--output"};
+  EXPECT_EQ(NearestWord("--inptu", options), "--input");
+  EXPECT_EQ(NearestWord("--conf", options), "--config") << "the only option it begins";
+  EXPECT_EQ(NearestWord("--ca", options), std::nullopt);
+}
+
+TEST(CommandLine, AMistypedOptionIsNamedWithTheNearestOneBeforeWhatItLeftOut) {
+  // --confg left --config out: CLI11 said only "--config is required".
+  ParsedLine parsed = RunWords({"track", "--confg", "m.yaml", "-i", "run.avi", "-o", "run.csv"});
+  EXPECT_EQ(parsed.exit_code, 2);
+  EXPECT_EQ(parsed.stderr_text,
+            "softsight track: error: unknown option \"--confg\"; did you mean \"--config\"?\n");
+  parsed = RunWords({"track", "-c", "m.yaml", "--inptu=run.avi", "-o", "run.csv"});
+  EXPECT_EQ(parsed.stderr_text,
+            "softsight track: error: unknown option \"--inptu\"; did you mean \"--input\"?\n");
+  parsed = RunWords({"plot", "run.csv", "--xyz"});
+  EXPECT_EQ(parsed.stderr_text,
+            "softsight plot: error: unknown option \"--xyz\" (see softsight plot --help)\n");
+  parsed = RunWords({"plot", "run.csv", "-O", "run.png"});
+  EXPECT_EQ(parsed.stderr_text,
+            "softsight plot: error: unknown option \"-O\"; did you mean \"-o\"?\n");
+  parsed = RunWords({"config", "stray"});
+  EXPECT_EQ(parsed.stderr_text, "softsight config: error: unexpected argument \"stray\" (see "
+                                "softsight config --help)\n");
+}
+
+// Every command's options, not only track's: a typo of each one's -o.
+TEST(CommandLine, EveryCommandNamesItsMistypedOptions) {
+  for (const CommandSetup& command : PluginCommands()) {
+    const ParsedLine parsed = RunWords({command.name, "--outptu", "x"});
+    EXPECT_EQ(parsed.exit_code, 2) << command.name;
+    EXPECT_THAT(parsed.stderr_text, HasSubstr(std::string("softsight ") + command.name +
+                                              ": error: unknown option \"--outptu\""));
+  }
 }
 
 TEST(HelpFormat, WidthIsColumnsElseTheTerminalElse80) {
@@ -89,6 +161,23 @@ TEST(HelpFormat, EveryCommandsHelpFitsTheWidth) {
       EXPECT_GT(lines, 3u) << command.name;
     }
   }
+}
+
+// The launcher alone (no plugin loaded: milliseconds): a command that does not exist.
+TEST(Launcher, AnUnknownCommandIsNamedWithTheNearestOne) {
+  TempDir dir;
+  testing::ProgramRun run = testing::RunProgram("trak -c m.yaml", dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.stderr_text,
+            "softsight: error: unknown command \"trak\"; did you mean \"track\"?\n");
+  run = testing::RunProgram("--hlep", dir);
+  EXPECT_EQ(run.stderr_text,
+            "softsight: error: unknown option \"--hlep\"; did you mean \"--help\"?\n");
+  run = testing::RunProgram("frobnicate", dir);
+  EXPECT_EQ(run.stderr_text,
+            "softsight: error: unknown command \"frobnicate\" (see softsight --help)\n");
+  EXPECT_EQ(testing::RunProgram("", dir).stderr_text,
+            "softsight: error: A subcommand is required (see softsight --help)\n");
 }
 
 // The launcher's own help, wrapped to COLUMNS.
