@@ -1,9 +1,10 @@
-// The command line's own rough edges (issue 47): a mistyped word named with the nearest one, help
-// wrapped to the terminal. In process, against the commands' real options:
+// The command line's own rough edges (issue 47): a mistyped word named with the nearest one, one
+// meaning for -o, help wrapped to the terminal. In process, against the commands' real options:
 // parsing fails before a command runs, so each case takes microseconds.
 #include <unistd.h>
 
 #include <cstdlib>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -105,6 +106,37 @@ TEST(CommandLine, EveryCommandNamesItsMistypedOptions) {
     EXPECT_EQ(parsed.exit_code, 2) << command.name;
     EXPECT_THAT(parsed.stderr_text, HasSubstr(std::string("softsight ") + command.name +
                                               ": error: unknown option \"--outptu\""));
+  }
+}
+
+// -o meant --csv, --out or --output depending on the command: now --output (the command's main
+// output) everywhere it exists, the old long names kept.
+TEST(CommandLine, DashOIsEveryCommandsMainOutputUnderItsOldNamesToo) {
+  const std::map<std::string, std::vector<std::string>> expected = {
+      {"track", {"output", "csv"}},       {"track-stereo", {"output", "csv"}},
+      {"control", {"output", "csv"}},     {"listen", {"output", "csv"}},
+      {"evaluate", {"output", "csv"}},    {"init", {"output", "out"}},
+      {"pick", {"output", "out"}},        {"synth", {"output", "out"}},
+      {"plot", {"output", "out"}},        {"calibrate", {"output", "out"}},
+      {"demo", {"output", "out-dir"}},    {"identify", {"output"}},
+      {"rig", {}},                        {"config", {}},
+      {"cameras", {}},
+  };
+  for (const CommandSetup& command : PluginCommands()) {
+    CLI::App app;
+    CLI::App* sub = app.add_subcommand(command.name);
+    command.setup(*sub);
+    const std::vector<std::string>& names = expected.at(command.name);
+    CLI::Option* output = nullptr;
+    for (CLI::Option* option : sub->get_options()) {
+      if (option->check_sname("o")) output = option;
+    }
+    if (names.empty()) {
+      EXPECT_EQ(output, nullptr) << command.name << " has no main output file";
+      continue;
+    }
+    ASSERT_NE(output, nullptr) << command.name;
+    EXPECT_EQ(output->get_lnames(), names) << command.name;
   }
 }
 

@@ -298,7 +298,8 @@ CommandRunner SetupListenCommand(CLI::App& sub) {
                  "Which records: frame (every column), measure (the measurements), marker/NAME "
                  "(one marker's columns)")
       ->capture_default_str();
-  sub.add_option("-o,--csv", o->csv_file, "Write the records to this CSV instead of printing them");
+  sub.add_option("-o,--output,--csv", o->csv_file,
+                 "Write the records to this CSV instead of printing them");
   sub.add_flag("--json", o->json, "Print each record's JSON as it came, one per line");
   sub.add_option("--count", o->count, "Stop after this many records")->check(NumberIn(1, 1e15));
   sub.add_option("--timeout-s", o->timeout_s,
