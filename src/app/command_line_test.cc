@@ -1,6 +1,7 @@
 // The command line's own rough edges (issue 47): a mistyped word named with the nearest one, one
 // meaning for -o, help wrapped to the terminal. In process, against the commands' real options:
-// parsing fails before a command runs, so each case takes microseconds.
+// parsing fails before a command runs, so each case takes microseconds. One test suite: ctest
+// starts the test program once per suite (or 8 tests), ~0.9 s each, more than all of these take.
 #include <unistd.h>
 
 #include <cstdlib>
@@ -57,7 +58,7 @@ ParsedLine RunWords(std::vector<std::string> words) {
   return {exit_code, ::testing::internal::GetCapturedStderr()};
 }
 
-TEST(EditDistance, CountsInsertionsDeletionsSubstitutionsAndSwaps) {
+TEST(CommandLine, EditDistanceCountsInsertionsDeletionsSubstitutionsAndSwaps) {
   EXPECT_EQ(EditDistance("track", "track"), 0u);
   EXPECT_EQ(EditDistance("trak", "track"), 1u);
   EXPECT_EQ(EditDistance("trakc", "track"), 1u) << "two neighbours swapped are one edit";
@@ -65,7 +66,7 @@ TEST(EditDistance, CountsInsertionsDeletionsSubstitutionsAndSwaps) {
   EXPECT_EQ(EditDistance("", "abc"), 3u);
 }
 
-TEST(NearestWord, OffersOnlyWhatIsCloseForItsLength) {
+TEST(CommandLine, NearestWordIsOnlyWhatIsCloseForItsLength) {
   const std::vector<std::string> commands = {"track", "track-stereo", "plot", "listen", "live"};
   EXPECT_EQ(NearestWord("trak", commands), "track");
   EXPECT_EQ(NearestWord("trak-sterio", commands), "track-stereo");
@@ -140,7 +141,7 @@ TEST(CommandLine, DashOIsEveryCommandsMainOutputUnderItsOldNamesToo) {
   }
 }
 
-TEST(HelpFormat, WidthIsColumnsElseTheTerminalElse80) {
+TEST(CommandLine, HelpWidthIsColumnsElseTheTerminalElse80) {
   const char* before = std::getenv("COLUMNS");
   const std::string saved = before != nullptr ? before : "";
   setenv("COLUMNS", "100", 1);
@@ -154,7 +155,7 @@ TEST(HelpFormat, WidthIsColumnsElseTheTerminalElse80) {
   if (before != nullptr) setenv("COLUMNS", saved.c_str(), 1);
 }
 
-TEST(HelpFormat, TextWrapsAtSpacesAndKeepsItsIndents) {
+TEST(CommandLine, HelpTextWrapsAtSpacesAndKeepsItsIndents) {
   EXPECT_EQ(WrapText("one two three four", 9, 0), "one two\nthree\nfour");
   // From column 4 on (the caller wrote the first 4): continuations indented to it.
   EXPECT_EQ(WrapText("aaa bbb ccc", 11, 4), "aaa bbb\n    ccc");
@@ -171,7 +172,7 @@ TEST(HelpFormat, TextWrapsAtSpacesAndKeepsItsIndents) {
 
 // Every command's --help at 80 columns: the descriptions (up to 388 characters on one line
 // before) stay within the width, in their column.
-TEST(HelpFormat, EveryCommandsHelpFitsTheWidth) {
+TEST(CommandLine, EveryCommandsHelpFitsTheWidth) {
   for (const size_t width : {size_t{80}, size_t{60}}) {
     for (const CommandSetup& command : PluginCommands()) {
       CLI::App app{kProgramDescription};
@@ -196,7 +197,7 @@ TEST(HelpFormat, EveryCommandsHelpFitsTheWidth) {
 }
 
 // The launcher alone (no plugin loaded: milliseconds): a command that does not exist.
-TEST(Launcher, AnUnknownCommandIsNamedWithTheNearestOne) {
+TEST(CommandLine, TheLauncherNamesAnUnknownCommandWithTheNearestOne) {
   TempDir dir;
   testing::ProgramRun run = testing::RunProgram("trak -c m.yaml", dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -213,7 +214,7 @@ TEST(Launcher, AnUnknownCommandIsNamedWithTheNearestOne) {
 }
 
 // The launcher's own help, wrapped to COLUMNS.
-TEST(Launcher, HelpIsWrappedToColumns) {
+TEST(CommandLine, TheLaunchersHelpIsWrappedToColumns) {
   TempDir dir;
   const std::string command = "COLUMNS=50 " + testing::SoftsightBinary() + " --help > " +
                               dir.file("help.txt");
