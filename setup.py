@@ -13,6 +13,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Optional, TextIO
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
@@ -36,9 +37,26 @@ def cmake_build_dir() -> Path:
     return Path(given).resolve() if given else ROOT / "build" / "pip"
 
 
-def run(command: list[str]) -> None:
-    print("setup.py:", " ".join(command), flush=True)
-    subprocess.run(command, check=True)
+def build_output() -> Optional[TextIO]:
+    """Where CMake's own output goes while pip builds: the terminal, when there is one.
+
+    pip captures a build backend's output and shows none of it without -v: a first build printed
+    only "still running..." for 2-3 minutes. So the configure and build steps write to the
+    controlling terminal (/dev/tty), and their progress shows as in a plain CMake build. Without
+    a terminal (CI, a service, cron) they write to the backend's output as before, which pip shows
+    with -v or when the build fails. SOFTSIGHT_BUILD_QUIET=1 keeps the terminal quiet.
+    """
+    if os.environ.get("SOFTSIGHT_BUILD_QUIET", "") not in ("", "0"):
+        return None
+    try:
+        return open("/dev/tty", "w")  # Closed by build_extension when the build is done.
+    except OSError:  # No controlling terminal.
+        return None
+
+
+def run(command: list[str], output: Optional[TextIO]) -> None:
+    print("setup.py:", " ".join(command), file=output or sys.stdout, flush=True)
+    subprocess.run(command, check=True, stdout=output, stderr=output)
 
 
 class CMakeBuildExt(build_ext):
@@ -46,13 +64,20 @@ class CMakeBuildExt(build_ext):
 
     def build_extension(self, ext: Extension) -> None:
         build = cmake_build_dir()
+        output = build_output()
+        if output:
+            # A line of its own: pip's "Building wheel ... -" spinner has the cursor.
+            print("\nsetup.py: building the C++ extension with CMake (a first build takes a few "
+                  "minutes); its progress follows", file=output, flush=True)
         if not (build / "CMakeCache.txt").exists():
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []
             run(["cmake", "-S", str(ROOT), "-B", str(build), *generator, "-DCMAKE_BUILD_TYPE=Release",
                  "-DSOFTSIGHT_BUILD_TESTS=OFF", "-DSOFTSIGHT_BUILD_BENCHMARKS=OFF",
-                 "-DSOFTSIGHT_BUILD_PYTHON=ON", f"-DPython3_EXECUTABLE={sys.executable}"])
+                 "-DSOFTSIGHT_BUILD_PYTHON=ON", f"-DPython3_EXECUTABLE={sys.executable}"], output)
         run(["cmake", "--build", str(build), "--target", "softsight_python",
-             "--parallel", str(os.cpu_count() or 1)])
+             "--parallel", str(os.cpu_count() or 1)], output)
+        if output:
+            output.close()
         package = build / "python" / "softsight"
         built = sorted(package.glob("_core*.so"))
         if len(built) != 1:
@@ -76,20 +101,22 @@ class PackageFiles(build_py):
 # setuptools' own scratch (its build/ and egg-info) goes inside the CMake build tree, not beside
 # the sources, where ./build is CMake's.
 SCRATCH = cmake_build_dir() / "setuptools"
-SCRATCH.mkdir(parents=True, exist_ok=True)
 
-setup(
-    name="softsight",
-    version=project_version(),
-    description="Measure soft robots with a camera",
-    license="Apache-2.0",
-    python_requires=">=3.8",
-    install_requires=["numpy"],
-    extras_require={"batch": ["dask[distributed]"], "pandas": ["pandas"]},
-    packages=["softsight"],
-    package_dir={"softsight": "python/softsight"},
-    ext_modules=[Extension("softsight._core", sources=[])],
-    cmdclass={"build_ext": CMakeBuildExt, "build_py": PackageFiles},
-    zip_safe=False,
-    options={"build": {"build_base": str(SCRATCH)}, "egg_info": {"egg_base": str(SCRATCH)}},
-)
+# pip (setuptools.build_meta) runs this file as __main__; a test reads build_output from it.
+if __name__ == "__main__":
+    SCRATCH.mkdir(parents=True, exist_ok=True)
+    setup(
+        name="softsight",
+        version=project_version(),
+        description="Measure soft robots with a camera",
+        license="Apache-2.0",
+        python_requires=">=3.8",
+        install_requires=["numpy"],
+        extras_require={"batch": ["dask[distributed]"], "pandas": ["pandas"]},
+        packages=["softsight"],
+        package_dir={"softsight": "python/softsight"},
+        ext_modules=[Extension("softsight._core", sources=[])],
+        cmdclass={"build_ext": CMakeBuildExt, "build_py": PackageFiles},
+        zip_safe=False,
+        options={"build": {"build_base": str(SCRATCH)}, "egg_info": {"egg_base": str(SCRATCH)}},
+    )

@@ -43,8 +43,12 @@ case $mode in
     pc_dir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")
     [ -n "$pc_dir" ] || fail "no softsight.pc under $prefix"
     flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs softsight)
+    # With the warnings CI builds softsight with: here (-I, unlike an imported CMake target's
+    # -isystem) the installed headers must not warn in a user's build either, e.g. designated
+    # initializers under -Wextra. OpenCV 4.6's own headers mix enums, which C++20 deprecates.
     # shellcheck disable=SC2086  # the flags are words
-    c++ -std=c++20 -O1 "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags
+    c++ -std=c++20 -O1 -Wall -Wextra -Werror -Wno-deprecated-enum-enum-conversion \
+        "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags
     "$out/track_rendered" "$config" 30
     ;;
   pip)

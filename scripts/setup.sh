@@ -22,6 +22,7 @@ PACKAGES=(
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` (setup.py) and its check in a fresh virtual environment
   mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
   python3-zmq            # softsight.stream.subscribe (the stream's Python end) and its test
+  python3-pandas         # Table.to_pandas(), track_many's summary and stream.to_dataframe, as docs/python.md uses them
 )
 
 missing=()

@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   }
   try {
     const softsight::TrackingConfig config = softsight::LoadTrackingConfig(argv[1]);
-    softsight::SyntheticScene scene(softsight::SceneOptions{});
+    // Designated initializers name only what they set: the rest keep their defaults (and
+    // -Wextra has nothing to say about them).
+    softsight::SyntheticScene scene(softsight::SceneOptions{.kind = softsight::SceneKind::kBending});
     const int frames = argc > 2 ? std::atoi(argv[2]) : 30;
     softsight::TrackingSession session(config);
     softsight::Frame frame;

@@ -7,6 +7,7 @@
 
 #include "bindings.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/sinks.h"
 
@@ -110,7 +111,7 @@ YAML::Node ToYaml(const py::handle& value, const std::string& file, const std::s
   if (py::hasattr(value, "dtype") && py::hasattr(value, "item")) {
     return ToYaml(value.attr("item")(), file, path, depth + 1);
   }
-  throw error("a " + Describe(value) +
+  throw error(WithArticle(Describe(value)) +
               " cannot be a config value (use numbers, strings, lists, dicts)");
 }
 
@@ -134,8 +135,8 @@ PyConfig LoadPyConfig(const py::handle& source, const std::optional<std::string>
     out.origin = py::module_::import("copy").attr("deepcopy")(source);
     return out;
   }
-  throw py::type_error("config: expected a path, a dict or a softsight.Config, got a " +
-                       Describe(source));
+  throw py::type_error("config: expected a path, a dict or a softsight.Config, got " +
+                       WithArticle(Describe(source)));
 }
 
 TrackingConfig ResolveConfig(const py::handle& source, const std::optional<std::string>& method) {
@@ -146,8 +147,9 @@ TrackingConfig ResolveConfig(const py::handle& source, const std::optional<std::
 cv::Mat ImageHeader(const py::array& array, const std::string& what, py::object* keep_alive) {
   const py::dtype dtype = array.dtype();
   if (dtype.kind() != 'u' || dtype.itemsize() != 1) {
-    throw InputError(what + ": a " + std::string(py::str(dtype.attr("name"))) +
-                     " array; softsight needs uint8 pixels (an HxWx3 BGR or HxW gray array, as "
+    const std::string dtype_name = py::str(dtype.attr("name"));
+    throw InputError(what + ": " + WithArticle(dtype_name + " array") +
+                     "; softsight needs uint8 pixels (an HxWx3 BGR or HxW gray array, as "
                      "cv2.VideoCapture.read() gives)");
   }
   const bool colour = array.ndim() == 3 && array.shape(2) == 3;

@@ -177,7 +177,7 @@ py::dict SummaryDict(const RunSummary& s) {
   out["latency_row_ms_median"] = optional(s.latency_row_ms_median);
   out["latency_row_ms_p99"] = optional(s.latency_row_ms_p99);
   out["wall_s"] = s.wall_s;
-  out["stop_reason"] = StopReasonName(s.stop_reason);
+  out["stop_reason"] = s.stop_text();  // The report's words, as the stream's end record has them.
   out["error"] = s.ok() ? py::object(py::none()) : py::object(py::str(s.error));
   out["report"] = s.FullReport();
   return out;

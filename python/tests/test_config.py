@@ -85,11 +85,16 @@ def test_a_dict_config_is_the_same_config_as_its_file(markers_yaml, tmp_path):
 
 
 def test_values_of_the_wrong_type_in_a_dict():
-    with pytest.raises(softsight.InputError, match=r"^<dict>: markers\[0\]\.hsv: a object cannot be"):
+    # The type's name with its article as it is said ("a ellipsis" was the issue's).
+    with pytest.raises(softsight.InputError, match=r"^<dict>: markers\[0\]\.hsv: an object cannot be"):
         softsight.load_config({"markers": [{"name": "red", "hsv": object()}]})
+    with pytest.raises(softsight.InputError, match=r"^<dict>: markers\[0\]\.hsv: an ellipsis cannot be"):
+        softsight.load_config({"markers": [{"name": "red", "hsv": ...}]})
+    with pytest.raises(softsight.InputError, match=r"^<dict>: markers\[0\]\.hsv: a set cannot be"):
+        softsight.load_config({"markers": [{"name": "red", "hsv": {1}}]})
     with pytest.raises(softsight.InputError, match=r"^<dict>: markers: key 3 is not a string"):
         softsight.load_config({"markers": {3: "x"}})
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match=r"got an int$"):
         softsight.load_config(42)
     markers = [{"name": "red", "hsv": {"h": [170, 10], "s": [80, 255], "v": [40, 255]}}]
     # A str is text, even when it spells a number; None is no value (it used to drop the mm

@@ -115,6 +115,9 @@ def test_the_gil_is_released_while_a_frame_is_processed(markers_yaml):
         (np.zeros((480, 640, 3), np.float32),
          "frame 0: a float32 array; softsight needs uint8 pixels (an HxWx3 BGR or HxW gray array, "
          "as cv2.VideoCapture.read() gives)"),
+        (np.zeros((480, 640, 3), np.int16),
+         "frame 0: an int16 array; softsight needs uint8 pixels (an HxWx3 BGR or HxW gray array, "
+         "as cv2.VideoCapture.read() gives)"),
         (np.zeros((480, 640, 4), np.uint8),
          "frame 0: an array of shape (480, 640, 4); softsight needs HxWx3 (BGR) or HxW (gray) pixels"),
         (np.zeros((640,), np.uint8),

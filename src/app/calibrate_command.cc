@@ -426,7 +426,7 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub) {
       ->required();
   sub.add_option("--square-mm", options->square_mm, "Side of one printed square in millimetres")
       ->required();
-  sub.add_option("--out", options->out_file, "File to write (OpenCV YAML)")->required();
+  sub.add_option("-o,--output,--out", options->out_file, "File to write (OpenCV YAML)")->required();
   sub.add_option("--step", options->step,
                  "Video input: use every N-th frame (default 1; with two videos, both)");
   sub.add_flag("--k3", options->estimate_k3,

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,8 @@
 
 #include "app/cli_checks.h"
 #include "app/command_table.h"
+#include "app/help_format.h"
+#include "app/unknown_word.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
@@ -24,6 +27,8 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
   // writer reports after cutting the file back to its last complete row, not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{kProgramDescription};
+  app.name("softsight");  // Not argv[0], the path it was started by: "Usage: softsight track".
+  app.formatter(TerminalHelpFormatter());  // Before the commands: they take the app's.
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("softsight ") + kVersion);
   std::map<const CLI::App*, CommandRunner> runners;
@@ -39,6 +44,12 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
+    // A mistyped option first: CLI11 reports a required option the typo left out before the
+    // word it did not know ("--config is required" for --confg).
+    if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
+      std::cerr << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
+      return kInputErrorExitCode;
+    }
     // One line like every other error, naming the command it was for.
     const std::vector<CLI::App*> parsed = app.get_subcommands();
     const std::string command =

@@ -18,10 +18,12 @@ struct CommandInfo {
   const char* plugin;  // softsight_<plugin>.so.
 };
 
+// One paragraph: --help wraps it to the terminal (app/help_format.h).
 inline constexpr char kProgramDescription[] =
-    "softsight measures soft robots with a camera: it finds coloured markers on an actuator,\n"
-    "computes its bending angle, radius of curvature, arc length and bending distance, and can\n"
-    "close the control loop over a serial link. Run `softsight <command> --help` for details.";
+    "softsight measures soft robots with a camera: it finds coloured markers on an actuator, "
+    "computes its bending angle, radius of curvature, arc length and bending distance, and can "
+    "close the control loop over a serial link. Run `softsight <command> --help` for details; "
+    "-o (--output) is every command's main output file.";
 
 // In the order --help lists them.
 inline constexpr CommandInfo kCommandTable[] = {

@@ -810,7 +810,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                  "With --target-from: the longest wait for the first target before the board is "
                  "opened, seconds")
       ->capture_default_str();
-  sub.add_option("-o,--csv", o->csv_file, "Where to write the per-frame CSV")->required();
+  sub.add_option("-o,--output,--csv", o->csv_file, "Where to write the per-frame CSV")->required();
   sub.add_option("--duration-s", o->duration_s,
                  "Run length in seconds (default: the profile's length + 2 s, else 10 s)");
   sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")

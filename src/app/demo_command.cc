@@ -102,7 +102,8 @@ CommandRunner SetupDemoCommand(CLI::App& sub) {
       "actuator with red, blue and green markers to a video, writes the marker config,\n"
       "tracks the video, compares the result with the truth and plots it.\n"
       "Example: softsight demo --out-dir demo_out");
-  sub.add_option("--out-dir", options->out_dir, "Folder for the video, truth, config, CSV and plot")
+  sub.add_option("-o,--output,--out-dir", options->out_dir,
+                 "Folder for the video, truth, config, CSV and plot")
       ->capture_default_str();
   sub.add_option("--frames", options->frames, "Frames to render")
       ->capture_default_str()

@@ -489,7 +489,8 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
                "instead of the marker's centre of symmetry");
   sub.add_flag("--square-mask", options->square_mask,
                "Template trackers match the whole template square, not the disc inscribed in it");
-  sub.add_option("--csv", options->csv_file, "Also write the table as CSV to this file");
+  sub.add_option("-o,--output,--csv", options->csv_file,
+                 "Also write the table as CSV to this file");
   sub.add_option("--seed", options->scene.seed,
                  "Background texture and noise seed (as `softsight synth --seed`: same frames)")
       ->capture_default_str();

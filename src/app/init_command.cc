@@ -337,7 +337,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
                  "finds get a roi from this frame on (not started before it)")
       ->capture_default_str()
       ->check(NumberIn(0, 1e12));
-  sub.add_option("-o,--out", args->options.config_out, "The config to write (YAML)")
+  sub.add_option("-o,--output,--out", args->options.config_out, "The config to write (YAML)")
       ->capture_default_str();
   sub.add_option("--picture", args->options.picture_out,
                  "The picture of what was found and rejected (default: the config's name .png)");
@@ -385,7 +385,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
     std::cout << "rejected " << f.rejected.size() << " other blobs (see the picture)\n"
               << "wrote " << options.config_out << " and " << result.picture_file << "\n"
               << "next: softsight track --config " << options.config_out << " --input "
-              << options.source.input << " --csv run.csv\n";
+              << options.source.input << " -o run.csv\n";
     return 0;
   };
 }
@@ -416,7 +416,7 @@ CommandRunner SetupPickCommand(CLI::App& sub) {
   sub.add_option("-c,--config", args->options.base_config,
                  "Update this config's markers in order instead of writing new ones")
       ->check(CLI::ExistingFile);
-  sub.add_option("-o,--out", args->options.config_out, "The config to write (YAML)")
+  sub.add_option("-o,--output,--out", args->options.config_out, "The config to write (YAML)")
       ->capture_default_str();
   sub.add_option("--fps", args->options.source.sequence_fps, "Frame rate of an image sequence")
       ->capture_default_str()

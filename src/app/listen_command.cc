@@ -130,8 +130,8 @@ void CheckHello(const ListenOptions& options, const Json& hello) {
   for (const char* key : {"source", "config", "config_digest"}) {
     const auto it = hello.find(key);
     if (it != hello.end() && !it->is_string()) {
-      throw InputError("listen " + options.endpoint + ": the publisher's hello has a " + key +
-                       " that is not text (" + it->dump().substr(0, 40) + ")");
+      throw InputError("listen " + options.endpoint + ": the publisher's hello has " +
+                       WithArticle(key) + " that is not text (" + it->dump().substr(0, 40) + ")");
     }
   }
   const auto columns = hello.find("columns");
@@ -160,6 +160,29 @@ void CheckRecordFields(const ListenOptions& options, const std::string& topic, c
 }
 
 }  // namespace
+
+std::string DescribeEndRecord(const std::string& body) {
+  const Json end = Json::parse(body, nullptr, /*allow_exceptions=*/false);
+  const auto number = [&end](const char* key) -> std::optional<int64_t> {
+    const auto it = end.is_object() ? end.find(key) : end.end();
+    if (it == end.end() || !it->is_number_integer()) return std::nullopt;
+    return it->get<int64_t>();
+  };
+  const auto text = [&end](const char* key) -> std::optional<std::string> {
+    const auto it = end.is_object() ? end.find(key) : end.end();
+    if (it == end.end() || !it->is_string()) return std::nullopt;
+    return it->get<std::string>();
+  };
+  const std::optional<int64_t> frames = number("frames"), sent = number("sent"),
+                               dropped = number("dropped");
+  const std::optional<std::string> reason = text("stop_reason"), error = text("error");
+  if (!frames || !reason) return "the run ended: " + body;
+  std::string line = "the run ended: " + std::to_string(*frames) + " frames (" + *reason + ")";
+  if (sent) line += ", " + std::to_string(*sent) + " messages sent";
+  if (dropped) line += ", " + std::to_string(*dropped) + " dropped";
+  if (error && !error->empty()) line += "; error: " + *error;
+  return line;
+}
 
 ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::ostream& err) {
   if (options.topic.empty() || options.topic.find(' ') != std::string::npos) {
@@ -205,7 +228,7 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
     if (message->topic == kEndTopic) {
       summary.ended = true;
       summary.end_record = message->body;
-      if (!options.quiet) err << "listen: the run ended: " << message->body << "\n";
+      if (!options.quiet) err << "listen: " << DescribeEndRecord(message->body) << "\n";
       break;
     }
     if (message->topic != options.topic) continue;  // A longer topic with this prefix.
@@ -275,7 +298,8 @@ CommandRunner SetupListenCommand(CLI::App& sub) {
                  "Which records: frame (every column), measure (the measurements), marker/NAME "
                  "(one marker's columns)")
       ->capture_default_str();
-  sub.add_option("-o,--csv", o->csv_file, "Write the records to this CSV instead of printing them");
+  sub.add_option("-o,--output,--csv", o->csv_file,
+                 "Write the records to this CSV instead of printing them");
   sub.add_flag("--json", o->json, "Print each record's JSON as it came, one per line");
   sub.add_option("--count", o->count, "Stop after this many records")->check(NumberIn(1, 1e15));
   sub.add_option("--timeout-s", o->timeout_s,

@@ -32,6 +32,11 @@ struct ListenSummary {
   std::string end_record;           // Its JSON.
 };
 
+// The run's end record as `listen` prints it, in the words the run's own summary printed:
+// "the run ended: 120 frames (duration reached), 122 messages sent, 0 dropped" (and the error,
+// when there was one). A body that is not such a record is shown as it came.
+std::string DescribeEndRecord(const std::string& body);
+
 // Runs until one of the ends above. Records go to `out` (unless csv_file), the hello and the end
 // to `err` (unless quiet). Throws InputError: a malformed endpoint, a publisher of another
 // format version, a record that is not JSON, the timeout, an unwritable CSV (rows written before

@@ -10,12 +10,15 @@
 #include <climits>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "app/command_table.h"
+#include "app/help_format.h"
+#include "app/unknown_word.h"
 #include "softsight/core/error.h"
 #include "softsight/version.h"
 
@@ -66,9 +69,12 @@ int RunPlugin(const CommandInfo& command, int argc, char** argv) {
   return 1;
 }
 
-// No command given: --help and --version, or the usage error, from the table alone.
+// No command given (or one the table does not have): --help and --version, or the usage error
+// naming the word that is no command, from the table alone.
 int RunWithoutCommand(int argc, char** argv) {
   CLI::App app{kProgramDescription};
+  app.name("softsight");  // Not argv[0], the path it was started by: "Usage: softsight track".
+  app.formatter(TerminalHelpFormatter());  // Before the commands: they take the app's.
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("softsight ") + kVersion);
   for (const CommandInfo& command : kCommandTable) app.add_subcommand(command.name, command.summary);
@@ -76,6 +82,10 @@ int RunWithoutCommand(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
+    if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
+      std::cerr << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
+      return kInputErrorExitCode;
+    }
     std::cerr << "softsight: error: " << EscapeForMessage(e.what()) << " (see softsight --help)\n";
     return kInputErrorExitCode;
   }

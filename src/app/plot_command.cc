@@ -34,7 +34,8 @@ CommandRunner SetupPlotCommand(CLI::App& sub) {
       "  softsight plot colour.csv zncc.csv --truth truth.csv --panels angle,radius,xy -o cmp.svg");
   sub.add_option("csv", args->csvs, "One or more CSVs written by `softsight track`, `live`, `control` or `track-stereo`")
       ->required();
-  sub.add_option("-o,--out", args->out, "Output figure: .png, .jpg (raster) or .svg (vector)")
+  sub.add_option("-o,--output,--out", args->out,
+                 "Output figure: .png, .jpg (raster) or .svg (vector)")
       ->required();
   sub.add_option("--truth", args->truth,
                  "A truth CSV with the same column names (softsight synth --truth), drawn in black");

@@ -162,12 +162,28 @@ TEST(Stream, TrackPublishesEveryCsvRowToTwoSubscribers) {
   // The end record says why the run stopped in the summary's words.
   const nlohmann::ordered_json end = nlohmann::ordered_json::parse(heard.end_record);
   EXPECT_EQ(end["stop_reason"], summary.stop_text());
+  EXPECT_THAT(DescribeEndRecord(heard.end_record),
+              HasSubstr("90 frames (" + summary.stop_text() + ")"));
+  EXPECT_THAT(summary.BriefReport(), HasSubstr("90 frames (" + summary.stop_text() + ")"));
   EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("none dropped")));
 }
 
 // Hostile trial D15: two runs started together on one ipc:// path both bound (ZeroMQ replaces a
 // socket file), and one published to nobody. A lock beside the path decides, whatever the timing;
 // the run leaves neither the socket file nor the lock behind.
+// listen says how the run ended in the run's own words (the end record's stop_reason is the
+// summary's), not as raw JSON.
+TEST(Stream, ListenSaysTheEndInTheRunsWords) {
+  EXPECT_EQ(DescribeEndRecord(R"({"frames":120,"stop_reason":"duration reached","error":"",)"
+                              R"("sent":122,"dropped":0})"),
+            "the run ended: 120 frames (duration reached), 122 messages sent, 0 dropped");
+  EXPECT_EQ(DescribeEndRecord(R"({"frames":3,"stop_reason":"error","error":"a.avi: frame 3: )"
+                              R"(cannot decode","sent":5,"dropped":1})"),
+            "the run ended: 3 frames (error), 5 messages sent, 1 dropped; error: a.avi: frame 3: "
+            "cannot decode");
+  EXPECT_EQ(DescribeEndRecord("{\"x\":1}"), "the run ended: {\"x\":1}");
+}
+
 TEST(Stream, OneIpcPathIsOneRunsAndNothingOfItStaysBehind) {
   TempDir dir;
   PublishOptions publish;

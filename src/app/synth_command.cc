@@ -135,7 +135,7 @@ CommandRunner SetupSynthCommand(CLI::App& sub) {
                  "blobs of every marker colour; plate: a gray view of a plate with 5 white dots "
                  "that tilts to 50 degrees and grows 1x to 2x (dot0..dot4)")
       ->capture_default_str();
-  sub.add_option("-o,--out", options->out,
+  sub.add_option("-o,--output,--out", options->out,
                  "Video (.avi/.mkv: lossless HuffYUV; .mp4: lossy) or image pattern "
                  "(frames/%04d.png)")
       ->required();

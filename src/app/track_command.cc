@@ -157,7 +157,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_option("--camera", options->source.camera,
                  "Camera index (V4L2) instead of --input: tracks until Ctrl-C or --max-frames")
       ->excludes(input);
-  sub.add_option("-o,--csv", options->csv_file,
+  sub.add_option("-o,--output,--csv", options->csv_file,
                  "Where to write the per-frame CSV; a folder (an existing one, or a path ending "
                  "in /) gets one CSV per input, named after it (run.avi -> FOLDER/run.csv)")
       ->required();

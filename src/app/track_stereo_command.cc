@@ -534,7 +534,8 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
   sub.add_option("--stereo", options->stereo_file,
                  "The rig from `softsight calibrate --left ... --right ...`")
       ->required();
-  sub.add_option("-o,--csv", options->csv_file, "Where to write the per-frame CSV")->required();
+  sub.add_option("-o,--output,--csv", options->csv_file, "Where to write the per-frame CSV")
+      ->required();
   sub.add_option("--frame-offset", options->frame_offset,
                  "Pair left frame i with right frame i + N (the right camera started N frames "
                  "earlier; negative: later). Not given: found from a flash or the motion, or "

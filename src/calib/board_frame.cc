@@ -9,6 +9,7 @@
 
 #include "calib/calibration_internals.h"
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 
 namespace softsight {
 
@@ -30,8 +31,8 @@ BoardFrame FitBoardFrame(const std::vector<std::optional<cv::Point3d>>& corners_
                          const ChessboardSpec& board) {
   const int width = board.inner_corners.width, height = board.inner_corners.height;
   if (static_cast<int>(corners_mm.size()) != width * height) {
-    throw InputError("board frame: " + std::to_string(corners_mm.size()) + " corners for a " +
-                     SizeText(board.inner_corners) + " board");
+    throw InputError("board frame: " + std::to_string(corners_mm.size()) + " corners for " +
+                     WithArticle(SizeText(board.inner_corners) + " board"));
   }
   std::vector<cv::Vec3d> ideal, measured;
   for (int r = 0; r < height; ++r) {

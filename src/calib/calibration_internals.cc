@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "softsight/core/error.h"
+#include "softsight/core/format.h"
 #include "softsight/core/file_write.h"
 
 namespace softsight::calib_internal {
@@ -60,8 +61,9 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std
   }
   if (m.empty()) throw InputError(file + ": " + key + ": missing");
   if ((rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols) || m.channels() != 1) {
-    throw InputError(file + ": " + key + ": expected a " + std::to_string(rows) + "x" +
-                     std::to_string(cols) + " matrix, got " + std::to_string(m.rows) + "x" +
+    throw InputError(file + ": " + key + ": expected " +
+                     WithArticle(std::to_string(rows) + "x" + std::to_string(cols) + " matrix") +
+                     ", got " + std::to_string(m.rows) + "x" +
                      std::to_string(m.cols));
   }
   m.convertTo(m, CV_64F);

@@ -35,5 +35,28 @@ TEST(Format, RoundTripNumberReadsBackTheIdenticalDouble) {
   }
 }
 
+// Messages that name a Python type, a dtype or a board's size: the "a ellipsis".
+TEST(Format, WithArticleFollowsHowTheWordIsSaid) {
+  EXPECT_EQ(WithArticle("ellipsis"), "an ellipsis");
+  EXPECT_EQ(WithArticle("int"), "an int");
+  EXPECT_EQ(WithArticle("object"), "an object");
+  EXPECT_EQ(WithArticle("list"), "a list");
+  EXPECT_EQ(WithArticle("NoneType"), "a NoneType");
+  EXPECT_EQ(WithArticle("int16 array"), "an int16 array");
+  EXPECT_EQ(WithArticle("float32 array"), "a float32 array");
+  EXPECT_EQ(WithArticle("uint16 array"), "a uint16 array");  // "you-int"
+  EXPECT_EQ(WithArticle("8x6 board"), "an 8x6 board");
+  EXPECT_EQ(WithArticle("9x6 board"), "a 9x6 board");
+  EXPECT_EQ(WithArticle("11x8 board"), "an 11x8 board");   // eleven
+  EXPECT_EQ(WithArticle("18x12 board"), "an 18x12 board");  // eighteen
+  EXPECT_EQ(WithArticle("180x3 matrix"), "a 180x3 matrix");  // one hundred and eighty
+  EXPECT_EQ(WithArticle("3x3 matrix"), "a 3x3 matrix");
+  EXPECT_EQ(WithArticle("SVG file"), "an SVG file");        // ess-vee-gee
+  EXPECT_EQ(WithArticle("PNG file"), "a PNG file");
+  EXPECT_EQ(WithArticle("hour"), "an hour");
+  EXPECT_EQ(WithArticle("hash"), "a hash");
+  EXPECT_EQ(WithArticle("config_digest"), "a config_digest");
+}
+
 }  // namespace
 }  // namespace softsight

@@ -226,6 +226,27 @@ TEST(RunPipeline, StopRequestEndsCleanlyWithASummary) {
   EXPECT_THAT(summary.FullReport(), HasSubstr("stop requested"));
 }
 
+// One stop reason everywhere: the command's words (RunOptions::describe_stop) are in both
+// reports and in what the sinks' end() gets (the stream's end record is made from it), where
+// the one-line report used to say "stop requested" and the full one "duration reached".
+TEST(RunPipeline, TheCommandsStopReasonIsTheSameInEveryReportAndEveryEnd) {
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
+  TrackingSession session(ThreeMarkerSceneConfig());
+  RecordingSink sink;
+  RunOptions options;
+  options.stop_requested = [&sink] { return sink.indices.size() >= 3; };
+  options.describe_stop = [](StopReason reason) {
+    return reason == StopReason::kStopRequested ? std::string("duration reached") : std::string();
+  };
+  const RunSummary summary = RunPipeline(*source, session, {&sink}, options);
+  ASSERT_EQ(summary.stop_reason, StopReason::kStopRequested);
+  EXPECT_EQ(summary.stop_text(), "duration reached");
+  EXPECT_EQ(sink.ended_with.stop_text(), "duration reached") << "the stream's end record";
+  EXPECT_THAT(summary.BriefReport(), HasSubstr("3 frames (duration reached)"));
+  EXPECT_THAT(summary.FullReport(), HasSubstr("(duration reached)"));
+  EXPECT_THAT(summary.FullReport(), ::testing::Not(HasSubstr("stop requested")));
+}
+
 TEST(RunPipeline, MaxFramesAndTheKnownCountReachTheSinks) {
   std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(50), NoiseOptions{});
   TrackingSession session(ThreeMarkerSceneConfig());

@@ -42,7 +42,7 @@ double RunSummary::found_rate(size_t i) const {
 std::string RunSummary::BriefReport() const {
   char text[160];
   std::snprintf(text, sizeof(text), "%lld frames (%s)", static_cast<long long>(frames),
-                StopReasonName(stop_reason));
+                stop_text().c_str());
   std::string line = text;
   if (dropped > 0) line += ", " + std::to_string(dropped) + " dropped by the source";
   if (!markers.empty()) {

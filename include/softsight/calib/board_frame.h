@@ -27,7 +27,7 @@ namespace softsight {
 struct BoardFrame {
   // camera_from_board: its columns are the board's X, Y, Z axes in the first camera's frame.
   cv::Matx33d rotation = cv::Matx33d::eye();
-  cv::Vec3d origin_mm;  // The board's first inner corner in the first camera's frame.
+  cv::Vec3d origin_mm{};  // The board's first inner corner in the first camera's frame.
   // The fit: RMS and largest distance of the triangulated corners from the fitted grid, and
   // how many corners it used.
   double rms_mm = 0.0, max_mm = 0.0;

@@ -40,20 +40,20 @@ std::optional<std::vector<cv::Point2f>> FindChessboard(const cv::Mat& image,
 
 // What calibrateCamera estimates. The distortion is OpenCV's (k1, k2, p1, p2, k3).
 struct CameraIntrinsics {
-  cv::Size image_size;
+  cv::Size image_size{};
   cv::Matx33d camera_matrix = cv::Matx33d::eye();
-  std::vector<double> distortion;
+  std::vector<double> distortion{};
 };
 
 struct CalibrationResult {
-  CameraIntrinsics camera;
-  double rms_px = 0.0;                  // Reprojection RMS over every corner of every view.
-  std::vector<std::string> used;        // Views where the board was found.
-  std::vector<std::string> not_found;   // Views where it was not (listed for the user).
+  CameraIntrinsics camera{};
+  double rms_px = 0.0;                   // Reprojection RMS over every corner of every view.
+  std::vector<std::string> used{};       // Views where the board was found.
+  std::vector<std::string> not_found{};  // Views where it was not (listed for the user).
 };
 
 struct CalibrationOptions {
-  ChessboardSpec board;
+  ChessboardSpec board{};
   // Estimate k3 too (default false: with a handful of views of a webcam lens, k3 mostly fits
   // noise; turn on for wide-angle lenses with strong barrel distortion).
   bool estimate_k3 = false;
@@ -121,7 +121,7 @@ struct PlaneCalibration {
   cv::Matx33d plane_mm_from_image = cv::Matx33d::eye();  // Undistorted px -> board mm.
   double mm_per_px = 0.0;  // Local scale at the board's centre (a summary for people).
   double rms_mm = 0.0;     // Corners mapped through the homography vs their true positions.
-  ChessboardSpec board;
+  ChessboardSpec board{};
 };
 
 // From the board's inner corners in UNDISTORTED image pixels (detection order).

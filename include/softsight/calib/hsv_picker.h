@@ -44,14 +44,15 @@ struct HsvPickOptions {
 };
 
 struct HsvPick {
-  HsvRange h, s, v;         // Ready for ColourParams (h.lo > h.hi when the range wraps through 0).
+  // Ready for ColourParams (h.lo > h.hi when the range wraps through 0).
+  HsvRange h{}, s{}, v{};
   // A white or black dot (PickHsvRange on a patch without colour that stands out from its
   // surroundings by its gray level): the gray-level range (ColourParams::gray) halfway between
   // the dot's levels and its surroundings', open towards white (or black). h, s, v are then the
   // full ranges.
   int sample_count = 0;     // Pixels sampled inside the image.
   double hue_spread = 0.0;  // Width of the hue percentile interval before margins, hue units.
-  std::optional<HsvRange> gray;
+  std::optional<HsvRange> gray{};
 };
 
 // Picks ranges from HSV samples (CV_8UC3 pixels as produced by cv::cvtColor(BGR2HSV)). Returns
@@ -72,8 +73,8 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
 // centred on the clicked pixel (clipped to the image), where the colour tracker looks for the
 // marker first.
 struct MarkerColourPick {
-  HsvPick ranges;
-  cv::Rect roi;
+  HsvPick ranges{};
+  cv::Rect roi{};
 };
 
 std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point2d click_px,

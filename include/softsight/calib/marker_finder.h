@@ -35,12 +35,12 @@ struct MarkerFinderOptions {
   // Only candidates whose centre lies in this rectangle (frame pixels) count; absent: the whole
   // frame. Restricting the search to the actuator removes look-alikes elsewhere; each marker then
   // gets a roi, which `track` applies from the analysed frame on (frame_index).
-  std::optional<cv::Rect> search_px;
+  std::optional<cv::Rect> search_px{};
   // How many markers the body carries; absent: as many as are verified. A different count is a
   // problem (the finding is not usable), never a silent choice.
-  std::optional<int> expected_count;
+  std::optional<int> expected_count{};
   // The end of the body nearest this point is the base; absent: the end nearer the image border.
-  std::optional<cv::Point2d> base_near_px;
+  std::optional<cv::Point2d> base_near_px{};
   // Weakest colour a marker may have (8-bit HSV saturation and value). Default 70 / 40: printed
   // or painted markers are far above; wood, skin and shadows mostly below.
   int min_saturation = 70;
@@ -51,7 +51,7 @@ struct MarkerFinderOptions {
   double max_area_fraction = 0.02;
   // The live window's click pick, used at each candidate's centre (its radius is shrunk to stay
   // inside small markers).
-  HsvPickOptions picker;
+  HsvPickOptions picker{};
   // Side of each marker's roi (as live's click box, `LiveOptions::select_box_px`), px; at least
   // four marker radii, and smaller than the distance to the nearest other candidate.
   int roi_side_px = 32;
@@ -65,14 +65,14 @@ struct MarkerFinderOptions {
 
 // A candidate that did not become a marker, and why ("shape", "contrast", "ambiguous: ...").
 struct RejectedCandidate {
-  cv::Point2d position_px;
+  cv::Point2d position_px{};
   double radius_px = 0;
-  std::string why;
+  std::string why{};
 };
 
 struct FoundMarker {
-  MarkerSpec spec;              // Name, method colour, ranges (and roi) ready for a config.
-  cv::Point2d position_px;      // Where the verifying tracker found it in the frame.
+  MarkerSpec spec{};            // Name, method colour, ranges (and roi) ready for a config.
+  cv::Point2d position_px{};    // Where the verifying tracker found it in the frame.
   double radius_px = 0;         // Of a disc of the blob's area.
   // Its colour alone does not tell it from other blobs of the frame (identical markers, or
   // look-alikes outside the search region): only its roi does, so the roi must stay.
@@ -80,16 +80,16 @@ struct FoundMarker {
 };
 
 struct MarkerFinding {
-  std::vector<FoundMarker> markers;  // In body order, base first.
-  std::vector<RejectedCandidate> rejected;
-  MeasureOptions measure;            // Triple (3 markers) or triple + chain (more); none below 3.
+  std::vector<FoundMarker> markers{};  // In body order, base first.
+  std::vector<RejectedCandidate> rejected{};
+  MeasureOptions measure{};          // Triple (3 markers) or triple + chain (more); none below 3.
   bool intensity = false;            // Gray-level dots (the frame is gray).
   // Empty when the markers can be used; otherwise why not, in one line (no markers, look-alikes,
   // a wrong count, an ambiguous order). The markers found so far are kept for the picture.
-  std::string problem;
+  std::string problem{};
   // What the finding decided without being sure of it, for the user to check ("base: the end
   // nearer the image border").
-  std::vector<std::string> notes;
+  std::vector<std::string> notes{};
 
   bool ok() const { return problem.empty(); }
 };

@@ -19,9 +19,9 @@
 namespace softsight {
 
 struct StereoCalibration {
-  CameraIntrinsics left, right;          // Both with the same image size.
+  CameraIntrinsics left{}, right{};      // Both with the same image size.
   cv::Matx33d R = cv::Matx33d::eye();    // right_from_left rotation.
-  cv::Vec3d T;                           // right_from_left translation (mm).
+  cv::Vec3d T{};                         // right_from_left translation (mm).
   cv::Matx33d E = cv::Matx33d::zeros();  // Essential matrix (normalised coordinates).
   cv::Matx33d F = cv::Matx33d::zeros();  // Fundamental matrix, UNDISTORTED pixels left -> right.
   // Rectification (stereoRectify, alpha 0): rotations into the common rectified frame, the
@@ -43,7 +43,7 @@ void CompleteStereoCalibration(StereoCalibration& stereo);
 struct StereoCalibrationOptions {
   // The board, k3 and the fewest views each camera's own calibration needs (min_views also
   // counts the pairs: the fewest pairs with the board in both views).
-  CalibrationOptions camera;
+  CalibrationOptions camera{};
   // A pair whose reprojection error (the larger of its two views') is above
   // max(outlier_factor x the median pair's, outlier_floor_px) does not fit the others (a board
   // that moved between the two exposures, a wrong corner order, motion blur): it is reported and
@@ -66,17 +66,17 @@ enum class StereoPairStatus {
 const char* StereoPairStatusName(StereoPairStatus status);
 
 struct StereoPairReport {
-  std::string left_name, right_name;
+  std::string left_name{}, right_name{};
   StereoPairStatus status = StereoPairStatus::kNeither;
   // Reprojection RMS of the left and right view of the pair in the joint calibration (also for
   // an outlier: the figure that left it out); absent when the board was not in both views.
-  std::optional<double> left_rms_px, right_rms_px;
+  std::optional<double> left_rms_px{}, right_rms_px{};
 };
 
 struct StereoCalibrationResult {
-  StereoCalibration stereo;
+  StereoCalibration stereo{};
   double left_rms_px = 0.0, right_rms_px = 0.0;  // Each camera's own calibration.
-  std::vector<StereoPairReport> pairs;           // Every pair added, in order.
+  std::vector<StereoPairReport> pairs{};         // Every pair added, in order.
   int pairs_used() const;
 };
 
@@ -108,8 +108,8 @@ class StereoCalibrator {
 
  private:
   struct Pair {
-    StereoPairReport report;
-    std::optional<std::vector<cv::Point2f>> left, right;
+    StereoPairReport report{};
+    std::optional<std::vector<cv::Point2f>> left{}, right{};
   };
   StereoCalibrationOptions options_;
   cv::Size image_size_;

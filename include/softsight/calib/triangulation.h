@@ -48,13 +48,13 @@ const char* StereoStatusName(StereoStatus status);
 
 struct StereoPoint {
   StereoStatus status = StereoStatus::kMissing;
-  std::optional<cv::Point3d> position_mm;  // Only with kFound.
-  std::optional<double> epipolar_px;       // Whenever both views have the marker.
-  std::optional<double> reprojection_px;   // RMS over both views after refinement (kFound).
+  std::optional<cv::Point3d> position_mm{};  // Only with kFound.
+  std::optional<double> epipolar_px{};       // Whenever both views have the marker.
+  std::optional<double> reprojection_px{};   // RMS over both views after refinement (kFound).
   // 1-sigma uncertainty of the position: the covariance (mm^2) and the RMS radius
   // sqrt(trace) of it, mostly along the depth (kFound).
-  std::optional<cv::Matx33d> covariance_mm2;
-  std::optional<double> sigma_mm;
+  std::optional<cv::Matx33d> covariance_mm2{};
+  std::optional<double> sigma_mm{};
 
   bool found() const { return status == StereoStatus::kFound; }
 };

@@ -40,11 +40,11 @@ struct ConfigChange {
   enum class Kind { kRespec, kReselect, kRetrack, kResetTipReference };
   Kind kind = Kind::kRespec;
   int64_t after_frame = 0;
-  MarkerSpec spec;     // kRespec: the marker's new spec (spec.name says which marker).
-  std::string marker;  // kReselect, kRetrack: which marker.
-  cv::Rect rect;       // kReselect: where the marker is on frame `after_frame`.
+  MarkerSpec spec{};     // kRespec: the marker's new spec (spec.name says which marker).
+  std::string marker{};  // kReselect, kRetrack: which marker.
+  cv::Rect rect{};       // kReselect: where the marker is on frame `after_frame`.
   // kRespec: the image file of spec's template (as TrackingConfig::template_files), "" if none.
-  std::string template_file;
+  std::string template_file{};
 
   static ConfigChange Respec(const MarkerSpec& spec) {
     return {Kind::kRespec, 0, spec, spec.name, {}, {}};
@@ -59,34 +59,34 @@ struct ConfigChange {
 };
 
 struct TrackingConfig {
-  std::vector<MarkerSpec> markers;
+  std::vector<MarkerSpec> markers{};
   // Marker name -> the image file its template was read from (`template.file`, as written:
   // relative to the config file), so that a saved config names it again. The pixels themselves
   // are the marker's TemplateParams::image; a template selected anew has no file until a saver
   // (the live window's `s`) writes one.
-  std::map<std::string, std::string> template_files;
+  std::map<std::string, std::string> template_files{};
   // Marker name -> its parameters of the kinds other than its own whose keys the file gives (a
   // template marker's colour keys: HSV ranges picked in the live window while it matched
   // templates), which a switch of method (`m` in live, `--method colour`) uses. At most one per
   // kind; a marker whose file gives no other kind's keys has none.
-  std::map<std::string, std::vector<MarkerParams>> params_aside;
-  MeasureOptions measure;              // Triple, chain, tip reference, metric model.
+  std::map<std::string, std::vector<MarkerParams>> params_aside{};
+  MeasureOptions measure{};            // Triple, chain, tip reference, metric model.
   // Lens model from `softsight calibrate` (the `camera:` key, relative to the config file).
   // Trackers work on the frames as recorded; measurements use undistorted marker positions.
-  std::optional<std::string> camera_file;
-  std::optional<CameraIntrinsics> camera;
+  std::optional<std::string> camera_file{};
+  std::optional<CameraIntrinsics> camera{};
   // The `control:` section (gains, limits, rig), when the file has one: `softsight control`.
-  std::optional<ControlConfig> control;
-  std::optional<RecordingOrigin> recording;  // Written by live recordings only.
-  std::vector<ConfigChange> changes;         // Likewise: edits made while recording, in order.
+  std::optional<ControlConfig> control{};
+  std::optional<RecordingOrigin> recording{};  // Written by live recordings only.
+  std::vector<ConfigChange> changes{};         // Likewise: edits made while recording, in order.
   // The `capture:` section: the camera's resolution, rate, pixel format, exposure, gain, white
   // balance and focus (softsight/io/camera_settings.h). (`camera:` names the lens calibration.)
   // A live recording saves what the camera accepted.
-  std::optional<CameraSettings> capture;
-  std::string source_file;             // Where this config was read from ("" if built in code).
+  std::optional<CameraSettings> capture{};
+  std::string source_file{};           // Where this config was read from ("" if built in code).
   // Every file reading this config opened: the config itself, then the camera, plane and
   // template image files it names (resolved), so no output may overwrite one of them.
-  std::vector<std::string> files_read;
+  std::vector<std::string> files_read{};
 };
 
 // The files a run of `config` reads, as inputs for CheckOutputsAreNotInputs: the config itself

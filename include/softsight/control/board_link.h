@@ -35,10 +35,10 @@ struct LinkOptions {
 // simulated clock; `softsight control` passes its Ctrl-C / SIGTERM flag.
 struct LinkEnvironment {
   // Monotonic time in milliseconds. Empty: std::chrono::steady_clock.
-  std::function<int64_t()> now_ms;
+  std::function<int64_t()> now_ms{};
   // Polled while waiting for an answer (at least every kStopPollMs); true ends the wait with
   // StopRequested. Never consulted by stop(), which must vent whatever happens. Empty: never.
-  std::function<bool()> stop_requested;
+  std::function<bool()> stop_requested{};
 };
 
 // Thrown by a wait for an answer that a stop request cut short: not an error of the link.

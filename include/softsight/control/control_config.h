@@ -12,11 +12,11 @@
 namespace softsight {
 
 struct ControlConfig {
-  ControllerOptions controller;
-  LinkOptions link;
-  InnerLoopGains inner_loop;  // Sent to the board at the handshake when given.
-  RigOptions rig;  // Used by `softsight rig` and `softsight control --simulate` only.
-  ActuatorModel model;  // Written by `softsight identify`; informative (the gains are above).
+  ControllerOptions controller{};
+  LinkOptions link{};
+  InnerLoopGains inner_loop{};  // Sent to the board at the handshake when given.
+  RigOptions rig{};  // Used by `softsight rig` and `softsight control --simulate` only.
+  ActuatorModel model{};  // Written by `softsight identify`; informative (the gains are above).
 
   // Returns false and names the bad field ("controller.max_kpa must be > min_kpa").
   bool Check(std::string* error) const;

@@ -94,7 +94,7 @@ struct ControllerOutput {
   enum class Action { kTrack, kHold, kVent };
   Action action = Action::kVent;
   double setpoint_kpa = 0.0;          // To send to the board (0 when venting).
-  std::optional<double> error_deg;    // measured - target, when measured.
+  std::optional<double> error_deg{};  // measured - target, when measured.
 };
 
 class ModelLoop;  // control/model_loop.h

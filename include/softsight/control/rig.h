@@ -43,8 +43,8 @@ struct PlantOptions {
 };
 
 struct RigOptions {
-  BoardConfig board;
-  PlantOptions plant;
+  BoardConfig board{};
+  PlantOptions plant{};
   // Body fraction between the base and tip markers (the renderer's defaults sit at 0.1 and 0.9),
   // which relates the bend to the paper's angle (RigSnapshot::angle_deg).
   double end_marker_span = 0.8;
@@ -60,7 +60,7 @@ struct RigSnapshot {
   double peak_pressure_kpa = 0.0;  // Highest true pressure since the start.
   double bend_deg = 0.0;           // Total turning of the centre line (the renderer's bend_deg).
   double angle_deg = 180.0;        // The paper's angle at the middle marker.
-  ValveOutputs drive;
+  ValveOutputs drive{};
   BoardMode mode = BoardMode::kIdle;
   uint16_t flags = 0;  // The board's <flags> (docs/protocol.md).
   uint32_t board_rejected = 0;

@@ -26,12 +26,12 @@ struct ControlTarget {
 // What happened in one frame: the row of the control log.
 struct ControlSample {
   double time_s = 0.0;                   // Since the first step.
-  std::optional<double> target_deg;      // kAngle only.
-  std::optional<double> measured_deg;
+  std::optional<double> target_deg{};    // kAngle only.
+  std::optional<double> measured_deg{};
   ControllerOutput::Action action = ControllerOutput::Action::kVent;
-  std::optional<double> setpoint_kpa;    // Sent pressure setpoint (absent when venting / duty).
-  std::optional<double> duty_command;    // Sent duty (kDuty).
-  BoardState board;                      // The board's answer.
+  std::optional<double> setpoint_kpa{};  // Sent pressure setpoint (absent when venting / duty).
+  std::optional<double> duty_command{};  // Sent duty (kDuty).
+  BoardState board{};                    // The board's answer.
 };
 
 // Safety is structural: once start() has shaken hands, the session sends STOP when it ends,

@@ -19,7 +19,7 @@ namespace softsight {
 
 // One decoded image with its position in the stream.
 struct Frame {
-  cv::Mat image;        // 8-bit BGR (CV_8UC3); sources convert gray input only when asked to.
+  cv::Mat image{};      // 8-bit BGR (CV_8UC3); sources convert gray input only when asked to.
   int64_t index = 0;    // 0-based position in the source.
   double time_s = 0.0;  // Timestamp given by the source (video PTS, file rate, or wall clock).
   // When the frame was read from its source, on this machine's steady clock: where its latency
@@ -62,8 +62,8 @@ const char* MarkerStatusName(MarkerStatus status);
 // What one tracker says about its marker in one frame. A marker that was not found has no
 // position: trackers never report a stale or predicted position as an observation.
 struct Observation {
-  std::optional<cv::Point2d> position_px;  // Sub-pixel, pixel-centre convention.
-  std::optional<double> score;             // Tracker-specific quality (see each tracker's header).
+  std::optional<cv::Point2d> position_px{};  // Sub-pixel, pixel-centre convention.
+  std::optional<double> score{};             // Tracker-specific quality (see its header).
   // The position's standard uncertainty along each image axis, px (set with position_px): from
   // the marker's size, contrast and noise, a partial view, the match's fit. A found marker lies
   // within 3 sigma of its true centre (docs/measurements.md, "Uncertainty").
@@ -103,40 +103,40 @@ const char* TrackStateName(TrackState state);
 
 // A named observation, as the pipeline hands it to measurement and sinks.
 struct MarkerObservation {
-  std::string name;
-  Observation observation;
+  std::string name{};
+  Observation observation{};
   TrackState track = TrackState::kLost;  // Set by the session after the frame's association.
 };
 
 // One frame's measurements. Absent where undefined (a marker missing, a straight actuator has
 // no radius), never 0. The _mm twins are present only when a metric model is configured.
 struct Measurement {
-  std::optional<double> angle_deg;        // Eq. 7 at the middle marker; 180 when straight.
-  std::optional<double> chord_px;         // c = |base - tip|.
-  std::optional<double> sagitta_px;       // d = distance of the middle marker from the chord.
-  std::optional<double> radius_px;        // Eq. 8, or the circle fit with more than 3 markers.
-  std::optional<double> arc_length_px;    // Eq. 9 (major arc when d > R); = c when straight.
-  std::optional<double> circumradius_px;  // Circle through the three points: a cross-check.
-  std::optional<double> tip_disp_px;      // Bending distance: tip displacement from reference.
+  std::optional<double> angle_deg{};        // Eq. 7 at the middle marker; 180 when straight.
+  std::optional<double> chord_px{};         // c = |base - tip|.
+  std::optional<double> sagitta_px{};       // d = distance of the middle marker from the chord.
+  std::optional<double> radius_px{};        // Eq. 8, or the circle fit with more than 3 markers.
+  std::optional<double> arc_length_px{};    // Eq. 9 (major arc when d > R); = c when straight.
+  std::optional<double> circumradius_px{};  // Circle through the three points: a cross-check.
+  std::optional<double> tip_disp_px{};      // Bending distance: tip displacement from reference.
   // With a chain of N >= 3 markers: the angle (eq. 7) at each inner marker chain[1] .. chain[N-2],
   // in chain order, between its two neighbours along the chain (the paper's multi-segment
   // actuators have one per hinge); absent where that marker or a neighbour is not found. Empty
   // without a chain. CSV: angle_<name>_deg.
-  std::vector<std::optional<double>> inner_angle_deg;
+  std::vector<std::optional<double>> inner_angle_deg{};
 
-  std::optional<double> chord_mm;
-  std::optional<double> sagitta_mm;
-  std::optional<double> radius_mm;
-  std::optional<double> arc_length_mm;
-  std::optional<double> tip_disp_mm;
+  std::optional<double> chord_mm{};
+  std::optional<double> sagitta_mm{};
+  std::optional<double> radius_mm{};
+  std::optional<double> arc_length_mm{};
+  std::optional<double> tip_disp_mm{};
 };
 
 // Everything the pipeline learned from one frame, as sinks (CSV, overlay, controller) see it.
 struct FrameResult {
   int64_t frame_index = 0;
   double time_s = 0.0;
-  std::vector<MarkerObservation> markers;  // In config order.
-  Measurement measurement;
+  std::vector<MarkerObservation> markers{};  // In config order.
+  Measurement measurement{};
   double proc_ms = 0.0;                    // Tracking + measurement time for this frame.
   // The frame's capture time (Frame::captured) and the time from it to this result (when the
   // session finished the frame: reading, queueing and tracking included).

@@ -9,7 +9,7 @@
 namespace softsight {
 
 struct CircleFit {
-  cv::Point2d centre;
+  cv::Point2d centre{};
   double radius = 0.0;
   double rms_residual = 0.0;  // sqrt(mean((|p - centre| - radius)^2)), in the points' unit.
 };

@@ -19,15 +19,15 @@ namespace softsight {
 struct MetricModel {
   // Two (undistorted) image points a known distance apart, e.g. the ends of a ruler clicked live.
   struct ScalePoints {
-    cv::Point2d a_px, b_px;
+    cv::Point2d a_px{}, b_px{};
     double distance_mm = 0.0;
   };
 
-  std::optional<double> scale_mm_per_px;
-  std::optional<cv::Matx33d> plane_mm_from_image;
+  std::optional<double> scale_mm_per_px{};
+  std::optional<cv::Matx33d> plane_mm_from_image{};
   // Where scale_mm_per_px came from, when it was measured between two points: kept so that a
   // saved config states the points (`scale_from_points`), not only the number they gave.
-  std::optional<ScalePoints> scale_points;
+  std::optional<ScalePoints> scale_points{};
 
   bool empty() const { return !scale_mm_per_px && !plane_mm_from_image; }
   // At most one of the two; the scale finite and > 0; the homography finite and invertible;
@@ -43,14 +43,14 @@ std::optional<cv::Point2d> MapToPlane(const cv::Matx33d& plane_from_image,
 struct MeasureOptions {
   // The triple, by marker name: all three named (the paper's measurements), or all three empty
   // (no triple: one or two markers, or a chain only; angle, chord, sagitta, ... stay absent).
-  std::string base, middle, tip;
+  std::string base{}, middle{}, tip{};
   // Optional: every marker along the body in order, base to tip. Gives the angle at every inner
   // marker (Measurement::inner_angle_deg); with more than three, radius and arc length come from
   // a least-squares (Taubin) circle fit through all found markers.
-  std::vector<std::string> chain;
+  std::vector<std::string> chain{};
   // Reference for the bending distance; absent: the tip's position in the first frame where found.
-  std::optional<cv::Point2d> tip_reference_px;
-  MetricModel metric;
+  std::optional<cv::Point2d> tip_reference_px{};
+  MetricModel metric{};
 
   bool has_triple() const { return !base.empty() || !middle.empty() || !tip.empty(); }
   // The chain's inner markers chain[1] .. chain[N-2], whose angles inner_angle_deg holds.

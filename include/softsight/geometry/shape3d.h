@@ -19,8 +19,8 @@ std::optional<double> AngleAtMiddle3dDeg(const cv::Point3d& base, const cv::Poin
                                          const cv::Point3d& tip);
 
 struct PlaneFit3d {
-  cv::Point3d centroid;
-  cv::Vec3d normal;           // Unit length; its sign is set by FitPlane3d's rule.
+  cv::Point3d centroid{};
+  cv::Vec3d normal{};         // Unit length; its sign is set by FitPlane3d's rule.
   double rms_residual = 0.0;  // RMS distance of the points from the plane.
 };
 
@@ -34,8 +34,8 @@ std::optional<PlaneFit3d> FitPlane3d(const std::vector<cv::Point3d>& points);
 std::optional<double> AngleBetweenPlanesDeg(const cv::Vec3d& normal_a, const cv::Vec3d& normal_b);
 
 struct CircleFit3d {
-  cv::Point3d centre;
-  cv::Vec3d normal;  // The plane the circle lies in (unit).
+  cv::Point3d centre{};
+  cv::Vec3d normal{};  // The plane the circle lies in (unit).
   double radius = 0.0;
   double rms_residual = 0.0;  // RMS distance of the points from the circle, in 3D.
 };
@@ -51,20 +51,20 @@ std::optional<double> ArcLength3d(const CircleFit3d& circle,
 
 // What a frame's 3D markers give.
 struct Shape3d {
-  std::optional<double> angle_deg;         // At the chain's middle marker.
-  std::optional<cv::Vec3d> plane_normal;   // The bending plane (all found markers).
-  std::optional<double> out_of_plane_deg;  // Bending plane vs the reference plane.
-  std::optional<double> radius;            // 3D circle fit through all found markers.
-  std::optional<double> arc_length;        // Along that circle, base to tip.
-  std::optional<double> tip_disp;          // Tip from its reference position.
+  std::optional<double> angle_deg{};         // At the chain's middle marker.
+  std::optional<cv::Vec3d> plane_normal{};   // The bending plane (all found markers).
+  std::optional<double> out_of_plane_deg{};  // Bending plane vs the reference plane.
+  std::optional<double> radius{};            // 3D circle fit through all found markers.
+  std::optional<double> arc_length{};        // Along that circle, base to tip.
+  std::optional<double> tip_disp{};          // Tip from its reference position.
 };
 
 // One hinge of a chain: the circle through three consecutive markers (per-segment curvature of
 // a multi-segment actuator).
 struct Segment3d {
-  std::optional<double> angle_deg;   // At the middle one of the three (eq. 7 in 3D).
-  std::optional<double> radius;      // Their circumcircle; absent when they are on a line.
-  std::optional<double> arc_length;  // First to last through the middle along that circle;
+  std::optional<double> angle_deg{};   // At the middle one of the three (eq. 7 in 3D).
+  std::optional<double> radius{};      // Their circumcircle; absent when they are on a line.
+  std::optional<double> arc_length{};  // First to last through the middle along that circle;
                                      // the two distances added when on a line.
 };
 

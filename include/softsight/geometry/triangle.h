@@ -51,12 +51,12 @@ std::optional<double> Circumradius(const cv::Point2d& a, const cv::Point2d& b,
 // are absent when any two of the points coincide (two markers on top of each other is a tracking
 // fault, not a straight actuator).
 struct TriangleMeasures {
-  std::optional<double> angle_deg;
+  std::optional<double> angle_deg{};
   double chord = 0.0;
-  std::optional<double> sagitta;
-  std::optional<double> radius;        // Eq. 8; absent when straight.
-  std::optional<double> arc_length;    // Eq. 9; = chord when straight.
-  std::optional<double> circumradius;  // Absent when collinear.
+  std::optional<double> sagitta{};
+  std::optional<double> radius{};        // Eq. 8; absent when straight.
+  std::optional<double> arc_length{};    // Eq. 9; = chord when straight.
+  std::optional<double> circumradius{};  // Absent when collinear.
 };
 
 TriangleMeasures MeasureTriangle(const cv::Point2d& base, const cv::Point2d& middle,

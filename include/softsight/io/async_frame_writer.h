@@ -66,7 +66,7 @@ class AsyncFrameWriter {
   std::mutex mutex_;
   std::condition_variable queued_cv_, freed_cv_;
   struct Slot {
-    cv::Mat image;
+    cv::Mat image{};
     int64_t index = 0;
   };
   std::vector<Slot> ring_;  // Queued: ring_[head_] .. count_ of them; the next free follows.

@@ -38,9 +38,9 @@ class CaptureBackend {
 };
 
 struct CameraSettingsReport {
-  CameraSettings accepted;           // What the camera has after applying (read back).
-  std::vector<std::string> refused;  // One line each: "camera 0: exposure 120 refused, kept 156".
-  std::string summary;               // One line: "camera 0: 1280x720 30 fps MJPG exposure 120 ...".
+  CameraSettings accepted{};           // What the camera has after applying (read back).
+  std::vector<std::string> refused{};  // One line each: "camera 0: exposure 120 refused, kept 156".
+  std::string summary{};               // One line: "camera 0: 1280x720 30 fps MJPG exposure 120".
 };
 
 // Applies every setting given (pixel format first, then size, rate, and each manual value after

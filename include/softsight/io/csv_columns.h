@@ -29,10 +29,10 @@ namespace softsight {
 // io/truth_csv.h).
 template <typename Row>
 struct BasicCsvColumn {
-  std::string name;
+  std::string name{};
   // Appends this column's field for `row_data` to `row` (nothing for an empty field). Fields must
   // not contain commas, quotes or newlines (numbers and names).
-  std::function<void(const Row& row_data, std::string& row)> append;
+  std::function<void(const Row& row_data, std::string& row)> append{};
 };
 using CsvColumn = BasicCsvColumn<FrameResult>;
 

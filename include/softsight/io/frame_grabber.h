@@ -23,8 +23,8 @@ namespace softsight {
 using SteadyClock = std::chrono::steady_clock;
 
 struct GrabbedFrame {
-  Frame frame;
-  SteadyClock::time_point captured;  // When the source returned it (start of the latency).
+  Frame frame{};
+  SteadyClock::time_point captured{};  // When the source returned it (start of the latency).
 };
 
 class FrameGrabber {

@@ -69,19 +69,19 @@ struct FrameOffsetEstimate {
   Method method = Method::kMotion;
   // Frame i of the first video shows the moment of frame i + offset_frames of the second.
   // Absent: refused, `refusal` says why.
-  std::optional<int64_t> offset_frames;
-  std::string refusal;
+  std::optional<int64_t> offset_frames{};
+  std::string refusal{};
   // A flash: the frame where each video's brightness stepped up, and the steps (grey levels).
-  std::optional<int64_t> left_flash_frame, right_flash_frame;
+  std::optional<int64_t> left_flash_frame{}, right_flash_frame{};
   double left_flash_step = 0.0, right_flash_step = 0.0;
   // The motion: the correlation's best peak and the best other one (absent when there is none).
-  std::optional<double> peak_correlation;
-  std::optional<int64_t> peak_offset;
-  std::optional<double> second_correlation;
-  std::optional<int64_t> second_offset;
+  std::optional<double> peak_correlation{};
+  std::optional<int64_t> peak_offset{};
+  std::optional<double> second_correlation{};
+  std::optional<int64_t> second_offset{};
   // The correlation (Pearson's r of the motion signals) at each offset searched, from
   // -max_offset_frames; absent where the overlap is too short or a signal does not vary.
-  std::vector<std::optional<double>> correlation;
+  std::vector<std::optional<double>> correlation{};
 };
 
 // The flash first (the first step up of at least flash_min_step in each video, the two within

@@ -75,8 +75,8 @@ struct FrameSourceSpec {
   // A video file (anything FFmpeg reads), a folder of images (sorted by name), a numbered
   // pattern such as "frames/%04d.png" (one %d or %0Nd; rows carry each file's number), or a
   // synthetic scene ("synth:bending").
-  std::string input;
-  std::optional<int> camera;           // V4L2 camera index (live).
+  std::string input{};
+  std::optional<int> camera{};         // V4L2 camera index (live).
   // Frame rate for image sequences, whose files carry no timestamps (frames per second).
   double sequence_fps = 30.0;
   // The camera's capture settings (config `capture:` and --camera-* options), applied when it

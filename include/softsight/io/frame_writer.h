@@ -23,11 +23,11 @@ struct FrameWriterOptions {
   // A video (*.avi, *.mkv: HuffYUV lossless by default; *.mp4: MPEG-4, lossy) or an image pattern
   // with one %d or %0Nd field, frames/%04d.png, "%%" for a literal % (one image per frame, named
   // by the frame's index).
-  std::string path;
+  std::string path{};
   // Video codec: hfyu (HuffYUV, lossless, fast: the default), ffv1 (lossless, ~1.4x smaller,
   // 8-10x slower to encode; older recordings), mjpg (Motion JPEG,
   // lossy, small: for videos people watch), mp4v (lossy). Empty: chosen by the extension.
-  std::string codec;
+  std::string codec{};
   double fps = 30.0;  // The video's nominal rate (ignored for image patterns). > 0.
 };
 

@@ -14,8 +14,8 @@
 namespace softsight {
 
 struct PathRole {
-  std::string role;  // How the user named it: "--csv", "--input", "the config's camera file".
-  std::string path;
+  std::string role{};  // How the user named it: "--csv", "--input", "the config's camera file".
+  std::string path{};
 };
 
 // Throws InputError (one line naming both roles and paths) when an output

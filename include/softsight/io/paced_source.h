@@ -20,8 +20,8 @@ namespace softsight {
 // The time source and the wait of a PacedFrameSource, replaceable so tests run without waiting.
 struct PacingClock {
   using Clock = std::chrono::steady_clock;
-  std::function<Clock::time_point()> now;               // Empty: steady_clock::now.
-  std::function<void(Clock::time_point)> sleep_until;  // Empty: std::this_thread::sleep_until.
+  std::function<Clock::time_point()> now{};             // Empty: steady_clock::now.
+  std::function<void(Clock::time_point)> sleep_until{};  // Empty: std::this_thread::sleep_until.
 };
 
 class PacedFrameSource : public FrameSource {

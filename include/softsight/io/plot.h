@@ -23,14 +23,14 @@ namespace softsight {
 struct PlotOptions {
   int width_px = 1000;        // Figure width. Narrower than ~400 leaves no room for tick labels.
   int panel_height_px = 240;  // Height of each stacked panel, including its label strip.
-  std::string title;          // Shown on top; empty: the CSVs' file names.
+  std::string title{};        // Shown on top; empty: the CSVs' file names.
   // Panels, top to bottom: "angle" (a track-stereo CSV's 3D angle with each camera's own),
   // "plane" (track-stereo's out-of-plane angle), "bending" (tip displacement), "arc" (arc
   // length), "radius" (radius of curvature), "xy" (each marker's x and y, or X, Y and Z in 3D,
   // one panel each), "control" (pressures, duty). Empty (default): angle, plane, bending, arc
   // and control, each when the CSV has its columns; a panel asked for by name whose columns no
   // CSV has is an error.
-  std::vector<std::string> panels;
+  std::vector<std::string> panels{};
   // Smallest span of a y axis, per unit: values that vary less are shown in an axis this tall,
   // centred on them. Defaults: 2 px (20x the colour tracker's ~0.1 px precision), 1 deg,
   // 0.5 mm. 0: the axis hugs the data.
@@ -43,8 +43,8 @@ struct PlotOptions {
 
 // What is plotted: one or more runs and, optionally, a truth to compare them with.
 struct PlotData {
-  std::vector<CsvTable> runs;     // CSVs of `track`, `live`, `control` (at least one).
-  std::optional<CsvTable> truth;  // `synth --truth` CSV: drawn in black, labelled "truth".
+  std::vector<CsvTable> runs{};     // CSVs of `track`, `live`, `control` (at least one).
+  std::optional<CsvTable> truth{};  // `synth --truth` CSV: drawn in black, labelled "truth".
 
   size_t table_count() const { return runs.size() + (truth ? 1 : 0); }
   // Runs first, then the truth.
@@ -52,13 +52,13 @@ struct PlotData {
 };
 
 struct PlotSeries {
-  std::string label;  // Legend text ("measured", "target", column name otherwise).
-  size_t column = 0;  // Index into CsvTable::values.
-  cv::Scalar bgr;     // Line colour.
-  size_t table = 0;   // Which table of the PlotData (0 with a single CSV).
+  std::string label{};  // Legend text ("measured", "target", column name otherwise).
+  size_t column = 0;    // Index into CsvTable::values.
+  cv::Scalar bgr{};     // Line colour.
+  size_t table = 0;     // Which table of the PlotData (0 with a single CSV).
   // A value above cap_factor times this column's value in the same row is drawn as a gap (the
   // radius of a nearly straight actuator: see PlotSeriesValue).
-  std::optional<size_t> cap_column;
+  std::optional<size_t> cap_column{};
   double cap_factor = 0.0;
 };
 
@@ -67,13 +67,13 @@ struct PlotSeries {
 std::optional<double> PlotSeriesValue(const CsvTable& table, const PlotSeries& series, size_t row);
 
 struct PlotPanel {
-  std::string y_label;  // With unit: "angle [deg]", "bending distance [mm]".
-  std::vector<PlotSeries> series;
-  cv::Rect plot_rect;           // The data area in figure pixels.
+  std::string y_label{};  // With unit: "angle [deg]", "bending distance [mm]".
+  std::vector<PlotSeries> series{};
+  cv::Rect plot_rect{};         // The data area in figure pixels.
   double x_min = 0, x_max = 1;  // Time range of the x axis, seconds.
   double y_min = 0, y_max = 1;  // Value range of the y axis.
-  std::string unit;             // Of the y axis ("deg", "px", "mm", ...), for its minimum span.
-  std::vector<double> x_ticks, y_ticks;
+  std::string unit{};           // Of the y axis ("deg", "px", "mm", ...), for its minimum span.
+  std::vector<double> x_ticks{}, y_ticks{};
   bool has_data = false;  // False: every value of every series is absent.
 
   // Figure pixel of data point (time_s, value). Row 0 is the top of the figure.
@@ -81,11 +81,11 @@ struct PlotPanel {
 };
 
 struct PlotLayout {
-  cv::Size size;  // Whole figure.
-  std::string title;
-  size_t time_column = 0;            // Of the first table.
-  std::vector<size_t> time_columns;  // Of each table of the PlotData.
-  std::vector<PlotPanel> panels;     // Top to bottom.
+  cv::Size size{};  // Whole figure.
+  std::string title{};
+  size_t time_column = 0;              // Of the first table.
+  std::vector<size_t> time_columns{};  // Of each table of the PlotData.
+  std::vector<PlotPanel> panels{};     // Top to bottom.
 };
 
 // Chooses the panels the tables support and lays them out. Throws InputError (naming the file)

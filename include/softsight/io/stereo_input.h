@@ -18,10 +18,10 @@
 namespace softsight {
 
 struct FramePair {
-  Frame left, right;  // Each with its own source's index and time.
+  Frame left{}, right{};  // Each with its own source's index and time.
   // Pairing by time: the right frame's time minus the left one's (after the time offset), in
   // milliseconds: the pairing error. Absent when paired by index.
-  std::optional<double> pair_dt_ms;
+  std::optional<double> pair_dt_ms{};
 };
 
 class StereoInput {
@@ -65,7 +65,7 @@ struct TimePairingOptions {
   // Frames further apart than this are not a pair (ms). Absent (default): half the shorter
   // frame interval of the two views (each from its source's fps(), else its first two frames),
   // so a frame can have at most one partner.
-  std::optional<double> max_dt_ms;
+  std::optional<double> max_dt_ms{};
 
   bool Check(std::string* error) const;
 };

@@ -24,13 +24,13 @@ using TruthCsvWriter = BasicCsvWriter<SceneTruth>;
 
 // A truth CSV read back for some markers.
 struct TruthCsv {
-  std::vector<std::string> markers;   // The wanted markers the file has <name>_x, <name>_y for.
-  std::vector<size_t> wanted_index;   // Each one's index in `wanted`.
-  std::vector<std::string> missing;   // The wanted markers it has no such columns for.
+  std::vector<std::string> markers{};  // The wanted markers the file has <name>_x, <name>_y for.
+  std::vector<size_t> wanted_index{};  // Each one's index in `wanted`.
+  std::vector<std::string> missing{};  // The wanted markers it has no such columns for.
   // In file order; each frame's markers are `markers`, in that order. A marker without a
   // `_visible` column is wholly visible where it has a position; columns the file lacks are
   // absent (time_s and bend_deg: 0).
-  std::vector<SceneTruth> frames;
+  std::vector<SceneTruth> frames{};
 };
 
 // Reads `file` for the markers `wanted`. Throws InputError naming the file (and line) when it

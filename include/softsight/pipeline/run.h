@@ -23,10 +23,10 @@ class KeyFrameGroups;
 
 struct RunOptions {
   // Stop after this many processed frames (absent: until the source ends). Must be >= 0.
-  std::optional<int64_t> max_frames;
+  std::optional<int64_t> max_frames{};
   // Polled before each frame is read; true ends the run cleanly with kStopRequested (every sink
   // still gets end()). Empty: never. Called from the running thread: make it cheap (a flag).
-  std::function<bool()> stop_requested;
+  std::function<bool()> stop_requested{};
   // A video that predicts frames (MPEG-4, H.264): each group of frames reaches the sinks only
   // after its next key frame was tracked, so that a marker the decoder's silent damage moved is
   // reported implausible instead of found (src/pipeline/key_frame_groups.h; frames of cameras,
@@ -37,7 +37,7 @@ struct RunOptions {
   // by SIGINT"; empty: StopReasonName's), asked once as it ends and kept in
   // RunSummary::stop_detail before the sinks' end(): the stream's end record and the printed
   // summary then say the same. Empty: none.
-  std::function<std::string(StopReason)> describe_stop;
+  std::function<std::string(StopReason)> describe_stop{};
 };
 
 // One run, frame by frame: RunPipeline's work per frame and its summary, for a caller whose own

@@ -18,13 +18,13 @@ namespace softsight {
 
 // What a sink learns before the first frame.
 struct RunInfo {
-  std::string source;                   // FrameSource::description().
-  cv::Size frame_size;                  // Of the first frame; empty when the source had none.
-  std::optional<double> fps;            // The source's nominal rate, when known.
-  std::optional<int64_t> frame_count;   // Frames the run will process when known (the source's
+  std::string source{};                  // FrameSource::description().
+  cv::Size frame_size{};                 // Of the first frame; empty when the source had none.
+  std::optional<double> fps{};           // The source's nominal rate, when known.
+  std::optional<int64_t> frame_count{};  // Frames the run will process when known (the source's
                                         // count, capped by RunOptions::max_frames).
   bool live = false;                    // A camera (frames may be dropped, no known end).
-  std::vector<std::string> marker_names;  // In config order, as in FrameResult::markers.
+  std::vector<std::string> marker_names{};  // In config order, as in FrameResult::markers.
   bool metric = false;                  // The measurement has _mm twins (a metric model is set).
 };
 

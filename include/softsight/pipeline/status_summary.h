@@ -39,12 +39,12 @@ class MarkerStatusSummary {
   struct PerStatus {
     int64_t frames = 0;
     int64_t runs = 0;
-    std::vector<Run> listed;  // The first kListedRuns runs.
-    bool open = false;        // The last frame added had this status (its run may continue).
+    std::vector<Run> listed{};  // The first kListedRuns runs.
+    bool open = false;          // The last frame added had this status (its run may continue).
   };
   struct PerMarker {
-    std::string name;
-    std::array<PerStatus, kStatusCount> status;
+    std::string name{};
+    std::array<PerStatus, kStatusCount> status{};
   };
   std::vector<PerMarker> markers_;
   int64_t last_frame_ = -1;

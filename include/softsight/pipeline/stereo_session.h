@@ -25,7 +25,7 @@
 namespace softsight {
 
 struct StereoOptions {
-  TriangulationOptions triangulation;
+  TriangulationOptions triangulation{};
   // What the out-of-plane angle is measured against: the first camera's image plane (default:
   // a bend seen face on reads 0), the bending plane of the first frame where it is defined
   // (three found markers not on a line): how far the bend has turned since, or a bench board's
@@ -35,7 +35,7 @@ struct StereoOptions {
   // kBoard: the board's normal in the first camera's frame (BoardFrame::rotation's third column,
   // calib/board_frame.h), any non-zero length; its sign does not matter. Absent by default;
   // required by kBoard, not used otherwise.
-  std::optional<cv::Vec3d> board_normal;
+  std::optional<cv::Vec3d> board_normal{};
 
   bool Check(std::string* error) const;
 };
@@ -44,12 +44,12 @@ struct StereoOptions {
 StereoOptions::ReferencePlane ParseReferencePlane(const std::string& text, const std::string& what);
 
 struct StereoMarkerResult {
-  std::string name;
-  Observation left, right;  // Each view's own observation (raw pixels).
-  StereoPoint point;        // The verified 3D point, or why there is none.
+  std::string name{};
+  Observation left{}, right{};  // Each view's own observation (raw pixels).
+  StereoPoint point{};          // The verified 3D point, or why there is none.
   // "found", "epipolar", "behind", "timing" (StereoStatus::kTiming), or the first view that did not find the marker and why
   // ("left_lost", "right_covered", ...).
-  std::string status;
+  std::string status{};
 };
 
 struct StereoFrameResult {
@@ -57,19 +57,19 @@ struct StereoFrameResult {
   int64_t right_frame_index = 0;            // The right view's frame paired with it.
   double time_s = 0.0;                      // The left view's.
   // Paired by time: the right frame's time minus the left one's (ms), the pairing error.
-  std::optional<double> pair_dt_ms;
+  std::optional<double> pair_dt_ms{};
   // When the markers' motion over the last pairs says the right view's frames are not of the
   // left one's moment: by how many right frames the right one is later (negative: earlier).
   // Moving markers are then not found in 3D (status "timing"). Absent: no sign of it.
-  std::optional<double> lag_frames;
-  std::vector<StereoMarkerResult> markers;  // In the left config's order.
+  std::optional<double> lag_frames{};
+  std::vector<StereoMarkerResult> markers{};  // In the left config's order.
   // In millimetres, the first camera's frame: the chain's angle, plane, circle and tip.
-  Shape3d shape;
+  Shape3d shape{};
   // A chain of more than 3 markers: the circle through each inner marker and its two
   // neighbours (StereoSession::segment_names), in chain order. Empty otherwise.
-  std::vector<Segment3d> segments;
+  std::vector<Segment3d> segments{};
   // What each camera alone measures (eq. 7 on its image positions), for comparison.
-  std::optional<double> left_angle_deg, right_angle_deg;
+  std::optional<double> left_angle_deg{}, right_angle_deg{};
   double proc_ms = 0.0;
 };
 

@@ -23,20 +23,20 @@ enum class StopReason {
 const char* StopReasonName(StopReason reason);
 
 struct MarkerRunSummary {
-  std::string name;
+  std::string name{};
   int64_t found = 0;  // Frames where the marker was reported found.
 };
 
 struct RunSummary {
-  std::string source;                  // FrameSource::description().
+  std::string source{};                // FrameSource::description().
   int64_t frames = 0;                  // Frames processed (each one reached every sink).
   // Frames the source skipped because the pipeline was slower than it (a live camera: newest
   // frame wins). Always 0 for files, image sequences and rendered scenes.
   int64_t dropped = 0;
-  std::optional<int64_t> first_index;  // Source indices of the first and last processed frame.
-  std::optional<int64_t> last_index;
-  std::vector<MarkerRunSummary> markers;  // In config order.
-  MarkerStatusSummary statuses;        // Why and when each marker was not found.
+  std::optional<int64_t> first_index{};  // Source indices of the first and last processed frame.
+  std::optional<int64_t> last_index{};
+  std::vector<MarkerRunSummary> markers{};  // In config order.
+  MarkerStatusSummary statuses{};      // Why and when each marker was not found.
   int64_t measured = 0;                // Frames with an angle.
   double proc_ms_median = 0.0;         // FrameResult::proc_ms over the processed frames.
   double proc_ms_p99 = 0.0;
@@ -48,15 +48,15 @@ struct RunSummary {
   double latency_done_ms_p99 = 0.0;
   // To the CSV row written (CsvSink::row_latencies_ms), when the command that owns the CSV
   // filled it in; absent: not reported.
-  std::optional<double> latency_row_ms_median;
-  std::optional<double> latency_row_ms_p99;
+  std::optional<double> latency_row_ms_median{};
+  std::optional<double> latency_row_ms_p99{};
   double wall_s = 0.0;                 // Whole run, reading and sinks included.
   StopReason stop_reason = StopReason::kEndOfInput;
   // With kStopRequested, who asked, when the caller knows: "stopped by SIGTERM".
-  std::string stop_detail;
-  std::string error;                   // With kError: the InputError's message.
+  std::string stop_detail{};
+  std::string error{};                 // With kError: the InputError's message.
   // What the source says about its input (FrameSource::note), e.g. gaps in a sequence.
-  std::vector<std::string> notes;
+  std::vector<std::string> notes{};
 
   // Fraction of processed frames in which marker `i` was found (0 without frames).
   double found_rate(size_t i) const;

@@ -26,7 +26,7 @@ struct ChessboardPattern {
 struct CameraModel {
   cv::Size image_size{640, 480};
   cv::Matx33d camera_matrix = cv::Matx33d(600, 0, 320, 0, 600, 240, 0, 0, 1);
-  std::vector<double> distortion;  // Empty: no distortion.
+  std::vector<double> distortion{};  // Empty: no distortion.
 };
 
 struct ChessboardLook {
@@ -42,14 +42,14 @@ struct ChessboardLook {
 
 // Where the board is: board-to-camera rotation (Rodrigues vector) and translation (mm).
 struct BoardPose {
-  cv::Vec3d rvec;
+  cv::Vec3d rvec{};
   cv::Vec3d tvec{0, 0, 500};
 };
 
 // The truth for one rendered view.
 struct ChessboardView {
-  std::vector<cv::Point2f> corners_px;  // Inner corners as the camera sees them (distorted).
-  bool all_corners_inside = false;      // Every inner corner projects into the image.
+  std::vector<cv::Point2f> corners_px{};  // Inner corners as the camera sees them (distorted).
+  bool all_corners_inside = false;        // Every inner corner projects into the image.
 };
 
 // Precomputes each sub-sample's ray once per camera, then renders any number of poses.

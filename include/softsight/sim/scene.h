@@ -41,9 +41,9 @@ struct Distractor {
 };
 
 struct SceneMarker {
-  std::string name;
-  cv::Vec3b bgr;            // Marker colour (saturated, so HSV thresholds separate it).
-  double body_fraction;     // Position along the body, 0 = base, 1 = tip.
+  std::string name{};
+  cv::Vec3b bgr{};          // Marker colour (saturated, so HSV thresholds separate it).
+  double body_fraction{};   // Position along the body, 0 = base, 1 = tip.
 };
 
 struct SceneOptions {
@@ -97,17 +97,17 @@ struct RenderOptions {
 // convention: integer values cover exactly the pixels of the cv::Rect (x, y, width, height),
 // fractional ones give anti-aliased edges.
 struct Occluder {
-  cv::Rect2d rect_px;
+  cv::Rect2d rect_px{};
   int first_frame = 0;
   int last_frame = 0;
   cv::Vec3b bgr{128, 128, 128};
 };
 
 struct MarkerTruth {
-  std::string name;
+  std::string name{};
   // Centroid of the marker's rendered visible area (pixel-centre convention); absent when the
   // marker is fully hidden.
-  std::optional<cv::Point2d> centroid_px;
+  std::optional<cv::Point2d> centroid_px{};
   double visible_fraction = 1.0;  // Visible area / unoccluded area.
 };
 
@@ -116,13 +116,13 @@ struct SceneTruth {
   double time_s = 0.0;
   double bend_deg = 0.0;                 // Total turning of the centre line (the actuator state).
   // Radius of the centre-line arc; absent when straight and for the wedge scenes (no arc).
-  std::optional<double> centreline_radius_px;
-  std::vector<MarkerTruth> markers;
+  std::optional<double> centreline_radius_px{};
+  std::vector<MarkerTruth> markers{};
   // The paper's measurements from the true centroids: base, middle and tip are the markers with
   // the smallest, median and largest body_fraction (all of them as a chain when more than 3);
   // the tip reference is the tip marker's centre when the actuator is straight. Default (empty)
   // with fewer than three markers and for the plate scene.
-  Measurement measurement;
+  Measurement measurement{};
 };
 
 class SyntheticScene {

@@ -19,7 +19,7 @@
 namespace softsight {
 
 struct StereoRig {
-  CameraModel left, right;
+  CameraModel left{}, right{};
   cv::Matx33d R = cv::Matx33d::eye();  // right_from_left.
   cv::Vec3d T{-100, 0, 0};  // right_from_left (mm); the right camera 100 mm to the right.
 };
@@ -37,15 +37,15 @@ cv::Point2d ProjectLeft(const StereoRig& rig, const cv::Point3d& point_mm);
 cv::Point2d ProjectRight(const StereoRig& rig, const cv::Point3d& point_mm);
 
 struct StereoMarker {
-  std::string name;
-  cv::Vec3b bgr;
+  std::string name{};
+  cv::Vec3b bgr{};
   double body_fraction = 0.0;  // 0 = base, 1 = tip.
 };
 
 // A marker covered in one view for a stretch of frames (a hand or a tube in front of one camera):
 // not drawn in that view; the other view and the truth are unchanged.
 struct StereoHiddenMarker {
-  std::string name;     // One of StereoSceneOptions::markers.
+  std::string name{};   // One of StereoSceneOptions::markers.
   int view = 1;         // 0: the left (first) camera, 1: the right one.
   int first_frame = 0;  // From this frame index on ...
   int frames = 1;       // ... for this many frames (>= 1).
@@ -64,7 +64,7 @@ struct StereoSceneOptions {
   // When not empty: the bend of each frame (deg, frame_count values), instead of the linear
   // ramp to max_bend_deg: motion that starts, stops and changes speed (what finding the offset
   // between two cameras' videos correlates), or none at all.
-  std::vector<double> bend_deg_per_frame;
+  std::vector<double> bend_deg_per_frame{};
   // The bending plane contains the straight direction; it is turned this much about it out of
   // the image-parallel plane (0: the bend is seen face on, 90: edge on), at frame 0 and at the
   // last frame (linear between: a turning, i.e. twisting, actuator).
@@ -76,7 +76,7 @@ struct StereoSceneOptions {
   double body_width_mm = 12.0;
   std::vector<StereoMarker> markers = {
       {"red", {40, 40, 220}, 0.1}, {"blue", {220, 90, 40}, 0.5}, {"green", {60, 200, 60}, 0.9}};
-  std::vector<StereoHiddenMarker> hidden;
+  std::vector<StereoHiddenMarker> hidden{};
   cv::Vec3b body_bgr{200, 200, 205};
   cv::Vec3b background_bgr{105, 110, 115};
   int supersample = 4;       // Sub-samples per pixel side for the markers' edges (1..16).
@@ -84,7 +84,7 @@ struct StereoSceneOptions {
   // A flash: from frame `flash_frame` on, for `flash_length_frames` frames (0: to the end: a
   // lamp switched on), every pixel of both views is `flash_gray` grey levels brighter
   // (saturating). Absent: no flash.
-  std::optional<int> flash_frame;
+  std::optional<int> flash_frame{};
   int flash_length_frames = 1;
   double flash_gray = 60.0;
   uint64_t seed = 7;
@@ -94,20 +94,20 @@ struct StereoSceneOptions {
 };
 
 struct StereoMarkerTruth {
-  std::string name;
-  cv::Point3d position_mm;        // The disc's centre.
-  cv::Point2d left_px, right_px;  // Its projection (raw pixels) in each view.
+  std::string name{};
+  cv::Point3d position_mm{};          // The disc's centre.
+  cv::Point2d left_px{}, right_px{};  // Its projection (raw pixels) in each view.
 };
 
 struct StereoSceneTruth {
   int index = 0;
   double bend_deg = 0.0;        // Total turning of the centre line.
   double plane_tilt_deg = 0.0;  // The bending plane vs the left camera's image plane.
-  cv::Vec3d plane_normal;       // Unit normal of the bending plane.
-  std::vector<StereoMarkerTruth> markers;
+  cv::Vec3d plane_normal{};     // Unit normal of the bending plane.
+  std::vector<StereoMarkerTruth> markers{};
   // From the true 3D centres (base, middle, tip: the first, middle and last marker).
-  double angle_deg = 0.0;           // At the middle marker, in 3D.
-  std::optional<double> radius_mm;  // Of the centre line (absent when straight).
+  double angle_deg = 0.0;             // At the middle marker, in 3D.
+  std::optional<double> radius_mm{};  // Of the centre line (absent when straight).
 };
 
 class StereoScene {

@@ -41,10 +41,10 @@ struct TruthScore {
   int64_t hidden = 0;         // Marker-frames fully hidden.
   int64_t false_reports = 0;  // Found while fully hidden.
   // |tracked - true centroid| over the hits; absent without hits.
-  std::optional<double> centroid_rms_px;
-  std::optional<double> centroid_max_px;
-  std::optional<double> centroid_p95_px;  // 95th percentile (nearest rank) of the same errors.
-  int64_t wrong_finds = 0;                // Hits farther than kWrongFindPx from the truth.
+  std::optional<double> centroid_rms_px{};
+  std::optional<double> centroid_max_px{};
+  std::optional<double> centroid_p95_px{};  // 95th percentile (nearest rank) of the same errors.
+  int64_t wrong_finds = 0;                  // Hits farther than kWrongFindPx from the truth.
   // The hits' reported uncertainty (Observation::sigma_px) against their errors: hits with a
   // sigma, those whose error along both axes is within 3 sigma, and those beyond 5 sigma on
   // either axis. A calibrated sigma keeps at least 99 % within 3 and none beyond 5.
@@ -53,11 +53,11 @@ struct TruthScore {
   int64_t beyond_5_sigma = 0;
   // The same after subtracting, per marker, the constant offset (tracked - true) of its first
   // hit: what remains once the half-pixel placement of a dragged template is taken out.
-  std::optional<double> precision_rms_px;
-  std::optional<double> precision_max_px;
+  std::optional<double> precision_rms_px{};
+  std::optional<double> precision_max_px{};
   // Angle (eq. 7) against the truth's over frames where both exist; absent when none did.
-  std::optional<double> angle_rms_deg;
-  std::optional<double> angle_max_deg;
+  std::optional<double> angle_rms_deg{};
+  std::optional<double> angle_max_deg{};
   int64_t angle_frames = 0;
 };
 

@@ -40,13 +40,13 @@ struct ColourParams {
   // Intensity markers (white or black dots): when set, h/s/v are ignored and a pixel is marker
   // when its gray level (BGR->gray luma, or the frame itself when it is CV_8UC1) lies in this
   // inclusive range 0..255. Works on gray and colour video alike.
-  std::optional<HsvRange> gray;
+  std::optional<HsvRange> gray{};
   // Automatic colour: when set, h/s/v are ignored. The nominal colour (B, G, R) gives the
   // threshold (hue within 12 of the nominal's, saturation and value at least half and
   // 40 % of the nominal's) and is the colour model candidates are verified against
   // until the marker's own colour is learned: a same-hue blob much darker or of another tint is
   // not the marker. A nominal gray (B = G = R, or saturation below 40) tracks by gray level.
-  std::optional<cv::Vec3b> auto_bgr;
+  std::optional<cv::Vec3b> auto_bgr{};
 
   // ---- Morphology: opening (removes specks) then closing (fills holes) ----------------------------
   enum class Shape { kRect, kEllipse, kCross };
@@ -102,7 +102,7 @@ struct ColourParams {
   // 2 px inside its edge: a speck's colour is a mix with its surroundings, and real footage is
   // full of glints and highlight rims). Later re-acquisitions search the whole frame,
   // preferring candidates that fit the learned model best, near the last known position.
-  std::optional<cv::Rect> roi;
+  std::optional<cv::Rect> roi{};
   // The frame (Frame::index) the roi was picked on: a pick or drag at frame N (live, `softsight
   // pick --frame N`, `init --frame N`) says where the marker is then, not at frame 0, where it
   // may have been anywhere. Before this frame the marker is not started (status not_started,

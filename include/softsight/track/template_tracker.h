@@ -99,8 +99,8 @@ struct TemplateParams {
   // and `rect`, its size, is where it was selected on `template_frame`: init() without a hint
   // starts tracking there, exactly as the selection did, instead of searching the whole frame.
   int template_frame = 0;
-  std::optional<cv::Rect> rect;
-  cv::Mat image;
+  std::optional<cv::Rect> rect{};
+  cv::Mat image{};
   // Match only the ellipse inscribed in the template rectangle (a disc for a square one), so the
   // background in the rectangle's corners, which rotates with the body or is clutter behind a
   // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a

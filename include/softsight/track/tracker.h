@@ -42,7 +42,7 @@ enum class CandidateVerdict : uint8_t {
 const char* CandidateVerdictName(CandidateVerdict verdict);
 
 struct MarkerCandidate {
-  cv::Point2d position_px;     // Centroid (complete blobs) or bounding-box centre (clipped ones).
+  cv::Point2d position_px{};   // Centroid (complete blobs) or bounding-box centre (clipped ones).
   double area_px = 0;
   double circularity = 0;      // See ColourParams::min_circularity.
   double misfit = 0;           // 0 perfect; above 1 rejected (see ColourParams::ambiguity_margin).
@@ -182,8 +182,8 @@ class MarkerParams {
 
 // Everything needed to build the tracker of one marker.
 struct MarkerSpec {
-  std::string name;     // Unique; prefixes the marker's CSV columns.
-  MarkerParams params;  // Colour by default.
+  std::string name{};     // Unique; prefixes the marker's CSV columns.
+  MarkerParams params{};  // Colour by default.
 };
 
 // Builds the tracker for `spec.params`. Throws InputError naming the marker when its parameters
