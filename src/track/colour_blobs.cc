@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "softsight/core/error.h"
+#include "track/chromaticity.h"
 #include "track/colour_tracker_impl.h"
 #include "track/colour_tracker_parts.h"
 #include "track/soft_centroid.h"
@@ -302,8 +303,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   std::array<cv::Vec3d, kQuarters> quarter_chroma_sum{};
   std::array<cv::Matx33d, kQuarters> quarter_chroma_outer{};
   const auto add_chroma = [](const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
-    const double scale = 1.0 / (c[0] + c[1] + c[2] + kChromaDarkLevels);
-    const cv::Vec3d chroma(c[0] * scale, c[1] * scale, c[2] * scale);
+    const cv::Vec3d chroma = Chromaticity(c[0], c[1], c[2]);
     sum += chroma;
     for (int k = 0; k < 3; ++k) {
       for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];

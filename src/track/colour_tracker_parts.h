@@ -49,12 +49,10 @@ constexpr double kContrastNoiseFloor = 2.0;
 // widths a frame still stands out), while a patch of background texture differs from its
 // surroundings by less than they vary, whatever its core does.
 constexpr double kCoreSigmaWeight = 0.5;
-// The contrast in chromaticity (B, G, R over B + G + R + kChromaDarkLevels, so that near-black
-// pixels, whose ratios are noise, count as grey): judged only where the marker's chromaticity
+// The contrast in chromaticity (track/chromaticity.h): judged only where the marker's chromaticity
 // differs from its surroundings' by kMinChromaContrastSpan at least (a tinted patch of the bench
 // differs by less; coloured markers by 0.1-0.4), with kChromaNoiseFloor as its noise floor (two
 // grey levels at mid brightness).
-constexpr double kChromaDarkLevels = 30.0;
 constexpr double kMinChromaContrastSpan = 0.05;
 constexpr double kChromaNoiseFloor = 0.005;
 

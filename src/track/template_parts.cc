@@ -233,12 +233,6 @@ cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask) {
   return best;
 }
 
-namespace {
-cv::Vec3d Chromaticity(const cv::Vec3d& bgr) {
-  return bgr / (bgr[0] + bgr[1] + bgr[2] + kChromaDarkLevels);
-}
-}  // namespace
-
 bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out) {
   if (bgr.type() != CV_8UC3 || bgr.cols < 5 || bgr.rows < 5) return false;
   cv::Vec3d centre(0, 0, 0), edge(0, 0, 0);
@@ -246,7 +240,7 @@ bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out) {
   for (int y = 0; y < bgr.rows; ++y) {
     const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3d c = Chromaticity(cv::Vec3d(row[x][0], row[x][1], row[x][2]));
+      const cv::Vec3d c = Chromaticity(row[x][0], row[x][1], row[x][2]);
       if (std::abs(2 * x - (bgr.cols - 1)) <= 2 && std::abs(2 * y - (bgr.rows - 1)) <= 2) {
         centre += c;
         ++centre_n;
@@ -274,7 +268,7 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
     const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3d c = Chromaticity(cv::Vec3d(row[x][0], row[x][1], row[x][2]));
+      const cv::Vec3d c = Chromaticity(row[x][0], row[x][1], row[x][2]);
       o[x] = cv::saturate_cast<uint8_t>(40.0 + scale * (c - chroma.background).dot(chroma.axis));
     }
   }

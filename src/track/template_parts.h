@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "track/chromaticity.h"
 #include "track/match_kernels.h"
 #include "track/soft_centroid.h"
 
@@ -416,13 +417,12 @@ cv::Mat MarkerProjection(const cv::Mat& bgr, const cv::Mat& mask);
 // shades a domed marker from bright to dark across its face: in any gray channel its blob's
 // centroid moves 2-4 px towards the lit flank (a physically rendered bench), while the
 // chromaticity hardly changes with the light's strength. Dark pixels' chromaticity is noise: the
-// sum is damped by kChromaDarkLevels.
+// sum is damped by kChromaDarkLevels (track/chromaticity.h).
 struct ChromaAxis {
   cv::Vec3d background;  // Chromaticity of the box's edge.
   cv::Vec3d axis;        // Unit vector from it towards the marker's (the box's centre).
   double span = 0;       // The marker's distance along the axis.
 };
-inline constexpr double kChromaDarkLevels = 30.0;
 // Below this span the marker's colour is the background's (a white dot on grey): no axis.
 inline constexpr double kMinChromaSpan = 0.05;
 // The axis of `bgr` (a selected template, 8-bit BGR); false when its centre's chromaticity does
