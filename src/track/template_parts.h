@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
@@ -249,8 +250,7 @@ class BlobMeter {
     // A priority flood from the seed, most marker-like first (256 buckets of marker-likeness):
     // the first edge pixel it takes sets the pass.
     for (auto& bucket : buckets_) bucket.clear();
-    visited_.create(gray.size(), CV_8UC1);
-    visited_.setTo(0);
+    ZeroedMask(gray.size(), visited_);
     const auto likeness = [&](int x, int y) {
       const int v = gray.at<uint8_t>(y, x);
       return bright_ ? v : 255 - v;
@@ -317,6 +317,12 @@ class BlobMeter {
     }
     return seed;
   }
+  // `out` made `size`, CV_8UC1, all 0: create() gives a continuous buffer, cleared by one memset
+  // (cv::Mat::setTo fills it byte by byte: issue 45).
+  static void ZeroedMask(cv::Size size, cv::Mat& out) {
+    out.create(size, CV_8UC1);
+    std::memset(out.data, 0, out.total());
+  }
   bool IsInside(const cv::Mat& gray, const cv::Mat& mask, int x, int y) const {
     return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
            (mask.empty() || mask.at<uint8_t>(y, x));
@@ -328,8 +334,7 @@ class BlobMeter {
   // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
-    label_.create(gray.size(), CV_8UC1);
-    label_.setTo(0);
+    ZeroedMask(gray.size(), label_);
     stack_.clear();
     stack_.push_back(seed);
     label_.at<uint8_t>(seed) = 1;
