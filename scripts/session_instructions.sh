@@ -8,12 +8,17 @@
 # counting only its timed frames (the function TimedFrame: no rendering, no warm-up) and
 # dividing by how often TimedFrame was called.
 #   scripts/session_instructions.sh [WIDTH HEIGHT]     (default 640 480; about 5 minutes)
+# PROGRAM=<a copy of the benchmark built from another commit> counts that one instead (before and
+# after a change).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WIDTH=${1:-640}
 HEIGHT=${2:-480}
 command -v valgrind >/dev/null || { echo "valgrind is not installed" >&2; exit 1; }
-cmake --build build --target softsight_tracking_session_benchmark >/dev/null
+if [ -z "${PROGRAM:-}" ]; then
+  cmake --build build --target softsight_tracking_session_benchmark >/dev/null
+  PROGRAM=build/src/pipeline/softsight_tracking_session_benchmark
+fi
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 
@@ -23,7 +28,7 @@ count() {
   # A second of the benchmark's own timing under callgrind: at least ~60 frames of the session,
   # every frame of the forth-and-back sweep.
   valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*TimedFrame*' \
-    --callgrind-out-file="$out" build/src/pipeline/softsight_tracking_session_benchmark \
+    --callgrind-out-file="$out" "$PROGRAM" \
     --benchmark_filter="^$1/$WIDTH/$HEIGHT\$" --benchmark_min_time=1 >/dev/null 2>&1
   # The caller tree lists each function's callers above it with the count of their calls:
   # "<Ir> (..)  < caller (Nx)" lines, then "<Ir> (..)  *  function". TimedFrame's own callers'
