@@ -7,7 +7,9 @@
 #   scripts/bench.sh [WORK_DIR]     (default: bench_out/, reused: rendered videos are kept)
 # Then the per-frame "Speed" table of docs/measurements.md of the trackers and recordings, from the Google
 # Benchmark programs (their JSON kept in WORK_DIR), each row beside the BGR -> gray pass its own
-# program measured in the same run.
+# program measured in the same run. Then the TrackingSession table: the session per frame with three
+# colour markers and with three ZNCC templates, at 640x480 and 1280x720, beside the gray pass
+# (issue 45; their instruction counts, steady on a busy machine: scripts/session_instructions.sh).
 # Takes about 4 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -196,10 +198,13 @@ for noise, label in ((0, "clean scene"), (4, "sensor noise sigma 4")):
           f"| | gray pass {wg:.3f} ms |")
 PYEOF
 
-# What TrackingSession costs beyond its trackers (issue 26, item 7): thread CPU time per frame,
-# each row beside the gray pass the session program measured in the same run.
+# What TrackingSession costs beside a gray pass (issue 45: at most one at 640x480, with three
+# colour markers and with three ZNCC templates) and beyond its trackers (issue 26, item 7): thread
+# CPU time per frame (OpenCV on one thread), each row beside the gray pass the session program
+# measured in the same run; wall time in brackets. Instruction counts of the same rows, which do
+# not move with the machine's load: scripts/session_instructions.sh.
 echo
-echo "TrackingSession per frame (thread CPU time, Google Benchmark):"
+echo "TrackingSession per frame (thread CPU time, Google Benchmark), load average $(cut -d' ' -f1-3 /proc/loadavg):"
 echo
 "$PY" - "$WORK" <<'PYEOF'
 import json, os, sys
@@ -207,20 +212,26 @@ with open(os.path.join(sys.argv[1], "session.json")) as f:
     b = {x["name"]: x for x in json.load(f)["benchmarks"]}
 sizes = ("640/480", "1280/720")
 cpu = lambda name, s: b[f"{name}/{s}"]["cpu_ms_per_frame"]
-print("| what (3 colour markers) | 640x480 | 1280x720 | target |")
+wall = lambda name, s: b[f"{name}/{s}"]["ms_per_frame"]
+print("| what | 640x480 | 1280x720 | target |")
 print("| --- | --- | --- | --- |")
-def row(what, name, target):
-    cells = " | ".join(f"{cpu(name, s):.3f} ms ({cpu(name, s) / cpu('BM_GrayReference', s):.2f}x gray)"
-                       for s in sizes)
-    print(f"| {what} | {cells} | {target} |")
-row("BGR -> gray pass (reference)", "BM_GrayReference", "")
-row("the three colour trackers alone", "BM_Trackers3", "")
-row("`TrackingSession::process` whole", "BM_Session3", "<= 0.12 / 0.25 ms")
-row("of it: `FrameChangeDetector::observe`", "BM_FrameChange", "")
-over = " | ".join(f"{cpu('BM_Session3', s) - cpu('BM_Trackers3', s):.3f} ms "
-                  f"({(cpu('BM_Session3', s) - cpu('BM_Trackers3', s)) / cpu('BM_Trackers3', s):.2f}x the trackers)"
-                  for s in sizes)
-print(f"| the session's own checks (whole - trackers) | {over} | <= the trackers' time |")
+def cell(name, s):
+    return (f"{cpu(name, s):.3f} ms ({cpu(name, s) / cpu('BM_GrayReference', s):.2f}x gray; wall "
+            f"{wall(name, s) / wall('BM_GrayReference', s):.2f}x)")
+def row(what, name, target=""):
+    print(f"| {what} | {' | '.join(cell(name, s) for s in sizes)} | {target} |")
+row("BGR -> gray pass (reference)", "BM_GrayReference")
+row("the three colour trackers alone", "BM_Trackers3")
+row("`TrackingSession::process`, 3 colour markers", "BM_Session3", "<= 1.0x gray at 640x480")
+row("the three ZNCC template trackers alone", "BM_Trackers3Zncc")
+row("`TrackingSession::process`, 3 ZNCC templates", "BM_Session3Zncc", "<= 1.0x gray at 640x480")
+row("of it: `FrameChangeDetector::observe`", "BM_FrameChange")
+for label, session, trackers in (("colour", "BM_Session3", "BM_Trackers3"),
+                                 ("ZNCC", "BM_Session3Zncc", "BM_Trackers3Zncc")):
+    over = " | ".join(f"{cpu(session, s) - cpu(trackers, s):.3f} ms "
+                      f"({(cpu(session, s) - cpu(trackers, s)) / cpu(trackers, s):.2f}x the trackers)"
+                      for s in sizes)
+    print(f"| the session's own checks (whole - trackers), {label} | {over} | <= the trackers' time |")
 PYEOF
 
 # The stream (--publish, issue 28): capture-to-subscriber latency beside the CSV row's, and the

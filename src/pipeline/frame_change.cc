@@ -31,7 +31,8 @@ constexpr double kRelitChangedFraction = 0.08;
 
 // Correlation of two cells' samples, or 1 when either is too flat to tell (noise alone, whose
 // pattern changes from frame to frame, correlates with nothing).
-float PatternCorrelation(const std::array<uint8_t, 64>& a, const std::array<uint8_t, 64>& b) {
+using CellSamples = decltype(FrameCell::gray);
+float PatternCorrelation(const CellSamples& a, const CellSamples& b) {
   // Standard deviation of the samples below which a cell is flat: well above a camera's noise.
   constexpr float kTexturedSpread = 10.0f;
   float sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;

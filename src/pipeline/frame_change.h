@@ -62,7 +62,7 @@ class FrameChangeDetector {
   // or more: else what moved may be the largest moving thing in view, not the camera), when it
   // cannot tell (too little texture, no clear single translation), or when the picture did not
   // move by a sample or more. Computed on demand (a phase
-  // correlation of the summaries' samples: about 120 x 160 at any resolution).
+  // correlation of the summaries' samples: about 60 x 80 at any resolution).
   std::optional<cv::Point2d> camera_shift_px();
 
   // Fraction of cells that changed against the last normal frame (for tests and tuning).

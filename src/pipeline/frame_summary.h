@@ -1,15 +1,20 @@
 // The frame-change detector's summary of a frame (pipeline/frame_change.h): a sample every
-// `step` pixels, 8 x 8 samples to a cell; per cell the mean colour, the texture (mean absolute
+// `step` pixels, 4 x 4 samples to a cell; per cell the mean colour, the texture (mean absolute
 // difference of horizontally and vertically adjacent samples) and the samples' gray levels.
 //
 // It runs on every frame the session sees, so it must cost a small fraction of the trackers'
-// work (issue 26: the first version, one loop over the samples with three integer divisions and
-// two branches per sample, cost 3x the three colour trackers at VGA). FrameSummariser copies
-// each sampled row into planes once, computes the row's differences and gray levels in loops
-// the compiler vectorises, and adds them up cell by cell, each cell's samples in the order the
-// reference adds them, so the floating-point sums are the same to the last bit.
-// SummariseFrameReference is the obviously correct version it is tested against
-// (frame_summary_test.cc: bit-identical on random, rendered and odd-sized frames).
+// work. Issue 26: the first version (a loop over the samples with three integer divisions and two
+// branches per sample) cost 3x the three colour trackers at VGA. Issue 45: 8 x 8 samples to a
+// cell, a sample every 4 px at VGA, still cost as many instructions as a BGR->gray pass of the
+// whole frame (36 % of the session's time). The detector's questions are about whole cells (32 px
+// at VGA) and the whole frame: most cells changed at once, a cell turned into decoded garbage, the
+// picture shifted as a whole; a sample every 8 px answers them as one every 4 px did (the tests
+// of the damaged, relit and bumped pictures, the real footage) for a quarter of the samples and
+// half the rows read. FrameSummariser copies each sampled row into planes once, computes the
+// row's differences and gray levels in loops the compiler vectorises, adds them up per column of
+// samples, and per cell once a row of cells is complete. Every sum is an integer, so it is the
+// same to the last bit as SummariseFrameReference, the obviously correct version it is tested
+// against (frame_summary_test.cc: bit-identical on random, rendered and odd-sized frames).
 #pragma once
 
 #include <array>
@@ -20,13 +25,15 @@
 
 namespace softsight {
 
-// Samples per cell side: cells of 8 x 8 samples (32 px at VGA) hold a marker or two.
-inline constexpr int kSamplesPerCell = 8;
+// Samples per cell side: cells of 4 x 4 samples (32 px at VGA) hold a marker or two.
+inline constexpr int kSamplesPerCell = 4;
 
 struct FrameCell {
   float b = 0, g = 0, r = 0;  // Mean colour.
-  float texture = 0;          // Mean |difference| of horizontally and vertically adjacent samples.
-  std::array<uint8_t, 64> gray{};  // The cell's 8 x 8 samples, (b + g + r) / 3.
+  // Mean over the cell's samples of each sample's mean |difference| to its left and upper
+  // neighbours (per channel; over the neighbours it has).
+  float texture = 0;
+  std::array<uint8_t, kSamplesPerCell * kSamplesPerCell> gray{};  // The samples, (b + g + r) / 3.
 };
 
 // Where the samples and cells of a frame of some size are.
@@ -35,7 +42,7 @@ struct CellGrid {
   int cell_px = 1;          // Cell side in pixels (kSamplesPerCell * step).
   int cols = 0, rows = 0;   // Cells per row and column (at least 1 each); the last column and
                             // row of cells also hold the samples beyond cols * cell_px.
-  // About 120 samples across the image's shorter side, whatever its resolution.
+  // About 60 samples across the image's shorter side, whatever its resolution.
   static CellGrid For(cv::Size size);
 };
 
@@ -46,10 +53,12 @@ class FrameSummariser {
   void summarise(const cv::Mat& bgr, const CellGrid& grid, std::vector<FrameCell>& cells);
 
  private:
-  // The sampled row and the one above it, as planes; the row's per-sample texture and gray.
+  // The sampled row and the one above it, as planes; the row's gray levels.
   std::vector<uint8_t> b_, g_, r_, above_b_, above_g_, above_r_, gray_;
-  std::vector<float> texture_;
-  std::vector<int> sum_b_, sum_g_, sum_r_;  // Per cell, exact (at most 16 x 16 samples of 255).
+  // Per column of samples, over the sampled rows of the current row of cells (at most 2 x 4 rows:
+  // the last row of cells takes the rest): the sums of the channels and of the samples' texture
+  // in sixths of a level (each at most 2 x 3 x 255), exact in 16 bits.
+  std::vector<uint16_t> column_b_, column_g_, column_r_, column_texture_sixths_;
 };
 
 // The reference: one pass over the samples, each added to its cell as the definition says.

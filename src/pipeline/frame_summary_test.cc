@@ -27,10 +27,12 @@ void ExpectSummariesEqual(const std::vector<FrameCell>& fast,
   }
 }
 
+// `fast` is the caller's, reused from frame to frame as the detector reuses its cells (what an
+// earlier frame of another size left there must not show).
 void ExpectSummarisedAsReference(FrameSummariser& summariser, const cv::Mat& bgr,
-                                 const std::string& what) {
+                                 std::vector<FrameCell>& fast, const std::string& what) {
   const CellGrid grid = CellGrid::For(bgr.size());
-  std::vector<FrameCell> fast, reference;
+  std::vector<FrameCell> reference;
   summariser.summarise(bgr, grid, fast);
   SummariseFrameReference(bgr, grid, reference);
   ASSERT_EQ(reference.size(), static_cast<size_t>(grid.cols) * grid.rows) << what;
@@ -43,26 +45,28 @@ std::string SizeName(cv::Size size) {
 
 TEST(FrameSummary, RandomFramesOfEverySizeAreSummarisedBitForBitAsTheReference) {
   // Sizes whose sample grids end exactly on a cell, just past one, or hold less than one cell
-  // (one cell taking every sample), with steps 1 to 9.
+  // (one cell taking every sample), with steps 1 to 18.
   const cv::Size sizes[] = {{1, 1},     {2, 3},     {7, 5},     {8, 8},     {9, 17},
                             {31, 17},   {33, 200},  {200, 33},  {119, 121}, {241, 240},
                             {479, 641}, {640, 480}, {641, 481}, {959, 541}, {1280, 720},
-                            {1279, 719}, {1920, 1080}};
+                            {1279, 719}, {1920, 1080}, {3, 2}};
   cv::RNG rng(26);
   FrameSummariser summariser;  // One for all sizes: its scratch rows follow the size.
+  std::vector<FrameCell> fast;
   for (const cv::Size& size : sizes) {
     cv::Mat bgr(size, CV_8UC3);
     rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
-    ExpectSummarisedAsReference(summariser, bgr, "random bytes " + SizeName(size));
+    ExpectSummarisedAsReference(summariser, bgr, fast, "random bytes " + SizeName(size));
     // Smooth content too: small differences, whose divisions by 3 and 6 round.
     cv::Mat smooth;
     cv::GaussianBlur(bgr, smooth, cv::Size(0, 0), 3.0);
-    ExpectSummarisedAsReference(summariser, smooth, "smooth " + SizeName(size));
+    ExpectSummarisedAsReference(summariser, smooth, fast, "smooth " + SizeName(size));
   }
 }
 
 TEST(FrameSummary, RenderedFramesAndAWindowOfALargerImageAreSummarisedAsTheReference) {
   FrameSummariser summariser;
+  std::vector<FrameCell> fast;
   for (const cv::Size& size : {cv::Size(640, 480), cv::Size(1280, 720)}) {
     SceneOptions options;
     options.size = size;
@@ -71,17 +75,17 @@ TEST(FrameSummary, RenderedFramesAndAWindowOfALargerImageAreSummarisedAsTheRefer
     SyntheticScene scene(options, noise);
     cv::Mat bgr;
     scene.render(7, bgr);
-    ExpectSummarisedAsReference(summariser, bgr, "rendered " + SizeName(size));
+    ExpectSummarisedAsReference(summariser, bgr, fast, "rendered " + SizeName(size));
     // Rows that are not contiguous in memory: a window of the frame.
     ExpectSummarisedAsReference(summariser, bgr(cv::Rect(13, 5, size.width / 2, size.height / 3)),
-                                "window of rendered " + SizeName(size));
+                                fast, "window of rendered " + SizeName(size));
   }
 }
 
 TEST(FrameSummary, AUniformFrameHasItsColourAndNoTextureInEveryCell) {
   const cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(10, 100, 221));
   const CellGrid grid = CellGrid::For(bgr.size());
-  EXPECT_EQ(grid.step, 4);
+  EXPECT_EQ(grid.step, 8);
   EXPECT_EQ(grid.cols, 20);
   EXPECT_EQ(grid.rows, 15);
   std::vector<FrameCell> cells;
@@ -97,21 +101,22 @@ TEST(FrameSummary, AUniformFrameHasItsColourAndNoTextureInEveryCell) {
 }
 
 TEST(FrameSummary, TextureIsTheMeanDifferenceOfNeighbouringSamples) {
-  // Columns alternating 0 and 90 in every channel from one sample to the next (step 4 at VGA):
+  // Columns alternating 0 and 90 in every channel from one sample to the next (step 8 at VGA):
   // every sample but the first column's differs by 90 from its left neighbour and by 0 from the
   // one above, so a cell's texture is the mean of 90 / 2 over its samples with two neighbours,
   // 90 for the first row's (left only) and 0 for the first column's.
   cv::Mat bgr(480, 640, CV_8UC3);
   for (int x = 0; x < bgr.cols; ++x) {
-    bgr.col(x).setTo(cv::Scalar::all((x / 4) % 2 == 0 ? 0 : 90));
+    bgr.col(x).setTo(cv::Scalar::all((x / 8) % 2 == 0 ? 0 : 90));
   }
   const CellGrid grid = CellGrid::For(bgr.size());
+  ASSERT_EQ(grid.step, 8);
   std::vector<FrameCell> cells;
   FrameSummariser().summarise(bgr, grid, cells);
-  // An inner cell: 64 samples of 45.
+  // An inner cell: 16 samples of 45.
   EXPECT_FLOAT_EQ(cells[static_cast<size_t>(5 * grid.cols + 5)].texture, 45.0f);
-  // The top-left cell: 7 first-row samples of 90, 7 x 7 of 45, the first column's 8 of 0.
-  EXPECT_FLOAT_EQ(cells[0].texture, (7 * 90.0f + 49 * 45.0f) / 64.0f);
+  // The top-left cell: 3 first-row samples of 90, 3 x 3 of 45, the first column's 4 of 0.
+  EXPECT_FLOAT_EQ(cells[0].texture, (3 * 90.0f + 9 * 45.0f) / 16.0f);
   EXPECT_FLOAT_EQ(cells[0].b, 45.0f);
 }
 

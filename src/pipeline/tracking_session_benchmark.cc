@@ -1,9 +1,12 @@
-// What TrackingSession::process costs beyond its trackers (issue 26, item 7), per frame, on the
-// rendered bending actuator with its three colour markers, at 640x480 and 1280x720:
+// What TrackingSession::process costs beyond its trackers (issue 26, item 7; issue 45: at most one
+// gray pass at 640x480), per frame, on the rendered bending actuator with its three markers, at
+// 640x480 and 1280x720:
 //   GrayReference   one cv::cvtColor BGR->GRAY of the same frame: the one-pass yardstick;
 //   Trackers3       the three colour trackers alone, as the session builds them (CreateTracker);
 //   Session3        TrackingSession::process whole: trackers, frame-change detector, association,
 //                   plausibility and the measurement;
+//   Trackers3Zncc,  the same with three ZNCC templates (the registry's defaults: gray, round
+//   Session3Zncc    mask) cut around the markers on the first frame;
 //   FrameChange     FrameChangeDetector::observe alone (the session's summary of the whole frame).
 // Every row reports ms_per_frame and the thread's CPU time per frame (cpu_ms_per_frame; OpenCV
 // runs single-threaded here, so that is the work done) and both over the gray pass's (x_gray,
@@ -92,6 +95,28 @@ TrackingConfig ThreeMarkerConfig() {
   return config;
 }
 
+// The same three markers as ZNCC templates, each a square of kTemplatePx cut around its marker
+// on the first frame (template_frame 0: the session cuts it there, as `track` does).
+constexpr int kTemplatePx = 32;
+TrackingConfig ThreeTemplateConfig(cv::Size size) {
+  TrackingConfig config = ThreeMarkerConfig();
+  SceneOptions options;
+  options.size = size;
+  options.frame_count = 10 * kFrames;
+  options.max_bend_deg = 120;
+  cv::Mat first;
+  const SceneTruth truth = SyntheticScene(options).render(0, first);
+  for (size_t i = 0; i < config.markers.size(); ++i) {
+    const cv::Point2d centre = *truth.markers[i].centroid_px;
+    MarkerParams& params = config.markers[i].params;
+    params = ParamsForMethod("zncc", {});
+    params.get<TemplateParams>().rect = cv::Rect(cvRound(centre.x) - kTemplatePx / 2,
+                                                 cvRound(centre.y) - kTemplatePx / 2,
+                                                 kTemplatePx, kTemplatePx);
+  }
+  return config;
+}
+
 cv::Size SizeOf(const benchmark::State& state) {
   return {static_cast<int>(state.range(0)), static_cast<int>(state.range(1))};
 }
@@ -125,17 +150,30 @@ GrayTimes GrayMs(cv::Size size) {
   return cache[size.width] = times;
 }
 
-// Runs `step(frame, index)` once per iteration and reports the per-frame counters.
+// One timed frame, a function of its own so that an instruction count can be limited to it:
+// `valgrind --tool=callgrind --toggle-collect='*TimedFrame*'` counts the timed frames only (not
+// the rendering, nor the warm-up), and callgrind reports how often it was called
+// (scripts/session_instructions.sh divides the one by the other).
+template <typename Step>
+[[gnu::noinline]] void TimedFrame(Step& step, const cv::Mat& frame, int64_t index) {
+  step(frame, index);
+}
+
+// Runs `step(frame, index)` once per iteration and reports the per-frame counters. The first
+// kWarmUpFrames frames are not timed: a session's first frames acquire every marker on the whole
+// frame, which a run of a few iterations (under callgrind) would otherwise count as steady work.
+constexpr int kWarmUpFrames = 2 * kFrames;
 template <typename Step>
 void PerFrame(benchmark::State& state, Step step) {
   const cv::Size size = SizeOf(state);
   const std::vector<cv::Mat>& frames = Frames(size);
   const GrayTimes gray = GrayMs(size);
   int64_t i = 0;
+  for (; i < kWarmUpFrames; ++i) step(FrameAt(frames, i), i);
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMs();
   for (auto _ : state) {
-    step(FrameAt(frames, i), i);
+    TimedFrame(step, FrameAt(frames, i), i);
     ++i;
   }
   const double wall_ms =
@@ -156,10 +194,15 @@ void BM_GrayReference(benchmark::State& state) {
   });
 }
 
-void BM_Trackers3(benchmark::State& state) {
-  const TrackingConfig config = ThreeMarkerConfig();
+// The trackers of `config` alone, each started on the first frame as the session starts it.
+void TrackersAlone(benchmark::State& state, const TrackingConfig& config) {
   std::vector<std::unique_ptr<Tracker>> trackers;
-  for (const MarkerSpec& spec : config.markers) trackers.push_back(CreateTracker(spec));
+  Frame first;
+  first.image = Frames(SizeOf(state)).front();
+  for (const MarkerSpec& spec : config.markers) {
+    trackers.push_back(CreateTracker(spec));
+    if (!trackers.back()->start(first)) state.SkipWithError("a tracker did not start");
+  }
   int64_t found = 0, looked = 0;
   PerFrame(state, [&](const cv::Mat& frame, int64_t) {
     for (auto& t : trackers) {
@@ -172,8 +215,13 @@ void BM_Trackers3(benchmark::State& state) {
   state.counters["found_rate"] = static_cast<double>(found) / static_cast<double>(looked);
 }
 
-void BM_Session3(benchmark::State& state) {
-  TrackingSession session(ThreeMarkerConfig());
+void BM_Trackers3(benchmark::State& state) { TrackersAlone(state, ThreeMarkerConfig()); }
+void BM_Trackers3Zncc(benchmark::State& state) {
+  TrackersAlone(state, ThreeTemplateConfig(SizeOf(state)));
+}
+
+void SessionWhole(benchmark::State& state, const TrackingConfig& config) {
+  TrackingSession session(config);
   Frame frame;
   int64_t found = 0, looked = 0;
   PerFrame(state, [&](const cv::Mat& image, int64_t i) {
@@ -191,6 +239,11 @@ void BM_Session3(benchmark::State& state) {
   state.counters["found_rate"] = static_cast<double>(found) / static_cast<double>(looked);
 }
 
+void BM_Session3(benchmark::State& state) { SessionWhole(state, ThreeMarkerConfig()); }
+void BM_Session3Zncc(benchmark::State& state) {
+  SessionWhole(state, ThreeTemplateConfig(SizeOf(state)));
+}
+
 void BM_FrameChange(benchmark::State& state) {
   FrameChangeDetector detector;
   int64_t changed = 0;
@@ -205,6 +258,8 @@ void BM_FrameChange(benchmark::State& state) {
 BENCHMARK(BM_GrayReference)->SOFTSIGHT_SIZES;
 BENCHMARK(BM_Trackers3)->SOFTSIGHT_SIZES;
 BENCHMARK(BM_Session3)->SOFTSIGHT_SIZES;
+BENCHMARK(BM_Trackers3Zncc)->SOFTSIGHT_SIZES;
+BENCHMARK(BM_Session3Zncc)->SOFTSIGHT_SIZES;
 BENCHMARK(BM_FrameChange)->SOFTSIGHT_SIZES;
 
 }  // namespace

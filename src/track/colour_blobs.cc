@@ -195,18 +195,20 @@ void ColourTracker::FillHoles(cv::Mat& own, cv::Point own_origin, ColourBlob* bl
   // highlight on a glossy marker, a glint, pixels noise pushed out of the range. They are part of
   // the marker: its area, centroid and shape are the filled region's, and its colour and ring
   // are measured around the filled region (a highlight inside is not its surroundings).
-  cv::Mat outside = Scratch(holes_store_, cv::Size(own.cols + 2, own.rows + 2), CV_8U);
-  outside.setTo(0);
-  own.copyTo(outside(cv::Rect(1, 1, own.cols, own.rows)));
-  cv::floodFill(outside, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 4);
+  // `own` holds 0 and 255: its outside is marked in place, then the holes are filled and the
+  // outside cleared again in one pass.
+  constexpr uchar kOutside = 1;
+  static_assert(kOutside != kFilledHole && kOutside != 255);
+  MarkOutside(own, kOutside, outside_stack_);
   int filled = 0;
   for (int y = 0; y < own.rows; ++y) {
-    const uchar* o = outside.ptr<uchar>(y + 1) + 1;
     uchar* w = own.ptr<uchar>(y);
     for (int x = 0; x < own.cols; ++x) {
-      if (o[x] == 0) {
+      if (w[x] == 0) {
         w[x] = kFilledHole;
         ++filled;
+      } else if (w[x] == kOutside) {
+        w[x] = 0;
       }
     }
   }
@@ -235,7 +237,10 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     std::memset(own.ptr<uchar>(y), 0, static_cast<size_t>(size.width));
   }
   labeller_.Draw(component, own, padded.tl() - labelled_tl);
-  FillHoles(own, padded.tl() + origin, blob);
+  // A hole pixel has the blob on its left and on its right in its row (else its row would join
+  // it to the outside): a blob of one run in each of its rows (a disc, most markers) has none.
+  const RunLabeller::Component& drawn = labeller_.components()[static_cast<size_t>(component)];
+  if (drawn.run_count > drawn.box.height) FillHoles(own, padded.tl() + origin, blob);
   // Asymmetry: the binary centroid against the centre of the smallest circle around the blob
   // (its convex hull's points are among each row's leftmost and rightmost pixels).
   edge_points_.clear();

@@ -388,6 +388,53 @@ void OpenClose3x3Reference(cv::Mat& mask, bool cross) {
   closed.copyTo(mask);
 }
 
+void MarkOutside(cv::Mat& mask, uchar outside, std::vector<cv::Point>& stack) {
+  CV_Assert(mask.type() == CV_8UC1 && outside != 0);
+  // A span fill: each seed's run of 0 in its row is marked at once, and the rows above and below
+  // it get one seed per run of 0 beside it (a pixel at a time, a stack push per pixel, cost 3x
+  // cv::floodFill).
+  stack.clear();
+  const int width = mask.cols, height = mask.rows;
+  const auto seed_runs = [&](int y, int x0, int x1) {  // One seed per run of 0 in [x0, x1].
+    const uchar* row = mask.ptr<uchar>(y);
+    for (int x = x0; x <= x1;) {
+      if (row[x] != 0) {
+        ++x;
+        continue;
+      }
+      stack.emplace_back(x, y);
+      while (x <= x1 && row[x] == 0) ++x;
+    }
+  };
+  seed_runs(0, 0, width - 1);
+  seed_runs(height - 1, 0, width - 1);
+  for (int y = 1; y + 1 < height; ++y) {
+    seed_runs(y, 0, 0);
+    seed_runs(y, width - 1, width - 1);
+  }
+  while (!stack.empty()) {
+    const cv::Point p = stack.back();
+    stack.pop_back();
+    uchar* row = mask.ptr<uchar>(p.y);
+    if (row[p.x] != 0) continue;  // Marked since it was seeded.
+    int left = p.x, right = p.x;
+    while (left > 0 && row[left - 1] == 0) --left;
+    while (right + 1 < width && row[right + 1] == 0) ++right;
+    std::memset(row + left, outside, static_cast<size_t>(right - left + 1));
+    if (p.y > 0) seed_runs(p.y - 1, left, right);
+    if (p.y + 1 < height) seed_runs(p.y + 1, left, right);
+  }
+}
+
+void MarkOutsideReference(cv::Mat& mask, uchar outside) {
+  CV_Assert(mask.type() == CV_8UC1 && outside != 0);
+  cv::Mat padded;
+  cv::copyMakeBorder(mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(outside), nullptr, cv::Scalar(), cv::Scalar(),
+                4);
+  padded(cv::Rect(1, 1, mask.cols, mask.rows)).copyTo(mask);
+}
+
 cv::Rect NonZeroBounds(const cv::Mat& mask) {
   CV_Assert(mask.type() == CV_8UC1);
   int top = -1, bottom = -1, left = mask.cols, right = -1;

@@ -83,6 +83,16 @@ cv::Rect NonZeroBounds(const cv::Mat& mask);
 // visits every pixel again.
 void NonZeroPoints(const cv::Mat& mask, std::vector<cv::Point>& points);
 
+// Sets to `outside` (nonzero) every 0 pixel of `mask` (CV_8UC1, any strides) that a 4-connected
+// path of 0 pixels joins to the mask's border, and leaves every other pixel: a 0 left afterwards
+// is a hole. `stack` is reused storage: no allocation once warm. cv::floodFill from a border
+// seed does this too, but allocates a mask of the image's size + 2 and clears it byte by byte on
+// every call (issue 45: that clearing alone was 5 % of a session's frame with three colour
+// markers, one call per marker and frame).
+void MarkOutside(cv::Mat& mask, uchar outside, std::vector<cv::Point>& stack);
+// The reference: cv::floodFill, from a corner of the mask padded by a ring of 0.
+void MarkOutsideReference(cv::Mat& mask, uchar outside);
+
 // 8-connected components of a binary mask (nonzero = in) from its runs: rows are scanned 16
 // bytes at a time, so the cost is the mask's area / 16 plus its runs, where
 // cv::connectedComponentsWithStats visits every pixel (which dominated whole-frame searches of

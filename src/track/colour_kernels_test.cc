@@ -164,6 +164,30 @@ TEST(ColourKernels, NonZeroPointsAreFindNonZerosPoints) {
   }
 }
 
+TEST(ColourKernels, MarkOutsideIsAFloodFillFromTheBorder) {
+  cv::RNG rng(45);
+  std::vector<cv::Point> stack;
+  for (int trial = 0; trial < 300; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 50), 1 + rng.uniform(0, 40));
+    cv::Mat parent(size.height + 2, size.width + 5, CV_8U, cv::Scalar(7));
+    cv::Mat mask = parent(cv::Rect(2, 1, size.width, size.height));  // A strided view.
+    cv::Mat noise(size, CV_32F);
+    rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+    // Blobs of 255 with holes and channels of 0 of every kind, from sparse to nearly full.
+    const double density = 0.1 + 0.2 * (trial % 5);
+    cv::Mat(noise < density).copyTo(mask);
+    if (trial % 2 == 1 && size.width > 4 && size.height > 4) {
+      cv::circle(mask, cv::Point(size.width / 2, size.height / 2),
+                 std::min(size.width, size.height) / 3, cv::Scalar(255), 1);  // A closed ring.
+    }
+    cv::Mat expected = mask.clone();
+    MarkOutsideReference(expected, 128);
+    MarkOutside(mask, 128, stack);
+    EXPECT_EQ(cv::countNonZero(mask != expected), 0) << size << " density " << density;
+    EXPECT_EQ(cv::countNonZero(parent.row(0) != 7), 0) << "wrote outside the view";
+  }
+}
+
 TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
   cv::RNG rng(5);
   RunLabeller labeller;

@@ -227,7 +227,7 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
-  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, holes_store_;
+  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
@@ -235,6 +235,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;
   std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.
+  std::vector<cv::Point> outside_stack_;  // FillHoles's flood of the outside.
   std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
   std::vector<std::pair<double, cv::Point2d>> off_rim_;  // Scratch of OffRimBulgePx.
 };

@@ -144,6 +144,66 @@ cv::Point2d MarkerSymmetryCentre(const cv::Mat& templ, const cv::Point2d& blob_c
   return SymmetryCentre(templ(around), strength) + cv::Point2d(around.tl());
 }
 
+void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist,
+                             std::vector<uint8_t>& row_distance) {
+  CV_Assert(label.type() == CV_8UC1 && dist.type() == CV_8UC1 && dist.size() == label.size());
+  if (area.empty()) return;
+  CV_Assert((area & cv::Rect(0, 0, label.cols, label.rows)) == area);
+  constexpr int kReach = 4, kNone = kReach + 1;
+  // The rows within reach of the area, and per row the distance from each of the area's columns
+  // to the row's nearest label pixel within reach (kNone: none).
+  const int top = std::max(0, area.y - kReach), bottom = std::min(label.rows, area.br().y + kReach);
+  const int width = area.width;
+  row_distance.resize(static_cast<size_t>((bottom - top) * width));
+  for (int y = top; y < bottom; ++y) {
+    const uint8_t* row = label.ptr<uint8_t>(y);
+    uint8_t* out = row_distance.data() + static_cast<size_t>((y - top) * width);
+    // Left to right, from reach before the area: the distance back to the last label pixel.
+    int since = kNone;
+    for (int x = std::max(0, area.x - kReach); x < area.br().x; ++x) {
+      since = row[x] ? 0 : std::min(since + 1, kNone);
+      if (x >= area.x) out[x - area.x] = static_cast<uint8_t>(since);
+    }
+    // Right to left, from reach after the area: the nearer of that and the next label pixel.
+    since = kNone;
+    for (int x = std::min(label.cols, area.br().x + kReach) - 1; x >= area.x; --x) {
+      since = row[x] ? 0 : std::min(since + 1, kNone);
+      if (x < area.br().x) {
+        uint8_t& d = out[x - area.x];
+        d = static_cast<uint8_t>(std::min<int>(d, since));
+      }
+    }
+  }
+  // Down the columns, a row at a time across the area (loops the compiler vectorises in 8-bit
+  // lanes): the least over the rows within reach of max(their distance along the row, |dy|).
+  for (int y = area.y; y < area.br().y; ++y) {
+    uint8_t* __restrict out = dist.ptr<uint8_t>(y) + area.x;
+    std::fill(out, out + width, static_cast<uint8_t>(kNone));
+    const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
+    for (int yy = first; yy <= last; ++yy) {
+      const uint8_t* __restrict along = row_distance.data() + static_cast<size_t>((yy - top) * width);
+      const uint8_t rows_away = static_cast<uint8_t>(std::abs(yy - y));
+      for (int x = 0; x < width; ++x) out[x] = std::min(out[x], std::max(along[x], rows_away));
+    }
+  }
+}
+
+void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist) {
+  for (int y = area.y; y < area.br().y; ++y) {
+    for (int x = area.x; x < area.br().x; ++x) {
+      int best = 5;
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if (yy < 0 || xx < 0 || yy >= label.rows || xx >= label.cols) continue;
+          if (label.at<uint8_t>(yy, xx)) best = std::min(best, std::max(std::abs(dx), std::abs(dy)));
+        }
+      }
+      dist.at<uint8_t>(y, x) = static_cast<uint8_t>(best);
+    }
+  }
+}
+
 void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out) {
   if (native.channels() == 1) {
     out = native;

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
@@ -118,6 +119,18 @@ inline constexpr double kBlobAgreePx = 0.75;
 // axis (`projection`, see ContrastProjection; empty: luma).
 void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& out);
 
+// The Chebyshev distance (max(|dx|, |dy|)) from each pixel of `area` to the nearest nonzero pixel
+// of `label` (CV_8UC1) at most 4 away, 5 where there is none, into the same pixels of `dist`
+// (CV_8UC1, label's size; nothing else of it is written). Separable: per row, the distance to
+// the row's nearest label pixel (a pass each way), then per pixel the least max(|dy|, that
+// distance) over the rows within 4, in 8-bit lanes. Looking at the 81 pixels within 4 of each
+// pixel (the reference) was a quarter of the work of three ZNCC templates' frame (issue 45).
+// `row_distance` is reused storage.
+void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist,
+                             std::vector<uint8_t>& row_distance);
+// The reference: every pixel within 4 of each pixel looked at.
+void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist);
+
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
@@ -161,6 +174,35 @@ class BlobMeter {
                cv::Point2d* centroid, double* area) {
     double low = 0, high = 0;
     if (!Segment(gray, mask, guess, &low, &high)) return false;
+    return MeasureSegmented(gray, mask, low, high, centroid, area);
+  }
+
+  // Measure of the component the last successful Locate found, with the same `gray` and `mask`
+  // (and guess): the segmentation is not done a second time (issue 45: it was 9 % of a frame of
+  // three ZNCC templates on colour footage, where the blob is measured in every frame).
+  bool MeasureLocated(const cv::Mat& gray, const cv::Mat& mask, cv::Point2d* centroid,
+                      double* area) {
+    return MeasureSegmented(gray, mask, located_low_, located_high_, centroid, area);
+  }
+
+  // The marker-side component nearest `guess`, as Measure finds it, with its binary centroid and
+  // pixel count: a quick check that the blob is there (a fraction of Measure's cost).
+  bool Locate(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
+              cv::Point2d* centroid, double* area) {
+    if (!Segment(gray, mask, guess, &located_low_, &located_high_)) return false;
+    const cv::Moments m = cv::moments(label_(box_), true);
+    if (!(m.m00 > 0)) return false;
+    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+    *area = m.m00;
+    return true;
+  }
+
+  double area() const { return area_; }  // At selection, px.
+
+ private:
+  // Measure's work once Segment has found the component (label_, box_) and its levels.
+  bool MeasureSegmented(const cv::Mat& gray, const cv::Mat& mask, double low, double high,
+                        cv::Point2d* centroid, double* area) {
     const cv::Rect box = box_;
     // The levels right at the blob: the marker's from its interior (pixels whose 4 neighbours are
     // all in the component), the background's from a ring 3-4 px outside it. Levels of the patch
@@ -168,26 +210,13 @@ class BlobMeter {
     // from what is at the rim.
     const cv::Rect grown = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
                            cv::Rect(0, 0, gray.cols, gray.rows);
-    auto distance = [&](int x, int y) {  // Chebyshev distance to the component, capped at 5.
-      int best = 5;
-      for (int dy = -4; dy <= 4; ++dy) {
-        for (int dx = -4; dx <= 4; ++dx) {
-          const int yy = y + dy, xx = x + dx;
-          if (yy < 0 || xx < 0 || yy >= gray.rows || xx >= gray.cols || !label_.at<uint8_t>(yy, xx)) {
-            continue;
-          }
-          best = std::min(best, std::max(std::abs(dx), std::abs(dy)));
-        }
-      }
-      return best;
-    };
     double fg_sum = 0, bg_sum = 0;
     int fg_n = 0, bg_n = 0;
     dist_.create(gray.size(), CV_8UC1);
+    CappedChebyshevDistance(label_, grown, dist_, row_distance_);
     for (int y = grown.y; y < grown.br().y; ++y) {
       for (int x = grown.x; x < grown.br().x; ++x) {
-        const int d = label_.at<uint8_t>(y, x) ? 0 : distance(x, y);
-        dist_.at<uint8_t>(y, x) = static_cast<uint8_t>(d);
+        const int d = dist_.at<uint8_t>(y, x);
         if (!IsInside(gray, mask, x, y)) continue;
         if (d == 0 && label_.at<uint8_t>(y - 1, x) && label_.at<uint8_t>(y + 1, x) &&
             label_.at<uint8_t>(y, x - 1) && label_.at<uint8_t>(y, x + 1)) {
@@ -219,22 +248,6 @@ class BlobMeter {
     return true;
   }
 
-  // The marker-side component nearest `guess`, as Measure finds it, with its binary centroid and
-  // pixel count: a quick check that the blob is there (a fraction of Measure's cost).
-  bool Locate(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
-              cv::Point2d* centroid, double* area) {
-    double low = 0, high = 0;
-    if (!Segment(gray, mask, guess, &low, &high)) return false;
-    const cv::Moments m = cv::moments(label_(box_), true);
-    if (!(m.m00 > 0)) return false;
-    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
-    *area = m.m00;
-    return true;
-  }
-
-  double area() const { return area_; }  // At selection, px.
-
- private:
   // The marker-side component around `guess`, isolated from the patch's edge: from the most
   // marker-like pixel within 2 px of the guess, the level at which it would join the patch's (or
   // the mask's) edge is the lowest (bright marker) level on the best path out: the pass. The
@@ -250,8 +263,7 @@ class BlobMeter {
     // A priority flood from the seed, most marker-like first (256 buckets of marker-likeness):
     // the first edge pixel it takes sets the pass.
     for (auto& bucket : buckets_) bucket.clear();
-    visited_.create(gray.size(), CV_8UC1);
-    visited_.setTo(0);
+    ZeroedMask(gray.size(), visited_);
     const auto likeness = [&](int x, int y) {
       const int v = gray.at<uint8_t>(y, x);
       return bright_ ? v : 255 - v;
@@ -318,9 +330,16 @@ class BlobMeter {
     }
     return seed;
   }
+  // `out` made `size`, CV_8UC1, all 0: create() gives a continuous buffer, cleared by one memset
+  // (cv::Mat::setTo fills it byte by byte: issue 45).
+  static void ZeroedMask(cv::Size size, cv::Mat& out) {
+    out.create(size, CV_8UC1);
+    std::memset(out.data, 0, out.total());
+  }
   bool IsInside(const cv::Mat& gray, const cv::Mat& mask, int x, int y) const {
+    // No mask: no data (cv::Mat::empty() is a call into OpenCV, and this runs for every pixel).
     return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
-           (mask.empty() || mask.at<uint8_t>(y, x));
+           (mask.data == nullptr || mask.at<uint8_t>(y, x));
   }
   bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
     const double v = gray.at<uint8_t>(y, x);
@@ -329,8 +348,7 @@ class BlobMeter {
   // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
-    label_.create(gray.size(), CV_8UC1);
-    label_.setTo(0);
+    ZeroedMask(gray.size(), label_);
     stack_.clear();
     stack_.push_back(seed);
     label_.at<uint8_t>(seed) = 1;
@@ -357,7 +375,9 @@ class BlobMeter {
   double area_ = 0;
   double contrast_ = 0;
   double range_ = 0;
+  double located_low_ = 0, located_high_ = 0;  // The last Locate's levels, for MeasureLocated.
   cv::Mat label_, dist_, visited_;
+  std::vector<uint8_t> row_distance_;  // CappedChebyshevDistance's scratch.
   cv::Rect box_;
   std::vector<cv::Point> stack_;
   std::array<std::vector<cv::Point>, 256> buckets_;

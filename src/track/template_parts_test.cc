@@ -10,6 +10,25 @@
 namespace softsight::template_internal {
 namespace {
 
+TEST(TemplateParts, CappedChebyshevDistanceIsTheReferences) {
+  cv::RNG rng(45);
+  std::vector<uint8_t> scratch;
+  for (int trial = 0; trial < 200; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 40), 1 + rng.uniform(0, 40));
+    cv::Mat noise(size, CV_32F);
+    rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+    // From a lone pixel or none to nearly full.
+    const double density = trial % 4 == 0 ? 0.002 : trial % 4 == 1 ? 0.02 : trial % 4 == 2 ? 0.2 : 0.8;
+    const cv::Mat label = noise < density;
+    const int x0 = rng.uniform(0, size.width), y0 = rng.uniform(0, size.height);
+    const cv::Rect area(x0, y0, rng.uniform(0, size.width - x0 + 1), rng.uniform(0, size.height - y0 + 1));
+    cv::Mat fast(size, CV_8UC1, cv::Scalar(99)), reference(size, CV_8UC1, cv::Scalar(99));
+    CappedChebyshevDistance(label, area, fast, scratch);
+    CappedChebyshevDistanceReference(label, area, reference);
+    EXPECT_EQ(cv::countNonZero(fast != reference), 0) << size << " " << area << " " << density;
+  }
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };

@@ -680,7 +680,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
     return cv::Point2d(0, 0);
   }
   // To be applied: measured with the soft centroid.
-  if (!blob_.Measure(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
+  if (!blob_.MeasureLocated(blob_gray_, rung.templ.mask(), &centroid, &area)) {
     return std::nullopt;
   }
   shift = centroid - expected;
