@@ -168,8 +168,18 @@ function(softsight_check_public_headers)
     file(CONFIGURE OUTPUT ${source} CONTENT "#include \"${header}\"\n")
     list(APPEND sources ${source})
   endforeach()
+  # The umbrella header (softsight/softsight.h) includes every other public header: one left out
+  # would be missing from `#include <softsight/softsight.h>` without any compile failing.
+  file(READ ${PROJECT_SOURCE_DIR}/include/softsight/softsight.h umbrella)
+  foreach(header ${headers})
+    if(NOT header STREQUAL "softsight/softsight.h" AND NOT umbrella MATCHES "#include \"${header}\"")
+      message(FATAL_ERROR "include/softsight/softsight.h does not include \"${header}\": add it")
+    endif()
+  endforeach()
   add_library(softsight_public_headers OBJECT ${sources})
-  target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include)
+  # version.h is generated (and installed beside the others).
+  target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include
+                                                              ${PROJECT_BINARY_DIR}/include)
   target_include_directories(softsight_public_headers SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
   target_precompile_headers(softsight_public_headers PRIVATE
     <opencv2/core.hpp> <string> <optional> <vector> <cstdint> <memory> <functional> <chrono>)

@@ -17,12 +17,14 @@ case $mode in
   prefix)
     rm -rf "$prefix"
     cmake --install "$build" --prefix "$prefix" >/dev/null
-    for f in include/softsight/pipeline/tracking_session.h include/softsight/version.h \
-             bin/softsight; do
+    for f in include/softsight/softsight.h include/softsight/pipeline/tracking_session.h \
+             include/softsight/version.h bin/softsight; do
       [ -e "$prefix/$f" ] || fail "$f not installed"
     done
     # Only the API: what the program or the tests alone use is not installed.
-    for f in include/softsight/gui include/softsight/sim/corruption.h; do
+    for f in include/softsight/gui include/softsight/sim/corruption.h \
+             include/softsight/io/frame_grabber.h include/softsight/io/read_ahead_source.h \
+             include/softsight/io/paced_source.h; do
       [ ! -e "$prefix/$f" ] || fail "$f installed, but it is not part of the library's API"
     done
     # The installed program finds its plugins from where it was installed.
