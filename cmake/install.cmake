@@ -1,14 +1,15 @@
 # The library for other projects (`cmake --install build --prefix DIR`):
 #  - the public headers (include/softsight/, the API; what only the program or the tests use
-#    lives in src/) and the generated softsight/version.h;
-#  - the static libraries of the modules below the program (core ... pipeline; gui and the
-#    commands are the program's own), as imported targets softsight::<module> and
-#    softsight::softsight (all of them) for find_package(softsight);
+#    lives in src/), softsight/softsight.h (all of them) and the generated softsight/version.h;
+#  - the libraries of the modules below the program (core ... pipeline; gui, stream and the
+#    commands are the program's own): shared and versioned (libsoftsight_<module>.so.0.1, with
+#    the libsoftsight_<module>.so link to build with), or static with -DBUILD_SHARED_LIBS=OFF;
+#    imported targets softsight::<module> and softsight::softsight (all of them) for
+#    find_package(softsight);
 #  - a pkg-config file, softsight.pc, for builds without CMake.
-# tests/install/ builds an outside project against an installed tree (ctest install.*).
+# scripts/check-install.sh builds outside programs against an installed tree (ctest install.*).
 include(CMakePackageConfigHelpers)
 
-set(SOFTSIGHT_INSTALLED_MODULES core geometry track sim calib control config io pipeline)
 set(_softsight_installed_targets "")
 foreach(module IN LISTS SOFTSIGHT_INSTALLED_MODULES)
   list(APPEND _softsight_installed_targets softsight_${module})
@@ -22,6 +23,7 @@ add_library(softsight::softsight ALIAS softsight_all)
 
 install(TARGETS ${_softsight_installed_targets} softsight_all EXPORT softsightTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT library
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT library
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/softsight DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         COMPONENT library FILES_MATCHING PATTERN "*.h")
@@ -39,8 +41,8 @@ install(FILES ${PROJECT_BINARY_DIR}/softsightConfig.cmake ${PROJECT_BINARY_DIR}/
         DESTINATION ${SOFTSIGHT_CMAKE_PACKAGE_DIR} COMPONENT library)
 
 # pkg-config: relocatable (prefix from the .pc file's own place), so --prefix at install time
-# moves it. The libraries are static: their dependencies are in Requires, not Requires.private,
-# and they are listed so that each comes before the ones it uses.
+# moves it. Every dependency is in Requires, as a static library needs (shared ones need less),
+# and the libraries are listed so that each comes before the ones it uses.
 file(RELATIVE_PATH SOFTSIGHT_PC_TO_PREFIX "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")
 string(REGEX REPLACE "/$" "" SOFTSIGHT_PC_TO_PREFIX "${SOFTSIGHT_PC_TO_PREFIX}")
 set(SOFTSIGHT_PC_LIBS "")

@@ -27,6 +27,16 @@ case $mode in
              include/softsight/io/paced_source.h; do
       [ ! -e "$prefix/$f" ] || fail "$f installed, but it is not part of the library's API"
     done
+    # The libraries: shared and versioned (or static, -DBUILD_SHARED_LIBS=OFF).
+    libdir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")/..
+    if grep -q "^BUILD_SHARED_LIBS:BOOL=ON" "$build/CMakeCache.txt"; then
+      version=$(sed -n 's/^Version: //p' "$libdir/pkgconfig/softsight.pc")
+      for f in libsoftsight_core.so "libsoftsight_core.so.${version%.*}" "libsoftsight_core.so.$version"; do
+        [ -e "$libdir/$f" ] || fail "$f not installed in $libdir"
+      done
+      soname=$(readelf -d "$libdir/libsoftsight_pipeline.so" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+      [ "$soname" = "libsoftsight_pipeline.so.${version%.*}" ] || fail "libsoftsight_pipeline.so's soname is '$soname'"
+    fi
     # The installed program finds its plugins from where it was installed.
     "$prefix/bin/softsight" synth --help >/dev/null || fail "the installed program cannot run synth"
     echo "check-install: installed into $prefix"
@@ -44,9 +54,12 @@ case $mode in
     mkdir -p "$out"
     pc_dir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")
     [ -n "$pc_dir" ] || fail "no softsight.pc under $prefix"
-    flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs softsight)
+    export PKG_CONFIG_PATH=$pc_dir
+    # Shared libraries outside the system's folders: the program finds them with an rpath.
+    rpath="-Wl,-rpath,$(pkg-config --variable=libdir softsight)"
+    flags=$(pkg-config --cflags --libs softsight)
     # shellcheck disable=SC2086  # the flags are words
-    c++ -std=c++20 -O1 "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags
+    c++ -std=c++20 -O1 "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags "$rpath"
     "$out/track_rendered" "$config" 30
     ;;
   pip)
@@ -68,6 +81,11 @@ case $mode in
     env -u PYTHONPATH "$venv/bin/python" - "$config" <<'PY'
 import sys, softsight, importlib.metadata as m
 assert softsight.__file__.startswith(sys.prefix), softsight.__file__
+# The extension and the shared libraries it links (when the build has them) come from the
+# environment, not from the build tree.
+loaded = {line.split()[-1] for line in open("/proc/self/maps") if "softsight" in line and ".so" in line}
+outside = [f for f in loaded if not f.startswith(sys.prefix)]
+assert not outside, f"loaded from outside the environment: {outside}"
 assert m.version("softsight") == softsight.__version__
 table = softsight.track("synth:bending", sys.argv[1], max_frames=10)
 found = int(table["red_found"].sum())

@@ -1,6 +1,7 @@
 """`cmake --install --prefix P` puts the package under P (P/lib/python3.X/dist-packages, or the
 site-packages of a virtual environment at P): it imports from there alone, with its version and
-licence metadata. (`pip install .` is checked by ctest's install.pip.)"""
+licence metadata, and its extension finds the shared libraries installed with it. (`pip install .`
+is checked by ctest's install.pip.)"""
 
 from __future__ import annotations
 
@@ -18,8 +19,10 @@ INSTALL_DIR = os.environ.get("SOFTSIGHT_PYTHON_INSTALL_DIR")
 
 @pytest.mark.skipif(not (CMAKE and BUILD_DIR and INSTALL_DIR), reason="run by ctest (python.test_install)")
 def test_cmake_install_puts_an_importable_package_into_site_packages(tmp_path):
-    subprocess.run([CMAKE, "--install", BUILD_DIR, "--component", "python", "--prefix", str(tmp_path)],
-                   check=True, capture_output=True, timeout=60)
+    # The package, and the libraries its extension links (shared ones, found from its own place).
+    for component in ("python", "library"):
+        subprocess.run([CMAKE, "--install", BUILD_DIR, "--component", component, "--prefix", str(tmp_path)],
+                       check=True, capture_output=True, timeout=60)
     site = tmp_path / INSTALL_DIR  # A relative install dir is under the prefix.
     assert not Path(INSTALL_DIR).is_absolute(), "the default install dir follows --prefix"
     assert (site / "softsight" / "__init__.py").exists()
