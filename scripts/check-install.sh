@@ -2,7 +2,9 @@
 # The installed library and Python package, used as an outside project would (ctest install.*):
 #   check-install.sh prefix   BUILD WORK  cmake --install of BUILD into WORK/prefix
 #   check-install.sh cmake    BUILD WORK  examples/library built with find_package(softsight), run
-#   check-install.sh pkg-config BUILD WORK  the same source built with `pkg-config softsight` only
+#   check-install.sh pkg-config BUILD WORK  the same sources built with `pkg-config softsight` and
+#                                         `pkg-config softsight-track` only (tracking alone links
+#                                         neither yaml-cpp, the serial port nor FFmpeg)
 #   check-install.sh pip      BUILD WORK  `pip install --no-build-isolation .` into a fresh virtual
 #                                         environment (reusing BUILD), imported, used, uninstalled
 # Each step prints what it checks and exits non-zero at the first thing that is wrong.
@@ -27,7 +29,8 @@ case $mode in
              include/softsight/io/paced_source.h; do
       [ ! -e "$prefix/$f" ] || fail "$f installed, but it is not part of the library's API"
     done
-    # The libraries: shared and versioned (or static, -DBUILD_SHARED_LIBS=OFF).
+    # The libraries: shared and versioned (or static, -DBUILD_SHARED_LIBS=OFF), one pkg-config
+    # file per module and one for all.
     libdir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")/..
     if grep -q "^BUILD_SHARED_LIBS:BOOL=ON" "$build/CMakeCache.txt"; then
       version=$(sed -n 's/^Version: //p' "$libdir/pkgconfig/softsight.pc")
@@ -37,6 +40,9 @@ case $mode in
       soname=$(readelf -d "$libdir/libsoftsight_pipeline.so" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
       [ "$soname" = "libsoftsight_pipeline.so.${version%.*}" ] || fail "libsoftsight_pipeline.so's soname is '$soname'"
     fi
+    for m in core geometry track sim calib control io config pipeline; do
+      [ -e "$libdir/pkgconfig/softsight-$m.pc" ] || fail "softsight-$m.pc not installed"
+    done
     # The installed program finds its plugins from where it was installed.
     "$prefix/bin/softsight" synth --help >/dev/null || fail "the installed program cannot run synth"
     echo "check-install: installed into $prefix"
@@ -48,6 +54,7 @@ case $mode in
           -DCMAKE_BUILD_TYPE=Release >/dev/null
     cmake --build "$out" >/dev/null
     "$out/track_rendered" "$config" 30
+    "$out/track_colour" 20
     ;;
   pkg-config)
     out=$work/pkg-config-example
@@ -55,12 +62,26 @@ case $mode in
     pc_dir=$(dirname "$(find "$prefix" -name softsight.pc | head -1)")
     [ -n "$pc_dir" ] || fail "no softsight.pc under $prefix"
     export PKG_CONFIG_PATH=$pc_dir
-    # Shared libraries outside the system's folders: the program finds them with an rpath.
+    # Shared libraries outside the system's folders: the programs find them with an rpath.
     rpath="-Wl,-rpath,$(pkg-config --variable=libdir softsight)"
     flags=$(pkg-config --cflags --libs softsight)
     # shellcheck disable=SC2086  # the flags are words
     c++ -std=c++20 -O1 "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags "$rpath"
     "$out/track_rendered" "$config" 30
+    # Tracking alone: the track module's flags name only it, softsight_core and OpenCV's core.
+    flags=$(pkg-config --cflags --libs softsight-track)
+    echo "check-install: pkg-config --libs softsight-track: $(pkg-config --libs softsight-track)"
+    if grep -q "^BUILD_SHARED_LIBS:BOOL=ON" "$build/CMakeCache.txt"; then
+      for lib in $(pkg-config --libs-only-l softsight-track); do
+        case $lib in -lsoftsight_track|-lsoftsight_core|-lopencv_core) ;; *) fail "softsight-track links $lib" ;; esac
+      done
+    fi
+    # shellcheck disable=SC2086
+    c++ -std=c++20 -O1 "$source_dir/examples/library/track_colour.cc" -o "$out/track_colour" $flags "$rpath"
+    "$out/track_colour" 20
+    needed=$(readelf -d "$out/track_colour" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p' | tr '\n' ' ')
+    case $needed in *serial*|*avformat*|*yaml*|*softsight_io*|*softsight_config*) fail "track_colour needs $needed" ;; esac
+    echo "check-install: track_colour needs only: $needed"
     ;;
   pip)
     venv=$work/venv
