@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian package softsight needs to build, test, benchmark and run its demo.
 # Non-interactive and idempotent: packages already present are left alone. Run as root or with sudo.
+#   scripts/setup.sh           what the build, the tests and CI need
+#   scripts/setup.sh docs      also doxygen, for the API reference (`cmake --build build --target docs`)
 set -euo pipefail
 
 PACKAGES=(
@@ -23,6 +25,13 @@ PACKAGES=(
   mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
   python3-zmq            # softsight.stream.subscribe (the stream's Python end) and its test
 )
+
+for group in "$@"; do
+  case $group in
+    docs) PACKAGES+=(doxygen) ;;
+    *) echo "setup: unknown group '$group' (docs)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do
