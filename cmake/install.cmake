@@ -42,16 +42,22 @@ install(FILES ${PROJECT_BINARY_DIR}/softsightConfig.cmake ${PROJECT_BINARY_DIR}/
         DESTINATION ${SOFTSIGHT_CMAKE_PACKAGE_DIR} COMPONENT library)
 
 # pkg-config: relocatable (prefix from the .pc file's own place), so --prefix at install time
-# moves it. One file per module, softsight-<module>.pc, whose Requires are the softsight modules
-# its public headers use, and softsight.pc for all of them: `pkg-config --libs softsight-track`
-# is -lsoftsight_track -lsoftsight_core -lopencv_core. What a module calls only inside (OpenCV's
-# other modules, yaml-cpp, libserial, FFmpeg) is the shared library's own business: in
-# Requires.private (OpenCV, whose headers the public ones include: its -I comes with --cflags)
-# and Libs.private (the rest, for --static, whose .pc files a user then needs no more than their
-# headers). The public headers use only OpenCV's core, so that is the one OpenCV library in
-# Libs. A static build's libraries need all of their dependencies linked: there they are Requires.
+# moves it (a tree configured for /usr, the .deb's, writes /usr). One file per module,
+# softsight-<module>.pc, whose Requires are the softsight modules its public headers use, and
+# softsight.pc for all of them: `pkg-config --libs softsight-track` is -lsoftsight_track
+# -lsoftsight_core -lopencv_core. What a module calls only inside (OpenCV's other modules,
+# yaml-cpp, libserial, FFmpeg) is the shared library's own business: in Requires.private OpenCV
+# (the public headers include its headers: its -I comes with --cflags), in Libs.private the rest
+# as plain -l flags (a user needs neither their headers nor their .pc files). The public headers
+# call only OpenCV's core, so that is the one OpenCV library in Libs. A static build's libraries
+# need all of their dependencies linked: there they are all Requires.
 file(RELATIVE_PATH SOFTSIGHT_PC_TO_PREFIX "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")
 string(REGEX REPLACE "/$" "" SOFTSIGHT_PC_TO_PREFIX "${SOFTSIGHT_PC_TO_PREFIX}")
+set(SOFTSIGHT_PC_PREFIX "\${pcfiledir}/${SOFTSIGHT_PC_TO_PREFIX}")
+if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  # The system's own prefix (the .deb): plain paths, which pkg-config leaves out of its flags.
+  set(SOFTSIGHT_PC_PREFIX /usr)
+endif()
 # What each module uses inside, as pkg-config packages (Requires) and as -l flags (Libs.private).
 set(_softsight_pc_core opencv4)
 set(_softsight_pc_geometry "")

@@ -2,6 +2,9 @@
 # Installs every Debian package softsight needs to build, test, benchmark and run its demo.
 # Non-interactive and idempotent: packages already present are left alone. Run as root or with sudo.
 #   scripts/setup.sh           what the build, the tests and CI need
+#   scripts/setup.sh deb       also what the Debian package needs (scripts/package-deb.sh: man pages
+#                              by help2man, dpkg-shlibdeps) and its check (scripts/check-deb.sh:
+#                              debootstrap makes the clean Debian 12 root)
 #   scripts/setup.sh docs      also doxygen, for the API reference (`cmake --build build --target docs`)
 set -euo pipefail
 
@@ -28,8 +31,9 @@ PACKAGES=(
 
 for group in "$@"; do
   case $group in
+    deb) PACKAGES+=(help2man dpkg-dev debootstrap) ;;
     docs) PACKAGES+=(doxygen) ;;
-    *) echo "setup: unknown group '$group' (docs)" >&2; exit 2 ;;
+    *) echo "setup: unknown group '$group' (deb, docs)" >&2; exit 2 ;;
   esac
 done
 
