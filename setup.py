@@ -54,6 +54,15 @@ def build_output() -> Optional[TextIO]:
         return None
 
 
+def shared_libraries(build: Path) -> list[Path]:
+    """The tree's shared softsight libraries by soname (libsoftsight_core.so.0.1), if it has them."""
+    cache = (build / "CMakeCache.txt").read_text()
+    if not re.search(r"^BUILD_SHARED_LIBS:BOOL=(ON|1|TRUE|YES)$", cache, re.MULTILINE | re.IGNORECASE):
+        return []
+    return sorted(p for p in (build / "src").glob("*/libsoftsight_*.so.*")
+                  if re.fullmatch(r"libsoftsight_[a-z]+\.so\.[0-9]+\.[0-9]+", p.name))
+
+
 def run(command: list[str], output: Optional[TextIO]) -> None:
     print("setup.py:", " ".join(command), file=output or sys.stdout, flush=True)
     subprocess.run(command, check=True, stdout=output, stderr=output)
@@ -71,9 +80,11 @@ class CMakeBuildExt(build_ext):
                   "minutes); its progress follows", file=output, flush=True)
         if not (build / "CMakeCache.txt").exists():
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []
+            # Static libraries: the extension carries the library's code, nothing to install beside it.
             run(["cmake", "-S", str(ROOT), "-B", str(build), *generator, "-DCMAKE_BUILD_TYPE=Release",
                  "-DSOFTSIGHT_BUILD_TESTS=OFF", "-DSOFTSIGHT_BUILD_BENCHMARKS=OFF",
-                 "-DSOFTSIGHT_BUILD_PYTHON=ON", f"-DPython3_EXECUTABLE={sys.executable}"], output)
+                 "-DBUILD_SHARED_LIBS=OFF", "-DSOFTSIGHT_BUILD_PYTHON=ON",
+                 f"-DPython3_EXECUTABLE={sys.executable}"], output)
         run(["cmake", "--build", str(build), "--target", "softsight_python",
              "--parallel", str(os.cpu_count() or 1)], output)
         if output:
@@ -85,6 +96,10 @@ class CMakeBuildExt(build_ext):
         target = Path(self.get_ext_fullpath(ext.name))
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(built[0], target)
+        # A reused tree built with shared libraries (the default, SOFTSIGHT_BUILD_DIR): the package
+        # carries copies of them, by soname, where the extension looks first ($ORIGIN).
+        for library in shared_libraries(build):
+            shutil.copyfile(library, target.parent / library.name)
 
 
 class PackageFiles(build_py):

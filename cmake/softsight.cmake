@@ -15,24 +15,50 @@ function(softsight_use_unity_build target)
   endif()
 endfunction()
 
-# softsight_add_library(<module> SOURCES ... DEPS ...)
+# softsight_add_library(<module> SOURCES ... DEPS ... [PRIVATE_DEPS ...])
 # Creates target softsight_<module>. Public headers live in include/softsight/<module>/,
 # private ones beside the sources in src/<module>/ (included as "<module>/x.h").
+# DEPS: what the module's public headers use (softsight modules, OpenCV's core), passed on to
+# whatever links it; PRIVATE_DEPS: what only its sources use (imgproc, yaml-cpp, libserial,
+# FFmpeg). A module of the installed library (SOFTSIGHT_INSTALLED_MODULES) is a shared, versioned
+# library under BUILD_SHARED_LIBS (libsoftsight_<module>.so.<major>.<minor>; a static one
+# otherwise); the program's own modules (stream, gui, cli) are always static, linked into its
+# plugins, so a plugin loads only the system libraries it calls (src/app/CMakeLists.txt).
 function(softsight_add_library module)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
   set(target softsight_${module})
-  add_library(${target} STATIC ${ARG_SOURCES})
+  if(BUILD_SHARED_LIBS AND module IN_LIST SOFTSIGHT_INSTALLED_MODULES)
+    add_library(${target} SHARED ${ARG_SOURCES})
+    # 0.x: a minor version may change the ABI as it may the API (softsightConfigVersion's
+    # SameMinorVersion), so the soname carries both: libsoftsight_core.so.0.1.
+    set_target_properties(${target} PROPERTIES VERSION ${PROJECT_VERSION}
+                          SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
+                          INSTALL_RPATH "${SOFTSIGHT_LIB_RPATH}"
+                          # Copies beside each other (a pip install reusing this tree: setup.py)
+                          # find each other before the build tree's.
+                          BUILD_RPATH "$ORIGIN")
+    # A library must name every library it calls (a PRIVATE_DEPS left out fails here, not in
+    # the program that links it). Not with the sanitizers: their runtime is the executable's.
+    if(NOT SOFTSIGHT_SANITIZE AND NOT SOFTSIGHT_FUZZ)
+      target_link_options(${target} PRIVATE LINKER:--no-undefined)
+    endif()
+  else()
+    add_library(${target} STATIC ${ARG_SOURCES})
+  endif()
   target_include_directories(${target}
     PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     PRIVATE ${PROJECT_SOURCE_DIR}/src)
-  target_link_libraries(${target} PUBLIC ${ARG_DEPS})
+  target_link_libraries(${target} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   # softsight::<module>, the same name in this tree and for find_package(softsight) users.
   add_library(softsight::${module} ALIAS ${target})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${module})
-  # The program's command plugins and the Python module are shared objects that link these
-  # static libraries: their code must be position independent. -fno-semantic-interposition keeps
-  # GCC inlining calls between the library's own functions (which plain -fPIC would forbid), so
-  # the programs stay as fast.
+  # Shared libraries, and the program's command plugins and the Python module (shared objects
+  # that link the static ones), need position-independent code. Every symbol keeps default
+  # visibility: the tests call a module's internal functions too, and the API needs no export
+  # list to keep in step. -fno-semantic-interposition keeps GCC inlining and calling directly
+  # between a library's own functions (which plain -fPIC would forbid, for the sake of
+  # replacing one of them from outside, which softsight does not support), so the programs stay
+  # as fast as with static libraries.
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   softsight_use_unity_build(${target})
   target_compile_options(${target} PRIVATE
@@ -172,8 +198,18 @@ function(softsight_check_public_headers)
   # And a user's designated initializers of the public structs, under the same warnings
   # (-Wextra's missing-field-initializers): tests/api/designated_initializers.cc.
   list(APPEND sources ${PROJECT_SOURCE_DIR}/tests/api/designated_initializers.cc)
+  # The umbrella header (softsight/softsight.h) includes every other public header: one left out
+  # would be missing from `#include <softsight/softsight.h>` without any compile failing.
+  file(READ ${PROJECT_SOURCE_DIR}/include/softsight/softsight.h umbrella)
+  foreach(header ${headers})
+    if(NOT header STREQUAL "softsight/softsight.h" AND NOT umbrella MATCHES "#include \"${header}\"")
+      message(FATAL_ERROR "include/softsight/softsight.h does not include \"${header}\": add it")
+    endif()
+  endforeach()
   add_library(softsight_public_headers OBJECT ${sources})
-  target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include)
+  # version.h is generated (and installed beside the others).
+  target_include_directories(softsight_public_headers PRIVATE ${PROJECT_SOURCE_DIR}/include
+                                                              ${PROJECT_BINARY_DIR}/include)
   target_include_directories(softsight_public_headers SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
   target_precompile_headers(softsight_public_headers PRIVATE
     <opencv2/core.hpp> <string> <optional> <vector> <cstdint> <memory> <functional> <chrono>)

@@ -6,7 +6,8 @@
 # time, that directory instead (relative: under the prefix).
 #
 # In (set by the install(CODE) before including this): SOFTSIGHT_PYTHON, SOFTSIGHT_PYTHON_SITE_DIR,
-# SOFTSIGHT_PYTHON_SITE_SCRIPT, SOFTSIGHT_PYTHON_MODULE (the built _core*.so),
+# SOFTSIGHT_PYTHON_SITE_SCRIPT, SOFTSIGHT_PYTHON_MODULE (the built _core*.so) and its installed rpath
+# SOFTSIGHT_PYTHON_MODULE_RPATH,
 # SOFTSIGHT_PYTHON_SOURCES (the package's other files), SOFTSIGHT_PYTHON_DIST_INFO (its metadata).
 cmake_policy(VERSION 3.22)  # cmake_install.cmake runs under CMake's oldest policies.
 if(SOFTSIGHT_PYTHON_SITE_DIR)
@@ -31,8 +32,15 @@ else()
 endif()
 
 file(INSTALL DESTINATION "${_site}/softsight" TYPE MODULE FILES "${SOFTSIGHT_PYTHON_MODULE}")
+get_filename_component(_module_name "${SOFTSIGHT_PYTHON_MODULE}" NAME)
+# The built module looks for the shared libraries in the build tree; installed, from its own
+# place (SOFTSIGHT_PYTHON_MODULE_RPATH, relative to $ORIGIN), or nowhere (static libraries, or
+# shared ones in a system folder). CMake leaves room in the built module's rpath for this one.
+if(CMAKE_VERSION VERSION_GREATER_EQUAL 3.21)
+  file(RPATH_SET FILE "$ENV{DESTDIR}${_site}/softsight/${_module_name}"
+       NEW_RPATH "${SOFTSIGHT_PYTHON_MODULE_RPATH}")
+endif()
 if(CMAKE_INSTALL_DO_STRIP)
-  get_filename_component(_module_name "${SOFTSIGHT_PYTHON_MODULE}" NAME)
   execute_process(COMMAND strip "$ENV{DESTDIR}${_site}/softsight/${_module_name}")
 endif()
 file(INSTALL DESTINATION "${_site}/softsight" TYPE FILE FILES ${SOFTSIGHT_PYTHON_SOURCES})

@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
 # Installs every Debian package softsight needs to build, test, benchmark and run its demo.
 # Non-interactive and idempotent: packages already present are left alone. Run as root or with sudo.
+#   scripts/setup.sh           what the build, the tests and CI need
+#   scripts/setup.sh deb       also what the Debian package needs (scripts/package-deb.sh: man pages
+#                              by help2man, dpkg-shlibdeps) and its check (scripts/check-deb.sh:
+#                              debootstrap makes the clean Debian 12 root)
+#   scripts/setup.sh docs      also doxygen, for the API reference (`cmake --build build --target docs`)
 set -euo pipefail
 
 PACKAGES=(
@@ -24,6 +29,14 @@ PACKAGES=(
   python3-zmq            # softsight.stream.subscribe (the stream's Python end) and its test
   python3-pandas         # Table.to_pandas(), track_many's summary and stream.to_dataframe, as docs/python.md uses them
 )
+
+for group in "$@"; do
+  case $group in
+    deb) PACKAGES+=(help2man dpkg-dev debootstrap) ;;
+    docs) PACKAGES+=(doxygen) ;;
+    *) echo "setup: unknown group '$group' (deb, docs)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -11,11 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "softsight/config/config.h"
-#include "softsight/core/error.h"
-#include "softsight/pipeline/tracking_session.h"
-#include "softsight/sim/scene.h"
-#include "softsight/version.h"
+#include <softsight/softsight.h>  // The whole API: config, renderer, session, measurements.
 
 int main(int argc, char** argv) {
   if (argc < 2) {

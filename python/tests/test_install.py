@@ -2,7 +2,8 @@
 the user site, so that `python3 -c "import softsight"` works with no setting (it landed in
 P/lib/python3.X/dist-packages, which no Python searches); any other P under P's own layout, with
 the PYTHONPATH to set said at install time. It imports from there alone, with its version and
-licence metadata. (`pip install .` is checked by ctest's install.pip.)"""
+licence metadata, and its extension finds the shared libraries installed with it. (`pip install .`
+is checked by ctest's install.pip.)"""
 
 from __future__ import annotations
 
@@ -28,10 +29,13 @@ def clean_environment(**values: str) -> dict[str, str]:
 
 
 def install_python_package(prefix: Path, env: dict[str, str]) -> str:
-    result = subprocess.run([CMAKE, "--install", BUILD_DIR, "--component", "python", "--prefix",
-                             str(prefix)], env=env, check=True, capture_output=True, text=True,
-                            timeout=60)
-    return result.stdout
+    """The package, and the libraries its extension links (shared ones, found from its own place)."""
+    said = ""
+    for component in ("python", "library"):
+        said += subprocess.run([CMAKE, "--install", BUILD_DIR, "--component", component, "--prefix",
+                                str(prefix)], env=env, check=True, capture_output=True, text=True,
+                               timeout=60).stdout
+    return said
 
 
 def imported_from(env: dict[str, str], cwd: Path) -> Path:

@@ -28,10 +28,10 @@
 
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
-#include "softsight/io/read_ahead_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "io/read_ahead_source.h"
 
 namespace softsight {
 namespace {

@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "softsight/calib/hsv_picker.h"
-#include "softsight/io/frame_grabber.h"
 #include "gui/live_options.h"
 #include "gui/overlay.h"
 #include "gui/live_pipeline.h"
 #include "gui/live_view.h"
 #include "gui/rate_meter.h"
+#include "io/frame_grabber.h"
 #include "gui/scale_clicks.h"
 #include "gui/strip_chart.h"
 #include "gui/timeline.h"

@@ -19,7 +19,7 @@
 #include "gui/seekable_source.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
-#include "softsight/io/paced_source.h"
+#include "io/paced_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include <fstream>

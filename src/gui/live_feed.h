@@ -16,7 +16,7 @@
 #include "softsight/core/types.h"
 #include "gui/live_controller.h"
 #include "softsight/io/frame_source.h"
-#include "softsight/io/paced_source.h"
+#include "io/paced_source.h"
 
 namespace softsight {
 

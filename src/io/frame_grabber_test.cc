@@ -1,4 +1,4 @@
-#include "softsight/io/frame_grabber.h"
+#include "io/frame_grabber.h"
 
 #include <gtest/gtest.h>
 

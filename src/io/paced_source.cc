@@ -1,4 +1,4 @@
-#include "softsight/io/paced_source.h"
+#include "io/paced_source.h"
 
 #include <thread>
 #include <utility>

@@ -1,4 +1,4 @@
-#include "softsight/io/read_ahead_source.h"
+#include "io/read_ahead_source.h"
 
 #include <algorithm>
 #include <chrono>

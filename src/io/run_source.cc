@@ -1,8 +1,8 @@
 #include "softsight/io/run_source.h"
 
-#include "softsight/io/frame_grabber.h"
-#include "softsight/io/paced_source.h"
-#include "softsight/io/read_ahead_source.h"
+#include "io/frame_grabber.h"
+#include "io/paced_source.h"
+#include "io/read_ahead_source.h"
 
 namespace softsight {
 

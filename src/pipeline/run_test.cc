@@ -9,11 +9,11 @@
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
+#include "io/frame_grabber.h"
+#include "io/read_ahead_source.h"
 #include "pipeline/scene_config_test_util.h"
 #include "softsight/core/error.h"
-#include "softsight/io/frame_grabber.h"
 #include "softsight/io/frame_writer.h"
-#include "softsight/io/read_ahead_source.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/sim/scene.h"
 

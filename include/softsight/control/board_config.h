@@ -1,6 +1,6 @@
 // What the board is set up with and what it drives: the settings of the inner loop, the valve and
 // pump outputs and the board's mode. Public because the simulated rig's options (rig.h) and its
-// snapshots carry them; the board's logic itself is private to control (src/control/board.h).
+// snapshots carry them; the board's logic itself is internal to the control library.
 //
 // Shared with the firmware: plain C++11, no heap, C headers only.
 #pragma once

@@ -17,7 +17,8 @@
 
 namespace softsight {
 
-// The wire format itself is private to control (src/control/protocol.h, shared with the firmware).
+// The wire format itself is internal to the control library (shared with the firmware:
+// docs/protocol.md).
 namespace wire {
 struct Message;
 enum class MessageType : uint8_t;

@@ -1,6 +1,6 @@
-// The simulated rig: the board (src/control/board.h, the firmware's own logic) driving a pneumatic
-// actuator (src/control/plant.h), served on a pseudo-terminal so the host drives it exactly as a
-// board on /dev/ttyACM0.
+// The simulated rig: the board (the firmware's own logic, compiled into the library) driving a
+// pneumatic actuator (PlantOptions below), served on a pseudo-terminal so the host drives it
+// exactly as a board on /dev/ttyACM0.
 //
 // Time is simulated: advance() runs the board's inner loop at its loop_hz and the plant between
 // periods. In lock-step use (tests, `softsight control --simulate`) the host advances the rig one
@@ -22,7 +22,8 @@
 
 namespace softsight {
 
-// The pneumatic actuator the rig simulates (src/control/plant.h gives the model).
+// The pneumatic actuator the rig simulates: a chamber filled by a pump and emptied by a vent,
+// bending with a lag and hysteresis; these are the model's parameters.
 struct PlantOptions {
   double chamber_volume_ml = 20.0;       // Chamber + tubing. Larger: slower pressure. Default 20 mL.
   double pump_flow_l_per_min = 1.0;      // Free flow of the pump (standard L/min). Default 1.0.

@@ -29,7 +29,7 @@ struct RunOptions {
   std::function<bool()> stop_requested{};
   // A video that predicts frames (MPEG-4, H.264): each group of frames reaches the sinks only
   // after its next key frame was tracked, so that a marker the decoder's silent damage moved is
-  // reported implausible instead of found (src/pipeline/key_frame_groups.h; frames of cameras,
+  // reported implausible instead of found (the library checks the group inside; frames of cameras,
   // image sequences and intra-only videos are not delayed). Off for a loop that acts on each
   // frame as it comes (`control`): it cannot wait for the next key frame.
   bool check_key_frame_groups = true;

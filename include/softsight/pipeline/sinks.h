@@ -1,5 +1,5 @@
 // The sinks every command shares: the per-frame CSV and the videos (raw recording, annotated).
-// The progress bar and the controller are sinks of the program (src/app); the live window's
+// The progress bar and the controller are sinks of the `softsight` program; the live window's
 // view is a sink of the GUI.
 #pragma once
 

@@ -95,7 +95,7 @@ class Tracker {
   virtual std::optional<cv::Rect> search_region() const;
 };
 
-class TrackerKind;  // What a kind of marker is to the program (src/track/tracker_kind.h).
+class TrackerKind;  // What a kind of marker is to the program (internal to the track library).
 
 namespace tracker_detail {
 // The registered kind whose parameter set is of `type`. A type no kind registered is a
@@ -105,11 +105,11 @@ const TrackerKind& KindOfParams(std::type_index type);
 
 // A marker's tracking parameters: the parameter set of one kind of marker. Built in: ColourParams
 // (colour or gray-level thresholding) and TemplateParams (template matching, whose measure, sad,
-// ssd or zncc, and gray/colour choice it carries); a kind registered in src/track/ adds its own
-// set (src/track/tracker_kind.h). A value: copies are independent. What differs between kinds
-// (checks, YAML keys, what a tracker needs from a frame, how a person selects the marker) is
-// asked of kind(), so only src/track/ tells kinds apart; code that edits one kind's own fields
-// (the live window's colour ranges) asks for that set by type with get_if<P>().
+// ssd or zncc, and gray/colour choice it carries); a kind registered inside the track library
+// adds its own set. A value: copies are independent. What differs between kinds (checks, YAML
+// keys, what a tracker needs from a frame, how a person selects the marker) is asked of kind(),
+// so only the track library tells kinds apart; code that edits one kind's own fields (the live
+// window's colour ranges) asks for that set by type with get_if<P>().
 class MarkerParams {
  public:
   MarkerParams();  // ColourParams' defaults.
