@@ -763,10 +763,12 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
   for (int i = 0; i < 3; ++i) live.on_event(UiEvent::Key('m'));
   ASSERT_EQ(TrackerMethodName(live.config().markers[0].params), "zncc");
   std::vector<FrameResult> shown = {*live.last_result()};  // Frame 7 with the new templates.
+  cv::Point2d dragged_around;
   while (feed.step(live)) {
     shown.push_back(*live.last_result());
     if (live.last_result()->frame_index == 12) {
       const cv::Point2d blue = *live.last_result()->markers[1].observation.position_px;
+      dragged_around = blue;
       Drag(live, blue - cv::Point2d(10, 12), blue + cv::Point2d(13, 10));
       ASSERT_NE(live.message().find("blue: reselected"), std::string::npos) << live.message();
       shown.back() = *live.last_result();  // Frame 12 as shown after the drag.
@@ -781,7 +783,13 @@ TEST_F(LiveFileTest, ReselectedTemplatesAreSavedAsImagesThatTrackReproducesAfter
   const TrackingConfig reloaded = LoadTrackingConfig(saved);
   EXPECT_EQ(reloaded.markers[0].params.get<TemplateParams>().template_frame, 7);
   EXPECT_EQ(reloaded.markers[1].params.get<TemplateParams>().template_frame, 12);
-  EXPECT_EQ(reloaded.markers[1].params.get<TemplateParams>().rect->size(), cv::Size(23, 22));
+  // Saved as the tracker cut it: the 23 x 22 box dragged, widened to hold the disc's
+  // surroundings (its rim came within kMinSurroundPx of the box's edge), pixels and box alike.
+  const TemplateParams& blue_saved = reloaded.markers[1].params.get<TemplateParams>();
+  EXPECT_TRUE(blue_saved.rect->contains(cv::Point(dragged_around)));
+  EXPECT_GT(blue_saved.rect->width, 23);
+  EXPECT_GT(blue_saved.rect->height, 22);
+  EXPECT_EQ(blue_saved.image.size(), blue_saved.rect->size());
 
   Track(saved, video, (dir_ / "tracked.csv").string());
   const CsvTable table = ReadCsvTable((dir_ / "tracked.csv").string());

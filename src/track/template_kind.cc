@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "track/track_options.h"
+#include "track/template_tracker_impl.h"
 #include "track/tracker_kind.h"
 
 namespace softsight {
@@ -101,9 +102,16 @@ class TemplateKind final : public TrackerKind {
   void remember_selection(MarkerParams& params, const Frame& frame,
                           const cv::Rect& rect) const override {
     TemplateParams& templ = params.get<TemplateParams>();
-    templ.rect = rect;
+    // The template is cut from the box the tracker took (the box dragged, or that box widened
+    // to hold the marker's surroundings): `track` then starts from the same pixels.
+    TemplateParams cut = templ;
+    cut.image = cv::Mat();
+    template_internal::TemplateTracker tracker(cut);
+    tracker.init(frame.image, rect);
+    const cv::Rect box = tracker.selection_box().empty() ? rect : tracker.selection_box();
+    templ.rect = box;
     templ.template_frame = static_cast<int>(std::max<int64_t>(0, frame.index));
-    templ.image = frame.image(rect & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
+    templ.image = frame.image(box & cv::Rect(0, 0, frame.image.cols, frame.image.rows)).clone();
   }
   // Cut from the recording's frame 0.
   void start_in(MarkerParams& params, const cv::Rect& box) const override {

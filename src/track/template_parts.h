@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "track/chromaticity.h"
 #include "track/match_kernels.h"
@@ -104,6 +105,12 @@ cv::Point2d MarkerSymmetryCentre(const cv::Mat& templ, const cv::Point2d& blob_c
 // body.
 
 inline constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker and background.
+// A selected template holds this much of the marker's surroundings on every side of its blob
+// (px): the background's level is read 3-4 px outside the blob (BlobMeter::MeasureSegmented).
+inline constexpr int kMinSurroundPx = 4;
+// Of a template's bright and dark blobs at its centre, the one this many times larger is the
+// marker (the other a highlight on it, or a dark fleck), whichever stands out more.
+inline constexpr double kMarkerOverGlint = 3.0;
 // The blob at a match has at least this fraction of the learned blob's area (at the current
 // scale), and at most its inverse: a tilt to 60 degrees halves a disc's area.
 inline constexpr double kMinBlobAreaRatio = 0.4;
@@ -139,13 +146,24 @@ class BlobMeter {
   // dot, or a dark one, on a band that may itself be brighter or darker than the background).
   bool Learn(const cv::Mat& gray, const cv::Mat& mask, cv::Point2d* centroid) {
     const cv::Point2d centre = HalfSize(gray.size());
-    double best = -1;
+    double best = -1, best_pixels = 0;
     bool best_bright = true;
+    learned_contrast_ = 0;
     for (const bool bright : {true, false}) {
       bright_ = bright;
       double low = 0, high = 0;
-      if (Segment(gray, mask, centre, &low, &high) && high - low > best) {
+      contrast_ = 0;
+      const bool segmented = Segment(gray, mask, centre, &low, &high);
+      learned_contrast_ = std::max(learned_contrast_, contrast_);
+      if (!segmented) continue;
+      // A highlight or glint on a domed marker stands out more than the marker, and is a small
+      // part of it: the much larger blob is the marker.
+      const double pixels = cv::countNonZero(label_(box_));
+      const bool much_larger = pixels > kMarkerOverGlint * best_pixels;
+      const bool much_smaller = best_pixels > kMarkerOverGlint * pixels;
+      if (best < 0 || much_larger || (!much_smaller && high - low > best)) {
         best = high - low;
+        best_pixels = pixels;
         best_bright = bright;
       }
     }
@@ -165,6 +183,9 @@ class BlobMeter {
   // channel in which a shadow beside the marker is nearly as dark as the marker scores less than
   // one in which only the marker differs).
   double isolation() const { return range_ > 0 ? contrast_ / range_ : 0.0; }
+  // After Learn, true or false: the most levels by which the centre stood out from the level at
+  // which it would join the patch's edge, in either polarity (what a refusal reports).
+  double learned_contrast() const { return learned_contrast_; }
 
   // The soft centroid of the marker-side component nearest `guess` (patch coordinates), and its
   // area in px (sum of weights). False when there is no such component within 2 px of the guess,
@@ -198,6 +219,9 @@ class BlobMeter {
   }
 
   double area() const { return area_; }  // At selection, px.
+  // The bounding box of the component the last Segment found (patch coordinates): after Learn,
+  // the learned blob's.
+  const cv::Rect& blob_box() const { return box_; }
 
  private:
   // Measure's work once Segment has found the component (label_, box_) and its levels.
@@ -374,6 +398,7 @@ class BlobMeter {
   bool bright_ = true;
   double area_ = 0;
   double contrast_ = 0;
+  double learned_contrast_ = 0;
   double range_ = 0;
   double located_low_ = 0, located_high_ = 0;  // The last Locate's levels, for MeasureLocated.
   cv::Mat label_, dist_, visited_;

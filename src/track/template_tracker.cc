@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -201,11 +202,89 @@ bool TemplateTracker::start(const Frame& frame) {
   return false;
 }
 
-bool TemplateTracker::ShowsAMarker(const cv::Mat& templ) const {
-  cv::Mat projection;
+TemplateTracker::BoxVerdict TemplateTracker::JudgeBox(const cv::Mat& native,
+                                                      const cv::Mat& selection_bgr) const {
+  BoxVerdict verdict;
+  cv::Mat projection, channel;
   BlobMeter meter;
   cv::Point2d centroid;
-  return LearnTemplateBlob(templ, MaskFor(templ.size()), &projection, &meter, &centroid);
+  const cv::Mat mask = MaskFor(native.size());
+  if (LearnTemplateBlob(native, mask, &projection, &meter, &centroid)) {
+    return {true, centroid, meter.learned_contrast(), meter.blob_box(), meter.area()};
+  }
+  verdict.contrast = meter.learned_contrast();
+  // A coloured marker may stand out only in its chromaticity where a groove, a shadow or wood
+  // grain beside it is as dark as it in the matched channel: SetTemplate measures its blob there.
+  ChromaAxis chroma;
+  if (!selection_bgr.empty() && LearnChromaAxis(selection_bgr, &chroma)) {
+    ChromaChannel(selection_bgr, chroma, channel);
+    BlobMeter colour_meter;
+    if (colour_meter.Learn(channel, mask, &centroid)) {
+      return {true, centroid, colour_meter.learned_contrast(), colour_meter.blob_box(),
+              colour_meter.area()};
+    }
+    verdict.contrast = std::max(verdict.contrast, colour_meter.learned_contrast());
+  }
+  return verdict;
+}
+
+void TemplateTracker::PrepareSelection(const cv::Mat& frame_bgr, const cv::Rect& box,
+                                       cv::Mat& native) {
+  projection_.release();
+  if (!params_.colour && params_.contrast_gray && frame_bgr.channels() == 3) {
+    projection_ = ContrastProjection(frame_bgr(box));
+  }
+  ToNative(frame_bgr(box), native);
+}
+
+// The box a person dragged, or the same box widened to hold the marker's surroundings. A person
+// drags the box around the whole marker, so the marker is the largest blob at its centre that
+// lies inside the box dragged (give or take a cut rim) with kMinSurroundPx of surroundings on
+// every side of it in the template. A box drawn tight around the marker shows only what stands
+// out inside it (a domed disc's highlight): its rim reaches the box's edge, so the disc itself
+// needs a wider box to stand out from. Empty when no box shows a marker so; `contrast` gets the
+// most levels anything at the centre stood out by.
+cv::Rect TemplateTracker::BoxShowingTheMarker(const cv::Mat& frame_bgr, const cv::Rect& hint,
+                                              cv::Mat& native, double* contrast) {
+  const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
+  const int side = std::min(hint.width, hint.height);
+  const int rim = std::max(2, side / 6);  // How far a blob may stick out of the box dragged.
+  const cv::Rect allowed(hint.x - rim, hint.y - rim, hint.width + 2 * rim, hint.height + 2 * rim);
+  const auto acceptable = [&](const BoxVerdict& v, const cv::Rect& box) {
+    const cv::Rect blob = v.blob_box + box.tl();
+    const cv::Point2d at = v.centroid + cv::Point2d(box.tl());
+    // An edge of the frame cannot be widened past: there the blob needs no surroundings.
+    return v.marker && (blob & allowed) == blob && at.x >= hint.x - 0.5 &&
+           at.y >= hint.y - 0.5 && at.x <= hint.br().x - 0.5 && at.y <= hint.br().y - 0.5 &&
+           (blob.x - box.x >= kMinSurroundPx || box.x == 0) &&
+           (blob.y - box.y >= kMinSurroundPx || box.y == 0) &&
+           (box.br().x - blob.br().x >= kMinSurroundPx || box.br().x == frame_rect.width) &&
+           (box.br().y - blob.br().y >= kMinSurroundPx || box.br().y == frame_rect.height);
+  };
+  *contrast = 0;
+  cv::Rect best;
+  double best_area = 0;
+  for (const double fraction : {0.0, 0.25, 0.5, 1.0}) {
+    const int margin = fraction == 0.0 ? 0 : std::max(kMinSurroundPx,
+                                                      static_cast<int>(std::lround(fraction * side)));
+    const cv::Rect box = cv::Rect(hint.x - margin, hint.y - margin, hint.width + 2 * margin,
+                                  hint.height + 2 * margin) & frame_rect;
+    if (static_cast<int>(box.area()) * frame_bgr.channels() > kMaxTemplateValues ||
+        box.width * frame_bgr.channels() > kMaxTemplateRowBytes) {
+      break;
+    }
+    PrepareSelection(frame_bgr, box, native);
+    const BoxVerdict verdict =
+        JudgeBox(native, frame_bgr.channels() == 3 ? frame_bgr(box) : cv::Mat());
+    *contrast = std::max(*contrast, verdict.contrast);
+    // A wider box wins only with a clearly larger blob (not the same one measured again).
+    if (acceptable(verdict, box) && verdict.area > 1.25 * best_area) {
+      best = box;
+      best_area = verdict.area;
+    }
+  }
+  if (!best.empty()) PrepareSelection(frame_bgr, best, native);
+  return best;
 }
 
 void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
@@ -218,34 +297,43 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
                        " frame");
     }
     const cv::Mat previous = projection_;  // Kept if the new selection is refused.
-    projection_.release();
-    if (!params_.colour && params_.contrast_gray && frame_bgr.channels() == 3) {
-      projection_ = ContrastProjection(frame_bgr(hint));
-    }
     cv::Mat native;
-    ToNative(frame_bgr(hint), native);
     try {
       // A box a person drags must hold a marker: a blob at its centre, wholly inside it and
       // standing out from its surroundings. A box of background (or cutting a marker) would be
       // matched wherever that background looks alike, and never lost.
-      if (!ShowsAMarker(native)) {
-        throw InputError("the box " + RectText(hint) + " holds no marker (nothing at its centre "
-                         "stands out from its surroundings): drag it around a marker, with some "
-                         "background on every side");
+      double contrast = 0;
+      const cv::Rect box = BoxShowingTheMarker(frame_bgr, hint, native, &contrast);
+      if (box.empty()) {
+        char measured[160];
+        if (contrast >= kMinBlobContrast) {
+          std::snprintf(measured, sizeof measured,
+                        "what stands out at its centre, by %.0f levels, is no blob lying "
+                        "inside the box with its surroundings, even with the box widened",
+                        contrast);
+        } else {
+          std::snprintf(measured, sizeof measured,
+                        "nothing at its centre stands out from its surroundings: %.0f levels at "
+                        "most, %.0f needed", contrast, kMinBlobContrast);
+        }
+        throw InputError("the box " + RectText(hint) + " holds no marker (" + measured +
+                         "): drag it around a marker, with some background on every side");
       }
-      SetTemplate(native.clone(), "template rect " + RectText(hint),
-                  frame_bgr.channels() == 3 ? frame_bgr(hint) : cv::Mat());
+      SetTemplate(native.clone(), "template rect " + RectText(box),
+                  frame_bgr.channels() == 3 ? frame_bgr(box) : cv::Mat());
+      // The person showed where the marker is on this frame: the first update looks right
+      // there, in a tracking window, not in a wide search that may hold look-alikes.
+      last_centre_ = cv::Point2d(box.x, box.y) + HalfSize(box.size());
+      selection_box_ = box;
     } catch (const InputError&) {
       projection_ = previous;
       throw;
     }
-    // The person showed where the marker is on this frame: the first update looks right there,
-    // in a tracking window, not in a wide search that may hold look-alikes.
-    last_centre_ = cv::Point2d(hint.x, hint.y) + HalfSize(hint.size());
     tracking_ = true;
     scan_pending_ = true;
   } else {
     const std::string where = "template image";
+    selection_box_ = cv::Rect();
     if (params_.image.empty()) {
       throw InputError(
           "template: none given (set template.rect or template.file, or select the "

@@ -29,6 +29,9 @@ class TemplateTracker final : public Tracker {
   Observation update(const cv::Mat& frame_bgr) override;
   const std::vector<MarkerCandidate>& candidates() const override { return weighed_; }
   std::optional<Observation> adopt(size_t index) override;
+  // The box the template was cut from at the last init with a box: the box dragged, or that box
+  // widened to hold the marker's surroundings (BoxShowingTheMarker). Empty after init from an image.
+  const cv::Rect& selection_box() const { return selection_box_; }
   void reset() override {
     tracking_ = false;
     last_centre_.reset();
@@ -61,9 +64,20 @@ class TemplateTracker final : public Tracker {
   bool ColourAgreesAt(const cv::Mat& frame, const Hit& hit) const;
   // The chromaticity distance of the core at `centre_px` from the marker's; empty when unknown.
   std::optional<double> ColourDistanceAt(const cv::Mat& frame, const cv::Point2d& centre_px) const;
-  // Whether `templ` (native) would show its marker's blob, as SetTemplate learns it; changes
-  // nothing.
-  bool ShowsAMarker(const cv::Mat& templ) const;
+  // Whether a selected box (its native pixels, and its BGR ones when the frame has colour) shows
+  // a marker's blob at its centre, as SetTemplate learns it; changes nothing.
+  struct BoxVerdict {
+    bool marker = false;
+    cv::Point2d centroid;  // The blob's, in the box.
+    double contrast = 0;   // Levels it stands out by (the most seen when there is no marker).
+    cv::Rect blob_box;     // The blob's bounding box, in the box.
+    double area = 0;       // The blob's, px.
+  };
+  BoxVerdict JudgeBox(const cv::Mat& native, const cv::Mat& selection_bgr) const;
+  // Sets projection_ for a selection at `box` and cuts its native pixels.
+  void PrepareSelection(const cv::Mat& frame_bgr, const cv::Rect& box, cv::Mat& native);
+  cv::Rect BoxShowingTheMarker(const cv::Mat& frame_bgr, const cv::Rect& hint, cv::Mat& native,
+                               double* contrast);
   // A point of the selected template in a rung of `size`. Template coordinates scale about the
   // pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
   cv::Point2d ToRung(const cv::Point2d& p, const cv::Size& size) const {
@@ -136,6 +150,7 @@ class TemplateTracker final : public Tracker {
   // Distance to the nearest look-alike seen around the marker (at the selected scale), or
   // infinity: re-acquisition never looks half of it away from the last position, so a marker
   // covered beside its twin is lost, not swapped.
+  cv::Rect selection_box_;  // See selection_box().
   double look_alike_px_ = std::numeric_limits<double>::infinity();
   bool scan_pending_ = false;           // Scan for look-alikes at the first match after a hint.
 

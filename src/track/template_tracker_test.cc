@@ -183,21 +183,20 @@ TEST(TemplateTrackerTest, GrayTemplatesTrackToATenthOfAPixel) {
   }
 }
 
-// Matched in luma, the green disc hardly differs from the band: the match misses frames the
-// contrast projection keeps. (Where found, both report the disc's blob measured in its
-// chromaticity, equally accurate.)
-TEST(TemplateTrackerTest, LumaGrayMatchesLessReliablyThanTheContrastProjection) {
+// Matched in luma, the green disc hardly differs from the band, and the band's structure at its
+// rim moves the match as the body turns; the position reported is the disc's blob, measured again
+// at every match, so luma finds every frame as accurately as the contrast projection. (With the
+// template's centre of symmetry reported, the default until the blob was, luma missed frames
+// near the largest turn.)
+TEST(TemplateTrackerTest, LumaGrayFindsEveryFrameByTheMarkersBlob) {
   TemplateParams luma;
   luma.contrast_gray = false;
   for (const char* method : kMethods) {
     const Stats plain = Track(Rendered("clean"), method, false, luma);
-    const Stats projected = Track(Rendered("clean"), method, false);
-    const std::string what = Describe(std::string(method) + " gray luma clean", plain);
-    std::printf("%s\n", what.c_str());
-    SCOPED_TRACE(what);
-    EXPECT_LE(plain.rms_px, 0.25);
-    EXPECT_LE(plain.max_px, 1.3);
-    EXPECT_GT(plain.missed, projected.missed);
+    SCOPED_TRACE(Describe(std::string(method) + " gray luma clean", plain));
+    EXPECT_LE(plain.rms_px, 0.1);
+    EXPECT_LE(plain.max_px, 0.35);
+    EXPECT_EQ(plain.missed, 0);
   }
 }
 
@@ -696,6 +695,69 @@ TEST(TemplateTrackerTest, SadAndSsdOnThePlateReportNotFoundRatherThanWrong) {
     EXPECT_EQ(f.far, 0);
     EXPECT_LE(f.max_px, 1.5);
     EXPECT_GT(f.found, 0);
+  }
+}
+
+// A domed disc lit from one side: a darker flank, a highlight off its centre, on a mottled
+// surface. Drawn at 4x and shrunk, so its rim is anti-aliased as a camera's would be.
+cv::Mat DomedDisc(const cv::Point2d& centre, double radius) {
+  constexpr int kUp = 4;
+  cv::Mat big(240 * kUp, 320 * kUp, CV_8UC3);
+  cv::RNG rng(7);
+  for (int y = 0; y < big.rows; y += kUp * 3) {
+    for (int x = 0; x < big.cols; x += kUp * 3) {  // Mottle in 3 px cells.
+      const int v = 150 + static_cast<int>(rng.uniform(-12, 12));
+      big(cv::Rect(x, y, kUp * 3, kUp * 3) & cv::Rect(0, 0, big.cols, big.rows)).setTo(cv::Scalar(v, v + 5, v + 10));
+    }
+  }
+  const cv::Point c(cvRound((centre.x + 0.5) * kUp - 0.5), cvRound((centre.y + 0.5) * kUp - 0.5));
+  const int r = cvRound(radius * kUp);
+  cv::circle(big, c, r, cv::Scalar(40, 40, 170), cv::FILLED, cv::LINE_AA);
+  cv::ellipse(big, c, cv::Size(r, r), 0, 100, 260, cv::Scalar(25, 25, 110), cv::FILLED, cv::LINE_AA);
+  cv::circle(big, c + cv::Point(-r / 3, -r / 3), r / 4, cv::Scalar(200, 200, 250), cv::FILLED, cv::LINE_AA);
+  cv::Mat frame;
+  cv::resize(big, frame, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
+  return frame;
+}
+
+// A box drawn tight around a marker (no margin, or cutting its rim) holds it, but not the
+// surroundings it stands out from: its rim reaches the box's edge, and inside the box only the
+// highlight stands out. The tracker widens the box until the whole disc stands out (and says
+// which box it took); the position is the disc's, not its highlight's. Before, such boxes were
+// refused on 18 of 115 boxes around the physically based scenes' markers, and accepted ones
+// latched onto a highlight 3-4.7 px off.
+TEST(TemplateTrackerTest, ABoxDrawnTightAroundAMarkerIsWidenedToHoldItsSurroundings) {
+  const cv::Point2d centre(160.3, 120.6);
+  constexpr double kRadius = 10.0;
+  const cv::Mat frame = DomedDisc(centre, kRadius);
+  for (const int cut : {0, 1}) {  // Tight to the rim, and 1 px into it.
+    const int half = static_cast<int>(kRadius) - cut;
+    const cv::Rect tight(cvRound(centre.x) - half, cvRound(centre.y) - half, 2 * half + 1,
+                         2 * half + 1);
+    for (const char* method : kMethods) {
+      SCOPED_TRACE(std::string(method) + " cut " + std::to_string(cut));
+      MarkerSpec spec;
+      spec.name = "red";
+      spec.params = ParamsForMethod(method, {TemplateParams{}});
+      std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+      ASSERT_NO_THROW(tracker->init(frame, tight));
+      const Observation found = tracker->update(frame);
+      ASSERT_TRUE(found.found());
+      EXPECT_LT(cv::norm(*found.position_px - centre), 0.5);
+    }
+  }
+  // A box of the mottled surface alone is still refused, naming what was measured.
+  MarkerSpec spec;
+  spec.name = "red";
+  spec.params = ParamsForMethod("zncc", {TemplateParams{}});
+  std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+  try {
+    tracker->init(frame, cv::Rect(20, 20, 21, 21));
+    ADD_FAILURE() << "a box of background was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("holds no marker"), std::string::npos) << what;
+    EXPECT_NE(what.find(" levels"), std::string::npos) << what;  // What was measured.
   }
 }
 

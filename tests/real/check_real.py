@@ -34,7 +34,7 @@ CASES = {
              'clutter (reference: ViSP vpDot2)',
         input='frames/image.%04d.png', args=['--fps', '30'], tol=1.5, ref_sigma=0.1,
         configs=[('colour', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 99.0),
-                 ('zncc', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 80.0)]),
+                 ('zncc', {f'd{k}': f'd{k}' for k in range(5)}, 'd1,d2,d3', 95.0)]),
     'cube': dict(
         what='ViSP cube: 80 real gray frames, 12 white dots on a cube face, other faces\' dots come '
              'into view (reference: ViSP vpDot2)',

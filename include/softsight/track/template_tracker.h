@@ -106,7 +106,7 @@ struct TemplateParams {
   // plate, does not count. Default true; false matches the whole rectangle (the paper's, and a
   // faster unmasked ZNCC kernel).
   bool round_mask = true;
-  // Which point is reported (see the contract above). Default kSymmetry: on colour footage where
+  // Which point is reported (see the contract above). Default kCentre. kSymmetry: on colour footage where
   // the marker stands out more in its chromaticity than in the matched channel, its blob's soft
   // centroid in that chromaticity, measured in every frame (shading does not move it); else the
   // marker's centre
@@ -122,7 +122,7 @@ struct TemplateParams {
   // plate (white dots on a dark plate) it is the more accurate (0.001 vs 0.048 px). kRectCentre: the
   // rectangle's centre, (x + (w-1)/2, y + (h-1)/2), scaled with the marker: the marker's centroid
   // only when the rectangle was centred on it (the paper's position).
-  TemplateReport report = TemplateReport::kSymmetry;
+  TemplateReport report = TemplateReport::kCentre;
   // Gray mode only: the single channel matched is not luma but BGR projected on the template's
   // principal colour axis (largest colour variance in the template: the marker against what is
   // around it), weights of L1 norm 1 plus an offset, so values stay 0..255 grey levels and SAD/SSD
