@@ -111,6 +111,9 @@ inline constexpr int kMinSurroundPx = 4;
 // Of a template's bright and dark blobs at its centre, the one this many times larger is the
 // marker (the other a highlight on it, or a dark fleck), whichever stands out more.
 inline constexpr double kMarkerOverGlint = 3.0;
+// How much lower than drift_min_zncc the first template may fit a match whose blob is found there
+// (the marker's blob, of its area, is evidence that the match has not drifted off it).
+inline constexpr double kBlobDriftAllowance = 0.2;
 // The blob at a match has at least this fraction of the learned blob's area (at the current
 // scale), and at most its inverse: a tilt to 60 degrees halves a disc's area.
 inline constexpr double kMinBlobAreaRatio = 0.4;

@@ -634,10 +634,23 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
                           (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
                           (best.y == 0 && window.y > 0) ||
                           (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
-  if (inner_edge) return std::nullopt;
-  const cv::Point2d top_left =
-      cv::Point2d(window.tl() + best) +
-      SubPixel(fine_sim_, best, params_.measure == MatchMeasure::kSad);
+  cv::Point2d top_left;
+  if (!inner_edge) {
+    top_left = cv::Point2d(window.tl() + best) +
+               SubPixel(fine_sim_, best, params_.measure == MatchMeasure::kSad);
+  } else if (blob_ok_) {
+    // The first template fits best farther than the window from the working template's match:
+    // a marker seen at a slant (a dot squashed by a tilt) fits its frontal template along a
+    // ridge, not at a point. The marker's blob places it (BlobShift); the first template only
+    // guards against drift, judged where the working template matched.
+    const cv::Point at(static_cast<int>(std::lround(centre_px.x - HalfSize(size).x)) - window.x,
+                       static_cast<int>(std::lround(centre_px.y - HalfSize(size).y)) - window.y);
+    if (at.x < 0 || at.y < 0 || at.x >= fine_sim_.cols || at.y >= fine_sim_.rows) return std::nullopt;
+    best = at;
+    top_left = cv::Point2d(window.tl() + best);
+  } else {
+    return std::nullopt;
+  }
   Fix fix;
   fix.centre = top_left + HalfSize(size);
   fix.reported = top_left + rung.anchor;
@@ -743,8 +756,16 @@ void TemplateTracker::TurnedTo() {
 std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, const Fix& fix) {
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
-  const cv::Rect at = WindowAround(fix.centre, size, 0);
-  if ((at & cv::Rect(0, 0, frame.cols, frame.rows)) != at) return std::nullopt;
+  // Measured on the template's place and some of its surroundings, unmasked: a marker seen at a
+  // slant (a disc squashed by a tilt) matches best at a scale where its long axis reaches the
+  // template's edge, and a blob cut by the edge is no blob (ViSP's mire-2: the big dot lost for
+  // 112 frames while plainly in view).
+  // (As much of them as the frame holds: the template's own place must be in it.)
+  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
+  const cv::Rect own = WindowAround(fix.centre, size, 0);
+  if ((own & frame_rect) != own) return std::nullopt;
+  const int grow = std::max(kMinSurroundPx, std::min(size.width, size.height) / 4);
+  const cv::Rect at = WindowAround(fix.centre, size, grow) & frame_rect;
   if (chroma_ok_ && frame.type() == CV_8UC3) {
     ChromaChannel(frame(at), chroma_, blob_gray_);
   } else {
@@ -756,7 +777,8 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
       fix.centre - HalfSize(size) - cv::Point2d(at.tl()) + rung.blob_anchor;
   cv::Point2d centroid;
   double area = 0;
-  if (!blob_.Locate(blob_gray_, rung.templ.mask(), expected, &centroid, &area)) {
+  const cv::Mat unmasked;
+  if (!blob_.Locate(blob_gray_, unmasked, expected, &centroid, &area)) {
     return std::nullopt;
   }
   const double learned = blob_.area() * rung_scale() * rung_scale();
@@ -768,7 +790,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
     return cv::Point2d(0, 0);
   }
   // To be applied: measured with the soft centroid.
-  if (!blob_.MeasureLocated(blob_gray_, rung.templ.mask(), &centroid, &area)) {
+  if (!blob_.MeasureLocated(blob_gray_, unmasked, &centroid, &area)) {
     return std::nullopt;
   }
   shift = centroid - expected;
@@ -965,7 +987,10 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
                                   fix->score <= (params_.measure == MatchMeasure::kSad
                                                      ? params_.max_sad
                                                      : params_.max_ssd));
-  if (!fix || !levels_fit || !(fix->zncc >= params_.drift_min_zncc)) {
+  // A marker with a blob may leave its first template further (a dot squashed by a tilt): the
+  // blob found at the match, of the marker's area, is the second piece of evidence against drift.
+  const double drift_floor = params_.drift_min_zncc - (blob_ok_ ? kBlobDriftAllowance : 0.0);
+  if (!fix || !levels_fit || !(fix->zncc >= drift_floor)) {
     if (adapts()) RestoreWorkingTemplate();  // The working template may have drifted.
     return Lose(MarkerStatus::kLost);
   }
