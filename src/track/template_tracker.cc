@@ -437,8 +437,14 @@ double TemplateTracker::ScoreOf(double similarity) const {
   return similarity;
 }
 
-bool TemplateTracker::Accept(const Hit& m, bool colour_agrees) const {
-  if (!(m.zncc >= params_.min_zncc - (colour_agrees ? kColourZnccAllowance : 0.0))) return false;
+bool TemplateTracker::Accept(const Hit& m, bool colour_agrees, bool followed) const {
+  // A marker followed from frame to frame whose blob is found at the match (Verify) may change
+  // its look faster than the working template follows (a segment turning under a marker, its
+  // edges in the box): the motion and the blob are evidence beside the score. Never when the
+  // whole region is searched, where a look-alike of the marker's colour and size could be.
+  const double floor = params_.min_zncc - (colour_agrees ? kColourZnccAllowance : 0.0) -
+                       (followed && blob_ok_ ? kBlobDriftAllowance : 0.0);
+  if (!(m.zncc >= floor)) return false;
   switch (params_.measure) {
     case MatchMeasure::kSad: return m.score <= params_.max_sad;
     case MatchMeasure::kSsd: return m.score <= params_.max_ssd;
@@ -890,12 +896,15 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     hit = Search(frame_bgr, window, search_template(), true);
     // Moving faster than the window (its best is on the window's edge, or is no match at all
     // because the marker left it): acquire.
-    if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit)))) {
+    if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), true))) {
       hit.reset();
     }
   }
+  const bool followed = hit.has_value();
   if (!hit) hit = Acquire(frame_bgr);
-  if (!hit || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit))) return Lose(MarkerStatus::kLost);
+  if (!hit || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), followed)) {
+    return Lose(MarkerStatus::kLost);
+  }
   // Of another colour than the marker: a look-alike (a blue disc for the green one's gray
   // template), not the marker; a rival of another colour is no rival.
   const auto centre_of = [&](cv::Point top_left) {

@@ -95,8 +95,10 @@ class TemplateTracker final : public Tracker {
   void Similarity(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& sim);
   double ScoreOf(double similarity) const;
   // The match passes the measure's thresholds; with `colour_agrees` (its core shows the
-  // marker's colour) min_zncc is lowered by kColourZnccAllowance.
-  bool Accept(const Hit& m, bool colour_agrees = false) const;
+  // marker's colour) min_zncc is lowered by kColourZnccAllowance, and `followed` (found in the
+  // tracking window, where the motion put it) by kBlobDriftAllowance more for a marker with a
+  // blob, which Verify then requires at the match.
+  bool Accept(const Hit& m, bool colour_agrees = false, bool followed = false) const;
   cv::Rect WindowAround(const cv::Point2d& centre_px, const cv::Size& size, int margin_px) const;
   std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
                             bool find_rival);
