@@ -49,7 +49,7 @@ int RunServeCommand(const ServeArgs& args) {
   }
   std::error_code error;
   if (!std::filesystem::is_directory(args.folder, error)) {
-    throw InputError("serve: --folder " + args.folder + " is not a folder");
+    throw InputError("--folder " + args.folder + " is not a folder");
   }
   ServeOptions options;
   options.folder = std::filesystem::canonical(args.folder);
@@ -62,7 +62,7 @@ int RunServeCommand(const ServeArgs& args) {
   // Off this computer's loopback anyone on the network could reach the rig: a token, printed
   // in the URL, is then asked of every request.
   if (!IsLoopbackAddress(args.bind)) options.server.token = NewAccessToken();
-  if (std::string problem; !options.live.Check(&problem)) throw InputError("serve: " + problem);
+  if (std::string problem; !options.live.Check(&problem)) throw InputError(problem);
 
   FrameSourceSpec spec;
   spec.camera = camera;

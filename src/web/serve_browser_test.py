@@ -91,6 +91,17 @@ class Page:
         actions.w3c_actions.pointer_action.click()
         actions.perform()
 
+    def drag(self, x0, y0, x1, y1):
+        from selenium.webdriver.common.action_chains import ActionChains
+        actions = ActionChains(self.driver)
+        pointer = actions.w3c_actions.pointer_action
+        pointer.move_to_location(int(round(x0)), int(round(y0)))
+        pointer.pointer_down()
+        pointer.move_to_location(int(round((x0 + x1) / 2)), int(round((y0 + y1) / 2)))
+        pointer.move_to_location(int(round(x1)), int(round(y1)))
+        pointer.pointer_up()
+        actions.perform()
+
     def click_image_point(self, x, y):
         cx, cy = self.state("window.softsight.clientPoint(%f, %f)" % (x, y))
         self.click_at(cx, cy)
@@ -189,6 +200,24 @@ def test_hostile_messages(page):
               (key, before[key], after[key]))
 
 
+def test_template_drag(page, truth, frame):
+    """Switch to templates (SAD), then drag a box around green: its template is cut there and
+    green is found where the truth is; undo takes the reselection back."""
+    page.click_button("method")
+    wait_for("the method switch", lambda: page.state("window.softsight.status.method") == "sad")
+    undo = page.state("window.softsight.status.undo")
+    x, y = float(truth["green_x"]), float(truth["green_y"])
+    x0, y0 = page.state("window.softsight.clientPoint(%f, %f)" % (x - 14, y - 14))
+    x1, y1 = page.state("window.softsight.clientPoint(%f, %f)" % (x + 14, y + 14))
+    page.drag(x0, y0, x1, y1)
+    wait_for("the reselection", lambda: page.state("window.softsight.status.undo") == undo + 1)
+    row = page.state("window.softsight.row(%d)" % frame)
+    assert_near_truth(row, truth, ["red", "blue", "green"])
+    check(page.state("window.softsight.status.active") == 2, "the drag did not select green")
+    page.click_button("undo")
+    wait_for("the undo", lambda: page.state("window.softsight.status.undo") == undo)
+
+
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-")
     video, truth_csv, config = (os.path.join(folder, n) for n in ("run.avi", "truth.csv", "cfg.yaml"))
@@ -215,8 +244,10 @@ def run(args, browser, driver):
                  lambda: first.state("window.softsight.framesShown >= 60 && window.softsight.results >= 60"))
         check(first.state("window.softsight.controls"), "the first page does not control the run")
         median, p95, n = latency_figures(first)
-        print("latency capture->page, 640x480 at 30 fps: median %.1f ms, p95 %.1f ms (%d frames)"
-              % (median, p95, n))
+        print("latency capture->page, 640x480 at 30 fps: median %.1f ms, p95 %.1f ms (%d frames);"
+              " page clock offset %.1f ms, fastest ping %.1f ms"
+              % (median, p95, n, first.state("window.softsight.clockOffsetMs"),
+                 first.state("window.softsight.bestRttMs")))
         frame = first.state("window.softsight.shownFrame")
         row = first.state("window.softsight.row(%d)" % frame)
         assert_near_truth(row, truth[frame], ["red", "green"])
@@ -282,6 +313,7 @@ def run(args, browser, driver):
         first.click_button("back")
         wait_for("a step after the flood", lambda: all(
             p.state("window.softsight.shownPosition") == target for p in pages))
+        test_template_drag(first, truth[target], target)
     except Exception:
         # What the pages said, for the failure's report.
         for i, page in enumerate(pages):

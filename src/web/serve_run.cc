@@ -1,7 +1,9 @@
 #include "web/serve_run.h"
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
@@ -69,6 +71,15 @@ std::string Number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3f", value);
   return text;
+}
+
+// The answer to a page's ping: its own time back, and the server's clock now.
+std::string Pong(double page_time_ms) {
+  const double now_ms = std::chrono::duration<double, std::milli>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+  return "{\"type\":\"pong\",\"t\":" + Number(page_time_ms) + ",\"server_ms\":" +
+         Number(now_ms) + "}";
 }
 
 std::string TextMessage(const char* type, const std::string& text) {
@@ -247,14 +258,9 @@ void ServeLoop::apply(const PageCommand& command, uint64_t page) {
     case Kind::kResetReference: key('b'); break;
     case Kind::kSave: save(command.name, page); break;
     case Kind::kTakeControl: server_.give_control(page); break;
-    case Kind::kPing: {
-      const double now_ms = std::chrono::duration<double, std::milli>(
-                                std::chrono::system_clock::now().time_since_epoch())
-                                .count();
-      server_.send_text(page, "{\"type\":\"pong\",\"t\":" + Number(command.page_time_ms) +
-                                  ",\"server_ms\":" + Number(now_ms) + "}");
+    case Kind::kPing:
+      server_.send_text(page, Pong(command.page_time_ms));
       return;
-    }
   }
   // An edit re-tracks the frame on screen (or the next one shows it): every page sees its
   // result now, also while paused.
@@ -328,7 +334,7 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
                        ServeOptions options, FrameSourceOpener reopen,
                        const std::function<bool()>& stop_requested, std::ostream& out) {
   if (options.jpeg_quality < 1 || options.jpeg_quality > 100) {
-    throw InputError("serve: --jpeg-quality " + std::to_string(options.jpeg_quality) +
+    throw InputError("--jpeg-quality " + std::to_string(options.jpeg_quality) +
                      " is outside 1..100");
   }
   SeekableSource* seekable = nullptr;
@@ -339,10 +345,21 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   }
   if (!options.live.record_fps) options.live.record_fps = source->fps();
   PageInbox inbox;
+  std::atomic<WebServer*> answering{nullptr};
   WebServer server(options.server, PageAssets(),
-                   [&inbox](uint64_t page, bool controls, std::string text) {
+                   [&inbox, &answering](uint64_t page, bool controls, std::string text) {
+                     // A ping is answered here, on the server's thread, at once: the page sets
+                     // its clock by the answer, which must not wait for the run's next frame.
+                     std::string ignored;
+                     WebServer* server = answering.load();
+                     const auto ping = ParsePageCommand(text, PageLimits{}, &ignored);
+                     if (server && ping && ping->kind == Kind::kPing) {
+                       server->send_text(page, Pong(ping->page_time_ms));
+                       return;
+                     }
                      inbox.push({page, controls, std::move(text)});
                    });
+  answering = &server;
   std::vector<std::string> names;
   for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
   WebSink sink(server, TrackingColumns(config), names, options.jpeg_quality);

@@ -305,14 +305,14 @@ void WebServer::Impl::listen() {
   beast::error_code error;
   const asio::ip::address address = asio::ip::make_address(options_.bind, error);
   const std::string where = options_.bind + ":" + std::to_string(options_.port);
-  if (error) throw InputError("serve: --bind " + options_.bind + " is not an IP address");
+  if (error) throw InputError("--bind " + options_.bind + " is not an IP address");
   const tcp::endpoint endpoint(address, static_cast<unsigned short>(options_.port));
   acceptor_.open(endpoint.protocol(), error);
   if (!error) acceptor_.set_option(asio::socket_base::reuse_address(true), error);
   if (!error) acceptor_.bind(endpoint, error);
   if (!error) acceptor_.listen(asio::socket_base::max_listen_connections, error);
   if (error) {
-    throw InputError("serve: cannot listen on " + where + ": " + error.message() +
+    throw InputError("cannot listen on " + where + ": " + error.message() +
                      " (another --port, or --port 0 for any free one)");
   }
   port_ = acceptor_.local_endpoint().port();

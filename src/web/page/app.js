@@ -52,7 +52,11 @@ function connect() {
     $('role').className = 'badge';
     log('connection closed (' + event.code + (event.reason ? ': ' + event.reason : '') + ')', true);
   };
-  ws.onopen = () => { ping(); setInterval(ping, 2000); };
+  // A few pings at once (the offset comes from the fastest round trip), then one every 2 s.
+  ws.onopen = () => {
+    for (let i = 0; i < 5; i++) setTimeout(ping, 100 * i);
+    setInterval(ping, 2000);
+  };
 }
 
 function ping() { send({type: 'ping', t: Date.now()}); }
@@ -181,7 +185,8 @@ function showReadout(frame) {
 // ---- The picture and its overlay --------------------------------------------------------
 function fitView() {
   if (!image) return;
-  const width = Math.min(image.width * 2, Math.max(320, window.innerWidth - 400));
+  // At most the image's own size (the plots stay on screen under it), less on a narrow window.
+  const width = Math.min(image.width, Math.max(320, window.innerWidth - 400));
   scale = width / image.width;
   const ratio = window.devicePixelRatio || 1;
   const w = Math.round(image.width * scale), h = Math.round(image.height * scale);
