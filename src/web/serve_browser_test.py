@@ -2,8 +2,9 @@
 """softsight serve in a real headless browser (Debian's chromium + chromium-driver, driven by
 python3-selenium): the page loads, frames and results arrive, a click picks a colour, a seek
 lands on the frame, hostile messages are refused and change nothing, a wrong token is refused,
-a second browser sees the same run read-only, and the server survives 100 connections opened
-and dropped. Measures the latency from capture to the picture on the page (640x480, 30 fps).
+a second browser sees the same run read-only, the server survives 100 connections opened and
+dropped, a dragged box sets a template, and a recording made from the page reproduces under
+`softsight track`. Measures the latency from capture to the picture on the page (640x480, 30 fps).
 
 Every wait polls the page's state (window.softsight) with a timeout: no sleep decides a result.
 Exit code 77 (ctest: skipped) only when chromium or its driver or selenium is missing.
@@ -182,6 +183,8 @@ def latency_figures(page):
 
 def test_hostile_messages(page):
     """Each bad message: one error on the page, nothing changed, the run goes on."""
+    wait_for("the status of the frame on screen", lambda: page.state(
+        "window.softsight.status.position === window.softsight.shownPosition"))
     before = page.state("window.softsight.status")
     errors = page.state("window.softsight.errors.length")
     bad = ["not json", json.dumps({"type": "format_disk"}),
@@ -216,6 +219,34 @@ def test_template_drag(page, truth, frame):
     check(page.state("window.softsight.status.active") == 2, "the drag did not select green")
     page.click_button("undo")
     wait_for("the undo", lambda: page.state("window.softsight.status.undo") == undo)
+
+
+def comparable_rows(path):
+    """The CSV's rows without the columns that time the run (proc_ms, latency_*)."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [{k: v for k, v in row.items() if k != "proc_ms" and not k.startswith("latency")}
+            for row in rows]
+
+
+def test_recording_reproduces(page, softsight, folder):
+    """Record from the page while the video plays, stop: `softsight track` on the raw video
+    with the recording's config gives the same rows."""
+    start = page.state("window.softsight.status.position")
+    page.click_button("record")
+    wait_for("the recording", lambda: page.state("window.softsight.status.recording"))
+    page.click_button("play")
+    wait_for("30 frames recorded", lambda: page.state("window.softsight.status.position") >= start + 30)
+    page.click_button("record")
+    wait_for("the recording's end", lambda: not page.state("window.softsight.status.recording"))
+    prefix = os.path.join(folder, "serve-001")
+    again = os.path.join(folder, "again.csv")
+    subprocess.run([softsight, "track", "--config", prefix + ".yaml", "--input", prefix + ".raw.avi",
+                    "-o", again], check=True, capture_output=True)
+    recorded, tracked = comparable_rows(prefix + ".csv"), comparable_rows(again)
+    check(len(recorded) >= 30, "only %d rows recorded" % len(recorded))
+    check(recorded == tracked, "track does not reproduce the page's recording (%d and %d rows)"
+          % (len(recorded), len(tracked)))
 
 
 def run(args, browser, driver):
@@ -314,6 +345,7 @@ def run(args, browser, driver):
         wait_for("a step after the flood", lambda: all(
             p.state("window.softsight.shownPosition") == target for p in pages))
         test_template_drag(first, truth[target], target)
+        test_recording_reproduces(first, args.softsight, folder)
     except Exception:
         # What the pages said, for the failure's report.
         for i, page in enumerate(pages):

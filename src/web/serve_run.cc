@@ -113,13 +113,13 @@ class WebSink : public FrameSink {
 
   void send_picture(const cv::Mat& image, const FrameResult& result, bool replay) {
     if (server_.pages() == 0 || image.empty()) return;  // Nobody watches: nothing to encode.
-    cv::imencode(".jpg", image, jpeg_, {cv::IMWRITE_JPEG_QUALITY, quality_});
-    header_ = "{\"frame\":" + std::to_string(result.frame_index) +
-              ",\"position\":" + std::to_string(position()) +
-              ",\"replay\":" + (replay ? "true" : "false") +
-              ",\"captured_ms\":" + Number(UnixMs(result.captured)) + "}";
+    cv::imencode(".jpg", image, jpeg_, jpeg_params_);
+    header_.clear();
+    AppendFrameFields(result, header_);
+    header_ += replay ? ",\"replay\":true}" : ",\"replay\":false}";
     // [header length, 4 bytes little-endian][header JSON][JPEG]: the page pairs the picture
-    // with its result by frame number.
+    // with its result by frame number. The message is new each frame (the server's thread
+    // writes it to every page after this returns); everything else here is reused.
     std::string bytes;
     bytes.reserve(4 + header_.size() + jpeg_.size());
     const uint32_t size = static_cast<uint32_t>(header_.size());
@@ -132,13 +132,12 @@ class WebSink : public FrameSink {
   // A result with no new picture (an edit re-tracked the frame on screen): `edit` says so.
   void send_result(const FrameResult& result, bool edit) {
     formatter_.format(topic_, result, record_);
-    std::string json = "{\"type\":\"result\",\"frame\":" + std::to_string(result.frame_index) +
-                       ",\"position\":" + std::to_string(position()) +
-                       ",\"captured_ms\":" + Number(UnixMs(result.captured)) +
-                       ",\"edit\":" + (edit ? "true" : "false") + ",\"row\":";
-    json.append(record_, topic_.topic.size() + 1);  // The record without its topic word.
-    json += '}';
-    server_.broadcast_text(std::move(json));
+    json_.assign("{\"type\":\"result\",");
+    AppendFrameFields(result, json_);
+    json_ += edit ? ",\"edit\":true,\"row\":" : ",\"edit\":false,\"row\":";
+    json_.append(record_, topic_.topic.size() + 1);  // The record without its topic word.
+    json_ += '}';
+    server_.broadcast_text(json_);  // One copy: the message the server's thread sends.
   }
 
  private:
@@ -150,9 +149,23 @@ class WebSink : public FrameSink {
   TopicColumns topic_;
   int quality_;
   const LiveController* controller_ = nullptr;
-  // Reused per frame; only the message handed to the server's thread is new each time.
+  // "frame": .., "position": .., "captured_ms": .. (the header opened by the caller).
+  void AppendFrameFields(const FrameResult& result, std::string& out) const {
+    if (out.empty()) out += '{';
+    out += "\"frame\":";
+    out += std::to_string(result.frame_index);  // Short: in the string's own buffer.
+    out += ",\"position\":";
+    out += std::to_string(position());
+    out += ",\"captured_ms\":";
+    char number[32];
+    std::snprintf(number, sizeof number, "%.3f", UnixMs(result.captured));
+    out += number;
+  }
+
+  // Reused per frame; only the messages handed to the server's thread are new each time.
   std::vector<uchar> jpeg_;
-  std::string header_, record_;
+  std::string header_, record_, json_;
+  const std::vector<int> jpeg_params_{cv::IMWRITE_JPEG_QUALITY, quality_};
 };
 
 std::string Greeting(const TrackingConfig& config, const FrameSource& source, bool seekable) {
@@ -394,7 +407,9 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
     // returns its newest frame.
     const bool got = waiting_for_page && controller.last_result() ? false : feed.step(controller);
     loop.relay_messages();
-    loop.send_status(/*force=*/false);
+    // A frame stepped or sought to while paused: its position goes out with it (while playing
+    // the status follows four times a second).
+    loop.send_status(/*force=*/got && controller.paused());
     if (!got) inbox.wait(std::chrono::milliseconds(20));
   }
   LiveRunResult result;
