@@ -257,7 +257,8 @@ void ServeLoop::apply(const PageCommand& command, uint64_t page) {
       if (controller_.paused() || controller_.ended()) key(' ');
       break;
     case Kind::kPause:
-      if (!controller_.paused()) key(' ');
+      // At the end the key would play from the start: a pause there leaves it as it is.
+      if (!controller_.paused() && !controller_.ended()) key(' ');
       break;
     case Kind::kStep: key(command.delta > 0 ? '.' : ','); break;
     case Kind::kSeek: controller_.seek_to(command.position); break;

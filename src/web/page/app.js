@@ -12,7 +12,7 @@ const PLOTS = [['angle_deg', 'angle [deg]'], ['radius', 'radius'], ['tip_disp', 
 const S = window.softsight = {
   hello: null, status: null, controls: false, pages: 0,
   framesShown: 0, results: 0, shownFrame: -1, shownPosition: -1,
-  latencies: [], messages: [], errors: [], closed: null,
+  latencies: [], sameClockLatencies: [], messages: [], errors: [], closed: null,
   clockOffsetMs: 0, bestRttMs: Infinity,
 };
 const rows = new Map();      // frame -> its row (the CSV's columns)
@@ -151,8 +151,12 @@ async function decodeNext() {
       showReadout(header.frame);
       S.framesShown++;
       // Capture to the picture on the page, in the server's clock (offset from the pings).
-      if (!header.replay) S.latencies.push(Date.now() + S.clockOffsetMs - header.captured_ms);
-      if (S.latencies.length > 2000) S.latencies.splice(0, 1000);
+      if (!header.replay) {
+        S.latencies.push(Date.now() + S.clockOffsetMs - header.captured_ms);
+        // Without the offset: exact when the page runs on the server's computer (one clock).
+        S.sameClockLatencies.push(Date.now() - header.captured_ms);
+      }
+      if (S.latencies.length > 2000) { S.latencies.splice(0, 1000); S.sameClockLatencies.splice(0, 1000); }
     } catch (e) {
       log('a frame did not decode: ' + e, true);
     }
@@ -190,14 +194,24 @@ function fitView() {
   scale = width / image.width;
   const ratio = window.devicePixelRatio || 1;
   const w = Math.round(image.width * scale), h = Math.round(image.height * scale);
-  if (view.width !== Math.round(w * ratio)) {
+  if (view.width !== Math.round(w * ratio) || view.style.width !== w + 'px') {
+    // Canvas pixels at the screen's own density: the overlay stays crisp.
     view.width = Math.round(w * ratio); view.height = Math.round(h * ratio);
     view.style.width = w + 'px'; view.style.height = h + 'px';
     for (const c of [timeline, plot]) {
       c.width = Math.round(w * ratio); c.style.width = w + 'px';
-      c.height = Math.round((c === plot ? 300 : 28) * ratio); c.style.height = (c === plot ? 300 : 28) + 'px';
+      c.height = Math.round((c === plot ? 240 : 28) * ratio); c.style.height = (c === plot ? 240 : 28) + 'px';
     }
   }
+}
+
+// Draws on `c` in the CSS pixels it is shown at, whatever its backing store's size.
+function cssContext(c) {
+  const ctx = c.getContext('2d');
+  if (c.clientWidth > 0 && c.clientHeight > 0) {
+    ctx.setTransform(c.width / c.clientWidth, 0, 0, c.height / c.clientHeight, 0, 0);
+  }
+  return ctx;
 }
 
 // Pixel centres are at integers: image pixel (x, y) is at ((x + 0.5) s, (y + 0.5) s) in the view.
@@ -211,9 +225,7 @@ function markerPoint(row, name) {
 function drawView() {
   if (!image) return;
   fitView();
-  const ctx = view.getContext('2d');
-  const ratio = window.devicePixelRatio || 1;
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const ctx = cssContext(view);
   ctx.drawImage(image, 0, 0, image.width * scale, image.height * scale);
   const row = rows.get(imageFrame);
   if (row && S.hello) drawOverlay(ctx, row);
@@ -267,9 +279,11 @@ function drawArc(ctx, b, m, t) {
 
 // ---- Mouse on the picture: click picks a colour, a drag reselects ---------------------------
 let drag = null;
+// The pointer in the view's CSS pixels (scale per image pixel), from where it is on screen.
 function viewPoint(event) {
   const rect = view.getBoundingClientRect();
-  return [event.clientX - rect.left, event.clientY - rect.top];
+  return [(event.clientX - rect.left) * view.clientWidth / rect.width,
+          (event.clientY - rect.top) * view.clientHeight / rect.height];
 }
 view.addEventListener('mousedown', (e) => {
   const [x, y] = viewPoint(e);
@@ -333,9 +347,7 @@ timeline.addEventListener('mousemove', (e) => { if (scrubbing) scrub(e, false); 
 timeline.addEventListener('mouseup', (e) => { if (scrubbing) scrub(e, true); scrubbing = false; });
 
 function drawTimeline() {
-  const ctx = timeline.getContext('2d');
-  const ratio = window.devicePixelRatio || 1;
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const ctx = cssContext(timeline);
   const w = timeline.clientWidth, h = timeline.clientHeight;
   ctx.fillStyle = '#222'; ctx.fillRect(0, 0, w, h);
   if (!length() || !S.hello) return;
@@ -382,15 +394,16 @@ function series(row, key) {
 
 function drawPlot() {
   plotDrawn = Date.now();
-  const ctx = plot.getContext('2d');
-  const ratio = window.devicePixelRatio || 1;
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const ctx = cssContext(plot);
   const w = plot.clientWidth, h = plot.clientHeight;
   ctx.fillStyle = '#111'; ctx.fillRect(0, 0, w, h);
   if (!sortedFrames) sortedFrames = [...rows.keys()].sort((a, b) => a - b);
   if (sortedFrames.length < 1) return;
   const times = sortedFrames.map((f) => rows.get(f).time_s);
-  const t0 = times[0], t1 = Math.max(times[times.length - 1], t0 + 1e-3);
+  // A file's whole run, under its timeline; a camera's, from the first result received.
+  const whole = length() > 1 && S.hello.fps > 0;
+  const t0 = whole ? 0 : times[0];
+  const t1 = whole ? (length() - 1) / S.hello.fps : Math.max(times[times.length - 1], t0 + 1e-3);
   const laneH = h / PLOTS.length;
   const x = (t) => 40 + (t - t0) / (t1 - t0) * (w - 50);
   PLOTS.forEach(([key, label], lane) => {
@@ -401,15 +414,22 @@ function drawPlot() {
     ctx.fillText(label + (key !== 'angle_deg' && S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
     ctx.strokeStyle = '#333'; ctx.strokeRect(40, top + 2, w - 50, laneH - 4);
     if (!finite.length) return;
-    let lo = finite.reduce((a, v) => Math.min(a, v)), hi = finite.reduce((a, v) => Math.max(a, v));
-    if (hi - lo < 1e-6) { lo -= 1; hi += 1; }
-    const y = (v) => top + laneH - 4 - (v - lo) / (hi - lo) * (laneH - 20);
+    // The 2nd to 98th percentile: a near-straight actuator's radius (tens of thousands of px
+    // for a frame or two) does not flatten the rest of the run; beyond, the curve is clipped.
+    const sorted = finite.slice().sort((a, b) => a - b);
+    let lo = sorted[Math.floor(0.02 * (sorted.length - 1))], hi = sorted[Math.ceil(0.98 * (sorted.length - 1))];
+    // At least one unit tall: a constant arc length's rounding is not drawn as a signal.
+    if (hi - lo < 1) { const mid = (hi + lo) / 2; lo = mid - 0.5; hi = mid + 0.5; }
+    const y = (v) => top + laneH - 4 - (Math.min(Math.max(v, lo), hi) - lo) / (hi - lo) * (laneH - 20);
     ctx.fillText(hi.toFixed(1), 2, top + 14); ctx.fillText(lo.toFixed(1), 2, top + laneH - 4);
-    ctx.strokeStyle = COLOURS[lane]; ctx.lineWidth = 1.2; ctx.beginPath();
+    ctx.strokeStyle = ctx.fillStyle = COLOURS[lane]; ctx.lineWidth = 1.2; ctx.beginPath();
     let drawing = false;
     values.forEach((v, i) => {
-      // A gap where the value is absent (a marker not found), never a line through it.
+      // A gap where the value is absent (a marker not found) or frames were not received (a
+      // seek jumped over them), never a line through it.
       if (v === null || v === undefined) { drawing = false; return; }
+      if (i > 0 && sortedFrames[i] - sortedFrames[i - 1] > 1) drawing = false;
+      if (!drawing) ctx.fillRect(x(times[i]) - 1, y(v) - 1, 3, 3);  // A lone point shows too.
       drawing ? ctx.lineTo(x(times[i]), y(v)) : ctx.moveTo(x(times[i]), y(v));
       drawing = true;
     });
@@ -431,10 +451,10 @@ plot.addEventListener('click', (e) => {
 });
 
 // For the browser test: where an image pixel is on the screen, and a raw message to send.
+// Where image pixel (x, y) is on the screen, from the picture's place and size alone.
 S.clientPoint = (x, y) => {
   const r = view.getBoundingClientRect();
-  const [vx, vy] = toView(x, y);
-  return [r.left + vx, r.top + vy];
+  return [r.left + (x + 0.5) * r.width / image.width, r.top + (y + 0.5) * r.height / image.height];
 };
 S.sendRaw = (text) => ws.send(text);
 S.row = (frame) => rows.get(frame) || null;
