@@ -238,6 +238,8 @@ def test_recording_reproduces(page, softsight, folder):
     wait_for("the recording", lambda: page.state("window.softsight.status.recording"))
     page.click_button("play")
     wait_for("30 frames recorded", lambda: page.state("window.softsight.status.position") >= start + 30)
+    print("the run's rate with %d pages open, recording: %.1f fps" % (
+        page.state("window.softsight.status.pages"), page.state("window.softsight.status.fps")))
     page.click_button("record")
     wait_for("the recording's end", lambda: not page.state("window.softsight.status.recording"))
     prefix = os.path.join(folder, "serve-001")
@@ -275,6 +277,7 @@ def run(args, browser, driver):
         wait_for("frames and results on the page",
                  lambda: first.state("window.softsight.framesShown >= 60 && window.softsight.results >= 60"))
         check(first.state("window.softsight.controls"), "the first page does not control the run")
+        print("the run's rate with 1 page open: %.1f fps" % first.state("window.softsight.status.fps"))
         median, p95, n = latency_figures(first)
         print("latency capture->page, 640x480 at 30 fps: median %.1f ms, p95 %.1f ms (%d frames);"
               " the page's clock offset estimate %.1f ms (true: 0), fastest ping %.1f ms"

@@ -389,15 +389,20 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
 
   ServeLoop loop(controller, server, sink, options, seekable != nullptr, out);
   LiveFeed feed(*source, seekable);
-  controller.take_messages();  // The window's start-up hint ("press h") is not the page's.
-  PageInbox::Message message;
-  // A file waits on its first frame for the first page: played to nobody, its start would be
-  // gone before anyone saw it. A camera runs from the start (its frames do not wait anyway).
-  bool waiting_for_page = !source->is_live();
+  // A file shows its first frame and waits, paused, for the first page: played to nobody, its
+  // start would be gone before anyone saw it (and, paused, its paced clock stops: no burst to
+  // catch up when the page comes). A camera runs from the start.
+  bool waiting_for_page = !source->is_live() && feed.step(controller) && server.pages() == 0;
+  if (waiting_for_page) controller.on_event(UiEvent::Key(' '));
+  controller.take_messages();  // The window's start-up hint ("press h") and that pause.
   int pages_seen = 0;
+  PageInbox::Message message;
   while (!stop_requested() && !controller.quit_requested()) {
+    if (waiting_for_page && server.pages() > 0) {
+      waiting_for_page = false;
+      if (controller.paused()) controller.on_event(UiEvent::Key(' '));
+    }
     while (inbox.pop(&message)) loop.handle(message);
-    if (waiting_for_page && server.pages() > 0) waiting_for_page = false;
     if (server.pages() > pages_seen && controller.last_result()) {
       // A page joined: it gets the frame on screen at once, playing or not.
       sink.resend(controller.frame_on_screen(), *controller.last_result());
@@ -406,7 +411,7 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
     pages_seen = server.pages();
     // A paced file waits here until its frame is due (at most a frame period); a camera
     // returns its newest frame.
-    const bool got = waiting_for_page && controller.last_result() ? false : feed.step(controller);
+    const bool got = feed.step(controller);
     loop.relay_messages();
     // A frame stepped or sought to while paused: its position goes out with it (while playing
     // the status follows four times a second).

@@ -172,6 +172,29 @@ TEST_F(WebServerTest, FramesAndResultsReachEveryPage) {
   }
 }
 
+TEST_F(WebServerTest, AnOversizedMessageClosesOnlyItsOwnConnection) {
+  Start("");
+  auto flooder = Connect("/ws");
+  auto watcher = Connect("/ws");
+  // Under 64 KB it reaches the run (which refuses it with an error, page_messages.h); beyond,
+  // the server closes that connection without reading it whole.
+  flooder->write(asio::buffer(std::string(5000, 'x')));
+  ASSERT_TRUE(WaitForMessages(1));
+  flooder->write(asio::buffer(std::string(70 * 1024, 'x')));
+  beast::error_code error;
+  for (int i = 0; i < 20 && !error; ++i) {
+    beast::flat_buffer buffer;
+    flooder->read(buffer, error);  // Role messages, then the close.
+  }
+  EXPECT_EQ(error, websocket::error::closed);
+  EXPECT_EQ(flooder->reason().code, websocket::close_code::too_big);
+  watcher->write(asio::buffer(std::string("still here")));
+  ASSERT_TRUE(WaitForMessages(2));
+  std::lock_guard lock(received_.mutex);
+  EXPECT_EQ(received_.messages.back().second, "still here");
+  EXPECT_EQ(received_.messages.size(), 2u);  // The 70 KB message never reached the run.
+}
+
 TEST_F(WebServerTest, SurvivesAHundredConnectionsOpenedAndDropped) {
   Start(NewAccessToken());
   for (int i = 0; i < 100; ++i) {
