@@ -336,6 +336,15 @@ def run(args, browser, driver):
         wait_for("the step seen by both pages", lambda: all(
             p.state("window.softsight.shownPosition") == target + 1 for p in pages))
 
+        # The page's CSV export: the CSV's columns, one row per frame received, in order.
+        lines = first.state("window.softsight.csvText()").splitlines()
+        header = lines[0].split(",")
+        check(header[:2] == ["frame", "time_s"] and "blue_x" in header and "angle_deg" in header,
+              "the page's CSV has other columns: %s" % header[:8])
+        frames = [int(line.split(",")[0]) for line in lines[1:]]
+        check(frames == sorted(set(frames)) and target in frames and len(frames) >= 60,
+              "the page's CSV rows: %d, not in frame order or without frame %d" % (len(frames), target))
+
         # Saved only in the server's folder, under a plain name.
         first.click_button("save")
         saved = os.path.join(folder, "markers.web.yaml")

@@ -131,6 +131,7 @@ class WebSink : public FrameSink {
 
   // A result with no new picture (an edit re-tracked the frame on screen): `edit` says so.
   void send_result(const FrameResult& result, bool edit) {
+    if (server_.pages() == 0) return;  // Nobody watches (a page that joins gets the frame on screen).
     formatter_.format(topic_, result, record_);
     json_.assign("{\"type\":\"result\",");
     AppendFrameFields(result, json_);

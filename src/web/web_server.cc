@@ -70,7 +70,7 @@ class WebServer::Impl {
   void leave(uint64_t id);
   void set_controller(uint64_t id);
   void each_page(const std::function<void(WebSocketPage&)>& action);
-  WebSocketPage* find(uint64_t id);
+  std::shared_ptr<WebSocketPage> find(uint64_t id);
   std::optional<http::response<http::string_body>> refuse(const http::request<http::string_body>& request) const;
   http::response<http::string_body> respond(const http::request<http::string_body>& request) const;
 
@@ -368,12 +368,9 @@ void WebServer::Impl::each_page(const std::function<void(WebSocketPage&)>& actio
   }
 }
 
-WebSocketPage* WebServer::Impl::find(uint64_t id) {
+std::shared_ptr<WebSocketPage> WebServer::Impl::find(uint64_t id) {
   const auto it = pages_.find(id);
-  if (it == pages_.end()) return nullptr;
-  auto page = it->second.lock();
-  return page.get();  // Alive while the server's thread runs this handler: pages_ owns a weak
-                      // reference and the page's pending operation a strong one.
+  return it == pages_.end() ? nullptr : it->second.lock();
 }
 
 WebServer::WebServer(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox)
@@ -419,7 +416,7 @@ void WebServer::broadcast_frame(std::string bytes) {
 void WebServer::send_text(uint64_t page, std::string text) {
   Message message = std::make_shared<const std::string>(std::move(text));
   asio::post(impl_->io_, [impl = impl_.get(), page, message] {
-    if (WebSocketPage* found = impl->find(page)) found->queue_text(message);
+    if (auto found = impl->find(page)) found->queue_text(message);
   });
 }
 

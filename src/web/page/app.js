@@ -326,6 +326,25 @@ $('record').onclick = () => send({type: 'record'});
 $('save').onclick = () => send({type: 'save', name: $('savename').value});
 $('take').onclick = () => send({type: 'take_control'});
 
+// Files made in the page, from what it has: the picture with its overlay, and the results.
+function download(name, blob) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+$('png').onclick = () => view.toBlob((blob) => download('softsight-frame-' + imageFrame + '.png', blob));
+// The CSV's own columns (the rows are its rows), in frame order; empty fields where absent.
+S.csvText = () => {
+  const frames = [...rows.keys()].sort((a, b) => a - b);
+  if (!frames.length) return '';
+  const columns = Object.keys(rows.get(frames[0])).filter((c) => c !== '_position');
+  const field = (v) => (v === null || v === undefined ? '' : String(v));
+  return [columns.join(',')].concat(frames.map((f) => columns.map((c) => field(rows.get(f)[c])).join(','))).join('\n') + '\n';
+};
+$('csv').onclick = () => download('softsight-page.csv', new Blob([S.csvText()], {type: 'text/csv'}));
+
 function length() { return S.status && S.status.length > 0 ? S.status.length : 0; }
 // The timeline's x (CSS pixels) of a position, and back: positions spread over the whole width.
 function positionX(p) { return length() > 1 ? p / (length() - 1) * (timeline.clientWidth - 1) : 0; }
