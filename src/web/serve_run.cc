@@ -144,13 +144,8 @@ class WebSink : public FrameSink {
  private:
   int64_t position() const { return controller_ ? controller_->position() : -1; }
 
-  WebServer& server_;
-  CsvColumnTable table_;
-  RecordFormatter formatter_;
-  TopicColumns topic_;
-  int quality_;
-  const LiveController* controller_ = nullptr;
-  // "frame": .., "position": .., "captured_ms": .. (the header opened by the caller).
+  // Appends "frame": .., "position": .., "captured_ms": .. (opening the object when `out` is
+  // empty: the picture's header; the result's has its "type" before).
   void AppendFrameFields(const FrameResult& result, std::string& out) const {
     if (out.empty()) out += '{';
     out += "\"frame\":";
@@ -163,6 +158,12 @@ class WebSink : public FrameSink {
     out += number;
   }
 
+  WebServer& server_;
+  CsvColumnTable table_;
+  RecordFormatter formatter_;
+  TopicColumns topic_;
+  int quality_;
+  const LiveController* controller_ = nullptr;
   // Reused per frame; only the messages handed to the server's thread are new each time.
   std::vector<uchar> jpeg_;
   std::string header_, record_, json_;
@@ -192,10 +193,6 @@ std::string Greeting(const TrackingConfig& config, const FrameSource& source, bo
   json += ",\"length\":" + (count ? std::to_string(*count) : std::string("null"));
   return json + "}";
 }
-
-}  // namespace
-
-namespace {
 
 // The run's side of the pages: their commands carried out on the controller, what the run says
 // and how it goes sent back.
