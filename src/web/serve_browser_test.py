@@ -322,6 +322,12 @@ def run(args, browser, driver):
 
         test_hostile_messages(first)
 
+        # The speed selector sets the paced file's speed (0.1x .. 4x), and back.
+        from selenium.webdriver.support.ui import Select
+        for speed in ("0.5", "1"):
+            Select(first.driver.find_element("id", "speed")).select_by_value(speed)
+            wait_for("speed " + speed, lambda: first.state("window.softsight.status.speed") == float(speed))
+
         # A second browser sees the same run, read-only.
         second = Page(browser, driver, url)
         pages.append(second)
