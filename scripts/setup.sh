@@ -28,6 +28,8 @@ PACKAGES=(
   mypy python3-tqdm      # the stubs' `mypy --strict` test; progress=True's bar (the tests cover it with and without)
   python3-zmq            # softsight.stream.subscribe (the stream's Python end) and its test
   python3-pandas         # Table.to_pandas(), track_many's summary and stream.to_dataframe, as docs/python.md uses them
+  libboost-dev           # softsight serve: Boost.Beast and Boost.Asio (header-only), the web server
+  chromium chromium-driver python3-selenium  # serve's end-to-end test drives the page in a headless browser
 )
 
 for group in "$@"; do

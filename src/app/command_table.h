@@ -42,6 +42,8 @@ inline constexpr CommandInfo kCommandTable[] = {
     {"calibrate", "Calibrate a camera or two (stereo) from chessboard views, or the plane's scale",
      "commands"},
     {"live", "Live window on a camera or video: overlay, mouse recalibration, recording", "live"},
+    {"serve", "The live bench as a web page: watch, tune, play back and record from a browser",
+     "live"},
     {"cameras", "List the V4L2 cameras with their pixel formats, sizes and frame rates",
      "commands"},
     {"control", "Close the loop: bend the actuator to a target angle over the serial link",

@@ -26,6 +26,8 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub);
 CommandRunner SetupTrackStereoWindowCommand(CLI::App& sub);
 CommandRunner SetupPlotCommand(CLI::App& sub);
 CommandRunner SetupLiveCommand(CLI::App& sub);
+// `serve` lives in the live plugin too (it drives the live window's controller; app/serve_command.cc).
+CommandRunner SetupServeCommand(CLI::App& sub);
 CommandRunner SetupCamerasCommand(CLI::App& sub);
 CommandRunner SetupConfigCommand(CLI::App& sub);
 CommandRunner SetupInitCommand(CLI::App& sub);

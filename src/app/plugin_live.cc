@@ -6,6 +6,8 @@
 extern "C" __attribute__((visibility("default"))) int softsight_run_command(int argc, char** argv) {
   using namespace softsight;
   static const std::vector<CommandSetup> kCommands = {
-      {"live", SetupLiveCommand}, {"track-stereo", SetupTrackStereoWindowCommand}};
+      {"live", SetupLiveCommand},
+      {"serve", SetupServeCommand},
+      {"track-stereo", SetupTrackStereoWindowCommand}};
   return RunCommandLine(argc, argv, kCommands);
 }

@@ -223,21 +223,35 @@ bool LiveController::scrub(const UiEvent& event, const LiveLayout& view) {
   const int64_t target =
       timeline_.position_at(event.position_px.x - view.timeline.x, view.timeline.width);
   if (target == position_ && event.type != Type::kMouseDown) return true;
+  if (!queue_seek(target)) scrubbing_ = false;
+  return true;
+}
+
+bool LiveController::queue_seek(int64_t position) {
   // A drag asks for many frames; only the newest one still matters.
   if (!playback_requests_.empty() && playback_requests_.back().kind == PlaybackRequest::Kind::kSeekTo) {
     playback_requests_.pop_back();
   }
-  PlaybackRequest request;
-  request.kind = PlaybackRequest::Kind::kSeekTo;
-  request.position = target;
   if (recording()) {
     say("stop the recording first (r): a recording holds consecutive frames");
-    scrubbing_ = false;
-    return true;
+    return false;
   }
+  PlaybackRequest request;
+  request.kind = PlaybackRequest::Kind::kSeekTo;
+  request.position = position;
   playback_requests_.push_back(request);
   dirty_ = true;
   return true;
+}
+
+void LiveController::seek_to(int64_t position) { queue_seek(position); }
+
+void LiveController::set_speed(double speed) {
+  int nearest = 0;
+  for (int i = 1; i < kSpeedCount; ++i) {
+    if (std::abs(kSpeeds[i] - speed) < std::abs(kSpeeds[nearest] - speed)) nearest = i;
+  }
+  change_speed(nearest - speed_step_);
 }
 
 void LiveController::request_playback(PlaybackRequest::Kind kind, double seconds) {
@@ -554,8 +568,10 @@ std::array<int, 6> LiveController::active_hsv() const {
 }
 
 void LiveController::save_config() {
-  const std::string path =
-      options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path;
+  save_config_to(options_.save_config_path.empty() ? "live.yaml" : options_.save_config_path);
+}
+
+void LiveController::save_config_to(const std::string& path) {
   try {
     // The session's config, and each marker's parameters of its other kinds as the window
     // keeps them (ranges picked or moved while it matched templates), so that loading the file

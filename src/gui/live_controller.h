@@ -143,6 +143,21 @@ class LiveController {
   const ViewZoom& zoom() const { return zoom_; }
   // Edits `u` can undo.
   size_t undo_depth() const { return undo_.size(); }
+  // The edits of the mouse and the timeline for an adapter that speaks image pixels and file
+  // positions instead of canvas pixels (the web page, src/web): the same calls a click, a drag
+  // and a timeline click make, so both front ends edit the session alike.
+  void pick_colour_at(const cv::Point2d& image_px) { click(image_px); }
+  void reselect(const cv::Rect& image_px) { drag(image_px); }
+  // Queues a seek to `position` in the file (refused, with a message, while recording).
+  void seek_to(int64_t position);
+  // The playing speed closest to `speed` among 0.1x .. 4x (the keys' steps).
+  void set_speed(double speed);
+  // Saves the config as `s` does, to `path` instead of the window's save path.
+  void save_config_to(const std::string& path);
+  // The frame on screen as captured (empty before the first), and its position in the file
+  // (-1 for a camera).
+  const cv::Mat& frame_on_screen() const { return frame_; }
+  int64_t position() const { return position_; }
   // A message from outside (the feed: "a camera cannot seek"), shown like the controller's own.
   void report(const std::string& message) { say(message); }
 
@@ -220,6 +235,8 @@ class LiveController {
   // Stops the running recording and says what it kept ("recorded N frames to P.*").
   std::string stop_recording();
   void save_config();
+  // Queues a seek (a timeline click or drag, or seek_to); false when refused (recording).
+  bool queue_seek(int64_t position);
   void start_scale();
   void cancel_scale();
   void scale_point(const cv::Point2d& p);

@@ -162,6 +162,49 @@ TEST_F(LiveControllerTest, ClickOnAFoundMarkerPicksThatMarker) {
   EXPECT_EQ(live.config().markers[2].params.get<ColourParams>().h.lo, before.lo);
 }
 
+// The calls a front end in image pixels makes (the web page, src/web): the edits of the mouse.
+TEST_F(LiveControllerTest, ImagePixelCallsEditAsTheMouseAndTheTimelineDo) {
+  TrackingConfig config = SceneConfig();
+  config.markers[1].params.get<ColourParams>().h = {140, 160};  // Wrong: blue is not found.
+  LiveController by_mouse(config, Options());
+  LiveController by_call(config, Options());
+  const SceneTruth first = Feed(by_mouse, 0);
+  Feed(by_call, 0);
+  for (LiveController* live : {&by_mouse, &by_call}) live->on_event(UiEvent::Key('2'));
+  Click(by_mouse, *first.markers[1].centroid_px);
+  by_call.pick_colour_at(*first.markers[1].centroid_px);
+  EXPECT_EQ(RangesOf(by_call.config().markers[1].params.get<ColourParams>()),
+            RangesOf(by_mouse.config().markers[1].params.get<ColourParams>()));
+  EXPECT_NE(by_call.config().markers[1].params.get<ColourParams>().h.lo, 140);
+  Feed(by_mouse, 1);
+  const SceneTruth second = Feed(by_call, 1);
+  ExpectAt(by_call, 1, second, 0.3);
+
+  // A box around green reselects green (the marker in it), one more edit to undo.
+  const cv::Point2d green = *second.markers[2].centroid_px;
+  by_call.reselect(cv::Rect(cvRound(green.x) - 12, cvRound(green.y) - 12, 24, 24));
+  EXPECT_EQ(by_call.active_marker(), 2);
+  EXPECT_EQ(by_call.undo_depth(), 2u);
+  ExpectAt(by_call, 2, second, 0.3);
+
+  // The speed closest to the one asked for among the keys' steps.
+  by_call.set_speed(0.3);
+  EXPECT_DOUBLE_EQ(by_call.speed(), 0.25);
+  by_call.set_speed(100);
+  EXPECT_DOUBLE_EQ(by_call.speed(), 4.0);
+  // A seek is queued as a timeline click's, for the feed to carry out.
+  by_call.seek_to(7);
+  const std::optional<PlaybackRequest> request = by_call.take_playback_request();
+  ASSERT_TRUE(request);
+  EXPECT_EQ(request->kind, PlaybackRequest::Kind::kSeekTo);
+  EXPECT_EQ(request->position, 7);
+  // Saved where the caller says, as `s` saves.
+  by_call.save_config_to((dir_ / "web.yaml").string());
+  const TrackingConfig saved = LoadTrackingConfig((dir_ / "web.yaml").string());
+  EXPECT_EQ(RangesOf(saved.markers[1].params.get<ColourParams>()),
+            RangesOf(by_call.config().markers[1].params.get<ColourParams>()));
+}
+
 TEST_F(LiveControllerTest, DragSelectsATemplateForTheMarkerInTheBox) {
   TrackingConfig config = SceneConfig();
   for (MarkerSpec& spec : config.markers) spec.params = ParamsForMethod("zncc", {});  // No templates yet.

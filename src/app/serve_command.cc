@@ -1,0 +1,138 @@
+// softsight serve: the live bench in a browser (src/web): a camera, a video or a rendered scene
+// tracked as `live` tracks it, watched and tuned from any number of pages, one in control.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/capture_options.h"
+#include "app/commands.h"
+#include "app/stop_request.h"
+#include "softsight/config/config.h"
+#include "softsight/core/error.h"
+#include "softsight/io/frame_source.h"
+#include "softsight/track/tracker.h"
+#include "web/access.h"
+#include "web/serve_run.h"
+
+namespace softsight {
+namespace {
+
+struct ServeArgs {
+  std::optional<int> camera;
+  std::string input;
+  std::string config;
+  std::optional<std::string> method;
+  std::string bind = "127.0.0.1";
+  int port = 8090;
+  std::string folder = ".";
+  std::string record_prefix = "serve";
+  int jpeg_quality = 80;
+  bool no_pace = false;
+  CaptureArgs capture;
+};
+
+int RunServeCommand(const ServeArgs& args) {
+  TrackingConfig config = LoadTrackingConfig(args.config, args.method);
+  const CameraSettings capture =
+      MergeCaptureOptions(args.capture, config.capture.value_or(CameraSettings{}));
+  std::optional<int> camera = args.camera;
+  if (!camera && args.input.empty()) camera = capture.device;
+  if (camera.has_value() == !args.input.empty()) {
+    throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
+                     args.config + ")");
+  }
+  if (!camera) {
+    RefuseCaptureWithoutCamera(args.capture, config.capture, args.config, "the file " + args.input,
+                               std::cerr);
+  }
+  std::error_code error;
+  if (!std::filesystem::is_directory(args.folder, error)) {
+    throw InputError("--folder " + args.folder + " is not a folder");
+  }
+  ServeOptions options;
+  options.folder = std::filesystem::canonical(args.folder);
+  options.config_path = args.config;
+  options.pace_files = !args.no_pace;
+  options.jpeg_quality = args.jpeg_quality;
+  options.live.record_prefix = (options.folder / args.record_prefix).string();
+  options.server.bind = args.bind;
+  options.server.port = args.port;
+  // Off this computer's loopback anyone on the network could reach the rig: a token, printed
+  // in the URL, is then asked of every request.
+  if (!IsLoopbackAddress(args.bind)) options.server.token = NewAccessToken();
+  if (std::string problem; !options.live.Check(&problem)) throw InputError(problem);
+
+  FrameSourceSpec spec;
+  spec.camera = camera;
+  spec.input = args.input;
+  spec.capture = capture;
+  CameraSettingsReport accepted;
+  spec.capture_report = &accepted;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
+  spec.capture_report = nullptr;
+  if (camera) {
+    PrintCaptureReport(accepted);
+    if (!capture.empty()) {
+      config.capture = accepted.accepted;
+      config.capture->device = camera;
+    }
+  }
+  FrameSourceOpener reopen;
+  if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
+  StopRequest stop;
+  LiveRunResult run = RunServe(config, std::move(source), options, reopen,
+                               [&stop] { return stop.requested(); }, std::cout);
+  std::cerr << run.summary.Report();
+  if (!run.last_recording.empty()) {
+    std::cerr << "softsight serve: last recording " << run.last_recording << ".*\n";
+  }
+  return ExitCodeAfterStop(0);
+}
+
+}  // namespace
+
+CommandRunner SetupServeCommand(CLI::App& sub) {
+  auto args = std::make_shared<ServeArgs>();
+  std::string methods;
+  for (const std::string& m : TrackerMethods()) methods += (methods.empty() ? "" : ", ") + m;
+  sub.footer(
+      "Serves the live bench as a web page: open the printed URL in a browser (this computer's,\n"
+      "or, with --bind 0.0.0.0, any on the network; the URL then carries a token that every\n"
+      "request needs). The page shows the frames with the overlay, the measurements, the status\n"
+      "(fps, dropped frames, latency), plots of the run against time and, for a file, a timeline\n"
+      "to seek. Click a marker to pick its colour, drag a box to reselect it or cut its template;\n"
+      "switch method, undo (saying what it undid), record, and save the config into --folder.\n"
+      "Several pages may watch; one controls the run at a time, the others are read-only until\n"
+      "they take control. Ctrl-C stops the server and prints the run's summary.\n"
+      "Example: softsight serve --input synth:bending --config examples/markers.yaml");
+  auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
+  auto* input = sub.add_option("-i,--input", args->input,
+                               "Video file, image sequence or synth:NAME instead of a camera");
+  camera->excludes(input);
+  sub.add_option("-c,--config", args->config, "Marker configuration (YAML, see examples/)")
+      ->required();
+  sub.add_option("--method", args->method, "Override every marker's method: " + methods);
+  sub.add_option("--bind", args->bind,
+                 "Address to listen on; any but loopback requires the printed token")
+      ->capture_default_str();
+  sub.add_option("--port", args->port, "TCP port; 0 picks a free one (the URL says which)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  sub.add_option("--folder", args->folder,
+                 "The only folder pages save configs and recordings in")
+      ->capture_default_str();
+  sub.add_option("--record-prefix", args->record_prefix,
+                 "Recordings go to <folder>/<prefix>-NNN.csv/.avi/.raw.avi/.yaml")
+      ->capture_default_str();
+  sub.add_option("--jpeg-quality", args->jpeg_quality, "Quality of the frames sent, 1-100")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  sub.add_flag("--no-pace", args->no_pace,
+               "Read a video file as fast as it decodes instead of at its frame rate");
+  AddCaptureOptions(sub, &args->capture);
+  return [args] { return RunServeCommand(*args); };
+}
+
+}  // namespace softsight

@@ -1,0 +1,211 @@
+#include "web/page_messages.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace softsight {
+namespace {
+
+using Json = nlohmann::json;
+using Kind = PageCommand::Kind;
+
+struct TypeInfo {
+  const char* name;
+  Kind kind;
+  std::set<std::string> fields;  // Besides "type".
+};
+
+const std::vector<TypeInfo>& Types() {
+  static const std::vector<TypeInfo> kTypes = {
+      {"play", Kind::kPlay, {}},           {"pause", Kind::kPause, {}},
+      {"step", Kind::kStep, {"delta"}},    {"seek", Kind::kSeek, {"position"}},
+      {"speed", Kind::kSpeed, {"value"}},  {"pick", Kind::kPick, {"x", "y"}},
+      {"select", Kind::kSelect, {"x", "y", "w", "h"}},
+      {"method", Kind::kMethod, {}},       {"undo", Kind::kUndo, {}},
+      {"marker", Kind::kMarker, {"index"}}, {"save", Kind::kSave, {"name"}},
+      {"record", Kind::kRecord, {}},       {"reset_reference", Kind::kResetReference, {}},
+      {"ping", Kind::kPing, {"t"}},        {"take_control", Kind::kTakeControl, {}},
+  };
+  return kTypes;
+}
+
+// A bound as a person writes it: 299, not 299.0.
+std::string Bound(double value) {
+  if (value == std::floor(value) && std::abs(value) < 1e15) {
+    return std::to_string(static_cast<int64_t>(value));
+  }
+  return Json(value).dump();
+}
+
+// The number in `field`, which must be finite and within [lo, hi].
+bool Number(const Json& message, const char* type, const char* field, double lo, double hi,
+            double* value, std::string* error) {
+  const Json& v = message.at(field);
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    *error = std::string(type) + ": " + field + " must be a number";
+    return false;
+  }
+  *value = v.get<double>();
+  if (*value < lo || *value > hi) {
+    *error = std::string(type) + ": " + field + " " + v.dump() + " is outside [" + Bound(lo) +
+             ", " + Bound(hi) + "]";
+    return false;
+  }
+  return true;
+}
+
+// The integer in `field` (a number with no fraction) within [lo, hi].
+bool Integer(const Json& message, const char* type, const char* field, int64_t lo, int64_t hi,
+             int64_t* value, std::string* error) {
+  double number = 0;
+  if (!Number(message, type, field, static_cast<double>(lo), static_cast<double>(hi), &number,
+              error)) {
+    return false;
+  }
+  if (number != std::floor(number)) {
+    *error = std::string(type) + ": " + field + " must be a whole number";
+    return false;
+  }
+  *value = static_cast<int64_t>(number);
+  return true;
+}
+
+bool NeedFrame(const PageLimits& limits, const char* type, std::string* error) {
+  if (limits.frame_size.area() > 0) return true;
+  *error = std::string(type) + ": no frame yet";
+  return false;
+}
+
+// The fields of a known type, checked against the run.
+bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, PageCommand* c,
+                std::string* error) {
+  const char* type = info.name;
+  const double w = limits.frame_size.width, h = limits.frame_size.height;
+  int64_t integer = 0;
+  switch (info.kind) {
+    case Kind::kStep:
+      if (!Integer(m, type, "delta", -1, 1, &integer, error)) return false;
+      if (integer == 0) {
+        *error = "step: delta must be 1 or -1";
+        return false;
+      }
+      c->delta = static_cast<int>(integer);
+      return true;
+    case Kind::kSeek: {
+      const int64_t last = limits.length ? std::max<int64_t>(0, *limits.length - 1) : INT32_MAX;
+      if (!Integer(m, type, "position", 0, last, &integer, error)) return false;
+      c->position = integer;
+      return true;
+    }
+    case Kind::kSpeed:
+      return Number(m, type, "value", 0.1, 4.0, &c->speed, error);
+    case Kind::kPick:
+      // Pixel centres are at integers: the image spans -0.5 .. size - 0.5.
+      return NeedFrame(limits, type, error) && Number(m, type, "x", 0, w - 1, &c->point_px.x, error) &&
+             Number(m, type, "y", 0, h - 1, &c->point_px.y, error);
+    case Kind::kSelect: {
+      int64_t x = 0, y = 0, bw = 0, bh = 0;
+      if (!NeedFrame(limits, type, error) || !Integer(m, type, "x", 0, w - 1, &x, error) ||
+          !Integer(m, type, "y", 0, h - 1, &y, error) || !Integer(m, type, "w", 3, w - x, &bw, error) ||
+          !Integer(m, type, "h", 3, h - y, &bh, error)) {
+        return false;
+      }
+      c->box_px = cv::Rect(static_cast<int>(x), static_cast<int>(y), static_cast<int>(bw),
+                           static_cast<int>(bh));
+      return true;
+    }
+    case Kind::kMarker:
+      if (!Integer(m, type, "index", 0, std::max(0, limits.markers - 1), &integer, error)) {
+        return false;
+      }
+      c->marker = static_cast<int>(integer);
+      return true;
+    case Kind::kSave:
+      if (!m.at("name").is_string()) {
+        *error = "save: name must be a string";
+        return false;
+      }
+      c->name = m.at("name").get<std::string>();
+      return ValidConfigName(c->name, error);
+    case Kind::kPing:
+      return Number(m, type, "t", 0, 1e15, &c->page_time_ms, error);
+    default:
+      return true;
+  }
+}
+
+}  // namespace
+
+bool ChangesTheRun(PageCommand::Kind kind) {
+  return kind != Kind::kPing && kind != Kind::kTakeControl;
+}
+
+bool ValidConfigName(std::string_view name, std::string* error) {
+  constexpr std::string_view kSuffix = ".yaml";
+  bool plain = !name.empty() && name.size() <= 64 && name.front() != '.';
+  for (const char ch : name) {
+    plain = plain && (std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_' ||
+                      ch == '-' || ch == '.');
+  }
+  if (!plain || name.size() <= kSuffix.size() ||
+      name.substr(name.size() - kSuffix.size()) != kSuffix) {
+    *error = "save: \"" + std::string(name.substr(0, 64)) +
+             "\" is not a config name (letters, digits, _ - . ending in .yaml; no folders)";
+    return false;
+  }
+  return true;
+}
+
+std::optional<PageCommand> ParsePageCommand(std::string_view text, const PageLimits& limits,
+                                            std::string* error) {
+  if (text.size() > kMaxPageMessageBytes) {
+    *error = "message of " + std::to_string(text.size()) + " bytes refused (at most " +
+             std::to_string(kMaxPageMessageBytes) + ")";
+    return std::nullopt;
+  }
+  const Json message = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (message.is_discarded() || !message.is_object()) {
+    *error = "message is not a JSON object";
+    return std::nullopt;
+  }
+  if (!message.contains("type") || !message["type"].is_string()) {
+    *error = "message has no \"type\"";
+    return std::nullopt;
+  }
+  const std::string type = message["type"].get<std::string>();
+  const TypeInfo* info = nullptr;
+  for (const TypeInfo& candidate : Types()) {
+    if (type == candidate.name) info = &candidate;
+  }
+  if (info == nullptr) {
+    *error = "unknown message type \"" + type.substr(0, 40) + "\"";
+    return std::nullopt;
+  }
+  for (const auto& [key, value] : message.items()) {
+    if (key != "type" && info->fields.count(key) == 0) {
+      *error = type + ": unknown field \"" + key.substr(0, 40) + "\"";
+      return std::nullopt;
+    }
+  }
+  for (const std::string& field : info->fields) {
+    if (!message.contains(field)) {
+      *error = type + ": missing field \"" + field + "\"";
+      return std::nullopt;
+    }
+  }
+  if ((info->kind == Kind::kStep || info->kind == Kind::kSeek) && !limits.seekable) {
+    *error = type + ": a camera plays as it comes (no stepping or seeking)";
+    return std::nullopt;
+  }
+  PageCommand command;
+  command.kind = info->kind;
+  if (!ReadFields(message, *info, limits, &command, error)) return std::nullopt;
+  return command;
+}
+
+}  // namespace softsight

@@ -1,0 +1,409 @@
+#!/usr/bin/env python3
+"""softsight serve in a real headless browser (Debian's chromium + chromium-driver, driven by
+python3-selenium): the page loads, frames and results arrive, a click picks a colour, a seek
+lands on the frame, hostile messages are refused and change nothing, a wrong token is refused,
+a second browser sees the same run read-only, the server survives 100 connections opened and
+dropped, a dragged box sets a template, and a recording made from the page reproduces under
+`softsight track`. Measures the latency from capture to the picture on the page (640x480, 30 fps).
+
+Every wait polls the page's state (window.softsight) with a timeout: no sleep decides a result.
+Exit code 77 (ctest: skipped) only when chromium or its driver or selenium is missing.
+
+  serve_browser_test.py --softsight build/src/app/softsight [--screenshot docs/images/serve.png]
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+SKIP = 77
+CONFIG = """\
+markers:
+  - {name: red,   hsv: {h: [170, 10], s: [80, 255], v: [40, 255]}}
+  # Wrong on purpose (a yellow range): blue is not found until the page picks its colour.
+  - {name: blue,  hsv: {h: [20, 30], s: [80, 255], v: [40, 255]}}
+  - {name: green, hsv: {h: [45, 85], s: [80, 255], v: [40, 255]}}
+triple: [red, blue, green]
+"""
+
+
+def find_chromium():
+    try:
+        from selenium import webdriver  # noqa: F401
+    except ImportError:
+        return None, "python3-selenium is not installed"
+    for browser in ("/usr/bin/chromium", shutil.which("chromium") or ""):
+        if browser and os.path.exists(browser):
+            driver = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+            if os.path.exists(driver):
+                return (browser, driver), None
+            return None, "chromium-driver is not installed"
+    return None, "chromium is not installed"
+
+
+def wait_for(what, condition, timeout=15.0, interval=0.05):
+    """Polls `condition` until it returns something true; fails naming `what` after `timeout`."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError("timed out waiting for " + what)
+        time.sleep(interval)
+
+
+def check(condition, message):
+    if not condition:
+        raise AssertionError(message)
+
+
+class Page:
+    def __init__(self, browser, driver_path, url):
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+        options = webdriver.ChromeOptions()
+        options.binary_location = browser
+        for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                     "--window-size=1500,1150", "--force-device-scale-factor=1"):
+            options.add_argument(flag)
+        # The page is on this computer: no proxy from the environment in between.
+        options.add_argument("--no-proxy-server")
+        self.driver = webdriver.Chrome(service=Service(driver_path), options=options)
+        self.driver.get(url)
+
+    def state(self, expression):
+        return self.driver.execute_script("return " + expression)
+
+    def click_at(self, x, y):
+        from selenium.webdriver.common.action_chains import ActionChains
+        actions = ActionChains(self.driver)
+        actions.w3c_actions.pointer_action.move_to_location(int(round(x)), int(round(y)))
+        actions.w3c_actions.pointer_action.click()
+        actions.perform()
+
+    def drag(self, x0, y0, x1, y1):
+        from selenium.webdriver.common.action_chains import ActionChains
+        actions = ActionChains(self.driver)
+        pointer = actions.w3c_actions.pointer_action
+        pointer.move_to_location(int(round(x0)), int(round(y0)))
+        pointer.pointer_down()
+        pointer.move_to_location(int(round((x0 + x1) / 2)), int(round((y0 + y1) / 2)))
+        pointer.move_to_location(int(round(x1)), int(round(y1)))
+        pointer.pointer_up()
+        actions.perform()
+
+    def click_image_point(self, x, y):
+        cx, cy = self.state("window.softsight.clientPoint(%f, %f)" % (x, y))
+        self.click_at(cx, cy)
+
+    def click_button(self, element_id):
+        self.driver.find_element("id", element_id).click()
+
+    def quit(self):
+        self.driver.quit()
+
+
+def start_server(softsight, folder, video, config):
+    server = subprocess.Popen(
+        [softsight, "serve", "--input", video, "--config", config, "--bind", "0.0.0.0",
+         "--port", "0", "--folder", folder],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = server.stdout.readline()
+    match = re.search(r"open (http://\S+)", line)
+    if not match:
+        server.kill()
+        raise AssertionError("serve printed no URL: %r %s" % (line, server.stderr.read()))
+    return server, match.group(1).replace("HOST", "127.0.0.1")
+
+
+def http_status(url):
+    # Straight to the server: a proxy from the environment must not answer for it.
+    opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
+    try:
+        with opener.open(url, timeout=5) as response:
+            return response.status
+    except urllib.error.HTTPError as error:
+        return error.code
+
+
+def websocket_handshake_status(port, target):
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(("GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+                      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                      "Sec-WebSocket-Version: 13\r\n\r\n" % (target, port)).encode())
+        status_line = sock.recv(4096).split(b"\r\n", 1)[0].decode()
+        return int(status_line.split()[1])
+
+
+def open_and_drop(port, count, token):
+    kinds = [b"", b"GET / HTT", ("GET /ws?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: "
+             "websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+             "Sec-WebSocket-Version: 13\r\n\r\n" % (token, port)).encode(), b"\xff" * 3000]
+    for i in range(count):
+        sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+        if kinds[i % 4]:
+            sock.sendall(kinds[i % 4])
+        sock.close()
+
+
+def truth_rows(path):
+    with open(path) as f:
+        return {int(row["frame"]): row for row in csv.DictReader(f)}
+
+
+def assert_near_truth(row, truth, names, tolerance=1.5):
+    for name in names:
+        check(row.get(name + "_found") == 1, "%s not found in frame %s" % (name, row.get("frame")))
+        dx = row[name + "_x"] - float(truth[name + "_x"])
+        dy = row[name + "_y"] - float(truth[name + "_y"])
+        check((dx * dx + dy * dy) ** 0.5 < tolerance,
+              "%s at (%.2f, %.2f), truth (%s, %s)" % (name, row[name + "_x"], row[name + "_y"],
+                                                       truth[name + "_x"], truth[name + "_y"]))
+
+
+def latency_figures(page):
+    # The first frames include the page's start (decoder warm-up); the run's own are after.
+    # The browser runs on the server's computer: one clock, no offset to estimate.
+    samples = sorted(page.state("window.softsight.sameClockLatencies.slice(10)"))
+    check(len(samples) >= 30, "only %d latency samples" % len(samples))
+    median = samples[len(samples) // 2]
+    p95 = samples[int(len(samples) * 0.95)]
+    return median, p95, len(samples)
+
+
+def test_hostile_messages(page):
+    """Each bad message: one error on the page, nothing changed, the run goes on."""
+    wait_for("the status of the frame on screen", lambda: page.state(
+        "window.softsight.status.position === window.softsight.shownPosition"))
+    before = page.state("window.softsight.status")
+    errors = page.state("window.softsight.errors.length")
+    bad = ["not json", json.dumps({"type": "format_disk"}),
+           json.dumps({"type": "seek", "position": 10 ** 9}),
+           json.dumps({"type": "pick", "x": -5, "y": 10}),
+           json.dumps({"type": "save", "name": "../../escaped.yaml"}),
+           json.dumps({"type": "save", "name": "x" * 5000 + ".yaml"}),
+           json.dumps({"type": "speed", "value": "fast"})]
+    for text in bad:
+        page.state("window.softsight.sendRaw(%s)" % json.dumps(text))
+    wait_for("an error for each hostile message",
+             lambda: page.state("window.softsight.errors.length") >= errors + len(bad))
+    after = page.state("window.softsight.status")
+    for key in ("position", "speed", "undo", "active", "method", "hsv", "paused"):
+        check(before[key] == after[key], "a refused message changed %s: %s -> %s" %
+              (key, before[key], after[key]))
+
+
+def test_template_drag(page, truth, frame):
+    """Switch to templates (SAD), then drag a box around green: its template is cut there and
+    green is found where the truth is; undo takes the reselection back."""
+    page.click_button("method")
+    wait_for("the method switch", lambda: page.state("window.softsight.status.method") == "sad")
+    undo = page.state("window.softsight.status.undo")
+    x, y = float(truth["green_x"]), float(truth["green_y"])
+    x0, y0 = page.state("window.softsight.clientPoint(%f, %f)" % (x - 14, y - 14))
+    x1, y1 = page.state("window.softsight.clientPoint(%f, %f)" % (x + 14, y + 14))
+    page.drag(x0, y0, x1, y1)
+    wait_for("the reselection", lambda: page.state("window.softsight.status.undo") == undo + 1)
+    row = page.state("window.softsight.row(%d)" % frame)
+    assert_near_truth(row, truth, ["red", "blue", "green"])
+    check(page.state("window.softsight.status.active") == 2, "the drag did not select green")
+    page.click_button("undo")
+    wait_for("the undo", lambda: page.state("window.softsight.status.undo") == undo)
+
+
+def comparable_rows(path):
+    """The CSV's rows without the columns that time the run (proc_ms, latency_*)."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [{k: v for k, v in row.items() if k != "proc_ms" and not k.startswith("latency")}
+            for row in rows]
+
+
+def test_recording_reproduces(page, softsight, folder):
+    """Record from the page while the video plays, stop: `softsight track` on the raw video
+    with the recording's config gives the same rows."""
+    start = page.state("window.softsight.status.position")
+    page.click_button("record")
+    wait_for("the recording", lambda: page.state("window.softsight.status.recording"))
+    page.click_button("play")
+    wait_for("30 frames recorded", lambda: page.state("window.softsight.status.position") >= start + 30)
+    print("the run's rate with %d pages open, recording: %.1f fps" % (
+        page.state("window.softsight.status.pages"), page.state("window.softsight.status.fps")))
+    page.click_button("record")
+    wait_for("the recording's end", lambda: not page.state("window.softsight.status.recording"))
+    prefix = os.path.join(folder, "serve-001")
+    again = os.path.join(folder, "again.csv")
+    subprocess.run([softsight, "track", "--config", prefix + ".yaml", "--input", prefix + ".raw.avi",
+                    "-o", again], check=True, capture_output=True)
+    recorded, tracked = comparable_rows(prefix + ".csv"), comparable_rows(again)
+    check(len(recorded) >= 30, "only %d rows recorded" % len(recorded))
+    check(recorded == tracked, "track does not reproduce the page's recording (%d and %d rows)"
+          % (len(recorded), len(tracked)))
+
+
+def run(args, browser, driver):
+    folder = tempfile.mkdtemp(prefix="softsight-serve-")
+    video, truth_csv, config = (os.path.join(folder, n) for n in ("run.avi", "truth.csv", "cfg.yaml"))
+    subprocess.run([args.softsight, "synth", "--scene", "bending", "--frames", "300", "--size",
+                    "640x480", "--fps", "30", "-o", video, "--truth", truth_csv],
+                   check=True, capture_output=True)
+    with open(config, "w") as f:
+        f.write(CONFIG)
+    truth = truth_rows(truth_csv)
+    server, url = start_server(args.softsight, folder, video, config)
+    port = int(re.search(r":(\d+)/", url).group(1))
+    token = re.search(r"token=([0-9a-f]+)", url).group(1)
+    pages = []
+    try:
+        # A wrong or missing token: refused, the page and its WebSocket alike.
+        check(http_status(url.replace(token, "0" * 32)) == 403, "a wrong token was not refused")
+        check(http_status("http://127.0.0.1:%d/" % port) == 403, "a missing token was not refused")
+        check(websocket_handshake_status(port, "/ws?token=" + "f" * 32) == 403,
+              "a WebSocket with a wrong token was not refused")
+
+        first = Page(browser, driver, url)
+        pages.append(first)
+        wait_for("frames and results on the page",
+                 lambda: first.state("window.softsight.framesShown >= 60 && window.softsight.results >= 60"))
+        check(first.state("window.softsight.controls"), "the first page does not control the run")
+        print("the run's rate with 1 page open: %.1f fps" % first.state("window.softsight.status.fps"))
+        median, p95, n = latency_figures(first)
+        print("latency capture->page, 640x480 at 30 fps: median %.1f ms, p95 %.1f ms (%d frames);"
+              " the page's clock offset estimate %.1f ms (true: 0), fastest ping %.1f ms"
+              % (median, p95, n, first.state("window.softsight.clockOffsetMs"),
+                 first.state("window.softsight.bestRttMs")))
+        frame = first.state("window.softsight.shownFrame")
+        row = first.state("window.softsight.row(%d)" % frame)
+        assert_near_truth(row, truth[frame], ["red", "green"])
+        check(row["blue_found"] == 0, "blue found with a yellow range")
+
+        # Pause, then click blue on the picture: its colour is picked, and it is found where it is.
+        first.click_button("play")
+        wait_for("the pause", lambda: first.state("window.softsight.status.paused"))
+        frame = wait_for("a steady frame", lambda: first.state(
+            "window.softsight.shownFrame === window.softsight.status.position && window.softsight.shownFrame"))
+        blue = truth[frame]
+        # Blue is lost, so the click cannot name it: its row in the table makes it the active
+        # marker, the one a click on no found marker picks for (as 2 does in the window).
+        first.driver.find_element("css selector", "#markers tbody tr:nth-child(2)").click()
+        wait_for("blue active", lambda: first.state("window.softsight.status.active") == 1)
+        first.click_image_point(float(blue["blue_x"]), float(blue["blue_y"]))
+        wait_for("blue found after the pick", lambda: (first.state(
+            "window.softsight.row(%d)" % frame) or {}).get("blue_found") == 1)
+        assert_near_truth(first.state("window.softsight.row(%d)" % frame), blue, ["red", "blue", "green"])
+        # The status follows the result: polled, then checked.
+        wait_for("blue's picked hue in the status", lambda: first.state(
+            "window.softsight.status.hsv[0] !== 20"), timeout=5)
+        hsv = first.state("window.softsight.status.hsv")
+        check(first.state("window.softsight.status.active") == 1 and 90 <= hsv[0] <= hsv[1] <= 140,
+              "the pick did not set blue's hue: %s" % hsv)
+
+        # A seek by a click on the timeline lands on that frame, tracked where the truth is.
+        target = 200
+        rect = first.state("document.getElementById('timeline').getBoundingClientRect().toJSON()")
+        first.click_at(rect["left"] + first.state("window.softsight.positionX(%d)" % target),
+                       rect["top"] + rect["height"] / 2)
+        wait_for("the seek to %d" % target, lambda: first.state(
+            "window.softsight.shownPosition === %d && window.softsight.row(%d) !== null" % (target, target)))
+        check(first.state("window.softsight.shownFrame") == target, "the picture is another frame")
+        assert_near_truth(first.state("window.softsight.row(%d)" % target), truth[target],
+                          ["red", "blue", "green"])
+
+        test_hostile_messages(first)
+
+        # The speed selector sets the paced file's speed (0.1x .. 4x), and back.
+        from selenium.webdriver.support.ui import Select
+        for speed in ("0.5", "1"):
+            Select(first.driver.find_element("id", "speed")).select_by_value(speed)
+            wait_for("speed " + speed, lambda: first.state("window.softsight.status.speed") == float(speed))
+
+        # A second browser sees the same run, read-only.
+        second = Page(browser, driver, url)
+        pages.append(second)
+        wait_for("the second page's picture",
+                 lambda: second.state("window.softsight.shownPosition === %d" % target))
+        check(not second.state("window.softsight.controls"), "the second page controls too")
+        errors = second.state("window.softsight.errors.length")
+        second.click_button("fwd")
+        wait_for("the read-only refusal", lambda: second.state("window.softsight.errors.length") > errors)
+        check(first.state("window.softsight.status.position") == target, "a read-only page moved the run")
+        first.click_button("fwd")
+        wait_for("the step seen by both pages", lambda: all(
+            p.state("window.softsight.shownPosition") == target + 1 for p in pages))
+
+        # The page's CSV export: the CSV's columns, one row per frame received, in order.
+        lines = first.state("window.softsight.csvText()").splitlines()
+        header = lines[0].split(",")
+        check(header[:2] == ["frame", "time_s"] and "blue_x" in header and "angle_deg" in header,
+              "the page's CSV has other columns: %s" % header[:8])
+        frames = [int(line.split(",")[0]) for line in lines[1:]]
+        check(frames == sorted(set(frames)) and target in frames and len(frames) >= 60,
+              "the page's CSV rows: %d, not in frame order or without frame %d" % (len(frames), target))
+
+        # Saved only in the server's folder, under a plain name.
+        first.click_button("save")
+        saved = os.path.join(folder, "markers.web.yaml")
+        wait_for("the saved config", lambda: os.path.exists(saved))
+
+        # 100 connections opened and dropped: the server goes on serving both pages.
+        open_and_drop(port, 100, token)
+        check(http_status(url) == 200, "the page is not served after 100 dropped connections")
+        first.click_button("back")
+        wait_for("a step after the flood", lambda: all(
+            p.state("window.softsight.shownPosition") == target for p in pages))
+        test_template_drag(first, truth[target], target)
+        test_recording_reproduces(first, args.softsight, folder)
+        if args.screenshot:
+            first.click_button("play")  # Pause (at the end: nothing).
+            wait_for("the pause", lambda: first.state(
+                "window.softsight.status.paused || window.softsight.status.ended"))
+            time.sleep(0.3)  # Only for the picture: the plots redraw at most every 120 ms.
+            first.driver.save_screenshot(args.screenshot)
+    except Exception:
+        # What the pages said, for the failure's report.
+        for i, page in enumerate(pages):
+            print("page %d messages: %s\n        errors: %s\n        status: %s" % (
+                i, page.state("window.softsight.messages.slice(-8)"),
+                page.state("window.softsight.errors.slice(-8)"), page.state("window.softsight.status")))
+        raise
+    finally:
+        for page in pages:
+            page.quit()
+        server.send_signal(signal.SIGINT)
+        try:
+            out, err = server.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            raise AssertionError("serve did not stop on SIGINT")
+    check(server.returncode == 130, "serve exited %d after SIGINT: %s" % (server.returncode, err))
+    shutil.rmtree(folder)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--softsight", required=True)
+    parser.add_argument("--screenshot", help="write the first page's screenshot (PNG) here")
+    args = parser.parse_args()
+    found, why = find_chromium()
+    if not found:
+        print("SKIPPED: %s (scripts/setup.sh installs chromium, chromium-driver, python3-selenium)" % why)
+        return SKIP
+    started = time.monotonic()
+    run(args, *found)
+    print("serve browser test passed in %.1f s" % (time.monotonic() - started))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

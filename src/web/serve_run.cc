@@ -1,0 +1,425 @@
+#include "web/serve_run.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <ostream>
+
+#include "gui/live_controller.h"
+#include "gui/live_feed.h"
+#include "gui/seekable_source.h"
+#include "softsight/core/error.h"
+#include "softsight/io/run_source.h"
+#include "softsight/pipeline/sinks.h"
+#include "stream/stream_format.h"
+#include "web/page_messages.h"
+
+namespace softsight {
+namespace {
+
+using Kind = PageCommand::Kind;
+
+// Pages' messages, from the server's thread to the run's. Bounded: a page that floods the run
+// loses its oldest messages, never the run its memory.
+class PageInbox {
+ public:
+  struct Message {
+    uint64_t page;
+    bool controls;
+    std::string text;
+  };
+  void push(Message message) {
+    std::lock_guard lock(mutex_);
+    if (queue_.size() >= kMaxWaiting) queue_.pop_front();
+    queue_.push_back(std::move(message));
+    ready_.notify_one();
+  }
+  bool pop(Message* message) {
+    std::lock_guard lock(mutex_);
+    if (queue_.empty()) return false;
+    *message = std::move(queue_.front());
+    queue_.pop_front();
+    return true;
+  }
+  void wait(std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    ready_.wait_for(lock, timeout, [this] { return !queue_.empty(); });
+  }
+
+ private:
+  static constexpr size_t kMaxWaiting = 256;
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<Message> queue_;
+};
+
+double UnixMs(SteadyClock::time_point steady) {
+  // The page compares it with its own clock (Date.now(), offset by the ping's estimate).
+  const auto now_system = std::chrono::system_clock::now();
+  const auto since = SteadyClock::now() - steady;
+  return std::chrono::duration<double, std::milli>(
+             (now_system - std::chrono::duration_cast<std::chrono::system_clock::duration>(since))
+                 .time_since_epoch())
+      .count();
+}
+
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", value);
+  return text;
+}
+
+// The answer to a page's ping: its own time back, and the server's clock now.
+std::string Pong(double page_time_ms) {
+  const double now_ms = std::chrono::duration<double, std::milli>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+  return "{\"type\":\"pong\",\"t\":" + Number(page_time_ms) + ",\"server_ms\":" +
+         Number(now_ms) + "}";
+}
+
+std::string TextMessage(const char* type, const std::string& text) {
+  std::string json = std::string("{\"type\":\"") + type + "\",\"message\":";
+  AppendJsonString(text, json);
+  return json + "}";
+}
+
+// The browser as a sink of the run: each frame's CSV row (the column table every CSV and the
+// stream use) as a text message, and its picture as a binary one, to every page.
+class WebSink : public FrameSink {
+ public:
+  WebSink(WebServer& server, CsvColumnTable table, const std::vector<std::string>& markers,
+          int jpeg_quality)
+      : server_(server), table_(std::move(table)), formatter_(table_),
+        topic_(StreamTopics(table_, markers).front()), quality_(jpeg_quality) {}
+
+  void set_controller(const LiveController* controller) { controller_ = controller; }
+
+  void consume(const Frame& frame, const FrameResult& result) override {
+    send_result(result, /*edit=*/false);
+    send_picture(frame.image, result, /*replay=*/false);
+  }
+
+  // The frame on screen again, for a page that just connected (a paused run sends no other).
+  // `replay`: the page does not count its capture-to-page latency.
+  void resend(const cv::Mat& image, const FrameResult& result) {
+    send_result(result, /*edit=*/true);
+    send_picture(image, result, /*replay=*/true);
+  }
+
+  void send_picture(const cv::Mat& image, const FrameResult& result, bool replay) {
+    if (server_.pages() == 0 || image.empty()) return;  // Nobody watches: nothing to encode.
+    cv::imencode(".jpg", image, jpeg_, jpeg_params_);
+    header_.clear();
+    AppendFrameFields(result, header_);
+    header_ += replay ? ",\"replay\":true}" : ",\"replay\":false}";
+    // [header length, 4 bytes little-endian][header JSON][JPEG]: the page pairs the picture
+    // with its result by frame number. The message is new each frame (the server's thread
+    // writes it to every page after this returns); everything else here is reused.
+    std::string bytes;
+    bytes.reserve(4 + header_.size() + jpeg_.size());
+    const uint32_t size = static_cast<uint32_t>(header_.size());
+    for (int i = 0; i < 4; ++i) bytes += static_cast<char>((size >> (8 * i)) & 0xFF);
+    bytes += header_;
+    bytes.append(reinterpret_cast<const char*>(jpeg_.data()), jpeg_.size());
+    server_.broadcast_frame(std::move(bytes));
+  }
+
+  // A result with no new picture (an edit re-tracked the frame on screen): `edit` says so.
+  void send_result(const FrameResult& result, bool edit) {
+    if (server_.pages() == 0) return;  // Nobody watches (a page that joins gets the frame on screen).
+    formatter_.format(topic_, result, record_);
+    json_.assign("{\"type\":\"result\",");
+    AppendFrameFields(result, json_);
+    json_ += edit ? ",\"edit\":true,\"row\":" : ",\"edit\":false,\"row\":";
+    json_.append(record_, topic_.topic.size() + 1);  // The record without its topic word.
+    json_ += '}';
+    server_.broadcast_text(json_);  // One copy: the message the server's thread sends.
+  }
+
+ private:
+  int64_t position() const { return controller_ ? controller_->position() : -1; }
+
+  // Appends "frame": .., "position": .., "captured_ms": .. (opening the object when `out` is
+  // empty: the picture's header; the result's has its "type" before).
+  void AppendFrameFields(const FrameResult& result, std::string& out) const {
+    if (out.empty()) out += '{';
+    out += "\"frame\":";
+    out += std::to_string(result.frame_index);  // Short: in the string's own buffer.
+    out += ",\"position\":";
+    out += std::to_string(position());
+    out += ",\"captured_ms\":";
+    char number[32];
+    std::snprintf(number, sizeof number, "%.3f", UnixMs(result.captured));
+    out += number;
+  }
+
+  WebServer& server_;
+  CsvColumnTable table_;
+  RecordFormatter formatter_;
+  TopicColumns topic_;
+  int quality_;
+  const LiveController* controller_ = nullptr;
+  // Reused per frame; only the messages handed to the server's thread are new each time.
+  std::vector<uchar> jpeg_;
+  std::string header_, record_, json_;
+  const std::vector<int> jpeg_params_{cv::IMWRITE_JPEG_QUALITY, quality_};
+};
+
+std::string Greeting(const TrackingConfig& config, const FrameSource& source, bool seekable) {
+  std::string json = "{\"type\":\"hello\",\"source\":";
+  AppendJsonString(source.description(), json);
+  json += ",\"markers\":[";
+  for (size_t i = 0; i < config.markers.size(); ++i) {
+    if (i > 0) json += ',';
+    AppendJsonString(config.markers[i].name, json);
+  }
+  json += "],\"triple\":[";
+  AppendJsonString(config.measure.base, json);
+  json += ',';
+  AppendJsonString(config.measure.middle, json);
+  json += ',';
+  AppendJsonString(config.measure.tip, json);
+  json += "],\"seekable\":";
+  json += seekable ? "true" : "false";
+  json += ",\"live\":";
+  json += source.is_live() ? "true" : "false";
+  json += ",\"fps\":" + Number(source.fps().value_or(0.0));
+  const std::optional<int64_t> count = source.frame_count();
+  json += ",\"length\":" + (count ? std::to_string(*count) : std::string("null"));
+  return json + "}";
+}
+
+// The run's side of the pages: their commands carried out on the controller, what the run says
+// and how it goes sent back.
+class ServeLoop {
+ public:
+  ServeLoop(LiveController& controller, WebServer& server, WebSink& sink, const ServeOptions& options,
+            bool seekable, std::ostream& out)
+      : controller_(controller), server_(server), sink_(sink), options_(options),
+        seekable_(seekable), out_(out) {}
+
+  void handle(const PageInbox::Message& message);
+  // Everything the controller said since the last call, to every page and to `out`.
+  void relay_messages();
+  void send_status(bool force);
+
+ private:
+  void apply(const PageCommand& command, uint64_t page);
+  void save(const std::string& name, uint64_t page);
+  PageLimits limits() const;
+
+  LiveController& controller_;
+  WebServer& server_;
+  WebSink& sink_;
+  const ServeOptions& options_;
+  bool seekable_;
+  std::ostream& out_;
+  std::string last_status_;
+  SteadyClock::time_point status_sent_{};
+};
+
+PageLimits ServeLoop::limits() const {
+  PageLimits limits;
+  limits.frame_size = controller_.frame_on_screen().size();
+  limits.seekable = seekable_;
+  limits.length = controller_.timeline().length();
+  limits.markers = static_cast<int>(controller_.config().markers.size());
+  return limits;
+}
+
+void ServeLoop::handle(const PageInbox::Message& message) {
+  std::string error;
+  const std::optional<PageCommand> command = ParsePageCommand(message.text, limits(), &error);
+  if (!command) {
+    server_.send_text(message.page, TextMessage("error", error));
+    return;
+  }
+  if (ChangesTheRun(command->kind) && !message.controls) {
+    server_.send_text(message.page,
+                      TextMessage("error", "read-only: another page controls the run (take "
+                                           "control to change it)"));
+    return;
+  }
+  apply(*command, message.page);
+}
+
+void ServeLoop::apply(const PageCommand& command, uint64_t page) {
+  const auto key = [this](int key) { controller_.on_event(UiEvent::Key(key)); };
+  switch (command.kind) {
+    case Kind::kPlay:
+      if (controller_.paused() || controller_.ended()) key(' ');
+      break;
+    case Kind::kPause:
+      // At the end the key would play from the start: a pause there leaves it as it is.
+      if (!controller_.paused() && !controller_.ended()) key(' ');
+      break;
+    case Kind::kStep: key(command.delta > 0 ? '.' : ','); break;
+    case Kind::kSeek: controller_.seek_to(command.position); break;
+    case Kind::kSpeed: controller_.set_speed(command.speed); break;
+    case Kind::kPick: controller_.pick_colour_at(command.point_px); break;
+    case Kind::kSelect: controller_.reselect(command.box_px); break;
+    case Kind::kMethod: key('m'); break;
+    case Kind::kUndo: key('u'); break;
+    case Kind::kMarker: key('1' + command.marker); break;
+    case Kind::kRecord: key('r'); break;
+    case Kind::kResetReference: key('b'); break;
+    case Kind::kSave: save(command.name, page); break;
+    case Kind::kTakeControl: server_.give_control(page); break;
+    case Kind::kPing:
+      server_.send_text(page, Pong(command.page_time_ms));
+      return;
+  }
+  // An edit re-tracks the frame on screen (or the next one shows it): every page sees its
+  // result now, also while paused.
+  const bool edit = command.kind == Kind::kPick || command.kind == Kind::kSelect ||
+                    command.kind == Kind::kMethod || command.kind == Kind::kUndo;
+  if (edit && controller_.last_result()) sink_.send_result(*controller_.last_result(), true);
+  send_status(/*force=*/true);
+}
+
+void ServeLoop::save(const std::string& name, uint64_t page) {
+  namespace fs = std::filesystem;
+  // The name is a plain file name (ParsePageCommand): joined to the folder it stays in it. A
+  // symbolic link of that name could still point out: refused, as the started config is.
+  const fs::path path = options_.folder / name;
+  std::error_code error;
+  std::string refusal;
+  if (fs::is_symlink(fs::symlink_status(path, error))) {
+    refusal = "save: " + name + " is a symbolic link in " + options_.folder.string() + "; choose another name";
+  } else if (!options_.config_path.empty() && fs::equivalent(path, options_.config_path, error)) {
+    refusal = "save: " + name + " is the config the server started with; choose another name";
+  }
+  if (!refusal.empty()) {
+    server_.send_text(page, TextMessage("error", refusal));
+    return;
+  }
+  controller_.save_config_to(path.string());
+}
+
+void ServeLoop::relay_messages() {
+  for (const std::string& said : controller_.take_messages()) {
+    out_ << "serve: " << said << std::endl;
+    server_.broadcast_text(TextMessage("message", said));
+  }
+}
+
+void ServeLoop::send_status(bool force) {
+  const SteadyClock::time_point now = SteadyClock::now();
+  if (!force && now - status_sent_ < std::chrono::milliseconds(250)) return;
+  status_sent_ = now;
+  const std::array<int, 6> hsv = controller_.active_hsv();
+  const TrackingConfig& config = controller_.config();
+  const int active = controller_.active_marker();
+  std::string json = "{\"type\":\"status\",\"fps\":" + Number(controller_.fps().value_or(0.0)) +
+                     ",\"latency_ms\":" + Number(controller_.latency_ms().value_or(0.0)) +
+                     ",\"dropped\":" + std::to_string(controller_.dropped_frames()) +
+                     ",\"skipped\":" + std::to_string(server_.frames_skipped()) +
+                     ",\"paused\":" + (controller_.paused() ? "true" : "false") +
+                     ",\"ended\":" + (controller_.ended() ? "true" : "false") +
+                     ",\"recording\":" + (controller_.recording() ? "true" : "false") +
+                     ",\"speed\":" + Number(controller_.speed()) +
+                     ",\"position\":" + std::to_string(controller_.position()) +
+                     ",\"length\":" + std::to_string(controller_.timeline().length().value_or(0)) +
+                     ",\"pages\":" + std::to_string(server_.pages()) +
+                     ",\"undo\":" + std::to_string(controller_.undo_depth()) +
+                     ",\"active\":" + std::to_string(active) + ",\"method\":";
+  AppendJsonString(TrackerMethodName(config.markers[active].params), json);
+  json += ",\"hsv\":[";
+  for (size_t i = 0; i < hsv.size(); ++i) {
+    if (i > 0) json += ',';
+    json += std::to_string(hsv[i]);
+  }
+  json += "]}";
+  if (!force && json == last_status_) return;
+  last_status_ = json;
+  server_.broadcast_text(std::move(json));
+}
+
+}  // namespace
+
+LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource> source,
+                       ServeOptions options, FrameSourceOpener reopen,
+                       const std::function<bool()>& stop_requested, std::ostream& out) {
+  if (options.jpeg_quality < 1 || options.jpeg_quality > 100) {
+    throw InputError("--jpeg-quality " + std::to_string(options.jpeg_quality) +
+                     " is outside 1..100");
+  }
+  SeekableSource* seekable = nullptr;
+  if (!source->is_live() && reopen) {
+    auto playable = std::make_unique<SeekableSource>(std::move(source), std::move(reopen));
+    seekable = playable.get();
+    source = std::move(playable);
+  }
+  if (!options.live.record_fps) options.live.record_fps = source->fps();
+  PageInbox inbox;
+  std::atomic<WebServer*> answering{nullptr};
+  WebServer server(options.server, PageAssets(),
+                   [&inbox, &answering](uint64_t page, bool controls, std::string text) {
+                     // A ping is answered here, on the server's thread, at once: the page sets
+                     // its clock by the answer, which must not wait for the run's next frame.
+                     std::string ignored;
+                     WebServer* server = answering.load();
+                     const auto ping = ParsePageCommand(text, PageLimits{}, &ignored);
+                     if (server && ping && ping->kind == Kind::kPing) {
+                       server->send_text(page, Pong(ping->page_time_ms));
+                       return;
+                     }
+                     inbox.push({page, controls, std::move(text)});
+                   });
+  answering = &server;
+  std::vector<std::string> names;
+  for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
+  WebSink sink(server, TrackingColumns(config), names, options.jpeg_quality);
+  options.live.sinks.push_back(&sink);
+  LiveController controller(config, options.live);
+  sink.set_controller(&controller);
+  controller.describe_source(*source);
+  server.set_greeting(Greeting(config, *source, seekable != nullptr));
+  source = SourceForRun(std::move(source),
+                        options.pace_files ? FilePacing::kRealTime : FilePacing::kInCallersThread);
+  out << "softsight serve: " << source->description() << ", " << config.markers.size()
+      << " markers; open " << server.url() << std::endl;
+
+  ServeLoop loop(controller, server, sink, options, seekable != nullptr, out);
+  LiveFeed feed(*source, seekable);
+  // A file shows its first frame and waits, paused, for the first page: played to nobody, its
+  // start would be gone before anyone saw it (and, paused, its paced clock stops: no burst to
+  // catch up when the page comes). A camera runs from the start.
+  bool waiting_for_page = !source->is_live() && feed.step(controller) && server.pages() == 0;
+  if (waiting_for_page) controller.on_event(UiEvent::Key(' '));
+  controller.take_messages();  // The window's start-up hint ("press h") and that pause.
+  int pages_seen = 0;
+  PageInbox::Message message;
+  while (!stop_requested() && !controller.quit_requested()) {
+    if (waiting_for_page && server.pages() > 0) {
+      waiting_for_page = false;
+      if (controller.paused()) controller.on_event(UiEvent::Key(' '));
+    }
+    while (inbox.pop(&message)) loop.handle(message);
+    if (server.pages() > pages_seen && controller.last_result()) {
+      // A page joined: it gets the frame on screen at once, playing or not.
+      sink.resend(controller.frame_on_screen(), *controller.last_result());
+      loop.send_status(/*force=*/true);
+    }
+    pages_seen = server.pages();
+    // A paced file waits here until its frame is due (at most a frame period); a camera
+    // returns its newest frame.
+    const bool got = feed.step(controller);
+    loop.relay_messages();
+    // A frame stepped or sought to while paused: its position goes out with it (while playing
+    // the status follows four times a second).
+    loop.send_status(/*force=*/got && controller.paused());
+    if (!got) inbox.wait(std::chrono::milliseconds(20));
+  }
+  LiveRunResult result;
+  result.last_recording = controller.last_recording();
+  result.summary = controller.run_summary();
+  return result;
+}
+
+}  // namespace softsight
