@@ -186,8 +186,16 @@ TEST_F(WebServerTest, AnOversizedMessageClosesOnlyItsOwnConnection) {
     beast::flat_buffer buffer;
     flooder->read(buffer, error);  // Role messages, then the close.
   }
-  EXPECT_EQ(error, websocket::error::closed);
-  EXPECT_EQ(flooder->reason().code, websocket::close_code::too_big);
+  // The server sends its close (too big) and drops the connection. The client sees the close,
+  // or, when the server's socket is gone before the client's answer to the close is written,
+  // that write failing (a broken pipe, a reset, not connected): either way it is over.
+  if (error == websocket::error::closed) {
+    EXPECT_EQ(flooder->reason().code, websocket::close_code::too_big);
+  } else {
+    EXPECT_TRUE(error == asio::error::broken_pipe || error == asio::error::connection_reset ||
+                error == asio::error::eof || error == asio::error::not_connected)
+        << error.message();
+  }
   watcher->write(asio::buffer(std::string("still here")));
   ASSERT_TRUE(WaitForMessages(2));
   std::lock_guard lock(received_.mutex);
