@@ -48,19 +48,24 @@ void AddRowToColumns(const uint8_t* __restrict b, const uint8_t* __restrict g,
                      bool first_row, size_t padded, uint16_t* __restrict texture_sixths,
                      uint16_t* __restrict sum_b, uint16_t* __restrict sum_g,
                      uint16_t* __restrict sum_r, uint8_t* __restrict gray) {
+  // Each sample's left neighbour: the planes shifted by one (index -1 is the padding sample).
+  // Indexing b[j - 1] with an unsigned j = 0 would wrap the offset (undefined; UBSan says so).
+  const uint8_t* __restrict left_b = b - 1;
+  const uint8_t* __restrict left_g = g - 1;
+  const uint8_t* __restrict left_r = r - 1;
   if (first_row) {
     for (size_t j0 = 0; j0 < padded; j0 += kLanes) {
       for (size_t j = j0; j < j0 + kLanes; ++j) {
-        const int left = AbsDifference(b[j], b[j - 1]) + AbsDifference(g[j], g[j - 1]) +
-                         AbsDifference(r[j], r[j - 1]);
+        const int left = AbsDifference(b[j], left_b[j]) + AbsDifference(g[j], left_g[j]) +
+                         AbsDifference(r[j], left_r[j]);
         texture_sixths[j] = static_cast<uint16_t>(texture_sixths[j] + 2 * left);
       }
     }
   } else {
     for (size_t j0 = 0; j0 < padded; j0 += kLanes) {
       for (size_t j = j0; j < j0 + kLanes; ++j) {
-        const int both = AbsDifference(b[j], b[j - 1]) + AbsDifference(g[j], g[j - 1]) +
-                         AbsDifference(r[j], r[j - 1]) + AbsDifference(b[j], above_b[j]) +
+        const int both = AbsDifference(b[j], left_b[j]) + AbsDifference(g[j], left_g[j]) +
+                         AbsDifference(r[j], left_r[j]) + AbsDifference(b[j], above_b[j]) +
                          AbsDifference(g[j], above_g[j]) + AbsDifference(r[j], above_r[j]);
         texture_sixths[j] = static_cast<uint16_t>(texture_sixths[j] + both);
       }
