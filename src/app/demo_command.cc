@@ -26,24 +26,6 @@ struct DemoOptions {
   bool quiet = false;
 };
 
-TrackingConfig ConfigFor(const SceneOptions& scene) {
-  TrackingConfig config;
-  for (const SceneMarker& marker : scene.markers) {
-    MarkerSpec spec;
-    spec.name = marker.name;
-    ColourParams colour = ThresholdsFor(marker.bgr);
-    // The demo renders with sensor noise: a light smoothing, as a person would add.
-    colour.filter = ColourParams::Filter::kGaussian;
-    colour.filter_ksize = 3;
-    spec.params = colour;
-    config.markers.push_back(spec);
-  }
-  config.measure = SceneMeasureOptions(scene);
-  // As if the camera saw the actuator's plane at 0.25 mm per pixel.
-  config.measure.metric.scale_mm_per_px = 0.25;
-  return config;
-}
-
 int RunDemo(const DemoOptions& options) {
   namespace fs = std::filesystem;
   std::error_code error;
@@ -64,7 +46,7 @@ int RunDemo(const DemoOptions& options) {
   RunSynth(synth, &truths);
 
   const std::string config_file = (dir / "markers.yaml").string();
-  SaveTrackingConfig(ConfigFor(synth.scene), config_file);
+  SaveTrackingConfig(ConfigForScene(synth.scene), config_file);
 
   TrackOptions track;
   track.config_file = config_file;

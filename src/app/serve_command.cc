@@ -8,6 +8,7 @@
 
 #include "app/capture_options.h"
 #include "app/commands.h"
+#include "app/scene_config.h"
 #include "app/stop_request.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
@@ -33,7 +34,10 @@ struct ServeArgs {
   CaptureArgs capture;
 };
 
-int RunServeCommand(const ServeArgs& args) {
+int RunServeCommand(ServeArgs args) {
+  // A rendered scene brings the config a person would write for it: `serve --input
+  // synth:bending` alone opens a page with markers to watch and tune.
+  if (args.config.empty()) args.config = ConfigForBuiltinInput(args.input, args.folder);
   TrackingConfig config = LoadTrackingConfig(args.config, args.method);
   const CameraSettings capture =
       MergeCaptureOptions(args.capture, config.capture.value_or(CameraSettings{}));
@@ -106,13 +110,14 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
       "switch method, undo (saying what it undid), record, and save the config into --folder.\n"
       "Several pages may watch; one controls the run at a time, the others are read-only until\n"
       "they take control. Ctrl-C stops the server and prints the run's summary.\n"
-      "Example: softsight serve --input synth:bending --config examples/markers.yaml");
+      "Example: softsight serve --input synth:bending");
   auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file, image sequence or synth:NAME instead of a camera");
   camera->excludes(input);
-  sub.add_option("-c,--config", args->config, "Marker configuration (YAML, see examples/)")
-      ->required();
+  sub.add_option("-c,--config", args->config,
+                 "Marker configuration (YAML, see examples/); a synth: input without one uses "
+                 "the scene's own, written to <folder>/synth-NAME.yaml");
   sub.add_option("--method", args->method, "Override every marker's method: " + methods);
   sub.add_option("--bind", args->bind,
                  "Address to listen on; any but loopback requires the printed token")

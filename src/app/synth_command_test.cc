@@ -1,4 +1,5 @@
 #include "app/synth_command.h"
+#include "app/scene_config.h"
 
 #include <unistd.h>
 
@@ -17,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "softsight/config/config.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -197,6 +199,34 @@ TEST(SynthCommandTest, ProgramReportsBadSceneOnce) {
   const std::vector<std::string> lines = ReadLines(err);
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_NE(lines[0].find("spiral"), std::string::npos) << lines[0];
+}
+
+// `serve --input synth:NAME` without --config: the scene brings the config a person would write
+// for it, written once into the folder; a config already there (saved from an earlier run) is
+// kept and used; other inputs still need --config, and the error says so.
+TEST(SynthCommandTest, ASynthSceneBringsItsOwnConfigWrittenOnceAndKept) {
+  testing::TempDir dir;
+  const std::string path = ConfigForBuiltinInput("synth:bending", dir.path().string());
+  EXPECT_EQ(fs::path(path).filename(), "synth-bending.yaml");
+  const TrackingConfig config = LoadTrackingConfig(path);
+  ASSERT_EQ(config.markers.size(), 3u);  // The bending scene's red, blue and green markers.
+  EXPECT_EQ(config.markers[0].name, "red");
+  EXPECT_TRUE(config.markers[0].params.holds<ColourParams>());
+  {
+    std::ofstream edited(path);
+    edited << "markers:\n  - name: mine\n    method: colour\n";
+  }
+  EXPECT_EQ(ConfigForBuiltinInput("synth:bending", dir.path().string()), path);
+  EXPECT_EQ(LoadTrackingConfig(path).markers.at(0).name, "mine");  // Not overwritten.
+  try {
+    ConfigForBuiltinInput("run.avi", dir.path().string());
+    ADD_FAILURE() << "a video file was given a config";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--config is required for run.avi"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ConfigForBuiltinInput("synth:plate", dir.path().string()), InputError);
+  EXPECT_THROW(ConfigForBuiltinInput("synth:nosuchscene", dir.path().string()), InputError);
 }
 
 }  // namespace
