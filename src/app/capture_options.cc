@@ -91,4 +91,37 @@ void PrintCaptureReport(const CameraSettingsReport& report) {
   for (const std::string& line : report.refused) std::cerr << line << "\n";
 }
 
+std::unique_ptr<FrameSource> OpenLiveSource(std::optional<int> camera, const std::string& input,
+                                            const CaptureArgs& capture_args,
+                                            const std::string& config_path,
+                                            TrackingConfig& config, FrameSourceSpec* spec) {
+  const CameraSettings capture =
+      MergeCaptureOptions(capture_args, config.capture.value_or(CameraSettings{}));
+  if (!camera && input.empty()) camera = capture.device;
+  if (camera.has_value() == !input.empty()) {
+    throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
+                     config_path + ")");
+  }
+  if (!camera) {
+    RefuseCaptureWithoutCamera(capture_args, config.capture, config_path, "the file " + input,
+                               std::cerr);
+  }
+  spec->camera = camera;
+  spec->input = input;
+  spec->capture = capture;
+  CameraSettingsReport accepted;
+  spec->capture_report = &accepted;
+  std::unique_ptr<FrameSource> source = OpenFrameSource(*spec);
+  spec->capture_report = nullptr;  // The reopener (files) needs none.
+  if (camera) {
+    // What the camera accepted is printed, and saved with every recording's config (and by `s`).
+    PrintCaptureReport(accepted);
+    if (!capture.empty()) {
+      config.capture = accepted.accepted;
+      config.capture->device = camera;
+    }
+  }
+  return source;
+}
+
 }  // namespace softsight

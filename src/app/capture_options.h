@@ -12,7 +12,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "softsight/config/config.h"
 #include "softsight/io/camera_settings.h"
+#include "softsight/io/frame_source.h"
 
 namespace softsight {
 
@@ -37,5 +39,16 @@ void RefuseCaptureWithoutCamera(const CaptureArgs& args,
 
 // What the camera accepted, on stderr: the summary line, then one line per refused setting.
 void PrintCaptureReport(const CameraSettingsReport& report);
+
+// The frame source of a live front end (`live`, `serve`): exactly one of `camera` (or the
+// config's capture.device) and `input`. The camera's settings are the config's `capture:`
+// section with the --camera-* options on top; what it accepted is printed and written back into
+// `config` (so every recording's config and a saved one hold it). Frames from a file refuse
+// --camera-* options. `spec` gets what opened the source (a file reopens from it). Throws
+// InputError naming the option, the config or the input.
+std::unique_ptr<FrameSource> OpenLiveSource(std::optional<int> camera, const std::string& input,
+                                            const CaptureArgs& capture_args,
+                                            const std::string& config_path,
+                                            TrackingConfig& config, FrameSourceSpec* spec);
 
 }  // namespace softsight

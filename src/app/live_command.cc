@@ -52,35 +52,9 @@ int RunLive(const LiveArgs& args) {
                      args.config + " --input VIDEO --csv out.csv`");
   }
   TrackingConfig config = LoadTrackingConfig(args.config, args.method);
-  // The camera's settings: the config's `capture:` section, the --camera-* options on top.
-  const CameraSettings capture =
-      MergeCaptureOptions(args.capture, config.capture.value_or(CameraSettings{}));
-  std::optional<int> camera = args.camera;
-  if (!camera && args.input.empty()) camera = capture.device;
-  if (camera.has_value() == !args.input.empty()) {
-    throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
-                     args.config + ")");
-  }
-  if (!camera) {
-    RefuseCaptureWithoutCamera(args.capture, config.capture, args.config, "the file " + args.input,
-                               std::cerr);
-  }
   FrameSourceSpec spec;
-  spec.camera = camera;
-  spec.input = args.input;
-  spec.capture = capture;
-  CameraSettingsReport accepted;
-  spec.capture_report = &accepted;
-  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
-  spec.capture_report = nullptr;  // The reopener (files) needs none.
-  if (camera) {
-    // What the camera accepted is printed, and saved with every recording's config (and by `s`).
-    PrintCaptureReport(accepted);
-    if (!capture.empty()) {
-      config.capture = accepted.accepted;
-      config.capture->device = camera;
-    }
-  }
+  std::unique_ptr<FrameSource> source =
+      OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   LiveOptions options;
   options.save_config_path =
       args.save_config.empty() ? DefaultSavePath(args.config) : args.save_config;

@@ -39,18 +39,6 @@ int RunServeCommand(ServeArgs args) {
   // synth:bending` alone opens a page with markers to watch and tune.
   if (args.config.empty()) args.config = ConfigForBuiltinInput(args.input, args.folder);
   TrackingConfig config = LoadTrackingConfig(args.config, args.method);
-  const CameraSettings capture =
-      MergeCaptureOptions(args.capture, config.capture.value_or(CameraSettings{}));
-  std::optional<int> camera = args.camera;
-  if (!camera && args.input.empty()) camera = capture.device;
-  if (camera.has_value() == !args.input.empty()) {
-    throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
-                     args.config + ")");
-  }
-  if (!camera) {
-    RefuseCaptureWithoutCamera(args.capture, config.capture, args.config, "the file " + args.input,
-                               std::cerr);
-  }
   std::error_code error;
   if (!std::filesystem::is_directory(args.folder, error)) {
     throw InputError("--folder " + args.folder + " is not a folder");
@@ -69,20 +57,8 @@ int RunServeCommand(ServeArgs args) {
   if (std::string problem; !options.live.Check(&problem)) throw InputError(problem);
 
   FrameSourceSpec spec;
-  spec.camera = camera;
-  spec.input = args.input;
-  spec.capture = capture;
-  CameraSettingsReport accepted;
-  spec.capture_report = &accepted;
-  std::unique_ptr<FrameSource> source = OpenFrameSource(spec);
-  spec.capture_report = nullptr;
-  if (camera) {
-    PrintCaptureReport(accepted);
-    if (!capture.empty()) {
-      config.capture = accepted.accepted;
-      config.capture->device = camera;
-    }
-  }
+  std::unique_ptr<FrameSource> source =
+      OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
   if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
   StopRequest stop;
