@@ -124,8 +124,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
           std::chrono::steady_clock::now() - *first_contact >=
               std::chrono::duration<double>(*options.disconnect_after_s);
       const bool pull_by_count =
-          options.disconnect_after_replies &&
-          server.replies() >= static_cast<uint64_t>(*options.disconnect_after_replies);
+          options.disconnect_after_replies && server.past_reply_limit();
       if (server.connected() && (pull_by_time || pull_by_count)) {
         server.disconnect();
         if (!options.quiet) {
@@ -181,8 +180,9 @@ CommandRunner SetupRigCommand(CLI::App& sub) {
                  "Close the port this many seconds after the host's first command (a pulled "
                  "cable) and keep running, to watch the watchdog vent");
   sub.add_option("--disconnect-after-replies", o->disconnect_after_replies,
-                 "Close the port once this many answer lines have been sent, and keep running "
-                 "(the same pulled cable, at a point that does not depend on timing)");
+                 "Answer this many lines, close the port when the host asks again (it has read "
+                 "them all), and keep running (the same pulled cable, at a point that does not "
+                 "depend on timing)");
   sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
   return [o] {
     RunRig(*o);

@@ -84,7 +84,9 @@ std::optional<wire::Message> BoardLink::exchange(
     const std::function<Verdict(const wire::Message&)>& classify, int64_t budget_ms,
     uint64_t* rejected, std::string* why) {
   const int64_t give_up_ms = budget_ms > 0 ? now_ms() + budget_ms : 0;
-  for (int attempt = 0; attempt <= options_.retries; ++attempt) {
+  // With a budget (STOP) the tries go on until it is spent, however short each try is: a loaded
+  // host or board that misses three 100 ms deadlines must not give up venting after 300 ms.
+  for (int attempt = 0; attempt <= options_.retries || give_up_ms != 0; ++attempt) {
     if (give_up_ms != 0 && now_ms() >= give_up_ms) break;
     if (attempt > 0) ++stats_.resends;
     if (honour_stop && environment_.stop_requested && environment_.stop_requested()) {

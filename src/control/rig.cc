@@ -172,17 +172,29 @@ void RigServer::serve() {
       std::lock_guard<std::mutex> lock(write_mutex_);
       waiting_to_write = !pending_.empty();
     }
-    // At the reply limit nothing more is read: the last answers are delivered, then the line is
-    // dead until disconnect() closes it.
+    // At the reply limit nothing more is answered: the last answers are delivered, and the next
+    // request (the host read them all) marks the point where disconnect() may close the line.
     const bool at_limit = reply_limit_ != 0 && replies_ >= reply_limit_;
-    if (at_limit && !waiting_to_write) break;
     // A short timeout: shutdown and disconnect are seen within 5 ms whatever the host does.
+    // At the limit a request is only looked at once every answer is out; it is never read.
+    const bool look_for_requests = !(at_limit && waiting_to_write);
     pollfd p{pty_.master_fd(),
-             static_cast<short>((at_limit ? 0 : POLLIN) | (waiting_to_write ? POLLOUT : 0)), 0};
+             static_cast<short>((look_for_requests ? POLLIN : 0) | (waiting_to_write ? POLLOUT : 0)),
+             0};
     const int ready = ::poll(&p, 1, 5);
     if (ready > 0 && (p.revents & POLLOUT) != 0) {
       std::lock_guard<std::mutex> lock(write_mutex_);
       flush_locked();
+    }
+    if (at_limit) {
+      if (!waiting_to_write && ready > 0 && (p.revents & POLLIN) != 0) {
+        past_reply_limit_ = true;
+        break;
+      }
+      if (ready > 0 && (p.revents & POLLOUT) == 0) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));  // A hang-up: no busy loop.
+      }
+      continue;
     }
     if (ready <= 0 || (p.revents & POLLIN) == 0) {
       // POLLHUP without data: nobody has the port open (we keep the slave, so rarely). Wait.

@@ -60,9 +60,10 @@ constexpr double kMaxBoardPressureLimitKpa = 1000.0;
 constexpr double kMinSensedPressureKpa = -101.325;
 constexpr double kMaxSensedPressureKpa = 2 * kMaxBoardPressureLimitKpa;
 
-// The longest a STOP may take, all retries together, ms: venting is tried at once and again,
-// but a silent board cannot hold the exit for retries x reply_timeout_ms (up to 110 s); its
-// watchdog vents on its own when the commands stop.
+// How long a STOP is tried, all re-sends together, ms: venting is tried at once and again
+// (every reply_timeout_ms, beyond `retries` if need be) until this is spent, but a silent board
+// cannot hold the exit for retries x reply_timeout_ms (up to 110 s); its watchdog vents on its
+// own when the commands stop.
 constexpr int kMaxStopMs = 1500;
 
 // The largest inner-loop gain the wire carries (duty per kPa, or per kPa*s): a full valve swing

@@ -123,8 +123,11 @@ class RigServer {
   // Answer lines queued for the host so far (a count tests and `rig` can wait on, unlike time).
   uint64_t replies() const { return replies_; }
   // After this many answer lines the server answers nothing more (0: no limit): a pulled cable at
-  // a point that does not depend on timing. Call disconnect() once replies() reaches it.
+  // a point that does not depend on timing. Call disconnect() once past_reply_limit().
   void set_reply_limit(uint64_t limit) { reply_limit_ = limit; }
+  // The host asked again after the last answer allowed: it has read every answer (a hang-up
+  // discards what the host has not read yet, so closing earlier would race with its reading).
+  bool past_reply_limit() const { return past_reply_limit_; }
 
  private:
   void serve();
@@ -143,6 +146,7 @@ class RigServer {
   std::atomic<uint64_t> dropped_replies_{0};
   std::atomic<uint64_t> replies_{0};
   std::atomic<uint64_t> reply_limit_{0};
+  std::atomic<bool> past_reply_limit_{false};
   std::atomic<bool> port_closed_{false};
   std::atomic<bool> contacted_{false};
   std::atomic<bool> shutdown_{false};
