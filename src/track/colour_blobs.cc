@@ -262,6 +262,13 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
     const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
     blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
+    blob->hull_asymmetry_px = blob->asymmetry_px;
+    cv::convexHull(edge_points_, hull_points_);
+    const cv::Moments hull = cv::moments(hull_points_);
+    if (hull.m00 > 0) {
+      const cv::Point2d hull_centre(hull.m10 / hull.m00, hull.m01 / hull.m00);
+      blob->hull_asymmetry_px = cv::norm(cv::Point2d(circle_centre) - hull_centre);
+    }
   }
   // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
   // core = more than kSoftBand inside, reach = within kRingOuter outside.

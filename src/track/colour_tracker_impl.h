@@ -45,6 +45,10 @@ struct ColourBlob {
   // about its centre, whatever its size (uniform shrinking under a dimmer light keeps it 0); a
   // marker partly covered shows the centroid's shift towards what is left of it.
   double asymmetry_px = 0;
+  // The same for the blob's convex hull. A dome's highlight or a dark speck at its rim bites a
+  // notch out of the blob that shifts its centroid (asymmetry_px) but not its hull's; a cover's
+  // straight or convex edge shifts both.
+  double hull_asymmetry_px = 0;
   bool measured = false;           // The colour statistics below are set.
   // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
   // marker should be): its colour is not the marker's under the usual light, and is not learned.
@@ -235,6 +239,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;
   std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.
+  std::vector<cv::Point> hull_points_;  // Their convex hull.
   std::vector<cv::Point> outside_stack_;  // FillHoles's flood of the outside.
   std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
   std::vector<std::pair<double, cv::Point2d>> off_rim_;  // Scratch of OffRimBulgePx.

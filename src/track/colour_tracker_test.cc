@@ -270,6 +270,33 @@ TEST(ColourTracker, APartlyCoveredMarkerIsHeldAndALookAlikeIsNotTakenForIt) {
   EXPECT_LT(cv::norm(*back.position_px - centre), 0.1);
 }
 
+TEST(ColourTracker, AHighlightBitingTheRimIsPartOfTheMarkerNotACover) {
+  // A domed marker under a lamp: its highlight is pale (below the saturation range) and bites a
+  // notch into the blob at the rim. The blob's centroid moves away from it as from a cover's cut,
+  // but its convex hull stays whole: the marker is found, where the notched blob's pixels are.
+  ColourTracker tracker(RedParams());
+  const cv::Point2d centre(150.5, 120.5);
+  cv::Mat image = Background();
+  PaintDisc(image, centre, 10, kRed);
+  ASSERT_TRUE(tracker.update(image).found());
+  ASSERT_TRUE(tracker.update(image).found());
+  cv::Mat lit = image.clone();
+  for (int y = 0; y < lit.rows; ++y) {
+    for (int x = 0; x < lit.cols; ++x) {
+      const bool on_disc = std::hypot(x - centre.x, y - centre.y) <= 10;
+      const bool in_highlight = std::hypot(x - (centre.x - 5), y - (centre.y - 6)) <= 5.5;
+      if (on_disc && in_highlight) lit.at<cv::Vec3b>(y, x) = cv::Vec3b(225, 230, 245);
+    }
+  }
+  const cv::Point2d notched = CentroidOfColour(lit, kRed);
+  ASSERT_GT(cv::norm(notched - centre), 1.2);  // Beyond the asymmetry a cover is judged by.
+  for (int i = 0; i < 5; ++i) {
+    const Observation obs = tracker.update(lit);
+    ASSERT_TRUE(obs.found()) << "frame " << i << ": " << MarkerStatusName(obs.not_found_reason);
+    EXPECT_LT(cv::norm(*obs.position_px - notched), 0.05) << "frame " << i;
+  }
+}
+
 TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {
   cv::Mat image = Background();
   PaintDisc(image, {60, 60}, 12, kRed);  // Larger: once "the marker", now a look-alike.

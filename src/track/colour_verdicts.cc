@@ -54,7 +54,9 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
   if (model_ && !b.rim_placed) {
     const double radius = std::sqrt(model_->area_px / CV_PI);
     const double tolerance = std::max(kPartialMinPx, kPartialRadii * radius);
-    partial = partial || b.asymmetry_px > model_->asymmetry_px + tolerance;
+    // Both the blob and its hull: a notch (a highlight, a speck) leaves the hull whole.
+    const double limit = model_->asymmetry_px + tolerance;
+    partial = partial || (b.asymmetry_px > limit && b.hull_asymmetry_px > limit);
   }
   if (!model_ && !acquire_roi_ && b.core_px < kMinCorePxWithoutModel) {
     return {CandidateVerdict::kSize, kInf};

@@ -56,7 +56,9 @@ CASES = {
         what='red screwdriver, red, green and blue caps and parts of the markers\' colours in view',
         # zncc: 93.5 % before a match whose core shows the marker's colour was accepted down to
         # a ZNCC of 0.7 (the moving green, 0.72-0.79 in gray)
-        configs=[('pick', 98.0, None),
+        # pick: green 34 of 36 (`covered`) until a notch bitten by the dome's highlight at its
+        # rim no longer counted as a cover (the blob's hull is whole, a cover cuts the hull too)
+        configs=[('pick', 99.0, None),
                  ('zncc', 99.0, None)]),
     'finger': dict(
         what='a finger covers the middle marker for 10 frames',
