@@ -34,6 +34,11 @@ install(FILES ${PROJECT_BINARY_DIR}/include/softsight/version.h
 set(SOFTSIGHT_CMAKE_PACKAGE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/softsight)
 install(EXPORT softsightTargets NAMESPACE softsight:: DESTINATION ${SOFTSIGHT_CMAKE_PACKAGE_DIR}
         COMPONENT library)
+# Whether io links Aravis (GenICam cameras): softsightConfig.cmake finds it for static users.
+set(SOFTSIGHT_WITH_ARAVIS OFF)
+if(ARAVIS_FOUND)
+  set(SOFTSIGHT_WITH_ARAVIS ON)
+endif()
 configure_package_config_file(cmake/softsightConfig.cmake.in
   ${PROJECT_BINARY_DIR}/softsightConfig.cmake INSTALL_DESTINATION ${SOFTSIGHT_CMAKE_PACKAGE_DIR})
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/softsightConfigVersion.cmake
@@ -66,6 +71,10 @@ set(_softsight_pc_sim opencv4)
 set(_softsight_pc_calib opencv4)
 set(_softsight_pc_control libserial)
 set(_softsight_pc_io opencv4 libavutil libavcodec libavformat)
+# Aravis (GenICam cameras), when the build has it: static users link it too.
+if(ARAVIS_FOUND)
+  list(APPEND _softsight_pc_io aravis-0.8)
+endif()
 set(_softsight_pc_config opencv4 yaml-cpp)
 set(_softsight_pc_pipeline opencv4)
 set(_softsight_libs_core "")
@@ -76,6 +85,9 @@ set(_softsight_libs_calib -lopencv_calib3d -lopencv_imgproc)
 set(_softsight_libs_control -lserial -pthread)
 set(_softsight_libs_io -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lavformat -lavcodec -lavutil
     -pthread)
+if(ARAVIS_FOUND)
+  list(APPEND _softsight_libs_io -laravis-0.8 -lgobject-2.0 -lglib-2.0)
+endif()
 set(_softsight_libs_config -lyaml-cpp -lopencv_imgcodecs)
 set(_softsight_libs_pipeline -lopencv_imgproc)
 set(_softsight_module_text_core "value types, errors, number formatting")

@@ -16,6 +16,7 @@ PACKAGES=(
   libyaml-cpp-dev        # configuration files
   libcli11-dev           # command-line parsing
   libserial-dev          # serial link to the pneumatic board
+  libaravis-dev aravis-tools libusb-1.0-0-dev  # GenICam cameras (--camera aravis:ID); Debian 12's aravis-0.8.pc needs libusb-1.0.pc too
   libzmq3-dev cppzmq-dev nlohmann-json3-dev  # --publish / listen / --target-from: ZeroMQ and its JSON records
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks

@@ -20,6 +20,20 @@ std::string FlagOf(const std::string& key) {
 
 }  // namespace
 
+CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
+                             std::optional<CameraId>* camera, const std::string& help) {
+  CLI::Validator is_camera(
+      [](std::string& text) { return CameraIdProblem(text).value_or(std::string()); }, "");
+  return sub
+      .add_option(name, *camera,
+                  help + ": a V4L2 index (0: /dev/video0), or aravis: for the first GenICam "
+                         "camera (GigE Vision, USB3 Vision) and aravis:DEVICE-ID for a named one "
+                         "(`softsight cameras` lists them; aravis:Fake_1 is Aravis' simulated "
+                         "camera)")
+      ->type_name("N|aravis:ID")
+      ->check(is_camera);
+}
+
 void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
   for (const Option<CameraSettings>& option : CameraSettingsTable()) {
     std::string help = option.doc;
@@ -91,13 +105,13 @@ void PrintCaptureReport(const CameraSettingsReport& report) {
   for (const std::string& line : report.refused) std::cerr << line << "\n";
 }
 
-std::unique_ptr<FrameSource> OpenLiveSource(std::optional<int> camera, const std::string& input,
+std::unique_ptr<FrameSource> OpenLiveSource(std::optional<CameraId> camera, const std::string& input,
                                             const CaptureArgs& capture_args,
                                             const std::string& config_path,
                                             TrackingConfig& config, FrameSourceSpec* spec) {
   const CameraSettings capture =
       MergeCaptureOptions(capture_args, config.capture.value_or(CameraSettings{}));
-  if (!camera && input.empty()) camera = capture.device;
+  if (!camera && input.empty() && capture.device) camera = CameraId(*capture.device);
   if (camera.has_value() == !input.empty()) {
     throw InputError("give exactly one of --camera N or --input VIDEO (or capture.device in " +
                      config_path + ")");
@@ -118,7 +132,9 @@ std::unique_ptr<FrameSource> OpenLiveSource(std::optional<int> camera, const std
     PrintCaptureReport(accepted);
     if (!capture.empty()) {
       config.capture = accepted.accepted;
-      config.capture->device = camera;
+      // capture.device holds a V4L2 index; an Aravis camera is named on the command line.
+      config.capture->device.reset();
+      if (!camera->aravis_device) config.capture->device = camera->index;
     }
   }
   return source;

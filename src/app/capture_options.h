@@ -21,6 +21,12 @@ namespace softsight {
 // The texts given on the command line, by table key.
 using CaptureArgs = std::map<std::string, std::string>;
 
+// A camera option (`--camera`, `--left-camera`): a V4L2 index or aravis:[DEVICE-ID]
+// (softsight/io/camera_settings.h), checked as it is parsed, so a wrong one is one line naming the
+// option. `help` says what the camera is for; the syntax is added to it.
+CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
+                             std::optional<CameraId>* camera, const std::string& help);
+
 // Registers one option per row of the table on `sub`; `args` must outlive parsing.
 void AddCaptureOptions(CLI::App& sub, CaptureArgs* args);
 
@@ -46,7 +52,7 @@ void PrintCaptureReport(const CameraSettingsReport& report);
 // `config` (so every recording's config and a saved one hold it). Frames from a file refuse
 // --camera-* options. `spec` gets what opened the source (a file reopens from it). Throws
 // InputError naming the option, the config or the input.
-std::unique_ptr<FrameSource> OpenLiveSource(std::optional<int> camera, const std::string& input,
+std::unique_ptr<FrameSource> OpenLiveSource(std::optional<CameraId> camera, const std::string& input,
                                             const CaptureArgs& capture_args,
                                             const std::string& config_path,
                                             TrackingConfig& config, FrameSourceSpec* spec);

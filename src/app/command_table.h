@@ -44,7 +44,7 @@ inline constexpr CommandInfo kCommandTable[] = {
     {"live", "Live window on a camera or video: overlay, mouse recalibration, recording", "live"},
     {"serve", "The live bench as a web page: watch, tune, play back and record from a browser",
      "live"},
-    {"cameras", "List the V4L2 cameras with their pixel formats, sizes and frame rates",
+    {"cameras", "List the V4L2 cameras (pixel formats, sizes, frame rates) and GenICam ones",
      "commands"},
     {"control", "Close the loop: bend the actuator to a target angle over the serial link",
      "commands"},

@@ -786,7 +786,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
   sub.add_flag("--simulate", o->simulate,
                "Drive an in-process simulated rig over a real pseudo-terminal, rendering its "
                "frames (simulated time: runs as fast as it can)");
-  sub.add_option("--camera", o->camera, "Camera index for the frames (live)");
+  AddCameraOption(sub, "--camera", &o->camera, "The camera for the frames (live)");
   sub.add_option("--rig-frames", o->rig_frames,
                  "Read frames from the file `softsight rig --frames FILE` keeps rewriting");
   sub.add_option("-i,--input", o->input,

@@ -14,6 +14,7 @@
 #include "control/identify.h"
 #include "control/step_metrics.h"
 #include "softsight/control/session.h"
+#include "softsight/io/camera_settings.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/sim/stereo_scene.h"
 #include "stream/publish_sink.h"
@@ -28,7 +29,7 @@ struct ControlStereoOptions {
   std::optional<std::string> right_config_file;  // The right view's markers when its rois differ.
   // Two live cameras (V4L2 indices), paired by capture time; none with `simulate`, which renders
   // both views of the simulated rig through the simulated pair.
-  std::optional<int> left_camera, right_camera;
+  std::optional<CameraId> left_camera, right_camera;
   // The angle the loop is given: "3d" (default: from the markers verified in both views), or
   // "left" / "right", what that camera alone measures on its image (to compare, not to use).
   std::string angle = "3d";
@@ -50,7 +51,7 @@ struct ControlOptions {
   // Frames: a camera index, a file the rig rewrites (`rig --frames`), or a video / image
   // sequence (replayed through the loop as fast as it decodes, its timestamps the loop's clock).
   // None of them with `simulate`: the simulated rig is rendered.
-  std::optional<int> camera;
+  std::optional<CameraId> camera;
   // The --camera-* options' texts by capture key (app/capture_options.h), over the config's
   // `capture:` section.
   std::map<std::string, std::string> capture_args;

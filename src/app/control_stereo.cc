@@ -34,10 +34,10 @@ std::string SizeText(const cv::Size& size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
-std::unique_ptr<FrameSource> OpenCamera(int index, const ControlOptions& options,
+std::unique_ptr<FrameSource> OpenCamera(const CameraId& camera, const ControlOptions& options,
                                         const TrackingConfig& config) {
   FrameSourceSpec spec;
-  spec.camera = index;
+  spec.camera = camera;
   spec.capture =
       MergeCaptureOptions(options.capture_args, config.capture.value_or(CameraSettings{}));
   CameraSettingsReport accepted;
@@ -235,12 +235,9 @@ void AddControlStereoOptions(CLI::App& sub, ControlStereoOptions* args) {
                  "Two cameras: close the loop on the 3D angle. The pair's calibration from "
                  "`softsight calibrate --left ... --right ...`, or `builtin` with --simulate (the "
                  "simulated pair of docs/stereo.md, the actuator bending out of the image plane)");
-  sub.add_option("--left-camera", args->left_camera,
-                 "With --stereo: the first camera (V4L2 index), paired with the second by capture "
-                 "time")
-      ->check(CLI::NonNegativeNumber);
-  sub.add_option("--right-camera", args->right_camera, "With --stereo: the second camera")
-      ->check(CLI::NonNegativeNumber);
+  AddCameraOption(sub, "--left-camera", &args->left_camera,
+                  "With --stereo: the first camera, paired with the second by capture time");
+  AddCameraOption(sub, "--right-camera", &args->right_camera, "With --stereo: the second camera");
   sub.add_option("--right-config", args->right_config_file,
                  "With --stereo: the right view's marker config, when its colours or rois differ "
                  "(same names)")

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/control_stereo.h"
 #include "app/publish_options.h"
@@ -111,7 +112,7 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   sub.add_option("-p,--port", o->port, "Serial device of the board (/dev/ttyACM0, /dev/pts/N)");
   sub.add_flag("--simulate", o->simulate,
                "The in-process simulated rig, its frames rendered and tracked (simulated time)");
-  sub.add_option("--camera", o->camera, "Camera index for the frames (live)");
+  AddCameraOption(sub, "--camera", &o->camera, "The camera for the frames (live)");
   sub.add_option("--rig-frames", o->rig_frames,
                  "Frames from the file `softsight rig --frames FILE` keeps rewriting");
   sub.add_option("--csv", o->csv_file, "Every frame of the experiment (tracking and board)");

@@ -18,7 +18,7 @@ struct IdentifyCommandOptions {
   std::optional<PublishOptions> publish;
   bool simulate = false;      // The in-process simulated rig, rendered and tracked.
   std::optional<std::string> port;
-  std::optional<int> camera;
+  std::optional<CameraId> camera;
   std::optional<std::string> rig_frames;
   // Two cameras: the experiment measures the 3D angle (control's --stereo; no camera, rig_frames).
   std::optional<ControlStereoOptions> stereo;

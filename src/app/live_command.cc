@@ -20,7 +20,7 @@ namespace softsight {
 namespace {
 
 struct LiveArgs {
-  std::optional<int> camera;
+  std::optional<CameraId> camera;
   std::string input;
   std::string config;
   std::optional<std::string> method;
@@ -121,7 +121,7 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "when the camera opens, read back and printed; `softsight cameras` lists the modes.\n"
       "Needs a display; without one use `softsight track`.\n"
       "Example: softsight live --camera 0 --config markers.yaml");
-  auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
+  auto* camera = AddCameraOption(sub, "--camera", &args->camera, "The camera");
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file or image sequence instead of a camera (played at its "
                                "frame rate)");

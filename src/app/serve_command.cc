@@ -21,7 +21,7 @@ namespace softsight {
 namespace {
 
 struct ServeArgs {
-  std::optional<int> camera;
+  std::optional<CameraId> camera;
   std::string input;
   std::string config;
   std::optional<std::string> method;
@@ -87,7 +87,7 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
       "Several pages may watch; one controls the run at a time, the others are read-only until\n"
       "they take control. Ctrl-C stops the server and prints the run's summary.\n"
       "Example: softsight serve --input synth:bending");
-  auto* camera = sub.add_option("--camera", args->camera, "Camera index (V4L2), e.g. 0");
+  auto* camera = AddCameraOption(sub, "--camera", &args->camera, "The camera");
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file, image sequence or synth:NAME instead of a camera");
   camera->excludes(input);

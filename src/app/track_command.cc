@@ -154,8 +154,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
                  "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
                  "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
                  "synth:plate. Repeat it for several inputs (with -o FOLDER/)");
-  sub.add_option("--camera", options->source.camera,
-                 "Camera index (V4L2) instead of --input: tracks until Ctrl-C or --max-frames")
+  AddCameraOption(sub, "--camera", &options->source.camera,
+                  "The camera instead of --input: tracks until Ctrl-C or --max-frames")
       ->excludes(input);
   sub.add_option("-o,--output,--csv", options->csv_file,
                  "Where to write the per-frame CSV; a folder (an existing one, or a path ending "

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/cli_checks.h"
+#include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/publish_options.h"
 #include "app/stop_request.h"
@@ -525,12 +526,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
   sub.add_option("--side-by-side", options->side_by_side,
                  "Instead of --left/--right: one video, the first camera in the left half of each "
                  "frame, the second in the right half");
-  sub.add_option("--left-camera", options->left_camera,
-                 "Instead of --left/--right: two live cameras (V4L2 indices), paired by capture "
-                 "time")
-      ->check(CLI::NonNegativeNumber);
-  sub.add_option("--right-camera", options->right_camera, "The second live camera")
-      ->check(CLI::NonNegativeNumber);
+  AddCameraOption(sub, "--left-camera", &options->left_camera,
+                  "Instead of --left/--right: two live cameras, paired by capture time");
+  AddCameraOption(sub, "--right-camera", &options->right_camera, "The second live camera");
   sub.add_option("--stereo", options->stereo_file,
                  "The rig from `softsight calibrate --left ... --right ...`")
       ->required();

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/commands.h"
+#include "softsight/io/camera_settings.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
@@ -34,7 +35,7 @@ struct TrackStereoOptions {
   std::optional<std::string> side_by_side;
   // Instead of left_input and right_input: two live cameras (V4L2 indices), paired by the time
   // each frame was captured.
-  std::optional<int> left_camera, right_camera;
+  std::optional<CameraId> left_camera, right_camera;
   std::string stereo_file;                       // From `calibrate --left --right`.
   std::string csv_file;
   // Pairing by index: the right view's frame paired with left frame i is i + frame_offset (the

@@ -3,6 +3,8 @@
 // the OpenCV capture as a CaptureBackend.
 #pragma once
 
+#include <string>
+
 #include <opencv2/videoio.hpp>
 
 #include "core/option_table.h"
@@ -11,6 +13,9 @@
 namespace softsight {
 
 const OptionTable<CameraSettings>& CameraSettingsTable();
+
+// The pixel format's name in the table ("MJPG", "Bayer8").
+std::string PixelFormatName(CameraSettings::PixelFormat format);
 
 class OpenCvCaptureBackend : public CaptureBackend {
  public:

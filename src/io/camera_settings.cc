@@ -13,9 +13,12 @@
 #include <opencv2/videoio.hpp>
 
 #include "io/camera_options.h"
+#include "softsight/core/error.h"
 
 namespace softsight {
 namespace {
+
+constexpr char kAravisPrefix[] = "aravis:";
 
 using PixelFormat = CameraSettings::PixelFormat;
 
@@ -80,16 +83,23 @@ OptionTable<CameraSettings> MakeTable() {
                     std::vector<std::pair<std::string, PixelFormat>>{
                         {"any", PixelFormat::kAny},
                         {"MJPG", PixelFormat::kMjpg},
-                        {"YUYV", PixelFormat::kYuyv}})
-          .Doc("MJPG (compressed: high rates at high resolution) or YUYV (raw, no JPEG "
-               "artefacts in the colours); any: the camera's choice"),
+                        {"YUYV", PixelFormat::kYuyv},
+                        {"Mono8", PixelFormat::kMono8},
+                        {"RGB8", PixelFormat::kRgb8},
+                        {"Bayer8", PixelFormat::kBayer8}})
+          .Doc("V4L2: MJPG (compressed: high rates at high resolution) or YUYV (raw, no JPEG "
+               "artefacts in the colours); Aravis: Mono8, RGB8 or Bayer8 (the sensor's 8-bit "
+               "Bayer layout, demosaiced here); any: the camera's choice (Aravis: a colour one "
+               "it has)"),
       DoubleOption<P>("exposure", &P::exposure)
           .Range(-100000, 100000)
-          .Doc("manual exposure in the driver's units (V4L2: often 100 us steps); given, "
-               "auto exposure is off, so the colours do not drift with the scene"),
+          .Doc("manual exposure in the driver's units (V4L2: often 100 us steps; Aravis: "
+               "ExposureTime in us); given, auto exposure is off, so the colours do not drift "
+               "with the scene"),
       DoubleOption<P>("gain", &P::gain)
           .Range(-100000, 100000)
-          .Doc("manual gain in the driver's units; given, automatic gain is off"),
+          .Doc("manual gain in the driver's units (Aravis: Gain, usually dB); given, automatic "
+               "gain is off"),
       DoubleOption<P>("white_balance", &P::white_balance_k)
           .Range(1000, 20000)
           .Unit("K")
@@ -98,6 +108,10 @@ OptionTable<CameraSettings> MakeTable() {
       DoubleOption<P>("focus", &P::focus)
           .Range(-100000, 100000)
           .Doc("manual focus in the driver's units; given, autofocus is off"),
+      StringOption<P>("trigger", &P::trigger)
+          .Doc("Aravis cameras: off (free running at fps), or the TriggerSource that starts "
+               "each frame: Line0, Line1... (a hardware trigger) or Software (each frame "
+               "triggered as it is read); not given: the camera's own setting"),
   };
 }
 
@@ -117,6 +131,18 @@ const OptionTable<CameraSettings>& CameraSettingsTable() {
   return table;
 }
 
+std::string PixelFormatName(CameraSettings::PixelFormat format) {
+  const std::optional<OptionValue> name = [&] {
+    CameraSettings settings;
+    settings.pixel_format = format;
+    for (const Option<CameraSettings>& option : CameraSettingsTable()) {
+      if (option.key == "pixel_format") return option.get(settings);
+    }
+    return std::optional<OptionValue>();
+  }();
+  return name ? std::get<std::string>(*name) : "?";
+}
+
 bool CameraSettings::Check(std::string* error) const {
   if (const auto problem = CheckOptions(CameraSettingsTable(), *this)) return Fail(error, *problem);
   return true;
@@ -124,7 +150,39 @@ bool CameraSettings::Check(std::string* error) const {
 
 bool CameraSettings::empty() const {
   return !width && !height && !fps && pixel_format == PixelFormat::kAny && !exposure && !gain &&
-         !white_balance_k && !focus;
+         !white_balance_k && !focus && trigger.empty();
+}
+
+std::optional<std::string> CameraIdProblem(const std::string& text) {
+  if (text.rfind(kAravisPrefix, 0) == 0) {
+    for (const char c : text) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        return "'" + text + "': a device id has no control characters";
+      }
+    }
+    return std::nullopt;
+  }
+  const bool digits = !text.empty() && text.size() <= 2 &&
+                      std::all_of(text.begin(), text.end(),
+                                  [](char c) { return c >= '0' && c <= '9'; });
+  if (digits && std::stoi(text) <= 63) return std::nullopt;
+  return "'" + text + "' is no camera: give a V4L2 index (0..63, as `softsight cameras` lists "
+         "them), or aravis: (the first GenICam camera) or aravis:DEVICE-ID";
+}
+
+CameraId::CameraId(const std::string& text) {
+  if (const std::optional<std::string> problem = CameraIdProblem(text)) {
+    throw InputError("--camera " + *problem);
+  }
+  if (text.rfind(kAravisPrefix, 0) == 0) {
+    aravis_device = text.substr(std::string(kAravisPrefix).size());
+  } else {
+    index = std::stoi(text);
+  }
+}
+
+std::string CameraId::text() const {
+  return aravis_device ? kAravisPrefix + *aravis_device : std::to_string(index);
 }
 
 CameraSettingsReport ApplyCameraSettings(CaptureBackend& backend, const CameraSettings& settings,
@@ -149,7 +207,22 @@ CameraSettingsReport ApplyCameraSettings(CaptureBackend& backend, const CameraSe
   };
   // V4L2 switches a mode with these values (OpenCV's V4L2 backend passes them through).
   constexpr double kManualExposure = 1.0, kOff = 0.0;
-  if (settings.pixel_format != PixelFormat::kAny) {
+  const bool genicam_format = settings.pixel_format == PixelFormat::kMono8 ||
+                              settings.pixel_format == PixelFormat::kRgb8 ||
+                              settings.pixel_format == PixelFormat::kBayer8;
+  if (genicam_format) {
+    // A GenICam format asked of a V4L2 camera (a config written for an Aravis camera).
+    report.refused.push_back(camera_name + ": pixel_format " + PixelFormatName(settings.pixel_format) +
+                             " refused (a GenICam format, for aravis: cameras), kept " +
+                             FourccText(backend.get(cv::CAP_PROP_FOURCC)));
+    report.accepted.pixel_format = PixelFormat::kAny;
+  }
+  if (!settings.trigger.empty()) {
+    report.refused.push_back(camera_name + ": trigger " + settings.trigger +
+                             " refused (V4L2 cameras have no trigger; aravis: cameras do)");
+    report.accepted.trigger.clear();
+  }
+  if (settings.pixel_format != PixelFormat::kAny && !genicam_format) {
     const char* code = settings.pixel_format == PixelFormat::kMjpg ? "MJPG" : "YUYV";
     const double fourcc = cv::VideoWriter::fourcc(code[0], code[1], code[2], code[3]);
     const bool took = backend.set(cv::CAP_PROP_FOURCC, fourcc);

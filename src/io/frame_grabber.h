@@ -84,6 +84,9 @@ class NewestFrameSource : public FrameSource {
   std::optional<double> fps() const override { return grabber_.source().fps(); }
   bool is_live() const override { return true; }
   int64_t dropped_frames() const override { return grabber_.dropped_count(); }
+  // The camera's own (what it accepted of its settings, frames it lost): the run's summary
+  // prints it. Sources make note() safe to call while their read() runs in the grabber thread.
+  std::optional<std::string> note() const override { return grabber_.source().note(); }
 
  private:
   FrameGrabber grabber_;

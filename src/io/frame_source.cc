@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "io/aravis_camera.h"
 #include "io/camera_options.h"
 #include "io/damaged_band.h"
 #include "io/decode_probe.h"
@@ -582,8 +583,11 @@ bool IsGrayscale(const cv::Mat& frame_bgr) {
 }
 
 std::unique_ptr<FrameSource> OpenFrameSource(const FrameSourceSpec& spec) {
+  if (spec.camera && spec.camera->aravis_device) {
+    return OpenAravisCamera(*spec.camera, spec.capture, spec.capture_report);
+  }
   if (spec.camera) {
-    return std::make_unique<CameraSource>(*spec.camera, spec.capture, spec.capture_report);
+    return std::make_unique<CameraSource>(spec.camera->index, spec.capture, spec.capture_report);
   }
   const std::string& input = spec.input;
   if (input.empty()) {

@@ -1,5 +1,6 @@
 // Where frames come from: a video file (anything FFmpeg reads), an image sequence (a folder or a
-// printf pattern), a camera (V4L2 index), or the synthetic renderer. Timestamps come from the source.
+// printf pattern), a camera (V4L2 index, or GenICam through Aravis), or the synthetic renderer.
+// Timestamps come from the source.
 #pragma once
 
 #include <cstdint>
@@ -76,7 +77,7 @@ struct FrameSourceSpec {
   // pattern such as "frames/%04d.png" (one %d or %0Nd; rows carry each file's number), or a
   // synthetic scene ("synth:bending").
   std::string input{};
-  std::optional<int> camera{};         // V4L2 camera index (live).
+  std::optional<CameraId> camera{};    // A camera (live): V4L2 index or Aravis device.
   // Frame rate for image sequences, whose files carry no timestamps (frames per second).
   double sequence_fps = 30.0;
   // The camera's capture settings (config `capture:` and --camera-* options), applied when it
