@@ -80,7 +80,8 @@ int RunServeCommand(ServeArgs args) {
           ? SimulatedRigCamera(*rig, args.rig.fps)
           : OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
-  if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
+  // A file can be opened again to seek in it; the simulated rig's frames cannot (nor a camera's).
+  if (!source->is_live() && !args.rig.simulate) reopen = [spec] { return OpenFrameSource(spec); };
   StopRequest stop;
   LiveRunResult run = RunServe(config, std::move(source), options, reopen,
                                [&stop] { return stop.requested(); }, std::cout);

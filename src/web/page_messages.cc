@@ -252,10 +252,12 @@ std::optional<PageCommand> ParsePageCommand(std::string_view text, const PageLim
     *error = type + ": no rig here (serve --simulate, or --board-port with a board)";
     return std::nullopt;
   }
-  if (info->kind == Kind::kPause && limits.rig) {
+  if ((info->kind == Kind::kPause || info->kind == Kind::kStep || info->kind == Kind::kSeek) &&
+      limits.rig) {
     // A paused run tracks no frame, and the loop steps on every frame: the board's watchdog
-    // would vent it behind the page's back. STOP is the way to vent.
-    *error = "pause: the rig's loop runs on every frame (STOP vents the actuator)";
+    // would vent it behind the page's back; a seek would turn its clock back. STOP is the way
+    // to vent.
+    *error = type + ": the rig's loop runs on every frame, as it comes (STOP vents the actuator)";
     return std::nullopt;
   }
   PageCommand command;

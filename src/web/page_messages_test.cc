@@ -167,6 +167,11 @@ TEST(PageMessagesTest, HostileRigMessagesAreRefusedNamingWhy) {
 
 TEST(PageMessagesTest, WithARigPauseIsRefusedTheLoopNeedsEveryFrame) {
   EXPECT_NE(Refusal(R"({"type":"pause"})", RigLimits()).find("STOP"), std::string::npos);
+  PageLimits seekable_rig = RigLimits();  // Even were its frames a file's.
+  seekable_rig.seekable = true;
+  seekable_rig.length = 300;
+  Refusal(R"({"type":"seek","position":3})", seekable_rig);
+  Refusal(R"({"type":"step","delta":-1})", seekable_rig);
   Parse(R"({"type":"play"})", RigLimits());
 }
 

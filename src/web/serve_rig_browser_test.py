@@ -41,7 +41,8 @@ def test_refusals(page):
     errors = page.state("window.softsight.errors.length")
     bad = ['{"type":"rig_run","target_deg":500}', '{"type":"rig_run","target_deg":"x"}',
            '{"type":"rig_run"}', '{"type":"rig_profile","text":"step 999\\n"}',
-           '{"type":"rig_profile","text":"' + "#" * 5000 + '"}', '{"type":"pause"}']
+           '{"type":"rig_profile","text":"' + "#" * 5000 + '"}', '{"type":"pause"}',
+           '{"type":"step","delta":1}', '{"type":"seek","position":0}']
     for text in bad:
         page.state("window.softsight.sendRaw(%s)" % json.dumps(text))
     wait(page, "an error for each refused message",

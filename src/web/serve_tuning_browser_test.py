@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""softsight serve's tuning in a real headless browser (chromium + chromium-driver through
+"""softsight serve's tuning and analysis tools in a real headless browser (chromium + chromium-driver through
 python3-selenium), on a rendered actuator (`--input synth:bending`, its own config): the mask
 view shows the active marker's pixels and each candidate blob's verdict; an HSV slider moved
 with the keyboard changes the range (and loses the marker), undo takes it back; a config saved
 under a name is listed and loaded back; names that leave the folder, or are not there, are
-refused with an error and change nothing.
+refused with an error and change nothing; the angle and distance tools measure what the
+tracker's own columns say, and a click on a trail seeks to that frame.
 
 Every wait is selenium's WebDriverWait on a condition of the page's state (window.softsight).
 Exit code 77 (ctest: skipped) when chromium, its driver or selenium is missing.
@@ -22,6 +23,48 @@ from serve_browser_test import (Page, browser_test_main, check, start_serve, sto
                                 webdriver_wait)
 
 wait = webdriver_wait
+
+
+def test_analysis(page, screenshot=None):
+    """An angle on red, blue and green clicked on the picture is the row's angle; a distance from
+    red to green is its chord in mm; both are plot lanes and CSV columns. With the trails shown, a
+    click on green's path where it was in another frame seeks there."""
+    # Played on into the bend (a trail to click, an angle well off straight), then paused.
+    page.click_button("play")
+    wait(page, "the bend", "window.softsight.status.position >= 110")
+    page.click_button("play")
+    wait(page, "the pause", "window.softsight.status.paused && "
+         "window.softsight.shownPosition === window.softsight.status.position && "
+         "window.softsight.row(window.softsight.shownFrame) !== null")
+    frame = page.state("window.softsight.shownFrame")
+    row = page.state("window.softsight.row(%d)" % frame)
+    for tool, names in (("toolangle", ("red", "blue", "green")), ("tooldistance", ("red", "green"))):
+        page.click_button(tool)
+        for name in names:
+            page.click_image_point(row[name + "_x"], row[name + "_y"])
+    wait(page, "two tools", "window.softsight.tools.length === 2")
+    angle = page.state("window.softsight.toolValue(0, %d)" % frame)
+    distance = page.state("window.softsight.toolValue(1, %d)" % frame)
+    check(abs(angle - row["angle_deg"]) < 0.01, "the angle tool: %s, the row's angle %s" % (angle, row["angle_deg"]))
+    check(abs(distance - row["chord_mm"]) < 0.005 * row["chord_mm"],
+          "the distance tool: %s mm, the row's chord %s mm" % (distance, row["chord_mm"]))
+    header = page.state("window.softsight.csvText()").splitlines()[0].split(",")
+    check(header[-2:] == ["angle_red_blue_green_deg", "distance_red_green_mm"], "the CSV's last columns: %s" % header[-3:])
+    check(len(page.state("window.softsight.toolLanes()")) == 2, "the tools are not plotted")
+    page.click_button("trails")
+    wait(page, "the trails drawn", "window.softsight.trailPoints > 10")
+    if screenshot:
+        page.driver.save_screenshot(screenshot)
+    # Where green was farthest from where it is now: a click there seeks to that frame.
+    rows = page.state("window.softsight.rowsIn().filter(r => r.green_found === 1 && r._position >= 0)")
+    far = max(rows, key=lambda r: (r["green_x"] - row["green_x"]) ** 2 + (r["green_y"] - row["green_y"]) ** 2)
+    page.click_image_point(far["green_x"], far["green_y"])
+    wait(page, "the seek from the trail", "window.softsight.shownPosition !== %d && "
+         "window.softsight.row(window.softsight.shownFrame) !== null" % row["_position"])
+    landed = page.state("window.softsight.row(window.softsight.shownFrame)")
+    check(((landed["green_x"] - far["green_x"]) ** 2 + (landed["green_y"] - far["green_y"]) ** 2) ** 0.5 < 6,
+          "the trail click landed on frame %d, green at (%.1f, %.1f), not near (%.1f, %.1f)" % (
+              landed["frame"], landed["green_x"], landed["green_y"], far["green_x"], far["green_y"]))
 
 
 def run(args, browser, driver):
@@ -83,6 +126,12 @@ def run(args, browser, driver):
         wait(page, "the loaded ranges", "window.softsight.status.hsv[2] === 255")
         page.click_button("maskview")
         wait(page, "the mask view off", "!window.softsight.status.mask_view && !window.softsight.shownMask")
+        # And the scene's own config back: red found again.
+        Select(page.driver.find_element("id", "configs")).select_by_value("synth-bending.yaml")
+        page.click_button("load")
+        wait(page, "the scene's ranges back", "window.softsight.status.hsv[2] !== 255 && "
+             "window.softsight.row(window.softsight.shownFrame).red_found === 1")
+        test_analysis(page, args.screenshot and args.screenshot.replace(".png", "-analysis.png"))
     except Exception:
         if page:
             print("messages: %s\nerrors: %s" % (page.state("window.softsight.messages.slice(-8)"),

@@ -245,6 +245,7 @@ function drawView() {
   const row = rows.get(imageFrame);
   if (S.shownMask) drawCandidates(ctx);
   else if (row && S.hello) drawOverlay(ctx, row);
+  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS);
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
@@ -361,6 +362,8 @@ window.addEventListener('mouseup', () => {
   const clamp = (v, hi) => Math.min(Math.max(v, 0), hi);
   if (!d.moved) {
     const [x, y] = toImage(d.x0, d.y0);
+    // A point of an analysis tool, or a click on a trail (analysis.js), before a colour pick.
+    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), scale)) { drawView(); schedulePlot(); return; }
     send({type: 'pick', x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)});
     return;
   }
@@ -401,8 +404,10 @@ S.csvText = () => {
   const frames = [...rows.keys()].sort((a, b) => a - b);
   if (!frames.length) return '';
   const columns = Object.keys(rows.get(frames[0])).filter((c) => c !== '_position');
+  const tools = S.toolColumns ? S.toolColumns() : [];  // The analysis tools' values after them.
   const field = (v) => (v === null || v === undefined ? '' : String(v));
-  return [columns.join(',')].concat(frames.map((f) => columns.map((c) => field(rows.get(f)[c])).join(','))).join('\n') + '\n';
+  const line = (row) => columns.map((c) => field(row[c])).concat(tools.map(([, value]) => field(value(row)))).join(',');
+  return [columns.concat(tools.map(([name]) => name)).join(',')].concat(frames.map((f) => line(rows.get(f)))).join('\n') + '\n';
 };
 $('csv').onclick = () => download('softsight-page.csv', new Blob([S.csvText()], {type: 'text/csv'}));
 
@@ -469,6 +474,7 @@ function schedulePlot() {
 
 function series(row, key) {
   if (key === 'angle_deg') return row.angle_deg;
+  if (key.startsWith('tool:')) return S.toolSeries(key, row);
   const mm = row[key + '_mm'];
   return mm !== undefined ? mm : row[key + '_px'];
 }
@@ -485,14 +491,16 @@ function drawPlot() {
   const whole = length() > 1 && S.hello.fps > 0;
   const t0 = whole ? 0 : times[0];
   const t1 = whole ? (length() - 1) / S.hello.fps : Math.max(times[times.length - 1], t0 + 1e-3);
-  const laneH = h / PLOTS.length;
+  const lanes = PLOTS.concat(S.toolLanes ? S.toolLanes() : []);  // An analysis tool's lane each.
+  const laneH = h / lanes.length;
   const x = (t) => 40 + (t - t0) / (t1 - t0) * (w - 50);
-  PLOTS.forEach(([key, label], lane) => {
+  lanes.forEach(([key, label], lane) => {
     const values = sortedFrames.map((f) => series(rows.get(f), key));
     const finite = values.filter((v) => v !== null && v !== undefined);
     const top = lane * laneH;
     ctx.fillStyle = '#aaa'; ctx.font = '11px sans-serif';
-    ctx.fillText(label + (key !== 'angle_deg' && S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
+    const own = key === 'angle_deg' || key.startsWith('tool:');  // Their labels carry the unit.
+    ctx.fillText(label + (own ? '' : S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
     ctx.strokeStyle = '#333'; ctx.strokeRect(40, top + 2, w - 50, laneH - 4);
     if (!finite.length) return;
     // The 2nd to 98th percentile: a near-straight actuator's radius (tens of thousands of px
@@ -542,6 +550,14 @@ S.sendRaw = (text) => ws.send(text);
 S.send = send;
 S.log = log;
 S.row = (frame) => rows.get(frame) || null;
+// Every row received, in frame order (analysis.js: trails, the run's scale).
+let rowsInOrder = null;  // Rebuilt only when a row came since (sortedFrames reset).
+S.rowsIn = () => {
+  if (!sortedFrames) { sortedFrames = [...rows.keys()].sort((a, b) => a - b); rowsInOrder = null; }
+  if (!rowsInOrder || rowsInOrder.length !== sortedFrames.length) rowsInOrder = sortedFrames.map((f) => rows.get(f));
+  return rowsInOrder;
+};
+S.redraw = () => { drawView(); schedulePlot(); };
 
 window.addEventListener('resize', () => { drawView(); drawTimeline(); schedulePlot(); });
 connect();
