@@ -7,11 +7,12 @@
 # interpreter), no public-header compile check (the plain build has it; it finds nothing at run
 # time). No -Werror: the plain build (scripts/test.sh) holds warnings at zero.
 # The tests built instrumented: the modules that take outside input (configs, videos, CSVs, board
-# answers, the stream) or hold the trackers' and the session's pixel arithmetic. The commands'
+# answers, the stream, a web page's messages) or hold the trackers' and the session's pixel
+# arithmetic (web: its C++ tests; its browser tests stay in the plain tree, src/web/CMakeLists.txt). The commands'
 # end-to-end tests are not rebuilt: scripts/test-sanitize.sh runs the plain tree's against the
 # instrumented program. The renderer, calibration, geometry and the live window run instrumented
 # inside the program and the tests above, and plainly in scripts/test.sh.
-SANITIZE_TEST_MODULES="core;config;io;control;stream;track;pipeline;firmware"
+SANITIZE_TEST_MODULES="core;config;io;control;stream;track;pipeline;firmware;web"
 ConfigureSanitizeTree() {
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)

@@ -9,6 +9,7 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/scene_config.h"
+#include "app/serve_rig.h"
 #include "app/stop_request.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
@@ -32,17 +33,29 @@ struct ServeArgs {
   int jpeg_quality = 80;
   bool no_pace = false;
   CaptureArgs capture;
+  ServeRigArgs rig;
 };
 
 int RunServeCommand(ServeArgs args) {
   // A rendered scene brings the config a person would write for it: `serve --input
   // synth:bending` alone opens a page with markers to watch and tune.
-  if (args.config.empty()) args.config = ConfigForBuiltinInput(args.input, args.folder);
-  TrackingConfig config = LoadTrackingConfig(args.config, args.method);
   std::error_code error;
   if (!std::filesystem::is_directory(args.folder, error)) {
     throw InputError("--folder " + args.folder + " is not a folder");
   }
+  // The rig's loop steps on every frame, on the frames' clock: frames that come live and in
+  // order (the simulated rig's own camera, or a camera), never a file that pauses or seeks.
+  if (args.rig.simulate && (args.camera || !args.input.empty())) {
+    throw InputError("serve --simulate renders the simulated rig's own frames: no --camera or --input");
+  }
+  if (args.rig.board_port && !args.camera) {
+    throw InputError("serve --board-port needs --camera: the loop runs on live frames");
+  }
+  if (args.config.empty()) {
+    args.config = args.rig.simulate ? ConfigForSimulatedRig(args.folder, args.rig.fps)
+                                    : ConfigForBuiltinInput(args.input, args.folder);
+  }
+  TrackingConfig config = LoadTrackingConfig(args.config, args.method);
   ServeOptions options;
   options.folder = std::filesystem::canonical(args.folder);
   options.config_path = args.config;
@@ -56,11 +69,19 @@ int RunServeCommand(ServeArgs args) {
   if (!IsLoopbackAddress(args.bind)) options.server.token = NewAccessToken();
   if (std::string problem; !options.live.Check(&problem)) throw InputError(problem);
 
+  std::unique_ptr<ServeRig> rig;
+  if (args.rig.simulate || args.rig.board_port) {
+    rig = OpenServeRig(args.rig, config, std::cout);
+    options.rig = rig->panel.get();
+  }
   FrameSourceSpec spec;
   std::unique_ptr<FrameSource> source =
-      OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
+      args.rig.simulate
+          ? SimulatedRigCamera(*rig, args.rig.fps)
+          : OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
-  if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
+  // A file can be opened again to seek in it; the simulated rig's frames cannot (nor a camera's).
+  if (!source->is_live() && !args.rig.simulate) reopen = [spec] { return OpenFrameSource(spec); };
   StopRequest stop;
   LiveRunResult run = RunServe(config, std::move(source), options, reopen,
                                [&stop] { return stop.requested(); }, std::cout);
@@ -86,7 +107,12 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
       "switch method, undo (saying what it undid), record, and save the config into --folder.\n"
       "Several pages may watch; one controls the run at a time, the others are read-only until\n"
       "they take control. Ctrl-C stops the server and prints the run's summary.\n"
-      "Example: softsight serve --input synth:bending");
+      "With a rig (--simulate, or --board-port with --camera) the page has a control\n"
+      "panel: a target angle or a profile, run and STOP (any page; it vents at once), the\n"
+      "pressure and angle traces, the board's state and the limits. A page that leaves\n"
+      "mid-run leaves the rig safe: its last pressure held for hold_s, then vented.\n"
+      "Examples: softsight serve --input synth:bending\n"
+      "          softsight serve --simulate");
   auto* camera = AddCameraOption(sub, "--camera", &args->camera, "The camera");
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file, image sequence or synth:NAME instead of a camera");
@@ -112,6 +138,19 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
       ->capture_default_str();
   sub.add_flag("--no-pace", args->no_pace,
                "Read a video file as fast as it decodes instead of at its frame rate");
+  auto* simulate = sub.add_flag(
+      "--simulate", args->rig.simulate,
+      "Serve the simulated rig (a board on a pseudo-terminal and its actuator, rendered in "
+      "lock-step with the loop at 30 fps, paced to the wall clock): the page's control panel "
+      "drives it; the config's `control:` section "
+      "applies, and without --config <folder>/rig-simulated.yaml is written and used");
+  auto* board = sub.add_option("--board-port", args->rig.board_port,
+                               "Serial device of a board to control from the page (with "
+                               "--camera): /dev/ttyACM0, or the /dev/pts/N `softsight rig "
+                               "--pty` prints");
+  simulate->excludes(board);
+  simulate->excludes(camera);
+  simulate->excludes(input);
   AddCaptureOptions(sub, &args->capture);
   return [args] { return RunServeCommand(*args); };
 }

@@ -588,6 +588,40 @@ void LiveController::save_config_to(const std::string& path) {
   }
 }
 
+void LiveController::load_markers_from(const std::string& path) {
+  TrackingConfig loaded;
+  try {
+    loaded = LoadTrackingConfig(path);
+  } catch (const InputError& e) {
+    say(std::string("load: ") + e.what());
+    return;
+  }
+  // Every marker must be there by name, and no other: the run's markers (its CSV's columns,
+  // its base-middle-tip triple) stay what they are.
+  const std::vector<MarkerSpec>& markers = config().markers;
+  std::vector<const MarkerSpec*> specs;
+  for (const MarkerSpec& marker : markers) {
+    const auto found = std::find_if(loaded.markers.begin(), loaded.markers.end(),
+                                    [&](const MarkerSpec& m) { return m.name == marker.name; });
+    if (found == loaded.markers.end() || loaded.markers.size() != markers.size()) {
+      say("load: " + path + " has other markers than this run (" + std::to_string(loaded.markers.size()) +
+          ", " + (found == loaded.markers.end() ? "no " + marker.name : std::string("not the same names")) +
+          "); nothing changed");
+      return;
+    }
+    specs.push_back(&*found);
+  }
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const int marker = static_cast<int>(i);
+    remember_for_undo(marker, "load of " + path);
+    const auto aside = loaded.params_aside.find(specs[i]->name);
+    aside_[i] = aside != loaded.params_aside.end() ? aside->second : std::vector<MarkerParams>{};
+    apply_spec(marker, *specs[i], std::nullopt);
+  }
+  ++hsv_revision_;
+  say("loaded " + path + ": " + std::to_string(specs.size()) + " markers (u undoes them one by one)");
+}
+
 void LiveController::start_scale() {
   if (recording() && options_.scale_distance_mm) {
     // The CSV's columns (with or without _mm) are fixed when a recording starts.
@@ -907,6 +941,10 @@ std::vector<std::string> LiveController::status_lines() const {
   // The hint stays while picking, whatever other keys say meanwhile.
   if (scale_.active() && message_ != scale_.hint()) lines.push_back(scale_.hint());
   return lines;
+}
+
+const Tracker& LiveController::active_tracker() const {
+  return pipeline_->session().tracker(active_);
 }
 
 const cv::Mat& LiveController::canvas() {

@@ -154,6 +154,11 @@ class LiveController {
   void set_speed(double speed);
   // Saves the config as `s` does, to `path` instead of the window's save path.
   void save_config_to(const std::string& path);
+  // Loads the markers' parameters of the config at `path` (one saved by save_config_to, or any
+  // config of the same markers): each marker takes the loaded marker of its name, its other
+  // kinds' parameters too; `u` undoes it marker by marker. Refused, with a message and nothing
+  // changed, when the file does not load or its markers are not these (by name).
+  void load_markers_from(const std::string& path);
   // The frame on screen as captured (empty before the first), and its position in the file
   // (-1 for a camera).
   const cv::Mat& frame_on_screen() const { return frame_; }
@@ -181,6 +186,9 @@ class LiveController {
   // Mask view (`v`): the active marker's member pixels, its candidate blobs with the verdict on
   // each, and its search region, instead of the annotated frame.
   bool mask_view() const { return mask_view_; }
+  // The active marker's tracker: what the mask view shows (its member pixels, its candidates
+  // with their verdicts, its search region), for an adapter that draws it itself (src/web).
+  const Tracker& active_tracker() const;
   // Scale mode (`c`): the next left clicks are the two scale points.
   bool scale_mode() const { return scale_.active(); }
   int active_marker() const { return active_; }

@@ -30,6 +30,12 @@ const std::vector<TypeInfo>& Types() {
       {"marker", Kind::kMarker, {"index"}}, {"save", Kind::kSave, {"name"}},
       {"record", Kind::kRecord, {}},       {"reset_reference", Kind::kResetReference, {}},
       {"ping", Kind::kPing, {"t"}},        {"take_control", Kind::kTakeControl, {}},
+      {"rig_run", Kind::kRigRun, {"target_deg"}},
+      {"rig_profile", Kind::kRigProfile, {"text"}},
+      {"rig_stop", Kind::kRigStop, {}},
+      {"hsv", Kind::kHsv, {"index", "value"}},
+      {"mask_view", Kind::kMaskView, {"on"}},
+      {"load", Kind::kLoad, {"name"}},     {"list_configs", Kind::kListConfigs, {}},
   };
   return kTypes;
 }
@@ -126,14 +132,51 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
       c->marker = static_cast<int>(integer);
       return true;
     case Kind::kSave:
+    case Kind::kLoad:
       if (!m.at("name").is_string()) {
-        *error = "save: name must be a string";
+        *error = std::string(type) + ": name must be a string";
         return false;
       }
       c->name = m.at("name").get<std::string>();
-      return ValidConfigName(c->name, error);
+      if (!ValidConfigName(c->name, error)) {
+        if (info.kind == Kind::kLoad) error->replace(0, 4, "load");  // "save: ..." -> "load: ...".
+        return false;
+      }
+      return true;
     case Kind::kPing:
       return Number(m, type, "t", 0, 1e15, &c->page_time_ms, error);
+    case Kind::kRigRun:
+      return Number(m, type, "target_deg", 0, 180, &c->target_deg, error);
+    case Kind::kHsv: {
+      // Hue is OpenCV's 0..179; a hue range with lo above hi wraps through red (170..10), as
+      // in a config: both ends are free within 0..179.
+      if (!Integer(m, type, "index", 0, 5, &integer, error)) return false;
+      c->hsv_index = static_cast<int>(integer);
+      if (!Integer(m, type, "value", 0, c->hsv_index < 2 ? 179 : 255, &integer, error)) return false;
+      c->hsv_value = static_cast<int>(integer);
+      return true;
+    }
+    case Kind::kMaskView:
+      if (!m.at("on").is_boolean()) {
+        *error = "mask_view: on must be true or false";
+        return false;
+      }
+      c->on = m.at("on").get<bool>();
+      return true;
+    case Kind::kRigProfile:
+      if (!m.at("text").is_string()) {
+        *error = "rig_profile: text must be a string";
+        return false;
+      }
+      try {
+        // The profile file's own checks (its bounds, every angle in 0..180): a page's profile is
+        // no less checked than a file given to `control --profile`.
+        c->profile = TargetProfile::Parse(m.at("text").get<std::string>(), "rig_profile");
+      } catch (const std::exception& refused) {
+        *error = refused.what();
+        return false;
+      }
+      return true;
     default:
       return true;
   }
@@ -142,7 +185,8 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
 }  // namespace
 
 bool ChangesTheRun(PageCommand::Kind kind) {
-  return kind != Kind::kPing && kind != Kind::kTakeControl;
+  return kind != Kind::kPing && kind != Kind::kTakeControl && kind != Kind::kRigStop &&
+         kind != Kind::kListConfigs;
 }
 
 bool ValidConfigName(std::string_view name, std::string* error) {
@@ -200,6 +244,20 @@ std::optional<PageCommand> ParsePageCommand(std::string_view text, const PageLim
   }
   if ((info->kind == Kind::kStep || info->kind == Kind::kSeek) && !limits.seekable) {
     *error = type + ": a camera plays as it comes (no stepping or seeking)";
+    return std::nullopt;
+  }
+  const bool for_rig =
+      info->kind == Kind::kRigRun || info->kind == Kind::kRigProfile || info->kind == Kind::kRigStop;
+  if (for_rig && !limits.rig) {
+    *error = type + ": no rig here (serve --simulate, or --board-port with a board)";
+    return std::nullopt;
+  }
+  if ((info->kind == Kind::kPause || info->kind == Kind::kStep || info->kind == Kind::kSeek) &&
+      limits.rig) {
+    // A paused run tracks no frame, and the loop steps on every frame: the board's watchdog
+    // would vent it behind the page's back; a seek would turn its clock back. STOP is the way
+    // to vent.
+    *error = type + ": the rig's loop runs on every frame, as it comes (STOP vents the actuator)";
     return std::nullopt;
   }
   PageCommand command;

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "softsight/control/profile.h"
+
 namespace softsight {
 
 // Larger messages are refused unread (a page never needs more than a few hundred bytes).
@@ -23,6 +25,7 @@ struct PageLimits {
   std::optional<int64_t> length;       // Frames in the file, when known.
   bool seekable = false;               // A file (a camera cannot step or seek).
   int markers = 0;                     // In the config.
+  bool rig = false;                    // A rig to control (serve --simulate / --board-port).
 };
 
 struct PageCommand {
@@ -31,6 +34,10 @@ struct PageCommand {
     kPick, kSelect, kMethod, kUndo, kMarker,       // Tuning.
     kSave, kRecord, kResetReference,               // Files and the bending reference.
     kPing, kTakeControl,                           // Any page, controlling or not.
+    kRigRun, kRigProfile,                          // The rig: the controlling page only.
+    kRigStop,                                      // The rig: any page, always.
+    kHsv, kMaskView,                               // Tuning: a range, the mask view.
+    kLoad, kListConfigs,                           // Named configs in the server's folder.
   };
   Kind kind = Kind::kPing;
   cv::Point2d point_px;   // kPick: the image pixel clicked.
@@ -39,11 +46,17 @@ struct PageCommand {
   int delta = 0;          // kStep: +1 or -1.
   double speed = 1.0;     // kSpeed: 0.1 .. 4.
   int marker = 0;         // kMarker: index in the config.
-  std::string name;       // kSave: a file name in the server's folder (ValidConfigName).
+  std::string name;       // kSave, kLoad: a file name in the server's folder (ValidConfigName).
   double page_time_ms = 0.0;  // kPing: the page's clock, echoed back (latency, clock offset).
+  double target_deg = 180.0;  // kRigRun: 0 .. 180 (180 straight).
+  int hsv_index = 0;          // kHsv: 0..5, H lo, H hi, S lo, S hi, V lo, V hi (kHsvTrackbars).
+  int hsv_value = 0;          // kHsv: 0..179 for hue, 0..255 for S and V.
+  bool on = false;            // kMaskView.
+  TargetProfile profile = TargetProfile::Constant(180.0);  // kRigProfile: parsed, in bounds.
 };
 
-// True for commands only the controlling page may send.
+// True for commands only the controlling page may send (a STOP of the rig is not one of them:
+// any page may vent the actuator, whoever controls the run).
 bool ChangesTheRun(PageCommand::Kind kind);
 
 // The command in `text`, or nullopt with `*error` saying what is wrong ("seek: position 9000 is

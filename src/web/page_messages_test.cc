@@ -113,5 +113,104 @@ TEST(PageMessagesTest, ConfigNamesArePlainNamesInTheFolder) {
   Refusal(R"({"type":"save","name":7})");
 }
 
+PageLimits RigLimits() {
+  PageLimits limits = FileLimits();
+  limits.seekable = false;
+  limits.length.reset();
+  limits.rig = true;
+  return limits;
+}
+
+TEST(PageMessagesTest, TheRigsMessagesAreReadWithTheirFields) {
+  using Kind = PageCommand::Kind;
+  EXPECT_DOUBLE_EQ(Parse(R"({"type":"rig_run","target_deg":120.5})", RigLimits()).target_deg, 120.5);
+  EXPECT_DOUBLE_EQ(Parse(R"({"type":"rig_run","target_deg":0})", RigLimits()).target_deg, 0.0);
+  EXPECT_DOUBLE_EQ(Parse(R"({"type":"rig_run","target_deg":180})", RigLimits()).target_deg, 180.0);
+  EXPECT_EQ(Parse(R"({"type":"rig_stop"})", RigLimits()).kind, Kind::kRigStop);
+  const PageCommand profile =
+      Parse(R"({"type":"rig_profile","text":"step 140\nhold 1\nramp 120 2\n"})", RigLimits());
+  EXPECT_EQ(profile.kind, Kind::kRigProfile);
+  EXPECT_DOUBLE_EQ(profile.profile.duration_s(), 3.0);
+  EXPECT_DOUBLE_EQ(profile.profile.lowest_deg(), 120.0);
+  // Only the controlling page runs the rig; any page may STOP it.
+  EXPECT_TRUE(ChangesTheRun(Kind::kRigRun));
+  EXPECT_TRUE(ChangesTheRun(Kind::kRigProfile));
+  EXPECT_FALSE(ChangesTheRun(Kind::kRigStop));
+}
+
+TEST(PageMessagesTest, HostileRigMessagesAreRefusedNamingWhy) {
+  const PageLimits rig = RigLimits();
+  EXPECT_NE(Refusal(R"({"type":"rig_run","target_deg":181})", rig).find("outside [0, 180]"),
+            std::string::npos);
+  Refusal(R"({"type":"rig_run","target_deg":-1})", rig);
+  Refusal(R"({"type":"rig_run","target_deg":"120"})", rig);
+  Refusal(R"({"type":"rig_run","target_deg":null})", rig);
+  Refusal(R"({"type":"rig_run","target_deg":1e400})", rig);
+  Refusal(R"({"type":"rig_run"})", rig);
+  Refusal(R"({"type":"rig_run","target_deg":120,"pressure_kpa":900})", rig);
+  Refusal(R"({"type":"rig_stop","now":true})", rig);
+  Refusal(R"({"type":"rig_profile","text":7})", rig);
+  EXPECT_NE(Refusal(R"({"type":"rig_profile","text":"step 250\n"})", rig).find("0..180"),
+            std::string::npos);
+  Refusal(R"({"type":"rig_profile","text":"hold 1e9\n"})", rig);  // Longer than a week.
+  Refusal(R"({"type":"rig_profile","text":"format c:\n"})", rig);
+  Refusal(R"({"type":"rig_profile","text":"sine 120 10 1000 1\n"})", rig);  // Above 100 Hz.
+  const std::string oversized =
+      R"({"type":"rig_profile","text":")" + std::string(5000, '#') + R"("})";
+  EXPECT_NE(Refusal(oversized, rig).find("bytes refused"), std::string::npos);
+  // Without a rig there is nothing to run or stop.
+  for (const char* text : {R"({"type":"rig_run","target_deg":120})", R"({"type":"rig_stop"})",
+                           R"({"type":"rig_profile","text":"step 120\n"})"}) {
+    EXPECT_NE(Refusal(text).find("no rig"), std::string::npos) << text;
+  }
+}
+
+TEST(PageMessagesTest, WithARigPauseIsRefusedTheLoopNeedsEveryFrame) {
+  EXPECT_NE(Refusal(R"({"type":"pause"})", RigLimits()).find("STOP"), std::string::npos);
+  PageLimits seekable_rig = RigLimits();  // Even were its frames a file's.
+  seekable_rig.seekable = true;
+  seekable_rig.length = 300;
+  Refusal(R"({"type":"seek","position":3})", seekable_rig);
+  Refusal(R"({"type":"step","delta":-1})", seekable_rig);
+  Parse(R"({"type":"play"})", RigLimits());
+}
+
+TEST(PageMessagesTest, TuningMessagesAreCheckedLikeTheTrackbars) {
+  using Kind = PageCommand::Kind;
+  const PageCommand hsv = Parse(R"({"type":"hsv","index":1,"value":179})");
+  EXPECT_EQ(hsv.kind, Kind::kHsv);
+  EXPECT_EQ(hsv.hsv_index, 1);
+  EXPECT_EQ(hsv.hsv_value, 179);
+  EXPECT_EQ(Parse(R"({"type":"hsv","index":5,"value":255})").hsv_value, 255);
+  EXPECT_NE(Refusal(R"({"type":"hsv","index":0,"value":180})").find("outside [0, 179]"),
+            std::string::npos);  // Hue is 0..179.
+  Refusal(R"({"type":"hsv","index":6,"value":0})");
+  Refusal(R"({"type":"hsv","index":-1,"value":0})");
+  Refusal(R"({"type":"hsv","index":2,"value":256})");
+  Refusal(R"({"type":"hsv","index":2,"value":12.5})");
+  Refusal(R"({"type":"hsv","index":"0","value":1})");
+  Refusal(R"({"type":"hsv","index":0})");
+  EXPECT_TRUE(Parse(R"({"type":"mask_view","on":true})").on);
+  EXPECT_FALSE(Parse(R"({"type":"mask_view","on":false})").on);
+  Refusal(R"({"type":"mask_view","on":1})");
+  Refusal(R"({"type":"mask_view"})");
+  EXPECT_TRUE(ChangesTheRun(Kind::kHsv));
+  EXPECT_TRUE(ChangesTheRun(Kind::kMaskView));
+}
+
+TEST(PageMessagesTest, ConfigsAreLoadedOnlyByAPlainNameInTheFolder) {
+  using Kind = PageCommand::Kind;
+  EXPECT_EQ(Parse(R"({"type":"load","name":"markers.web.yaml"})").name, "markers.web.yaml");
+  for (const char* bad : {R"({"type":"load","name":"../cfg.yaml"})", R"({"type":"load","name":"/etc/x.yaml"})",
+                          R"({"type":"load","name":"a/b.yaml"})", R"({"type":"load","name":".x.yaml"})",
+                          R"({"type":"load","name":"x.txt"})", R"({"type":"load","name":7})",
+                          R"({"type":"load"})"}) {
+    EXPECT_EQ(Refusal(bad).rfind("load", 0), 0u) << bad;
+  }
+  EXPECT_EQ(Parse(R"({"type":"list_configs"})").kind, Kind::kListConfigs);
+  EXPECT_TRUE(ChangesTheRun(Kind::kLoad));
+  EXPECT_FALSE(ChangesTheRun(Kind::kListConfigs));  // Reading the folder's names changes nothing.
+}
+
 }  // namespace
 }  // namespace softsight

@@ -68,6 +68,48 @@ def check(condition, message):
         raise AssertionError(message)
 
 
+def webdriver_wait(page, what, expression, timeout=10.0, details="window.softsight.status"):
+    """Selenium's WebDriverWait until the page's `expression` is true (event-driven, no fixed
+    sleep); fails naming `what` and showing the page's `details` expression."""
+    from selenium.webdriver.support.ui import WebDriverWait
+    try:
+        return WebDriverWait(page.driver, timeout, poll_frequency=0.02).until(
+            lambda driver: driver.execute_script("return " + expression))
+    except Exception as error:
+        raise AssertionError("timed out waiting for %s (%s): %s; errors on the page: %s" % (
+            what, expression, page.state(details),
+            page.state("window.softsight.errors.slice(-4)"))) from error
+
+
+def stop_server(server):
+    """SIGINT, as Ctrl-C: the server must end within 20 s with exit code 130. Its output."""
+    server.send_signal(signal.SIGINT)
+    try:
+        out, err = server.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        server.kill()
+        raise AssertionError("serve did not stop on SIGINT")
+    check(server.returncode == 130, "serve exited %d after SIGINT: %s" % (server.returncode, err))
+    return out, err
+
+
+def browser_test_main(doc, run, what):
+    """The command line of each browser test: --softsight, --screenshot; 77 when the browser,
+    its driver or selenium is missing."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--softsight", required=True)
+    parser.add_argument("--screenshot", help="write the page's screenshot (PNG) here")
+    args = parser.parse_args()
+    found, why = find_chromium()
+    if not found:
+        print("SKIPPED: %s (scripts/setup.sh installs chromium, chromium-driver, python3-selenium)" % why)
+        return SKIP
+    started = time.monotonic()
+    run(args, *found)
+    print("%s passed in %.1f s" % (what, time.monotonic() - started))
+    return 0
+
+
 class Page:
     def __init__(self, browser, driver_path, url):
         from selenium import webdriver
@@ -114,17 +156,23 @@ class Page:
         self.driver.quit()
 
 
+def start_serve(softsight, arguments):
+    """`softsight serve ARGUMENTS` and the page's URL it prints (after what it says of a rig)."""
+    server = subprocess.Popen([softsight, "serve"] + arguments, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+    lines = []
+    for _ in range(5):
+        lines.append(server.stdout.readline())
+        match = re.search(r"open (http://\S+)", lines[-1])
+        if match:
+            return server, match.group(1).replace("HOST", "127.0.0.1")
+    server.kill()
+    raise AssertionError("serve printed no URL: %r %s" % (lines, server.stderr.read()))
+
+
 def start_server(softsight, folder, video, config):
-    server = subprocess.Popen(
-        [softsight, "serve", "--input", video, "--config", config, "--bind", "0.0.0.0",
-         "--port", "0", "--folder", folder],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = server.stdout.readline()
-    match = re.search(r"open (http://\S+)", line)
-    if not match:
-        server.kill()
-        raise AssertionError("serve printed no URL: %r %s" % (line, server.stderr.read()))
-    return server, match.group(1).replace("HOST", "127.0.0.1")
+    return start_serve(softsight, ["--input", video, "--config", config, "--bind", "0.0.0.0",
+                                   "--port", "0", "--folder", folder])
 
 
 def http_status(url):
@@ -380,30 +428,9 @@ def run(args, browser, driver):
     finally:
         for page in pages:
             page.quit()
-        server.send_signal(signal.SIGINT)
-        try:
-            out, err = server.communicate(timeout=20)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            raise AssertionError("serve did not stop on SIGINT")
-    check(server.returncode == 130, "serve exited %d after SIGINT: %s" % (server.returncode, err))
+        stop_server(server)
     shutil.rmtree(folder)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--softsight", required=True)
-    parser.add_argument("--screenshot", help="write the first page's screenshot (PNG) here")
-    args = parser.parse_args()
-    found, why = find_chromium()
-    if not found:
-        print("SKIPPED: %s (scripts/setup.sh installs chromium, chromium-driver, python3-selenium)" % why)
-        return SKIP
-    started = time.monotonic()
-    run(args, *found)
-    print("serve browser test passed in %.1f s" % (time.monotonic() - started))
-    return 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(browser_test_main(__doc__, run, "serve browser test"))

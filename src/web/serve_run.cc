@@ -1,5 +1,6 @@
 #include "web/serve_run.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -17,6 +18,7 @@
 #include "softsight/pipeline/sinks.h"
 #include "stream/stream_format.h"
 #include "web/page_messages.h"
+#include "web/rig_panel.h"
 
 namespace softsight {
 namespace {
@@ -47,7 +49,30 @@ class PageInbox {
   }
   void wait(std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);
-    ready_.wait_for(lock, timeout, [this] { return !queue_.empty(); });
+    ready_.wait_for(lock, timeout, [this] {
+      return !queue_.empty() || !departed_.empty() || stops_.load() > 0;
+    });
+  }
+  // A page's STOP of the rig: never queued behind (or dropped with) other messages, so a page
+  // flooding the inbox cannot delay or lose it. Presses before the run sees them count as one.
+  void press_stop() {
+    stops_.fetch_add(1);
+    std::lock_guard lock(mutex_);
+    ready_.notify_one();
+  }
+  bool take_stop() { return stops_.exchange(0) > 0; }
+  // A page that left: kept apart from the bounded queue too (each page leaves once).
+  void depart(uint64_t page) {
+    std::lock_guard lock(mutex_);
+    departed_.push_back(page);
+    ready_.notify_one();
+  }
+  bool pop_departure(uint64_t* page) {
+    std::lock_guard lock(mutex_);
+    if (departed_.empty()) return false;
+    *page = departed_.front();
+    departed_.pop_front();
+    return true;
   }
 
  private:
@@ -55,6 +80,8 @@ class PageInbox {
   std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<Message> queue_;
+  std::deque<uint64_t> departed_;
+  std::atomic<int> stops_{0};
 };
 
 double UnixMs(SteadyClock::time_point steady) {
@@ -113,10 +140,13 @@ class WebSink : public FrameSink {
 
   void send_picture(const cv::Mat& image, const FrameResult& result, bool replay) {
     if (server_.pages() == 0 || image.empty()) return;  // Nobody watches: nothing to encode.
-    cv::imencode(".jpg", image, jpeg_, jpeg_params_);
+    const bool mask = controller_ != nullptr && controller_->mask_view();
+    cv::imencode(".jpg", mask ? masked(image) : image, jpeg_, jpeg_params_);
     header_.clear();
     AppendFrameFields(result, header_);
+    header_ += mask ? ",\"mask\":true" : ",\"mask\":false";
     header_ += replay ? ",\"replay\":true}" : ",\"replay\":false}";
+    if (mask) send_candidates(result);
     // [header length, 4 bytes little-endian][header JSON][JPEG]: the page pairs the picture
     // with its result by frame number. The message is new each frame (the server's thread
     // writes it to every page after this returns); everything else here is reused.
@@ -127,6 +157,45 @@ class WebSink : public FrameSink {
     bytes += header_;
     bytes.append(reinterpret_cast<const char*>(jpeg_.data()), jpeg_.size());
     server_.broadcast_frame(std::move(bytes));
+  }
+
+  // The mask view (as the window's `v`): the active marker's member pixels in their own
+  // colours, the rest dimmed to a quarter. The buffers are reused.
+  const cv::Mat& masked(const cv::Mat& image) {
+    const bool has_mask = controller_->active_tracker().membership(image, mask_);
+    image.convertTo(mask_image_, -1, 0.25, 0);
+    if (has_mask) image.copyTo(mask_image_, mask_);
+    return mask_image_;
+  }
+
+  // The active marker's candidate blobs with their verdicts and its search region, for the
+  // page to draw over the mask (text crisp at any zoom): why a marker is or is not found.
+  void send_candidates(const FrameResult& result) {
+    const Tracker& tracker = controller_->active_tracker();
+    mask_json_.assign("{\"type\":\"mask\",\"frame\":");
+    mask_json_ += std::to_string(result.frame_index);
+    mask_json_ += ",\"marker\":" + std::to_string(controller_->active_marker());
+    mask_json_ += ",\"region\":";
+    if (const std::optional<cv::Rect> region = tracker.search_region()) {
+      mask_json_ += "[" + std::to_string(region->x) + "," + std::to_string(region->y) + "," +
+                    std::to_string(region->width) + "," + std::to_string(region->height) + "]";
+    } else {
+      mask_json_ += "null";
+    }
+    mask_json_ += ",\"candidates\":[";
+    char item[200];
+    bool first = true;
+    for (const MarkerCandidate& c : tracker.candidates()) {
+      std::snprintf(item, sizeof item,
+                    "%s{\"x\":%.2f,\"y\":%.2f,\"area\":%.1f,\"circularity\":%.3f,"
+                    "\"misfit\":%.3f,\"verdict\":\"%s\"}",
+                    first ? "" : ",", c.position_px.x, c.position_px.y, c.area_px, c.circularity,
+                    c.misfit, CandidateVerdictName(c.verdict));
+      mask_json_ += item;
+      first = false;
+    }
+    mask_json_ += "]}";
+    server_.broadcast_text(mask_json_);
   }
 
   // A result with no new picture (an edit re-tracked the frame on screen): `edit` says so.
@@ -166,11 +235,13 @@ class WebSink : public FrameSink {
   const LiveController* controller_ = nullptr;
   // Reused per frame; only the messages handed to the server's thread are new each time.
   std::vector<uchar> jpeg_;
-  std::string header_, record_, json_;
+  std::string header_, record_, json_, mask_json_;
+  cv::Mat mask_, mask_image_;
   const std::vector<int> jpeg_params_{cv::IMWRITE_JPEG_QUALITY, quality_};
 };
 
-std::string Greeting(const TrackingConfig& config, const FrameSource& source, bool seekable) {
+std::string Greeting(const TrackingConfig& config, const FrameSource& source, bool seekable,
+                     const RigPanel* rig) {
   std::string json = "{\"type\":\"hello\",\"source\":";
   AppendJsonString(source.description(), json);
   json += ",\"markers\":[";
@@ -191,6 +262,7 @@ std::string Greeting(const TrackingConfig& config, const FrameSource& source, bo
   json += ",\"fps\":" + Number(source.fps().value_or(0.0));
   const std::optional<int64_t> count = source.frame_count();
   json += ",\"length\":" + (count ? std::to_string(*count) : std::string("null"));
+  json += ",\"rig\":" + (rig ? rig->limits_json() : std::string("null"));
   return json + "}";
 }
 
@@ -207,10 +279,17 @@ class ServeLoop {
   // Everything the controller said since the last call, to every page and to `out`.
   void relay_messages();
   void send_status(bool force);
+  // The rig's state to every page when it changed (a step, a STOP), or `force`d.
+  void send_rig(bool force);
+  // The rig's STOP, from any page: vents at once.
+  void stop_rig();
 
  private:
   void apply(const PageCommand& command, uint64_t page);
   void save(const std::string& name, uint64_t page);
+  void load(const std::string& name, uint64_t page);
+  // The configs a page may load: plain names (ValidConfigName) of regular files in the folder.
+  void list_configs(uint64_t page);
   PageLimits limits() const;
 
   LiveController& controller_;
@@ -221,6 +300,7 @@ class ServeLoop {
   std::ostream& out_;
   std::string last_status_;
   SteadyClock::time_point status_sent_{};
+  int64_t rig_sent_ = -1;
 };
 
 PageLimits ServeLoop::limits() const {
@@ -229,6 +309,7 @@ PageLimits ServeLoop::limits() const {
   limits.seekable = seekable_;
   limits.length = controller_.timeline().length();
   limits.markers = static_cast<int>(controller_.config().markers.size());
+  limits.rig = options_.rig != nullptr;
   return limits;
 }
 
@@ -269,16 +350,48 @@ void ServeLoop::apply(const PageCommand& command, uint64_t page) {
     case Kind::kRecord: key('r'); break;
     case Kind::kResetReference: key('b'); break;
     case Kind::kSave: save(command.name, page); break;
+    case Kind::kLoad: load(command.name, page); break;
+    case Kind::kListConfigs: list_configs(page); return;
     case Kind::kTakeControl: server_.give_control(page); break;
     case Kind::kPing:
       server_.send_text(page, Pong(command.page_time_ms));
       return;
+    case Kind::kRigRun:
+    case Kind::kRigProfile: {
+      const std::string refused =
+          command.kind == Kind::kRigRun ? options_.rig->run_target(command.target_deg, page)
+                                        : options_.rig->run_profile(command.profile, page);
+      if (!refused.empty()) server_.send_text(page, TextMessage("error", refused));
+      relay_messages();
+      return;
+    }
+    case Kind::kRigStop:
+      stop_rig();
+      return;
+    case Kind::kHsv:
+      controller_.on_event(UiEvent::Trackbar(command.hsv_index, command.hsv_value));
+      break;
+    case Kind::kMaskView:
+      if (controller_.mask_view() != command.on) key('v');
+      break;
   }
+  if (command.kind == Kind::kSave) list_configs(0);  // Every page's list has the new name.
   // An edit re-tracks the frame on screen (or the next one shows it): every page sees its
   // result now, also while paused.
   const bool edit = command.kind == Kind::kPick || command.kind == Kind::kSelect ||
-                    command.kind == Kind::kMethod || command.kind == Kind::kUndo;
-  if (edit && controller_.last_result()) sink_.send_result(*controller_.last_result(), true);
+                    command.kind == Kind::kMethod || command.kind == Kind::kUndo ||
+                    command.kind == Kind::kHsv || command.kind == Kind::kLoad;
+  // The picture itself changes when the mask view is turned on or off, and in it with the
+  // ranges and the active marker: sent again at once (also paused).
+  const bool picture = command.kind == Kind::kMaskView ||
+                       (controller_.mask_view() && (edit || command.kind == Kind::kMarker));
+  if (controller_.last_result()) {
+    if (picture) {
+      sink_.resend(controller_.frame_on_screen(), *controller_.last_result());
+    } else if (edit) {
+      sink_.send_result(*controller_.last_result(), true);
+    }
+  }
   send_status(/*force=*/true);
 }
 
@@ -301,11 +414,76 @@ void ServeLoop::save(const std::string& name, uint64_t page) {
   controller_.save_config_to(path.string());
 }
 
+void ServeLoop::load(const std::string& name, uint64_t page) {
+  namespace fs = std::filesystem;
+  // A plain name (ParsePageCommand) joined to the folder stays in it; a symbolic link of that
+  // name could point out of it, and is refused as save() refuses it.
+  const fs::path path = options_.folder / name;
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(path, error);
+  std::string refusal;
+  if (fs::is_symlink(status)) {
+    refusal = "load: " + name + " is a symbolic link in " + options_.folder.string();
+  } else if (!fs::is_regular_file(status)) {
+    refusal = "load: no config " + name + " in " + options_.folder.string();
+  }
+  if (!refusal.empty()) {
+    server_.send_text(page, TextMessage("error", refusal));
+    return;
+  }
+  controller_.load_markers_from(path.string());
+}
+
+void ServeLoop::list_configs(uint64_t page) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names;
+  std::error_code error;
+  for (fs::directory_iterator it(options_.folder, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    std::string ignored;
+    if (it->is_symlink(error) || !it->is_regular_file(error) || !ValidConfigName(name, &ignored)) continue;
+    names.push_back(name);
+    if (names.size() >= 500) break;  // A folder of thousands: the first 500 are a long list already.
+  }
+  std::sort(names.begin(), names.end());
+  std::string json = "{\"type\":\"configs\",\"names\":[";
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) json += ',';
+    AppendJsonString(names[i], json);
+  }
+  json += "]}";
+  if (page == 0) {
+    server_.broadcast_text(std::move(json));
+  } else {
+    server_.send_text(page, std::move(json));
+  }
+}
+
 void ServeLoop::relay_messages() {
   for (const std::string& said : controller_.take_messages()) {
     out_ << "serve: " << said << std::endl;
     server_.broadcast_text(TextMessage("message", said));
   }
+  if (options_.rig == nullptr) return;
+  for (const std::string& said : options_.rig->take_messages()) {
+    out_ << "serve: " << said << std::endl;
+    server_.broadcast_text(TextMessage("message", said));
+  }
+}
+
+void ServeLoop::stop_rig() {
+  if (options_.rig == nullptr) return;
+  options_.rig->stop("pressed on a page");
+  // Every page sees the vent now, not with the next frame.
+  send_rig(/*force=*/true);
+  relay_messages();
+}
+
+void ServeLoop::send_rig(bool force) {
+  if (options_.rig == nullptr) return;
+  if (!force && options_.rig->updates() == rig_sent_) return;
+  rig_sent_ = options_.rig->updates();
+  server_.broadcast_text(options_.rig->status_json());  // A copy: the panel's buffer is reused.
 }
 
 void ServeLoop::send_status(bool force) {
@@ -327,6 +505,7 @@ void ServeLoop::send_status(bool force) {
                      ",\"length\":" + std::to_string(controller_.timeline().length().value_or(0)) +
                      ",\"pages\":" + std::to_string(server_.pages()) +
                      ",\"undo\":" + std::to_string(controller_.undo_depth()) +
+                     ",\"mask_view\":" + (controller_.mask_view() ? "true" : "false") +
                      ",\"active\":" + std::to_string(active) + ",\"method\":";
   AppendJsonString(TrackerMethodName(config.markers[active].params), json);
   json += ",\"hsv\":[";
@@ -358,28 +537,39 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   if (!options.live.record_fps) options.live.record_fps = source->fps();
   PageInbox inbox;
   std::atomic<WebServer*> answering{nullptr};
-  WebServer server(options.server, PageAssets(),
-                   [&inbox, &answering](uint64_t page, bool controls, std::string text) {
-                     // A ping is answered here, on the server's thread, at once: the page sets
-                     // its clock by the answer, which must not wait for the run's next frame.
-                     std::string ignored;
-                     WebServer* server = answering.load();
-                     const auto ping = ParsePageCommand(text, PageLimits{}, &ignored);
-                     if (server && ping && ping->kind == Kind::kPing) {
-                       server->send_text(page, Pong(ping->page_time_ms));
-                       return;
-                     }
-                     inbox.push({page, controls, std::move(text)});
-                   });
+  PageLimits checked_here;  // Pings and STOPs need nothing of the run's state.
+  checked_here.rig = options.rig != nullptr;
+  WebServer server(
+      options.server, PageAssets(),
+      [&inbox, &answering, checked_here](uint64_t page, bool controls, std::string text) {
+        // A ping is answered here, on the server's thread, at once: the page sets its clock by
+        // the answer, which must not wait for the run's next frame. A STOP of the rig jumps the
+        // queue (PageInbox::press_stop).
+        std::string ignored;
+        WebServer* server = answering.load();
+        const auto command = ParsePageCommand(text, checked_here, &ignored);
+        if (server && command && command->kind == Kind::kPing) {
+          server->send_text(page, Pong(command->page_time_ms));
+          return;
+        }
+        if (command && command->kind == Kind::kRigStop) {
+          inbox.press_stop();
+          return;
+        }
+        inbox.push({page, controls, std::move(text)});
+      },
+      [&inbox](uint64_t page, bool) { inbox.depart(page); });
   answering = &server;
   std::vector<std::string> names;
   for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
   WebSink sink(server, TrackingColumns(config), names, options.jpeg_quality);
+  // The rig's loop steps on each frame before the frame goes out: its state travels with it.
+  if (options.rig != nullptr) options.live.sinks.push_back(options.rig);
   options.live.sinks.push_back(&sink);
   LiveController controller(config, options.live);
   sink.set_controller(&controller);
   controller.describe_source(*source);
-  server.set_greeting(Greeting(config, *source, seekable != nullptr));
+  server.set_greeting(Greeting(config, *source, seekable != nullptr, options.rig));
   source = SourceForRun(std::move(source),
                         options.pace_files ? FilePacing::kRealTime : FilePacing::kInCallersThread);
   out << "softsight serve: " << source->description() << ", " << config.markers.size()
@@ -400,16 +590,23 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
       waiting_for_page = false;
       if (controller.paused()) controller.on_event(UiEvent::Key(' '));
     }
+    if (inbox.take_stop()) loop.stop_rig();  // First: nothing the pages sent comes before.
+    uint64_t departed = 0;
+    while (inbox.pop_departure(&departed)) {
+      if (options.rig != nullptr) options.rig->page_left(departed);
+    }
     while (inbox.pop(&message)) loop.handle(message);
     if (server.pages() > pages_seen && controller.last_result()) {
       // A page joined: it gets the frame on screen at once, playing or not.
       sink.resend(controller.frame_on_screen(), *controller.last_result());
       loop.send_status(/*force=*/true);
+      loop.send_rig(/*force=*/true);
     }
     pages_seen = server.pages();
     // A paced file waits here until its frame is due (at most a frame period); a camera
     // returns its newest frame.
     const bool got = feed.step(controller);
+    loop.send_rig(/*force=*/false);
     loop.relay_messages();
     // A frame stepped or sought to while paused: its position goes out with it (while playing
     // the status follows four times a second).

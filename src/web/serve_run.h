@@ -21,6 +21,8 @@
 
 namespace softsight {
 
+class RigPanel;
+
 struct ServeOptions {
   WebServerOptions server;
   // The window's settings that a page shares (record_prefix: in `folder`; the picker, the box
@@ -32,6 +34,9 @@ struct ServeOptions {
   std::string config_path;
   bool pace_files = true;  // A file plays at its frame rate (false: as fast as it decodes).
   int jpeg_quality = 80;   // 1..100. 80: ~40 KB a 640x480 frame, no visible blocks at 1x.
+  // The rig's control panel (serve --simulate / --board-port), or none. Its loop steps on every
+  // tracked frame (it becomes a sink of the run); pages run it, and any page's STOP vents it.
+  RigPanel* rig = nullptr;
 };
 
 // Serves until `stop_requested()` returns true (polled between frames, at least every 20 ms).

@@ -50,8 +50,10 @@ class WebSocketPage;
 
 class WebServer::Impl {
  public:
-  Impl(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox)
-      : options_(options), policy_(options.token), inbox_(std::move(inbox)), acceptor_(io_) {
+  Impl(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox,
+       Departure departure)
+      : options_(options), policy_(options.token), inbox_(std::move(inbox)),
+        departure_(std::move(departure)), acceptor_(io_) {
     for (PageAsset& asset : assets) assets_[asset.path] = std::move(asset);
   }
 
@@ -77,6 +79,7 @@ class WebServer::Impl {
   WebServerOptions options_;
   AccessPolicy policy_;
   Inbox inbox_;
+  Departure departure_;
   std::map<std::string, PageAsset> assets_;
   // Before the acceptor (built on it); destroyed last, with the handlers still pending in it,
   // which hold the pages and connections (whose destructors touch nothing else of the server).
@@ -344,6 +347,7 @@ void WebServer::Impl::join(const std::shared_ptr<WebSocketPage>& page) {
 void WebServer::Impl::leave(uint64_t id) {
   if (pages_.erase(id) == 0) return;
   page_count_ = static_cast<int>(pages_.size());
+  if (departure_) departure_(id, controller_ == id);
   // The page that controlled the run left (closed, or its connection broke): the page
   // connected longest takes over, so the run is never left without one while pages watch.
   if (controller_ == id) controller_ = pages_.empty() ? 0 : pages_.begin()->first;
@@ -373,8 +377,10 @@ std::shared_ptr<WebSocketPage> WebServer::Impl::find(uint64_t id) {
   return it == pages_.end() ? nullptr : it->second.lock();
 }
 
-WebServer::WebServer(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox)
-    : impl_(std::make_unique<Impl>(options, std::move(assets), std::move(inbox))) {
+WebServer::WebServer(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox,
+                     Departure departure)
+    : impl_(std::make_unique<Impl>(options, std::move(assets), std::move(inbox),
+                                   std::move(departure))) {
   impl_->listen();
   impl_->start();
 }

@@ -40,9 +40,14 @@ class WebServer {
  public:
   // A page's text message, on the server's thread: which page, and whether it controls the run.
   using Inbox = std::function<void(uint64_t page, bool controls, std::string text)>;
+  // A page's WebSocket ended (closed, or its connection broke), on the server's thread: which
+  // page, and whether it controlled the run then. Once per page. The rig's panel holds, then
+  // vents, when the page that runs the rig leaves mid-run.
+  using Departure = std::function<void(uint64_t page, bool controlled)>;
 
   // Listens at once (so port() is known); throws InputError naming the address when it cannot.
-  WebServer(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox);
+  WebServer(const WebServerOptions& options, std::vector<PageAsset> assets, Inbox inbox,
+            Departure departure = {});
   ~WebServer();  // Closes every connection.
   WebServer(const WebServer&) = delete;
   WebServer& operator=(const WebServer&) = delete;

@@ -32,6 +32,7 @@ struct Received {
   std::condition_variable changed;
   std::vector<std::pair<uint64_t, std::string>> messages;
   std::vector<bool> controls;
+  std::vector<std::pair<uint64_t, bool>> departures;  // (page, controlled then)
 };
 
 class WebServerTest : public ::testing::Test {
@@ -46,6 +47,11 @@ class WebServerTest : public ::testing::Test {
           std::lock_guard lock(received_.mutex);
           received_.messages.emplace_back(page, std::move(text));
           received_.controls.push_back(controls);
+          received_.changed.notify_all();
+        },
+        [this](uint64_t page, bool controlled) {
+          std::lock_guard lock(received_.mutex);
+          received_.departures.emplace_back(page, controlled);
           received_.changed.notify_all();
         });
   }
@@ -91,6 +97,12 @@ class WebServerTest : public ::testing::Test {
     std::unique_lock lock(received_.mutex);
     return received_.changed.wait_for(lock, std::chrono::seconds(10),
                                       [&] { return received_.messages.size() >= count; });
+  }
+
+  bool WaitForDepartures(size_t count) {
+    std::unique_lock lock(received_.mutex);
+    return received_.changed.wait_for(lock, std::chrono::seconds(10),
+                                      [&] { return received_.departures.size() >= count; });
   }
 
   asio::io_context io_;
@@ -148,8 +160,21 @@ TEST_F(WebServerTest, OnePageControlsAndTheNextTakesOverWhenItLeaves) {
   EXPECT_NE(ReadUntil(*second, "\"controls\":true").find("\"pages\":1"), std::string::npos);
   second->write(asio::buffer(std::string("now in control")));
   ASSERT_TRUE(WaitForMessages(3));
+  {
+    std::lock_guard lock(received_.mutex);
+    EXPECT_TRUE(received_.controls[2]);
+    // The run was told the first page left, while it controlled (the rig holds, then vents).
+    ASSERT_EQ(received_.departures.size(), 1u);
+    EXPECT_EQ(received_.departures[0].first, received_.messages[0].second == "from first"
+                                                 ? received_.messages[0].first
+                                                 : received_.messages[1].first);
+    EXPECT_TRUE(received_.departures[0].second);
+  }
+  // A connection dropped without a close (a crashed browser, a pulled cable) is a departure too.
+  second->next_layer().close();
+  ASSERT_TRUE(WaitForDepartures(2));
   std::lock_guard lock(received_.mutex);
-  EXPECT_TRUE(received_.controls[2]);
+  EXPECT_TRUE(received_.departures[1].second);
 }
 
 TEST_F(WebServerTest, FramesAndResultsReachEveryPage) {

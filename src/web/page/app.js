@@ -69,6 +69,7 @@ function onText(m) {
       $('role').textContent = m.controls ? 'you control the run' : 'read-only: another page controls the run';
       $('role').className = 'badge ' + (m.controls ? 'controls' : 'readonly');
       $('take').hidden = m.controls;
+      if (S.onRole) S.onRole();
       break;
     case 'result':
       rows.set(m.frame, Object.assign({_position: m.position}, m.row));
@@ -77,6 +78,16 @@ function onText(m) {
       if (m.edit || m.frame === imageFrame) { drawView(); showReadout(m.frame); }
       break;
     case 'status': onStatus(m); break;
+    case 'mask': S.mask = m; if (m.frame === imageFrame) drawView(); break;
+    case 'configs': {
+      S.configs = m.names;
+      const select = $('configs'), chosen = select.value;
+      select.innerHTML = '';
+      for (const name of m.names) select.add(new Option(name, name));
+      if (m.names.includes(chosen)) select.value = chosen;
+      break;
+    }
+    case 'rig': if (S.onRig) S.onRig(m); break;  // rig.js
     case 'message': log(m.message, false); break;
     case 'error': log(m.message, true); break;
     case 'pong': {
@@ -100,6 +111,8 @@ function onHello(m) {
     tr.onclick = () => send({type: 'marker', index: i});
   });
   for (const id of ['back', 'fwd']) $(id).disabled = !m.seekable;
+  if (S.onRigHello) S.onRigHello(m.rig);  // rig.js: the control panel, when there is a rig.
+  send({type: 'list_configs'});
 }
 
 function onStatus(m) {
@@ -118,6 +131,7 @@ function onStatus(m) {
       m.hsv[0] + '-' + m.hsv[1] + ' s ' + m.hsv[2] + '-' + m.hsv[3] + ' v ' + m.hsv[4] + '-' + m.hsv[5] +
       (m.undo ? '   undo: ' + m.undo : '');
   [...$('markers').tBodies[0].rows].forEach((tr, i) => tr.classList.toggle('active', i === m.active));
+  showRanges(m);
   $('where').textContent = m.length > 0 ? 'frame ' + m.position + ' / ' + (m.length - 1) : '';
   drawTimeline();
 }
@@ -145,6 +159,7 @@ async function decodeNext() {
       if (image) image.close();
       image = bitmap;
       imageFrame = header.frame;
+      S.shownMask = header.mask;
       S.shownFrame = header.frame;
       S.shownPosition = header.position;
       drawView();
@@ -228,7 +243,9 @@ function drawView() {
   const ctx = cssContext(view);
   ctx.drawImage(image, 0, 0, image.width * scale, image.height * scale);
   const row = rows.get(imageFrame);
-  if (row && S.hello) drawOverlay(ctx, row);
+  if (S.shownMask) drawCandidates(ctx);
+  else if (row && S.hello) drawOverlay(ctx, row);
+  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS);
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
@@ -258,6 +275,49 @@ function drawOverlay(ctx, row) {
     ctx.fillText(name, x + 13, y - 8);
   });
 }
+
+// The mask view: each candidate blob of the active marker, green chosen, yellow fitting, red
+// rejected, with its verdict and what it was judged on; the search region dashed.
+const VERDICT_COLOURS = {chosen: '#40ff40', fits: '#ffd040'};
+function drawCandidates(ctx) {
+  const m = S.mask;
+  if (!m || m.frame !== imageFrame) return;
+  ctx.font = '11px sans-serif'; ctx.lineWidth = 1.5;
+  if (m.region) {
+    const [x, y] = toView(m.region[0] - 0.5, m.region[1] - 0.5);
+    ctx.strokeStyle = '#80c0ff'; ctx.setLineDash([4, 3]);
+    ctx.strokeRect(x, y, m.region[2] * scale, m.region[3] * scale);
+    ctx.setLineDash([]); ctx.fillStyle = '#80c0ff'; ctx.fillText('searched', x + 3, y + m.region[3] * scale - 4);
+  }
+  for (const c of m.candidates) {
+    const [x, y] = toView(c.x, c.y);
+    const r = Math.max(4, Math.sqrt(c.area / Math.PI) * scale + 3);
+    ctx.strokeStyle = ctx.fillStyle = VERDICT_COLOURS[c.verdict] || '#ff5050';
+    ctx.beginPath(); ctx.arc(x, y, r, 0, 2 * Math.PI); ctx.stroke();
+    ctx.fillText(c.verdict + ' ' + c.area.toFixed(0) + ' px\u00b2 circ ' + c.circularity.toFixed(2) +
+                 ' misfit ' + c.misfit.toFixed(2), x + r + 3, y + 4);
+  }
+  S.candidatesDrawn = m.candidates.length;
+}
+
+// ---- The HSV sliders of the active marker ---------------------------------------------------
+let sliding = -1, slideSent = 0;
+function showRanges(m) {
+  for (let i = 0; i < 6; i++) if (i !== sliding) $('hsv' + i).value = m.hsv[i];
+  for (let k = 0; k < 3; k++) $('hsvt' + k).textContent = m.hsv[2 * k] + '-' + m.hsv[2 * k + 1] + (k === 0 && m.hsv[0] > m.hsv[1] ? ' (wraps through red)' : '');
+  $('maskview').checked = m.mask_view;
+}
+for (let i = 0; i < 6; i++) {
+  const slider = $('hsv' + i);
+  const sendValue = () => send({type: 'hsv', index: i, value: Number(slider.value)});
+  // While dragged: at most ~12 ranges a second (each re-tracks the frame on screen).
+  slider.addEventListener('input', () => {
+    sliding = i;
+    if (Date.now() - slideSent > 80) { slideSent = Date.now(); sendValue(); }
+  });
+  slider.addEventListener('change', () => { sliding = -1; sendValue(); });
+}
+$('maskview').onchange = () => send({type: 'mask_view', on: $('maskview').checked});
 
 // The circle through base, middle and tip, drawn from base to tip through the middle.
 function drawArc(ctx, b, m, t) {
@@ -302,6 +362,8 @@ window.addEventListener('mouseup', () => {
   const clamp = (v, hi) => Math.min(Math.max(v, 0), hi);
   if (!d.moved) {
     const [x, y] = toImage(d.x0, d.y0);
+    // A point of an analysis tool, or a click on a trail (analysis.js), before a colour pick.
+    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), scale)) { drawView(); schedulePlot(); return; }
     send({type: 'pick', x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)});
     return;
   }
@@ -324,6 +386,8 @@ $('undo').onclick = () => send({type: 'undo'});
 $('reset').onclick = () => send({type: 'reset_reference'});
 $('record').onclick = () => send({type: 'record'});
 $('save').onclick = () => send({type: 'save', name: $('savename').value});
+$('load').onclick = () => { if ($('configs').value) send({type: 'load', name: $('configs').value}); };
+$('configs').addEventListener('focus', () => send({type: 'list_configs'}));
 $('take').onclick = () => send({type: 'take_control'});
 
 // Files made in the page, from what it has: the picture with its overlay, and the results.
@@ -340,8 +404,10 @@ S.csvText = () => {
   const frames = [...rows.keys()].sort((a, b) => a - b);
   if (!frames.length) return '';
   const columns = Object.keys(rows.get(frames[0])).filter((c) => c !== '_position');
+  const tools = S.toolColumns ? S.toolColumns() : [];  // The analysis tools' values after them.
   const field = (v) => (v === null || v === undefined ? '' : String(v));
-  return [columns.join(',')].concat(frames.map((f) => columns.map((c) => field(rows.get(f)[c])).join(','))).join('\n') + '\n';
+  const line = (row) => columns.map((c) => field(row[c])).concat(tools.map(([, value]) => field(value(row)))).join(',');
+  return [columns.concat(tools.map(([name]) => name)).join(',')].concat(frames.map((f) => line(rows.get(f)))).join('\n') + '\n';
 };
 $('csv').onclick = () => download('softsight-page.csv', new Blob([S.csvText()], {type: 'text/csv'}));
 
@@ -380,11 +446,12 @@ function drawTimeline() {
 }
 
 document.addEventListener('keydown', (e) => {
-  if (e.target.tagName === 'INPUT') return;
+  if (e.target.tagName === 'INPUT' || e.target.tagName === 'TEXTAREA') return;
   const keys = {' ': () => $('play').onclick(), '.': () => send({type: 'step', delta: 1}),
     ',': () => send({type: 'step', delta: -1}), 'm': () => send({type: 'method'}),
     'u': () => send({type: 'undo'}), 'b': () => send({type: 'reset_reference'}),
     'r': () => send({type: 'record'}),
+    'v': () => send({type: 'mask_view', on: !(S.status && S.status.mask_view)}),
     ']': () => seekBy(1), '[': () => seekBy(-1), 'ArrowRight': () => seekBy(1), 'ArrowLeft': () => seekBy(-1),
     'Home': () => send({type: 'seek', position: 0}), 'End': () => length() && send({type: 'seek', position: length() - 1})};
   if (keys[e.key]) { keys[e.key](); e.preventDefault(); return; }
@@ -407,6 +474,7 @@ function schedulePlot() {
 
 function series(row, key) {
   if (key === 'angle_deg') return row.angle_deg;
+  if (key.startsWith('tool:')) return S.toolSeries(key, row);
   const mm = row[key + '_mm'];
   return mm !== undefined ? mm : row[key + '_px'];
 }
@@ -423,14 +491,16 @@ function drawPlot() {
   const whole = length() > 1 && S.hello.fps > 0;
   const t0 = whole ? 0 : times[0];
   const t1 = whole ? (length() - 1) / S.hello.fps : Math.max(times[times.length - 1], t0 + 1e-3);
-  const laneH = h / PLOTS.length;
+  const lanes = PLOTS.concat(S.toolLanes ? S.toolLanes() : []);  // An analysis tool's lane each.
+  const laneH = h / lanes.length;
   const x = (t) => 40 + (t - t0) / (t1 - t0) * (w - 50);
-  PLOTS.forEach(([key, label], lane) => {
+  lanes.forEach(([key, label], lane) => {
     const values = sortedFrames.map((f) => series(rows.get(f), key));
     const finite = values.filter((v) => v !== null && v !== undefined);
     const top = lane * laneH;
     ctx.fillStyle = '#aaa'; ctx.font = '11px sans-serif';
-    ctx.fillText(label + (key !== 'angle_deg' && S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
+    const own = key === 'angle_deg' || key.startsWith('tool:');  // Their labels carry the unit.
+    ctx.fillText(label + (own ? '' : S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
     ctx.strokeStyle = '#333'; ctx.strokeRect(40, top + 2, w - 50, laneH - 4);
     if (!finite.length) return;
     // The 2nd to 98th percentile: a near-straight actuator's radius (tens of thousands of px
@@ -447,7 +517,8 @@ function drawPlot() {
       // A gap where the value is absent (a marker not found) or frames were not received (a
       // seek jumped over them), never a line through it.
       if (v === null || v === undefined) { drawing = false; return; }
-      if (i > 0 && sortedFrames[i] - sortedFrames[i - 1] > 1) drawing = false;
+      // (A camera's dropped frames are no gap: its frames come as they can.)
+      if (i > 0 && S.hello.seekable && sortedFrames[i] - sortedFrames[i - 1] > 1) drawing = false;
       if (!drawing) ctx.fillRect(x(times[i]) - 1, y(v) - 1, 3, 3);  // A lone point shows too.
       drawing ? ctx.lineTo(x(times[i]), y(v)) : ctx.moveTo(x(times[i]), y(v));
       drawing = true;
@@ -476,7 +547,17 @@ S.clientPoint = (x, y) => {
   return [r.left + (x + 0.5) * r.width / image.width, r.top + (y + 0.5) * r.height / image.height];
 };
 S.sendRaw = (text) => ws.send(text);
+S.send = send;
+S.log = log;
 S.row = (frame) => rows.get(frame) || null;
+// Every row received, in frame order (analysis.js: trails, the run's scale).
+let rowsInOrder = null;  // Rebuilt only when a row came since (sortedFrames reset).
+S.rowsIn = () => {
+  if (!sortedFrames) { sortedFrames = [...rows.keys()].sort((a, b) => a - b); rowsInOrder = null; }
+  if (!rowsInOrder || rowsInOrder.length !== sortedFrames.length) rowsInOrder = sortedFrames.map((f) => rows.get(f));
+  return rowsInOrder;
+};
+S.redraw = () => { drawView(); schedulePlot(); };
 
 window.addEventListener('resize', () => { drawView(); drawTimeline(); schedulePlot(); });
 connect();
