@@ -43,6 +43,9 @@ std::vector<size_t> BodyOrder(const TrackingConfig& config) {
 // at 30 fps. A damaged stretch of a recording lasts several frames; a marker that really moves
 // onto the place of one lost that long ago is missed for the frame or two it spends there.
 constexpr int64_t kRecentFrames = 30;
+// Frames missing from the source predicted over at most (two seconds at 30 fps): longer, a
+// track is lost anyway and its gate needs to grow no further.
+constexpr int64_t kMaxMissingFramesPredicted = 60;
 
 }  // namespace
 
@@ -81,6 +84,14 @@ void TrackingSession::restart(const TrackingConfig& config) {
 
 const FrameResult& TrackingSession::process(const Frame& frame) {
   const int64_t start = cv::getTickCount();
+  // Frames the source skipped (a camera that dropped them, an image sequence with numbers
+  // missing, frames a reader could not decode) passed for the markers too: their motion is
+  // predicted over each, as over a frame in which nothing was believed, so the gate reaches as
+  // far as they could have moved meanwhile. (A source that hides its drops cannot be helped.)
+  if (last_frame_ >= 0 && frame.index > last_frame_ + 1) {
+    const int64_t missing = std::min<int64_t>(frame.index - last_frame_ - 1, kMaxMissingFramesPredicted);
+    for (int64_t k = 0; k < missing; ++k) tracks_->skip();
+  }
   last_frame_ = frame.index;
   // A live recording's raw video names the live source's frames (config.recording).
   result_.frame_index = frame.index;
@@ -363,6 +374,7 @@ void TrackingSession::jump() {
     previous_px_[i].reset();
   }
   frame_change_ = std::make_unique<FrameChangeDetector>();
+  last_frame_ = -1;  // The frame sought is no later frame of the same run: nothing went missing.
 }
 
 void TrackingSession::set_metric(const MetricModel& metric) {
