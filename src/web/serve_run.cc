@@ -374,7 +374,9 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   answering = &server;
   std::vector<std::string> names;
   for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
-  WebSink sink(server, TrackingColumns(config), names, options.jpeg_quality);
+  // The page's values: the CSV's columns, a hook's too (after the hook's sink, first in sinks).
+  WebSink sink(server, TrackingColumns(config, options.live.extra_columns), names,
+               options.jpeg_quality);
   options.live.sinks.push_back(&sink);
   LiveController controller(config, options.live);
   sink.set_controller(&controller);
