@@ -51,21 +51,19 @@ bool MakePythonGlobal() {
   return dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL) != nullptr;  // Kept.
 }
 
-class Interpreter {
- public:
-  Interpreter() : global_(MakePythonGlobal()), interpreter_(/*init_signal_handlers=*/false) {
-    released_ = std::make_unique<py::gil_scoped_release>();
-  }
-  ~Interpreter() { released_.reset(); }  // Takes the GIL back before the interpreter ends.
-
- private:
-  bool global_;  // Before the interpreter: extension modules resolve against it.
-  py::scoped_interpreter interpreter_;
-  std::unique_ptr<py::gil_scoped_release> released_;
-};
-
+// The interpreter, started with the first hook (on whichever thread loads it: a test's, a batch
+// job's) and never finalized: Py_FinalizeEx at exit waits for the thread that started it, which
+// may be gone (a hang), and a second start after a finalize is not safe for extension modules
+// such as numpy. The process's end frees it. Ctrl-C stays the program's: no Python signal
+// handlers. The starting thread lets go of the GIL for good, so a hook may run on any thread.
 void StartInterpreter() {
-  static Interpreter interpreter;  // Once, also when several runs load hooks at once.
+  static const bool started = [] {
+    MakePythonGlobal();
+    py::initialize_interpreter(/*init_signal_handlers=*/false);
+    PyEval_SaveThread();
+    return true;
+  }();
+  (void)started;
 }
 
 // What a hook's `result` is: softsight.FrameResult's attributes that a hook reads, in plain
