@@ -262,3 +262,25 @@ for n in (0, 1, 10):
           f"wall {r['real_time']:.3f} ms, CPU {r['cpu_time']:.3f} ms | | without --publish: wall "
           f"{base['real_time']:.3f} ms, CPU {base['cpu_time']:.3f} ms |")
 PYEOF
+
+# The per-frame hook (--hook, issue 47): what HookSink::consume costs the run's thread per frame.
+echo
+echo "The per-frame hook (--hook), load average $(cut -d' ' -f1-3 /proc/loadavg):"
+echo
+build/src/app/softsight_hook_benchmark --benchmark_repetitions=5 \
+  --benchmark_report_aggregates_only=true --benchmark_out_format=json \
+  --benchmark_out="$WORK/hook.json" >/dev/null 2>"$WORK/hook.log"
+"$PY" - "$WORK" <<'PYEOF'
+import json, os, sys
+with open(os.path.join(sys.argv[1], "hook.json")) as f:
+    b = {x["name"]: x for x in json.load(f)["benchmarks"]}
+print("| hook | per frame (median of 5) | CPU |")
+print("| --- | --- | --- |")
+for name, label in (("BM_CppHookInTheRun", "trivial C++ hook, in the run (a file)"),
+                    ("BM_CppHookOnItsThread/real_time", "trivial C++ hook, on its own thread (a camera: VGA frame copied, handed over, waited for)"),
+                    ("BM_PythonEmptyHook", "empty Python hook file (`--hook`), in the run"),
+                    ("BM_PythonMarkerHook", "Python hook summing the markers' x, in the run")):
+    r = b[name + "_median"]
+    unit = {"ns": 1e-6, "us": 1e-3, "ms": 1.0}[r["time_unit"]]
+    print(f"| {label} | {r['real_time'] * unit:.4f} ms | {r['cpu_time'] * unit:.4f} ms |")
+PYEOF

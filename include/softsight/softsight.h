@@ -72,6 +72,7 @@
 #include "softsight/config/control_config.h"
 
 // pipeline: TrackingSession, RunPipeline, the sinks and the run's summary, two cameras.
+#include "softsight/pipeline/hook.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/sinks.h"

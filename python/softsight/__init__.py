@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Generator, Optional, Tuple, Union
+from typing import Callable, Dict, Generator, Optional, Sequence, Tuple, Union
 
 from . import _core, _progress
 from ._core import Config, FrameResult, InputError, Marker, Session, calib, geometry, load_config, sim
@@ -71,6 +71,9 @@ def track(
     csv: Optional[PathLike] = None,
     fps: float = 30.0,
     method: Optional[str] = None,
+    hook: Optional[Callable[..., Optional[Dict[str, Optional[float]]]]] = None,
+    hook_columns: Optional[Sequence[str]] = None,
+    hook_stop_on_error: bool = False,
 ) -> Table:
     """Tracks the markers of ``config`` in ``input`` and returns the CSV's columns.
 
@@ -84,6 +87,16 @@ def track(
     not know its length; an exception it raises ends the run and is raised here), True for a
     tqdm bar (a line on ``sys.stderr`` without tqdm), False or None for none (the default).
 
+    ``hook``: a callable ``hook(frame, result)`` run on every frame (``frame`` a read-only
+    numpy view of the BGR image, valid during the call: copy what you keep; ``result`` its
+    FrameResult) that returns a dict of column name -> number (None or NaN: an empty field) or
+    None; its columns are ``hook_columns`` (or the callable's ``columns`` attribute), after
+    the tracking columns in the table and the CSV (``--hook``, docs/usage.md). A hook that
+    raises has its traceback written to ``sys.stderr`` once, is switched off and the run goes
+    on (``table.summary["hook_error"]`` holds the traceback); with ``hook_stop_on_error`` the
+    run stops there and InputError is raised. A value that is not a number or a column not
+    declared raises InputError.
+
     Returns a Table (a dict of numpy arrays, one per CSV column, in order: ``frame`` int64,
     ``<marker>_found`` bool, ``<marker>_status`` and ``<marker>_track`` str, the rest float64 with NaN for an empty
     field) holding the same values as the CLI's CSV; ``table.summary`` has the run's summary.
@@ -93,10 +106,20 @@ def track(
     ``table`` attribute holds the rows before it (the CSV keeps them too, as the CLI's does).
     The GIL is released while frames are processed; Ctrl-C stops the run.
     """
+    if hook is not None:
+        if not callable(hook):
+            raise TypeError("hook: a callable hook(frame, result), got %s" % type(hook).__name__)
+        if hook_columns is None:
+            hook_columns = getattr(hook, "columns", None)
+        if hook_columns is None:
+            raise TypeError("hook_columns: the names of the values the hook returns, e.g. "
+                            "hook_columns=[\"tip_speed\"] (or a `columns` attribute of the hook)")
+        hook_columns = list(hook_columns) if isinstance(hook_columns, (list, tuple)) else hook_columns
     report = _progress.reporter(progress, "track", "frames")
     try:
         columns, summary = _core._track(
-            input, config, max_frames, report, None if csv is None else os.fspath(csv), fps, method
+            input, config, max_frames, report, None if csv is None else os.fspath(csv), fps, method,
+            hook, hook_columns, hook_stop_on_error
         )
     finally:
         if report is not None:

@@ -1,6 +1,6 @@
 # Type stubs for editors and type checkers: the public API of the softsight package.
 import os
-from typing import Any, Callable, Dict, Generator, List, Mapping, Optional, Tuple, Union
+from typing import Any, Callable, Dict, Generator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -144,6 +144,11 @@ def track(
     csv: Optional[PathLike] = None,
     fps: float = 30.0,
     method: Optional[str] = None,
+    hook: Optional[
+        Callable[[npt.NDArray[np.uint8], FrameResult], Optional[Mapping[str, Optional[float]]]]
+    ] = None,
+    hook_columns: Optional[Sequence[str]] = None,
+    hook_stop_on_error: bool = False,
 ) -> Table: ...
 def track_stereo(
     left: PathLike,

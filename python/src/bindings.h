@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 #include <yaml-cpp/yaml.h>
 
+#include "hook_call.h"
 #include "softsight/config/config.h"
 
 namespace softsight::python {
@@ -61,14 +62,7 @@ cv::Mat ImageHeader(const py::array& array, const std::string& what, py::object*
 // An image as a new numpy array (copied: the Mat's buffer is reused by its owner).
 py::array ToNumpy(const cv::Mat& image);
 
-// The measurement as a dict with the CSV's names, None where the CSV has an empty field (the
-// session's results and the renderer's truth both use it).
-py::dict MeasurementDict(const Measurement& m);
-
-// None for an absent value.
-inline py::object Optional(const std::optional<double>& value) {
-  return value ? py::object(py::float_(*value)) : py::object(py::none());
-}
+// MeasurementDict and Optional: hook_call.h (the program's embedded hooks use them too).
 
 // An (x, y) pair or a numpy array of two numbers as a point; throws ValueError naming `what`.
 cv::Point2d ToPoint(const py::handle& value, const char* what);

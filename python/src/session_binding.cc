@@ -131,22 +131,6 @@ void MeasurementProperty(Class& c, const char* name, std::optional<double> Measu
 
 }  // namespace
 
-py::dict MeasurementDict(const Measurement& m) {
-  py::dict out;
-  out["angle_deg"] = Optional(m.angle_deg);
-  out["chord_px"] = Optional(m.chord_px);
-  out["sagitta_px"] = Optional(m.sagitta_px);
-  out["radius_px"] = Optional(m.radius_px);
-  out["arc_length_px"] = Optional(m.arc_length_px);
-  out["circumradius_px"] = Optional(m.circumradius_px);
-  out["tip_disp_px"] = Optional(m.tip_disp_px);
-  out["chord_mm"] = Optional(m.chord_mm);
-  out["sagitta_mm"] = Optional(m.sagitta_mm);
-  out["radius_mm"] = Optional(m.radius_mm);
-  out["arc_length_mm"] = Optional(m.arc_length_mm);
-  out["tip_disp_mm"] = Optional(m.tip_disp_mm);
-  return out;
-}
 
 void BindSession(py::module_& m) {
   py::class_<MarkerObservation>(m, "Marker", R"doc(

@@ -16,6 +16,7 @@
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/io/run_source.h"
+#include "softsight/pipeline/hook.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
@@ -84,6 +85,29 @@ class ProgressCallback : public FrameSink {
   std::optional<int64_t> total_;
   int64_t done_ = 0;
   bool failed_ = false;
+};
+
+// hook=: a Python callable hook(frame, result) -> {column: number} run on every frame, in the
+// run's thread (a file's run: every row gets its values), holding the GIL only for the call.
+// `frame` is a read-only numpy view of the frame, `result` a softsight.FrameResult.
+class CallableHook : public FrameHook {
+ public:
+  CallableHook(py::object callable, std::vector<std::string> columns)
+      : callable_(std::move(callable)), columns_(std::move(columns)) {}
+  std::vector<std::string> columns() const override { return columns_; }
+  void on_frame(const Frame& frame, const FrameResult& result, HookValues& out) override {
+    py::gil_scoped_acquire gil;
+    try {
+      TakeValues(callable_(FrameView(frame.image), py::cast(result)), out);
+    } catch (py::error_already_set& error) {
+      // The hook's own failure: HookSink reports it (the traceback) and switches it off.
+      throw std::runtime_error(TracebackText(error));
+    }
+  }
+
+ private:
+  py::object callable_;
+  std::vector<std::string> columns_;
 };
 
 enum class Kind { kInt, kBool, kText, kNumber };
@@ -180,6 +204,9 @@ py::dict SummaryDict(const RunSummary& s) {
   out["stop_reason"] = s.stop_text();  // The report's words, as the stream's end record has them.
   out["error"] = s.ok() ? py::object(py::none()) : py::object(py::str(s.error));
   out["report"] = s.FullReport();
+  py::list notes;
+  for (const std::string& note : s.notes) notes.append(note);
+  out["notes"] = notes;  // The sinks' and the source's notes (a hook's: its calls, skips, failure).
   return out;
 }
 
@@ -208,7 +235,8 @@ FrameSourceSpec InputSpec(const py::object& input, double fps) {
 py::tuple Track(const py::object& input, const py::object& config_source,
                 std::optional<int64_t> max_frames, const py::object& progress,
                 const py::object& csv_path, double fps,
-                const std::optional<std::string>& method) {
+                const std::optional<std::string>& method, const py::object& hook_callable,
+                const py::object& hook_columns, bool hook_stop_on_error) {
   CheckMaxFrames(max_frames);
   const TrackingConfig config = ResolveConfig(config_source, method);
   const FrameSourceSpec spec = InputSpec(input, fps);
@@ -218,7 +246,27 @@ py::tuple Track(const py::object& input, const py::object& config_source,
     if (!csv) throw py::type_error("csv: a path (str, bytes or os.PathLike)");
   }
   RunSummary summary;
-  const CsvColumnTable table = TrackingColumns(config);
+  // hook=: its columns after the tracking ones, in the table and the CSV; its sink first.
+  std::optional<CallableHook> hook;
+  std::optional<HookSink> hook_sink;
+  std::optional<std::string> hook_error;
+  if (!hook_callable.is_none()) {
+    hook.emplace(hook_callable, ColumnNames(hook_columns, "hook_columns"));
+    HookOptions options;
+    options.stop_on_error = hook_stop_on_error;
+    // Its traceback once, where Python writes its errors (a notebook shows it).
+    options.on_error = [&hook_error, hook_stop_on_error](const std::string& error) {
+      hook_error = error;
+      py::gil_scoped_acquire gil;
+      py::module_::import("sys").attr("stderr").attr("write")(
+          std::string("softsight.track: the hook raised") +
+          (hook_stop_on_error ? ":\n" : "; it is switched off and the run goes on:\n") + error);
+    };
+    hook_sink.emplace(*hook, std::move(options));
+    hook_sink->check_against(TrackingColumns(config));
+  }
+  const CsvColumnTable table =
+      TrackingColumns(config, hook_sink ? hook_sink->columns() : std::vector<CsvColumn>{});
   RowSink rows(table);
   std::optional<ProgressCallback> progress_sink;  // Made and destroyed holding the GIL.
   if (!progress.is_none()) progress_sink.emplace(progress);
@@ -229,14 +277,16 @@ py::tuple Track(const py::object& input, const py::object& config_source,
     std::unique_ptr<FrameSource> source = SourceForRun(OpenFrameSource(spec), FilePacing::kReadAhead);
     TrackingSession session(config);
     std::optional<CsvSink> file;
-    std::vector<FrameSink*> sinks = {&rows};
+    std::vector<FrameSink*> sinks;
+    if (hook_sink) sinks.push_back(&*hook_sink);  // Before the rows that hold its columns.
+    sinks.push_back(&rows);
     if (csv) {
       // The same guard as the program's: the CSV may not be the video, an image of the
       // sequence, the config or a file the config names.
       std::vector<PathRole> inputs = ConfigInputs(config);
       for (const std::string& name : source->files()) inputs.push_back({"input", name});
       CheckOutputsAreNotInputs({{"csv", *csv}}, inputs);
-      file.emplace(*csv, TrackingColumns(config));
+      file.emplace(*csv, table);
       sinks.push_back(&*file);
     }
     if (progress_sink) sinks.push_back(&*progress_sink);
@@ -256,7 +306,9 @@ py::tuple Track(const py::object& input, const py::object& config_source,
     summary = RunPipeline(*source, session, sinks, run);
   }
   if (interrupted || (progress_sink && progress_sink->failed())) throw py::error_already_set();
-  return py::make_tuple(Columns(rows, table, config), SummaryDict(summary));
+  py::dict summary_dict = SummaryDict(summary);
+  summary_dict["hook_error"] = hook_error ? py::object(py::str(*hook_error)) : py::object(py::none());
+  return py::make_tuple(Columns(rows, table, config), summary_dict);
 }
 
 // softsight.frames' reader: the frames of `input` through the library's own source (videos,
@@ -339,7 +391,8 @@ void BindTrack(py::module_& m) {
       .def_property_readonly("done", &FrameStream::done);
 
   m.def("_track", &Track, py::arg("input"), py::arg("config"), py::arg("max_frames"),
-        py::arg("progress"), py::arg("csv"), py::arg("fps"), py::arg("method"),
+        py::arg("progress"), py::arg("csv"), py::arg("fps"), py::arg("method"), py::arg("hook"),
+        py::arg("hook_columns"), py::arg("hook_stop_on_error"),
         "softsight.track without the table: (columns dict, summary dict).");
 }
 

@@ -111,6 +111,9 @@ ControlTarget CheckedTarget(const ControlOptions& options) {
                      "(or the simulated rig with --simulate), not --camera, --rig-frames or "
                      "--input");
   }
+  if (options.stereo && !options.hook.file.empty()) {
+    throw InputError("control --stereo: --hook is not offered with two cameras yet");
+  }
   if (options.stereo && options.publish) {
     throw InputError("control --stereo: --publish is not offered with two cameras yet");
   }
@@ -546,6 +549,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   // Optional for an identification (`softsight identify` without --csv).
   const bool write_csv = !options.csv_file.empty() || !options.identify;
   std::optional<CsvSink> csv;
+  std::unique_ptr<CommandHook> hook;  // --hook: after the controller, before the CSV.
   std::optional<BasicCsvWriter<StereoFrameResult>> stereo_csv;
   if (pairs) {
     if (write_csv) {
@@ -553,10 +557,17 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
                          StereoCsvColumns(control, experiment, options.identify, *pairs));
     }
   } else {
-    CsvColumnTable columns = TrackingColumns(
-        tracking_config,
+    std::vector<CsvColumn> extra =
         ControlColumns<FrameResult>(control, experiment, options.identify,
-                                    frames.rendered ? &frames.rendered->truth() : nullptr));
+                                    frames.rendered ? &frames.rendered->truth() : nullptr);
+    // A camera's hook runs beside the loop (the board's watchdog waits for nobody); a rendered
+    // rig or a file's runs in it, every frame.
+    hook = CommandHook::Open(options.hook, frames.source->is_live(),
+                             TrackingColumns(tracking_config, extra), std::cerr);
+    if (hook) {
+      for (CsvColumn& column : hook->columns()) extra.push_back(std::move(column));
+    }
+    CsvColumnTable columns = TrackingColumns(tracking_config, extra);
     columns.insert_before("latency_row_ms", control.latency_column());
     if (publish) publish->set_columns(columns);
     if (write_csv) csv.emplace(options.csv_file, std::move(columns));
@@ -566,6 +577,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   std::vector<FrameSink*> sinks;
   if (rig && !rendered) sinks.push_back(&rig_clock.emplace(*rig));
   sinks.push_back(&control);  // Before the CSV and the stream: their columns read this frame's step.
+  if (hook) sinks.push_back(&hook->sink());  // Sees the step too; before the columns it fills.
   if (csv) sinks.push_back(&*csv);
   if (publish) sinks.push_back(publish.get());
   // What the stream and the target's source add to the summary's notes.
@@ -831,6 +843,7 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
   auto publish = std::make_shared<PublishArgs>();
   AddPublishOptions(sub, publish.get());
+  AddHookOptions(sub, &o->hook);
   auto stereo = std::make_shared<ControlStereoOptions>();
   control_parts::AddControlStereoOptions(sub, stereo.get());
   return [o, auto_tune, closed_loop_s, publish, stereo, &sub] {

@@ -17,6 +17,7 @@
 #include "softsight/io/camera_settings.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/sim/stereo_scene.h"
+#include "app/python_hook.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
@@ -68,6 +69,8 @@ struct ControlOptions {
   double target_wait_s = 10.0;
   // --publish: every frame's record (the CSV's columns) to subscribers as it happens.
   std::optional<PublishOptions> publish;
+  // --hook: a Python file run on every frame, its values in the CSV and the stream.
+  HookArgs hook;
   std::string csv_file;
   std::optional<double> duration_s;     // Default: the profile's length + 2 s, or 10 s.
   double fps = 30.0;                    // Frame rate of simulate / rig_frames.

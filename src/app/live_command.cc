@@ -9,10 +9,12 @@
 #include "app/capture_options.h"
 #include "app/commands.h"
 #include "app/publish_options.h"
+#include "app/python_hook.h"
 #include "softsight/core/error.h"
 #include "gui/live_window.h"
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/io/output_guard.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/track/tracker.h"
 
@@ -30,8 +32,10 @@ struct LiveArgs {
   std::optional<double> scale_distance_mm;
   bool no_pace = false;
   bool no_trackbars = false;
+  std::string csv;  // Every frame the window tracks, as the stream has them.
   CaptureArgs capture;
   PublishArgs publish;
+  HookArgs hook;
 };
 
 // markers.yaml -> markers.live.yaml beside it: saving never overwrites the hand-written config.
@@ -65,8 +69,24 @@ int RunLive(const LiveArgs& args) {
   // The stream sees every frame the window tracks (stepped and sought ones too, by their own
   // frame numbers); its columns are those of the config as the window opens.
   const std::unique_ptr<PublishSink> publish = OpenPublishSink(args.publish.resolved(), args.config);
+  // The hook first among the sinks: the CSV, the stream and the recordings write its columns.
+  // From a camera it runs beside the window's loop; a file waits for it on every frame.
+  const std::unique_ptr<CommandHook> hook =
+      CommandHook::Open(args.hook, source->is_live(), TrackingColumns(config), std::cerr);
+  if (hook) {
+    options.sinks.push_back(&hook->sink());
+    options.extra_columns = hook->columns();
+  }
+  std::optional<CsvSink> csv;
+  if (!args.csv.empty()) {
+    std::vector<PathRole> inputs = ConfigInputs(config);
+    for (const std::string& file : source->files()) inputs.push_back({"--input", file});
+    CheckOutputsAreNotInputs({{"--csv", args.csv}}, inputs);
+    csv.emplace(args.csv, TrackingColumns(config, options.extra_columns));
+    options.sinks.push_back(&*csv);
+  }
   if (publish) {
-    publish->set_columns(TrackingColumns(config));
+    publish->set_columns(TrackingColumns(config, options.extra_columns));
     options.sinks.push_back(publish.get());
   }
   std::cerr << "softsight live: " << source->description() << ", " << config.markers.size()
@@ -77,10 +97,9 @@ int RunLive(const LiveArgs& args) {
   FrameSourceOpener reopen;
   if (!source->is_live()) reopen = [spec] { return OpenFrameSource(spec); };
   LiveRunResult run = RunLiveWindow(config, std::move(source), options, window, reopen);
-  if (publish) {
-    publish->end(run.summary.run);
-    publish->report(run.summary.run);
-  }
+  // The window's run does not end the program's sinks: they end here, with its summary.
+  for (FrameSink* sink : options.sinks) sink->end(run.summary.run);
+  for (FrameSink* sink : options.sinks) sink->report(run.summary.run);
   std::cerr << run.summary.Report();
   if (!run.last_recording.empty()) {
     std::cerr << "softsight live: last recording " << run.last_recording << ".*\n";
@@ -144,7 +163,11 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
                "Read a video file as fast as it decodes instead of at its frame rate");
   sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");
   AddCaptureOptions(sub, &args->capture);
+  sub.add_option("--csv", args->csv,
+                 "Also write a CSV row for every frame the window tracks (stepped and sought "
+                 "ones too, by their own frame numbers), as `track --csv` does");
   AddPublishOptions(sub, &args->publish);
+  AddHookOptions(sub, &args->hook);
   return [args] { return RunLive(*args); };
 }
 

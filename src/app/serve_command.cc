@@ -8,12 +8,14 @@
 
 #include "app/capture_options.h"
 #include "app/commands.h"
+#include "app/python_hook.h"
 #include "app/scene_config.h"
 #include "app/serve_rig.h"
 #include "app/stop_request.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/track/tracker.h"
 #include "web/access.h"
 #include "web/serve_run.h"
@@ -34,6 +36,7 @@ struct ServeArgs {
   bool no_pace = false;
   CaptureArgs capture;
   ServeRigArgs rig;
+  HookArgs hook;
 };
 
 int RunServeCommand(ServeArgs args) {
@@ -82,9 +85,20 @@ int RunServeCommand(ServeArgs args) {
   FrameSourceOpener reopen;
   // A file can be opened again to seek in it; the simulated rig's frames cannot (nor a camera's).
   if (!source->is_live() && !args.rig.simulate) reopen = [spec] { return OpenFrameSource(spec); };
+  // The hook first among the sinks: the page and the recordings show its columns.
+  const std::unique_ptr<CommandHook> hook =
+      CommandHook::Open(args.hook, source->is_live(), TrackingColumns(config), std::cerr);
+  if (hook) {
+    options.live.sinks.push_back(&hook->sink());
+    options.live.extra_columns = hook->columns();
+  }
   StopRequest stop;
   LiveRunResult run = RunServe(config, std::move(source), options, reopen,
                                [&stop] { return stop.requested(); }, std::cout);
+  if (hook) {  // The run does not end the program's sinks: the hook ends here, with its summary.
+    hook->sink().end(run.summary.run);
+    hook->sink().report(run.summary.run);
+  }
   std::cerr << run.summary.Report();
   if (!run.last_recording.empty()) {
     std::cerr << "softsight serve: last recording " << run.last_recording << ".*\n";
@@ -152,6 +166,7 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
   simulate->excludes(camera);
   simulate->excludes(input);
   AddCaptureOptions(sub, &args->capture);
+  AddHookOptions(sub, &args->hook);
   return [args] { return RunServeCommand(*args); };
 }
 

@@ -88,11 +88,18 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   // Sinks in the order they see each frame; every output is opened (and checked) before the run,
   // the stream's endpoint first: a bad one is refused before the CSV is made.
   const std::unique_ptr<PublishSink> publish = OpenPublishSink(options.publish, options.config_file);
-  CsvSink csv(options.csv_file, TrackingColumns(config));
-  std::vector<FrameSink*> sinks = {&csv};
+  // The hook before the CSV: a bad hook file is refused before the CSV is made. A file's run
+  // waits for the hook on every frame (every row has its values); a camera's does not.
+  const std::unique_ptr<CommandHook> hook =
+      CommandHook::Open(options.hook, source->is_live(), TrackingColumns(config), std::cerr);
+  const std::vector<CsvColumn> hook_columns = hook ? hook->columns() : std::vector<CsvColumn>{};
+  CsvSink csv(options.csv_file, TrackingColumns(config, hook_columns));
+  std::vector<FrameSink*> sinks;
+  if (hook) sinks.push_back(&hook->sink());  // Before every sink that writes its columns.
+  sinks.push_back(&csv);
   if (publish) {
     // Right after the CSV: each frame's record leaves as its row is written.
-    publish->set_columns(TrackingColumns(config));
+    publish->set_columns(TrackingColumns(config, hook_columns));
     sinks.push_back(publish.get());
   }
   std::optional<VideoSink> annotated;
@@ -189,6 +196,7 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
   AddPublishOptions(sub, publish.get());
+  AddHookOptions(sub, &options->hook);
   return [options, inputs, jobs, capture, publish] {
     options->publish = publish->resolved();
     const bool from_files = !inputs->empty() || !options->source.input.empty();

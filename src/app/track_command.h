@@ -14,6 +14,7 @@
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/summary.h"
+#include "app/python_hook.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
@@ -32,6 +33,8 @@ struct TrackOptions {
   std::optional<int64_t> max_frames;
   // --publish: every frame's record to subscribers as it happens (stream/publish_sink.h).
   std::optional<PublishOptions> publish;
+  // --hook: a Python file run on every frame, its values in the CSV and the stream.
+  HookArgs hook;
   bool quiet = false;                        // No progress bar, no summary.
   bool brief = false;                        // No progress bar, a one-line summary.
 };

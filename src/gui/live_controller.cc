@@ -58,7 +58,8 @@ LiveController::LiveController(const TrackingConfig& config, LiveOptions options
   // The session holds the only copy of the config: every live edit goes through it, and `s`
   // and recordings save what it holds; the pipeline feeds it and its sinks (the recording).
   pipeline_ = std::make_unique<LivePipeline>(
-      config, LiveRecordingSettings{options_.record_prefix, std::move(before_encode)},
+      config,
+      LiveRecordingSettings{options_.record_prefix, std::move(before_encode), options_.extra_columns},
       options_.sinks);
   for (const MarkerSpec& spec : config.markers) {
     // Its keys of other kinds in the file (a template marker's colour keys) are those methods'

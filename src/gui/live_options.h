@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "softsight/calib/hsv_picker.h"
+#include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/sink.h"
 #include "gui/overlay.h"
 
@@ -46,6 +47,9 @@ struct LiveOptions {
   // in the window's run (PipelineRun) from its first frame. Not owned; the caller ends them when
   // RunLiveWindow returns, with its summary.
   std::vector<FrameSink*> sinks;
+  // Columns a recording's CSV has after the tracking ones (`--hook`: the hook's, whose sink is
+  // first in `sinks`), the same for every recording.
+  std::vector<CsvColumn> extra_columns;
 
   bool Check(std::string* error) const;
 };

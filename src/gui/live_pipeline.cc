@@ -82,7 +82,7 @@ const FrameResult& LivePipeline::start_recording(
   // files first: when that fails, the session is as it was.
   auto recording = std::make_unique<LiveRecording>(
       settings_.prefix, snapshot, info, RecordingOrigin{frame.index, frame.time_s},
-      std::move(draw), settings_.before_encode);
+      std::move(draw), settings_.before_encode, settings_.extra_columns);
   recording->begin(info);
   // Built afresh from the recording's config before the recording listens (these are its start,
   // not edits made during it): `track` on the recording starts from that config alone, without

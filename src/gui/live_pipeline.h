@@ -31,6 +31,8 @@ struct LiveRecordingSettings {
   std::string prefix = "softsight-live";  // Files <prefix>-NNN.{csv,raw.avi,avi,yaml}.
   // Tests: both videos' encoder hook (AsyncFrameWriter), to make an encoder fall behind.
   std::function<void(int64_t index)> before_encode;
+  // The recordings' CSV columns after the tracking ones (LiveOptions::extra_columns).
+  std::vector<CsvColumn> extra_columns;
 };
 
 class LivePipeline {

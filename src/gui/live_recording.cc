@@ -29,9 +29,10 @@ std::string FreePrefix(const std::string& base) {
 
 LiveRecording::LiveRecording(const std::string& base, const TrackingConfig& config,
                              const RunInfo& info, const RecordingOrigin& origin, FrameDrawer draw,
-                             std::function<void(int64_t index)> before_encode)
+                             std::function<void(int64_t index)> before_encode,
+                             const std::vector<CsvColumn>& extra_columns)
     : prefix_(FreePrefix(base)), info_(info) {
-  auto csv = std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config));
+  auto csv = std::make_unique<CsvSink>(prefix_ + ".csv", TrackingColumns(config, extra_columns));
   auto raw = std::make_unique<VideoSink>(prefix_ + ".raw.avi", "", info.fps, FrameDrawer{},
                                          before_encode);
   auto annotated = std::make_unique<VideoSink>(prefix_ + ".avi", "mjpg", info.fps, std::move(draw),

@@ -31,9 +31,11 @@ class LiveRecording : public FrameSink {
   // The videos keep every frame: an encoder a whole queue behind holds up the window (counted;
   // `info.live`, a camera: a deeper queue, see VideoSink). `before_encode` (tests): both videos'
   // encoder hook (AsyncFrameWriter).
+  // `extra_columns`: the CSV's columns after the tracking ones (a hook's: LiveOptions).
   LiveRecording(const std::string& base, const TrackingConfig& config, const RunInfo& info,
                 const RecordingOrigin& origin, FrameDrawer draw,
-                std::function<void(int64_t index)> before_encode = {});
+                std::function<void(int64_t index)> before_encode = {},
+                const std::vector<CsvColumn>& extra_columns = {});
   ~LiveRecording() override;  // Closes every file, if end() has not.
 
   // Starts the files for frames of the size given at construction (`info` is the run's: the

@@ -2,6 +2,7 @@
 // The screenshot is Xvfb's own framebuffer (-fbdir writes the screen as an XWD file), so no
 // screenshot tool is needed; keys reach the window through xdotool (XTEST), as a person's would.
 #include <fcntl.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/test_util.h"
@@ -24,6 +25,7 @@
 #include "gui/live_view.h"  // StatusBandHeight
 #include "gui/live_test_util.h"
 #include "gui/overlay.h"
+#include "app/scene_markers_test_util.h"
 #include "app/stereo_test_util.h"
 #include "calib/stereo_test_util.h"
 #include "softsight/calib/stereo_calibration.h"
@@ -489,6 +491,64 @@ TEST_F(LiveWindowTest, WithoutADisplayOneErrorSuggestsTrack) {
             2)
       << output;
   EXPECT_NE(output.find("cannot open display ':59999'"), std::string::npos) << output;
+}
+
+// Issue 47's done line: a Python hook in `live --input synth:bending` adds its own column to the
+// CSV and the stream, with the values it computed (the markers' x summed, checked against the
+// CSV's own columns); `listen` gets the same column and values.
+TEST_F(LiveWindowTest, APythonHookAddsItsColumnToTheCsvAndTheStream) {
+  const std::string config = (dir_ / "markers.yaml").string();
+  std::ofstream(config) << testing::kScaledSceneMarkersYaml;
+  const std::string hook = (dir_ / "h.py").string();
+  std::ofstream(hook) << "columns = ['x_sum']\n"
+                         "def on_frame(frame, result):\n"
+                         "    if all(m.found for m in result.markers):\n"
+                         "        return {'x_sum': sum(m.x for m in result.markers)}\n";
+  const std::string csv = (dir_ / "out.csv").string(), heard = (dir_ / "heard.csv").string();
+  const std::string endpoint = "ipc://" + (dir_ / "s.ipc").string();
+  const std::string display = StartXvfb();
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  Child listen = Spawn({binary_, "listen", endpoint, "--csv", heard, "--quiet", "--timeout-s", "60"},
+                       {}, true);
+  ASSERT_GT(listen.pid, 0);
+  live_ = Spawn({binary_, "live", "--input", "synth:bending", "--config", config, "--no-trackbars",
+                 "--no-pace", "--hook", hook, "--csv", csv, "--publish", endpoint,
+                 "--publish-wait", "1"},
+                {"DISPLAY=" + display}, true);
+  ASSERT_GT(live_.pid, 0);
+  std::string output;
+  ASSERT_TRUE(WaitForOutput(live_, "end of input", 60s, &output)) << output;
+  const std::vector<std::string> env = {"DISPLAY=" + display};
+  std::string out;
+  ASSERT_EQ(FocusLiveWindow(env, &out), 0) << out;
+  ASSERT_EQ(RunProcess({"xdotool", "key", "q"}, env, &out), 0) << out;
+  WaitForOutput(live_, "\x01never", 20s, &output);  // The summary, until it exits.
+  EXPECT_EQ(WaitExit(live_, 20s), 0) << output;
+  live_.pid = -1;
+  EXPECT_THAT(output, ::testing::HasSubstr("hook " + hook + ": values in 300 of 300 rows"));
+  std::string listened;
+  WaitForOutput(listen, "\x01never", 20s, &listened);
+  EXPECT_EQ(WaitExit(listen, 20s), 0) << listened;
+
+  const CsvTable table = ReadCsvTable(csv);
+  ASSERT_EQ(table.row_count(), 300u);
+  const size_t sum = table.find("x_sum").value();
+  int summed = 0;
+  for (size_t r = 0; r < table.row_count(); ++r) {
+    const auto x = [&](const char* name) { return table.values[table.find(name).value()][r]; };
+    if (x("red_x") && x("blue_x") && x("green_x")) {
+      ASSERT_TRUE(table.values[sum][r]) << r;
+      EXPECT_NEAR(*table.values[sum][r], *x("red_x") + *x("blue_x") + *x("green_x"), 1e-3) << r;
+      ++summed;
+    } else {
+      EXPECT_FALSE(table.values[sum][r]) << r;
+    }
+  }
+  EXPECT_GT(summed, 250);
+  const CsvTable stream = ReadCsvTable(heard);
+  EXPECT_EQ(stream.columns, table.columns);
+  ASSERT_EQ(stream.row_count(), table.row_count());
+  EXPECT_EQ(stream.values[sum], table.values[sum]) << "the stream has the hook's values";
 }
 
 TEST_F(LiveWindowTest, PlotCommandWritesTheFigure) {

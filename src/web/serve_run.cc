@@ -562,7 +562,9 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   answering = &server;
   std::vector<std::string> names;
   for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
-  WebSink sink(server, TrackingColumns(config), names, options.jpeg_quality);
+  // The page's values: the CSV's columns, a hook's too (after the hook's sink, first in sinks).
+  WebSink sink(server, TrackingColumns(config, options.live.extra_columns), names,
+               options.jpeg_quality);
   // The rig's loop steps on each frame before the frame goes out: its state travels with it.
   if (options.rig != nullptr) options.live.sinks.push_back(options.rig);
   options.live.sinks.push_back(&sink);
