@@ -6,20 +6,22 @@
 # Debian packages python3-numpy, python3-pytest, python3-dask install for /usr/bin/python3).
 
 set(_softsight_python_default OFF)
-if(NOT SOFTSIGHT_SANITIZE)  # An ASan-built module cannot be loaded by an uninstrumented python.
-  if(NOT Python3_EXECUTABLE)
-    find_program(_softsight_path_python3 NAMES python3 NO_CACHE)
-    foreach(candidate IN ITEMS ${_softsight_path_python3} /usr/bin/python3)
-      if(EXISTS "${candidate}")
-        execute_process(COMMAND "${candidate}" -c "import numpy"
-                        RESULT_VARIABLE _softsight_numpy_rc OUTPUT_QUIET ERROR_QUIET)
-        if(_softsight_numpy_rc EQUAL 0)
-          set(Python3_EXECUTABLE "${candidate}" CACHE FILEPATH "Python for the softsight module")
-          break()
-        endif()
+# Chosen in every tree, the sanitizer's too: the program embeds this interpreter for --hook
+# (src/app), and a hook's frame is a numpy array.
+if(NOT Python3_EXECUTABLE)
+  find_program(_softsight_path_python3 NAMES python3 NO_CACHE)
+  foreach(candidate IN ITEMS ${_softsight_path_python3} /usr/bin/python3)
+    if(EXISTS "${candidate}")
+      execute_process(COMMAND "${candidate}" -c "import numpy"
+                      RESULT_VARIABLE _softsight_numpy_rc OUTPUT_QUIET ERROR_QUIET)
+      if(_softsight_numpy_rc EQUAL 0)
+        set(Python3_EXECUTABLE "${candidate}" CACHE FILEPATH "Python for the softsight module")
+        break()
       endif()
-    endforeach()
-  endif()
+    endif()
+  endforeach()
+endif()
+if(NOT SOFTSIGHT_SANITIZE)  # An ASan-built module cannot be loaded by an uninstrumented python.
   if(Python3_EXECUTABLE)
     find_package(Python3 3.8 COMPONENTS Interpreter Development.Module NumPy)
     set(PYBIND11_FINDPYTHON ON)
