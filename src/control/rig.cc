@@ -175,9 +175,9 @@ void RigServer::serve() {
     // At the reply limit nothing more is answered: the last answers are delivered, and the next
     // request (the host read them all) marks the point where disconnect() may close the line.
     const bool at_limit = reply_limit_ != 0 && replies_ >= reply_limit_;
-    // A short timeout: shutdown and disconnect are seen within 5 ms whatever the host does.
     // At the limit a request is only looked at once every answer is out; it is never read.
     const bool look_for_requests = !(at_limit && waiting_to_write);
+    // A short timeout: shutdown and disconnect are seen within 5 ms whatever the host does.
     pollfd p{pty_.master_fd(),
              static_cast<short>((look_for_requests ? POLLIN : 0) | (waiting_to_write ? POLLOUT : 0)),
              0};

@@ -24,19 +24,9 @@ namespace softsight {
 namespace {
 
 using ::testing::HasSubstr;
+using testing::SmallScene;
 using testing::TempDir;
 using testing::ThreeMarkerSceneConfig;
-
-SceneOptions HookScene(int frames) {
-  SceneOptions scene;
-  scene.size = {320, 240};
-  scene.length_px = 150;
-  scene.width_px = 24;
-  scene.marker_radius_px = 6;
-  scene.frame_count = frames;
-  scene.max_bend_deg = 120;
-  return scene;
-}
 
 // A hook given as a function, with its columns.
 class FunctionHook : public FrameHook {
@@ -70,7 +60,7 @@ struct HookRun {
 
 HookRun RunWithHook(const TempDir& dir, HookSink& hook, int frames,
                     std::vector<FrameSink*> after = {}) {
-  std::unique_ptr<FrameSource> source = OpenSyntheticSource(HookScene(frames), NoiseOptions{});
+  std::unique_ptr<FrameSource> source = OpenSyntheticSource(SmallScene(frames), NoiseOptions{});
   const TrackingConfig config = ThreeMarkerSceneConfig();
   TrackingSession session(config);
   const CsvColumnTable table = TrackingColumns(config);

@@ -23,18 +23,8 @@ namespace {
 using testing::ThreeMarkerSceneConfig;
 
 using ::testing::HasSubstr;
+using testing::SmallScene;
 using testing::TempDir;
-
-SceneOptions SmallScene(int frames) {
-  SceneOptions scene;
-  scene.size = {320, 240};
-  scene.length_px = 150;
-  scene.width_px = 24;
-  scene.marker_radius_px = 6;
-  scene.frame_count = frames;
-  scene.max_bend_deg = 120;
-  return scene;
-}
 
 // Remembers what it was given, and can ask the run to stop or fail after some frames.
 class RecordingSink : public FrameSink {

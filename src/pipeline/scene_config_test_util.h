@@ -5,6 +5,7 @@
 #include <string>
 
 #include "softsight/config/config.h"
+#include "softsight/sim/scene.h"
 
 namespace softsight::testing {
 
@@ -29,6 +30,18 @@ inline TrackingConfig ThreeMarkerSceneConfig() {
   config.measure.middle = "blue";
   config.measure.tip = "green";
   return config;
+}
+
+// The default bending scene, small (320x240, 6 px markers) so a run of many frames is quick.
+inline SceneOptions SmallScene(int frames) {
+  SceneOptions scene;
+  scene.size = {320, 240};
+  scene.length_px = 150;
+  scene.width_px = 24;
+  scene.marker_radius_px = 6;
+  scene.frame_count = frames;
+  scene.max_bend_deg = 120;
+  return scene;
 }
 
 }  // namespace softsight::testing
