@@ -303,7 +303,11 @@ BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
     evidence.excess_asymmetry_px = blob.asymmetry_px - model.asymmetry_px;
   }
   evidence.rim_placed = blob.rim_placed;
-  if (blob.rim_placed) evidence.area_px = std::max(blob.area_px, model.area_px);
+  if (blob.rim_placed) {
+    evidence.area_px = std::max(blob.area_px, model.area_px);
+  } else {
+    evidence.centroid_disagreement_px = cv::norm(blob.centroid_px - blob.binary_centroid_px);
+  }
   return evidence;
 }
 }  // namespace

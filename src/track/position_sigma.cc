@@ -12,6 +12,7 @@ constexpr double kFloorPx = 0.05;            // Quantisation and compression: an
 constexpr double kBlobShapePerRadius = 0.04;  // Segmentation bias, per px of the blob's radius.
 constexpr double kRimPlacedPerRadius = 0.10;  // A circle fitted to part of a rim.
 constexpr double kAsymmetryShare = 0.5;       // Of the excess asymmetry.
+constexpr double kDisagreementShare = 1.0;    // Of the soft and binary centroids' disagreement.
 constexpr double kMatchShapePerSize = 0.02;   // A match's drift, per px of the template's half size.
 constexpr double kMatchMisfitPerSize = 0.25;  // Per px of half size and unit of (1 - zncc).
 
@@ -32,7 +33,9 @@ double BlobCentroidSigmaPx(const BlobEvidence& blob) {
   const double shape = (blob.rim_placed ? kRimPlacedPerRadius : kBlobShapePerRadius) * r;
   const double noise = NoiseSigmaPx(blob);
   const double asymmetry = kAsymmetryShare * std::max(blob.excess_asymmetry_px, 0.0);
-  return std::sqrt(kFloorPx * kFloorPx + shape * shape + noise * noise + asymmetry * asymmetry);
+  const double disagreement = kDisagreementShare * blob.centroid_disagreement_px;
+  return std::sqrt(kFloorPx * kFloorPx + shape * shape + noise * noise + asymmetry * asymmetry +
+                   disagreement * disagreement);
 }
 
 double TemplateMatchSigmaPx(double zncc, double template_width_px, double template_height_px,

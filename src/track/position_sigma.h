@@ -22,6 +22,11 @@ struct BlobEvidence {
   // smeared by motion), px.
   double excess_asymmetry_px = 0;
   bool rim_placed = false;     // The centre is a circle fitted to part of the rim.
+  // How far the reported (soft) centroid lies from the mask's own (binary) one, px. On a flat
+  // printed dot both agree to a few hundredths; where they part, what is marker and what is not
+  // is uncertain at the rim (a lit dome's pale flank, its shaded one outside the hue range), and
+  // the truth is about as far from either.
+  double centroid_disagreement_px = 0;
 };
 
 // Per axis, px: a colour blob's (or a template's blob's) centroid.

@@ -31,6 +31,20 @@ TEST(PositionSigma, ABlobsSigmaGrowsWithSizeNoisePartialViewAndARimFit) {
   EXPECT_GT(BlobCentroidSigmaPx(rim), base);
 }
 
+TEST(PositionSigma, ABlobsSigmaCoversTheSoftAndBinaryCentroidsDisagreement) {
+  // A lit dome: its pale flank counts little in the soft centroid, its shaded one, outside the hue
+  // range, counts in it alone; the two centroids part by 0.9 px and the truth lies about as far
+  // (the physically rendered fast bend: 1.3-1.9 px from the soft one, 0.3-1.0 from the binary).
+  const double base = BlobCentroidSigmaPx(Disc(8));
+  BlobEvidence dome = Disc(8);
+  dome.centroid_disagreement_px = 0.9;
+  EXPECT_GE(BlobCentroidSigmaPx(dome), 0.9);
+  // A flat printed dot's centroids agree to a few hundredths: its sigma barely moves.
+  BlobEvidence dot = Disc(8);
+  dot.centroid_disagreement_px = 0.03;
+  EXPECT_LT(BlobCentroidSigmaPx(dot), base + 0.01);
+}
+
 TEST(PositionSigma, AMatchsSigmaGrowsAsTheMatchFitsLess) {
   const BlobEvidence none;
   const double good = TemplateMatchSigmaPx(0.99, 31, 31, none);

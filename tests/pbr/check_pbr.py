@@ -34,6 +34,10 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TOL = 1.5   # px: a report farther than this from the truth is wrong (issue 43)
+# A found position's sigma (<marker>_sigma_px, per axis) must cover its error: at least this share
+# of the found marker-frames within 3 sigma along both axes, none beyond 5 (renderer truth has
+# no error of its own).
+WITHIN_3_SIGMA_FLOOR = 98.0
 
 # scene: what it shows, and per config: (config file, floor of found visible marker-frames in %,
 # None or why it is known to fail today). The input is the scene's video.avi or video.mp4.
@@ -121,7 +125,7 @@ def score(track_csv, truth_csv, name_map, group):
     for r in truth:
         by_frame.setdefault(int(r['frame']), {})[r['marker']] = r
     s = dict(visible=0, found=0, wrong=0, covered=0, reported_covered=0, errors=[], worst=None,
-             angle=[], per_marker={})
+             angle=[], per_marker={}, within_3_sigma=0, beyond_5_sigma=0)
     for r in truth:
         name = name_map[r['marker']]
         row = rows.get(int(r['frame']))
@@ -137,8 +141,12 @@ def score(track_csv, truth_csv, name_map, group):
             continue
         s['found'] += 1
         pm[0] += 1
-        d = math.hypot(float(row[f'{name}_x']) - float(r['x']), float(row[f'{name}_y']) - float(r['y']))
+        ex, ey = float(row[f'{name}_x']) - float(r['x']), float(row[f'{name}_y']) - float(r['y'])
+        d = math.hypot(ex, ey)
         s['errors'].append(d)
+        normalised = max(abs(ex), abs(ey)) / float(row[f'{name}_sigma_px'])
+        s['within_3_sigma'] += normalised <= 3
+        s['beyond_5_sigma'] += normalised > 5
         if d > TOL:
             s['wrong'] += 1
             if s['worst'] is None or d > s['worst'][0]:
@@ -192,6 +200,12 @@ def run_scene(program, name, case, keep):
             problems.append(f"{s['reported_covered']} reported found while less than half visible")
         if s['rate'] < floor:
             problems.append(f"found {s['rate']:.1f} % < floor {floor:g} %")
+        s['sigma_rate'] = 100.0 * s['within_3_sigma'] / max(1, s['found'])
+        if s['found'] and s['sigma_rate'] < WITHIN_3_SIGMA_FLOOR:
+            problems.append(f"{s['sigma_rate']:.1f} % of the found positions within 3 sigma "
+                            f"< {WITHIN_3_SIGMA_FLOOR:g} %")
+        if s['beyond_5_sigma']:
+            problems.append(f"{s['beyond_5_sigma']} found positions beyond 5 sigma")
         s['problems'] = problems
         ok = ok and (not problems or known is not None)
         results.append(s)
@@ -278,8 +292,8 @@ def main():
         return 0 if all_ok else 1
     if a.markdown:
         print('| scene | config | found (floor) | per marker | wrong (> 1.5 px) | reported while covered '
-              '| median / RMS px | angle error median / max |')
-        print('| --- | --- | --- | --- | --- | --- | --- | --- |')
+              '| median / RMS px | within 3 sigma / beyond 5 | angle error median / max |')
+        print('| --- | --- | --- | --- | --- | --- | --- | --- | --- |')
     for name in a.scene or list(CASES):
         ok, results = run_scene(program, name, CASES[name], a.keep)
         all_ok = all_ok and ok
@@ -295,13 +309,15 @@ def main():
             if a.markdown:
                 print(f"| {name} | {s['config']}{mark} | {s['found']}/{s['visible']} = {s['rate']:.1f} % "
                       f"({s['floor']:g} %) | {per} | {s['wrong']} | {s['reported_covered']} of "
-                      f"{s['covered']} | {spread} | {angle} |")
+                      f"{s['covered']} | {spread} | {s['sigma_rate']:.1f} % / {s['beyond_5_sigma']} "
+                      f"| {angle} |")
             else:
                 verdict = ('KNOWN' if s['known'] else 'FAIL') if s['problems'] else 'ok'
                 print(f"{verdict} {name} {s['config']}: found {s['found']}/{s['visible']} "
                       f"({s['rate']:.1f} %, floor {s['floor']:g} %; {per}), wrong (> {TOL:g} px) "
                       f"{s['wrong']}, reported while covered {s['reported_covered']} of {s['covered']}, "
                       f"median {median(s['errors']):.2f} px, RMS {rms(s['errors']):.2f} px, "
+                      f"within 3 sigma {s['sigma_rate']:.1f} % (beyond 5: {s['beyond_5_sigma']}), "
                       f"angle error {angle}{mark}"
                       + ''.join(f'\n    {p}' for p in s['problems'])
                       + (f"\n    known: {s['known']}" if s['known'] and s['problems'] else ''))
