@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <thread>
@@ -223,6 +224,20 @@ class LiveWindowTest : public ::testing::Test {
     return display;
   }
 
+  // The screen once `drawn` holds for it (the window's picture reaches Xvfb's screen file a
+  // moment after the program says what it shows, later on a loaded machine), else the last one
+  // read when `timeout` runs out, for the assertions to say what is missing.
+  cv::Mat ScreenWhen(const std::function<bool(const cv::Mat&)>& drawn,
+                     std::chrono::seconds timeout = 20s) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+    while (!(!screen.empty() && drawn(screen)) && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(50ms);
+      screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+    }
+    return screen;
+  }
+
   std::string binary_;
   fs::path dir_;
   Child xvfb_;
@@ -248,9 +263,16 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   ASSERT_GT(live.pid, 0);
   std::string output;
   ASSERT_TRUE(WaitForOutput(live, "end of input", 60s, &output)) << output;
-  std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
-
-  const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+  // The last frame on screen: its pixels where the overlay does not draw (found below).
+  const auto last_frame_shown = [&](const cv::Mat& screen) {
+    if (screen.cols < last.cols || screen.rows < last.rows) return false;
+    cv::Mat score;
+    cv::matchTemplate(screen, last, score, cv::TM_CCOEFF_NORMED);
+    double best = 0;
+    cv::minMaxLoc(score, nullptr, &best);
+    return best > 0.9;
+  };
+  const cv::Mat screen = ScreenWhen(last_frame_shown);
   ASSERT_FALSE(screen.empty()) << "cannot read Xvfb's screen file";
   EXPECT_EQ(screen.size(), cv::Size(800, 720));
   // Where is the window's image? Match the raw last frame: the overlay covers only a little.
@@ -286,12 +308,17 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
   const std::vector<std::string> env = {"DISPLAY=" + display};
   ASSERT_EQ(FocusLiveWindow(env, &xdotool_output), 0) << xdotool_output;
   ASSERT_EQ(RunProcess({"xdotool", "key", "h"}, env, &xdotool_output), 0) << xdotool_output;
-  std::this_thread::sleep_for(700ms);
-  const cv::Mat with_help = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
-  ASSERT_FALSE(with_help.empty());
   // The help is a panel right of the image, which stays as it was: no marker is hidden.
   const cv::Rect help_block(shown.x + shown.width + 4, shown.y + 4, 150, 120);
-  ASSERT_LE(help_block.x + help_block.width, with_help.cols);
+  ASSERT_LE(help_block.x + help_block.width, screen.cols);
+  const auto light_in_help_block = [&](const cv::Mat& on_screen) {
+    cv::Mat gray;
+    cv::cvtColor(on_screen(help_block), gray, cv::COLOR_BGR2GRAY);
+    return cv::countNonZero(gray > 200);
+  };
+  const cv::Mat with_help =
+      ScreenWhen([&](const cv::Mat& on_screen) { return light_in_help_block(on_screen) > 200; });
+  ASSERT_FALSE(with_help.empty());
   cv::Mat help_gray;
   cv::cvtColor(with_help(help_block), help_gray, cv::COLOR_BGR2GRAY);
   EXPECT_GT(cv::countNonZero(help_gray > 200), 200) << "no key list right of the image";
@@ -309,10 +336,8 @@ TEST_F(LiveWindowTest, OverlayIsDrawnWhereTheMarkersAreAndKeysAndMouseWork) {
                        env, &xdotool_output),
             0)
       << xdotool_output;
-  const std::string saved = (dir_ / "markers.live.yaml").string();
-  for (int i = 0; i < 50 && !fs::exists(saved); ++i) std::this_thread::sleep_for(100ms);
-  std::this_thread::sleep_for(200ms);
-  const TrackingConfig picked = LoadTrackingConfig(saved);
+  ASSERT_TRUE(WaitForOutput(live, "live: saved", 20s, &output)) << output;
+  const TrackingConfig picked = LoadTrackingConfig((dir_ / "markers.live.yaml").string());
   ASSERT_EQ(picked.markers.size(), 3u);
   const HsvRange h = picked.markers[1].params.get<ColourParams>().h;
   EXPECT_TRUE(h.lo != 95 || h.hi != 125) << "the click did not change blue's range";
@@ -352,18 +377,21 @@ TEST_F(LiveWindowTest, A720pVideoFitsALaptopScreenStepsBackAndClicksPickTheRight
                                               StatusBandHeight(), /*timeline=*/true);
   ASSERT_LE(layout.canvas.width, 1366);
   ASSERT_LE(layout.canvas.height, 768);
+  const auto rings_on = [&](const cv::Mat& screen, int index, int m) {
+    const cv::Point2d at = layout.to_view(*truth[index].markers[m].centroid_px);
+    return RingPoints(screen, at, cvRound(12 * layout.scale_x()));
+  };
   const auto expect_rings_on = [&](int index) {
-    std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
-    const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
+    const cv::Mat screen = ScreenWhen([&](const cv::Mat& on_screen) {
+      return rings_on(on_screen, index, 0) >= 18 && rings_on(on_screen, index, 1) >= 18;
+    });
     ASSERT_FALSE(screen.empty());
     // The strip chart's dark background is on screen, under the scaled image.
     const cv::Rect chart = layout.chart & cv::Rect(0, 0, screen.cols, screen.rows);
     EXPECT_EQ(chart, layout.chart);
     EXPECT_LT(cv::mean(screen(chart))[0], 70);
     for (int m = 0; m < 2; ++m) {
-      const cv::Point2d at = layout.to_view(*truth[index].markers[m].centroid_px);
-      EXPECT_GE(RingPoints(screen, at, cvRound(12 * layout.scale_x())), 18)
-          << truth[index].markers[m].name << " frame " << index;
+      EXPECT_GE(rings_on(screen, index, m), 18) << truth[index].markers[m].name << " frame " << index;
     }
   };
   expect_rings_on(11);
@@ -677,11 +705,18 @@ TEST_F(TrackStereoWindowTest, BothViewsOnScreenAndSpacePausesAndQStops) {
   const int paused = std::stoi(output.substr(at));
   ASSERT_GE(paused, 0);
   ASSERT_LT(paused, kFrames) << "ended before the pause";
-  std::this_thread::sleep_for(500ms);  // Let the X server finish drawing.
-  const cv::Mat screen = ReadXwdScreen((dir_ / "Xvfb_screen0").string());
-  ASSERT_FALSE(screen.empty()) << "cannot read Xvfb's screen file";
   // The window at the screen's top-left (no window manager), the views at full size side by
   // side: each marker's ring around its true position in each view of the paused pair.
+  const cv::Mat screen = ScreenWhen([&](const cv::Mat& on_screen) {
+    for (const StereoMarkerTruth& m : truths_[paused].markers) {
+      if (RingPoints(on_screen, m.left_px) < 20 ||
+          RingPoints(on_screen, m.right_px + cv::Point2d(640, 0)) < 20) {
+        return false;
+      }
+    }
+    return true;
+  });
+  ASSERT_FALSE(screen.empty()) << "cannot read Xvfb's screen file";
   for (const StereoMarkerTruth& m : truths_[paused].markers) {
     EXPECT_GE(RingPoints(screen, m.left_px), 20) << m.name << " left, frame " << paused;
     EXPECT_GE(RingPoints(screen, m.right_px + cv::Point2d(640, 0)), 20)
