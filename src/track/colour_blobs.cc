@@ -427,6 +427,31 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   blob->whole_ring_contrast =
       std::sqrt(axis2) /
       (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  if (chromatic) {
+    // Against the whole ring in chroma too: a coloured marker on speckled or shaded silicone
+    // stands out in chroma from all of its surroundings at once, while their dark and bright
+    // pixels spread the levels; a patch of the bench's texture differs from them in brightness,
+    // its chroma about the same (kMinWholeRingChromaSpan).
+    cv::Vec3d ring_chroma_sum(0, 0, 0);
+    cv::Matx33d ring_chroma_outer = cv::Matx33d::zeros();
+    for (int q = 0; q < kQuarters; ++q) {
+      ring_chroma_sum += quarter_chroma_sum[q];
+      ring_chroma_outer += quarter_chroma_outer[q];
+    }
+    const cv::Vec3d core_chroma = core_chroma_sum / core_n;
+    const cv::Vec3d ring_chroma = ring_chroma_sum / ring_n;
+    const cv::Vec3d chroma_direction = core_chroma - ring_chroma;
+    const double chroma_distance = std::sqrt(chroma_direction.dot(chroma_direction));
+    if (chroma_distance >= kMinWholeRingChromaSpan) {
+      const double core_along =
+          spread_along(chroma_direction, core_chroma_outer, core_chroma, core_n, 3);
+      const double ring_along =
+          spread_along(chroma_direction, ring_chroma_outer, ring_chroma, ring_n, 3);
+      blob->whole_ring_contrast =
+          std::max(blob->whole_ring_contrast,
+                   chroma_distance / (kCoreSigmaWeight * core_along + ring_along + kChromaNoiseFloor));
+    }
+  }
   if (quarters == 0) {
     blob->contrast = blob->whole_ring_contrast;
   } else {

@@ -55,6 +55,11 @@ constexpr double kCoreSigmaWeight = 0.5;
 // grey levels at mid brightness).
 constexpr double kMinChromaContrastSpan = 0.05;
 constexpr double kChromaNoiseFloor = 0.005;
+// The contrast against the whole ring in chromaticity, which a whole-frame search with nothing
+// learned (init) relies on, only where the blob's chromaticity differs from its whole ring's by
+// this much: coloured domes on a bench's actuator differ by 0.20-0.34 (physically rendered,
+// under front and side light), a peg hole's shadow or a tinted patch of wood by up to 0.16.
+constexpr double kMinWholeRingChromaSpan = 0.18;
 
 // ---- Verification (ColourTracker::judge) -----------------------------------------------------------
 // A candidate whose contrast is below this does not stand out from its surroundings.

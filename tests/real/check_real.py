@@ -54,7 +54,11 @@ CASES = {
                  ('pick_cart1', {'cart1': 'green'}, '', 96.0),
                  ('auto', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 96.0),
                  ('zncc', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 96.0),
-                 ('mistake', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 16.0)]),
+                 # One yellow range for both carts and no roi: the two dots fit alike, so both
+                 # markers are `ambiguous` in every frame (until the whole-ring contrast was judged
+                 # in chroma too, the second dot did not stand out in frames 0-5 and the first was
+                 # taken); nothing may be reported wrong.
+                 ('mistake', {'cart1': 'cart1', 'cart2': 'cart2'}, '', 0.0)]),
     'balltoss': dict(
         what='OSP Tracker: a white ball thrown over black cloth (reference: hand clicks)',
         input='BallToss_new_BallToss.mp4', args=[], tol=3.0, ref_sigma=1.0,
