@@ -317,7 +317,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
   auto args = std::make_shared<Args>();
   sub.description(
       "Write a marker config without a GUI: find the markers in one frame by themselves\n"
-      "(compact, saturated blobs of distinct colours; on gray video white or black dots), take\n"
+      "(compact, saturated blobs of distinct colours; else white or black dots), take\n"
       "each one's HSV range from its own pixels (as a click in `live` does), order them from\n"
       "base (the end that stays put in the frames that follow) to tip, and write the config\n"
       "(markers, roi, triple or chain) plus a picture of what was found (green rings, numbered\n"

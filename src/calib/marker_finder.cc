@@ -538,14 +538,18 @@ MarkerFinding FindMarkers(const cv::Mat& input, const MarkerFinderOptions& optio
   if (input.channels() == 1) cv::cvtColor(input, frame, cv::COLOR_GRAY2BGR);
   if (IsGrayFrame(frame)) return FindMarkersAs(frame, options, true);
   MarkerFinding colour = FindMarkersAs(frame, options, false);
-  // Hardly any colour and no coloured blob that could be a marker at all (not look-alikes
-  // refused, which stay refused): white or black dots on footage stored in colour.
-  if (colour.markers.empty() && colour.problem.rfind("no markers", 0) == 0 &&
-      IsNearlyGrayFrame(frame)) {
+  // No coloured blob that could be a marker at all (not look-alikes refused, which stay
+  // refused): white or black dots, on footage stored in colour (hardly any colour: one dot is
+  // enough) or on a colourful bench (white domes on a dark actuator before a pegboard). There a
+  // lone bright blob is more likely a lamp or a glint than a set of markers: two at least, which
+  // the dots' own checks judge as usual (many alike, a pegboard's holes, are refused).
+  if (colour.markers.empty() && colour.problem.rfind("no markers", 0) == 0) {
+    const bool nearly_gray = IsNearlyGrayFrame(frame);
     MarkerFinding dots = FindMarkersAs(frame, options, true);
-    if (!dots.markers.empty()) {
-      dots.notes.push_back("no coloured marker in a frame with hardly any colour: white or black "
-                           "dots, by gray level");
+    if (dots.markers.size() >= (nearly_gray ? 1u : 2u)) {
+      dots.notes.push_back(nearly_gray ? "no coloured marker in a frame with hardly any colour: "
+                                         "white or black dots, by gray level"
+                                       : "no coloured marker: white or black dots, by gray level");
       return dots;
     }
   }

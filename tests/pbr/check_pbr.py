@@ -280,8 +280,8 @@ INIT_EXPECTED = {
     'side': 2,
     # caps of the markers' colours in view: init will not guess which blob is the marker
     'distractors': None,
-    # white dots on colour video: init looks for saturated blobs (gray video: white or black dots)
-    'whitedots': None,
+    # white dots on a colourful bench: no coloured marker, so white or black dots by gray level
+    'whitedots': 3,
 }
 
 
