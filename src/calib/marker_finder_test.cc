@@ -81,5 +81,36 @@ TEST(MarkerFinder, WhiteDotsOnColourFootageOfAGrayBenchAreFoundAndWrittenWithout
   EXPECT_TRUE(said);
 }
 
+// White dots on a colourful bench (strongly tinted blotches): no coloured blob could be a
+// marker, so the dots are found by gray level. A lone white blob there (a lamp, a glint) is not
+// taken for a set of markers: init refuses.
+TEST(MarkerFinder, WhiteDotsOnAColourfulBenchAreFoundButALoneBrightBlobIsNot) {
+  testing::DotSceneOptions options;
+  options.tint_sigma = 30.0;
+  const cv::Point2d layout[3] = {{200, 300}, {320, 240}, {440, 200}};
+  std::vector<testing::DotShape> shapes;
+  for (const cv::Point2d& p : layout) {
+    shapes.push_back({{7, 7}, {245, 245, 245}, {}, 0, {}, [p](double) { return testing::DotPose{p}; }});
+  }
+  const MarkerFinding finding = FindMarkers(testing::DotScene(options, shapes).render(0), {});
+  ASSERT_TRUE(finding.ok()) << finding.problem;
+  EXPECT_TRUE(finding.intensity);
+  ASSERT_EQ(finding.markers.size(), 3u);
+  for (const FoundMarker& m : finding.markers) {
+    double nearest = 1e9;
+    for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
+    EXPECT_LT(nearest, 0.5) << m.spec.name;
+  }
+  bool said = false;  // The colourful frame's path, not the one for frames with hardly any colour.
+  for (const std::string& note : finding.notes) {
+    said = said || note == "no coloured marker: white or black dots, by gray level";
+  }
+  EXPECT_TRUE(said);
+  shapes.resize(1);
+  const MarkerFinding lone = FindMarkers(testing::DotScene(options, shapes).render(0), {});
+  EXPECT_FALSE(lone.ok());
+  EXPECT_TRUE(lone.markers.empty());
+}
+
 }  // namespace
 }  // namespace softsight
