@@ -784,6 +784,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   cv::Point2d centroid;
   double area = 0;
   const cv::Mat unmasked;
+  blob_disagreement_px_ = 0.0;
   if (!blob_.Locate(blob_gray_, unmasked, expected, &centroid, &area)) {
     return std::nullopt;
   }
@@ -795,10 +796,13 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   if (!blob_reported_ && cv::norm(shift) <= kBlobAgreePx) {
     return cv::Point2d(0, 0);
   }
-  // To be applied: measured with the soft centroid.
+  // To be applied: measured with the soft centroid (how far it lies from the binary one goes
+  // into the position's sigma: track/position_sigma.h).
+  const cv::Point2d binary = centroid;
   if (!blob_.MeasureLocated(blob_gray_, unmasked, &centroid, &area)) {
     return std::nullopt;
   }
+  blob_disagreement_px_ = cv::norm(centroid - binary);
   shift = centroid - expected;
   const double reach = std::max(kMinBlobShiftPx, 0.25 * std::min(size.width, size.height));
   if (!(cv::norm(shift) <= reach)) return std::nullopt;
@@ -1032,7 +1036,10 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   observation.position_px = at.reported;
   observation.score = score;
   BlobEvidence blob;
-  if (blob_ok_) blob.area_px = blob_.area() * rung_scale() * rung_scale();
+  if (blob_ok_) {
+    blob.area_px = blob_.area() * rung_scale() * rung_scale();
+    blob.centroid_disagreement_px = blob_disagreement_px_;
+  }
   const cv::Size size = current().templ.size();
   observation.sigma_px = TemplateMatchSigmaPx(fix->zncc, size.width, size.height, blob);
   return observation;

@@ -184,6 +184,9 @@ class TemplateTracker final : public Tracker {
   // The marker's blob in the template: every match is verified against it (BlobShift).
   BlobMeter blob_;
   bool blob_ok_ = false;                // The template shows a blob (its foreground).
+  // This frame's blob: how far its soft centroid lies from its binary one (0 when only the
+  // binary one was needed: the match already on the blob).
+  double blob_disagreement_px_ = 0.0;
   bool chroma_ok_ = false;              // ... measured in its chromaticity (chroma_).
   ChromaAxis chroma_;
   // The blob's centroid, measured in every frame, is the reported point (report: centre, or a
