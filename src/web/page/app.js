@@ -19,7 +19,11 @@ const rows = new Map();      // frame -> its row (the CSV's columns)
 let sortedFrames = null;     // Cache of rows' keys in order, for the plots.
 let image = null;            // The ImageBitmap on screen.
 let imageFrame = -1;
-let scale = 1;               // Canvas pixels per image pixel.
+let scale = 1;               // Canvas pixels per image pixel, the whole image in view.
+// Zoom and pan: `zoom` times the fitted size, the view's top left at image point (ox, oy)
+// (pixel edges: the image spans 0..width). k = scale * zoom: CSS pixels per image pixel.
+let zoom = 1, ox = 0, oy = 0;
+const MAX_ZOOM = 16;
 let pending = null, decoding = false;  // Newest-wins decoding of frames.
 let ws = null;
 
@@ -229,9 +233,33 @@ function cssContext(c) {
   return ctx;
 }
 
-// Pixel centres are at integers: image pixel (x, y) is at ((x + 0.5) s, (y + 0.5) s) in the view.
-const toView = (x, y) => [(x + 0.5) * scale, (y + 0.5) * scale];
-const toImage = (vx, vy) => [vx / scale - 0.5, vy / scale - 0.5];
+// Pixel centres are at integers: image pixel (x, y) is at ((x + 0.5 - ox) k, (y + 0.5 - oy) k)
+// in the view, whatever the zoom: every click and every overlay goes through these two.
+const viewScale = () => scale * zoom;
+const toView = (x, y) => [(x + 0.5 - ox) * viewScale(), (y + 0.5 - oy) * viewScale()];
+const toImage = (vx, vy) => [vx / viewScale() + ox - 0.5, vy / viewScale() + oy - 0.5];
+
+// Keeps the view inside the image (no empty margin at any zoom).
+function clampPan() {
+  if (!image) return;
+  ox = Math.min(Math.max(ox, 0), image.width - image.width / zoom);
+  oy = Math.min(Math.max(oy, 0), image.height - image.height / zoom);
+}
+// Zooms by `factor` about the view point (vx, vy) (CSS pixels): the image point under it stays.
+function zoomAt(vx, vy, factor) {
+  if (!image) return;
+  const ex = vx / viewScale() + ox, ey = vy / viewScale() + oy;  // Pixel-edge coordinates.
+  zoom = Math.min(MAX_ZOOM, Math.max(1, zoom * factor));
+  ox = ex - vx / viewScale(); oy = ey - vy / viewScale();
+  clampPan();
+  showZoom();
+  drawView();
+}
+function resetZoom() { zoom = 1; ox = 0; oy = 0; showZoom(); drawView(); }
+function showZoom() {
+  $('zoomtext').textContent = zoom > 1.001 ? zoom.toFixed(zoom < 10 ? 2 : 1) + 'x' : '';
+  $('zoomreset').disabled = zoom <= 1.001;
+}
 
 function markerPoint(row, name) {
   return row && row[name + '_found'] === 1 ? [row[name + '_x'], row[name + '_y']] : null;
@@ -241,11 +269,14 @@ function drawView() {
   if (!image) return;
   fitView();
   const ctx = cssContext(view);
-  ctx.drawImage(image, 0, 0, image.width * scale, image.height * scale);
+  clampPan();
+  // Zoomed in, the pixels are shown as they are (square), not blurred into each other.
+  ctx.imageSmoothingEnabled = zoom < 2;
+  ctx.drawImage(image, ox, oy, image.width / zoom, image.height / zoom, 0, 0, image.width * scale, image.height * scale);
   const row = rows.get(imageFrame);
   if (S.shownMask) drawCandidates(ctx);
   else if (row && S.hello) drawOverlay(ctx, row);
-  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS);
+  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS, viewScale());
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
@@ -286,12 +317,12 @@ function drawCandidates(ctx) {
   if (m.region) {
     const [x, y] = toView(m.region[0] - 0.5, m.region[1] - 0.5);
     ctx.strokeStyle = '#80c0ff'; ctx.setLineDash([4, 3]);
-    ctx.strokeRect(x, y, m.region[2] * scale, m.region[3] * scale);
-    ctx.setLineDash([]); ctx.fillStyle = '#80c0ff'; ctx.fillText('searched', x + 3, y + m.region[3] * scale - 4);
+    ctx.strokeRect(x, y, m.region[2] * viewScale(), m.region[3] * viewScale());
+    ctx.setLineDash([]); ctx.fillStyle = '#80c0ff'; ctx.fillText('searched', x + 3, y + m.region[3] * viewScale() - 4);
   }
   for (const c of m.candidates) {
     const [x, y] = toView(c.x, c.y);
-    const r = Math.max(4, Math.sqrt(c.area / Math.PI) * scale + 3);
+    const r = Math.max(4, Math.sqrt(c.area / Math.PI) * viewScale() + 3);
     ctx.strokeStyle = ctx.fillStyle = VERDICT_COLOURS[c.verdict] || '#ff5050';
     ctx.beginPath(); ctx.arc(x, y, r, 0, 2 * Math.PI); ctx.stroke();
     ctx.fillText(c.verdict + ' ' + c.area.toFixed(0) + ' px\u00b2 circ ' + c.circularity.toFixed(2) +
@@ -334,28 +365,54 @@ function drawArc(ctx, b, m, t) {
   const ccw = norm(am - ab) < norm(at - ab);  // The middle lies on the way from base to tip.
   const [vx, vy] = toView(cx, cy);
   ctx.strokeStyle = 'rgba(255,220,0,0.9)'; ctx.lineWidth = 1.5;
-  ctx.beginPath(); ctx.arc(vx, vy, r * scale, ab, at, !ccw); ctx.stroke();
+  ctx.beginPath(); ctx.arc(vx, vy, r * viewScale(), ab, at, !ccw); ctx.stroke();
 }
 
 // ---- Mouse on the picture: click picks a colour, a drag reselects ---------------------------
-let drag = null;
-// The pointer in the view's CSS pixels (scale per image pixel), from where it is on screen.
+// The wheel zooms about the pointer, a right (or middle) drag pans, "whole image" (z) resets.
+let drag = null, panning = null;
+// The pointer in the view's CSS pixels (k per image pixel), from where it is on screen.
 function viewPoint(event) {
   const rect = view.getBoundingClientRect();
   return [(event.clientX - rect.left) * view.clientWidth / rect.width,
           (event.clientY - rect.top) * view.clientHeight / rect.height];
 }
+let pointer = null;  // The last view point the mouse was at (the keys zoom about it).
+view.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  const [x, y] = viewPoint(e);
+  // One notch (100 px of deltaY) is a factor of sqrt(2); a touchpad's small steps zoom smoothly.
+  const delta = e.deltaMode === 1 ? e.deltaY * 33 : e.deltaY;
+  zoomAt(x, y, Math.pow(2, -delta / 200));
+}, {passive: false});
+view.addEventListener('contextmenu', (e) => e.preventDefault());
 view.addEventListener('mousedown', (e) => {
   const [x, y] = viewPoint(e);
+  if (e.button !== 0) {
+    e.preventDefault();
+    panning = {x, y, ox, oy};
+    return;
+  }
   drag = {x0: x, y0: y, x1: x, y1: y, moved: false};
 });
+view.addEventListener('mouseleave', () => { pointer = null; });
+window.addEventListener('mousemove', (e) => {
+  if (!panning) return;
+  const [x, y] = viewPoint(e);
+  ox = panning.ox - (x - panning.x) / viewScale();
+  oy = panning.oy - (y - panning.y) / viewScale();
+  clampPan();
+  drawView();
+});
 view.addEventListener('mousemove', (e) => {
+  pointer = viewPoint(e);
   if (!drag) return;
   [drag.x1, drag.y1] = viewPoint(e);
   drag.moved = drag.moved || Math.hypot(drag.x1 - drag.x0, drag.y1 - drag.y0) > 4;
   if (drag.moved) drawView();
 });
 window.addEventListener('mouseup', () => {
+  if (panning) { panning = null; return; }
   if (!drag || !image) { drag = null; return; }
   const d = drag;
   drag = null;
@@ -363,15 +420,15 @@ window.addEventListener('mouseup', () => {
   if (!d.moved) {
     const [x, y] = toImage(d.x0, d.y0);
     // A point of an analysis tool, or a click on a trail (analysis.js), before a colour pick.
-    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), scale)) { drawView(); schedulePlot(); return; }
+    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), viewScale())) { drawView(); schedulePlot(); return; }
     send({type: 'pick', x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)});
     return;
   }
-  // Whole pixels covered by the box.
-  const x0 = clamp(Math.round(Math.min(d.x0, d.x1) / scale), image.width - 1);
-  const y0 = clamp(Math.round(Math.min(d.y0, d.y1) / scale), image.height - 1);
-  const x1 = clamp(Math.round(Math.max(d.x0, d.x1) / scale), image.width);
-  const y1 = clamp(Math.round(Math.max(d.y0, d.y1) / scale), image.height);
+  // Whole pixels covered by the box (pixel edges: the view's point plus half a pixel).
+  const [ax, ay] = toImage(Math.min(d.x0, d.x1), Math.min(d.y0, d.y1));
+  const [bx, by] = toImage(Math.max(d.x0, d.x1), Math.max(d.y0, d.y1));
+  const x0 = clamp(Math.round(ax + 0.5), image.width - 1), y0 = clamp(Math.round(ay + 0.5), image.height - 1);
+  const x1 = clamp(Math.round(bx + 0.5), image.width), y1 = clamp(Math.round(by + 0.5), image.height);
   send({type: 'select', x: x0, y: y0, w: x1 - x0, h: y1 - y0});
   drawView();
 });
@@ -389,6 +446,7 @@ $('save').onclick = () => send({type: 'save', name: $('savename').value});
 $('load').onclick = () => { if ($('configs').value) send({type: 'load', name: $('configs').value}); };
 $('configs').addEventListener('focus', () => send({type: 'list_configs'}));
 $('take').onclick = () => send({type: 'take_control'});
+$('zoomreset').onclick = resetZoom;
 
 // Files made in the page, from what it has: the picture with its overlay, and the results.
 function download(name, blob) {
@@ -451,12 +509,19 @@ document.addEventListener('keydown', (e) => {
     ',': () => send({type: 'step', delta: -1}), 'm': () => send({type: 'method'}),
     'u': () => send({type: 'undo'}), 'b': () => send({type: 'reset_reference'}),
     'r': () => send({type: 'record'}),
+    '+': () => zoomKey(Math.SQRT2), '=': () => zoomKey(Math.SQRT2), '-': () => zoomKey(Math.SQRT1_2),
+    'z': resetZoom,
     'v': () => send({type: 'mask_view', on: !(S.status && S.status.mask_view)}),
     ']': () => seekBy(1), '[': () => seekBy(-1), 'ArrowRight': () => seekBy(1), 'ArrowLeft': () => seekBy(-1),
     'Home': () => send({type: 'seek', position: 0}), 'End': () => length() && send({type: 'seek', position: length() - 1})};
   if (keys[e.key]) { keys[e.key](); e.preventDefault(); return; }
   if (e.key >= '1' && e.key <= '9') send({type: 'marker', index: Number(e.key) - 1});
 });
+// The keys zoom about the pointer when it is on the picture, else about the picture's centre.
+function zoomKey(factor) {
+  const [x, y] = pointer || [view.clientWidth / 2, view.clientHeight / 2];
+  zoomAt(x, y, factor);
+}
 function seekBy(seconds) {
   if (!S.status || !length()) return;
   const fps = S.hello.fps || 30;
@@ -544,8 +609,12 @@ plot.addEventListener('click', (e) => {
 // Where image pixel (x, y) is on the screen, from the picture's place and size alone.
 S.clientPoint = (x, y) => {
   const r = view.getBoundingClientRect();
-  return [r.left + (x + 0.5) * r.width / image.width, r.top + (y + 0.5) * r.height / image.height];
+  const [vx, vy] = toView(x, y);
+  return [r.left + vx * r.width / view.clientWidth, r.top + vy * r.height / view.clientHeight];
 };
+// The image point (pixel centres at integers) under a point of the screen, and the zoom.
+S.imagePoint = (clientX, clientY) => toImage(...viewPoint({clientX, clientY}));
+S.zoom = () => ({zoom, ox, oy, k: viewScale()});
 S.sendRaw = (text) => ws.send(text);
 S.send = send;
 S.log = log;
