@@ -299,6 +299,31 @@ def test_zoomed_pick(page, blue, frame):
     wait_for("the whole image", lambda: page.state("window.softsight.zoom().zoom") == 1)
 
 
+def test_mm_scale(page, truth, frame, earlier):
+    """Two points 400 px apart clicked with the mm scale tool and "100" typed: the scene's own
+    scale (synth renders 0.25 mm per px). The frame on screen is measured again in mm, its chord
+    the truth's within 0.5 %; a row from before the scale is plotted in mm too (its px times the
+    scale); the readout says mm."""
+    page.click_button("toolscale")
+    page.click_image_point(100.0, 440.0)
+    page.click_image_point(500.0, 440.0)
+    field = page.driver.find_element("id", "scalemm")
+    wait_for("the distance field", lambda: field.is_displayed())
+    from selenium.webdriver.common.keys import Keys
+    field.send_keys("100" + Keys.ENTER)
+    wait_for("the scale", lambda: page.state("window.softsight.status.mm_per_px"))
+    scale = page.state("window.softsight.status.mm_per_px")
+    check(abs(scale - 0.25) < 0.25 * 0.005, "100 mm over 400 px gave %.5f mm/px" % scale)
+    wait_for("the frame on screen in mm", lambda: (page.state(
+        "window.softsight.row(%d)" % frame) or {}).get("chord_mm") is not None)
+    for f, row in ((frame, truth[frame]), (earlier, truth[earlier])):
+        chord = page.state("window.softsight.lengthOf(%d, 'chord')" % f)
+        true_mm = float(row["chord_px"]) * 0.25
+        check(abs(chord - true_mm) < 0.005 * true_mm,
+              "frame %d's chord %.2f mm, the truth %.2f mm" % (f, chord, true_mm))
+    check(" mm" in page.driver.find_element("id", "readout").text, "the readout is not in mm")
+
+
 def test_hostile_messages(page):
     """Each bad message: one error on the page, nothing changed, the run goes on."""
     wait_for("the status of the frame on screen", lambda: page.state(
@@ -434,6 +459,7 @@ def run(args, browser, driver):
         assert_near_truth(first.state("window.softsight.row(%d)" % target), truth[target],
                           ["red", "blue", "green"])
 
+        test_mm_scale(first, truth, target, frame)
         test_hostile_messages(first)
 
         # The speed selector sets the paced file's speed (0.1x .. 4x), and back.
@@ -468,7 +494,9 @@ def run(args, browser, driver):
         # Saved only in the server's folder, under a plain name.
         first.click_button("save")
         saved = os.path.join(folder, "markers.web.yaml")
-        wait_for("the saved config", lambda: os.path.exists(saved))
+        # (Read until whole: the file is written while this polls.)
+        wait_for("the saved config with the page's scale", lambda: os.path.exists(saved) and
+                 re.search(r"scale_from_points:[\s\S]*distance_mm: 100\b", open(saved).read()))
 
         # 100 connections opened and dropped: the server goes on serving both pages.
         open_and_drop(port, 100, token)

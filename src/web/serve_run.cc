@@ -100,6 +100,13 @@ std::string Number(double value) {
   return text;
 }
 
+// A scale (mm per px) to six significant digits.
+std::string Number6(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
 // The answer to a page's ping: its own time back, and the server's clock now.
 std::string Pong(double page_time_ms) {
   const double now_ms = std::chrono::duration<double, std::milli>(
@@ -122,9 +129,15 @@ class WebSink : public FrameSink {
   WebSink(WebServer& server, CsvColumnTable table, const std::vector<std::string>& markers,
           int jpeg_quality)
       : server_(server), table_(std::move(table)), formatter_(table_),
-        topic_(StreamTopics(table_, markers).front()), quality_(jpeg_quality) {}
+        topic_(StreamTopics(table_, markers).front()), markers_(markers), quality_(jpeg_quality) {}
 
   void set_controller(const LiveController* controller) { controller_ = controller; }
+
+  // The rows' columns from now on (a scale set from a page adds the _mm ones).
+  void set_columns(CsvColumnTable table) {
+    table_ = std::move(table);  // formatter_ reads table_ (a reference to this member).
+    topic_ = StreamTopics(table_, markers_).front();
+  }
 
   void consume(const Frame& frame, const FrameResult& result) override {
     send_result(result, /*edit=*/false);
@@ -231,6 +244,7 @@ class WebSink : public FrameSink {
   CsvColumnTable table_;
   RecordFormatter formatter_;
   TopicColumns topic_;
+  std::vector<std::string> markers_;
   int quality_;
   const LiveController* controller_ = nullptr;
   // Reused per frame; only the messages handed to the server's thread are new each time.
@@ -374,13 +388,20 @@ void ServeLoop::apply(const PageCommand& command, uint64_t page) {
     case Kind::kMaskView:
       if (controller_.mask_view() != command.on) key('v');
       break;
+    case Kind::kRange: controller_.edit_range_at(command.point_px, command.grow); break;
+    case Kind::kScale:
+      controller_.set_scale_from_points(command.point_px, command.point_b_px, command.distance_mm);
+      // The rows have the _mm columns from now on (the frame on screen's too).
+      sink_.set_columns(TrackingColumns(controller_.config(), options_.live.extra_columns));
+      break;
   }
   if (command.kind == Kind::kSave) list_configs(0);  // Every page's list has the new name.
   // An edit re-tracks the frame on screen (or the next one shows it): every page sees its
   // result now, also while paused.
   const bool edit = command.kind == Kind::kPick || command.kind == Kind::kSelect ||
                     command.kind == Kind::kMethod || command.kind == Kind::kUndo ||
-                    command.kind == Kind::kHsv || command.kind == Kind::kLoad;
+                    command.kind == Kind::kHsv || command.kind == Kind::kLoad ||
+                    command.kind == Kind::kRange || command.kind == Kind::kScale;
   // The picture itself changes when the mask view is turned on or off, and in it with the
   // ranges and the active marker: sent again at once (also paused).
   const bool picture = command.kind == Kind::kMaskView ||
@@ -506,7 +527,11 @@ void ServeLoop::send_status(bool force) {
                      ",\"pages\":" + std::to_string(server_.pages()) +
                      ",\"undo\":" + std::to_string(controller_.undo_depth()) +
                      ",\"mask_view\":" + (controller_.mask_view() ? "true" : "false") +
-                     ",\"active\":" + std::to_string(active) + ",\"method\":";
+                     ",\"active\":" + std::to_string(active) + ",\"mm_per_px\":" +
+                     (config.measure.metric.scale_mm_per_px
+                          ? Number6(*config.measure.metric.scale_mm_per_px)
+                          : std::string("null")) +
+                     ",\"method\":";
   AppendJsonString(TrackerMethodName(config.markers[active].params), json);
   json += ",\"hsv\":[";
   for (size_t i = 0; i < hsv.size(); ++i) {

@@ -120,7 +120,9 @@ function onHello(m) {
 }
 
 function onStatus(m) {
+  const rescaled = !S.status || S.status.mm_per_px !== m.mm_per_px;
   S.status = m;
+  if (rescaled) { drawView(); showReadout(imageFrame); schedulePlot(); }
   const lat = recentLatency();
   $('status').textContent =
       (m.paused ? 'PAUSED  ' : '') + (m.ended ? 'END  ' : '') + (m.recording ? 'REC  ' : '') +
@@ -186,14 +188,29 @@ async function decodeNext() {
 
 function fmt(v, digits) { return v === null || v === undefined ? '-' : Number(v).toFixed(digits); }
 
+// The run's lengths in mm: the rows' own _mm columns, or (rows from before a scale was set
+// on a page) their px times the config's scale. True once any is known.
+function inMm() {
+  if (S.status && S.status.mm_per_px) return true;
+  const last = sortedFrames && sortedFrames.length ? rows.get(sortedFrames[sortedFrames.length - 1]) : null;
+  return !!last && last.radius_mm !== undefined;
+}
+// A length measure of `row` (radius, arc_length, tip_disp, chord), in mm when inMm().
+function length_(row, key) {
+  const mm = row[key + '_mm'];
+  if (mm !== undefined) return mm;
+  const px = row[key + '_px'], scale = S.status && S.status.mm_per_px;
+  return scale && px !== null && px !== undefined ? px * scale : px;
+}
+S.lengthOf = (frame, key) => { const row = rows.get(frame); return row ? length_(row, key) : null; };
+
 function showReadout(frame) {
   const row = rows.get(frame);
   if (!row || !S.hello) return;
-  const mm = row.radius_mm !== undefined;
-  const u = mm ? 'mm' : 'px';
+  const u = row.radius_mm !== undefined || (S.status && S.status.mm_per_px) ? 'mm' : 'px';
   $('readout').textContent = 'frame ' + frame + '  t ' + fmt(row.time_s, 3) + ' s   angle ' +
-      fmt(row.angle_deg, 2) + ' deg   R ' + fmt(row['radius_' + u], 1) + ' ' + u + '   L ' +
-      fmt(row['arc_length_' + u], 1) + ' ' + u + '   tip ' + fmt(row['tip_disp_' + u], 1) + ' ' + u;
+      fmt(row.angle_deg, 2) + ' deg   R ' + fmt(length_(row, 'radius'), 1) + ' ' + u + '   L ' +
+      fmt(length_(row, 'arc_length'), 1) + ' ' + u + '   tip ' + fmt(length_(row, 'tip_disp'), 1) + ' ' + u;
   const body = $('markers').tBodies[0];
   S.hello.markers.forEach((name, i) => {
     const tr = body.rows[i];
@@ -461,7 +478,11 @@ $('png').onclick = () => view.toBlob((blob) => download('softsight-frame-' + ima
 S.csvText = () => {
   const frames = [...rows.keys()].sort((a, b) => a - b);
   if (!frames.length) return '';
-  const columns = Object.keys(rows.get(frames[0])).filter((c) => c !== '_position');
+  // The columns of the row that has most (a scale set on a page adds the _mm ones: rows from
+  // before it leave them empty).
+  let widest = rows.get(frames[0]);
+  for (const f of frames) if (Object.keys(rows.get(f)).length > Object.keys(widest).length) widest = rows.get(f);
+  const columns = Object.keys(widest).filter((c) => c !== '_position');
   const tools = S.toolColumns ? S.toolColumns() : [];  // The analysis tools' values after them.
   const field = (v) => (v === null || v === undefined ? '' : String(v));
   const line = (row) => columns.map((c) => field(row[c])).concat(tools.map(([, value]) => field(value(row)))).join(',');
@@ -540,8 +561,7 @@ function schedulePlot() {
 function series(row, key) {
   if (key === 'angle_deg') return row.angle_deg;
   if (key.startsWith('tool:')) return S.toolSeries(key, row);
-  const mm = row[key + '_mm'];
-  return mm !== undefined ? mm : row[key + '_px'];
+  return length_(row, key);
 }
 
 function drawPlot() {
@@ -565,7 +585,7 @@ function drawPlot() {
     const top = lane * laneH;
     ctx.fillStyle = '#aaa'; ctx.font = '11px sans-serif';
     const own = key === 'angle_deg' || key.startsWith('tool:');  // Their labels carry the unit.
-    ctx.fillText(label + (own ? '' : S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
+    ctx.fillText(label + (own ? '' : inMm() ? ' [mm]' : ' [px]'), 44, top + 12);
     ctx.strokeStyle = '#333'; ctx.strokeRect(40, top + 2, w - 50, laneH - 4);
     if (!finite.length) return;
     // The 2nd to 98th percentile: a near-straight actuator's radius (tens of thousands of px
