@@ -257,6 +257,45 @@ def latency_figures(page):
     return median, p95, len(samples)
 
 
+def in_ranges(hsv, ranges):
+    """True when the OpenCV HSV pixel lies in the six ranges (a hue range with lo > hi wraps)."""
+    h, s, v = hsv
+    hue = ranges[0] <= h <= ranges[1] if ranges[0] <= ranges[1] else (h >= ranges[0] or h <= ranges[1])
+    return hue and ranges[2] <= s <= ranges[3] and ranges[4] <= v <= ranges[5]
+
+
+def test_mask_click_grows(page, video, blue):
+    """In the mask view of blue (its range yellow on purpose: none of its pixels), a click on
+    blue widens the ranges to take in the pixel clicked (its HSV read from the video with
+    OpenCV, not from the page); undo puts the yellow range back and says what it undid."""
+    import cv2
+    page.click_button("maskview")
+    wait_for("the mask view", lambda: page.state(
+        "window.softsight.status.mask_view && window.softsight.shownMask === true"))
+    before = page.state("window.softsight.status.hsv")
+    undo = page.state("window.softsight.status.undo")
+    position = page.state("window.softsight.shownPosition")
+    cx, cy = (round(v) for v in page.state("window.softsight.clientPoint(%s, %s)" % (blue["blue_x"], blue["blue_y"])))
+    x, y = (int(round(v)) for v in page.state("window.softsight.imagePoint(%d, %d)" % (cx, cy)))
+    capture = cv2.VideoCapture(video)
+    capture.set(cv2.CAP_PROP_POS_FRAMES, position)
+    ok, picture = capture.read()
+    check(ok, "OpenCV did not read frame %d of the video" % position)
+    pixel = [int(c) for c in cv2.cvtColor(picture[y:y + 1, x:x + 1], cv2.COLOR_BGR2HSV)[0, 0]]
+    check(not in_ranges(pixel, before), "blue's pixel %s is in the yellow range %s already" % (pixel, before))
+    page.click_at(cx, cy)
+    wait_for("the range edit", lambda: page.state("window.softsight.status.undo") == undo + 1)
+    grown = page.state("window.softsight.status.hsv")
+    check(in_ranges(pixel, grown), "the clicked pixel (HSV %s) is not in the grown ranges %s" % (pixel, grown))
+    page.click_button("undo")
+    wait_for("the undo", lambda: page.state("window.softsight.status.hsv") == before)
+    wait_for("what the undo undid", lambda: any(
+        "undone: added colours of blue" in m for m in page.state("window.softsight.messages")))
+    page.click_button("maskview")
+    wait_for("the mask view off", lambda: page.state(
+        "!window.softsight.status.mask_view && window.softsight.shownMask === false"))
+
+
 def test_zoomed_pick(page, blue, frame):
     """Three wheel notches up near blue zoom in about the pointer (the image point under it stays),
     a right drag pans (the picture follows the pointer), the picture under blue's true position is
@@ -440,6 +479,7 @@ def run(args, browser, driver):
         # marker, the one a click on no found marker picks for (as 2 does in the window).
         first.driver.find_element("css selector", "#markers tbody tr:nth-child(2)").click()
         wait_for("blue active", lambda: first.state("window.softsight.status.active") == 1)
+        test_mask_click_grows(first, video, blue)
         test_zoomed_pick(first, blue, frame)
         # The status follows the result: polled, then checked.
         wait_for("blue's picked hue in the status", lambda: first.state(

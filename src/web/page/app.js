@@ -428,7 +428,7 @@ view.addEventListener('mousemove', (e) => {
   drag.moved = drag.moved || Math.hypot(drag.x1 - drag.x0, drag.y1 - drag.y0) > 4;
   if (drag.moved) drawView();
 });
-window.addEventListener('mouseup', () => {
+window.addEventListener('mouseup', (e) => {
   if (panning) { panning = null; return; }
   if (!drag || !image) { drag = null; return; }
   const d = drag;
@@ -438,7 +438,11 @@ window.addEventListener('mouseup', () => {
     const [x, y] = toImage(d.x0, d.y0);
     // A point of an analysis tool, or a click on a trail (analysis.js), before a colour pick.
     if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), viewScale())) { drawView(); schedulePlot(); return; }
-    send({type: 'pick', x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)});
+    const at = {x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)};
+    // In the mask view (as the window's): a click adds the colours there to the active
+    // marker's ranges, a shift-click takes them out; elsewhere a click picks a colour afresh.
+    if (S.status && S.status.mask_view) send(Object.assign({type: 'range', grow: !e.shiftKey}, at));
+    else send(Object.assign({type: 'pick'}, at));
     return;
   }
   // Whole pixels covered by the box (pixel edges: the view's point plus half a pixel).
