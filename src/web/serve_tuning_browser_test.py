@@ -51,6 +51,7 @@ def test_analysis(page, screenshot=None):
     header = page.state("window.softsight.csvText()").splitlines()[0].split(",")
     check(header[-2:] == ["angle_red_blue_green_deg", "distance_red_green_mm"], "the CSV's last columns: %s" % header[-3:])
     check(len(page.state("window.softsight.toolLanes()")) == 2, "the tools are not plotted")
+    test_fixed_point_dragged(page, frame, row)
     page.click_button("trails")
     wait(page, "the trails drawn", "window.softsight.trailPoints > 10")
     if screenshot:
@@ -65,6 +66,29 @@ def test_analysis(page, screenshot=None):
     check(((landed["green_x"] - far["green_x"]) ** 2 + (landed["green_y"] - far["green_y"]) ** 2) ** 0.5 < 6,
           "the trail click landed on frame %d, green at (%.1f, %.1f), not near (%.1f, %.1f)" % (
               landed["frame"], landed["green_x"], landed["green_y"], far["green_x"], far["green_y"]))
+
+
+def test_fixed_point_dragged(page, frame, row):
+    """A distance from red to a fixed point away from every marker; that point dragged onto
+    green's place: the distance is then red to green, the row's chord (mm); the drag moved the
+    point, not a box (no reselection: the undo depth is unchanged)."""
+    spot = (row["red_x"] + 80, row["red_y"] + 40)
+    page.click_button("tooldistance")
+    page.click_image_point(row["red_x"], row["red_y"])
+    page.click_image_point(*spot)
+    wait(page, "the third tool", "window.softsight.tools.length === 3")
+    check(page.state("window.softsight.tools[2].points.map(p => p.marker || null)") == ["red", None],
+          "not a distance from red to a fixed point: %s" % page.state("window.softsight.tools[2].points"))
+    undo = page.state("window.softsight.status.undo")
+    x0, y0 = page.state("window.softsight.clientPoint(%f, %f)" % spot)
+    x1, y1 = page.state("window.softsight.clientPoint(%f, %f)" % (row["green_x"], row["green_y"]))
+    page.drag(x0, y0, x1, y1)
+    wait(page, "the fixed point on green", "Math.hypot(window.softsight.tools[2].points[1].x - %f, "
+         "window.softsight.tools[2].points[1].y - %f) < 1" % (row["green_x"], row["green_y"]))
+    distance = page.state("window.softsight.toolValue(2, %d)" % frame)
+    check(abs(distance - row["chord_mm"]) < 0.005 * row["chord_mm"],
+          "the dragged distance: %s mm, the row's chord %s mm" % (distance, row["chord_mm"]))
+    check(page.state("window.softsight.status.undo") == undo, "the drag reselected a marker")
 
 
 def run(args, browser, driver):

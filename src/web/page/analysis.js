@@ -156,6 +156,41 @@
     return false;
   };
 
+  // A fixed point of a tool is dragged to move it (a marker's point follows its marker).
+  const GRAB_PX = 8;   // A press this close (screen pixels) to a fixed point takes it.
+  let moving = null;   // {tool, point}: the fixed point being dragged.
+  function fixedPointNear(x, y, viewScale) {
+    let best = null, bestD = GRAB_PX;
+    for (const tool of tools) {
+      for (const point of tool.points) {
+        if (point.marker) continue;
+        const d = Math.hypot(point.x - x, point.y - y) * viewScale;
+        if (d <= bestD) { bestD = d; best = {tool, point}; }
+      }
+    }
+    return best;
+  }
+  // The picture's mouse (image pixels): true when the press took a fixed point to drag.
+  S.toolNear = (x, y, viewScale) => !placing && fixedPointNear(x, y, viewScale) !== null;
+  S.toolGrab = (x, y, viewScale) => {
+    if (placing) return false;
+    moving = fixedPointNear(x, y, viewScale);
+    return moving !== null;
+  };
+  S.toolMove = (x, y) => {
+    if (!moving) return;
+    moving.point.x = x; moving.point.y = y;
+    S.redraw();
+  };
+  S.toolRelease = () => {
+    if (!moving) return;
+    const tool = moving.tool;
+    moving = null;
+    tool.label = tool.kind + ' ' + tool.points.map(pointName).join('-');
+    hint(tool.label + ' [' + unit(tool) + ']');
+    S.redraw();
+  };
+
   // Drawn over the overlay: the trails, then each tool with its value on the frame on screen.
   S.drawTools = (ctx, row, toView, colours) => {
     // The scale's points (being placed, or the last set here): cyan crosses and the line.

@@ -387,7 +387,7 @@ function drawArc(ctx, b, m, t) {
 
 // ---- Mouse on the picture: click picks a colour, a drag reselects ---------------------------
 // The wheel zooms about the pointer, a right (or middle) drag pans, "whole image" (z) resets.
-let drag = null, panning = null;
+let drag = null, panning = null, movingPoint = false;
 // The pointer in the view's CSS pixels (k per image pixel), from where it is on screen.
 function viewPoint(event) {
   const rect = view.getBoundingClientRect();
@@ -410,10 +410,17 @@ view.addEventListener('mousedown', (e) => {
     panning = {x, y, ox, oy};
     return;
   }
+  // A press on a fixed point of an angle or distance tool drags it (analysis.js).
+  if (S.toolGrab && S.toolGrab(...toImage(x, y), viewScale())) { movingPoint = true; return; }
   drag = {x0: x, y0: y, x1: x, y1: y, moved: false};
 });
 view.addEventListener('mouseleave', () => { pointer = null; });
 window.addEventListener('mousemove', (e) => {
+  if (movingPoint && image) {
+    const [x, y] = toImage(...viewPoint(e));
+    S.toolMove(Math.min(Math.max(x, 0), image.width - 1), Math.min(Math.max(y, 0), image.height - 1));
+    return;
+  }
   if (!panning) return;
   const [x, y] = viewPoint(e);
   ox = panning.ox - (x - panning.x) / viewScale();
@@ -423,13 +430,17 @@ window.addEventListener('mousemove', (e) => {
 });
 view.addEventListener('mousemove', (e) => {
   pointer = viewPoint(e);
-  if (!drag) return;
+  if (!drag) {
+    view.style.cursor = movingPoint || (S.toolNear && S.toolNear(...toImage(...pointer), viewScale())) ? 'move' : '';
+    return;
+  }
   [drag.x1, drag.y1] = viewPoint(e);
   drag.moved = drag.moved || Math.hypot(drag.x1 - drag.x0, drag.y1 - drag.y0) > 4;
   if (drag.moved) drawView();
 });
 window.addEventListener('mouseup', (e) => {
   if (panning) { panning = null; return; }
+  if (movingPoint) { movingPoint = false; S.toolRelease(); schedulePlot(); return; }
   if (!drag || !image) { drag = null; return; }
   const d = drag;
   drag = null;
