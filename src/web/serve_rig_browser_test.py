@@ -54,6 +54,32 @@ def test_refusals(page):
     check(not page.state("window.softsight.status.paused"), "a refused pause paused the run")
 
 
+CONTROL_COLUMNS = ["target_deg", "setpoint_kpa", "board_pressure_kpa", "board_setpoint_kpa", "duty",
+                   "board_flags", "control_action", "rig_state"]
+
+
+def test_control_columns_and_whole_run(page):
+    """Each frame's row carries the loop's columns (control's CSV names), with the values the
+    rig's own message said for that frame; the page's CSV has them. The traces switched to the
+    whole run span it from the first sample this page got."""
+    rig = page.state("window.softsight.rig")
+    row = page.state("window.softsight.rowsIn().find(r => Math.abs(r.time_s - %f) < 5e-4) || null" % rig["t"])
+    check(row is not None, "no row for the rig's frame at t %.3f s" % rig["t"])
+    check(row["target_deg"] == 120 and row["rig_state"] == 1 and
+          abs(row["setpoint_kpa"] - rig["setpoint_kpa"]) < 0.006 and
+          abs(row["board_pressure_kpa"] - rig["pressure_kpa"]) < 0.006 and abs(row["duty"] - rig["duty"]) < 6e-4,
+          "the row at t %.3f s: %s; the rig said %s" % (rig["t"], {k: row.get(k) for k in CONTROL_COLUMNS}, rig))
+    header = page.state("window.softsight.csvText()").splitlines()[0].split(",")
+    check(all(c in header for c in CONTROL_COLUMNS), "the page's CSV has no control columns: %s" % header)
+    from selenium.webdriver.support.ui import Select
+    Select(page.driver.find_element("id", "rigspan")).select_by_value("whole")
+    wait(page, "the whole run drawn", "window.softsight.rigTrace.whole && "
+         "window.softsight.rigTrace.t0 === Math.min(window.softsight.rigStates[0].t, window.softsight.rigTrace.t1 - 1)")
+    Select(page.driver.find_element("id", "rigspan")).select_by_value("last")
+    wait(page, "the last 20 s drawn", "!window.softsight.rigTrace.whole && "
+         "Math.abs(window.softsight.rigTrace.t1 - window.softsight.rigTrace.t0 - 20) < 1e-9")
+
+
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-rig-")
     server, url = start_serve(args.softsight, ["--simulate", "--port", "0", "--folder", folder])
@@ -75,6 +101,7 @@ def run(args, browser, driver):
         wait(first, "the loop running and the pressure building",
              "window.softsight.rig.state === 'running' && window.softsight.rig.pressure_kpa > 5")
         wait(first, "the angle near 120 deg", "Math.abs(window.softsight.rig.measured_deg - 120) < 5")
+        test_control_columns_and_whole_run(first)
 
         # A second browser: the same run, read-only; its own STOP vents it all the same.
         second = Page(browser, driver, url)

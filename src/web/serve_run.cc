@@ -560,6 +560,10 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
     source = std::move(playable);
   }
   if (!options.live.record_fps) options.live.record_fps = source->fps();
+  // With a rig, every row (the page's, a recording's) carries the loop's columns too.
+  if (options.rig != nullptr) {
+    for (CsvColumn& column : options.rig->columns()) options.live.extra_columns.push_back(std::move(column));
+  }
   PageInbox inbox;
   std::atomic<WebServer*> answering{nullptr};
   PageLimits checked_here;  // Pings and STOPs need nothing of the run's state.
