@@ -6,7 +6,9 @@ a second browser sees the same run read-only, the server survives 100 connection
 dropped, a dragged box sets a template, and a recording made from the page reproduces under
 `softsight track`. Measures the latency from capture to the picture on the page (640x480, 30 fps).
 
-Every wait polls the page's state (window.softsight) with a timeout: no sleep decides a result.
+Every wait on the page is a condition on its state (window.softsight) checked in the page on every
+message and redraw (Page.wait), with a timeout: no polling, and no sleep decides a result. The
+browsers start while the video renders.
 Exit code 77 (ctest: skipped) only when chromium or its driver or selenium is missing.
 
   serve_browser_test.py --softsight build/src/app/softsight [--screenshot docs/images/serve.png]
@@ -69,16 +71,9 @@ def check(condition, message):
 
 
 def webdriver_wait(page, what, expression, timeout=10.0, details="window.softsight.status"):
-    """Selenium's WebDriverWait until the page's `expression` is true (event-driven, no fixed
-    sleep); fails naming `what` and showing the page's `details` expression."""
-    from selenium.webdriver.support.ui import WebDriverWait
-    try:
-        return WebDriverWait(page.driver, timeout, poll_frequency=0.02).until(
-            lambda driver: driver.execute_script("return " + expression))
-    except Exception as error:
-        raise AssertionError("timed out waiting for %s (%s): %s; errors on the page: %s" % (
-            what, expression, page.state(details),
-            page.state("window.softsight.errors.slice(-4)"))) from error
+    """Waits until the page's `expression` is true (Page.wait: checked in the page on every
+    message and redraw, no polling); fails naming `what` and showing the page's `details`."""
+    return page.wait(what, expression, timeout, details)
 
 
 def stop_server(server):
@@ -111,7 +106,9 @@ def browser_test_main(doc, run, what):
 
 
 class Page:
-    def __init__(self, browser, driver_path, url):
+    """A headless chromium. `url` None: started only (open() it later), so that browsers start
+    while the video renders and the server starts (start_pages)."""
+    def __init__(self, browser, driver_path, url=None):
         from selenium import webdriver
         from selenium.webdriver.chrome.service import Service
         options = webdriver.ChromeOptions()
@@ -122,10 +119,30 @@ class Page:
         # The page is on this computer: no proxy from the environment in between.
         options.add_argument("--no-proxy-server")
         self.driver = webdriver.Chrome(service=Service(driver_path), options=options)
+        if url:
+            self.open(url)
+
+    def open(self, url):
         self.driver.get(url)
 
     def state(self, expression):
         return self.driver.execute_script("return " + expression)
+
+    def wait(self, what, expression, timeout=15.0, details="window.softsight.status"):
+        """The first true value of the page's `expression`, checked in the page at once and after
+        every message and redraw it handles (softsight.when): no polling, no sleep. Fails after
+        `timeout` naming `what`, with the page's `details` and its last errors."""
+        self.driver.set_script_timeout(timeout + 10)
+        value = self.driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];"
+            "const wait = () => window.softsight.when(() => (%s), %d).then((v) => done(v === undefined ? null : v));"
+            # Before the page's script has run (just opened): once it has.
+            "if (window.softsight && window.softsight.when) wait();"
+            "else window.addEventListener('load', wait);" % (expression, int(timeout * 1000)))
+        if not value:
+            raise AssertionError("timed out waiting for %s (%s): %s; errors on the page: %s" % (
+                what, expression, self.state(details), self.state("window.softsight.errors.slice(-4)")))
+        return value
 
     def click_at(self, x, y):
         from selenium.webdriver.common.action_chains import ActionChains
@@ -180,7 +197,43 @@ class Page:
         self.driver.find_element("id", element_id).click()
 
     def quit(self):
-        self.driver.quit()
+        """Idempotent: a test may quit a page early (a page that leaves)."""
+        if self.driver is not None:
+            self.driver.quit()
+            self.driver = None
+
+
+def start_pages(browser, driver, count):
+    """`count` browsers started at once, each in its own thread (a browser takes ~2 s to start,
+    mostly waiting): not yet on a page."""
+    import concurrent.futures
+    with concurrent.futures.ThreadPoolExecutor(count) as pool:
+        return list(pool.map(lambda _: Page(browser, driver), range(count)))
+
+
+def quit_pages(pages):
+    """Every browser quit at once (each takes a few hundred ms)."""
+    import concurrent.futures
+    with concurrent.futures.ThreadPoolExecutor(max(1, len(pages))) as pool:
+        list(pool.map(lambda page: page.quit(), pages))
+
+
+def serve_with_pages(softsight, arguments, browser, driver, count):
+    """`softsight serve ARGUMENTS` and `count` browsers, started at once: (server, url, pages),
+    the pages not yet opened. Nothing left running when one of them fails."""
+    import concurrent.futures
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        browsers = pool.submit(start_pages, browser, driver, count)
+        try:
+            server, url = start_serve(softsight, arguments)
+        except BaseException:
+            quit_pages(browsers.result())
+            raise
+        try:
+            return server, url, browsers.result()
+        except BaseException:
+            server.kill()
+            raise
 
 
 def start_serve(softsight, arguments):
@@ -270,8 +323,7 @@ def test_mask_click_grows(page, video, blue):
     OpenCV, not from the page); undo puts the yellow range back and says what it undid."""
     import cv2
     page.click_button("maskview")
-    wait_for("the mask view", lambda: page.state(
-        "window.softsight.status.mask_view && window.softsight.shownMask === true"))
+    page.wait("the mask view", "window.softsight.status.mask_view && window.softsight.shownMask === true")
     before = page.state("window.softsight.status.hsv")
     undo = page.state("window.softsight.status.undo")
     position = page.state("window.softsight.shownPosition")
@@ -284,16 +336,15 @@ def test_mask_click_grows(page, video, blue):
     pixel = [int(c) for c in cv2.cvtColor(picture[y:y + 1, x:x + 1], cv2.COLOR_BGR2HSV)[0, 0]]
     check(not in_ranges(pixel, before), "blue's pixel %s is in the yellow range %s already" % (pixel, before))
     page.click_at(cx, cy)
-    wait_for("the range edit", lambda: page.state("window.softsight.status.undo") == undo + 1)
+    page.wait("the range edit", "window.softsight.status.undo === %d" % (undo + 1))
     grown = page.state("window.softsight.status.hsv")
     check(in_ranges(pixel, grown), "the clicked pixel (HSV %s) is not in the grown ranges %s" % (pixel, grown))
     page.click_button("undo")
-    wait_for("the undo", lambda: page.state("window.softsight.status.hsv") == before)
-    wait_for("what the undo undid", lambda: any(
-        "undone: added colours of blue" in m for m in page.state("window.softsight.messages")))
+    page.wait("the undo", "window.softsight.status.hsv.join() === '%s'" % ",".join(map(str, before)))
+    page.wait("what the undo undid",
+              "window.softsight.messages.some(m => m.includes('undone: added colours of blue'))")
     page.click_button("maskview")
-    wait_for("the mask view off", lambda: page.state(
-        "!window.softsight.status.mask_view && window.softsight.shownMask === false"))
+    page.wait("the mask view off", "!window.softsight.status.mask_view && window.softsight.shownMask === false")
 
 
 def test_zoomed_pick(page, blue, frame):
@@ -309,7 +360,7 @@ def test_zoomed_pick(page, blue, frame):
     px, py = round(px), round(py)
     under = page.state("window.softsight.imagePoint(%d, %d)" % (px, py))
     page.wheel_at(px, py, -300)
-    wait_for("the zoom", lambda: page.state("window.softsight.zoom().zoom") > 2.5)
+    page.wait("the zoom", "window.softsight.zoom().zoom > 2.5")
     zoom = page.state("window.softsight.zoom()")
     check(2.7 < zoom["zoom"] < 3.0, "three wheel notches zoomed to %.2fx, not 2.83x" % zoom["zoom"])
     after = page.state("window.softsight.imagePoint(%d, %d)" % (px, py))
@@ -320,7 +371,7 @@ def test_zoomed_pick(page, blue, frame):
     sx, sy = round(rect["left"] + size[0] / 2), round(rect["top"] + size[1] / 2)
     grabbed = page.state("window.softsight.imagePoint(%d, %d)" % (sx, sy))
     page.right_drag(sx, sy, sx - 50, sy - 35)
-    wait_for("the pan", lambda: page.state("window.softsight.zoom().ox") != zoom["ox"])
+    page.wait("the pan", "window.softsight.zoom().ox !== %r" % zoom["ox"])
     moved = page.state("window.softsight.imagePoint(%d, %d)" % (sx - 50, sy - 35))
     check(abs(moved[0] - grabbed[0]) < 0.5 and abs(moved[1] - grabbed[1]) < 0.5,
           "the pan did not follow the pointer: (%.2f, %.2f) is under the drag's end, not (%.2f, %.2f)"
@@ -331,11 +382,10 @@ def test_zoomed_pick(page, blue, frame):
     r, g, b = page.view_colour(cx, cy)
     check(b > r + 60 and b > g + 30, "the zoomed picture at blue's place is (%d, %d, %d), not blue" % (r, g, b))
     page.click_at(cx, cy)
-    wait_for("blue found after the zoomed pick", lambda: (page.state(
-        "window.softsight.row(%d)" % frame) or {}).get("blue_found") == 1)
+    page.wait("blue found after the zoomed pick", "(window.softsight.row(%d) || {}).blue_found === 1" % frame)
     assert_near_truth(page.state("window.softsight.row(%d)" % frame), blue, ["red", "blue", "green"])
     page.driver.find_element("tag name", "body").send_keys("z")
-    wait_for("the whole image", lambda: page.state("window.softsight.zoom().zoom") == 1)
+    page.wait("the whole image", "window.softsight.zoom().zoom === 1")
 
 
 def test_mm_scale(page, truth, frame, earlier):
@@ -347,14 +397,13 @@ def test_mm_scale(page, truth, frame, earlier):
     page.click_image_point(100.0, 440.0)
     page.click_image_point(500.0, 440.0)
     field = page.driver.find_element("id", "scalemm")
-    wait_for("the distance field", lambda: field.is_displayed())
+    page.wait("the distance field", "!document.getElementById('scalebox').hidden")
     from selenium.webdriver.common.keys import Keys
     field.send_keys("100" + Keys.ENTER)
-    wait_for("the scale", lambda: page.state("window.softsight.status.mm_per_px"))
+    page.wait("the scale", "window.softsight.status.mm_per_px")
     scale = page.state("window.softsight.status.mm_per_px")
     check(abs(scale - 0.25) < 0.25 * 0.005, "100 mm over 400 px gave %.5f mm/px" % scale)
-    wait_for("the frame on screen in mm", lambda: (page.state(
-        "window.softsight.row(%d)" % frame) or {}).get("chord_mm") is not None)
+    page.wait("the frame on screen in mm", "(window.softsight.row(%d) || {}).chord_mm != null" % frame)
     for f, row in ((frame, truth[frame]), (earlier, truth[earlier])):
         chord = page.state("window.softsight.lengthOf(%d, 'chord')" % f)
         true_mm = float(row["chord_px"]) * 0.25
@@ -365,8 +414,7 @@ def test_mm_scale(page, truth, frame, earlier):
 
 def test_hostile_messages(page):
     """Each bad message: one error on the page, nothing changed, the run goes on."""
-    wait_for("the status of the frame on screen", lambda: page.state(
-        "window.softsight.status.position === window.softsight.shownPosition"))
+    page.wait("the status of the frame on screen", "window.softsight.status.position === window.softsight.shownPosition")
     before = page.state("window.softsight.status")
     errors = page.state("window.softsight.errors.length")
     bad = ["not json", json.dumps({"type": "format_disk"}),
@@ -377,8 +425,7 @@ def test_hostile_messages(page):
            json.dumps({"type": "speed", "value": "fast"})]
     for text in bad:
         page.state("window.softsight.sendRaw(%s)" % json.dumps(text))
-    wait_for("an error for each hostile message",
-             lambda: page.state("window.softsight.errors.length") >= errors + len(bad))
+    page.wait("an error for each hostile message", "window.softsight.errors.length >= %d" % (errors + len(bad)))
     after = page.state("window.softsight.status")
     for key in ("position", "speed", "undo", "active", "method", "hsv", "paused"):
         check(before[key] == after[key], "a refused message changed %s: %s -> %s" %
@@ -389,18 +436,18 @@ def test_template_drag(page, truth, frame):
     """Switch to templates (SAD), then drag a box around green: its template is cut there and
     green is found where the truth is; undo takes the reselection back."""
     page.click_button("method")
-    wait_for("the method switch", lambda: page.state("window.softsight.status.method") == "sad")
+    page.wait("the method switch", "window.softsight.status.method === 'sad'")
     undo = page.state("window.softsight.status.undo")
     x, y = float(truth["green_x"]), float(truth["green_y"])
     x0, y0 = page.state("window.softsight.clientPoint(%f, %f)" % (x - 14, y - 14))
     x1, y1 = page.state("window.softsight.clientPoint(%f, %f)" % (x + 14, y + 14))
     page.drag(x0, y0, x1, y1)
-    wait_for("the reselection", lambda: page.state("window.softsight.status.undo") == undo + 1)
+    page.wait("the reselection", "window.softsight.status.undo === %d" % (undo + 1))
     row = page.state("window.softsight.row(%d)" % frame)
     assert_near_truth(row, truth, ["red", "blue", "green"])
     check(page.state("window.softsight.status.active") == 2, "the drag did not select green")
     page.click_button("undo")
-    wait_for("the undo", lambda: page.state("window.softsight.status.undo") == undo)
+    page.wait("the undo", "window.softsight.status.undo === %d" % undo)
 
 
 def comparable_rows(path):
@@ -416,13 +463,13 @@ def test_recording_reproduces(page, softsight, folder):
     with the recording's config gives the same rows."""
     start = page.state("window.softsight.status.position")
     page.click_button("record")
-    wait_for("the recording", lambda: page.state("window.softsight.status.recording"))
+    page.wait("the recording", "window.softsight.status.recording")
     page.click_button("play")
-    wait_for("30 frames recorded", lambda: page.state("window.softsight.status.position") >= start + 30)
+    page.wait("30 frames recorded", "window.softsight.status.position >= %d" % (start + 30))
     print("the run's rate with %d pages open, recording: %.1f fps" % (
         page.state("window.softsight.status.pages"), page.state("window.softsight.status.fps")))
     page.click_button("record")
-    wait_for("the recording's end", lambda: not page.state("window.softsight.status.recording"))
+    page.wait("the recording's end", "!window.softsight.status.recording")
     prefix = os.path.join(folder, "serve-001")
     again = os.path.join(folder, "again.csv")
     subprocess.run([softsight, "track", "--config", prefix + ".yaml", "--input", prefix + ".raw.avi",
@@ -436,9 +483,19 @@ def test_recording_reproduces(page, softsight, folder):
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-")
     video, truth_csv, config = (os.path.join(folder, n) for n in ("run.avi", "truth.csv", "cfg.yaml"))
-    subprocess.run([args.softsight, "synth", "--scene", "bending", "--frames", "300", "--size",
-                    "640x480", "--fps", "30", "-o", video, "--truth", truth_csv],
-                   check=True, capture_output=True)
+    # The two browsers start while the video renders (each takes seconds, mostly waiting).
+    synth = subprocess.Popen([args.softsight, "synth", "--scene", "bending", "--frames", "300", "--size",
+                              "640x480", "--fps", "30", "-o", video, "--truth", truth_csv],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    browsers = []
+    try:
+        browsers = start_pages(browser, driver, 2)
+        _, err = synth.communicate(timeout=60)
+        check(synth.returncode == 0, "synth failed: %s" % err)
+    except BaseException:
+        synth.kill()
+        quit_pages(browsers)
+        raise
     with open(config, "w") as f:
         f.write(CONFIG)
     truth = truth_rows(truth_csv)
@@ -453,10 +510,10 @@ def run(args, browser, driver):
         check(websocket_handshake_status(port, "/ws?token=" + "f" * 32) == 403,
               "a WebSocket with a wrong token was not refused")
 
-        first = Page(browser, driver, url)
+        first = browsers[0]
+        first.open(url)
         pages.append(first)
-        wait_for("frames and results on the page",
-                 lambda: first.state("window.softsight.framesShown >= 60 && window.softsight.results >= 60"))
+        first.wait("frames and results on the page", "window.softsight.framesShown >= 60 && window.softsight.results >= 60")
         check(first.state("window.softsight.controls"), "the first page does not control the run")
         print("the run's rate with 1 page open: %.1f fps" % first.state("window.softsight.status.fps"))
         median, p95, n = latency_figures(first)
@@ -471,19 +528,18 @@ def run(args, browser, driver):
 
         # Pause, then click blue on the picture: its colour is picked, and it is found where it is.
         first.click_button("play")
-        wait_for("the pause", lambda: first.state("window.softsight.status.paused"))
-        frame = wait_for("a steady frame", lambda: first.state(
-            "window.softsight.shownFrame === window.softsight.status.position && window.softsight.shownFrame"))
+        first.wait("the pause", "window.softsight.status.paused")
+        frame = first.wait("a steady frame",
+                           "window.softsight.shownFrame === window.softsight.status.position && window.softsight.shownFrame")
         blue = truth[frame]
         # Blue is lost, so the click cannot name it: its row in the table makes it the active
         # marker, the one a click on no found marker picks for (as 2 does in the window).
         first.driver.find_element("css selector", "#markers tbody tr:nth-child(2)").click()
-        wait_for("blue active", lambda: first.state("window.softsight.status.active") == 1)
+        first.wait("blue active", "window.softsight.status.active === 1")
         test_mask_click_grows(first, video, blue)
         test_zoomed_pick(first, blue, frame)
         # The status follows the result: polled, then checked.
-        wait_for("blue's picked hue in the status", lambda: first.state(
-            "window.softsight.status.hsv[0] !== 20"), timeout=5)
+        first.wait("blue's picked hue in the status", "window.softsight.status.hsv[0] !== 20", timeout=5)
         hsv = first.state("window.softsight.status.hsv")
         check(first.state("window.softsight.status.active") == 1 and 90 <= hsv[0] <= hsv[1] <= 140,
               "the pick did not set blue's hue: %s" % hsv)
@@ -493,8 +549,8 @@ def run(args, browser, driver):
         rect = first.state("document.getElementById('timeline').getBoundingClientRect().toJSON()")
         first.click_at(rect["left"] + first.state("window.softsight.positionX(%d)" % target),
                        rect["top"] + rect["height"] / 2)
-        wait_for("the seek to %d" % target, lambda: first.state(
-            "window.softsight.shownPosition === %d && window.softsight.row(%d) !== null" % (target, target)))
+        first.wait("the seek to %d" % target,
+                   "window.softsight.shownPosition === %d && window.softsight.row(%d) !== null" % (target, target))
         check(first.state("window.softsight.shownFrame") == target, "the picture is another frame")
         assert_near_truth(first.state("window.softsight.row(%d)" % target), truth[target],
                           ["red", "blue", "green"])
@@ -506,21 +562,21 @@ def run(args, browser, driver):
         from selenium.webdriver.support.ui import Select
         for speed in ("0.5", "1"):
             Select(first.driver.find_element("id", "speed")).select_by_value(speed)
-            wait_for("speed " + speed, lambda: first.state("window.softsight.status.speed") == float(speed))
+            first.wait("speed " + speed, "window.softsight.status.speed === %s" % speed)
 
         # A second browser sees the same run, read-only.
-        second = Page(browser, driver, url)
+        second = browsers[1]
+        second.open(url)
         pages.append(second)
-        wait_for("the second page's picture",
-                 lambda: second.state("window.softsight.shownPosition === %d" % target))
+        second.wait("the second page's picture", "window.softsight.shownPosition === %d" % target)
         check(not second.state("window.softsight.controls"), "the second page controls too")
         errors = second.state("window.softsight.errors.length")
         second.click_button("fwd")
-        wait_for("the read-only refusal", lambda: second.state("window.softsight.errors.length") > errors)
+        second.wait("the read-only refusal", "window.softsight.errors.length > %d" % errors)
         check(first.state("window.softsight.status.position") == target, "a read-only page moved the run")
         first.click_button("fwd")
-        wait_for("the step seen by both pages", lambda: all(
-            p.state("window.softsight.shownPosition") == target + 1 for p in pages))
+        for page in pages:
+            page.wait("the step seen by both pages", "window.softsight.shownPosition === %d" % (target + 1))
 
         # The page's CSV export: the CSV's columns, one row per frame received, in order.
         lines = first.state("window.softsight.csvText()").splitlines()
@@ -542,14 +598,13 @@ def run(args, browser, driver):
         open_and_drop(port, 100, token)
         check(http_status(url) == 200, "the page is not served after 100 dropped connections")
         first.click_button("back")
-        wait_for("a step after the flood", lambda: all(
-            p.state("window.softsight.shownPosition") == target for p in pages))
+        for page in pages:
+            page.wait("a step after the flood", "window.softsight.shownPosition === %d" % target)
         test_template_drag(first, truth[target], target)
         test_recording_reproduces(first, args.softsight, folder)
         if args.screenshot:
             first.click_button("play")  # Pause (at the end: nothing).
-            wait_for("the pause", lambda: first.state(
-                "window.softsight.status.paused || window.softsight.status.ended"))
+            first.wait("the pause", "window.softsight.status.paused || window.softsight.status.ended")
             time.sleep(0.3)  # Only for the picture: the plots redraw at most every 120 ms.
             first.driver.save_screenshot(args.screenshot)
     except Exception:
@@ -560,8 +615,7 @@ def run(args, browser, driver):
                 page.state("window.softsight.errors.slice(-8)"), page.state("window.softsight.status")))
         raise
     finally:
-        for page in pages:
-            page.quit()
+        quit_pages(browsers)
         stop_server(server)
     shutil.rmtree(folder)
 

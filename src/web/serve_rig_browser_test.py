@@ -6,8 +6,9 @@ rig's closed loop; a second browser sees the same run and its STOP vents the rig
 first page controls it (STOP to vented, measured in the page); and a page that leaves mid-run
 leaves the rig held for controller.hold_s, then vented.
 
-Every wait is selenium's WebDriverWait on a condition of the page's state (window.softsight):
-no sleep decides a result. Exit code 77 (ctest: skipped) when chromium, its driver or selenium
+Every wait is a condition on the page's state (window.softsight) checked in the page on every
+message and redraw (Page.wait): no polling, and no sleep decides a result. The server and both
+browsers start at once. Exit code 77 (ctest: skipped) when chromium, its driver or selenium
 is missing.
 
   serve_rig_browser_test.py --softsight build/src/app/softsight [--screenshot docs/images/serve-rig.png]
@@ -19,8 +20,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from serve_browser_test import (Page, browser_test_main, check, start_serve, stop_server,  # noqa: E402
-                                webdriver_wait)
+from serve_browser_test import (browser_test_main, check, quit_pages, serve_with_pages,  # noqa: E402
+                                stop_server, webdriver_wait)
 
 
 def wait(page, what, expression, timeout=10.0):
@@ -82,11 +83,14 @@ def test_control_columns_and_whole_run(page):
 
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-rig-")
-    server, url = start_serve(args.softsight, ["--simulate", "--port", "0", "--folder", folder])
+    # The server and both browsers start at once.
+    server, url, browsers = serve_with_pages(args.softsight, ["--simulate", "--port", "0", "--folder", folder],
+                                             browser, driver, 2)
     pages = []
     figures = {}
     try:
-        first = Page(browser, driver, url)
+        first = browsers[0]
+        first.open(url)
         pages.append(first)
         wait(first, "the panel, idle and vented",
              "window.softsight.rig !== null && window.softsight.rigLimits !== null && "
@@ -104,7 +108,8 @@ def run(args, browser, driver):
         test_control_columns_and_whole_run(first)
 
         # A second browser: the same run, read-only; its own STOP vents it all the same.
-        second = Page(browser, driver, url)
+        second = browsers[1]
+        second.open(url)
         pages.append(second)
         wait(second, "the second page sees the run",
              "window.softsight.rig !== null && window.softsight.rig.state === 'running'")
@@ -162,8 +167,7 @@ def run(args, browser, driver):
                 page.state("window.softsight.errors.slice(-8)"), page.state("window.softsight.rig")))
         raise
     finally:
-        for page in pages:
-            page.quit()
+        quit_pages(browsers)
         out, err = stop_server(server)
     check("left mid-run" in out and "STOP" in out, "the server's log: %s" % out[-2000:])
     print("STOP pressed on a read-only page -> the page shows the rig vented: %.1f ms" % figures["stop_ms"])

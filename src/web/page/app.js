@@ -27,6 +27,25 @@ const MAX_ZOOM = 16;
 let pending = null, decoding = false;  // Newest-wins decoding of frames.
 let ws = null;
 
+// Waiters on the page's state (the browser test's waits, so it need not poll): each predicate
+// is checked at once, after every message handled and after every redraw of the picture.
+const waiters = new Set();
+function changed() { for (const check of [...waiters]) check(); }
+S.changed = changed;
+// A promise of the predicate's first true value, or of null after `timeoutMs`.
+S.when = (predicate, timeoutMs) => new Promise((resolve) => {
+  let timer = null;
+  const check = () => {
+    let value = false;
+    try { value = predicate(); } catch (e) { value = false; }
+    if (!value) return;
+    waiters.delete(check); clearTimeout(timer); resolve(value);
+  };
+  waiters.add(check);
+  timer = setTimeout(() => { waiters.delete(check); resolve(null); }, timeoutMs);
+  check();
+});
+
 function send(message) {
   if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(message));
 }
@@ -49,12 +68,14 @@ function connect() {
   ws.onmessage = (event) => {
     if (typeof event.data === 'string') onText(JSON.parse(event.data));
     else onFrame(event.data);
+    changed();
   };
   ws.onclose = (event) => {
     S.closed = event.code;
     $('role').textContent = 'disconnected';
     $('role').className = 'badge';
     log('connection closed (' + event.code + (event.reason ? ': ' + event.reason : '') + ')', true);
+    changed();
   };
   // A few pings at once (the offset comes from the fastest round trip), then one every 2 s.
   ws.onopen = () => {
@@ -171,6 +192,7 @@ async function decodeNext() {
       drawView();
       showReadout(header.frame);
       S.framesShown++;
+      changed();  // (drawView ran before the count and the latency.)
       // Capture to the picture on the page, in the server's clock (offset from the pings).
       if (!header.replay) {
         S.latencies.push(Date.now() + S.clockOffsetMs - header.captured_ms);
@@ -299,6 +321,7 @@ function drawView() {
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
     ctx.setLineDash([]);
   }
+  changed();
 }
 
 function drawOverlay(ctx, row) {
@@ -628,6 +651,7 @@ function drawPlot() {
   const shown = rows.get(imageFrame);
   if (shown) { ctx.fillStyle = '#fff'; ctx.fillRect(x(shown.time_s), 0, 1, h); }
   plot._t0 = t0; plot._t1 = t1;
+  changed();
 }
 plot.addEventListener('click', (e) => {
   if (!length() || !S.hello || plot._t0 === undefined) return;

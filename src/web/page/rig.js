@@ -117,6 +117,7 @@
     const t0 = whole ? Math.min(trace.t[0], t1 - 1) : t1 - TRACE_S;
     const x = (t) => 36 + (t - t0) / (t1 - t0) * (w - 42);
     S.rigTrace = {t0, t1, samples: trace.t.length, whole};  // For the test: the span drawn.
+    S.changed();
     // The angle lane from 10 deg under the lowest angle in view (rounded to 10) to straight.
     let lowest = 170;
     for (let j = 0; j < trace.t.length; j++) {
