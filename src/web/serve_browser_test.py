@@ -480,6 +480,36 @@ def test_recording_reproduces(page, softsight, folder):
           % (len(recorded), len(tracked)))
 
 
+def test_compare(page, recording_csv):
+    """A file that is no run's CSV is refused. The recording's CSV opened as the run to compare
+    (read in the page): sought to a frame in
+    the middle of it, the compared row is that very frame (matched by time alone), its markers
+    are drawn on the picture within 1 px of the served run's (the same video and config), its
+    curves are in the plots, and its numbers under the readout."""
+    with open(recording_csv) as f:
+        recorded = list(csv.DictReader(f))
+    # Not a CSV of a run (the recording's config): refused with an error, nothing compared.
+    errors = page.state("window.softsight.errors.length")
+    page.driver.find_element("id", "comparefile").send_keys(recording_csv.replace(".csv", ".yaml"))
+    page.wait("the refusal", "window.softsight.errors.length > %d && window.softsight.compare === null" % errors)
+    page.driver.find_element("id", "comparefile").send_keys(recording_csv)
+    page.wait("the compared run read", "window.softsight.compare && window.softsight.compare.rows === %d" % len(recorded))
+    page.state("window.softsight.send({type: 'pause'})")
+    frame = int(recorded[len(recorded) // 2]["frame"])
+    page.state("window.softsight.send({type: 'seek', position: %d})" % frame)
+    page.wait("the seek to a recorded frame, compared", "window.softsight.shownPosition === %d && "
+              "window.softsight.row(%d) !== null && window.softsight.compareDrawn === 3 && "
+              "window.softsight.comparePlotted > 0" % (frame, frame))
+    other = page.state("window.softsight.compareRow(%d)" % frame)
+    check(other is not None and other["frame"] == frame, "frame %d compared with %s" % (frame, other and other["frame"]))
+    row = page.state("window.softsight.row(%d)" % frame)
+    for name in ("red", "blue", "green"):
+        d = ((other[name + "_x"] - row[name + "_x"]) ** 2 + (other[name + "_y"] - row[name + "_y"]) ** 2) ** 0.5
+        check(d < 1, "%s: %.2f px from the served run's in the compared run" % (name, d))
+    check(("frame %d" % frame) in page.driver.find_element("id", "comparereadout").text,
+          "the compared numbers are not shown")
+
+
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-")
     video, truth_csv, config = (os.path.join(folder, n) for n in ("run.avi", "truth.csv", "cfg.yaml"))
@@ -602,8 +632,9 @@ def run(args, browser, driver):
             page.wait("a step after the flood", "window.softsight.shownPosition === %d" % target)
         test_template_drag(first, truth[target], target)
         test_recording_reproduces(first, args.softsight, folder)
+        test_compare(first, os.path.join(folder, "serve-001.csv"))
         if args.screenshot:
-            first.click_button("play")  # Pause (at the end: nothing).
+            first.state("window.softsight.send({type: 'pause'})")
             first.wait("the pause", "window.softsight.status.paused || window.softsight.status.ended")
             time.sleep(0.3)  # Only for the picture: the plots redraw at most every 120 ms.
             first.driver.save_screenshot(args.screenshot)

@@ -316,6 +316,7 @@ function drawView() {
   if (S.shownMask) drawCandidates(ctx);
   else if (row && S.hello) drawOverlay(ctx, row);
   if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS, viewScale());
+  if (S.drawCompare) S.drawCompare(ctx, row, toView, COLOURS);  // compare.js: another run.
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
@@ -617,6 +618,7 @@ function drawPlot() {
   const lanes = PLOTS.concat(S.toolLanes ? S.toolLanes() : []);  // An analysis tool's lane each.
   const laneH = h / lanes.length;
   const x = (t) => 40 + (t - t0) / (t1 - t0) * (w - 50);
+  let compared = 0;  // Points of another run drawn (compare.js).
   lanes.forEach(([key, label], lane) => {
     const values = sortedFrames.map((f) => series(rows.get(f), key));
     const finite = values.filter((v) => v !== null && v !== undefined);
@@ -647,7 +649,9 @@ function drawPlot() {
       drawing = true;
     });
     ctx.stroke();
+    if (S.drawCompareLane) compared += S.drawCompareLane(ctx, key, x, y, series, t0, t1);
   });
+  S.comparePlotted = compared;
   const shown = rows.get(imageFrame);
   if (shown) { ctx.fillStyle = '#fff'; ctx.fillRect(x(shown.time_s), 0, 1, h); }
   plot._t0 = t0; plot._t1 = t1;
