@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "softsight/control/actuator_model.h"
+#include "control/sample_columns.h"
 #include "softsight/core/format.h"
 #include "stream/stream_format.h"
 
@@ -237,21 +238,7 @@ const std::string& RigPanel::status_json() {
 }
 
 std::vector<CsvColumn> RigPanel::columns() const {
-  const auto column = [this](const char* name, auto value) {
-    return NumberColumn(name, [this, value](const FrameResult&) -> std::optional<double> {
-      return value(last_);
-    });
-  };
-  using S = const ControlSample&;
-  std::vector<CsvColumn> columns = {
-      column("target_deg", [](S s) { return s.target_deg; }),
-      column("setpoint_kpa", [](S s) { return s.setpoint_kpa; }),
-      column("board_pressure_kpa", [](S s) { return s.board.pressure_kpa; }),
-      column("board_setpoint_kpa", [](S s) { return s.board.setpoint_kpa; }),
-      column("duty", [](S s) { return s.board.duty; }),
-      column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
-      column("control_action", [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
-  };
+  std::vector<CsvColumn> columns = ControlSampleColumns(&last_);
   columns.push_back(NumberColumn("rig_state", [this](const FrameResult&) -> std::optional<double> {
     return static_cast<double>(static_cast<int>(state_));
   }));
