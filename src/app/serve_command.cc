@@ -26,6 +26,7 @@ namespace {
 struct ServeArgs {
   std::optional<CameraId> camera;
   std::string input;
+  std::string compare;  // A second video beside the first (--compare).
   std::string config;
   std::optional<std::string> method;
   std::string bind = "127.0.0.1";
@@ -83,6 +84,16 @@ int RunServeCommand(ServeArgs args) {
           ? SimulatedRigCamera(*rig, args.rig.fps)
           : OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
+  if (!args.compare.empty()) {
+    if (args.input.empty()) {
+      throw InputError("--compare needs --input (a file served: a camera cannot seek to the same position)");
+    }
+    FrameSourceSpec compare_spec;
+    compare_spec.input = args.compare;
+    compare_spec.sequence_fps = spec.sequence_fps;
+    OpenFrameSource(compare_spec);  // Checked now: a missing file is an error before serving.
+    options.compare = [compare_spec] { return OpenFrameSource(compare_spec); };
+  }
   // A file can be opened again to seek in it; the simulated rig's frames cannot (nor a camera's).
   if (!source->is_live() && !args.rig.simulate) reopen = [spec] { return OpenFrameSource(spec); };
   // The hook first among the sinks: the page and the recordings show its columns.
@@ -131,6 +142,9 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file, image sequence or synth:NAME instead of a camera");
   camera->excludes(input);
+  sub.add_option("--compare", args->compare,
+                 "A second video shown beside --input's, frame by frame at the same position "
+                 "(two runs side by side in sync; the page's compare opens its CSV)");
   sub.add_option("-c,--config", args->config,
                  "Marker configuration (YAML, see examples/); a synth: input without one uses "
                  "the scene's own, written to <folder>/synth-NAME.yaml");

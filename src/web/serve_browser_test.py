@@ -211,6 +211,26 @@ def start_pages(browser, driver, count):
         return list(pool.map(lambda _: Page(browser, driver), range(count)))
 
 
+def render_with_pages(softsight, folder, frames, browser, driver, count):
+    """The bending scene rendered to FOLDER/run.avi (640x480, 30 fps, `frames` frames) with its
+    truth (FOLDER/truth.csv), while `count` browsers start (each takes seconds, mostly waiting):
+    (video, truth_csv, pages not yet opened). Nothing left running when one of them fails."""
+    video, truth_csv = os.path.join(folder, "run.avi"), os.path.join(folder, "truth.csv")
+    synth = subprocess.Popen([softsight, "synth", "--scene", "bending", "--frames", str(frames), "--size",
+                              "640x480", "--fps", "30", "-o", video, "--truth", truth_csv],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    browsers = []
+    try:
+        browsers = start_pages(browser, driver, count)
+        _, err = synth.communicate(timeout=60)
+        check(synth.returncode == 0, "synth failed: %s" % err)
+    except BaseException:
+        synth.kill()
+        quit_pages(browsers)
+        raise
+    return video, truth_csv, browsers
+
+
 def quit_pages(pages):
     """Every browser quit at once (each takes a few hundred ms)."""
     import concurrent.futures
@@ -512,20 +532,8 @@ def test_compare(page, recording_csv):
 
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-")
-    video, truth_csv, config = (os.path.join(folder, n) for n in ("run.avi", "truth.csv", "cfg.yaml"))
-    # The two browsers start while the video renders (each takes seconds, mostly waiting).
-    synth = subprocess.Popen([args.softsight, "synth", "--scene", "bending", "--frames", "300", "--size",
-                              "640x480", "--fps", "30", "-o", video, "--truth", truth_csv],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    browsers = []
-    try:
-        browsers = start_pages(browser, driver, 2)
-        _, err = synth.communicate(timeout=60)
-        check(synth.returncode == 0, "synth failed: %s" % err)
-    except BaseException:
-        synth.kill()
-        quit_pages(browsers)
-        raise
+    config = os.path.join(folder, "cfg.yaml")
+    video, truth_csv, browsers = render_with_pages(args.softsight, folder, 300, browser, driver, 2)
     with open(config, "w") as f:
         f.write(CONFIG)
     truth = truth_rows(truth_csv)

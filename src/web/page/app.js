@@ -4,7 +4,7 @@
 'use strict';
 
 const $ = (id) => document.getElementById(id);
-const view = $('view'), timeline = $('timeline'), plot = $('plot');
+const view = $('view'), view2 = $('view2'), timeline = $('timeline'), plot = $('plot');
 const COLOURS = ['#ff5050', '#50a0ff', '#50e070', '#ffd040', '#e070ff', '#40e0e0', '#ffa040', '#c0c0c0', '#ff80c0'];
 const PLOTS = [['angle_deg', 'angle [deg]'], ['radius', 'radius'], ['tip_disp', 'bending distance'], ['arc_length', 'arc length']];
 
@@ -18,6 +18,7 @@ const S = window.softsight = {
 const rows = new Map();      // frame -> its row (the CSV's columns)
 let sortedFrames = null;     // Cache of rows' keys in order, for the plots.
 let image = null;            // The ImageBitmap on screen.
+let image2 = null;           // The second video's (serve --compare), at the same position.
 let imageFrame = -1;
 let scale = 1;               // Canvas pixels per image pixel, the whole image in view.
 // Zoom and pan: `zoom` times the fitted size, the view's top left at image point (ox, oy)
@@ -136,6 +137,8 @@ function onHello(m) {
     tr.onclick = () => send({type: 'marker', index: i});
   });
   for (const id of ['back', 'fwd']) $(id).disabled = !m.seekable;
+  view2.hidden = !m.compare;  // A second video beside the first (serve --compare).
+  if (m.compare) view2.title = m.compare + ' at the same position, zoomed and panned with the first';
   if (S.onRigHello) S.onRigHello(m.rig);  // rig.js: the control panel, when there is a rig.
   send({type: 'list_configs'});
 }
@@ -168,21 +171,30 @@ function recentLatency() {
   return l.length ? l[Math.floor(l.length / 2)] : null;
 }
 
-// Binary: [header length, 4 bytes LE][header JSON][JPEG].
+// Binary: [header length, 4 bytes LE][header JSON][JPEG][the second video's JPEG, when the
+// header has compare_bytes].
 function onFrame(buffer) {
   const size = new DataView(buffer).getUint32(0, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, size)));
-  pending = {header, blob: new Blob([new Uint8Array(buffer, 4 + size)], {type: 'image/jpeg'})};
+  const second = header.compare_bytes || 0, end = buffer.byteLength - second;
+  pending = {header, blob: new Blob([new Uint8Array(buffer, 4 + size, end - 4 - size)], {type: 'image/jpeg'}),
+             second: second ? new Blob([new Uint8Array(buffer, end, second)], {type: 'image/jpeg'}) : null};
   if (!decoding) decodeNext();
 }
 
 async function decodeNext() {
   decoding = true;
   while (pending) {
-    const {header, blob} = pending;
+    const {header, blob, second} = pending;
     pending = null;
     try {
       const bitmap = await createImageBitmap(blob);
+      if (second) {
+        const bitmap2 = await createImageBitmap(second);
+        if (image2) image2.close();
+        image2 = bitmap2;
+        S.compareVideoFrame = header.compare_frame;
+      }
       if (image) image.close();
       image = bitmap;
       imageFrame = header.frame;
@@ -248,14 +260,18 @@ function showReadout(frame) {
 function fitView() {
   if (!image) return;
   // At most the image's own size (the plots stay on screen under it), less on a narrow window.
-  const width = Math.min(image.width, Math.max(320, window.innerWidth - 400));
+  // With a second video beside it, each takes half.
+  const room = window.innerWidth - 400;
+  const width = Math.min(image.width, Math.max(320, view2.hidden ? room : room / 2 - 6));
   scale = width / image.width;
   const ratio = window.devicePixelRatio || 1;
   const w = Math.round(image.width * scale), h = Math.round(image.height * scale);
   if (view.width !== Math.round(w * ratio) || view.style.width !== w + 'px') {
     // Canvas pixels at the screen's own density: the overlay stays crisp.
-    view.width = Math.round(w * ratio); view.height = Math.round(h * ratio);
-    view.style.width = w + 'px'; view.style.height = h + 'px';
+    for (const v of [view, view2]) {
+      v.width = Math.round(w * ratio); v.height = Math.round(h * ratio);
+      v.style.width = w + 'px'; v.style.height = h + 'px';
+    }
     for (const c of [timeline, plot]) {
       c.width = Math.round(w * ratio); c.style.width = w + 'px';
       c.height = Math.round((c === plot ? 240 : 28) * ratio); c.style.height = (c === plot ? 240 : 28) + 'px';
@@ -316,7 +332,16 @@ function drawView() {
   if (S.shownMask) drawCandidates(ctx);
   else if (row && S.hello) drawOverlay(ctx, row);
   if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS, viewScale());
-  if (S.drawCompare) S.drawCompare(ctx, row, toView, COLOURS);  // compare.js: another run.
+  // The second video at the same zoom and pan; another run's CSV (compare.js) drawn over it,
+  // or over the first without one.
+  let ctx2 = null;
+  if (image2 && !view2.hidden) {
+    ctx2 = cssContext(view2);
+    ctx2.imageSmoothingEnabled = zoom < 2;
+    ctx2.drawImage(image2, ox * image2.width / image.width, oy * image2.height / image.height,
+                   image2.width / zoom, image2.height / zoom, 0, 0, image.width * scale, image.height * scale);
+  }
+  if (S.drawCompare) S.drawCompare(ctx2 || ctx, row, toView, COLOURS);  // compare.js: another run.
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
