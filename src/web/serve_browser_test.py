@@ -430,6 +430,8 @@ def test_mm_scale(page, truth, frame, earlier):
         check(abs(chord - true_mm) < 0.005 * true_mm,
               "frame %d's chord %.2f mm, the truth %.2f mm" % (f, chord, true_mm))
     check(" mm" in page.driver.find_element("id", "readout").text, "the readout is not in mm")
+    shown = re.search(r"scale ([0-9.]+) mm/px", page.driver.find_element("id", "status").text)
+    check(shown and abs(float(shown.group(1)) - scale) < 1e-4, "the status line does not say the scale")
 
 
 def test_hostile_messages(page):

@@ -152,7 +152,8 @@ function onStatus(m) {
       (m.paused ? 'PAUSED  ' : '') + (m.ended ? 'END  ' : '') + (m.recording ? 'REC  ' : '') +
       'fps ' + m.fps.toFixed(1) + '   dropped ' + m.dropped + '   skipped for this page ' + m.skipped +
       '   capture->result ' + m.latency_ms.toFixed(1) + ' ms   capture->page ' +
-      (lat === null ? '-' : lat.toFixed(0) + ' ms') + '   pages ' + m.pages;
+      (lat === null ? '-' : lat.toFixed(0) + ' ms') + '   pages ' + m.pages +
+      (m.mm_per_px ? '   scale ' + m.mm_per_px.toFixed(4) + ' mm/px' : '');
   $('play').textContent = m.paused || m.ended ? 'play' : 'pause';
   $('speed').value = String(+m.speed.toFixed(2));
   $('record').textContent = m.recording ? 'stop recording' : 'record';
