@@ -516,9 +516,12 @@ def test_compare(page, recording_csv):
     page.wait("the refusal", "window.softsight.errors.length > %d && window.softsight.compare === null" % errors)
     page.driver.find_element("id", "comparefile").send_keys(recording_csv)
     page.wait("the compared run read", "window.softsight.compare && window.softsight.compare.rows === %d" % len(recorded))
-    page.state("window.softsight.send({type: 'pause'})")
     frame = int(recorded[len(recorded) // 2]["frame"])
-    page.state("window.softsight.send({type: 'seek', position: %d})" % frame)
+    # The video may have played to its end meanwhile, and a seek from the end plays on: seek,
+    # pause, seek again (the server takes them in order), so it stays on the frame.
+    for message in ("{type: 'seek', position: %d}" % frame, "{type: 'pause'}",
+                    "{type: 'seek', position: %d}" % frame):
+        page.state("window.softsight.send(%s)" % message)
     page.wait("the seek to a recorded frame, compared", "window.softsight.shownPosition === %d && "
               "window.softsight.row(%d) !== null && window.softsight.compareDrawn === 3 && "
               "window.softsight.comparePlotted > 0" % (frame, frame))
