@@ -52,6 +52,9 @@ int RunServeCommand(ServeArgs args) {
   if (args.rig.simulate && (args.camera || !args.input.empty())) {
     throw InputError("serve --simulate renders the simulated rig's own frames: no --camera or --input");
   }
+  if (!args.compare.empty() && args.input.empty()) {
+    throw InputError("--compare needs --input (a file served: a camera cannot seek to the same position)");
+  }
   if (args.rig.board_port && !args.camera) {
     throw InputError("serve --board-port needs --camera: the loop runs on live frames");
   }
@@ -85,9 +88,6 @@ int RunServeCommand(ServeArgs args) {
           : OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
   if (!args.compare.empty()) {
-    if (args.input.empty()) {
-      throw InputError("--compare needs --input (a file served: a camera cannot seek to the same position)");
-    }
     FrameSourceSpec compare_spec;
     compare_spec.input = args.compare;
     compare_spec.sequence_fps = spec.sequence_fps;
