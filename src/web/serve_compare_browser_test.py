@@ -90,6 +90,10 @@ def run(args, browser, driver):
                   "at position %d (%s): the second picture at blue's place in frame %d is %s, at its place in "
                   "frame %d %s; the first picture there %s" % (position, how, position + OFFSET, there, position,
                                                                 here, first))
+        # The wheel over the second picture zooms both about the pointer.
+        rect = page.state("document.getElementById('view2').getBoundingClientRect().toJSON()")
+        page.wheel_at(rect["left"] + rect["width"] / 2, rect["top"] + rect["height"] / 2, -200)
+        page.wait("the zoom from the second picture", "window.softsight.zoom().zoom > 1.9")
         if args.screenshot:
             page.driver.save_screenshot(args.screenshot)
     except Exception:

@@ -439,20 +439,30 @@ function drawArc(ctx, b, m, t) {
 // The wheel zooms about the pointer, a right (or middle) drag pans, "whole image" (z) resets.
 let drag = null, panning = null, movingPoint = false;
 // The pointer in the view's CSS pixels (k per image pixel), from where it is on screen.
-function viewPoint(event) {
-  const rect = view.getBoundingClientRect();
-  return [(event.clientX - rect.left) * view.clientWidth / rect.width,
-          (event.clientY - rect.top) * view.clientHeight / rect.height];
+// (`on`: the second video's canvas, the same size and mapping, for its wheel and pan.)
+function viewPoint(event, on = view) {
+  const rect = on.getBoundingClientRect();
+  return [(event.clientX - rect.left) * on.clientWidth / rect.width,
+          (event.clientY - rect.top) * on.clientHeight / rect.height];
 }
 let pointer = null;  // The last view point the mouse was at (the keys zoom about it).
-view.addEventListener('wheel', (e) => {
+// The wheel and the right or middle drag on either picture zoom and pan both.
+for (const canvas of [view, view2]) {
+  canvas.addEventListener('wheel', (e) => {
+    e.preventDefault();
+    const [x, y] = viewPoint(e, canvas);
+    // One notch (100 px of deltaY) is a factor of sqrt(2); a touchpad's small steps zoom smoothly.
+    const delta = e.deltaMode === 1 ? e.deltaY * 33 : e.deltaY;
+    zoomAt(x, y, Math.pow(2, -delta / 200));
+  }, {passive: false});
+  canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+}
+view2.addEventListener('mousedown', (e) => {
+  if (e.button === 0) return;
   e.preventDefault();
-  const [x, y] = viewPoint(e);
-  // One notch (100 px of deltaY) is a factor of sqrt(2); a touchpad's small steps zoom smoothly.
-  const delta = e.deltaMode === 1 ? e.deltaY * 33 : e.deltaY;
-  zoomAt(x, y, Math.pow(2, -delta / 200));
-}, {passive: false});
-view.addEventListener('contextmenu', (e) => e.preventDefault());
+  const [x, y] = viewPoint(e);  // Only the moves count: in the first picture's pixels alike.
+  panning = {x, y, ox, oy};
+});
 view.addEventListener('mousedown', (e) => {
   const [x, y] = viewPoint(e);
   if (e.button !== 0) {
