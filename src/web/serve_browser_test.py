@@ -340,7 +340,8 @@ def in_ranges(hsv, ranges):
 def test_mask_click_grows(page, video, blue):
     """In the mask view of blue (its range yellow on purpose: none of its pixels), a click on
     blue widens the ranges to take in the pixel clicked (its HSV read from the video with
-    OpenCV, not from the page); undo puts the yellow range back and says what it undid."""
+    OpenCV, not from the page); a shift-click there takes it out again; two undos put the yellow
+    range back, each saying what it undid."""
     import cv2
     page.click_button("maskview")
     page.wait("the mask view", "window.softsight.status.mask_view && window.softsight.shownMask === true")
@@ -359,6 +360,28 @@ def test_mask_click_grows(page, video, blue):
     page.wait("the range edit", "window.softsight.status.undo === %d" % (undo + 1))
     grown = page.state("window.softsight.status.hsv")
     check(in_ranges(pixel, grown), "the clicked pixel (HSV %s) is not in the grown ranges %s" % (pixel, grown))
+    # A shift-click there takes those colours out again: the pixel is no member any more.
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
+    actions = ActionChains(page.driver)
+    actions.key_down(Keys.SHIFT)
+    # Each pointer step with a pause of the keyboard beside it: the shift stays down until the
+    # button is up (the two devices step together, one action each per tick).
+    pointer, keys = actions.w3c_actions.pointer_action, actions.w3c_actions.key_action
+    pointer.move_to_location(cx, cy)
+    keys.pause(0)
+    pointer.pointer_down()
+    keys.pause(0)
+    pointer.pointer_up()
+    keys.pause(0)
+    actions.key_up(Keys.SHIFT)
+    actions.perform()
+    page.wait("the shift-click's edit", "window.softsight.status.undo === %d" % (undo + 2))
+    shrunk = page.state("window.softsight.status.hsv")
+    check(not in_ranges(pixel, shrunk), "the shift-clicked pixel (HSV %s) is still in %s" % (pixel, shrunk))
+    page.click_button("undo")
+    page.wait("what the first undo undid",
+              "window.softsight.messages.some(m => m.includes('undone: removed colours of blue'))")
     page.click_button("undo")
     page.wait("the undo", "window.softsight.status.hsv.join() === '%s'" % ",".join(map(str, before)))
     page.wait("what the undo undid",
