@@ -4,7 +4,9 @@ python3-selenium): a second video beside the served one, frame by frame at the s
 The second video is the first's frames from frame 60 on (an image sequence written by the test),
 so at position p the second picture must be the first video's frame p + 60: the picture under
 blue's true position in frame p + 60 is blue there (and not, where the markers moved, under its
-position in frame p), after a seek and after a step.
+position in frame p), after a seek and after a step. The second run's CSV (`track` on its
+images) opened with "compare" gives, at position p, its own frame p, where the truth of frame
+p + 60 has the markers, drawn on the second picture.
 
 Every wait is a condition on the page's state checked in the page (Page.wait): no polling.
 Exit code 77 (ctest: skipped) when chromium, its driver or selenium is missing.
@@ -13,6 +15,7 @@ Exit code 77 (ctest: skipped) when chromium, its driver or selenium is missing.
 """
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -90,6 +93,21 @@ def run(args, browser, driver):
                   "at position %d (%s): the second picture at blue's place in frame %d is %s, at its place in "
                   "frame %d %s; the first picture there %s" % (position, how, position + OFFSET, there, position,
                                                                 here, first))
+        # The second run's CSV (`track` on its images) opened with "compare": its row at this
+        # position is its own frame 31 (the first video's frame 91), blue where the truth of
+        # that frame has it, and its markers are drawn on the second picture.
+        later_csv = os.path.join(folder, "later.csv")
+        subprocess.run([args.softsight, "track", "--input", later, "--config", config, "-o", later_csv],
+                       check=True, capture_output=True)
+        page.driver.find_element("id", "comparefile").send_keys(later_csv)
+        page.wait("the second run's markers drawn", "window.softsight.compare !== null && window.softsight.compareDrawn >= 2")
+        other = page.state("window.softsight.compareRow(31)")
+        truth_later = truth[31 + OFFSET]
+        check(other["frame"] == 31 and other["red_found"] == 1 and other["green_found"] == 1 and
+              abs(other["red_x"] - float(truth_later["red_x"])) < 1.5 and
+              abs(other["green_y"] - float(truth_later["green_y"])) < 1.5,
+              "the second run's row at position 31: %s; the truth of frame %d: %s" % (
+                  {k: other.get(k) for k in ("frame", "red_x", "green_y")}, 31 + OFFSET, truth_later))
         # The wheel over the second picture zooms both about the pointer.
         rect = page.state("document.getElementById('view2').getBoundingClientRect().toJSON()")
         page.wheel_at(rect["left"] + rect["width"] / 2, rect["top"] + rect["height"] / 2, -200)
