@@ -26,6 +26,7 @@
 #include "app/target_feed.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
+#include "control/sample_columns.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sink.h"
@@ -225,27 +226,14 @@ class ControlSink : public FrameSink {
   // rows of one camera's results (FrameResult) or two cameras' (StereoFrameResult).
   template <typename Row = FrameResult>
   std::vector<BasicCsvColumn<Row>> columns() const {
-    const auto column = [this](const char* name, auto value) {
-      return NumberColumn<Row>(name, [this, value](const Row&) -> std::optional<double> {
-        return value(sample_);
-      });
-    };
-    using S = const ControlSample&;
-    return {
-        column("target_deg", [](S s) { return s.target_deg; }),
-        column("setpoint_kpa", [](S s) { return s.setpoint_kpa; }),
-        column("board_pressure_kpa", [](S s) { return s.board.pressure_kpa; }),
-        column("board_setpoint_kpa", [](S s) { return s.board.setpoint_kpa; }),
-        column("duty", [](S s) { return s.board.duty; }),
-        column("board_flags", [](S s) { return static_cast<double>(s.board.flags); }),
-        column("control_action",
-               [](S s) { return static_cast<double>(static_cast<int>(s.action)); }),
-        NumberColumn<Row>("link_rejected",
-                          [this](const Row&) -> std::optional<double> {
-                            return static_cast<double>(link_.stats().rejected_lines);
-                          }),
-        column("board_rejected", [](S s) { return static_cast<double>(s.board.board_rejected); }),
-    };
+    std::vector<BasicCsvColumn<Row>> columns = ControlSampleColumns<Row>(&sample_);
+    columns.push_back(NumberColumn<Row>("link_rejected", [this](const Row&) -> std::optional<double> {
+      return static_cast<double>(link_.stats().rejected_lines);
+    }));
+    columns.push_back(NumberColumn<Row>("board_rejected", [this](const Row&) -> std::optional<double> {
+      return static_cast<double>(sample_.board.board_rejected);
+    }));
+    return columns;
   }
 
   // latency_command_ms: from the frame's capture to the serial command its step sent (goes

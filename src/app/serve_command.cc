@@ -26,6 +26,7 @@ namespace {
 struct ServeArgs {
   std::optional<CameraId> camera;
   std::string input;
+  std::string compare;  // A second video beside the first (--compare).
   std::string config;
   std::optional<std::string> method;
   std::string bind = "127.0.0.1";
@@ -50,6 +51,9 @@ int RunServeCommand(ServeArgs args) {
   // order (the simulated rig's own camera, or a camera), never a file that pauses or seeks.
   if (args.rig.simulate && (args.camera || !args.input.empty())) {
     throw InputError("serve --simulate renders the simulated rig's own frames: no --camera or --input");
+  }
+  if (!args.compare.empty() && args.input.empty()) {
+    throw InputError("--compare needs --input (a file served: a camera cannot seek to the same position)");
   }
   if (args.rig.board_port && !args.camera) {
     throw InputError("serve --board-port needs --camera: the loop runs on live frames");
@@ -83,6 +87,13 @@ int RunServeCommand(ServeArgs args) {
           ? SimulatedRigCamera(*rig, args.rig.fps)
           : OpenLiveSource(args.camera, args.input, args.capture, args.config, config, &spec);
   FrameSourceOpener reopen;
+  if (!args.compare.empty()) {
+    FrameSourceSpec compare_spec;
+    compare_spec.input = args.compare;
+    compare_spec.sequence_fps = spec.sequence_fps;
+    OpenFrameSource(compare_spec);  // Checked now: a missing file is an error before serving.
+    options.compare = [compare_spec] { return OpenFrameSource(compare_spec); };
+  }
   // A file can be opened again to seek in it; the simulated rig's frames cannot (nor a camera's).
   if (!source->is_live() && !args.rig.simulate) reopen = [spec] { return OpenFrameSource(spec); };
   // The hook first among the sinks: the page and the recordings show its columns.
@@ -131,6 +142,9 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
   auto* input = sub.add_option("-i,--input", args->input,
                                "Video file, image sequence or synth:NAME instead of a camera");
   camera->excludes(input);
+  sub.add_option("--compare", args->compare,
+                 "A second video shown beside --input's, frame by frame at the same position "
+                 "(two runs side by side in sync; the page's compare opens its CSV)");
   sub.add_option("-c,--config", args->config,
                  "Marker configuration (YAML, see examples/); a synth: input without one uses "
                  "the scene's own, written to <folder>/synth-NAME.yaml");

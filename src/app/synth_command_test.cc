@@ -229,5 +229,26 @@ TEST(SynthCommandTest, ASynthSceneBringsItsOwnConfigWrittenOnceAndKept) {
   EXPECT_THROW(ConfigForBuiltinInput("synth:nosuchscene", dir.path().string()), InputError);
 }
 
+// `serve --compare VIDEO` shows a second video at the served file's position: with the rig's own
+// frames (or a camera) there is no position to match. One line naming --compare, exit code 2,
+// and nothing written into the folder first (the simulated rig's config is written later).
+TEST(SynthCommandTest, ServeCompareNeedsAFileServedAndWritesNothingFirst) {
+  const testing::TempDir temp;
+  const fs::path& dir = temp.path();
+  const fs::path err = dir / "stderr.txt";
+  const fs::path folder = dir / "folder";
+  fs::create_directory(folder);
+  const std::string command = testing::SoftsightBinary() + " serve --simulate --compare " +
+                              (dir / "b.avi").string() + " --port 0 --folder " + folder.string() +
+                              " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::vector<std::string> lines = ReadLines(err);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("--compare needs --input"), std::string::npos) << lines[0];
+  EXPECT_TRUE(fs::is_empty(folder));
+}
+
 }  // namespace
 }  // namespace softsight

@@ -647,16 +647,45 @@ void LiveController::scale_point(const cv::Point2d& p) {
     say(message);
     return;
   }
-  const bool replaced_plane = config().measure.metric.plane_mm_from_image.has_value();
-  try {
-    session().set_metric(*metric);
-  } catch (const InputError& e) {
+  if (std::string refused; !apply_scale(*metric, scale_.span_px(), *options_.scale_distance_mm, &refused)) {
     scale_.restart();
-    say(std::string(e.what()) + "; click the first point again");
+    say(refused + "; click the first point again");
     return;
   }
   scale_.stop();
   pointer_->forget_pointer();
+}
+
+void LiveController::set_scale_from_points(const cv::Point2d& a_px, const cv::Point2d& b_px,
+                                           double distance_mm) {
+  if (recording()) {
+    // The CSV's columns (with or without _mm) are fixed when a recording starts.
+    say("scale: stop the recording first (r)");
+    return;
+  }
+  ScaleClicks clicks(distance_mm);
+  clicks.start();
+  std::string message;
+  clicks.add(a_px, session().measurement_point(a_px), &message);
+  const std::optional<MetricModel> metric =
+      clicks.add(b_px, session().measurement_point(b_px), &message);
+  if (!metric) {
+    // ScaleClicks speaks of clicking again: the page's two points are placed again there.
+    say(message.substr(0, message.find("; click")));
+    return;
+  }
+  if (std::string refused; !apply_scale(*metric, clicks.span_px(), distance_mm, &refused)) say(refused);
+}
+
+bool LiveController::apply_scale(const MetricModel& metric, double span_px, double distance_mm,
+                                 std::string* refused) {
+  const bool replaced_plane = config().measure.metric.plane_mm_from_image.has_value();
+  try {
+    session().set_metric(metric);
+  } catch (const InputError& e) {
+    *refused = e.what();
+    return false;
+  }
   // Measure the frame on screen again, so the mm values appear now, also while paused. The
   // strip chart restarts in mm: its px history cannot share the new axis.
   if (!frame_.empty()) {
@@ -665,9 +694,10 @@ void LiveController::scale_point(const cv::Point2d& p) {
     chart_.clear();
     chart_.add(*last_result_);
   }
-  say("scale " + FixedNumber(*metric->scale_mm_per_px, 4) + " mm/px (" +
-      DistanceText(*options_.scale_distance_mm) + " mm over " + FixedNumber(scale_.span_px(), 1) +
-      " px" + (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
+  say("scale " + FixedNumber(*metric.scale_mm_per_px, 4) + " mm/px (" + DistanceText(distance_mm) +
+      " mm over " + FixedNumber(span_px, 1) + " px" +
+      (replaced_plane ? ", replaces the plane homography" : "") + "); s saves it");
+  return true;
 }
 
 std::string LiveController::stop_recording() {

@@ -148,6 +148,13 @@ class LiveController {
   // and a timeline click make, so both front ends edit the session alike.
   void pick_colour_at(const cv::Point2d& image_px) { click(image_px); }
   void reselect(const cv::Rect& image_px) { drag(image_px); }
+  // The mask view's click (image pixels): `grow` adds the colours around it to the active
+  // marker's ranges, else takes them out (shift-click); one undo step each.
+  void edit_range_at(const cv::Point2d& image_px, bool grow) { edit_range(image_px, grow); }
+  // The mm scale from two image points `distance_mm` apart, as the window's `c` and two clicks
+  // make it (points less than ScaleClicks::kMinSpanPx apart, or a recording running: refused,
+  // with a message, nothing changed). The frame on screen is measured again.
+  void set_scale_from_points(const cv::Point2d& a_px, const cv::Point2d& b_px, double distance_mm);
   // Queues a seek to `position` in the file (refused, with a message, while recording).
   void seek_to(int64_t position);
   // The playing speed closest to `speed` among 0.1x .. 4x (the keys' steps).
@@ -248,6 +255,9 @@ class LiveController {
   void start_scale();
   void cancel_scale();
   void scale_point(const cv::Point2d& p);
+  // Hands `metric` (two points `span_px` apart, `distance_mm` in truth) to the session and
+  // measures the frame on screen again; false, `*refused` saying why, when the session refuses it.
+  bool apply_scale(const MetricModel& metric, double span_px, double distance_mm, std::string* refused);
   LiveLayout layout() const;
   // The state line (recording, pause, end, loop, drops, active marker, scale), the last message
   // and the scale hint.

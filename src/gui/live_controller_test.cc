@@ -510,6 +510,34 @@ TEST_F(LiveControllerTest, TwoClickedPointsSetTheMillimetreScaleThatSavingAndRec
   }
 }
 
+// The page's two points and typed distance (serve): the same scale as the window's two clicks,
+// no --scale-distance-mm needed; too close or while recording refused, nothing changed.
+TEST_F(LiveControllerTest, AScaleFromTwoGivenPointsIsTheScaleOfTwoClicks) {
+  LiveController live(SceneConfig(), Options());
+  for (int i = 0; i < 3; ++i) Feed(live, i);
+  live.set_scale_from_points({100, 120}, {105, 120}, 50);  // 5 px apart.
+  EXPECT_NE(live.message().find("too close"), std::string::npos) << live.message();
+  EXPECT_EQ(live.message().find("click the first point"), std::string::npos) << live.message();
+  EXPECT_TRUE(live.config().measure.metric.empty());
+
+  live.set_scale_from_points({100, 120}, {200, 120}, 50);  // 100 px: 0.5 mm/px.
+  EXPECT_NE(live.message().find("scale 0.5000 mm/px (50 mm over 100.0 px)"), std::string::npos)
+      << live.message();
+  EXPECT_EQ(live.config().measure.metric.scale_mm_per_px, 0.5);
+  ASSERT_TRUE(live.config().measure.metric.scale_points.has_value());
+  EXPECT_EQ(live.config().measure.metric.scale_points->b_px, cv::Point2d(200, 120));
+  // The frame on screen measured again, in mm.
+  ASSERT_TRUE(live.last_result()->measurement.chord_mm.has_value());
+  EXPECT_DOUBLE_EQ(*live.last_result()->measurement.chord_mm, 0.5 * *live.last_result()->measurement.chord_px);
+
+  live.on_event(UiEvent::Key('r'));
+  ASSERT_TRUE(live.recording()) << live.message();
+  live.set_scale_from_points({100, 120}, {300, 120}, 50);
+  EXPECT_NE(live.message().find("stop the recording first"), std::string::npos);
+  EXPECT_EQ(live.config().measure.metric.scale_mm_per_px, 0.5);
+  live.on_event(UiEvent::Key('r'));
+}
+
 TEST_F(LiveControllerTest, ScaleModeEscCancelsTooCloseRetriesAndNoDistanceOnlyHints) {
   {
     LiveController live(SceneConfig(), Options());  // No --scale-distance-mm.

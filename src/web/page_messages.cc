@@ -36,6 +36,8 @@ const std::vector<TypeInfo>& Types() {
       {"hsv", Kind::kHsv, {"index", "value"}},
       {"mask_view", Kind::kMaskView, {"on"}},
       {"load", Kind::kLoad, {"name"}},     {"list_configs", Kind::kListConfigs, {}},
+      {"range", Kind::kRange, {"x", "y", "grow"}},
+      {"scale", Kind::kScale, {"ax", "ay", "bx", "by", "mm"}},
   };
   return kTypes;
 }
@@ -123,6 +125,29 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
       }
       c->box_px = cv::Rect(static_cast<int>(x), static_cast<int>(y), static_cast<int>(bw),
                            static_cast<int>(bh));
+      return true;
+    }
+    case Kind::kRange:
+      if (!m.at("grow").is_boolean()) {
+        *error = "range: grow must be true or false";
+        return false;
+      }
+      c->grow = m.at("grow").get<bool>();
+      return NeedFrame(limits, type, error) && Number(m, type, "x", 0, w - 1, &c->point_px.x, error) &&
+             Number(m, type, "y", 0, h - 1, &c->point_px.y, error);
+    case Kind::kScale: {
+      // A distance of 0 (or a negative one) is no scale; a million mm is a kilometre.
+      if (!NeedFrame(limits, type, error) || !Number(m, type, "ax", 0, w - 1, &c->point_px.x, error) ||
+          !Number(m, type, "ay", 0, h - 1, &c->point_px.y, error) ||
+          !Number(m, type, "bx", 0, w - 1, &c->point_b_px.x, error) ||
+          !Number(m, type, "by", 0, h - 1, &c->point_b_px.y, error) ||
+          !Number(m, type, "mm", 0, 1e6, &c->distance_mm, error)) {
+        return false;
+      }
+      if (c->distance_mm <= 0) {
+        *error = "scale: mm must be above 0";
+        return false;
+      }
       return true;
     }
     case Kind::kMarker:

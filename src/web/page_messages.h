@@ -38,9 +38,14 @@ struct PageCommand {
     kRigStop,                                      // The rig: any page, always.
     kHsv, kMaskView,                               // Tuning: a range, the mask view.
     kLoad, kListConfigs,                           // Named configs in the server's folder.
+    kRange,                                        // The mask view's click: grow / shrink.
+    kScale,                                        // The mm scale from two points.
   };
   Kind kind = Kind::kPing;
-  cv::Point2d point_px;   // kPick: the image pixel clicked.
+  cv::Point2d point_px;   // kPick, kRange: the image pixel clicked; kScale: the first point.
+  cv::Point2d point_b_px;  // kScale: the second point (image pixels).
+  double distance_mm = 0.0;  // kScale: the points' true distance, (0, 1e6] mm.
+  bool grow = true;          // kRange: add the colours there (false: take them out).
   cv::Rect box_px;        // kSelect: the box dragged, image pixels.
   int64_t position = 0;   // kSeek: the frame's position in the file (0-based).
   int delta = 0;          // kStep: +1 or -1.

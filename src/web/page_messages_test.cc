@@ -212,5 +212,37 @@ TEST(PageMessagesTest, ConfigsAreLoadedOnlyByAPlainNameInTheFolder) {
   EXPECT_FALSE(ChangesTheRun(Kind::kListConfigs));  // Reading the folder's names changes nothing.
 }
 
+TEST(PageMessagesTest, TheMaskViewsClickAndTheMmScaleAreReadAndChecked) {
+  using Kind = PageCommand::Kind;
+  const PageCommand grow = Parse(R"({"type":"range","x":12.5,"y":479,"grow":true})");
+  EXPECT_EQ(grow.kind, Kind::kRange);
+  EXPECT_EQ(grow.point_px, cv::Point2d(12.5, 479));
+  EXPECT_TRUE(grow.grow);
+  EXPECT_FALSE(Parse(R"({"type":"range","x":0,"y":0,"grow":false})").grow);
+  EXPECT_NE(Refusal(R"({"type":"range","x":640,"y":0,"grow":true})").find("outside [0, 639]"),
+            std::string::npos);
+  EXPECT_NE(Refusal(R"({"type":"range","x":1,"y":1,"grow":1})").find("true or false"), std::string::npos);
+  PageLimits before_first_frame = FileLimits();
+  before_first_frame.frame_size = cv::Size();
+  EXPECT_NE(Refusal(R"({"type":"range","x":1,"y":1,"grow":true})", before_first_frame).find("no frame"),
+            std::string::npos);
+
+  const PageCommand scale = Parse(R"({"type":"scale","ax":100,"ay":440,"bx":500.5,"by":440,"mm":100})");
+  EXPECT_EQ(scale.kind, Kind::kScale);
+  EXPECT_EQ(scale.point_px, cv::Point2d(100, 440));
+  EXPECT_EQ(scale.point_b_px, cv::Point2d(500.5, 440));
+  EXPECT_DOUBLE_EQ(scale.distance_mm, 100);
+  EXPECT_TRUE(ChangesTheRun(Kind::kScale));
+  EXPECT_TRUE(ChangesTheRun(Kind::kRange));
+  EXPECT_NE(Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":440,"mm":0})").find("above 0"),
+            std::string::npos);
+  Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":440,"mm":-5})");
+  Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":440,"mm":2e6})");
+  Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":480,"mm":10})");
+  EXPECT_NE(Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":440})").find("missing field \"mm\""),
+            std::string::npos);
+  Refusal(R"({"type":"scale","ax":100,"ay":440,"bx":500,"by":440,"mm":"100"})");
+}
+
 }  // namespace
 }  // namespace softsight

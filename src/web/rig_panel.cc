@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "softsight/control/actuator_model.h"
+#include "control/sample_columns.h"
 #include "softsight/core/format.h"
 #include "stream/stream_format.h"
 
@@ -234,6 +235,14 @@ const std::string& RigPanel::status_json() {
                   : std::nullopt);
   json_ += ",\"updates\":" + std::to_string(updates_) + "}";
   return json_;
+}
+
+std::vector<CsvColumn> RigPanel::columns() const {
+  std::vector<CsvColumn> columns = ControlSampleColumns(&last_);
+  columns.push_back(NumberColumn("rig_state", [this](const FrameResult&) -> std::optional<double> {
+    return static_cast<double>(static_cast<int>(state_));
+  }));
+  return columns;
 }
 
 std::string RigPanel::limits_json() const {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "softsight/control/profile.h"
+#include "softsight/io/csv_columns.h"
 #include "softsight/control/session.h"
 #include "softsight/pipeline/sink.h"
 
@@ -60,6 +61,11 @@ class RigPanel : public FrameSink {
   const std::string& status_json();
   // The host's and the board's limits, a JSON object for the page's greeting.
   std::string limits_json() const;
+  // The loop's columns of each frame's row, as `control`'s CSV has them (target_deg,
+  // setpoint_kpa, board_pressure_kpa, board_setpoint_kpa, duty, board_flags, control_action,
+  // rig_state: 0 idle, 1 running, 2 holding, 3 failed): the sample of the frame's own step (the
+  // panel is a sink before the page's and the recording's). The panel must outlive them.
+  std::vector<CsvColumn> columns() const;
   // What the panel said since the last call (runs started, STOP, hold, vent, failures).
   std::vector<std::string> take_messages();
 

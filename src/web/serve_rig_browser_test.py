@@ -6,8 +6,9 @@ rig's closed loop; a second browser sees the same run and its STOP vents the rig
 first page controls it (STOP to vented, measured in the page); and a page that leaves mid-run
 leaves the rig held for controller.hold_s, then vented.
 
-Every wait is selenium's WebDriverWait on a condition of the page's state (window.softsight):
-no sleep decides a result. Exit code 77 (ctest: skipped) when chromium, its driver or selenium
+Every wait is a condition on the page's state (window.softsight) checked in the page on every
+message and redraw (Page.wait): no polling, and no sleep decides a result. The server and both
+browsers start at once. Exit code 77 (ctest: skipped) when chromium, its driver or selenium
 is missing.
 
   serve_rig_browser_test.py --softsight build/src/app/softsight [--screenshot docs/images/serve-rig.png]
@@ -19,8 +20,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from serve_browser_test import (Page, browser_test_main, check, start_serve, stop_server,  # noqa: E402
-                                webdriver_wait)
+from serve_browser_test import (browser_test_main, check, quit_pages, serve_with_pages,  # noqa: E402
+                                stop_server, webdriver_wait)
 
 
 def wait(page, what, expression, timeout=10.0):
@@ -54,13 +55,42 @@ def test_refusals(page):
     check(not page.state("window.softsight.status.paused"), "a refused pause paused the run")
 
 
+CONTROL_COLUMNS = ["target_deg", "setpoint_kpa", "board_pressure_kpa", "board_setpoint_kpa", "duty",
+                   "board_flags", "control_action", "rig_state"]
+
+
+def test_control_columns_and_whole_run(page):
+    """Each frame's row carries the loop's columns (control's CSV names), with the values the
+    rig's own message said for that frame; the page's CSV has them. The traces switched to the
+    whole run span it from the first sample this page got."""
+    rig = page.state("window.softsight.rig")
+    row = page.state("window.softsight.rowsIn().find(r => Math.abs(r.time_s - %f) < 5e-4) || null" % rig["t"])
+    check(row is not None, "no row for the rig's frame at t %.3f s" % rig["t"])
+    check(row["target_deg"] == 120 and row["rig_state"] == 1 and
+          abs(row["setpoint_kpa"] - rig["setpoint_kpa"]) < 0.006 and
+          abs(row["board_pressure_kpa"] - rig["pressure_kpa"]) < 0.006 and abs(row["duty"] - rig["duty"]) < 6e-4,
+          "the row at t %.3f s: %s; the rig said %s" % (rig["t"], {k: row.get(k) for k in CONTROL_COLUMNS}, rig))
+    header = page.state("window.softsight.csvText()").splitlines()[0].split(",")
+    check(all(c in header for c in CONTROL_COLUMNS), "the page's CSV has no control columns: %s" % header)
+    from selenium.webdriver.support.ui import Select
+    Select(page.driver.find_element("id", "rigspan")).select_by_value("whole")
+    wait(page, "the whole run drawn", "window.softsight.rigTrace.whole && "
+         "window.softsight.rigTrace.t0 === Math.min(window.softsight.rigStates[0].t, window.softsight.rigTrace.t1 - 1)")
+    Select(page.driver.find_element("id", "rigspan")).select_by_value("last")
+    wait(page, "the last 20 s drawn", "!window.softsight.rigTrace.whole && "
+         "Math.abs(window.softsight.rigTrace.t1 - window.softsight.rigTrace.t0 - 20) < 1e-9")
+
+
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-rig-")
-    server, url = start_serve(args.softsight, ["--simulate", "--port", "0", "--folder", folder])
+    # The server and both browsers start at once.
+    server, url, browsers = serve_with_pages(args.softsight, ["--simulate", "--port", "0", "--folder", folder],
+                                             browser, driver, 2)
     pages = []
     figures = {}
     try:
-        first = Page(browser, driver, url)
+        first = browsers[0]
+        first.open(url)
         pages.append(first)
         wait(first, "the panel, idle and vented",
              "window.softsight.rig !== null && window.softsight.rigLimits !== null && "
@@ -75,9 +105,11 @@ def run(args, browser, driver):
         wait(first, "the loop running and the pressure building",
              "window.softsight.rig.state === 'running' && window.softsight.rig.pressure_kpa > 5")
         wait(first, "the angle near 120 deg", "Math.abs(window.softsight.rig.measured_deg - 120) < 5")
+        test_control_columns_and_whole_run(first)
 
         # A second browser: the same run, read-only; its own STOP vents it all the same.
-        second = Page(browser, driver, url)
+        second = browsers[1]
+        second.open(url)
         pages.append(second)
         wait(second, "the second page sees the run",
              "window.softsight.rig !== null && window.softsight.rig.state === 'running'")
@@ -135,8 +167,7 @@ def run(args, browser, driver):
                 page.state("window.softsight.errors.slice(-8)"), page.state("window.softsight.rig")))
         raise
     finally:
-        for page in pages:
-            page.quit()
+        quit_pages(browsers)
         out, err = stop_server(server)
     check("left mid-run" in out and "STOP" in out, "the server's log: %s" % out[-2000:])
     print("STOP pressed on a read-only page -> the page shows the rig vented: %.1f ms" % figures["stop_ms"])

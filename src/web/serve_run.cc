@@ -100,6 +100,13 @@ std::string Number(double value) {
   return text;
 }
 
+// A scale (mm per px) to six significant digits.
+std::string Number6(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
 // The answer to a page's ping: its own time back, and the server's clock now.
 std::string Pong(double page_time_ms) {
   const double now_ms = std::chrono::duration<double, std::milli>(
@@ -122,9 +129,17 @@ class WebSink : public FrameSink {
   WebSink(WebServer& server, CsvColumnTable table, const std::vector<std::string>& markers,
           int jpeg_quality)
       : server_(server), table_(std::move(table)), formatter_(table_),
-        topic_(StreamTopics(table_, markers).front()), quality_(jpeg_quality) {}
+        topic_(StreamTopics(table_, markers).front()), markers_(markers), quality_(jpeg_quality) {}
 
   void set_controller(const LiveController* controller) { controller_ = controller; }
+  // The second video, sent with each picture at the same position (its frame there).
+  void set_compare(SeekableSource* compare) { compare_ = compare; }
+
+  // The rows' columns from now on (a scale set from a page adds the _mm ones).
+  void set_columns(CsvColumnTable table) {
+    table_ = std::move(table);  // formatter_ reads table_ (a reference to this member).
+    topic_ = StreamTopics(table_, markers_).front();
+  }
 
   void consume(const Frame& frame, const FrameResult& result) override {
     send_result(result, /*edit=*/false);
@@ -145,17 +160,26 @@ class WebSink : public FrameSink {
     header_.clear();
     AppendFrameFields(result, header_);
     header_ += mask ? ",\"mask\":true" : ",\"mask\":false";
-    header_ += replay ? ",\"replay\":true}" : ",\"replay\":false}";
+    header_ += replay ? ",\"replay\":true" : ",\"replay\":false";
     if (mask) send_candidates(result);
-    // [header length, 4 bytes little-endian][header JSON][JPEG]: the page pairs the picture
-    // with its result by frame number. The message is new each frame (the server's thread
-    // writes it to every page after this returns); everything else here is reused.
+    // With a second video, its frame at this position travels in the same message (after the
+    // picture, compare_bytes long): a page too slow for a frame skips both, never one of them.
+    const bool compared = encode_compare();
+    if (compared) {
+      header_ += ",\"compare_frame\":" + std::to_string(compare_frame_.index) +
+                 ",\"compare_bytes\":" + std::to_string(compare_jpeg_.size());
+    }
+    header_ += '}';
+    // [header length, 4 bytes little-endian][header JSON][JPEG][its JPEG]: the page pairs the
+    // picture with its result by frame number. The message is new each frame (the server's
+    // thread writes it to every page after this returns); everything else here is reused.
     std::string bytes;
-    bytes.reserve(4 + header_.size() + jpeg_.size());
+    bytes.reserve(4 + header_.size() + jpeg_.size() + (compared ? compare_jpeg_.size() : 0));
     const uint32_t size = static_cast<uint32_t>(header_.size());
     for (int i = 0; i < 4; ++i) bytes += static_cast<char>((size >> (8 * i)) & 0xFF);
     bytes += header_;
     bytes.append(reinterpret_cast<const char*>(jpeg_.data()), jpeg_.size());
+    if (compared) bytes.append(reinterpret_cast<const char*>(compare_jpeg_.data()), compare_jpeg_.size());
     server_.broadcast_frame(std::move(bytes));
   }
 
@@ -198,6 +222,23 @@ class WebSink : public FrameSink {
     server_.broadcast_text(mask_json_);
   }
 
+  // The second video's frame at the position of the frame on screen, encoded into
+  // compare_jpeg_; false when there is none (no second video, a camera, past its end: the page
+  // keeps its last). A video that fails to read is dropped, once, saying why on stderr.
+  bool encode_compare() {
+    if (compare_ == nullptr || position() < 0) return false;
+    try {
+      if (compare_->position() != position()) compare_->seek(position());
+      if (!compare_->read(compare_frame_)) return false;
+    } catch (const std::exception& failed) {
+      std::fprintf(stderr, "serve: --compare dropped: %s\n", failed.what());
+      compare_ = nullptr;
+      return false;
+    }
+    cv::imencode(".jpg", compare_frame_.image, compare_jpeg_, jpeg_params_);
+    return true;
+  }
+
   // A result with no new picture (an edit re-tracked the frame on screen): `edit` says so.
   void send_result(const FrameResult& result, bool edit) {
     if (server_.pages() == 0) return;  // Nobody watches (a page that joins gets the frame on screen).
@@ -231,8 +272,12 @@ class WebSink : public FrameSink {
   CsvColumnTable table_;
   RecordFormatter formatter_;
   TopicColumns topic_;
+  std::vector<std::string> markers_;
   int quality_;
   const LiveController* controller_ = nullptr;
+  SeekableSource* compare_ = nullptr;
+  Frame compare_frame_;
+  std::vector<uchar> compare_jpeg_;
   // Reused per frame; only the messages handed to the server's thread are new each time.
   std::vector<uchar> jpeg_;
   std::string header_, record_, json_, mask_json_;
@@ -241,7 +286,7 @@ class WebSink : public FrameSink {
 };
 
 std::string Greeting(const TrackingConfig& config, const FrameSource& source, bool seekable,
-                     const RigPanel* rig) {
+                     const RigPanel* rig, const FrameSource* compare) {
   std::string json = "{\"type\":\"hello\",\"source\":";
   AppendJsonString(source.description(), json);
   json += ",\"markers\":[";
@@ -263,6 +308,12 @@ std::string Greeting(const TrackingConfig& config, const FrameSource& source, bo
   const std::optional<int64_t> count = source.frame_count();
   json += ",\"length\":" + (count ? std::to_string(*count) : std::string("null"));
   json += ",\"rig\":" + (rig ? rig->limits_json() : std::string("null"));
+  json += ",\"compare\":";
+  if (compare != nullptr) {
+    AppendJsonString(compare->description(), json);
+  } else {
+    json += "null";
+  }
   return json + "}";
 }
 
@@ -374,13 +425,20 @@ void ServeLoop::apply(const PageCommand& command, uint64_t page) {
     case Kind::kMaskView:
       if (controller_.mask_view() != command.on) key('v');
       break;
+    case Kind::kRange: controller_.edit_range_at(command.point_px, command.grow); break;
+    case Kind::kScale:
+      controller_.set_scale_from_points(command.point_px, command.point_b_px, command.distance_mm);
+      // The rows have the _mm columns from now on (the frame on screen's too).
+      sink_.set_columns(TrackingColumns(controller_.config(), options_.live.extra_columns));
+      break;
   }
   if (command.kind == Kind::kSave) list_configs(0);  // Every page's list has the new name.
   // An edit re-tracks the frame on screen (or the next one shows it): every page sees its
   // result now, also while paused.
   const bool edit = command.kind == Kind::kPick || command.kind == Kind::kSelect ||
                     command.kind == Kind::kMethod || command.kind == Kind::kUndo ||
-                    command.kind == Kind::kHsv || command.kind == Kind::kLoad;
+                    command.kind == Kind::kHsv || command.kind == Kind::kLoad ||
+                    command.kind == Kind::kRange || command.kind == Kind::kScale;
   // The picture itself changes when the mask view is turned on or off, and in it with the
   // ranges and the active marker: sent again at once (also paused).
   const bool picture = command.kind == Kind::kMaskView ||
@@ -506,7 +564,11 @@ void ServeLoop::send_status(bool force) {
                      ",\"pages\":" + std::to_string(server_.pages()) +
                      ",\"undo\":" + std::to_string(controller_.undo_depth()) +
                      ",\"mask_view\":" + (controller_.mask_view() ? "true" : "false") +
-                     ",\"active\":" + std::to_string(active) + ",\"method\":";
+                     ",\"active\":" + std::to_string(active) + ",\"mm_per_px\":" +
+                     (config.measure.metric.scale_mm_per_px
+                          ? Number6(*config.measure.metric.scale_mm_per_px)
+                          : std::string("null")) +
+                     ",\"method\":";
   AppendJsonString(TrackerMethodName(config.markers[active].params), json);
   json += ",\"hsv\":[";
   for (size_t i = 0; i < hsv.size(); ++i) {
@@ -535,6 +597,10 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
     source = std::move(playable);
   }
   if (!options.live.record_fps) options.live.record_fps = source->fps();
+  // With a rig, every row (the page's, a recording's) carries the loop's columns too.
+  if (options.rig != nullptr) {
+    for (CsvColumn& column : options.rig->columns()) options.live.extra_columns.push_back(std::move(column));
+  }
   PageInbox inbox;
   std::atomic<WebServer*> answering{nullptr};
   PageLimits checked_here;  // Pings and STOPs need nothing of the run's state.
@@ -565,13 +631,19 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   // The page's values: the CSV's columns, a hook's too (after the hook's sink, first in sinks).
   WebSink sink(server, TrackingColumns(config, options.live.extra_columns), names,
                options.jpeg_quality);
+  std::unique_ptr<SeekableSource> compare;
+  if (options.compare) {
+    if (seekable == nullptr) throw InputError("--compare needs a file served (--input), not a camera");
+    compare = std::make_unique<SeekableSource>(options.compare(), options.compare);
+    sink.set_compare(compare.get());
+  }
   // The rig's loop steps on each frame before the frame goes out: its state travels with it.
   if (options.rig != nullptr) options.live.sinks.push_back(options.rig);
   options.live.sinks.push_back(&sink);
   LiveController controller(config, options.live);
   sink.set_controller(&controller);
   controller.describe_source(*source);
-  server.set_greeting(Greeting(config, *source, seekable != nullptr, options.rig));
+  server.set_greeting(Greeting(config, *source, seekable != nullptr, options.rig, compare.get()));
   source = SourceForRun(std::move(source),
                         options.pace_files ? FilePacing::kRealTime : FilePacing::kInCallersThread);
   out << "softsight serve: " << source->description() << ", " << config.markers.size()

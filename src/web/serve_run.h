@@ -37,6 +37,9 @@ struct ServeOptions {
   // The rig's control panel (serve --simulate / --board-port), or none. Its loop steps on every
   // tracked frame (it becomes a sink of the run); pages run it, and any page's STOP vents it.
   RigPanel* rig = nullptr;
+  // A second video shown beside the served one, frame by frame at the same position (a file
+  // served: two runs side by side in sync), or none: opens it from its first frame.
+  FrameSourceOpener compare;
 };
 
 // Serves until `stop_requested()` returns true (polled between frames, at least every 20 ms).

@@ -7,7 +7,8 @@ under a name is listed and loaded back; names that leave the folder, or are not 
 refused with an error and change nothing; the angle and distance tools measure what the
 tracker's own columns say, and a click on a trail seeks to that frame.
 
-Every wait is selenium's WebDriverWait on a condition of the page's state (window.softsight).
+Every wait is a condition on the page's state (window.softsight) checked in the page on every
+message and redraw (Page.wait): no polling. The server and the browser start at once.
 Exit code 77 (ctest: skipped) when chromium, its driver or selenium is missing.
 
   serve_tuning_browser_test.py --softsight build/src/app/softsight [--screenshot docs/images/serve-mask.png]
@@ -19,7 +20,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from serve_browser_test import (Page, browser_test_main, check, start_serve, stop_server,  # noqa: E402
+from serve_browser_test import (browser_test_main, check, serve_with_pages, stop_server,  # noqa: E402
                                 webdriver_wait)
 
 wait = webdriver_wait
@@ -29,7 +30,10 @@ def test_analysis(page, screenshot=None):
     """An angle on red, blue and green clicked on the picture is the row's angle; a distance from
     red to green is its chord in mm; both are plot lanes and CSV columns. With the trails shown, a
     click on green's path where it was in another frame seeks there."""
-    # Played on into the bend (a trail to click, an angle well off straight), then paused.
+    # Played on into the bend (a trail to click, an angle well off straight) at 4x, then paused.
+    from selenium.webdriver.support.ui import Select
+    Select(page.driver.find_element("id", "speed")).select_by_value("4")
+    wait(page, "4x", "window.softsight.status.speed === 4")
     page.click_button("play")
     wait(page, "the bend", "window.softsight.status.position >= 110")
     page.click_button("play")
@@ -51,6 +55,7 @@ def test_analysis(page, screenshot=None):
     header = page.state("window.softsight.csvText()").splitlines()[0].split(",")
     check(header[-2:] == ["angle_red_blue_green_deg", "distance_red_green_mm"], "the CSV's last columns: %s" % header[-3:])
     check(len(page.state("window.softsight.toolLanes()")) == 2, "the tools are not plotted")
+    test_fixed_point_dragged(page, frame, row)
     page.click_button("trails")
     wait(page, "the trails drawn", "window.softsight.trailPoints > 10")
     if screenshot:
@@ -67,12 +72,36 @@ def test_analysis(page, screenshot=None):
               landed["frame"], landed["green_x"], landed["green_y"], far["green_x"], far["green_y"]))
 
 
+def test_fixed_point_dragged(page, frame, row):
+    """A distance from red to a fixed point away from every marker; that point dragged onto
+    green's place: the distance is then red to green, the row's chord (mm); the drag moved the
+    point, not a box (no reselection: the undo depth is unchanged)."""
+    spot = (row["red_x"] + 80, row["red_y"] + 40)
+    page.click_button("tooldistance")
+    page.click_image_point(row["red_x"], row["red_y"])
+    page.click_image_point(*spot)
+    wait(page, "the third tool", "window.softsight.tools.length === 3")
+    check(page.state("window.softsight.tools[2].points.map(p => p.marker || null)") == ["red", None],
+          "not a distance from red to a fixed point: %s" % page.state("window.softsight.tools[2].points"))
+    undo = page.state("window.softsight.status.undo")
+    x0, y0 = page.state("window.softsight.clientPoint(%f, %f)" % spot)
+    x1, y1 = page.state("window.softsight.clientPoint(%f, %f)" % (row["green_x"], row["green_y"]))
+    page.drag(x0, y0, x1, y1)
+    wait(page, "the fixed point on green", "Math.hypot(window.softsight.tools[2].points[1].x - %f, "
+         "window.softsight.tools[2].points[1].y - %f) < 1" % (row["green_x"], row["green_y"]))
+    distance = page.state("window.softsight.toolValue(2, %d)" % frame)
+    check(abs(distance - row["chord_mm"]) < 0.005 * row["chord_mm"],
+          "the dragged distance: %s mm, the row's chord %s mm" % (distance, row["chord_mm"]))
+    check(page.state("window.softsight.status.undo") == undo, "the drag reselected a marker")
+
+
 def run(args, browser, driver):
     folder = tempfile.mkdtemp(prefix="softsight-serve-tuning-")
-    server, url = start_serve(args.softsight, ["--input", "synth:bending", "--port", "0", "--folder", folder])
-    page = None
+    # The server and the browser start at once.
+    server, url, (page,) = serve_with_pages(
+        args.softsight, ["--input", "synth:bending", "--port", "0", "--folder", folder], browser, driver, 1)
     try:
-        page = Page(browser, driver, url)
+        page.open(url)
         wait(page, "results with red found", "window.softsight.results > 5 && "
              "window.softsight.row(window.softsight.shownFrame) !== null && "
              "window.softsight.row(window.softsight.shownFrame).red_found === 1")

@@ -3,7 +3,9 @@
 // a tracked marker (a click near its ring) or a fixed image point (a click elsewhere); the
 // markers' trajectory trails, a click on a trail seeking to that frame. Each tool's value is
 // drawn on the picture, plotted over the run under the other measures (the cursor at the frame
-// on screen), and a column of the page's CSV.
+// on screen), and a column of the page's CSV. The mm scale: two points clicked a known distance
+// apart and that distance typed; the server takes it as the window's `c` does (the config's
+// scale_from_points), so the rows, the plots and the tools are in mm from then on.
 'use strict';
 
 (() => {
@@ -14,31 +16,62 @@
   const tools = [];    // {kind: 'angle' | 'distance', points: [{marker} | {x, y}], name}
   let placing = null;  // The tool being placed: {kind, points}.
   let trails = false;
-  let mmPerPx = null;  // The run's scale (the rows' chord in mm over px), once known.
+  let mmPerPx = null;  // The rows' scale (their chord in mm over px), once known.
+  let scannedRows = -1;  // How many rows scale() last looked through, finding none.
+  let scaleLine = null;  // The two points of the last scale set from this page, image pixels.
   S.tools = tools;
 
   function hint(text) { $('toolhint').textContent = text; }
 
   function startTool(kind) {
     placing = {kind, points: []};
+    $('scalebox').hidden = true;
+    if (kind === 'scale') {
+      hint('click two points a known distance apart (a ruler in the actuator\'s plane, far apart); Esc cancels');
+      return;
+    }
     hint('click ' + (kind === 'angle' ? 'three points, the vertex second' : 'two points') +
          ' (near a marker: follows it; elsewhere: a fixed point); Esc cancels');
   }
+  $('toolscale').onclick = () => startTool('scale');
+  // The distance typed: the server checks it (above 0, the points 20 px apart at least).
+  function setScale() {
+    const mm = Number($('scalemm').value);
+    if (!placing || placing.kind !== 'scale' || placing.points.length !== 2) return;
+    if (!$('scalemm').value || !(mm > 0)) { S.log('scale: type the distance in mm (above 0)', true); return; }
+    const [a, b] = placing.points;
+    S.send({type: 'scale', ax: a.x, ay: a.y, bx: b.x, by: b.y, mm});
+    scaleLine = placing.points;
+    placing = null;
+    $('scalebox').hidden = true;
+    hint('');
+    S.redraw();
+  }
+  $('scaleset').onclick = setScale;
+  $('scalemm').addEventListener('keydown', (e) => { if (e.key === 'Enter') setScale(); });
   $('toolangle').onclick = () => startTool('angle');
   $('tooldistance').onclick = () => startTool('distance');
   $('toolsclear').onclick = () => { tools.length = 0; placing = null; hint(''); S.redraw(); };
   $('trails').onchange = () => { trails = $('trails').checked; S.redraw(); };
-  document.addEventListener('keydown', (e) => { if (e.key === 'Escape' && placing) { placing = null; hint(''); } });
+  document.addEventListener('keydown', (e) => {
+    if (e.key === 'Escape' && placing) { placing = null; hint(''); $('scalebox').hidden = true; S.redraw(); }
+  });
 
   const pointName = (p) => p.marker || '(' + p.x.toFixed(0) + ' ' + p.y.toFixed(0) + ')';
   const fixedName = (p) => p.marker || 'p' + p.x.toFixed(0) + '_' + p.y.toFixed(0);
 
-  // The run's scale from the rows (chord_mm / chord_px, the median of the first ones that have
-  // both): uniform at the body's plane, which is what a metric model measures in.
+  // The run's scale: the config's mm per px (the server's status: a scale_mm_per_px, or two
+  // points clicked), else from the rows (chord_mm / chord_px, the median of the first ones
+  // that have both: a plane's homography, uniform at the body's plane, which is what a metric
+  // model measures in).
   function scale() {
+    if (S.status && S.status.mm_per_px) return S.status.mm_per_px;
     if (mmPerPx !== null) return mmPerPx;
+    const all = S.rowsIn();
+    if (all.length === scannedRows) return null;  // No new row since: still no scale.
+    scannedRows = all.length;
     const ratios = [];
-    for (const row of S.rowsIn()) {
+    for (const row of all) {
       if (row.chord_mm !== null && row.chord_mm !== undefined && row.chord_px > 0) ratios.push(row.chord_mm / row.chord_px);
       if (ratios.length >= 15) break;
     }
@@ -64,14 +97,28 @@
       return Math.acos(Math.min(1, Math.max(-1, (u[0] * v[0] + u[1] * v[1]) / n))) * 180 / Math.PI;
     }
     const d = Math.hypot(ps[0][0] - ps[1][0], ps[0][1] - ps[1][1]);
-    return tool.mm ? d * tool.mm : d;
+    const mm = scale();
+    return mm ? d * mm : d;
   }
-  const unit = (tool) => (tool.kind === 'angle' ? 'deg' : tool.mm ? 'mm' : 'px');
+  const unit = (tool) => (tool.kind === 'angle' ? 'deg' : scale() ? 'mm' : 'px');
+  S.mmPerPx = scale;
   S.toolValue = (i, frame) => value(tools[i], S.row(frame));
 
   // A click on the picture (image pixels): a point of the tool being placed, or, with the
   // trails shown, a seek to the frame of the trail point clicked. True when it was taken.
   S.toolClick = (x, y, row, viewScale) => {
+    if (placing && placing.kind === 'scale') {
+      // Fixed points (a ruler's marks), never a marker.
+      placing.points.push({x, y});
+      if (placing.points.length < 2) {
+        hint('point 1 at (' + x.toFixed(1) + ', ' + y.toFixed(1) + '): click point 2');
+      } else {
+        hint('their distance:');
+        $('scalebox').hidden = false;
+        $('scalemm').focus();
+      }
+      return true;
+    }
     if (placing) {
       let point = {x, y};
       for (const name of S.hello.markers) {
@@ -87,9 +134,7 @@
       const tool = placing;
       placing = null;
       tool.colour = TOOL_COLOURS[tools.length % TOOL_COLOURS.length];
-      tool.mm = tool.kind === 'distance' ? scale() : null;
       tool.label = tool.kind + ' ' + tool.points.map(pointName).join('-');
-      tool.column = tool.kind + '_' + tool.points.map(fixedName).join('_') + '_' + unit(tool);
       tools.push(tool);
       hint(tool.label + ' [' + unit(tool) + ']');
       S.redraw();
@@ -111,8 +156,55 @@
     return false;
   };
 
+  // A fixed point of a tool is dragged to move it (a marker's point follows its marker).
+  const GRAB_PX = 8;   // A press this close (screen pixels) to a fixed point takes it.
+  let moving = null;   // {tool, point}: the fixed point being dragged.
+  function fixedPointNear(x, y, viewScale) {
+    let best = null, bestD = GRAB_PX;
+    for (const tool of tools) {
+      for (const point of tool.points) {
+        if (point.marker) continue;
+        const d = Math.hypot(point.x - x, point.y - y) * viewScale;
+        if (d <= bestD) { bestD = d; best = {tool, point}; }
+      }
+    }
+    return best;
+  }
+  // The picture's mouse (image pixels): true when the press took a fixed point to drag.
+  S.toolNear = (x, y, viewScale) => !placing && fixedPointNear(x, y, viewScale) !== null;
+  S.toolGrab = (x, y, viewScale) => {
+    if (placing) return false;
+    moving = fixedPointNear(x, y, viewScale);
+    return moving !== null;
+  };
+  S.toolMove = (x, y) => {
+    if (!moving) return;
+    moving.point.x = x; moving.point.y = y;
+    S.redraw();
+  };
+  S.toolRelease = () => {
+    if (!moving) return;
+    const tool = moving.tool;
+    moving = null;
+    tool.label = tool.kind + ' ' + tool.points.map(pointName).join('-');
+    hint(tool.label + ' [' + unit(tool) + ']');
+    S.redraw();
+  };
+
   // Drawn over the overlay: the trails, then each tool with its value on the frame on screen.
   S.drawTools = (ctx, row, toView, colours) => {
+    // The scale's points (being placed, or the last set here): cyan crosses and the line.
+    const marks = placing && placing.kind === 'scale' ? placing.points : scaleLine;
+    if (marks && marks.length) {
+      ctx.strokeStyle = '#40e0ff'; ctx.lineWidth = 1.5;
+      ctx.beginPath();
+      for (const p of marks) {
+        const [x, y] = toView(p.x, p.y);
+        ctx.moveTo(x - 6, y); ctx.lineTo(x + 6, y); ctx.moveTo(x, y - 6); ctx.lineTo(x, y + 6);
+      }
+      if (marks.length === 2) { ctx.moveTo(...toView(marks[0].x, marks[0].y)); ctx.lineTo(...toView(marks[1].x, marks[1].y)); }
+      ctx.stroke();
+    }
     S.trailPoints = 0;
     if (trails) {
       S.hello.markers.forEach((name, i) => {
@@ -155,5 +247,6 @@
   // Each tool a lane of the plots and a column of the CSV.
   S.toolLanes = () => tools.map((tool, i) => ['tool:' + i, tool.label + ' [' + unit(tool) + ']']);
   S.toolSeries = (key, row) => value(tools[Number(key.slice(5))], row);
-  S.toolColumns = () => tools.map((tool) => [tool.column, (row) => value(tool, row)]);
+  S.toolColumns = () => tools.map((tool) => [tool.kind + '_' + tool.points.map(fixedName).join('_') + '_' + unit(tool),
+                                              (row) => value(tool, row)]);
 })();

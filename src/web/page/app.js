@@ -4,7 +4,7 @@
 'use strict';
 
 const $ = (id) => document.getElementById(id);
-const view = $('view'), timeline = $('timeline'), plot = $('plot');
+const view = $('view'), view2 = $('view2'), timeline = $('timeline'), plot = $('plot');
 const COLOURS = ['#ff5050', '#50a0ff', '#50e070', '#ffd040', '#e070ff', '#40e0e0', '#ffa040', '#c0c0c0', '#ff80c0'];
 const PLOTS = [['angle_deg', 'angle [deg]'], ['radius', 'radius'], ['tip_disp', 'bending distance'], ['arc_length', 'arc length']];
 
@@ -18,10 +18,34 @@ const S = window.softsight = {
 const rows = new Map();      // frame -> its row (the CSV's columns)
 let sortedFrames = null;     // Cache of rows' keys in order, for the plots.
 let image = null;            // The ImageBitmap on screen.
+let image2 = null;           // The second video's (serve --compare), at the same position.
 let imageFrame = -1;
-let scale = 1;               // Canvas pixels per image pixel.
+let scale = 1;               // Canvas pixels per image pixel, the whole image in view.
+// Zoom and pan: `zoom` times the fitted size, the view's top left at image point (ox, oy)
+// (pixel edges: the image spans 0..width). k = scale * zoom: CSS pixels per image pixel.
+let zoom = 1, ox = 0, oy = 0;
+const MAX_ZOOM = 16;
 let pending = null, decoding = false;  // Newest-wins decoding of frames.
 let ws = null;
+
+// Waiters on the page's state (the browser test's waits, so it need not poll): each predicate
+// is checked at once, after every message handled and after every redraw of the picture.
+const waiters = new Set();
+function changed() { for (const check of [...waiters]) check(); }
+S.changed = changed;
+// A promise of the predicate's first true value, or of null after `timeoutMs`.
+S.when = (predicate, timeoutMs) => new Promise((resolve) => {
+  let timer = null;
+  const check = () => {
+    let value = false;
+    try { value = predicate(); } catch (e) { value = false; }
+    if (!value) return;
+    waiters.delete(check); clearTimeout(timer); resolve(value);
+  };
+  waiters.add(check);
+  timer = setTimeout(() => { waiters.delete(check); resolve(null); }, timeoutMs);
+  check();
+});
 
 function send(message) {
   if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(message));
@@ -45,12 +69,14 @@ function connect() {
   ws.onmessage = (event) => {
     if (typeof event.data === 'string') onText(JSON.parse(event.data));
     else onFrame(event.data);
+    changed();
   };
   ws.onclose = (event) => {
     S.closed = event.code;
     $('role').textContent = 'disconnected';
     $('role').className = 'badge';
     log('connection closed (' + event.code + (event.reason ? ': ' + event.reason : '') + ')', true);
+    changed();
   };
   // A few pings at once (the offset comes from the fastest round trip), then one every 2 s.
   ws.onopen = () => {
@@ -111,18 +137,23 @@ function onHello(m) {
     tr.onclick = () => send({type: 'marker', index: i});
   });
   for (const id of ['back', 'fwd']) $(id).disabled = !m.seekable;
+  view2.hidden = !m.compare;  // A second video beside the first (serve --compare).
+  if (m.compare) view2.title = m.compare + ' at the same position, zoomed and panned with the first';
   if (S.onRigHello) S.onRigHello(m.rig);  // rig.js: the control panel, when there is a rig.
   send({type: 'list_configs'});
 }
 
 function onStatus(m) {
+  const rescaled = !S.status || S.status.mm_per_px !== m.mm_per_px;
   S.status = m;
+  if (rescaled) { drawView(); showReadout(imageFrame); schedulePlot(); }
   const lat = recentLatency();
   $('status').textContent =
       (m.paused ? 'PAUSED  ' : '') + (m.ended ? 'END  ' : '') + (m.recording ? 'REC  ' : '') +
       'fps ' + m.fps.toFixed(1) + '   dropped ' + m.dropped + '   skipped for this page ' + m.skipped +
       '   capture->result ' + m.latency_ms.toFixed(1) + ' ms   capture->page ' +
-      (lat === null ? '-' : lat.toFixed(0) + ' ms') + '   pages ' + m.pages;
+      (lat === null ? '-' : lat.toFixed(0) + ' ms') + '   pages ' + m.pages +
+      (m.mm_per_px ? '   scale ' + m.mm_per_px.toFixed(4) + ' mm/px' : '');
   $('play').textContent = m.paused || m.ended ? 'play' : 'pause';
   $('speed').value = String(+m.speed.toFixed(2));
   $('record').textContent = m.recording ? 'stop recording' : 'record';
@@ -141,21 +172,30 @@ function recentLatency() {
   return l.length ? l[Math.floor(l.length / 2)] : null;
 }
 
-// Binary: [header length, 4 bytes LE][header JSON][JPEG].
+// Binary: [header length, 4 bytes LE][header JSON][JPEG][the second video's JPEG, when the
+// header has compare_bytes].
 function onFrame(buffer) {
   const size = new DataView(buffer).getUint32(0, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, size)));
-  pending = {header, blob: new Blob([new Uint8Array(buffer, 4 + size)], {type: 'image/jpeg'})};
+  const second = header.compare_bytes || 0, end = buffer.byteLength - second;
+  pending = {header, blob: new Blob([new Uint8Array(buffer, 4 + size, end - 4 - size)], {type: 'image/jpeg'}),
+             second: second ? new Blob([new Uint8Array(buffer, end, second)], {type: 'image/jpeg'}) : null};
   if (!decoding) decodeNext();
 }
 
 async function decodeNext() {
   decoding = true;
   while (pending) {
-    const {header, blob} = pending;
+    const {header, blob, second} = pending;
     pending = null;
     try {
       const bitmap = await createImageBitmap(blob);
+      if (second) {
+        const bitmap2 = await createImageBitmap(second);
+        if (image2) image2.close();
+        image2 = bitmap2;
+        S.compareVideoFrame = header.compare_frame;
+      }
       if (image) image.close();
       image = bitmap;
       imageFrame = header.frame;
@@ -165,6 +205,7 @@ async function decodeNext() {
       drawView();
       showReadout(header.frame);
       S.framesShown++;
+      changed();  // (drawView ran before the count and the latency.)
       // Capture to the picture on the page, in the server's clock (offset from the pings).
       if (!header.replay) {
         S.latencies.push(Date.now() + S.clockOffsetMs - header.captured_ms);
@@ -182,14 +223,29 @@ async function decodeNext() {
 
 function fmt(v, digits) { return v === null || v === undefined ? '-' : Number(v).toFixed(digits); }
 
+// The run's lengths in mm: the rows' own _mm columns, or (rows from before a scale was set
+// on a page) their px times the config's scale. True once any is known.
+function inMm() {
+  if (S.status && S.status.mm_per_px) return true;
+  const last = sortedFrames && sortedFrames.length ? rows.get(sortedFrames[sortedFrames.length - 1]) : null;
+  return !!last && last.radius_mm !== undefined;
+}
+// A length measure of `row` (radius, arc_length, tip_disp, chord), in mm when inMm().
+function length_(row, key) {
+  const mm = row[key + '_mm'];
+  if (mm !== undefined) return mm;
+  const px = row[key + '_px'], scale = S.status && S.status.mm_per_px;
+  return scale && px !== null && px !== undefined ? px * scale : px;
+}
+S.lengthOf = (frame, key) => { const row = rows.get(frame); return row ? length_(row, key) : null; };
+
 function showReadout(frame) {
   const row = rows.get(frame);
   if (!row || !S.hello) return;
-  const mm = row.radius_mm !== undefined;
-  const u = mm ? 'mm' : 'px';
+  const u = row.radius_mm !== undefined || (S.status && S.status.mm_per_px) ? 'mm' : 'px';
   $('readout').textContent = 'frame ' + frame + '  t ' + fmt(row.time_s, 3) + ' s   angle ' +
-      fmt(row.angle_deg, 2) + ' deg   R ' + fmt(row['radius_' + u], 1) + ' ' + u + '   L ' +
-      fmt(row['arc_length_' + u], 1) + ' ' + u + '   tip ' + fmt(row['tip_disp_' + u], 1) + ' ' + u;
+      fmt(row.angle_deg, 2) + ' deg   R ' + fmt(length_(row, 'radius'), 1) + ' ' + u + '   L ' +
+      fmt(length_(row, 'arc_length'), 1) + ' ' + u + '   tip ' + fmt(length_(row, 'tip_disp'), 1) + ' ' + u;
   const body = $('markers').tBodies[0];
   S.hello.markers.forEach((name, i) => {
     const tr = body.rows[i];
@@ -205,14 +261,18 @@ function showReadout(frame) {
 function fitView() {
   if (!image) return;
   // At most the image's own size (the plots stay on screen under it), less on a narrow window.
-  const width = Math.min(image.width, Math.max(320, window.innerWidth - 400));
+  // With a second video beside it, each takes half.
+  const room = window.innerWidth - 400;
+  const width = Math.min(image.width, Math.max(320, view2.hidden ? room : room / 2 - 6));
   scale = width / image.width;
   const ratio = window.devicePixelRatio || 1;
   const w = Math.round(image.width * scale), h = Math.round(image.height * scale);
   if (view.width !== Math.round(w * ratio) || view.style.width !== w + 'px') {
     // Canvas pixels at the screen's own density: the overlay stays crisp.
-    view.width = Math.round(w * ratio); view.height = Math.round(h * ratio);
-    view.style.width = w + 'px'; view.style.height = h + 'px';
+    for (const v of [view, view2]) {
+      v.width = Math.round(w * ratio); v.height = Math.round(h * ratio);
+      v.style.width = w + 'px'; v.style.height = h + 'px';
+    }
     for (const c of [timeline, plot]) {
       c.width = Math.round(w * ratio); c.style.width = w + 'px';
       c.height = Math.round((c === plot ? 240 : 28) * ratio); c.style.height = (c === plot ? 240 : 28) + 'px';
@@ -229,9 +289,33 @@ function cssContext(c) {
   return ctx;
 }
 
-// Pixel centres are at integers: image pixel (x, y) is at ((x + 0.5) s, (y + 0.5) s) in the view.
-const toView = (x, y) => [(x + 0.5) * scale, (y + 0.5) * scale];
-const toImage = (vx, vy) => [vx / scale - 0.5, vy / scale - 0.5];
+// Pixel centres are at integers: image pixel (x, y) is at ((x + 0.5 - ox) k, (y + 0.5 - oy) k)
+// in the view, whatever the zoom: every click and every overlay goes through these two.
+const viewScale = () => scale * zoom;
+const toView = (x, y) => [(x + 0.5 - ox) * viewScale(), (y + 0.5 - oy) * viewScale()];
+const toImage = (vx, vy) => [vx / viewScale() + ox - 0.5, vy / viewScale() + oy - 0.5];
+
+// Keeps the view inside the image (no empty margin at any zoom).
+function clampPan() {
+  if (!image) return;
+  ox = Math.min(Math.max(ox, 0), image.width - image.width / zoom);
+  oy = Math.min(Math.max(oy, 0), image.height - image.height / zoom);
+}
+// Zooms by `factor` about the view point (vx, vy) (CSS pixels): the image point under it stays.
+function zoomAt(vx, vy, factor) {
+  if (!image) return;
+  const ex = vx / viewScale() + ox, ey = vy / viewScale() + oy;  // Pixel-edge coordinates.
+  zoom = Math.min(MAX_ZOOM, Math.max(1, zoom * factor));
+  ox = ex - vx / viewScale(); oy = ey - vy / viewScale();
+  clampPan();
+  showZoom();
+  drawView();
+}
+function resetZoom() { zoom = 1; ox = 0; oy = 0; showZoom(); drawView(); }
+function showZoom() {
+  $('zoomtext').textContent = zoom > 1.001 ? zoom.toFixed(zoom < 10 ? 2 : 1) + 'x' : '';
+  $('zoomreset').disabled = zoom <= 1.001;
+}
 
 function markerPoint(row, name) {
   return row && row[name + '_found'] === 1 ? [row[name + '_x'], row[name + '_y']] : null;
@@ -241,16 +325,30 @@ function drawView() {
   if (!image) return;
   fitView();
   const ctx = cssContext(view);
-  ctx.drawImage(image, 0, 0, image.width * scale, image.height * scale);
+  clampPan();
+  // Zoomed in, the pixels are shown as they are (square), not blurred into each other.
+  ctx.imageSmoothingEnabled = zoom < 2;
+  ctx.drawImage(image, ox, oy, image.width / zoom, image.height / zoom, 0, 0, image.width * scale, image.height * scale);
   const row = rows.get(imageFrame);
   if (S.shownMask) drawCandidates(ctx);
   else if (row && S.hello) drawOverlay(ctx, row);
-  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS);
+  if (row && S.hello && S.drawTools) S.drawTools(ctx, row, toView, COLOURS, viewScale());
+  // The second video at the same zoom and pan; another run's CSV (compare.js) drawn over it,
+  // or over the first without one.
+  let ctx2 = null;
+  if (image2 && !view2.hidden) {
+    ctx2 = cssContext(view2);
+    ctx2.imageSmoothingEnabled = zoom < 2;
+    ctx2.drawImage(image2, ox * image2.width / image.width, oy * image2.height / image.height,
+                   image2.width / zoom, image2.height / zoom, 0, 0, image.width * scale, image.height * scale);
+  }
+  if (S.drawCompare) S.drawCompare(ctx2 || ctx, row, toView, COLOURS);  // compare.js: another run.
   if (drag && drag.moved) {
     ctx.strokeStyle = '#ffff00'; ctx.setLineDash([4, 3]); ctx.lineWidth = 1.5;
     ctx.strokeRect(drag.x0, drag.y0, drag.x1 - drag.x0, drag.y1 - drag.y0);
     ctx.setLineDash([]);
   }
+  changed();
 }
 
 function drawOverlay(ctx, row) {
@@ -286,12 +384,12 @@ function drawCandidates(ctx) {
   if (m.region) {
     const [x, y] = toView(m.region[0] - 0.5, m.region[1] - 0.5);
     ctx.strokeStyle = '#80c0ff'; ctx.setLineDash([4, 3]);
-    ctx.strokeRect(x, y, m.region[2] * scale, m.region[3] * scale);
-    ctx.setLineDash([]); ctx.fillStyle = '#80c0ff'; ctx.fillText('searched', x + 3, y + m.region[3] * scale - 4);
+    ctx.strokeRect(x, y, m.region[2] * viewScale(), m.region[3] * viewScale());
+    ctx.setLineDash([]); ctx.fillStyle = '#80c0ff'; ctx.fillText('searched', x + 3, y + m.region[3] * viewScale() - 4);
   }
   for (const c of m.candidates) {
     const [x, y] = toView(c.x, c.y);
-    const r = Math.max(4, Math.sqrt(c.area / Math.PI) * scale + 3);
+    const r = Math.max(4, Math.sqrt(c.area / Math.PI) * viewScale() + 3);
     ctx.strokeStyle = ctx.fillStyle = VERDICT_COLOURS[c.verdict] || '#ff5050';
     ctx.beginPath(); ctx.arc(x, y, r, 0, 2 * Math.PI); ctx.stroke();
     ctx.fillText(c.verdict + ' ' + c.area.toFixed(0) + ' px\u00b2 circ ' + c.circularity.toFixed(2) +
@@ -334,28 +432,75 @@ function drawArc(ctx, b, m, t) {
   const ccw = norm(am - ab) < norm(at - ab);  // The middle lies on the way from base to tip.
   const [vx, vy] = toView(cx, cy);
   ctx.strokeStyle = 'rgba(255,220,0,0.9)'; ctx.lineWidth = 1.5;
-  ctx.beginPath(); ctx.arc(vx, vy, r * scale, ab, at, !ccw); ctx.stroke();
+  ctx.beginPath(); ctx.arc(vx, vy, r * viewScale(), ab, at, !ccw); ctx.stroke();
 }
 
 // ---- Mouse on the picture: click picks a colour, a drag reselects ---------------------------
-let drag = null;
-// The pointer in the view's CSS pixels (scale per image pixel), from where it is on screen.
-function viewPoint(event) {
-  const rect = view.getBoundingClientRect();
-  return [(event.clientX - rect.left) * view.clientWidth / rect.width,
-          (event.clientY - rect.top) * view.clientHeight / rect.height];
+// The wheel zooms about the pointer, a right (or middle) drag pans, "whole image" (z) resets.
+let drag = null, panning = null, movingPoint = false;
+// The pointer in the view's CSS pixels (k per image pixel), from where it is on screen.
+// (`on`: the second video's canvas, the same size and mapping, for its wheel and pan.)
+function viewPoint(event, on = view) {
+  const rect = on.getBoundingClientRect();
+  return [(event.clientX - rect.left) * on.clientWidth / rect.width,
+          (event.clientY - rect.top) * on.clientHeight / rect.height];
 }
+let pointer = null;  // The last view point the mouse was at (the keys zoom about it).
+// The wheel and the right or middle drag on either picture zoom and pan both.
+for (const canvas of [view, view2]) {
+  canvas.addEventListener('wheel', (e) => {
+    e.preventDefault();
+    const [x, y] = viewPoint(e, canvas);
+    // One notch (100 px of deltaY) is a factor of sqrt(2); a touchpad's small steps zoom smoothly.
+    const delta = e.deltaMode === 1 ? e.deltaY * 33 : e.deltaY;
+    zoomAt(x, y, Math.pow(2, -delta / 200));
+  }, {passive: false});
+  canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+}
+view2.addEventListener('mousedown', (e) => {
+  if (e.button === 0) return;
+  e.preventDefault();
+  const [x, y] = viewPoint(e);  // Only the moves count: in the first picture's pixels alike.
+  panning = {x, y, ox, oy};
+});
 view.addEventListener('mousedown', (e) => {
   const [x, y] = viewPoint(e);
+  if (e.button !== 0) {
+    e.preventDefault();
+    panning = {x, y, ox, oy};
+    return;
+  }
+  // A press on a fixed point of an angle or distance tool drags it (analysis.js).
+  if (S.toolGrab && S.toolGrab(...toImage(x, y), viewScale())) { movingPoint = true; return; }
   drag = {x0: x, y0: y, x1: x, y1: y, moved: false};
 });
+view.addEventListener('mouseleave', () => { pointer = null; });
+window.addEventListener('mousemove', (e) => {
+  if (movingPoint && image) {
+    const [x, y] = toImage(...viewPoint(e));
+    S.toolMove(Math.min(Math.max(x, 0), image.width - 1), Math.min(Math.max(y, 0), image.height - 1));
+    return;
+  }
+  if (!panning) return;
+  const [x, y] = viewPoint(e);
+  ox = panning.ox - (x - panning.x) / viewScale();
+  oy = panning.oy - (y - panning.y) / viewScale();
+  clampPan();
+  drawView();
+});
 view.addEventListener('mousemove', (e) => {
-  if (!drag) return;
+  pointer = viewPoint(e);
+  if (!drag) {
+    view.style.cursor = movingPoint || (S.toolNear && S.toolNear(...toImage(...pointer), viewScale())) ? 'move' : '';
+    return;
+  }
   [drag.x1, drag.y1] = viewPoint(e);
   drag.moved = drag.moved || Math.hypot(drag.x1 - drag.x0, drag.y1 - drag.y0) > 4;
   if (drag.moved) drawView();
 });
-window.addEventListener('mouseup', () => {
+window.addEventListener('mouseup', (e) => {
+  if (panning) { panning = null; return; }
+  if (movingPoint) { movingPoint = false; S.toolRelease(); schedulePlot(); return; }
   if (!drag || !image) { drag = null; return; }
   const d = drag;
   drag = null;
@@ -363,15 +508,19 @@ window.addEventListener('mouseup', () => {
   if (!d.moved) {
     const [x, y] = toImage(d.x0, d.y0);
     // A point of an analysis tool, or a click on a trail (analysis.js), before a colour pick.
-    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), scale)) { drawView(); schedulePlot(); return; }
-    send({type: 'pick', x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)});
+    if (S.toolClick && S.toolClick(x, y, rows.get(imageFrame), viewScale())) { drawView(); schedulePlot(); return; }
+    const at = {x: clamp(x, image.width - 1), y: clamp(y, image.height - 1)};
+    // In the mask view (as the window's): a click adds the colours there to the active
+    // marker's ranges, a shift-click takes them out; elsewhere a click picks a colour afresh.
+    if (S.status && S.status.mask_view) send(Object.assign({type: 'range', grow: !e.shiftKey}, at));
+    else send(Object.assign({type: 'pick'}, at));
     return;
   }
-  // Whole pixels covered by the box.
-  const x0 = clamp(Math.round(Math.min(d.x0, d.x1) / scale), image.width - 1);
-  const y0 = clamp(Math.round(Math.min(d.y0, d.y1) / scale), image.height - 1);
-  const x1 = clamp(Math.round(Math.max(d.x0, d.x1) / scale), image.width);
-  const y1 = clamp(Math.round(Math.max(d.y0, d.y1) / scale), image.height);
+  // Whole pixels covered by the box (pixel edges: the view's point plus half a pixel).
+  const [ax, ay] = toImage(Math.min(d.x0, d.x1), Math.min(d.y0, d.y1));
+  const [bx, by] = toImage(Math.max(d.x0, d.x1), Math.max(d.y0, d.y1));
+  const x0 = clamp(Math.round(ax + 0.5), image.width - 1), y0 = clamp(Math.round(ay + 0.5), image.height - 1);
+  const x1 = clamp(Math.round(bx + 0.5), image.width), y1 = clamp(Math.round(by + 0.5), image.height);
   send({type: 'select', x: x0, y: y0, w: x1 - x0, h: y1 - y0});
   drawView();
 });
@@ -389,6 +538,7 @@ $('save').onclick = () => send({type: 'save', name: $('savename').value});
 $('load').onclick = () => { if ($('configs').value) send({type: 'load', name: $('configs').value}); };
 $('configs').addEventListener('focus', () => send({type: 'list_configs'}));
 $('take').onclick = () => send({type: 'take_control'});
+$('zoomreset').onclick = resetZoom;
 
 // Files made in the page, from what it has: the picture with its overlay, and the results.
 function download(name, blob) {
@@ -403,7 +553,11 @@ $('png').onclick = () => view.toBlob((blob) => download('softsight-frame-' + ima
 S.csvText = () => {
   const frames = [...rows.keys()].sort((a, b) => a - b);
   if (!frames.length) return '';
-  const columns = Object.keys(rows.get(frames[0])).filter((c) => c !== '_position');
+  // The columns of the row that has most (a scale set on a page adds the _mm ones: rows from
+  // before it leave them empty).
+  let widest = rows.get(frames[0]);
+  for (const f of frames) if (Object.keys(rows.get(f)).length > Object.keys(widest).length) widest = rows.get(f);
+  const columns = Object.keys(widest).filter((c) => c !== '_position');
   const tools = S.toolColumns ? S.toolColumns() : [];  // The analysis tools' values after them.
   const field = (v) => (v === null || v === undefined ? '' : String(v));
   const line = (row) => columns.map((c) => field(row[c])).concat(tools.map(([, value]) => field(value(row)))).join(',');
@@ -451,12 +605,19 @@ document.addEventListener('keydown', (e) => {
     ',': () => send({type: 'step', delta: -1}), 'm': () => send({type: 'method'}),
     'u': () => send({type: 'undo'}), 'b': () => send({type: 'reset_reference'}),
     'r': () => send({type: 'record'}),
+    '+': () => zoomKey(Math.SQRT2), '=': () => zoomKey(Math.SQRT2), '-': () => zoomKey(Math.SQRT1_2),
+    'z': resetZoom,
     'v': () => send({type: 'mask_view', on: !(S.status && S.status.mask_view)}),
     ']': () => seekBy(1), '[': () => seekBy(-1), 'ArrowRight': () => seekBy(1), 'ArrowLeft': () => seekBy(-1),
     'Home': () => send({type: 'seek', position: 0}), 'End': () => length() && send({type: 'seek', position: length() - 1})};
   if (keys[e.key]) { keys[e.key](); e.preventDefault(); return; }
   if (e.key >= '1' && e.key <= '9') send({type: 'marker', index: Number(e.key) - 1});
 });
+// The keys zoom about the pointer when it is on the picture, else about the picture's centre.
+function zoomKey(factor) {
+  const [x, y] = pointer || [view.clientWidth / 2, view.clientHeight / 2];
+  zoomAt(x, y, factor);
+}
 function seekBy(seconds) {
   if (!S.status || !length()) return;
   const fps = S.hello.fps || 30;
@@ -475,8 +636,7 @@ function schedulePlot() {
 function series(row, key) {
   if (key === 'angle_deg') return row.angle_deg;
   if (key.startsWith('tool:')) return S.toolSeries(key, row);
-  const mm = row[key + '_mm'];
-  return mm !== undefined ? mm : row[key + '_px'];
+  return length_(row, key);
 }
 
 function drawPlot() {
@@ -494,13 +654,14 @@ function drawPlot() {
   const lanes = PLOTS.concat(S.toolLanes ? S.toolLanes() : []);  // An analysis tool's lane each.
   const laneH = h / lanes.length;
   const x = (t) => 40 + (t - t0) / (t1 - t0) * (w - 50);
+  let compared = 0;  // Points of another run drawn (compare.js).
   lanes.forEach(([key, label], lane) => {
     const values = sortedFrames.map((f) => series(rows.get(f), key));
     const finite = values.filter((v) => v !== null && v !== undefined);
     const top = lane * laneH;
     ctx.fillStyle = '#aaa'; ctx.font = '11px sans-serif';
     const own = key === 'angle_deg' || key.startsWith('tool:');  // Their labels carry the unit.
-    ctx.fillText(label + (own ? '' : S.hello && rows.get(sortedFrames[0]).radius_mm !== undefined ? ' [mm]' : key !== 'angle_deg' ? ' [px]' : ''), 44, top + 12);
+    ctx.fillText(label + (own ? '' : inMm() ? ' [mm]' : ' [px]'), 44, top + 12);
     ctx.strokeStyle = '#333'; ctx.strokeRect(40, top + 2, w - 50, laneH - 4);
     if (!finite.length) return;
     // The 2nd to 98th percentile: a near-straight actuator's radius (tens of thousands of px
@@ -524,10 +685,13 @@ function drawPlot() {
       drawing = true;
     });
     ctx.stroke();
+    if (S.drawCompareLane) compared += S.drawCompareLane(ctx, key, x, y, series, t0, t1);
   });
+  S.comparePlotted = compared;
   const shown = rows.get(imageFrame);
   if (shown) { ctx.fillStyle = '#fff'; ctx.fillRect(x(shown.time_s), 0, 1, h); }
   plot._t0 = t0; plot._t1 = t1;
+  changed();
 }
 plot.addEventListener('click', (e) => {
   if (!length() || !S.hello || plot._t0 === undefined) return;
@@ -544,8 +708,12 @@ plot.addEventListener('click', (e) => {
 // Where image pixel (x, y) is on the screen, from the picture's place and size alone.
 S.clientPoint = (x, y) => {
   const r = view.getBoundingClientRect();
-  return [r.left + (x + 0.5) * r.width / image.width, r.top + (y + 0.5) * r.height / image.height];
+  const [vx, vy] = toView(x, y);
+  return [r.left + vx * r.width / view.clientWidth, r.top + vy * r.height / view.clientHeight];
 };
+// The image point (pixel centres at integers) under a point of the screen, and the zoom.
+S.imagePoint = (clientX, clientY) => toImage(...viewPoint({clientX, clientY}));
+S.zoom = () => ({zoom, ox, oy, k: viewScale()});
 S.sendRaw = (text) => ws.send(text);
 S.send = send;
 S.log = log;

@@ -1,16 +1,22 @@
 // softsight serve: the rig's control panel (serve --simulate / --board-port). The server runs
 // the loop; this page asks it to run a target or a profile (the controlling page only) and to
 // STOP (any page, always), and draws what every frame's {"type":"rig"} says: the state, the
-// board's answer, and the angle and pressure traces of the last TRACE_S seconds.
+// board's answer, and the angle and pressure traces of the last TRACE_S seconds or of the whole
+// run (every sample since the page opened, halved in density past MAX_POINTS). Each frame's row
+// carries the loop's columns too (target_deg, setpoint_kpa, board_pressure_kpa, ...: the
+// server's RigPanel::columns), so the page's CSV has them.
 'use strict';
 
 (() => {
   const S = window.softsight;
   const $ = (id) => document.getElementById(id);
   const TRACE_S = 20;
-  const MAX_POINTS = 30 * TRACE_S * 2;  // A 30 fps loop's last 40 s at most.
-  // The traces: parallel arrays, trimmed from the front (a few thousand numbers).
+  // An hour at 30 fps is 108 000 samples: past this, every other sample is dropped (the whole
+  // run stays, at half the density), so a long run costs a few MB at most.
+  const MAX_POINTS = 60000;
+  // The traces: parallel arrays.
   const trace = {t: [], target: [], measured: [], setpoint: [], pressure: []};
+  let whole = false;  // The whole run, else the last TRACE_S seconds.
   let limits = null;
   S.rig = null;             // The last {"type":"rig"} message.
   S.rigLimits = null;       // The host's and the board's limits (the greeting's "rig").
@@ -69,7 +75,7 @@
     if (trace.t.length && m.t <= trace.t[trace.t.length - 1]) return;  // A STOP's repeat of the frame.
     trace.t.push(m.t); trace.target.push(m.target_deg); trace.measured.push(m.measured_deg);
     trace.setpoint.push(m.setpoint_kpa); trace.pressure.push(m.pressure_kpa);
-    if (trace.t.length > MAX_POINTS) for (const k in trace) trace[k].splice(0, trace[k].length - MAX_POINTS / 2);
+    if (trace.t.length > MAX_POINTS) for (const k in trace) trace[k] = trace[k].filter((_, j) => j % 2 === 0);
     scheduleTrace();
   };
 
@@ -91,6 +97,7 @@
   };
   $('rigtarget').addEventListener('keydown', (e) => { if (e.key === 'Enter') $('rigrun').onclick(); });
   $('rigprofilerun').onclick = () => S.send({type: 'rig_profile', text: $('rigprofile').value});
+  $('rigspan').onchange = () => { whole = $('rigspan').value === 'whole'; drawTrace(); };
 
   // ---- Traces -----------------------------------------------------------------------------
   let queued = false;
@@ -106,8 +113,11 @@
     const w = c.width, h = c.height;
     ctx.fillStyle = '#111'; ctx.fillRect(0, 0, w, h);
     if (!trace.t.length || !limits) return;
-    const t1 = trace.t[trace.t.length - 1], t0 = t1 - TRACE_S;
-    const x = (t) => 36 + (t - t0) / TRACE_S * (w - 42);
+    const t1 = trace.t[trace.t.length - 1];
+    const t0 = whole ? Math.min(trace.t[0], t1 - 1) : t1 - TRACE_S;
+    const x = (t) => 36 + (t - t0) / (t1 - t0) * (w - 42);
+    S.rigTrace = {t0, t1, samples: trace.t.length, whole};  // For the test: the span drawn.
+    S.changed();
     // The angle lane from 10 deg under the lowest angle in view (rounded to 10) to straight.
     let lowest = 170;
     for (let j = 0; j < trace.t.length; j++) {
