@@ -49,6 +49,26 @@ TEST(OrderAlongBody, WithoutAHintTheBaseIsTheEndNearerTheBorder) {
 namespace softsight {
 namespace {
 
+// White discs (radius 7 px) standing still at `layout`'s places.
+template <size_t N>
+std::vector<testing::DotShape> WhiteDotsAt(const cv::Point2d (&layout)[N], uchar level) {
+  std::vector<testing::DotShape> shapes;
+  for (const cv::Point2d& p : layout) {
+    shapes.push_back({{7, 7}, {level, level, level}, {}, 0, {}, [p](double) { return testing::DotPose{p}; }});
+  }
+  return shapes;
+}
+
+// Every marker found lies within 0.5 px of one of `layout`'s places.
+template <size_t N>
+void ExpectEachAtOneOf(const MarkerFinding& finding, const cv::Point2d (&layout)[N]) {
+  for (const FoundMarker& m : finding.markers) {
+    double nearest = 1e9;
+    for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
+    EXPECT_LT(nearest, 0.5) << m.spec.name;
+  }
+}
+
 // White dots on a gray bench, filmed by a gray camera and stored in colour (each channel with a
 // level or two of its own noise: the frame is not exactly gray), laid out as a plate (two rows of two and one in the middle: no order along a
 // body). The finder finds them by gray level, each with its roi, and writes them without a body.
@@ -57,20 +77,14 @@ TEST(MarkerFinder, WhiteDotsOnColourFootageOfAGrayBenchAreFoundAndWrittenWithout
   options.noise_sigma = 1.5;
   options.tint_sigma = 0.0;
   const cv::Point2d layout[5] = {{260, 200}, {380, 200}, {320, 240}, {260, 280}, {380, 280}};
-  std::vector<testing::DotShape> shapes;
-  for (const cv::Point2d& p : layout) {
-    shapes.push_back({{7, 7}, {240, 240, 240}, {}, 0, {}, [p](double) { return testing::DotPose{p}; }});
-  }
-  const testing::DotScene scene(options, shapes);
+  const testing::DotScene scene(options, WhiteDotsAt(layout, 240));
   const cv::Mat frame = scene.render(0);
   const MarkerFinding finding = FindMarkers(frame, MarkerFinderOptions{});
   ASSERT_TRUE(finding.ok()) << finding.problem;
   EXPECT_TRUE(finding.intensity);
   ASSERT_EQ(finding.markers.size(), 5u);
+  ExpectEachAtOneOf(finding, layout);
   for (const FoundMarker& m : finding.markers) {
-    double nearest = 1e9;
-    for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
-    EXPECT_LT(nearest, 0.5) << m.spec.name;
     const ColourParams& colour = m.spec.params.get<ColourParams>();
     EXPECT_TRUE(colour.gray && colour.roi) << m.spec.name;
   }
@@ -88,19 +102,12 @@ TEST(MarkerFinder, WhiteDotsOnAColourfulBenchAreFoundButALoneBrightBlobIsNot) {
   testing::DotSceneOptions options;
   options.tint_sigma = 30.0;
   const cv::Point2d layout[3] = {{200, 300}, {320, 240}, {440, 200}};
-  std::vector<testing::DotShape> shapes;
-  for (const cv::Point2d& p : layout) {
-    shapes.push_back({{7, 7}, {245, 245, 245}, {}, 0, {}, [p](double) { return testing::DotPose{p}; }});
-  }
+  std::vector<testing::DotShape> shapes = WhiteDotsAt(layout, 245);
   const MarkerFinding finding = FindMarkers(testing::DotScene(options, shapes).render(0), {});
   ASSERT_TRUE(finding.ok()) << finding.problem;
   EXPECT_TRUE(finding.intensity);
   ASSERT_EQ(finding.markers.size(), 3u);
-  for (const FoundMarker& m : finding.markers) {
-    double nearest = 1e9;
-    for (const cv::Point2d& p : layout) nearest = std::min(nearest, cv::norm(m.position_px - p));
-    EXPECT_LT(nearest, 0.5) << m.spec.name;
-  }
+  ExpectEachAtOneOf(finding, layout);
   bool said = false;  // The colourful frame's path, not the one for frames with hardly any colour.
   for (const std::string& note : finding.notes) {
     said = said || note == "no coloured marker: white or black dots, by gray level";

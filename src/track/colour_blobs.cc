@@ -387,6 +387,20 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     }
     return std::sqrt(std::max(0.0, variance));
   };
+  // The contrast in chromaticity against ring pixels whose chromaticities sum to `ring_sum` (second
+  // moments `ring_outer`, `n` of them): 0 where the blob's chromaticity differs from theirs by
+  // less than `min_span`.
+  const auto chroma_contrast = [&](const cv::Vec3d& ring_sum, const cv::Matx33d& ring_outer,
+                                   double n, double min_span) {
+    const cv::Vec3d core_chroma = core_chroma_sum / core_n;
+    const cv::Vec3d ring_chroma = ring_sum / n;
+    const cv::Vec3d direction = core_chroma - ring_chroma;
+    const double distance = std::sqrt(direction.dot(direction));
+    if (distance < min_span) return 0.0;
+    const double core_along = spread_along(direction, core_chroma_outer, core_chroma, core_n, 3);
+    const double ring_along = spread_along(direction, ring_outer, ring_chroma, n, 3);
+    return distance / (kCoreSigmaWeight * core_along + ring_along + kChromaNoiseFloor);
+  };
   std::array<double, kQuarters> quarter_contrast{};
   int quarters = 0;
   for (int q = 0; q < kQuarters; ++q) {
@@ -409,18 +423,8 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
       // brightness: a dim blue dome beside the shaded ribs and lit band of a side-lit body, a
       // green one on speckled silicone. Their dark and bright pixels spread the levels along the
       // marker's direction, not its chromaticity.
-      const cv::Vec3d core_chroma = core_chroma_sum / core_n;
-      const cv::Vec3d ring_chroma = quarter_chroma_sum[q] / n;
-      const cv::Vec3d chroma_direction = core_chroma - ring_chroma;
-      const double chroma_distance = std::sqrt(chroma_direction.dot(chroma_direction));
-      if (chroma_distance >= kMinChromaContrastSpan) {
-        const double core_chroma_along =
-            spread_along(chroma_direction, core_chroma_outer, core_chroma, core_n, 3);
-        const double ring_chroma_along =
-            spread_along(chroma_direction, quarter_chroma_outer[q], ring_chroma, n, 3);
-        contrast = std::max(contrast, chroma_distance / (kCoreSigmaWeight * core_chroma_along +
-                                                         ring_chroma_along + kChromaNoiseFloor));
-      }
+      contrast = std::max(contrast, chroma_contrast(quarter_chroma_sum[q], quarter_chroma_outer[q],
+                                                    n, kMinChromaContrastSpan));
     }
     quarter_contrast[quarters++] = contrast;
   }
@@ -438,19 +442,9 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
       ring_chroma_sum += quarter_chroma_sum[q];
       ring_chroma_outer += quarter_chroma_outer[q];
     }
-    const cv::Vec3d core_chroma = core_chroma_sum / core_n;
-    const cv::Vec3d ring_chroma = ring_chroma_sum / ring_n;
-    const cv::Vec3d chroma_direction = core_chroma - ring_chroma;
-    const double chroma_distance = std::sqrt(chroma_direction.dot(chroma_direction));
-    if (chroma_distance >= kMinWholeRingChromaSpan) {
-      const double core_along =
-          spread_along(chroma_direction, core_chroma_outer, core_chroma, core_n, 3);
-      const double ring_along =
-          spread_along(chroma_direction, ring_chroma_outer, ring_chroma, ring_n, 3);
-      blob->whole_ring_contrast =
-          std::max(blob->whole_ring_contrast,
-                   chroma_distance / (kCoreSigmaWeight * core_along + ring_along + kChromaNoiseFloor));
-    }
+    blob->whole_ring_contrast =
+        std::max(blob->whole_ring_contrast, chroma_contrast(ring_chroma_sum, ring_chroma_outer,
+                                                            ring_n, kMinWholeRingChromaSpan));
   }
   if (quarters == 0) {
     blob->contrast = blob->whole_ring_contrast;
