@@ -341,60 +341,6 @@ TEST(MarkerTracks, MarkersThatJumpTogetherByOneTranslationMoveTheirTracks) {
   EXPECT_FALSE(alone.FollowCamera(one, {-300, 0}));
 }
 
-// Two markers, one moving right at 10 px a frame, one down at 4 px a frame, for `frames` frames;
-// their reports `frames + gap - 1` frames in (the source hid gap - 1 frames), marker 1's moved
-// by `off1`.
-struct HiddenGapCase {
-  MarkerTracks tracks{{6.0, 6.0}};
-  std::vector<MarkerObservation> reports;
-  HiddenGapCase(int frames, int gap, cv::Point2d off1 = {0, 0}) {
-    const auto at = [](int f) {
-      return std::vector<std::optional<cv::Point2d>>{cv::Point2d(10.0 * f, 0), cv::Point2d(100, 4.0 * f)};
-    };
-    for (int f = 0; f < frames; ++f) {
-      std::vector<MarkerObservation> m = Reports(at(f));
-      tracks.associate(m, {nullptr, nullptr});
-      tracks.commit(m);
-    }
-    std::vector<std::optional<cv::Point2d>> p = at(frames + gap - 1);
-    *p[1] += off1;
-    reports = Reports(p);
-  }
-};
-
-TEST(MarkerTracks, MarkersAsManyFramesOfTheirOwnMotionAheadTellFramesTheSourceHid) {
-  for (int gap : {4, 7, 12, 40}) {
-    HiddenGapCase c(10, gap);
-    ASSERT_TRUE(c.tracks.AnyJustLost(c.reports)) << gap;
-    EXPECT_EQ(c.tracks.FramesPassed(c.reports), std::optional<int>(gap)) << gap;
-    // Predicted over the hidden frames, both reports continue their tracks.
-    for (int k = 1; k < gap; ++k) c.tracks.skip();
-    const auto& d = c.tracks.associate(c.reports, {nullptr, nullptr});
-    EXPECT_EQ(d[0].action, MarkerTracks::Decision::Action::kKeep) << gap;
-    EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kKeep) << gap;
-    EXPECT_TRUE(c.reports[0].observation.found() && c.reports[1].observation.found()) << gap;
-  }
-  // No frame hidden: nothing to tell.
-  HiddenGapCase none(10, 1);
-  EXPECT_FALSE(none.tracks.FramesPassed(none.reports).has_value());
-}
-
-TEST(MarkerTracks, ReportsThatDisagreeOnTheTimeThatPassedTellNone) {
-  // Marker 1 as far as 10 frames of its motion, marker 0 as far as 5: not one gap.
-  HiddenGapCase disagree(10, 5, {0, 20});
-  EXPECT_FALSE(disagree.tracks.FramesPassed(disagree.reports).has_value());
-  // Marker 1's report beside its path (a look-alike 30 px off it).
-  HiddenGapCase beside(10, 6, {30, 0});
-  EXPECT_FALSE(beside.tracks.FramesPassed(beside.reports).has_value());
-  // Marker 1 reported where it was a frame ago while marker 0 is 6 frames ahead.
-  HiddenGapCase stayed(10, 6, {0, -20});
-  EXPECT_FALSE(stayed.tracks.FramesPassed(stayed.reports).has_value());
-  // One marker's step is no clock: marker 1 not found.
-  HiddenGapCase alone(10, 6);
-  alone.reports[1].observation = Observation::NotFound(MarkerStatus::kLost);
-  EXPECT_FALSE(alone.tracks.FramesPassed(alone.reports).has_value());
-}
-
 // A look-alike in view elsewhere when a marker is lost is another object: however far the
 // marker's reach grows while it is lost, it never takes it; a candidate that appears later
 // within the reach is taken.

@@ -46,19 +46,6 @@ constexpr double kOtherFirstStepSizes = 3.0;
 constexpr double kBodyGateSigmas = 4.0;
 // ... and no closer than this is ever asked of it (px): sub-pixel noise is not a contradiction.
 constexpr double kBodyGateMinPx = 1.5;
-// A source that drops frames without saying so (a camera's driver under load, a video cut or
-// re-encoded at a variable rate): every moving marker's report lies where its own velocity takes
-// it over the same number of frames. A marker at least this fast (px per frame) moves enough for
-// its step to measure time ...
-constexpr double kPassedFramesMinSpeedPx = 0.5;
-// ... and each moving marker says how many frames passed (its displacement along its velocity
-// over its speed). They must agree within this fraction (or one frame) ...
-constexpr double kPassedFramesAgreement = 0.25;
-// ... and each displacement may turn off its velocity by this fraction of its length (the
-// marker's path curves meanwhile) plus the marker's size.
-constexpr double kPassedFramesTurn = 0.35;
-// At most this many frames are predicted over (as many as for frames the source says it missed).
-constexpr int kMaxPassedFrames = 60;
 
 double DistanceToSegment(const cv::Point2d& p, const cv::Point2d& a, const cv::Point2d& b) {
   const cv::Point2d ab = b - a;
@@ -345,45 +332,6 @@ std::optional<cv::Point2d> MarkerTracks::CommonShift(
     if (cv::norm(*o.position_px - t.motion.position() - mean) > size_px_[i]) return std::nullopt;
   }
   return mean;
-}
-
-std::optional<int> MarkerTracks::FramesPassed(const std::vector<MarkerObservation>& markers) {
-  CV_Assert(markers.size() == tracks_.size());
-  predict_all();
-  int moving = 0;
-  bool any_left_its_gate = false;
-  double lo = 0.0, hi = 0.0, sum = 0.0;
-  for (size_t i = 0; i < tracks_.size(); ++i) {
-    const Track& t = tracks_[i];
-    const Observation& o = markers[i].observation;
-    if (!t.motion.started() || t.misses > 0 || !t.last_px || !o.found()) continue;
-    const bool in_gate = InGate(i, *o.position_px);
-    const cv::Point2d velocity = t.motion.velocity();
-    const double speed = cv::norm(velocity);
-    if (speed < kPassedFramesMinSpeedPx) {
-      if (in_gate) continue;  // A still marker tells no time.
-      return std::nullopt;    // A still marker jumped: no time explains that.
-    }
-    // How many frames of its velocity its report is from where it was last believed, give or
-    // take its size and the turn of a curving path (else a look-alike, a jump).
-    const cv::Point2d step = *o.position_px - *t.last_px;
-    const double frames = step.dot(velocity) / (speed * speed);
-    if (cv::norm(step - frames * velocity) > size_px_[i] + kPassedFramesTurn * cv::norm(step)) {
-      return std::nullopt;
-    }
-    any_left_its_gate |= !in_gate;
-    lo = moving == 0 ? frames : std::min(lo, frames);
-    hi = moving == 0 ? frames : std::max(hi, frames);
-    sum += frames;
-    ++moving;
-  }
-  // One marker's step alone is no clock; all of them in their gates need none.
-  if (moving < 2 || !any_left_its_gate) return std::nullopt;
-  const double mean = sum / moving;
-  if (hi - lo > std::max(1.0, kPassedFramesAgreement * mean)) return std::nullopt;
-  const int passed = static_cast<int>(std::lround(mean));
-  if (passed < 2 || passed > kMaxPassedFrames) return std::nullopt;
-  return passed;
 }
 
 bool MarkerTracks::FollowCamera(const std::vector<MarkerObservation>& markers,

@@ -87,14 +87,6 @@ class MarkerTracks {
   // than it takes out (a shift that explains no report is not the markers' camera). Returns
   // whether the tracks moved.
   bool FollowCamera(const std::vector<MarkerObservation>& markers, const cv::Point2d& shift_px);
-  // How many frames passed since the last one, when the source dropped some without saying so:
-  // every moving marker believed in the last frame (two at least, one of them now outside its
-  // gate) has a report along its own velocity, all of them the same number of frames' motion
-  // away (2 to 60), and no still marker jumped. Absent otherwise (one frame passed, or the
-  // reports disagree: a look-alike, a jump). The caller predicts the tracks over the frames it
-  // says were hidden (skip()), then associates as usual: the gates, grown over them, still judge
-  // every report.
-  std::optional<int> FramesPassed(const std::vector<MarkerObservation>& markers);
   // A frame in which nothing was believed (it changed as a whole): the tracks are predicted over
   // it, nothing else.
   void skip();

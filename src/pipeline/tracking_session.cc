@@ -87,7 +87,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   // Frames the source skipped (a camera that dropped them, an image sequence with numbers
   // missing, frames a reader could not decode) passed for the markers too: their motion is
   // predicted over each, as over a frame in which nothing was believed, so the gate reaches as
-  // far as they could have moved meanwhile. (One that hides its drops: see FramesPassed below.)
+  // far as they could have moved meanwhile. (A source that hides its drops cannot be helped.)
   if (last_frame_ >= 0 && frame.index > last_frame_ + 1) {
     const int64_t missing = std::min<int64_t>(frame.index - last_frame_ - 1, kMaxMissingFramesPredicted);
     for (int64_t k = 0; k < missing; ++k) tracks_->skip();
@@ -136,19 +136,10 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     // candidate the tracker weighed but did not choose may be its marker.
     // A marker believed a frame ago that now has no report where its motion puts it: if the
     // whole picture moved (a bumped camera), the tracks move with it first.
-    // Else, if every moving marker is as many frames' motion ahead as the others, the source
-    // dropped those frames without saying so: the tracks are predicted over them, as over frames
-    // it says it missed, and they count in the time the checks below see.
     if (tracks_->AnyJustLost(result_.markers)) {
       std::optional<cv::Point2d> shift = frame_change_->camera_shift_px();
       if (!shift) shift = tracks_->CommonShift(result_.markers);
-      const bool followed = shift && tracks_->FollowCamera(result_.markers, *shift);
-      if (!followed) {
-        if (std::optional<int> passed = tracks_->FramesPassed(result_.markers)) {
-          for (int k = 1; k < *passed; ++k) tracks_->skip();
-          hidden_frames_ += *passed - 1;
-        }
-      }
+      if (shift) tracks_->FollowCamera(result_.markers, *shift);
     }
     const std::vector<MarkerTracks::Decision>& decisions =
         tracks_->associate(result_.markers, candidate_lists_);
@@ -186,8 +177,8 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     // missing now, just was is that other marker in this one's colour (a decoding error that
     // shifted the colours of part of the frame) or a look-alike at its place.
     for (size_t i = 0; i < believed_px_.size(); ++i) {
-      const bool recent = believed_px_[i] && elapsed_frame(frame) >= believed_frame_[i] &&
-                          elapsed_frame(frame) - believed_frame_[i] <= kRecentFrames;
+      const bool recent = believed_px_[i] && frame.index >= believed_frame_[i] &&
+                          frame.index - believed_frame_[i] <= kRecentFrames;
       recent_px_[i] = recent ? believed_px_[i] : std::nullopt;
     }
     for (size_t i : FindMarkersOnAMissingMarkersPlace(result_.markers, recent_px_)) {
@@ -203,13 +194,13 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       }
     }
   }
-  for (size_t i : plausibility_->check(elapsed_frame(frame), result_.markers)) trackers_[i]->reset();
+  for (size_t i : plausibility_->check(frame.index, result_.markers)) trackers_[i]->reset();
   if (!frame_change_->whole_frame_changed()) tracks_->commit(result_.markers);
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
     if (previous_px_[i]) {
       believed_px_[i] = previous_px_[i];
-      believed_frame_[i] = elapsed_frame(frame);
+      believed_frame_[i] = frame.index;
     }
   }
   return finish(frame, start);
@@ -309,7 +300,7 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     previous_px_[i] = result_.markers[i].observation.position_px;
     if (previous_px_[i]) {
       believed_px_[i] = previous_px_[i];
-      believed_frame_[i] = elapsed_frame(frame);
+      believed_frame_[i] = frame.index;
     }
     // A new track: it starts on this report at the next frame's association.
     result_.markers[i].track = previous_px_[i] ? TrackState::kTentative : TrackState::kLost;

@@ -97,10 +97,6 @@ class TrackingSession {
   void edited(ConfigChange change) const;  // Tells the listener, if any.
   EditListener edit_listener_;
   int64_t last_frame_ = -1;  // The index of the frame process() saw last.
-  // Frames the source dropped without saying so (MarkerTracks::FramesPassed), added to a frame's
-  // index for the checks that count time in frames.
-  int64_t hidden_frames_ = 0;
-  int64_t elapsed_frame(const Frame& frame) const { return frame.index + hidden_frames_; }
   void measure(const Frame& frame);  // result_.measurement from result_.markers.
   // The frame's measurement, timing and latency, then the live edits made after it.
   const FrameResult& finish(const Frame& frame, int64_t start_ticks);
