@@ -23,6 +23,7 @@
 #include "softsight/io/output_guard.h"
 #include "softsight/io/run_source.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/pipeline/summary.h"
 #include "softsight/track/colour_tracker.h"
@@ -269,6 +270,8 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   }
   std::string error;
   if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+  // The 3D results in the bench board's frame instead of the first camera's.
+  if (bench) stereo_options.results_in_board = *bench;
 
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
@@ -286,101 +289,49 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   const std::unique_ptr<PublishSink> publish =
       OpenPublishSink(options.publish, options.config_file);
 
+  // The wiring: pairs -> StereoSession -> the CSV, the stream, the window, the figures.
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
-
   const BasicCsvColumnTable<StereoFrameResult> columns =
       StereoColumns(names, session.segment_names());
-  BasicCsvWriter<StereoFrameResult> csv(options.csv_file, columns);
-  std::string published_row;
-  if (publish) {
-    publish->set_row_columns(columns.names(),
-                             {"_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status"});
-    RunInfo info;
-    info.source = input.description();
-    info.live = options.left_camera.has_value();
-    info.marker_names = names;
-    publish->begin(info);
-  }
+  BasicCsvSink<FramePair, StereoFrameResult> csv(options.csv_file, columns);
+  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> published;
+  if (publish) published.emplace(*publish, columns, StereoMarkerSuffixes());
+  StereoFiguresSink figures_sink;
+  std::vector<PairSink*> sinks{&csv};
+  if (published) sinks.push_back(&*published);
+  sinks.insert(sinks.end(), hooks.sinks.begin(), hooks.sinks.end());
+  sinks.push_back(&figures_sink);
+
+  RunOptions run_options;
+  run_options.max_frames = options.max_frames;
+  run_options.stop_requested = hooks.stop_requested;
+  // The report's words for a stop (below), in the stream's end record too.
+  const auto stop_words = [&hooks] {
+    return hooks.stop_reason ? hooks.stop_reason() : std::string("stopped from the window");
+  };
+  run_options.describe_stop = [&stop_words](StopReason reason) {
+    return reason == StopReason::kStopRequested ? stop_words() : std::string();
+  };
+  const RunSummary run = RunPipeline(input, session, sinks, run_options);
+  // The error is reported once, where it is handled; the stream's end record has said it.
+  if (!run.ok()) throw InputError(run.error);
+
+  const StereoRunFigures& figures = figures_sink.figures();
   TrackStereoSummary summary;
   summary.frame_offset = frame_offset;
-  summary.found.assign(names.size(), {"", 0});
-  summary.epipolar.assign(names.size(), {"", 0});
-  summary.timing.assign(names.size(), {"", 0});
-  for (size_t i = 0; i < names.size(); ++i)
-    summary.found[i].first = summary.epipolar[i].first = summary.timing[i].first = names[i];
-  std::vector<double> lags;
+  summary.pairs = run.frames;
+  summary.stopped = run.stop_reason == StopReason::kStopRequested;
+  for (size_t i = 0; i < names.size(); ++i) {
+    summary.found.emplace_back(names[i], run.markers[i].found);
+    summary.epipolar.emplace_back(names[i], figures.epipolar[i]);
+    summary.timing.emplace_back(names[i], figures.timing[i]);
+  }
   if (bench) summary.bench_board_rms_mm = bench->rms_mm;
-  std::vector<double> sigmas, epipolar_distances;
-  FramePair pair;
-  StereoFrameResult in_board;
-  bool by_time = false;
-  RunSummary run;  // For the stream's end record and its note.
-  run.source = input.description();
-  for (StereoSink* sink : hooks.sinks) sink->begin(left_config, right_config);
-  try {
-    while (!options.max_frames || summary.pairs < *options.max_frames) {
-      if (hooks.stop_requested && hooks.stop_requested()) {
-        summary.stopped = true;
-        break;
-      }
-      if (!input.read(pair)) break;
-      const StereoFrameResult& result = session.process(pair);
-      if (bench) {
-        in_board = result;
-        ExpressInBoardFrame(*bench, in_board);
-      }
-      const StereoFrameResult& row = bench ? in_board : result;
-      csv.write(row);
-      if (publish) {
-        columns.append_row(row, published_row);
-        publish->publish_row(published_row);
-      }
-      for (StereoSink* sink : hooks.sinks) {
-        sink->consume(pair, row, session.left_result(), session.right_result());
-      }
-      ++summary.pairs;
-      if (result.pair_dt_ms) {
-        by_time = true;
-        summary.max_abs_pair_dt_ms =
-            std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
-      }
-      if (result.lag_frames) lags.push_back(*result.lag_frames);
-      for (size_t i = 0; i < result.markers.size(); ++i) {
-        const StereoPoint& p = result.markers[i].point;
-        if (p.status == StereoStatus::kTiming) ++summary.timing[i].second;
-        if (p.found()) {
-          ++summary.found[i].second;
-          sigmas.push_back(*p.sigma_mm);
-        }
-        if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
-        if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
-      }
-    }
-  } catch (const InputError& e) {
-    // The subscribers learn that the run ended, and why; the error itself is reported once,
-    // where it is handled.
-    if (publish) {
-      run.frames = summary.pairs;
-      run.stop_reason = StopReason::kError;
-      run.error = e.what();
-      publish->end(run);
-    }
-    throw;
-  }
-  if (publish) {
-    run.frames = summary.pairs;
-    run.stop_reason = summary.stopped ? StopReason::kStopRequested
-                      : options.max_frames && summary.pairs >= *options.max_frames
-                          ? StopReason::kMaxFrames
-                          : StopReason::kEndOfInput;
-    // The report's words for a stop (below), in the end record too.
-    if (summary.stopped) {
-      run.stop_detail = hooks.stop_reason ? hooks.stop_reason() : "stopped from the window";
-    }
-    publish->end(run);
-    publish->report(run);
-  }
+  const bool by_time = figures.paired_by_time;
+  summary.max_abs_pair_dt_ms = figures.max_abs_pair_dt_ms;
+  std::vector<double> sigmas = figures.sigma_mm, epipolar_distances = figures.epipolar_px;
+  std::vector<double> lags = figures.lag_frames;
   summary.median_sigma_mm = Median(sigmas);
   summary.median_epipolar_px = Median(epipolar_distances);
   summary.lagging_pairs = static_cast<int64_t>(lags.size());
@@ -412,7 +363,7 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
     report << " (right frame = left frame + 0)";
   }
   if (summary.stopped) {
-    report << "; " << (hooks.stop_reason ? hooks.stop_reason() : "stopped from the window");
+    report << "; " << run.stop_detail;
   } else if (const std::optional<std::string> ended = input.ended_first()) {
     report << "; " << *ended;
   }
@@ -606,7 +557,12 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
         // The launcher runs `track-stereo --window` in the live plugin; this one has no GUI.
         throw InputError("--window: this build's track-stereo has no window (softsight_live.so)");
       }
-      window = open_window(*options);
+      // The window draws each view's triangle: it reads the configs the run will.
+      const TrackingConfig left = LoadStereoViewConfig(options->config_file);
+      const TrackingConfig right = options->right_config_file
+                                       ? LoadStereoViewConfig(*options->right_config_file)
+                                       : left;
+      window = open_window(*options, left, right);
       hooks.sinks = {window->sink.get()};
     }
     hooks.stop_requested = [&stop, &window] {

@@ -14,12 +14,11 @@
 
 #include "app/commands.h"
 #include "softsight/io/camera_settings.h"
+#include "softsight/pipeline/stereo_session.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
 
-class StereoInput;
-class StereoSink;
 struct TrackingConfig;
 
 // One view's marker config (LoadTrackingConfig), every marker ready for a run without the mouse
@@ -75,7 +74,8 @@ struct TrackStereoOptions {
 
 // What a run feeds besides the CSV, and what may end it early: the stereo window.
 struct StereoRunHooks {
-  std::vector<StereoSink*> sinks;  // Not owned; each sees every pair after its CSV row.
+  // Not owned; each sees every pair after its CSV row and its record on the stream.
+  std::vector<PairSink*> sinks;
   // Polled before each pair is read: true ends the run there, as the end of the input would
   // (the window's q, Escape or close; Ctrl-C). Empty: never.
   std::function<bool()> stop_requested;
@@ -119,10 +119,13 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
 // by the live plugin (the only one that loads the GUI's libraries): `track-stereo --window` runs
 // there (app/command_table.h). Throws InputError when there is no display.
 struct StereoWindowRun {
-  std::unique_ptr<StereoSink> sink;
+  std::unique_ptr<PairSink> sink;
   std::function<bool()> stop_requested;
 };
-using StereoWindowOpener = StereoWindowRun (*)(const TrackStereoOptions& options);
+// `left` and `right`: each view's config (the markers each view's triangle joins).
+using StereoWindowOpener = StereoWindowRun (*)(const TrackStereoOptions& options,
+                                               const TrackingConfig& left,
+                                               const TrackingConfig& right);
 
 // The command line of `track-stereo`; `open_window` makes the window for --window (null: none,
 // the commands plugin).
