@@ -41,7 +41,7 @@ using control_parts::SimulatedRigSource;
 using control_parts::OpenStereoPairs;
 using control_parts::OpenStereoSession;
 using control_parts::SimulatedStereoRigInput;
-using control_parts::RunStereoControl;
+using control_parts::StereoControlSink;
 using control_parts::StereoControlColumns;
 using control_parts::StereoControlFrames;
 
@@ -113,9 +113,6 @@ ControlTarget CheckedTarget(const ControlOptions& options) {
   }
   if (options.stereo && !options.hook.file.empty()) {
     throw InputError("control --stereo: --hook is not offered with two cameras yet");
-  }
-  if (options.stereo && options.publish) {
-    throw InputError("control --stereo: --publish is not offered with two cameras yet");
   }
   if (!options.stereo && (sources > 1 || (sources == 0 && !options.simulate))) {
     throw InputError("control: give one frame source: --camera, --rig-frames or --input (or "
@@ -550,12 +547,15 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   const bool write_csv = !options.csv_file.empty() || !options.identify;
   std::optional<CsvSink> csv;
   std::unique_ptr<CommandHook> hook;  // --hook: after the controller, before the CSV.
-  std::optional<BasicCsvWriter<StereoFrameResult>> stereo_csv;
+  // Two cameras: the same sinks over the pairs' rows (the stereo columns and the controller's).
+  std::optional<StereoControlSink> stereo_control;
+  std::optional<BasicCsvSink<FramePair, StereoFrameResult>> stereo_csv;
+  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> stereo_publish;
   if (pairs) {
-    if (write_csv) {
-      stereo_csv.emplace(options.csv_file,
-                         StereoCsvColumns(control, experiment, options.identify, *pairs));
-    }
+    BasicCsvColumnTable<StereoFrameResult> columns =
+        StereoCsvColumns(control, experiment, options.identify, *pairs);
+    if (publish) stereo_publish.emplace(*publish, columns, StereoMarkerSuffixes());
+    if (write_csv) stereo_csv.emplace(options.csv_file, std::move(columns));
   } else {
     std::vector<CsvColumn> extra =
         ControlColumns<FrameResult>(control, experiment, options.identify,
@@ -580,6 +580,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (hook) sinks.push_back(&hook->sink());  // Sees the step too; before the columns it fills.
   if (csv) sinks.push_back(&*csv);
   if (publish) sinks.push_back(publish.get());
+  std::vector<PairSink*> pair_sinks;  // In the same order.
+  if (pairs) {
+    pair_sinks.push_back(&stereo_control.emplace(control, pairs->angle));
+    if (stereo_csv) pair_sinks.push_back(&*stereo_csv);
+    if (stereo_publish) pair_sinks.push_back(&*stereo_publish);
+  }
   // What the stream and the target's source add to the summary's notes.
   const auto add_notes = [&] {
     if (feed) {
@@ -621,8 +627,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     return "";
   };
   try {
-    summary.run = pairs ? RunStereoControl(*pairs->input, *pairs->session, pairs->angle, control,
-                                           stereo_csv ? &*stereo_csv : nullptr, run.stop_requested)
+    summary.run = pairs ? RunPipeline(*pairs->input, *pairs->session, pair_sinks, run)
                         : RunPipeline(*frames.source, *tracking, sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).

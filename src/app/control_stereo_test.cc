@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/control_command.h"
 #include "app/identify_command.h"
@@ -20,6 +22,7 @@
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/stereo_scene.h"
+#include "stream/subscriber_test_util.h"
 
 namespace softsight {
 namespace {
@@ -237,6 +240,53 @@ TEST(ControlStereo, IdentifyThroughTwoCamerasThenTheModelBasedLoop) {
 }
 
 // Bad options: one error line naming what is wrong, exit code 2, before the board is opened.
+// `control --stereo --publish` (refused before the pair run shared the one loop): a subscriber
+// connected before the first pair gets every row of the CSV, with its columns and values (the
+// stereo columns and the controller's), a marker's 3D columns, and the run's end in the
+// summary's words.
+TEST(ControlStereo, PublishSendsEveryPairsRowAsTheCsvHasIt) {
+  TempDir dir;
+  ControlOptions options = StereoStep(dir, 120.0, "published.csv");
+  options.duration_s = 1.0;
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir.file("control.ipc");
+  publish.wait_subscribers = 1;
+  options.publish = publish;
+  StreamSubscriber records(publish.endpoint, {"hello", "frame", "marker/blue", "end"}, "test");
+  auto controlled = std::async(std::launch::async, [&] { return RunControl(options); });
+  auto received = testing::ReceiveUntilEnd(records);
+  const ControlSummary summary = controlled.get();
+  ASSERT_EQ(received["hello"].size(), 1u);
+  ASSERT_EQ(received["end"].size(), 1u) << "no end record";
+  const nlohmann::ordered_json& hello = received["hello"][0];
+  const nlohmann::ordered_json& end = received["end"][0];
+  const std::vector<nlohmann::ordered_json>& frames = received["frame"];
+  const std::vector<nlohmann::ordered_json>& blue = received["marker/blue"];
+  EXPECT_EQ(summary.run.frames, 31);
+  EXPECT_EQ(end["frames"], summary.run.frames);
+  EXPECT_EQ(end["stop_reason"], summary.run.stop_text());
+  EXPECT_EQ(end["stop_reason"], "duration reached");
+  EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("--publish " + publish.endpoint)));
+
+  std::ifstream csv(options.csv_file);
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = testing::SplitCsv(line);
+  EXPECT_EQ(hello["columns"].get<std::vector<std::string>>(), header);
+  EXPECT_NE(std::find(header.begin(), header.end(), "blue_Z"), header.end());
+  EXPECT_NE(std::find(header.begin(), header.end(), "measured_deg"), header.end());
+  EXPECT_NE(std::find(header.begin(), header.end(), "setpoint_kpa"), header.end());
+  ASSERT_EQ(frames.size(), 31u);
+  for (size_t r = 0; r < frames.size(); ++r) {
+    ASSERT_TRUE(static_cast<bool>(std::getline(csv, line))) << r;
+    testing::ExpectRecordIsRow(frames[r], header, testing::SplitCsv(line),
+                               "record " + std::to_string(r));
+  }
+  ASSERT_EQ(blue.size(), frames.size());
+  EXPECT_EQ(blue.back()["blue_Z"], frames.back()["blue_Z"]);
+  EXPECT_TRUE(frames.back()["blue_Z"].is_number());
+}
+
 TEST(ControlStereo, BadOptionsGiveOneErrorLineAndExit2) {
   TempDir dir;
   // A pair calibrated at another image size than the simulated cameras'.
