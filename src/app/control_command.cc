@@ -408,7 +408,7 @@ void CollectControlSummary(const ControlSink& control, const BoardLink& link,
   if (control.stale_frames() > 0) {
     summary->notes.push_back(
         "the camera repeated its last picture in " + std::to_string(control.stale_frames()) +
-        " of " + std::to_string(summary->frames) +
+        " of " + std::to_string(summary->run.frames) +
         " frames (markers `stale`: a frozen camera or a stalled frame relay): no new measurement "
         "there, so the loop held, then vented");
   }
@@ -640,7 +640,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     // The session's destructor sends STOP on the way out.
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
     add_notes();
-    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
+    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.run.frames);
     throw;
   }
   const RunSummary ran = summary.run;
@@ -685,8 +685,8 @@ std::string FormatControlSummary(const ControlSummary& s) {
   std::ostringstream out;
   char line[256];
   std::snprintf(line, sizeof(line), "frames: %lld over %.2f s (%s), angle measured in %lld\n",
-                static_cast<long long>(s.frames), s.duration_s, s.stop_reason.c_str(),
-                static_cast<long long>(s.measured));
+                static_cast<long long>(s.run.frames), s.duration_s, s.stop_reason.c_str(),
+                static_cast<long long>(s.run.measured));
   out << line;
   if (s.rms_error_deg) {
     std::snprintf(line, sizeof(line), "angle error: RMS %.2f deg over the run, final %+.2f deg\n",
@@ -712,7 +712,7 @@ std::string FormatControlSummary(const ControlSummary& s) {
                 s.max_pressure_kpa, static_cast<unsigned long long>(s.link_rejected),
                 static_cast<unsigned long long>(s.resends), s.board_rejected);
   out << line;
-  if (s.frames > 0) {
+  if (s.run.frames > 0) {
     std::snprintf(line, sizeof(line),
                   "latency from capture, median / p99: result %.3f / %.3f ms, serial command "
                   "%.3f / %.3f ms, CSV row %.3f / %.3f ms\n",

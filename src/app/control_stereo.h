@@ -99,6 +99,7 @@ class StereoControlSink : public PairSink {
   void consume(const FramePair& pair, const StereoFrameResult& result) override {
     control_.step(pair.left, StereoMeasuredAngle(result, angle_));
   }
+  void end(const RunSummary& summary) override { control_.end(summary); }
 
  private:
   ControlSink& control_;

@@ -80,8 +80,8 @@ TEST(ControlStereo, OutOfPlaneBendSettlesOnThe3dAngleWhereOneCameraSettlesWrong)
   TempDir dir;
   const ControlOptions stereo = StereoStep(dir, 120.0, "run3d.csv");
   const ControlSummary run = RunControl(stereo);
-  EXPECT_EQ(run.frames, 91);
-  EXPECT_EQ(run.measured, 91);
+  EXPECT_EQ(run.run.frames, 91);
+  EXPECT_EQ(run.run.measured, 91);
   ASSERT_TRUE(run.metrics.settling_1deg_s) << FormatStepMetrics(run.metrics);
   ASSERT_TRUE(run.metrics.overshoot_percent);
   const Rows rows = ReadRows(stereo.csv_file);
@@ -142,8 +142,8 @@ TEST(ControlStereo, APairWithAMarkerHiddenInOneViewIsNotAMeasurement) {
   options.duration_s = 5.0;
   options.stereo->sim_hidden = {{"green", 1, 30, 8}, {"green", 1, 60, 24}};
   const ControlSummary run = RunControl(options);
-  EXPECT_EQ(run.frames, 151);
-  EXPECT_EQ(run.measured, 151 - 8 - 24);
+  EXPECT_EQ(run.run.frames, 151);
+  EXPECT_EQ(run.run.measured, 151 - 8 - 24);
   const Rows rows = ReadRows(options.csv_file);
   ASSERT_EQ(rows.size(), 151u);
   const auto hidden = [](size_t i) { return (i >= 30 && i < 38) || (i >= 60 && i < 84); };
@@ -196,8 +196,8 @@ TEST(ControlStereo, PairsRefusedByTheEpipolarCheckAreNotMeasurements) {
   SaveStereoCalibration(wrong_rig, ChessboardSpec{}, dir.file("wrong.yaml"));
   options.stereo->stereo_file = dir.file("wrong.yaml");
   const ControlSummary run = RunControl(options);
-  EXPECT_EQ(run.frames, 31);
-  EXPECT_EQ(run.measured, 0);
+  EXPECT_EQ(run.run.frames, 31);
+  EXPECT_EQ(run.run.measured, 0);
   for (const auto& row : ReadRows(options.csv_file)) {
     for (const char* marker : {"red", "blue", "green"}) {
       EXPECT_EQ(row.at(std::string(marker) + "_status"), "epipolar");
