@@ -209,6 +209,128 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
                           right);
 }
 
+// What the command returns: the run's counts, the figures only a pair has, the pairing.
+TrackStereoSummary Summarise(const RunSummary& run, const StereoRunFigures& figures,
+                             const StereoInput& input, const std::vector<std::string>& names,
+                             std::optional<int64_t> frame_offset,
+                             const std::optional<BoardFrame>& bench) {
+  TrackStereoSummary summary;
+  summary.frame_offset = frame_offset;
+  summary.pairs = run.frames;
+  summary.stopped = run.stop_reason == StopReason::kStopRequested;
+  for (size_t i = 0; i < names.size(); ++i) {
+    summary.found.emplace_back(names[i], run.markers[i].found);
+    summary.epipolar.emplace_back(names[i], figures.epipolar[i]);
+    summary.timing.emplace_back(names[i], figures.timing[i]);
+  }
+  if (bench) summary.bench_board_rms_mm = bench->rms_mm;
+  summary.max_abs_pair_dt_ms = figures.max_abs_pair_dt_ms;
+  std::vector<double> sigmas = figures.sigma_mm, epipolar_distances = figures.epipolar_px;
+  std::vector<double> lags = figures.lag_frames;
+  summary.median_sigma_mm = Median(sigmas);
+  summary.median_epipolar_px = Median(epipolar_distances);
+  summary.lagging_pairs = static_cast<int64_t>(lags.size());
+  summary.median_lag_frames = Median(lags);
+  // One wrong offset lags by one amount all along; two frame rates or a dropped frame by a
+  // changing one (no single offset then pairs one moment).
+  if (lags.size() >= 4) {
+    std::sort(lags.begin(), lags.end());
+    summary.steady_lag = lags[lags.size() * 3 / 4] - lags[lags.size() / 4] <= 0.5;
+  }
+  summary.left_unpaired = input.left_unpaired();
+  summary.right_unpaired = input.right_unpaired();
+
+  return summary;
+}
+
+// The report: the pairs and how they were paired, each marker found in 3D, the medians, the
+// CSV's frame, the notes.
+void PrintReport(const TrackStereoOptions& options, const TrackStereoSummary& summary,
+                 const RunSummary& run, const StereoInput& input, const StereoCalibration& stereo,
+                 const StereoOptions& stereo_options, const std::vector<std::string>& names,
+                 std::ostream& report) {
+  report << summary.pairs << " pairs of frames";
+  if (summary.max_abs_pair_dt_ms) {
+    report << " (paired by time; left out without a partner within half a frame interval: "
+           << summary.left_unpaired << " left, " << summary.right_unpaired << " right frames";
+    if (summary.max_abs_pair_dt_ms) {
+      report << "; pairing error up to " << std::fixed << std::setprecision(1)
+             << *summary.max_abs_pair_dt_ms << " ms";
+    }
+    report << ")";
+  } else if (summary.left_unpaired > 0 || summary.right_unpaired > 0) {
+    const int64_t offset = summary.right_unpaired - summary.left_unpaired;
+    report << " (right frame = left frame " << (offset >= 0 ? "+ " : "- ") << std::abs(offset)
+           << ")";
+  } else {
+    report << " (right frame = left frame + 0)";
+  }
+  if (summary.stopped) {
+    report << "; " << run.stop_detail;
+  } else if (const std::optional<std::string> ended = input.ended_first()) {
+    report << "; " << *ended;
+  }
+  report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
+  for (size_t i = 0; i < names.size(); ++i) {
+    report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
+           << summary.pairs;
+    if (summary.epipolar[i].second > 0 || summary.timing[i].second > 0) {
+      report << " (";
+      if (summary.epipolar[i].second > 0) {
+        report << summary.epipolar[i].second << " refused by the epipolar check";
+      }
+      if (summary.timing[i].second > 0) {
+        report << (summary.epipolar[i].second > 0 ? ", " : "") << summary.timing[i].second
+               << " by the pairing check (timing)";
+      }
+      report << ")";
+    }
+    report << "\n";
+  }
+  report << std::setprecision(3);
+  if (summary.median_epipolar_px) {
+    report << "epipolar distance: median " << *summary.median_epipolar_px << " px (limit "
+           << options.max_epipolar_px << ")";
+  }
+  if (summary.median_sigma_mm)
+    report << "; 3D uncertainty: median " << *summary.median_sigma_mm << " mm";
+  report << "\nwrote " << options.csv_file;
+  if (stereo_options.results_in_board) {
+    report << ": <m>_X/_Y/_Z and plane_n* in the bench board's frame (origin at its first inner "
+              "corner, X along its first row, Y along its columns, Z into the bench)";
+  } else {
+    report << ": <m>_X/_Y/_Z in the first camera's frame";
+  }
+  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
+    report << "; out_of_plane_deg against the bench board's plane";
+  }
+  report << "\n";
+  for (const std::string& note : run.notes) report << "note: " << note << "\n";
+  if (summary.median_lag_frames) {
+    // A moving marker's right point lies where the marker was some frames before or after: on
+    // its epipolar line while it moves along the line, at a wrong depth. Said once, with what
+    // would pair one moment.
+    const double lag = *summary.median_lag_frames;
+    report << "note: in " << summary.lagging_pairs << " of " << summary.pairs
+           << " pairs the markers' motion says the right frame is about " << std::fixed
+           << std::setprecision(1) << std::abs(lag) << " frames " << (lag > 0 ? "later" : "earlier")
+           << " than the left one (moving markers there: status timing, not found in 3D)";
+    if (summary.frame_offset && summary.steady_lag) {
+      const int64_t better = *summary.frame_offset - std::llround(lag);
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: try --frame-offset " << better;
+    } else if (summary.frame_offset) {
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: leave --frame-offset out to have it found from the motion (two "
+                "frame rates: --pair-by time)";
+    } else {
+      report << "; the two views are not paired at one moment (their clocks or --time-offset-ms?)";
+    }
+    report << "\n";
+  }
+  report.unsetf(std::ios::floatfield);
+}
+
 // The run on `input`; `bench` is the bench board's frame when already located.
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                        std::ostream& report, std::optional<BoardFrame> bench,
@@ -317,115 +439,9 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   // The error is reported once, where it is handled; the stream's end record has said it.
   if (!run.ok()) throw InputError(run.error);
 
-  const StereoRunFigures& figures = figures_sink.figures();
-  TrackStereoSummary summary;
-  summary.frame_offset = frame_offset;
-  summary.pairs = run.frames;
-  summary.stopped = run.stop_reason == StopReason::kStopRequested;
-  for (size_t i = 0; i < names.size(); ++i) {
-    summary.found.emplace_back(names[i], run.markers[i].found);
-    summary.epipolar.emplace_back(names[i], figures.epipolar[i]);
-    summary.timing.emplace_back(names[i], figures.timing[i]);
-  }
-  if (bench) summary.bench_board_rms_mm = bench->rms_mm;
-  const bool by_time = figures.paired_by_time;
-  summary.max_abs_pair_dt_ms = figures.max_abs_pair_dt_ms;
-  std::vector<double> sigmas = figures.sigma_mm, epipolar_distances = figures.epipolar_px;
-  std::vector<double> lags = figures.lag_frames;
-  summary.median_sigma_mm = Median(sigmas);
-  summary.median_epipolar_px = Median(epipolar_distances);
-  summary.lagging_pairs = static_cast<int64_t>(lags.size());
-  summary.median_lag_frames = Median(lags);
-  // One wrong offset lags by one amount all along; two frame rates or a dropped frame by a
-  // changing one (no single offset then pairs one moment).
-  bool one_lag = false;
-  if (lags.size() >= 4) {
-    std::sort(lags.begin(), lags.end());
-    one_lag = lags[lags.size() * 3 / 4] - lags[lags.size() / 4] <= 0.5;
-  }
-  summary.left_unpaired = input.left_unpaired();
-  summary.right_unpaired = input.right_unpaired();
-
-  report << summary.pairs << " pairs of frames";
-  if (by_time) {
-    report << " (paired by time; left out without a partner within half a frame interval: "
-           << summary.left_unpaired << " left, " << summary.right_unpaired << " right frames";
-    if (summary.max_abs_pair_dt_ms) {
-      report << "; pairing error up to " << std::fixed << std::setprecision(1)
-             << *summary.max_abs_pair_dt_ms << " ms";
-    }
-    report << ")";
-  } else if (summary.left_unpaired > 0 || summary.right_unpaired > 0) {
-    const int64_t offset = summary.right_unpaired - summary.left_unpaired;
-    report << " (right frame = left frame " << (offset >= 0 ? "+ " : "- ") << std::abs(offset)
-           << ")";
-  } else {
-    report << " (right frame = left frame + 0)";
-  }
-  if (summary.stopped) {
-    report << "; " << run.stop_detail;
-  } else if (const std::optional<std::string> ended = input.ended_first()) {
-    report << "; " << *ended;
-  }
-  report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
-  for (size_t i = 0; i < names.size(); ++i) {
-    report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
-           << summary.pairs;
-    if (summary.epipolar[i].second > 0 || summary.timing[i].second > 0) {
-      report << " (";
-      if (summary.epipolar[i].second > 0) {
-        report << summary.epipolar[i].second << " refused by the epipolar check";
-      }
-      if (summary.timing[i].second > 0) {
-        report << (summary.epipolar[i].second > 0 ? ", " : "") << summary.timing[i].second
-               << " by the pairing check (timing)";
-      }
-      report << ")";
-    }
-    report << "\n";
-  }
-  report << std::setprecision(3);
-  if (summary.median_epipolar_px) {
-    report << "epipolar distance: median " << *summary.median_epipolar_px << " px (limit "
-           << options.max_epipolar_px << ")";
-  }
-  if (summary.median_sigma_mm)
-    report << "; 3D uncertainty: median " << *summary.median_sigma_mm << " mm";
-  report << "\nwrote " << options.csv_file;
-  if (bench) {
-    report << ": <m>_X/_Y/_Z and plane_n* in the bench board's frame (origin at its first inner "
-              "corner, X along its first row, Y along its columns, Z into the bench)";
-  } else {
-    report << ": <m>_X/_Y/_Z in the first camera's frame";
-  }
-  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
-    report << "; out_of_plane_deg against the bench board's plane";
-  }
-  report << "\n";
-  for (const std::string& note : run.notes) report << "note: " << note << "\n";
-  if (summary.median_lag_frames) {
-    // A moving marker's right point lies where the marker was some frames before or after: on
-    // its epipolar line while it moves along the line, at a wrong depth. Said once, with what
-    // would pair one moment.
-    const double lag = *summary.median_lag_frames;
-    report << "note: in " << summary.lagging_pairs << " of " << summary.pairs
-           << " pairs the markers' motion says the right frame is about " << std::fixed
-           << std::setprecision(1) << std::abs(lag) << " frames " << (lag > 0 ? "later" : "earlier")
-           << " than the left one (moving markers there: status timing, not found in 3D)";
-    if (summary.frame_offset && one_lag) {
-      const int64_t better = *summary.frame_offset - std::llround(lag);
-      report << "; the frame offset " << *summary.frame_offset
-             << " looks wrong: try --frame-offset " << better;
-    } else if (summary.frame_offset) {
-      report << "; the frame offset " << *summary.frame_offset
-             << " looks wrong: leave --frame-offset out to have it found from the motion (two "
-                "frame rates: --pair-by time)";
-    } else {
-      report << "; the two views are not paired at one moment (their clocks or --time-offset-ms?)";
-    }
-    report << "\n";
-  }
-  report.unsetf(std::ios::floatfield);
+  const TrackStereoSummary summary =
+      Summarise(run, figures_sink.figures(), input, names, frame_offset, bench);
+  PrintReport(options, summary, run, input, stereo, stereo_options, names, report);
   return summary;
 }
 

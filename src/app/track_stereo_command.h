@@ -93,6 +93,9 @@ struct TrackStereoSummary {
   // median lag they showed (right frames; positive: the right frame is later).
   int64_t lagging_pairs = 0;
   std::optional<double> median_lag_frames;
+  // The lag was one amount all along (at least 4 lagging pairs, their quartiles within half a
+  // frame): a wrong frame offset, not two rates or a dropped frame.
+  bool steady_lag = false;
   std::optional<double> median_sigma_mm;     // Over the found points.
   std::optional<double> median_epipolar_px;  // Over the pairs both views found.
   // Pairing: the offset used (by index), and frames of each view left without a partner (by

@@ -183,11 +183,11 @@ void ExpressInBoardFrame(const BoardFrame& frame, StereoFrameResult& result);
 // per segment (inner marker <s> of a chain of more than 3) angle_<s>_deg, radius_<s>_mm,
 // arc_length_<s>_mm; then angle_left_deg, angle_right_deg, proc_ms. Absent values are empty
 // fields.
-// The suffixes of a marker's columns in StereoColumns (_X ... _status): its marker/<name> topic
-// on the stream.
-std::vector<std::string> StereoMarkerSuffixes();
 BasicCsvColumnTable<StereoFrameResult> StereoColumns(
     const std::vector<std::string>& marker_names,
     const std::vector<std::string>& segment_names = {});
+// The suffixes of a marker's columns in StereoColumns (_X ... _status): its marker/<name> topic
+// on the stream.
+std::vector<std::string> StereoMarkerSuffixes();
 
 }  // namespace softsight
