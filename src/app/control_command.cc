@@ -42,6 +42,7 @@ using control_parts::OpenStereoPairs;
 using control_parts::OpenStereoSession;
 using control_parts::SimulatedStereoRigInput;
 using control_parts::StereoControlSink;
+using control_parts::StereoHookSink;
 using control_parts::StereoControlColumns;
 using control_parts::StereoControlFrames;
 
@@ -110,9 +111,6 @@ ControlTarget CheckedTarget(const ControlOptions& options) {
     throw InputError("control --stereo: the frames come from --left-camera and --right-camera "
                      "(or the simulated rig with --simulate), not --camera, --rig-frames or "
                      "--input");
-  }
-  if (options.stereo && !options.hook.file.empty()) {
-    throw InputError("control --stereo: --hook is not offered with two cameras yet");
   }
   if (!options.stereo && (sources > 1 || (sources == 0 && !options.simulate))) {
     throw InputError("control: give one frame source: --camera, --rig-frames or --input (or "
@@ -293,7 +291,8 @@ std::vector<BasicCsvColumn<Row>> ControlColumns(
 // with the simulated pair the true bending plane's tilt out of the first camera's image plane.
 BasicCsvColumnTable<StereoFrameResult> StereoCsvColumns(
     const ControlSink& control, const std::optional<IdentificationExperiment>& experiment,
-    bool identify, const StereoControlFrames& pairs) {
+    bool identify, const StereoControlFrames& pairs,
+    std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns = {}) {
   using Row = StereoFrameResult;
   std::vector<BasicCsvColumn<Row>> extra{NumberColumn<Row>(
       "measured_deg", [&control](const Row&) { return control.measured_deg(); })};
@@ -308,6 +307,7 @@ BasicCsvColumnTable<StereoFrameResult> StereoCsvColumns(
       return scene ? std::optional<double>(scene->plane_tilt_deg) : std::nullopt;
     }));
   }
+  for (BasicCsvColumn<Row>& column : hook_columns) extra.push_back(std::move(column));
   return StereoControlColumns(*pairs.session, std::move(extra), control.latency_column<Row>());
 }
 
@@ -551,9 +551,16 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   std::optional<StereoControlSink> stereo_control;
   std::optional<BasicCsvSink<FramePair, StereoFrameResult>> stereo_csv;
   std::optional<PublishRowsSink<FramePair, StereoFrameResult>> stereo_publish;
+  std::optional<StereoHookSink> stereo_hook;
   if (pairs) {
-    BasicCsvColumnTable<StereoFrameResult> columns =
-        StereoCsvColumns(control, experiment, options.identify, *pairs);
+    // As for one camera: a camera's hook beside the loop, a rendered rig's in it.
+    hook = CommandHook::Open(options.hook, pairs->input->is_live(),
+                             StereoCsvColumns(control, experiment, options.identify, *pairs).names(),
+                             std::cerr);
+    std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns;
+    if (hook) hook_columns = stereo_hook.emplace(hook->sink()).columns();
+    BasicCsvColumnTable<StereoFrameResult> columns = StereoCsvColumns(
+        control, experiment, options.identify, *pairs, std::move(hook_columns));
     if (publish) stereo_publish.emplace(*publish, columns, StereoMarkerSuffixes());
     if (write_csv) stereo_csv.emplace(options.csv_file, std::move(columns));
   } else {
@@ -583,6 +590,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   std::vector<PairSink*> pair_sinks;  // In the same order.
   if (pairs) {
     pair_sinks.push_back(&stereo_control.emplace(control, pairs->angle));
+    if (stereo_hook) pair_sinks.push_back(&*stereo_hook);
     if (stereo_csv) pair_sinks.push_back(&*stereo_csv);
     if (stereo_publish) pair_sinks.push_back(&*stereo_publish);
   }

@@ -20,6 +20,7 @@
 #include "softsight/control/rig.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/hook.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/pipeline/summary.h"
 #include "softsight/sim/stereo_scene.h"
@@ -104,6 +105,36 @@ class StereoControlSink : public PairSink {
  private:
   ControlSink& control_;
   StereoAngle angle_;
+};
+
+// --hook with two cameras: the hook runs as on one camera's frames, on each pair's first
+// (left) frame and that camera's own tracking of it (its markers in image pixels, its own
+// angle); its values go into the pair's row. A hook that wants 3D values reads the row's
+// columns afterwards (the CSV, the stream): the hook's Python side knows one view's result.
+class StereoHookSink : public PairSink {
+ public:
+  explicit StereoHookSink(HookSink& hook) : hook_(hook) {}
+  // The hook's columns over the pair's rows: each the value the hook gave for the row's left
+  // frame, or an empty field.
+  std::vector<BasicCsvColumn<StereoFrameResult>> columns() const {
+    std::vector<BasicCsvColumn<StereoFrameResult>> columns;
+    for (CsvColumn& column : hook_.columns()) {
+      columns.push_back({column.name, [append = std::move(column.append)](
+                                          const StereoFrameResult& row, std::string& text) {
+                           append(*row.left_view, text);
+                         }});
+    }
+    return columns;
+  }
+  void begin(const RunInfo& info) override { hook_.begin(info); }
+  void consume(const FramePair& pair, const StereoFrameResult& result) override {
+    hook_.consume(pair.left, *result.left_view);
+  }
+  void end(const RunSummary& summary) override { hook_.end(summary); }
+  void report(RunSummary& summary) const override { hook_.report(summary); }
+
+ private:
+  HookSink& hook_;
 };
 
 // The command line's two-camera options (control and identify): --stereo, --left-camera,

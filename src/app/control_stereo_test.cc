@@ -287,6 +287,42 @@ TEST(ControlStereo, PublishSendsEveryPairsRowAsTheCsvHasIt) {
   EXPECT_TRUE(frames.back()["blue_Z"].is_number());
 }
 
+// `control --stereo --hook` (refused before the pair run shared the one loop): the hook runs on
+// every pair's first frame with that camera's own tracking, and its values are in that pair's
+// row: the left frame's index, the left camera's own angle (the row's angle_left_deg) and the
+// frame's width.
+TEST(ControlStereo, HookRunsOnEveryPairsFirstViewAndFillsItsRow) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("h.py"), R"py(
+columns = ["hook_frame", "hook_left_angle", "hook_width"]
+
+def on_frame(frame, result):
+    return {"hook_frame": result.frame, "hook_left_angle": result.angle_deg,
+            "hook_width": frame.shape[1]}
+)py");
+  const testing::ProgramRun run = testing::RunProgram(
+      "control --config " + RigStereoExample() +
+          " --simulate --stereo builtin --target-deg 120 --duration-s 1 --quiet --csv " +
+          dir.file("run.csv") + " --hook " + dir.file("h.py"),
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+  const Rows rows = ReadRows(dir.file("run.csv"));
+  ASSERT_EQ(rows.size(), 31u);
+  int angles = 0;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    EXPECT_EQ(Field(rows[r], "hook_frame"), Field(rows[r], "frame")) << r;
+    EXPECT_EQ(Field(rows[r], "hook_width"), 640.0) << r;
+    const std::optional<double> left = Field(rows[r], "angle_left_deg");
+    const std::optional<double> hooked = Field(rows[r], "hook_left_angle");
+    ASSERT_EQ(left.has_value(), hooked.has_value()) << r;
+    if (left) {
+      EXPECT_NEAR(*hooked, *left, 1e-4) << r;  // The CSV's 4 decimals.
+      ++angles;
+    }
+  }
+  EXPECT_EQ(angles, 31);
+}
+
 TEST(ControlStereo, BadOptionsGiveOneErrorLineAndExit2) {
   TempDir dir;
   // A pair calibrated at another image size than the simulated cameras'.
