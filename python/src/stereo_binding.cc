@@ -16,6 +16,7 @@
 #include "softsight/io/frame_source.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/run.h"
 #include "softsight/pipeline/stereo_session.h"
 
 namespace softsight::python {
@@ -67,6 +68,23 @@ py::dict StereoColumnsDict(const BasicCsvColumnTable<StereoFrameResult>& table,
   }
   return out;
 }
+
+// Each pair's row as the CSV's text.
+class RowTextSink : public PairSink {
+ public:
+  RowTextSink(BasicCsvColumnTable<StereoFrameResult> table, std::vector<std::string>& rows)
+      : table_(std::move(table)), rows_(rows) {}
+  void consume(const FramePair& pair, const StereoFrameResult& result) override {
+    (void)pair;
+    table_.append_row(result, row_);
+    rows_.push_back(row_);
+  }
+
+ private:
+  BasicCsvColumnTable<StereoFrameResult> table_;
+  std::vector<std::string>& rows_;
+  std::string row_;
+};
 
 // The bench board's frame (`track-stereo --bench-board`): the board from `chessboard` and
 // `square_mm`, else the stereo file's.
@@ -148,6 +166,8 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
     frame_offset = found_offset->offset_frames;
   }
 
+  // The one run (pipeline/run.h RunPipeline on pairs), with `track-stereo`'s CSV table and
+  // figures; the rows kept as the CSV's text, made into columns below.
   std::vector<std::string> rows;
   int64_t pairs = 0;
   py::dict found, epipolar;
@@ -157,29 +177,20 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
     py::gil_scoped_release release;
     const std::unique_ptr<StereoInput> input = PairByIndex(
         OpenFrameSource(left_spec), OpenFrameSource(right_spec), *frame_offset, "frame_offset");
+    if (bench) options.results_in_board = *bench;
     StereoSession session(left_config, other_config, calibration, options);
     names = session.marker_names();
     segments = session.segment_names();
-    found_count.assign(names.size(), 0);
-    epipolar_count.assign(names.size(), 0);
-    const BasicCsvColumnTable<StereoFrameResult> table = StereoColumns(names, segments);
-    FramePair pair;
-    std::string row;
-    StereoFrameResult in_board;
-    while (!max_frames || pairs < *max_frames) {
-      if (!input->read(pair)) break;
-      const StereoFrameResult& result = session.process(pair);
-      if (bench) {
-        in_board = result;
-        ExpressInBoardFrame(*bench, in_board);
-      }
-      table.append_row(bench ? in_board : result, row);
-      rows.push_back(row);
-      ++pairs;
-      for (size_t i = 0; i < result.markers.size(); ++i) {
-        if (result.markers[i].point.found()) ++found_count[i];
-        if (result.markers[i].point.status == StereoStatus::kEpipolar) ++epipolar_count[i];
-      }
+    RowTextSink kept(StereoColumns(names, segments), rows);
+    StereoFiguresSink figures;
+    RunOptions run_options;
+    run_options.max_frames = max_frames;
+    const RunSummary run = RunPipeline(*input, session, {&kept, &figures}, run_options);
+    if (!run.ok()) throw InputError(run.error);
+    pairs = run.frames;
+    for (size_t i = 0; i < names.size(); ++i) {
+      found_count.push_back(run.markers[i].found);
+      epipolar_count.push_back(figures.figures().epipolar[i]);
     }
   }
   for (size_t i = 0; i < names.size(); ++i) {

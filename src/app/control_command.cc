@@ -41,7 +41,8 @@ using control_parts::SimulatedRigSource;
 using control_parts::OpenStereoPairs;
 using control_parts::OpenStereoSession;
 using control_parts::SimulatedStereoRigInput;
-using control_parts::RunStereoControl;
+using control_parts::StereoControlSink;
+using control_parts::StereoHookSink;
 using control_parts::StereoControlColumns;
 using control_parts::StereoControlFrames;
 
@@ -110,12 +111,6 @@ ControlTarget CheckedTarget(const ControlOptions& options) {
     throw InputError("control --stereo: the frames come from --left-camera and --right-camera "
                      "(or the simulated rig with --simulate), not --camera, --rig-frames or "
                      "--input");
-  }
-  if (options.stereo && !options.hook.file.empty()) {
-    throw InputError("control --stereo: --hook is not offered with two cameras yet");
-  }
-  if (options.stereo && options.publish) {
-    throw InputError("control --stereo: --publish is not offered with two cameras yet");
   }
   if (!options.stereo && (sources > 1 || (sources == 0 && !options.simulate))) {
     throw InputError("control: give one frame source: --camera, --rig-frames or --input (or "
@@ -296,7 +291,8 @@ std::vector<BasicCsvColumn<Row>> ControlColumns(
 // with the simulated pair the true bending plane's tilt out of the first camera's image plane.
 BasicCsvColumnTable<StereoFrameResult> StereoCsvColumns(
     const ControlSink& control, const std::optional<IdentificationExperiment>& experiment,
-    bool identify, const StereoControlFrames& pairs) {
+    bool identify, const StereoControlFrames& pairs,
+    std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns = {}) {
   using Row = StereoFrameResult;
   std::vector<BasicCsvColumn<Row>> extra{NumberColumn<Row>(
       "measured_deg", [&control](const Row&) { return control.measured_deg(); })};
@@ -311,6 +307,7 @@ BasicCsvColumnTable<StereoFrameResult> StereoCsvColumns(
       return scene ? std::optional<double>(scene->plane_tilt_deg) : std::nullopt;
     }));
   }
+  for (BasicCsvColumn<Row>& column : hook_columns) extra.push_back(std::move(column));
   return StereoControlColumns(*pairs.session, std::move(extra), control.latency_column<Row>());
 }
 
@@ -411,7 +408,7 @@ void CollectControlSummary(const ControlSink& control, const BoardLink& link,
   if (control.stale_frames() > 0) {
     summary->notes.push_back(
         "the camera repeated its last picture in " + std::to_string(control.stale_frames()) +
-        " of " + std::to_string(summary->frames) +
+        " of " + std::to_string(summary->run.frames) +
         " frames (markers `stale`: a frozen camera or a stalled frame relay): no new measurement "
         "there, so the loop held, then vented");
   }
@@ -550,12 +547,22 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   const bool write_csv = !options.csv_file.empty() || !options.identify;
   std::optional<CsvSink> csv;
   std::unique_ptr<CommandHook> hook;  // --hook: after the controller, before the CSV.
-  std::optional<BasicCsvWriter<StereoFrameResult>> stereo_csv;
+  // Two cameras: the same sinks over the pairs' rows (the stereo columns and the controller's).
+  std::optional<StereoControlSink> stereo_control;
+  std::optional<BasicCsvSink<FramePair, StereoFrameResult>> stereo_csv;
+  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> stereo_publish;
+  std::optional<StereoHookSink> stereo_hook;
   if (pairs) {
-    if (write_csv) {
-      stereo_csv.emplace(options.csv_file,
-                         StereoCsvColumns(control, experiment, options.identify, *pairs));
-    }
+    // As for one camera: a camera's hook beside the loop, a rendered rig's in it.
+    hook = CommandHook::Open(options.hook, pairs->input->is_live(),
+                             StereoCsvColumns(control, experiment, options.identify, *pairs).names(),
+                             std::cerr);
+    std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns;
+    if (hook) hook_columns = stereo_hook.emplace(hook->sink()).columns();
+    BasicCsvColumnTable<StereoFrameResult> columns = StereoCsvColumns(
+        control, experiment, options.identify, *pairs, std::move(hook_columns));
+    if (publish) stereo_publish.emplace(*publish, columns, StereoMarkerSuffixes());
+    if (write_csv) stereo_csv.emplace(options.csv_file, std::move(columns));
   } else {
     std::vector<CsvColumn> extra =
         ControlColumns<FrameResult>(control, experiment, options.identify,
@@ -580,6 +587,13 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   if (hook) sinks.push_back(&hook->sink());  // Sees the step too; before the columns it fills.
   if (csv) sinks.push_back(&*csv);
   if (publish) sinks.push_back(publish.get());
+  std::vector<PairSink*> pair_sinks;  // In the same order.
+  if (pairs) {
+    pair_sinks.push_back(&stereo_control.emplace(control, pairs->angle));
+    if (stereo_hook) pair_sinks.push_back(&*stereo_hook);
+    if (stereo_csv) pair_sinks.push_back(&*stereo_csv);
+    if (stereo_publish) pair_sinks.push_back(&*stereo_publish);
+  }
   // What the stream and the target's source add to the summary's notes.
   const auto add_notes = [&] {
     if (feed) {
@@ -621,8 +635,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     return "";
   };
   try {
-    summary.run = pairs ? RunStereoControl(*pairs->input, *pairs->session, pairs->angle, control,
-                                           stereo_csv ? &*stereo_csv : nullptr, run.stop_requested)
+    summary.run = pairs ? RunPipeline(*pairs->input, *pairs->session, pair_sinks, run)
                         : RunPipeline(*frames.source, *tracking, sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
@@ -635,7 +648,7 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     // The session's destructor sends STOP on the way out.
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
     add_notes();
-    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.frames);
+    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.run.frames);
     throw;
   }
   const RunSummary ran = summary.run;
@@ -680,8 +693,8 @@ std::string FormatControlSummary(const ControlSummary& s) {
   std::ostringstream out;
   char line[256];
   std::snprintf(line, sizeof(line), "frames: %lld over %.2f s (%s), angle measured in %lld\n",
-                static_cast<long long>(s.frames), s.duration_s, s.stop_reason.c_str(),
-                static_cast<long long>(s.measured));
+                static_cast<long long>(s.run.frames), s.duration_s, s.stop_reason.c_str(),
+                static_cast<long long>(s.run.measured));
   out << line;
   if (s.rms_error_deg) {
     std::snprintf(line, sizeof(line), "angle error: RMS %.2f deg over the run, final %+.2f deg\n",
@@ -707,7 +720,7 @@ std::string FormatControlSummary(const ControlSummary& s) {
                 s.max_pressure_kpa, static_cast<unsigned long long>(s.link_rejected),
                 static_cast<unsigned long long>(s.resends), s.board_rejected);
   out << line;
-  if (s.frames > 0) {
+  if (s.run.frames > 0) {
     std::snprintf(line, sizeof(line),
                   "latency from capture, median / p99: result %.3f / %.3f ms, serial command "
                   "%.3f / %.3f ms, CSV row %.3f / %.3f ms\n",

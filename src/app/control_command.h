@@ -106,9 +106,15 @@ struct IdentifyOutcome {
   std::vector<IdentifySample> samples;     // Every frame of the experiment.
 };
 
+// A control run's summary: the run's own (RunSummary: frames, frames with an angle, found rates,
+// timings, why it stopped) and what only the controller and the link know.
 struct ControlSummary {
-  int64_t frames = 0;
-  int64_t measured = 0;                 // Frames with an angle.
+  // The run's summary, as every command's run gives it (frames, `measured`: frames with an
+  // angle (two cameras: the 3D angle), found rates, the latency per frame from its capture (the
+  // camera's frame handed over; the simulated rig's frame rendered) to the tracker's result and
+  // to every output written, the CSV row's from the CSV sink). A run a signal or an error
+  // stopped in a wait for the board: as far as it got.
+  RunSummary run;
   double duration_s = 0.0;              // Covered by the frames' timestamps.
   std::optional<double> rms_error_deg;  // measured - target over frames with both, angle mode.
   std::optional<double> final_error_deg;
@@ -120,10 +126,6 @@ struct ControlSummary {
   // SIGINT or SIGTERM when a signal stopped the run (stop_reason says so), else 0. An
   // identification a signal stopped returns without `identified` instead of throwing.
   int stop_signal = 0;
-  // The pipeline's own summary of the run (frames, found rates, timings; the latency per frame
-  // from its capture (the camera's frame handed over; the simulated rig's frame rendered) to the
-  // tracker's result and to every output written, the CSV row's from the CSV sink).
-  RunSummary run;
   // From the capture to the serial command that frame's step sent, ms: median and 99th
   // percentile (the controller's own figure).
   double latency_command_ms_median = 0.0, latency_command_ms_p99 = 0.0;

@@ -90,8 +90,8 @@ TEST(ControlCommand, SimulatedRigStepTo120DegreesThroughTheTracker) {
   TempDir dir;
   const ControlOptions options = SimulatedStepTo120(dir);
   const ControlSummary summary = RunControl(options);
-  EXPECT_EQ(summary.frames, 121);
-  EXPECT_EQ(summary.measured, 121);
+  EXPECT_EQ(summary.run.frames, 121);
+  EXPECT_EQ(summary.run.measured, 121);
   ASSERT_TRUE(summary.final_error_deg);
   EXPECT_LT(std::abs(*summary.final_error_deg), 2.0);
   EXPECT_EQ(summary.link_rejected, 0u);

@@ -164,6 +164,9 @@ class ControlSink : public FrameSink {
     if (frame.repeated) ++stale_frames_;
     step(frame, result.measurement.angle_deg);
   }
+  // The run's summary as it ended (also when a wait for the board was stopped or failed): the
+  // controller's summary holds it.
+  void end(const RunSummary& summary) override { ended_run_ = summary; }
   // Frames the camera repeated (Frame::repeated): no new measurement, the loop held, then vented.
   int64_t stale_frames() const { return stale_frames_; }
 
@@ -193,11 +196,9 @@ class ControlSink : public FrameSink {
                   std::chrono::duration<double, std::milli>(sent - frame.captured).count())
             : std::nullopt;
     if (latency_command_ms_) command_latencies_ms_.push_back(*latency_command_ms_);
-    ++frames_;
     summary_.duration_s = sample_.time_s;
     summary_.max_pressure_kpa = std::max(summary_.max_pressure_kpa, sample_.board.pressure_kpa);
     summary_.board_rejected = sample_.board.board_rejected;
-    if (sample_.measured_deg) ++summary_.measured;
     if (sample_.measured_deg && sample_.target_deg) {
       const double e = *sample_.measured_deg - *sample_.target_deg;
       sum_sq_ += e * e;
@@ -249,7 +250,7 @@ class ControlSink : public FrameSink {
   // The figures so far (frames, errors, pressures); the link's counters are the caller's.
   ControlSummary summary() const {
     ControlSummary out = summary_;
-    out.frames = frames_;
+    out.run = ended_run_;
     std::vector<double> latencies = command_latencies_ms_;
     SummariseTimes(latencies, &out.latency_command_ms_median, &out.latency_command_ms_p99);
     if (errors_ > 0) out.rms_error_deg = std::sqrt(sum_sq_ / static_cast<double>(errors_));
@@ -304,7 +305,7 @@ class ControlSink : public FrameSink {
   std::optional<double> latency_command_ms_;
   std::vector<double> command_latencies_ms_;
   ControlSummary summary_;
-  int64_t frames_ = 0;
+  RunSummary ended_run_;
   double sum_sq_ = 0.0;
   int64_t errors_ = 0;
   bool done_ = false;

@@ -180,56 +180,6 @@ BasicCsvColumnTable<StereoFrameResult> StereoControlColumns(
   return columns;
 }
 
-RunSummary RunStereoControl(StereoInput& input, StereoSession& session, StereoAngle angle,
-                            ControlSink& control, BasicCsvWriter<StereoFrameResult>* csv,
-                            const std::function<bool()>& stop_requested) {
-  using Clock = std::chrono::steady_clock;
-  RunSummary summary;
-  summary.source = input.description();
-  for (const std::string& name : session.marker_names()) summary.markers.push_back({name, 0});
-  std::vector<double> proc_ms, result_ms, done_ms;
-  const auto ms_since = [](Clock::time_point from) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - from).count();
-  };
-  const Clock::time_point start = Clock::now();
-  FramePair pair;
-  try {
-    while (true) {
-      if ((stop_requested && stop_requested()) || control.done()) {
-        summary.stop_reason = StopReason::kStopRequested;
-        break;
-      }
-      if (!input.read(pair)) {
-        summary.stop_reason = StopReason::kEndOfInput;
-        break;
-      }
-      if (pair.left.captured == Clock::time_point{}) pair.left.captured = Clock::now();
-      const StereoFrameResult& result = session.process(pair);
-      result_ms.push_back(ms_since(pair.left.captured));
-      const std::optional<double> measured_deg = StereoMeasuredAngle(result, angle);
-      control.step(pair.left, measured_deg);
-      if (csv != nullptr) csv->write(result);
-      done_ms.push_back(ms_since(pair.left.captured));
-      proc_ms.push_back(result.proc_ms);
-      if (!summary.first_index) summary.first_index = result.frame_index;
-      summary.last_index = result.frame_index;
-      ++summary.frames;
-      if (measured_deg) ++summary.measured;
-      for (size_t i = 0; i < result.markers.size() && i < summary.markers.size(); ++i) {
-        if (result.markers[i].point.found()) ++summary.markers[i].found;
-      }
-    }
-  } catch (const InputError& e) {
-    summary.stop_reason = StopReason::kError;
-    summary.error = e.what();
-  }
-  summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-  SummariseTimes(proc_ms, &summary.proc_ms_median, &summary.proc_ms_p99);
-  SummariseTimes(result_ms, &summary.latency_result_ms_median, &summary.latency_result_ms_p99);
-  SummariseTimes(done_ms, &summary.latency_done_ms_median, &summary.latency_done_ms_p99);
-  return summary;
-}
-
 void AddControlStereoOptions(CLI::App& sub, ControlStereoOptions* args) {
   sub.add_option("--stereo", args->stereo_file,
                  "Two cameras: close the loop on the 3D angle. The pair's calibration from "

@@ -1,8 +1,9 @@
 // `softsight control --stereo`: the loop closed on the angle measured in 3D. The pairs of frames
 // (two live cameras paired by capture time, or the simulated rig rendered into both views of the
-// simulated pair), each through a StereoSession, and one measurement per pair for the controller:
-// the same ControlSink as one camera's, which is handed an angle and never learns where it came
-// from. Private to the command; RunControl wires it.
+// simulated pair), each through a StereoSession on the one run loop (RunPipeline on pairs), and
+// one measurement per pair for the controller: the same ControlSink as one camera's, which is
+// handed an angle and never learns where it came from. Private to the command; RunControl wires
+// it.
 #pragma once
 
 #include <functional>
@@ -19,6 +20,7 @@
 #include "softsight/control/rig.h"
 #include "softsight/io/csv_writer.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/hook.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/pipeline/summary.h"
 #include "softsight/sim/stereo_scene.h"
@@ -89,13 +91,51 @@ BasicCsvColumnTable<StereoFrameResult> StereoControlColumns(
     const StereoSession& session, std::vector<BasicCsvColumn<StereoFrameResult>> extra,
     BasicCsvColumn<StereoFrameResult> latency);
 
-// The run: pairs until the input ends, `stop_requested` says so or `control` is done; each pair
-// through the session, its measurement to `control`, its row to `csv` (when given). An InputError
-// (a frame of the wrong size, a camera gone, a failed link) ends the run with kError and its
-// message, as RunPipeline does; StopRequested (Ctrl-C while waiting for the board) propagates.
-RunSummary RunStereoControl(StereoInput& input, StereoSession& session, StereoAngle angle,
-                            ControlSink& control, BasicCsvWriter<StereoFrameResult>* csv,
-                            const std::function<bool()>& stop_requested);
+// The controller as a sink of the pair run (pipeline/run.h RunPipeline on pairs): each pair's
+// angle (StereoMeasuredAngle) is one step of `control`, on the left frame's time, as one
+// camera's frame is. Before the CSV and the stream: their columns read this pair's step.
+class StereoControlSink : public PairSink {
+ public:
+  StereoControlSink(ControlSink& control, StereoAngle angle) : control_(control), angle_(angle) {}
+  void consume(const FramePair& pair, const StereoFrameResult& result) override {
+    control_.step(pair.left, StereoMeasuredAngle(result, angle_));
+  }
+  void end(const RunSummary& summary) override { control_.end(summary); }
+
+ private:
+  ControlSink& control_;
+  StereoAngle angle_;
+};
+
+// --hook with two cameras: the hook runs as on one camera's frames, on each pair's first
+// (left) frame and that camera's own tracking of it (its markers in image pixels, its own
+// angle); its values go into the pair's row. A hook that wants 3D values reads the row's
+// columns afterwards (the CSV, the stream): the hook's Python side knows one view's result.
+class StereoHookSink : public PairSink {
+ public:
+  explicit StereoHookSink(HookSink& hook) : hook_(hook) {}
+  // The hook's columns over the pair's rows: each the value the hook gave for the row's left
+  // frame, or an empty field.
+  std::vector<BasicCsvColumn<StereoFrameResult>> columns() const {
+    std::vector<BasicCsvColumn<StereoFrameResult>> columns;
+    for (CsvColumn& column : hook_.columns()) {
+      columns.push_back({column.name, [append = std::move(column.append)](
+                                          const StereoFrameResult& row, std::string& text) {
+                           append(*row.left_view, text);
+                         }});
+    }
+    return columns;
+  }
+  void begin(const RunInfo& info) override { hook_.begin(info); }
+  void consume(const FramePair& pair, const StereoFrameResult& result) override {
+    hook_.consume(pair.left, *result.left_view);
+  }
+  void end(const RunSummary& summary) override { hook_.end(summary); }
+  void report(RunSummary& summary) const override { hook_.report(summary); }
+
+ private:
+  HookSink& hook_;
+};
 
 // The command line's two-camera options (control and identify): --stereo, --left-camera,
 // --right-camera, --right-config, --stereo-angle, --max-epipolar-px, --sim-tilt-deg, into

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/control_command.h"
 #include "app/identify_command.h"
@@ -20,6 +22,7 @@
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/stereo_scene.h"
+#include "stream/subscriber_test_util.h"
 
 namespace softsight {
 namespace {
@@ -77,8 +80,8 @@ TEST(ControlStereo, OutOfPlaneBendSettlesOnThe3dAngleWhereOneCameraSettlesWrong)
   TempDir dir;
   const ControlOptions stereo = StereoStep(dir, 120.0, "run3d.csv");
   const ControlSummary run = RunControl(stereo);
-  EXPECT_EQ(run.frames, 91);
-  EXPECT_EQ(run.measured, 91);
+  EXPECT_EQ(run.run.frames, 91);
+  EXPECT_EQ(run.run.measured, 91);
   ASSERT_TRUE(run.metrics.settling_1deg_s) << FormatStepMetrics(run.metrics);
   ASSERT_TRUE(run.metrics.overshoot_percent);
   const Rows rows = ReadRows(stereo.csv_file);
@@ -139,8 +142,8 @@ TEST(ControlStereo, APairWithAMarkerHiddenInOneViewIsNotAMeasurement) {
   options.duration_s = 5.0;
   options.stereo->sim_hidden = {{"green", 1, 30, 8}, {"green", 1, 60, 24}};
   const ControlSummary run = RunControl(options);
-  EXPECT_EQ(run.frames, 151);
-  EXPECT_EQ(run.measured, 151 - 8 - 24);
+  EXPECT_EQ(run.run.frames, 151);
+  EXPECT_EQ(run.run.measured, 151 - 8 - 24);
   const Rows rows = ReadRows(options.csv_file);
   ASSERT_EQ(rows.size(), 151u);
   const auto hidden = [](size_t i) { return (i >= 30 && i < 38) || (i >= 60 && i < 84); };
@@ -193,8 +196,8 @@ TEST(ControlStereo, PairsRefusedByTheEpipolarCheckAreNotMeasurements) {
   SaveStereoCalibration(wrong_rig, ChessboardSpec{}, dir.file("wrong.yaml"));
   options.stereo->stereo_file = dir.file("wrong.yaml");
   const ControlSummary run = RunControl(options);
-  EXPECT_EQ(run.frames, 31);
-  EXPECT_EQ(run.measured, 0);
+  EXPECT_EQ(run.run.frames, 31);
+  EXPECT_EQ(run.run.measured, 0);
   for (const auto& row : ReadRows(options.csv_file)) {
     for (const char* marker : {"red", "blue", "green"}) {
       EXPECT_EQ(row.at(std::string(marker) + "_status"), "epipolar");
@@ -237,6 +240,89 @@ TEST(ControlStereo, IdentifyThroughTwoCamerasThenTheModelBasedLoop) {
 }
 
 // Bad options: one error line naming what is wrong, exit code 2, before the board is opened.
+// `control --stereo --publish` (refused before the pair run shared the one loop): a subscriber
+// connected before the first pair gets every row of the CSV, with its columns and values (the
+// stereo columns and the controller's), a marker's 3D columns, and the run's end in the
+// summary's words.
+TEST(ControlStereo, PublishSendsEveryPairsRowAsTheCsvHasIt) {
+  TempDir dir;
+  ControlOptions options = StereoStep(dir, 120.0, "published.csv");
+  options.duration_s = 1.0;
+  PublishOptions publish;
+  publish.endpoint = "ipc://" + dir.file("control.ipc");
+  publish.wait_subscribers = 1;
+  options.publish = publish;
+  StreamSubscriber records(publish.endpoint, {"hello", "frame", "marker/blue", "end"}, "test");
+  auto controlled = std::async(std::launch::async, [&] { return RunControl(options); });
+  auto received = testing::ReceiveUntilEnd(records);
+  const ControlSummary summary = controlled.get();
+  ASSERT_EQ(received["hello"].size(), 1u);
+  ASSERT_EQ(received["end"].size(), 1u) << "no end record";
+  const nlohmann::ordered_json& hello = received["hello"][0];
+  const nlohmann::ordered_json& end = received["end"][0];
+  const std::vector<nlohmann::ordered_json>& frames = received["frame"];
+  const std::vector<nlohmann::ordered_json>& blue = received["marker/blue"];
+  EXPECT_EQ(summary.run.frames, 31);
+  EXPECT_EQ(end["frames"], summary.run.frames);
+  EXPECT_EQ(end["stop_reason"], summary.run.stop_text());
+  EXPECT_EQ(end["stop_reason"], "duration reached");
+  EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("--publish " + publish.endpoint)));
+
+  std::ifstream csv(options.csv_file);
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = testing::SplitCsv(line);
+  EXPECT_EQ(hello["columns"].get<std::vector<std::string>>(), header);
+  EXPECT_NE(std::find(header.begin(), header.end(), "blue_Z"), header.end());
+  EXPECT_NE(std::find(header.begin(), header.end(), "measured_deg"), header.end());
+  EXPECT_NE(std::find(header.begin(), header.end(), "setpoint_kpa"), header.end());
+  ASSERT_EQ(frames.size(), 31u);
+  for (size_t r = 0; r < frames.size(); ++r) {
+    ASSERT_TRUE(static_cast<bool>(std::getline(csv, line))) << r;
+    testing::ExpectRecordIsRow(frames[r], header, testing::SplitCsv(line),
+                               "record " + std::to_string(r));
+  }
+  ASSERT_EQ(blue.size(), frames.size());
+  EXPECT_EQ(blue.back()["blue_Z"], frames.back()["blue_Z"]);
+  EXPECT_TRUE(frames.back()["blue_Z"].is_number());
+}
+
+// `control --stereo --hook` (refused before the pair run shared the one loop): the hook runs on
+// every pair's first frame with that camera's own tracking, and its values are in that pair's
+// row: the left frame's index, the left camera's own angle (the row's angle_left_deg) and the
+// frame's width.
+TEST(ControlStereo, HookRunsOnEveryPairsFirstViewAndFillsItsRow) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("h.py"), R"py(
+columns = ["hook_frame", "hook_left_angle", "hook_width"]
+
+def on_frame(frame, result):
+    return {"hook_frame": result.frame, "hook_left_angle": result.angle_deg,
+            "hook_width": frame.shape[1]}
+)py");
+  const testing::ProgramRun run = testing::RunProgram(
+      "control --config " + RigStereoExample() +
+          " --simulate --stereo builtin --target-deg 120 --duration-s 1 --quiet --csv " +
+          dir.file("run.csv") + " --hook " + dir.file("h.py"),
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+  const Rows rows = ReadRows(dir.file("run.csv"));
+  ASSERT_EQ(rows.size(), 31u);
+  int angles = 0;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    EXPECT_EQ(Field(rows[r], "hook_frame"), Field(rows[r], "frame")) << r;
+    EXPECT_EQ(Field(rows[r], "hook_width"), 640.0) << r;
+    const std::optional<double> left = Field(rows[r], "angle_left_deg");
+    const std::optional<double> hooked = Field(rows[r], "hook_left_angle");
+    ASSERT_EQ(left.has_value(), hooked.has_value()) << r;
+    if (left) {
+      EXPECT_NEAR(*hooked, *left, 1e-4) << r;  // The CSV's 4 decimals.
+      ++angles;
+    }
+  }
+  EXPECT_EQ(angles, 31);
+}
+
 TEST(ControlStereo, BadOptionsGiveOneErrorLineAndExit2) {
   TempDir dir;
   // A pair calibrated at another image size than the simulated cameras'.

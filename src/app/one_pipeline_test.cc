@@ -84,7 +84,7 @@ TEST(OnePipeline, TrackLiveAndControlGiveTheSameTrackingColumnsForTheSameVideo) 
   control.csv_file = dir.file("control.csv");
   control.quiet = true;
   const ControlSummary summary = RunControl(control);
-  EXPECT_EQ(summary.frames, 12);
+  EXPECT_EQ(summary.run.frames, 12);
   EXPECT_EQ(summary.stop_reason, "end of input");
 
   // `live --no-pace`: the window's controller fed by the unpaced file, each frame's result as

@@ -246,6 +246,15 @@ std::unique_ptr<CommandHook> CommandHook::Open(const HookArgs& args, bool camera
   return hook;
 }
 
+std::unique_ptr<CommandHook> CommandHook::Open(const HookArgs& args, bool camera,
+                                               const std::vector<std::string>& run_columns,
+                                               std::ostream& err) {
+  // The check asks a table only for its names: one of the names alone does.
+  CsvColumnTable named;
+  for (const std::string& name : run_columns) named.add({name, {}});
+  return Open(args, camera, named, err);
+}
+
 CommandHook::~CommandHook() {
   sink_.reset();  // Its thread first: it may be running the hook.
   hook_.reset();

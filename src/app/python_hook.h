@@ -45,6 +45,11 @@ class CommandHook {
   // or bad `columns`, a column the run already has (`table`).
   static std::unique_ptr<CommandHook> Open(const HookArgs& args, bool camera,
                                            const CsvColumnTable& table, std::ostream& err);
+  // The same for a run whose rows are not one view's (control --stereo): `run_columns` are the
+  // names of its table's columns.
+  static std::unique_ptr<CommandHook> Open(const HookArgs& args, bool camera,
+                                           const std::vector<std::string>& run_columns,
+                                           std::ostream& err);
   ~CommandHook();
 
   HookSink& sink() { return *sink_; }

@@ -23,6 +23,7 @@
 #include "softsight/io/output_guard.h"
 #include "softsight/io/run_source.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/pipeline/summary.h"
 #include "softsight/track/colour_tracker.h"
@@ -208,6 +209,128 @@ BoardFrame FindBenchBoard(const TrackStereoOptions& options, const StereoCalibra
                           right);
 }
 
+// What the command returns: the run's counts, the figures only a pair has, the pairing.
+TrackStereoSummary Summarise(const RunSummary& run, const StereoRunFigures& figures,
+                             const StereoInput& input, const std::vector<std::string>& names,
+                             std::optional<int64_t> frame_offset,
+                             const std::optional<BoardFrame>& bench) {
+  TrackStereoSummary summary;
+  summary.frame_offset = frame_offset;
+  summary.pairs = run.frames;
+  summary.stopped = run.stop_reason == StopReason::kStopRequested;
+  for (size_t i = 0; i < names.size(); ++i) {
+    summary.found.emplace_back(names[i], run.markers[i].found);
+    summary.epipolar.emplace_back(names[i], figures.epipolar[i]);
+    summary.timing.emplace_back(names[i], figures.timing[i]);
+  }
+  if (bench) summary.bench_board_rms_mm = bench->rms_mm;
+  summary.max_abs_pair_dt_ms = figures.max_abs_pair_dt_ms;
+  std::vector<double> sigmas = figures.sigma_mm, epipolar_distances = figures.epipolar_px;
+  std::vector<double> lags = figures.lag_frames;
+  summary.median_sigma_mm = Median(sigmas);
+  summary.median_epipolar_px = Median(epipolar_distances);
+  summary.lagging_pairs = static_cast<int64_t>(lags.size());
+  summary.median_lag_frames = Median(lags);
+  // One wrong offset lags by one amount all along; two frame rates or a dropped frame by a
+  // changing one (no single offset then pairs one moment).
+  if (lags.size() >= 4) {
+    std::sort(lags.begin(), lags.end());
+    summary.steady_lag = lags[lags.size() * 3 / 4] - lags[lags.size() / 4] <= 0.5;
+  }
+  summary.left_unpaired = input.left_unpaired();
+  summary.right_unpaired = input.right_unpaired();
+
+  return summary;
+}
+
+// The report: the pairs and how they were paired, each marker found in 3D, the medians, the
+// CSV's frame, the notes.
+void PrintReport(const TrackStereoOptions& options, const TrackStereoSummary& summary,
+                 const RunSummary& run, const StereoInput& input, const StereoCalibration& stereo,
+                 const StereoOptions& stereo_options, const std::vector<std::string>& names,
+                 std::ostream& report) {
+  report << summary.pairs << " pairs of frames";
+  if (summary.max_abs_pair_dt_ms) {
+    report << " (paired by time; left out without a partner within half a frame interval: "
+           << summary.left_unpaired << " left, " << summary.right_unpaired << " right frames";
+    if (summary.max_abs_pair_dt_ms) {
+      report << "; pairing error up to " << std::fixed << std::setprecision(1)
+             << *summary.max_abs_pair_dt_ms << " ms";
+    }
+    report << ")";
+  } else if (summary.left_unpaired > 0 || summary.right_unpaired > 0) {
+    const int64_t offset = summary.right_unpaired - summary.left_unpaired;
+    report << " (right frame = left frame " << (offset >= 0 ? "+ " : "- ") << std::abs(offset)
+           << ")";
+  } else {
+    report << " (right frame = left frame + 0)";
+  }
+  if (summary.stopped) {
+    report << "; " << run.stop_detail;
+  } else if (const std::optional<std::string> ended = input.ended_first()) {
+    report << "; " << *ended;
+  }
+  report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
+  for (size_t i = 0; i < names.size(); ++i) {
+    report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
+           << summary.pairs;
+    if (summary.epipolar[i].second > 0 || summary.timing[i].second > 0) {
+      report << " (";
+      if (summary.epipolar[i].second > 0) {
+        report << summary.epipolar[i].second << " refused by the epipolar check";
+      }
+      if (summary.timing[i].second > 0) {
+        report << (summary.epipolar[i].second > 0 ? ", " : "") << summary.timing[i].second
+               << " by the pairing check (timing)";
+      }
+      report << ")";
+    }
+    report << "\n";
+  }
+  report << std::setprecision(3);
+  if (summary.median_epipolar_px) {
+    report << "epipolar distance: median " << *summary.median_epipolar_px << " px (limit "
+           << options.max_epipolar_px << ")";
+  }
+  if (summary.median_sigma_mm)
+    report << "; 3D uncertainty: median " << *summary.median_sigma_mm << " mm";
+  report << "\nwrote " << options.csv_file;
+  if (stereo_options.results_in_board) {
+    report << ": <m>_X/_Y/_Z and plane_n* in the bench board's frame (origin at its first inner "
+              "corner, X along its first row, Y along its columns, Z into the bench)";
+  } else {
+    report << ": <m>_X/_Y/_Z in the first camera's frame";
+  }
+  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
+    report << "; out_of_plane_deg against the bench board's plane";
+  }
+  report << "\n";
+  for (const std::string& note : run.notes) report << "note: " << note << "\n";
+  if (summary.median_lag_frames) {
+    // A moving marker's right point lies where the marker was some frames before or after: on
+    // its epipolar line while it moves along the line, at a wrong depth. Said once, with what
+    // would pair one moment.
+    const double lag = *summary.median_lag_frames;
+    report << "note: in " << summary.lagging_pairs << " of " << summary.pairs
+           << " pairs the markers' motion says the right frame is about " << std::fixed
+           << std::setprecision(1) << std::abs(lag) << " frames " << (lag > 0 ? "later" : "earlier")
+           << " than the left one (moving markers there: status timing, not found in 3D)";
+    if (summary.frame_offset && summary.steady_lag) {
+      const int64_t better = *summary.frame_offset - std::llround(lag);
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: try --frame-offset " << better;
+    } else if (summary.frame_offset) {
+      report << "; the frame offset " << *summary.frame_offset
+             << " looks wrong: leave --frame-offset out to have it found from the motion (two "
+                "frame rates: --pair-by time)";
+    } else {
+      report << "; the two views are not paired at one moment (their clocks or --time-offset-ms?)";
+    }
+    report << "\n";
+  }
+  report.unsetf(std::ios::floatfield);
+}
+
 // The run on `input`; `bench` is the bench board's frame when already located.
 TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
                        std::ostream& report, std::optional<BoardFrame> bench,
@@ -269,6 +392,8 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   }
   std::string error;
   if (!stereo_options.Check(&error)) throw InputError("--max-epipolar-px: " + error);
+  // The 3D results in the bench board's frame instead of the first camera's.
+  if (bench) stereo_options.results_in_board = *bench;
 
   std::vector<PathRole> inputs = ConfigInputs(left_config);
   if (options.right_config_file) {
@@ -286,195 +411,37 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
   const std::unique_ptr<PublishSink> publish =
       OpenPublishSink(options.publish, options.config_file);
 
+  // The wiring: pairs -> StereoSession -> the CSV, the stream, the window, the figures.
   StereoSession session(left_config, right_config, stereo, stereo_options);
   const std::vector<std::string> names = session.marker_names();
-
   const BasicCsvColumnTable<StereoFrameResult> columns =
       StereoColumns(names, session.segment_names());
-  BasicCsvWriter<StereoFrameResult> csv(options.csv_file, columns);
-  std::string published_row;
-  if (publish) {
-    publish->set_row_columns(columns.names(),
-                             {"_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status"});
-    RunInfo info;
-    info.source = input.description();
-    info.live = options.left_camera.has_value();
-    info.marker_names = names;
-    publish->begin(info);
-  }
-  TrackStereoSummary summary;
-  summary.frame_offset = frame_offset;
-  summary.found.assign(names.size(), {"", 0});
-  summary.epipolar.assign(names.size(), {"", 0});
-  summary.timing.assign(names.size(), {"", 0});
-  for (size_t i = 0; i < names.size(); ++i)
-    summary.found[i].first = summary.epipolar[i].first = summary.timing[i].first = names[i];
-  std::vector<double> lags;
-  if (bench) summary.bench_board_rms_mm = bench->rms_mm;
-  std::vector<double> sigmas, epipolar_distances;
-  FramePair pair;
-  StereoFrameResult in_board;
-  bool by_time = false;
-  RunSummary run;  // For the stream's end record and its note.
-  run.source = input.description();
-  for (StereoSink* sink : hooks.sinks) sink->begin(left_config, right_config);
-  try {
-    while (!options.max_frames || summary.pairs < *options.max_frames) {
-      if (hooks.stop_requested && hooks.stop_requested()) {
-        summary.stopped = true;
-        break;
-      }
-      if (!input.read(pair)) break;
-      const StereoFrameResult& result = session.process(pair);
-      if (bench) {
-        in_board = result;
-        ExpressInBoardFrame(*bench, in_board);
-      }
-      const StereoFrameResult& row = bench ? in_board : result;
-      csv.write(row);
-      if (publish) {
-        columns.append_row(row, published_row);
-        publish->publish_row(published_row);
-      }
-      for (StereoSink* sink : hooks.sinks) {
-        sink->consume(pair, row, session.left_result(), session.right_result());
-      }
-      ++summary.pairs;
-      if (result.pair_dt_ms) {
-        by_time = true;
-        summary.max_abs_pair_dt_ms =
-            std::max(summary.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
-      }
-      if (result.lag_frames) lags.push_back(*result.lag_frames);
-      for (size_t i = 0; i < result.markers.size(); ++i) {
-        const StereoPoint& p = result.markers[i].point;
-        if (p.status == StereoStatus::kTiming) ++summary.timing[i].second;
-        if (p.found()) {
-          ++summary.found[i].second;
-          sigmas.push_back(*p.sigma_mm);
-        }
-        if (p.status == StereoStatus::kEpipolar) ++summary.epipolar[i].second;
-        if (p.epipolar_px) epipolar_distances.push_back(*p.epipolar_px);
-      }
-    }
-  } catch (const InputError& e) {
-    // The subscribers learn that the run ended, and why; the error itself is reported once,
-    // where it is handled.
-    if (publish) {
-      run.frames = summary.pairs;
-      run.stop_reason = StopReason::kError;
-      run.error = e.what();
-      publish->end(run);
-    }
-    throw;
-  }
-  if (publish) {
-    run.frames = summary.pairs;
-    run.stop_reason = summary.stopped ? StopReason::kStopRequested
-                      : options.max_frames && summary.pairs >= *options.max_frames
-                          ? StopReason::kMaxFrames
-                          : StopReason::kEndOfInput;
-    // The report's words for a stop (below), in the end record too.
-    if (summary.stopped) {
-      run.stop_detail = hooks.stop_reason ? hooks.stop_reason() : "stopped from the window";
-    }
-    publish->end(run);
-    publish->report(run);
-  }
-  summary.median_sigma_mm = Median(sigmas);
-  summary.median_epipolar_px = Median(epipolar_distances);
-  summary.lagging_pairs = static_cast<int64_t>(lags.size());
-  summary.median_lag_frames = Median(lags);
-  // One wrong offset lags by one amount all along; two frame rates or a dropped frame by a
-  // changing one (no single offset then pairs one moment).
-  bool one_lag = false;
-  if (lags.size() >= 4) {
-    std::sort(lags.begin(), lags.end());
-    one_lag = lags[lags.size() * 3 / 4] - lags[lags.size() / 4] <= 0.5;
-  }
-  summary.left_unpaired = input.left_unpaired();
-  summary.right_unpaired = input.right_unpaired();
+  BasicCsvSink<FramePair, StereoFrameResult> csv(options.csv_file, columns);
+  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> published;
+  if (publish) published.emplace(*publish, columns, StereoMarkerSuffixes());
+  StereoFiguresSink figures_sink;
+  std::vector<PairSink*> sinks{&csv};
+  if (published) sinks.push_back(&*published);
+  sinks.insert(sinks.end(), hooks.sinks.begin(), hooks.sinks.end());
+  sinks.push_back(&figures_sink);
 
-  report << summary.pairs << " pairs of frames";
-  if (by_time) {
-    report << " (paired by time; left out without a partner within half a frame interval: "
-           << summary.left_unpaired << " left, " << summary.right_unpaired << " right frames";
-    if (summary.max_abs_pair_dt_ms) {
-      report << "; pairing error up to " << std::fixed << std::setprecision(1)
-             << *summary.max_abs_pair_dt_ms << " ms";
-    }
-    report << ")";
-  } else if (summary.left_unpaired > 0 || summary.right_unpaired > 0) {
-    const int64_t offset = summary.right_unpaired - summary.left_unpaired;
-    report << " (right frame = left frame " << (offset >= 0 ? "+ " : "- ") << std::abs(offset)
-           << ")";
-  } else {
-    report << " (right frame = left frame + 0)";
-  }
-  if (summary.stopped) {
-    report << "; " << (hooks.stop_reason ? hooks.stop_reason() : "stopped from the window");
-  } else if (const std::optional<std::string> ended = input.ended_first()) {
-    report << "; " << *ended;
-  }
-  report << "; baseline " << std::fixed << std::setprecision(1) << stereo.baseline_mm() << " mm\n";
-  for (size_t i = 0; i < names.size(); ++i) {
-    report << "  " << names[i] << ": found in 3D in " << summary.found[i].second << " of "
-           << summary.pairs;
-    if (summary.epipolar[i].second > 0 || summary.timing[i].second > 0) {
-      report << " (";
-      if (summary.epipolar[i].second > 0) {
-        report << summary.epipolar[i].second << " refused by the epipolar check";
-      }
-      if (summary.timing[i].second > 0) {
-        report << (summary.epipolar[i].second > 0 ? ", " : "") << summary.timing[i].second
-               << " by the pairing check (timing)";
-      }
-      report << ")";
-    }
-    report << "\n";
-  }
-  report << std::setprecision(3);
-  if (summary.median_epipolar_px) {
-    report << "epipolar distance: median " << *summary.median_epipolar_px << " px (limit "
-           << options.max_epipolar_px << ")";
-  }
-  if (summary.median_sigma_mm)
-    report << "; 3D uncertainty: median " << *summary.median_sigma_mm << " mm";
-  report << "\nwrote " << options.csv_file;
-  if (bench) {
-    report << ": <m>_X/_Y/_Z and plane_n* in the bench board's frame (origin at its first inner "
-              "corner, X along its first row, Y along its columns, Z into the bench)";
-  } else {
-    report << ": <m>_X/_Y/_Z in the first camera's frame";
-  }
-  if (stereo_options.reference_plane == StereoOptions::ReferencePlane::kBoard) {
-    report << "; out_of_plane_deg against the bench board's plane";
-  }
-  report << "\n";
-  for (const std::string& note : run.notes) report << "note: " << note << "\n";
-  if (summary.median_lag_frames) {
-    // A moving marker's right point lies where the marker was some frames before or after: on
-    // its epipolar line while it moves along the line, at a wrong depth. Said once, with what
-    // would pair one moment.
-    const double lag = *summary.median_lag_frames;
-    report << "note: in " << summary.lagging_pairs << " of " << summary.pairs
-           << " pairs the markers' motion says the right frame is about " << std::fixed
-           << std::setprecision(1) << std::abs(lag) << " frames " << (lag > 0 ? "later" : "earlier")
-           << " than the left one (moving markers there: status timing, not found in 3D)";
-    if (summary.frame_offset && one_lag) {
-      const int64_t better = *summary.frame_offset - std::llround(lag);
-      report << "; the frame offset " << *summary.frame_offset
-             << " looks wrong: try --frame-offset " << better;
-    } else if (summary.frame_offset) {
-      report << "; the frame offset " << *summary.frame_offset
-             << " looks wrong: leave --frame-offset out to have it found from the motion (two "
-                "frame rates: --pair-by time)";
-    } else {
-      report << "; the two views are not paired at one moment (their clocks or --time-offset-ms?)";
-    }
-    report << "\n";
-  }
-  report.unsetf(std::ios::floatfield);
+  RunOptions run_options;
+  run_options.max_frames = options.max_frames;
+  run_options.stop_requested = hooks.stop_requested;
+  // The report's words for a stop (below), in the stream's end record too.
+  const auto stop_words = [&hooks] {
+    return hooks.stop_reason ? hooks.stop_reason() : std::string("stopped from the window");
+  };
+  run_options.describe_stop = [&stop_words](StopReason reason) {
+    return reason == StopReason::kStopRequested ? stop_words() : std::string();
+  };
+  const RunSummary run = RunPipeline(input, session, sinks, run_options);
+  // The error is reported once, where it is handled; the stream's end record has said it.
+  if (!run.ok()) throw InputError(run.error);
+
+  const TrackStereoSummary summary =
+      Summarise(run, figures_sink.figures(), input, names, frame_offset, bench);
+  PrintReport(options, summary, run, input, stereo, stereo_options, names, report);
   return summary;
 }
 
@@ -606,7 +573,12 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
         // The launcher runs `track-stereo --window` in the live plugin; this one has no GUI.
         throw InputError("--window: this build's track-stereo has no window (softsight_live.so)");
       }
-      window = open_window(*options);
+      // The window draws each view's triangle: it reads the configs the run will.
+      const TrackingConfig left = LoadStereoViewConfig(options->config_file);
+      const TrackingConfig right = options->right_config_file
+                                       ? LoadStereoViewConfig(*options->right_config_file)
+                                       : left;
+      window = open_window(*options, left, right);
       hooks.sinks = {window->sink.get()};
     }
     hooks.stop_requested = [&stop, &window] {

@@ -14,12 +14,11 @@
 
 #include "app/commands.h"
 #include "softsight/io/camera_settings.h"
+#include "softsight/pipeline/stereo_session.h"
 #include "stream/publish_sink.h"
 
 namespace softsight {
 
-class StereoInput;
-class StereoSink;
 struct TrackingConfig;
 
 // One view's marker config (LoadTrackingConfig), every marker ready for a run without the mouse
@@ -75,7 +74,8 @@ struct TrackStereoOptions {
 
 // What a run feeds besides the CSV, and what may end it early: the stereo window.
 struct StereoRunHooks {
-  std::vector<StereoSink*> sinks;  // Not owned; each sees every pair after its CSV row.
+  // Not owned; each sees every pair after its CSV row and its record on the stream.
+  std::vector<PairSink*> sinks;
   // Polled before each pair is read: true ends the run there, as the end of the input would
   // (the window's q, Escape or close; Ctrl-C). Empty: never.
   std::function<bool()> stop_requested;
@@ -93,6 +93,9 @@ struct TrackStereoSummary {
   // median lag they showed (right frames; positive: the right frame is later).
   int64_t lagging_pairs = 0;
   std::optional<double> median_lag_frames;
+  // The lag was one amount all along (at least 4 lagging pairs, their quartiles within half a
+  // frame): a wrong frame offset, not two rates or a dropped frame.
+  bool steady_lag = false;
   std::optional<double> median_sigma_mm;     // Over the found points.
   std::optional<double> median_epipolar_px;  // Over the pairs both views found.
   // Pairing: the offset used (by index), and frames of each view left without a partner (by
@@ -119,10 +122,13 @@ TrackStereoSummary RunTrackStereo(const TrackStereoOptions& options, StereoInput
 // by the live plugin (the only one that loads the GUI's libraries): `track-stereo --window` runs
 // there (app/command_table.h). Throws InputError when there is no display.
 struct StereoWindowRun {
-  std::unique_ptr<StereoSink> sink;
+  std::unique_ptr<PairSink> sink;
   std::function<bool()> stop_requested;
 };
-using StereoWindowOpener = StereoWindowRun (*)(const TrackStereoOptions& options);
+// `left` and `right`: each view's config (the markers each view's triangle joins).
+using StereoWindowOpener = StereoWindowRun (*)(const TrackStereoOptions& options,
+                                               const TrackingConfig& left,
+                                               const TrackingConfig& right);
 
 // The command line of `track-stereo`; `open_window` makes the window for --window (null: none,
 // the commands plugin).

@@ -27,7 +27,7 @@
 #include "softsight/io/csv_reader.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/stereo_scene.h"
-#include "stream/subscriber.h"
+#include "stream/subscriber_test_util.h"
 
 namespace softsight {
 namespace {
@@ -394,25 +394,16 @@ TEST_F(TrackStereoCommandTest, PublishSendsEveryRowWithTheCsvsColumnsAsItHappens
   StreamSubscriber records(publish.endpoint, {"hello", "frame", "marker/green", "end"}, "test");
   std::ostringstream report;
   auto run = std::async(std::launch::async, [&] { return RunTrackStereo(options, report); });
-  std::optional<nlohmann::ordered_json> hello, end;
-  std::vector<nlohmann::ordered_json> frames, green;
-  for (int waits = 0; !end && waits < 600;) {
-    const std::optional<StreamMessage> message = records.receive(100);
-    if (!message) {
-      ++waits;  // At most a minute of silence in all.
-      continue;
-    }
-    const nlohmann::ordered_json body = nlohmann::ordered_json::parse(message->body);
-    if (message->topic == "hello") hello = body;
-    if (message->topic == "frame") frames.push_back(body);
-    if (message->topic == "marker/green") green.push_back(body);
-    if (message->topic == "end") end = body;
-  }
+  auto received = testing::ReceiveUntilEnd(records);
   const TrackStereoSummary summary = run.get();
-  ASSERT_TRUE(end.has_value()) << "no end record";
-  ASSERT_TRUE(hello.has_value());
-  EXPECT_EQ((*end)["frames"], kFrames);
-  EXPECT_EQ((*end)["stop_reason"], "end of input");
+  ASSERT_EQ(received["end"].size(), 1u) << "no end record";
+  ASSERT_EQ(received["hello"].size(), 1u);
+  const nlohmann::ordered_json& hello = received["hello"][0];
+  const nlohmann::ordered_json& end = received["end"][0];
+  const std::vector<nlohmann::ordered_json>& frames = received["frame"];
+  const std::vector<nlohmann::ordered_json>& green = received["marker/green"];
+  EXPECT_EQ(end["frames"], kFrames);
+  EXPECT_EQ(end["stop_reason"], "end of input");
   EXPECT_THAT(report.str(), HasSubstr("note: --publish " + publish.endpoint));
   EXPECT_THAT(report.str(), HasSubstr("none dropped"));
 
@@ -420,27 +411,15 @@ TEST_F(TrackStereoCommandTest, PublishSendsEveryRowWithTheCsvsColumnsAsItHappens
   std::string line;
   std::getline(csv, line);
   const std::vector<std::string> header = testing::SplitCsv(line);
-  EXPECT_EQ((*hello)["columns"].get<std::vector<std::string>>(), header);
-  EXPECT_EQ((*hello)["markers"].get<std::vector<std::string>>(),
+  EXPECT_EQ(hello["columns"].get<std::vector<std::string>>(), header);
+  EXPECT_EQ(hello["markers"].get<std::vector<std::string>>(),
             (std::vector<std::string>{"red", "blue", "green"}));
   ASSERT_EQ(frames.size(), static_cast<size_t>(summary.pairs));
   ASSERT_EQ(frames.size(), static_cast<size_t>(kFrames));
   for (size_t r = 0; r < frames.size(); ++r) {
     ASSERT_TRUE(static_cast<bool>(std::getline(csv, line)));
-    const std::vector<std::string> fields = testing::SplitCsv(line);
-    std::vector<std::string> keys;
-    for (const auto& item : frames[r].items()) keys.push_back(item.key());
-    ASSERT_EQ(keys, header) << "record " << r;
-    for (size_t c = 0; c < header.size(); ++c) {
-      const nlohmann::ordered_json& value = frames[r][header[c]];
-      if (fields[c].empty()) {
-        EXPECT_TRUE(value.is_null()) << header[c] << ", record " << r;
-      } else if (value.is_string()) {
-        EXPECT_EQ(value.get<std::string>(), fields[c]) << header[c] << ", record " << r;
-      } else {
-        EXPECT_EQ(value.get<double>(), std::stod(fields[c])) << header[c] << ", record " << r;
-      }
-    }
+    testing::ExpectRecordIsRow(frames[r], header, testing::SplitCsv(line),
+                               "record " + std::to_string(r));
   }
   ASSERT_EQ(green.size(), frames.size());
   std::vector<std::string> green_keys;

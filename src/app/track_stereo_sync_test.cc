@@ -388,20 +388,21 @@ TEST(TrackStereoSinkTest, EachPairReachesTheSinksAsItsRowAndAStopEndsTheRun) {
       both.write(wide, i);
     }
   }
-  struct Seen : StereoSink {
+  struct Seen : PairSink {
     int begun = 0;
     std::vector<cv::Size> left_sizes, right_sizes;
     std::vector<std::optional<double>> angles, left_angles;
     std::vector<std::vector<std::string>> left_markers;
     std::vector<cv::Point2d> blue_left_px;
-    void begin(const TrackingConfig& left, const TrackingConfig& right) override {
-      begun += left.markers.size() == 3 && right.markers.size() == 3;
+    void begin(const RunInfo& info) override {
+      begun += info.marker_names == std::vector<std::string>{"red", "blue", "green"};
     }
-    void consume(const FramePair& pair, const StereoFrameResult& result, const FrameResult& left,
-                 const FrameResult& right) override {
+    void consume(const FramePair& pair, const StereoFrameResult& result) override {
       left_sizes.push_back(pair.left.image.size());
       right_sizes.push_back(pair.right.image.size());
       angles.push_back(result.shape.angle_deg);
+      const FrameResult& left = *result.left_view;
+      const FrameResult& right = *result.right_view;
       left_angles.push_back(left.measurement.angle_deg);
       std::vector<std::string> names;
       for (const MarkerObservation& m : left.markers) names.push_back(m.name);

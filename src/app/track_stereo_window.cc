@@ -13,7 +13,8 @@
 namespace softsight {
 namespace {
 
-StereoWindowRun OpenStereoWindow(const TrackStereoOptions& options) {
+StereoWindowRun OpenStereoWindow(const TrackStereoOptions& options, const TrackingConfig& left,
+                                 const TrackingConfig& right) {
   std::string why;
   if (!HaveDisplay(&why)) {
     throw InputError(why + ": --window needs a display; without it, drop --window (the CSV is "
@@ -26,7 +27,7 @@ StereoWindowRun OpenStereoWindow(const TrackStereoOptions& options) {
   if (std::string problem; !window.chart.Check(&problem)) {
     throw InputError("--chart-seconds: " + problem);
   }
-  auto sink = std::make_unique<StereoWindow>(window);
+  auto sink = std::make_unique<StereoWindow>(window, left, right);
   const StereoWindow* shown = sink.get();
   return {std::move(sink), [shown] { return shown->quit_requested(); }};
 }

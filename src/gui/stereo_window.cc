@@ -28,24 +28,23 @@ std::string StereoWindowKeys::press(int key) {
   return "";
 }
 
-StereoWindow::StereoWindow(StereoWindowOptions options)
+StereoWindow::StereoWindow(StereoWindowOptions options, const TrackingConfig& left,
+                           const TrackingConfig& right)
     : options_(std::move(options)), view_([&] {
         StereoViewOptions view;
         view.chart = options_.chart;
         const cv::Size screen = options_.screen_px.area() > 0 ? options_.screen_px : ScreenSize();
         if (screen.area() > 0) view.max_canvas = MaxCanvasForScreen(screen);
         return view;
-      }()) {}
+      }()) {
+  view_.set_configs(left, right);
+}
 
 StereoWindow::~StereoWindow() {
   if (open_) {
     cv::destroyWindow(options_.title);
     cv::waitKey(1);
   }
-}
-
-void StereoWindow::begin(const TrackingConfig& left, const TrackingConfig& right) {
-  view_.set_configs(left, right);
 }
 
 void StereoWindow::show_and_poll(int wait_ms) {
@@ -65,8 +64,9 @@ void StereoWindow::show_and_poll(int wait_ms) {
   }
 }
 
-void StereoWindow::consume(const FramePair& pair, const StereoFrameResult& result,
-                           const FrameResult& left, const FrameResult& right) {
+void StereoWindow::consume(const FramePair& pair, const StereoFrameResult& result) {
+  const FrameResult& left = *result.left_view;
+  const FrameResult& right = *result.right_view;
   view_.add(result);
   shown_frame_ = result.frame_index;
   view_.compose(pair, result, left, right, keys_.paused ? "PAUSED (space: play, .: next pair)" : "");

@@ -36,16 +36,17 @@ struct StereoWindowOptions {
   cv::Size screen_px;  // The screen the window must fit; empty: the X screen's.
 };
 
-class StereoWindow : public StereoSink {
+class StereoWindow : public PairSink {
  public:
-  explicit StereoWindow(StereoWindowOptions options);
+  // `left`, `right`: each view's config (the markers each view's triangle joins).
+  StereoWindow(StereoWindowOptions options, const TrackingConfig& left,
+               const TrackingConfig& right);
   ~StereoWindow() override;  // Closes the window.
   StereoWindow(const StereoWindow&) = delete;
   StereoWindow& operator=(const StereoWindow&) = delete;
 
-  void begin(const TrackingConfig& left, const TrackingConfig& right) override;
-  void consume(const FramePair& pair, const StereoFrameResult& result, const FrameResult& left,
-               const FrameResult& right) override;
+  // Draws the pair with each view's own tracking (StereoFrameResult::left_view / right_view).
+  void consume(const FramePair& pair, const StereoFrameResult& result) override;
   // q, Escape or the window closed: the run should stop before the next pair.
   bool quit_requested() const { return keys_.quit; }
 

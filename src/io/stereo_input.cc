@@ -45,6 +45,8 @@ class IndexPairs : public StereoInput {
   std::string description() const override {
     return left_->description() + " + " + right_->description();
   }
+  std::optional<double> fps() const override { return left_->fps(); }
+  bool is_live() const override { return left_->is_live(); }
   int64_t left_unpaired() const override { return left_unpaired_; }
   int64_t right_unpaired() const override { return right_unpaired_; }
   std::optional<std::string> ended_first() const override { return ended_; }
@@ -161,6 +163,8 @@ class TimePairs : public StereoInput {
   std::string description() const override {
     return left_.source->description() + " + " + right_.source->description();
   }
+  std::optional<double> fps() const override { return left_.source->fps(); }
+  bool is_live() const override { return left_.source->is_live(); }
   int64_t left_unpaired() const override { return left_.unpaired; }
   int64_t right_unpaired() const override { return right_.unpaired; }
   std::optional<std::string> ended_first() const override { return ended_; }
@@ -212,6 +216,8 @@ class SideBySide : public StereoInput {
     return true;
   }
   std::string description() const override { return source_->description() + " (side by side)"; }
+  std::optional<double> fps() const override { return source_->fps(); }
+  bool is_live() const override { return source_->is_live(); }
   std::vector<std::string> files() const override { return FilesOf(*source_, nullptr); }
 
  private:

@@ -4,11 +4,13 @@
 #include <chrono>
 #include <deque>
 #include <string>
+#include <type_traits>
 
 #include <opencv2/core.hpp>
 
 #include "pipeline/key_frame_groups.h"
 #include "softsight/core/error.h"
+#include "softsight/pipeline/stereo_session.h"
 #include "track/tracker_kind.h"
 
 namespace softsight {
@@ -50,13 +52,65 @@ RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
   return info;
 }
 
-PipelineRun::PipelineRun(TrackingSession& session, RunInfo info, std::vector<FrameSink*> sinks)
+RunInfo DescribeRun(const StereoInput& input, const StereoSession& session,
+                    const RunOptions& options) {
+  RunInfo info;
+  info.marker_names = session.marker_names();
+  info.source = input.description();
+  info.fps = input.fps();
+  info.live = input.is_live();
+  info.frame_count = options.max_frames;
+  return info;
+}
+
+namespace {
+
+// What differs between one view's step and a pair's, for the one run below: the frame whose
+// index, capture time and size stand for the input (a pair's left one), whether the session
+// refuses gray frames, and what a result counts in the summary.
+Frame& FirstView(Frame& frame) { return frame; }
+Frame& FirstView(FramePair& pair) { return pair.left; }
+const Frame& FirstView(const Frame& frame) { return frame; }
+const Frame& FirstView(const FramePair& pair) { return pair.left; }
+
+bool IsGrayInput(const Frame& frame) { return IsGrayscale(frame.image); }
+bool IsGrayInput(const FramePair& pair) {
+  return IsGrayscale(pair.left.image) || IsGrayscale(pair.right.image);
+}
+
+bool SessionNeedsColour(const TrackingSession& session) { return NeedsColour(session.config()); }
+bool SessionNeedsColour(const StereoSession& session) {
+  return NeedsColour(session.left_config()) || NeedsColour(session.right_config());
+}
+
+// A marker counts as found where its tracker found it; a frame as measured where it has an
+// angle; why markers were not found is summarised per marker.
+void CountResult(const FrameResult& result, RunSummary& summary) {
+  for (size_t i = 0; i < result.markers.size(); ++i) {
+    summary.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
+  }
+  summary.statuses.add(result);
+  summary.measured += result.measurement.angle_deg ? 1 : 0;
+}
+// A pair: found in 3D (both views and the checks), measured where the 3D angle is.
+void CountResult(const StereoFrameResult& result, RunSummary& summary) {
+  for (size_t i = 0; i < result.markers.size() && i < summary.markers.size(); ++i) {
+    summary.markers[i].found += result.markers[i].point.found() ? 1 : 0;
+  }
+  summary.measured += result.shape.angle_deg ? 1 : 0;
+}
+
+}  // namespace
+
+template <typename Session>
+BasicPipelineRun<Session>::BasicPipelineRun(Session& session, RunInfo info,
+                                            std::vector<Sink*> sinks)
     : session_(session),
       info_(std::move(info)),
       sinks_(std::move(sinks)),
-      needs_colour_(NeedsColour(session.config())),
+      needs_colour_(SessionNeedsColour(session)),
       start_(std::chrono::steady_clock::now()),
-      deliver_([this](const Frame& frame, const FrameResult& result) { deliver(frame, result); }) {
+      deliver_([this](const Input& input, const Result& result) { deliver(input, result); }) {
   summary_.source = info_.source;
   for (const std::string& name : info_.marker_names) summary_.markers.push_back({name, 0});
   if (info_.frame_count) {
@@ -68,9 +122,9 @@ PipelineRun::PipelineRun(TrackingSession& session, RunInfo info, std::vector<Fra
   }
 }
 
-void PipelineRun::describe_source(const FrameSource& source) {
+template <typename Session>
+void BasicPipelineRun<Session>::describe(const RunInfo& described) {
   CV_Assert(summary_.frames == 0);
-  RunInfo described = DescribeRun(source, session_);
   info_.source = described.source;
   info_.fps = described.fps;
   info_.live = described.live;
@@ -78,62 +132,74 @@ void PipelineRun::describe_source(const FrameSource& source) {
   summary_.source = info_.source;
 }
 
-void PipelineRun::begin_sinks() {
+template <typename Session>
+void BasicPipelineRun<Session>::begin_sinks() {
   for (; begun_ < sinks_.size(); ++begun_) sinks_[begun_]->begin(info_);
 }
 
-void PipelineRun::join(FrameSink& sink) { joined_.push_back(&sink); }
+template <typename Session>
+void BasicPipelineRun<Session>::join(Sink& sink) {
+  joined_.push_back(&sink);
+}
 
-void PipelineRun::leave(FrameSink& sink) {
+template <typename Session>
+void BasicPipelineRun<Session>::leave(Sink& sink) {
   joined_.erase(std::remove(joined_.begin(), joined_.end(), &sink), joined_.end());
 }
 
-PipelineRun::~PipelineRun() = default;
+template <typename Session>
+BasicPipelineRun<Session>::~BasicPipelineRun() = default;
 
-const FrameResult& PipelineRun::process(Frame& frame) {
-  if (frame.captured == std::chrono::steady_clock::time_point{}) {
-    frame.captured = std::chrono::steady_clock::now();
+template <typename Session>
+auto BasicPipelineRun<Session>::process(Input& input) -> const Result& {
+  Frame& first = FirstView(input);
+  if (first.captured == std::chrono::steady_clock::time_point{}) {
+    first.captured = std::chrono::steady_clock::now();
   }
   if (processed_ == 0) {
-    if (needs_colour_ && IsGrayscale(frame.image)) {
+    if (needs_colour_ && IsGrayInput(input)) {
       throw InputError(summary_.source + ": the video is grayscale, but " + GrayFrameProblem());
     }
-    info_.frame_size = frame.image.size();
+    info_.frame_size = first.image.size();
     begin_sinks();
-    summary_.first_index = frame.index;
+    summary_.first_index = first.index;
   }
-  const FrameResult& result = session_.process(frame);
+  const Result& result = session_.process(input);
   ++processed_;
-  if (key_frame_groups_) {
-    key_frame_groups_->add(frame, result, deliver_);
-  } else {
-    deliver(frame, result);
+  if constexpr (std::is_same_v<Session, TrackingSession>) {
+    if (key_frame_groups_) {
+      key_frame_groups_->add(input, result, deliver_);
+      return result;
+    }
   }
+  deliver(input, result);
   return result;
 }
 
-void PipelineRun::deliver(const Frame& frame, const FrameResult& result) {
-  for (size_t i = 0; i < result.markers.size(); ++i) {
-    summary_.markers[i].found += result.markers[i].observation.found() ? 1 : 0;
-  }
-  summary_.statuses.add(result);
-  summary_.measured += result.measurement.angle_deg ? 1 : 0;
+template <typename Session>
+void BasicPipelineRun<Session>::deliver(const Input& input, const Result& result) {
+  CountResult(result, summary_);
   proc_ms_.push_back(result.proc_ms);
   latency_result_ms_.push_back(result.latency_result_ms);
-  for (FrameSink* sink : sinks_) sink->consume(frame, result);
-  for (FrameSink* sink : joined_) sink->consume(frame, result);
+  for (Sink* sink : sinks_) sink->consume(input, result);
+  for (Sink* sink : joined_) sink->consume(input, result);
+  const Frame& first = FirstView(input);
   latency_done_ms_.push_back(
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frame.captured)
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - first.captured)
           .count());
   ++summary_.frames;
-  summary_.last_index = frame.index;
+  summary_.last_index = first.index;
 }
 
-void PipelineRun::check_key_frame_groups() {
-  if (!key_frame_groups_) key_frame_groups_ = std::make_unique<KeyFrameGroups>();
+template <typename Session>
+void BasicPipelineRun<Session>::check_key_frame_groups() {
+  if constexpr (std::is_same_v<Session, TrackingSession>) {
+    if (!key_frame_groups_) key_frame_groups_ = std::make_unique<KeyFrameGroups>();
+  }
 }
 
-RunSummary PipelineRun::summary() const {
+template <typename Session>
+RunSummary BasicPipelineRun<Session>::summary() const {
   RunSummary summary = summary_;
   std::vector<double> proc = proc_ms_, result = latency_result_ms_, done = latency_done_ms_;
   SummariseTimes(proc, &summary.proc_ms_median, &summary.proc_ms_p99);
@@ -144,22 +210,25 @@ RunSummary PipelineRun::summary() const {
   return summary;
 }
 
-RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<std::string> notes,
-                               std::string error) {
+template <typename Session>
+RunSummary BasicPipelineRun<Session>::finish(StopReason reason, int64_t dropped,
+                                             std::vector<std::string> notes, std::string error) {
   CV_Assert(!finished_);
   finished_ = true;
-  if (key_frame_groups_) {
-    // The last group has no key frame after it: it goes on unchecked.
-    try {
-      key_frame_groups_->flush(deliver_, reason == StopReason::kError);
-    } catch (const InputError& e) {
-      if (error.empty()) error = e.what();
-      reason = StopReason::kError;
-    }
-    if (key_frame_groups_->demoted() > 0) {
-      notes.push_back(std::to_string(key_frame_groups_->demoted()) +
-                      " marker-frames not believed: moved by damage the decoder did not report, "
-                      "undone at the next key frame");
+  if constexpr (std::is_same_v<Session, TrackingSession>) {
+    if (key_frame_groups_) {
+      // The last group has no key frame after it: it goes on unchecked.
+      try {
+        key_frame_groups_->flush(deliver_, reason == StopReason::kError);
+      } catch (const InputError& e) {
+        if (error.empty()) error = e.what();
+        reason = StopReason::kError;
+      }
+      if (key_frame_groups_->demoted() > 0) {
+        notes.push_back(std::to_string(key_frame_groups_->demoted()) +
+                        " marker-frames not believed: moved by damage the decoder did not report, "
+                        "undone at the next key frame");
+      }
     }
   }
   // An empty source, or a stop before the first frame: the sinks still see begin() and end().
@@ -175,19 +244,36 @@ RunSummary PipelineRun::finish(StopReason reason, int64_t dropped, std::vector<s
   return summary;
 }
 
-RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
-                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
-  PipelineRun run(session, DescribeRun(source, session, options), sinks);
+template class BasicPipelineRun<TrackingSession>;
+template class BasicPipelineRun<StereoSession>;
+
+namespace {
+
+// What a source says beyond its frames: the frames it dropped (a camera's newest-frame reader),
+// and its note (gaps in an image sequence). A pair input drops none and says how it ended in
+// its own words (StereoInput::ended_first, for the command's report).
+int64_t DroppedFrames(const FrameSource& source) { return source.dropped_frames(); }
+int64_t DroppedFrames(const StereoInput&) { return 0; }
+std::vector<std::string> SourceNotes(const FrameSource& source) {
+  std::vector<std::string> notes;
+  if (const std::optional<std::string> note = source.note()) notes.push_back(*note);
+  return notes;
+}
+std::vector<std::string> SourceNotes(const StereoInput&) { return {}; }
+
+// The one loop: read, process, hand on, until the input ends, max_frames are done, a stop is
+// asked for or an InputError ends it.
+template <typename Source, typename Session>
+RunSummary RunLoop(Source& source, Session& session,
+                   const std::vector<BasicFrameSink<typename Session::Input,
+                                                    typename Session::Result>*>& sinks,
+                   const RunOptions& options) {
+  BasicPipelineRun<Session> run(session, DescribeRun(source, session, options), sinks);
   if (options.check_key_frame_groups) run.check_key_frame_groups();
   run.describe_stop_with(options.describe_stop);
-  const auto notes = [&source] {
-    std::vector<std::string> notes;
-    if (const std::optional<std::string> note = source.note()) notes.push_back(*note);
-    return notes;
-  };
   StopReason reason = StopReason::kEndOfInput;
   std::string error;
-  Frame frame;
+  typename Session::Input input;
   try {
     for (;;) {
       if (options.max_frames && run.frames() >= *options.max_frames) {
@@ -198,8 +284,8 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
         reason = StopReason::kStopRequested;
         break;
       }
-      frame.captured = {};
-      if (!source.read(frame)) {
+      FirstView(input).captured = {};
+      if (!source.read(input)) {
         reason = StopReason::kEndOfInput;
         if (run.frames() == 0) {
           // A file that ends before its first frame is a wrong input, not a run.
@@ -208,7 +294,7 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
         }
         break;
       }
-      run.process(frame);
+      run.process(input);
     }
   } catch (const InputError& e) {
     reason = StopReason::kError;
@@ -216,10 +302,22 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
   } catch (const std::exception& e) {
     // Not a user error (a bug, or a caller's own exception such as a stop raised mid-wait):
     // the sinks still close their files, then it goes on to the caller.
-    run.finish(StopReason::kError, source.dropped_frames(), notes(), e.what());
+    run.finish(StopReason::kError, DroppedFrames(source), SourceNotes(source), e.what());
     throw;
   }
-  return run.finish(reason, source.dropped_frames(), notes(), std::move(error));
+  return run.finish(reason, DroppedFrames(source), SourceNotes(source), std::move(error));
+}
+
+}  // namespace
+
+RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
+                       const std::vector<FrameSink*>& sinks, const RunOptions& options) {
+  return RunLoop(source, session, sinks, options);
+}
+
+RunSummary RunPipeline(StereoInput& input, StereoSession& session,
+                       const std::vector<PairSink*>& sinks, const RunOptions& options) {
+  return RunLoop(input, session, sinks, options);
 }
 
 // Collects the results the run delivers (after their key-frame group was checked) for next().

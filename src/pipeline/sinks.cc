@@ -9,6 +9,7 @@
 #include "softsight/core/error.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/pipeline/run.h"
+#include "softsight/pipeline/stereo_session.h"
 
 namespace softsight {
 namespace {
@@ -36,17 +37,20 @@ CsvColumnTable TrackingColumns(const TrackingConfig& config, const std::vector<C
                          config.measure.inner_markers());
 }
 
-CsvSink::CsvSink(const std::string& path, CsvColumnTable columns)
+template <typename Input, typename Row>
+BasicCsvSink<Input, Row>::BasicCsvSink(const std::string& path, BasicCsvColumnTable<Row> columns)
     : writer_(path, std::move(columns)) {}
 
-void CsvSink::begin(const RunInfo& info) {
+template <typename Input, typename Row>
+void BasicCsvSink<Input, Row>::begin(const RunInfo& info) {
   // Reserved once: no reallocation per row for a file (a camera's run grows it geometrically).
   if (info.frame_count) {
     row_latency_ms_.reserve(static_cast<size_t>(std::clamp<int64_t>(*info.frame_count, 0, int64_t{1} << 22)));
   }
 }
 
-void CsvSink::report(RunSummary& summary) const {
+template <typename Input, typename Row>
+void BasicCsvSink<Input, Row>::report(RunSummary& summary) const {
   if (row_latency_ms_.empty()) return;
   std::vector<double> sorted = row_latency_ms_;  // SummariseTimes sorts; once per run.
   double median = 0.0, p99 = 0.0;
@@ -55,16 +59,19 @@ void CsvSink::report(RunSummary& summary) const {
   summary.latency_row_ms_p99 = p99;
 }
 
-void CsvSink::consume(const Frame& frame, const FrameResult& result) {
-  (void)frame;
-  writer_.write(result);
-  if (result.captured != std::chrono::steady_clock::time_point{}) {
+template <typename Input, typename Row>
+void BasicCsvSink<Input, Row>::consume(const Input& input, const Row& row) {
+  (void)input;
+  writer_.write(row);
+  if (row.captured != std::chrono::steady_clock::time_point{}) {
     row_latency_ms_.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - result.captured)
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - row.captured)
             .count());
   }
 }
 
+template class BasicCsvSink<Frame, FrameResult>;
+template class BasicCsvSink<FramePair, StereoFrameResult>;
 
 VideoSink::VideoSink(std::string path, std::string codec, std::optional<double> fps,
                      FrameDrawer draw, std::function<void(int64_t index)> before_encode)

@@ -247,6 +247,8 @@ const StereoFrameResult& StereoSession::process(const FramePair& pair) {
   return impl_->result;
 }
 const Triangulator& StereoSession::triangulator() const { return impl_->triangulator; }
+const TrackingConfig& StereoSession::left_config() const { return impl_->left.config(); }
+const TrackingConfig& StereoSession::right_config() const { return impl_->right.config(); }
 const FrameResult& StereoSession::left_result() const { return *impl_->left_result; }
 const FrameResult& StereoSession::right_result() const { return *impl_->right_result; }
 
@@ -320,9 +322,44 @@ const StereoFrameResult& StereoSession::process(const Frame& left_frame, const F
     s.reference_normal = out.shape.plane_normal;
     out.shape.out_of_plane_deg = 0.0;
   }
-  out.proc_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto now = std::chrono::steady_clock::now();
+  out.proc_ms = std::chrono::duration<double, std::milli>(now - start).count();
+  out.left_view = &left;
+  out.right_view = &right;
+  if (s.options.results_in_board) ExpressInBoardFrame(*s.options.results_in_board, out);
+  out.captured = left_frame.captured;
+  out.latency_result_ms =
+      out.captured == std::chrono::steady_clock::time_point{}
+          ? 0.0
+          : std::chrono::duration<double, std::milli>(now - out.captured).count();
   return out;
+}
+
+std::vector<std::string> StereoMarkerSuffixes() {
+  return {"_X", "_Y", "_Z", "_sigma_mm", "_epipolar_px", "_status"};
+}
+
+void StereoFiguresSink::begin(const RunInfo& info) {
+  figures_ = StereoRunFigures{};
+  figures_.epipolar.assign(info.marker_names.size(), 0);
+  figures_.timing.assign(info.marker_names.size(), 0);
+}
+
+void StereoFiguresSink::consume(const FramePair& pair, const StereoFrameResult& result) {
+  (void)pair;
+  if (result.pair_dt_ms) {
+    figures_.paired_by_time = true;
+    figures_.max_abs_pair_dt_ms =
+        std::max(figures_.max_abs_pair_dt_ms.value_or(0.0), std::abs(*result.pair_dt_ms));
+  }
+  if (result.lag_frames) figures_.lag_frames.push_back(*result.lag_frames);
+  for (size_t i = 0; i < result.markers.size() && i < figures_.epipolar.size(); ++i) {
+    const StereoPoint& p = result.markers[i].point;
+    if (p.status == StereoStatus::kTiming) ++figures_.timing[i];
+    if (p.status == StereoStatus::kEpipolar) ++figures_.epipolar[i];
+    if (p.found()) figures_.sigma_mm.push_back(*p.sigma_mm);
+    if (p.epipolar_px) figures_.epipolar_px.push_back(*p.epipolar_px);
+  }
 }
 
 void ExpressInBoardFrame(const BoardFrame& frame, StereoFrameResult& result) {

@@ -128,4 +128,32 @@ class PublishSink : public FrameSink {
   std::vector<double> send_latency_ms_;
 };
 
+// The stream of a step whose rows are not one view's FrameResult (a pair's StereoFrameResult):
+// each row as its CSV table writes it, published through `publish` (set_row_columns /
+// publish_row), which this sink begins, ends and reports as the run does. So the stream of any
+// run is the CSV's columns, whatever its step.
+template <typename Input, typename Row>
+class PublishRowsSink : public BasicFrameSink<Input, Row> {
+ public:
+  // `marker_suffixes`: the suffixes of a marker's columns (its marker/<name> topic).
+  PublishRowsSink(PublishSink& publish, BasicCsvColumnTable<Row> columns,
+                  std::vector<std::string> marker_suffixes)
+      : publish_(publish), columns_(std::move(columns)) {
+    publish_.set_row_columns(columns_.names(), std::move(marker_suffixes));
+  }
+  void begin(const RunInfo& info) override { publish_.begin(info); }
+  void consume(const Input& input, const Row& row) override {
+    (void)input;
+    columns_.append_row(row, text_);
+    publish_.publish_row(text_);
+  }
+  void end(const RunSummary& summary) override { publish_.end(summary); }
+  void report(RunSummary& summary) const override { publish_.report(summary); }
+
+ private:
+  PublishSink& publish_;
+  BasicCsvColumnTable<Row> columns_;
+  std::string text_;  // Reused: no allocation per row once grown.
+};
+
 }  // namespace softsight

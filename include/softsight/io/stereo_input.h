@@ -32,6 +32,10 @@ class StereoInput {
   virtual bool read(FramePair& pair) = 0;
   // "video left.avi + video right.avi", for messages.
   virtual std::string description() const = 0;
+  // The first (left) view's nominal rate, when known; whether it is a live camera (pairs may be
+  // missed, no known end). What a run tells its sinks (RunInfo), as of a FrameSource.
+  virtual std::optional<double> fps() const { return std::nullopt; }
+  virtual bool is_live() const { return false; }
   // Frames read but left without a partner (pairing by time: none of the other view's frames
   // within the tolerance; pairing by index: the first |frame_offset| frames of the view that
   // started earlier).

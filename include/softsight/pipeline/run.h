@@ -40,33 +40,52 @@ struct RunOptions {
   std::function<std::string(StopReason)> describe_stop{};
 };
 
-// One run, frame by frame: RunPipeline's work per frame and its summary, for a caller whose own
+// What RunPipeline tells its sinks in begin() (frame_size left empty: the first frame's). For a
+// sink that joins a run late (a recording started in the live window), so it is told the same.
+// Two views: pipeline/stereo_session.h.
+RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
+                    const RunOptions& options = {});
+
+// One run, step by step: RunPipeline's work per step and its summary, for a caller whose own
 // loop decides when a frame comes (the live window plays, pauses, steps and seeks as the user
 // says, and a recording joins and leaves the run). RunPipeline is this class driven by a source.
-class PipelineRun {
+// `Session` is the step: a TrackingSession (one view: a Frame in, a FrameResult out) or a
+// StereoSession (two views: a FramePair in, a StereoFrameResult out; pipeline/stereo_session.h).
+// The run, its sinks and its summary are the same for both; only what a result counts in the
+// summary and the key-frame check (one view only, so far) depend on the step.
+template <typename Session>
+class BasicPipelineRun {
  public:
+  using Input = typename Session::Input;
+  using Result = typename Session::Result;
+  using Sink = BasicFrameSink<Input, Result>;
+
   // `info` as DescribeRun gives it (frame_size is set from the first frame). `sinks` begin at
   // the first frame and end in finish(). The session must outlive the run.
-  PipelineRun(TrackingSession& session, RunInfo info, std::vector<FrameSink*> sinks = {});
-  ~PipelineRun();
-  PipelineRun(const PipelineRun&) = delete;
-  PipelineRun& operator=(const PipelineRun&) = delete;
+  BasicPipelineRun(Session& session, RunInfo info, std::vector<Sink*> sinks = {});
+  ~BasicPipelineRun();
+  BasicPipelineRun(const BasicPipelineRun&) = delete;
+  BasicPipelineRun& operator=(const BasicPipelineRun&) = delete;
   // Before the first frame: the source the frames come from (its description, rate, whether it
   // is live, its frame count), for the sinks' begin() and the summary.
-  void describe_source(const FrameSource& source);
+  template <typename Source>
+  void describe_source(const Source& source) {
+    describe(DescribeRun(source, session_, RunOptions{}));
+  }
 
-  // The frame through the session and to every sink, counted in the summary. `frame.captured`
-  // unset: stamped now. At the first frame a session that needs colour refuses a grayscale frame
-  // and the sinks begin. Throws InputError (from the session or a sink; RunPipeline ends the run
-  // with it).
-  const FrameResult& process(Frame& frame);
+  // The input through the session and to every sink, counted in the summary. Its (first view's)
+  // `captured` unset: stamped now. At the first input a session that needs colour refuses a
+  // grayscale frame and the sinks begin. Throws InputError (from the session or a sink;
+  // RunPipeline ends the run with it).
+  const Result& process(Input& input);
   // A sink joining the run after it began (its owner has begun it: a live recording), and
   // leaving it (its owner ends it); leave() of a sink not in the run does nothing.
-  void join(FrameSink& sink);
-  void leave(FrameSink& sink);
+  void join(Sink& sink);
+  void leave(Sink& sink);
   // From now on, hold a predicted video's frames until the next key frame shows whether the
   // decoder damaged them (RunOptions::check_key_frame_groups); process() still returns each
-  // frame's result at once, the sinks get it when its group is checked.
+  // frame's result at once, the sinks get it when its group is checked. One view only: a pair
+  // run's results go on at once (its views' groups need not end together).
   void check_key_frame_groups();
   const RunInfo& info() const { return info_; }
   int64_t frames() const { return processed_; }  // Processed so far (the sinks may lag).
@@ -85,15 +104,16 @@ class PipelineRun {
   }
 
  private:
+  void describe(const RunInfo& described);
   void begin_sinks();
   // A result reaches the summary and the sinks.
-  void deliver(const Frame& frame, const FrameResult& result);
+  void deliver(const Input& input, const Result& result);
 
-  TrackingSession& session_;
+  Session& session_;
   RunInfo info_;
-  std::vector<FrameSink*> sinks_;
+  std::vector<Sink*> sinks_;
   size_t begun_ = 0;  // sinks_[0, begun_) have begun.
-  std::vector<FrameSink*> joined_;  // Begun and ended by their owners.
+  std::vector<Sink*> joined_;  // Begun and ended by their owners.
   bool needs_colour_;
   bool finished_ = false;
   std::function<std::string(StopReason)> describe_stop_;
@@ -102,8 +122,11 @@ class PipelineRun {
   int64_t processed_ = 0;
   std::vector<double> proc_ms_, latency_result_ms_, latency_done_ms_;
   std::unique_ptr<KeyFrameGroups> key_frame_groups_;  // Set by check_key_frame_groups().
-  std::function<void(const Frame&, const FrameResult&)> deliver_;
+  std::function<void(const Input&, const Result&)> deliver_;
 };
+
+// One view's run (`track`, `control`, `live`, Python).
+using PipelineRun = BasicPipelineRun<TrackingSession>;
 
 // Runs the pipeline. Pacing is the source's business (a camera decorator drops stale frames, a
 // file never does); every frame read is processed and reaches every sink in order.
@@ -167,10 +190,5 @@ std::string NoFramesProblem(const std::string& source);
 // What a run of `config` tells its sinks of the markers: their names, and whether measurements
 // come in millimetres. DescribeRun adds the source.
 RunInfo DescribeMarkers(const TrackingConfig& config);
-
-// What RunPipeline tells its sinks in begin() (frame_size left empty: the first frame's). For a
-// sink that joins a run late (a recording started in the live window), so it is told the same.
-RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
-                    const RunOptions& options = {});
 
 }  // namespace softsight

@@ -1,7 +1,11 @@
-// Where a FrameResult goes: the CSV table, an annotated or raw video, a progress bar, the
-// controller, the live window. A sink only consumes; the data flows one way:
-//   FrameSource -> TrackingSession -> FrameResult -> every FrameSink, in the order given.
-// Sinks are called from the thread that runs RunPipeline, one frame at a time.
+// Where a step's result goes: the CSV table, an annotated or raw video, a progress bar, the
+// controller, the stream, the live or stereo window. A sink only consumes; the data flows one way:
+//   source -> session (the step) -> result -> every sink, in the order given.
+// One view's run hands each Frame and its FrameResult to FrameSinks; two views' run each
+// FramePair and its StereoFrameResult to PairSinks (pipeline/stereo_session.h). Both are one
+// BasicFrameSink over what the step consumes and produces, so a sink that needs only the row
+// (the CSV, the stream) is written once for both. Sinks are called from the thread that runs
+// RunPipeline, one frame (or pair) at a time.
 #pragma once
 
 #include <cstdint>
@@ -28,9 +32,12 @@ struct RunInfo {
   bool metric = false;                  // The measurement has _mm twins (a metric model is set).
 };
 
-class FrameSink {
+// `Input`: what the step consumed (Frame, FramePair); `Result`: what it produced (FrameResult,
+// StereoFrameResult).
+template <typename Input, typename Result>
+class BasicFrameSink {
  public:
-  virtual ~FrameSink() = default;
+  virtual ~BasicFrameSink() = default;
 
   // Once, after the first frame has been read and before it is consumed (when the source is
   // empty: once, with an empty frame_size, before end()). May throw InputError (a file that
@@ -38,7 +45,7 @@ class FrameSink {
   virtual void begin(const RunInfo& info) { (void)info; }
   // Every processed frame, in source order. `frame` is the image as read (no overlay).
   // May throw InputError (a full disk): the run stops with StopReason::kError.
-  virtual void consume(const Frame& frame, const FrameResult& result) = 0;
+  virtual void consume(const Input& frame, const Result& result) = 0;
   // Once at the end of every run that called begin(), whatever the reason, with the summary.
   // Must not throw.
   virtual void end(const RunSummary& summary) { (void)summary; }
@@ -48,5 +55,8 @@ class FrameSink {
   // Must not throw.
   virtual void report(RunSummary& summary) const { (void)summary; }
 };
+
+// One view's sink: every Frame as read and its FrameResult.
+using FrameSink = BasicFrameSink<Frame, FrameResult>;
 
 }  // namespace softsight

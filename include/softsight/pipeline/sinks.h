@@ -23,28 +23,33 @@ namespace softsight {
 CsvColumnTable TrackingColumns(const TrackingConfig& config,
                                const std::vector<CsvColumn>& extra = {});
 
-// One CSV row per processed frame, with the columns of `columns` (TrackingColumns for the
-// session's markers, plus the caller's extra columns by name). The file and its header are
-// written in the constructor, so an unwritable path fails before the run; rows are flushed whole
-// as they are written.
-class CsvSink : public FrameSink {
+// One CSV row per processed frame (or pair), with the columns of `columns` (one view:
+// TrackingColumns for the session's markers, plus the caller's extra columns by name; a pair:
+// StereoColumns). The file and its header are written in the constructor, so an unwritable path
+// fails before the run; rows are flushed whole as they are written. `Row` is the step's result
+// (FrameResult, StereoFrameResult); it carries its capture time (`captured`).
+template <typename Input, typename Row>
+class BasicCsvSink : public BasicFrameSink<Input, Row> {
  public:
-  CsvSink(const std::string& path, CsvColumnTable columns);
+  BasicCsvSink(const std::string& path, BasicCsvColumnTable<Row> columns);
   void begin(const RunInfo& info) override;
-  void consume(const Frame& frame, const FrameResult& result) override;
+  void consume(const Input& input, const Row& row) override;
 
   const std::string& path() const { return writer_.path(); }
-  // The latency from each frame's capture (Frame::captured) to its row written (the write
-  // returned), ms, in row order: for the summary (SummariseTimes). The CSV's latency_row_ms
-  // column is taken just before the write.
+  // The latency from each frame's capture to its row written (the write returned), ms, in row
+  // order: for the summary (SummariseTimes). The CSV's latency_row_ms column is taken just
+  // before the write.
   const std::vector<double>& row_latencies_ms() const { return row_latency_ms_; }
   // The summary's latency_row_ms_median / _p99 (when any row carried a capture time).
   void report(RunSummary& summary) const override;
 
  private:
-  CsvWriter writer_;
+  BasicCsvWriter<Row> writer_;
   std::vector<double> row_latency_ms_;  // Reserved in begin() for a file's frame count.
 };
+
+// One view's CSV (a pair's: BasicCsvSink<FramePair, StereoFrameResult>).
+using CsvSink = BasicCsvSink<Frame, FrameResult>;
 
 // Draws the result on a copy of the frame (the overlay lives in gui: the caller passes it).
 using FrameDrawer = std::function<void(cv::Mat& canvas, const FrameResult& result)>;

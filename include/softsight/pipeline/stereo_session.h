@@ -5,6 +5,7 @@
 // status says why (never a point from an unverified pair).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -21,6 +22,8 @@
 #include "softsight/geometry/shape3d.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/stereo_input.h"
+#include "softsight/pipeline/run.h"
+#include "softsight/pipeline/sink.h"
 
 namespace softsight {
 
@@ -36,6 +39,11 @@ struct StereoOptions {
   // calib/board_frame.h), any non-zero length; its sign does not matter. Absent by default;
   // required by kBoard, not used otherwise.
   std::optional<cv::Vec3d> board_normal{};
+  // The frame every result is expressed in: absent (default) the first camera's; a bench board's
+  // (calib/board_frame.h, `track-stereo --bench-board`): each result's positions, covariances
+  // and bending-plane normal in the board's frame (ExpressInBoardFrame), after the session has
+  // measured in the camera's.
+  std::optional<BoardFrame> results_in_board{};
 
   bool Check(std::string* error) const;
 };
@@ -71,10 +79,24 @@ struct StereoFrameResult {
   // What each camera alone measures (eq. 7 on its image positions), for comparison.
   std::optional<double> left_angle_deg{}, right_angle_deg{};
   double proc_ms = 0.0;
+  // Each view's own tracking of this pair (StereoSession::left_result / right_result: its
+  // markers in its config's order, raw pixels, and what that camera alone measures), for a sink
+  // that draws the views (the stereo window). Owned by the session: valid while the pair's
+  // sinks run (until its next pair); a copy kept longer must not use them.
+  const FrameResult* left_view = nullptr;
+  const FrameResult* right_view = nullptr;
+  // The left frame's capture time (Frame::captured) and the time from it to this result, as
+  // FrameResult has them.
+  std::chrono::steady_clock::time_point captured{};
+  double latency_result_ms = 0.0;
 };
 
 class StereoSession {
  public:
+  // The step a run drives (pipeline/run.h): a pair of frames in, its 3D result out.
+  using Input = FramePair;
+  using Result = StereoFrameResult;
+
   // `left` and `right` configure each view's markers (colours may look different through two
   // cameras; rois differ); every marker of `left` must be in `right` by name. The chain measured
   // is left.measure's chain, else its triple. Throws InputError naming what is wrong.
@@ -95,6 +117,9 @@ class StereoSession {
   // more than 3 markers; else none).
   std::vector<std::string> segment_names() const;
   const Triangulator& triangulator() const;
+  // Each view's config, as given.
+  const TrackingConfig& left_config() const;
+  const TrackingConfig& right_config() const;
   // Each view's own tracking of the last pair: its markers (in its config's order, raw pixels)
   // and what that camera alone measures; what the stereo window draws on each view. Empty
   // before the first pair; valid until the next process().
@@ -106,22 +131,44 @@ class StereoSession {
   std::unique_ptr<Impl> impl_;
 };
 
-// Where each pair's results go besides the CSV (the stereo window): a sink only consumes; the
-// data flows one way, pairs -> StereoSession -> every sink, in the order given, from the thread
-// that runs the loop, pair by pair.
-class StereoSink {
+// Two views' sink: every pair as read and its 3D result (with each view's own tracking:
+// StereoFrameResult::left_view / right_view, for the stereo window).
+using PairSink = BasicFrameSink<FramePair, StereoFrameResult>;
+// Two views' run: RunPipeline's loop, summary and sinks over pairs (pipeline/run.h). Its summary
+// counts a marker found where it is found in 3D, and a frame measured where the 3D angle is.
+using StereoPipelineRun = BasicPipelineRun<StereoSession>;
+
+// What a pair run tells its sinks in begin(): the input (its description, the left view's rate,
+// live or not; frame_count only from `options.max_frames`) and the markers' names.
+RunInfo DescribeRun(const StereoInput& input, const StereoSession& session,
+                    const RunOptions& options = {});
+// The one run (pipeline/run.h RunPipeline) on pairs: each pair through the session and to every
+// sink, until the input ends, max_frames pairs are done, a stop is requested or an InputError
+// ends it (kError, its message in the summary). A session that needs colour refuses a gray
+// pair. The key-frame check is one view's only (RunOptions::check_key_frame_groups is not used).
+RunSummary RunPipeline(StereoInput& input, StereoSession& session,
+                       const std::vector<PairSink*>& sinks, const RunOptions& options = {});
+
+// What a pair run's report says beyond its RunSummary (whose markers count the pairs each was
+// found in 3D): per marker the pairs refused by the epipolar check and by the pairing check
+// (timing), the 3D uncertainty of each found point and the epipolar distance of each pair both
+// views found, the lag the markers' motion showed, and the pairing error (pairing by time).
+struct StereoRunFigures {
+  std::vector<int64_t> epipolar{}, timing{};  // Per marker, in the session's order.
+  std::vector<double> sigma_mm{}, epipolar_px{}, lag_frames{};
+  bool paired_by_time = false;  // A pair had a pairing error (pair_dt_ms).
+  std::optional<double> max_abs_pair_dt_ms{};
+};
+
+// Collects StereoRunFigures over a pair run (track-stereo's report, Python's summary).
+class StereoFiguresSink : public PairSink {
  public:
-  virtual ~StereoSink() = default;
-  // Once, before the first pair: each view's config (the markers an overlay's triangle joins).
-  virtual void begin(const TrackingConfig& left, const TrackingConfig& right) {
-    (void)left;
-    (void)right;
-  }
-  // Every pair tracked, after its CSV row: the frames as read (no overlay), the row's results,
-  // and each view's own tracking (StereoSession::left_result / right_result). May throw
-  // InputError: the run stops with it.
-  virtual void consume(const FramePair& pair, const StereoFrameResult& result,
-                       const FrameResult& left, const FrameResult& right) = 0;
+  void begin(const RunInfo& info) override;
+  void consume(const FramePair& pair, const StereoFrameResult& result) override;
+  const StereoRunFigures& figures() const { return figures_; }
+
+ private:
+  StereoRunFigures figures_;
 };
 
 // Expresses a frame's 3D results in a board's frame (calib/board_frame.h) instead of the first
@@ -139,5 +186,8 @@ void ExpressInBoardFrame(const BoardFrame& frame, StereoFrameResult& result);
 BasicCsvColumnTable<StereoFrameResult> StereoColumns(
     const std::vector<std::string>& marker_names,
     const std::vector<std::string>& segment_names = {});
+// The suffixes of a marker's columns in StereoColumns (_X ... _status): its marker/<name> topic
+// on the stream.
+std::vector<std::string> StereoMarkerSuffixes();
 
 }  // namespace softsight

@@ -24,6 +24,10 @@ class MarkerTracks;
 
 class TrackingSession {
  public:
+  // The step a run drives (pipeline/run.h): one frame in, its result out.
+  using Input = Frame;
+  using Result = FrameResult;
+
   // Builds one tracker per configured marker. Throws InputError on a bad spec.
   explicit TrackingSession(const TrackingConfig& config);
   ~TrackingSession();
