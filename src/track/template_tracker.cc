@@ -760,6 +760,7 @@ void TemplateTracker::TurnedTo() {
 // merged with its surroundings (it reaches the patch's edge), one whose area is far from the
 // learned blob's at this scale, or one farther than a quarter of the template.
 std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, const Fix& fix) {
+  blob_disagreement_px_ = 0.0;  // This frame's, set below where both centroids are measured.
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   // Measured on the template's place and some of its surroundings, unmasked: a marker seen at a
@@ -784,7 +785,6 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
   cv::Point2d centroid;
   double area = 0;
   const cv::Mat unmasked;
-  blob_disagreement_px_ = 0.0;
   if (!blob_.Locate(blob_gray_, unmasked, expected, &centroid, &area)) {
     return std::nullopt;
   }

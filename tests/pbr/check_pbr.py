@@ -92,6 +92,11 @@ CASES = {
 }
 
 
+def scene_video(folder):
+    """The scene's video file name: video.avi, or video.mp4 (the H.264 scene)."""
+    return 'video.avi' if os.path.exists(os.path.join(folder, 'video.avi')) else 'video.mp4'
+
+
 def config_markers(path):
     """The marker names of a config in their order, and its triple or chain (a small reader for
     the configs written by scripts/pbr/post.py and `softsight pick`, not a YAML parser)."""
@@ -169,7 +174,7 @@ def score(track_csv, truth_csv, name_map, group):
 def run_scene(program, name, case, keep):
     """Tracks and scores every config of one scene; returns (ok, [result per config])."""
     folder = os.path.join(HERE, name)
-    video = 'video.avi' if os.path.exists(os.path.join(folder, 'video.avi')) else 'video.mp4'
+    video = scene_video(folder)
     with open(os.path.join(folder, 'truth.csv'), newline='') as f:
         truth_names = list(dict.fromkeys(r['marker'] for r in csv.DictReader(f)))
     out = os.path.join(keep, name) if keep else tempfile.mkdtemp(prefix=f'softsight_pbr_{name}_')
@@ -225,7 +230,7 @@ def box_margins(program, name, margins):
     margin (0: tight around the marker), in the scene's zncc config. Every box must be accepted and
     track with no report beyond the tolerance and none while covered. Returns (ok, lines)."""
     folder = os.path.join(HERE, name)
-    video = 'video.avi' if os.path.exists(os.path.join(folder, 'video.avi')) else 'video.mp4'
+    video = scene_video(folder)
     with open(os.path.join(folder, 'scene.json')) as f:
         outlines = {m['name']: m['bbox'] for m in json.load(f)['markers']}
     with open(os.path.join(folder, 'truth.csv'), newline='') as f:
@@ -294,7 +299,7 @@ INIT_KNOWN = {
 def init_scene(program, name):
     """Runs init on the scene's frame 0 and tracks with what it wrote; returns (ok, line)."""
     folder = os.path.join(HERE, name)
-    video = 'video.avi' if os.path.exists(os.path.join(folder, 'video.avi')) else 'video.mp4'
+    video = scene_video(folder)
     expected = INIT_EXPECTED[name]
     with tempfile.TemporaryDirectory(prefix=f'softsight_pbr_init_{name}_') as out:
         cfg, csv_path = os.path.join(out, 'init.yaml'), os.path.join(out, 'init.csv')
@@ -306,7 +311,7 @@ def init_scene(program, name):
             return ok, f"{'ok' if ok else 'FAIL'} {name} init: refused ({last[:120]})"
         if done.returncode != 0:
             return False, f'FAIL {name} init: exited {done.returncode}: {done.stderr.strip()[-200:]}'
-        names, group = config_markers(cfg)
+        names, _ = config_markers(cfg)
         if len(names) != expected:
             return False, f'FAIL {name} init: {len(names)} markers written ({names}), expected {expected}'
         done = subprocess.run([program, 'track', '-c', cfg, '-i', video, '--csv', csv_path, '--quiet'],
