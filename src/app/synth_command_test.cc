@@ -1,18 +1,15 @@
 #include "app/synth_command.h"
 #include "app/scene_config.h"
 
-#include <unistd.h>
-
-#include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
-#include <sys/wait.h>
-
 #include <gtest/gtest.h>
 
+#include "app/program_test_util.h"
 #include "core/test_util.h"
 #include "softsight/io/truth_csv.h"
 #include <opencv2/imgcodecs.hpp>
@@ -28,6 +25,13 @@ namespace fs = std::filesystem;
 
 using testing::ReadLines;
 using testing::SplitCsv;
+
+// The program refused: exit code 2 and one line on stderr that says `names`.
+void ExpectOneErrorLine(const testing::ProgramRun& run, const std::string& names) {
+  EXPECT_EQ(run.exit_code, 2) << run.stderr_text;
+  EXPECT_EQ(std::count(run.stderr_text.begin(), run.stderr_text.end(), '\n'), 1) << run.stderr_text;
+  EXPECT_NE(run.stderr_text.find(names), std::string::npos) << run.stderr_text;
+}
 
 SynthOptions SmallRun(const fs::path& out) {
   SynthOptions o;
@@ -187,18 +191,9 @@ TEST(SynthCommandTest, BadInputIsOneLineInputError) {
 
 // Through the real program: an unknown scene is one line on stderr and exit code 2.
 TEST(SynthCommandTest, ProgramReportsBadSceneOnce) {
-  const std::string binary = testing::SoftsightBinary();
-  const testing::TempDir temp;
-  const fs::path& dir = temp.path();
-  const fs::path err = dir / "stderr.txt";
-  const std::string command = binary + " synth --scene spiral --out " +
-                              (dir / "a.avi").string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 2);
-  const std::vector<std::string> lines = ReadLines(err);
-  ASSERT_EQ(lines.size(), 1u);
-  EXPECT_NE(lines[0].find("spiral"), std::string::npos) << lines[0];
+  const testing::TempDir dir;
+  ExpectOneErrorLine(testing::RunProgram("synth --scene spiral --out " + dir.file("a.avi"), dir),
+                     "spiral");
 }
 
 // `serve --input synth:NAME` without --config: the scene brings the config a person would write
@@ -233,20 +228,13 @@ TEST(SynthCommandTest, ASynthSceneBringsItsOwnConfigWrittenOnceAndKept) {
 // frames (or a camera) there is no position to match. One line naming --compare, exit code 2,
 // and nothing written into the folder first (the simulated rig's config is written later).
 TEST(SynthCommandTest, ServeCompareNeedsAFileServedAndWritesNothingFirst) {
-  const testing::TempDir temp;
-  const fs::path& dir = temp.path();
-  const fs::path err = dir / "stderr.txt";
-  const fs::path folder = dir / "folder";
+  const testing::TempDir dir;
+  const fs::path folder = dir.path() / "folder";
   fs::create_directory(folder);
-  const std::string command = testing::SoftsightBinary() + " serve --simulate --compare " +
-                              (dir / "b.avi").string() + " --port 0 --folder " + folder.string() +
-                              " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 2);
-  const std::vector<std::string> lines = ReadLines(err);
-  ASSERT_EQ(lines.size(), 1u);
-  EXPECT_NE(lines[0].find("--compare needs --input"), std::string::npos) << lines[0];
+  ExpectOneErrorLine(testing::RunProgram("serve --simulate --compare " + dir.file("b.avi") +
+                                             " --port 0 --folder " + folder.string(),
+                                         dir),
+                     "--compare needs --input");
   EXPECT_TRUE(fs::is_empty(folder));
 }
 
