@@ -63,6 +63,11 @@ function(softsight_add_library module)
   softsight_use_unity_build(${target})
   target_compile_options(${target} PRIVATE
     $<$<CXX_COMPILER_ID:GNU>:-fno-semantic-interposition>)
+  # SOFTSIGHT_O1_MODULES: these modules at -O1 whatever the tree's level (the instrumented tree is
+  # -O0 but for the modules its tests spend their time in: scripts/sanitizer/configure.sh).
+  if(module IN_LIST SOFTSIGHT_O1_MODULES)
+    target_compile_options(${target} PRIVATE -O1)
+  endif()
 endfunction()
 
 # The tests' precompiled header (SOFTSIGHT_UNITY_BUILD goes with it): GoogleTest, GoogleMock and
@@ -76,7 +81,10 @@ function(softsight_test_definitions target)
   target_compile_definitions(${target} PRIVATE
     SOFTSIGHT_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     SOFTSIGHT_TEST_BINARY="${PROJECT_BINARY_DIR}/src/app/softsight")
-  target_compile_options(${target} PRIVATE $<$<CONFIG:Release,RelWithDebInfo>:-O1>)
+  # (The instrumented tree compiles its tests at its own -O0: scripts/sanitizer/configure.sh.)
+  if(NOT SOFTSIGHT_SANITIZE)
+    target_compile_options(${target} PRIVATE $<$<CONFIG:Release,RelWithDebInfo>:-O1>)
+  endif()
 endfunction()
 # The firmware's test is left out: its sketch's definitions (SOFTSIGHT_HOST_BUILD) differ.
 function(softsight_reuse_test_pch target)

@@ -8,12 +8,20 @@
 #      softsight`, examples/library built with find_package(softsight) and run, and its tracking-only
 #      program built with `pkg-config softsight-track` alone, run, and checked to link neither
 #      yaml-cpp, libserial nor FFmpeg.
-# Needs root (debootstrap, chroot, mounting /proc in the root) and Debian's mirrors. Not in CI: it
-# takes minutes. Measured on a loaded 2-core machine: the package's first build 11 min
-# (scripts/package-deb.sh); then the first check 410 s (debootstrap 136 s, apt-get installing
-# the package and its 391 dependencies 173 s, the demo 12 s, the outside builds 54 s); a later
-# one 85 s, reusing build-deb/, the base root and the downloaded packages (build-deb/check-deb/).
-#   scripts/check-deb.sh              prints each step's time and the total
+# Needs root (debootstrap, chroot, mounting /proc in the root) and Debian's mirrors.
+#   scripts/check-deb.sh              builds build-deb/'s package (scripts/package-deb.sh), checks it
+#   scripts/check-deb.sh DEB          checks the package DEB (CI: the one cpack made from build/)
+#   scripts/check-deb.sh --wait FILE  makes the clean root and fetches the packages it will install
+#                                     now, then waits for FILE to hold the package's path (or
+#                                     "skip") and checks it: CI starts this at its beginning, so the
+#                                     network- and disk-bound part runs beside the compilers
+# Downloads (debootstrap's and apt's .debs) are kept between runs in SOFTSIGHT_DEB_CACHE (default
+# build-deb/check-deb; CI: /var/cache/softsight-ci/check-deb, like a CI's cache of apt downloads):
+# only downloads, so every run still makes its root from Debian's packages and installs into it;
+# an empty or missing cache is filled, the run only slower. Measured on a loaded 2-core machine:
+# the package's first build 11 min (scripts/package-deb.sh); then the first check 410 s
+# (debootstrap 136 s, apt-get installing the package and its 391 dependencies 173 s, the demo
+# 12 s, the outside builds 54 s); docs/measurements.md has CI's numbers.
 #   SOFTSIGHT_DEB_MIRROR=http://...   another Debian mirror (default deb.debian.org)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,17 +31,24 @@ step() { echo "check-deb: [$((SECONDS - start)) s] $*"; }
 fail() { echo "check-deb: FAILED: $*" >&2; exit 1; }
 [ "$(id -u)" -eq 0 ] || fail "needs root (debootstrap, chroot): sudo $0"
 
-scripts/package-deb.sh
 build=${SOFTSIGHT_DEB_BUILD:-build-deb}
-deb=$(ls "$build"/softsight_*.deb)
-step "package built: $deb ($(du -h "$deb" | cut -f1))"
+deb="" wait_file=""
+case ${1:-} in
+  "") scripts/package-deb.sh
+      deb=$(ls "$build"/softsight_*.deb)
+      step "package built: $deb ($(du -h "$deb" | cut -f1))" ;;
+  --wait) wait_file=${2:?"--wait FILE"}; rm -f "$wait_file"
+          scripts/setup.sh deb >/dev/null ;;
+  *) deb=$(realpath "$1"); [ -f "$deb" ] || fail "no package $1" ;;
+esac
 
-work=$PWD/$build/check-deb
+cache=$(realpath -m "${SOFTSIGHT_DEB_CACHE:-build-deb/check-deb}")
+work=$PWD/$build/check-deb-run  # This run's root (removed at the end) and logs (kept).
+rm -rf --one-file-system "$work" && mkdir -p "$work"
 mirror=${SOFTSIGHT_DEB_MIRROR:-http://deb.debian.org/debian}
-base=$work/bookworm-minbase.tar
-archives=$work/apt-archives  # Downloaded packages, kept between runs.
+archives=$cache/apt-archives  # Downloaded packages, kept between runs.
 root=$work/root
-mkdir -p "$work" "$archives/partial"
+mkdir -p "$cache/debootstrap" "$archives/partial"
 
 cleanup() {
   for m in var/cache/apt/archives proc; do
@@ -43,25 +58,22 @@ cleanup() {
   if [ -d "$root" ]; then rm -rf --one-file-system "$root"; fi
 }
 trap cleanup EXIT
-cleanup
+trap 'exit 143' TERM INT  # (stopped by CI when the suite fails first: the EXIT trap still cleans up)
 
-# A minimal Debian 12 (debootstrap's minbase: apt, dpkg, bash, coreutils), made once and kept as a
-# tarball; each run unpacks a fresh copy, so no run sees what an earlier one installed.
-if [ ! -f "$base" ]; then
-  rm -rf --one-file-system "$work/base"
-  debootstrap --variant=minbase bookworm "$work/base" "$mirror" > "$work/debootstrap.log" 2>&1 ||
-    { tail -n 20 "$work/debootstrap.log"; fail "debootstrap (log: $work/debootstrap.log)"; }
-  cat > "$work/base/etc/apt/sources.list" <<SOURCES
+# A minimal Debian 12 (debootstrap's minbase: apt, dpkg, bash, coreutils), made afresh each run
+# from the cached .debs. dpkg's force-unsafe-io, as Debian's own build roots (sbuild, pbuilder)
+# use: no fsync per file in a root that is thrown away (the ~400 packages' unpacking was
+# disk-bound).
+debootstrap --variant=minbase --cache-dir="$cache/debootstrap" bookworm "$root" "$mirror" \
+  > "$work/debootstrap.log" 2>&1 ||
+  { tail -n 20 "$work/debootstrap.log"; fail "debootstrap (log: $work/debootstrap.log)"; }
+cat > "$root/etc/apt/sources.list" <<SOURCES
 deb $mirror bookworm main
 deb $mirror bookworm-updates main
 deb http://deb.debian.org/debian-security bookworm-security main
 SOURCES
-  tar -C "$work/base" -cf "$base" .
-  rm -rf --one-file-system "$work/base"
-  step "clean Debian 12 root made (debootstrap minbase)"
-fi
-mkdir -p "$root"
-tar -C "$root" -xf "$base"
+echo force-unsafe-io > "$root/etc/dpkg/dpkg.cfg.d/softsight-unsafe-io"
+step "clean Debian 12 root made (debootstrap minbase)"
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount -t proc proc "$root/proc"
 mount --bind "$archives" "$root/var/cache/apt/archives"
@@ -70,11 +82,26 @@ printf '#!/bin/sh\nexit 101\n' > "$root/usr/sbin/policy-rc.d" && chmod +x "$root
 in_root() { chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/sbin:/usr/bin:/sbin:/bin LANG=C.UTF-8 \
                    DEBIAN_FRONTEND=noninteractive "$@"; }
 
+in_root apt-get update -qq
+# Fetched now, installed by nothing: the package's Depends as they were last (libopencv-dev and
+# the runtime libraries dpkg-shlibdeps names) and the tools step 3 installs. Only downloads (into
+# the cache): the root stays clean, `apt-get install ./softsight_*.deb` below resolves the real
+# Depends, and a name missing here is downloaded there (slower, not wrong).
+in_root apt-get install --download-only -y -qq --no-install-recommends libopencv-dev python3 \
+  python3-numpy libserial1 libyaml-cpp0.7 libzmq5 libaravis-0.8-0 libx11-6 \
+  g++ cmake make pkg-config > "$work/apt-prefetch.log" 2>&1 ||
+  { tail -n 5 "$work/apt-prefetch.log"; echo "check-deb: (fetching ahead failed: apt-get install fetches)"; }
+step "packages fetched ($(find "$archives" -maxdepth 1 -name '*.deb' | wc -l) .debs in $archives)"
+if [ -n "$wait_file" ]; then
+  until [ -s "$wait_file" ]; do sleep 2; done
+  deb=$(cat "$wait_file")
+  if [ "$deb" = skip ]; then step "no package to check (skip)"; exit 0; fi
+  [ -f "$deb" ] || fail "no package $deb"
+fi
 cp "$deb" "$root/tmp/"
 mkdir -p "$root/tmp/example"
 cp examples/library/CMakeLists.txt examples/library/*.cc "$root/tmp/example/"
 cp examples/markers.yaml "$root/tmp/"
-in_root apt-get update -qq
 step "root ready, installing $(basename "$deb")"
 in_root sh -c 'cd /tmp && apt-get install -y -qq --no-install-recommends ./softsight_*.deb' \
   > "$work/apt-install.log" 2>&1 || { tail -n 30 "$work/apt-install.log"; fail "apt-get install ./softsight_*.deb"; }

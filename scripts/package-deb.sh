@@ -6,7 +6,11 @@
 # Python module (~10 min on 2 cores), later runs only what changed.
 #   scripts/package-deb.sh                 # then: sudo apt-get install ./build-deb/softsight_*.deb
 #   scripts/package-deb.sh -DFOO=BAR       # extra CMake options for the first configure
-# SOFTSIGHT_DEB_BUILD names another tree than build-deb/.
+# SOFTSIGHT_DEB_BUILD names another tree than build-deb/. An existing tree is set to the package's
+# folders (/usr), man pages and Debian's python3 and built again: CI packages its tested build/
+# that way (.ci/run), which recompiles only the launcher (it holds the plugins' folder relative to
+# its own) instead of a third build of everything. Note that a tree set to /usr installs its
+# libraries without an rpath: install it under /usr, or make the package.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh deb
@@ -19,6 +23,9 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr \
         -DBUILD_SHARED_LIBS=ON -DSOFTSIGHT_MAN_PAGES=ON -DSOFTSIGHT_BUILD_TESTS=OFF \
         -DSOFTSIGHT_BUILD_BENCHMARKS=OFF -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
+else
+  cmake -S . -B "$build" -DCMAKE_INSTALL_PREFIX=/usr -DBUILD_SHARED_LIBS=ON -DSOFTSIGHT_MAN_PAGES=ON \
+        -DPython3_EXECUTABLE=/usr/bin/python3 "$@" >/dev/null
 fi
 cmake --build "$build" --parallel "$(nproc)"
 rm -f "$build"/softsight_*.deb

@@ -10,6 +10,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
+  lld                    # the linker (CMakeLists.txt: -fuse-ld=lld, much faster than GNU ld's links)
   libopencv-dev          # image processing, video I/O, calibration, GUI (OpenCV 4.6)
   libavutil-dev          # FFmpeg's log (OpenCV decodes with FFmpeg): which frames a decoder found damaged
   libavcodec-dev libavformat-dev  # FFmpeg's own marks of the frames it concealed damage in

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The suite again with AddressSanitizer + UBSan (clang, -O1; README's second, optional test
-# command; CI runs it after scripts/test.sh). Any memory error, leak (system libraries in
-# scripts/sanitizer/lsan.supp aside) or undefined behaviour fails the test that caused it.
+# The suite again with AddressSanitizer + UBSan (clang, -O0/-O1: scripts/sanitizer/configure.sh;
+# README's second, optional test command; CI runs it after scripts/test.sh). Any memory error,
+# leak (system libraries in scripts/sanitizer/lsan.supp aside) or undefined behaviour fails the
+# test that caused it.
 # One instrumented tree, build-sanitize/, holds the program, the fuzz targets (scripts/fuzz.sh)
 # and the tests of the modules that take outside input (scripts/sanitizer/configure.sh lists
 # them). Two runs:

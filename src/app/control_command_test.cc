@@ -535,7 +535,9 @@ TEST(RigCommand, SigtermEndsItWhileAHostFloodsAndNeverReads) {
     const ssize_t n = write(fd, batch.data(), batch.size());
     if (n > 0) written += static_cast<size_t>(n);
     pollfd p{fd, POLLOUT, 0};
-    if (n <= 0 && poll(&p, 1, 200) == 0) break;  // The rig stopped reading: flooded.
+    // The rig stopped reading: flooded. (1 s, not 200 ms: a rig slowed by the sanitizers on a
+    // loaded machine paused that long before its queue was full: 56 kB written, not 100 kB.)
+    if (n <= 0 && poll(&p, 1, 1000) == 0) break;
   }
   EXPECT_GT(written, 100000u);  // Far more answers than any buffer holds.
   kill(rig, SIGTERM);
