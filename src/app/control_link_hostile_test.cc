@@ -265,14 +265,16 @@ HostileRun RunAgainst(Hostility hostility) {
 }
 
 // The checks every hostile board must pass. The reply deadline is 3 tries of 100 ms; STOP after
-// it is waited for as long again at most; "within 1 s of the deadline" gets 1 s of slack more
-// for a loaded machine here (the exact figures are in simulated time in board_link_test.cc).
+// it is waited for as long again at most. The exact figures are checked in simulated time in
+// board_link_test.cc; here, in real time, the bound only tells an end from a hang (a silent
+// board holding the exit for retries x timeouts, up to 110 s), with room for an instrumented
+// build on a loaded machine (2.34 s was seen against the 2.3 s this allowed before).
 void ExpectCleanEnd(const HostileRun& run, bool port_open, const std::string& why) {
   std::printf("hostile board (%s): the program ended %.2f s after the board turned hostile\n",
               ::testing::UnitTest::GetInstance()->current_test_info()->name(),
               run.end_after_hostile_s);
   EXPECT_EQ(run.exit_code, 2) << run.err;
-  EXPECT_LT(run.end_after_hostile_s, 0.3 + 1.0 + 1.0) << run.err;
+  EXPECT_LT(run.end_after_hostile_s, 0.3 + 1.0 + 5.0) << run.err;
   // One line on stderr, the error, naming the port and saying why.
   const std::vector<std::string> lines = [&] {
     std::vector<std::string> out;

@@ -247,6 +247,35 @@ TEST(MarkerTracks, ARepeatedFrameIsBelievedAndTheStepAfterItIsExpected) {
 }
 
 
+// The checks after association ask the one motion model how well a report continues its track:
+// 0 at the prediction, growing with its distance from it, and no support at all for a marker not
+// believed in the last frame, a first report, or a report outside the gate.
+TEST(MarkerTracks, MotionSupportSaysHowWellAReportContinuesItsTrack) {
+  MarkerTracks tracks({6.0});
+  const std::vector<MarkerCandidate> none;
+  std::vector<MarkerObservation> m = Reports({cv::Point2d(100, 100)});
+  tracks.associate(m, {&none});
+  EXPECT_FALSE(tracks.MotionSupport(0, {100, 100})) << "no track before its first report";
+  tracks.commit(m);
+  for (int f = 1; f < 10; ++f) {
+    m = Reports({cv::Point2d(100 + 5.0 * f, 100)});
+    tracks.associate(m, {&none});
+    tracks.commit(m);
+  }
+  m = Reports({cv::Point2d(150, 100)});
+  tracks.associate(m, {&none});
+  const std::optional<double> on_course = tracks.MotionSupport(0, {150, 100});
+  const std::optional<double> off_course = tracks.MotionSupport(0, {150, 104});
+  ASSERT_TRUE(on_course && off_course);
+  EXPECT_LT(*on_course, 0.1);
+  EXPECT_GT(*off_course, *on_course);
+  EXPECT_FALSE(tracks.MotionSupport(0, {350, 100})) << "200 px off: outside the gate";
+  tracks.commit(Reports({std::nullopt}));
+  m = Reports({cv::Point2d(160, 100)});
+  tracks.associate(m, {&none});
+  EXPECT_FALSE(tracks.MotionSupport(0, {160, 100})) << "not believed in the last frame";
+}
+
 // A soft actuator at rest, then a sudden step of pressure: the tip marker, still for 60 frames
 // (its learned acceleration at the minimum), leaps 40 px in one frame and goes on. Its gate
 // rejects the first reports; three in a row on one smooth motion restart the track, and from

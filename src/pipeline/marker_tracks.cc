@@ -368,6 +368,12 @@ bool MarkerTracks::InGate(size_t i, const cv::Point2d& p) const {
          IsRepeat(t, p);
 }
 
+std::optional<double> MarkerTracks::MotionSupport(size_t i, const cv::Point2d& p) const {
+  const Track& t = tracks_.at(i);
+  if (!t.motion.started() || t.restart || skipped_ || !Continues(i, p)) return std::nullopt;
+  return IsRepeat(t, p) ? 0.0 : std::sqrt(t.motion.distance2(p) / kGate2);
+}
+
 bool MarkerTracks::InReach(size_t i, const cv::Point2d& p) const {
   const Track& t = tracks_[i];
   if (InGate(i, p)) return true;

@@ -100,6 +100,14 @@ class MarkerTracks {
   // reports the gate had rejected): its motion before is no evidence against it.
   bool restarting(size_t i) const { return tracks_.at(i).restart; }
 
+  // How well a report of marker i at `p` continues its track, for the checks after association
+  // (pipeline/arrangement_check.h): its distance from the track's prediction in gate units (0 at
+  // the prediction, 1 at the Mahalanobis gate's edge; 0 for a repeated frame) when the marker was
+  // believed in the last frame and `p` lies in its gate proper. Absent when its motion does not
+  // support the report: no track, coasting, restarting, or outside the gate. Call between
+  // associate() and commit().
+  std::optional<double> MotionSupport(size_t i, const cv::Point2d& p) const;
+
   // For tests: marker i's motion model.
   const MotionModel& motion(size_t i) const { return tracks_.at(i).motion; }
   // For tests: how many other objects are followed, and how many of them marker i may never take.

@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/frame_change.h"
-#include "pipeline/marker_plausibility.h"
+#include "pipeline/arrangement_check.h"
 #include "pipeline/scene_config_test_util.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "sim/corruption.h"
@@ -401,140 +401,104 @@ TEST(Plausibility, AMarkerFoundWhereAMissingMarkerJustWasIsNotBelieved) {
   EXPECT_GE(implausible, 1) << "the blue disc at red's place was seen and refused";
 }
 
-// The rules on their own, with positions given by hand.
+// The arrangement check on its own, with positions and motion support given by hand.
 std::vector<MarkerObservation> Chain3(cv::Point2d a, cv::Point2d b, cv::Point2d c) {
   return {{"a", Observation{a, 1.0}}, {"b", Observation{b, 1.0}}, {"c", Observation{c, 1.0}}};
 }
+// Each report continues its track this well (gate units), or has no support (nullopt).
+using Support = std::vector<std::optional<double>>;
+const Support kAllSupported = {0.1, 0.1, 0.1};
 
-TEST(MarkerPlausibility, LearnsTheArrangementAndRejectsTheMarkerThatBreaksIt) {
-  MarkerPlausibility rules({5, 5, 5}, {0, 1, 2});
+TEST(ArrangementCheck, LearnsTheArrangementAndRejectsTheMarkerThatBreaksIt) {
+  ArrangementCheck rules(3, {0, 1, 2});
   for (int64_t f = 0; f < 4; ++f) {
     auto markers = Chain3({100.0 + f, 100}, {200.0 + f, 100}, {300.0 + f, 100});
-    EXPECT_TRUE(rules.check(f, markers).empty()) << f;
+    EXPECT_TRUE(rules.check(markers, kAllSupported).empty()) << f;
   }
   ASSERT_EQ(rules.segment_px().size(), 2u);
   EXPECT_NEAR(rules.segment_px()[0], 100.0, 1e-6);
-  // b re-acquired (forgotten) at a place that stretches a-b to 2.5x: b is the culprit.
-  rules.forget(1);
+  // b re-acquired (no motion supports it) at a place that stretches a-b to 2.5x: b is the culprit.
   auto markers = Chain3({104, 100}, {354, 100}, {304, 100});
-  const std::vector<size_t> rejected = rules.check(4, markers);
+  const std::vector<size_t> rejected = rules.check(markers, {0.1, std::nullopt, 0.1});
   EXPECT_EQ(rejected, std::vector<size_t>{1});
   EXPECT_EQ(markers[1].observation.status(), MarkerStatus::kImplausible);
   EXPECT_TRUE(markers[0].observation.found() && markers[2].observation.found());
   // Re-acquired where it belongs: believed, though far from its stale position.
   markers = Chain3({105, 100}, {205, 130}, {305, 100});
-  EXPECT_TRUE(rules.check(5, markers).empty());
+  EXPECT_TRUE(rules.check(markers, {0.1, std::nullopt, 0.1}).empty());
 }
 
-// A marker back after frames in which it was not found is not vouched for by its motion, even
-// within the motion's (gap-widened) bound: like a re-acquisition it must fit its segments within
-// 1.25x. A look-alike 1.33x from its neighbour is refused; back at 1.1x it is believed.
-TEST(MarkerPlausibility, AMarkerBackAfterAGapFitsTheArrangementLikeAReacquisition) {
-  MarkerPlausibility rules({19, 19, 19}, {0, 1, 2});
+// Of two supported markers breaking a segment, the one its motion supports less goes.
+TEST(ArrangementCheck, TheCulpritIsTheMarkerItsMotionSupportsLess) {
+  for (const bool a_worse : {true, false}) {
+    ArrangementCheck rules(3, {0, 1, 2});
+    for (int64_t f = 0; f < 4; ++f) {
+      auto markers = Chain3({100.0 + f, 100}, {200.0 + f, 100}, {300.0 + f, 100});
+      ASSERT_TRUE(rules.check(markers, kAllSupported).empty()) << f;
+    }
+    // a-b 3x: without a, b-c fits; without b, a-c does.
+    auto markers = Chain3({104, 100}, {404, 100}, {304, 100});
+    const Support support = a_worse ? Support{0.9, 0.2, 0.2} : Support{0.2, 0.9, 0.2};
+    EXPECT_EQ(rules.check(markers, support), std::vector<size_t>{a_worse ? 0u : 1u});
+  }
+}
+
+// A marker back after frames in which it was not found has no motion support: like a
+// re-acquisition it must fit its segments within 1.25x. A look-alike 1.33x from its neighbour is
+// refused; back at 1.1x it is believed.
+TEST(ArrangementCheck, AMarkerWithoutMotionSupportMustFitItsSegmentsClosely) {
+  ArrangementCheck rules(3, {0, 1, 2});
   for (int64_t f = 0; f < 4; ++f) {
     auto markers = Chain3({100, 100.0 + f}, {100, 200.0 + f}, {100, 300.0 + f});
-    EXPECT_TRUE(rules.check(f, markers).empty()) << f;
+    EXPECT_TRUE(rules.check(markers, kAllSupported).empty()) << f;
   }
   // b not found for two frames.
   for (int64_t f = 4; f < 6; ++f) {
     auto markers = Chain3({100, 100.0 + f}, {100, 0}, {100, 300.0 + f});
     markers[1].observation = Observation::NotFound(MarkerStatus::kCovered);
-    EXPECT_TRUE(rules.check(f, markers).empty()) << f;
+    EXPECT_TRUE(rules.check(markers, {0.1, std::nullopt, 0.1}).empty()) << f;
   }
-  // Then reported 45 px from its prediction (the gap's bound for a 19 px marker is 60 px), 133 px
-  // from a: refused.
+  // Then reported 139 px from a (1.39x): refused; with motion support (up to 1.5x) believed.
+  ArrangementCheck supported = rules;
   auto markers = Chain3({100, 106}, {140, 239}, {100, 306});
-  EXPECT_EQ(rules.check(6, markers), std::vector<size_t>{1});
+  EXPECT_TRUE(supported.check(markers, kAllSupported).empty());
+  markers = Chain3({100, 106}, {140, 239}, {100, 306});
+  EXPECT_EQ(rules.check(markers, {0.1, std::nullopt, 0.1}), std::vector<size_t>{1});
   // Where it belongs (a-b 1.1x): believed.
   markers = Chain3({100, 107}, {100, 217}, {100, 307});
-  EXPECT_TRUE(rules.check(7, markers).empty());
+  EXPECT_TRUE(rules.check(markers, {0.1, std::nullopt, 0.1}).empty());
 }
 
-TEST(MarkerPlausibility, AJumpAgainstTheMotionIsImplausibleWithoutAnyArrangement) {
-  MarkerPlausibility rules({5}, {});
-  std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
-  for (int64_t f = 0; f < 10; ++f) {
-    ball[0].observation = Observation{cv::Point2d(10.0 + 20.0 * f, 10.0), 1.0};  // 20 px/frame.
-    EXPECT_TRUE(rules.check(f, ball).empty()) << "steady fast motion, frame " << f;
-  }
-  // Then 80 px off its course in one frame.
-  ball[0].observation = Observation{cv::Point2d(210.0, 90.0), 1.0};
-  EXPECT_EQ(rules.check(10, ball), std::vector<size_t>{0});
-  // Its next report is a re-acquisition: believed wherever it is.
-  ball[0].observation = Observation{cv::Point2d(400.0, 300.0), 1.0};
-  EXPECT_TRUE(rules.check(11, ball).empty());
-}
-
-// A marker found implausible stays suspect until the arrangement vouches for it: alone (its
-// neighbour not found) it is not believed wherever it is reported; beside its neighbour at the
-// learned spacing it is, and then it is tracked as before. This is what keeps a look-alike of the
-// background from being taken for a marker once the body has been taken away, while markers that
-// all jump together (the camera was bumped) come back at once.
-TEST(MarkerPlausibility, AMarkerFoundImplausibleIsBelievedOnlyWhereItsNeighbourVouchesForIt) {
-  MarkerPlausibility rules({5, 5, 5}, {0, 1, 2});
+// A marker found to break the arrangement stays suspect until the arrangement vouches for it:
+// alone (its neighbour not found) it is not believed wherever it is reported; beside its
+// neighbour at the learned spacing it is, and then it is tracked as before. This is what keeps a
+// look-alike of the background from being taken for a marker once the body has been taken away,
+// while markers that all jump together (the camera was bumped) come back at once.
+TEST(ArrangementCheck, AMarkerFoundImplausibleIsBelievedOnlyWhereItsNeighbourVouchesForIt) {
+  ArrangementCheck rules(3, {0, 1, 2});
   for (int64_t f = 0; f < 4; ++f) {
     auto markers = Chain3({100.0 + f, 100}, {200.0 + f, 100}, {300.0 + f, 100});
-    ASSERT_TRUE(rules.check(f, markers).empty()) << f;
+    ASSERT_TRUE(rules.check(markers, kAllSupported).empty()) << f;
   }
-  // The body is gone; c's tracker reports a look-alike 150 px away: a jump.
-  auto markers = Chain3({0, 0}, {0, 0}, {450, 300});
+  const Support none = {std::nullopt, std::nullopt, std::nullopt};
+  // b re-acquired 2x from c, both without support: neither is believed, both are suspect.
+  auto markers = Chain3({0, 0}, {250, 150}, {450, 150});
   markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
-  markers[1].observation = Observation::NotFound(MarkerStatus::kLost);
-  EXPECT_EQ(rules.check(4, markers), std::vector<size_t>{2});
-  // The look-alike again, for frames on end: with no neighbour to vouch, never believed.
+  EXPECT_EQ(rules.check(markers, none), (std::vector<size_t>{1, 2}));
+  // c's look-alike again, for frames on end: with no neighbour to vouch, never believed.
   for (int64_t f = 5; f < 20; ++f) {
     markers = Chain3({0, 0}, {0, 0}, {450, 300});
     markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
     markers[1].observation = Observation::NotFound(MarkerStatus::kLost);
-    EXPECT_EQ(rules.check(f, markers), std::vector<size_t>{2}) << f;
+    EXPECT_EQ(rules.check(markers, none), std::vector<size_t>{2}) << f;
     EXPECT_EQ(markers[2].observation.status(), MarkerStatus::kImplausible);
   }
-  // Something at b's place, but c's report 200 px from it (2x the segment): neither is believed.
-  markers = Chain3({0, 0}, {250, 150}, {450, 150});
-  markers[0].observation = Observation::NotFound(MarkerStatus::kLost);
-  EXPECT_EQ(rules.check(20, markers), (std::vector<size_t>{1, 2}));
   // The body back, moved 60 px (the camera was bumped): c beside b at the learned spacing.
   markers = Chain3({160, 160}, {260, 160}, {360, 160});
-  EXPECT_TRUE(rules.check(21, markers).empty());
-  // And tracked from there by its motion as before.
+  EXPECT_TRUE(rules.check(markers, none).empty());
+  // And tracked from there as before.
   markers = Chain3({161, 160}, {261, 160}, {361, 160});
-  EXPECT_TRUE(rules.check(22, markers).empty());
-}
-
-// Footage that starts repeating frames to fill its rate (a webcam that falls to a third of its
-// rate in dim light): a marker moving 10 px per frame stands exactly still for two frames, then
-// moves three frames' worth. Its motion history waits out the repeats, so the step after them
-// is believed. Without that, the 30 px step (against a bound of 5 px plus the 2.5 px per frame
-// its speed had decayed to) was refused at every pose.
-TEST(MarkerPlausibility, RepeatedFramesDoNotMakeTheNextStepAJump) {
-  MarkerPlausibility rules({5}, {});
-  std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
-  for (int64_t f = 0; f < 40; ++f) {
-    // 10 px/frame; from frame 10 on each pose three times.
-    const double x = f < 10 ? 10.0 + 10.0 * f : 110.0 + 30.0 * static_cast<double>((f - 10) / 3);
-    ball[0].observation = Observation{cv::Point2d(x, 10.0), 1.0};
-    EXPECT_TRUE(rules.check(f, ball).empty()) << "frame " << f;
-  }
-  // A jump after repeated frames is still one: 100 px off the course it had.
-  ball[0].observation = Observation{cv::Point2d(410.0, 110.0), 1.0};
-  EXPECT_EQ(rules.check(40, ball), std::vector<size_t>{0});
-}
-
-// A marker that stops for good is learned as stopped once it has stood still longer than a
-// repeat lasts: a look-alike 40 px away afterwards is a jump, not a step of its old speed.
-TEST(MarkerPlausibility, AMarkerThatStopsIsLearnedAsStopped) {
-  MarkerPlausibility rules({5}, {});
-  std::vector<MarkerObservation> ball = {{"ball", Observation{cv::Point2d(10, 10), 1.0}}};
-  for (int64_t f = 0; f < 10; ++f) {
-    ball[0].observation = Observation{cv::Point2d(10.0 + 20.0 * f, 10.0), 1.0};  // 20 px/frame.
-    EXPECT_TRUE(rules.check(f, ball).empty()) << f;
-  }
-  for (int64_t f = 10; f < 20; ++f) {  // Stopped where frame 9 left it.
-    ball[0].observation = Observation{cv::Point2d(190.0, 10.0), 1.0};
-    EXPECT_TRUE(rules.check(f, ball).empty()) << f;
-  }
-  ball[0].observation = Observation{cv::Point2d(230.0, 10.0), 1.0};
-  EXPECT_EQ(rules.check(20, ball), std::vector<size_t>{0});
+  EXPECT_TRUE(rules.check(markers, kAllSupported).empty());
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 
 #include "pipeline/coincident_markers.h"
 #include "pipeline/frame_change.h"
-#include "pipeline/marker_plausibility.h"
+#include "pipeline/arrangement_check.h"
 #include "pipeline/marker_tracks.h"
 #include "softsight/core/error.h"
 #include "track/tracker_kind.h"
@@ -63,7 +63,8 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
     sizes.push_back(MarkerSizePx(spec));
   }
   frame_change_ = std::make_unique<FrameChangeDetector>();
-  plausibility_ = std::make_unique<MarkerPlausibility>(sizes, BodyOrder(config_));
+  arrangement_ = std::make_unique<ArrangementCheck>(sizes.size(), BodyOrder(config_));
+  motion_support_.assign(sizes.size(), std::nullopt);
   tracks_ = std::make_unique<MarkerTracks>(sizes);
   candidate_lists_.resize(trackers_.size());
   if (config_.camera) {
@@ -146,12 +147,12 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     for (size_t i = 0; i < trackers_.size(); ++i) {
       // Where the other markers' arrangement puts it: its own motion before (a jump with its
       // body, or a stretch lost) is no evidence against it; the arrangement still judges it.
-      if (decisions[i].vouched_by_body) plausibility_->forget(i);
+      if (decisions[i].vouched_by_body) arrangement_->forget(i);
       switch (decisions[i].action) {
         case MarkerTracks::Decision::Action::kKeep:
-          // A track restarted on its tracker's own run of reports: the motion the plausibility
-          // check remembers is the one that run left behind; the arrangement still judges it.
-          if (tracks_->restarting(i)) plausibility_->forget(i);
+          // A track restarted on its tracker's own run of reports: that run is the evidence,
+          // not a suspicion from before it; the arrangement still judges it.
+          if (tracks_->restarting(i)) arrangement_->forget(i);
           break;
         case MarkerTracks::Decision::Action::kReject:
           trackers_[i]->reset();
@@ -194,7 +195,15 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       }
     }
   }
-  for (size_t i : plausibility_->check(frame.index, result_.markers)) trackers_[i]->reset();
+  // The body's arrangement judges what is left, each report weighed by how well it continues its
+  // own track (the one motion model's verdict).
+  for (size_t i = 0; i < result_.markers.size(); ++i) {
+    const Observation& o = result_.markers[i].observation;
+    motion_support_[i] = o.found() && !frame_change_->whole_frame_changed()
+                             ? tracks_->MotionSupport(i, *o.position_px)
+                             : std::nullopt;
+  }
+  for (size_t i : arrangement_->check(result_.markers, motion_support_)) trackers_[i]->reset();
   if (!frame_change_->whole_frame_changed()) tracks_->commit(result_.markers);
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     previous_px_[i] = result_.markers[i].observation.position_px;
@@ -278,7 +287,7 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     if (config_.markers[i].name != marker) continue;
     trackers_[i]->init(frame.image, rect);
     initialised_[i] = true;
-    plausibility_->forget(i);  // A person said where it is: no history to contradict that.
+    arrangement_->forget(i);  // A person said where it is: nothing to suspect.
     tracks_->forget(i);
     // ... nor another marker's last position there (the person may have swapped two markers).
     std::fill(believed_px_.begin(), believed_px_.end(), std::nullopt);
@@ -315,7 +324,7 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (config_.markers[i].name != marker) continue;
     if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
-    plausibility_->forget(i);
+    arrangement_->forget(i);
     tracks_->forget(i);
     if (!initialised_[i]) {
       result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
@@ -346,7 +355,7 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     }
     config_.markers[i] = spec;
     initialised_[i] = false;
-    plausibility_->forget(i);
+    arrangement_->forget(i);
     tracks_->forget(i);
     believed_px_[i].reset();
     edited(ConfigChange::Respec(spec));
@@ -369,7 +378,7 @@ void TrackingSession::edited(ConfigChange change) const {
 void TrackingSession::jump() {
   for (size_t i = 0; i < trackers_.size(); ++i) {
     if (initialised_[i]) trackers_[i]->reset();
-    plausibility_->forget(i);
+    arrangement_->forget(i);
     tracks_->forget(i);
     previous_px_[i].reset();
   }

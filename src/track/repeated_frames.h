@@ -1,8 +1,8 @@
 // Footage that repeats frames to fill its rate (a 30 fps file from a webcam that delivered 15 or
 // 10 in dim light, a converter's constant frame rate) shows a moving marker exactly still for a
 // frame or two, then moved by all those frames' worth at once. The template tracker (its velocity)
-// and the session's plausibility rules (the motion history) both keep what they knew of the
-// motion over such frames, by this one rule, so the step after them is expected.
+// and the session's tracks (pipeline/marker_tracks.h) both keep what they knew of the motion over
+// such frames, by this one rule, so the step after them is expected.
 #pragma once
 
 #include <opencv2/core.hpp>

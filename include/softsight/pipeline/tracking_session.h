@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,7 @@
 namespace softsight {
 
 class FrameChangeDetector;
-class MarkerPlausibility;
+class ArrangementCheck;
 class MarkerTracks;
 
 // FrameResult (one frame's observations + measurement) is a core value type: core/types.h.
@@ -44,7 +45,8 @@ class TrackingSession {
   // Tracks every marker in `frame` and measures. On the first frame (and on a marker's template
   // frame) trackers are initialised from the config's ROIs and template rectangles. A live
   // recording's edits (config.changes) are made after the row of their frame, as live. Only
-  // plausible reports are found (pipeline/marker_plausibility.h, pipeline/frame_change.h): in a
+  // plausible reports are found (the association with each marker's motion, the body's
+  // arrangement and the frame-change check, in src/pipeline/): in a
   // frame that changed all at once (another video's frame, a flash) no marker is found and the
   // trackers do not see it; a report next to decoded garbage, that jumps against the marker's
   // motion, or that breaks the markers' arrangement along the body is kImplausible and its
@@ -117,7 +119,8 @@ class TrackingSession {
   std::vector<int64_t> believed_frame_;
   std::vector<std::optional<cv::Point2d>> recent_px_;
   std::unique_ptr<FrameChangeDetector> frame_change_;
-  std::unique_ptr<MarkerPlausibility> plausibility_;
+  std::unique_ptr<ArrangementCheck> arrangement_;
+  std::vector<std::optional<double>> motion_support_;  // Per marker, this frame (reused).
   std::unique_ptr<MarkerTracks> tracks_;  // Motion models and the global association.
   std::vector<const std::vector<MarkerCandidate>*> candidate_lists_;  // Reused per frame.
   Measurer measurer_;
