@@ -12,6 +12,7 @@
 #include "softsight/core/file_write.h"
 #include "softsight/core/format.h"
 #include "softsight/core/hsv_range.h"
+#include "softsight/core/option_table.h"
 #include "softsight/core/types.h"
 
 // geometry: the paper's measurements on marker positions, circle fit, 3D shape.
@@ -24,6 +25,7 @@
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 // sim: the renderers with exact ground truth and the truth scorer.
 #include "softsight/sim/builtin_scenes.h"

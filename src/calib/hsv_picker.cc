@@ -1,4 +1,5 @@
 #include "softsight/calib/hsv_picker.h"
+#include "softsight/track/colour_tracker.h"
 
 #include <algorithm>
 #include <cmath>

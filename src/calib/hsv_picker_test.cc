@@ -6,6 +6,7 @@
 #include <random>
 
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "softsight/core/error.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

@@ -14,13 +14,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_sections.h"  // DocumentConfig
-#include "core/option_table.h"
 #include "core/test_util.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
+#include "softsight/core/option_table.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/tracking_session.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

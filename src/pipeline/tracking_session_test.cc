@@ -13,6 +13,8 @@
 #include "softsight/core/error.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {
