@@ -78,12 +78,13 @@ case $mode in
     c++ -std=c++20 -O1 -Wall -Wextra -Werror -Wno-deprecated-enum-enum-conversion \
         "$source_dir/examples/library/custom_kind.cc" -o "$out/custom_kind" $flags "$rpath"
     "$out/custom_kind" "$work/custom-kind-pc" 40
-    # Tracking alone: the track module's flags name only it, softsight_core and OpenCV's core.
+    # Tracking alone: the track module's flags name only it, the modules below it (geometry: the
+    # marker finder's MeasureOptions; core) and OpenCV's core.
     flags=$(pkg-config --cflags --libs softsight-track)
     echo "check-install: pkg-config --libs softsight-track: $(pkg-config --libs softsight-track)"
     if grep -q "^BUILD_SHARED_LIBS:BOOL=ON" "$build/CMakeCache.txt"; then
       for lib in $(pkg-config --libs-only-l softsight-track); do
-        case $lib in -lsoftsight_track|-lsoftsight_core|-lopencv_core) ;; *) fail "softsight-track links $lib" ;; esac
+        case $lib in -lsoftsight_track|-lsoftsight_geometry|-lsoftsight_core|-lopencv_core) ;; *) fail "softsight-track links $lib" ;; esac
       done
     fi
     # shellcheck disable=SC2086

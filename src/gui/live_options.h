@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "softsight/calib/hsv_picker.h"
+#include "softsight/track/hsv_picker.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/sink.h"
 #include "gui/overlay.h"

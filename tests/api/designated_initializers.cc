@@ -7,7 +7,7 @@
 #include <string>
 
 #include "softsight/calib/camera_calibration.h"
-#include "softsight/calib/marker_finder.h"
+#include "softsight/track/marker_finder.h"
 #include "softsight/config/config.h"
 #include "softsight/core/types.h"
 #include "softsight/geometry/measurement.h"

@@ -25,7 +25,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "softsight/calib/hsv_picker.h"
+#include "softsight/track/hsv_picker.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
 

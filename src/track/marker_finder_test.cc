@@ -1,6 +1,6 @@
 // The body order of marker_finder.h on points with a known order, and the finder on footage of
 // its own renderer.
-#include "softsight/calib/marker_finder.h"
+#include "softsight/track/marker_finder.h"
 #include "softsight/track/colour_tracker.h"
 
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "softsight/calib/hsv_picker.h"
+#include "softsight/track/hsv_picker.h"
 #include "softsight/track/colour_tracker.h"
 
 #include <algorithm>
