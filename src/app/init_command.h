@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "softsight/track/marker_finder.h"
 #include "softsight/config/config.h"
 #include "softsight/core/types.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/track/marker_finder.h"
 
 namespace softsight {
 

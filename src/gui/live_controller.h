@@ -25,10 +25,10 @@
 #include "gui/strip_chart.h"
 #include "gui/timeline.h"
 #include "io/frame_grabber.h"
-#include "softsight/track/hsv_picker.h"
 #include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/track/colour_tracker.h"
+#include "softsight/track/hsv_picker.h"
 
 namespace softsight {
 

@@ -80,9 +80,8 @@ class DarkSpotTracker final : public Tracker {
 class DarkSpotKind final : public TrackerKind {
  public:
   std::string name() const override { return "dark spot"; }
+  // One method: method_of and select_method keep their defaults.
   std::vector<std::string> methods() const override { return {"dark"}; }
-  std::string method_of(const MarkerParams& /*params*/) const override { return "dark"; }
-  void select_method(MarkerParams& /*params*/, const std::string& /*method*/) const override {}
   MarkerParams defaults() const override { return DarkSpotParams{}; }
   const OptionTable<MarkerParams>& options() const override {
     static const OptionTable<MarkerParams> rows = KindOptions(DarkSpotOptions());

@@ -1,5 +1,4 @@
 #include "softsight/track/hsv_picker.h"
-#include "softsight/track/colour_tracker.h"
 
 #include <algorithm>
 #include <cmath>
