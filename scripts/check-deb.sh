@@ -140,6 +140,7 @@ in_root sh -c 'cmake -S /tmp/example -B /tmp/example/build -DCMAKE_BUILD_TYPE=Re
   { tail -n 30 "$work/example-cmake.log"; fail "the find_package(softsight) example did not build"; }
 in_root /tmp/example/build/track_rendered /tmp/markers.yaml 30
 in_root /tmp/example/build/track_colour 20
+in_root /tmp/example/build/custom_kind /tmp/custom-kind 40
 in_root sh -c 'c++ -std=c++20 -O1 /tmp/example/track_rendered.cc -o /tmp/track_rendered_pc \
                $(pkg-config --cflags --libs softsight) &&
                c++ -std=c++20 -O1 /tmp/example/track_colour.cc -o /tmp/track_colour_pc \

@@ -2,6 +2,7 @@
 # The installed library and Python package, used as an outside project would (ctest install.*):
 #   check-install.sh prefix   BUILD WORK  cmake --install of BUILD into WORK/prefix
 #   check-install.sh cmake    BUILD WORK  examples/library built with find_package(softsight), run
+#                                         (custom_kind: a kind of marker of its own, registered)
 #   check-install.sh pkg-config BUILD WORK  the same sources built with `pkg-config softsight` and
 #                                         `pkg-config softsight-track` only (tracking alone links
 #                                         neither yaml-cpp, the serial port nor FFmpeg)
@@ -55,6 +56,7 @@ case $mode in
     cmake --build "$out" >/dev/null
     "$out/track_rendered" "$config" 30
     "$out/track_colour" 20
+    "$out/custom_kind" "$work/custom-kind" 40
     ;;
   pkg-config)
     out=$work/pkg-config-example
@@ -72,12 +74,17 @@ case $mode in
     c++ -std=c++20 -O1 -Wall -Wextra -Werror -Wno-deprecated-enum-enum-conversion \
         "$source_dir/examples/library/track_rendered.cc" -o "$out/track_rendered" $flags "$rpath"
     "$out/track_rendered" "$config" 30
-    # Tracking alone: the track module's flags name only it, softsight_core and OpenCV's core.
+    # shellcheck disable=SC2086
+    c++ -std=c++20 -O1 -Wall -Wextra -Werror -Wno-deprecated-enum-enum-conversion \
+        "$source_dir/examples/library/custom_kind.cc" -o "$out/custom_kind" $flags "$rpath"
+    "$out/custom_kind" "$work/custom-kind-pc" 40
+    # Tracking alone: the track module's flags name only it, the modules below it (geometry: the
+    # marker finder's MeasureOptions; core) and OpenCV's core.
     flags=$(pkg-config --cflags --libs softsight-track)
     echo "check-install: pkg-config --libs softsight-track: $(pkg-config --libs softsight-track)"
     if grep -q "^BUILD_SHARED_LIBS:BOOL=ON" "$build/CMakeCache.txt"; then
       for lib in $(pkg-config --libs-only-l softsight-track); do
-        case $lib in -lsoftsight_track|-lsoftsight_core|-lopencv_core) ;; *) fail "softsight-track links $lib" ;; esac
+        case $lib in -lsoftsight_track|-lsoftsight_geometry|-lsoftsight_core|-lopencv_core) ;; *) fail "softsight-track links $lib" ;; esac
       done
     fi
     # shellcheck disable=SC2086

@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "softsight/track/colour_tracker.h"
 #include "softsight/track/tracker.h"
 #include "softsight/version.h"
 

@@ -12,6 +12,7 @@
 #include "softsight/core/file_write.h"
 #include "softsight/core/format.h"
 #include "softsight/core/hsv_range.h"
+#include "softsight/core/option_table.h"
 #include "softsight/core/types.h"
 
 // geometry: the paper's measurements on marker positions, circle fit, 3D shape.
@@ -20,10 +21,14 @@
 #include "softsight/geometry/shape3d.h"
 #include "softsight/geometry/triangle.h"
 
-// track: the Tracker interface, its parameters and the colour and template trackers.
+// track: the Tracker interface, its parameters, the registry of kinds, the colour and template
+// trackers, colour picking and init's marker finder.
 #include "softsight/track/colour_tracker.h"
+#include "softsight/track/hsv_picker.h"
+#include "softsight/track/marker_finder.h"
 #include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 // sim: the renderers with exact ground truth and the truth scorer.
 #include "softsight/sim/builtin_scenes.h"
@@ -33,11 +38,9 @@
 #include "softsight/sim/stereo_scene.h"
 #include "softsight/sim/truth_score.h"
 
-// calib: camera and stereo calibration, triangulation, colour picking, marker finding.
+// calib: camera and stereo calibration, triangulation.
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/camera_calibration.h"
-#include "softsight/calib/hsv_picker.h"
-#include "softsight/calib/marker_finder.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/calib/triangulation.h"
 

@@ -19,14 +19,16 @@
 #include "app/progress.h"
 #include "app/scene_config.h"
 #include "app/truth_sink.h"
-#include "softsight/io/truth_csv.h"
-#include "softsight/core/error.h"
 #include "softsight/config/config.h"
+#include "softsight/core/error.h"
 #include "softsight/core/format.h"
+#include "softsight/io/truth_csv.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/builtin_scenes.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

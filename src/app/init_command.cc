@@ -14,11 +14,12 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
-#include "softsight/core/error.h"
 #include "gui/live_options.h"
+#include "softsight/core/error.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sink.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

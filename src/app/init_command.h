@@ -1,5 +1,5 @@
 // `softsight init` and `softsight pick`: a marker config without a GUI.
-//   init: finds the markers in one frame by itself (calib/marker_finder.h), verifies and orders
+//   init: finds the markers in one frame by itself (track/marker_finder.h), verifies and orders
 //         them, writes the config and a picture of what it found and rejected.
 //   pick: the live window's click pick (PickMarkerColourAt) at given points of one frame.
 #pragma once
@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "softsight/calib/marker_finder.h"
 #include "softsight/config/config.h"
 #include "softsight/core/types.h"
 #include "softsight/io/frame_source.h"
+#include "softsight/track/marker_finder.h"
 
 namespace softsight {
 

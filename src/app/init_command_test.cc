@@ -16,13 +16,14 @@
 #include "app/track_command.h"
 #include "app/truth_sink.h"
 #include "core/test_util.h"
+#include "gui/live_controller.h"
 #include "sim/opencv_samples.h"
 #include "softsight/core/error.h"
-#include "gui/live_controller.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/plate_scene.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

@@ -7,6 +7,7 @@
 
 #include "softsight/core/error.h"
 #include "softsight/sim/builtin_scenes.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 

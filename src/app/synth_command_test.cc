@@ -17,6 +17,7 @@
 
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

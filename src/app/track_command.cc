@@ -7,20 +7,21 @@
 #include <optional>
 #include <vector>
 
-#include "app/cli_checks.h"
 #include "app/capture_options.h"
+#include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/publish_options.h"
 #include "app/stop_request.h"
 #include "app/track_many.h"
-#include "softsight/core/error.h"
 #include "gui/overlay.h"
+#include "softsight/core/error.h"
 #include "softsight/io/run_source.h"
 #include "softsight/pipeline/run.h"
-#include "track/tracker_kind.h"
 #include "softsight/pipeline/sinks.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "softsight/track/template_tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

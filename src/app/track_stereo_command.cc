@@ -8,8 +8,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "app/cli_checks.h"
 #include "app/capture_options.h"
+#include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/publish_options.h"
 #include "app/stop_request.h"
@@ -27,7 +27,7 @@
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/pipeline/summary.h"
 #include "softsight/track/colour_tracker.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 

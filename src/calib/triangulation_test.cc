@@ -12,11 +12,11 @@
 #include <gtest/gtest.h>
 
 #include "calib/stereo_test_util.h"
-#include "softsight/calib/marker_finder.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/shape3d.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/stereo_scene.h"
+#include "softsight/track/marker_finder.h"
 
 namespace softsight {
 namespace {

@@ -6,6 +6,7 @@
 #include "core/test_util.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

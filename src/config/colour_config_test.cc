@@ -9,6 +9,7 @@
 #include "config/yaml_map.h"
 #include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

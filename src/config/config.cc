@@ -5,14 +5,14 @@
 #include <fstream>
 #include <set>
 
-#include "control/control_options.h"
-#include "geometry/measure_options.h"
 #include "config/config_sections.h"
 #include "config/option_yaml.h"
 #include "config/yaml_map.h"
+#include "control/control_options.h"
+#include "geometry/measure_options.h"
 #include "io/camera_options.h"
-#include "track/tracker_kind.h"
 #include "softsight/core/error.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

@@ -9,16 +9,16 @@
 #include <string>
 #include <vector>
 
-#include "core/option_table.h"
 #include "config/yaml_map.h"
 #include "softsight/control/control_config.h"
+#include "softsight/core/option_table.h"
 #include "softsight/geometry/measurement.h"
 #include "softsight/track/tracker.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 
-// marker_config.cc: a marker's keys of one kind (track/tracker_kind.h): the kind's option rows and,
+// marker_config.cc: a marker's keys of one kind (softsight/track/tracker_kind.h): the kind's option rows and,
 // for a kind that holds an image, the key naming the image file. The file is the config's
 // business, not the tracker's, so its name is kept here beside the parameters (its pixels go
 // into the parameters).

@@ -6,9 +6,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/test_util.h"
 #include "config/config_test_util.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

@@ -1,4 +1,4 @@
-// A marker's keys of one kind of marker (src/track/tracker_kind.h): every key, its unit, range
+// A marker's keys of one kind of marker (softsight/track/tracker_kind.h): every key, its unit, range
 // and doc is a row of the kind's option table (the colour kind's in src/track/colour_options.cc,
 // the template kind's in src/track/template_options.cc; `softsight config --doc` prints them and
 // examples/markers.yaml documents them), plus, for a kind that holds an image, the key naming
@@ -29,7 +29,7 @@
 
 #include "config/config_sections.h"
 #include "config/option_yaml.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 

@@ -1,4 +1,4 @@
-// Tests generated from an option table (core/option_table.h), for every option of every table:
+// Tests generated from an option table (softsight/core/option_table.h), for every option of every table:
 //   - a non-default value written to YAML reads back identical (read(write(x)) == x);
 //   - a value out of range gives the same message from the YAML reader (after "file:line: path.")
 //     as from Check();
@@ -16,11 +16,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "core/option_table.h"
-#include "core/test_util.h"
 #include "config/option_yaml.h"
 #include "config/yaml_map.h"
+#include "core/test_util.h"
 #include "softsight/core/error.h"
+#include "softsight/core/option_table.h"
 
 namespace softsight::testing {
 

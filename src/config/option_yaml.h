@@ -1,4 +1,4 @@
-// The YAML side of the option tables (core/option_table.h): one reader and one writer for every
+// The YAML side of the option tables (softsight/core/option_table.h): one reader and one writer for every
 // options struct, so a key, its range and its message are written once, in the struct's table.
 #pragma once
 
@@ -8,8 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "core/option_table.h"
 #include "config/yaml_map.h"
+#include "softsight/core/option_table.h"
 
 namespace softsight {
 

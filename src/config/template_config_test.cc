@@ -9,10 +9,11 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "core/test_util.h"
 #include "config/config_test_util.h"
-#include "softsight/core/error.h"
+#include "core/test_util.h"
 #include "softsight/config/config.h"
+#include "softsight/core/error.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

@@ -6,9 +6,9 @@
 #include <numbers>
 
 #include "control/control_options.h"
-#include "core/option_table.h"
 #include "softsight/core/error.h"
 #include "softsight/core/format.h"
+#include "softsight/core/option_table.h"
 
 namespace softsight {
 

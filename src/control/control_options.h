@@ -1,10 +1,10 @@
-// The option tables of the `control:` section (core/option_table.h): every key of the controller,
+// The option tables of the `control:` section (softsight/core/option_table.h): every key of the controller,
 // the link and the simulated rig, with its unit, range and doc. The structs' Check() functions run
 // them; the config reader and writer (config/control_config.cc) iterate them.
 #pragma once
 
-#include "core/option_table.h"
 #include "softsight/control/control_config.h"
+#include "softsight/core/option_table.h"
 
 namespace softsight {
 

@@ -1,4 +1,4 @@
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 
 #include "softsight/core/format.h"
 

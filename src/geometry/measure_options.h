@@ -1,10 +1,10 @@
-// The option tables of the measurement settings (core/option_table.h): the config's top-level
+// The option tables of the measurement settings (softsight/core/option_table.h): the config's top-level
 // triple, chain, tip_reference and metric keys, with their units, ranges and docs.
 // MeasureOptions::Check() and MetricModel::Check() run them; the config reader and writer iterate
 // them. (Whether the named markers exist is the config's business.)
 #pragma once
 
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 #include "softsight/geometry/measurement.h"
 
 namespace softsight {

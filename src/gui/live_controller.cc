@@ -6,15 +6,17 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "track/tracker_kind.h"
-#include "softsight/calib/camera_calibration.h"
-#include "softsight/core/error.h"
-#include "softsight/core/format.h"
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
 #include "gui/live_recording.h"  // SaveLiveConfig
-#include "gui/range_edit.h"
 #include "gui/live_view.h"
+#include "gui/range_edit.h"
+#include "softsight/calib/camera_calibration.h"
+#include "softsight/core/error.h"
+#include "softsight/core/format.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

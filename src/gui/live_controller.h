@@ -16,18 +16,19 @@
 #include <string>
 #include <vector>
 
-#include "softsight/calib/hsv_picker.h"
 #include "gui/live_options.h"
-#include "gui/overlay.h"
 #include "gui/live_pipeline.h"
 #include "gui/live_view.h"
+#include "gui/overlay.h"
 #include "gui/rate_meter.h"
-#include "io/frame_grabber.h"
 #include "gui/scale_clicks.h"
 #include "gui/strip_chart.h"
 #include "gui/timeline.h"
+#include "io/frame_grabber.h"
 #include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/hsv_picker.h"
 
 namespace softsight {
 

@@ -9,23 +9,25 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "softsight/core/error.h"
+#include "core/test_util.h"
 #include "gui/live_feed.h"
 #include "gui/live_layout.h"
 #include "gui/live_pointer.h"
-#include "gui/range_edit.h"
-#include "core/test_util.h"
 #include "gui/live_test_util.h"
+#include "gui/range_edit.h"
 #include "gui/seekable_source.h"
+#include "io/paced_source.h"
+#include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_writer.h"
-#include "io/paced_source.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/sinks.h"
 #include <fstream>
 #include "softsight/config/config.h"
 #include "softsight/io/plot.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "softsight/calib/hsv_picker.h"
+#include "gui/overlay.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/sink.h"
-#include "gui/overlay.h"
+#include "softsight/track/hsv_picker.h"
 
 namespace softsight {
 

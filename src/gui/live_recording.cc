@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "track/tracker_kind.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

@@ -10,6 +10,7 @@
 #include "gui/range_edit.h"
 
 #include "softsight/core/format.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

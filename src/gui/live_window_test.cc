@@ -22,19 +22,20 @@
 #include <sstream>
 #include <thread>
 
-#include "gui/live_layout.h"
-#include "gui/live_view.h"  // StatusBandHeight
-#include "gui/live_test_util.h"
-#include "gui/overlay.h"
 #include "app/scene_markers_test_util.h"
 #include "app/stereo_test_util.h"
 #include "calib/stereo_test_util.h"
+#include "gui/live_layout.h"
+#include "gui/live_test_util.h"
+#include "gui/live_view.h"  // StatusBandHeight
+#include "gui/overlay.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/config/config.h"
-#include "softsight/io/frame_writer.h"
-#include "softsight/sim/stereo_scene.h"
 #include "softsight/io/csv_reader.h"
+#include "softsight/io/frame_writer.h"
 #include "softsight/sim/scene.h"
+#include "softsight/sim/stereo_scene.h"
+#include "softsight/track/colour_tracker.h"
 
 extern char** environ;
 

@@ -6,6 +6,7 @@
 #include "gui/overlay.h"
 #include "gui/strip_chart.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <opencv2/videoio.hpp>
 
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 #include "softsight/io/camera_settings.h"
 
 namespace softsight {

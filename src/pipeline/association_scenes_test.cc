@@ -13,8 +13,10 @@
 
 #include "pipeline/scene_config_test_util.h"
 #include "sim/dot_scene_test_util.h"
-#include "softsight/calib/marker_finder.h"
 #include "softsight/pipeline/tracking_session.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/marker_finder.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

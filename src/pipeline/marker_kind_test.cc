@@ -14,13 +14,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_sections.h"  // DocumentConfig
-#include "core/option_table.h"
 #include "core/test_util.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
+#include "softsight/core/option_table.h"
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/tracking_session.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {
@@ -79,9 +80,8 @@ class DarkSpotTracker final : public Tracker {
 class DarkSpotKind final : public TrackerKind {
  public:
   std::string name() const override { return "dark spot"; }
+  // One method: method_of and select_method keep their defaults.
   std::vector<std::string> methods() const override { return {"dark"}; }
-  std::string method_of(const MarkerParams& /*params*/) const override { return "dark"; }
-  void select_method(MarkerParams& /*params*/, const std::string& /*method*/) const override {}
   MarkerParams defaults() const override { return DarkSpotParams{}; }
   const OptionTable<MarkerParams>& options() const override {
     static const OptionTable<MarkerParams> rows = KindOptions(DarkSpotOptions());

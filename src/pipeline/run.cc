@@ -11,7 +11,7 @@
 #include "pipeline/key_frame_groups.h"
 #include "softsight/core/error.h"
 #include "softsight/pipeline/stereo_session.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 bool NeedsColour(const TrackingConfig& config) {

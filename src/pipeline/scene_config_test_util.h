@@ -6,6 +6,7 @@
 
 #include "softsight/config/config.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight::testing {
 

@@ -11,7 +11,7 @@
 #include "pipeline/arrangement_check.h"
 #include "pipeline/marker_tracks.h"
 #include "softsight/core/error.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 namespace {

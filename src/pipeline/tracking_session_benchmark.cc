@@ -27,6 +27,8 @@
 #include "softsight/config/config.h"
 #include "softsight/pipeline/tracking_session.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {

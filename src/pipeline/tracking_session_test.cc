@@ -9,10 +9,12 @@
 
 #include "core/test_util.h"
 #include "pipeline/scene_config_test_util.h"
-#include "softsight/calib/hsv_picker.h"
 #include "softsight/core/error.h"
 #include "softsight/geometry/triangle.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/hsv_picker.h"
+#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 namespace {

@@ -1,9 +1,9 @@
 // The colour kind: ColourParams, the colour tracker, a marker a person clicks on.
 #include <algorithm>
 
+#include "softsight/track/tracker_kind.h"
 #include "track/colour_tracker_impl.h"
 #include "track/track_options.h"
-#include "track/tracker_kind.h"
 
 namespace softsight {
 namespace {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <sstream>
 
-#include "track/track_options.h"
+#include "softsight/track/tracker_kind.h"
 #include "track/template_tracker_impl.h"
-#include "track/tracker_kind.h"
+#include "track/track_options.h"
 
 namespace softsight {
 namespace {

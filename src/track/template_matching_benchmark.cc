@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "softsight/sim/scene.h"
+#include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
 #include "track/match_kernels.h"
 

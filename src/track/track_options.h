@@ -1,9 +1,9 @@
-// The option tables of the trackers' settings (core/option_table.h): every key a marker's colour
+// The option tables of the trackers' settings (softsight/core/option_table.h): every key a marker's colour
 // and template settings can have, with its unit, range and doc. ColourParams::Check() and
 // TemplateParams::Check() run them; the config reader and writer (config) iterate them.
 #pragma once
 
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 #include "softsight/track/colour_tracker.h"
 #include "softsight/track/template_tracker.h"
 

@@ -1,4 +1,4 @@
-// The registry of marker kinds (src/track/tracker_kind.h) and what is asked of it by method
+// The registry of marker kinds (softsight/track/tracker_kind.h) and what is asked of it by method
 // name: the method names are spelled by the kinds (colour_kind.cc, template_kind.cc) only.
 #include <map>
 #include <memory>
@@ -7,8 +7,10 @@
 #include <vector>
 
 #include "softsight/core/error.h"
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
-#include "track/tracker_kind.h"
+#include "softsight/track/tracker_kind.h"
 
 namespace softsight {
 

@@ -1,6 +1,8 @@
 // The tracker registry and how a tracker starts itself: CreateTracker builds each method by its
 // name, and every tracker decides from its own parameters when it can start (Tracker::start), so
 // no caller looks at method names or template fields to start one.
+#include "softsight/track/colour_tracker.h"
+#include "softsight/track/template_tracker.h"
 #include "softsight/track/tracker.h"
 
 #include <algorithm>

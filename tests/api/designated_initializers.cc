@@ -7,7 +7,6 @@
 #include <string>
 
 #include "softsight/calib/camera_calibration.h"
-#include "softsight/calib/marker_finder.h"
 #include "softsight/config/config.h"
 #include "softsight/core/types.h"
 #include "softsight/geometry/measurement.h"
@@ -18,6 +17,7 @@
 #include "softsight/pipeline/run.h"
 #include "softsight/pipeline/stereo_session.h"
 #include "softsight/sim/scene.h"
+#include "softsight/track/marker_finder.h"
 
 namespace softsight {
 

@@ -1,4 +1,7 @@
 // The one interface every marker tracker implements, and the table that builds them by name.
+// The concrete trackers' parameters are in colour_tracker.h and template_tracker.h; a kind of
+// marker (built in, or added by a program: tracker_kind.h) is registered with the registry,
+// which builds its tracker, so this interface names no concrete tracker.
 //
 // A tracker follows one marker. It knows nothing of files, windows or serial ports: it is given
 // images and answers with Observations. Modelled on OpenCV's cv::Tracker (init + update).
@@ -18,8 +21,6 @@
 #include <opencv2/core.hpp>
 
 #include "softsight/core/types.h"
-#include "softsight/track/colour_tracker.h"
-#include "softsight/track/template_tracker.h"
 
 namespace softsight {
 
@@ -95,7 +96,7 @@ class Tracker {
   virtual std::optional<cv::Rect> search_region() const;
 };
 
-class TrackerKind;  // What a kind of marker is to the program (internal to the track library).
+class TrackerKind;  // What a kind of marker is to the program: softsight/track/tracker_kind.h.
 
 namespace tracker_detail {
 // The registered kind whose parameter set is of `type`. A type no kind registered is a
@@ -105,8 +106,8 @@ const TrackerKind& KindOfParams(std::type_index type);
 
 // A marker's tracking parameters: the parameter set of one kind of marker. Built in: ColourParams
 // (colour or gray-level thresholding) and TemplateParams (template matching, whose measure, sad,
-// ssd or zncc, and gray/colour choice it carries); a kind registered inside the track library
-// adds its own set. A value: copies are independent. What differs between kinds (checks, YAML
+// ssd or zncc, and gray/colour choice it carries); a kind registered with RegisterTrackerKind
+// (tracker_kind.h, by the library or by a program) adds its own set. A value: copies are independent. What differs between kinds (checks, YAML
 // keys, what a tracker needs from a frame, how a person selects the marker) is asked of kind(),
 // so only the track library tells kinds apart; code that edits one kind's own fields (the live
 // window's colour ranges) asks for that set by type with get_if<P>().

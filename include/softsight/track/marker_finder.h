@@ -25,8 +25,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "softsight/calib/hsv_picker.h"
 #include "softsight/geometry/measurement.h"
+#include "softsight/track/hsv_picker.h"
 #include "softsight/track/tracker.h"
 
 namespace softsight {

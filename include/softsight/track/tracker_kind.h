@@ -1,14 +1,20 @@
-// A kind of marker, as the rest of the program sees it: one descriptor per parameter set
-// (ColourParams, TemplateParams, or a kind added later), registered here, so that everything
-// that differs between kinds is asked of the descriptor and only src/track/ tells kinds apart.
-// OpenCV's tracker factory is the model: a new kind is a class here and its option rows, and the
-// config, the session, the run loop, the live window and the program follow.
+// A kind of marker, as the library sees it: one descriptor per parameter set (ColourParams,
+// TemplateParams, or a kind a program adds), registered once, so that everything that differs
+// between kinds is asked of the descriptor and only the kind itself tells kinds apart. OpenCV's
+// tracker factory is the model (a small interface, a name-to-factory table); the config, the
+// session, the run loop, the live window and the program follow a registered kind.
 //
-// Adding a kind (docs/architecture.md, "Where a new piece goes", has a worked example):
-//   1. its parameter struct with Check(), and its option table (key, unit, range, doc per field);
-//   2. its Tracker;
-//   3. a TrackerKind subclass saying what this header asks, registered with RegisterTrackerKind()
-//      (the built-in kinds are listed in tracker_registry.cc).
+// Adding a kind, inside the library or in a program of your own (examples/library/
+// custom_kind.cc is a whole one; docs/architecture.md, "A new kind of marker", walks through it):
+//   1. its parameter struct (plain fields with defaults) with Check(), and its option table
+//      (softsight/core/option_table.h: key, unit, range, doc per field), which the config reads,
+//      writes, range-checks and documents;
+//   2. its Tracker (softsight/track/tracker.h): start(), update() -> Observation, reset();
+//   3. a TrackerKind subclass answering what this header asks (the pure virtual functions; the
+//      others have defaults that fit a kind with one method and no image file), registered with
+//      RegisterTrackerKind<Params>() before a config names it. A config's `method:` then selects
+//      it, CreateTracker builds its tracker, and a TrackingSession runs it.
+// The built-in kinds are registered in src/track/tracker_registry.cc.
 #pragma once
 
 #include <functional>
@@ -21,7 +27,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 #include "softsight/core/types.h"
 #include "softsight/track/tracker.h"
 
@@ -43,10 +49,17 @@ class TrackerKind {
   // The `method:` names that select this kind, in the order --help lists them. Unique across
   // kinds: a method names one kind.
   virtual std::vector<std::string> methods() const = 0;
-  // The method `params` (of this kind) select.
-  virtual std::string method_of(const MarkerParams& params) const = 0;
-  // Makes `params` (of this kind) select `method` (one of methods()).
-  virtual void select_method(MarkerParams& params, const std::string& method) const = 0;
+  // The method `params` (of this kind) select. Default: the first of methods() (a kind with one).
+  virtual std::string method_of(const MarkerParams& params) const {
+    (void)params;
+    return methods().front();
+  }
+  // Makes `params` (of this kind) select `method` (one of methods()). Default: nothing to change
+  // (a kind with one method).
+  virtual void select_method(MarkerParams& params, const std::string& method) const {
+    (void)params;
+    (void)method;
+  }
   // Whether a marker's entry in a config file says this kind is meant when it names no method,
   // given which of its keys are present (`has_key`): a `template:` key means template matching.
   // The first kind that claims a marker is its default; else the first kind registered.
@@ -58,7 +71,7 @@ class TrackerKind {
   // --- Parameters -----------------------------------------------------------------------------
   // A default parameter set of this kind.
   virtual MarkerParams defaults() const = 0;
-  // Its settings, one row each (core/option_table.h): the config reads, writes, range-checks and
+  // Its settings, one row each (softsight/core/option_table.h): the config reads, writes, range-checks and
   // documents them (`softsight config --doc`), every key of every kind in a marker's entry.
   virtual const OptionTable<MarkerParams>& options() const = 0;
   // Keys a marker's entry may not give together, with why ({"hsv", "auto_colour"}: one replaces

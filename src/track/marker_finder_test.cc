@@ -1,12 +1,13 @@
 // The body order of marker_finder.h on points with a known order, and the finder on footage of
 // its own renderer.
-#include "softsight/calib/marker_finder.h"
+#include "softsight/track/marker_finder.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include "sim/dot_scene_test_util.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {

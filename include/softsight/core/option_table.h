@@ -10,8 +10,11 @@
 // The idea is COLMAP's OptionManager (src/colmap/controllers/option_manager.cc) with the range
 // checks of Ceres' Solver::Options (OPTION_GE in internal/ceres/solver.cc), without a dependency.
 //
+// Public so that a program adding its own kind of marker (softsight/track/tracker_kind.h) declares
+// its keys the way the library does.
+//
 // A table is a std::vector<Option<T>>, built from the helpers at the end of this file:
-//   IntOption<T>("window", &T::window_px).Range(8, 4096).OrZero("search the whole frame")
+//   IntOption<T>("window", &T::window_px).Range(8, 4096).Or(0, "search the whole frame")
 //       .Unit("px").Doc("side of the square tracking window")
 // Keys are dotted paths ("blob.min_area"): each dot is one nested YAML mapping.
 #pragma once

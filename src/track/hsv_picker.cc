@@ -1,4 +1,4 @@
-#include "softsight/calib/hsv_picker.h"
+#include "softsight/track/hsv_picker.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "softsight/calib/hsv_picker.h"
+#include "softsight/track/hsv_picker.h"
 
 #include <gtest/gtest.h>
 
@@ -6,6 +6,7 @@
 #include <random>
 
 #include "softsight/sim/scene.h"
+#include "softsight/track/colour_tracker.h"
 
 namespace softsight {
 namespace {
