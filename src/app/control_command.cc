@@ -855,10 +855,10 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
                "that reach, instead of refusing it");
   sub.add_flag("-q,--quiet", o->quiet, "No summary");
   auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
-  AddHookOptions(sub, &o->hook);
+  AddFlags(sub, PublishFlags(), publish.get());
+  AddFlags(sub, HookFlags(), &o->hook);
   auto stereo = std::make_shared<ControlStereoOptions>();
-  control_parts::AddControlStereoOptions(sub, stereo.get());
+  AddFlags(sub, control_parts::ControlStereoFlags(), stereo.get());
   return [o, auto_tune, closed_loop_s, publish, stereo, &sub] {
     o->publish = publish->resolved();
     o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);

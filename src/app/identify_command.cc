@@ -125,9 +125,9 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")->capture_default_str();
   sub.add_flag("-q,--quiet", o->quiet, "Only errors");
   auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
+  AddFlags(sub, PublishFlags(), publish.get());
   auto stereo = std::make_shared<ControlStereoOptions>();
-  control_parts::AddControlStereoOptions(sub, stereo.get());
+  AddFlags(sub, control_parts::ControlStereoFlags(), stereo.get());
   return [o, publish, stereo, &sub] {
     o->publish = publish->resolved();
     o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);

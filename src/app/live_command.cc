@@ -166,8 +166,8 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
   sub.add_option("--csv", args->csv,
                  "Also write a CSV row for every frame the window tracks (stepped and sought "
                  "ones too, by their own frame numbers), as `track --csv` does");
-  AddPublishOptions(sub, &args->publish);
-  AddHookOptions(sub, &args->hook);
+  AddFlags(sub, PublishFlags(), &args->publish);
+  AddFlags(sub, HookFlags(), &args->hook);
   return [args] { return RunLive(*args); };
 }
 

@@ -180,7 +180,7 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
   simulate->excludes(camera);
   simulate->excludes(input);
   AddCaptureOptions(sub, &args->capture);
-  AddHookOptions(sub, &args->hook);
+  AddFlags(sub, HookFlags(), &args->hook);
   return [args] { return RunServeCommand(*args); };
 }
 

@@ -195,8 +195,8 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       ->check(NumberIn(0, 1e15));
   sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
   sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
-  AddPublishOptions(sub, publish.get());
-  AddHookOptions(sub, &options->hook);
+  AddFlags(sub, PublishFlags(), publish.get());
+  AddFlags(sub, HookFlags(), &options->hook);
   return [options, inputs, jobs, capture, publish] {
     options->publish = publish->resolved();
     const bool from_files = !inputs->empty() || !options->source.input.empty();

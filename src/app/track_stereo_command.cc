@@ -557,7 +557,7 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
       ->capture_default_str()
       ->check(NumberIn(0.2, 3600));
   auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
+  AddFlags(sub, PublishFlags(), publish.get());
   return [options, publish, open_window] {
     options->publish = publish->resolved();
     // Ctrl-C or SIGTERM ends the run between pairs with every row written and the summary;
