@@ -4,6 +4,7 @@
 #include "app/flag_table.h"
 
 #include <algorithm>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -19,6 +20,7 @@
 #include "app/publish_options.h"
 #include "app/python_hook.h"
 #include "app/shared_flags.h"
+#include "core/test_util.h"
 #include "io/camera_options.h"
 
 namespace softsight {
@@ -105,9 +107,11 @@ TEST(FlagTable, HelpShowsTheRowsHelpAndDefault) {
 
 // Through the whole command line: a range check refused is one line naming the flag.
 TEST(FlagTable, ACommandsRangeCheckIsOneErrorLineNamingTheFlag) {
-  const std::vector<CommandSetup> commands = {{"track", SetupTrackCommand},
-                                              {"control", SetupControlCommand}};
-  std::vector<std::string> words = {"softsight", "track", "-c",    "m.yaml",        "-i",
+  testing::TempDir dir;
+  const std::string config = dir.file("m.yaml");
+  std::ofstream(config) << "markers: []\n";  // Exists: --config's own check passes.
+  const std::vector<CommandSetup> commands = {{"track", SetupTrackCommand}};
+  std::vector<std::string> words = {"softsight", "track", "-c",    config,          "-i",
                                     "a.avi",     "-o",    "a.csv", "--publish-hwm", "0"};
   std::vector<char*> argv;
   for (std::string& word : words) argv.push_back(word.data());
@@ -117,6 +121,7 @@ TEST(FlagTable, ACommandsRangeCheckIsOneErrorLineNamingTheFlag) {
   EXPECT_EQ(exit_code, 2);
   EXPECT_THAT(err, HasSubstr("softsight track: error: "));
   EXPECT_THAT(err, HasSubstr("--publish-hwm"));
+  EXPECT_THAT(err, HasSubstr("Value 0 not in range 1 to 1000000"));
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
