@@ -31,15 +31,6 @@ std::string CameraHelp(const std::string& what) {
                 "lists them; aravis:Fake_1 is Aravis' simulated camera)";
 }
 
-CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
-                             std::optional<CameraId>* camera, const std::string& help) {
-  return sub.add_option(name, *camera, CameraHelp(help))
-      ->type_name("N|aravis:ID")
-      ->check(CameraIdCheck());
-}
-
-void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) { AddFlags(sub, CaptureFlags(), args); }
-
 const FlagTable<CaptureArgs>& CaptureFlags() {
   static const FlagTable<CaptureArgs> table = [] {
     FlagTable<CaptureArgs> flags;

@@ -42,12 +42,6 @@ FlagBuilder<Args> CameraFlag(const std::string& name, Access access, const std::
 // the row; the texts given land in a CaptureArgs, which must outlive parsing.
 const FlagTable<CaptureArgs>& CaptureFlags();
 
-// Until every command declares its flags in a table: --camera and the --camera-* flags added
-// one call each.
-CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
-                             std::optional<CameraId>* camera, const std::string& help);
-void AddCaptureOptions(CLI::App& sub, CaptureArgs* args);
-
 // The config's settings with the command line's on top. Throws InputError naming the option
 // ("--camera-width 5: must lie within 16..8192").
 CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings settings);
