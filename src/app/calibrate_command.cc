@@ -391,19 +391,20 @@ namespace {
 const FlagTable<CalibrateOptions>& CalibrateFlags() {
   using A = CalibrateOptions;
   static const FlagTable<CalibrateOptions> table = {
-      InputFlag<A>(&A::input,
-                   "Chessboard views: a folder of images, a printf pattern (shots/%03d.png) or a "
-                   "video file"),
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Chessboard views: a folder of images, a printf pattern (shots/%03d.png) or a "
+                "video file"),
       ValueFlag<A>("--plane", &A::plane_image)
           .Help("One image of the chessboard lying flat in the actuator's plane: writes the "
                 "image-to-millimetre homography instead")
           .Excludes("--input"),
-      LeftFlag<A>(&A::left,
-                  "Two cameras: the first camera's chessboard views (folder, pattern or video), "
-                  "paired one to one in order with --right's")
+      ValueFlag<A>(kLeftFlag, &A::left)
+          .Help("Two cameras: the first camera's chessboard views (folder, pattern or video), "
+                "paired one to one in order with --right's")
           .Excludes("--input")
           .Excludes("--plane"),
-      RightFlag<A>(&A::right, "Two cameras: the second camera's views of the same moments")
+      ValueFlag<A>(kRightFlag, &A::right)
+          .Help("Two cameras: the second camera's views of the same moments")
           .Excludes("--input")
           .Excludes("--plane"),
       ValueFlag<A>("--picture", &A::picture_file)
@@ -413,11 +414,13 @@ const FlagTable<CalibrateOptions>& CalibrateFlags() {
           .Help("With --plane: the camera file from an earlier `calibrate --input` run, used to "
                 "remove lens distortion")
           .Needs("--plane"),
-      ChessboardFlag<A>(&A::chessboard,
-                        "INNER corners per row x per column, e.g. 9x6 for a board of 10 x 7 "
-                        "squares")
+      ValueFlag<A>(kChessboardFlag, &A::chessboard)
+          .Help("INNER corners per row x per column, e.g. 9x6 for a board of 10 x 7 "
+                "squares")
           .Required(),
-      SquareMmFlag<A>(&A::square_mm, "Side of one printed square in millimetres").Required(),
+      ValueFlag<A>(kSquareMmFlag, &A::square_mm)
+          .Help("Side of one printed square in millimetres")
+          .Required(),
       OutputFlag<A>(&A::out_file, "out", "File to write (OpenCV YAML)").Required(),
       ValueFlag<A>("--step", &A::step)
           .Help("Video input: use every N-th frame (default 1; with two videos, both)"),

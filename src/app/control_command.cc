@@ -808,13 +808,13 @@ const FlagTable<ControlArgs>& ControlFlags() {
   // A field of the options: [](A& a) -> auto& { return a.options.x; } for each row, spelled once.
   auto in = [](auto O::*field) { return [field](A& a) -> auto& { return a.options.*field; }; };
   static const FlagTable<ControlArgs> table = {
-      ConfigFlag<A>(in(&O::config_file),
-                    "Markers and `control:` section (YAML), see examples/rig.yaml")
+      ValueFlag<A>(kConfigFlag, in(&O::config_file))
+          .Help("Markers and `control:` section (YAML), see examples/rig.yaml")
           .Required()
           .Check(CLI::ExistingFile),
-      InputFlag<A>(in(&O::input),
-                   "Frames from a video or image sequence (a recorded run replayed through the "
-                   "loop; with --simulate the simulated board follows the frames' timestamps)"),
+      ValueFlag<A>(kInputFlag, in(&O::input))
+          .Help("Frames from a video or image sequence (a recorded run replayed through the "
+                "loop; with --simulate the simulated board follows the frames' timestamps)"),
       ValueFlag<A>("-t,--target-deg", in(&O::target_deg))
           .Help("Target angle at the middle marker, degrees (180 = straight)"),
       ValueFlag<A>("--profile", in(&O::profile_file))
@@ -849,7 +849,7 @@ const FlagTable<ControlArgs>& ControlFlags() {
       SwitchFlag<A>("--allow-saturation", in(&O::allow_saturation))
           .Help("Run a target beyond the identified actuator's reach (control.model) limited to "
                 "that reach, instead of refusing it"),
-      QuietFlag<A>(in(&O::quiet), "No summary"),
+      SwitchFlag<A>(kQuietFlag, in(&O::quiet)).Help("No summary"),
   };
   return table;
 }

@@ -184,11 +184,11 @@ BasicCsvColumnTable<StereoFrameResult> StereoControlColumns(
 const FlagTable<ControlStereoOptions>& ControlStereoFlags() {
   using A = ControlStereoOptions;
   static const FlagTable<ControlStereoOptions> table = {
-      StereoFileFlag<A>(&A::stereo_file,
-                        "Two cameras: close the loop on the 3D angle. The pair's calibration "
-                        "from `softsight calibrate --left ... --right ...`, or `builtin` with "
-                        "--simulate (the simulated pair of docs/stereo.md, the actuator bending "
-                        "out of the image plane)"),
+      ValueFlag<A>(kStereoFlag, &A::stereo_file)
+          .Help("Two cameras: close the loop on the 3D angle. The pair's calibration "
+                "from `softsight calibrate --left ... --right ...`, or `builtin` with "
+                "--simulate (the simulated pair of docs/stereo.md, the actuator bending "
+                "out of the image plane)"),
       CameraFlag<A>("--left-camera", &A::left_camera,
                     "With --stereo: the first camera, paired with the second by capture time"),
       CameraFlag<A>("--right-camera", &A::right_camera, "With --stereo: the second camera"),

@@ -84,7 +84,7 @@ const FlagTable<DemoOptions>& DemoFlags() {
       FramesFlag<A>(&A::frames, "Frames to render").Check(CLI::Range(2, 100000)),
       SceneFlag<A>(&A::scene, "bending, wedge1 or wedge4"),
       NoiseFlag<A>(&A::noise_sigma).Check(CLI::Range(0.0, 50.0)),
-      QuietFlag<A>(&A::quiet, "No progress bar and no summary"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("No progress bar and no summary"),
   };
   return table;
 }

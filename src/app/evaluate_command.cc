@@ -487,15 +487,16 @@ const FlagTable<EvaluateArgs>& EvaluateFlags() {
                     "Also write the table as CSV to this file"),
       SeedFlag<A>([](A& a) -> auto& { return a.options.scene.seed; },
                   "Background texture and noise seed (as `softsight synth --seed`: same frames)"),
-      QuietFlag<A>([](A& a) -> auto& { return a.options.quiet; }, "No progress line"),
-      InputFlag<A>([](A& a) -> auto& { return a.video.source.input; },
-                   "Your recording (video, image sequence or synth:NAME) to score instead of the "
-                   "built-in comparison; needs --truth and --config"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No progress line"),
+      ValueFlag<A>(kInputFlag, [](A& a) -> auto& { return a.video.source.input; })
+          .Help("Your recording (video, image sequence or synth:NAME) to score instead of the "
+                "built-in comparison; needs --truth and --config"),
       ValueFlag<A>("--truth", [](A& a) -> auto& { return a.video.truth_csv; })
           .Help("With --input: the truth CSV (frame, <name>_x, <name>_y[, <name>_visible]; "
                 "`softsight synth --truth` writes one)"),
-      ConfigFlag<A>([](A& a) -> auto& { return a.video.config_file; },
-                    "With --input: the marker config to score"),
+      ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.video.config_file; })
+          .Help("With --input: the marker config to score"),
       SequenceFpsFlag<A>([](A& a) -> auto& { return a.video.source.sequence_fps; },
                          "With --input: an image sequence's frame rate"),
   };

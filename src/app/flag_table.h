@@ -15,7 +15,6 @@
 
 #include <functional>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -65,7 +64,11 @@ std::string ConfigKeyHelp(const OptionSpec& spec, const std::string& key_path);
 template <typename Args>
 class FlagBuilder {
  public:
-  explicit FlagBuilder(Flag<Args> flag) : flag_(std::move(flag)) {}
+  using Bind = decltype(Flag<Args>::bind);
+  FlagBuilder(std::string names, Bind bind) {
+    flag_.names = std::move(names);
+    flag_.bind = std::move(bind);
+  }
   FlagBuilder& Help(std::string help) {
     flag_.help = std::move(help);
     return *this;
@@ -110,40 +113,30 @@ class FlagBuilder {
 template <typename Args, typename Access>
 FlagBuilder<Args> ValueFlag(std::string names, Access access) {
   auto field = option_detail::Accessor<Args>(access);
-  Flag<Args> flag;
-  flag.names = std::move(names);
-  flag.bind = [field](CLI::App& app, Args& args, const Flag<Args>& f) {
-    return app.add_option(f.names, field(args), f.help);
-  };
-  return FlagBuilder<Args>(std::move(flag));
+  return {std::move(names), [field](CLI::App& app, Args& args, const Flag<Args>& flag) {
+            return app.add_option(flag.names, field(args), flag.help);
+          }};
 }
 
 // A flag without a value that sets a bool field: CLI11's add_flag.
 template <typename Args, typename Access>
 FlagBuilder<Args> SwitchFlag(std::string names, Access access) {
   auto field = option_detail::Accessor<Args>(access);
-  Flag<Args> flag;
-  flag.names = std::move(names);
-  flag.bind = [field](CLI::App& app, Args& args, const Flag<Args>& f) {
-    static_assert(std::is_same_v<std::remove_reference_t<decltype(field(args))>, bool>,
-                  "SwitchFlag sets a bool");
-    return app.add_flag(f.names, field(args), f.help);
-  };
-  return FlagBuilder<Args>(std::move(flag));
+  return {std::move(names), [field](CLI::App& app, Args& args, const Flag<Args>& flag) {
+            bool& value = field(args);  // A switch sets a bool.
+            return app.add_flag(flag.names, value, flag.help);
+          }};
 }
 
 // A flag without a value that does something to `args` when given (--colour sets a field to
 // true, --gray the same field to false).
 template <typename Args>
 FlagBuilder<Args> ActionFlag(std::string names, std::function<void(Args&)> action) {
-  Flag<Args> flag;
-  flag.names = std::move(names);
-  flag.bind = [action](CLI::App& app, Args& args, const Flag<Args>& f) {
-    Args* bound = &args;
-    return app.add_flag_callback(
-        f.names, [action, bound] { action(*bound); }, f.help);
-  };
-  return FlagBuilder<Args>(std::move(flag));
+  return {std::move(names), [action](CLI::App& app, Args& args, const Flag<Args>& flag) {
+            Args* bound = &args;
+            return app.add_flag_callback(flag.names, [action, bound] { action(*bound); },
+                                         flag.help);
+          }};
 }
 
 }  // namespace softsight

@@ -45,10 +45,8 @@ const FlagTable<ToyArgs>& ToyFlags() {
           .ShowDefault()
           .Check(CLI::Range(16, 8192)),
       ValueFlag<A>("--scale", &A::scale).Help("Scale").Check(NumberIn(1e-3, 1e3)),
-      QuietFlag<A>(&A::quiet, "Say nothing"),
-      ValueFlag<A>(
-          "--name", [](A & a) -> auto& { return a.inner.name; })
-          .Help("A name"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("Say nothing"),
+      ValueFlag<A>("--name", [](A& a) -> auto& { return a.inner.name; }).Help("A name"),
       ActionFlag<A>("--wide", [](A& a) { a.width = 1920; }).Help("1920 wide").Excludes("--width"),
   };
   return table;

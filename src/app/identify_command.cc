@@ -91,7 +91,8 @@ namespace {
 const FlagTable<IdentifyCommandOptions>& IdentifyFlags() {
   using A = IdentifyCommandOptions;
   static const FlagTable<IdentifyCommandOptions> table = {
-      ConfigFlag<A>(&A::config_file, "Markers and `control:` section (YAML), read only")
+      ValueFlag<A>(kConfigFlag, &A::config_file)
+          .Help("Markers and `control:` section (YAML), read only")
           .Required()
           .Check(CLI::ExistingFile),
       OutputFlag<A>(&A::output_file, "",
@@ -105,7 +106,7 @@ const FlagTable<IdentifyCommandOptions>& IdentifyFlags() {
           .Help("SIMC closed-loop time constant (default max(dead time, 3 camera periods)); "
                 "larger: gentler gains"),
       ValueFlag<A>("--max-s", &A::max_s).Help("Longest the experiment may take (default 600 s)"),
-      QuietFlag<A>(&A::quiet, "Only errors"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("Only errors"),
   };
   return table;
 }

@@ -327,9 +327,8 @@ struct PickArgs {
 template <typename Args>
 FlagTable<Args> OneFrameFlags(const std::string& frame_help) {
   return {
-      InputFlag<Args>([](Args& a) -> auto& { return a.options.source.input; },
-                      "Video file, folder of images, printf pattern (frames/%04d.png) or "
-                      "synth:NAME")
+      ValueFlag<Args>(kInputFlag, [](Args& a) -> auto& { return a.options.source.input; })
+          .Help("Video file, folder of images, printf pattern (frames/%04d.png) or synth:NAME")
           .Required(),
       ValueFlag<Args>("--frame", [](Args& a) -> auto& { return a.options.frame; })
           .Help(frame_help)
@@ -377,8 +376,8 @@ const FlagTable<PickArgs>& PickFlags() {
         ValueFlag<A>("--at", &A::at)
             .Help("X,Y of a marker's centre in pixels (repeat per marker)")
             .Required(),
-        ConfigFlag<A>([](A& a) -> auto& { return a.options.base_config; },
-                      "Update this config's markers in order instead of writing new ones")
+        ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.options.base_config; })
+            .Help("Update this config's markers in order instead of writing new ones")
             .Check(CLI::ExistingFile),
     };
     flags.insert(flags.end(), own.begin(), own.end());

@@ -302,7 +302,7 @@ const FlagTable<ListenOptions>& ListenFlags() {
       ValueFlag<A>("--timeout-s", &A::timeout_s)
           .Help("Fail (exit 2) when nothing at all arrives for this many seconds (default: wait)")
           .Check(NumberIn(1e-3, 1e9)),
-      QuietFlag<A>(&A::quiet, "Nothing on stderr but errors"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("Nothing on stderr but errors"),
   };
   return table;
 }

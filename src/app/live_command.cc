@@ -113,10 +113,12 @@ const FlagTable<LiveArgs>& LiveFlags() {
   using A = LiveArgs;
   static const FlagTable<LiveArgs> table = {
       CameraFlag<A>("--camera", &A::camera, "The camera"),
-      InputFlag<A>(&A::input,
-                   "Video file or image sequence instead of a camera (played at its frame rate)")
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Video file or image sequence instead of a camera (played at its frame rate)")
           .Excludes("--camera"),
-      ConfigFlag<A>(&A::config, "Marker configuration (YAML, see examples/)").Required(),
+      ValueFlag<A>(kConfigFlag, &A::config)
+          .Help("Marker configuration (YAML, see examples/)")
+          .Required(),
       MethodFlag<A>(&A::method),
       ValueFlag<A>("--save-config", &A::save_config)
           .Help("Where `s` saves the config (default: <config>.live.yaml beside it)"),

@@ -166,9 +166,9 @@ const FlagTable<RigCommandOptions>& RigFlags() {
       SwitchFlag<A>("--pty", &A::pty)
           .Help("Serve on a new pseudo-terminal and print its path")
           .Required(),
-      ConfigFlag<A>(&A::config_file,
-                    "Config whose `control: rig:` section sets the board and plant (defaults "
-                    "without)")
+      ValueFlag<A>(kConfigFlag, &A::config_file)
+          .Help("Config whose `control: rig:` section sets the board and plant (defaults "
+                "without)")
           .Check(CLI::ExistingFile),
       ValueFlag<A>("--frames", &A::frames_file)
           .Help("Render the actuator to this image file at --fps (rewritten atomically), for "
@@ -182,7 +182,7 @@ const FlagTable<RigCommandOptions>& RigFlags() {
           .Help("Answer this many lines, close the port when the host asks again (it has read "
                 "them all), and keep running (the same pulled cable, at a point that does not "
                 "depend on timing)"),
-      QuietFlag<A>(&A::quiet, "No state-change lines on stderr"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("No state-change lines on stderr"),
   };
   return table;
 }

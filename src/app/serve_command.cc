@@ -122,14 +122,15 @@ const FlagTable<ServeArgs>& ServeFlags() {
   using A = ServeArgs;
   static const FlagTable<ServeArgs> table = {
       CameraFlag<A>("--camera", &A::camera, "The camera"),
-      InputFlag<A>(&A::input, "Video file, image sequence or synth:NAME instead of a camera")
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Video file, image sequence or synth:NAME instead of a camera")
           .Excludes("--camera"),
       ValueFlag<A>("--compare", &A::compare)
           .Help("A second video shown beside --input's, frame by frame at the same position "
                 "(two runs side by side in sync; the page's compare opens its CSV)"),
-      ConfigFlag<A>(&A::config,
-                    "Marker configuration (YAML, see examples/); a synth: input without one uses "
-                    "the scene's own, written to <folder>/synth-NAME.yaml"),
+      ValueFlag<A>(kConfigFlag, &A::config)
+          .Help("Marker configuration (YAML, see examples/); a synth: input without one uses "
+                "the scene's own, written to <folder>/synth-NAME.yaml"),
       MethodFlag<A>(&A::method),
       ValueFlag<A>("--bind", &A::bind)
           .Help("Address to listen on; any but loopback requires the printed token")

@@ -16,17 +16,19 @@
 
 namespace softsight {
 
-// -c,--config: the YAML the command reads (markers, control: section).
-template <typename Args, typename Access>
-FlagBuilder<Args> ConfigFlag(Access access, std::string help) {
-  return ValueFlag<Args>("-c,--config", access).Help(std::move(help));
-}
-
-// -i,--input: frames from a file (a video, an image sequence or synth:NAME) instead of a camera.
-template <typename Args, typename Access>
-FlagBuilder<Args> InputFlag(Access access, std::string help) {
-  return ValueFlag<Args>("-i,--input", access).Help(std::move(help));
-}
+// Flags several commands take whose help, check and default are each command's own (what the
+// config holds, whether it is required): their names, declared once.
+inline constexpr const char* kConfigFlag = "-c,--config";  // The YAML the command reads.
+inline constexpr const char* kInputFlag = "-i,--input";    // Frames (or views) from files.
+inline constexpr const char* kQuietFlag = "-q,--quiet";    // Less on stderr.
+// A printed chessboard: calibrate's, and track-stereo's --bench-board.
+inline constexpr const char* kChessboardFlag = "--chessboard";
+inline constexpr const char* kSquareMmFlag = "--square-mm";
+// The two cameras: their recordings (track-stereo's videos, calibrate's views) and the pair's
+// calibration (track-stereo, control and identify --stereo).
+inline constexpr const char* kLeftFlag = "--left";
+inline constexpr const char* kRightFlag = "--right";
+inline constexpr const char* kStereoFlag = "--stereo";
 
 // -o is --output, the command's main output, everywhere; `old_name` ("csv", "out", "out-dir";
 // "" for none) is the long name it had before and keeps.
@@ -34,12 +36,6 @@ template <typename Args, typename Access>
 FlagBuilder<Args> OutputFlag(Access access, const std::string& old_name, std::string help) {
   const std::string names = old_name.empty() ? "-o,--output" : "-o,--output,--" + old_name;
   return ValueFlag<Args>(names, access).Help(std::move(help));
-}
-
-// -q,--quiet: less on stderr; `help` says what is left out.
-template <typename Args, typename Access>
-FlagBuilder<Args> QuietFlag(Access access, std::string help) {
-  return SwitchFlag<Args>("-q,--quiet", access).Help(std::move(help));
 }
 
 // --fps: an image sequence's frame rate, for its timestamps (a video has its own).
@@ -80,33 +76,10 @@ FlagBuilder<Args> ChartSecondsFlag(Access access, std::string help) {
   return ValueFlag<Args>("--chart-seconds", access).Help(std::move(help)).ShowDefault();
 }
 
-// --chessboard and --square-mm: a printed chessboard, as calibrate and track-stereo's
-// --bench-board read it.
-template <typename Args, typename Access>
-FlagBuilder<Args> ChessboardFlag(Access access, std::string help) {
-  return ValueFlag<Args>("--chessboard", access).Help(std::move(help));
-}
-template <typename Args, typename Access>
-FlagBuilder<Args> SquareMmFlag(Access access, std::string help) {
-  return ValueFlag<Args>("--square-mm", access).Help(std::move(help));
-}
 
-// --left and --right: the two cameras' recordings (track-stereo's videos, calibrate's views).
-template <typename Args, typename Access>
-FlagBuilder<Args> LeftFlag(Access access, std::string help) {
-  return ValueFlag<Args>("--left", access).Help(std::move(help));
-}
-template <typename Args, typename Access>
-FlagBuilder<Args> RightFlag(Access access, std::string help) {
-  return ValueFlag<Args>("--right", access).Help(std::move(help));
-}
 
-// The two cameras of track-stereo and control/identify --stereo: the pair's calibration, the
-// right view's own config and how far from its epipolar line a pair is still believed.
-template <typename Args, typename Access>
-FlagBuilder<Args> StereoFileFlag(Access access, std::string help) {
-  return ValueFlag<Args>("--stereo", access).Help(std::move(help));
-}
+// The two cameras of track-stereo and control/identify --stereo: the right view's own config
+// and how far from its epipolar line a pair is still believed.
 template <typename Args, typename Access>
 FlagBuilder<Args> RightConfigFlag(Access access, std::string help) {
   return ValueFlag<Args>("--right-config", access).Help(std::move(help)).Check(CLI::ExistingFile);

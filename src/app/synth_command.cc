@@ -187,7 +187,8 @@ const FlagTable<SynthArgs>& SynthFlags() {
           .ShowDefault(),
       ValueFlag<A>("--codec", [](A& a) -> auto& { return a.options.codec; })
           .Help("Video codec override: ffv1, hfyu, mjpg or mp4v"),
-      QuietFlag<A>([](A& a) -> auto& { return a.options.quiet; }, "No summary line"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No summary line"),
   };
   return table;
 }

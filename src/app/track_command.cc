@@ -152,14 +152,14 @@ struct TrackArgs {
 const FlagTable<TrackArgs>& TrackFlags() {
   using A = TrackArgs;
   static const FlagTable<TrackArgs> table = {
-      ConfigFlag<A>([](A& a) -> auto& { return a.options.config_file; },
-                    "Marker config (YAML), see examples/")
+      ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.options.config_file; })
+          .Help("Marker config (YAML), see examples/")
           .Required()
           .Check(CLI::ExistingFile),
-      InputFlag<A>(&A::inputs,
-                   "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
-                   "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
-                   "synth:plate. Repeat it for several inputs (with -o FOLDER/)"),
+      ValueFlag<A>(kInputFlag, &A::inputs)
+          .Help("Video file, folder of images, printf pattern such as frames/%04d.png, or a "
+                "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
+                "synth:plate. Repeat it for several inputs (with -o FOLDER/)"),
       CameraFlag<A>("--camera", [](A& a) -> auto& { return a.options.source.camera; },
                     "The camera instead of --input: tracks until Ctrl-C or --max-frames")
           .Excludes("--input"),
@@ -188,7 +188,8 @@ const FlagTable<TrackArgs>& TrackFlags() {
                          "Frame rate of an image sequence, for its timestamps"),
       MaxFramesFlag<A>([](A& a) -> auto& { return a.options.max_frames; },
                        "Stop after this many frames"),
-      QuietFlag<A>([](A& a) -> auto& { return a.options.quiet; }, "No progress bar and no summary"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No progress bar and no summary"),
       SwitchFlag<A>("--brief", [](A& a) -> auto& { return a.options.brief; })
           .Help("No progress bar; a one-line summary at the end"),
   };

@@ -453,22 +453,23 @@ namespace {
 const FlagTable<TrackStereoOptions>& TrackStereoFlags() {
   using A = TrackStereoOptions;
   static const FlagTable<TrackStereoOptions> table = {
-      ConfigFlag<A>(&A::config_file, "Marker config (YAML), see examples/")
+      ValueFlag<A>(kConfigFlag, &A::config_file).Help("Marker config (YAML), see examples/")
           .Required()
           .Check(CLI::ExistingFile),
       RightConfigFlag<A>(&A::right_config_file,
                          "The right view's marker config, when its colours or rois differ (same "
                          "names)"),
-      LeftFlag<A>(&A::left_input, "The first camera's video (or image sequence)"),
-      RightFlag<A>(&A::right_input, "The second camera's video (or image sequence)"),
+      ValueFlag<A>(kLeftFlag, &A::left_input).Help("The first camera's video (or image sequence)"),
+      ValueFlag<A>(kRightFlag, &A::right_input)
+          .Help("The second camera's video (or image sequence)"),
       ValueFlag<A>("--side-by-side", &A::side_by_side)
           .Help("Instead of --left/--right: one video, the first camera in the left half of each "
                 "frame, the second in the right half"),
       CameraFlag<A>("--left-camera", &A::left_camera,
                     "Instead of --left/--right: two live cameras, paired by capture time"),
       CameraFlag<A>("--right-camera", &A::right_camera, "The second live camera"),
-      StereoFileFlag<A>(&A::stereo_file,
-                        "The rig from `softsight calibrate --left ... --right ...`")
+      ValueFlag<A>(kStereoFlag, &A::stereo_file)
+          .Help("The rig from `softsight calibrate --left ... --right ...`")
           .Required(),
       OutputFlag<A>(&A::csv_file, "csv", "Where to write the per-frame CSV").Required(),
       ValueFlag<A>("--frame-offset", &A::frame_offset)
@@ -501,11 +502,11 @@ const FlagTable<TrackStereoOptions>& TrackStereoFlags() {
                 "along its first row, Y along its columns, Z into the bench) instead of the "
                 "first camera's")
           .Finish([](CLI::Option* o) { o->expected(2); }),
-      ChessboardFlag<A>(&A::chessboard,
-                        "The --bench-board board's inner corners WxH (default: the --stereo "
-                        "file's)"),
-      SquareMmFlag<A>(&A::square_mm,
-                      "The --bench-board board's square side in mm (default: the --stereo file's)"),
+      ValueFlag<A>(kChessboardFlag, &A::chessboard)
+          .Help("The --bench-board board's inner corners WxH (default: the --stereo "
+                "file's)"),
+      ValueFlag<A>(kSquareMmFlag, &A::square_mm)
+          .Help("The --bench-board board's square side in mm (default: the --stereo file's)"),
       SequenceFpsFlag<A>(&A::sequence_fps, "Frame rate of image sequences"),
       ValueFlag<A>("--right-fps", &A::right_sequence_fps)
           .Help("Frame rate of the right image sequence, when it differs from --fps")
