@@ -14,6 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "io/sequence_pattern.h"
 #include "softsight/calib/camera_calibration.h"
 #include "softsight/calib/stereo_calibration.h"
@@ -385,6 +386,52 @@ CalibrateSummary RunCalibrate(const CalibrateOptions& options, std::ostream& rep
                        : CalibratePlaneMode(options, board, report);
 }
 
+namespace {
+
+const FlagTable<CalibrateOptions>& CalibrateFlags() {
+  using A = CalibrateOptions;
+  static const FlagTable<CalibrateOptions> table = {
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Chessboard views: a folder of images, a printf pattern (shots/%03d.png) or a "
+                "video file"),
+      ValueFlag<A>("--plane", &A::plane_image)
+          .Help("One image of the chessboard lying flat in the actuator's plane: writes the "
+                "image-to-millimetre homography instead")
+          .Excludes("--input"),
+      ValueFlag<A>(kLeftFlag, &A::left)
+          .Help("Two cameras: the first camera's chessboard views (folder, pattern or video), "
+                "paired one to one in order with --right's")
+          .Excludes("--input")
+          .Excludes("--plane"),
+      ValueFlag<A>(kRightFlag, &A::right)
+          .Help("Two cameras: the second camera's views of the same moments")
+          .Excludes("--input")
+          .Excludes("--plane"),
+      ValueFlag<A>("--picture", &A::picture_file)
+          .Help("With --left/--right: write the first pair rectified side by side with epipolar "
+                "lines (PNG)"),
+      ValueFlag<A>("--camera", &A::camera_file)
+          .Help("With --plane: the camera file from an earlier `calibrate --input` run, used to "
+                "remove lens distortion")
+          .Needs("--plane"),
+      ValueFlag<A>(kChessboardFlag, &A::chessboard)
+          .Help("INNER corners per row x per column, e.g. 9x6 for a board of 10 x 7 "
+                "squares")
+          .Required(),
+      ValueFlag<A>(kSquareMmFlag, &A::square_mm)
+          .Help("Side of one printed square in millimetres")
+          .Required(),
+      OutputFlag<A>(&A::out_file, "out", "File to write (OpenCV YAML)").Required(),
+      ValueFlag<A>("--step", &A::step)
+          .Help("Video input: use every N-th frame (default 1; with two videos, both)"),
+      SwitchFlag<A>("--k3", &A::estimate_k3)
+          .Help("Also estimate the k3 radial term (wide-angle lenses only)"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupCalibrateCommand(CLI::App& sub) {
   auto options = std::make_shared<CalibrateOptions>();
   sub.description(
@@ -399,38 +446,7 @@ CommandRunner SetupCalibrateCommand(CLI::App& sub) {
       "stereo.yaml is for `track-stereo` (docs/stereo.md).\n"
       "Take 10-20 views of the board filling much of the frame at different tilts and\n"
       "positions, including the image corners.");
-  auto* input = sub.add_option("--input", options->input,
-                               "Chessboard views: a folder of images, a printf pattern "
-                               "(shots/%03d.png) or a video file");
-  auto* plane = sub.add_option("--plane", options->plane_image,
-                               "One image of the chessboard lying flat in the actuator's plane: "
-                               "writes the image-to-millimetre homography instead");
-  input->excludes(plane);
-  auto* left =
-      sub.add_option("--left", options->left,
-                     "Two cameras: the first camera's chessboard views (folder, pattern or "
-                     "video), paired one to one in order with --right's");
-  auto* right = sub.add_option("--right", options->right,
-                               "Two cameras: the second camera's views of the same moments");
-  left->excludes(input)->excludes(plane);
-  right->excludes(input)->excludes(plane);
-  sub.add_option("--picture", options->picture_file,
-                 "With --left/--right: write the first pair rectified side by side with epipolar "
-                 "lines (PNG)");
-  sub.add_option("--camera", options->camera_file,
-                 "With --plane: the camera file from an earlier `calibrate --input` run, used to "
-                 "remove lens distortion")
-      ->needs(plane);
-  sub.add_option("--chessboard", options->chessboard,
-                 "INNER corners per row x per column, e.g. 9x6 for a board of 10 x 7 squares")
-      ->required();
-  sub.add_option("--square-mm", options->square_mm, "Side of one printed square in millimetres")
-      ->required();
-  sub.add_option("-o,--output,--out", options->out_file, "File to write (OpenCV YAML)")->required();
-  sub.add_option("--step", options->step,
-                 "Video input: use every N-th frame (default 1; with two videos, both)");
-  sub.add_flag("--k3", options->estimate_k3,
-               "Also estimate the k3 radial term (wide-angle lenses only)");
+  AddFlags(sub, CalibrateFlags(), options.get());
   return [options] {
     RunCalibrate(*options, std::cout);
     return 0;

@@ -20,35 +20,37 @@ std::string FlagOf(const std::string& key) {
 
 }  // namespace
 
-CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
-                             std::optional<CameraId>* camera, const std::string& help) {
-  CLI::Validator is_camera(
+CLI::Validator CameraIdCheck() {
+  return CLI::Validator(
       [](std::string& text) { return CameraIdProblem(text).value_or(std::string()); }, "");
-  return sub
-      .add_option(name, *camera,
-                  help + ": a V4L2 index (0: /dev/video0), or aravis: for the first GenICam "
-                         "camera (GigE Vision, USB3 Vision) and aravis:DEVICE-ID for a named one "
-                         "(`softsight cameras` lists them; aravis:Fake_1 is Aravis' simulated "
-                         "camera)")
-      ->type_name("N|aravis:ID")
-      ->check(is_camera);
 }
 
-void AddCaptureOptions(CLI::App& sub, CaptureArgs* args) {
-  for (const Option<CameraSettings>& option : CameraSettingsTable()) {
-    std::string help = option.doc;
-    if (!option.unit.empty()) help += " [" + option.unit + "]";
-    help += "; " + OptionRangeText(option) + " (config: capture." + option.key + ")";
-    // The map's nodes stay where they are: the option writes into its own entry.
-    // Read as text and checked by MergeCaptureOptions (one message for the flag and the config
-    // key alike); the help names the kind of value.
-    const char* type_name = option.kind == OptionKind::kInt      ? "INT"
-                            : option.kind == OptionKind::kDouble ? "FLOAT"
-                                                                 : "TEXT";
-    sub.add_option(FlagOf(option.key), (*args)[option.key], help)
-        ->type_name(type_name)
-        ->group("Camera settings (when the frames come from a camera)");
-  }
+std::string CameraHelp(const std::string& what) {
+  return what + ": a V4L2 index (0: /dev/video0), or aravis: for the first GenICam camera (GigE "
+                "Vision, USB3 Vision) and aravis:DEVICE-ID for a named one (`softsight cameras` "
+                "lists them; aravis:Fake_1 is Aravis' simulated camera)";
+}
+
+const FlagTable<CaptureArgs>& CaptureFlags() {
+  static const FlagTable<CaptureArgs> table = [] {
+    FlagTable<CaptureArgs> flags;
+    for (const Option<CameraSettings>& option : CameraSettingsTable()) {
+      // Read as text and checked by MergeCaptureOptions (one message for the flag and the
+      // config key alike); the help names the kind of value.
+      const char* type_name = option.kind == OptionKind::kInt      ? "INT"
+                              : option.kind == OptionKind::kDouble ? "FLOAT"
+                                                                   : "TEXT";
+      const std::string key = option.key;
+      // The map's nodes stay where they are: the flag writes into its own entry.
+      auto text = [key](CaptureArgs& args) -> std::string& { return args[key]; };
+      flags.push_back(ValueFlag<CaptureArgs>(FlagOf(key), text)
+                          .Help(ConfigKeyHelp(option, "capture." + key))
+                          .TypeName(type_name)
+                          .Group("Camera settings (when the frames come from a camera)"));
+    }
+    return flags;
+  }();
+  return table;
 }
 
 CameraSettings MergeCaptureOptions(const CaptureArgs& args, CameraSettings settings) {

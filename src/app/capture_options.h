@@ -1,5 +1,6 @@
-// The camera's capture settings as command-line options of live, track and control, made from
-// the settings' option table (io/camera_options.h), so each setting is described once:
+// The camera on the command line: --camera N|aravis:ID (CameraFlag), and its capture settings
+// as flags of live, serve, track and control, made from the settings' option table
+// (io/camera_options.h), so each setting is described once:
 // --camera-width, --camera-height, --camera-fps, --camera-pixel-format, --camera-exposure,
 // --camera-gain, --camera-white-balance, --camera-focus (and --camera-device).
 #pragma once
@@ -12,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/flag_table.h"
 #include "softsight/config/config.h"
 #include "softsight/io/camera_settings.h"
 #include "softsight/io/frame_source.h"
@@ -21,14 +23,24 @@ namespace softsight {
 // The texts given on the command line, by table key.
 using CaptureArgs = std::map<std::string, std::string>;
 
-// A camera option (`--camera`, `--left-camera`): a V4L2 index or aravis:[DEVICE-ID]
-// (softsight/io/camera_settings.h), checked as it is parsed, so a wrong one is one line naming the
-// option. `help` says what the camera is for; the syntax is added to it.
-CLI::Option* AddCameraOption(CLI::App& sub, const std::string& name,
-                             std::optional<CameraId>* camera, const std::string& help);
+// A camera option's check: a V4L2 index or aravis:[DEVICE-ID] (softsight/io/camera_settings.h),
+// checked as it is parsed, so a wrong one is one line naming the option.
+CLI::Validator CameraIdCheck();
+// A camera option's help: `what` the camera is for, then the syntax.
+std::string CameraHelp(const std::string& what);
 
-// Registers one option per row of the table on `sub`; `args` must outlive parsing.
-void AddCaptureOptions(CLI::App& sub, CaptureArgs* args);
+// A camera flag (`--camera`, `--left-camera`) setting a std::optional<CameraId> field.
+template <typename Args, typename Access>
+FlagBuilder<Args> CameraFlag(const std::string& name, Access access, const std::string& what) {
+  return ValueFlag<Args>(name, access)
+      .Help(CameraHelp(what))
+      .TypeName("N|aravis:ID")
+      .Check(CameraIdCheck());
+}
+
+// One flag per row of the camera settings' table (--camera-width ...), its help and range from
+// the row; the texts given land in a CaptureArgs, which must outlive parsing.
+const FlagTable<CaptureArgs>& CaptureFlags();
 
 // The config's settings with the command line's on top. Throws InputError naming the option
 // ("--camera-width 5: must lie within 16..8192").

@@ -16,6 +16,7 @@
 #include "app/control_parts.h"
 #include "app/control_stereo.h"
 #include "app/publish_options.h"
+#include "app/shared_flags.h"
 #include "app/target_feed.h"
 #include "app/stop_request.h"
 #include "softsight/control/board_link.h"
@@ -781,9 +782,83 @@ std::string FormatIdentifyOutcome(const IdentifyOutcome& found) {
   return text;
 }
 
+namespace {
+
+// What control's flags set until it runs.
+struct ControlArgs {
+  ControlOptions options;
+  bool auto_tune = false;
+  std::optional<double> closed_loop_s;  // With --auto-tune.
+  PublishArgs publish;
+  ControlStereoOptions stereo;
+};
+
+const FlagTable<ControlOptions>& ControlRigFlags() {
+  static const FlagTable<ControlOptions> table = RigSourceFlags<ControlOptions>(
+      "Serial device of the board: /dev/ttyACM0, or the /dev/pts/N `softsight rig --pty` prints",
+      "Drive an in-process simulated rig over a real pseudo-terminal, rendering its frames "
+      "(simulated time: runs as fast as it can)",
+      "Read frames from the file `softsight rig --frames FILE` keeps rewriting");
+  return table;
+}
+
+const FlagTable<ControlArgs>& ControlFlags() {
+  using A = ControlArgs;
+  using O = ControlOptions;
+  // A field of the options: [](A& a) -> auto& { return a.options.x; } for each row, spelled once.
+  auto in = [](auto O::*field) { return [field](A& a) -> auto& { return a.options.*field; }; };
+  static const FlagTable<ControlArgs> table = {
+      ValueFlag<A>(kConfigFlag, in(&O::config_file))
+          .Help("Markers and `control:` section (YAML), see examples/rig.yaml")
+          .Required()
+          .Check(CLI::ExistingFile),
+      ValueFlag<A>(kInputFlag, in(&O::input))
+          .Help("Frames from a video or image sequence (a recorded run replayed through the "
+                "loop; with --simulate the simulated board follows the frames' timestamps)"),
+      ValueFlag<A>("-t,--target-deg", in(&O::target_deg))
+          .Help("Target angle at the middle marker, degrees (180 = straight)"),
+      ValueFlag<A>("--profile", in(&O::profile_file))
+          .Help("Target profile file: steps, ramps, sines (docs/control.md)")
+          .Check(CLI::ExistingFile),
+      ValueFlag<A>("--pressure-kpa", in(&O::pressure_kpa))
+          .Help("Open loop: hold this pressure setpoint (characterise an actuator)"),
+      ValueFlag<A>("--pwm", in(&O::pwm))
+          .Help("Open loop: this valve duty in -1..1 (> 0 inflate, < 0 vent)"),
+      ValueFlag<A>("--target-from", in(&O::target_from))
+          .Help("Target angles from another program: a ZeroMQ endpoint it publishes on "
+                "(tcp://HOST:5557, ipc://PATH), messages `target {\"angle_deg\": 120}`; checked "
+                "as a profile (0..180, the model's reach), followed at most at "
+                "controller.target_max_rate_deg_per_s, vented when silent longer than "
+                "controller.target_silence_s (docs/stream.md)"),
+      ValueFlag<A>("--target-wait-s", in(&O::target_wait_s))
+          .Help("With --target-from: the longest wait for the first target before the board is "
+                "opened, seconds")
+          .ShowDefault(),
+      OutputFlag<A>(in(&O::csv_file), "csv", "Where to write the per-frame CSV").Required(),
+      ValueFlag<A>("--duration-s", in(&O::duration_s))
+          .Help("Run length in seconds (default: the profile's length + 2 s, else 10 s)"),
+      ValueFlag<A>("--metrics-csv", in(&O::metrics_csv_file))
+          .Help("Write the step-response figures (rise, settling +-1/+-2 deg, overshoot, "
+                "steady-state error, RMS error) as a two-line CSV"),
+      SwitchFlag<A>("--auto-tune", &A::auto_tune)
+          .Help("Identify the actuator first (`softsight identify`: steps and a PRBS, its CSV "
+                "beside --csv as *_identify.csv), then run the loop with the gains it found"),
+      ValueFlag<A>("--closed-loop-s", &A::closed_loop_s)
+          .Help("With --auto-tune: the SIMC closed-loop time (default max(dead time, 3 camera "
+                "periods))"),
+      SwitchFlag<A>("--allow-saturation", in(&O::allow_saturation))
+          .Help("Run a target beyond the identified actuator's reach (control.model) limited to "
+                "that reach, instead of refusing it"),
+      SwitchFlag<A>(kQuietFlag, in(&O::quiet)).Help("No summary"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupControlCommand(CLI::App& sub) {
-  auto o = std::make_shared<ControlOptions>();
-  AddCaptureOptions(sub, &o->capture_args);
+  auto args = std::make_shared<ControlArgs>();
+  AddFlags(sub, CaptureFlags(), &args->options.capture_args);
   sub.description(
       "Close the loop: track the markers, turn the bending-angle error into a pressure setpoint\n"
       "(the outer loop) and send it over the serial link to the board, whose inner loop holds\n"
@@ -801,64 +876,17 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       "--target-deg 120 --csv run3d.csv\n"
       "  softsight control --config rig.yaml --stereo stereo.yaml --left-camera 0 --right-camera 2 "
       "--port /dev/ttyACM0 --target-deg 120 --csv run3d.csv");
-  sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), see "
-                 "examples/rig.yaml")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sub.add_option("-p,--port", o->port,
-                 "Serial device of the board: /dev/ttyACM0, or the /dev/pts/N `softsight rig "
-                 "--pty` prints");
-  sub.add_flag("--simulate", o->simulate,
-               "Drive an in-process simulated rig over a real pseudo-terminal, rendering its "
-               "frames (simulated time: runs as fast as it can)");
-  AddCameraOption(sub, "--camera", &o->camera, "The camera for the frames (live)");
-  sub.add_option("--rig-frames", o->rig_frames,
-                 "Read frames from the file `softsight rig --frames FILE` keeps rewriting");
-  sub.add_option("-i,--input", o->input,
-                 "Frames from a video or image sequence (a recorded run replayed through the "
-                 "loop; with --simulate the simulated board follows the frames' timestamps)");
-  sub.add_option("-t,--target-deg", o->target_deg,
-                 "Target angle at the middle marker, degrees (180 = straight)");
-  sub.add_option("--profile", o->profile_file,
-                 "Target profile file: steps, ramps, sines (docs/control.md)")
-      ->check(CLI::ExistingFile);
-  sub.add_option("--pressure-kpa", o->pressure_kpa,
-                 "Open loop: hold this pressure setpoint (characterise an actuator)");
-  sub.add_option("--pwm", o->pwm, "Open loop: this valve duty in -1..1 (> 0 inflate, < 0 vent)");
-  sub.add_option("--target-from", o->target_from,
-                 "Target angles from another program: a ZeroMQ endpoint it publishes on "
-                 "(tcp://HOST:5557, ipc://PATH), messages `target {\"angle_deg\": 120}`; checked "
-                 "as a profile (0..180, the model's reach), followed at most at "
-                 "controller.target_max_rate_deg_per_s, vented when silent longer than "
-                 "controller.target_silence_s (docs/stream.md)");
-  sub.add_option("--target-wait-s", o->target_wait_s,
-                 "With --target-from: the longest wait for the first target before the board is "
-                 "opened, seconds")
-      ->capture_default_str();
-  sub.add_option("-o,--output,--csv", o->csv_file, "Where to write the per-frame CSV")->required();
-  sub.add_option("--duration-s", o->duration_s,
-                 "Run length in seconds (default: the profile's length + 2 s, else 10 s)");
-  sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")
-      ->capture_default_str();
-  sub.add_option("--metrics-csv", o->metrics_csv_file,
-                 "Write the step-response figures (rise, settling +-1/+-2 deg, overshoot, "
-                 "steady-state error, RMS error) as a two-line CSV");
-  auto auto_tune = std::make_shared<bool>(false);
-  auto closed_loop_s = std::make_shared<std::optional<double>>();
-  sub.add_flag("--auto-tune", *auto_tune,
-               "Identify the actuator first (`softsight identify`: steps and a PRBS, its CSV "
-               "beside --csv as *_identify.csv), then run the loop with the gains it found");
-  sub.add_option("--closed-loop-s", *closed_loop_s,
-                 "With --auto-tune: the SIMC closed-loop time (default max(dead time, 3 camera periods))");
-  sub.add_flag("--allow-saturation", o->allow_saturation,
-               "Run a target beyond the identified actuator's reach (control.model) limited to "
-               "that reach, instead of refusing it");
-  sub.add_flag("-q,--quiet", o->quiet, "No summary");
-  auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
-  AddHookOptions(sub, &o->hook);
-  auto stereo = std::make_shared<ControlStereoOptions>();
-  control_parts::AddControlStereoOptions(sub, stereo.get());
+  AddFlags(sub, ControlRigFlags(), &args->options);
+  AddFlags(sub, ControlFlags(), args.get());
+  AddFlags(sub, PublishFlags(), &args->publish);
+  AddFlags(sub, HookFlags(), &args->options.hook);
+  AddFlags(sub, control_parts::ControlStereoFlags(), &args->stereo);
+  // The run's parts, each keeping `args` alive.
+  const std::shared_ptr<ControlOptions> o(args, &args->options);
+  const std::shared_ptr<bool> auto_tune(args, &args->auto_tune);
+  const std::shared_ptr<std::optional<double>> closed_loop_s(args, &args->closed_loop_s);
+  const std::shared_ptr<PublishArgs> publish(args, &args->publish);
+  const std::shared_ptr<ControlStereoOptions> stereo(args, &args->stereo);
   return [o, auto_tune, closed_loop_s, publish, stereo, &sub] {
     o->publish = publish->resolved();
     o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);

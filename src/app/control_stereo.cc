@@ -6,6 +6,7 @@
 
 #include "app/capture_options.h"
 #include "app/cli_checks.h"
+#include "app/shared_flags.h"
 #include "app/track_stereo_command.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
@@ -180,32 +181,34 @@ BasicCsvColumnTable<StereoFrameResult> StereoControlColumns(
   return columns;
 }
 
-void AddControlStereoOptions(CLI::App& sub, ControlStereoOptions* args) {
-  sub.add_option("--stereo", args->stereo_file,
-                 "Two cameras: close the loop on the 3D angle. The pair's calibration from "
-                 "`softsight calibrate --left ... --right ...`, or `builtin` with --simulate (the "
-                 "simulated pair of docs/stereo.md, the actuator bending out of the image plane)");
-  AddCameraOption(sub, "--left-camera", &args->left_camera,
-                  "With --stereo: the first camera, paired with the second by capture time");
-  AddCameraOption(sub, "--right-camera", &args->right_camera, "With --stereo: the second camera");
-  sub.add_option("--right-config", args->right_config_file,
-                 "With --stereo: the right view's marker config, when its colours or rois differ "
-                 "(same names)")
-      ->check(CLI::ExistingFile);
-  sub.add_option("--stereo-angle", args->angle,
-                 "With --stereo: the angle the loop closes on: 3d (verified in both views), or "
-                 "left / right (that camera's own 2D angle, to compare)")
-      ->capture_default_str();
-  sub.add_option("--max-epipolar-px", args->max_epipolar_px,
-                 "With --stereo: a pair farther than this from its epipolar line is not believed "
-                 "(a lost marker to the loop)")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e3));
-  sub.add_option("--sim-tilt-deg", args->sim_tilt_deg,
-                 "With --simulate --stereo: the simulated actuator's bending plane, turned this "
-                 "far out of the first camera's image plane (deg)")
-      ->capture_default_str()
-      ->check(NumberIn(0, 80));
+const FlagTable<ControlStereoOptions>& ControlStereoFlags() {
+  using A = ControlStereoOptions;
+  static const FlagTable<ControlStereoOptions> table = {
+      ValueFlag<A>(kStereoFlag, &A::stereo_file)
+          .Help("Two cameras: close the loop on the 3D angle. The pair's calibration "
+                "from `softsight calibrate --left ... --right ...`, or `builtin` with "
+                "--simulate (the simulated pair of docs/stereo.md, the actuator bending "
+                "out of the image plane)"),
+      CameraFlag<A>("--left-camera", &A::left_camera,
+                    "With --stereo: the first camera, paired with the second by capture time"),
+      CameraFlag<A>("--right-camera", &A::right_camera, "With --stereo: the second camera"),
+      RightConfigFlag<A>(&A::right_config_file,
+                         "With --stereo: the right view's marker config, when its colours or rois "
+                         "differ (same names)"),
+      ValueFlag<A>("--stereo-angle", &A::angle)
+          .Help("With --stereo: the angle the loop closes on: 3d (verified in both views), or "
+                "left / right (that camera's own 2D angle, to compare)")
+          .ShowDefault(),
+      MaxEpipolarFlag<A>(&A::max_epipolar_px,
+                         "With --stereo: a pair farther than this from its epipolar line is not "
+                         "believed (a lost marker to the loop)"),
+      ValueFlag<A>("--sim-tilt-deg", &A::sim_tilt_deg)
+          .Help("With --simulate --stereo: the simulated actuator's bending plane, turned this "
+                "far out of the first camera's image plane (deg)")
+          .ShowDefault()
+          .Check(NumberIn(0, 80)),
+  };
+  return table;
 }
 
 std::optional<ControlStereoOptions> StereoOptionsGiven(const CLI::App& sub,

@@ -16,6 +16,7 @@
 
 #include "app/control_command.h"
 #include "app/control_parts.h"
+#include "app/flag_table.h"
 #include "softsight/config/config.h"
 #include "softsight/control/rig.h"
 #include "softsight/io/csv_writer.h"
@@ -138,10 +139,10 @@ class StereoHookSink : public PairSink {
 };
 
 // The command line's two-camera options (control and identify): --stereo, --left-camera,
-// --right-camera, --right-config, --stereo-angle, --max-epipolar-px, --sim-tilt-deg, into
-// `args`. StereoOptionsGiven then says whether they ask for two cameras (--stereo), and refuses
-// the others without it.
-void AddControlStereoOptions(CLI::App& sub, ControlStereoOptions* args);
+// --right-camera, --right-config, --stereo-angle, --max-epipolar-px, --sim-tilt-deg, into the
+// command's ControlStereoOptions. StereoOptionsGiven then says whether they ask for two cameras
+// (--stereo), and refuses the others without it.
+const FlagTable<ControlStereoOptions>& ControlStereoFlags();
 std::optional<ControlStereoOptions> StereoOptionsGiven(const CLI::App& sub,
                                                        const ControlStereoOptions& args);
 

@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "app/scene_config.h"
+#include "app/shared_flags.h"
 #include "app/synth_command.h"
 #include "app/track_command.h"
 #include "app/truth_sink.h"
@@ -75,6 +76,19 @@ int RunDemo(const DemoOptions& options) {
   return 0;
 }
 
+const FlagTable<DemoOptions>& DemoFlags() {
+  using A = DemoOptions;
+  static const FlagTable<DemoOptions> table = {
+      OutputFlag<A>(&A::out_dir, "out-dir", "Folder for the video, truth, config, CSV and plot")
+          .ShowDefault(),
+      FramesFlag<A>(&A::frames, "Frames to render").Check(CLI::Range(2, 100000)),
+      SceneFlag<A>(&A::scene, "bending, wedge1 or wedge4"),
+      NoiseFlag<A>(&A::noise_sigma).Check(CLI::Range(0.0, 50.0)),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("No progress bar and no summary"),
+  };
+  return table;
+}
+
 }  // namespace
 
 CommandRunner SetupDemoCommand(CLI::App& sub) {
@@ -84,17 +98,7 @@ CommandRunner SetupDemoCommand(CLI::App& sub) {
       "actuator with red, blue and green markers to a video, writes the marker config,\n"
       "tracks the video, compares the result with the truth and plots it.\n"
       "Example: softsight demo --out-dir demo_out");
-  sub.add_option("-o,--output,--out-dir", options->out_dir,
-                 "Folder for the video, truth, config, CSV and plot")
-      ->capture_default_str();
-  sub.add_option("--frames", options->frames, "Frames to render")
-      ->capture_default_str()
-      ->check(CLI::Range(2, 100000));
-  sub.add_option("--scene", options->scene, "bending, wedge1 or wedge4")->capture_default_str();
-  sub.add_option("--noise", options->noise_sigma, "Sensor noise sigma in grey levels")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 50.0));
-  sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
+  AddFlags(sub, DemoFlags(), options.get());
   return [options] { return RunDemo(*options); };
 }
 

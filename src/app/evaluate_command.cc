@@ -18,6 +18,7 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/scene_config.h"
+#include "app/shared_flags.h"
 #include "app/truth_sink.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
@@ -449,11 +450,65 @@ EvaluateReport RunVideoEvaluate(const VideoEvaluateOptions& options) {
   return report;
 }
 
+namespace {
+
+// What evaluate's flags set until it runs: the built-in comparison's options, or a recording's.
+struct EvaluateArgs {
+  EvaluateOptions options;
+  std::string scene_name = "bending";
+  std::string gain_ramp;  // START,END
+  VideoEvaluateOptions video;
+};
+
+const FlagTable<EvaluateArgs>& EvaluateFlags() {
+  using A = EvaluateArgs;
+  static const FlagTable<EvaluateArgs> table = {
+      SceneFlag<A>(&A::scene_name,
+                   "bending, wedge1, wedge4 or bench (textured, with look-alike blobs)"),
+      FramesFlag<A>([](A& a) -> auto& { return a.options.scene.frame_count; },
+                    "Frames to render and track"),
+      NoiseFlag<A>([](A& a) -> auto& { return a.options.noise.sigma; }),
+      BlurFlag<A>([](A& a) -> auto& { return a.options.noise.blur_sigma_px; }),
+      ValueFlag<A>("--gain-ramp", &A::gain_ramp)
+          .Help("Illumination gain START,END, ramping linearly over the sequence (e.g. 0.6,1.4)"),
+      ValueFlag<A>("--methods", [](A& a) -> auto& { return a.options.methods; })
+          .Help("Methods, comma separated: " + JoinNames(TrackerMethods()))
+          .Finish([](CLI::Option* o) { o->delimiter(','); })
+          .ShowDefault(),
+      ValueFlag<A>("--modes", [](A& a) -> auto& { return a.options.modes; })
+          .Help("Template matching modes, comma separated: gray,colour")
+          .Finish([](CLI::Option* o) { o->delimiter(','); })
+          .ShowDefault(),
+      SwitchFlag<A>("--rect-centre", [](A& a) -> auto& { return a.options.rect_centre; })
+          .Help("Template trackers report the dragged rectangle's centre (the paper's position) "
+                "instead of the marker's centre of symmetry"),
+      SwitchFlag<A>("--square-mask", [](A& a) -> auto& { return a.options.square_mask; })
+          .Help("Template trackers match the whole template square, not the disc inscribed in "
+                "it"),
+      OutputFlag<A>([](A& a) -> auto& { return a.options.csv_file; }, "csv",
+                    "Also write the table as CSV to this file"),
+      SeedFlag<A>([](A& a) -> auto& { return a.options.scene.seed; },
+                  "Background texture and noise seed (as `softsight synth --seed`: same frames)"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No progress line"),
+      ValueFlag<A>(kInputFlag, [](A& a) -> auto& { return a.video.source.input; })
+          .Help("Your recording (video, image sequence or synth:NAME) to score instead of the "
+                "built-in comparison; needs --truth and --config"),
+      ValueFlag<A>("--truth", [](A& a) -> auto& { return a.video.truth_csv; })
+          .Help("With --input: the truth CSV (frame, <name>_x, <name>_y[, <name>_visible]; "
+                "`softsight synth --truth` writes one)"),
+      ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.video.config_file; })
+          .Help("With --input: the marker config to score"),
+      SequenceFpsFlag<A>([](A& a) -> auto& { return a.video.source.sequence_fps; },
+                         "With --input: an image sequence's frame rate"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupEvaluateCommand(CLI::App& sub) {
-  auto options = std::make_shared<EvaluateOptions>();
-  auto scene_name = std::make_shared<std::string>("bending");
-  auto gain_ramp = std::make_shared<std::string>();
-  auto video = std::make_shared<VideoEvaluateOptions>();
+  auto args = std::make_shared<EvaluateArgs>();
   sub.description(
       "Compare the tracking methods on a rendered scene with exact ground truth: the colour\n"
       "tracker and the SAD, SSD and ZNCC template trackers (gray and colour) run over the same\n"
@@ -469,43 +524,12 @@ CommandRunner SetupEvaluateCommand(CLI::App& sub) {
       "  softsight evaluate --noise 5 --csv noise5.csv\n"
       "  softsight synth --frames 100 --out run.avi --truth truth.csv\n"
       "  softsight evaluate --input run.avi --truth truth.csv --config markers.yaml");
-  sub.add_option("--scene", *scene_name, "bending, wedge1, wedge4 or bench (textured, with look-alike blobs)")->capture_default_str();
-  sub.add_option("--frames", options->scene.frame_count, "Frames to render and track")
-      ->capture_default_str();
-  sub.add_option("--noise", options->noise.sigma, "Sensor noise sigma in grey levels")
-      ->capture_default_str();
-  sub.add_option("--blur", options->noise.blur_sigma_px, "Optical blur sigma in pixels")
-      ->capture_default_str();
-  sub.add_option("--gain-ramp", *gain_ramp,
-                 "Illumination gain START,END, ramping linearly over the sequence (e.g. 0.6,1.4)");
-  sub.add_option("--methods", options->methods,
-                 "Methods, comma separated: " + JoinNames(TrackerMethods()))
-      ->delimiter(',')
-      ->capture_default_str();
-  sub.add_option("--modes", options->modes,
-                 "Template matching modes, comma separated: gray,colour")
-      ->delimiter(',')
-      ->capture_default_str();
-  sub.add_flag("--rect-centre", options->rect_centre,
-               "Template trackers report the dragged rectangle's centre (the paper's position) "
-               "instead of the marker's centre of symmetry");
-  sub.add_flag("--square-mask", options->square_mask,
-               "Template trackers match the whole template square, not the disc inscribed in it");
-  sub.add_option("-o,--output,--csv", options->csv_file,
-                 "Also write the table as CSV to this file");
-  sub.add_option("--seed", options->scene.seed,
-                 "Background texture and noise seed (as `softsight synth --seed`: same frames)")
-      ->capture_default_str();
-  sub.add_flag("-q,--quiet", options->quiet, "No progress line");
-  sub.add_option("-i,--input", video->source.input,
-                 "Your recording (video, image sequence or synth:NAME) to score instead of the "
-                 "built-in comparison; needs --truth and --config");
-  sub.add_option("--truth", video->truth_csv,
-                 "With --input: the truth CSV (frame, <name>_x, <name>_y[, <name>_visible]; "
-                 "`softsight synth --truth` writes one)");
-  sub.add_option("-c,--config", video->config_file, "With --input: the marker config to score");
-  sub.add_option("--fps", video->source.sequence_fps, "With --input: an image sequence's frame rate")
-      ->capture_default_str();
+  AddFlags(sub, EvaluateFlags(), args.get());
+  // The run's parts, each keeping `args` alive.
+  const std::shared_ptr<EvaluateOptions> options(args, &args->options);
+  const std::shared_ptr<std::string> scene_name(args, &args->scene_name);
+  const std::shared_ptr<std::string> gain_ramp(args, &args->gain_ramp);
+  const std::shared_ptr<VideoEvaluateOptions> video(args, &args->video);
   return [options, scene_name, gain_ramp, video, &sub] {
     if (!video->source.input.empty() || !video->truth_csv.empty() || !video->config_file.empty()) {
       if (video->source.input.empty() || video->truth_csv.empty() || video->config_file.empty()) {

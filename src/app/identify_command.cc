@@ -9,6 +9,7 @@
 #include "app/commands.h"
 #include "app/control_stereo.h"
 #include "app/publish_options.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "softsight/config/config.h"
@@ -85,6 +86,41 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
   return found;
 }
 
+namespace {
+
+const FlagTable<IdentifyCommandOptions>& IdentifyFlags() {
+  using A = IdentifyCommandOptions;
+  static const FlagTable<IdentifyCommandOptions> table = {
+      ValueFlag<A>(kConfigFlag, &A::config_file)
+          .Help("Markers and `control:` section (YAML), read only")
+          .Required()
+          .Check(CLI::ExistingFile),
+      OutputFlag<A>(&A::output_file, "",
+                    "The config to write (the input's with the gains and model:); not the input")
+          .Required(),
+      ValueFlag<A>("--csv", &A::csv_file)
+          .Help("Every frame of the experiment (tracking and board)"),
+      ValueFlag<A>("--model-csv", &A::model_csv_file)
+          .Help("Measured against the fitted model per frame, for `softsight plot`"),
+      ValueFlag<A>("--closed-loop-s", &A::closed_loop_s)
+          .Help("SIMC closed-loop time constant (default max(dead time, 3 camera periods)); "
+                "larger: gentler gains"),
+      ValueFlag<A>("--max-s", &A::max_s).Help("Longest the experiment may take (default 600 s)"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("Only errors"),
+  };
+  return table;
+}
+
+const FlagTable<IdentifyCommandOptions>& IdentifyRigFlags() {
+  static const FlagTable<IdentifyCommandOptions> table = RigSourceFlags<IdentifyCommandOptions>(
+      "Serial device of the board (/dev/ttyACM0, /dev/pts/N)",
+      "The in-process simulated rig, its frames rendered and tracked (simulated time)",
+      "Frames from the file `softsight rig --frames FILE` keeps rewriting");
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupIdentifyCommand(CLI::App& sub) {
   auto o = std::make_shared<IdentifyCommandOptions>();
   sub.description(
@@ -103,31 +139,12 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
       "  softsight identify --config rig.yaml --port /dev/ttyACM0 --camera 0 -o tuned.yaml\n"
       "  softsight identify --config rig.yaml --port /dev/ttyACM0 --stereo stereo.yaml "
       "--left-camera 0 --right-camera 2 -o tuned.yaml   (the 3D angle)");
-  sub.add_option("-c,--config", o->config_file, "Markers and `control:` section (YAML), read only")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sub.add_option("-o,--output", o->output_file,
-                 "The config to write (the input's with the gains and model:); not the input")
-      ->required();
-  sub.add_option("-p,--port", o->port, "Serial device of the board (/dev/ttyACM0, /dev/pts/N)");
-  sub.add_flag("--simulate", o->simulate,
-               "The in-process simulated rig, its frames rendered and tracked (simulated time)");
-  AddCameraOption(sub, "--camera", &o->camera, "The camera for the frames (live)");
-  sub.add_option("--rig-frames", o->rig_frames,
-                 "Frames from the file `softsight rig --frames FILE` keeps rewriting");
-  sub.add_option("--csv", o->csv_file, "Every frame of the experiment (tracking and board)");
-  sub.add_option("--model-csv", o->model_csv_file,
-                 "Measured against the fitted model per frame, for `softsight plot`");
-  sub.add_option("--closed-loop-s", o->closed_loop_s,
-                 "SIMC closed-loop time constant (default max(dead time, 3 camera periods)); larger: "
-                 "gentler gains");
-  sub.add_option("--max-s", o->max_s, "Longest the experiment may take (default 600 s)");
-  sub.add_option("--fps", o->fps, "Frame rate of --simulate and --rig-frames")->capture_default_str();
-  sub.add_flag("-q,--quiet", o->quiet, "Only errors");
+  AddFlags(sub, IdentifyFlags(), o.get());
+  AddFlags(sub, IdentifyRigFlags(), o.get());
   auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
+  AddFlags(sub, PublishFlags(), publish.get());
   auto stereo = std::make_shared<ControlStereoOptions>();
-  control_parts::AddControlStereoOptions(sub, stereo.get());
+  AddFlags(sub, control_parts::ControlStereoFlags(), stereo.get());
   return [o, publish, stereo, &sub] {
     o->publish = publish->resolved();
     o->stereo = control_parts::StereoOptionsGiven(sub, *stereo);

@@ -14,6 +14,7 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "gui/live_options.h"
 #include "softsight/core/error.h"
 #include "softsight/pipeline/run.h"
@@ -309,13 +310,87 @@ TrackingConfig RunPick(const PickOptions& options) {
   return LoadTrackingConfig(options.config_out);
 }
 
-CommandRunner SetupInitCommand(CLI::App& sub) {
-  struct Args {
-    InitOptions options;
-    std::optional<std::string> roi, base;
-    std::optional<int> markers;
+namespace {
+
+// What init's and pick's flags set until they run.
+struct InitArgs {
+  InitOptions options;
+  std::optional<std::string> roi, base;
+  std::optional<int> markers;
+};
+struct PickArgs {
+  PickOptions options;
+  std::vector<std::string> at;
+};
+
+// The frame init and pick read and the config they write: -i, --frame, -o and --fps, in
+// `options` of Args (its source, frame and config_out).
+template <typename Args>
+FlagTable<Args> OneFrameFlags(const std::string& frame_help) {
+  return {
+      ValueFlag<Args>(kInputFlag, [](Args& a) -> auto& { return a.options.source.input; })
+          .Help("Video file, folder of images, printf pattern (frames/%04d.png) or synth:NAME")
+          .Required(),
+      ValueFlag<Args>("--frame", [](Args& a) -> auto& { return a.options.frame; })
+          .Help(frame_help)
+          .ShowDefault()
+          .Check(NumberIn(0, 1e12)),
+      OutputFlag<Args>([](Args& a) -> auto& { return a.options.config_out; }, "out",
+                       "The config to write (YAML)")
+          .ShowDefault(),
+      SequenceFpsFlag<Args>([](Args& a) -> auto& { return a.options.source.sequence_fps; },
+                            "Frame rate of an image sequence"),
   };
-  auto args = std::make_shared<Args>();
+}
+
+const FlagTable<InitArgs>& InitFlags() {
+  using A = InitArgs;
+  static const FlagTable<InitArgs> table = [] {
+    FlagTable<InitArgs> flags = OneFrameFlags<A>(
+        "Which frame to analyse, counting from 0. After the first, markers told apart by colour "
+        "get no roi (track finds them from the first frame); dots and --roi finds get a roi from "
+        "this frame on (not started before it)");
+    const FlagTable<InitArgs> own = {
+        ValueFlag<A>("--picture", [](A& a) -> auto& { return a.options.picture_out; })
+            .Help("The picture of what was found and rejected (default: the config's name .png)"),
+        ValueFlag<A>("--roi", &A::roi)
+            .Help("Look only inside X,Y,W,H (the actuator's area): look-alikes elsewhere are "
+                  "ignored, and each marker gets a roi"),
+        ValueFlag<A>("--markers", &A::markers)
+            .Help("How many markers the body carries: any other count found is an error")
+            .Check(NumberIn(1, 64)),
+        ValueFlag<A>("--base", &A::base)
+            .Help("X,Y near the base (the fixed end). Default: the end that stays put over the "
+                  "next 90 frames, else the end nearer the image border"),
+    };
+    flags.insert(flags.end(), own.begin(), own.end());
+    return flags;
+  }();
+  return table;
+}
+
+const FlagTable<PickArgs>& PickFlags() {
+  using A = PickArgs;
+  static const FlagTable<PickArgs> table = [] {
+    FlagTable<PickArgs> flags = OneFrameFlags<A>("Which frame, counting from 0");
+    const FlagTable<PickArgs> own = {
+        ValueFlag<A>("--at", &A::at)
+            .Help("X,Y of a marker's centre in pixels (repeat per marker)")
+            .Required(),
+        ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.options.base_config; })
+            .Help("Update this config's markers in order instead of writing new ones")
+            .Check(CLI::ExistingFile),
+    };
+    flags.insert(flags.end(), own.begin(), own.end());
+    return flags;
+  }();
+  return table;
+}
+
+}  // namespace
+
+CommandRunner SetupInitCommand(CLI::App& sub) {
+  auto args = std::make_shared<InitArgs>();
   sub.description(
       "Write a marker config without a GUI: find the markers in one frame by themselves\n"
       "(compact, saturated blobs of distinct colours; else white or black dots), take\n"
@@ -329,32 +404,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight init --input run.avi -o markers.yaml        (also writes markers.png)\n"
       "  softsight init --input run.avi --roi 100,40,400,380 --markers 3 -o markers.yaml");
-  sub.add_option("-i,--input", args->options.source.input,
-                 "Video file, folder of images, printf pattern (frames/%04d.png) or synth:NAME")
-      ->required();
-  sub.add_option("--frame", args->options.frame,
-                 "Which frame to analyse, counting from 0. After the first, markers told apart "
-                 "by colour get no roi (track finds them from the first frame); dots and --roi "
-                 "finds get a roi from this frame on (not started before it)")
-      ->capture_default_str()
-      ->check(NumberIn(0, 1e12));
-  sub.add_option("-o,--output,--out", args->options.config_out, "The config to write (YAML)")
-      ->capture_default_str();
-  sub.add_option("--picture", args->options.picture_out,
-                 "The picture of what was found and rejected (default: the config's name .png)");
-  sub.add_option("--roi", args->roi,
-                 "Look only inside X,Y,W,H (the actuator's area): look-alikes elsewhere are "
-                 "ignored, and each marker gets a roi");
-  sub.add_option("--markers", args->markers,
-                 "How many markers the body carries: any other count found is an error")
-      ->check(NumberIn(1, 64));
-  sub.add_option("--base", args->base,
-                 "X,Y near the base (the fixed end). Default: the end that stays put over the next "
-                 "90 frames, else the end nearer the image border");
-  sub.add_option("--fps", args->options.source.sequence_fps,
-                 "Frame rate of an image sequence")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e6));
+  AddFlags(sub, InitFlags(), args.get());
   return [args] {
     InitOptions options = args->options;
     if (args->roi) options.finder.search_px = ParseRectOption(*args->roi, "--roi");
@@ -392,11 +442,7 @@ CommandRunner SetupInitCommand(CLI::App& sub) {
 }
 
 CommandRunner SetupPickCommand(CLI::App& sub) {
-  struct Args {
-    PickOptions options;
-    std::vector<std::string> at;
-  };
-  auto args = std::make_shared<Args>();
+  auto args = std::make_shared<PickArgs>();
   sub.description(
       "Write HSV ranges for markers at given pixels of one frame, exactly as a click on them in\n"
       "`live` gives (the same pick: the pixels within 5 px of the point, and a 32 px search box\n"
@@ -406,22 +452,7 @@ CommandRunner SetupPickCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight pick --input run.avi --frame 0 --at 212,300 --at 300,250 --at 390,300 -o m.yaml\n"
       "  softsight pick --input run.avi --config markers.yaml --at 212,300 -o markers2.yaml");
-  sub.add_option("-i,--input", args->options.source.input,
-                 "Video file, folder of images, printf pattern (frames/%04d.png) or synth:NAME")
-      ->required();
-  sub.add_option("--frame", args->options.frame, "Which frame, counting from 0")
-      ->capture_default_str()
-      ->check(NumberIn(0, 1e12));
-  sub.add_option("--at", args->at, "X,Y of a marker's centre in pixels (repeat per marker)")
-      ->required();
-  sub.add_option("-c,--config", args->options.base_config,
-                 "Update this config's markers in order instead of writing new ones")
-      ->check(CLI::ExistingFile);
-  sub.add_option("-o,--output,--out", args->options.config_out, "The config to write (YAML)")
-      ->capture_default_str();
-  sub.add_option("--fps", args->options.source.sequence_fps, "Frame rate of an image sequence")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e6));
+  AddFlags(sub, PickFlags(), args.get());
   return [args] {
     PickOptions options = args->options;
     for (const std::string& at : args->at) options.at_px.push_back(ParsePointOption(at, "--at"));

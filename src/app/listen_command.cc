@@ -10,6 +10,7 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "softsight/core/error.h"
 #include "softsight/core/format.h"
@@ -280,6 +281,34 @@ ListenSummary RunListen(const ListenOptions& options, std::ostream& out, std::os
   return summary;
 }
 
+namespace {
+
+const FlagTable<ListenOptions>& ListenFlags() {
+  using A = ListenOptions;
+  static const FlagTable<ListenOptions> table = {
+      ValueFlag<A>("endpoint", &A::endpoint)
+          .Help("Where the run publishes: tcp://HOST:PORT or ipc://PATH (its --publish, with * "
+                "replaced by its host name)")
+          .Required(),
+      ValueFlag<A>("--topic", &A::topic)
+          .Help("Which records: frame (every column), measure (the measurements), marker/NAME "
+                "(one marker's columns)")
+          .ShowDefault(),
+      OutputFlag<A>(&A::csv_file, "csv", "Write the records to this CSV instead of printing them"),
+      SwitchFlag<A>("--json", &A::json).Help("Print each record's JSON as it came, one per line"),
+      ValueFlag<A>("--count", &A::count)
+          .Help("Stop after this many records")
+          .Check(NumberIn(1, 1e15)),
+      ValueFlag<A>("--timeout-s", &A::timeout_s)
+          .Help("Fail (exit 2) when nothing at all arrives for this many seconds (default: wait)")
+          .Check(NumberIn(1e-3, 1e9)),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("Nothing on stderr but errors"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupListenCommand(CLI::App& sub) {
   auto o = std::make_shared<ListenOptions>();
   sub.description(
@@ -290,22 +319,7 @@ CommandRunner SetupListenCommand(CLI::App& sub) {
       "  softsight listen tcp://localhost:5556\n"
       "  softsight listen tcp://rig-pc:5556 --csv remote.csv\n"
       "  softsight listen ipc:///tmp/softsight.ipc --topic marker/green --json");
-  sub.add_option("endpoint", o->endpoint,
-                 "Where the run publishes: tcp://HOST:PORT or ipc://PATH (its --publish, with * "
-                 "replaced by its host name)")
-      ->required();
-  sub.add_option("--topic", o->topic,
-                 "Which records: frame (every column), measure (the measurements), marker/NAME "
-                 "(one marker's columns)")
-      ->capture_default_str();
-  sub.add_option("-o,--output,--csv", o->csv_file,
-                 "Write the records to this CSV instead of printing them");
-  sub.add_flag("--json", o->json, "Print each record's JSON as it came, one per line");
-  sub.add_option("--count", o->count, "Stop after this many records")->check(NumberIn(1, 1e15));
-  sub.add_option("--timeout-s", o->timeout_s,
-                 "Fail (exit 2) when nothing at all arrives for this many seconds (default: wait)")
-      ->check(NumberIn(1e-3, 1e9));
-  sub.add_flag("-q,--quiet", o->quiet, "Nothing on stderr but errors");
+  AddFlags(sub, ListenFlags(), o.get());
   return [o] {
     const StopRequest stop;
     ListenOptions options = *o;

@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "app/publish_options.h"
 #include "app/python_hook.h"
+#include "app/shared_flags.h"
 #include "softsight/core/error.h"
 #include "gui/live_window.h"
 #include "softsight/config/config.h"
@@ -107,12 +108,47 @@ int RunLive(const LiveArgs& args) {
   return run.exit_code;
 }
 
+
+const FlagTable<LiveArgs>& LiveFlags() {
+  using A = LiveArgs;
+  static const FlagTable<LiveArgs> table = {
+      CameraFlag<A>("--camera", &A::camera, "The camera"),
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Video file or image sequence instead of a camera (played at its frame rate)")
+          .Excludes("--camera"),
+      ValueFlag<A>(kConfigFlag, &A::config)
+          .Help("Marker configuration (YAML, see examples/)")
+          .Required(),
+      MethodFlag<A>(&A::method),
+      ValueFlag<A>("--save-config", &A::save_config)
+          .Help("Where `s` saves the config (default: <config>.live.yaml beside it)"),
+      RecordPrefixFlag<A>(&A::record_prefix, ""),
+      ChartSecondsFlag<A>(&A::window_s, "Time span of the strip chart, seconds"),
+      ValueFlag<A>("--scale-distance-mm", &A::scale_distance_mm)
+          .Help("Known distance between the two points clicked after `c` (mm), e.g. 50 for two "
+                "ruler marks 50 mm apart; sets the mm scale live")
+          .Check(CLI::PositiveNumber),
+      NoPaceFlag<A>([](A& a) { a.no_pace = true; }),
+      SwitchFlag<A>("--no-trackbars", &A::no_trackbars).Help("Hide the HSV trackbars"),
+  };
+  return table;
+}
+
+// After the camera's settings in --help, as before.
+const FlagTable<LiveArgs>& LiveOutputFlags() {
+  using A = LiveArgs;
+  static const FlagTable<LiveArgs> table = {
+      ValueFlag<A>("--csv", &A::csv)
+          .Help("Also write a CSV row for every frame the window tracks (stepped and sought "
+                "ones too, by their own frame numbers), as `track --csv` does"),
+  };
+  return table;
+}
+
 }  // namespace
 
 CommandRunner SetupLiveCommand(CLI::App& sub) {
   auto args = std::make_shared<LiveArgs>();
-  std::string methods;
-  for (const std::string& m : TrackerMethods()) methods += (methods.empty() ? "" : ", ") + m;
   sub.footer(
       "The window shows each marker, the base-middle-tip triangle, the fitted arc, the\n"
       "measurements (mm when the config has a scale), fps, processing time and capture-to-result\n"
@@ -140,34 +176,11 @@ CommandRunner SetupLiveCommand(CLI::App& sub) {
       "when the camera opens, read back and printed; `softsight cameras` lists the modes.\n"
       "Needs a display; without one use `softsight track`.\n"
       "Example: softsight live --camera 0 --config markers.yaml");
-  auto* camera = AddCameraOption(sub, "--camera", &args->camera, "The camera");
-  auto* input = sub.add_option("-i,--input", args->input,
-                               "Video file or image sequence instead of a camera (played at its "
-                               "frame rate)");
-  camera->excludes(input);
-  sub.add_option("-c,--config", args->config, "Marker configuration (YAML, see examples/)")
-      ->required();
-  sub.add_option("--method", args->method, "Override every marker's method: " + methods);
-  sub.add_option("--save-config", args->save_config,
-                 "Where `s` saves the config (default: <config>.live.yaml beside it)");
-  sub.add_option("--record-prefix", args->record_prefix,
-                 "Recordings go to <prefix>-NNN.csv/.avi/.raw.avi/.yaml")
-      ->capture_default_str();
-  sub.add_option("--chart-seconds", args->window_s, "Time span of the strip chart, seconds")
-      ->capture_default_str();
-  sub.add_option("--scale-distance-mm", args->scale_distance_mm,
-                 "Known distance between the two points clicked after `c` (mm), e.g. 50 for two "
-                 "ruler marks 50 mm apart; sets the mm scale live")
-      ->check(CLI::PositiveNumber);
-  sub.add_flag("--no-pace", args->no_pace,
-               "Read a video file as fast as it decodes instead of at its frame rate");
-  sub.add_flag("--no-trackbars", args->no_trackbars, "Hide the HSV trackbars");
-  AddCaptureOptions(sub, &args->capture);
-  sub.add_option("--csv", args->csv,
-                 "Also write a CSV row for every frame the window tracks (stepped and sought "
-                 "ones too, by their own frame numbers), as `track --csv` does");
-  AddPublishOptions(sub, &args->publish);
-  AddHookOptions(sub, &args->hook);
+  AddFlags(sub, LiveFlags(), args.get());
+  AddFlags(sub, CaptureFlags(), &args->capture);
+  AddFlags(sub, LiveOutputFlags(), args.get());
+  AddFlags(sub, PublishFlags(), &args->publish);
+  AddFlags(sub, HookFlags(), &args->hook);
   return [args] { return RunLive(*args); };
 }
 

@@ -8,18 +8,68 @@
 
 #include "app/cli_checks.h"
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "softsight/io/plot.h"
 
 namespace softsight {
 
-CommandRunner SetupPlotCommand(CLI::App& sub) {
-  struct Args {
-    std::vector<std::string> csvs;
-    std::optional<std::string> truth;
-    std::string out;
-    PlotOptions options;
+namespace {
+
+// What plot's flags set until it runs.
+struct PlotArgs {
+  std::vector<std::string> csvs;
+  std::optional<std::string> truth;
+  std::string out;
+  PlotOptions options;
+};
+
+const FlagTable<PlotArgs>& PlotFlags() {
+  using A = PlotArgs;
+  auto in = [](auto PlotOptions::*field) {
+    return [field](A& a) -> auto& { return a.options.*field; };
   };
-  auto args = std::make_shared<Args>();
+  static const FlagTable<PlotArgs> table = {
+      ValueFlag<A>("csv", &A::csvs)
+          .Help("One or more CSVs written by `softsight track`, `live`, `control` or "
+                "`track-stereo`")
+          .Required(),
+      OutputFlag<A>(&A::out, "out", "Output figure: .png, .jpg (raster) or .svg (vector)")
+          .Required(),
+      ValueFlag<A>("--truth", &A::truth)
+          .Help("A truth CSV with the same column names (softsight synth --truth), drawn in "
+                "black"),
+      ValueFlag<A>("--panels", in(&PlotOptions::panels))
+          .Help(std::string("Panels top to bottom, comma separated: ") + PlotPanelNames() +
+                " (default: angle, bending, arc and control, as the CSV has them)")
+          .Finish([](CLI::Option* o) { o->delimiter(','); }),
+      ValueFlag<A>("--min-span-px", in(&PlotOptions::min_span_px))
+          .Help("Smallest span of a pixel axis (px); 0 lets the axis hug the data")
+          .ShowDefault()
+          .Check(NumberIn(0, 1e9)),
+      ValueFlag<A>("--min-span-deg", in(&PlotOptions::min_span_deg))
+          .Help("Smallest span of an angle axis (deg)")
+          .ShowDefault()
+          .Check(NumberIn(0, 1e9)),
+      ValueFlag<A>("--min-span-mm", in(&PlotOptions::min_span_mm))
+          .Help("Smallest span of a millimetre axis")
+          .ShowDefault()
+          .Check(NumberIn(0, 1e9)),
+      ValueFlag<A>("--width", in(&PlotOptions::width_px))
+          .Help("Figure width in pixels")
+          .ShowDefault(),
+      ValueFlag<A>("--panel-height", in(&PlotOptions::panel_height_px))
+          .Help("Height of each stacked panel in pixels")
+          .ShowDefault(),
+      ValueFlag<A>("--title", in(&PlotOptions::title))
+          .Help("Figure title (default: the CSVs' file names)"),
+  };
+  return table;
+}
+
+}  // namespace
+
+CommandRunner SetupPlotCommand(CLI::App& sub) {
+  auto args = std::make_shared<PlotArgs>();
   sub.description(
       "Draw CSVs of `softsight track`, `live` or `control` against time: stacked panels of the\n"
       "angle [deg], bending distance (tip displacement) and arc length (mm when the CSV has the\n"
@@ -32,33 +82,7 @@ CommandRunner SetupPlotCommand(CLI::App& sub) {
       "Examples:\n"
       "  softsight plot run.csv -o run.png\n"
       "  softsight plot colour.csv zncc.csv --truth truth.csv --panels angle,radius,xy -o cmp.svg");
-  sub.add_option("csv", args->csvs, "One or more CSVs written by `softsight track`, `live`, `control` or `track-stereo`")
-      ->required();
-  sub.add_option("-o,--output,--out", args->out,
-                 "Output figure: .png, .jpg (raster) or .svg (vector)")
-      ->required();
-  sub.add_option("--truth", args->truth,
-                 "A truth CSV with the same column names (softsight synth --truth), drawn in black");
-  sub.add_option("--panels", args->options.panels,
-                 std::string("Panels top to bottom, comma separated: ") + PlotPanelNames() +
-                     " (default: angle, bending, arc and control, as the CSV has them)")
-      ->delimiter(',');
-  sub.add_option("--min-span-px", args->options.min_span_px,
-                 "Smallest span of a pixel axis (px); 0 lets the axis hug the data")
-      ->capture_default_str()
-      ->check(NumberIn(0, 1e9));
-  sub.add_option("--min-span-deg", args->options.min_span_deg, "Smallest span of an angle axis (deg)")
-      ->capture_default_str()
-      ->check(NumberIn(0, 1e9));
-  sub.add_option("--min-span-mm", args->options.min_span_mm, "Smallest span of a millimetre axis")
-      ->capture_default_str()
-      ->check(NumberIn(0, 1e9));
-  sub.add_option("--width", args->options.width_px, "Figure width in pixels")
-      ->capture_default_str();
-  sub.add_option("--panel-height", args->options.panel_height_px,
-                 "Height of each stacked panel in pixels")
-      ->capture_default_str();
-  sub.add_option("--title", args->options.title, "Figure title (default: the CSVs' file names)");
+  AddFlags(sub, PlotFlags(), args.get());
   return [args] {
     std::vector<PathRole> inputs;
     for (const std::string& csv : args->csvs) inputs.push_back({"a CSV", csv});

@@ -10,26 +10,30 @@
 
 namespace softsight {
 
-void AddPublishOptions(CLI::App& sub, PublishArgs* args) {
-  sub.add_option("--publish", args->endpoint,
-                 "Also send every frame's result as it happens to other programs: a ZeroMQ "
-                 "endpoint to listen on, tcp://*:5556 (any machine), tcp://127.0.0.1:5556 (this "
-                 "one) or ipc:///tmp/softsight.ipc; receive with `softsight listen ENDPOINT` or "
-                 "Python's softsight.stream.subscribe (docs/stream.md)");
-  sub.add_option("--publish-hwm", args->options.high_water_mark,
-                 "With --publish: messages queued per subscriber; beyond, a slow subscriber "
-                 "misses messages (counted in the summary) and the run never waits")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
-  sub.add_option("--publish-wait", args->options.wait_subscribers,
-                 "With --publish: before the first frame, wait for this many subscribers (each "
-                 "`softsight listen` or subscribe() is one), so they get every frame")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1000));
-  sub.add_option("--publish-wait-s", args->options.wait_timeout_s,
-                 "With --publish-wait: the longest wait, seconds; then the run stops with an error")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 86400));
+const FlagTable<PublishArgs>& PublishFlags() {
+  using A = PublishArgs;
+  static const FlagTable<PublishArgs> table = {
+      ValueFlag<A>("--publish", &A::endpoint)
+          .Help("Also send every frame's result as it happens to other programs: a ZeroMQ "
+                "endpoint to listen on, tcp://*:5556 (any machine), tcp://127.0.0.1:5556 (this "
+                "one) or ipc:///tmp/softsight.ipc; receive with `softsight listen ENDPOINT` or "
+                "Python's softsight.stream.subscribe (docs/stream.md)"),
+      ValueFlag<A>("--publish-hwm", [](A& a) -> auto& { return a.options.high_water_mark; })
+          .Help("With --publish: messages queued per subscriber; beyond, a slow subscriber "
+                "misses messages (counted in the summary) and the run never waits")
+          .ShowDefault()
+          .Check(CLI::Range(1, 1000000)),
+      ValueFlag<A>("--publish-wait", [](A& a) -> auto& { return a.options.wait_subscribers; })
+          .Help("With --publish: before the first frame, wait for this many subscribers (each "
+                "`softsight listen` or subscribe() is one), so they get every frame")
+          .ShowDefault()
+          .Check(CLI::Range(0, 1000)),
+      ValueFlag<A>("--publish-wait-s", [](A& a) -> auto& { return a.options.wait_timeout_s; })
+          .Help("With --publish-wait: the longest wait, seconds; then the run stops with an error")
+          .ShowDefault()
+          .Check(NumberIn(1e-3, 86400)),
+  };
+  return table;
 }
 
 std::optional<PublishOptions> PublishArgs::resolved() const {

@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/flag_table.h"
+
 #include "softsight/io/output_guard.h"
 #include "stream/publish_sink.h"
 
@@ -22,8 +24,8 @@ struct PublishArgs {
   std::optional<PublishOptions> resolved() const;
 };
 
-// Adds --publish, --publish-hwm, --publish-wait and --publish-wait-s to `sub`.
-void AddPublishOptions(CLI::App& sub, PublishArgs* args);
+// --publish, --publish-hwm, --publish-wait and --publish-wait-s.
+const FlagTable<PublishArgs>& PublishFlags();
 
 // The sink for --publish, bound now (nullptr without --publish), its hello naming `config_file`
 // and the digest of its bytes. Throws InputError for a bad endpoint, before any output is made.

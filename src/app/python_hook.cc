@@ -15,20 +15,24 @@
 
 namespace softsight {
 
-void AddHookOptions(CLI::App& sub, HookArgs* args) {
-  sub.add_option("--hook", args->file,
-                 "A Python file run on every frame: it defines columns = [\"name\", ...] and "
-                 "on_frame(frame, result) returning a dict of those names -> numbers, which go "
-                 "into the CSV and the stream (docs/usage.md, \"A per-frame hook\")");
-  sub.add_option("--hook-wait-ms", args->wait_ms,
-                 "From a camera, the hook runs beside the loop: how long the loop waits for a "
-                 "frame's values before it writes the row without them (frames that come while "
-                 "the hook is busy are skipped by it, and counted)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
-  sub.add_flag("--hook-stop-on-error", args->stop_on_error,
-               "A hook that raises ends the run with one error line (default: its traceback is "
-               "printed once and the run goes on without it)");
+const FlagTable<HookArgs>& HookFlags() {
+  using A = HookArgs;
+  static const FlagTable<HookArgs> table = {
+      ValueFlag<A>("--hook", &A::file)
+          .Help("A Python file run on every frame: it defines columns = [\"name\", ...] and "
+                "on_frame(frame, result) returning a dict of those names -> numbers, which go "
+                "into the CSV and the stream (docs/usage.md, \"A per-frame hook\")"),
+      ValueFlag<A>("--hook-wait-ms", &A::wait_ms)
+          .Help("From a camera, the hook runs beside the loop: how long the loop waits for a "
+                "frame's values before it writes the row without them (frames that come while "
+                "the hook is busy are skipped by it, and counted)")
+          .ShowDefault()
+          .Check(CLI::Range(0.0, 1e6)),
+      SwitchFlag<A>("--hook-stop-on-error", &A::stop_on_error)
+          .Help("A hook that raises ends the run with one error line (default: its traceback is "
+                "printed once and the run goes on without it)"),
+  };
+  return table;
 }
 
 #ifdef SOFTSIGHT_HAVE_PYTHON_HOOK

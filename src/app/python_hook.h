@@ -20,6 +20,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/flag_table.h"
+
 #include "softsight/io/csv_columns.h"
 #include "softsight/pipeline/hook.h"
 
@@ -32,8 +34,8 @@ struct HookArgs {
   bool stop_on_error = false;  // --hook-stop-on-error.
 };
 
-// Adds --hook, --hook-wait-ms and --hook-stop-on-error to `sub`.
-void AddHookOptions(CLI::App& sub, HookArgs* args);
+// --hook, --hook-wait-ms and --hook-stop-on-error.
+const FlagTable<HookArgs>& HookFlags();
 
 // A command's hook: the Python file loaded, and the sink that runs it.
 class CommandHook {

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "softsight/io/output_guard.h"
 #include "softsight/control/rig.h"
@@ -157,6 +158,37 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
   return summary;
 }
 
+namespace {
+
+const FlagTable<RigCommandOptions>& RigFlags() {
+  using A = RigCommandOptions;
+  static const FlagTable<RigCommandOptions> table = {
+      SwitchFlag<A>("--pty", &A::pty)
+          .Help("Serve on a new pseudo-terminal and print its path")
+          .Required(),
+      ValueFlag<A>(kConfigFlag, &A::config_file)
+          .Help("Config whose `control: rig:` section sets the board and plant (defaults "
+                "without)")
+          .Check(CLI::ExistingFile),
+      ValueFlag<A>("--frames", &A::frames_file)
+          .Help("Render the actuator to this image file at --fps (rewritten atomically), for "
+                "`softsight control --rig-frames`"),
+      ValueFlag<A>("--fps", &A::fps).Help("Frame rate of --frames").ShowDefault(),
+      ValueFlag<A>("--duration-s", &A::duration_s).Help("Stop after this many seconds"),
+      ValueFlag<A>("--disconnect-after-s", &A::disconnect_after_s)
+          .Help("Close the port this many seconds after the host's first command (a pulled "
+                "cable) and keep running, to watch the watchdog vent"),
+      ValueFlag<A>("--disconnect-after-replies", &A::disconnect_after_replies)
+          .Help("Answer this many lines, close the port when the host asks again (it has read "
+                "them all), and keep running (the same pulled cable, at a point that does not "
+                "depend on timing)"),
+      SwitchFlag<A>(kQuietFlag, &A::quiet).Help("No state-change lines on stderr"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupRigCommand(CLI::App& sub) {
   auto o = std::make_shared<RigCommandOptions>();
   sub.description(
@@ -167,23 +199,7 @@ CommandRunner SetupRigCommand(CLI::App& sub) {
       "  softsight control --config examples/rig.yaml --port /dev/pts/N --rig-frames rig.png "
       "--target-deg 120 --csv run.csv\n"
       "or type commands by hand (docs/protocol.md). Stops on Ctrl-C.");
-  sub.add_flag("--pty", o->pty, "Serve on a new pseudo-terminal and print its path")->required();
-  sub.add_option("-c,--config", o->config_file, "Config whose `control: rig:` section sets the "
-                 "board and plant (defaults without)")
-      ->check(CLI::ExistingFile);
-  sub.add_option("--frames", o->frames_file,
-                 "Render the actuator to this image file at --fps (rewritten atomically), for "
-                 "`softsight control --rig-frames`");
-  sub.add_option("--fps", o->fps, "Frame rate of --frames")->capture_default_str();
-  sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds");
-  sub.add_option("--disconnect-after-s", o->disconnect_after_s,
-                 "Close the port this many seconds after the host's first command (a pulled "
-                 "cable) and keep running, to watch the watchdog vent");
-  sub.add_option("--disconnect-after-replies", o->disconnect_after_replies,
-                 "Answer this many lines, close the port when the host asks again (it has read "
-                 "them all), and keep running (the same pulled cable, at a point that does not "
-                 "depend on timing)");
-  sub.add_flag("-q,--quiet", o->quiet, "No state-change lines on stderr");
+  AddFlags(sub, RigFlags(), o.get());
   return [o] {
     RunRig(*o);
     return ExitCodeAfterStop(0);  // 130 / 143 when Ctrl-C / SIGTERM ended it.

@@ -11,6 +11,7 @@
 #include "app/python_hook.h"
 #include "app/scene_config.h"
 #include "app/serve_rig.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "softsight/config/config.h"
 #include "softsight/core/error.h"
@@ -117,12 +118,55 @@ int RunServeCommand(ServeArgs args) {
   return ExitCodeAfterStop(0);
 }
 
+const FlagTable<ServeArgs>& ServeFlags() {
+  using A = ServeArgs;
+  static const FlagTable<ServeArgs> table = {
+      CameraFlag<A>("--camera", &A::camera, "The camera"),
+      ValueFlag<A>(kInputFlag, &A::input)
+          .Help("Video file, image sequence or synth:NAME instead of a camera")
+          .Excludes("--camera"),
+      ValueFlag<A>("--compare", &A::compare)
+          .Help("A second video shown beside --input's, frame by frame at the same position "
+                "(two runs side by side in sync; the page's compare opens its CSV)"),
+      ValueFlag<A>(kConfigFlag, &A::config)
+          .Help("Marker configuration (YAML, see examples/); a synth: input without one uses "
+                "the scene's own, written to <folder>/synth-NAME.yaml"),
+      MethodFlag<A>(&A::method),
+      ValueFlag<A>("--bind", &A::bind)
+          .Help("Address to listen on; any but loopback requires the printed token")
+          .ShowDefault(),
+      ValueFlag<A>("--port", &A::port)
+          .Help("TCP port; 0 picks a free one (the URL says which)")
+          .Check(CLI::Range(0, 65535))
+          .ShowDefault(),
+      ValueFlag<A>("--folder", &A::folder)
+          .Help("The only folder pages save configs and recordings in")
+          .ShowDefault(),
+      RecordPrefixFlag<A>(&A::record_prefix, "<folder>/"),
+      ValueFlag<A>("--jpeg-quality", &A::jpeg_quality)
+          .Help("Quality of the frames sent, 1-100")
+          .Check(CLI::Range(1, 100))
+          .ShowDefault(),
+      NoPaceFlag<A>([](A& a) { a.no_pace = true; }),
+      SwitchFlag<A>("--simulate", [](A& a) -> auto& { return a.rig.simulate; })
+          .Help("Serve the simulated rig (a board on a pseudo-terminal and its actuator, rendered "
+                "in lock-step with the loop at 30 fps, paced to the wall clock): the page's "
+                "control panel drives it; the config's `control:` section applies, and without "
+                "--config <folder>/rig-simulated.yaml is written and used")
+          .Excludes("--camera")
+          .Excludes("--input"),
+      ValueFlag<A>("--board-port", [](A& a) -> auto& { return a.rig.board_port; })
+          .Help("Serial device of a board to control from the page (with --camera): "
+                "/dev/ttyACM0, or the /dev/pts/N `softsight rig --pty` prints")
+          .Excludes("--simulate"),
+  };
+  return table;
+}
+
 }  // namespace
 
 CommandRunner SetupServeCommand(CLI::App& sub) {
   auto args = std::make_shared<ServeArgs>();
-  std::string methods;
-  for (const std::string& m : TrackerMethods()) methods += (methods.empty() ? "" : ", ") + m;
   sub.footer(
       "Serves the live bench as a web page: open the printed URL in a browser (this computer's,\n"
       "or, with --bind 0.0.0.0, any on the network; the URL then carries a token that every\n"
@@ -138,49 +182,9 @@ CommandRunner SetupServeCommand(CLI::App& sub) {
       "mid-run leaves the rig safe: its last pressure held for hold_s, then vented.\n"
       "Examples: softsight serve --input synth:bending\n"
       "          softsight serve --simulate");
-  auto* camera = AddCameraOption(sub, "--camera", &args->camera, "The camera");
-  auto* input = sub.add_option("-i,--input", args->input,
-                               "Video file, image sequence or synth:NAME instead of a camera");
-  camera->excludes(input);
-  sub.add_option("--compare", args->compare,
-                 "A second video shown beside --input's, frame by frame at the same position "
-                 "(two runs side by side in sync; the page's compare opens its CSV)");
-  sub.add_option("-c,--config", args->config,
-                 "Marker configuration (YAML, see examples/); a synth: input without one uses "
-                 "the scene's own, written to <folder>/synth-NAME.yaml");
-  sub.add_option("--method", args->method, "Override every marker's method: " + methods);
-  sub.add_option("--bind", args->bind,
-                 "Address to listen on; any but loopback requires the printed token")
-      ->capture_default_str();
-  sub.add_option("--port", args->port, "TCP port; 0 picks a free one (the URL says which)")
-      ->check(CLI::Range(0, 65535))
-      ->capture_default_str();
-  sub.add_option("--folder", args->folder,
-                 "The only folder pages save configs and recordings in")
-      ->capture_default_str();
-  sub.add_option("--record-prefix", args->record_prefix,
-                 "Recordings go to <folder>/<prefix>-NNN.csv/.avi/.raw.avi/.yaml")
-      ->capture_default_str();
-  sub.add_option("--jpeg-quality", args->jpeg_quality, "Quality of the frames sent, 1-100")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
-  sub.add_flag("--no-pace", args->no_pace,
-               "Read a video file as fast as it decodes instead of at its frame rate");
-  auto* simulate = sub.add_flag(
-      "--simulate", args->rig.simulate,
-      "Serve the simulated rig (a board on a pseudo-terminal and its actuator, rendered in "
-      "lock-step with the loop at 30 fps, paced to the wall clock): the page's control panel "
-      "drives it; the config's `control:` section "
-      "applies, and without --config <folder>/rig-simulated.yaml is written and used");
-  auto* board = sub.add_option("--board-port", args->rig.board_port,
-                               "Serial device of a board to control from the page (with "
-                               "--camera): /dev/ttyACM0, or the /dev/pts/N `softsight rig "
-                               "--pty` prints");
-  simulate->excludes(board);
-  simulate->excludes(camera);
-  simulate->excludes(input);
-  AddCaptureOptions(sub, &args->capture);
-  AddHookOptions(sub, &args->hook);
+  AddFlags(sub, ServeFlags(), args.get());
+  AddFlags(sub, CaptureFlags(), &args->capture);
+  AddFlags(sub, HookFlags(), &args->hook);
   return [args] { return RunServeCommand(*args); };
 }
 

@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "app/commands.h"
+#include "app/shared_flags.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/io/output_guard.h"
@@ -115,64 +116,99 @@ SynthSummary RunSynth(const SynthOptions& options, std::vector<SceneTruth>* trut
   return summary;
 }
 
+namespace {
+
+// What synth's flags set until it runs.
+struct SynthArgs {
+  SynthOptions options;
+  std::string scene_name = "bending";
+  std::string size = "640x480";       // WIDTHxHEIGHT
+  std::vector<std::string> occlusions;  // x,y,w,h,first,last each
+};
+
+const FlagTable<SynthArgs>& SynthFlags() {
+  using A = SynthArgs;
+  // A field of the scene (or of the noise): one accessor per row, spelled once.
+  auto scene = [](auto SceneOptions::*field) {
+    return [field](A& a) -> auto& { return a.options.scene.*field; };
+  };
+  auto noise = [](auto NoiseOptions::*field) {
+    return [field](A& a) -> auto& { return a.options.noise.*field; };
+  };
+  static const FlagTable<SynthArgs> table = {
+      SceneFlag<A>(&A::scene_name,
+                   "bending: a silicone band bending from straight to --max-bend degrees; "
+                   "wedge1 / wedge4: the paper's triangle actuators (1 segment opening 20 degrees, "
+                   "4 segments opening 80); bench: bending on a textured bench with look-alike "
+                   "blobs of every marker colour; plate: a gray view of a plate with 5 white dots "
+                   "that tilts to 50 degrees and grows 1x to 2x (dot0..dot4)"),
+      OutputFlag<A>([](A& a) -> auto& { return a.options.out; }, "out",
+                    "Video (.avi/.mkv: lossless HuffYUV; .mp4: lossy) or image pattern "
+                    "(frames/%04d.png)")
+          .Required(),
+      ValueFlag<A>("--truth", [](A& a) -> auto& { return a.options.truth_csv; })
+          .Help("Ground-truth CSV (one row per frame)"),
+      FramesFlag<A>(scene(&SceneOptions::frame_count), "Number of frames"),
+      ValueFlag<A>("--size", &A::size).Help("Image size WIDTHxHEIGHT").ShowDefault(),
+      ValueFlag<A>("--fps", scene(&SceneOptions::fps))
+          .Help("Frame rate (sets time_s and the video's rate)")
+          .ShowDefault(),
+      ValueFlag<A>("--max-bend", scene(&SceneOptions::max_bend_deg))
+          .Help("bending: total turning of the centre line at full bend, degrees (<= 330)")
+          .ShowDefault(),
+      SwitchFlag<A>("--oscillate", scene(&SceneOptions::oscillate))
+          .Help("Bend and unbend instead of one sweep"),
+      ValueFlag<A>("--cycles", scene(&SceneOptions::oscillate_cycles))
+          .Help("With --oscillate: bend-unbend cycles")
+          .ShowDefault(),
+      ValueFlag<A>("--length", scene(&SceneOptions::length_px))
+          .Help("Body length along its centre line, pixels")
+          .ShowDefault(),
+      ValueFlag<A>("--width", scene(&SceneOptions::width_px))
+          .Help("Body width, pixels")
+          .ShowDefault(),
+      ValueFlag<A>("--marker-radius", scene(&SceneOptions::marker_radius_px))
+          .Help("Marker disc radius, pixels")
+          .ShowDefault(),
+      SeedFlag<A>(scene(&SceneOptions::seed), "Background texture (and noise) seed"),
+      NoiseFlag<A>(noise(&NoiseOptions::sigma)),
+      BlurFlag<A>(noise(&NoiseOptions::blur_sigma_px)),
+      ValueFlag<A>("--gain-start", noise(&NoiseOptions::gain_start))
+          .Help("Illumination gain at the first frame")
+          .ShowDefault(),
+      ValueFlag<A>("--gain-end", noise(&NoiseOptions::gain_end))
+          .Help("Illumination gain at the last frame (linear ramp)")
+          .ShowDefault(),
+      ValueFlag<A>("--occlude", &A::occlusions)
+          .Help("x,y,w,h,first,last: a grey rectangle over everything during frames "
+                "first..last (repeatable)"),
+      ValueFlag<A>("--supersample", [](A& a) -> auto& { return a.options.render.supersample; })
+          .Help("Anti-aliasing sub-samples per pixel side (truth is exact at this resolution)")
+          .ShowDefault(),
+      ValueFlag<A>("--codec", [](A& a) -> auto& { return a.options.codec; })
+          .Help("Video codec override: ffv1, hfyu, mjpg or mp4v"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No summary line"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupSynthCommand(CLI::App& sub) {
-  auto options = std::make_shared<SynthOptions>();
-  auto scene_name = std::make_shared<std::string>("bending");
-  auto size = std::make_shared<std::string>("640x480");
-  auto occlusions = std::make_shared<std::vector<std::string>>();
-  SceneOptions& scene = options->scene;
-  NoiseOptions& noise = options->noise;
+  auto args = std::make_shared<SynthArgs>();
   sub.description(
       "Render a synthetic soft actuator carrying red, blue and green disc markers on a textured\n"
       "background, with exact ground truth: every marker's centroid (of its visible area), the\n"
       "bend and the paper's measurements, per frame. Use it to try `softsight track` or to check\n"
       "accuracy. Example:\n"
       "  softsight synth --scene bending --frames 300 --out demo.avi --truth truth.csv");
-  sub.add_option("--scene", *scene_name,
-                 "bending: a silicone band bending from straight to --max-bend degrees; "
-                 "wedge1 / wedge4: the paper's triangle actuators (1 segment opening 20 degrees, "
-                 "4 segments opening 80); bench: bending on a textured bench with look-alike "
-                 "blobs of every marker colour; plate: a gray view of a plate with 5 white dots "
-                 "that tilts to 50 degrees and grows 1x to 2x (dot0..dot4)")
-      ->capture_default_str();
-  sub.add_option("-o,--output,--out", options->out,
-                 "Video (.avi/.mkv: lossless HuffYUV; .mp4: lossy) or image pattern "
-                 "(frames/%04d.png)")
-      ->required();
-  sub.add_option("--truth", options->truth_csv, "Ground-truth CSV (one row per frame)");
-  sub.add_option("-n,--frames", scene.frame_count, "Number of frames")->capture_default_str();
-  sub.add_option("--size", *size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  sub.add_option("--fps", scene.fps, "Frame rate (sets time_s and the video's rate)")
-      ->capture_default_str();
-  sub.add_option("--max-bend", scene.max_bend_deg,
-                 "bending: total turning of the centre line at full bend, degrees (<= 330)")
-      ->capture_default_str();
-  sub.add_flag("--oscillate", scene.oscillate, "Bend and unbend instead of one sweep");
-  sub.add_option("--cycles", scene.oscillate_cycles, "With --oscillate: bend-unbend cycles")
-      ->capture_default_str();
-  sub.add_option("--length", scene.length_px, "Body length along its centre line, pixels")
-      ->capture_default_str();
-  sub.add_option("--width", scene.width_px, "Body width, pixels")->capture_default_str();
-  sub.add_option("--marker-radius", scene.marker_radius_px, "Marker disc radius, pixels")
-      ->capture_default_str();
-  sub.add_option("--seed", scene.seed, "Background texture (and noise) seed")
-      ->capture_default_str();
-  sub.add_option("--noise", noise.sigma, "Gaussian sensor noise sigma, grey levels")
-      ->capture_default_str();
-  sub.add_option("--blur", noise.blur_sigma_px, "Optical blur (Gaussian sigma), pixels")
-      ->capture_default_str();
-  sub.add_option("--gain-start", noise.gain_start, "Illumination gain at the first frame")
-      ->capture_default_str();
-  sub.add_option("--gain-end", noise.gain_end, "Illumination gain at the last frame (linear ramp)")
-      ->capture_default_str();
-  sub.add_option("--occlude", *occlusions,
-                 "x,y,w,h,first,last: a grey rectangle over everything during frames "
-                 "first..last (repeatable)");
-  sub.add_option("--supersample", options->render.supersample,
-                 "Anti-aliasing sub-samples per pixel side (truth is exact at this resolution)")
-      ->capture_default_str();
-  sub.add_option("--codec", options->codec, "Video codec override: ffv1, hfyu, mjpg or mp4v");
-  sub.add_flag("-q,--quiet", options->quiet, "No summary line");
+  AddFlags(sub, SynthFlags(), args.get());
+  // The run's parts, each keeping `args` alive.
+  const std::shared_ptr<SynthOptions> options(args, &args->options);
+  const std::shared_ptr<std::string> scene_name(args, &args->scene_name);
+  const std::shared_ptr<std::string> size(args, &args->size);
+  const std::shared_ptr<std::vector<std::string>> occlusions(args, &args->occlusions);
   return [options, scene_name, size, occlusions] {
     options->scene.size = ParseSize(*size);
     options->plate.reset();

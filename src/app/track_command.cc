@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "app/publish_options.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "app/track_many.h"
 #include "gui/overlay.h"
@@ -137,14 +138,69 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   return summary;
 }
 
+namespace {
+
+// What track's flags set until it runs. Several inputs (or an output folder) run as a batch:
+// one CSV per input (track_many.h).
+struct TrackArgs {
+  TrackOptions options;
+  std::vector<std::string> inputs;
+  int jobs = DefaultJobs();
+  CaptureArgs capture;
+  PublishArgs publish;
+};
+
+const FlagTable<TrackArgs>& TrackFlags() {
+  using A = TrackArgs;
+  static const FlagTable<TrackArgs> table = {
+      ValueFlag<A>(kConfigFlag, [](A& a) -> auto& { return a.options.config_file; })
+          .Help("Marker config (YAML), see examples/")
+          .Required()
+          .Check(CLI::ExistingFile),
+      ValueFlag<A>(kInputFlag, &A::inputs)
+          .Help("Video file, folder of images, printf pattern such as frames/%04d.png, or a "
+                "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
+                "synth:plate. Repeat it for several inputs (with -o FOLDER/)"),
+      CameraFlag<A>("--camera", [](A& a) -> auto& { return a.options.source.camera; },
+                    "The camera instead of --input: tracks until Ctrl-C or --max-frames")
+          .Excludes("--input"),
+      OutputFlag<A>([](A& a) -> auto& { return a.options.csv_file; }, "csv",
+                    "Where to write the per-frame CSV; a folder (an existing one, or a path "
+                    "ending in /) gets one CSV per input, named after it (run.avi -> "
+                    "FOLDER/run.csv)")
+          .Required(),
+      ValueFlag<A>("-j,--jobs", &A::jobs)
+          .Help("With several inputs: how many are tracked at the same time (default: the "
+                "number of cores)")
+          .Check(CLI::Range(1, 1024)),
+      MethodFlag<A>([](A& a) -> auto& { return a.options.method; }),
+      ActionFlag<A>("--gray", [](A& a) { a.options.template_colour = false; })
+          .Help("Template matching on gray frames (the default unless the config says colour)"),
+      ActionFlag<A>("--colour", [](A& a) { a.options.template_colour = true; })
+          .Help("Template matching on BGR frames: 3x the work, tells same-shape markers of "
+                "different colours apart")
+          .Excludes("--gray"),
+      ValueFlag<A>("--annotated", [](A& a) -> auto& { return a.options.annotated_file; })
+          .Help("Also write a video with the overlay drawn on each frame (.avi)"),
+      ValueFlag<A>("--record", [](A& a) -> auto& { return a.options.record_file; })
+          .Help("Also write every processed frame as read (.avi/.mkv: lossless HuffYUV, or "
+                "frames/%04d.png), e.g. to track a camera run again later"),
+      SequenceFpsFlag<A>([](A& a) -> auto& { return a.options.source.sequence_fps; },
+                         "Frame rate of an image sequence, for its timestamps"),
+      MaxFramesFlag<A>([](A& a) -> auto& { return a.options.max_frames; },
+                       "Stop after this many frames"),
+      SwitchFlag<A>(kQuietFlag, [](A& a) -> auto& { return a.options.quiet; })
+          .Help("No progress bar and no summary"),
+      SwitchFlag<A>("--brief", [](A& a) -> auto& { return a.options.brief; })
+          .Help("No progress bar; a one-line summary at the end"),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupTrackCommand(CLI::App& sub) {
-  auto options = std::make_shared<TrackOptions>();
-  // Several inputs (or an output folder) run as a batch: one CSV per input (track_many.h).
-  auto inputs = std::make_shared<std::vector<std::string>>();
-  auto jobs = std::make_shared<int>(DefaultJobs());
-  auto capture = std::make_shared<CaptureArgs>();
-  AddCaptureOptions(sub, capture.get());
-  auto publish = std::make_shared<PublishArgs>();
+  auto args = std::make_shared<TrackArgs>();
   sub.description(
       "Track the markers of a config in a video (or image sequence) and write one CSV row per\n"
       "frame: every marker's centroid, the bending angle, chord, sagitta, radius of curvature,\n"
@@ -155,49 +211,16 @@ CommandRunner SetupTrackCommand(CLI::App& sub) {
       "  softsight track -c markers.yaml -i a.avi -i b.avi -i c.avi -o results/ --jobs 2\n"
       "  softsight track -c markers.yaml --camera 0 --csv run.csv --publish tcp://*:5556\n"
       "      (and in another terminal: softsight listen tcp://localhost:5556)");
-  sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
-      ->required()
-      ->check(CLI::ExistingFile);
-  CLI::Option* input = sub.add_option("-i,--input", *inputs,
-                 "Video file, folder of images, printf pattern such as frames/%04d.png, or a "
-                 "built-in scene: synth:bending, synth:wedge1, synth:wedge4, synth:bench, "
-                 "synth:plate. Repeat it for several inputs (with -o FOLDER/)");
-  AddCameraOption(sub, "--camera", &options->source.camera,
-                  "The camera instead of --input: tracks until Ctrl-C or --max-frames")
-      ->excludes(input);
-  sub.add_option("-o,--output,--csv", options->csv_file,
-                 "Where to write the per-frame CSV; a folder (an existing one, or a path ending "
-                 "in /) gets one CSV per input, named after it (run.avi -> FOLDER/run.csv)")
-      ->required();
-  sub.add_option("-j,--jobs", *jobs,
-                 "With several inputs: how many are tracked at the same time (default: the "
-                 "number of cores)")
-      ->check(CLI::Range(1, 1024));
-  sub.add_option("-m,--method", options->method,
-                 "Use this method for every marker: colour, sad, ssd or zncc");
-  CLI::Option* gray = sub.add_flag_function(
-      "--gray", [options](int64_t) { options->template_colour = false; },
-      "Template matching on gray frames (the default unless the config says colour)");
-  sub.add_flag_function(
-         "--colour", [options](int64_t) { options->template_colour = true; },
-         "Template matching on BGR frames: 3x the work, tells same-shape markers of different "
-         "colours apart")
-      ->excludes(gray);
-  sub.add_option("--annotated", options->annotated_file,
-                 "Also write a video with the overlay drawn on each frame (.avi)");
-  sub.add_option("--record", options->record_file,
-                 "Also write every processed frame as read (.avi/.mkv: lossless HuffYUV, or "
-                 "frames/%04d.png), e.g. to track a camera run again later");
-  sub.add_option("--fps", options->source.sequence_fps,
-                 "Frame rate of an image sequence, for its timestamps")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e6));
-  sub.add_option("--max-frames", options->max_frames, "Stop after this many frames")
-      ->check(NumberIn(0, 1e15));
-  sub.add_flag("-q,--quiet", options->quiet, "No progress bar and no summary");
-  sub.add_flag("--brief", options->brief, "No progress bar; a one-line summary at the end");
-  AddPublishOptions(sub, publish.get());
-  AddHookOptions(sub, &options->hook);
+  AddFlags(sub, CaptureFlags(), &args->capture);
+  AddFlags(sub, TrackFlags(), args.get());
+  AddFlags(sub, PublishFlags(), &args->publish);
+  AddFlags(sub, HookFlags(), &args->options.hook);
+  // The run's parts, each keeping `args` alive.
+  const std::shared_ptr<TrackOptions> options(args, &args->options);
+  const std::shared_ptr<std::vector<std::string>> inputs(args, &args->inputs);
+  const std::shared_ptr<int> jobs(args, &args->jobs);
+  const std::shared_ptr<CaptureArgs> capture(args, &args->capture);
+  const std::shared_ptr<PublishArgs> publish(args, &args->publish);
   return [options, inputs, jobs, capture, publish] {
     options->publish = publish->resolved();
     const bool from_files = !inputs->empty() || !options->source.input.empty();

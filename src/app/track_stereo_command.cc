@@ -12,6 +12,7 @@
 #include "app/cli_checks.h"
 #include "app/commands.h"
 #include "app/publish_options.h"
+#include "app/shared_flags.h"
 #include "app/stop_request.h"
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
@@ -447,6 +448,84 @@ TrackStereoSummary Run(const TrackStereoOptions& options, StereoInput& input,
 
 }  // namespace
 
+namespace {
+
+const FlagTable<TrackStereoOptions>& TrackStereoFlags() {
+  using A = TrackStereoOptions;
+  static const FlagTable<TrackStereoOptions> table = {
+      ValueFlag<A>(kConfigFlag, &A::config_file).Help("Marker config (YAML), see examples/")
+          .Required()
+          .Check(CLI::ExistingFile),
+      RightConfigFlag<A>(&A::right_config_file,
+                         "The right view's marker config, when its colours or rois differ (same "
+                         "names)"),
+      ValueFlag<A>(kLeftFlag, &A::left_input).Help("The first camera's video (or image sequence)"),
+      ValueFlag<A>(kRightFlag, &A::right_input)
+          .Help("The second camera's video (or image sequence)"),
+      ValueFlag<A>("--side-by-side", &A::side_by_side)
+          .Help("Instead of --left/--right: one video, the first camera in the left half of each "
+                "frame, the second in the right half"),
+      CameraFlag<A>("--left-camera", &A::left_camera,
+                    "Instead of --left/--right: two live cameras, paired by capture time"),
+      CameraFlag<A>("--right-camera", &A::right_camera, "The second live camera"),
+      ValueFlag<A>(kStereoFlag, &A::stereo_file)
+          .Help("The rig from `softsight calibrate --left ... --right ...`")
+          .Required(),
+      OutputFlag<A>(&A::csv_file, "csv", "Where to write the per-frame CSV").Required(),
+      ValueFlag<A>("--frame-offset", &A::frame_offset)
+          .Help("Pair left frame i with right frame i + N (the right camera started N frames "
+                "earlier; negative: later). Not given: found from a flash or the motion, or "
+                "refused"),
+      ValueFlag<A>("--max-offset-frames", &A::max_offset_frames)
+          .Help("Without --frame-offset: search offsets up to this many frames either way")
+          .ShowDefault()
+          .Check(NumberIn(0, 100000)),
+      ValueFlag<A>("--pair-by", &A::pair_by)
+          .Help("index (frame i with frame i + offset) or time (each frame with the other "
+                "view's nearest in time, within half a frame interval; CSV column pair_dt_ms)")
+          .ShowDefault(),
+      ValueFlag<A>("--time-offset-ms", &A::time_offset_ms)
+          .Help("With --pair-by time: the right view's clock minus the left one's (ms)")
+          .ShowDefault()
+          .Check(NumberIn(-1e9, 1e9)),
+      MaxEpipolarFlag<A>(&A::max_epipolar_px,
+                         "A pair farther than this from its epipolar line is not believed (status "
+                         "epipolar)"),
+      ValueFlag<A>("--reference-plane", &A::reference_plane)
+          .Help("The out-of-plane angle against: image (the first camera's image plane), first "
+                "(the first frame's bending plane) or board (the --bench-board's plane: the "
+                "bench)")
+          .ShowDefault(),
+      ValueFlag<A>("--bench-board", &A::bench_board)
+          .Help("LEFT RIGHT: one pair of images of the chessboard lying on the bench; the 3D "
+                "coordinates are then in the board's frame (origin at its first inner corner, X "
+                "along its first row, Y along its columns, Z into the bench) instead of the "
+                "first camera's")
+          .Finish([](CLI::Option* o) { o->expected(2); }),
+      ValueFlag<A>(kChessboardFlag, &A::chessboard)
+          .Help("The --bench-board board's inner corners WxH (default: the --stereo "
+                "file's)"),
+      ValueFlag<A>(kSquareMmFlag, &A::square_mm)
+          .Help("The --bench-board board's square side in mm (default: the --stereo file's)"),
+      SequenceFpsFlag<A>(&A::sequence_fps, "Frame rate of image sequences"),
+      ValueFlag<A>("--right-fps", &A::right_sequence_fps)
+          .Help("Frame rate of the right image sequence, when it differs from --fps")
+          .Check(NumberIn(1e-3, 1e6)),
+      MaxFramesFlag<A>(&A::max_frames, "Stop after this many pairs"),
+      SwitchFlag<A>("--window", &A::window)
+          .Help("Show both views side by side with their overlay and a strip chart of the 3D, "
+                "each camera's and the out-of-plane angle while tracking (needs a display)"),
+      NoPaceFlag<A>([](A& a) { a.pace = false; },
+                    "With --window: play recorded inputs as fast as they are tracked instead of "
+                    "at their frame rate"),
+      ChartSecondsFlag<A>(&A::chart_seconds, "With --window: the strip chart's time span, seconds")
+          .Check(NumberIn(0.2, 3600)),
+  };
+  return table;
+}
+
+}  // namespace
+
 CommandRunner SetupTrackStereoCommand(CLI::App& sub) {
   return SetupTrackStereoCommand(sub, nullptr);
 }
@@ -481,83 +560,9 @@ CommandRunner SetupTrackStereoCommand(CLI::App& sub, StereoWindowOpener open_win
       "as fast as they are tracked); the window closes at the end of the input:\n"
       "  softsight track-stereo -c markers.yaml --left-camera 0 --right-camera 2 "
       "--stereo stereo.yaml --csv live3d.csv --window");
-  sub.add_option("-c,--config", options->config_file, "Marker config (YAML), see examples/")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sub.add_option("--right-config", options->right_config_file,
-                 "The right view's marker config, when its colours or rois differ (same names)")
-      ->check(CLI::ExistingFile);
-  sub.add_option("--left", options->left_input, "The first camera's video (or image sequence)");
-  sub.add_option("--right", options->right_input,
-                 "The second camera's video (or image sequence)");
-  sub.add_option("--side-by-side", options->side_by_side,
-                 "Instead of --left/--right: one video, the first camera in the left half of each "
-                 "frame, the second in the right half");
-  AddCameraOption(sub, "--left-camera", &options->left_camera,
-                  "Instead of --left/--right: two live cameras, paired by capture time");
-  AddCameraOption(sub, "--right-camera", &options->right_camera, "The second live camera");
-  sub.add_option("--stereo", options->stereo_file,
-                 "The rig from `softsight calibrate --left ... --right ...`")
-      ->required();
-  sub.add_option("-o,--output,--csv", options->csv_file, "Where to write the per-frame CSV")
-      ->required();
-  sub.add_option("--frame-offset", options->frame_offset,
-                 "Pair left frame i with right frame i + N (the right camera started N frames "
-                 "earlier; negative: later). Not given: found from a flash or the motion, or "
-                 "refused");
-  sub.add_option("--max-offset-frames", options->max_offset_frames,
-                 "Without --frame-offset: search offsets up to this many frames either way")
-      ->capture_default_str()
-      ->check(NumberIn(0, 100000));
-  sub.add_option("--pair-by", options->pair_by,
-                 "index (frame i with frame i + offset) or time (each frame with the other "
-                 "view's nearest in time, within half a frame interval; CSV column pair_dt_ms)")
-      ->capture_default_str();
-  sub.add_option("--time-offset-ms", options->time_offset_ms,
-                 "With --pair-by time: the right view's clock minus the left one's (ms)")
-      ->capture_default_str()
-      ->check(NumberIn(-1e9, 1e9));
-  sub.add_option("--max-epipolar-px", options->max_epipolar_px,
-                 "A pair farther than this from its epipolar line is not believed (status "
-                 "epipolar)")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e3));
-  sub.add_option("--reference-plane", options->reference_plane,
-                 "The out-of-plane angle against: image (the first camera's image plane), first "
-                 "(the first frame's bending plane) or board (the --bench-board's plane: the "
-                 "bench)")
-      ->capture_default_str();
-  sub.add_option("--bench-board", options->bench_board,
-                 "LEFT RIGHT: one pair of images of the chessboard lying on the bench; the 3D "
-                 "coordinates are then in the board's frame (origin at its first inner corner, X "
-                 "along its first row, Y along its columns, Z into the bench) instead of the "
-                 "first camera's")
-      ->expected(2);
-  sub.add_option("--chessboard", options->chessboard,
-                 "The --bench-board board's inner corners WxH (default: the --stereo file's)");
-  sub.add_option("--square-mm", options->square_mm,
-                 "The --bench-board board's square side in mm (default: the --stereo file's)");
-  sub.add_option("--fps", options->sequence_fps, "Frame rate of image sequences")
-      ->capture_default_str()
-      ->check(NumberIn(1e-3, 1e6));
-  sub.add_option("--right-fps", options->right_sequence_fps,
-                 "Frame rate of the right image sequence, when it differs from --fps")
-      ->check(NumberIn(1e-3, 1e6));
-  sub.add_option("--max-frames", options->max_frames, "Stop after this many pairs")
-      ->check(NumberIn(0, 1e15));
-  sub.add_flag("--window", options->window,
-               "Show both views side by side with their overlay and a strip chart of the 3D, "
-               "each camera's and the out-of-plane angle while tracking (needs a display)");
-  sub.add_flag_callback(
-      "--no-pace", [options] { options->pace = false; },
-      "With --window: play recorded inputs as fast as they are tracked instead of at their frame "
-      "rate");
-  sub.add_option("--chart-seconds", options->chart_seconds,
-                 "With --window: the strip chart's time span, seconds")
-      ->capture_default_str()
-      ->check(NumberIn(0.2, 3600));
+  AddFlags(sub, TrackStereoFlags(), options.get());
   auto publish = std::make_shared<PublishArgs>();
-  AddPublishOptions(sub, publish.get());
+  AddFlags(sub, PublishFlags(), publish.get());
   return [options, publish, open_window] {
     options->publish = publish->resolved();
     // Ctrl-C or SIGTERM ends the run between pairs with every row written and the summary;
