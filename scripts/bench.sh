@@ -10,6 +10,8 @@
 # program measured in the same run. Then the TrackingSession table: the session per frame with three
 # colour markers and with three ZNCC templates, at 640x480 and 1280x720, beside the gray pass
 # (issue 45; their instruction counts, steady on a busy machine: scripts/session_instructions.sh).
+# Then `track` on H.264 (VGA and 1080p, a key frame every 250 frames) beside a bare decode of the
+# same file: wall, CPU and peak RSS, and how long rows waited for their key-frame group's check.
 # Then the real sequence mire-2 beside ViSP's vpDot2 (needs libvisp-dev; skipped with a message
 # without it).
 # Takes about 4 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
