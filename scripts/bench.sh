@@ -10,6 +10,10 @@
 # program measured in the same run. Then the TrackingSession table: the session per frame with three
 # colour markers and with three ZNCC templates, at 640x480 and 1280x720, beside the gray pass
 # (issue 45; their instruction counts, steady on a busy machine: scripts/session_instructions.sh).
+# Then `track` on H.264 (VGA and 1080p, a key frame every 250 frames) beside a bare decode of the
+# same file: wall, CPU and peak RSS, and how long rows waited for their key-frame group's check.
+# Then the real sequence mire-2 beside ViSP's vpDot2 (needs libvisp-dev; skipped with a message
+# without it).
 # Takes about 4 minutes on an idle 2-core machine. Needs a build (scripts/build.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -233,6 +237,73 @@ for label, session, trackers in (("colour", "BM_Session3", "BM_Trackers3"),
                       for s in sizes)
     print(f"| the session's own checks (whole - trackers), {label} | {over} | <= the trackers' time |")
 PYEOF
+
+# `track` on H.264 (issue 45: <= 1.2x the bare decode of the same file and <= 2x its memory, rows
+# not held back by more than one key-frame group): a VGA and a 1080p rendering re-encoded as H.264
+# with a key frame every 250 frames (libx264's default; softsight_h264_clip), `softsight track`
+# (CSV only) beside a bare decode loop of the file in a process of its own, both under
+# /usr/bin/time (wall, CPU, peak RSS), alternated, median of 3 rounds; how long rows waited for
+# their group's check: the CSV's latency_row_ms (a file's frame is stamped as it is tracked).
+cmake --build build --target softsight_h264_clip >/dev/null
+for size in 640x480 1920x1080; do
+  [ -f "$WORK/h264_$size.mp4" ] && continue
+  "$S" synth --scene bending --frames 300 --seed 1 --size "$size" --out "$WORK/h264_$size.avi" -q
+  build/src/app/softsight_h264_clip "$WORK/h264_$size.avi" "$WORK/h264_$size.mp4" 250 >/dev/null
+  rm -f "$WORK/h264_$size.avi"
+done
+echo
+echo "\`track\` on H.264, load average $(cut -d' ' -f1-3 /proc/loadavg):"
+echo
+"$PY" - "$S" "$CFG" "$WORK" <<'PYEOF'
+import csv, os, statistics, subprocess, sys, tempfile
+softsight, config, work = sys.argv[1:4]
+def timed(cmd):
+    with tempfile.NamedTemporaryFile("r") as t:
+        subprocess.run(["/usr/bin/time", "-f", "%e %U %S %M", "-o", t.name, *cmd], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        wall, user, system, rss_kb = t.read().split()[-4:]
+    return float(wall), float(user) + float(system), int(rss_kb) / 1024
+print("| what | `track` | bare decode of the same file, in the same run | target |")
+print("| --- | --- | --- | --- |")
+for size in ("640x480", "1920x1080"):
+    clip = os.path.join(work, f"h264_{size}.mp4")
+    out = os.path.join(work, f"h264_{size}.csv")
+    runs = {"track": [], "decode": []}
+    for _ in range(3):
+        runs["decode"].append(timed(["build/src/app/softsight_speed_report", "--decode", clip]))
+        runs["track"].append(timed([softsight, "track", "-c", config, "-i", clip, "-o", out, "-q"]))
+    med = {k: [statistics.median(r[i] for r in v) for i in range(3)] for k, v in runs.items()}
+    (tw, tc, tm), (dw, dc, dm) = med["track"], med["decode"]
+    with open(out) as f:
+        waits = sorted(float(r["latency_row_ms"]) for r in csv.DictReader(f) if r["latency_row_ms"])
+    print(f"| `track` of a {size} H.264 file (300 frames, a key frame every 250), CSV only: wall / "
+          f"CPU / peak RSS | {tw:.2f} s ({tw / dw:.2f}x) / {tc:.2f} s ({tc / dc:.2f}x) / {tm:.0f} MB "
+          f"({tm / dm:.2f}x); rows waited median {waits[len(waits) // 2]:.0f} ms, max {waits[-1]:.0f} ms "
+          f"| {dw:.2f} s / {dc:.2f} s / {dm:.0f} MB | <= 1.2x wall, <= 2x memory |")
+PYEOF
+
+# The real-sequence case (issue 45: the session <= 3x ViSP's vpDot2 per frame, the same dots
+# found): ViSP's mire-2 (tests/real/mire2, 501 real 384x288 frames, 5 white dots), its colour and
+# ZNCC configs, both trackers on the same preloaded frames in one process and thread, each
+# figure beside vpDot2's from the same run (src/app/vpdot2_compare.cc). ViSP is needed by this
+# row only (Debian: libvisp-dev; SOFTSIGHT_BENCH_INSTALL=1 installs it with apt-get).
+echo
+echo "The real sequence beside vpDot2, load average $(cut -d' ' -f1-3 /proc/loadavg):"
+echo
+if ! dpkg -s libvisp-dev >/dev/null 2>&1 && [ "${SOFTSIGHT_BENCH_INSTALL:-0}" = 1 ]; then
+  apt-get install -y libvisp-dev >/dev/null && cmake -S . -B build >/dev/null
+fi
+if cmake --build build --target softsight_vpdot2_compare >/dev/null 2>&1; then
+  echo "| what | softsight | vpDot2 in the same run |"
+  echo "| --- | --- | --- |"
+  for cfg in colour zncc; do
+    (cd tests/real/mire2 && "$OLDPWD/build/src/app/softsight_vpdot2_compare" "$cfg.yaml" \
+      'frames/image.%04d.png' 5)
+  done
+else
+  echo "(skipped: ViSP is not installed, so softsight_vpdot2_compare is not built; install"
+  echo "libvisp-dev, or run with SOFTSIGHT_BENCH_INSTALL=1, and reconfigure)"
+fi
 
 # The stream (--publish, issue 28): capture-to-subscriber latency beside the CSV row's, and the
 # run's own time per frame with 0, 1 and 10 subscribers beside a run without --publish.

@@ -35,6 +35,7 @@ class ProgressSink : public FrameSink {
   void begin(const RunInfo& info) override;
   void consume(const Frame& frame, const FrameResult& result) override;
   void end(const RunSummary& summary) override;
+  bool uses_image() const override { return false; }
 
  private:
   std::string label_;

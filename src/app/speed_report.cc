@@ -11,6 +11,7 @@
 //     its CPU time / N, which is the bound to compare the threaded run with (decoding may
 //     already keep every core busy, and then max(decode, track) is out of reach).
 // Each is the median of `kRepeats` runs. A benchmark, not a test: it asserts nothing.
+// softsight_speed_report --decode VIDEO: the bare decode loop alone, once (for its peak memory).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -100,8 +101,18 @@ Pass Track(const TrackingConfig& config, const std::string& video, const std::st
 }
 
 int Main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--decode") {
+    // The bare decode loop alone, in a process of its own: its peak memory (/usr/bin/time -v)
+    // and CPU time beside `softsight track`'s on the same file (scripts/bench.sh).
+    const Pass decoded = DecodeOnly(argv[2]);
+    std::printf("%lld frames, %.3f ms/frame, CPU %.3f ms/frame\n",
+                static_cast<long long>(decoded.frames), decoded.ms_per_frame,
+                decoded.cpu_ms_per_frame);
+    return 0;
+  }
   if (argc != 4) {
-    std::cerr << "usage: softsight_speed_report CONFIG VIDEO OUT_DIR\n";
+    std::cerr << "usage: softsight_speed_report CONFIG VIDEO OUT_DIR\n"
+                 "       softsight_speed_report --decode VIDEO\n";
     return 2;
   }
   const TrackingConfig config = LoadTrackingConfig(argv[1]);

@@ -19,6 +19,7 @@ class TruthScoreSink : public FrameSink {
   void consume(const Frame& frame, const FrameResult& result) override {
     scorer_.add(truths_.at(static_cast<size_t>(frame.index)), result);
   }
+  bool uses_image() const override { return false; }
   TruthScore score() const { return scorer_.score(); }
 
  private:

@@ -38,8 +38,10 @@ void KeyFrameGroups::add(const Frame& frame, const FrameResult& result, const Re
     check(result);
     release_held(release, /*checked=*/true);
   }
-  const size_t bytes = frame.image.total() * frame.image.elemSize();
-  if (count_ > 0 && held_bytes_ + bytes > max_held_bytes_) release_held(release, /*checked=*/false);
+  const size_t bytes = hold_images_ ? frame.image.total() * frame.image.elemSize() : 0;
+  if (count_ > 0 && (held_bytes_ + bytes > max_held_bytes_ || count_ >= max_held_frames_)) {
+    release_held(release, /*checked=*/false);
+  }
   hold(frame, result);
 }
 
@@ -54,13 +56,17 @@ void KeyFrameGroups::flush(const Release& release, bool damaged) {
 void KeyFrameGroups::hold(const Frame& frame, const FrameResult& result) {
   if (count_ == held_.size()) held_.emplace_back();
   Held& slot = held_[count_++];
-  frame.image.copyTo(slot.frame.image);  // Into the slot's own buffer: no allocation once sized.
+  if (hold_images_) {
+    frame.image.copyTo(slot.frame.image);  // Into the slot's own buffer: no allocation once sized.
+    held_bytes_ += frame.image.total() * frame.image.elemSize();
+  } else {
+    slot.frame.image.release();
+  }
   slot.frame.index = frame.index;
   slot.frame.time_s = frame.time_s;
   slot.frame.captured = frame.captured;
   slot.frame.key_frame = frame.key_frame;
   slot.result = result;
-  held_bytes_ += frame.image.total() * frame.image.elemSize();
 }
 
 void KeyFrameGroups::release_held(const Release& release, bool checked) {

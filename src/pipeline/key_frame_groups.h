@@ -58,10 +58,23 @@ class KeyFrameGroups {
   // A held frame handed on, in source order.
   using Release = std::function<void(const Frame& frame, const FrameResult& result)>;
 
-  // Groups that would hold more than `max_held_bytes` of images are handed on unchecked as the
-  // limit is reached (counted in unchecked_frames()).
-  explicit KeyFrameGroups(size_t max_held_bytes = size_t{512} << 20)
-      : max_held_bytes_(max_held_bytes) {}
+  // Groups that would hold more than `max_held_bytes` of images, or more than `max_held_frames`
+  // frames, are handed on unchecked as the limit is reached (counted in unchecked_frames()).
+  // `hold_images` false: the frames are held without their pixels (what receives them reads only
+  // the results, e.g. a CSV): a group then costs its rows, not its pictures, and frames handed on
+  // have an empty image.
+  explicit KeyFrameGroups(size_t max_held_bytes = size_t{512} << 20, bool hold_images = true,
+                          size_t max_held_frames = kMaxHeldFrames)
+      : max_held_bytes_(max_held_bytes), max_held_frames_(max_held_frames),
+        hold_images_(hold_images) {}
+  // Twenty seconds at 30 fps (libx264's default key-frame interval is 250 frames; a VGA group
+  // with images reaches the byte limit at 582): a longer group is not checked beyond it, and its
+  // rows wait no longer than this for their check.
+  static constexpr size_t kMaxHeldFrames = 600;
+
+  // From the next frame on, hold images too (a sink that reads them joined the run).
+  void hold_images() { hold_images_ = true; }
+  bool holds_images() const { return hold_images_; }
 
   // The next frame and its result: held, or handed on (with any group this frame ends) through
   // `release` before add() returns.
@@ -93,6 +106,8 @@ class KeyFrameGroups {
   void release_held(const Release& release, bool checked);
 
   size_t max_held_bytes_;
+  size_t max_held_frames_;
+  bool hold_images_;
   bool predicted_seen_ = false;  // Until a predicted frame comes, every frame passes through.
   std::vector<Held> held_;       // Slots reused across groups: their images keep their buffers.
   size_t count_ = 0;             // held_[0, count_) is the open group.

@@ -302,5 +302,53 @@ TEST(KeyFrameGroups, AGroupOverTheMemoryLimitGoesOnUncheckedInOrder) {
   EXPECT_GT(groups.unchecked_frames(), 0);
 }
 
+TEST(KeyFrameGroups, WithoutImagesTheSameDamageIsFoundAndFramesGoOnWithoutPixels) {
+  // The first test's damage, held once with images and once without (what a CSV-only run does):
+  // the same results, in the same order; the frames handed on carry no image.
+  const auto damage = [](int i, int m) {
+    return i >= 28 && i < 36 && m < 2 ? cv::Point2d(-16, 0) : cv::Point2d(0, 0);
+  };
+  const std::vector<FrameResult> results = Track{}.results(48, damage);
+  KeyFrameGroups with_images;
+  KeyFrameGroups without(size_t{512} << 20, /*hold_images=*/false);
+  const Released a = CheckGroups(results, true, with_images);
+  int empty_images = 0, frames = 0;
+  Released b;
+  const KeyFrameGroups::Release release = [&](const Frame& frame, const FrameResult& result) {
+    ++frames;
+    // Frames before the first predicted one pass straight through, as they came.
+    empty_images += frame.image.empty() ? 1 : 0;
+    b.order.push_back(frame.index);
+    b.results.push_back(result);
+  };
+  Frame frame;
+  frame.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  for (const FrameResult& result : results) {
+    frame.index = result.frame_index;
+    frame.key_frame = result.frame_index % kKeyFrameInterval == 0;
+    without.add(frame, result, release);
+  }
+  without.flush(release);
+  ExpectEveryFrameOnceInOrder(b, 48);
+  EXPECT_EQ(empty_images, 47);  // All but frame 0, the key frame before any predicted one.
+  EXPECT_EQ(without.demoted(), with_images.demoted());
+  EXPECT_GT(without.demoted(), 0);
+  for (size_t i = 0; i < a.results.size(); ++i) {
+    for (size_t m = 0; m < 3; ++m) {
+      EXPECT_EQ(a.results[i].markers[m].observation.status(),
+                b.results[i].markers[m].observation.status())
+          << "frame " << i << " marker " << m;
+    }
+  }
+}
+
+TEST(KeyFrameGroups, AGroupOverTheFrameLimitGoesOnUncheckedInOrder) {
+  const auto none = [](int, int) { return cv::Point2d(0, 0); };
+  KeyFrameGroups groups(size_t{512} << 20, /*hold_images=*/false, /*max_held_frames=*/5);
+  const Released released = CheckGroups(Track{}.results(30, none), true, groups);
+  ExpectEveryFrameOnceInOrder(released, 30);
+  EXPECT_GT(groups.unchecked_frames(), 0);
+}
+
 }  // namespace
 }  // namespace softsight

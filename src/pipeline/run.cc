@@ -139,6 +139,9 @@ void BasicPipelineRun<Session>::begin_sinks() {
 
 template <typename Session>
 void BasicPipelineRun<Session>::join(Sink& sink) {
+  // Frames held back before it joined have no image when no sink read them: it gets the frames
+  // from the next one on.
+  if (key_frame_groups_ && sink.uses_image()) key_frame_groups_->hold_images();
   joined_.push_back(&sink);
 }
 
@@ -182,8 +185,11 @@ void BasicPipelineRun<Session>::deliver(const Input& input, const Result& result
   proc_ms_.push_back(result.proc_ms);
   latency_result_ms_.push_back(result.latency_result_ms);
   for (Sink* sink : sinks_) sink->consume(input, result);
-  for (Sink* sink : joined_) sink->consume(input, result);
   const Frame& first = FirstView(input);
+  for (Sink* sink : joined_) {
+    if (first.image.empty() && sink->uses_image()) continue;  // Held before it joined (join()).
+    sink->consume(input, result);
+  }
   latency_done_ms_.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - first.captured)
           .count());
@@ -194,7 +200,13 @@ void BasicPipelineRun<Session>::deliver(const Input& input, const Result& result
 template <typename Session>
 void BasicPipelineRun<Session>::check_key_frame_groups() {
   if constexpr (std::is_same_v<Session, TrackingSession>) {
-    if (!key_frame_groups_) key_frame_groups_ = std::make_unique<KeyFrameGroups>();
+    if (!key_frame_groups_) {
+      // Their images only when a sink reads them (Sink::uses_image).
+      const auto reads = [](const Sink* sink) { return sink->uses_image(); };
+      const bool images = std::any_of(sinks_.begin(), sinks_.end(), reads) ||
+                          std::any_of(joined_.begin(), joined_.end(), reads);
+      key_frame_groups_ = std::make_unique<KeyFrameGroups>(size_t{512} << 20, images);
+    }
   }
 }
 

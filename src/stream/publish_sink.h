@@ -85,6 +85,7 @@ class PublishSink : public FrameSink {
   void end(const RunSummary& summary) override;
   // A note: the endpoint, messages sent, subscriptions seen and messages dropped.
   void report(RunSummary& summary) const override;
+  bool uses_image() const override { return false; }  // Rows only.
 
   // The endpoint as bound (a tcp port given as * is the one chosen).
   const std::string& endpoint() const { return bound_endpoint_; }
@@ -142,6 +143,7 @@ class PublishRowsSink : public BasicFrameSink<Input, Row> {
     publish_.set_row_columns(columns_.names(), std::move(marker_suffixes));
   }
   void begin(const RunInfo& info) override { publish_.begin(info); }
+  bool uses_image() const override { return false; }
   void consume(const Input& input, const Row& row) override {
     (void)input;
     columns_.append_row(row, text_);

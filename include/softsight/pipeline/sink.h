@@ -54,6 +54,11 @@ class BasicFrameSink {
   // RunPipeline (track, control, Python) reports the same figures without patching them in.
   // Must not throw.
   virtual void report(RunSummary& summary) const { (void)summary; }
+  // Whether consume() looks at the input's image (a video, a hook, a window do; the CSV, the
+  // progress bar and the stream do not). A run that holds frames back (a predicted video's
+  // key-frame groups, RunOptions::check_key_frame_groups) keeps their images only when one of its
+  // sinks does: a 1080p group of 250 frames is 1.5 GB of pixels and 250 rows of a few kB.
+  virtual bool uses_image() const { return true; }
 };
 
 // One view's sink: every Frame as read and its FrameResult.

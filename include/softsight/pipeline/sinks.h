@@ -42,6 +42,7 @@ class BasicCsvSink : public BasicFrameSink<Input, Row> {
   const std::vector<double>& row_latencies_ms() const { return row_latency_ms_; }
   // The summary's latency_row_ms_median / _p99 (when any row carried a capture time).
   void report(RunSummary& summary) const override;
+  bool uses_image() const override { return false; }
 
  private:
   BasicCsvWriter<Row> writer_;
