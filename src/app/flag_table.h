@@ -20,7 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "core/option_table.h"
+#include "softsight/core/option_table.h"
 
 namespace softsight {
 
