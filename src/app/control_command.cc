@@ -520,7 +520,9 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
       OpenSerialTransport(rig_server ? rig_server->port() : *options.port, config.link.baud);
   LinkEnvironment environment;
   environment.stop_requested = [&stop] { return stop.requested(); };
-  BoardLink link(*transport, config.link, environment);
+  // The simulated board of --simulate answers from a thread of this process: see rig.h.
+  BoardLink link(*transport, rig_server ? InProcessLinkOptions(config.link) : config.link,
+                 environment);
   // Declared after the link, so destroyed before it: from the handshake on, any way out of this
   // function (an error, an exception) sends STOP first.
   ControlSession session(config.controller, link, target);

@@ -66,7 +66,8 @@ std::unique_ptr<ServeRig> OpenServeRig(const ServeRigArgs& args, const TrackingC
   rig->transport = OpenSerialTransport(port, control.link.baud);
   // No stop request in the link's waits: Ctrl-C ends the serve loop between frames, and the
   // session's destructor vents then; a wait (at most retries x reply_timeout_ms) is never cut.
-  rig->link = std::make_unique<BoardLink>(*rig->transport, control.link);
+  rig->link = std::make_unique<BoardLink>(
+      *rig->transport, rig->rig_server ? InProcessLinkOptions(control.link) : control.link);
   rig->session = std::make_unique<ControlSession>(control.controller, *rig->link, ControlTarget{});
   rig->session->set_inner_loop_gains(control.inner_loop);
   rig->session->set_model(control.model);

@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -110,6 +111,11 @@ RigSnapshot SimulatedRig::snapshot() const {
   s.flags = p.board.flags();
   s.board_rejected = p.board.rejected();
   return s;
+}
+
+LinkOptions InProcessLinkOptions(LinkOptions configured) {
+  configured.reply_timeout_ms = std::max(configured.reply_timeout_ms, kInProcessReplyTimeoutMs);
+  return configured;
 }
 
 RigServer::RigServer(SimulatedRig& rig, bool realtime) : rig_(rig) {

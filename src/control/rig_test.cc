@@ -59,7 +59,7 @@ LoopRun RunLoop(SimulatedRig& rig, BoardLink& link, const ControllerOptions& con
 class LoopHarness {
  public:
   explicit LoopHarness(RigOptions rig_options = {}, ControllerOptions controller = {},
-                       LinkOptions link = {})
+                       LinkOptions link = InProcessLinkOptions({}))
       : rig_(rig_options),
         server_(rig_),
         transport_(OpenSerialTransport(server_.port(), 115200)),
@@ -111,6 +111,21 @@ ControlTarget AngleTarget(TargetProfile profile) {
   t.mode = ControlMode::kAngle;
   t.profile = std::move(profile);
   return t;
+}
+
+// An in-process simulated board (`--simulate`) is waited for longer than a real board: its
+// thread may be held back on a busy machine, and its time is simulated. A longer configured
+// deadline stays; the retries are as configured.
+TEST(InProcessLink, WaitsAtLeastTheInProcessDeadlineAndKeepsALongerOne) {
+  LinkOptions configured;
+  configured.reply_timeout_ms = 100;
+  configured.retries = 4;
+  const LinkOptions in_process = InProcessLinkOptions(configured);
+  EXPECT_EQ(in_process.reply_timeout_ms, kInProcessReplyTimeoutMs);
+  EXPECT_EQ(in_process.retries, 4);
+  EXPECT_EQ(in_process.baud, configured.baud);
+  configured.reply_timeout_ms = kInProcessReplyTimeoutMs + 500;
+  EXPECT_EQ(InProcessLinkOptions(configured).reply_timeout_ms, kInProcessReplyTimeoutMs + 500);
 }
 
 TEST(ClosedLoop, StepTo120DegreesSettlesWithin3sWithSmallOvershoot) {

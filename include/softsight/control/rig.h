@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "softsight/control/board_config.h"
+#include "softsight/control/board_link.h"
 #include "softsight/control/transport.h"
 
 namespace softsight {
@@ -91,6 +92,13 @@ class SimulatedRig {
   mutable std::mutex mutex_;
   std::unique_ptr<Parts> parts_;
 };
+
+// The link options for a RigServer of this process (`--simulate`): its board answers from a
+// thread that a busy machine may hold back for longer than a real board's firmware ever takes,
+// and its time is simulated (it advances on the host's commands), so a longer wait costs the run
+// nothing. Each try waits at least kInProcessReplyTimeoutMs; the rest is as configured.
+inline constexpr int kInProcessReplyTimeoutMs = 2000;
+LinkOptions InProcessLinkOptions(LinkOptions configured);
 
 // Serves a SimulatedRig on a new pseudo-terminal. Writes to the pty never block: answers wait in
 // a bounded queue (kMaxPendingBytes) while the host is not reading, and when that is full new
