@@ -26,7 +26,7 @@
 #include "app/target_feed.h"
 #include "softsight/control/board_link.h"
 #include "softsight/control/rig.h"
-#include "control/sample_columns.h"
+#include "pipeline/control_sample_columns.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_source.h"
 #include "softsight/pipeline/sink.h"

@@ -1,6 +1,7 @@
-// Internal to control and its users (app, web). The loop's sample as CSV columns, under the
-// names `softsight control` writes: one table for `control`'s CSV (app/control_parts.h) and for
-// serve's rows with a rig (web/rig_panel.h).
+// Private to the program (app, web). The control loop's sample as CSV columns, under the names
+// `softsight control` writes: one table for `control`'s CSV (app/control_parts.h) and for
+// serve's rows with a rig (web/rig_panel.h). Here, not in control: it joins control's sample to
+// io's column table, and control comes before io in the layers (docs/architecture.md).
 #pragma once
 
 #include <optional>

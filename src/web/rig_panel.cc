@@ -4,7 +4,7 @@
 #include <exception>
 
 #include "softsight/control/actuator_model.h"
-#include "control/sample_columns.h"
+#include "pipeline/control_sample_columns.h"
 #include "softsight/core/format.h"
 #include "stream/stream_format.h"
 
