@@ -2,9 +2,12 @@
 // the process: no network): the program writes one row per frame, and with the camera showing a
 // rendered actuator (the test's painter, as a Bayer sensor sends it) the tracked centroids match
 // the renderer's truth frame by frame. Bad camera names are one line naming them.
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <string>
 #include <mutex>
+#include <regex>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -52,6 +55,62 @@ TEST(TrackAravis, TheProgramWritesARowForEachFrameOfTheSimulatedCamera) {
   const auto rows = ReadRows(dir.file("run.csv"));
   ASSERT_EQ(rows.size(), 8u);
   EXPECT_THAT(run.stderr_text, HasSubstr("8 frames (max frames reached)"));
+}
+
+// A hook far slower than the camera (100 ms a call against a frame every 10 ms) on a live
+// camera: it runs on its own thread, so the run still writes a whole row for every frame, the
+// hook's column empty where its values did not come in time, and the summary says how many
+// frames it skipped while busy. However loaded the machine, such a hook cannot take every frame;
+// one that held up the loop would skip none.
+TEST(TrackAravis, ASlowHookOnTheCameraSkipsFramesAndEveryRowIsWhole) {
+  TempDir dir;
+  testing::WriteTextFile(dir.file("markers.yaml"), testing::kSceneMarkersYaml);
+  testing::WriteTextFile(dir.file("slow.py"), R"py(
+import time
+columns = ["slow_mean"]
+
+def on_frame(frame, result):
+    time.sleep(0.1)
+    return {"slow_mean": float(frame.mean())}
+)py");
+  const testing::ProgramRun run = testing::RunProgram(
+      "track -c " + dir.file("markers.yaml") + " --camera aravis:Fake_1 --max-frames 30 " +
+          "--camera-width 320 --camera-height 240 --camera-fps 100 -o " + dir.file("run.csv") +
+          " --hook " + dir.file("slow.py"),
+      dir);
+  if (run.stderr_text.find("built without Python") != std::string::npos) {
+    GTEST_SKIP() << "this build has no Python hooks";
+  }
+  ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+  const std::vector<std::string> lines = testing::ReadLines(dir.file("run.csv"));
+  ASSERT_EQ(lines.size(), 31u) << "a header and one row per frame";
+  const std::vector<std::string> header = testing::SplitCsv(lines[0]);
+  const auto column = std::find(header.begin(), header.end(), "slow_mean");
+  ASSERT_NE(column, header.end());
+  const size_t c = static_cast<size_t>(column - header.begin());
+  int filled = 0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> cells = testing::SplitCsv(lines[i]);
+    ASSERT_EQ(cells.size(), header.size()) << "row " << i << " is whole";
+    if (cells[c].empty()) continue;
+    ++filled;
+    EXPECT_GT(std::stod(cells[c]), 0.0) << "row " << i;  // Aravis' pattern is not black.
+  }
+  // The summary: "<hook>: values in V of 30 rows; skipped S of 30 frames (still busy), L late
+  // (over 5 ms; left empty)". The loop waits 5 ms for a frame's values (--hook-wait-ms), so
+  // a 100 ms call's values come late and its row is written without them.
+  std::smatch note;
+  ASSERT_TRUE(std::regex_search(
+      run.stderr_text, note,
+      std::regex("values in ([0-9]+) of 30 rows; skipped ([0-9]+) of 30 frames \\(still busy\\), "
+                 "([0-9]+) late")))
+      << run.stderr_text;
+  const int values = std::stoi(note[1].str()), skipped = std::stoi(note[2].str()),
+            late = std::stoi(note[3].str());
+  EXPECT_EQ(values, filled);
+  EXPECT_EQ(values + skipped + late, 30);
+  EXPECT_GE(skipped, 1) << "frames came while the hook was busy";
+  EXPECT_GE(values + late, 1) << "the hook ran";
 }
 
 TEST(TrackAravis, ACameraThatCannotBeOpenedIsOneLineNamingIt) {
