@@ -276,6 +276,31 @@ TEST(MarkerTracks, MotionSupportSaysHowWellAReportContinuesItsTrack) {
   EXPECT_FALSE(tracks.MotionSupport(0, {160, 100})) << "not believed in the last frame";
 }
 
+// A thing seen once (a lamp the tracker weighed and no marker took) has no motion yet, only a
+// wide reach for its first step (3 sizes plus the fastest marker's speed). A marker whose next
+// report continues its own track inside that reach is the marker, not the thing's first step.
+// Before, the ball toss's ball (45 px a frame) was refused at the top of its arc this way.
+TEST(MarkerTracks, AThingSeenOnceDoesNotTakeAReportThatContinuesAMarkersTrack) {
+  MarkerTracks tracks({10.0});
+  for (int f = 0; f < 5; ++f) {
+    const cv::Point2d at(100 + 40.0 * f, 200);
+    std::vector<MarkerObservation> m = Reports({at});
+    std::vector<MarkerCandidate> list = {Candidate(at, CandidateVerdict::kChosen)};
+    // In frame 4 the tracker also weighed a look-alike far from the ball's course.
+    if (f == 4) list.push_back(Candidate({280, 140}, CandidateVerdict::kFits));
+    const auto& d = tracks.associate(m, {&list});
+    ASSERT_EQ(d[0].action, MarkerTracks::Decision::Action::kKeep) << f;
+    tracks.commit(m);
+  }
+  EXPECT_EQ(tracks.others(), 1u);
+  // Frame 5: the ball where its track puts it, 63 px from the look-alike (within its first
+  // step's reach of 70 px).
+  std::vector<MarkerObservation> m = Reports({cv::Point2d(300, 200)});
+  const std::vector<MarkerCandidate> list = {Candidate({300, 200}, CandidateVerdict::kChosen)};
+  EXPECT_EQ(tracks.associate(m, {&list})[0].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_TRUE(m[0].observation.found());
+}
+
 // A soft actuator at rest, then a sudden step of pressure: the tip marker, still for 60 frames
 // (its learned acceleration at the minimum), leaps 40 px in one frame and goes on. Its gate
 // rejects the first reports; three in a row on one smooth motion restart the track, and from

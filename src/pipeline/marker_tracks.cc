@@ -368,6 +368,13 @@ bool MarkerTracks::InGate(size_t i, const cv::Point2d& p) const {
          IsRepeat(t, p);
 }
 
+bool MarkerTracks::ContinuesAnyTrack(const cv::Point2d& p) const {
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (tracks_[i].motion.started() && Continues(i, p)) return true;
+  }
+  return false;
+}
+
 std::optional<double> MarkerTracks::MotionSupport(size_t i, const cv::Point2d& p) const {
   const Track& t = tracks_.at(i);
   if (!t.motion.started() || t.restart || skipped_ || !Continues(i, p)) return std::nullopt;
@@ -404,7 +411,13 @@ void MarkerTracks::MatchOthers() {
                               : kOtherFirstStepSizes * size + speed * (1 + other.unseen);
     for (size_t k = 0; k < pooled_.size(); ++k) {
       const double d = cv::norm(pooled_[k].position_px - (other.position_px + step));
-      if (d <= radius) other_pairs_.push_back({d, k, o});
+      if (d > radius) continue;
+      // An object seen once has no motion yet, only a wide reach for its first step; a candidate
+      // that continues a marker's own track (believed in the last frame, inside its gate) is
+      // explained by that track far better. Seen: a ball tossed past a lamp seen once took the
+      // lamp's first step and was refused at the top of its arc.
+      if (!other.step_px && ContinuesAnyTrack(pooled_[k].position_px)) continue;
+      other_pairs_.push_back({d, k, o});
     }
   }
   std::sort(other_pairs_.begin(), other_pairs_.end(),

@@ -148,6 +148,8 @@ class MarkerTracks {
   // plus a frame's motion, a repeated frame, or, while coasting, within reach of anywhere between
   // where it was last seen and where it would be now.
   bool InReach(size_t i, const cv::Point2d& p) const;
+  // Whether a report at `p` would continue some started marker's track.
+  bool ContinuesAnyTrack(const cv::Point2d& p) const;
   // Whether pooled candidate k is followed as another object that marker i may never take.
   bool IsOtherObject(size_t i, size_t k) const {
     return pooled_other_[k] && others_[*pooled_other_[k]].not_marker[i];
