@@ -76,8 +76,6 @@ FlagBuilder<Args> ChartSecondsFlag(Access access, std::string help) {
   return ValueFlag<Args>("--chart-seconds", access).Help(std::move(help)).ShowDefault();
 }
 
-
-
 // The two cameras of track-stereo and control/identify --stereo: the right view's own config
 // and how far from its epipolar line a pair is still believed.
 template <typename Args, typename Access>

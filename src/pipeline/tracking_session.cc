@@ -199,9 +199,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   // own track (the one motion model's verdict).
   for (size_t i = 0; i < result_.markers.size(); ++i) {
     const Observation& o = result_.markers[i].observation;
-    motion_support_[i] = o.found() && !frame_change_->whole_frame_changed()
-                             ? tracks_->MotionSupport(i, *o.position_px)
-                             : std::nullopt;
+    motion_support_[i] = o.found() ? tracks_->MotionSupport(i, *o.position_px) : std::nullopt;
   }
   for (size_t i : arrangement_->check(result_.markers, motion_support_)) trackers_[i]->reset();
   if (!frame_change_->whole_frame_changed()) tracks_->commit(result_.markers);
