@@ -421,5 +421,127 @@ TEST(MarkerTracks, ALostMarkerNeverTakesAnObjectThatWasElsewhereWhenItWasLost) {
   EXPECT_EQ(tracks.others_excluded_for(0), 1u);
 }
 
+// Two markers cannot be at one place: candidates closer than kCoincidentMarkerPx are one, which
+// one marker takes at most. Two markers' first acquisitions on one place are nobody's: nothing
+// tells which marker it is.
+TEST(MarkerTracks, TwoMarkersNeverTakeOnePlace) {
+  MarkerTracks tracks({2.0, 2.0});
+  const std::vector<MarkerCandidate> none;
+  std::vector<MarkerObservation> both = Reports({cv::Point2d(50, 50), cv::Point2d(52.5, 50)});
+  const auto& first = tracks.associate(both, {&none, &none});
+  EXPECT_EQ(first[0].action, MarkerTracks::Decision::Action::kReject);
+  EXPECT_EQ(first[1].action, MarkerTracks::Decision::Action::kReject);
+  EXPECT_FALSE(both[0].observation.found());
+  EXPECT_FALSE(both[1].observation.found());
+  tracks.commit(both);
+  // Apart, each is believed; then marker 1's tracker jumps onto marker 0 (2 px off): marker 0's
+  // track explains that place, marker 1's does not.
+  for (int f = 0; f < 5; ++f) {
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(50, 50), cv::Point2d(80, 50)});
+    tracks.associate(m, {&none, &none});
+    EXPECT_TRUE(m[0].observation.found() && m[1].observation.found()) << "frame " << f;
+    tracks.commit(m);
+  }
+  std::vector<MarkerObservation> jumped = Reports({cv::Point2d(50, 50), cv::Point2d(52, 50)});
+  const auto& d = tracks.associate(jumped, {&none, &none});
+  EXPECT_EQ(d[0].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kReject);
+}
+
+// A decoding error turned part of a frame's colours: the red marker looked blue, and the blue
+// tracker acquired it there while red itself was not found. Two markers cannot swap places within
+// a second: that report is not believed. The place is anyone's again once red is reported where
+// its motion allows, a second after it was last believed there, or when the places are forgotten
+// (a person re-selected a marker).
+TEST(MarkerTracks, AReportWhereAMissingMarkerWasAMomentAgoIsNotBelieved) {
+  const std::vector<MarkerCandidate> none;
+  const cv::Point2d red_last(220, 300), on_red(221, 300.5);
+  // Red moves right at 30 px a frame (last believed at red_last), then is missing `missing`
+  // frames; blue has never been found.
+  const auto red_gone = [&](int missing) {
+    MarkerTracks tracks({6.0, 6.0});
+    for (int f = 0; f < 5; ++f) {
+      std::vector<MarkerObservation> m = Reports({cv::Point2d(100 + 30.0 * f, 300), std::nullopt});
+      tracks.associate(m, {&none, &none});
+      tracks.commit(m);
+    }
+    for (int f = 0; f < missing; ++f) {
+      std::vector<MarkerObservation> m = Reports({std::nullopt, std::nullopt});
+      tracks.associate(m, {&none, &none});
+      tracks.commit(m);
+    }
+    return tracks;
+  };
+  const auto blue_believed = [&](MarkerTracks& tracks, std::optional<cv::Point2d> red) {
+    std::vector<MarkerObservation> m = Reports({red, on_red});
+    tracks.associate(m, {&none, &none});
+    return m[1].observation.found();
+  };
+  {
+    MarkerTracks tracks = red_gone(5);
+    std::vector<MarkerObservation> m = Reports({std::nullopt, on_red});
+    tracks.associate(m, {&none, &none});
+    EXPECT_FALSE(m[1].observation.found());
+    EXPECT_EQ(m[1].observation.status(), MarkerStatus::kImplausible);
+  }
+  {
+    MarkerTracks tracks = red_gone(5);
+    tracks.forget_places();
+    EXPECT_TRUE(blue_believed(tracks, std::nullopt));
+  }
+  {
+    MarkerTracks tracks = red_gone(40);
+    EXPECT_TRUE(blue_believed(tracks, std::nullopt));
+  }
+  {
+    // Red back on its path, where its motion since allows: it has left that place.
+    MarkerTracks tracks = red_gone(1);
+    EXPECT_TRUE(blue_believed(tracks, cv::Point2d(280, 300)));
+  }
+}
+
+// What the decoder made of damaged data is no candidate: a report next to it is not believed,
+// and another candidate of the marker's elsewhere, where its motion puts it, may be adopted.
+TEST(MarkerTracks, NothingNextToDecodedGarbageIsACandidate) {
+  const std::vector<MarkerCandidate> none;
+  const auto moving = [&]() {
+    MarkerTracks tracks({6.0});
+    for (int f = 0; f < 5; ++f) {
+      std::vector<MarkerObservation> m = Reports({cv::Point2d(100 + 5.0 * f, 100)});
+      tracks.associate(m, {&none});
+      tracks.commit(m);
+    }
+    return tracks;
+  };
+  const auto garbage = [](const cv::Point2d& p) { return p.x > 120; };
+  {
+    MarkerTracks tracks = moving();
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(125, 100)});
+    const std::vector<MarkerCandidate> list = {Candidate({125, 100}, CandidateVerdict::kChosen)};
+    EXPECT_EQ(tracks.associate(m, {&list}, garbage)[0].action,
+              MarkerTracks::Decision::Action::kReject);
+    EXPECT_EQ(m[0].observation.status(), MarkerStatus::kImplausible);
+  }
+  {
+    // The same report in an undamaged frame is the marker's.
+    MarkerTracks tracks = moving();
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(125, 100)});
+    const std::vector<MarkerCandidate> list = {Candidate({125, 100}, CandidateVerdict::kChosen)};
+    EXPECT_EQ(tracks.associate(m, {&list})[0].action, MarkerTracks::Decision::Action::kKeep);
+  }
+  {
+    // Damage on the right only: the tracker's choice there is not believed; its other candidate,
+    // where the motion puts the marker, is adopted.
+    MarkerTracks tracks = moving();
+    const auto right = [](const cv::Point2d& p) { return p.x > 150; };
+    std::vector<MarkerObservation> m = Reports({cv::Point2d(160, 100)});
+    const std::vector<MarkerCandidate> list = {Candidate({160, 100}, CandidateVerdict::kChosen),
+                                               Candidate({125, 100}, CandidateVerdict::kFits)};
+    const auto& d = tracks.associate(m, {&list}, right);
+    ASSERT_EQ(d[0].action, MarkerTracks::Decision::Action::kAdopt);
+    EXPECT_EQ(d[0].candidate, 1u);
+  }
+}
+
 }  // namespace
 }  // namespace softsight

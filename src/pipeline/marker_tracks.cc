@@ -28,6 +28,11 @@ constexpr double kFirstAcquisitionCost = 1.2;
 constexpr double kUnassignedCost = 1.5;
 // Rejected reports in a row, on one smooth motion, that restart a track: 0.1 s at 30 fps.
 constexpr int kReacquireFrames = 3;
+// How long a marker's last believed place still says where it is for the swap rule ("a moment
+// ago"): a second at 30 fps. A damaged stretch of a recording lasts several frames; a marker that
+// really moves onto the place of one lost that long ago is missed for the frame or two it spends
+// there.
+constexpr int kRecentPlaceFrames = 30;
 // How far a rejected report may lie from where the run's constant velocity puts it: the
 // marker's size plus this fraction of the run's step (it may be slowing down or speeding up).
 constexpr double kRunStepTolerance = 0.5;
@@ -97,6 +102,7 @@ void MarkerTracks::forget(size_t i) {
   t.last_px.reset();
   t.repeats = 0;
   t.misses = 0;
+  t.since_believed = 0;
   body_.forget(i);
   body_prediction_[i].reset();
 }
@@ -146,11 +152,38 @@ bool MarkerTracks::BodyVouches(size_t i, const cv::Point2d& p) const {
 void MarkerTracks::skip() {
   skipped_ = true;
   predict_all();
-  for (Track& t : tracks_) t.predicted = false;
+  for (Track& t : tracks_) {
+    t.predicted = false;
+    ++t.since_believed;
+  }
+}
+
+void MarkerTracks::forget_places() {
+  for (Track& t : tracks_) t.since_believed = kRecentPlaceFrames + 1;
+}
+
+bool MarkerTracks::OnAMissingMarkersPlace(size_t i, const cv::Point2d& p,
+                                          const std::vector<MarkerObservation>& markers) const {
+  const auto recently_at = [&](size_t j) {
+    const Track& t = tracks_[j];
+    return t.last_px && t.since_believed <= kRecentPlaceFrames &&
+           cv::norm(p - *t.last_px) < kCoincidentMarkerPx;
+  };
+  if (recently_at(i)) return false;  // Still at its own place, whatever another's record says.
+  for (size_t j = 0; j < tracks_.size(); ++j) {
+    if (j == i || !recently_at(j)) continue;
+    // Marker j is missing unless it has a report its motion can have made (a report out of its
+    // reach is not believed).
+    const Observation& o = markers[j].observation;
+    const bool reported = o.found() && (!tracks_[j].motion.started() || InReach(j, *o.position_px));
+    if (!reported) return true;
+  }
+  return false;
 }
 
 size_t MarkerTracks::pool(const cv::Point2d& p, double size_px) {
-  const double same_px = std::max(kSamePlacePx, kSamePlaceSizes * size_px);
+  // Two markers cannot be at one place: what lies closer than kCoincidentMarkerPx is one.
+  const double same_px = std::max({kSamePlacePx, kCoincidentMarkerPx, kSamePlaceSizes * size_px});
   for (size_t k = 0; k < pooled_.size(); ++k) {
     if (cv::norm(pooled_[k].position_px - p) <= same_px) return k;
   }
@@ -160,8 +193,11 @@ size_t MarkerTracks::pool(const cv::Point2d& p, double size_px) {
 
 const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     std::vector<MarkerObservation>& markers,
-    const std::vector<const std::vector<MarkerCandidate>*>& candidates) {
+    const std::vector<const std::vector<MarkerCandidate>*>& candidates,
+    const GarbageTest& garbage_near) {
   CV_Assert(markers.size() == tracks_.size() && candidates.size() == tracks_.size());
+  // A position next to decoded garbage is whatever the garbage made of the marker: no candidate.
+  const auto damaged = [&](const cv::Point2d& p) { return garbage_near && garbage_near(p); };
   predict_all();
   pooled_.clear();
   for (size_t i = 0; i < markers.size(); ++i) {
@@ -170,7 +206,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     report_pooled_[i].reset();
     tracks_[i].repeated = false;
     const Observation& o = markers[i].observation;
-    if (o.found()) {
+    if (o.found() && !damaged(*o.position_px)) {
       // The report, with its candidate's misfit when the tracker lists it.
       double misfit = 0.0;
       std::optional<size_t> index;
@@ -190,7 +226,7 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     if (!tracks_[i].motion.started() || !candidates[i]) continue;
     const std::vector<MarkerCandidate>& list = *candidates[i];
     for (size_t c = 0; c < list.size(); ++c) {
-      if (!Fits(list[c].verdict)) continue;
+      if (!Fits(list[c].verdict) || damaged(list[c].position_px)) continue;
       const size_t k = pool(list[c].position_px, size_px_[i]);
       if (report_pooled_[i] && k == *report_pooled_[i]) continue;
       entries_[i].push_back({k, c, list[c].misfit});
@@ -220,9 +256,16 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     const Track& t = tracks_[i];
     for (const Entry& e : entries_[i]) {
       const cv::Point2d p = pooled_[e.pooled].position_px;
+      if (OnAMissingMarkersPlace(i, p, markers)) continue;
       if (!t.motion.started()) {
-        // No track yet: the tracker's own first acquisition (its report only).
-        if (report_pooled_[i] && e.pooled == *report_pooled_[i]) {
+        // No track yet: the tracker's own first acquisition (its report only), unless another
+        // marker's first acquisition is the same place: nothing tells which marker it is.
+        bool claimed = false;
+        for (size_t j = 0; j < markers.size(); ++j) {
+          claimed = claimed || (j != i && !tracks_[j].motion.started() && report_pooled_[j] &&
+                                *report_pooled_[j] == e.pooled);
+        }
+        if (report_pooled_[i] && e.pooled == *report_pooled_[i] && !claimed) {
           cost_[i][e.pooled] = kFirstAcquisitionCost;
         }
         continue;
@@ -259,7 +302,11 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
       if (o.found()) {
         // (A run may restart the track on an object followed as another one: the run's own
         // start, near where the marker was last believed, is the evidence it is the marker.)
-        if (tracks_[i].motion.started() && report_pooled_[i] &&
+        // (Not on a candidate another marker took: two markers cannot be at one place.)
+        const bool taken = report_pooled_[i] &&
+                           std::find(assigned.begin(), assigned.end(),
+                                     static_cast<int>(*report_pooled_[i])) != assigned.end();
+        if (tracks_[i].motion.started() && report_pooled_[i] && !taken &&
             ExtendsARejectedRun(i, *o.position_px)) {
           tracks_[i].restart = true;  // kKeep: the report stands, the track restarts on it.
           continue;
@@ -570,9 +617,11 @@ void MarkerTracks::commit(const std::vector<MarkerObservation>& markers) {
     if (!o.found()) {
       t.repeats = 0;
       ++t.misses;
+      ++t.since_believed;
       continue;
     }
     t.misses = 0;
+    t.since_believed = 0;
     const cv::Point2d p = *o.position_px;
     if (t.repeated && t.last_px && cv::norm(p - *t.last_px) <= kRepeatStillPx) {
       ++t.repeats;  // The prediction has moved on a frame, as the marker did behind the repeat.

@@ -21,6 +21,14 @@
 // track restarts on them (the first frames stay not believed). The run must also be able to have
 // left the marker's last believed place at its own speed: a look-alike elsewhere starts none.
 //
+// Two markers cannot be at one place: candidates closer than kCoincidentMarkerPx are one pooled
+// candidate, which at most one marker takes. Nor can two markers swap places within a second: a
+// candidate within kCoincidentMarkerPx of where another marker was believed a moment ago
+// (kRecentPlaceFrames), while that marker has no report it can have made now, is not allowed to
+// any other marker that was not there itself (a decoding error that shifted the colours of part
+// of a frame shows one marker in another's colour; a look-alike at its place). And a candidate
+// next to decoded garbage (the caller says where) is no candidate at all.
+//
 // Candidates no marker takes are things of their own (a look-alike, a second cart's identical
 // dot), followed from frame to frame by their own constant velocity while they keep being seen.
 // One that was, in its first frame, where marker i could not be (marker i believed elsewhere in
@@ -30,6 +38,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -42,6 +51,11 @@
 #include "softsight/track/tracker.h"
 
 namespace softsight {
+
+// Distinct markers on one body are at least a marker diameter apart; a false lock lands on the
+// neighbour's centroid to within a pixel or two. 3 px separates the two cases for markers of any
+// usable size (radius >= 2 px).
+inline constexpr double kCoincidentMarkerPx = 3.0;
 
 class MarkerTracks {
  public:
@@ -63,13 +77,19 @@ class MarkerTracks {
   // the gate (a start, a stop, a sharp turn within one frame).
   explicit MarkerTracks(std::vector<double> size_px, MotionModelOptions motion = {});
 
+  // Whether a place is next to what the decoder made of damaged data (frame_change.h): nothing
+  // seen there is a candidate.
+  using GarbageTest = std::function<bool(const cv::Point2d&)>;
+
   // The association of this frame. `markers`: the trackers' reports; `candidates[i]`: what
-  // marker i's tracker weighed (may be empty). Rejected reports are turned into
-  // NotFound(kImplausible) here; adopted ones are left to the caller (the tracker makes the
-  // candidate its report). Returns one decision per marker (reused).
+  // marker i's tracker weighed (may be empty); `garbage_near`: where the frame is damaged (empty:
+  // nowhere). Rejected reports are turned into NotFound(kImplausible) here; adopted ones are left
+  // to the caller (the tracker makes the candidate its report). Returns one decision per marker
+  // (reused).
   const std::vector<Decision>& associate(
       std::vector<MarkerObservation>& markers,
-      const std::vector<const std::vector<MarkerCandidate>*>& candidates);
+      const std::vector<const std::vector<MarkerCandidate>*>& candidates,
+      const GarbageTest& garbage_near = {});
   // The frame's believed reports (after every other check) update the tracks. Call once per
   // frame after associate().
   void commit(const std::vector<MarkerObservation>& markers);
@@ -92,6 +112,10 @@ class MarkerTracks {
   void skip();
   // Marker i starts afresh (re-selected, re-specified, or the video jumped): no motion.
   void forget(size_t i);
+  // Where the markers were believed a moment ago says nothing any more (a person re-selected a
+  // marker, perhaps at the place of another): the swap rule (see the file comment) waits for new
+  // believed places.
+  void forget_places();
 
   // Where marker i's track stands after this frame's commit() (or skip()).
   TrackState state(size_t i) const;
@@ -120,6 +144,9 @@ class MarkerTracks {
     bool predicted = false;       // predict() ran for this frame.
     int repeats = 0;              // Reports in a row exactly where the last one was.
     int misses = 0;               // Frames since the last believed report.
+    // Frames since last_px was believed, frames nothing was believed in included (the swap rule's
+    // "a moment ago").
+    int since_believed = 0;
     std::optional<cv::Point2d> last_px;  // The last believed report.
     bool repeated = false;        // This frame's report is a repeated frame (see commit).
     // Reports the gate rejected, while they follow one motion of their own: the last one, the
@@ -171,6 +198,10 @@ class MarkerTracks {
   bool BodyVouches(size_t i, const cv::Point2d& p) const;
   // The pooled candidate at `p` (a marker of about `size_px`), added when there is none.
   size_t pool(const cv::Point2d& p, double size_px);
+  // Whether marker i may not take a candidate at `p` because another marker, believed there a
+  // moment ago, has no report of its own it can have made now (see the file comment).
+  bool OnAMissingMarkersPlace(size_t i, const cv::Point2d& p,
+                              const std::vector<MarkerObservation>& markers) const;
 
   std::vector<double> size_px_;
   std::vector<Track> tracks_;

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 
-#include "pipeline/coincident_markers.h"
 #include "pipeline/frame_change.h"
 #include "pipeline/arrangement_check.h"
 #include "pipeline/marker_tracks.h"
@@ -39,10 +38,6 @@ std::vector<size_t> BodyOrder(const TrackingConfig& config) {
   return body.size() == names.size() ? body : std::vector<size_t>();
 }
 
-// How long a marker's last believed position still says where it is ("a moment ago"): a second
-// at 30 fps. A damaged stretch of a recording lasts several frames; a marker that really moves
-// onto the place of one lost that long ago is missed for the frame or two it spends there.
-constexpr int64_t kRecentFrames = 30;
 // Frames missing from the source predicted over at most (two seconds at 30 fps): longer, a
 // track is lost anyway and its gate needs to grow no further.
 constexpr int64_t kMaxMissingFramesPredicted = 60;
@@ -55,10 +50,6 @@ TrackingSession::TrackingSession(const TrackingConfig& config)
   for (const MarkerSpec& spec : config_.markers) {
     trackers_.push_back(CreateTracker(spec));
     initialised_.push_back(false);
-    previous_px_.emplace_back();
-    believed_px_.emplace_back();
-    believed_frame_.push_back(0);
-    recent_px_.emplace_back();
     result_.markers.push_back({spec.name, {}});
     sizes.push_back(MarkerSizePx(spec));
   }
@@ -114,7 +105,6 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       if (initialised_[i]) result_.markers[i].observation = Observation::NotFound(MarkerStatus::kStale);
     }
     tracks_->skip();
-    for (size_t i = 0; i < result_.markers.size(); ++i) previous_px_[i].reset();
     return finish(frame, start);
   }
   frame_change_->observe(frame.image, frame.key_frame);
@@ -142,8 +132,10 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
       if (!shift) shift = tracks_->CommonShift(result_.markers);
       if (shift) tracks_->FollowCamera(result_.markers, *shift);
     }
-    const std::vector<MarkerTracks::Decision>& decisions =
-        tracks_->associate(result_.markers, candidate_lists_);
+    const FrameChangeDetector& change = *frame_change_;
+    const std::vector<MarkerTracks::Decision>& decisions = tracks_->associate(
+        result_.markers, candidate_lists_,
+        [&change](const cv::Point2d& p) { return change.garbage_near(p); });
     for (size_t i = 0; i < trackers_.size(); ++i) {
       // Where the other markers' arrangement puts it: its own motion before (a jump with its
       // body, or a stretch lost) is no evidence against it; the arrangement still judges it.
@@ -167,33 +159,6 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
           break;
       }
     }
-    // Two markers cannot be at one place: a report that jumped onto another marker (a
-    // look-alike re-acquired while its own marker is covered) is dropped, and its tracker
-    // searches afresh.
-    for (size_t i : FindCoincidentMarkers(result_.markers, previous_px_)) {
-      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-      trackers_[i]->reset();
-    }
-    // Nor can two markers swap places within a second: a marker found where another one,
-    // missing now, just was is that other marker in this one's colour (a decoding error that
-    // shifted the colours of part of the frame) or a look-alike at its place.
-    for (size_t i = 0; i < believed_px_.size(); ++i) {
-      const bool recent = believed_px_[i] && frame.index >= believed_frame_[i] &&
-                          frame.index - believed_frame_[i] <= kRecentFrames;
-      recent_px_[i] = recent ? believed_px_[i] : std::nullopt;
-    }
-    for (size_t i : FindMarkersOnAMissingMarkersPlace(result_.markers, recent_px_)) {
-      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-      trackers_[i]->reset();
-    }
-    // A position next to decoded garbage is whatever the garbage made of the marker.
-    for (size_t i = 0; i < result_.markers.size(); ++i) {
-      const Observation& o = result_.markers[i].observation;
-      if (o.found() && frame_change_->garbage_near(*o.position_px)) {
-        result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-        trackers_[i]->reset();
-      }
-    }
   }
   // The body's arrangement judges what is left, each report weighed by how well it continues its
   // own track (the one motion model's verdict).
@@ -203,13 +168,6 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
   }
   for (size_t i : arrangement_->check(result_.markers, motion_support_)) trackers_[i]->reset();
   if (!frame_change_->whole_frame_changed()) tracks_->commit(result_.markers);
-  for (size_t i = 0; i < result_.markers.size(); ++i) {
-    previous_px_[i] = result_.markers[i].observation.position_px;
-    if (previous_px_[i]) {
-      believed_px_[i] = previous_px_[i];
-      believed_frame_[i] = frame.index;
-    }
-  }
   return finish(frame, start);
 }
 
@@ -287,8 +245,8 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     initialised_[i] = true;
     arrangement_->forget(i);  // A person said where it is: nothing to suspect.
     tracks_->forget(i);
-    // ... nor another marker's last position there (the person may have swapped two markers).
-    std::fill(believed_px_.begin(), believed_px_.end(), std::nullopt);
+    // ... nor another marker's last place there (the person may have swapped two markers).
+    tracks_->forget_places();
     // Saved configs must reproduce what the mouse did (the marker's kind says how: a template's
     // own pixels, cut here, or a colour marker's roi from this frame), so that `track` starts it
     // there and then, as here. A template file held the old template.
@@ -304,13 +262,9 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     } else {
       result_.markers[i].observation = trackers_[i]->update(frame.image);
     }
-    previous_px_[i] = result_.markers[i].observation.position_px;
-    if (previous_px_[i]) {
-      believed_px_[i] = previous_px_[i];
-      believed_frame_[i] = frame.index;
-    }
     // A new track: it starts on this report at the next frame's association.
-    result_.markers[i].track = previous_px_[i] ? TrackState::kTentative : TrackState::kLost;
+    result_.markers[i].track =
+        result_.markers[i].observation.found() ? TrackState::kTentative : TrackState::kLost;
     measure(frame);
     edited(ConfigChange::Reselect(marker, rect));
     return result_;
@@ -331,8 +285,8 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
     } else {
       result_.markers[i].observation = trackers_[i]->update(frame.image);
     }
-    previous_px_[i] = result_.markers[i].observation.position_px;
-    result_.markers[i].track = previous_px_[i] ? TrackState::kTentative : TrackState::kLost;
+    result_.markers[i].track =
+        result_.markers[i].observation.found() ? TrackState::kTentative : TrackState::kLost;
     measure(frame);
     edited(ConfigChange::Retrack(marker));
     return result_;
@@ -355,7 +309,6 @@ void TrackingSession::respec(const MarkerSpec& spec) {
     initialised_[i] = false;
     arrangement_->forget(i);
     tracks_->forget(i);
-    believed_px_[i].reset();
     edited(ConfigChange::Respec(spec));
     return;
   }
@@ -378,7 +331,6 @@ void TrackingSession::jump() {
     if (initialised_[i]) trackers_[i]->reset();
     arrangement_->forget(i);
     tracks_->forget(i);
-    previous_px_[i].reset();
   }
   frame_change_ = std::make_unique<FrameChangeDetector>();
   last_frame_ = -1;  // The frame sought is no later frame of the same run: nothing went missing.

@@ -112,12 +112,6 @@ class TrackingSession {
   TrackingConfig config_;
   std::vector<std::unique_ptr<Tracker>> trackers_;
   std::vector<bool> initialised_;
-  std::vector<std::optional<cv::Point2d>> previous_px_;  // Last frame's positions.
-  // Each marker's last believed position and its frame; recent_px_ holds those believed at most
-  // about a second ago (reused per frame).
-  std::vector<std::optional<cv::Point2d>> believed_px_;
-  std::vector<int64_t> believed_frame_;
-  std::vector<std::optional<cv::Point2d>> recent_px_;
   std::unique_ptr<FrameChangeDetector> frame_change_;
   std::unique_ptr<ArrangementCheck> arrangement_;
   std::vector<std::optional<double>> motion_support_;  // Per marker, this frame (reused).
