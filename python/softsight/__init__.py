@@ -11,6 +11,8 @@ The C++ library's API with numpy at the edges (docs/python.md has a tour):
   ``softsight track`` writes.
 - ``frames(input, config)``: the same input and tracking, one FrameResult per frame, as a
   generator (``for r in softsight.frames("run.avi", config): ...``).
+- ``track_stereo(left, right, config, stereo)``: two calibrated cameras, the columns of
+  ``softsight track-stereo``; ``frames_stereo(...)``: the same run, one pair's row at a time.
 - ``geometry``, ``calib``, ``sim``: the measurements, calibration and the renderer with its
   exact truth, on numpy arrays. ``batch.track_many``: many inputs on a Dask cluster.
   ``stream.subscribe(address)``: a run's results as they happen (its ``--publish``).
@@ -50,6 +52,7 @@ __all__ = [
     "batch",
     "calib",
     "frames",
+    "frames_stereo",
     "geometry",
     "load_config",
     "sim",
@@ -208,6 +211,48 @@ def frames(
     """
     stream = _core._FrameStream(input, config, max_frames, fps, method)
     return _frames(stream, _progress.reporter(progress, "frames", "frames"))
+
+
+def frames_stereo(
+    left: PathLike,
+    right: PathLike,
+    config: Union[Config, PathLike, dict],
+    stereo: PathLike,
+    max_frames: Optional[int] = None,
+    *,
+    right_config: Union[Config, PathLike, dict, None] = None,
+    frame_offset: Optional[int] = None,
+    max_offset_frames: int = 60,
+    max_epipolar_px: float = 2.0,
+    reference_plane: str = "image",
+    fps: float = 30.0,
+    bench_board: Optional[Tuple[PathLike, PathLike]] = None,
+    chessboard: Optional[str] = None,
+    square_mm: Optional[float] = None,
+    progress: Progress = False,
+) -> Generator[Dict[str, Union[int, float, str]], None, None]:
+    """Tracks a calibrated pair of cameras pair by pair: a generator of each pair's row, in order.
+
+    The arguments are ``track_stereo``'s (the frame offset is found the same way when not given,
+    reading both inputs once more first), and ``progress`` is ``frames``'s (``total`` is
+    ``max_frames``, None without it: a pair does not know its length). Each row is a dict of
+    column name -> value holding exactly what ``track_stereo``'s table has for that pair:
+    ``frame`` and ``right_frame`` int, ``<m>_status`` str, the rest float (NaN for an empty
+    field), in the columns' order. The pairs run through the same run loop as ``track_stereo``
+    and ``softsight track-stereo``, so a pair of predicted videos' (MPEG-4, H.264) rows come
+    once each view's next key frame has been tracked (a marker either view's decoder silently
+    damaged is then not found in 3D), and the GIL is released while pairs are read and tracked.
+
+    A bad config, calibration or input raises InputError (the CLI's message) when
+    ``frames_stereo`` is called; a frame that does not decode raises it from the loop, after the
+    rows before it. Both inputs are let go of when the loop ends, ``break``s (the generator is
+    closed when it is dropped) or ``close()`` is called on the generator.
+    """
+    stream = _core._StereoFrameStream(
+        left, right, config, stereo, max_frames, right_config, frame_offset, max_offset_frames,
+        max_epipolar_px, reference_plane, fps, bench_board, chessboard, square_mm
+    )
+    return _frames(stream, _progress.reporter(progress, "frames_stereo", "pairs"))
 
 
 def _frames(stream: "_core._FrameStream", report: Optional[_progress.Reporter]) -> Generator[FrameResult, None, None]:

@@ -176,3 +176,21 @@ def frames(
     method: Optional[str] = None,
     progress: Progress = False,
 ) -> Generator[FrameResult, None, None]: ...
+def frames_stereo(
+    left: PathLike,
+    right: PathLike,
+    config: ConfigSource,
+    stereo: PathLike,
+    max_frames: Optional[int] = None,
+    *,
+    right_config: Optional[ConfigSource] = None,
+    frame_offset: Optional[int] = None,
+    max_offset_frames: int = 60,
+    max_epipolar_px: float = 2.0,
+    reference_plane: str = "image",
+    fps: float = 30.0,
+    bench_board: Optional[Tuple[PathLike, PathLike]] = None,
+    chessboard: Optional[str] = None,
+    square_mm: Optional[float] = None,
+    progress: Progress = False,
+) -> Generator[Dict[str, Union[int, float, str]], None, None]: ...

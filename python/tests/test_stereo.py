@@ -256,3 +256,110 @@ def test_a_repeating_motion_is_refused_with_the_clis_message(markers_yaml, stere
                                   frame_offset=3).summary["pairs"] == 33
     with pytest.raises(softsight.InputError, match="max_offset_frames: must be in"):
         softsight.track_stereo(left, right, markers_yaml, stereo_yaml, max_offset_frames=-1)
+
+
+def _assert_rows_are_the_tables(rows: list, table) -> None:
+    """Each row of frames_stereo holds the values of track_stereo's table row (proc_ms: each
+    run's own clock)."""
+    assert len(rows) == len(table["frame"])
+    for i, row in enumerate(rows):
+        assert list(row) == list(table), "the table's columns, in order"
+        for name, value in row.items():
+            if name == "proc_ms":
+                continue
+            expected = table[name][i]
+            if isinstance(value, float) and np.isnan(value):
+                assert np.isnan(expected), (i, name)
+            else:
+                assert value == expected, (i, name, value, expected)
+                assert type(value) is type(expected.item()), (i, name)
+
+
+def test_frames_stereo_gives_track_stereos_rows_pair_by_pair(markers_yaml, stereo_yaml, tmp_path):
+    # The offset found as track_stereo finds it (+5), then exact 3D in every row.
+    left, right = _two_videos(tmp_path, _jerky_walk(41), 5, 36)
+    table = softsight.track_stereo(left, right, markers_yaml, stereo_yaml)
+    rows = list(softsight.frames_stereo(left, right, markers_yaml, stereo_yaml))
+    assert len(rows) == 31
+    _assert_rows_are_the_tables(rows, table)
+    for i, row in enumerate(rows):
+        assert row["right_frame"] == row["frame"] + 5 == i + 5
+        for name in ("red", "blue", "green"):
+            assert row[f"{name}_status"] == "found"
+            assert row[f"{name}_Z"] == pytest.approx(300.0, abs=1e-3)
+    # max_frames and the progress callback: the pairs done, of max_frames.
+    seen = []
+    rows = list(softsight.frames_stereo(left, right, markers_yaml, stereo_yaml, 4, frame_offset=5,
+                                        progress=lambda done, total: seen.append((done, total))))
+    assert [r["frame"] for r in rows] == [0, 1, 2, 3]
+    assert seen == [(1, 4), (2, 4), (3, 4), (4, 4)]
+
+
+def _mpeg4_copy(video: Path, out: Path) -> Path:
+    """The video as MPEG-4 (a key frame every 12th frame as OpenCV writes it)."""
+    import cv2
+    reader = cv2.VideoCapture(str(video))
+    writer = cv2.VideoWriter(str(out), cv2.VideoWriter_fourcc(*"mp4v"), 30.0, (640, 480))
+    while True:
+        ok, image = reader.read()
+        if not ok:
+            break
+        writer.write(image)
+    writer.release()
+    return out
+
+
+def test_frames_stereo_of_predicted_videos_gives_the_rows_after_their_key_frame_check(
+        bending_video, markers_yaml, stereo_yaml, tmp_path):
+    # A pair of MPEG-4 videos: each row comes once both views' groups are checked, as
+    # track_stereo's rows do, with the same values.
+    left = _mpeg4_copy(bending_video, tmp_path / "left.mp4")
+    table = softsight.track_stereo(left, bending_video, markers_yaml, stereo_yaml, frame_offset=0)
+    rows = list(softsight.frames_stereo(left, bending_video, markers_yaml, stereo_yaml,
+                                        frame_offset=0))
+    assert len(rows) == 24
+    _assert_rows_are_the_tables(rows, table)
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="needs Linux's /proc/self/fd")
+def test_frames_stereo_lets_go_of_both_videos_and_says_the_clis_errors(
+        bending_video, markers_yaml, stereo_yaml, tmp_path):
+    from test_frames import open_files
+    right = tmp_path / "right.avi"
+    right.write_bytes(Path(bending_video).read_bytes())
+    left, right = str(Path(bending_video).resolve()), str(right.resolve())
+    gen = softsight.frames_stereo(left, right, markers_yaml, stereo_yaml, frame_offset=0)
+    assert next(gen)["frame"] == 0
+    assert left in open_files() and right in open_files()  # Held while the loop runs ...
+    gen.close()
+    assert left not in open_files() and right not in open_files()  # ... not after close().
+    with pytest.raises(StopIteration):
+        next(gen)
+    for row in softsight.frames_stereo(left, right, markers_yaml, stereo_yaml, frame_offset=0):
+        if row["frame"] == 2:
+            break  # The generator is closed when it is dropped.
+    del row
+    assert left not in open_files() and right not in open_files()
+
+    # Bad input: track_stereo's message, at the call.
+    with pytest.raises(softsight.InputError) as at_call:
+        softsight.frames_stereo(left, right, markers_yaml, tmp_path / "missing.yaml")
+    with pytest.raises(softsight.InputError) as in_table:
+        softsight.track_stereo(left, right, markers_yaml, tmp_path / "missing.yaml")
+    assert str(at_call.value) == str(in_table.value)
+    assert "missing.yaml: cannot open" in str(at_call.value)
+    with pytest.raises(softsight.InputError, match="max_frames: -1 must be >= 0"):
+        softsight.frames_stereo(left, right, markers_yaml, stereo_yaml, -1, frame_offset=0)
+    # A left video cut mid-stream: the rows before it, then track_stereo's error.
+    data = Path(bending_video).read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    with pytest.raises(softsight.InputError) as in_table:
+        softsight.track_stereo(cut, right, markers_yaml, stereo_yaml, frame_offset=0)
+    got = []
+    with pytest.raises(softsight.InputError) as in_loop:
+        for row in softsight.frames_stereo(cut, right, markers_yaml, stereo_yaml, frame_offset=0):
+            got.append(row["frame"])
+    assert str(in_loop.value) == str(in_table.value)
+    assert got == list(range(len(got))) and 0 < len(got) < 24
+    assert str(cut.resolve()) not in open_files() and right not in open_files()

@@ -453,9 +453,12 @@ IdentifyOutcome IdentifiedFrom(const IdentificationExperiment& experiment,
   return outcome;
 }
 
+// A signal stopped the run (before its loop, or in a wait for the board): the run's stop, in the
+// words RunOptions::describe_stop gives a signal inside the loop.
 void StoppedBySignal(const StopRequest& stop, ControlSummary* summary) {
-  summary->stop_reason = StopSignalReason(stop.signal());
-  summary->stop_signal = stop.signal();
+  summary->run.stop_reason = StopReason::kStopRequested;
+  summary->run.stop_detail = StopSignalReason(stop.signal());
+  summary->run.error.clear();
 }
 
 }  // namespace
@@ -647,11 +650,12 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     StoppedBySignal(stop, &summary);
     session.stop();
     return summary;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
     // The session's destructor sends STOP on the way out.
     CollectControlSummary(control, link, session, limited_to_reach, &summary);
     add_notes();
-    summary.stop_reason = "stopped by an error at frame " + std::to_string(summary.run.frames);
+    summary.run.stop_reason = StopReason::kError;
+    if (summary.run.error.empty()) summary.run.error = e.what();
     throw;
   }
   const RunSummary ran = summary.run;
@@ -667,23 +671,10 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
     throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
                         ShortNumber(summary.duration_s) + " s); vented");
   }
-  switch (ran.stop_reason) {
-    case StopReason::kEndOfInput:
-      summary.stop_reason = run.describe_stop(ran.stop_reason);
-      break;
-    case StopReason::kMaxFrames:
-    case StopReason::kStopRequested:
-      if (control.done()) {
-        summary.stop_reason = run.describe_stop(ran.stop_reason);
-      } else {
-        StoppedBySignal(stop, &summary);
-      }
-      break;
-    case StopReason::kError:
-      // The session's destructor sends STOP on the way out.
-      summary.stop_reason = "stopped by an error at frame " + std::to_string(ran.frames);
-      throw InputError(ran.error);
-  }
+  // The run's stop_detail already says why in the loop's words (describe_stop: the end of the
+  // input, the duration reached, the signal).
+  // The session's destructor sends STOP on the way out.
+  if (ran.stop_reason == StopReason::kError) throw InputError(ran.error);
   session.stop();  // Vent at the end of the run.
   if (experiment) summary.identified = IdentifiedFrom(*experiment, config, options);
   if (!options.metrics_csv_file.empty()) {
@@ -692,11 +683,19 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   return summary;
 }
 
+bool IdentificationStoppedBySignal(const ControlSummary& summary) {
+  return !summary.identified && summary.run.stop_reason == StopReason::kStopRequested;
+}
+
 std::string FormatControlSummary(const ControlSummary& s) {
   std::ostringstream out;
   char line[256];
+  const std::string stopped =
+      s.run.stop_reason == StopReason::kError
+          ? "stopped by an error at frame " + std::to_string(s.run.frames)
+          : s.run.stop_text();
   std::snprintf(line, sizeof(line), "frames: %lld over %.2f s (%s), angle measured in %lld\n",
-                static_cast<long long>(s.run.frames), s.duration_s, s.stop_reason.c_str(),
+                static_cast<long long>(s.run.frames), s.duration_s, stopped.c_str(),
                 static_cast<long long>(s.run.measured));
   out << line;
   if (s.rms_error_deg) {
@@ -907,9 +906,10 @@ CommandRunner SetupControlCommand(CLI::App& sub) {
       identify.csv_file = IdentifyCsvBeside(o->csv_file);
       identify.other_outputs = {{"--csv", o->csv_file}, {"--metrics-csv", o->metrics_csv_file}};
       const ControlSummary found = RunControl(identify);
-      if (found.stop_signal != 0) {
+      if (IdentificationStoppedBySignal(found)) {
         // Vented; the loop never starts. Said even with --quiet: nothing was tuned.
-        std::cerr << "control --auto-tune: " << found.stop_reason << " during the identification at "
+        std::cerr << "control --auto-tune: " << found.run.stop_text()
+                  << " during the identification at "
                   << ShortNumber(found.duration_s) << " s; vented, the loop not started\n";
         return ExitCodeAfterStop(0);  // 130 / 143.
       }

@@ -122,10 +122,11 @@ struct ControlSummary {
   uint64_t link_rejected = 0;           // Lines from the board the host rejected.
   uint32_t board_rejected = 0;          // Lines from the host the board rejected.
   uint64_t resends = 0;
-  std::string stop_reason;
-  // SIGINT or SIGTERM when a signal stopped the run (stop_reason says so), else 0. An
-  // identification a signal stopped returns without `identified` instead of throwing.
-  int stop_signal = 0;
+  // Why the run stopped is the run's: run.stop_reason and run.stop_text() ("end of input",
+  // "duration reached", "stopped by SIGTERM" (kStopRequested, StopSignalReason's words in
+  // run.stop_detail), kError with run.error). The signal's number is not kept here: the exit
+  // code takes it from the StopRequest (ExitCodeAfterStop), and a caller asks only whether a
+  // signal stopped an identification (IdentificationStoppedBySignal).
   // From the capture to the serial command that frame's step sent, ms: median and 99th
   // percentile (the controller's own figure).
   double latency_command_ms_median = 0.0, latency_command_ms_p99 = 0.0;
@@ -146,6 +147,11 @@ struct ControlSummary {
 // Runs the loop. Throws InputError for bad input or a failed link (e.g. the port disappears);
 // every CSV row written before stays intact. `summary_out` receives the summary even then.
 ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary_out = nullptr);
+// Whether a signal (Ctrl-C, SIGTERM) stopped an identification run (ControlOptions::identify)
+// that RunControl returned from: it then has no `identified` and run.stop_reason is
+// kStopRequested (a finished experiment also ends with a stop request, the controller's, but
+// with its model). It vented and the caller writes nothing.
+bool IdentificationStoppedBySignal(const ControlSummary& summary);
 std::string FormatControlSummary(const ControlSummary& summary);
 // Three lines: the static map, the dynamics, the gains.
 std::string FormatIdentifyOutcome(const IdentifyOutcome& found);

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "app/program_test_util.h"
+#include "app/stop_request.h"
 #include "app/scene_markers_test_util.h"
 #include "core/test_util.h"
 #include "control/protocol.h"
@@ -183,6 +184,10 @@ TEST(ControlCommand, SimulatedStepSummaryGivesRiseSettlingOvershootSteadyStateAn
   EXPECT_NEAR(*again.rms_error_deg, *m.rms_error_deg, 1e-3);
 
   const std::string printed = FormatControlSummary(summary);
+  // The rendered rig ends at the duration: the run's own stop, in the loop's words.
+  EXPECT_EQ(summary.run.stop_reason, StopReason::kEndOfInput);
+  EXPECT_EQ(summary.run.stop_text(), "duration reached");
+  EXPECT_THAT(printed, HasSubstr(" s (duration reached), angle measured in "));
   for (const char* figure : {"rise (10-90 %)", "settling +-1 deg", "+-2 deg", "overshoot",
                              "steady-state error", "RMS error"}) {
     EXPECT_NE(printed.find(figure), std::string::npos) << figure << " in\n" << printed;
@@ -190,6 +195,34 @@ TEST(ControlCommand, SimulatedStepSummaryGivesRiseSettlingOvershootSteadyStateAn
   const std::vector<std::string> metrics = ReadLines(options.metrics_csv_file);
   ASSERT_EQ(metrics.size(), 2u);
   EXPECT_EQ(metrics[0].rfind("step_time_s,", 0), 0u);
+}
+
+// Why a control run stopped is its RunSummary's (no second copy in ControlSummary): the printed
+// summary says the run's stop, an error with the frame it stopped at, and an identification
+// stopped by a signal is told from one that finished by the run's stop and its missing model.
+TEST(ControlSummary, SaysWhyTheRunStoppedFromTheRunsOwnStop) {
+  ControlSummary s;
+  s.run.frames = 7;
+  s.duration_s = 0.25;
+  s.run.stop_reason = StopReason::kStopRequested;
+  s.run.stop_detail = StopSignalReason(SIGTERM);
+  EXPECT_THAT(FormatControlSummary(s), HasSubstr("frames: 7 over 0.25 s (stopped by SIGTERM)"));
+  EXPECT_TRUE(IdentificationStoppedBySignal(s));
+  s.identified.emplace();  // The experiment finished: its controller stopped the run.
+  s.run.stop_detail = "duration reached";
+  EXPECT_FALSE(IdentificationStoppedBySignal(s));
+  EXPECT_THAT(FormatControlSummary(s), HasSubstr("frames: 7 over 0.25 s (duration reached)"));
+  s.identified.reset();
+  s.run.stop_reason = StopReason::kError;
+  s.run.stop_detail.clear();
+  s.run.error = "/dev/ttyACM0: the port disappeared";
+  EXPECT_FALSE(IdentificationStoppedBySignal(s));
+  EXPECT_THAT(FormatControlSummary(s),
+              HasSubstr("frames: 7 over 0.25 s (stopped by an error at frame 7)"));
+  s.run.stop_reason = StopReason::kEndOfInput;
+  s.run.error.clear();
+  EXPECT_FALSE(IdentificationStoppedBySignal(s));
+  EXPECT_THAT(FormatControlSummary(s), HasSubstr("(end of input)"));
 }
 
 TEST(ControlCommand, RefusesAmbiguousTargetsAndSources) {

@@ -62,12 +62,12 @@ std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options
   // lost to an output that cannot be written, nor is the input config written over.
   run.other_outputs = {{"-o", options.output_file}, {"--model-csv", options.model_csv_file}};
   ControlSummary summary = RunControl(run);
-  if (summary.stop_signal != 0) {
+  if (IdentificationStoppedBySignal(summary)) {
     if (stopped_out != nullptr) *stopped_out = summary;
     return std::nullopt;
   }
   if (!summary.identified) {
-    throw IdentifyAbort("identify: the experiment stopped (" + summary.stop_reason +
+    throw IdentifyAbort("identify: the experiment stopped (" + summary.run.stop_text() +
                         "); vented, nothing written");
   }
   IdentifyOutcome found = std::move(*summary.identified);
@@ -157,7 +157,7 @@ CommandRunner SetupIdentifyCommand(CLI::App& sub) {
     if (!found) {
       // Said even with --quiet: nothing was written.
       std::fprintf(stderr, "identify: %s during the experiment at %.2f s; vented, nothing written\n",
-                   stopped.stop_reason.c_str(), stopped.duration_s);
+                   stopped.run.stop_text().c_str(), stopped.duration_s);
       return ExitCodeAfterStop(0);  // 130 / 143, as for a process the signal killed.
     }
     if (!o->quiet) {

@@ -35,7 +35,7 @@ struct IdentifyCommandOptions {
 // Throws InputError (IdentifyAbort for an experiment stopped for safety) after venting; the
 // output is then not written. Refuses an output that is the input. Ctrl-C or SIGTERM during the
 // experiment is no error: it vents, writes nothing and returns nullopt, with the run's summary
-// (stop_reason, stop_signal, duration) in `stopped_out`.
+// (run.stop_text(), duration) in `stopped_out`.
 std::optional<IdentifyOutcome> RunIdentify(const IdentifyCommandOptions& options,
                                            ControlSummary* stopped_out = nullptr);
 

@@ -85,7 +85,8 @@ TEST(OnePipeline, TrackLiveAndControlGiveTheSameTrackingColumnsForTheSameVideo) 
   control.quiet = true;
   const ControlSummary summary = RunControl(control);
   EXPECT_EQ(summary.run.frames, 12);
-  EXPECT_EQ(summary.stop_reason, "end of input");
+  EXPECT_EQ(summary.run.stop_reason, StopReason::kEndOfInput);
+  EXPECT_EQ(summary.run.stop_text(), "end of input");
 
   // `live --no-pace`: the window's controller fed by the unpaced file, each frame's result as
   // the window shows it written through the same column table.

@@ -255,3 +255,141 @@ void KeyFrameGroups::check_unverified(size_t m) {
 }
 
 }  // namespace softsight
+
+namespace softsight {
+
+PairKeyFrameGroups::PairKeyFrameGroups(size_t max_held_bytes, bool hold_images)
+    : max_held_bytes_(max_held_bytes), hold_images_(hold_images),
+      // Each view's check holds only the rows: the pictures are held here, once per pair.
+      left_(max_held_bytes, /*hold_images=*/false), right_(max_held_bytes, /*hold_images=*/false),
+      left_checked_([this](const Frame&, const FrameResult& result) {
+        held_[left_done_++].left = result;
+      }),
+      right_checked_([this](const Frame&, const FrameResult& result) {
+        held_[right_done_++].right = result;
+      }),
+      pass_([](const Frame&, const FrameResult&) {}) {}
+
+PairKeyFrameGroups::~PairKeyFrameGroups() = default;
+
+namespace {
+
+size_t PairBytes(const FramePair& pair) {
+  return pair.left.image.total() * pair.left.image.elemSize() +
+         pair.right.image.total() * pair.right.image.elemSize();
+}
+
+void CopyFrame(const Frame& from, bool with_image, Frame& to) {
+  if (with_image) {
+    from.image.copyTo(to.image);  // Into the slot's own buffer: no allocation once sized.
+  } else {
+    to.image.release();
+  }
+  to.index = from.index;
+  to.time_s = from.time_s;
+  to.captured = from.captured;
+  to.key_frame = from.key_frame;
+}
+
+const Observation* ViewObservation(const FrameResult& view, const std::string& name) {
+  for (const MarkerObservation& m : view.markers) {
+    if (m.name == name) return &m.observation;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+void PairKeyFrameGroups::add(const FramePair& pair, const StereoFrameResult& result,
+                             const Release& release) {
+  CV_Assert(result.left_view != nullptr && result.right_view != nullptr);
+  if (!pair.left.key_frame || !pair.right.key_frame) predicted_seen_ = true;
+  if (!predicted_seen_) {
+    // Only key frames so far (cameras, image sequences, intra-only videos): each view's check
+    // passes them through unchanged (it still learns each marker's last position), so the pair
+    // goes on as it is, without a copy.
+    left_.add(pair.left, *result.left_view, pass_);
+    right_.add(pair.right, *result.right_view, pass_);
+    release(pair, result);
+    return;
+  }
+  const size_t bytes = hold_images_ ? PairBytes(pair) : 0;
+  if (count_ > 0 && held_bytes_ + bytes > max_held_bytes_) {
+    // Over the memory limit: what is held goes on unchecked, as one view's group does.
+    left_.flush(left_checked_);
+    right_.flush(right_checked_);
+    release_ready(release);
+  }
+  if (count_ == held_.size()) held_.emplace_back();
+  Held& slot = held_[count_++];
+  CopyFrame(pair.left, hold_images_, slot.pair.left);
+  CopyFrame(pair.right, hold_images_, slot.pair.right);
+  slot.pair.pair_dt_ms = pair.pair_dt_ms;
+  slot.result = result;
+  held_bytes_ += bytes;
+  // Each view's check hands its frames back (checked) into their pair's slot, in order.
+  left_.add(pair.left, *result.left_view, left_checked_);
+  right_.add(pair.right, *result.right_view, right_checked_);
+  release_ready(release);
+}
+
+void PairKeyFrameGroups::flush(const Release& release, bool damaged) {
+  left_.flush(predicted_seen_ ? left_checked_ : pass_, damaged);
+  right_.flush(predicted_seen_ ? right_checked_ : pass_, damaged);
+  release_ready(release);
+}
+
+void PairKeyFrameGroups::release_ready(const Release& release) {
+  const size_t ready = std::min(left_done_, right_done_);
+  while (head_ < ready) {
+    Held& held = held_[head_++];  // Counted as handed on before release() may throw.
+    believe_views(held);
+    release(held.pair, held.result);
+  }
+  // The pairs one view still holds move to the front (their slots' buffers go along).
+  if (head_ > 0) {
+    std::rotate(held_.begin(), held_.begin() + static_cast<std::ptrdiff_t>(head_),
+                held_.begin() + static_cast<std::ptrdiff_t>(count_));
+    count_ -= head_;
+    left_done_ -= head_;
+    right_done_ -= head_;
+    head_ = 0;
+    held_bytes_ = 0;
+    if (hold_images_) {
+      for (size_t i = 0; i < count_; ++i) held_bytes_ += PairBytes(held_[i].pair);
+    }
+  }
+}
+
+// The pair's row as its views' checks left them: a marker a view's check did not believe is not
+// found in 3D (its status says which view refused it and why, as for a view that lost it), and
+// the measurements made with it are absent.
+void PairKeyFrameGroups::believe_views(Held& held) {
+  StereoFrameResult& result = held.result;
+  bool demoted = false;
+  for (StereoMarkerResult& m : result.markers) {
+    const Observation* left = ViewObservation(held.left, m.name);
+    const Observation* right = ViewObservation(held.right, m.name);
+    const bool left_refused = left != nullptr && m.left.found() && !left->found();
+    const bool right_refused = right != nullptr && m.right.found() && !right->found();
+    if (!left_refused && !right_refused) continue;
+    if (left_refused) m.left = *left;
+    if (right_refused) m.right = *right;
+    m.point = StereoPoint{};
+    m.status = !m.left.found() ? std::string("left_") + MarkerStatusName(m.left.status())
+                               : std::string("right_") + MarkerStatusName(m.right.status());
+    demoted = true;
+    ++demoted_;
+  }
+  if (demoted) {
+    result.shape = Shape3d{};
+    for (Segment3d& segment : result.segments) segment = Segment3d{};
+  }
+  result.left_angle_deg = held.left.measurement.angle_deg;
+  result.right_angle_deg = held.right.measurement.angle_deg;
+  // Each view's own tracking of this pair, as checked (the session's is a later pair's by now).
+  result.left_view = &held.left;
+  result.right_view = &held.right;
+}
+
+}  // namespace softsight

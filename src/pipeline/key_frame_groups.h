@@ -50,6 +50,7 @@
 #include <opencv2/core.hpp>
 
 #include "softsight/core/types.h"
+#include "softsight/pipeline/stereo_session.h"
 
 namespace softsight {
 
@@ -127,6 +128,60 @@ class KeyFrameGroups {
   std::vector<double> scratch_;
   int64_t demoted_ = 0;
   int64_t unchecked_frames_ = 0;
+};
+
+// A pair's frames (two views, pipeline/stereo_session.h) through the same check: each view's
+// groups are checked by a KeyFrameGroups of their own, as one view's are (the two views' key
+// frames need not come together: two cameras, two encoders), and a pair goes on once both its
+// frames have been checked, in source order. A marker either view's check did not believe is
+// not found in 3D in that pair (its status "left_implausible" or "right_implausible", as for a
+// view that did not find it), and the pair's 3D shape and segments, measured with it, are
+// absent; the view's own angle (angle_left_deg / angle_right_deg) is as that view's check left
+// it. Only key frames so far: pairs pass straight through.
+class PairKeyFrameGroups {
+ public:
+  using Release = std::function<void(const FramePair& pair, const StereoFrameResult& result)>;
+
+  // `max_held_bytes` bounds the held pairs' pictures (both views); beyond it the held pairs go
+  // on unchecked. `hold_images` false: the pairs are held without their pixels.
+  explicit PairKeyFrameGroups(size_t max_held_bytes = size_t{512} << 20, bool hold_images = true);
+  ~PairKeyFrameGroups();
+  PairKeyFrameGroups(const PairKeyFrameGroups&) = delete;
+  PairKeyFrameGroups& operator=(const PairKeyFrameGroups&) = delete;
+
+  void hold_images() { hold_images_ = true; }
+  bool holds_images() const { return hold_images_; }
+  // The next pair and its result (its left_view and right_view set, as StereoSession gives
+  // them): held, or handed on with every pair now checked in both views through `release`. A
+  // pair handed on has its left_view / right_view pointing at its views' checked results, valid
+  // during release().
+  void add(const FramePair& pair, const StereoFrameResult& result, const Release& release);
+  // The end of the run: every held pair, each view's last group unchecked (KeyFrameGroups::flush).
+  void flush(const Release& release, bool damaged = false);
+  // Pair marker-frames no longer found because a view's check did not believe the marker.
+  int64_t demoted() const { return demoted_; }
+
+ private:
+  struct Held {
+    FramePair pair;
+    StereoFrameResult result;
+    FrameResult left, right;  // Each view's result as its check handed it back.
+  };
+  void release_ready(const Release& release);
+  void believe_views(Held& held);
+
+  size_t max_held_bytes_;
+  bool hold_images_;
+  bool predicted_seen_ = false;
+  KeyFrameGroups left_, right_;
+  // held_[0, count_) are held in source order; each view's check has handed back
+  // held_[0, left_done_) and held_[0, right_done_); held_[0, head_) have gone on (moved out at
+  // the end of release_ready). Slots are reused: their buffers stay.
+  std::vector<Held> held_;
+  size_t count_ = 0, left_done_ = 0, right_done_ = 0, head_ = 0;
+  size_t held_bytes_ = 0;
+  KeyFrameGroups::Release left_checked_, right_checked_, pass_;
+  int64_t demoted_ = 0;
 };
 
 }  // namespace softsight

@@ -350,5 +350,88 @@ TEST(KeyFrameGroups, AGroupOverTheFrameLimitGoesOnUncheckedInOrder) {
   EXPECT_GT(groups.unchecked_frames(), 0);
 }
 
+// Pairs: the left view clean (a key frame every 12th), the right one's frames 22-29 slid for
+// markers 0 and 1 up to its key frame 30 (its key frames every 10th), each pair's row as StereoSession makes it (every
+// marker found in 3D, the shape measured). What is handed on, in order.
+struct ReleasedPairs {
+  std::vector<int64_t> order;
+  std::vector<StereoFrameResult> results;
+};
+
+ReleasedPairs CheckPairs(int frames, PairKeyFrameGroups& groups) {
+  const auto none = [](int, int) { return cv::Point2d(0, 0); };
+  const auto slid = [](int i, int m) {
+    return i >= 22 && i < 30 && m < 2 ? cv::Point2d(-16, 0) : cv::Point2d(0, 0);
+  };
+  const std::vector<FrameResult> left = Track{}.results(frames, none);
+  const std::vector<FrameResult> right = Track{}.results(frames, slid);
+  ReleasedPairs released;
+  const PairKeyFrameGroups::Release release = [&](const FramePair& pair,
+                                                  const StereoFrameResult& result) {
+    EXPECT_EQ(pair.left.index, result.frame_index);
+    // The views' results as their checks handed them on, for a sink that draws each view.
+    EXPECT_EQ(result.left_view->frame_index, result.frame_index);
+    EXPECT_EQ(result.right_view->frame_index, result.frame_index);
+    released.order.push_back(pair.left.index);
+    released.results.push_back(result);
+  };
+  FramePair pair;
+  pair.left.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  pair.right.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  StereoFrameResult result;
+  for (int i = 0; i < frames; ++i) {
+    pair.left.index = pair.right.index = i;
+    pair.left.key_frame = i % 12 == 0;
+    pair.right.key_frame = i % 10 == 0;
+    result.frame_index = result.right_frame_index = i;
+    result.markers.resize(3);
+    for (size_t m = 0; m < 3; ++m) {
+      StereoMarkerResult& marker = result.markers[m];
+      marker.name = left[i].markers[m].name;
+      marker.left = left[i].markers[m].observation;
+      marker.right = right[i].markers[m].observation;
+      marker.point.status = StereoStatus::kFound;
+      marker.point.position_mm = cv::Point3d(0, 0, 300);
+      marker.status = "found";
+    }
+    result.shape.angle_deg = 150.0;
+    result.left_angle_deg = result.right_angle_deg = 150.0;
+    result.left_view = &left[i];
+    result.right_view = &right[i];
+    groups.add(pair, result, release);
+  }
+  groups.flush(release);
+  return released;
+}
+
+TEST(PairKeyFrameGroups, AMarkerOneViewsDecoderMovedIsNotFoundIn3DInThosePairs) {
+  PairKeyFrameGroups groups;
+  const ReleasedPairs released = CheckPairs(60, groups);
+  ASSERT_EQ(released.order.size(), 60u);
+  for (int i = 0; i < 60; ++i) {
+    EXPECT_EQ(released.order[i], i) << "every pair once, in order";
+    const StereoFrameResult& row = released.results[i];
+    const bool damaged = i >= 22 && i < 30;
+    for (int m = 0; m < 3; ++m) {
+      const StereoMarkerResult& marker = row.markers[m];
+      const bool refused = damaged && m < 2;
+      EXPECT_EQ(marker.point.found(), !refused) << "frame " << i << " marker " << m;
+      EXPECT_EQ(marker.status, refused ? "right_implausible" : "found") << i << " " << m;
+      EXPECT_TRUE(marker.left.found());
+    }
+    EXPECT_EQ(row.shape.angle_deg.has_value(), !damaged) << i;
+    EXPECT_EQ(row.right_angle_deg.has_value(), !damaged) << i;
+    EXPECT_TRUE(row.left_angle_deg.has_value()) << i;
+  }
+  EXPECT_EQ(groups.demoted(), 2 * 8);
+}
+
+TEST(PairKeyFrameGroups, PairsOverTheMemoryLimitGoOnUncheckedInOrder) {
+  PairKeyFrameGroups groups(/*max_held_bytes=*/2 * 4 * 4 * 3 * 5);  // Five of the test's pairs.
+  const ReleasedPairs released = CheckPairs(40, groups);
+  ASSERT_EQ(released.order.size(), 40u);
+  for (int i = 0; i < 40; ++i) EXPECT_EQ(released.order[i], i);
+}
+
 }  // namespace
 }  // namespace softsight

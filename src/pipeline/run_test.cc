@@ -12,9 +12,11 @@
 #include "io/frame_grabber.h"
 #include "io/read_ahead_source.h"
 #include "pipeline/scene_config_test_util.h"
+#include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
 #include "softsight/io/frame_writer.h"
 #include "softsight/pipeline/sinks.h"
+#include "softsight/pipeline/stereo_session.h"
 #include "softsight/sim/scene.h"
 
 namespace softsight {
@@ -421,6 +423,140 @@ TEST(RunStream, PullsRunPipelinesCheckedResultsThenItsError) {
     for (size_t m = 0; m < 3; ++m) clean_found += pulled[f].markers[m].observation.found();
   }
   EXPECT_EQ(clean_found, 28 * 3) << "the frames before the damage are tracked";
+}
+
+// A pair of predicted videos (two cameras, two encoders: the left's key frames every 12th, the
+// right's every 10th) of one rendered scene, through a rig that sees every pixel the two views
+// share at Z = 300 mm (the right camera 100 mm to the right, its principal point 100 px further
+// right, f = 300 px). The left decoder silently slid frames 28-35 by 16 px (a flipped bit), which
+// the epipolar check cannot see (the slide is along the epipolar line): without the key-frame
+// check those markers are found in 3D, 48 mm too far.
+class SlidPredictedPairs : public StereoInput {
+ public:
+  explicit SlidPredictedPairs(int frames) : scene_(SmallScene(frames)) {}
+  bool read(FramePair& pair) override {
+    if (next_ >= scene_.options().frame_count) return false;
+    scene_.render(next_, pair.left.image);
+    pair.left.image.copyTo(pair.right.image);
+    if (next_ >= 28 && next_ < 36) {
+      const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, -16, 0, 1, 0);
+      cv::warpAffine(pair.left.image.clone(), pair.left.image, shift, pair.left.image.size(),
+                     cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+    }
+    for (Frame* view : {&pair.left, &pair.right}) {
+      view->index = next_;
+      view->time_s = next_ / 30.0;
+    }
+    pair.left.key_frame = next_ % 12 == 0;
+    pair.right.key_frame = next_ % 10 == 0;
+    ++next_;
+    return true;
+  }
+  std::string description() const override { return "left.mp4 + right.mp4"; }
+  std::optional<double> fps() const override { return 30.0; }
+  std::vector<std::string> files() const override { return {}; }
+
+ private:
+  SyntheticScene scene_;
+  int next_ = 0;
+};
+
+StereoCalibration RigSeeingThePictureAt300Mm() {
+  StereoCalibration stereo;
+  stereo.left = {cv::Size(320, 240), cv::Matx33d(300, 0, 160, 0, 300, 120, 0, 0, 1), {0, 0, 0, 0, 0}};
+  stereo.right = {cv::Size(320, 240), cv::Matx33d(300, 0, 260, 0, 300, 120, 0, 0, 1), {0, 0, 0, 0, 0}};
+  stereo.T = cv::Vec3d(-100, 0, 0);
+  CompleteStereoCalibration(stereo);
+  return stereo;
+}
+
+// Every pair's row as the sinks get it.
+class PairRows : public PairSink {
+ public:
+  void consume(const FramePair& pair, const StereoFrameResult& result) override {
+    EXPECT_EQ(pair.left.index, result.frame_index);
+    ASSERT_NE(result.left_view, nullptr);  // The views' own results, as checked, for a window.
+    EXPECT_EQ(result.left_view->frame_index, result.frame_index);
+    EXPECT_EQ(result.right_view->frame_index, result.right_frame_index);
+    rows.push_back(result);
+  }
+  std::vector<StereoFrameResult> rows;
+};
+
+TEST(RunPipeline, APairMarkerTheLeftDecoderSilentlyMovedIsNotFoundIn3DInThoseRows) {
+  const StereoCalibration rig = RigSeeingThePictureAt300Mm();
+  RunOptions unchecked;
+  unchecked.check_key_frame_groups = false;
+  SlidPredictedPairs believed_input(48);
+  StereoSession believed_session(ThreeMarkerSceneConfig(), ThreeMarkerSceneConfig(), rig);
+  PairRows believed;
+  RunPipeline(believed_input, believed_session, {&believed}, unchecked);
+  ASSERT_EQ(believed.rows.size(), 48u);
+  for (int f = 28; f < 36; ++f) {
+    for (const StereoMarkerResult& m : believed.rows[f].markers) {
+      ASSERT_TRUE(m.point.found()) << "the damage this check is for: frame " << f << " " << m.name;
+      EXPECT_GT(m.point.position_mm->z, 340.0) << "frame " << f << " " << m.name;
+    }
+  }
+
+  SlidPredictedPairs input(48);
+  StereoSession session(ThreeMarkerSceneConfig(), ThreeMarkerSceneConfig(), rig);
+  PairRows sink;
+  const RunSummary summary = RunPipeline(input, session, {&sink});
+  ASSERT_EQ(summary.stop_reason, StopReason::kEndOfInput) << summary.error;
+  ASSERT_EQ(sink.rows.size(), 48u);
+  for (int f = 0; f < 48; ++f) {
+    const StereoFrameResult& row = sink.rows[f];
+    EXPECT_EQ(row.frame_index, f) << "in source order";
+    const bool slid = f >= 28 && f < 36;
+    for (const StereoMarkerResult& m : row.markers) {
+      if (slid) {
+        EXPECT_FALSE(m.point.found()) << "frame " << f << " " << m.name;
+        EXPECT_EQ(m.status, "left_implausible") << "frame " << f << " " << m.name;
+        EXPECT_TRUE(m.right.found()) << "the right view was not damaged";
+      } else {
+        ASSERT_TRUE(m.point.found()) << "frame " << f << " " << m.name << ": " << m.status;
+        EXPECT_NEAR(m.point.position_mm->z, 300.0, 1e-6) << "frame " << f << " " << m.name;
+      }
+    }
+    // Measured with the damaged markers: absent there, as one view's row's measurements are.
+    EXPECT_EQ(row.shape.angle_deg.has_value(), !slid) << "frame " << f;
+    EXPECT_EQ(row.left_angle_deg.has_value(), !slid) << "frame " << f;
+    EXPECT_TRUE(row.right_angle_deg.has_value()) << "frame " << f;
+  }
+  for (const MarkerRunSummary& marker : summary.markers) EXPECT_EQ(marker.found, 40) << marker.name;
+  EXPECT_THAT(summary.notes, ::testing::Contains(HasSubstr("24 marker-frames not believed")));
+}
+
+// RunStream over pairs: the same run, pulled; the same rows as RunPipeline pushes.
+TEST(RunStream, PullsAPairRunsCheckedRows) {
+  const StereoCalibration rig = RigSeeingThePictureAt300Mm();
+  SlidPredictedPairs pushed_input(40);
+  StereoSession pushed_session(ThreeMarkerSceneConfig(), ThreeMarkerSceneConfig(), rig);
+  PairRows pushed;
+  const RunSummary summary = RunPipeline(pushed_input, pushed_session, {&pushed});
+
+  SlidPredictedPairs input(40);
+  StereoSession session(ThreeMarkerSceneConfig(), ThreeMarkerSceneConfig(), rig);
+  StereoRunStream stream(input, session);
+  std::vector<StereoFrameResult> pulled;
+  while (std::optional<StereoFrameResult> result = stream.next()) {
+    EXPECT_EQ(result->left_view, nullptr) << "a kept result does not point into the session";
+    pulled.push_back(*result);
+  }
+  ASSERT_TRUE(stream.ended());
+  ASSERT_EQ(pulled.size(), pushed.rows.size());
+  ASSERT_EQ(pulled.size(), 40u);
+  for (size_t f = 0; f < pulled.size(); ++f) {
+    EXPECT_EQ(pulled[f].frame_index, pushed.rows[f].frame_index);
+    for (size_t m = 0; m < 3; ++m) {
+      EXPECT_EQ(pulled[f].markers[m].status, pushed.rows[f].markers[m].status) << f;
+      EXPECT_EQ(pulled[f].markers[m].point.position_mm, pushed.rows[f].markers[m].point.position_mm);
+    }
+  }
+  EXPECT_EQ(pulled[30].markers[0].status, "left_implausible");
+  EXPECT_EQ(stream.summary().frames, summary.frames);
+  EXPECT_EQ(stream.summary().notes, summary.notes);
 }
 
 TEST(RunStream, AnInputWithoutFramesIsAnErrorAndMaxFramesEndsIt) {

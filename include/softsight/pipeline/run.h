@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "softsight/io/frame_source.h"
@@ -19,7 +20,8 @@
 
 namespace softsight {
 
-class KeyFrameGroups;
+class KeyFrameGroups;      // One view's key-frame check (pipeline/key_frame_groups.h),
+class PairKeyFrameGroups;  // and a pair's: each view's groups, a pair on once both are checked.
 
 struct RunOptions {
   // Stop after this many processed frames (absent: until the source ends). Must be >= 0.
@@ -51,8 +53,8 @@ RunInfo DescribeRun(const FrameSource& source, const TrackingSession& session,
 // says, and a recording joins and leaves the run). RunPipeline is this class driven by a source.
 // `Session` is the step: a TrackingSession (one view: a Frame in, a FrameResult out) or a
 // StereoSession (two views: a FramePair in, a StereoFrameResult out; pipeline/stereo_session.h).
-// The run, its sinks and its summary are the same for both; only what a result counts in the
-// summary and the key-frame check (one view only, so far) depend on the step.
+// The run, its sinks, its summary and its key-frame check are the same for both; only what a
+// result counts in the summary depends on the step.
 template <typename Session>
 class BasicPipelineRun {
  public:
@@ -84,8 +86,9 @@ class BasicPipelineRun {
   void leave(Sink& sink);
   // From now on, hold a predicted video's frames until the next key frame shows whether the
   // decoder damaged them (RunOptions::check_key_frame_groups); process() still returns each
-  // frame's result at once, the sinks get it when its group is checked. One view only: a pair
-  // run's results go on at once (its views' groups need not end together).
+  // frame's result at once, the sinks get it when its group is checked. A pair goes on once
+  // both its views' groups are checked (they need not end together), and a marker either
+  // view's check did not believe is not found in 3D there.
   void check_key_frame_groups();
   const RunInfo& info() const { return info_; }
   int64_t frames() const { return processed_; }  // Processed so far (the sinks may lag).
@@ -121,7 +124,9 @@ class BasicPipelineRun {
   RunSummary summary_;  // Its frames: those the sinks have had.
   int64_t processed_ = 0;
   std::vector<double> proc_ms_, latency_result_ms_, latency_done_ms_;
-  std::unique_ptr<KeyFrameGroups> key_frame_groups_;  // Set by check_key_frame_groups().
+  using KeyFrameCheck =
+      std::conditional_t<std::is_same_v<Input, Frame>, KeyFrameGroups, PairKeyFrameGroups>;
+  std::unique_ptr<KeyFrameCheck> key_frame_groups_;  // Set by check_key_frame_groups().
   std::function<void(const Input&, const Result&)> deliver_;
 };
 
@@ -139,21 +144,27 @@ RunSummary RunPipeline(FrameSource& source, TrackingSession& session,
                        const std::vector<FrameSink*>& sinks, const RunOptions& options = {});
 
 // RunPipeline turned inside out, for a caller that pulls one result at a time (Python's
-// softsight.frames): the same reading, max_frames, stop request, grayscale check and key-frame
-// check (a predicted video's results come out once their group is checked, so next() may read
-// several frames before it returns one), without sinks. The source and the session must outlive
-// the stream while it runs; once ended() the source is not read again (it may be closed).
-class RunStream {
+// softsight.frames and frames_stereo): the same reading, max_frames, stop request, grayscale
+// check and key-frame check (a predicted video's results come out once their group is checked,
+// so next() may read several frames before it returns one), without sinks. The source and the
+// session must outlive the stream while it runs; once ended() the source is not read again (it
+// may be closed). One view: RunStream; a pair (pipeline/stereo_session.h): StereoRunStream,
+// whose results have no left_view / right_view (those are the session's, gone by then).
+template <typename Source, typename Session>
+class BasicRunStream {
  public:
-  RunStream(FrameSource& source, TrackingSession& session, const RunOptions& options = {});
-  ~RunStream();
-  RunStream(const RunStream&) = delete;
-  RunStream& operator=(const RunStream&) = delete;
+  using Input = typename Session::Input;
+  using Result = typename Session::Result;
+
+  BasicRunStream(Source& source, Session& session, const RunOptions& options = {});
+  ~BasicRunStream();
+  BasicRunStream(const BasicRunStream&) = delete;
+  BasicRunStream& operator=(const BasicRunStream&) = delete;
 
   // The next frame's result, in source order, or nothing once the run has ended. An InputError
   // (a frame that does not decode, an input without frames, a gray video for colour markers)
   // is thrown after every result before it has been returned; the run has ended then.
-  std::optional<FrameResult> next();
+  std::optional<Result> next();
   bool ended() const { return ended_; }
   const RunInfo& info() const;
   int64_t returned() const { return returned_; }  // Results next() has returned.
@@ -167,15 +178,17 @@ class RunStream {
   void fill();
   void end(StopReason reason, std::string error);
 
-  FrameSource& source_;
+  Source& source_;
   RunOptions options_;
   std::unique_ptr<Queue> queue_;
-  std::unique_ptr<PipelineRun> run_;
-  Frame frame_;
+  std::unique_ptr<BasicPipelineRun<Session>> run_;
+  Input input_;
   bool ended_ = false;
   int64_t returned_ = 0;
   RunSummary summary_;
 };
+
+using RunStream = BasicRunStream<FrameSource, TrackingSession>;
 
 // Whether a run of `config` needs colour frames: a marker whose colour range accepts gray pixels
 // (a gray-level range, white or black dots) is tracked on gray video as well; only the others

@@ -137,6 +137,8 @@ using PairSink = BasicFrameSink<FramePair, StereoFrameResult>;
 // Two views' run: RunPipeline's loop, summary and sinks over pairs (pipeline/run.h). Its summary
 // counts a marker found where it is found in 3D, and a frame measured where the 3D angle is.
 using StereoPipelineRun = BasicPipelineRun<StereoSession>;
+// A pair run pulled one pair at a time (pipeline/run.h BasicRunStream; Python's frames_stereo).
+using StereoRunStream = BasicRunStream<StereoInput, StereoSession>;
 
 // What a pair run tells its sinks in begin(): the input (its description, the left view's rate,
 // live or not; frame_count only from `options.max_frames`) and the markers' names.
@@ -145,7 +147,11 @@ RunInfo DescribeRun(const StereoInput& input, const StereoSession& session,
 // The one run (pipeline/run.h RunPipeline) on pairs: each pair through the session and to every
 // sink, until the input ends, max_frames pairs are done, a stop is requested or an InputError
 // ends it (kError, its message in the summary). A session that needs colour refuses a gray
-// pair. The key-frame check is one view's only (RunOptions::check_key_frame_groups is not used).
+// pair. With RunOptions::check_key_frame_groups (the default), a pair of predicted videos is
+// checked view by view as one view's video is (pipeline/run.h), and a pair goes on once both
+// its views' groups are checked: a marker either view's decoder silently moved is not found in
+// 3D there (status "left_implausible" / "right_implausible"), and the 3D shape made with it is
+// absent.
 RunSummary RunPipeline(StereoInput& input, StereoSession& session,
                        const std::vector<PairSink*>& sinks, const RunOptions& options = {});
 
