@@ -271,10 +271,12 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     }
   }
   // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
-  // core = more than kSoftBand inside, reach = within kRingOuter outside.
-  cv::Mat distance = Scratch(distance_store_, size, CV_16U);
-  ChamferToEdge(own, distance);
+  // core = more than kSoftBand inside, reach = within kRingOuter outside. Only those comparisons
+  // are read, so EdgeZones' stand-in, which answers them as ChamferToEdge's distance does, serves.
+  cv::Mat distance = Scratch(distance_store_, size, CV_8U);
+  EdgeZones(own, distance, zone_store_);
   constexpr int kNear = 3 * kSoftBand, kReach = 3 * kRingOuter;
+  static_assert(kNear == kZoneNear && kReach == kZoneReach && kZoneFar > kReach);
   const cv::Mat pixels = filtered(padded);
   const cv::Mat others = mask(padded);
   const int channels = pixels.channels();
@@ -292,7 +294,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   bool core_empty = true;
   for (int y = 0; y < size.height && core_empty; ++y) {
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* d = distance.ptr<uint16_t>(y);
+    const uchar* d = distance.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] == 255 && d[x] > kNear);
   }
   const int core_depth = core_empty ? 0 : kNear;
@@ -324,7 +326,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* d = distance.ptr<uint16_t>(y);
+    const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) {
       const uchar* c = p + x * channels;
@@ -507,7 +509,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* dist = distance.ptr<uint16_t>(y);
+    const uchar* dist = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     double row_w = 0, row_x = 0;
     for (int x = 0; x < size.width; ++x) {

@@ -2,6 +2,7 @@
 // test (vector kernel, scalar reference and OpenCV's cvtColor + inRange all agree), random masks
 // and strided views for the morphology.
 #include "track/colour_kernels.h"
+#include "track/colour_tracker_parts.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -185,6 +186,55 @@ TEST(ColourKernels, MarkOutsideIsAFloodFillFromTheBorder) {
     MarkOutside(mask, 128, stack);
     EXPECT_EQ(cv::countNonZero(mask != expected), 0) << size << " density " << density;
     EXPECT_EQ(cv::countNonZero(parent.row(0) != 7), 0) << "wrote outside the view";
+  }
+}
+
+TEST(ColourKernels, EdgeZonesAnswerWhatTheChamferDistanceAnswers) {
+  // The measurement asks the chamfer distance d of each pixel (ChamferToEdge) d > 6 (every pixel)
+  // and d <= 12 (a pixel outside the blob); EdgeZones' stand-in must answer both as d does, and
+  // its vector path must be its reference, on masks of blobs, holes (128) and noise, in views.
+  cv::RNG rng(4545);
+  cv::Mat scratch;
+  for (int trial = 0; trial < 600; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 70), 1 + rng.uniform(0, 50));
+    cv::Mat parent(size.height + 2, size.width + 7, CV_8U, cv::Scalar(255));
+    cv::Mat own = parent(cv::Rect(3, 1, size.width, size.height));  // A strided view.
+    own.setTo(0);
+    if (trial % 3 == 0) {
+      cv::Mat noise(size, CV_32F);
+      rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::Mat(noise < 0.1 + 0.2 * (trial % 5)).copyTo(own);
+    } else {
+      const cv::Point centre(rng.uniform(0, size.width), rng.uniform(0, size.height));
+      const int radius = 1 + rng.uniform(0, std::max(1, std::min(size.width, size.height)));
+      cv::ellipse(own, centre, cv::Size(radius, 1 + rng.uniform(0, radius + 1)),
+                  rng.uniform(0.0, 180.0), 0, 360, cv::Scalar(255), cv::FILLED);
+    }
+    for (int k = rng.uniform(0, 4); k > 0; --k) {  // Holes, filled as FillHoles marks them.
+      own.at<uchar>(rng.uniform(0, size.height), rng.uniform(0, size.width)) = 128;
+    }
+    cv::Mat zones(size, CV_8U, cv::Scalar(99)), reference(size, CV_8U, cv::Scalar(77));
+    cv::Mat distance(size, CV_16U);
+    EdgeZones(own, zones, scratch);
+    EdgeZonesReference(own, reference);
+    colour_internal::ChamferToEdge(own, distance);
+    cv::Mat differ;
+    cv::findNonZero(zones != reference, differ);
+    ASSERT_TRUE(differ.empty()) << size << " trial " << trial << ": " << differ.total()
+                                << " pixels differ, the first at " << differ.at<cv::Point>(0)
+                                << " (" << int(zones.at<uchar>(differ.at<cv::Point>(0))) << " for "
+                                << int(reference.at<uchar>(differ.at<cv::Point>(0))) << ")";
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        const int d = distance.at<uint16_t>(y, x), z = zones.at<uchar>(y, x);
+        ASSERT_EQ(d > 6, z > 6) << size << " trial " << trial << " at " << x << "," << y;
+        ASSERT_EQ(d > 0, z > 0);
+        if (own.at<uchar>(y, x) != 255) {
+          ASSERT_EQ(d <= 12, z <= 12) << size << " trial " << trial << " at " << x << "," << y;
+        }
+      }
+    }
+    EXPECT_EQ(cv::countNonZero(parent.row(0) != 255), 0) << "wrote outside the view";
   }
 }
 

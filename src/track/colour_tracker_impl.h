@@ -231,7 +231,7 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
-  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
+  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
