@@ -518,7 +518,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
       }
     }
     rim_points_.assign(edge_points_.begin(), edge_points_.end());
-    blob->rim = FitRimOfRadius(rim_points_, *radius);
+    blob->rim = FitRimOfRadius(rim_points_, *radius, kRimInlierPx, &rim_angles_);
     // A whole marker seen at a slant (an ellipse narrower than the learned disc) fits the circle
     // along part of its edge too; the rest of its edge bulges outwards where a cut's is straight
     // or pushed in. Its centroid is its centre.

@@ -242,6 +242,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Point> hull_points_;  // Their convex hull.
   std::vector<cv::Point> outside_stack_;  // FillHoles's flood of the outside.
   std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
+  std::vector<double> rim_angles_;       // Scratch of FitRimOfRadius.
   std::vector<std::pair<double, cv::Point2d>> off_rim_;  // Scratch of OffRimBulgePx.
 };
 
