@@ -317,7 +317,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   std::array<cv::Vec3d, kQuarters> quarter_chroma_sum{};
   std::array<cv::Matx33d, kQuarters> quarter_chroma_outer{};
   const auto add_chroma = [](const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
-    const cv::Vec3d chroma = Chromaticity(c[0], c[1], c[2]);
+    const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
     sum += chroma;
     for (int k = 0; k < 3; ++k) {
       for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];

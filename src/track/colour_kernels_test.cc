@@ -2,10 +2,12 @@
 // test (vector kernel, scalar reference and OpenCV's cvtColor + inRange all agree), random masks
 // and strided views for the morphology.
 #include "track/colour_kernels.h"
+#include "track/chromaticity.h"
 #include "track/colour_tracker_parts.h"
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -236,6 +238,20 @@ TEST(ColourKernels, EdgeZonesAnswerWhatTheChamferDistanceAnswers) {
     }
     EXPECT_EQ(cv::countNonZero(parent.row(0) != 255), 0) << "wrote outside the view";
   }
+}
+
+TEST(ColourKernels, ChromaticityOfLevelsIsChromaticityForEveryColour) {
+  int differ = 0;
+  for (int b = 0; b < 256; ++b) {
+    for (int g = 0; g < 256; ++g) {
+      for (int r = 0; r < 256; ++r) {
+        const cv::Vec3d table = ChromaticityOfLevels(b, g, r);
+        const cv::Vec3d divided = Chromaticity(b, g, r);
+        differ += std::memcmp(table.val, divided.val, sizeof(table.val)) != 0;
+      }
+    }
+  }
+  EXPECT_EQ(differ, 0);
 }
 
 TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
