@@ -96,6 +96,43 @@ TEST(ColourKernels, ScalarReferenceAndStridedViews) {
   }
 }
 
+TEST(ColourKernels, GrayFramesHandedOverAsBgrAreClassifiedAsTheScalarReference) {
+  // A gray recording converted to BGR (b == g == r everywhere): whole chunks of 16 flat pixels
+  // take the vector path's flat shortcut; rows with a few coloured pixels take the full test.
+  // Every level, every box of the other tests' kinds, rows of several widths, views.
+  const HsvBox boxes[] = {
+      {{0, 179}, {0, 60}, {170, 255}},     // mire-2's white dots
+      {{0, 179}, {0, 40}, {200, 255}},     // white: any hue
+      {{0, 0}, {0, 0}, {0, 255}},          // hue 0 only, gray pixels
+      {{170, 10}, {0, 255}, {40, 200}},    // red, wrapping, saturation from 0
+      {{45, 85}, {80, 255}, {40, 255}},    // green: no gray pixel is in
+  };
+  cv::RNG rng(45);
+  cv::Mat levels(40, 300, CV_8U);
+  rng.fill(levels, cv::RNG::UNIFORM, 0, 256);
+  for (int x = 0; x < 256; ++x) levels.at<uchar>(0, x) = static_cast<uchar>(x);  // Every level.
+  cv::Mat gray;
+  cv::cvtColor(levels, gray, cv::COLOR_GRAY2BGR);
+  cv::Mat mixed = gray.clone();
+  for (int y = 1; y < mixed.rows; y += 3) mixed.at<cv::Vec3b>(y, (7 * y) % mixed.cols)[1] ^= 9;
+  for (const HsvBox& box : boxes) {
+    const HsvClassifier classifier(box);
+    for (const cv::Mat* image : {&gray, &mixed}) {
+      for (const cv::Rect& r : {cv::Rect(0, 0, 300, 40), cv::Rect(3, 5, 37, 11),
+                                cv::Rect(1, 1, 15, 3), cv::Rect(0, 0, 16, 40),
+                                cv::Rect(250, 2, 50, 30)}) {
+        const cv::Mat view = (*image)(r);
+        cv::Mat fast(view.size(), CV_8U), scalar(view.size(), CV_8U), reference;
+        classifier.Classify(view, fast);
+        classifier.ClassifyScalar(view, scalar);
+        ClassifyHsvOpenCv(view, box, reference);
+        EXPECT_EQ(cv::countNonZero(fast != scalar), 0) << Name(box) << " " << r;
+        EXPECT_EQ(cv::countNonZero(scalar != reference), 0) << Name(box) << " " << r;
+      }
+    }
+  }
+}
+
 TEST(ColourKernels, OpenClose3x3IsMorphologyEx) {
   cv::RNG rng(11);
   cv::Mat scratch;
