@@ -271,10 +271,12 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     }
   }
   // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
-  // core = more than kSoftBand inside, reach = within kRingOuter outside.
-  cv::Mat distance = Scratch(distance_store_, size, CV_16U);
-  ChamferToEdge(own, distance);
+  // core = more than kSoftBand inside, reach = within kRingOuter outside. Only those comparisons
+  // are read, so EdgeZones' stand-in, which answers them as ChamferToEdge's distance does, serves.
+  cv::Mat distance = Scratch(distance_store_, size, CV_8U);
+  EdgeZones(own, distance, zone_store_);
   constexpr int kNear = 3 * kSoftBand, kReach = 3 * kRingOuter;
+  static_assert(kNear == kZoneNear && kReach == kZoneReach && kZoneFar > kReach);
   const cv::Mat pixels = filtered(padded);
   const cv::Mat others = mask(padded);
   const int channels = pixels.channels();
@@ -292,7 +294,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   bool core_empty = true;
   for (int y = 0; y < size.height && core_empty; ++y) {
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* d = distance.ptr<uint16_t>(y);
+    const uchar* d = distance.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] == 255 && d[x] > kNear);
   }
   const int core_depth = core_empty ? 0 : kNear;
@@ -315,36 +317,53 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   std::array<cv::Vec3d, kQuarters> quarter_chroma_sum{};
   std::array<cv::Matx33d, kQuarters> quarter_chroma_outer{};
   const auto add_chroma = [](const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
-    const cv::Vec3d chroma = Chromaticity(c[0], c[1], c[2]);
+    const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
     sum += chroma;
     for (int k = 0; k < 3; ++k) {
       for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];
     }
   };
+  // The levels' sums and second moments are sums of integers, accumulated as integers: every
+  // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
+  // so the totals are the same bits in any order. Lower triangles: (0,0) (1,0) (1,1) (2,0) (2,1)
+  // (2,2); ring sums per sector, second moments per quarter.
+  std::array<int64_t, 3> core_sum_i{};
+  std::array<int64_t, 6> core_outer_i{};
+  std::array<std::array<int64_t, 3>, kSectors> sector_sum_i{};
+  std::array<std::array<int64_t, 6>, kQuarters> quarter_outer_i{};
+  const auto add_levels = [channels](const uchar* c, int64_t* sum, int64_t* outer) {
+    if (channels == 3) {
+      const int b = c[0], g = c[1], r = c[2];
+      sum[0] += b;
+      sum[1] += g;
+      sum[2] += r;
+      outer[0] += b * b;
+      outer[1] += g * b;
+      outer[2] += g * g;
+      outer[3] += r * b;
+      outer[4] += r * g;
+      outer[5] += r * r;
+    } else {
+      sum[0] += c[0];
+      outer[0] += c[0] * c[0];
+    }
+  };
+  const auto lower = [](int k, int l) { return k * (k + 1) / 2 + l; };
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* d = distance.ptr<uint16_t>(y);
+    const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     for (int x = 0; x < size.width; ++x) {
       const uchar* c = p + x * channels;
       if (ow[x] == 255 && d[x] > core_depth) {  // A filled hole is not the marker's colour.
-        for (int k = 0; k < channels; ++k) {
-          core_sum[k] += c[k];
-          core_sq[k] += c[k] * c[k];
-          for (int l = 0; l <= k; ++l) core_outer(k, l) += c[k] * c[l];
-        }
+        add_levels(c, core_sum_i.data(), core_outer_i.data());
         if (chromatic) add_chroma(c, core_chroma_sum, core_chroma_outer);
         core_n += 1;
       } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
-        cv::Matx33d& outer = quarter_outer[sector * kQuarters / kSectors];
-        for (int k = 0; k < channels; ++k) {
-          ring_sum[k] += c[k];
-          ring_sq[k] += c[k] * c[k];
-          sector_sum[sector][k] += c[k];
-          for (int l = 0; l <= k; ++l) outer(k, l) += c[k] * c[l];
-        }
+        add_levels(c, sector_sum_i[sector].data(),
+                   quarter_outer_i[sector * kQuarters / kSectors].data());
         if (chromatic) {
           const int quarter = sector * kQuarters / kSectors;
           add_chroma(c, quarter_chroma_sum[quarter], quarter_chroma_outer[quarter]);
@@ -353,6 +372,26 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
         ring_n += 1;
       }
     }
+  }
+  for (int k = 0; k < channels; ++k) {
+    core_sum[k] = static_cast<double>(core_sum_i[k]);
+    core_sq[k] = static_cast<double>(core_outer_i[lower(k, k)]);
+    for (int l = 0; l <= k; ++l) {
+      core_outer(k, l) = static_cast<double>(core_outer_i[lower(k, l)]);
+    }
+    int64_t ring_total = 0, ring_squares = 0;
+    for (int i = 0; i < kSectors; ++i) {
+      sector_sum[i][k] = static_cast<double>(sector_sum_i[i][k]);
+      ring_total += sector_sum_i[i][k];
+    }
+    for (int q = 0; q < kQuarters; ++q) {
+      ring_squares += quarter_outer_i[q][lower(k, k)];
+      for (int l = 0; l <= k; ++l) {
+        quarter_outer[q](k, l) = static_cast<double>(quarter_outer_i[q][lower(k, l)]);
+      }
+    }
+    ring_sum[k] = static_cast<double>(ring_total);
+    ring_sq[k] = static_cast<double>(ring_squares);
   }
   if (core_n < 1 || ring_n < 3) return;  // Crowded by other blobs: no local background.
   double core_var = 0, ring_var = 0;
@@ -479,7 +518,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
       }
     }
     rim_points_.assign(edge_points_.begin(), edge_points_.end());
-    blob->rim = FitRimOfRadius(rim_points_, *radius);
+    blob->rim = FitRimOfRadius(rim_points_, *radius, kRimInlierPx, &rim_angles_);
     // A whole marker seen at a slant (an ellipse narrower than the learned disc) fits the circle
     // along part of its edge too; the rest of its edge bulges outwards where a cut's is straight
     // or pushed in. Its centroid is its centre.
@@ -507,7 +546,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   for (int y = 0; y < size.height; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
-    const uint16_t* dist = distance.ptr<uint16_t>(y);
+    const uchar* dist = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     double row_w = 0, row_x = 0;
     for (int x = 0; x < size.width; ++x) {

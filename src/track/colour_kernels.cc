@@ -214,6 +214,12 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
     const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
     const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
+    // 16 flat pixels (a gray recording handed over as BGR: b == g == r): hue 0 and saturation 0
+    // exactly, so each is in by its value alone, as the flat case below decides it.
+    if (v_check_all(d8 == v_setzero_u8())) {
+      v_store(mask + x, gray_in & v_ok);
+      continue;
+    }
     // Most pixels of a scene are far from the marker's hue, value or saturation: when all 16
     // are out on those alone (exact, as above), the full test is not needed. First (8-bit, the
     // cheapest) when none of the 16 has its largest channel in a sector whose hues reach the box
@@ -617,6 +623,130 @@ std::vector<RunLabeller::Component> LabelReference(const cv::Mat& mask) {
     }
   }
   return out;
+}
+
+void EdgeZonesReference(const cv::Mat& own, cv::Mat& zones) {
+  CV_Assert(own.type() == CV_8UC1 && zones.type() == CV_8UC1 && zones.size() == own.size());
+  const int w = own.cols, h = own.rows;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool blob = own.at<uchar>(y, x) == 255;
+      bool near = false, reach = false;
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          const int qx = x + dx, qy = y + dy;
+          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+          if ((own.at<uchar>(qy, qx) == 255) == blob) continue;  // Same kind.
+          const int big = std::max(std::abs(dx), std::abs(dy));
+          const int small = std::min(std::abs(dx), std::abs(dy));
+          const int d = 3 * big + small;
+          near = near || d <= 6;
+          reach = reach || d <= 12;
+        }
+      }
+      zones.at<uchar>(y, x) = near ? kZoneNear : reach && !blob ? kZoneReach : kZoneFar;
+    }
+  }
+}
+
+void EdgeZones(const cv::Mat& own, cv::Mat& zones, cv::Mat& scratch) {
+  CV_Assert(own.type() == CV_8UC1 && zones.type() == CV_8UC1 && zones.size() == own.size());
+  const int w = own.cols, h = own.rows;
+  if (w == 0 || h == 0) return;
+#if CV_SIMD128
+  using namespace cv;
+  // Planes of the mask padded by kPad zero pixels all round (outside the mask nothing counts):
+  // `a` the blob (255), `b` the rest; a1..a4 the maximum of `a` over a row's x +- 1..4, b1, b2 of
+  // `b` over x +- 1, 2. Rows of the padded width rounded up to 16 plus 16 bytes of slack, so a
+  // chunk of 16 reading 4 columns either side stays inside its row.
+  constexpr int kPad = 4;
+  const int chunks = (w + 15) / 16;
+  const int stride = 16 * chunks + 2 * kPad + 16;
+  const int rows = h + 2 * kPad;
+  constexpr int kPlanes = 8;
+  const size_t plane = static_cast<size_t>(stride) * rows;
+  const size_t bytes = plane * kPlanes;
+  if (scratch.empty() || scratch.total() * scratch.elemSize() < bytes) {
+    scratch.create(1, static_cast<int>(bytes), CV_8U);
+  }
+  uchar* base = scratch.data;
+  uchar* a = base;
+  uchar* b = base + plane;
+  uchar* a1 = base + 2 * plane;
+  uchar* a2 = base + 3 * plane;
+  uchar* a3 = base + 4 * plane;
+  uchar* a4 = base + 5 * plane;
+  uchar* b1 = base + 6 * plane;
+  uchar* b2 = base + 7 * plane;
+  std::memset(a, 0, 2 * plane);
+  const v_uint8x16 k255 = v_setall_u8(255);
+  for (int y = 0; y < h; ++y) {
+    const uchar* in = own.ptr<uchar>(y);
+    uchar* ar = a + static_cast<size_t>(y + kPad) * stride + kPad;
+    uchar* br = b + static_cast<size_t>(y + kPad) * stride + kPad;
+    int x = 0;
+    for (; x + 16 <= w; x += 16) {
+      const v_uint8x16 blob = v_load(in + x) == k255;
+      v_store(ar + x, blob);
+      v_store(br + x, ~blob);
+    }
+    for (; x < w; ++x) {
+      ar[x] = in[x] == 255 ? 255 : 0;
+      br[x] = in[x] == 255 ? 0 : 255;
+    }
+  }
+  // Row maxima (every row: the padding rows give 0).
+  for (int r = 0; r < rows; ++r) {
+    const size_t o = static_cast<size_t>(r) * stride + kPad;
+    for (int c = 0; c < chunks; ++c) {
+      const size_t i = o + 16 * c;
+      const v_uint8x16 m1 = v_load(a + i - 1) | v_load(a + i) | v_load(a + i + 1);
+      const v_uint8x16 m2 = m1 | v_load(a + i - 2) | v_load(a + i + 2);
+      const v_uint8x16 m3 = m2 | v_load(a + i - 3) | v_load(a + i + 3);
+      const v_uint8x16 m4 = m3 | v_load(a + i - 4) | v_load(a + i + 4);
+      v_store(a1 + i, m1);
+      v_store(a2 + i, m2);
+      v_store(a3 + i, m3);
+      v_store(a4 + i, m4);
+      const v_uint8x16 n1 = v_load(b + i - 1) | v_load(b + i) | v_load(b + i + 1);
+      v_store(b1 + i, n1);
+      v_store(b2 + i, n1 | v_load(b + i - 2) | v_load(b + i + 2));
+    }
+  }
+  const v_uint8x16 near_v = v_setall_u8(kZoneNear), reach_v = v_setall_u8(kZoneReach),
+                   far_v = v_setall_u8(kZoneFar);
+  const ptrdiff_t s = stride;
+  for (int y = 0; y < h; ++y) {
+    uchar* out = zones.ptr<uchar>(y);
+    const size_t o = static_cast<size_t>(y + kPad) * stride + kPad;
+    for (int c = 0; c < chunks; ++c) {
+      const size_t i = o + 16 * c;
+      // Within 6 of a pixel of the kind: the 3x3 square, and two along the row or the column.
+      const v_uint8x16 a6 = v_load(a1 + i - s) | v_load(a1 + i) | v_load(a1 + i + s) |
+                            v_load(a2 + i) | v_load(a + i - 2 * s) | v_load(a + i + 2 * s);
+      const v_uint8x16 b6 = v_load(b1 + i - s) | v_load(b1 + i) | v_load(b1 + i + s) |
+                            v_load(b2 + i) | v_load(b + i - 2 * s) | v_load(b + i + 2 * s);
+      // Within 12 of the blob: the 7x7 square, and four along the row or the column.
+      const v_uint8x16 a12 = v_load(a3 + i - 3 * s) | v_load(a3 + i - 2 * s) |
+                             v_load(a3 + i - s) | v_load(a3 + i) | v_load(a3 + i + s) |
+                             v_load(a3 + i + 2 * s) | v_load(a3 + i + 3 * s) | v_load(a4 + i) |
+                             v_load(a + i - 4 * s) | v_load(a + i + 4 * s);
+      const v_uint8x16 blob = v_load(a + i);
+      const v_uint8x16 near = v_select(blob, b6, a6);
+      const v_uint8x16 zone = v_select(near, near_v, v_select(a12 & ~blob, reach_v, far_v));
+      if (16 * c + 16 <= w) {
+        v_store(out + 16 * c, zone);
+      } else {
+        uchar last[16];
+        v_store(last, zone);
+        std::memcpy(out + 16 * c, last, static_cast<size_t>(w - 16 * c));
+      }
+    }
+  }
+#else
+  (void)scratch;
+  EdgeZonesReference(own, zones);
+#endif
 }
 
 }  // namespace softsight

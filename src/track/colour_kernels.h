@@ -93,6 +93,23 @@ void MarkOutside(cv::Mat& mask, uchar outside, std::vector<cv::Point>& stack);
 // The reference: cv::floodFill, from a corner of the mask padded by a ring of 0.
 void MarkOutsideReference(cv::Mat& mask, uchar outside);
 
+// Where each pixel of a blob's own mask lies against the blob's edge, as the colour tracker's
+// measurement reads the chamfer (3-4) distance of ChamferToEdge (track/colour_tracker_parts.h):
+// only whether it is more than 6 (two pixels, kSoftBand) and, for a pixel outside the blob, at most
+// 12 (four pixels, kRingOuter). `own` (CV_8UC1) holds 255 for the blob and anything else (0, a
+// filled hole's 128) for the rest; `zones` (CV_8UC1, its size) gets a stand-in for the distance
+// that answers those questions as the chamfer distance d does: kZoneNear when d <= 6, kZoneReach
+// when 6 < d <= 12, kZoneFar when d > 12 (a blob pixel: kZoneNear or kZoneFar, as d > 6 or not).
+// The chamfer distance of a pixel is 3 max(|dx|, |dy|) + min(|dx|, |dy|) to the nearest pixel of
+// the other kind in the mask, so d <= 6 is a pixel of the other kind in the 3x3 square or two
+// pixels away along a row or column, and d <= 12 one in the 7x7 square or four away along a row
+// or column: dilations, 16 pixels at a time, where the chamfer map is a serial recurrence of ~40
+// instructions a pixel (issue 45). `scratch` is reused storage: no allocation once warm.
+constexpr uchar kZoneNear = 6, kZoneReach = 12, kZoneFar = 13;
+void EdgeZones(const cv::Mat& own, cv::Mat& zones, cv::Mat& scratch);
+// The reference: the definition above, pixel by pixel over the neighbourhoods.
+void EdgeZonesReference(const cv::Mat& own, cv::Mat& zones);
+
 // 8-connected components of a binary mask (nonzero = in) from its runs: rows are scanned 16
 // bytes at a time, so the cost is the mask's area / 16 plus its runs, where
 // cv::connectedComponentsWithStats visits every pixel (which dominated whole-frame searches of

@@ -2,9 +2,12 @@
 // test (vector kernel, scalar reference and OpenCV's cvtColor + inRange all agree), random masks
 // and strided views for the morphology.
 #include "track/colour_kernels.h"
+#include "track/chromaticity.h"
+#include "track/colour_tracker_parts.h"
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -90,6 +93,43 @@ TEST(ColourKernels, ScalarReferenceAndStridedViews) {
     ClassifyHsvOpenCv(view, box, reference);
     EXPECT_EQ(cv::countNonZero(fast != reference), 0) << r;
     EXPECT_EQ(cv::countNonZero(scalar != reference), 0) << r;
+  }
+}
+
+TEST(ColourKernels, GrayFramesHandedOverAsBgrAreClassifiedAsTheScalarReference) {
+  // A gray recording converted to BGR (b == g == r everywhere): whole chunks of 16 flat pixels
+  // take the vector path's flat shortcut; rows with a few coloured pixels take the full test.
+  // Every level, every box of the other tests' kinds, rows of several widths, views.
+  const HsvBox boxes[] = {
+      {{0, 179}, {0, 60}, {170, 255}},     // mire-2's white dots
+      {{0, 179}, {0, 40}, {200, 255}},     // white: any hue
+      {{0, 0}, {0, 0}, {0, 255}},          // hue 0 only, gray pixels
+      {{170, 10}, {0, 255}, {40, 200}},    // red, wrapping, saturation from 0
+      {{45, 85}, {80, 255}, {40, 255}},    // green: no gray pixel is in
+  };
+  cv::RNG rng(45);
+  cv::Mat levels(40, 300, CV_8U);
+  rng.fill(levels, cv::RNG::UNIFORM, 0, 256);
+  for (int x = 0; x < 256; ++x) levels.at<uchar>(0, x) = static_cast<uchar>(x);  // Every level.
+  cv::Mat gray;
+  cv::cvtColor(levels, gray, cv::COLOR_GRAY2BGR);
+  cv::Mat mixed = gray.clone();
+  for (int y = 1; y < mixed.rows; y += 3) mixed.at<cv::Vec3b>(y, (7 * y) % mixed.cols)[1] ^= 9;
+  for (const HsvBox& box : boxes) {
+    const HsvClassifier classifier(box);
+    for (const cv::Mat* image : {&gray, &mixed}) {
+      for (const cv::Rect& r : {cv::Rect(0, 0, 300, 40), cv::Rect(3, 5, 37, 11),
+                                cv::Rect(1, 1, 15, 3), cv::Rect(0, 0, 16, 40),
+                                cv::Rect(250, 2, 50, 30)}) {
+        const cv::Mat view = (*image)(r);
+        cv::Mat fast(view.size(), CV_8U), scalar(view.size(), CV_8U), reference;
+        classifier.Classify(view, fast);
+        classifier.ClassifyScalar(view, scalar);
+        ClassifyHsvOpenCv(view, box, reference);
+        EXPECT_EQ(cv::countNonZero(fast != scalar), 0) << Name(box) << " " << r;
+        EXPECT_EQ(cv::countNonZero(scalar != reference), 0) << Name(box) << " " << r;
+      }
+    }
   }
 }
 
@@ -186,6 +226,69 @@ TEST(ColourKernels, MarkOutsideIsAFloodFillFromTheBorder) {
     EXPECT_EQ(cv::countNonZero(mask != expected), 0) << size << " density " << density;
     EXPECT_EQ(cv::countNonZero(parent.row(0) != 7), 0) << "wrote outside the view";
   }
+}
+
+TEST(ColourKernels, EdgeZonesAnswerWhatTheChamferDistanceAnswers) {
+  // The measurement asks the chamfer distance d of each pixel (ChamferToEdge) d > 6 (every pixel)
+  // and d <= 12 (a pixel outside the blob); EdgeZones' stand-in must answer both as d does, and
+  // its vector path must be its reference, on masks of blobs, holes (128) and noise, in views.
+  cv::RNG rng(4545);
+  cv::Mat scratch;
+  for (int trial = 0; trial < 600; ++trial) {
+    const cv::Size size(1 + rng.uniform(0, 70), 1 + rng.uniform(0, 50));
+    cv::Mat parent(size.height + 2, size.width + 7, CV_8U, cv::Scalar(255));
+    cv::Mat own = parent(cv::Rect(3, 1, size.width, size.height));  // A strided view.
+    own.setTo(0);
+    if (trial % 3 == 0) {
+      cv::Mat noise(size, CV_32F);
+      rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::Mat(noise < 0.1 + 0.2 * (trial % 5)).copyTo(own);
+    } else {
+      const cv::Point centre(rng.uniform(0, size.width), rng.uniform(0, size.height));
+      const int radius = 1 + rng.uniform(0, std::max(1, std::min(size.width, size.height)));
+      cv::ellipse(own, centre, cv::Size(radius, 1 + rng.uniform(0, radius + 1)),
+                  rng.uniform(0.0, 180.0), 0, 360, cv::Scalar(255), cv::FILLED);
+    }
+    for (int k = rng.uniform(0, 4); k > 0; --k) {  // Holes, filled as FillHoles marks them.
+      own.at<uchar>(rng.uniform(0, size.height), rng.uniform(0, size.width)) = 128;
+    }
+    cv::Mat zones(size, CV_8U, cv::Scalar(99)), reference(size, CV_8U, cv::Scalar(77));
+    cv::Mat distance(size, CV_16U);
+    EdgeZones(own, zones, scratch);
+    EdgeZonesReference(own, reference);
+    colour_internal::ChamferToEdge(own, distance);
+    cv::Mat differ;
+    cv::findNonZero(zones != reference, differ);
+    ASSERT_TRUE(differ.empty()) << size << " trial " << trial << ": " << differ.total()
+                                << " pixels differ, the first at " << differ.at<cv::Point>(0)
+                                << " (" << int(zones.at<uchar>(differ.at<cv::Point>(0))) << " for "
+                                << int(reference.at<uchar>(differ.at<cv::Point>(0))) << ")";
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        const int d = distance.at<uint16_t>(y, x), z = zones.at<uchar>(y, x);
+        ASSERT_EQ(d > 6, z > 6) << size << " trial " << trial << " at " << x << "," << y;
+        ASSERT_EQ(d > 0, z > 0);
+        if (own.at<uchar>(y, x) != 255) {
+          ASSERT_EQ(d <= 12, z <= 12) << size << " trial " << trial << " at " << x << "," << y;
+        }
+      }
+    }
+    EXPECT_EQ(cv::countNonZero(parent.row(0) != 255), 0) << "wrote outside the view";
+  }
+}
+
+TEST(ColourKernels, ChromaticityOfLevelsIsChromaticityForEveryColour) {
+  int differ = 0;
+  for (int b = 0; b < 256; ++b) {
+    for (int g = 0; g < 256; ++g) {
+      for (int r = 0; r < 256; ++r) {
+        const cv::Vec3d table = ChromaticityOfLevels(b, g, r);
+        const cv::Vec3d divided = Chromaticity(b, g, r);
+        differ += std::memcmp(table.val, divided.val, sizeof(table.val)) != 0;
+      }
+    }
+  }
+  EXPECT_EQ(differ, 0);
 }
 
 TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {

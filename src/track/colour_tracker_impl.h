@@ -231,7 +231,7 @@ class ColourTracker : public Tracker {
 
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
-  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_;
+  cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
@@ -242,6 +242,7 @@ class ColourTracker : public Tracker {
   std::vector<cv::Point> hull_points_;  // Their convex hull.
   std::vector<cv::Point> outside_stack_;  // FillHoles's flood of the outside.
   std::vector<cv::Point2d> rim_points_;  // A partial blob's edge pixels, for its rim fit.
+  std::vector<double> rim_angles_;       // Scratch of FitRimOfRadius.
   std::vector<std::pair<double, cv::Point2d>> off_rim_;  // Scratch of OffRimBulgePx.
 };
 

@@ -177,7 +177,8 @@ inline double DiamondAngle(double dx, double dy) {
 // Chamfer (3-4) distance to the edge of the nonzero pixels of `inside`, in thirds of a pixel,
 // into `distance` (CV_16U, same size): for an outside pixel, to the nearest inside one; for an
 // inside pixel, to the nearest outside one (pixels beyond the image count as inside, as erosion
-// by OpenCV's default border does).
+// by OpenCV's default border does). The measurement no longer computes it: EdgeZones
+// (track/colour_kernels.h) answers the only questions it asked of it, and is tested against it.
 inline void ChamferToEdge(const cv::Mat& inside, cv::Mat& distance) {
   constexpr int kFar = 0x3fff;
   const int w = inside.cols, h = inside.rows;

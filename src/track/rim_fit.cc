@@ -17,7 +17,7 @@ int CountInliers(const std::vector<cv::Point2d>& pts, const cv::Point2d& c, doub
 }  // namespace
 
 std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, double radius_px,
-                                     double inlier_px) {
+                                     double inlier_px, std::vector<double>* scratch) {
   const size_t n = edge_px.size();
   if (n < 6 || !(radius_px > 0)) return std::nullopt;
   // Candidate centres: the two circles of the radius through pairs of points about a quarter of
@@ -69,7 +69,9 @@ std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, do
   }
   RimFit fit;
   fit.centre_px = c;
-  std::vector<double> angles;
+  std::vector<double> own_angles;
+  std::vector<double>& angles = scratch ? *scratch : own_angles;
+  angles.clear();
   double sum2 = 0;
   for (const cv::Point2d& p : edge_px) {
     const double residual = cv::norm(p - c) - radius_px;

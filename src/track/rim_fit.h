@@ -22,9 +22,11 @@ struct RimFit {
 
 // Fits a circle of radius `radius_px` to `edge_px` (the blob's edge pixels' centres). A point
 // within `inlier_px` of the circle is on the rim. Absent when no circle has at least 6 rim points.
-// Deterministic (candidate circles from pairs of points taken in a fixed order).
+// Deterministic (candidate circles from pairs of points taken in a fixed order). `scratch`, when
+// given, is reused storage for the rim points' angles (no allocation once warm).
 std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, double radius_px,
-                                     double inlier_px = 0.75);
+                                     double inlier_px = 0.75,
+                                     std::vector<double>* scratch = nullptr);
 
 // How far the edge that is not on the fitted circle bulges outwards (px) beyond the straight line
 // joining its two ends. A disc cut by a straight edge leaves a chord (0); a finger or a paddle

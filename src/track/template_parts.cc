@@ -300,7 +300,7 @@ bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out) {
   for (int y = 0; y < bgr.rows; ++y) {
     const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3d c = Chromaticity(row[x][0], row[x][1], row[x][2]);
+      const cv::Vec3d c = ChromaticityOfLevels(row[x][0], row[x][1], row[x][2]);
       if (std::abs(2 * x - (bgr.cols - 1)) <= 2 && std::abs(2 * y - (bgr.rows - 1)) <= 2) {
         centre += c;
         ++centre_n;
@@ -328,7 +328,7 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
     const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3d c = Chromaticity(row[x][0], row[x][1], row[x][2]);
+      const cv::Vec3d c = ChromaticityOfLevels(row[x][0], row[x][1], row[x][2]);
       o[x] = cv::saturate_cast<uint8_t>(40.0 + scale * (c - chroma.background).dot(chroma.axis));
     }
   }
