@@ -233,10 +233,8 @@ std::string PairName(const StereoPairReport& pair) {
   return pair.left_name + " + " + pair.right_name;
 }
 
-CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const ChessboardSpec& board,
-                                     std::ostream& report) {
-  ViewSequence left(*options.left, "--left", options.step);
-  ViewSequence right(*options.right, "--right", options.step);
+// The two sequences pair one to one, and no view is both cameras'; none is an output.
+void CheckStereoViews(const CalibrateOptions& options, ViewSequence& left, ViewSequence& right) {
   if (left.file_count() && right.file_count() && *left.file_count() != *right.file_count()) {
     throw InputError("--left has " + std::to_string(*left.file_count()) + " images but --right " +
                      std::to_string(*right.file_count()) +
@@ -256,33 +254,92 @@ CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const Ches
   }
   CheckOutputsAreNotInputs(
       {{"--out", options.out_file}, {"--picture", options.picture_file.value_or("")}}, inputs);
+}
 
-  StereoCalibrationOptions calibration;
-  calibration.camera.board = board;
-  calibration.camera.estimate_k3 = options.estimate_k3;
-  StereoCalibrator calibrator(calibration);
-  std::string left_name, right_name;
-  cv::Mat left_image, right_image, picture_left, picture_right;
-  std::string picture_pair;
+// What reading the pairs leaves besides the calibrator's corners: why the pairs ended early, and
+// the first used pair (for --picture).
+struct StereoPairsRead {
   std::optional<std::string> length_note;
+  cv::Mat picture_left, picture_right;
+  std::string picture_pair;
+};
+
+// Every pair to the calibrator, until either sequence ends.
+StereoPairsRead AddStereoPairs(const CalibrateOptions& options, ViewSequence& left,
+                               ViewSequence& right, StereoCalibrator& calibrator) {
+  std::string left_name, right_name;
+  cv::Mat left_image, right_image;
+  StereoPairsRead read;
   while (true) {
     const bool have_left = left.next(left_name, left_image);
     const bool have_right = right.next(right_name, right_image);
     if (!have_left || !have_right) {
       if (have_left || have_right) {
-        length_note = std::string(have_left ? "--right" : "--left") +
-                      " ended first: the other's views after " +
-                      (have_left ? left_name : right_name) + " have no partner and were not used";
+        read.length_note = std::string(have_left ? "--right" : "--left") +
+                           " ended first: the other's views after " +
+                           (have_left ? left_name : right_name) +
+                           " have no partner and were not used";
       }
       break;
     }
     const StereoPairStatus status = calibrator.add(left_name, left_image, right_name, right_image);
-    if (status == StereoPairStatus::kUsed && picture_left.empty() && options.picture_file) {
-      picture_left = left_image.clone();
-      picture_right = right_image.clone();
-      picture_pair = left_name + " + " + right_name;
+    if (status == StereoPairStatus::kUsed && read.picture_left.empty() && options.picture_file) {
+      read.picture_left = left_image.clone();
+      read.picture_right = right_image.clone();
+      read.picture_pair = left_name + " + " + right_name;
     }
   }
+  return read;
+}
+
+// Why a pair was left out of the calibration.
+std::string WhyLeftOut(const StereoPairReport& pair) {
+  switch (pair.status) {
+    case StereoPairStatus::kLeftOnly: return "board in the left view only";
+    case StereoPairStatus::kRightOnly: return "board in the right view only";
+    case StereoPairStatus::kNeither: return "board in neither view";
+    case StereoPairStatus::kOutlier: {
+      std::ostringstream text;
+      text << std::fixed << std::setprecision(3) << "does not fit the other pairs ("
+           << *pair.left_rms_px << " / " << *pair.right_rms_px
+           << " px: did the board move between the two pictures?)";
+      return text.str();
+    }
+    case StereoPairStatus::kUsed:
+      break;
+  }
+  return "";
+}
+
+// --picture: the first used pair rectified side by side.
+void WriteRectifiedPicture(const CalibrateOptions& options, const StereoCalibration& stereo,
+                           const StereoPairsRead& read, std::ostream& report) {
+  const cv::Mat picture = DrawRectifiedPair(stereo, read.picture_left, read.picture_right);
+  bool written = false;
+  try {
+    written = cv::imwrite(*options.picture_file, picture);
+  } catch (const cv::Exception&) {
+  }
+  if (!written) {
+    throw InputError(
+        "--picture " + *options.picture_file +
+        ": cannot write (use an image extension such as .png, in a writable folder)");
+  }
+  report << "wrote " << *options.picture_file << " (" << read.picture_pair
+         << " rectified: each point of the scene should lie on one line in both halves)\n";
+}
+
+CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const ChessboardSpec& board,
+                                     std::ostream& report) {
+  ViewSequence left(*options.left, "--left", options.step);
+  ViewSequence right(*options.right, "--right", options.step);
+  CheckStereoViews(options, left, right);
+
+  StereoCalibrationOptions calibration;
+  calibration.camera.board = board;
+  calibration.camera.estimate_k3 = options.estimate_k3;
+  StereoCalibrator calibrator(calibration);
+  const StereoPairsRead read = AddStereoPairs(options, left, right, calibrator);
   const StereoCalibrationResult result = calibrator.calibrate();
   SaveStereoCalibration(result, board, options.out_file);
 
@@ -296,7 +353,7 @@ CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const Ches
   for (const ViewSequence* views : {&left, &right}) {
     if (views->note()) report << *views->note() << "\n";
   }
-  if (length_note) report << *length_note << "\n";
+  if (read.length_note) report << *read.length_note << "\n";
   report << std::fixed << std::setprecision(2);
   report << "board " << options.chessboard << " (" << board.square_mm
          << " mm squares) in both views of " << summary.pairs_used << " of " << summary.pairs
@@ -309,22 +366,7 @@ CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const Ches
              << " px\n";
       continue;
     }
-    std::string why;
-    switch (pair.status) {
-      case StereoPairStatus::kLeftOnly: why = "board in the left view only"; break;
-      case StereoPairStatus::kRightOnly: why = "board in the right view only"; break;
-      case StereoPairStatus::kNeither: why = "board in neither view"; break;
-      case StereoPairStatus::kOutlier: {
-        std::ostringstream text;
-        text << std::fixed << std::setprecision(3) << "does not fit the other pairs ("
-             << *pair.left_rms_px << " / " << *pair.right_rms_px
-             << " px: did the board move between the two pictures?)";
-        why = text.str();
-        break;
-      }
-      case StereoPairStatus::kUsed: break;
-    }
-    report << "  " << PairName(pair) << ": left out, " << why << "\n";
+    report << "  " << PairName(pair) << ": left out, " << WhyLeftOut(pair) << "\n";
     summary.left_out.push_back(PairName(pair) + ": " + StereoPairStatusName(pair.status));
   }
   const StereoCalibration& s = result.stereo;
@@ -338,21 +380,7 @@ CalibrateSummary CalibrateStereoMode(const CalibrateOptions& options, const Ches
          << std::setprecision(3) << s.rms_px << " px"
          << (s.rms_px > 1.0 ? " (high: were the pairs taken at the same moment?)" : "") << "\n";
   report << "wrote " << options.out_file << "\n";
-  if (options.picture_file) {
-    const cv::Mat picture = DrawRectifiedPair(s, picture_left, picture_right);
-    bool written = false;
-    try {
-      written = cv::imwrite(*options.picture_file, picture);
-    } catch (const cv::Exception&) {
-    }
-    if (!written) {
-      throw InputError(
-          "--picture " + *options.picture_file +
-          ": cannot write (use an image extension such as .png, in a writable folder)");
-    }
-    report << "wrote " << *options.picture_file << " (" << picture_pair
-           << " rectified: each point of the scene should lie on one line in both halves)\n";
-  }
+  if (options.picture_file) WriteRectifiedPicture(options, s, read, report);
   report.unsetf(std::ios::floatfield);
   return summary;
 }

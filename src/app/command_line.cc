@@ -43,12 +43,8 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandSetup>& comma
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
-    // A mistyped option first: CLI11 reports a required option the typo left out before the
-    // word it did not know ("--config is required" for --confg).
-    if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
-      std::cerr << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
-      return kInputErrorExitCode;
+    if (const std::optional<int> answered = AnswerHelpOrUnknownWord(app, e, std::cerr)) {
+      return *answered;
     }
     // One line like every other error, naming the command it was for.
     const std::vector<CLI::App*> parsed = app.get_subcommands();

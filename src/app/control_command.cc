@@ -461,6 +461,224 @@ void StoppedBySignal(const StopRequest& stop, ControlSummary* summary) {
   summary->run.error.clear();
 }
 
+// One camera's frames, or (two cameras) the pairs opened; `frames` stays empty then.
+ControlFrames OpenFrames(const ControlOptions& options, const TrackingConfig& tracking_config,
+                         SimulatedRig* rig, double duration_s, const std::vector<PathRole>& outputs,
+                         const std::vector<PathRole>& inputs,
+                         std::optional<StereoControlFrames>& pairs) {
+  if (pairs) {
+    OpenStereoPairs(options, tracking_config, rig, duration_s, &*pairs);
+    return {};
+  }
+  return OpenControlFrames(options, tracking_config, rig, duration_s, outputs, inputs);
+}
+
+// The handshake; nothing when a signal stopped it.
+std::optional<BoardInfo> StartUnlessStopped(ControlSession& session) {
+  try {
+    return session.start();
+  } catch (const StopRequested&) {
+    return std::nullopt;
+  }
+}
+
+// With no camera, the capture settings of the options or the config are refused (named).
+void RefuseCaptureWithoutACamera(const ControlOptions& options,
+                                 const TrackingConfig& tracking_config) {
+  if (!options.camera && !(options.stereo && options.stereo->left_camera)) {
+    RefuseCaptureWithoutCamera(options.capture_args, tracking_config.capture, options.config_file,
+                               options.input        ? "the file " + *options.input
+                               : options.rig_frames ? "the rig's frames " + *options.rig_frames
+                                                    : std::string("the simulated rig"),
+                               std::cerr);
+  }
+}
+
+// The files and the socket this command writes.
+std::vector<PathRole> ControlOutputs(const ControlOptions& options) {
+  std::vector<PathRole> outputs{{"--csv", options.csv_file},
+                                {"--metrics-csv", options.metrics_csv_file}};
+  outputs.insert(outputs.end(), options.other_outputs.begin(), options.other_outputs.end());
+  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) outputs.push_back(*socket);
+  return outputs;
+}
+
+// The files this command reads (the stereo calibration's are added when it is opened).
+std::vector<PathRole> ControlInputs(const ControlOptions& options,
+                                    const TrackingConfig& tracking_config) {
+  std::vector<PathRole> inputs = ConfigInputs(tracking_config);
+  if (options.profile_file) inputs.push_back({"--profile", *options.profile_file});
+  if (options.input) inputs.push_back({"--input", *options.input});
+  if (options.rig_frames) inputs.push_back({"--rig-frames", *options.rig_frames});
+  return inputs;
+}
+
+// --target-from: subscribes and waits for the first target, which becomes the run's constant
+// target. False when a signal stopped the wait.
+bool FollowTargetStream(const ControlOptions& options, const ControlConfig& config,
+                        const StopRequest& stop, std::optional<TargetSubscriber>* target_source,
+                        std::optional<TargetFeed>* feed, ControlTarget* target) {
+  target_source->emplace(*options.target_from);
+  feed->emplace(*options.target_from, TargetFeedOptionsFor(config, options.allow_saturation));
+  const ReceivedTargets arrived =
+      (*target_source)->wait(options.target_wait_s, [&stop] { return stop.requested(); });
+  if (stop.requested()) return false;
+  target->profile = TargetProfile::Constant((*feed)->first(arrived, options.target_wait_s));
+  return true;
+}
+
+// The sinks of the run and what they own, in the order each frame reaches them.
+struct ControlSinks {
+  std::optional<CsvSink> csv;
+  std::unique_ptr<CommandHook> hook;  // --hook: after the controller, before the CSV.
+  // Two cameras: the same sinks over the pairs' rows (the stereo columns and the controller's).
+  std::optional<StereoControlSink> stereo_control;
+  std::optional<BasicCsvSink<FramePair, StereoFrameResult>> stereo_csv;
+  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> stereo_publish;
+  std::optional<StereoHookSink> stereo_hook;
+  std::optional<RigClockSink> rig_clock;
+  std::vector<FrameSink*> sinks;
+  std::vector<PairSink*> pair_sinks;  // In the same order.
+};
+
+// Two cameras: the hook, the stream and the CSV over the pairs' rows.
+void OpenStereoRowSinks(const ControlOptions& options, const StereoControlFrames& pairs,
+                        const ControlSink& control,
+                        const std::optional<IdentificationExperiment>& experiment,
+                        PublishSink* publish, bool write_csv, ControlSinks* out) {
+  // As for one camera: a camera's hook beside the loop, a rendered rig's in it.
+  out->hook = CommandHook::Open(
+      options.hook, pairs.input->is_live(),
+      StereoCsvColumns(control, experiment, options.identify, pairs).names(), std::cerr);
+  std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns;
+  if (out->hook) hook_columns = out->stereo_hook.emplace(out->hook->sink()).columns();
+  BasicCsvColumnTable<StereoFrameResult> columns = StereoCsvColumns(
+      control, experiment, options.identify, pairs, std::move(hook_columns));
+  if (publish) out->stereo_publish.emplace(*publish, columns, StereoMarkerSuffixes());
+  if (write_csv) out->stereo_csv.emplace(options.csv_file, std::move(columns));
+}
+
+// One camera: the hook, the stream and the CSV over the frames' rows.
+void OpenFrameRowSinks(const ControlOptions& options, const TrackingConfig& tracking_config,
+                       const ControlFrames& frames, ControlSink& control,
+                       const std::optional<IdentificationExperiment>& experiment,
+                       PublishSink* publish, bool write_csv, ControlSinks* out) {
+  std::vector<CsvColumn> extra =
+      ControlColumns<FrameResult>(control, experiment, options.identify,
+                                  frames.rendered ? &frames.rendered->truth() : nullptr);
+  // A camera's hook runs beside the loop (the board's watchdog waits for nobody); a rendered
+  // rig or a file's runs in it, every frame.
+  out->hook = CommandHook::Open(options.hook, frames.source->is_live(),
+                                TrackingColumns(tracking_config, extra), std::cerr);
+  if (out->hook) {
+    for (CsvColumn& column : out->hook->columns()) extra.push_back(std::move(column));
+  }
+  CsvColumnTable columns = TrackingColumns(tracking_config, extra);
+  columns.insert_before("latency_row_ms", control.latency_column());
+  if (publish) publish->set_columns(columns);
+  if (write_csv) out->csv.emplace(options.csv_file, std::move(columns));
+}
+
+// The hook, the stream and the CSV over the rows of the pairs or of the frames.
+void OpenRowSinks(const ControlOptions& options, const TrackingConfig& tracking_config,
+                  const ControlFrames& frames, const std::optional<StereoControlFrames>& pairs,
+                  ControlSink& control, const std::optional<IdentificationExperiment>& experiment,
+                  PublishSink* publish, ControlSinks* out) {
+  // Optional for an identification (`softsight identify` without --csv).
+  const bool write_csv = !options.csv_file.empty() || !options.identify;
+  if (pairs) {
+    OpenStereoRowSinks(options, *pairs, control, experiment, publish, write_csv, out);
+  } else {
+    OpenFrameRowSinks(options, tracking_config, frames, control, experiment, publish, write_csv,
+                      out);
+  }
+}
+
+// The order of the sinks: the rig's clock, the controller, the hook, the CSV, the stream.
+void OrderControlSinks(SimulatedRig* rig, bool rendered, ControlSink& control,
+                       PublishSink* publish, std::optional<StereoControlFrames>& pairs,
+                       ControlSinks* out) {
+  if (rig && !rendered) out->sinks.push_back(&out->rig_clock.emplace(*rig));
+  // Before the CSV and the stream: their columns read this frame's step.
+  out->sinks.push_back(&control);
+  // The hook sees the step too; before the columns it fills.
+  if (out->hook) out->sinks.push_back(&out->hook->sink());
+  if (out->csv) out->sinks.push_back(&*out->csv);
+  if (publish) out->sinks.push_back(publish);
+  if (pairs) {
+    out->pair_sinks.push_back(&out->stereo_control.emplace(control, pairs->angle));
+    if (out->stereo_hook) out->pair_sinks.push_back(&*out->stereo_hook);
+    if (out->stereo_csv) out->pair_sinks.push_back(&*out->stereo_csv);
+    if (out->stereo_publish) out->pair_sinks.push_back(&*out->stereo_publish);
+  }
+}
+
+// The controller's summary with what the stream and the target's source add to its notes.
+void CollectRunSummary(const ControlSink& control, const BoardLink& link,
+                       const ControlSession& session,
+                       const std::optional<std::string>& limited_to_reach,
+                       std::optional<TargetFeed>& feed, PublishSink* publish,
+                       ControlSummary* summary) {
+  CollectControlSummary(control, link, session, limited_to_reach, summary);
+  if (feed) {
+    for (std::string& note : feed->notes()) summary->notes.push_back(std::move(note));
+  }
+  if (publish) {
+    RunSummary published;
+    publish->report(published);
+    for (std::string& note : published.notes) summary->notes.push_back(std::move(note));
+  }
+}
+
+// The loop stops when the user or the controller (its duration) says so; why, in the summary's
+// words: the stream's end record says the same.
+RunOptions ControlRunOptions(const StopRequest& stop, const ControlSink& control, bool rendered) {
+  RunOptions run;
+  run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
+  run.check_key_frame_groups = false;  // The loop acts on each frame as it comes.
+  run.describe_stop = [&stop, &control, rendered](StopReason reason) -> std::string {
+    switch (reason) {
+      case StopReason::kEndOfInput:
+        return rendered ? "duration reached" : "end of input";
+      case StopReason::kMaxFrames:
+      case StopReason::kStopRequested:
+        if (control.done()) return "duration reached";
+        return stop.signal() != 0 ? StopSignalReason(stop.signal()) : std::string();
+      case StopReason::kError:
+        return "";
+    }
+    return "";
+  };
+  return run;
+}
+
+// After a loop that returned: an identification the frames cut short, the run's error, the
+// vent, the model identified and the step metrics.
+void FinishControlRun(const ControlOptions& options, const ControlConfig& config,
+                      const StopRequest& stop, ControlSession& session,
+                      const std::optional<IdentificationExperiment>& experiment,
+                      ControlSummary* summary) {
+  const RunSummary& ran = summary->run;
+  if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
+    session.stop();
+    if (stop.requested()) {  // Not a failure: the caller says which signal and exits 130/143.
+      StoppedBySignal(stop, summary);
+      return;
+    }
+    throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
+                        ShortNumber(summary->duration_s) + " s); vented");
+  }
+  // The run's stop_detail already says why in the loop's words (describe_stop: the end of the
+  // input, the duration reached, the signal).
+  // The session's destructor sends STOP on the way out.
+  if (ran.stop_reason == StopReason::kError) throw InputError(ran.error);
+  session.stop();  // Vent at the end of the run.
+  if (experiment) summary->identified = IdentifiedFrom(*experiment, config, options);
+  if (!options.metrics_csv_file.empty()) {
+    WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary->steps));
+  }
+}
+
 }  // namespace
 
 // The wiring: checks, the board (a device, or the simulated rig behind a real pseudo-terminal),
@@ -472,22 +690,10 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
 
   ControlTarget target = CheckedTarget(options);
   const TrackingConfig tracking_config = LoadTrackingConfig(options.config_file);
-  if (!options.camera && !(options.stereo && options.stereo->left_camera)) {
-    RefuseCaptureWithoutCamera(options.capture_args, tracking_config.capture, options.config_file,
-                               options.input        ? "the file " + *options.input
-                               : options.rig_frames ? "the rig's frames " + *options.rig_frames
-                                                    : std::string("the simulated rig"),
-                               std::cerr);
-  }
+  RefuseCaptureWithoutACamera(options, tracking_config);
   // Before the board is opened: no output may be an input or another output of this command.
-  std::vector<PathRole> outputs{{"--csv", options.csv_file},
-                                {"--metrics-csv", options.metrics_csv_file}};
-  outputs.insert(outputs.end(), options.other_outputs.begin(), options.other_outputs.end());
-  if (const std::optional<PathRole> socket = PublishOutput(options.publish)) outputs.push_back(*socket);
-  std::vector<PathRole> inputs = ConfigInputs(tracking_config);
-  if (options.profile_file) inputs.push_back({"--profile", *options.profile_file});
-  if (options.input) inputs.push_back({"--input", *options.input});
-  if (options.rig_frames) inputs.push_back({"--rig-frames", *options.rig_frames});
+  const std::vector<PathRole> outputs = ControlOutputs(options);
+  std::vector<PathRole> inputs = ControlInputs(options, tracking_config);
   // Two cameras: the calibration and both views' markers, checked before the port is opened.
   std::optional<StereoControlFrames> pairs;
   if (options.stereo) pairs = OpenStereoSession(options, tracking_config, &inputs);
@@ -501,24 +707,15 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   const StopRequest stop;
   std::optional<TargetSubscriber> target_source;
   std::optional<TargetFeed> feed;
-  if (options.target_from) {
-    target_source.emplace(*options.target_from);
-    feed.emplace(*options.target_from, TargetFeedOptionsFor(config, options.allow_saturation));
-    const ReceivedTargets arrived =
-        target_source->wait(options.target_wait_s, [&stop] { return stop.requested(); });
-    if (stop.requested()) {
-      StoppedBySignal(stop, &summary);
-      return summary;
-    }
-    target.profile = TargetProfile::Constant(feed->first(arrived, options.target_wait_s));
+  if (options.target_from &&
+      !FollowTargetStream(options, config, stop, &target_source, &feed, &target)) {
+    StoppedBySignal(stop, &summary);
+    return summary;
   }
 
-  std::unique_ptr<SimulatedRig> rig;
-  std::unique_ptr<RigServer> rig_server;
-  if (options.simulate) {
-    rig = std::make_unique<SimulatedRig>(config.rig);
-    rig_server = std::make_unique<RigServer>(*rig);
-  }
+  const std::unique_ptr<SimulatedRig> rig =
+      options.simulate ? std::make_unique<SimulatedRig>(config.rig) : nullptr;
+  const std::unique_ptr<RigServer> rig_server = rig ? std::make_unique<RigServer>(*rig) : nullptr;
   std::unique_ptr<Transport> transport =
       OpenSerialTransport(rig_server ? rig_server->port() : *options.port, config.link.baud);
   LinkEnvironment environment;
@@ -536,12 +733,8 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   }
   // One camera (a FrameSource through a TrackingSession), or two (pairs through a
   // StereoSession): either way the controller is handed one angle per frame.
-  ControlFrames frames;
-  if (pairs) {
-    OpenStereoPairs(options, tracking_config, rig.get(), duration_s, &*pairs);
-  } else {
-    frames = OpenControlFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs);
-  }
+  const ControlFrames frames =
+      OpenFrames(options, tracking_config, rig.get(), duration_s, outputs, inputs, pairs);
   const bool rendered = frames.rendered != nullptr || (pairs && pairs->rendered != nullptr);
 
   std::optional<TrackingSession> tracking;  // One camera's (two: the pairs' StereoSession).
@@ -549,137 +742,41 @@ ControlSummary RunControl(const ControlOptions& options, ControlSummary* summary
   ControlSink control(session, link, duration_s,
                       /*stop_at_duration=*/!rendered || options.identify);
   std::optional<IdentificationExperiment> experiment;  // Made once the board's limit is known.
-  // Optional for an identification (`softsight identify` without --csv).
-  const bool write_csv = !options.csv_file.empty() || !options.identify;
-  std::optional<CsvSink> csv;
-  std::unique_ptr<CommandHook> hook;  // --hook: after the controller, before the CSV.
-  // Two cameras: the same sinks over the pairs' rows (the stereo columns and the controller's).
-  std::optional<StereoControlSink> stereo_control;
-  std::optional<BasicCsvSink<FramePair, StereoFrameResult>> stereo_csv;
-  std::optional<PublishRowsSink<FramePair, StereoFrameResult>> stereo_publish;
-  std::optional<StereoHookSink> stereo_hook;
-  if (pairs) {
-    // As for one camera: a camera's hook beside the loop, a rendered rig's in it.
-    hook = CommandHook::Open(options.hook, pairs->input->is_live(),
-                             StereoCsvColumns(control, experiment, options.identify, *pairs).names(),
-                             std::cerr);
-    std::vector<BasicCsvColumn<StereoFrameResult>> hook_columns;
-    if (hook) hook_columns = stereo_hook.emplace(hook->sink()).columns();
-    BasicCsvColumnTable<StereoFrameResult> columns = StereoCsvColumns(
-        control, experiment, options.identify, *pairs, std::move(hook_columns));
-    if (publish) stereo_publish.emplace(*publish, columns, StereoMarkerSuffixes());
-    if (write_csv) stereo_csv.emplace(options.csv_file, std::move(columns));
-  } else {
-    std::vector<CsvColumn> extra =
-        ControlColumns<FrameResult>(control, experiment, options.identify,
-                                    frames.rendered ? &frames.rendered->truth() : nullptr);
-    // A camera's hook runs beside the loop (the board's watchdog waits for nobody); a rendered
-    // rig or a file's runs in it, every frame.
-    hook = CommandHook::Open(options.hook, frames.source->is_live(),
-                             TrackingColumns(tracking_config, extra), std::cerr);
-    if (hook) {
-      for (CsvColumn& column : hook->columns()) extra.push_back(std::move(column));
-    }
-    CsvColumnTable columns = TrackingColumns(tracking_config, extra);
-    columns.insert_before("latency_row_ms", control.latency_column());
-    if (publish) publish->set_columns(columns);
-    if (write_csv) csv.emplace(options.csv_file, std::move(columns));
-  }
+  ControlSinks sinks;
+  OpenRowSinks(options, tracking_config, frames, pairs, control, experiment, publish.get(), &sinks);
   if (feed) control.follow(&*target_source, &*feed);
-  std::optional<RigClockSink> rig_clock;
-  std::vector<FrameSink*> sinks;
-  if (rig && !rendered) sinks.push_back(&rig_clock.emplace(*rig));
-  sinks.push_back(&control);  // Before the CSV and the stream: their columns read this frame's step.
-  if (hook) sinks.push_back(&hook->sink());  // Sees the step too; before the columns it fills.
-  if (csv) sinks.push_back(&*csv);
-  if (publish) sinks.push_back(publish.get());
-  std::vector<PairSink*> pair_sinks;  // In the same order.
-  if (pairs) {
-    pair_sinks.push_back(&stereo_control.emplace(control, pairs->angle));
-    if (stereo_hook) pair_sinks.push_back(&*stereo_hook);
-    if (stereo_csv) pair_sinks.push_back(&*stereo_csv);
-    if (stereo_publish) pair_sinks.push_back(&*stereo_publish);
-  }
-  // What the stream and the target's source add to the summary's notes.
-  const auto add_notes = [&] {
-    if (feed) {
-      for (std::string& note : feed->notes()) summary.notes.push_back(std::move(note));
-    }
-    if (publish) {
-      RunSummary published;
-      publish->report(published);
-      for (std::string& note : published.notes) summary.notes.push_back(std::move(note));
-    }
-  };
+  OrderControlSinks(rig.get(), rendered, control, publish.get(), pairs, &sinks);
 
-  BoardInfo info;
-  try {
-    info = session.start();
-  } catch (const StopRequested&) {
+  const std::optional<BoardInfo> info = StartUnlessStopped(session);
+  if (!info) {
     StoppedBySignal(stop, &summary);
     return summary;
   }
-  CheckFrameRateAgainstWatchdog(pairs ? pairs->fps : frames.source->fps(), info);
-  if (options.identify) StartIdentification(options, session, info, &experiment, &control);
-  AnnounceRun(options, *transport, info, session, config.inner_loop);
+  CheckFrameRateAgainstWatchdog(pairs ? pairs->fps : frames.source->fps(), *info);
+  if (options.identify) StartIdentification(options, session, *info, &experiment, &control);
+  AnnounceRun(options, *transport, *info, session, config.inner_loop);
 
-  RunOptions run;
-  run.stop_requested = [&stop, &control] { return stop.requested() || control.done(); };
-  run.check_key_frame_groups = false;  // The loop acts on each frame as it comes.
-  // Why the loop stopped, in the summary's words; the stream's end record says the same.
-  run.describe_stop = [&](StopReason reason) -> std::string {
-    switch (reason) {
-      case StopReason::kEndOfInput:
-        return rendered ? "duration reached" : "end of input";
-      case StopReason::kMaxFrames:
-      case StopReason::kStopRequested:
-        if (control.done()) return "duration reached";
-        return stop.signal() != 0 ? StopSignalReason(stop.signal()) : std::string();
-      case StopReason::kError:
-        return "";
-    }
-    return "";
-  };
+  const RunOptions run = ControlRunOptions(stop, control, rendered);
   try {
-    summary.run = pairs ? RunPipeline(*pairs->input, *pairs->session, pair_sinks, run)
-                        : RunPipeline(*frames.source, *tracking, sinks, run);
+    summary.run = pairs ? RunPipeline(*pairs->input, *pairs->session, sinks.pair_sinks, run)
+                        : RunPipeline(*frames.source, *tracking, sinks.sinks, run);
   } catch (const StopRequested&) {
     // Ctrl-C while waiting for the board: the row of that frame is not written (no answer).
-    CollectControlSummary(control, link, session, limited_to_reach, &summary);
-    add_notes();
+    CollectRunSummary(control, link, session, limited_to_reach, feed, publish.get(), &summary);
     StoppedBySignal(stop, &summary);
     session.stop();
     return summary;
   } catch (const std::exception& e) {
     // The session's destructor sends STOP on the way out.
-    CollectControlSummary(control, link, session, limited_to_reach, &summary);
-    add_notes();
+    CollectRunSummary(control, link, session, limited_to_reach, feed, publish.get(), &summary);
     summary.run.stop_reason = StopReason::kError;
     if (summary.run.error.empty()) summary.run.error = e.what();
     throw;
   }
   const RunSummary ran = summary.run;
-  CollectControlSummary(control, link, session, limited_to_reach, &summary);
-  add_notes();
+  CollectRunSummary(control, link, session, limited_to_reach, feed, publish.get(), &summary);
   summary.run = ran;
-  if (experiment && !experiment->done() && ran.stop_reason != StopReason::kError) {
-    session.stop();
-    if (stop.requested()) {  // Not a failure: the caller says which signal and exits 130/143.
-      StoppedBySignal(stop, &summary);
-      return summary;
-    }
-    throw IdentifyAbort("identify: the experiment did not finish (the frames ran out at " +
-                        ShortNumber(summary.duration_s) + " s); vented");
-  }
-  // The run's stop_detail already says why in the loop's words (describe_stop: the end of the
-  // input, the duration reached, the signal).
-  // The session's destructor sends STOP on the way out.
-  if (ran.stop_reason == StopReason::kError) throw InputError(ran.error);
-  session.stop();  // Vent at the end of the run.
-  if (experiment) summary.identified = IdentifiedFrom(*experiment, config, options);
-  if (!options.metrics_csv_file.empty()) {
-    WriteWholeFileOrThrow(options.metrics_csv_file, StepMetricsCsv(summary.steps));
-  }
+  FinishControlRun(options, config, stop, session, experiment, &summary);
   return summary;
 }
 

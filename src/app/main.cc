@@ -81,10 +81,8 @@ int RunWithoutCommand(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version.
-    if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
-      std::cerr << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
-      return kInputErrorExitCode;
+    if (const std::optional<int> answered = AnswerHelpOrUnknownWord(app, e, std::cerr)) {
+      return *answered;
     }
     std::cerr << "softsight: error: " << EscapeForMessage(e.what()) << " (see softsight --help)\n";
     return kInputErrorExitCode;

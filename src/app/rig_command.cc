@@ -42,9 +42,8 @@ void WriteAtomically(const std::string& file, const cv::Mat& image) {
   }
 }
 
-}  // namespace
-
-RigCommandSummary RunRig(const RigCommandOptions& options) {
+// The options' numbers in their ranges; the picture written must not replace the config.
+void CheckRigOptions(const RigCommandOptions& options) {
   if (!options.pty) throw InputError("rig: give --pty (the rig serves on a pseudo-terminal)");
   // Tests for the good range: every comparison with NaN is false.
   if (!(options.fps > 0.0 && options.fps <= 240.0)) {
@@ -68,26 +67,58 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
     CheckOutputsAreNotInputs({{"--frames", *options.frames_file}},
                              {{"--config", options.config_file.value_or("")}});
   }
+}
+
+// --frames: the rig's camera, a rendered scene, and its first frame written before anyone
+// connects.
+std::unique_ptr<SyntheticScene> OpenRigCamera(const RigCommandOptions& options,
+                                              const SimulatedRig& rig, cv::Mat& image) {
+  SceneOptions scene_options;
+  scene_options.fps = options.fps;
+  RenderOptions render;
+  render.supersample = options.supersample;
+  // A camera's sensor noise: every frame is a new picture, as from a real camera, so a reader
+  // can tell a frame the rig wrote from the last one read again (control: a stalled relay).
+  NoiseOptions noise;
+  noise.sigma = kRigCameraNoise;
+  auto scene = std::make_unique<SyntheticScene>(scene_options, noise, render);
+  const RigSnapshot s = rig.snapshot();
+  scene->render_at_bend(s.bend_deg, s.time_s, 0, image);
+  WriteAtomically(*options.frames_file, image);  // A first frame before anyone connects.
+  return scene;
+}
+
+// --disconnect-after-s, --disconnect-after-replies: the port closes once either is due.
+void PullCableWhenDue(const RigCommandOptions& options, const RigSnapshot& s, RigServer& server,
+                      std::optional<std::chrono::steady_clock::time_point>& first_contact) {
+  // The cable is pulled that long after the host's first command, however late it started.
+  if (!first_contact && server.contacted()) first_contact = std::chrono::steady_clock::now();
+  const bool pull_by_time =
+      options.disconnect_after_s && first_contact &&
+      std::chrono::steady_clock::now() - *first_contact >=
+          std::chrono::duration<double>(*options.disconnect_after_s);
+  const bool pull_by_count =
+      options.disconnect_after_replies && server.past_reply_limit();
+  if (server.connected() && (pull_by_time || pull_by_count)) {
+    server.disconnect();
+    if (!options.quiet) {
+      std::fprintf(stderr, "rig: t=%.3f s: port closed (cable pulled), rig keeps running\n",
+                   s.time_s);
+    }
+  }
+}
+
+}  // namespace
+
+RigCommandSummary RunRig(const RigCommandOptions& options) {
+  CheckRigOptions(options);
   const ControlConfig config =
       options.config_file ? LoadControlConfig(*options.config_file) : ControlConfig{};
   SimulatedRig rig(config.rig);
   RigServer server(rig, /*realtime=*/true);
-  std::unique_ptr<SyntheticScene> scene;
   cv::Mat image;
-  if (options.frames_file) {
-    SceneOptions scene_options;
-    scene_options.fps = options.fps;
-    RenderOptions render;
-    render.supersample = options.supersample;
-    // A camera's sensor noise: every frame is a new picture, as from a real camera, so a reader
-    // can tell a frame the rig wrote from the last one read again (control: a stalled relay).
-    NoiseOptions noise;
-    noise.sigma = kRigCameraNoise;
-    scene = std::make_unique<SyntheticScene>(scene_options, noise, render);
-    const RigSnapshot s = rig.snapshot();
-    scene->render_at_bend(s.bend_deg, s.time_s, 0, image);
-    WriteAtomically(*options.frames_file, image);  // A first frame before anyone connects.
-  }
+  const std::unique_ptr<SyntheticScene> scene =
+      options.frames_file ? OpenRigCamera(options, rig, image) : nullptr;
   if (options.disconnect_after_replies) {
     server.set_reply_limit(static_cast<uint64_t>(*options.disconnect_after_replies));
   }
@@ -118,21 +149,7 @@ RigCommandSummary RunRig(const RigCommandOptions& options) {
       }
       last_mode = s.mode;
       last_limit = limit;
-      // The cable is pulled that long after the host's first command, however late it started.
-      if (!first_contact && server.contacted()) first_contact = std::chrono::steady_clock::now();
-      const bool pull_by_time =
-          options.disconnect_after_s && first_contact &&
-          std::chrono::steady_clock::now() - *first_contact >=
-              std::chrono::duration<double>(*options.disconnect_after_s);
-      const bool pull_by_count =
-          options.disconnect_after_replies && server.past_reply_limit();
-      if (server.connected() && (pull_by_time || pull_by_count)) {
-        server.disconnect();
-        if (!options.quiet) {
-          std::fprintf(stderr, "rig: t=%.3f s: port closed (cable pulled), rig keeps running\n",
-                       s.time_s);
-        }
-      }
+      PullCableWhenDue(options, s, server, first_contact);
       if (scene && std::chrono::steady_clock::now() >= next_frame) {
         next_frame += frame_period;
         scene->render_at_bend(s.bend_deg, s.time_s, frame_index++, image);

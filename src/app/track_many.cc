@@ -117,6 +117,113 @@ std::string LastLine(const std::string& text) {
   return last;
 }
 
+// The options a run over an output folder cannot take (they write one file or read a camera).
+void RefuseSingleRunOptions(const TrackManyOptions& options) {
+  const TrackOptions& common = options.common;
+  if (options.inputs.empty()) throw InputError("track: no input given (--input)");
+  if (options.jobs < 1) throw InputError("--jobs " + std::to_string(options.jobs) + ": must be 1 or more");
+  if (common.annotated_file || common.record_file) {
+    throw InputError(std::string(common.annotated_file ? "--annotated" : "--record") +
+                     ": with an output folder, give one input and a CSV file (-o run.csv) to "
+                     "also write videos");
+  }
+  if (common.publish) {
+    throw InputError("--publish " + common.publish->endpoint +
+                     ": with an output folder, give one input and a CSV file (-o run.csv) to "
+                     "also publish its results");
+  }
+  if (common.source.camera) {
+    throw InputError("--camera: with an output folder, give --input files (a camera run writes "
+                     "one CSV: -o bench.csv)");
+  }
+}
+
+// The output folder made, and every input's CSV in it, none of them an input.
+std::vector<std::string> PrepareOutputFolder(const TrackManyOptions& options,
+                                             const TrackingConfig& config) {
+  if (fs::exists(options.out_dir) && !fs::is_directory(options.out_dir)) {
+    throw InputError(options.out_dir + ": the output folder is a file");
+  }
+  std::error_code made;
+  fs::create_directories(options.out_dir, made);
+  if (made) throw InputError(options.out_dir + ": cannot create the output folder (" + made.message() + ")");
+  const std::vector<std::string> csvs = CsvNamesForInputs(options.inputs, options.out_dir);
+  std::vector<PathRole> outputs, inputs;
+  for (size_t i = 0; i < csvs.size(); ++i) {
+    outputs.push_back({"the CSV of --input " + options.inputs[i], csvs[i]});
+  }
+  for (const PathRole& file : ConfigInputs(config)) inputs.push_back(file);
+  for (const std::string& input : options.inputs) {
+    // A folder's images are checked by its own run; here every input as given.
+    if (!fs::is_directory(input)) inputs.push_back({"--input", input});
+  }
+  CheckOutputsAreNotInputs(outputs, inputs);
+  return csvs;
+}
+
+// What the children did, counted as each ends.
+struct ChildTally {
+  size_t done = 0, stopped = 0;
+  int64_t frames = 0;
+  int exit_code = 0;  // The first failed child's.
+  std::vector<std::string> failed;
+};
+
+// A child's output ended: it is waited for, counted, and its line reported.
+void FinishChild(const TrackManyOptions& options, const std::vector<std::string>& csvs,
+                 const std::string& of_total, Child& child, ChildTally* tally,
+                 std::ostream& report) {
+  const TrackOptions& common = options.common;
+  close(child.output_fd);
+  int status = 0;
+  while (waitpid(child.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  const std::string& input = options.inputs[child.input];
+  const std::string line = LastLine(child.output);
+  const std::string lead = "track: [" + std::to_string(child.input + 1) + of_total + input;
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  if (WIFEXITED(status) && (code == 0 || code == 128 + SIGINT || code == 128 + SIGTERM) &&
+      line.find(": error:") == std::string::npos) {
+    tally->frames += std::strtoll(line.c_str(), nullptr, 10);  // "300 frames (end of input), ..."
+    if (code == 0) {
+      ++tally->done;
+    } else {
+      ++tally->stopped;
+    }
+    if (!common.quiet) report << lead << " -> " << csvs[child.input] << ": " << line << "\n";
+  } else {
+    tally->failed.push_back(input);
+    if (tally->exit_code == 0) tally->exit_code = code;
+    report << lead << ": "
+           << (WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
+                                   : line.empty() ? "failed, exit code " + std::to_string(code)
+                                                  : line)
+           << "\n";
+  }
+}
+
+// The closing line: the inputs done, stopped, failed and not started, and the frame rate.
+void ReportTally(const TrackManyOptions& options, const ChildTally& tally, size_t next,
+                 double wall_s, std::ostream& report) {
+  const size_t total = options.inputs.size();
+  char rate[96];
+  std::snprintf(rate, sizeof(rate), "%lld frames in %.2f s (%.0f frames/s)",
+                static_cast<long long>(tally.frames), wall_s,
+                wall_s > 0 ? tally.frames / wall_s : 0.0);
+  report << "track: " << total << " inputs, --jobs " << options.jobs << ": " << tally.done
+         << " done";
+  if (tally.stopped > 0) report << ", " << tally.stopped << " stopped";
+  if (!tally.failed.empty()) {
+    report << ", " << tally.failed.size() << " failed (";
+    for (size_t i = 0; i < tally.failed.size(); ++i) {
+      report << (i == 0 ? "" : ", ") << tally.failed[i];
+    }
+    report << ")";
+  }
+  if (next < total) report << ", " << total - next << " not started (stop requested)";
+  report << "; " << rate << "\n";
+}
+
 }  // namespace
 
 std::vector<std::string> CsvNamesForInputs(const std::vector<std::string>& inputs,
@@ -136,50 +243,17 @@ std::vector<std::string> CsvNamesForInputs(const std::vector<std::string>& input
 int RunTrackMany(const TrackManyOptions& options, std::ostream& report) {
   const auto start = std::chrono::steady_clock::now();
   const TrackOptions& common = options.common;
-  if (options.inputs.empty()) throw InputError("track: no input given (--input)");
-  if (options.jobs < 1) throw InputError("--jobs " + std::to_string(options.jobs) + ": must be 1 or more");
-  if (common.annotated_file || common.record_file) {
-    throw InputError(std::string(common.annotated_file ? "--annotated" : "--record") +
-                     ": with an output folder, give one input and a CSV file (-o run.csv) to "
-                     "also write videos");
-  }
-  if (common.publish) {
-    throw InputError("--publish " + common.publish->endpoint +
-                     ": with an output folder, give one input and a CSV file (-o run.csv) to "
-                     "also publish its results");
-  }
-  if (common.source.camera) {
-    throw InputError("--camera: with an output folder, give --input files (a camera run writes "
-                     "one CSV: -o bench.csv)");
-  }
+  RefuseSingleRunOptions(options);
   // What concerns every input fails once, before any child starts.
   const TrackingConfig config = LoadTrackConfig(common);
-  if (fs::exists(options.out_dir) && !fs::is_directory(options.out_dir)) {
-    throw InputError(options.out_dir + ": the output folder is a file");
-  }
-  std::error_code made;
-  fs::create_directories(options.out_dir, made);
-  if (made) throw InputError(options.out_dir + ": cannot create the output folder (" + made.message() + ")");
-  const std::vector<std::string> csvs = CsvNamesForInputs(options.inputs, options.out_dir);
-  std::vector<PathRole> outputs, inputs;
-  for (size_t i = 0; i < csvs.size(); ++i) {
-    outputs.push_back({"the CSV of --input " + options.inputs[i], csvs[i]});
-  }
-  for (const PathRole& file : ConfigInputs(config)) inputs.push_back(file);
-  for (const std::string& input : options.inputs) {
-    // A folder's images are checked by its own run; here every input as given.
-    if (!fs::is_directory(input)) inputs.push_back({"--input", input});
-  }
-  CheckOutputsAreNotInputs(outputs, inputs);
+  const std::vector<std::string> csvs = PrepareOutputFolder(options, config);
 
   const size_t total = options.inputs.size();
   const StopRequest stop;  // Ctrl-C reaches the children too (same process group): they stop.
   bool forwarded = false;
   std::vector<Child> running;
-  size_t next = 0, done = 0, stopped = 0;
-  int64_t frames = 0;
-  int exit_code = 0;
-  std::vector<std::string> failed;
+  size_t next = 0;
+  ChildTally tally;
   const std::string of_total = "/" + std::to_string(total) + "] ";
   while (next < total || !running.empty()) {
     while (!stop.requested() && next < total && running.size() < static_cast<size_t>(options.jobs)) {
@@ -208,54 +282,16 @@ int RunTrackMany(const TrackManyOptions& options, std::ostream& report) {
       }
       if (got < 0 && errno == EINTR) continue;
       // End of its output: the child has exited (or is about to).
-      close(child.output_fd);
-      int status = 0;
-      while (waitpid(child.pid, &status, 0) < 0 && errno == EINTR) {
-      }
-      const std::string& input = options.inputs[child.input];
-      const std::string line = LastLine(child.output);
-      const std::string lead = "track: [" + std::to_string(child.input + 1) + of_total + input;
-      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      if (WIFEXITED(status) && (code == 0 || code == 128 + SIGINT || code == 128 + SIGTERM) &&
-          line.find(": error:") == std::string::npos) {
-        frames += std::strtoll(line.c_str(), nullptr, 10);  // "300 frames (end of input), ..."
-        if (code == 0) {
-          ++done;
-        } else {
-          ++stopped;
-        }
-        if (!common.quiet) report << lead << " -> " << csvs[child.input] << ": " << line << "\n";
-      } else {
-        failed.push_back(input);
-        if (exit_code == 0) exit_code = code;
-        report << lead << ": "
-               << (WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
-                                       : line.empty() ? "failed, exit code " + std::to_string(code)
-                                                      : line)
-               << "\n";
-      }
+      FinishChild(options, csvs, of_total, child, &tally, report);
       report.flush();
       running.erase(running.begin() + static_cast<std::ptrdiff_t>(i));
     }
   }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!common.quiet) {
-    char rate[96];
-    std::snprintf(rate, sizeof(rate), "%lld frames in %.2f s (%.0f frames/s)",
-                  static_cast<long long>(frames), wall_s, wall_s > 0 ? frames / wall_s : 0.0);
-    report << "track: " << total << " inputs, --jobs " << options.jobs << ": " << done << " done";
-    if (stopped > 0) report << ", " << stopped << " stopped";
-    if (!failed.empty()) {
-      report << ", " << failed.size() << " failed (";
-      for (size_t i = 0; i < failed.size(); ++i) report << (i == 0 ? "" : ", ") << failed[i];
-      report << ")";
-    }
-    if (next < total) report << ", " << total - next << " not started (stop requested)";
-    report << "; " << rate << "\n";
-  }
+  if (!common.quiet) ReportTally(options, tally, next, wall_s, report);
   if (stop.requested()) return 128 + stop.signal();
-  return exit_code;
+  return tally.exit_code;
 }
 
 }  // namespace softsight

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include "softsight/core/error.h"
+
 namespace softsight {
 namespace {
 
@@ -113,6 +115,16 @@ std::optional<UnknownWord> FindUnknownWord(const CLI::App& app) {
     if (std::optional<UnknownWord> word = UnknownWordOf(*sub, program + " " + sub->get_name())) {
       return word;
     }
+  }
+  return std::nullopt;
+}
+
+std::optional<int> AnswerHelpOrUnknownWord(CLI::App& app, const CLI::ParseError& error,
+                                           std::ostream& err) {
+  if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version.
+  if (const std::optional<UnknownWord> unknown = FindUnknownWord(app)) {
+    err << unknown->command << ": error: " << EscapeForMessage(unknown->message) << "\n";
+    return kInputErrorExitCode;
   }
   return std::nullopt;
 }

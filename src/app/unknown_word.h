@@ -5,6 +5,7 @@
 #pragma once
 
 #include <optional>
+#include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,5 +35,12 @@ struct UnknownWord {
   std::string message;
 };
 std::optional<UnknownWord> FindUnknownWord(const CLI::App& app);
+
+// A failed parse of `app` that is --help or --version (CLI11 prints them), or a mistyped word (one
+// error line on `err`, from FindUnknownWord): the exit code. nullopt for any other error, which
+// the caller words itself. The mistyped word comes first: CLI11 reports a required option the
+// typo left out before the word it did not know ("--config is required" for --confg).
+std::optional<int> AnswerHelpOrUnknownWord(CLI::App& app, const CLI::ParseError& error,
+                                           std::ostream& err);
 
 }  // namespace softsight

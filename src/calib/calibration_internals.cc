@@ -86,6 +86,16 @@ std::string Now() {
   return text;
 }
 
+void WriteCalibrationHeader(cv::FileStorage& fs, const cv::Size& image_size,
+                            const ChessboardSpec& board) {
+  fs << "calibration_time" << Now();
+  fs << "image_width" << image_size.width;
+  fs << "image_height" << image_size.height;
+  fs << "board_width" << board.inner_corners.width;
+  fs << "board_height" << board.inner_corners.height;
+  fs << "square_size_mm" << board.square_mm;
+}
+
 double CalibrateFromCorners(const CalibrationOptions& options, const cv::Size& image_size,
                             const std::vector<std::vector<cv::Point2f>>& corners,
                             CameraIntrinsics& camera, std::vector<double>* per_view_rms_px) {

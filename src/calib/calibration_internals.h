@@ -31,6 +31,9 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& file, const std
                    int rows, int cols);
 int ReadPositiveInt(const cv::FileStorage& fs, const std::string& file, const std::string& key);
 std::string Now();  // UTC, ISO 8601, for the files' calibration_time.
+// What every calibration file starts with: when it was made, the image size and the board.
+void WriteCalibrationHeader(cv::FileStorage& fs, const cv::Size& image_size,
+                            const ChessboardSpec& board);
 
 // cv::calibrateCamera on the views' corners (board from `options`, k3 as it says); returns the
 // reprojection RMS and, when `per_view_rms_px` is given, each view's.

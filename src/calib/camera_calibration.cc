@@ -21,6 +21,7 @@ using calib_internal::Now;
 using calib_internal::OpenForReading;
 using calib_internal::FinishWriting;
 using calib_internal::OpenForWriting;
+using calib_internal::WriteCalibrationHeader;
 using calib_internal::ReadMatrix;
 using calib_internal::ReadPositiveInt;
 using calib_internal::SizeText;
@@ -148,12 +149,7 @@ CalibrationResult ChessboardCalibrator::calibrate() const {
 void SaveCameraCalibration(const CalibrationResult& result, const ChessboardSpec& board,
                            const std::string& file) {
   cv::FileStorage fs = OpenForWriting(file);
-  fs << "calibration_time" << Now();
-  fs << "image_width" << result.camera.image_size.width;
-  fs << "image_height" << result.camera.image_size.height;
-  fs << "board_width" << board.inner_corners.width;
-  fs << "board_height" << board.inner_corners.height;
-  fs << "square_size_mm" << board.square_mm;
+  WriteCalibrationHeader(fs, result.camera.image_size, board);
   fs << "camera_matrix" << cv::Mat(result.camera.camera_matrix);
   fs << "distortion_coefficients" << DistortionMat(result.camera.distortion);
   fs << "avg_reprojection_error" << result.rms_px;

@@ -13,7 +13,6 @@ namespace softsight {
 
 using calib_internal::CalibrateFromCorners;
 using calib_internal::DistortionMat;
-using calib_internal::Now;
 using calib_internal::OpenForReading;
 using calib_internal::FinishWriting;
 using calib_internal::OpenForWriting;
@@ -272,12 +271,7 @@ void SaveStereoCalibration(const StereoCalibrationResult& result, const Chessboa
                            const std::string& file) {
   const StereoCalibration& s = result.stereo;
   cv::FileStorage fs = OpenForWriting(file);
-  fs << "calibration_time" << Now();
-  fs << "image_width" << s.left.image_size.width;
-  fs << "image_height" << s.left.image_size.height;
-  fs << "board_width" << board.inner_corners.width;
-  fs << "board_height" << board.inner_corners.height;
-  fs << "square_size_mm" << board.square_mm;
+  calib_internal::WriteCalibrationHeader(fs, s.left.image_size, board);
   fs << "camera_matrix_left" << cv::Mat(s.left.camera_matrix);
   fs << "distortion_left" << DistortionMat(s.left.distortion);
   fs << "camera_matrix_right" << cv::Mat(s.right.camera_matrix);

@@ -206,18 +206,6 @@ std::optional<std::vector<double>> YamlMap::numbers(const std::string& key, size
   return values;
 }
 
-std::optional<std::vector<std::string>> YamlMap::strings(const std::string& key) {
-  if (!has(key)) return std::nullopt;
-  const YAML::Node child = node_[key];
-  if (!child.IsSequence()) fail(key, "expected a list of names, got " + Shown(child));
-  std::vector<std::string> values;
-  for (const YAML::Node& item : child) {
-    if (!item.IsScalar()) fail(key, "expected names, got " + Shown(item));
-    values.push_back(item.Scalar());
-  }
-  return values;
-}
-
 void YamlMap::finish() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
     const std::string key = it->first.Scalar();  // Checked scalar by the constructor.

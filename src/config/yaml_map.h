@@ -33,7 +33,6 @@ class YamlMap {
   std::optional<std::vector<int>> integers(const std::string& key, size_t count, int min, int max);
   std::optional<std::vector<double>> numbers(const std::string& key, size_t count, double min,
                                              double max);
-  std::optional<std::vector<std::string>> strings(const std::string& key);
 
   // Throws InputError for the first key that no getter asked for (a typo or an unknown option).
   void finish() const;

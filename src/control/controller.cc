@@ -9,6 +9,52 @@
 #include "control/model_loop.h"
 
 namespace softsight {
+namespace {
+
+// The error's derivative on the measurement (bending, the angle decreasing, reduces the
+// setpoint's rise), low-pass filtered over `filter_s`; 0 without a previous measurement.
+double FilteredDerivative(double previous_deg_per_s, double measured_deg,
+                          std::optional<double> last_measured_deg, double dt_s, double filter_s) {
+  if (!last_measured_deg || !(dt_s > 0.0)) return 0.0;
+  const double raw = -(measured_deg - *last_measured_deg) / dt_s;  // d(error)/dt at fixed target.
+  const double a = filter_s > 0.0 ? dt_s / (filter_s + dt_s) : 1.0;
+  double derivative = previous_deg_per_s;
+  derivative += a * (raw - derivative);
+  return derivative;
+}
+
+// The target's rate, for the lead (none across a jump, or before a previous target), and its
+// acceleration (0 without two rates).
+struct TargetMotion {
+  std::optional<double> rate_deg_per_s;
+  double accel_deg_per_s2 = 0.0;
+};
+
+TargetMotion MotionOf(double target_deg, std::optional<double> last_target_deg,
+                      std::optional<double> last_rate_deg_per_s, double dt_s) {
+  TargetMotion motion;
+  if (last_target_deg && dt_s > 0.0) {
+    motion.rate_deg_per_s = (target_deg - *last_target_deg) / dt_s;
+    if (std::abs(*motion.rate_deg_per_s) > kStepRateDegPerS) motion.rate_deg_per_s.reset();
+  }
+  if (motion.rate_deg_per_s && last_rate_deg_per_s && dt_s > 0.0) {
+    motion.accel_deg_per_s2 = (*motion.rate_deg_per_s - *last_rate_deg_per_s) / dt_s;
+  }
+  return motion;
+}
+
+// Anti-windup (conditional integration): the new integral is kept only when the output is not
+// held back by a limit in the direction the error pushes it, and the error is within the
+// integral band (when there is one).
+bool KeepsIntegral(double error_deg, double limited_kpa, double wanted_kpa,
+                   double integral_band_deg) {
+  const bool pushing_up = error_deg > 0.0 && limited_kpa < wanted_kpa - 1e-9;
+  const bool pushing_down = error_deg < 0.0 && limited_kpa > wanted_kpa + 1e-9;
+  const bool outside_band = integral_band_deg > 0.0 && std::abs(error_deg) >= integral_band_deg;
+  return !pushing_up && !pushing_down && !outside_band;
+}
+
+}  // namespace
 
 bool ControllerOptions::Check(std::string* error) const {
   // Each field's range is its row in control/control_options.cc; only rules across fields here.
@@ -128,32 +174,18 @@ ControllerOutput AngleController::update(double time_s, double target_deg_in,
   }
   const double error_deg = *measured_deg - target_deg;
 
-  // Derivative on the measurement: bending (angle decreasing) reduces the setpoint's rise.
-  if (last_measured_deg_ && dt_s > 0.0) {
-    const double raw = -(*measured_deg - *last_measured_deg_) / dt_s;  // d(error)/dt at fixed target.
-    const double a = options_.derivative_filter_s > 0.0
-                         ? dt_s / (options_.derivative_filter_s + dt_s)
-                         : 1.0;
-    derivative_deg_per_s_ += a * (raw - derivative_deg_per_s_);
-  } else {
-    derivative_deg_per_s_ = 0.0;
-  }
+  derivative_deg_per_s_ = FilteredDerivative(derivative_deg_per_s_, *measured_deg,
+                                             last_measured_deg_, dt_s,
+                                             options_.derivative_filter_s);
   last_measured_deg_ = measured_deg;
 
   // The target's last direction of motion (a smaller angle is more bend) selects the branch of
   // the hysteresis the actuator is on.
   if (last_target_deg_ && target_deg < *last_target_deg_) bend_direction_ = 1.0;
   if (last_target_deg_ && target_deg > *last_target_deg_) bend_direction_ = -1.0;
-  // The target's rate, for the lead; none across a jump (or before a previous target).
-  std::optional<double> target_rate_deg_per_s;
-  if (last_input_deg_ && dt_s > 0.0) {
-    target_rate_deg_per_s = (target_deg_in - *last_input_deg_) / dt_s;
-    if (std::abs(*target_rate_deg_per_s) > kStepRateDegPerS) target_rate_deg_per_s.reset();
-  }
-  double target_accel_deg_per_s2 = 0.0;
-  if (target_rate_deg_per_s && last_target_rate_ && dt_s > 0.0) {
-    target_accel_deg_per_s2 = (*target_rate_deg_per_s - *last_target_rate_) / dt_s;
-  }
+  const TargetMotion motion = MotionOf(target_deg_in, last_input_deg_, last_target_rate_, dt_s);
+  const std::optional<double>& target_rate_deg_per_s = motion.rate_deg_per_s;
+  const double target_accel_deg_per_s2 = motion.accel_deg_per_s2;
   last_target_deg_ = target_deg;
   last_input_deg_ = target_deg_in;
   last_target_rate_ = target_rate_deg_per_s;
@@ -174,13 +206,7 @@ ControllerOutput AngleController::update(double time_s, double target_deg_in,
     const double step = options_.max_rate_kpa_per_s * dt_s;
     limited = std::clamp(limited, setpoint_kpa_ - step, setpoint_kpa_ + step);
   }
-  // Anti-windup (conditional integration): keep the new integral only when the output is not held
-  // back by a limit in the direction the error pushes it.
-  const bool pushing_up = error_deg > 0.0 && limited < wanted - 1e-9;
-  const bool pushing_down = error_deg < 0.0 && limited > wanted + 1e-9;
-  const bool outside_band =
-      options_.integral_band_deg > 0.0 && std::abs(error_deg) >= options_.integral_band_deg;
-  if (!pushing_up && !pushing_down && !outside_band) {
+  if (KeepsIntegral(error_deg, limited, wanted, options_.integral_band_deg)) {
     integral_kpa_ = candidate_integral;
   }
   // The integral alone never needs to exceed the output range.

@@ -154,6 +154,157 @@ std::array<double, 3> GridSearch(double frame_s, Cost cost) {
   return best;
 }
 
+// FitStaticMap's saturation, bottom up: starting from the three lowest bent levels of the up
+// branch, each next level is taken while its up point lies on the line through the levels below
+// (within the scatter); the first that lies above it (less bent than the line predicts) is where
+// the bend saturates, and it and every point at its level or above (both branches) are left out
+// of `bent`, `fit` becoming the line below. 0: no saturation seen.
+double SaturationPressure(std::vector<StaticPoint>* bent, LineFit* fit) {
+  std::vector<double> levels;  // Up-branch pressures, ascending.
+  for (const StaticPoint& p : *bent) {
+    if (p.up) levels.push_back(p.pressure_kpa);
+  }
+  std::sort(levels.begin(), levels.end());
+  // The same level reached from above reads a slightly different pressure: a level's points
+  // are those below a third of the way up to the next level.
+  const auto below_level = [&](size_t i) {
+    return i + 1 < levels.size() ? levels[i] + (levels[i + 1] - levels[i]) / 3.0 : 1e9;
+  };
+  const auto points_to = [&](size_t i) {
+    std::vector<StaticPoint> out;
+    for (const StaticPoint& p : *bent) {
+      if (p.pressure_kpa < below_level(i)) out.push_back(p);
+    }
+    return out;
+  };
+  for (size_t i = 3; i < levels.size(); ++i) {
+    const std::vector<StaticPoint> below = points_to(i - 1);
+    LineFit line;
+    if (!FitBranches(below, &line) || !(line.slope > 0.0)) break;
+    double sum_sq = 0.0;
+    for (const StaticPoint& p : below) sum_sq += Residual(line, p) * Residual(line, p);
+    const double scatter = std::sqrt(sum_sq / static_cast<double>(below.size()));
+    const StaticPoint* next = nullptr;
+    for (const StaticPoint& p : *bent) {
+      if (p.up && p.pressure_kpa == levels[i]) next = &p;
+    }
+    if (Residual(line, *next) > std::max(1.5, 3.0 * scatter)) {
+      const double saturated_deg = next->angle_deg;  // (`next` points into `bent`.)
+      *bent = below;
+      *fit = line;
+      return (fit->c + fit->half_width - saturated_deg) / fit->slope;
+    }
+  }
+  return 0.0;
+}
+
+// One robust pass: points far off the fit (a step not quite settled) are dropped.
+void DropOutliers(std::vector<StaticPoint>* bent, LineFit* fit) {
+  std::vector<double> r;
+  for (const StaticPoint& p : *bent) r.push_back(std::abs(Residual(*fit, p)));
+  std::vector<double> sorted = r;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(1.0, 4.0 * sorted[sorted.size() / 2]);
+  std::vector<StaticPoint> kept;
+  for (size_t i = 0; i < bent->size(); ++i) {
+    if (r[i] <= limit) kept.push_back((*bent)[i]);
+  }
+  LineFit refit;
+  if (kept.size() >= 3 && kept.size() < bent->size() && FitBranches(kept, &refit) &&
+      refit.slope > 0.0) {
+    *bent = kept;
+    *fit = refit;
+  }
+}
+
+// The PRBS part of an experiment, with an angle and a pressure in every frame used: time,
+// setpoint, sensed pressure, angle.
+struct PrbsFrames {
+  std::vector<double> t, u, p, a;
+};
+
+PrbsFrames PrbsFramesOf(const IdentificationExperiment& experiment) {
+  PrbsFrames f;
+  for (const IdentifySample& s : experiment.samples()) {
+    if (s.phase != IdentificationExperiment::kPrbs || !s.angle_deg ||
+        !std::isfinite(s.pressure_kpa)) {
+      continue;
+    }
+    f.t.push_back(s.time_s);
+    f.u.push_back(s.setpoint_kpa);
+    f.p.push_back(s.pressure_kpa);
+    f.a.push_back(*s.angle_deg);
+  }
+  return f;
+}
+
+// Bending: sensed pressure -> static map with its play -> lag + dead time -> angle. The cost of
+// (lag, dead time): the squared error left after an offset and a scale (least squares, for each
+// candidate) absorb what the static fit left.
+double BendCost(const ActuatorModel& m, const PrbsFrames& f, double d0, double lag, double dead) {
+  const std::vector<double>& t = f.t, &p = f.p, &a = f.a;
+  const std::vector<double> d = SimulateBend(m, t, p, d0, lag, dead);
+  // a = alpha - beta d.
+  double n = 0, sd = 0, sdd = 0, sa = 0, sda = 0;
+  for (size_t k = 0; k < d.size(); ++k) {
+    n += 1;
+    sd += d[k];
+    sdd += d[k] * d[k];
+    sa += a[k];
+    sda += d[k] * a[k];
+  }
+  const double det = n * sdd - sd * sd;
+  double alpha = sa / n, beta = 0.0;
+  if (det > 1e-12) {
+    beta = -(n * sda - sd * sa) / det;
+    alpha = (sa + beta * sd) / n;
+  }
+  double sse = 0.0;
+  for (size_t k = 0; k < d.size(); ++k) {
+    const double e = a[k] - (alpha - beta * d[k]);
+    sse += e * e;
+  }
+  return sse;
+}
+
+// The same as the board's loop works (ActuatorModel::pressure_duty_per_kpa): a duty
+// proportional to the error, saturating, times the probe's rates; the gain by a grid of 6 %
+// steps (as the lags).
+void FitDutyLoop(const InnerLoopMeasurement& probe, const InnerLoopGains& gains,
+                 const PrbsFrames& f, double frame_s, ActuatorModel* m) {
+  const std::vector<double>& t = f.t, &u = f.u, &p = f.p;
+  const double inflate = std::max(1e-3, probe.inflate_kpa_per_s);
+  const double vent = std::max(1e-3, probe.vent_kpa_per_s) * (gains.given() ? gains.vent_scale : 1.0);
+  const double vent_at = std::max(0.05, probe.vent_at_kpa);
+  const auto duty_cost = [&](double gain, double dead) {
+    double x = p[0], sse = 0.0;
+    for (size_t k = 0; k + 1 < t.size(); ++k) {
+      const double h = (t[k + 1] - t[k]) / kSubsteps;
+      for (int sub = 0; sub < kSubsteps; ++sub) {
+        const double sp = HeldAt(t, u, t[k] + (sub + 0.5) * h - dead);
+        const double duty = std::clamp(gain * (sp - x), -1.0, 1.0);
+        const double rate = duty >= 0.0 ? duty * inflate
+                                         : duty * vent * std::sqrt(std::max(x, 0.05) / vent_at);
+        const double next = x + h * rate;
+        x = std::max(0.0, (next - sp) * (x - sp) < 0.0 ? sp : next);
+      }
+      sse += (x - p[k + 1]) * (x - p[k + 1]);
+    }
+    return sse;
+  };
+  std::array<double, 3> best = {0.0, 0.0, std::numeric_limits<double>::infinity()};
+  const double dead_step = std::max(1e-3, frame_s / 4.0);
+  for (double gain = 0.005; gain <= 20.0; gain *= 1.06) {
+    for (double dead = 0.0; dead <= 0.2 + 1e-9; dead += dead_step) {
+      const double c = duty_cost(gain, dead);
+      if (c < best[2]) best = {gain, dead, c};
+    }
+  }
+  m->pressure_duty_per_kpa = best[0];
+  m->pressure_duty_dead_time_s = best[1];
+  m->pressure_duty_rms_kpa = std::sqrt(best[2] / static_cast<double>(t.size()));
+}
+
 }  // namespace
 
 // ---- The experiment ------------------------------------------------------------------------------
@@ -396,68 +547,10 @@ ActuatorModel FitStaticMap(const std::vector<StaticPoint>& points, double straig
   };
   if (bent.size() < 3 || !FitBranches(bent, &fit) || !(fit.slope > 0.0)) throw no_bend();
 
-  // Saturation, bottom up: starting from the three lowest bent levels of the up branch, each next
-  // level is taken while its up point lies on the line through the levels below (within the
-  // scatter); the first that lies above it (less bent than the line predicts) is where the bend
-  // saturates, and it and every point at its level or above (both branches) are left out.
-  double saturation_kpa = 0.0;
-  {
-    std::vector<double> levels;  // Up-branch pressures, ascending.
-    for (const StaticPoint& p : bent) {
-      if (p.up) levels.push_back(p.pressure_kpa);
-    }
-    std::sort(levels.begin(), levels.end());
-    // The same level reached from above reads a slightly different pressure: a level's points
-    // are those below a third of the way up to the next level.
-    const auto below_level = [&](size_t i) {
-      return i + 1 < levels.size() ? levels[i] + (levels[i + 1] - levels[i]) / 3.0 : 1e9;
-    };
-    const auto points_to = [&](size_t i) {
-      std::vector<StaticPoint> out;
-      for (const StaticPoint& p : bent) {
-        if (p.pressure_kpa < below_level(i)) out.push_back(p);
-      }
-      return out;
-    };
-    for (size_t i = 3; i < levels.size(); ++i) {
-      const std::vector<StaticPoint> below = points_to(i - 1);
-      LineFit line;
-      if (!FitBranches(below, &line) || !(line.slope > 0.0)) break;
-      double sum_sq = 0.0;
-      for (const StaticPoint& p : below) sum_sq += Residual(line, p) * Residual(line, p);
-      const double scatter = std::sqrt(sum_sq / static_cast<double>(below.size()));
-      const StaticPoint* next = nullptr;
-      for (const StaticPoint& p : bent) {
-        if (p.up && p.pressure_kpa == levels[i]) next = &p;
-      }
-      if (Residual(line, *next) > std::max(1.5, 3.0 * scatter)) {
-        const double saturated_deg = next->angle_deg;  // (`next` points into `bent`.)
-        bent = below;
-        fit = line;
-        saturation_kpa = (fit.c + fit.half_width - saturated_deg) / fit.slope;
-        break;
-      }
-    }
-    if (saturation_kpa == 0.0 && !FitBranches(bent, &fit)) throw no_bend();
-  }
-  // One robust pass: points far off the fit (a step not quite settled) are dropped.
-  {
-    std::vector<double> r;
-    for (const StaticPoint& p : bent) r.push_back(std::abs(Residual(fit, p)));
-    std::vector<double> sorted = r;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double limit = std::max(1.0, 4.0 * sorted[sorted.size() / 2]);
-    std::vector<StaticPoint> kept;
-    for (size_t i = 0; i < bent.size(); ++i) {
-      if (r[i] <= limit) kept.push_back(bent[i]);
-    }
-    LineFit refit;
-    if (kept.size() >= 3 && kept.size() < bent.size() && FitBranches(kept, &refit) &&
-        refit.slope > 0.0) {
-      bent = kept;
-      fit = refit;
-    }
-  }
+  // Where the bend saturates (its points left out), then one robust pass.
+  const double saturation_kpa = SaturationPressure(&bent, &fit);
+  if (saturation_kpa == 0.0 && !FitBranches(bent, &fit)) throw no_bend();
+  DropOutliers(&bent, &fit);
   ActuatorModel m;
   m.straight_deg = straight_deg;
   m.slope_deg_per_kpa = fit.slope;
@@ -505,18 +598,8 @@ std::vector<double> PredictPressures(const ActuatorModel& m,
 ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
   if (!experiment.straight_deg()) throw IdentifyAbort("identify: the experiment did not finish");
   ActuatorModel m = FitStaticMap(experiment.static_points(), *experiment.straight_deg());
-  // The PRBS part, with an angle and a pressure in every frame used.
-  std::vector<double> t, u, p, a;
-  for (const IdentifySample& s : experiment.samples()) {
-    if (s.phase != IdentificationExperiment::kPrbs || !s.angle_deg ||
-        !std::isfinite(s.pressure_kpa)) {
-      continue;
-    }
-    t.push_back(s.time_s);
-    u.push_back(s.setpoint_kpa);
-    p.push_back(s.pressure_kpa);
-    a.push_back(*s.angle_deg);
-  }
+  const PrbsFrames frames = PrbsFramesOf(experiment);
+  const std::vector<double>& t = frames.t, &u = frames.u, &p = frames.p, &a = frames.a;
   if (t.size() < 20) throw IdentifyAbort("identify: too few frames in the dynamic test");
   const double frame_s = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
 
@@ -538,64 +621,10 @@ ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
   // and a scale (least squares, for each candidate) absorb what the static fit left.
   const double d0 = m.straight_deg - a[0];
   const auto bend_cost = [&](double lag, double dead) {
-    const std::vector<double> d = SimulateBend(m, t, p, d0, lag, dead);
-    // a = alpha - beta d.
-    double n = 0, sd = 0, sdd = 0, sa = 0, sda = 0;
-    for (size_t k = 0; k < d.size(); ++k) {
-      n += 1;
-      sd += d[k];
-      sdd += d[k] * d[k];
-      sa += a[k];
-      sda += d[k] * a[k];
-    }
-    const double det = n * sdd - sd * sd;
-    double alpha = sa / n, beta = 0.0;
-    if (det > 1e-12) {
-      beta = -(n * sda - sd * sa) / det;
-      alpha = (sa + beta * sd) / n;
-    }
-    double sse = 0.0;
-    for (size_t k = 0; k < d.size(); ++k) {
-      const double e = a[k] - (alpha - beta * d[k]);
-      sse += e * e;
-    }
-    return sse;
+    return BendCost(m, frames, d0, lag, dead);
   };
-  // The same as the board's loop works (ActuatorModel::pressure_duty_per_kpa): a duty
-  // proportional to the error, saturating, times the probe's rates; the gain by a grid of 6 %
-  // steps (as the lags above).
   if (const std::optional<InnerLoopMeasurement>& probe = experiment.inner_loop()) {
-    const double inflate = std::max(1e-3, probe->inflate_kpa_per_s);
-    const InnerLoopGains& gains = experiment.inner_loop_gains();
-    const double vent = std::max(1e-3, probe->vent_kpa_per_s) * (gains.given() ? gains.vent_scale : 1.0);
-    const double vent_at = std::max(0.05, probe->vent_at_kpa);
-    const auto duty_cost = [&](double gain, double dead) {
-      double x = p[0], sse = 0.0;
-      for (size_t k = 0; k + 1 < t.size(); ++k) {
-        const double h = (t[k + 1] - t[k]) / kSubsteps;
-        for (int sub = 0; sub < kSubsteps; ++sub) {
-          const double sp = HeldAt(t, u, t[k] + (sub + 0.5) * h - dead);
-          const double duty = std::clamp(gain * (sp - x), -1.0, 1.0);
-          const double rate = duty >= 0.0 ? duty * inflate
-                                           : duty * vent * std::sqrt(std::max(x, 0.05) / vent_at);
-          const double next = x + h * rate;
-          x = std::max(0.0, (next - sp) * (x - sp) < 0.0 ? sp : next);
-        }
-        sse += (x - p[k + 1]) * (x - p[k + 1]);
-      }
-      return sse;
-    };
-    std::array<double, 3> best = {0.0, 0.0, std::numeric_limits<double>::infinity()};
-    const double dead_step = std::max(1e-3, frame_s / 4.0);
-    for (double gain = 0.005; gain <= 20.0; gain *= 1.06) {
-      for (double dead = 0.0; dead <= 0.2 + 1e-9; dead += dead_step) {
-        const double c = duty_cost(gain, dead);
-        if (c < best[2]) best = {gain, dead, c};
-      }
-    }
-    m.pressure_duty_per_kpa = best[0];
-    m.pressure_duty_dead_time_s = best[1];
-    m.pressure_duty_rms_kpa = std::sqrt(best[2] / static_cast<double>(t.size()));
+    FitDutyLoop(*probe, experiment.inner_loop_gains(), frames, frame_s, &m);
   }
 
   const auto bend_fit = GridSearch(frame_s, bend_cost);

@@ -18,6 +18,20 @@ double Branch(double wanted, double play, double last) {
   return last;
 }
 
+// The setpoint in [lo_kpa, hi_kpa] whose pressure after the frame is `goal` (the nearer end where
+// the goal is out of reach), by bisection.
+template <typename PressureAfter>
+double SetpointFor(double goal, double lo_kpa, double hi_kpa, const PressureAfter& pressure_after) {
+  if (pressure_after(hi_kpa) <= goal) return hi_kpa;
+  if (pressure_after(lo_kpa) >= goal) return lo_kpa;
+  double lo = lo_kpa, hi = hi_kpa;
+  for (int i = 0; i < 30 && hi - lo > 1e-4; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (pressure_after(mid) < goal ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 }  // namespace
 
 ModelLoop::ModelLoop(const ActuatorModel& m, double vent_scale, const ControllerOptions& options)
@@ -96,9 +110,9 @@ void ModelLoop::sent(double setpoint_kpa) {
   if (!sent_.empty()) sent_.back().second = setpoint_kpa;
 }
 
-double ModelLoop::update(double time_s, std::optional<double> measured_deg, double target_deg,
-                         const AngleController::Preview& preview, double lo_kpa,
-                         double hi_kpa) {
+// The model advanced to this frame, its error against the measurement (seen through the
+// camera's dead time) filtered, and the histories it needs kept short.
+void ModelLoop::follow_measurement(double time_s, std::optional<double> measured_deg) {
   const double measured_d = straight_ - measured_deg.value_or(straight_);
   if (!started_) {
     started_ = true;
@@ -137,6 +151,12 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
     initial_u_ = sent_.front().second;
     sent_.pop_front();
   }
+}
+
+double ModelLoop::update(double time_s, std::optional<double> measured_deg, double target_deg,
+                         const AngleController::Preview& preview, double lo_kpa,
+                         double hi_kpa) {
+  follow_measurement(time_s, measured_deg);
 
   const double frame = frame_s_;
   const double look = theta_p_ + theta_b_;  // What a setpoint sent now takes to be seen.
@@ -219,18 +239,7 @@ double ModelLoop::update(double time_s, std::optional<double> measured_deg, doub
   if (!full) {
     const double goal = std::max(0.0, std::min(p0_ + (aim + direction_ * half_) / k_,
                                                std::max(p0_, sat_)));
-    if (pressure_after(hi_kpa) <= goal) {
-      setpoint = hi_kpa;
-    } else if (pressure_after(lo_kpa) >= goal) {
-      setpoint = lo_kpa;
-    } else {
-      double lo = lo_kpa, hi = hi_kpa;
-      for (int i = 0; i < 30 && hi - lo > 1e-4; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (pressure_after(mid) < goal ? lo : hi) = mid;
-      }
-      setpoint = 0.5 * (lo + hi);
-    }
+    setpoint = SetpointFor(goal, lo_kpa, hi_kpa, pressure_after);
   }
   sent_.emplace_back(time_s, setpoint);
   return setpoint;

@@ -52,10 +52,6 @@ class ModelLoop {
   // The overshoot a full-pressure frame may leave in the model's prediction.
   static constexpr double kOvershootDeg = 0.2;
 
-  // For tests: the model's angle now and the model error it corrects.
-  double model_angle_deg() const { return straight_ - state_.d; }
-  double correction_deg() const { return correction_; }
-
  private:
   struct State {
     double time_s = 0.0;
@@ -70,6 +66,8 @@ class ModelLoop {
   void advance(State* s, double to_s, const Command& command) const;
   double sent_at(double time_s) const;  // From the history of setpoints.
   double static_pressure(double deflection_deg, double direction) const;
+  // update()'s first step: the model against this frame's measurement.
+  void follow_measurement(double time_s, std::optional<double> measured_deg);
 
   // The model.
   double straight_, p0_, k_, sat_, half_, tau_b_, theta_b_, g_, theta_p_, inflate_, vent_,

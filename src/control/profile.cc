@@ -14,6 +14,55 @@ namespace {
 constexpr double kMinAngleDeg = 0.0;
 constexpr double kMaxAngleDeg = 180.0;
 
+// The words after a segment's keyword, each a finite number; `where` is "file:line: ".
+std::vector<double> SegmentNumbers(std::istringstream& words, const std::string& where,
+                                   const std::string& keyword) {
+  std::vector<double> values;
+  std::string word;
+  while (words >> word) {
+    size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(word, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != word.size() || !std::isfinite(v)) {
+      throw InputError(where + keyword + ": '" + word + "' is not a number");
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+void ExpectCount(const std::vector<double>& values, size_t n, const char* usage,
+                 const std::string& where, const std::string& keyword) {
+  if (values.size() != n) {
+    throw InputError(where + keyword + ": expected " + usage + ", got " +
+                     std::to_string(values.size()) + " value(s)");
+  }
+}
+
+double CheckedAngle(double v, const std::string& where, const std::string& keyword) {
+  if (v < kMinAngleDeg || v > kMaxAngleDeg) {
+    throw InputError(where + keyword + ": angle " + std::to_string(v) +
+                     " deg is outside 0..180 (the angle at the middle marker)");
+  }
+  return v;
+}
+
+// A segment's duration, `v`, starting at `t` s into the profile.
+double CheckedDuration(double v, double t, const std::string& where, const std::string& keyword) {
+  if (!(v > 0.0)) {
+    throw InputError(where + keyword + ": duration " + std::to_string(v) + " s must be > 0");
+  }
+  if (t + v > TargetProfile::kMaxSeconds) {
+    throw InputError(where + keyword + ": the profile would last " + ShortNumber(t + v) +
+                     " s, longer than a week (" + ShortNumber(TargetProfile::kMaxSeconds) + " s)");
+  }
+  return v;
+}
+
 }  // namespace
 
 TargetProfile TargetProfile::Constant(double angle_deg) {
@@ -38,44 +87,12 @@ TargetProfile TargetProfile::Parse(std::string_view text, const std::string& sou
     std::string keyword;
     if (!(words >> keyword)) continue;
     const std::string where = source + ":" + std::to_string(line_no) + ": ";
-    std::vector<double> values;
-    std::string word;
-    while (words >> word) {
-      size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(word, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != word.size() || !std::isfinite(v)) {
-        throw InputError(where + keyword + ": '" + word + "' is not a number");
-      }
-      values.push_back(v);
-    }
-    auto expect = [&](size_t n, const char* usage) {
-      if (values.size() != n) {
-        throw InputError(where + keyword + ": expected " + usage + ", got " +
-                         std::to_string(values.size()) + " value(s)");
-      }
+    const std::vector<double> values = SegmentNumbers(words, where, keyword);
+    const auto expect = [&](size_t n, const char* usage) {
+      ExpectCount(values, n, usage, where, keyword);
     };
-    auto angle = [&](double v) {
-      if (v < kMinAngleDeg || v > kMaxAngleDeg) {
-        throw InputError(where + keyword + ": angle " + std::to_string(v) +
-                         " deg is outside 0..180 (the angle at the middle marker)");
-      }
-      return v;
-    };
-    auto duration = [&](double v) {
-      if (!(v > 0.0)) {
-        throw InputError(where + keyword + ": duration " + std::to_string(v) + " s must be > 0");
-      }
-      if (t + v > kMaxSeconds) {
-        throw InputError(where + keyword + ": the profile would last " + ShortNumber(t + v) +
-                         " s, longer than a week (" + ShortNumber(kMaxSeconds) + " s)");
-      }
-      return v;
-    };
+    const auto angle = [&](double v) { return CheckedAngle(v, where, keyword); };
+    const auto duration = [&](double v) { return CheckedDuration(v, t, where, keyword); };
     if (p.segments_.size() >= kMaxSegments) {
       throw InputError(where + "more than " + std::to_string(kMaxSegments) + " segments");
     }

@@ -138,13 +138,6 @@ void RigServer::set_reply_filter(std::function<std::string(const std::string&)> 
   filter_ = std::move(filter);
 }
 
-void RigServer::inject(std::string_view bytes) {
-  std::lock_guard<std::mutex> lock(write_mutex_);
-  if (port_closed_) return;
-  enqueue_locked(bytes);  // Behind any queued answer, so never in the middle of one.
-  flush_locked();
-}
-
 bool RigServer::enqueue_locked(std::string_view bytes) {
   if (pending_.size() + bytes.size() > kMaxPendingBytes) return false;
   pending_.append(bytes.data(), bytes.size());

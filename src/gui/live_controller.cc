@@ -43,6 +43,29 @@ void TakeFromAside(std::vector<MarkerParams>& aside, const TrackerKind& kind) {
   std::erase_if(aside, [&kind](const MarkerParams& kept) { return &kept.kind() == &kind; });
 }
 
+// The playback a key asks for: a step ('.', ','), a second either way (']', '[' and the arrows),
+// the start ('<', Home) or the end ('>', End); the seconds for a seek.
+std::pair<PlaybackRequest::Kind, double> PlaybackKey(int key) {
+  using Kind = PlaybackRequest::Kind;
+  switch (key) {
+    case '.':
+      return {Kind::kStepForward, 0.0};
+    case ',':
+      return {Kind::kStepBack, 0.0};
+    case ']':
+    case kKeyRight:
+      return {Kind::kSeekSeconds, 1.0};
+    case '[':
+    case kKeyLeft:
+      return {Kind::kSeekSeconds, -1.0};
+    case '<':
+    case kKeyHome:
+      return {Kind::kStart, 0.0};
+    default:  // '>', End.
+      return {Kind::kEnd, 0.0};
+  }
+}
+
 }  // namespace
 
 LiveController::LiveController(const TrackingConfig& config, LiveOptions options,
@@ -820,133 +843,135 @@ void LiveController::handle(const UiEvent& event) {
       // In scale mode the pointer is followed without a button too: the line to the first point.
       if (pointer_->move(at, scale_.active())) dirty_ = true;
       break;
-    case Type::kMouseUp: {
-      const PointerGesture gesture = pointer_->up(at, in_image);
-      if (gesture.kind == PointerGesture::Kind::kNone) break;
-      dirty_ = true;
-      if (scale_.active()) {
-        // Where the button is released, so a person can press, aim and let go.
-        scale_point(gesture.release);
-      } else if (gesture.kind == PointerGesture::Kind::kClick) {
-        if (event.shift || mask_view_) {
-          edit_range(gesture.press, !event.shift);
-        } else {
-          click(gesture.press);
-        }
-      } else {
-        drag(gesture.box);
-      }
+    case Type::kMouseUp:
+      release_pointer(event, at, in_image);
       break;
-    }
     case Type::kTrackbar:
       set_hsv(event.trackbar, event.value);
       break;
     case Type::kKey:
-      switch (event.key) {
-        case 'h':
-          help_ = !help_;
-          dirty_ = true;
-          break;
-        case ' ':
-        case 'p':
-          if (ended_ && !loop_) {
-            request_playback(PlaybackRequest::Kind::kStart);
-            paused_ = false;
-            say("playing from the first frame");
-            break;
-          }
-          paused_ = !paused_;
-          meter_.restart();  // A pause is no slow playback: the rates start over.
-          say(paused_ ? "paused" : "running");
-          break;
-        case '.':
-          request_playback(PlaybackRequest::Kind::kStepForward);
-          break;
-        case ',':
-          request_playback(PlaybackRequest::Kind::kStepBack);
-          break;
-        case ']':
-        case kKeyRight:
-          request_playback(PlaybackRequest::Kind::kSeekSeconds, 1.0);
-          break;
-        case '[':
-        case kKeyLeft:
-          request_playback(PlaybackRequest::Kind::kSeekSeconds, -1.0);
-          break;
-        case '<':
-        case kKeyHome:
-          request_playback(PlaybackRequest::Kind::kStart);
-          break;
-        case '>':
-        case kKeyEnd:
-          request_playback(PlaybackRequest::Kind::kEnd);
-          break;
-        case 'v':
-          mask_view_ = !mask_view_;
-          say(mask_view_ ? "mask view of " + config().markers[active_].name +
-                               ": click adds colours, shift-click removes them"
-                         : "mask view off");
-          break;
-        case 'l':
-          loop_ = !loop_;
-          say(loop_ ? "loop on" : "loop off");
-          break;
-        case '0':
-          restart();
-          break;
-        case 'r':
-          toggle_recording();
-          break;
-        case 's':
-          save_config();
-          break;
-        case 'b':
-          session().reset_tip_reference();
-          say("bending distance: the next tip position is the new reference");
-          break;
-        case 'm':
-          switch_method();
-          break;
-        case 'u':
-          undo();
-          break;
-        case '}':
-          change_speed(+1);
-          break;
-        case '{':
-          change_speed(-1);
-          break;
-        case '+':
-        case '=':
-        case '-': {
-          // At the pointer when it is over the image, else at the middle of what is shown.
-          const cv::Point2d middle =
-              zoom_.origin_px + cv::Point2d(frame_.cols, frame_.rows) * (0.5 / zoom_.zoom) -
-              cv::Point2d(0.5, 0.5);
-          zoom_at(pointer_image_.value_or(middle), event.key == '-' ? 1 / kZoomStep : kZoomStep);
-          break;
-        }
-        case 'z':
-          zoom_ = {};
-          dirty_ = true;
-          break;
-        case 'c':
-          start_scale();
-          break;
-        case 27:
-          if (scale_.active()) {
-            cancel_scale();
-            break;
-          }
-          [[fallthrough]];
-        case 'q':
-          if (recording()) toggle_recording();
-          quit_ = true;
-          break;
-        default:
-          if (event.key >= '1' && event.key <= '9') select_marker(event.key - '1');
-      }
+      press_key(event);
       break;
+  }
+}
+
+// A button released: the scale's point, a click (a marker, or colours in the mask view) or a
+// dragged box.
+void LiveController::release_pointer(const UiEvent& event, const cv::Point2d& at, bool in_image) {
+  const PointerGesture gesture = pointer_->up(at, in_image);
+  if (gesture.kind == PointerGesture::Kind::kNone) return;
+  dirty_ = true;
+  if (scale_.active()) {
+    // Where the button is released, so a person can press, aim and let go.
+    scale_point(gesture.release);
+  } else if (gesture.kind == PointerGesture::Kind::kClick) {
+    if (event.shift || mask_view_) {
+      edit_range(gesture.press, !event.shift);
+    } else {
+      click(gesture.press);
+    }
+  } else {
+    drag(gesture.box);
+  }
+}
+
+// A key: the playback, the view, the edits, the recording, quitting.
+void LiveController::press_key(const UiEvent& event) {
+  switch (event.key) {
+    case 'h':
+      help_ = !help_;
+      dirty_ = true;
+      break;
+    case ' ':
+    case 'p':
+      if (ended_ && !loop_) {
+        request_playback(PlaybackRequest::Kind::kStart);
+        paused_ = false;
+        say("playing from the first frame");
+        break;
+      }
+      paused_ = !paused_;
+      meter_.restart();  // A pause is no slow playback: the rates start over.
+      say(paused_ ? "paused" : "running");
+      break;
+    case '.':
+    case ',':
+    case ']':
+    case kKeyRight:
+    case '[':
+    case kKeyLeft:
+    case '<':
+    case kKeyHome:
+    case '>':
+    case kKeyEnd: {
+      const auto [kind, seconds] = PlaybackKey(event.key);
+      request_playback(kind, seconds);
+      break;
+    }
+    case 'v':
+      mask_view_ = !mask_view_;
+      say(mask_view_ ? "mask view of " + config().markers[active_].name +
+                           ": click adds colours, shift-click removes them"
+                     : "mask view off");
+      break;
+    case 'l':
+      loop_ = !loop_;
+      say(loop_ ? "loop on" : "loop off");
+      break;
+    case '0':
+      restart();
+      break;
+    case 'r':
+      toggle_recording();
+      break;
+    case 's':
+      save_config();
+      break;
+    case 'b':
+      session().reset_tip_reference();
+      say("bending distance: the next tip position is the new reference");
+      break;
+    case 'm':
+      switch_method();
+      break;
+    case 'u':
+      undo();
+      break;
+    case '}':
+      change_speed(+1);
+      break;
+    case '{':
+      change_speed(-1);
+      break;
+    case '+':
+    case '=':
+    case '-': {
+      // At the pointer when it is over the image, else at the middle of what is shown.
+      const cv::Point2d middle =
+          zoom_.origin_px + cv::Point2d(frame_.cols, frame_.rows) * (0.5 / zoom_.zoom) -
+          cv::Point2d(0.5, 0.5);
+      zoom_at(pointer_image_.value_or(middle), event.key == '-' ? 1 / kZoomStep : kZoomStep);
+      break;
+    }
+    case 'z':
+      zoom_ = {};
+      dirty_ = true;
+      break;
+    case 'c':
+      start_scale();
+      break;
+    case 27:
+      if (scale_.active()) {
+        cancel_scale();
+        break;
+      }
+      [[fallthrough]];
+    case 'q':
+      if (recording()) toggle_recording();
+      quit_ = true;
+      break;
+    default:
+      if (event.key >= '1' && event.key <= '9') select_marker(event.key - '1');
   }
 }
 

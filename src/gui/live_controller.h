@@ -238,6 +238,9 @@ class LiveController {
  private:
 
   void handle(const UiEvent& event);
+  // The steps of handle(): a button released, a key pressed.
+  void release_pointer(const UiEvent& event, const cv::Point2d& at, bool in_image);
+  void press_key(const UiEvent& event);
   TrackingSession& session();
   // The recording stopped by itself (a full disk, an edit it could not keep): say why.
   void report_recording_failure();

@@ -21,7 +21,6 @@ bool LiveFeed::read(LiveController& controller, FrameOrder order) {
   const SteadyClock::time_point captured = frame_.captured;
   controller.set_dropped_frames(source_.dropped_frames());
   controller.on_frame(frame_, captured, order);
-  ++fed_;
   return true;
 }
 

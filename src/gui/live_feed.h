@@ -35,7 +35,6 @@ class LiveFeed {
   bool step(LiveController& controller);
 
   bool ended() const { return ended_; }
-  int64_t frames_fed() const { return fed_; }
 
  private:
   bool carry_out(const PlaybackRequest& request, LiveController& controller);
@@ -49,7 +48,6 @@ class LiveFeed {
   SeekableSource* seekable_;  // Null: no transport.
   Frame frame_;               // Reused: no allocation per frame.
   bool ended_ = false;
-  int64_t fed_ = 0;
   int64_t shown_ = -1;  // Position (in seekable_) of the frame on screen.
 };
 

@@ -21,6 +21,55 @@ const cv::Scalar kBackground(32, 32, 32);
 const cv::Scalar kGridColour(70, 70, 70);
 const cv::Scalar kLabel(220, 220, 220);
 
+// The lane's value range [lo, hi] as shown: 0..1 without values, a fixed span around a
+// near-constant value (so that rounding noise stays flat), else the values' padded by 8%.
+void ShownRange(double* lo, double* hi) {
+  if (*lo > *hi) {
+    *lo = 0;
+    *hi = 1;
+  } else if (const double min_span = std::max(1.0, 0.05 * std::max(std::abs(*lo), std::abs(*hi)));
+             *hi - *lo < min_span) {
+    const double centre = (*lo + *hi) / 2;
+    *lo = centre - min_span / 2;
+    *hi = centre + min_span / 2;
+  } else {
+    const double pad = 0.08 * (*hi - *lo);
+    *lo -= pad;
+    *hi += pad;
+  }
+}
+
+// A curve's part of its lane's label: after the lane's label (the first curve's), its current
+// value (null: no samples yet), named when the lane has several curves.
+std::string CurveLabel(std::string text, const std::string& name, int count,
+                       const std::optional<double>* current) {
+  if (current != nullptr) {
+    char value[32];
+    if (*current) {
+      std::snprintf(value, sizeof(value), "%.1f", **current);
+    } else {
+      std::snprintf(value, sizeof(value), "--");
+    }
+    text += "  ";
+    if (count > 1) text += name + " ";
+    text += value;
+  } else if (count > 1) {
+    text += "  " + name;
+  }
+  return text;
+}
+
+// One unbroken run of a curve (a lone sample: a dot), then an empty run for the next.
+void DrawRun(cv::Mat& lane_area, const cv::Scalar& colour, std::vector<cv::Point>* run) {
+  if (run->size() == 1) {
+    cv::circle(lane_area, (*run)[0], 2 << kSubPixelShift, colour, cv::FILLED, cv::LINE_AA,
+               kSubPixelShift);
+  } else if (run->size() > 1) {
+    cv::polylines(lane_area, *run, false, colour, 1, cv::LINE_AA, kSubPixelShift);
+  }
+  run->clear();
+}
+
 }  // namespace
 
 // Same hues as the plot command's series, brightened for a dark background.
@@ -127,20 +176,7 @@ void StripChart::draw(cv::Mat& area) const {
         }
       }
     }
-    if (lo > hi) {
-      lo = 0;
-      hi = 1;
-    } else if (const double min_span = std::max(1.0, 0.05 * std::max(std::abs(lo), std::abs(hi)));
-               hi - lo < min_span) {
-      // A near-constant value: a fixed span around it, so that rounding noise stays flat.
-      const double centre = (lo + hi) / 2;
-      lo = centre - min_span / 2;
-      hi = centre + min_span / 2;
-    } else {
-      const double pad = 0.08 * (hi - lo);
-      lo -= pad;
-      hi += pad;
-    }
+    ShownRange(&lo, &hi);
     lane.y_min = lo;
     lane.y_max = hi;
     ticks[i] = NiceTicks(lo, hi, 3);
@@ -181,21 +217,10 @@ void StripChart::draw(cv::Mat& area) const {
     const int count = static_cast<int>(spec.series.size());
     cv::Point at(r.x + 6, r.y + 14);
     for (int k = 0; k < count; ++k) {
-      std::string text = k == 0 ? lane.label : "";
-      if (!samples_.empty()) {
-        char value[32];
-        const std::optional<double>& v = samples_.back().values[first + k];
-        if (v) {
-          std::snprintf(value, sizeof(value), "%.1f", *v);
-        } else {
-          std::snprintf(value, sizeof(value), "--");
-        }
-        text += "  ";
-        if (count > 1) text += spec.series[k].name + " ";
-        text += value;
-      } else if (count > 1) {
-        text += "  " + spec.series[k].name;
-      }
+      const std::optional<double>* current =
+          samples_.empty() ? nullptr : &samples_.back().values[first + k];
+      const std::string text =
+          CurveLabel(k == 0 ? lane.label : "", spec.series[k].name, count, current);
       cv::putText(area, text, at, kGuiFont, kFontScale, spec.series[k].colour, 1, cv::LINE_AA);
       at.x += cv::getTextSize(text, kGuiFont, kFontScale, 1, &baseline).width;
     }
@@ -205,15 +230,7 @@ void StripChart::draw(cv::Mat& area) const {
     for (int k = count - 1; k >= 0; --k) {
       const cv::Scalar& colour = spec.series[k].colour;
       run.clear();
-      auto flush = [&] {
-        if (run.size() == 1) {
-          cv::circle(lane_area, run[0], 2 << kSubPixelShift, colour, cv::FILLED, cv::LINE_AA,
-                     kSubPixelShift);
-        } else if (run.size() > 1) {
-          cv::polylines(lane_area, run, false, colour, 1, cv::LINE_AA, kSubPixelShift);
-        }
-        run.clear();
-      };
+      const auto flush = [&] { DrawRun(lane_area, colour, &run); };
       for (const Sample& s : samples_) {
         const std::optional<double>& v = s.values[first + k];
         if (!v) {

@@ -232,39 +232,13 @@ class AravisCameraSource : public FrameSource {
     report.accepted = settings;
     Error error;
     const auto refuse = [&](const std::string& what, const std::string& kept) {
-      report.refused.push_back(name_ + ": " + what + " refused" +
-                               (error ? " (" + error.text() + ")" : std::string()) + ", kept " +
-                               kept);
+      add_refusal(what, error, kept, &report);
     };
     const auto close = [](double a, double b, double relative) {
       return std::abs(a - b) <= relative * std::max(std::abs(b), 1.0);
     };
 
-    if (!settings.trigger.empty()) {
-      if (settings.trigger == "off") {
-        arv_camera_clear_triggers(camera, error.out());
-        if (error) refuse("trigger off", TriggerText());
-      } else {
-        guint count = 0;
-        const char** sources = arv_camera_dup_available_trigger_sources(camera, &count, error.out());
-        std::string names;
-        bool known = false;
-        for (guint i = 0; i < count; ++i) {
-          names += (i ? ", " : "") + std::string(sources[i]);
-          known = known || settings.trigger == sources[i];
-        }
-        g_free(sources);
-        if (!known) {
-          refuse("trigger " + settings.trigger + " (it has: " + (names.empty() ? "none" : names) +
-                     ")",
-                 TriggerText());
-        } else {
-          arv_camera_set_trigger(camera, settings.trigger.c_str(), error.out());
-          if (error) refuse("trigger " + settings.trigger, TriggerText());
-        }
-      }
-      report.accepted.trigger = TriggerText();
-    }
+    if (!settings.trigger.empty()) choose_trigger(settings.trigger, &report, error);
 
     choose_pixel_format(settings.pixel_format, &report, error);
 
@@ -306,30 +280,76 @@ class AravisCameraSource : public FrameSource {
     }
     apply("gain", settings.gain, arv_camera_set_gain, arv_camera_get_gain, 0.01,
           &report.accepted.gain);
-    // V4L2's controls, which GenICam has no standard feature for softsight to set.
+    refuse_v4l2_only(settings, &report);
+
+    report.summary = read_back();
+    return report;
+  }
+
+  // "<camera>: <what> refused (<the camera's error>), kept <kept>".
+  void add_refusal(const std::string& what, const Error& error, const std::string& kept,
+                   CameraSettingsReport* report) const {
+    report->refused.push_back(name_ + ": " + what + " refused" +
+                              (error ? " (" + error.text() + ")" : std::string()) + ", kept " +
+                              kept);
+  }
+
+  // The trigger: "off", or one of the camera's sources (a name it does not have is refused,
+  // naming those it has).
+  void choose_trigger(const std::string& trigger, CameraSettingsReport* report, Error& error) {
+    ArvCamera* camera = camera_.get();
+    if (trigger == "off") {
+      arv_camera_clear_triggers(camera, error.out());
+      if (error) add_refusal("trigger off", error, TriggerText(), report);
+    } else {
+      guint count = 0;
+      const char** sources = arv_camera_dup_available_trigger_sources(camera, &count, error.out());
+      std::string names;
+      bool known = false;
+      for (guint i = 0; i < count; ++i) {
+        names += (i ? ", " : "") + std::string(sources[i]);
+        known = known || trigger == sources[i];
+      }
+      g_free(sources);
+      if (!known) {
+        add_refusal("trigger " + trigger + " (it has: " + (names.empty() ? "none" : names) + ")",
+                    error, TriggerText(), report);
+      } else {
+        arv_camera_set_trigger(camera, trigger.c_str(), error.out());
+        if (error) add_refusal("trigger " + trigger, error, TriggerText(), report);
+      }
+    }
+    report->accepted.trigger = TriggerText();
+  }
+
+  // V4L2's controls, which GenICam has no standard feature for softsight to set.
+  void refuse_v4l2_only(const CameraSettings& settings, CameraSettingsReport* report) const {
     if (settings.white_balance_k) {
-      report.refused.push_back(name_ + ": white_balance " + ShortNumber(*settings.white_balance_k) +
-                               " refused (V4L2 only; set a GenICam camera's balance with its "
-                               "vendor's tool)");
-      report.accepted.white_balance_k.reset();
+      report->refused.push_back(name_ + ": white_balance " + ShortNumber(*settings.white_balance_k) +
+                                " refused (V4L2 only; set a GenICam camera's balance with its "
+                                "vendor's tool)");
+      report->accepted.white_balance_k.reset();
     }
     if (settings.focus) {
-      report.refused.push_back(name_ + ": focus " + ShortNumber(*settings.focus) +
-                               " refused (V4L2 only)");
-      report.accepted.focus.reset();
+      report->refused.push_back(name_ + ": focus " + ShortNumber(*settings.focus) +
+                                " refused (V4L2 only)");
+      report->accepted.focus.reset();
     }
+  }
 
+  // What the camera now runs with, read back (its frame rate kept for fps()), in one line.
+  std::string read_back() {
+    ArvCamera* camera = camera_.get();
     gint x = 0, y = 0, width = 0, height = 0;
     arv_camera_get_region(camera, &x, &y, &width, &height, nullptr);
     fps_ = arv_camera_get_frame_rate(camera, nullptr);
     if (!(fps_ && *fps_ > 0)) fps_.reset();
     const char* format = arv_camera_get_pixel_format_as_string(camera, nullptr);
-    report.summary = name_ + ": " + std::to_string(width) + "x" + std::to_string(height) + " " +
-                     (fps_ ? ShortNumber(*fps_) : std::string("?")) + " fps " +
-                     (format ? format : "?") + " exposure " +
-                     ShortNumber(arv_camera_get_exposure_time(camera, nullptr)) + " us gain " +
-                     ShortNumber(arv_camera_get_gain(camera, nullptr)) + " trigger " + TriggerText();
-    return report;
+    return name_ + ": " + std::to_string(width) + "x" + std::to_string(height) + " " +
+           (fps_ ? ShortNumber(*fps_) : std::string("?")) + " fps " + (format ? format : "?") +
+           " exposure " + ShortNumber(arv_camera_get_exposure_time(camera, nullptr)) +
+           " us gain " + ShortNumber(arv_camera_get_gain(camera, nullptr)) + " trigger " +
+           TriggerText();
   }
 
   // The format asked; any: the camera's own when softsight converts it and it is in colour

@@ -178,45 +178,113 @@ void AddLengthPanel(const PlotData& data, const Legend& legend, const std::strin
   if (!panel.series.empty()) panels->push_back(panel);
 }
 
+// The angle: measured (a track-stereo CSV's 3D angle beside each camera's), target and model.
+void AddAnglePanel(const PlotData& data, const Legend& legend, std::vector<PlotPanel>* panels) {
+  PlotPanel panel = MakePanel("angle [deg]");
+  panel.unit = "deg";
+  for (size_t t = 0; t < data.table_count(); ++t) {
+    const CsvTable& table = data.table(t);
+    const auto angle = table.find("angle_deg");
+    const auto target = table.find("target_deg");
+    const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
+    if (target) panel.series.push_back(Series(legend.label(t, "target"), *target, kTarget, t));
+    if (model) panel.series.push_back(Series(legend.label(t, "model"), *model, kTarget, t));
+    // A track-stereo CSV: the 3D angle beside what each camera alone measures.
+    const auto left = table.find("angle_left_deg"), right = table.find("angle_right_deg");
+    if (angle) {
+      const std::string quantity =
+          legend.single() ? (target || model ? "measured" : left ? "3D" : "angle") : "";
+      panel.series.push_back(Series(legend.label(t, quantity), *angle, legend.colour(t, kMeasured), t));
+    }
+    if (left && legend.single()) {
+      panel.series.push_back(Series("left camera", *left, kPalette[0], t));
+      if (right) panel.series.push_back(Series("right camera", *right, kPalette[1], t));
+    }
+  }
+  if (!panel.series.empty()) panels->push_back(panel);
+}
+
+// track-stereo: the bending plane's angle out of the reference plane.
+void AddPlanePanel(const PlotData& data, const Legend& legend, std::vector<PlotPanel>* panels) {
+  PlotPanel panel = MakePanel("out-of-plane angle [deg]");
+  panel.unit = "deg";
+  for (size_t t = 0; t < data.table_count(); ++t) {
+    const auto column = data.table(t).find("out_of_plane_deg");
+    if (column) {
+      panel.series.push_back(Series(legend.label(t, legend.single() ? "out of plane" : ""),
+                                    *column, legend.colour(t, kArc), t));
+    }
+  }
+  if (!panel.series.empty()) panels->push_back(panel);
+}
+
+// One panel per coordinate of every marker of the first run whose columns <m><axis> all exist
+// (`axes[0]` names them), in its column order.
+void AddCoordinatePanels(const PlotData& data, const Legend& legend,
+                         std::initializer_list<const char*> axes, const char* unit,
+                         std::vector<PlotPanel>* panels) {
+  const CsvTable& first = data.runs.front();
+  const std::string first_axis = *axes.begin();
+  for (const std::string& column : first.columns) {
+    if (column.size() < 3 || column.compare(column.size() - 2, 2, first_axis) != 0) continue;
+    const std::string name = column.substr(0, column.size() - 2);
+    if (!std::all_of(axes.begin() + 1, axes.end(),
+                     [&](const char* axis) { return first.find(name + axis).has_value(); })) {
+      continue;
+    }
+    for (const char* axis : axes) {
+      PlotPanel panel = MakePanel(name + " " + (axis + 1) + " [" + unit + "]");
+      panel.unit = unit;
+      for (size_t t = 0; t < data.table_count(); ++t) {
+        const auto c = data.table(t).find(name + axis);
+        if (c) panel.series.push_back(Series(legend.label(t, legend.single() ? name + " " + (axis + 1) : ""),
+                                       *c, legend.colour(t, kMeasured), t));
+      }
+      panels->push_back(panel);
+    }
+  }
+}
+
+// Controller columns: every pressure (a name with "pressure" or a pressure unit, such as
+// `softsight control`'s setpoint_kpa and board_pressure_kpa) in one panel, every duty*
+// column in another.
+void AddControllerPanels(const PlotData& data, const Legend& legend,
+                         std::vector<PlotPanel>* panels) {
+  const auto is_pressure = [](const std::string& column) {
+    const std::string unit = UnitOf(column);
+    return column.find("pressure") != std::string::npos || unit == "kPa" || unit == "Pa" ||
+           unit == "mbar" || unit == "bar" || unit == "psi";
+  };
+  const auto is_duty = [](const std::string& column) { return StartsWith(column, "duty"); };
+  const std::pair<const char*, bool (*)(const std::string&)> kControllerPanels[] = {
+      {"pressure", +is_pressure}, {"duty", +is_duty}};
+  for (const auto& [label, belongs] : kControllerPanels) {
+    PlotPanel panel;
+    std::string unit;
+    for (size_t t = 0; t < data.runs.size(); ++t) {
+      const CsvTable& table = data.runs[t];
+      for (size_t c = 0; c < table.columns.size(); ++c) {
+        if (!belongs(table.columns[c])) continue;
+        if (panel.series.empty()) unit = UnitOf(table.columns[c]);
+        const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
+        panel.series.push_back(Series(legend.label(t, table.columns[c]), c, colour, t));
+      }
+    }
+    if (!panel.series.empty()) {
+      panel.y_label = WithUnit(label, unit);
+      panel.unit = unit;
+      panels->push_back(panel);
+    }
+  }
+}
+
 // The panels of `kind`, appended to `panels`.
 void AddPanels(const std::string& kind, const PlotData& data, const Legend& legend,
                std::vector<PlotPanel>* panels) {
-  const CsvTable& first = data.runs.front();
   if (kind == "angle") {
-    PlotPanel panel = MakePanel("angle [deg]");
-    panel.unit = "deg";
-    for (size_t t = 0; t < data.table_count(); ++t) {
-      const CsvTable& table = data.table(t);
-      const auto angle = table.find("angle_deg");
-      const auto target = table.find("target_deg");
-      const auto model = table.find("model_angle_deg");  // `softsight identify --model-csv`.
-      if (target) panel.series.push_back(Series(legend.label(t, "target"), *target, kTarget, t));
-      if (model) panel.series.push_back(Series(legend.label(t, "model"), *model, kTarget, t));
-      // A track-stereo CSV: the 3D angle beside what each camera alone measures.
-      const auto left = table.find("angle_left_deg"), right = table.find("angle_right_deg");
-      if (angle) {
-        const std::string quantity =
-            legend.single() ? (target || model ? "measured" : left ? "3D" : "angle") : "";
-        panel.series.push_back(Series(legend.label(t, quantity), *angle, legend.colour(t, kMeasured), t));
-      }
-      if (left && legend.single()) {
-        panel.series.push_back(Series("left camera", *left, kPalette[0], t));
-        if (right) panel.series.push_back(Series("right camera", *right, kPalette[1], t));
-      }
-    }
-    if (!panel.series.empty()) panels->push_back(panel);
+    AddAnglePanel(data, legend, panels);
   } else if (kind == "plane") {
-    // track-stereo: the bending plane's angle out of the reference plane.
-    PlotPanel panel = MakePanel("out-of-plane angle [deg]");
-    panel.unit = "deg";
-    for (size_t t = 0; t < data.table_count(); ++t) {
-      const auto column = data.table(t).find("out_of_plane_deg");
-      if (column) {
-        panel.series.push_back(Series(legend.label(t, legend.single() ? "out of plane" : ""),
-                                      *column, legend.colour(t, kArc), t));
-      }
-    }
-    if (!panel.series.empty()) panels->push_back(panel);
+    AddPlanePanel(data, legend, panels);
   } else if (kind == "bending") {
     AddLengthPanel(data, legend, "tip_disp", "bending distance", kBending, panels);
   } else if (kind == "arc") {
@@ -227,66 +295,10 @@ void AddPanels(const std::string& kind, const PlotData& data, const Legend& lege
   } else if (kind == "xy") {
     // The markers of the first run, in its column order: one panel for x, one for y each; a
     // track-stereo CSV's markers in 3D (<m>_X, _Y, _Z, mm): one panel per coordinate.
-    for (const std::string& column : first.columns) {
-      if (column.size() < 3 || column.compare(column.size() - 2, 2, "_X") != 0) continue;
-      const std::string name = column.substr(0, column.size() - 2);
-      if (!first.find(name + "_Y") || !first.find(name + "_Z")) continue;
-      for (const char* axis : {"_X", "_Y", "_Z"}) {
-        PlotPanel panel = MakePanel(name + " " + (axis + 1) + " [mm]");
-        panel.unit = "mm";
-        for (size_t t = 0; t < data.table_count(); ++t) {
-          const auto c = data.table(t).find(name + axis);
-          if (c) panel.series.push_back(Series(legend.label(t, legend.single() ? name + " " + (axis + 1) : ""),
-                                         *c, legend.colour(t, kMeasured), t));
-        }
-        panels->push_back(panel);
-      }
-    }
-    for (const std::string& column : first.columns) {
-      if (column.size() < 3 || column.compare(column.size() - 2, 2, "_x") != 0) continue;
-      const std::string name = column.substr(0, column.size() - 2);
-      if (!first.find(name + "_y")) continue;
-      for (const char* axis : {"_x", "_y"}) {
-        PlotPanel panel = MakePanel(name + " " + (axis + 1) + " [px]");
-        panel.unit = "px";
-        for (size_t t = 0; t < data.table_count(); ++t) {
-          const auto c = data.table(t).find(name + axis);
-          if (c) panel.series.push_back(Series(legend.label(t, legend.single() ? name + " " + (axis + 1) : ""),
-                                         *c, legend.colour(t, kMeasured), t));
-        }
-        panels->push_back(panel);
-      }
-    }
+    AddCoordinatePanels(data, legend, {"_X", "_Y", "_Z"}, "mm", panels);
+    AddCoordinatePanels(data, legend, {"_x", "_y"}, "px", panels);
   } else if (kind == "control") {
-    // Controller columns: every pressure (a name with "pressure" or a pressure unit, such as
-    // `softsight control`'s setpoint_kpa and board_pressure_kpa) in one panel, every duty*
-    // column in another.
-    const auto is_pressure = [](const std::string& column) {
-      const std::string unit = UnitOf(column);
-      return column.find("pressure") != std::string::npos || unit == "kPa" || unit == "Pa" ||
-             unit == "mbar" || unit == "bar" || unit == "psi";
-    };
-    const auto is_duty = [](const std::string& column) { return StartsWith(column, "duty"); };
-    const std::pair<const char*, bool (*)(const std::string&)> kControllerPanels[] = {
-        {"pressure", +is_pressure}, {"duty", +is_duty}};
-    for (const auto& [label, belongs] : kControllerPanels) {
-      PlotPanel panel;
-      std::string unit;
-      for (size_t t = 0; t < data.runs.size(); ++t) {
-        const CsvTable& table = data.runs[t];
-        for (size_t c = 0; c < table.columns.size(); ++c) {
-          if (!belongs(table.columns[c])) continue;
-          if (panel.series.empty()) unit = UnitOf(table.columns[c]);
-          const cv::Scalar colour = kPalette[panel.series.size() % std::size(kPalette)];
-          panel.series.push_back(Series(legend.label(t, table.columns[c]), c, colour, t));
-        }
-      }
-      if (!panel.series.empty()) {
-        panel.y_label = WithUnit(label, unit);
-        panel.unit = unit;
-        panels->push_back(panel);
-      }
-    }
+    AddControllerPanels(data, legend, panels);
   }
 }
 

@@ -155,20 +155,18 @@ cv::Vec3f PatchColour(PatchTint tint, const cv::Vec3f& wood, cv::RNG& rng) {
   return wood;
 }
 
-}  // namespace
+// A point of the image to the supersampled image (pixel centres kept).
+cv::Point SupersampledPixel(int s, const cv::Point2d& p) {
+  return cv::Point(cvRound((p.x + 0.5) * s - 0.5), cvRound((p.y + 0.5) * s - 0.5));
+}
 
-void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* background_ss,
-                           cv::Mat* background) {
-  cv::RNG rng(seed * 0xD1B54A32D192ED03ull + 0x8CB92BA72F3D8DD7ull);
-  const int s = supersample;
-  const double w = size.width, h = size.height;
-  const double scale = std::min(w, h) / 480.0;
-
-  // Wood: a base colour between light oak and walnut, grain stripes along a near-horizontal
-  // direction warped by a smooth field, streaks stretched along the grain.
+// Wood: a base colour (`wood`) between light oak and walnut, grain stripes along a
+// near-horizontal direction warped by a smooth field, streaks stretched along the grain.
+cv::Mat3f WoodGrain(cv::Size size, double scale, cv::RNG& rng, cv::Vec3f* wood_out) {
   const double mix = rng.uniform(0.0, 1.0);
   const cv::Vec3f oak(112, 160, 200), walnut(62, 96, 138);
   const cv::Vec3f wood = oak * static_cast<float>(1 - mix) + walnut * static_cast<float>(mix);
+  *wood_out = wood;
   const double grain_angle = rng.uniform(-0.25, 0.25);
   const double period = rng.uniform(7.0, 13.0) * scale + 2.0;
   const cv::Mat1f warp = SmoothField(size, 4, 1.0, rng);
@@ -193,8 +191,14 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
       out[x] = wood * m;
     }
   }
+  return bench;
+}
 
-  // Patches: ragged blotches (an ellipse eaten by a smooth field), in every colour class.
+// Patches: ragged blotches (an ellipse eaten by a smooth field), in every colour class.
+void AddPatches(const cv::Vec3f& wood, double scale, uint64_t seed, cv::RNG& rng,
+                cv::Mat3f& bench) {
+  const cv::Size size = bench.size();
+  const double w = size.width, h = size.height;
   const cv::Mat1f ragged = SmoothField(size, 16, 1.0, rng);
   const int patches = std::max(8, static_cast<int>(std::lround(14 * w * h / (640.0 * 480.0))));
   for (int i = 0; i < patches; ++i) {
@@ -221,6 +225,11 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
       }
     }
   }
+}
+
+// The sensor's grain over the bench, to 8 bits.
+cv::Mat3b WithGrain(const cv::Mat3f& bench, cv::RNG& rng) {
+  const cv::Size size = bench.size();
   cv::Mat1f grain(size);
   rng.fill(grain, cv::RNG::NORMAL, 0.0, 4.0);
   cv::Mat3b low(size);
@@ -231,14 +240,12 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
       for (int k = 0; k < 3; ++k) out[x][k] = cv::saturate_cast<uchar>(in[x][k] + grain(y, x));
     }
   }
-  cv::resize(low, *background_ss, cv::Size(size.width * s, size.height * s), 0, 0,
-             cv::INTER_LINEAR);
-  cv::Mat& ss = *background_ss;
-  auto to_ss = [s](const cv::Point2d& p) {
-    return cv::Point(cvRound((p.x + 0.5) * s - 0.5), cvRound((p.y + 0.5) * s - 0.5));
-  };
+  return low;
+}
 
-  // Tape strips: long rotated rectangles, slightly translucent, with a darker edge line.
+// Tape strips: long rotated rectangles, slightly translucent, with a darker edge line.
+void AddTapes(cv::Size size, double scale, int s, cv::RNG& rng, cv::Mat& ss) {
+  const double w = size.width, h = size.height;
   const cv::Scalar tapes[] = {{150, 196, 214},   // masking tape
                               {158, 160, 162},   // grey duct tape
                               {228, 230, 232},   // white tape
@@ -250,10 +257,10 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
     const double width = rng.uniform(14.0, 26.0) * scale + 2;
     const double a = rng.uniform(0.0, CV_PI);
     const cv::Point2d d(std::cos(a), std::sin(a)), n(-std::sin(a), std::cos(a));
-    const cv::Point corners[4] = {to_ss(c - d * (length / 2) - n * (width / 2)),
-                                  to_ss(c + d * (length / 2) - n * (width / 2)),
-                                  to_ss(c + d * (length / 2) + n * (width / 2)),
-                                  to_ss(c - d * (length / 2) + n * (width / 2))};
+    const cv::Point corners[4] = {SupersampledPixel(s, c - d * (length / 2) - n * (width / 2)),
+                                  SupersampledPixel(s, c + d * (length / 2) - n * (width / 2)),
+                                  SupersampledPixel(s, c + d * (length / 2) + n * (width / 2)),
+                                  SupersampledPixel(s, c - d * (length / 2) + n * (width / 2))};
     const cv::Scalar colour = tapes[rng.uniform(0, 4)];
     cv::Mat layer = ss.clone();
     cv::fillConvexPoly(layer, corners, 4, colour, cv::LINE_8);
@@ -261,14 +268,17 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
                   std::max(1, s / 2), cv::LINE_8);
     cv::addWeighted(layer, 0.88, ss, 0.12, 0.0, ss);
   }
+}
 
-  // A cable: a long thin curve across the bench, dark with a highlight.
+// A cable: a long thin curve across the bench, dark with a highlight.
+void AddCable(cv::Size size, double scale, int s, cv::RNG& rng, cv::Mat& ss) {
+  const double w = size.width, h = size.height;
   const cv::Point2d ctrl[4] = {{rng.uniform(-0.1, 0.3) * w, -10},
                                {rng.uniform(-0.2, 1.2) * w, rng.uniform(0.2, 0.5) * h},
                                {rng.uniform(-0.2, 1.2) * w, rng.uniform(0.5, 0.8) * h},
                                {rng.uniform(0.7, 1.1) * w, h + 10}};
   std::vector<cv::Point> cable;
-  for (int i = 0; i <= 96; ++i) cable.push_back(to_ss(Bezier(ctrl, i / 96.0)));
+  for (int i = 0; i <= 96; ++i) cable.push_back(SupersampledPixel(s, Bezier(ctrl, i / 96.0)));
   const double cable_px = rng.uniform(3.5, 6.0) * scale + 1;
   const int grey = rng.uniform(22, 48);
   cv::polylines(ss, cable, false, cv::Scalar(grey, grey, grey + 4), cvRound(cable_px * s),
@@ -277,6 +287,25 @@ void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Ma
   for (cv::Point& p : shine) p.x -= cvRound(0.2 * cable_px * s);
   cv::polylines(ss, shine, false, cv::Scalar(grey + 45, grey + 45, grey + 48),
                 std::max(1, cvRound(0.2 * cable_px * s)), cv::LINE_8);
+}
+
+}  // namespace
+
+void RenderBenchBackground(cv::Size size, int supersample, uint64_t seed, cv::Mat* background_ss,
+                           cv::Mat* background) {
+  cv::RNG rng(seed * 0xD1B54A32D192ED03ull + 0x8CB92BA72F3D8DD7ull);
+  const int s = supersample;
+  const double scale = std::min(size.width, size.height) / 480.0;
+  // One generator through every step, in this order: a seed gives the same bench.
+  cv::Vec3f wood;
+  cv::Mat3f bench = WoodGrain(size, scale, rng, &wood);
+  AddPatches(wood, scale, seed, rng, bench);
+  const cv::Mat3b low = WithGrain(bench, rng);
+  cv::resize(low, *background_ss, cv::Size(size.width * s, size.height * s), 0, 0,
+             cv::INTER_LINEAR);
+  cv::Mat& ss = *background_ss;
+  AddTapes(size, scale, s, rng, ss);
+  AddCable(size, scale, s, rng, ss);
   cv::resize(ss, *background, size, 0, 0, cv::INTER_AREA);
 }
 

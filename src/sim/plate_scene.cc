@@ -11,6 +11,7 @@
 #include "sim/camera.h"
 #include "sim/distractors.h"
 #include "sim/raster.h"
+#include "sim/scene_checks.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -25,11 +26,6 @@ constexpr double kMarginRadii = 2.5;
 // Margin kept between the plate and the image border where the path has room for it.
 constexpr double kBorderFraction = 0.03;
 
-
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
-}
 
 cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
   const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
@@ -46,14 +42,7 @@ cv::Matx33d AxisRotation(const cv::Vec3d& axis, double angle) {
 }  // namespace
 
 bool PlateSceneOptions::Check(std::string* error) const {
-  if (size.width < 16 || size.height < 16 || size.width > 8192 || size.height > 8192) {
-    return Fail(error, "size: must be between 16x16 and 8192x8192 pixels, got " +
-                           std::to_string(size.width) + "x" + std::to_string(size.height));
-  }
-  if (frame_count < 1) {
-    return Fail(error, "frame_count: must be at least 1, got " + std::to_string(frame_count));
-  }
-  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + ShortNumber(fps));
+  if (!sim::CheckVideoShape(size, frame_count, fps, error)) return false;
   if (dot_count < 1 || dot_count > kMaxDots) {
     return Fail(error, "dot_count: must be in [1, " + std::to_string(kMaxDots) + "], got " +
                            std::to_string(dot_count));

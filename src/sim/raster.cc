@@ -10,6 +10,15 @@ namespace {
 
 constexpr int kShiftBits = 8;  // Sub-pixel vertex precision for cv::fillPoly.
 
+// Paints `bgr` over the pixel `p` in proportion to the shape's coverage `c` of it (0, 1].
+void BlendPixel(const cv::Vec3b& bgr, double c, cv::Vec3b& p) {
+  if (c >= 1) {
+    p = bgr;
+  } else {
+    for (int k = 0; k < 3; ++k) p[k] = cv::saturate_cast<uchar>(p[k] + c * (bgr[k] - p[k]));
+  }
+}
+
 }  // namespace
 
 bool DiscSpan(const cv::Point2d& c, double r, int y, int* x0, int* x1) {
@@ -90,12 +99,7 @@ void FillDisc(const cv::Point2d& centre, double radius, const cv::Point& origin,
     for (int x = x0; x <= x1; ++x) {
       const double c = DiscCoverage(centre, radius, x, y);
       if (c <= 0) continue;
-      cv::Vec3b& p = row[x - origin.x];
-      if (c >= 1) {
-        p = bgr;
-      } else {
-        for (int k = 0; k < 3; ++k) p[k] = cv::saturate_cast<uchar>(p[k] + c * (bgr[k] - p[k]));
-      }
+      BlendPixel(bgr, c, row[x - origin.x]);
     }
   }
 }
@@ -160,12 +164,7 @@ void FillConic(const Conic& conic, const cv::Point& origin, const cv::Vec3b& bgr
     for (int x = box.x; x < box.x + box.width; ++x) {
       const double c = conic.coverage(x, y);
       if (c <= 0) continue;
-      cv::Vec3b& p = row[x - origin.x];
-      if (c >= 1) {
-        p = bgr;
-      } else {
-        for (int k = 0; k < 3; ++k) p[k] = cv::saturate_cast<uchar>(p[k] + c * (bgr[k] - p[k]));
-      }
+      BlendPixel(bgr, c, row[x - origin.x]);
     }
   }
 }

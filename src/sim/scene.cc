@@ -15,6 +15,7 @@
 #include "sim/camera.h"
 #include "sim/distractors.h"
 #include "sim/raster.h"
+#include "sim/scene_checks.h"
 #include "softsight/core/error.h"
 
 namespace softsight {
@@ -23,23 +24,10 @@ namespace {
 // Beyond this the bending band would run into its own base.
 constexpr double kMaxBendingDeg = 330.0;
 
-
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
-}
-
 }  // namespace
 
 bool SceneOptions::Check(std::string* error) const {
-  if (size.width < 16 || size.height < 16 || size.width > 8192 || size.height > 8192) {
-    return Fail(error, "size: must be between 16x16 and 8192x8192 pixels, got " +
-                           std::to_string(size.width) + "x" + std::to_string(size.height));
-  }
-  if (frame_count < 1) {
-    return Fail(error, "frame_count: must be at least 1, got " + std::to_string(frame_count));
-  }
-  if (!(std::isfinite(fps) && fps > 0)) return Fail(error, "fps: must be > 0, got " + ShortNumber(fps));
+  if (!sim::CheckVideoShape(size, frame_count, fps, error)) return false;
   if (!(std::isfinite(length_px) && length_px > 0)) {
     return Fail(error, "length_px: must be > 0, got " + ShortNumber(length_px));
   }

@@ -34,6 +34,122 @@ cv::Point2d Project(const CameraModel& camera, const cv::Matx33d& rotation,
 cv::Point3d ToPoint(const cv::Vec3d& v) { return cv::Point3d(v[0], v[1], v[2]); }
 cv::Vec3d ToVec(const cv::Point3d& p) { return cv::Vec3d(p.x, p.y, p.z); }
 
+// The body: its centre line as a thick anti-aliased polyline (not part of the truth).
+void DrawBody(const StereoSceneOptions& o, const CameraModel& camera, const cv::Mat& distortion,
+              const cv::Matx33d& rotation, const cv::Vec3d& rvec, const cv::Vec3d& translation,
+              const StereoSceneTruth& truth, cv::Mat& image) {
+  const double curvature = truth.bend_deg * kStereoDegToRad / o.length_mm;
+  const cv::Vec3d d0 = cv::normalize(o.straight_direction);
+  const cv::Vec3d bend_direction = truth.plane_normal.cross(d0);
+  std::vector<cv::Point3d> line;
+  for (int i = 0; i <= 48; ++i) {
+    const double s = o.length_mm * i / 48.0;
+    const cv::Vec3d p = curvature > 0
+                            ? ToVec(o.base_mm) + (std::sin(curvature * s) / curvature) * d0 +
+                                  ((1.0 - std::cos(curvature * s)) / curvature) * bend_direction
+                            : ToVec(o.base_mm) + s * d0;
+    line.push_back(ToPoint(p));
+  }
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(line, rvec, translation, camera.camera_matrix, distortion, projected);
+  std::vector<cv::Point> polyline;
+  constexpr int kShift = 4;  // Sub-pixel vertices for the anti-aliased line.
+  for (const cv::Point2d& p : projected) {
+    polyline.emplace_back(cv::saturate_cast<int>(p.x * (1 << kShift)),
+                          cv::saturate_cast<int>(p.y * (1 << kShift)));
+  }
+  const double depth = (rotation * ToVec(o.base_mm) + translation)[2];
+  const int thickness = std::max(
+      1, static_cast<int>(std::lround(o.body_width_mm * camera.camera_matrix(0, 0) / depth)));
+  cv::polylines(image, polyline, false, cv::Scalar(o.body_bgr[0], o.body_bgr[1], o.body_bgr[2]),
+                thickness, cv::LINE_AA, kShift);
+}
+
+// The pixels a marker's disc (centre and normal in the camera's frame) may cover: its projected
+// rim's bounds, with a margin, within the image.
+cv::Rect DiscBox(const CameraModel& camera, const cv::Mat& distortion, const cv::Vec3d& centre,
+                 const cv::Vec3d& normal, double radius_mm, const cv::Size& image_size) {
+  cv::Vec3d u = normal.cross(cv::Vec3d(0, 0, 1));
+  if (cv::norm(u) < 1e-9) u = cv::Vec3d(1, 0, 0);
+  u = cv::normalize(u);
+  const cv::Vec3d v = normal.cross(u);
+  std::vector<cv::Point3d> rim;
+  for (int k = 0; k < 32; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / 32.0;
+    rim.push_back(ToPoint(centre + radius_mm * (std::cos(a) * u + std::sin(a) * v)));
+  }
+  std::vector<cv::Point2d> rim_px;
+  cv::projectPoints(rim, cv::Vec3d(), cv::Vec3d(), camera.camera_matrix, distortion, rim_px);
+  const cv::Rect2d bounds =
+      cv::boundingRect(std::vector<cv::Point2f>(rim_px.begin(), rim_px.end()));
+  return cv::Rect(static_cast<int>(std::floor(bounds.x)) - 2,
+                  static_cast<int>(std::floor(bounds.y)) - 2,
+                  static_cast<int>(std::ceil(bounds.width)) + 5,
+                  static_cast<int>(std::ceil(bounds.height)) + 5) &
+         cv::Rect(0, 0, image_size.width, image_size.height);
+}
+
+// A pixel takes the marker's colour in proportion to its s x s sub-samples whose rays (through
+// the lens model, undistorted) meet the disc's plane inside the disc.
+void FillMarkerDisc(const CameraModel& camera, const cv::Mat& distortion, const cv::Vec3d& centre,
+                    const cv::Vec3d& normal, double radius_mm, const cv::Vec3b& colour, int s,
+                    const cv::Rect& box, cv::Mat& image) {
+  std::vector<cv::Point2d> samples;
+  samples.reserve(static_cast<size_t>(box.area() * s * s));
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      for (int i = 0; i < s; ++i) {
+        for (int j = 0; j < s; ++j) {
+          samples.emplace_back(x - 0.5 + (j + 0.5) / s, y - 0.5 + (i + 0.5) / s);
+        }
+      }
+    }
+  }
+  std::vector<cv::Point2d> rays;
+  cv::undistortPoints(
+      samples, rays, camera.camera_matrix, distortion, cv::noArray(), cv::noArray(),
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+  const double plane_offset = normal.dot(centre);
+  const double r2 = radius_mm * radius_mm;
+  size_t k = 0;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    cv::Vec3b* row = image.ptr<cv::Vec3b>(y);
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      int inside = 0;
+      for (int q = 0; q < s * s; ++q, ++k) {
+        const cv::Vec3d ray(rays[k].x, rays[k].y, 1.0);
+        const double along = normal.dot(ray);
+        if (std::abs(along) < 1e-12) continue;
+        const cv::Vec3d hit = (plane_offset / along) * ray - centre;
+        if (hit.dot(hit) <= r2) ++inside;
+      }
+      if (inside == 0) continue;
+      const double a = static_cast<double>(inside) / (s * s);
+      for (int c = 0; c < 3; ++c) {
+        row[x][c] = cv::saturate_cast<uint8_t>((1.0 - a) * row[x][c] + a * colour[c]);
+      }
+    }
+  }
+}
+
+// The flash (a frame range brightened) and the sensor's noise, seeded per frame and view.
+void AddFlashAndNoise(const StereoSceneOptions& o, int index, int view, cv::Mat& image) {
+  if (o.flash_frame && index >= *o.flash_frame &&
+      (o.flash_length_frames == 0 || index < *o.flash_frame + o.flash_length_frames)) {
+    image += cv::Scalar::all(o.flash_gray);  // Saturating.
+  }
+
+  if (o.noise_sigma > 0) {
+    cv::Mat noise(image.size(), CV_32FC3);
+    cv::RNG rng(sim::Mix(o.seed, static_cast<uint64_t>(index) * 2 + static_cast<uint64_t>(view)));
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
+    cv::Mat as_float;
+    image.convertTo(as_float, CV_32FC3);
+    as_float += noise;
+    as_float.convertTo(image, CV_8UC3);
+  }
+}
+
 }  // namespace
 
 StereoRig MakeStereoRig(double baseline_mm, double convergence_mm) {
@@ -219,33 +335,8 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
   cv::Vec3d rvec;
   cv::Rodrigues(rotation, rvec);
 
-  // The body: its centre line as a thick anti-aliased polyline (not part of the truth).
   if (o.body_width_mm > 0) {
-    const double curvature = truth.bend_deg * kStereoDegToRad / o.length_mm;
-    const cv::Vec3d d0 = cv::normalize(o.straight_direction);
-    const cv::Vec3d bend_direction = truth.plane_normal.cross(d0);
-    std::vector<cv::Point3d> line;
-    for (int i = 0; i <= 48; ++i) {
-      const double s = o.length_mm * i / 48.0;
-      const cv::Vec3d p = curvature > 0
-                              ? ToVec(o.base_mm) + (std::sin(curvature * s) / curvature) * d0 +
-                                    ((1.0 - std::cos(curvature * s)) / curvature) * bend_direction
-                              : ToVec(o.base_mm) + s * d0;
-      line.push_back(ToPoint(p));
-    }
-    std::vector<cv::Point2d> projected;
-    cv::projectPoints(line, rvec, translation, camera.camera_matrix, distortion, projected);
-    std::vector<cv::Point> polyline;
-    constexpr int kShift = 4;  // Sub-pixel vertices for the anti-aliased line.
-    for (const cv::Point2d& p : projected) {
-      polyline.emplace_back(cv::saturate_cast<int>(p.x * (1 << kShift)),
-                            cv::saturate_cast<int>(p.y * (1 << kShift)));
-    }
-    const double depth = (rotation * ToVec(o.base_mm) + translation)[2];
-    const int thickness = std::max(
-        1, static_cast<int>(std::lround(o.body_width_mm * camera.camera_matrix(0, 0) / depth)));
-    cv::polylines(image, polyline, false, cv::Scalar(o.body_bgr[0], o.body_bgr[1], o.body_bgr[2]),
-                  thickness, cv::LINE_AA, kShift);
+    DrawBody(o, camera, distortion, rotation, rvec, translation, truth, image);
   }
 
   // The markers: flat discs in the bending plane's orientation. Each sub-sample's ray (through
@@ -261,78 +352,14 @@ void StereoScene::draw(const CameraModel& camera, const cv::Matx33d& rotation,
     const bool hidden = std::any_of(o.hidden.begin(), o.hidden.end(), covers);
     if (hidden) continue;
     const cv::Vec3d centre = rotation * ToVec(truth.markers[m].position_mm) + translation;
-    cv::Vec3d u = normal.cross(cv::Vec3d(0, 0, 1));
-    if (cv::norm(u) < 1e-9) u = cv::Vec3d(1, 0, 0);
-    u = cv::normalize(u);
-    const cv::Vec3d v = normal.cross(u);
-    std::vector<cv::Point3d> rim;
-    for (int k = 0; k < 32; ++k) {
-      const double a = 2.0 * std::numbers::pi * k / 32.0;
-      rim.push_back(ToPoint(centre + o.marker_radius_mm * (std::cos(a) * u + std::sin(a) * v)));
-    }
-    std::vector<cv::Point2d> rim_px;
-    cv::projectPoints(rim, cv::Vec3d(), cv::Vec3d(), camera.camera_matrix, distortion, rim_px);
-    const cv::Rect2d bounds =
-        cv::boundingRect(std::vector<cv::Point2f>(rim_px.begin(), rim_px.end()));
-    const cv::Rect box = cv::Rect(static_cast<int>(std::floor(bounds.x)) - 2,
-                                  static_cast<int>(std::floor(bounds.y)) - 2,
-                                  static_cast<int>(std::ceil(bounds.width)) + 5,
-                                  static_cast<int>(std::ceil(bounds.height)) + 5) &
-                         cv::Rect(0, 0, image.cols, image.rows);
+    const cv::Rect box =
+        DiscBox(camera, distortion, centre, normal, o.marker_radius_mm, image.size());
     if (box.empty()) continue;
-    std::vector<cv::Point2d> samples;
-    samples.reserve(static_cast<size_t>(box.area() * s * s));
-    for (int y = box.y; y < box.y + box.height; ++y) {
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        for (int i = 0; i < s; ++i) {
-          for (int j = 0; j < s; ++j) {
-            samples.emplace_back(x - 0.5 + (j + 0.5) / s, y - 0.5 + (i + 0.5) / s);
-          }
-        }
-      }
-    }
-    std::vector<cv::Point2d> rays;
-    cv::undistortPoints(
-        samples, rays, camera.camera_matrix, distortion, cv::noArray(), cv::noArray(),
-        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-    const double plane_offset = normal.dot(centre);
-    const double r2 = o.marker_radius_mm * o.marker_radius_mm;
-    const cv::Vec3b colour = o.markers[m].bgr;
-    size_t k = 0;
-    for (int y = box.y; y < box.y + box.height; ++y) {
-      cv::Vec3b* row = image.ptr<cv::Vec3b>(y);
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        int inside = 0;
-        for (int q = 0; q < s * s; ++q, ++k) {
-          const cv::Vec3d ray(rays[k].x, rays[k].y, 1.0);
-          const double along = normal.dot(ray);
-          if (std::abs(along) < 1e-12) continue;
-          const cv::Vec3d hit = (plane_offset / along) * ray - centre;
-          if (hit.dot(hit) <= r2) ++inside;
-        }
-        if (inside == 0) continue;
-        const double a = static_cast<double>(inside) / (s * s);
-        for (int c = 0; c < 3; ++c) {
-          row[x][c] = cv::saturate_cast<uint8_t>((1.0 - a) * row[x][c] + a * colour[c]);
-        }
-      }
-    }
+    FillMarkerDisc(camera, distortion, centre, normal, o.marker_radius_mm, o.markers[m].bgr, s,
+                   box, image);
   }
 
-  if (o.flash_frame && index >= *o.flash_frame &&
-      (o.flash_length_frames == 0 || index < *o.flash_frame + o.flash_length_frames)) {
-    image += cv::Scalar::all(o.flash_gray);  // Saturating.
-  }
-
-  if (o.noise_sigma > 0) {
-    cv::Mat noise(image.size(), CV_32FC3);
-    cv::RNG rng(sim::Mix(o.seed, static_cast<uint64_t>(index) * 2 + static_cast<uint64_t>(view)));
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
-    cv::Mat as_float;
-    image.convertTo(as_float, CV_32FC3);
-    as_float += noise;
-    as_float.convertTo(image, CV_8UC3);
-  }
+  AddFlashAndNoise(o, index, view, image);
 }
 
 }  // namespace softsight

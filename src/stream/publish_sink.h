@@ -91,8 +91,6 @@ class PublishSink : public FrameSink {
   const std::string& endpoint() const { return bound_endpoint_; }
   int64_t sent() const { return sent_; }        // Messages handed to ZeroMQ.
   int64_t dropped() const { return dropped_; }  // Of those, missed by at least one subscriber.
-  // Capture-to-send latency of every frame record sent, ms (for the benchmark).
-  const std::vector<double>& send_latencies_ms() const { return send_latency_ms_; }
 
  private:
   // Reads the subscriptions that arrived; a new one to "hello" gets the hello.

@@ -89,11 +89,82 @@ bool NeedFrame(const PageLimits& limits, const char* type, std::string* error) {
   return false;
 }
 
+// A point of the frame (x, y). Pixel centres are at integers: the image spans -0.5 .. size - 0.5.
+bool ReadPoint(const Json& m, const char* type, const PageLimits& limits, PageCommand* c,
+               std::string* error) {
+  const double w = limits.frame_size.width, h = limits.frame_size.height;
+  return NeedFrame(limits, type, error) && Number(m, type, "x", 0, w - 1, &c->point_px.x, error) &&
+         Number(m, type, "y", 0, h - 1, &c->point_px.y, error);
+}
+
+// A box of at least 3 x 3 pixels inside the frame (x, y, w, h).
+bool ReadBox(const Json& m, const char* type, const PageLimits& limits, PageCommand* c,
+             std::string* error) {
+  const double w = limits.frame_size.width, h = limits.frame_size.height;
+  int64_t x = 0, y = 0, bw = 0, bh = 0;
+  if (!NeedFrame(limits, type, error) || !Integer(m, type, "x", 0, w - 1, &x, error) ||
+      !Integer(m, type, "y", 0, h - 1, &y, error) || !Integer(m, type, "w", 3, w - x, &bw, error) ||
+      !Integer(m, type, "h", 3, h - y, &bh, error)) {
+    return false;
+  }
+  c->box_px = cv::Rect(static_cast<int>(x), static_cast<int>(y), static_cast<int>(bw),
+                       static_cast<int>(bh));
+  return true;
+}
+
+// Two points of the frame and the distance between them in mm. A distance of 0 (or a negative
+// one) is no scale; a million mm is a kilometre.
+bool ReadScale(const Json& m, const char* type, const PageLimits& limits, PageCommand* c,
+               std::string* error) {
+  const double w = limits.frame_size.width, h = limits.frame_size.height;
+  if (!NeedFrame(limits, type, error) || !Number(m, type, "ax", 0, w - 1, &c->point_px.x, error) ||
+      !Number(m, type, "ay", 0, h - 1, &c->point_px.y, error) ||
+      !Number(m, type, "bx", 0, w - 1, &c->point_b_px.x, error) ||
+      !Number(m, type, "by", 0, h - 1, &c->point_b_px.y, error) ||
+      !Number(m, type, "mm", 0, 1e6, &c->distance_mm, error)) {
+    return false;
+  }
+  if (c->distance_mm <= 0) {
+    *error = "scale: mm must be above 0";
+    return false;
+  }
+  return true;
+}
+
+// The config's name of a save or a load.
+bool ReadConfigName(const Json& m, const TypeInfo& info, PageCommand* c, std::string* error) {
+  if (!m.at("name").is_string()) {
+    *error = std::string(info.name) + ": name must be a string";
+    return false;
+  }
+  c->name = m.at("name").get<std::string>();
+  if (!ValidConfigName(c->name, error)) {
+    if (info.kind == Kind::kLoad) error->replace(0, 4, "load");  // "save: ..." -> "load: ...".
+    return false;
+  }
+  return true;
+}
+
+// A target profile's text, with the profile file's own checks (its bounds, every angle in
+// 0..180): a page's profile is no less checked than a file given to `control --profile`.
+bool ReadProfile(const Json& m, PageCommand* c, std::string* error) {
+  if (!m.at("text").is_string()) {
+    *error = "rig_profile: text must be a string";
+    return false;
+  }
+  try {
+    c->profile = TargetProfile::Parse(m.at("text").get<std::string>(), "rig_profile");
+  } catch (const std::exception& refused) {
+    *error = refused.what();
+    return false;
+  }
+  return true;
+}
+
 // The fields of a known type, checked against the run.
 bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, PageCommand* c,
                 std::string* error) {
   const char* type = info.name;
-  const double w = limits.frame_size.width, h = limits.frame_size.height;
   int64_t integer = 0;
   switch (info.kind) {
     case Kind::kStep:
@@ -113,43 +184,18 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
     case Kind::kSpeed:
       return Number(m, type, "value", 0.1, 4.0, &c->speed, error);
     case Kind::kPick:
-      // Pixel centres are at integers: the image spans -0.5 .. size - 0.5.
-      return NeedFrame(limits, type, error) && Number(m, type, "x", 0, w - 1, &c->point_px.x, error) &&
-             Number(m, type, "y", 0, h - 1, &c->point_px.y, error);
-    case Kind::kSelect: {
-      int64_t x = 0, y = 0, bw = 0, bh = 0;
-      if (!NeedFrame(limits, type, error) || !Integer(m, type, "x", 0, w - 1, &x, error) ||
-          !Integer(m, type, "y", 0, h - 1, &y, error) || !Integer(m, type, "w", 3, w - x, &bw, error) ||
-          !Integer(m, type, "h", 3, h - y, &bh, error)) {
-        return false;
-      }
-      c->box_px = cv::Rect(static_cast<int>(x), static_cast<int>(y), static_cast<int>(bw),
-                           static_cast<int>(bh));
-      return true;
-    }
+      return ReadPoint(m, type, limits, c, error);
+    case Kind::kSelect:
+      return ReadBox(m, type, limits, c, error);
     case Kind::kRange:
       if (!m.at("grow").is_boolean()) {
         *error = "range: grow must be true or false";
         return false;
       }
       c->grow = m.at("grow").get<bool>();
-      return NeedFrame(limits, type, error) && Number(m, type, "x", 0, w - 1, &c->point_px.x, error) &&
-             Number(m, type, "y", 0, h - 1, &c->point_px.y, error);
-    case Kind::kScale: {
-      // A distance of 0 (or a negative one) is no scale; a million mm is a kilometre.
-      if (!NeedFrame(limits, type, error) || !Number(m, type, "ax", 0, w - 1, &c->point_px.x, error) ||
-          !Number(m, type, "ay", 0, h - 1, &c->point_px.y, error) ||
-          !Number(m, type, "bx", 0, w - 1, &c->point_b_px.x, error) ||
-          !Number(m, type, "by", 0, h - 1, &c->point_b_px.y, error) ||
-          !Number(m, type, "mm", 0, 1e6, &c->distance_mm, error)) {
-        return false;
-      }
-      if (c->distance_mm <= 0) {
-        *error = "scale: mm must be above 0";
-        return false;
-      }
-      return true;
-    }
+      return ReadPoint(m, type, limits, c, error);
+    case Kind::kScale:
+      return ReadScale(m, type, limits, c, error);
     case Kind::kMarker:
       if (!Integer(m, type, "index", 0, std::max(0, limits.markers - 1), &integer, error)) {
         return false;
@@ -158,16 +204,7 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
       return true;
     case Kind::kSave:
     case Kind::kLoad:
-      if (!m.at("name").is_string()) {
-        *error = std::string(type) + ": name must be a string";
-        return false;
-      }
-      c->name = m.at("name").get<std::string>();
-      if (!ValidConfigName(c->name, error)) {
-        if (info.kind == Kind::kLoad) error->replace(0, 4, "load");  // "save: ..." -> "load: ...".
-        return false;
-      }
-      return true;
+      return ReadConfigName(m, info, c, error);
     case Kind::kPing:
       return Number(m, type, "t", 0, 1e15, &c->page_time_ms, error);
     case Kind::kRigRun:
@@ -189,19 +226,7 @@ bool ReadFields(const Json& m, const TypeInfo& info, const PageLimits& limits, P
       c->on = m.at("on").get<bool>();
       return true;
     case Kind::kRigProfile:
-      if (!m.at("text").is_string()) {
-        *error = "rig_profile: text must be a string";
-        return false;
-      }
-      try {
-        // The profile file's own checks (its bounds, every angle in 0..180): a page's profile is
-        // no less checked than a file given to `control --profile`.
-        c->profile = TargetProfile::Parse(m.at("text").get<std::string>(), "rig_profile");
-      } catch (const std::exception& refused) {
-        *error = refused.what();
-        return false;
-      }
-      return true;
+      return ReadProfile(m, c, error);
     default:
       return true;
   }

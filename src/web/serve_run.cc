@@ -581,6 +581,55 @@ void ServeLoop::send_status(bool force) {
   server_.broadcast_text(std::move(json));
 }
 
+// A file served with a way to reopen it: seekable (the page's timeline); `source` becomes it.
+SeekableSource* MakeSeekable(std::unique_ptr<FrameSource>& source, FrameSourceOpener reopen) {
+  if (source->is_live() || !reopen) return nullptr;
+  auto playable = std::make_unique<SeekableSource>(std::move(source), std::move(reopen));
+  SeekableSource* const seekable = playable.get();
+  source = std::move(playable);
+  return seekable;
+}
+
+// The server's handler of a page's text. A ping is answered here, on the server's thread, at
+// once: the page sets its clock by the answer, which must not wait for the run's next frame. A
+// STOP of the rig jumps the queue (PageInbox::press_stop). Everything else waits in the inbox.
+WebServer::Inbox AnswerOrQueue(PageInbox& inbox, std::atomic<WebServer*>& answering,
+                               PageLimits checked_here) {
+  return [&inbox, &answering, checked_here](uint64_t page, bool controls, std::string text) {
+    std::string ignored;
+    WebServer* server = answering.load();
+    const auto command = ParsePageCommand(text, checked_here, &ignored);
+    if (server && command && command->kind == Kind::kPing) {
+      server->send_text(page, Pong(command->page_time_ms));
+      return;
+    }
+    if (command && command->kind == Kind::kRigStop) {
+      inbox.press_stop();
+      return;
+    }
+    inbox.push({page, controls, std::move(text)});
+  };
+}
+
+// What the pages did since the last frame: a STOP, pages that left, their messages, and a page
+// that joined (it gets the frame on screen at once, playing or not).
+void TakePages(PageInbox& inbox, const ServeOptions& options, const WebServer& server,
+               WebSink& sink, LiveController& controller, ServeLoop& loop, int* pages_seen) {
+  if (inbox.take_stop()) loop.stop_rig();  // First: nothing the pages sent comes before.
+  uint64_t departed = 0;
+  while (inbox.pop_departure(&departed)) {
+    if (options.rig != nullptr) options.rig->page_left(departed);
+  }
+  PageInbox::Message message;
+  while (inbox.pop(&message)) loop.handle(message);
+  if (server.pages() > *pages_seen && controller.last_result()) {
+    sink.resend(controller.frame_on_screen(), *controller.last_result());
+    loop.send_status(/*force=*/true);
+    loop.send_rig(/*force=*/true);
+  }
+  *pages_seen = server.pages();
+}
+
 }  // namespace
 
 LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource> source,
@@ -590,12 +639,7 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
     throw InputError("--jpeg-quality " + std::to_string(options.jpeg_quality) +
                      " is outside 1..100");
   }
-  SeekableSource* seekable = nullptr;
-  if (!source->is_live() && reopen) {
-    auto playable = std::make_unique<SeekableSource>(std::move(source), std::move(reopen));
-    seekable = playable.get();
-    source = std::move(playable);
-  }
+  SeekableSource* const seekable = MakeSeekable(source, std::move(reopen));
   if (!options.live.record_fps) options.live.record_fps = source->fps();
   // With a rig, every row (the page's, a recording's) carries the loop's columns too.
   if (options.rig != nullptr) {
@@ -605,26 +649,8 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   std::atomic<WebServer*> answering{nullptr};
   PageLimits checked_here;  // Pings and STOPs need nothing of the run's state.
   checked_here.rig = options.rig != nullptr;
-  WebServer server(
-      options.server, PageAssets(),
-      [&inbox, &answering, checked_here](uint64_t page, bool controls, std::string text) {
-        // A ping is answered here, on the server's thread, at once: the page sets its clock by
-        // the answer, which must not wait for the run's next frame. A STOP of the rig jumps the
-        // queue (PageInbox::press_stop).
-        std::string ignored;
-        WebServer* server = answering.load();
-        const auto command = ParsePageCommand(text, checked_here, &ignored);
-        if (server && command && command->kind == Kind::kPing) {
-          server->send_text(page, Pong(command->page_time_ms));
-          return;
-        }
-        if (command && command->kind == Kind::kRigStop) {
-          inbox.press_stop();
-          return;
-        }
-        inbox.push({page, controls, std::move(text)});
-      },
-      [&inbox](uint64_t page, bool) { inbox.depart(page); });
+  WebServer server(options.server, PageAssets(), AnswerOrQueue(inbox, answering, checked_here),
+                   [&inbox](uint64_t page, bool) { inbox.depart(page); });
   answering = &server;
   std::vector<std::string> names;
   for (const MarkerSpec& marker : config.markers) names.push_back(marker.name);
@@ -658,25 +684,12 @@ LiveRunResult RunServe(const TrackingConfig& config, std::unique_ptr<FrameSource
   if (waiting_for_page) controller.on_event(UiEvent::Key(' '));
   controller.take_messages();  // The window's start-up hint ("press h") and that pause.
   int pages_seen = 0;
-  PageInbox::Message message;
   while (!stop_requested() && !controller.quit_requested()) {
     if (waiting_for_page && server.pages() > 0) {
       waiting_for_page = false;
       if (controller.paused()) controller.on_event(UiEvent::Key(' '));
     }
-    if (inbox.take_stop()) loop.stop_rig();  // First: nothing the pages sent comes before.
-    uint64_t departed = 0;
-    while (inbox.pop_departure(&departed)) {
-      if (options.rig != nullptr) options.rig->page_left(departed);
-    }
-    while (inbox.pop(&message)) loop.handle(message);
-    if (server.pages() > pages_seen && controller.last_result()) {
-      // A page joined: it gets the frame on screen at once, playing or not.
-      sink.resend(controller.frame_on_screen(), *controller.last_result());
-      loop.send_status(/*force=*/true);
-      loop.send_rig(/*force=*/true);
-    }
-    pages_seen = server.pages();
+    TakePages(inbox, options, server, sink, controller, loop, &pages_seen);
     // A paced file waits here until its frame is due (at most a frame period); a camera
     // returns its newest frame.
     const bool got = feed.step(controller);

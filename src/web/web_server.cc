@@ -432,6 +432,5 @@ void WebServer::give_control(uint64_t page) {
 
 int WebServer::pages() const { return impl_->page_count_; }
 int64_t WebServer::frames_skipped() const { return impl_->frames_skipped_; }
-int64_t WebServer::texts_dropped() const { return impl_->texts_dropped_; }
 
 }  // namespace softsight

@@ -66,7 +66,6 @@ class WebServer {
 
   int pages() const;                 // Connected WebSocket pages.
   int64_t frames_skipped() const;    // Frames a page was too slow for, all pages together.
-  int64_t texts_dropped() const;
 
   class Impl;  // web_server.cc: the state on the server's thread.
 

@@ -118,8 +118,6 @@ class RigServer {
   const std::string& port() const { return pty_.slave_path(); }
   // Rewrites each answer line (with its '\n') before it is sent; "" drops it. For tests.
   void set_reply_filter(std::function<std::string(const std::string&)> filter);
-  // Sends raw bytes to the host (tests: garbage on the line).
-  void inject(std::string_view bytes);
   // The port disappears: both ends of the pseudo-terminal close and the host sees a hang-up. The
   // rig itself keeps its state; its watchdog vents it as time advances.
   void disconnect();
