@@ -116,6 +116,14 @@ double Triangulator::signed_epipolar_distance_px(const cv::Point2d& left_px,
   return line.dot(cv::Vec3d(r.x, r.y, 1.0)) / norm;
 }
 
+cv::Point2d Triangulator::project_left(const cv::Point3d& point_mm) const {
+  cv::Point2d out;
+  cv::projectPoints(cv::Mat(1, 1, CV_64FC3, const_cast<cv::Point3d*>(&point_mm)), cv::Vec3d(),
+                    cv::Vec3d(), stereo_.left.camera_matrix, left_distortion_,
+                    cv::Mat(1, 1, CV_64FC2, &out));
+  return out;
+}
+
 cv::Point2d Triangulator::project_right(const cv::Point3d& point_mm) const {
   cv::Vec3d rvec;
   cv::Rodrigues(stereo_.R, rvec);

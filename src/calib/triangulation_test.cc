@@ -35,6 +35,7 @@ TEST(TriangulatorTest, ExactProjectionsGiveTheExactPoint) {
     EXPECT_LT(*p.epipolar_px, 1e-6);
     EXPECT_LT(*p.reprojection_px, 1e-6);
     // The triangulator's own projection is the renderer's.
+    EXPECT_LT(cv::norm(triangulator.project_left(truth) - ProjectLeft(rig, truth)), 1e-9);
     EXPECT_LT(cv::norm(triangulator.project_right(truth) - ProjectRight(rig, truth)), 1e-9);
   }
 }

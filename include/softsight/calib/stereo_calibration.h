@@ -104,6 +104,8 @@ class StereoCalibrator {
   // many pairs were looked at), or fewer remain once the outliers are left out.
   StereoCalibrationResult calibrate() const;
 
+  int pairs_seen() const { return static_cast<int>(pairs_.size()); }
+
  private:
   struct Pair {
     StereoPairReport report{};

@@ -79,7 +79,8 @@ class Triangulator {
   double signed_epipolar_distance_px(const cv::Point2d& left_px, const cv::Point2d& right_px,
                                      cv::Vec2d* line_normal) const;
 
-  // A point (mm, first camera's frame) to raw (distorted) pixels of the second camera.
+  // A point (mm, first camera's frame) to raw (distorted) pixels of each camera.
+  cv::Point2d project_left(const cv::Point3d& point_mm) const;
   cv::Point2d project_right(const cv::Point3d& point_mm) const;
 
   const StereoCalibration& stereo() const { return stereo_; }
