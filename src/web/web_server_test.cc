@@ -205,8 +205,10 @@ TEST_F(WebServerTest, AnOversizedMessageClosesOnlyItsOwnConnection) {
   // the server closes that connection without reading it whole.
   flooder->write(asio::buffer(std::string(5000, 'x')));
   ASSERT_TRUE(WaitForMessages(1));
-  flooder->write(asio::buffer(std::string(70 * 1024, 'x')));
+  // (The server may close while the 70 KB are still being written: the write itself then fails
+  // with a broken pipe or a reset, which is the same end.)
   beast::error_code error;
+  flooder->write(asio::buffer(std::string(70 * 1024, 'x')), error);
   for (int i = 0; i < 20 && !error; ++i) {
     beast::flat_buffer buffer;
     flooder->read(buffer, error);  // Role messages, then the close.
