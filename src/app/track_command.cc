@@ -79,6 +79,10 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   RunSummary& summary = summary_out != nullptr ? *summary_out : local;
   summary = RunSummary{};
 
+  // Ctrl-C ends a camera run (or a long file) with its summary. Caught from before anything is
+  // written: a signal after the CSV's header and before the first frame ends the run through its
+  // own path too (it was the default action, death, in that gap).
+  const StopRequest stop;
   const TrackingConfig config = LoadTrackConfig(options);
   std::unique_ptr<FrameSource> source =
       seams.open_source ? seams.open_source() : OpenFrameSource(options.source);
@@ -124,7 +128,6 @@ RunSummary RunTrack(const TrackOptions& options, RunSummary* summary_out,
   ProgressSink progress("track", !options.quiet && !options.brief);
   sinks.push_back(&progress);
 
-  const StopRequest stop;  // Ctrl-C ends a camera run (or a long file) with its summary.
   RunOptions run;
   run.max_frames = options.max_frames;
   run.stop_requested = [&stop] { return stop.requested(); };
