@@ -57,23 +57,23 @@ bool ColourTracker::membership(const cv::Mat& frame_bgr, cv::Mat& mask) const {
   return true;
 }
 
-void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask) {
+void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask, bool dimmed) {
   if (gray_) {
-    const HsvRange& g = coarse ? *coarse_gray_ : *gray_;
+    const HsvRange& g = dimmed ? *dim_gray_ : coarse ? *coarse_gray_ : *gray_;
     cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
     return;
   }
   // One pass, bit-exact with cvtColor(BGR2HSV) + inRange (track/colour_kernels.h).
-  (coarse ? coarse_hsv_ : fine_hsv_).Classify(src, mask);
+  (dimmed ? *dim_hsv_ : coarse ? coarse_hsv_ : fine_hsv_).Classify(src, mask);
 }
 
 void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
-                            std::vector<ColourBlob>* blobs) {
+                            std::vector<ColourBlob>* blobs, bool dimmed) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
   region &= frame_rect;
   if (region.empty()) return;
   if (region.area() >= kCoarseMinArea) {
-    analyse_region(frame, region, blobs);
+    analyse_region(frame, region, blobs, dimmed);
     return;
   }
   // A window is a few thousand pixels: handing its pieces to OpenCV's thread pool (TBB) costs
@@ -84,15 +84,15 @@ void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
   // allocations and microseconds per window, and a re-acquisition analyses dozens.
   const bool opencv_parallel = opencv_in_windows_ || frame.channels() != (gray_ ? 1 : 3);
   if (!opencv_parallel) {
-    analyse_region(frame, region, blobs);
+    analyse_region(frame, region, blobs, dimmed);
     return;
   }
   cv::parallel_for_(cv::Range(0, 1),
-                    [&](const cv::Range&) { analyse_region(frame, region, blobs); });
+                    [&](const cv::Range&) { analyse_region(frame, region, blobs, dimmed); });
 }
 
 void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
-                                   std::vector<ColourBlob>* blobs) {
+                                   std::vector<ColourBlob>* blobs, bool dimmed) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
   const int m = margin_px_;
   const cv::Rect extended =
@@ -114,7 +114,7 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
 
   // 2. Binarise.
   cv::Mat mask = Scratch(mask_store_, extended.size(), CV_8U);
-  classify(filtered, false, mask);
+  classify(filtered, false, mask, dimmed);
 
   // 3. Opening then closing, only where it can change anything: outside the bounding box of the
   //    marker-coloured pixels the mask is 0 and stays 0 (opening only removes, closing only fills

@@ -114,6 +114,13 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     derived.v = v;
     fine_hsv_ = HsvClassifier(HsvBox::Make(h, s, v));
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
+    if (v.lo >= kDimMinFloor) {
+      const int floor = static_cast<int>(v.lo * kDimFloor);
+      dim_hsv_ = HsvClassifier(HsvBox::Make(h, s, HsvRange{floor, v.hi}));
+    }
+  }
+  if (gray_ && gray_->lo >= kDimMinFloor) {
+    dim_gray_ = HsvRange{static_cast<int>(gray_->lo * kDimFloor), gray_->hi};
   }
   acquire_roi_ = params_.roi;
   opencv_in_windows_ = gray_ || params_.filter != ColourParams::Filter::kNone ||
@@ -328,7 +335,8 @@ Observation ColourTracker::report(const Choice& choice) {
     return Observation::NotFound(choice.status, choice.tied);
   }
   const ColourBlob& blob = *choice.blob;
-  if (!blob.rim_placed) learn(blob, tracking_);  // What is left of it is not its looks.
+  // What is left of it is not its looks, nor is a blob segmented with the lowered floor.
+  if (!blob.rim_placed && !blob.dimmed) learn(blob, tracking_);
   lost_frames_ = 0;
   last_seen_px_ = blob.centroid_px;
   // After frames held covered, the step from the last position spans them: no velocity.
@@ -365,6 +373,7 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     size_t best_index = 0;
     double best_dist = std::numeric_limits<double>::infinity();
     double nearest_partial = std::numeric_limits<double>::infinity();
+    cv::Point2d sliver_px;  // The nearest partial blob's centroid.
     for (ColourBlob& b : blobs_) {
       auto [verdict, misfit] = judge(b);
       const double d = cv::norm(b.centroid_px - predicted);
@@ -394,9 +403,11 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
         if (b.at_frame_edge) partly_out_ = true;
         // A sliver of it where it should be is the marker covered, as much as a partial blob:
         // a whole look-alike farther away is not it.
+        if (d < nearest_partial) sliver_px = b.centroid_px;
         nearest_partial = std::min(nearest_partial, d);
       }
       if (verdict == CandidateVerdict::kPartial) {
+        if (d < nearest_partial) sliver_px = b.centroid_px;
         nearest_partial = std::min(nearest_partial, d);
       }
       if (verdict != CandidateVerdict::kFits) continue;
@@ -408,8 +419,15 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     }
     // The marker partly hidden (covered, or leaving the frame) nearer than the best whole blob:
     // that is where the marker is, and what is left of it is not measured. A look-alike farther
-    // away is not it.
-    if (nearest_partial < best_dist) return Choice{};
+    // away is not it. Unless what is left is only the brightest part of the marker, the rest
+    // fallen below the range's floor: the dim pass measures it whole.
+    const double reach = ref_radius + cv::norm(velocity_px_) + 1.0;
+    if (nearest_partial < best_dist) {
+      if (nearest_partial <= reach && !partly_out_) {
+        return dim_search(frame, window, predicted, reach, sliver_px);
+      }
+      return Choice{};
+    }
     // A blob cut by the window's border may be the marker extending outside, and nearer than
     // the best complete one: never report a clipped centroid, look wider instead.
     bool nearer_clipped = false;
@@ -426,6 +444,55 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     if (window == frame_rect) break;
   }
   return Choice{};
+}
+
+ColourTracker::Choice ColourTracker::dim_search(const cv::Mat& frame, const cv::Rect& window,
+                                                const cv::Point2d& predicted, double reach,
+                                                const cv::Point2d& sliver) {
+  if (!model_ || !(dim_hsv_ || dim_gray_)) return Choice{};
+  dim_blobs_.clear();
+  analyse(frame, window, &dim_blobs_, true);
+  std::sort(dim_blobs_.begin(), dim_blobs_.end(), CentroidBefore);
+  // The marker darkened is the one blob there that holds the sliver the range saw and fits the
+  // marker in all but brightness: size, shape, symmetry (not itself partly hidden), contrast to
+  // its surroundings and, for a coloured marker, chroma. Two such blobs: neither is taken.
+  const ColourBlob* only = nullptr;
+  double only_misfit = 0;
+  int fitting = 0;
+  for (const ColourBlob& b : dim_blobs_) {
+    if (cv::norm(b.centroid_px - predicted) > reach) continue;
+    const cv::Rect& box = b.bbox_px;
+    if (!(sliver.x >= box.x && sliver.x <= box.x + box.width - 1 && sliver.y >= box.y &&
+          sliver.y <= box.y + box.height - 1)) {
+      continue;
+    }
+    const auto [verdict, misfit] = judge(b, true);
+    if (verdict != CandidateVerdict::kFits) continue;
+    ++fitting;
+    only = &b;
+    only_misfit = misfit;
+  }
+  if (fitting != 1) return Choice{};
+  // The dim pass's blobs are the candidates now; only the chosen one is judged without its
+  // brightness (the others as any search judges them, so none is offered as the marker).
+  ColourBlob chosen = *only;
+  chosen.shaded = true;
+  chosen.dimmed = true;
+  std::swap(blobs_, dim_blobs_);
+  candidates_.clear();
+  Choice choice;
+  for (ColourBlob& b : blobs_) {
+    if (SameBlob(b, chosen)) {
+      b = chosen;
+      candidates_.push_back(candidate(b, CandidateVerdict::kChosen, only_misfit + kShadowMisfit));
+      continue;
+    }
+    const auto [verdict, misfit] = judge(b);
+    candidates_.push_back(candidate(b, verdict, misfit));
+  }
+  choice.blob = chosen;
+  choice.status = MarkerStatus::kFound;
+  return choice;
 }
 
 ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {

@@ -53,6 +53,9 @@ struct ColourBlob {
   // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
   // marker should be): its colour is not the marker's under the usual light, and is not learned.
   bool shaded = false;
+  // Segmented by the dim pass (the range's brightness floor lowered): its area and shape are not
+  // what the range gives, so they are not learned.
+  bool dimmed = false;
   // Mean colour (B, G, R, or the gray level in [0]) of the blob's core (2 px inside its edge, or
   // the whole blob when that is empty) and of its surroundings (a ring 3-4 px outside, pixels of
   // other blobs excluded), with their RMS spread (over channels).
@@ -130,14 +133,17 @@ class ColourTracker : public Tracker {
  private:
   // Full-resolution pipeline on `region` (clipped to the frame); appends every blob with its
   // complete/clipped flag. Blobs below min_area_px are skipped unless clipped.
-  void analyse(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs);
+  // With `dimmed`, pixels are classified by the range with its brightness floor lowered (the
+  // dim pass of track_in_windows).
+  void analyse(const cv::Mat& frame, cv::Rect region, std::vector<ColourBlob>* blobs,
+               bool dimmed = false);
   void analyse_region(const cv::Mat& frame, const cv::Rect& region,
-                      std::vector<ColourBlob>* blobs);
+                      std::vector<ColourBlob>* blobs, bool dimmed);
   // `src` with the channels the classifier needs (1 in gray mode, else 3), converted into `store`
   // when the frame has the other kind.
   cv::Mat prepare(const cv::Mat& src, cv::Mat& store);
   // Marker mask of `src` (prepared, filtered) into `mask`.
-  void classify(const cv::Mat& src, bool coarse, cv::Mat& mask);
+  void classify(const cv::Mat& src, bool coarse, cv::Mat& mask, bool dimmed = false);
   // Colour statistics and soft centroid of the labeller's `component`, whose box in the labelled
   // mask is `box`; `labelled_tl` is that mask's origin in `filtered` / `mask`, `origin` the
   // latter's in the frame.
@@ -170,6 +176,12 @@ class ColourTracker : public Tracker {
   void check_frame(const cv::Mat& frame) const;
   Observation search(const cv::Mat& frame);  // update() without the snapshot.
   Choice track_in_windows(const cv::Mat& frame);
+  // The marker darker than its range's floor where it should be (a shadow, the dim edge of the
+  // light): `window`, around `predicted`, classified with the floor lowered; the one blob within
+  // `reach` that fits the marker in everything but brightness, whole, around the sliver of it
+  // the range still saw at `sliver`.
+  Choice dim_search(const cv::Mat& frame, const cv::Rect& window, const cv::Point2d& predicted,
+                    double reach, const cv::Point2d& sliver);
   Choice acquire(const cv::Mat& frame);
   // After a lasting change of the light: the one blob near where the marker was last seen that
   // fits everything but the learned brightness, if there is exactly one.
@@ -182,6 +194,10 @@ class ColourTracker : public Tracker {
   cv::Mat kernel_;          // Morphology structuring element.
   int margin_px_ = 0;       // Filter radius + 4 morphology radii (+1).
   HsvClassifier fine_hsv_, coarse_hsv_;  // The marker test, and the lenient coarse one.
+  // The marker test with the brightness floor lowered (kDimFloor), for the dim pass; absent when
+  // lowering changes nothing (a floor near 0).
+  std::optional<HsvClassifier> dim_hsv_;
+  std::optional<HsvRange> dim_gray_;
   bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
   // A window's analysis calls OpenCV functions that may parallelise (gray inRange, a pre-filter,
   // morphology other than 3x3), besides a colour conversion of a frame of the other kind.
@@ -235,7 +251,7 @@ class ColourTracker : public Tracker {
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
-  std::vector<ColourBlob> blobs_, pending_;
+  std::vector<ColourBlob> blobs_, pending_, dim_blobs_;
   std::vector<cv::Rect> windows_, boxes_;
   std::vector<cv::Point> points_;
   std::vector<cv::Point> edge_points_;  // A blob's leftmost and rightmost pixel of each row.

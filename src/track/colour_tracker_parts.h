@@ -132,6 +132,13 @@ constexpr double kRelearnRadii = 6.0;
 // it in everything but brightness is the marker in a shadow, taken at once; its misfit is raised
 // by this, so the marker at its own brightness wins where both are in view.
 constexpr double kShadowMisfit = 1.0;
+// The dim pass: a marker whose pixels have fallen below its range's brightness floor (a shadow
+// over part of the bench, the dim edge of the light, a ball falling out of the lamp's cone) shows
+// only a sliver of its brightest pixels in range. Its window is classified again with the floor
+// at this fraction of the range's (the light halved), hue and saturation as configured. Floors
+// below kDimMinFloor are not lowered: the pass would see nearly the same pixels.
+constexpr double kDimFloor = 0.5;
+constexpr int kDimMinFloor = 20;
 
 // ---- Automatic colour (ColourParams::auto_bgr) -------------------------------------------------------
 constexpr int kAutoHueTolerance = 12;        // hue units (2 degrees each)

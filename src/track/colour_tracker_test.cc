@@ -740,6 +740,110 @@ TEST(ColourTracker, AMarkerInAShadowWhereItShouldBeIsFoundAtOnceADarkLookAlikeBe
   EXPECT_FALSE(tracker.update(gone).found());
 }
 
+// A dark cloth (levels 15-35, fixed seed) for a white marker, and a disc on it lit from the
+// left: its level falls linearly from `left` at its left edge to `right` at its right edge.
+cv::Mat DarkCloth() {
+  cv::Mat grey(240, 320, CV_8U), image;
+  cv::RNG rng(777);
+  rng.fill(grey, cv::RNG::UNIFORM, 15, 35);
+  cv::cvtColor(grey, image, cv::COLOR_GRAY2BGR);
+  return image;
+}
+
+cv::Point2d PaintLitDisc(cv::Mat& image, cv::Point2d centre, double radius_px, int left,
+                         int right) {
+  double sx = 0, sy = 0, n = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) > radius_px) continue;
+      const double t = (x - (centre.x - radius_px)) / (2 * radius_px);
+      const int level = cvRound(left + t * (right - left));
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(level, level, level);
+      sx += x;
+      sy += y;
+      n += 1;
+    }
+  }
+  return {sx / n, sy / n};
+}
+
+ColourParams WhiteBallParams() {
+  // As a user writes for a white ball on black cloth (tests/real/balltoss/ball.yaml).
+  ColourParams p;
+  p.h = {0, 179};
+  p.s = {0, 90};
+  p.v = {150, 255};
+  p.morph_size = 1;
+  p.centroid = ColourParams::Centroid::kBinary;
+  return p;
+}
+
+TEST(ColourTracker, AMarkerFallenBelowItsRangeWhereItShouldBeIsMeasuredWhole) {
+  // The ball falls out of the lamp's light: only its lit left side stays above the range's
+  // floor (150). The dim pass classifies its window with the floor halved and measures the
+  // whole disc, exactly; it is found every frame while it moves 4 px a frame.
+  ColourTracker tracker(WhiteBallParams());
+  cv::Point2d centre(100.5, 120.5);
+  cv::Mat image = DarkCloth();
+  PaintLitDisc(image, centre, 8, 230, 230);
+  ASSERT_TRUE(tracker.update(image).found());
+  for (int f = 0; f < 10; ++f) {
+    centre += cv::Point2d(4, 1);
+    cv::Mat frame = DarkCloth();
+    const cv::Point2d truth = PaintLitDisc(frame, centre, 8, 165, 85);
+    const Observation obs = tracker.update(frame);
+    ASSERT_TRUE(obs.found()) << "frame " << f;
+    EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9) << "frame " << f;
+    EXPECT_NEAR(obs.position_px->y, truth.y, 1e-9) << "frame " << f;
+    ASSERT_TRUE(obs.sigma_px.has_value());
+  }
+  // Back in the light: the range finds it again, and what the dim pass measured was not learned
+  // as the marker's looks (its area is the one the range gave).
+  centre += cv::Point2d(4, 1);
+  cv::Mat lit = DarkCloth();
+  const cv::Point2d truth = PaintLitDisc(lit, centre, 8, 230, 230);
+  const Observation obs = tracker.update(lit);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, truth.x, 1e-9);
+}
+
+TEST(ColourTracker, TheDimPassTakesNothingThatIsNotTheWholeMarker) {
+  ColourTracker tracker(WhiteBallParams());
+  const cv::Point2d centre(100.5, 120.5);
+  cv::Mat image = DarkCloth();
+  PaintLitDisc(image, centre, 8, 230, 230);
+  ASSERT_TRUE(tracker.update(image).found());
+  // Its bright sliver in a dim patch of the same level, far larger than the marker (a pale
+  // sheet in the shade): no blob there is the marker's size and shape, so it is held covered.
+  cv::Mat patch = DarkCloth();
+  cv::rectangle(patch, cv::Rect(70, 95, 60, 50), cv::Scalar(110, 110, 110), cv::FILLED);
+  PaintLitDisc(patch, centre, 3, 165, 165);
+  Observation obs = tracker.update(patch);
+  EXPECT_FALSE(obs.found());
+  EXPECT_EQ(obs.status(), MarkerStatus::kCovered);
+  // Dimmed but joined to a dim bar of its level (a shaded edge beside it): not round, not taken.
+  cv::Mat joined = DarkCloth();
+  cv::rectangle(joined, cv::Rect(100, 117, 40, 7), cv::Scalar(100, 100, 100), cv::FILLED);
+  PaintLitDisc(joined, centre, 8, 165, 85);
+  obs = tracker.update(joined);
+  EXPECT_FALSE(obs.found());
+  // Dimmed and cut by a dark cover over its right half: what is left of it is placed as any
+  // partly covered round marker is, by the circle of its visible rim (near its centre), never
+  // by the centroid of what is left (4 px off).
+  cv::Mat covered = DarkCloth();
+  PaintLitDisc(covered, centre, 8, 165, 85);
+  cv::rectangle(covered, cv::Rect(101, 100, 30, 40), cv::Scalar(20, 20, 20), cv::FILLED);
+  obs = tracker.update(covered);
+  ASSERT_TRUE(obs.found());
+  EXPECT_NEAR(obs.position_px->x, centre.x, 0.1);
+  EXPECT_NEAR(obs.position_px->y, centre.y, 0.1);
+  // Dimmed and cut by a cover over more than half of it: too little rim to place it.
+  cv::Mat mostly = DarkCloth();
+  PaintLitDisc(mostly, centre, 8, 165, 85);
+  cv::rectangle(mostly, cv::Rect(97, 100, 30, 40), cv::Scalar(20, 20, 20), cv::FILLED);
+  EXPECT_FALSE(tracker.update(mostly).found());
+}
+
 TEST(ColourTrackerScene, WindowedEqualsWholeFrameAndCoarseEqualsFullResolution) {
   // Binary centroid: bit-identical (same pixels, same moments, same integer offsets). Soft
   // centroid: within 1e-3 px, because OpenCV's 8-bit Gaussian filter may round a pixel of a view

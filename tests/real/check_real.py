@@ -62,7 +62,7 @@ CASES = {
     'balltoss': dict(
         what='OSP Tracker: a white ball thrown over black cloth (reference: hand clicks)',
         input='BallToss_new_BallToss.mp4', args=[], tol=3.0, ref_sigma=1.0,
-        configs=[('ball', {'ball': 'ball'}, '', 90.0)]),
+        configs=[('ball', {'ball': 'ball'}, '', 100.0)]),
     'blender-bench': dict(
         what='A physically based render (Blender Cycles, not this project\'s renderer) of a '
              'ribbed silicone actuator with domed markers on a bench; MJPG (exact truth: each '
