@@ -13,6 +13,7 @@ constexpr double kBlobShapePerRadius = 0.04;  // Segmentation bias, per px of th
 constexpr double kRimPlacedPerRadius = 0.10;  // A circle fitted to part of a rim.
 constexpr double kAsymmetryShare = 0.5;       // Of the excess asymmetry.
 constexpr double kDisagreementShare = 1.0;    // Of the soft and binary centroids' disagreement.
+constexpr double kDefinitionShare = 0.5;      // Of the spread between channels (truth between).
 constexpr double kMatchShapePerSize = 0.02;   // A match's drift, per px of the template's half size.
 constexpr double kMatchMisfitPerSize = 0.25;  // Per px of half size and unit of (1 - zncc).
 
@@ -34,8 +35,9 @@ double BlobCentroidSigmaPx(const BlobEvidence& blob) {
   const double noise = NoiseSigmaPx(blob);
   const double asymmetry = kAsymmetryShare * std::max(blob.excess_asymmetry_px, 0.0);
   const double disagreement = kDisagreementShare * blob.centroid_disagreement_px;
+  const double definition = kDefinitionShare * blob.definition_spread_px;
   return std::sqrt(kFloorPx * kFloorPx + shape * shape + noise * noise + asymmetry * asymmetry +
-                   disagreement * disagreement);
+                   disagreement * disagreement + definition * definition);
 }
 
 double TemplateMatchSigmaPx(double zncc, double template_width_px, double template_height_px,

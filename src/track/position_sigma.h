@@ -27,6 +27,9 @@ struct BlobEvidence {
   // is uncertain at the rim (a lit dome's pale flank, its shaded one outside the hue range), and
   // the truth is about as far from either.
   double centroid_disagreement_px = 0;
+  // How far the marker's centre moves between the channels it stands out in (a template's blob
+  // in its matched channel and in its chromaticity), px: a bias no frame averages away.
+  double definition_spread_px = 0;
 };
 
 // Per axis, px: a colour blob's (or a template's blob's) centroid.

@@ -92,17 +92,22 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   blob_ok_ = LearnTemplateBlob(templ, MaskFor(templ.size()), &blob_projection_, &blob_,
                                &blob_anchor_px_);
   chroma_ok_ = false;
+  anchor_spread_px_ = 0.0;
   if (!selection_bgr.empty() && selection_bgr.size() == templ.size() &&
       LearnChromaAxis(selection_bgr, &chroma_)) {
     cv::Mat channel;
     ChromaChannel(selection_bgr, chroma_, channel);
     BlobMeter meter;
     cv::Point2d centroid;
+    const bool in_chroma = meter.Learn(channel, MaskFor(templ.size()), &centroid);
+    // Both channels show the marker but put its centre apart (a dome's shaded flank is dark in
+    // gray and of the marker's tint in chroma; the two carts' yellow dots, 1.8-2.2 px): which
+    // of the two is the marker's centre is uncertain by that much, in every frame.
+    if (in_chroma && blob_ok_) anchor_spread_px_ = cv::norm(centroid - blob_anchor_px_);
     // Taken where the marker stands out more in its chromaticity than in the matched channel (a
     // shaded coloured dome: 0.59-0.77 against 0.24-0.43); a yellow dot on a green cart, already
     // clear in the matched channel, keeps it (its chromaticity blurs with the motion).
-    if (meter.Learn(channel, MaskFor(templ.size()), &centroid) &&
-        (!blob_ok_ || meter.isolation() > blob_.isolation())) {
+    if (in_chroma && (!blob_ok_ || meter.isolation() > blob_.isolation())) {
       blob_ = meter;
       blob_anchor_px_ = centroid;
       blob_ok_ = true;
@@ -1039,6 +1044,7 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   if (blob_ok_) {
     blob.area_px = blob_.area() * rung_scale() * rung_scale();
     blob.centroid_disagreement_px = blob_disagreement_px_;
+    blob.definition_spread_px = anchor_spread_px_ * rung_scale();
   }
   const cv::Size size = current().templ.size();
   observation.sigma_px = TemplateMatchSigmaPx(fix->zncc, size.width, size.height, blob);

@@ -193,6 +193,10 @@ class TemplateTracker final : public Tracker {
   // blob measured in its chromaticity).
   bool blob_reported_ = false;
   cv::Point2d blob_anchor_px_{0, 0};    // Its soft centroid, in the selected template.
+  // How far the blob's centroid in the selected template moves between the two channels it
+  // stands out in, the matched one and its chromaticity (0 when it shows in only one): where
+  // the marker's centre is, is defined no better than that (position_sigma.h).
+  double anchor_spread_px_ = 0.0;
   // The colour of the marker's core in the selection (CoreColour), when it was cut from a colour
   // frame: a place of another colour is not the marker, however well it matches.
   std::optional<cv::Vec3d> core_colour_;

@@ -517,6 +517,48 @@ TEST(TemplateTrackerTest, MinimalConfigReportsTheMarkerCentreToATenthOfAPixel) {
   EXPECT_LE(paper.rms_px, 0.1);
 }
 
+// A yellow disc on a green cart, its right half in shade: in gray only its lit half stands out
+// (a centroid 0.42 radii left of the disc's centre), in chromaticity the whole disc does. Which
+// is the marker's centre is uncertain by that much, and the position's sigma says so: the
+// reported position lies within 3 sigma of the disc's centre, and a disc lit evenly keeps a
+// small sigma.
+TEST(TemplateTrackerTest, AMarkerWhoseChannelsPutItsCentreApartCarriesThatInItsSigma) {
+  const cv::Point2d centre(60.3, 50.6);
+  constexpr double kRadius = 7.0;
+  auto render = [&](bool shaded) {
+    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(60, 140, 60));
+    for (int y = 0; y < frame.rows; ++y) {
+      for (int x = 0; x < frame.cols; ++x) {
+        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
+        const bool dark = shaded && x > centre.x;
+        frame.at<cv::Vec3b>(y, x) = dark ? cv::Vec3b(15, 95, 105) : cv::Vec3b(40, 200, 220);
+      }
+    }
+    return frame;
+  };
+  double sigma_even = 0;
+  for (const bool shaded : {false, true}) {
+    SCOPED_TRACE(shaded ? "half in shade" : "lit evenly");
+    const cv::Mat frame = render(shaded);
+    MarkerSpec spec;
+    spec.name = "dot";
+    spec.params = ParamsForMethod("zncc", {TemplateParams{}});
+    std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+    tracker->init(frame, RectAround(centre, 21));
+    const Observation o = tracker->update(frame);
+    ASSERT_TRUE(o.found());
+    ASSERT_TRUE(o.sigma_px.has_value());
+    const double error = cv::norm(*o.position_px - centre);
+    EXPECT_LE(error, 3 * *o.sigma_px) << "error " << error << " px, sigma " << *o.sigma_px;
+    if (!shaded) {
+      sigma_even = *o.sigma_px;
+      EXPECT_LT(sigma_even, 0.5);
+    } else {
+      EXPECT_GT(*o.sigma_px, sigma_even + 0.5);
+    }
+  }
+}
+
 // Two white dots on a dark card, drawn anti-aliased at sub-pixel centres (cv::circle with 4
 // fractional bits): look-alikes, as the dots on a hand-held plate are.
 cv::Mat TwoDots(cv::Point2d a, cv::Point2d b, double radius, std::optional<cv::Rect> cover = {}) {
