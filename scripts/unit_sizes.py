@@ -171,11 +171,22 @@ def functions_in(code):
 
     def scan(start, end):
         header_start = start
+        parens = 0  # Open parentheses of the declaration being read.
         k = start
         while k < end:
             c = code[k]
+            if c in '()':
+                parens += 1 if c == '(' else -1
+                k += 1
+                continue
+            if c == '{' and parens > 0:
+                # A brace inside a parameter list or initialiser (`= {}`, a lambda member
+                # initialiser): part of the declaration.
+                k = matching_brace(code, k) + 1
+                continue
             if c in ';}':
                 header_start = k + 1
+                parens = 0
                 k += 1
                 continue
             if c == ':' and re.match(r'(public|private|protected)\s*$',
@@ -203,6 +214,7 @@ def functions_in(code):
                 first = header_start + len(header) - len(header.lstrip())
                 found.append((function_name(bare), first, close))
             header_start = close + 1
+            parens = 0
             k = close + 1
 
     scan(0, len(code))
