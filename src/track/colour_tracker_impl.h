@@ -143,6 +143,12 @@ class ColourTracker : public Tracker {
   // latter's in the frame.
   void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
+  // The blob's asymmetry_px and hull_asymmetry_px from its mask `own` (whose top-left pixel is
+  // `own_origin` in the frame).
+  void measure_asymmetry(const cv::Mat& own, cv::Point own_origin, ColourBlob* blob);
+  // A partial round blob: the circle of the marker's `radius` fitted to its edge (not where the
+  // frame cuts it), and its centre as the centroid when the fit is good (RimCentre).
+  void fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius, ColourBlob* blob);
   // Fills the holes of the blob's mask `own` (whose top-left pixel is `own_origin` in the frame)
   // and, when there were any, sets the blob's area, centroids and circularity from the filled
   // mask.
@@ -152,6 +158,10 @@ class ColourTracker : public Tracker {
   // Coarse candidates -> full-resolution windows -> complete blobs.
   void coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
                       std::vector<ColourBlob>* blobs);
+  // The full-resolution windows (into windows_) around the groups of the candidate cells
+  // (points_, cells of `factor` x `factor` pixels of `region`, `cells` of them).
+  void cell_group_windows(const cv::Rect& region, int factor, cv::Size cells,
+                          const cv::Rect& frame_rect);
 
   // The outcome of one search: the chosen blob, or why there is none.
   struct Choice {
