@@ -13,6 +13,7 @@
 // whole-frame analysis finds.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -181,6 +182,25 @@ class ColourTracker : public Tracker {
   Observation search(const cv::Mat& frame);  // update() without the snapshot.
   Choice track_in_windows(const cv::Mat& frame);
   Choice acquire(const cv::Mat& frame);
+  // An acquisition's candidates (blobs_) ranked by cost: the best whole one, the runner-up's
+  // cost, and the best partly hidden one's (which is never reported, but is a rival).
+  struct Ranking {
+    size_t best = 0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    double second_cost = std::numeric_limits<double>::infinity();
+    double partial_cost = std::numeric_limits<double>::infinity();
+    bool partial_at_edge = false;  // The best partial one is cut by the frame's edge.
+  };
+  // Judges every blob into candidates_ and ranks those that fit; `diagonal` is the frame's.
+  Ranking rank_candidates(double diagonal);
+  // A candidate's cost: its misfit, plus its distance from the last position over `diagonal`.
+  double acquisition_cost(double misfit, const cv::Point2d& position_px, double diagonal) const;
+  // kAmbiguous, with how many whole candidates cost within `margin` of the best; with
+  // `by_uniqueness` every fitting candidate becomes a rival.
+  Choice ambiguous_choice(double best_cost, double margin, double diagonal, bool by_uniqueness);
+  // Whether the one candidate left, `only`, may be a look-alike among the rivals tied before:
+  // it was one of them, in its place still, and another of them has vanished.
+  bool a_rival_may_be_it(const ColourBlob& only) const;
   // After a lasting change of the light: the one blob near where the marker was last seen that
   // fits everything but the learned brightness, if there is exactly one.
   Choice relearn(const cv::Point2d& last_seen);
