@@ -63,6 +63,10 @@ class PreparedTemplate {
 
  private:
   friend struct KernelAccess;
+  // The counted pixels' runs of each row (run_rows_, runs_), from mask_image_.
+  void find_runs();
+  // The vector layout (row_bytes_ .. words_) of image_ and mask_image_.
+  void lay_out_chunks();
   cv::Mat image_;
   cv::Mat mask_image_;
   int count_ = 0;
