@@ -118,8 +118,6 @@ class ColourTracker : public Tracker {
     return model_ ? std::optional<double>(model_->area_px) : std::nullopt;
   }
   const std::optional<ColourModel>& model() const { return model_; }
-  // True when pixels are classified by gray level (`gray`, or a nominal gray `auto_bgr`).
-  bool gray_mode() const { return gray_.has_value(); }
   // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit; infinite for a
   // rejection; kPartial is a blob that fits but is partly hidden, with its finite misfit). With
   // `any_brightness` the learned colour's brightness is not held against it (its chroma is).

@@ -99,7 +99,8 @@ struct KernelAccess {
 
 namespace {
 
-// MatchCrossCorrelation with the buffer for the widened image given (defined below).
+// sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC and SSD are built on.
+// The image widened to 16 bits is kept in `widened` (defined below).
 void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                       std::vector<int16_t>& widened);
 
@@ -634,11 +635,6 @@ void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::M
 }
 
 }  // namespace
-
-void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
-  std::vector<int16_t> widened;
-  CrossCorrelation(image, templ, result, widened);
-}
 
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch) {

@@ -115,8 +115,6 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
-// sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC is built on.
-void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 
 // Slow scalar references, straight from the definitions (ZNCC in double with explicit means).
 // `mask` as in PreparedTemplate::Prepare.
