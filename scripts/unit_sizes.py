@@ -16,10 +16,16 @@ How a function is found (docs/measurements.md, "Size of units (issue 45)"):
 
 Tests, test utilities and benchmarks are left out unless --tests is given.
 
-Usage: scripts/unit_sizes.py [--over N] [--tests] DIR_OR_FILE...
+With --unused, it lists instead the functions of the given paths whose name is used in no
+function body (its own definition aside) in src/, include/ or python/ (tests included, comments
+and strings left out; every word of a Python file counts): candidates to check by hand, since
+a constructor, an overload or a callback taken by address at namespace scope shows up too.
+
+Usage: scripts/unit_sizes.py [--over N] [--tests] [--unused] DIR_OR_FILE...
 """
 
 import argparse
+import collections
 import os
 import re
 import sys
@@ -257,6 +263,47 @@ def measure(path):
         yield name, a, b - a + 1
 
 
+def names_used(roots=('src', 'include', 'python')):
+    """How often each word stands in a function body of the C++ files under `roots` (the name of
+    the function being defined not counted) or anywhere in their Python files."""
+    uses = collections.Counter()
+    for root_dir in roots:
+        for root, _, files in os.walk(root_dir):
+            for name in files:
+                path = os.path.join(root, name)
+                if name.endswith(('.py', '.pyi')):
+                    with open(path, encoding='utf-8', errors='replace') as f:
+                        uses.update(re.findall(r'[A-Za-z_]\w*', f.read()))
+                    continue
+                if not name.endswith(('.cc', '.h', '.cpp', '.hpp')):
+                    continue
+                with open(path, encoding='utf-8', errors='replace') as f:
+                    code = blank_non_code(f.read())
+                for function, first, close in functions_in(code):
+                    words = collections.Counter(re.findall(r'[A-Za-z_]\w*', code[first:close + 1]))
+                    own = function.split('::')[-1]
+                    if words[own]:
+                        words[own] -= 1
+                    uses.update(words)
+    return uses
+
+
+def print_unused(paths, with_tests):
+    uses = names_used()
+    unused = 0
+    for path in source_files(paths, with_tests):
+        with open(path, encoding='utf-8', errors='replace') as f:
+            code = blank_non_code(f.read())
+        line_starts = [0] + [m.end() for m in re.finditer('\n', code)]
+        for function, first, _ in functions_in(code):
+            own = function.split('::')[-1]
+            if own.startswith(('~', 'operator')) or own == '?' or uses[own]:
+                continue
+            unused += 1
+            print(f'{path}:{line_of(code, first, line_starts)}  {function}')
+    print(f'{unused} functions whose name no function body uses')
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('paths', nargs='+', help='directories or files')
@@ -266,7 +313,13 @@ def main():
                         help='include tests, test utilities and benchmarks')
     parser.add_argument('--longest', type=int, default=0,
                         help='also print the N longest functions')
+    parser.add_argument('--unused', action='store_true',
+                        help='list the functions whose name no function body uses (run from the '
+                             'repository\'s root)')
     args = parser.parse_args()
+    if args.unused:
+        print_unused(args.paths, args.tests)
+        return 0
     rows = []
     for path in source_files(args.paths, args.tests):
         for name, line, length in measure(path):
