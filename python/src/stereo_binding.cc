@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "run_reader.h"
 #include "softsight/calib/board_frame.h"
 #include "softsight/calib/stereo_calibration.h"
 #include "softsight/core/error.h"
@@ -284,7 +285,7 @@ py::tuple TrackStereo(const py::object& left, const py::object& right, const py:
 // pipeline/run.h StereoRunStream, with its key-frame check), one pair's row per next() as the
 // table has it, the GIL released while the pair is read and tracked. close() (or the end, or an
 // error) releases both inputs, so a generator closed early lets go of the files.
-class StereoFrameStream {
+class StereoFrameStream : public ClosableRunReader<StereoFrameStream> {
  public:
   StereoFrameStream(const py::object& left, const py::object& right, const py::object& config,
                     const py::object& stereo, std::optional<int64_t> max_frames,
@@ -354,21 +355,9 @@ class StereoFrameStream {
     return out;
   }
 
-  void close() {
-    py::gil_scoped_release release;
-    const std::lock_guard<std::mutex> lock(mutex_);
-    close_locked();
-  }
-  bool closed() const { return closed_; }
-  // max_frames, when given (a pair input does not know its length).
-  std::optional<int64_t> total() const { return stream_->info().frame_count; }
-  int64_t done() const { return stream_->returned(); }
-
  private:
-  void close_locked() {
-    closed_ = true;  // The stream is not asked again: its input is gone.
-    input_.reset();  // Both videos or image sequences are let go of here.
-  }
+  friend class ClosableRunReader<StereoFrameStream>;
+  void release_input() { input_.reset(); }  // Both videos or image sequences.
 
   StereoSetup setup_;
   std::unique_ptr<StereoInput> input_;
@@ -376,8 +365,6 @@ class StereoFrameStream {
   std::unique_ptr<BasicCsvColumnTable<StereoFrameResult>> table_;
   std::unique_ptr<StereoRunStream> stream_;
   std::string row_;
-  bool closed_ = false;
-  std::mutex mutex_;
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "run_reader.h"
 #include "softsight/core/error.h"
 #include "softsight/io/csv_columns.h"
 #include "softsight/io/frame_source.h"
@@ -315,7 +316,7 @@ py::tuple Track(const py::object& input, const py::object& config_source,
 // sequences, folders, built-in scenes, with track's decode rules) and one run's session, one
 // frame per next(), the GIL released while a frame is read and tracked. close() (or the end of
 // the input, or an error) releases the source, so a generator closed early lets go of the file.
-class FrameStream {
+class FrameStream : public ClosableRunReader<FrameStream> {
  public:
   FrameStream(const py::object& input, const py::object& config_source,
               std::optional<int64_t> max_frames, double fps,
@@ -352,27 +353,13 @@ class FrameStream {
     }
   }
 
-  void close() {
-    py::gil_scoped_release release;
-    const std::lock_guard<std::mutex> lock(mutex_);
-    close_locked();
-  }
-  bool closed() const { return closed_; }
-  // The frames the run will have (max_frames when fewer), when the source knows its length.
-  std::optional<int64_t> total() const { return stream_->info().frame_count; }
-  int64_t done() const { return stream_->returned(); }
-
  private:
-  void close_locked() {
-    closed_ = true;   // The stream is not asked again: its source is gone.
-    source_.reset();  // The video file or the image sequence is let go of here.
-  }
+  friend class ClosableRunReader<FrameStream>;
+  void release_input() { source_.reset(); }  // The video file or the image sequence.
 
   std::unique_ptr<FrameSource> source_;
   std::unique_ptr<TrackingSession> session_;
   std::unique_ptr<RunStream> stream_;
-  bool closed_ = false;
-  std::mutex mutex_;
 };
 
 }  // namespace

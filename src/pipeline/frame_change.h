@@ -65,11 +65,6 @@ class FrameChangeDetector {
   // correlation of the summaries' samples: about 60 x 80 at any resolution).
   std::optional<cv::Point2d> camera_shift_px();
 
-  // Fraction of cells that changed against the last normal frame (for tests and tuning).
-  double changed_fraction() const { return changed_fraction_; }
-  // Fraction of cells holding garbage against the last normal frame (for tests and tuning).
-  double garbage_fraction() const { return garbage_fraction_; }
-
  private:
   using Cell = FrameCell;
   static bool Changed(const Cell& now, const Cell& before, const cv::Vec3f& gain, bool relit);

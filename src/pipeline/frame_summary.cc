@@ -146,6 +146,86 @@ void SummariseFrameReference(const cv::Mat& bgr, const CellGrid& grid,
   }
 }
 
+namespace {
+
+// One sampled row of the frame (`n` samples `stride` bytes apart from `row`) into the planes b, g
+// and r, and each plane's padding sample (index -1) a copy of its first.
+void GatherSamples(const uint8_t* row, size_t stride, size_t n, uint8_t* b, uint8_t* g,
+                   uint8_t* r) {
+  const uint8_t* p = row;
+  size_t j = 0;
+  for (; j + 4 <= n; j += 4, p += 4 * stride) {  // Four at a time: a quarter of the loop's own work.
+    for (size_t k = 0; k < 4; ++k) {
+      b[j + k] = p[k * stride];
+      g[j + k] = p[k * stride + 1];
+      r[j + k] = p[k * stride + 2];
+    }
+  }
+  for (; j < n; ++j, p += stride) {
+    b[j] = p[0];
+    g[j] = p[1];
+    r[j] = p[2];
+  }
+  b[-1] = b[0];
+  g[-1] = g[0];
+  r[-1] = r[0];
+}
+
+// The gray levels of a sampled row (`nx` samples) into the cells of row `cy` of the grid
+// (`cols` cells a row), as their gray samples' row `sy`.
+void CopyGraySamples(const uint8_t* gray, int nx, int cy, int sy, int cols,
+                     std::vector<FrameCell>& cells) {
+  constexpr int K = kSamplesPerCell;
+  for (int cx = 0; cx < cols; ++cx) {
+    const int begin = cx * K;
+    uint8_t* to = cells[static_cast<size_t>(cy) * cols + cx].gray.data() + sy * K;
+    if (begin + K <= nx) {
+      std::memcpy(to, gray + begin, K);  // A constant size: one move, no call.
+    } else {
+      std::copy(gray + begin, gray + nx, to);  // A frame narrower than a cell.
+    }
+  }
+}
+
+// Per column of samples, the sums over a row of cells' sampled rows.
+struct ColumnSums {
+  const uint16_t* b;
+  const uint16_t* g;
+  const uint16_t* r;
+  const uint16_t* texture_sixths;
+};
+
+// The cells of row `cy` (`cols` cells; `nx` samples a row, `height` sampled rows) from their
+// columns' sums: their mean colour and texture.
+void CellsFromColumns(const ColumnSums& sums, int nx, int cy, int height, int cols,
+                      std::vector<FrameCell>& cells) {
+  constexpr int K = kSamplesPerCell;
+  for (int cx = 0; cx < cols; ++cx) {
+    const int begin = cx * K, end = cx == cols - 1 ? nx : begin + K;
+    int cell_b = 0, cell_g = 0, cell_r = 0, cell_texture = 0;
+    const auto add_column = [&](int j) {
+      cell_b += sums.b[j];
+      cell_g += sums.g[j];
+      cell_r += sums.r[j];
+      cell_texture += sums.texture_sixths[j];
+    };
+    if (end - begin == K) {
+      for (int k = 0; k < K; ++k) add_column(begin + k);  // A constant count: unrolled.
+    } else {
+      for (int j = begin; j < end; ++j) add_column(j);
+    }
+    FrameCell& cell = cells[static_cast<size_t>(cy) * cols + cx];
+    const int samples = (end - begin) * height;
+    const float count = static_cast<float>(samples);
+    cell.b = static_cast<float>(cell_b) / count;
+    cell.g = static_cast<float>(cell_g) / count;
+    cell.r = static_cast<float>(cell_r) / count;
+    cell.texture = MeanTexture(cell_texture, samples);
+  }
+}
+
+}  // namespace
+
 // Sample (i, j) of the grid is pixel (half + i * step, half + j * step), and it belongs to cell
 // (min(i / K, rows - 1), min(j / K, cols - 1)) at place (i % K, j % K), K = kSamplesPerCell:
 // half < step, so (half + j * step) / (K * step) == j / K. The reference's per-pixel divisions and
@@ -190,68 +270,18 @@ void FrameSummariser::summarise(const cv::Mat& bgr, const CellGrid& grid,
     uint8_t* b = b_.data() + 1;
     uint8_t* g = g_.data() + 1;
     uint8_t* r = r_.data() + 1;
-    const size_t stride = 3 * static_cast<size_t>(step);
-    const uint8_t* p = row;
-    size_t j = 0;
-    for (; j + 4 <= n; j += 4, p += 4 * stride) {  // Four at a time: a quarter of the loop's own work.
-      for (size_t k = 0; k < 4; ++k) {
-        b[j + k] = p[k * stride];
-        g[j + k] = p[k * stride + 1];
-        r[j + k] = p[k * stride + 2];
-      }
-    }
-    for (; j < n; ++j, p += stride) {
-      b[j] = p[0];
-      g[j] = p[1];
-      r[j] = p[2];
-    }
-    b[-1] = b[0];
-    g[-1] = g[0];
-    r[-1] = r[0];
+    GatherSamples(row, 3 * static_cast<size_t>(step), n, b, g, r);
     AddRowToColumns(b, g, r, above_b_.data() + 1, above_g_.data() + 1, above_r_.data() + 1, i == 0,
                     padded, column_texture_sixths_.data(), column_b_.data(), column_g_.data(),
                     column_r_.data(), gray_.data());
-    const uint16_t* texture = column_texture_sixths_.data();
-    const uint16_t *sum_b = column_b_.data(), *sum_g = column_g_.data(), *sum_r = column_r_.data();
-    const uint8_t* gray = gray_.data();
     const int cy = std::min(i / K, rows - 1), sy = i - cy * K;
-    if (sy < K) {
-      for (int cx = 0; cx < cols; ++cx) {
-        const int begin = cx * K;
-        uint8_t* to = cells[static_cast<size_t>(cy) * cols + cx].gray.data() + sy * K;
-        if (begin + K <= nx) {
-          std::memcpy(to, gray + begin, K);  // A constant size: one move, no call.
-        } else {
-          std::copy(gray + begin, gray + nx, to);  // A frame narrower than a cell.
-        }
-      }
-    }
+    if (sy < K) CopyGraySamples(gray_.data(), nx, cy, sy, cols, cells);
     // A row of cells is complete: its cells from the columns' sums, and the columns start again.
     const bool last_of_its_cells = cy < rows - 1 ? (i + 1) % K == 0 : i == ny - 1;
     if (last_of_its_cells) {
-      const int height = i + 1 - cy * K;
-      for (int cx = 0; cx < cols; ++cx) {
-        const int begin = cx * K, end = cx == cols - 1 ? nx : begin + K;
-        int cell_b = 0, cell_g = 0, cell_r = 0, cell_texture = 0;
-        const auto add_column = [&](int j) {
-          cell_b += sum_b[j];
-          cell_g += sum_g[j];
-          cell_r += sum_r[j];
-          cell_texture += texture[j];
-        };
-        if (end - begin == K) {
-          for (int k = 0; k < K; ++k) add_column(begin + k);  // A constant count: unrolled.
-        } else {
-          for (int j = begin; j < end; ++j) add_column(j);
-        }
-        FrameCell& cell = cells[static_cast<size_t>(cy) * cols + cx];
-        const int samples = (end - begin) * height;
-        const float count = static_cast<float>(samples);
-        cell.b = static_cast<float>(cell_b) / count;
-        cell.g = static_cast<float>(cell_g) / count;
-        cell.r = static_cast<float>(cell_r) / count;
-        cell.texture = MeanTexture(cell_texture, samples);
-      }
+      CellsFromColumns({column_b_.data(), column_g_.data(), column_r_.data(),
+                        column_texture_sixths_.data()},
+                       nx, cy, i + 1 - cy * K, cols, cells);
       for (std::vector<uint16_t>* column :
            {&column_b_, &column_g_, &column_r_, &column_texture_sixths_}) {
         std::fill(column->begin(), column->end(), 0);

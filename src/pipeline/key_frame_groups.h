@@ -75,7 +75,6 @@ class KeyFrameGroups {
 
   // From the next frame on, hold images too (a sink that reads them joined the run).
   void hold_images() { hold_images_ = true; }
-  bool holds_images() const { return hold_images_; }
 
   // The next frame and its result: held, or handed on (with any group this frame ends) through
   // `release` before add() returns.
@@ -150,7 +149,6 @@ class PairKeyFrameGroups {
   PairKeyFrameGroups& operator=(const PairKeyFrameGroups&) = delete;
 
   void hold_images() { hold_images_ = true; }
-  bool holds_images() const { return hold_images_; }
   // The next pair and its result (its left_view and right_view set, as StereoSession gives
   // them): held, or handed on with every pair now checked in both views through `release`. A
   // pair handed on has its left_view / right_view pointing at its views' checked results, valid

@@ -196,10 +196,33 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
     const std::vector<const std::vector<MarkerCandidate>*>& candidates,
     const GarbageTest& garbage_near) {
   CV_Assert(markers.size() == tracks_.size() && candidates.size() == tracks_.size());
-  // A position next to decoded garbage is whatever the garbage made of the marker: no candidate.
-  const auto damaged = [&](const cv::Point2d& p) { return garbage_near && garbage_near(p); };
   predict_all();
   pooled_.clear();
+  gather_entries(markers, candidates, garbage_near);
+  add_unlisted_in_gates();
+  MatchOthers();
+  predict_from_body(markers);
+  // The cost matrix.
+  for (size_t i = 0; i < markers.size(); ++i) {
+    cost_[i].assign(pooled_.size(), kForbidden);
+    unassigned_[i] = kUnassignedCost;
+    for (const Entry& e : entries_[i]) {
+      if (const std::optional<double> cost = cost_of(i, e.pooled, e.misfit, markers)) {
+        cost_[i][e.pooled] = *cost;
+      }
+    }
+  }
+  const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
+  apply_assignment(assigned, markers);
+  FollowOthers(assigned);
+  return decisions_;
+}
+
+void MarkerTracks::gather_entries(const std::vector<MarkerObservation>& markers,
+                                  const std::vector<const std::vector<MarkerCandidate>*>& candidates,
+                                  const GarbageTest& garbage_near) {
+  // A position next to decoded garbage is whatever the garbage made of the marker: no candidate.
+  const auto damaged = [&](const cv::Point2d& p) { return garbage_near && garbage_near(p); };
   for (size_t i = 0; i < markers.size(); ++i) {
     decisions_[i] = Decision{};
     entries_[i].clear();
@@ -232,11 +255,14 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
       entries_[i].push_back({k, c, list[c].misfit});
     }
   }
+}
+
+void MarkerTracks::add_unlisted_in_gates() {
   // A candidate inside a started marker's gate proper (its prediction, not a coasting reach) that
   // its tracker did not list (lost, or covered, this frame) is still that marker's to explain:
   // it may take it (and stays not found: its tracker did not verify it), so a marker coasting
   // with a wide reach does not take the place another marker was just predicted at.
-  for (size_t j = 0; j < markers.size(); ++j) {
+  for (size_t j = 0; j < tracks_.size(); ++j) {
     const Track& t = tracks_[j];
     if (!t.motion.started()) continue;
     for (size_t k = 0; k < pooled_.size(); ++k) {
@@ -247,54 +273,50 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
       entries_[j].push_back({k, std::nullopt, kUnlistedMisfit});
     }
   }
-  MatchOthers();
-  predict_from_body(markers);
-  // The cost matrix.
-  for (size_t i = 0; i < markers.size(); ++i) {
-    cost_[i].assign(pooled_.size(), kForbidden);
-    unassigned_[i] = kUnassignedCost;
-    const Track& t = tracks_[i];
-    for (const Entry& e : entries_[i]) {
-      const cv::Point2d p = pooled_[e.pooled].position_px;
-      if (OnAMissingMarkersPlace(i, p, markers)) continue;
-      if (!t.motion.started()) {
-        // No track yet: the tracker's own first acquisition (its report only), unless another
-        // marker's first acquisition is the same place: nothing tells which marker it is.
-        bool claimed = false;
-        for (size_t j = 0; j < markers.size(); ++j) {
-          claimed = claimed || (j != i && !tracks_[j].motion.started() && report_pooled_[j] &&
-                                *report_pooled_[j] == e.pooled);
-        }
-        if (report_pooled_[i] && e.pooled == *report_pooled_[i] && !claimed) {
-          cost_[i][e.pooled] = kFirstAcquisitionCost;
-        }
-        continue;
-      }
-      const bool continues = Continues(i, p);
-      const double motion_fit =
-          IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
-      double fit = 0.0;
-      if (BodyVouches(i, p)) {
-        // Where the others put it (re-acquired, or jumped with its body: a shaken plate). That
-        // outweighs having been followed as another object meanwhile.
-        const BodyConstellation::Prediction& b = *body_prediction_[i];
-        const double d = cv::norm(p - b.position_px) / BodyGatePx(b);
-        fit = continues ? std::min(motion_fit, d * d) : d * d;
-      } else if (IsOtherObject(i, e.pooled)) {
-        continue;
-      } else if (continues) {
-        // The track goes on: its motion judges the report.
-        fit = motion_fit;
-      } else if (InReach(i, p) && BodyAllows(i, p)) {
-        // Re-acquired within its motion's reach, and not where the body says it cannot be.
-        fit = motion_fit;
-      } else {
-        continue;
-      }
-      cost_[i][e.pooled] = fit + kMisfitWeight * std::min(e.misfit, 2.0);
+}
+
+std::optional<double> MarkerTracks::cost_of(size_t i, size_t k, double misfit,
+                                            const std::vector<MarkerObservation>& markers) const {
+  const Track& t = tracks_[i];
+  const cv::Point2d p = pooled_[k].position_px;
+  if (OnAMissingMarkersPlace(i, p, markers)) return std::nullopt;
+  if (!t.motion.started()) {
+    // No track yet: the tracker's own first acquisition (its report only), unless another
+    // marker's first acquisition is the same place: nothing tells which marker it is.
+    bool claimed = false;
+    for (size_t j = 0; j < markers.size(); ++j) {
+      claimed = claimed || (j != i && !tracks_[j].motion.started() && report_pooled_[j] &&
+                            *report_pooled_[j] == k);
     }
+    if (report_pooled_[i] && k == *report_pooled_[i] && !claimed) return kFirstAcquisitionCost;
+    return std::nullopt;
   }
-  const std::vector<int>& assigned = solver_.solve(cost_, unassigned_);
+  const bool continues = Continues(i, p);
+  const double motion_fit =
+      IsRepeat(t, p) ? 0.0 : std::min(t.motion.distance2(p), kGate2) / kGate2;
+  double fit = 0.0;
+  if (BodyVouches(i, p)) {
+    // Where the others put it (re-acquired, or jumped with its body: a shaken plate). That
+    // outweighs having been followed as another object meanwhile.
+    const BodyConstellation::Prediction& b = *body_prediction_[i];
+    const double d = cv::norm(p - b.position_px) / BodyGatePx(b);
+    fit = continues ? std::min(motion_fit, d * d) : d * d;
+  } else if (IsOtherObject(i, k)) {
+    return std::nullopt;
+  } else if (continues) {
+    // The track goes on: its motion judges the report.
+    fit = motion_fit;
+  } else if (InReach(i, p) && BodyAllows(i, p)) {
+    // Re-acquired within its motion's reach, and not where the body says it cannot be.
+    fit = motion_fit;
+  } else {
+    return std::nullopt;
+  }
+  return fit + kMisfitWeight * std::min(misfit, 2.0);
+}
+
+void MarkerTracks::apply_assignment(const std::vector<int>& assigned,
+                                    std::vector<MarkerObservation>& markers) {
   for (size_t i = 0; i < markers.size(); ++i) {
     Observation& o = markers[i].observation;
     tracks_[i].restart = false;
@@ -339,8 +361,6 @@ const std::vector<MarkerTracks::Decision>& MarkerTracks::associate(
       o = Observation::NotFound(MarkerStatus::kImplausible);
     }
   }
-  FollowOthers(assigned);
-  return decisions_;
 }
 
 bool MarkerTracks::AnyJustLost(const std::vector<MarkerObservation>& markers) {

@@ -202,6 +202,19 @@ class MarkerTracks {
   // moment ago, has no report of its own it can have made now (see the file comment).
   bool OnAMissingMarkersPlace(size_t i, const cv::Point2d& p,
                               const std::vector<MarkerObservation>& markers) const;
+  // associate()'s steps. Each marker's entries: its report and the other candidates that fit it
+  // (not those next to decoded garbage), pooled.
+  void gather_entries(const std::vector<MarkerObservation>& markers,
+                      const std::vector<const std::vector<MarkerCandidate>*>& candidates,
+                      const GarbageTest& garbage_near);
+  // The pooled candidates inside a started marker's gate proper that its tracker did not list.
+  void add_unlisted_in_gates();
+  // The cost of marker i taking pooled candidate k (its tracker's misfit `misfit`); none when it
+  // may not take it.
+  std::optional<double> cost_of(size_t i, size_t k, double misfit,
+                                const std::vector<MarkerObservation>& markers) const;
+  // The decisions from the solver's assignment: keep, adopt or reject each marker's report.
+  void apply_assignment(const std::vector<int>& assigned, std::vector<MarkerObservation>& markers);
 
   std::vector<double> size_px_;
   std::vector<Track> tracks_;

@@ -50,7 +50,6 @@ class MotionModel {
   double distance2(const cv::Point2d& position_px) const;
   // The 1-sigma position uncertainty of the prediction, its largest axis (px).
   double sigma_px() const;
-  double accel_sigma_px() const { return accel_sigma_; }
   int updates() const { return updates_; }  // Reports folded in since start().
 
  private:

@@ -42,6 +42,22 @@ std::vector<size_t> BodyOrder(const TrackingConfig& config) {
 // track is lost anyway and its gate needs to grow no further.
 constexpr int64_t kMaxMissingFramesPredicted = 60;
 
+// A marker's report on a frame its tracker tracks afresh, once a person chose its place or asked
+// it to look again: not started when the tracker could not start, implausible when the whole
+// frame changed, else the tracker's own. A new track: it starts on this report at the next
+// frame's association.
+void TrackAfresh(MarkerObservation& marker, bool started, bool whole_frame_changed,
+                 Tracker& tracker, const cv::Mat& image) {
+  if (!started) {
+    marker.observation = Observation::NotFound(MarkerStatus::kNotStarted);
+  } else if (whole_frame_changed) {
+    marker.observation = Observation::NotFound(MarkerStatus::kImplausible);
+  } else {
+    marker.observation = tracker.update(image);
+  }
+  marker.track = marker.observation.found() ? TrackState::kTentative : TrackState::kLost;
+}
+
 }  // namespace
 
 TrackingSession::TrackingSession(const TrackingConfig& config)
@@ -257,14 +273,8 @@ const FrameResult& TrackingSession::reselect(const std::string& marker, const Fr
     // reference frame: the window shows the new result now, and the tracker has seen the frames
     // it would have seen in `track`. The other markers already saw this frame; the joint checks
     // are not repeated (the person chose this place).
-    if (frame_change_->whole_frame_changed()) {
-      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-    } else {
-      result_.markers[i].observation = trackers_[i]->update(frame.image);
-    }
-    // A new track: it starts on this report at the next frame's association.
-    result_.markers[i].track =
-        result_.markers[i].observation.found() ? TrackState::kTentative : TrackState::kLost;
+    TrackAfresh(result_.markers[i], initialised_[i], frame_change_->whole_frame_changed(),
+                *trackers_[i], frame.image);
     measure(frame);
     edited(ConfigChange::Reselect(marker, rect));
     return result_;
@@ -278,15 +288,8 @@ const FrameResult& TrackingSession::retrack(const std::string& marker, const Fra
     if (!initialised_[i]) initialised_[i] = trackers_[i]->start(frame);
     arrangement_->forget(i);
     tracks_->forget(i);
-    if (!initialised_[i]) {
-      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kNotStarted);
-    } else if (frame_change_->whole_frame_changed()) {
-      result_.markers[i].observation = Observation::NotFound(MarkerStatus::kImplausible);
-    } else {
-      result_.markers[i].observation = trackers_[i]->update(frame.image);
-    }
-    result_.markers[i].track =
-        result_.markers[i].observation.found() ? TrackState::kTentative : TrackState::kLost;
+    TrackAfresh(result_.markers[i], initialised_[i], frame_change_->whole_frame_changed(),
+                *trackers_[i], frame.image);
     measure(frame);
     edited(ConfigChange::Retrack(marker));
     return result_;

@@ -222,6 +222,309 @@ void ColourTracker::FillHoles(cv::Mat& own, cv::Point own_origin, ColourBlob* bl
   blob->circularity = m.m00 * m.m00 / (2.0 * CV_PI * (m.mu20 + m.mu02 + m.m00 / 6.0));
 }
 
+namespace {
+
+// Distances to a blob's edge, in thirds of a pixel (EdgeZones): `near` is within kSoftBand of the
+// edge, `reach` within kRingOuter outside it. Only those comparisons are read, so EdgeZones'
+// stand-in, which answers them as ChamferToEdge's distance does, serves.
+constexpr int kNearThirds = 3 * kSoftBand, kReachThirds = 3 * kRingOuter;
+static_assert(kNearThirds == kZoneNear && kReachThirds == kZoneReach && kZoneFar > kReachThirds);
+// The ring's second moments are kept per quarter (four sectors each), for the contrast.
+constexpr int kRingQuarters = 4;
+
+// The local background varies around a marker (the body's edge, texture): the ring is split into
+// kSectors angular sectors about the blob's centroid, and an edge pixel's background is
+// interpolated between the two sectors nearest its direction. The sector of pixel (x, y), as a
+// continuous coordinate in [0, kSectors).
+struct RingSectors {
+  cv::Point2d centre;  // The blob's binary centroid, in the pixels' coordinates.
+  double operator()(int x, int y) const {
+    const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
+    return std::clamp(u, 0.0, kSectors - 1e-9);
+  }
+};
+
+// Whether the blob `own` (255) has pixels deeper than kSoftBand inside its edge.
+bool HasDeepCore(const cv::Mat& own, const cv::Mat& distance) {
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* ow = own.ptr<uchar>(y);
+    const uchar* d = distance.ptr<uchar>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      if (ow[x] == 255 && d[x] > kNearThirds) return true;
+    }
+  }
+  return false;
+}
+
+// Pass 1 of a blob's measurement: the colour of its core and of the ring around it, overall, per
+// sector and per quarter of the ring, and (colour only) the same in chromaticity.
+struct RingStatistics {
+  cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
+  // Second moments (lower triangle) of the core and of each quarter of the ring.
+  cv::Matx33d core_outer = cv::Matx33d::zeros();
+  std::array<cv::Matx33d, kRingQuarters> quarter_outer{};
+  std::array<cv::Vec3d, kSectors> sector_sum{};
+  std::array<int, kSectors> sector_n{};
+  double core_n = 0, ring_n = 0;
+  // In chromaticity: the core's and each quarter's sum and second moments.
+  cv::Vec3d core_chroma_sum = cv::Vec3d(0, 0, 0);
+  cv::Matx33d core_chroma_outer = cv::Matx33d::zeros();
+  std::array<cv::Vec3d, kRingQuarters> quarter_chroma_sum{};
+  std::array<cv::Matx33d, kRingQuarters> quarter_chroma_outer{};
+};
+
+void AddChromaticity(const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
+  const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
+  sum += chroma;
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];
+  }
+}
+
+// Adds a pixel's levels to integer sums and lower-triangle second moments: (0,0) (1,0) (1,1)
+// (2,0) (2,1) (2,2).
+void AddLevels(const uchar* c, int channels, int64_t* sum, int64_t* outer) {
+  if (channels == 3) {
+    const int b = c[0], g = c[1], r = c[2];
+    sum[0] += b;
+    sum[1] += g;
+    sum[2] += r;
+    outer[0] += b * b;
+    outer[1] += g * b;
+    outer[2] += g * g;
+    outer[3] += r * b;
+    outer[4] += r * g;
+    outer[5] += r * r;
+  } else {
+    sum[0] += c[0];
+    outer[0] += c[0] * c[0];
+  }
+}
+
+int LowerTriangle(int k, int l) { return k * (k + 1) / 2 + l; }
+
+// Pass 1 over the padded box: `pixels` (filtered), `own` (the blob, 255), `distance` (its edge
+// zones), `others` (every blob of the mask). Core pixels are the blob's deeper than `core_depth`
+// (a filled hole is not the marker's colour); ring pixels lie outside every blob, beyond the soft
+// band and within the ring's reach.
+RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
+                                    const cv::Mat& distance, const cv::Mat& others, int core_depth,
+                                    const RingSectors& sector_of) {
+  RingStatistics s;
+  const int channels = pixels.channels();
+  const bool chromatic = channels == 3;
+  // The levels' sums and second moments are sums of integers, accumulated as integers: every
+  // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
+  // so the totals are the same bits in any order. Ring sums per sector, second moments per
+  // quarter.
+  std::array<int64_t, 3> core_sum_i{};
+  std::array<int64_t, 6> core_outer_i{};
+  std::array<std::array<int64_t, 3>, kSectors> sector_sum_i{};
+  std::array<std::array<int64_t, 6>, kRingQuarters> quarter_outer_i{};
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uchar* d = distance.ptr<uchar>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      const uchar* c = p + x * channels;
+      if (ow[x] == 255 && d[x] > core_depth) {
+        AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
+        if (chromatic) AddChromaticity(c, s.core_chroma_sum, s.core_chroma_outer);
+        s.core_n += 1;
+      } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
+        const int sector = static_cast<int>(sector_of(x, y));
+        AddLevels(c, channels, sector_sum_i[sector].data(),
+                  quarter_outer_i[sector * kRingQuarters / kSectors].data());
+        if (chromatic) {
+          const int quarter = sector * kRingQuarters / kSectors;
+          AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
+        }
+        ++s.sector_n[sector];
+        s.ring_n += 1;
+      }
+    }
+  }
+  for (int k = 0; k < channels; ++k) {
+    s.core_sum[k] = static_cast<double>(core_sum_i[k]);
+    s.core_sq[k] = static_cast<double>(core_outer_i[LowerTriangle(k, k)]);
+    for (int l = 0; l <= k; ++l) {
+      s.core_outer(k, l) = static_cast<double>(core_outer_i[LowerTriangle(k, l)]);
+    }
+    int64_t ring_total = 0, ring_squares = 0;
+    for (int i = 0; i < kSectors; ++i) {
+      s.sector_sum[i][k] = static_cast<double>(sector_sum_i[i][k]);
+      ring_total += sector_sum_i[i][k];
+    }
+    for (int q = 0; q < kRingQuarters; ++q) {
+      ring_squares += quarter_outer_i[q][LowerTriangle(k, k)];
+      for (int l = 0; l <= k; ++l) {
+        s.quarter_outer[q](k, l) = static_cast<double>(quarter_outer_i[q][LowerTriangle(k, l)]);
+      }
+    }
+    s.ring_sum[k] = static_cast<double>(ring_total);
+    s.ring_sq[k] = static_cast<double>(ring_squares);
+  }
+  return s;
+}
+
+// The spread (RMS) along `direction` of `n` values with mean `mean` and second moments `second`
+// (lower triangle; `dims` channels). 0 for no direction or no values.
+double SpreadAlong(const cv::Vec3d& direction, const cv::Matx33d& second, const cv::Vec3d& mean,
+                   double n, int dims) {
+  const double length = std::sqrt(direction.dot(direction));
+  if (!(length > 0) || !(n > 0)) return 0.0;
+  const cv::Vec3d u = direction / length;
+  double variance = 0;
+  for (int k = 0; k < dims; ++k) {
+    for (int l = 0; l < dims; ++l) {
+      const double moment = (k >= l ? second(k, l) : second(l, k)) / n;
+      variance += u[k] * u[l] * (moment - mean[k] * mean[l]);
+    }
+  }
+  return std::sqrt(std::max(0.0, variance));
+}
+
+// The contrast in chromaticity of the blob's core against ring pixels whose chromaticities sum
+// to `ring_sum` (second moments `ring_outer`, `n` of them): 0 where the blob's chromaticity
+// differs from theirs by less than `min_span`.
+double ChromaContrast(const RingStatistics& s, const cv::Vec3d& ring_sum,
+                      const cv::Matx33d& ring_outer, double n, double min_span) {
+  const cv::Vec3d core_chroma = s.core_chroma_sum / s.core_n;
+  const cv::Vec3d ring_chroma = ring_sum / n;
+  const cv::Vec3d direction = core_chroma - ring_chroma;
+  const double distance = std::sqrt(direction.dot(direction));
+  if (distance < min_span) return 0.0;
+  const double core_along = SpreadAlong(direction, s.core_chroma_outer, core_chroma, s.core_n, 3);
+  const double ring_along = SpreadAlong(direction, ring_outer, ring_chroma, n, 3);
+  return distance / (kCoreSigmaWeight * core_along + ring_along + kChromaNoiseFloor);
+}
+
+// The median of `count` values (at most four: insertion sort), sorting them.
+double MedianOfFew(std::array<double, kRingQuarters>& values, int count) {
+  for (int a = 1; a < count; ++a) {
+    for (int b = a; b > 0 && values[b - 1] > values[b]; --b) std::swap(values[b - 1], values[b]);
+  }
+  return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+// The blob's contrast (ColourBlob::contrast, whole_ring_contrast) from its core and ring colours
+// and the ring's statistics; `axis2` is |core colour - ring colour|^2.
+//
+// The contrast is judged against each quarter of the ring on its own, along the colour axis that
+// separates the marker from that quarter, with that quarter's spread along it: a marker at an
+// actuator's edge has a bright band on one side and the body's shaded ribs on the other, and the
+// spread of the two together (or shading across the ring, which spreads it along grey while a
+// dim saturated marker differs in chroma) would hide a marker a person sees plainly. The median
+// over the quarters: a patch of background texture stands out from few of them.
+void SetContrast(const RingStatistics& s, int channels, double axis2, ColourBlob* blob) {
+  const bool chromatic = channels == 3;
+  std::array<double, kRingQuarters> quarter_contrast{};
+  int quarters = 0;
+  for (int q = 0; q < kRingQuarters; ++q) {
+    cv::Vec3d sum(0, 0, 0);
+    int n = 0;
+    for (int i = q * kSectors / kRingQuarters; i < (q + 1) * kSectors / kRingQuarters; ++i) {
+      sum += s.sector_sum[i];
+      n += s.sector_n[i];
+    }
+    if (n < 3) continue;
+    const cv::Vec3d mean = sum / n;
+    const cv::Vec3d direction = blob->core_colour - mean;
+    const double core_along =
+        SpreadAlong(direction, s.core_outer, blob->core_colour, s.core_n, channels);
+    const double ring_along = SpreadAlong(direction, s.quarter_outer[q], mean, n, channels);
+    double contrast = std::sqrt(direction.dot(direction)) /
+                      (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
+    if (chromatic) {
+      // A marker differs from its surroundings in chroma where light and texture vary them in
+      // brightness: a dim blue dome beside the shaded ribs and lit band of a side-lit body, a
+      // green one on speckled silicone. Their dark and bright pixels spread the levels along the
+      // marker's direction, not its chromaticity.
+      contrast = std::max(contrast, ChromaContrast(s, s.quarter_chroma_sum[q],
+                                                   s.quarter_chroma_outer[q], n,
+                                                   kMinChromaContrastSpan));
+    }
+    quarter_contrast[quarters++] = contrast;
+  }
+  blob->whole_ring_contrast =
+      std::sqrt(axis2) /
+      (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
+  if (chromatic) {
+    // Against the whole ring in chroma too: a coloured marker on speckled or shaded silicone
+    // stands out in chroma from all of its surroundings at once, while their dark and bright
+    // pixels spread the levels; a patch of the bench's texture differs from them in brightness,
+    // its chroma about the same (kMinWholeRingChromaSpan).
+    cv::Vec3d ring_chroma_sum(0, 0, 0);
+    cv::Matx33d ring_chroma_outer = cv::Matx33d::zeros();
+    for (int q = 0; q < kRingQuarters; ++q) {
+      ring_chroma_sum += s.quarter_chroma_sum[q];
+      ring_chroma_outer += s.quarter_chroma_outer[q];
+    }
+    blob->whole_ring_contrast =
+        std::max(blob->whole_ring_contrast, ChromaContrast(s, ring_chroma_sum, ring_chroma_outer,
+                                                           s.ring_n, kMinWholeRingChromaSpan));
+  }
+  blob->contrast = quarters == 0 ? blob->whole_ring_contrast
+                                 : MedianOfFew(quarter_contrast, quarters);
+}
+
+// Weighted sums of the soft centroid over the padded box, in its coordinates.
+struct WeightedSums {
+  double w = 0, x = 0, y = 0;
+};
+
+// Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
+// pixel's colour lies between its local background (0) and the core colour (1), on the line
+// through them. Pixels of other blobs count 0.
+WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
+                              const cv::Mat& others, const RingSectors& sector_of,
+                              const RingStatistics& s, const ColourBlob& blob) {
+  const int channels = pixels.channels();
+  std::array<cv::Vec3d, kSectors> sector_mean;
+  for (int i = 0; i < kSectors; ++i) {
+    sector_mean[i] = s.sector_n[i] >= 2 ? s.sector_sum[i] / s.sector_n[i] : blob.ring_colour;
+  }
+  const cv::Vec3d& f = blob.core_colour;
+  WeightedSums sums;
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uchar* dist = distance.ptr<uchar>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    double row_w = 0, row_x = 0;
+    for (int x = 0; x < own.cols; ++x) {
+      if (!ow[x] && dist[x] > kNearThirds) continue;  // Beyond the band.
+      double w = 1.0;
+      if (!(ow[x] && dist[x] > kNearThirds)) {
+        if (ot[x] && !ow[x]) continue;
+        const uchar* c = p + x * channels;
+        // Sector centres sit at i + 0.5.
+        const double u = sector_of(x, y) - 0.5;
+        const double lower = std::floor(u);
+        const double t = u - lower;
+        const int i0 = (static_cast<int>(lower) + kSectors) % kSectors;
+        const int i1 = (i0 + 1) % kSectors;
+        double background[3], core[3];
+        for (int k = 0; k < channels; ++k) {
+          background[k] = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
+          core[k] = f[k];
+        }
+        w = track_internal::Membership(c, channels, background, core, kMembershipDeadband,
+                                       ow[x] != 0);
+      }
+      row_w += w;
+      row_x += w * x;
+    }
+    sums.w += row_w;
+    sums.x += row_x;
+    sums.y += row_w * y;
+  }
+  return sums;
+}
+
+}  // namespace
+
 void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int component,
                             const cv::Rect& box, cv::Point labelled_tl, cv::Point origin,
                             ColourBlob* blob) {
@@ -241,13 +544,60 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // it to the outside): a blob of one run in each of its rows (a disc, most markers) has none.
   const RunLabeller::Component& drawn = labeller_.components()[static_cast<size_t>(component)];
   if (drawn.run_count > drawn.box.height) FillHoles(own, padded.tl() + origin, blob);
-  // Asymmetry: the binary centroid against the centre of the smallest circle around the blob
-  // (its convex hull's points are among each row's leftmost and rightmost pixels).
+  measure_asymmetry(own, padded.tl() + origin, blob);
+  cv::Mat distance = Scratch(distance_store_, size, CV_8U);
+  EdgeZones(own, distance, zone_store_);
+  const cv::Mat pixels = filtered(padded);
+  const cv::Mat others = mask(padded);
+  const int channels = pixels.channels();
+  const RingSectors sector_of{blob->binary_centroid_px - cv::Point2d(padded.tl() + origin)};
+
+  // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
+  const bool pure_core = HasDeepCore(own, distance);
+  const int core_depth = pure_core ? kNearThirds : 0;
+  const RingStatistics s = GatherRingStatistics(pixels, own, distance, others, core_depth,
+                                                sector_of);
+  if (s.core_n < 1 || s.ring_n < 3) return;  // Crowded by other blobs: no local background.
+  double core_var = 0, ring_var = 0;
+  for (int k = 0; k < channels; ++k) {
+    blob->core_colour[k] = s.core_sum[k] / s.core_n;
+    blob->ring_colour[k] = s.ring_sum[k] / s.ring_n;
+    core_var +=
+        std::max(0.0, s.core_sq[k] / s.core_n - blob->core_colour[k] * blob->core_colour[k]);
+    ring_var +=
+        std::max(0.0, s.ring_sq[k] / s.ring_n - blob->ring_colour[k] * blob->ring_colour[k]);
+  }
+  blob->core_px = pure_core ? static_cast<int>(s.core_n) : 0;
+  blob->core_sigma = std::sqrt(core_var);
+  blob->ring_sigma = std::sqrt(ring_var);
+  const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
+  const double axis2 = axis.dot(axis);
+  SetContrast(s, channels, axis2, blob);
+  blob->measured = true;
+  // A round marker partly hidden: the circle of its radius through its edge (not where the
+  // frame cuts it).
+  if (const std::optional<double> radius = rim_radius_px();
+      radius && blob->area_px < kWholeRimFraction * model_->area_px) {
+    fit_rim(own, padded.tl() + origin, *radius, blob);
+  }
+  if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
+  const WeightedSums sums = SoftCentroidSums(pixels, own, distance, others, sector_of, s, *blob);
+  if (sums.w <= 0) return;
+  // Offsets added as one integer: the same blob in a window and in the whole frame gives the
+  // same bits.
+  blob->centroid_px = cv::Point2d(sums.x / sums.w + (padded.x + origin.x),
+                                  sums.y / sums.w + (padded.y + origin.y));
+}
+
+void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
+                                      ColourBlob* blob) {
+  // The binary centroid against the centre of the smallest circle around the blob (its convex
+  // hull's points are among each row's leftmost and rightmost pixels).
   edge_points_.clear();
-  for (int y = 0; y < size.height; ++y) {
+  for (int y = 0; y < own.rows; ++y) {
     const uchar* row = own.ptr<uchar>(y);
     int first = -1, last = -1;
-    for (int x = 0; x < size.width; ++x) {
+    for (int x = 0; x < own.cols; ++x) {
       if (!row[x]) continue;
       if (first < 0) first = x;
       last = x;
@@ -256,329 +606,51 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     edge_points_.emplace_back(first, y);
     if (last != first) edge_points_.emplace_back(last, y);
   }
-  if (!edge_points_.empty()) {
-    cv::Point2f circle_centre;
-    float circle_radius = 0.0f;
-    cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
-    const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
-    blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
-    blob->hull_asymmetry_px = blob->asymmetry_px;
-    cv::convexHull(edge_points_, hull_points_);
-    const cv::Moments hull = cv::moments(hull_points_);
-    if (hull.m00 > 0) {
-      const cv::Point2d hull_centre(hull.m10 / hull.m00, hull.m01 / hull.m00);
-      blob->hull_asymmetry_px = cv::norm(cv::Point2d(circle_centre) - hull_centre);
-    }
+  if (edge_points_.empty()) return;
+  cv::Point2f circle_centre;
+  float circle_radius = 0.0f;
+  cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
+  const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(own_origin);
+  blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
+  blob->hull_asymmetry_px = blob->asymmetry_px;
+  cv::convexHull(edge_points_, hull_points_);
+  const cv::Moments hull = cv::moments(hull_points_);
+  if (hull.m00 > 0) {
+    const cv::Point2d hull_centre(hull.m10 / hull.m00, hull.m01 / hull.m00);
+    blob->hull_asymmetry_px = cv::norm(cv::Point2d(circle_centre) - hull_centre);
   }
-  // Distances to the blob's edge (chamfer, thirds of a pixel): near = within kSoftBand outside,
-  // core = more than kSoftBand inside, reach = within kRingOuter outside. Only those comparisons
-  // are read, so EdgeZones' stand-in, which answers them as ChamferToEdge's distance does, serves.
-  cv::Mat distance = Scratch(distance_store_, size, CV_8U);
-  EdgeZones(own, distance, zone_store_);
-  constexpr int kNear = 3 * kSoftBand, kReach = 3 * kRingOuter;
-  static_assert(kNear == kZoneNear && kReach == kZoneReach && kZoneFar > kReach);
-  const cv::Mat pixels = filtered(padded);
-  const cv::Mat others = mask(padded);
-  const int channels = pixels.channels();
+}
 
-  // The local background varies around a marker (the body's edge, texture): the ring is split
-  // into kSectors angular sectors about the blob's centroid, and an edge pixel's background is
-  // interpolated between the two sectors nearest its direction.
-  const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(padded.tl() + origin);
-  auto sector_of = [&](int x, int y) {
-    const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
-    return std::clamp(u, 0.0, kSectors - 1e-9);
-  };
-
-  // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
-  bool core_empty = true;
-  for (int y = 0; y < size.height && core_empty; ++y) {
+void ColourTracker::fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius,
+                            ColourBlob* blob) {
+  edge_points_.clear();
+  for (int y = 0; y < own.rows; ++y) {
     const uchar* ow = own.ptr<uchar>(y);
-    const uchar* d = distance.ptr<uchar>(y);
-    for (int x = 0; x < size.width; ++x) core_empty = core_empty && !(ow[x] == 255 && d[x] > kNear);
-  }
-  const int core_depth = core_empty ? 0 : kNear;
-  const bool pure_core = !core_empty;
-
-  // Pass 1: core colour, ring colour (overall and per sector).
-  cv::Vec3d core_sum, core_sq, ring_sum, ring_sq;
-  // Second moments (lower triangle) of the core and of each quarter of the ring (four sectors
-  // each), for the contrast (see below).
-  constexpr int kQuarters = 4;
-  cv::Matx33d core_outer = cv::Matx33d::zeros();
-  std::array<cv::Matx33d, kQuarters> quarter_outer{};
-  std::array<cv::Vec3d, kSectors> sector_sum{};
-  std::array<int, kSectors> sector_n{};
-  double core_n = 0, ring_n = 0;
-  // The same in chromaticity (colour only): the core's and each quarter's sum and second moments.
-  const bool chromatic = channels == 3;
-  cv::Vec3d core_chroma_sum(0, 0, 0);
-  cv::Matx33d core_chroma_outer = cv::Matx33d::zeros();
-  std::array<cv::Vec3d, kQuarters> quarter_chroma_sum{};
-  std::array<cv::Matx33d, kQuarters> quarter_chroma_outer{};
-  const auto add_chroma = [](const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
-    const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
-    sum += chroma;
-    for (int k = 0; k < 3; ++k) {
-      for (int l = 0; l <= k; ++l) outer(k, l) += chroma[k] * chroma[l];
-    }
-  };
-  // The levels' sums and second moments are sums of integers, accumulated as integers: every
-  // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
-  // so the totals are the same bits in any order. Lower triangles: (0,0) (1,0) (1,1) (2,0) (2,1)
-  // (2,2); ring sums per sector, second moments per quarter.
-  std::array<int64_t, 3> core_sum_i{};
-  std::array<int64_t, 6> core_outer_i{};
-  std::array<std::array<int64_t, 3>, kSectors> sector_sum_i{};
-  std::array<std::array<int64_t, 6>, kQuarters> quarter_outer_i{};
-  const auto add_levels = [channels](const uchar* c, int64_t* sum, int64_t* outer) {
-    if (channels == 3) {
-      const int b = c[0], g = c[1], r = c[2];
-      sum[0] += b;
-      sum[1] += g;
-      sum[2] += r;
-      outer[0] += b * b;
-      outer[1] += g * b;
-      outer[2] += g * g;
-      outer[3] += r * b;
-      outer[4] += r * g;
-      outer[5] += r * r;
-    } else {
-      sum[0] += c[0];
-      outer[0] += c[0] * c[0];
-    }
-  };
-  const auto lower = [](int k, int l) { return k * (k + 1) / 2 + l; };
-  for (int y = 0; y < size.height; ++y) {
-    const uchar* p = pixels.ptr<uchar>(y);
-    const uchar* ow = own.ptr<uchar>(y);
-    const uchar* d = distance.ptr<uchar>(y);
-    const uchar* ot = others.ptr<uchar>(y);
-    for (int x = 0; x < size.width; ++x) {
-      const uchar* c = p + x * channels;
-      if (ow[x] == 255 && d[x] > core_depth) {  // A filled hole is not the marker's colour.
-        add_levels(c, core_sum_i.data(), core_outer_i.data());
-        if (chromatic) add_chroma(c, core_chroma_sum, core_chroma_outer);
-        core_n += 1;
-      } else if (!ow[x] && d[x] > kNear && d[x] <= kReach && !ot[x]) {
-        const int sector = static_cast<int>(sector_of(x, y));
-        add_levels(c, sector_sum_i[sector].data(),
-                   quarter_outer_i[sector * kQuarters / kSectors].data());
-        if (chromatic) {
-          const int quarter = sector * kQuarters / kSectors;
-          add_chroma(c, quarter_chroma_sum[quarter], quarter_chroma_outer[quarter]);
-        }
-        ++sector_n[sector];
-        ring_n += 1;
-      }
+    for (int x = 0; x < own.cols; ++x) {
+      if (!ow[x]) continue;
+      const bool edge = x == 0 || y == 0 || x == own.cols - 1 || y == own.rows - 1 ||
+                        !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
+                        !own.ptr<uchar>(y + 1)[x];
+      const int fx = x + frame_origin.x, fy = y + frame_origin.y;
+      const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
+                                 fy == frame_size_.height - 1;
+      if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
     }
   }
-  for (int k = 0; k < channels; ++k) {
-    core_sum[k] = static_cast<double>(core_sum_i[k]);
-    core_sq[k] = static_cast<double>(core_outer_i[lower(k, k)]);
-    for (int l = 0; l <= k; ++l) {
-      core_outer(k, l) = static_cast<double>(core_outer_i[lower(k, l)]);
-    }
-    int64_t ring_total = 0, ring_squares = 0;
-    for (int i = 0; i < kSectors; ++i) {
-      sector_sum[i][k] = static_cast<double>(sector_sum_i[i][k]);
-      ring_total += sector_sum_i[i][k];
-    }
-    for (int q = 0; q < kQuarters; ++q) {
-      ring_squares += quarter_outer_i[q][lower(k, k)];
-      for (int l = 0; l <= k; ++l) {
-        quarter_outer[q](k, l) = static_cast<double>(quarter_outer_i[q][lower(k, l)]);
-      }
-    }
-    ring_sum[k] = static_cast<double>(ring_total);
-    ring_sq[k] = static_cast<double>(ring_squares);
+  rim_points_.assign(edge_points_.begin(), edge_points_.end());
+  blob->rim = FitRimOfRadius(rim_points_, radius, kRimInlierPx, &rim_angles_);
+  // A whole marker seen at a slant (an ellipse narrower than the learned disc) fits the circle
+  // along part of its edge too; the rest of its edge bulges outwards where a cut's is straight
+  // or pushed in. Its centroid is its centre.
+  if (blob->rim) {
+    const std::optional<double> bulge =
+        OffRimBulgePx(rim_points_, *blob->rim, radius, kRimInlierPx, &off_rim_);
+    if (bulge && *bulge > kMaxCutBulgePx) blob->rim.reset();
   }
-  if (core_n < 1 || ring_n < 3) return;  // Crowded by other blobs: no local background.
-  double core_var = 0, ring_var = 0;
-  for (int k = 0; k < channels; ++k) {
-    blob->core_colour[k] = core_sum[k] / core_n;
-    blob->ring_colour[k] = ring_sum[k] / ring_n;
-    core_var += std::max(0.0, core_sq[k] / core_n - blob->core_colour[k] * blob->core_colour[k]);
-    ring_var += std::max(0.0, ring_sq[k] / ring_n - blob->ring_colour[k] * blob->ring_colour[k]);
+  if (const std::optional<cv::Point2d> centre = RimCentre(*blob)) {
+    blob->centroid_px = *centre;
+    blob->rim_placed = true;
   }
-  blob->core_px = pure_core ? static_cast<int>(core_n) : 0;
-  blob->core_sigma = std::sqrt(core_var);
-  blob->ring_sigma = std::sqrt(ring_var);
-  // The contrast is judged against each quarter of the ring on its own, along the colour axis
-  // that separates the marker from that quarter, with that quarter's spread along it: a marker
-  // at an actuator's edge has a bright band on one side and the body's shaded ribs on the other,
-  // and the spread of the two together (or shading across the ring, which spreads it along grey
-  // while a dim saturated marker differs in chroma) would hide a marker a person sees plainly.
-  // The median over the quarters: a patch of background texture stands out from few of them.
-  const cv::Vec3d axis = blob->core_colour - blob->ring_colour;
-  const double axis2 = axis.dot(axis);
-  const auto spread_along = [&](const cv::Vec3d& direction, const cv::Matx33d& second,
-                                const cv::Vec3d& mean, double n, int dims) {
-    const double length = std::sqrt(direction.dot(direction));
-    if (!(length > 0) || !(n > 0)) return 0.0;
-    const cv::Vec3d u = direction / length;
-    double variance = 0;
-    for (int k = 0; k < dims; ++k) {
-      for (int l = 0; l < dims; ++l) {
-        const double moment = (k >= l ? second(k, l) : second(l, k)) / n;
-        variance += u[k] * u[l] * (moment - mean[k] * mean[l]);
-      }
-    }
-    return std::sqrt(std::max(0.0, variance));
-  };
-  // The contrast in chromaticity against ring pixels whose chromaticities sum to `ring_sum` (second
-  // moments `ring_outer`, `n` of them): 0 where the blob's chromaticity differs from theirs by
-  // less than `min_span`.
-  const auto chroma_contrast = [&](const cv::Vec3d& ring_sum, const cv::Matx33d& ring_outer,
-                                   double n, double min_span) {
-    const cv::Vec3d core_chroma = core_chroma_sum / core_n;
-    const cv::Vec3d ring_chroma = ring_sum / n;
-    const cv::Vec3d direction = core_chroma - ring_chroma;
-    const double distance = std::sqrt(direction.dot(direction));
-    if (distance < min_span) return 0.0;
-    const double core_along = spread_along(direction, core_chroma_outer, core_chroma, core_n, 3);
-    const double ring_along = spread_along(direction, ring_outer, ring_chroma, n, 3);
-    return distance / (kCoreSigmaWeight * core_along + ring_along + kChromaNoiseFloor);
-  };
-  std::array<double, kQuarters> quarter_contrast{};
-  int quarters = 0;
-  for (int q = 0; q < kQuarters; ++q) {
-    cv::Vec3d sum(0, 0, 0);
-    int n = 0;
-    for (int i = q * kSectors / kQuarters; i < (q + 1) * kSectors / kQuarters; ++i) {
-      sum += sector_sum[i];
-      n += sector_n[i];
-    }
-    if (n < 3) continue;
-    const cv::Vec3d mean = sum / n;
-    const cv::Vec3d direction = blob->core_colour - mean;
-    const double core_along =
-        spread_along(direction, core_outer, blob->core_colour, core_n, channels);
-    const double ring_along = spread_along(direction, quarter_outer[q], mean, n, channels);
-    double contrast = std::sqrt(direction.dot(direction)) /
-                      (kCoreSigmaWeight * core_along + ring_along + kContrastNoiseFloor);
-    if (chromatic) {
-      // A marker differs from its surroundings in chroma where light and texture vary them in
-      // brightness: a dim blue dome beside the shaded ribs and lit band of a side-lit body, a
-      // green one on speckled silicone. Their dark and bright pixels spread the levels along the
-      // marker's direction, not its chromaticity.
-      contrast = std::max(contrast, chroma_contrast(quarter_chroma_sum[q], quarter_chroma_outer[q],
-                                                    n, kMinChromaContrastSpan));
-    }
-    quarter_contrast[quarters++] = contrast;
-  }
-  blob->whole_ring_contrast =
-      std::sqrt(axis2) /
-      (kCoreSigmaWeight * blob->core_sigma + blob->ring_sigma + kContrastNoiseFloor);
-  if (chromatic) {
-    // Against the whole ring in chroma too: a coloured marker on speckled or shaded silicone
-    // stands out in chroma from all of its surroundings at once, while their dark and bright
-    // pixels spread the levels; a patch of the bench's texture differs from them in brightness,
-    // its chroma about the same (kMinWholeRingChromaSpan).
-    cv::Vec3d ring_chroma_sum(0, 0, 0);
-    cv::Matx33d ring_chroma_outer = cv::Matx33d::zeros();
-    for (int q = 0; q < kQuarters; ++q) {
-      ring_chroma_sum += quarter_chroma_sum[q];
-      ring_chroma_outer += quarter_chroma_outer[q];
-    }
-    blob->whole_ring_contrast =
-        std::max(blob->whole_ring_contrast, chroma_contrast(ring_chroma_sum, ring_chroma_outer,
-                                                            ring_n, kMinWholeRingChromaSpan));
-  }
-  if (quarters == 0) {
-    blob->contrast = blob->whole_ring_contrast;
-  } else {
-    for (int a = 1; a < quarters; ++a) {  // At most four: insertion.
-      for (int b = a; b > 0 && quarter_contrast[b - 1] > quarter_contrast[b]; --b) {
-        std::swap(quarter_contrast[b - 1], quarter_contrast[b]);
-      }
-    }
-    blob->contrast = quarters % 2 ? quarter_contrast[quarters / 2]
-                                  : 0.5 * (quarter_contrast[quarters / 2 - 1] +
-                                           quarter_contrast[quarters / 2]);
-  }
-  blob->measured = true;
-  // A round marker partly hidden: the circle of its radius through its edge (not where the
-  // frame cuts it).
-  if (const std::optional<double> radius = rim_radius_px();
-      radius && blob->area_px < kWholeRimFraction * model_->area_px) {
-    edge_points_.clear();
-    const cv::Point frame_origin = padded.tl() + origin;
-    for (int y = 0; y < size.height; ++y) {
-      const uchar* ow = own.ptr<uchar>(y);
-      for (int x = 0; x < size.width; ++x) {
-        if (!ow[x]) continue;
-        const bool edge = x == 0 || y == 0 || x == size.width - 1 || y == size.height - 1 ||
-                          !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
-                          !own.ptr<uchar>(y + 1)[x];
-        const int fx = x + frame_origin.x, fy = y + frame_origin.y;
-        const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
-                                   fy == frame_size_.height - 1;
-        if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
-      }
-    }
-    rim_points_.assign(edge_points_.begin(), edge_points_.end());
-    blob->rim = FitRimOfRadius(rim_points_, *radius, kRimInlierPx, &rim_angles_);
-    // A whole marker seen at a slant (an ellipse narrower than the learned disc) fits the circle
-    // along part of its edge too; the rest of its edge bulges outwards where a cut's is straight
-    // or pushed in. Its centroid is its centre.
-    if (blob->rim) {
-      const std::optional<double> bulge =
-          OffRimBulgePx(rim_points_, *blob->rim, *radius, kRimInlierPx, &off_rim_);
-      if (bulge && *bulge > kMaxCutBulgePx) blob->rim.reset();
-    }
-    if (const std::optional<cv::Point2d> centre = RimCentre(*blob)) {
-      blob->centroid_px = *centre;
-      blob->rim_placed = true;
-    }
-  }
-  if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
-
-  // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
-  // pixel's colour lies between its local background (0) and the core colour (1), on the line
-  // through them. Pixels of other blobs count 0.
-  std::array<cv::Vec3d, kSectors> sector_mean;
-  for (int i = 0; i < kSectors; ++i) {
-    sector_mean[i] = sector_n[i] >= 2 ? sector_sum[i] / sector_n[i] : blob->ring_colour;
-  }
-  const cv::Vec3d& f = blob->core_colour;
-  double sw = 0, sx = 0, sy = 0;
-  for (int y = 0; y < size.height; ++y) {
-    const uchar* p = pixels.ptr<uchar>(y);
-    const uchar* ow = own.ptr<uchar>(y);
-    const uchar* dist = distance.ptr<uchar>(y);
-    const uchar* ot = others.ptr<uchar>(y);
-    double row_w = 0, row_x = 0;
-    for (int x = 0; x < size.width; ++x) {
-      if (!ow[x] && dist[x] > kNear) continue;  // Beyond the band.
-      double w = 1.0;
-      if (!(ow[x] && dist[x] > kNear)) {
-        if (ot[x] && !ow[x]) continue;
-        const uchar* c = p + x * channels;
-        // Sector centres sit at i + 0.5.
-        const double u = sector_of(x, y) - 0.5;
-        const double lower = std::floor(u);
-        const double t = u - lower;
-        const int i0 = (static_cast<int>(lower) + kSectors) % kSectors;
-        const int i1 = (i0 + 1) % kSectors;
-        double background[3], core[3];
-        for (int k = 0; k < channels; ++k) {
-          background[k] = (1 - t) * sector_mean[i0][k] + t * sector_mean[i1][k];
-          core[k] = f[k];
-        }
-        w = track_internal::Membership(c, channels, background, core, kMembershipDeadband, ow[x] != 0);
-      }
-      row_w += w;
-      row_x += w * x;
-    }
-    sw += row_w;
-    sx += row_x;
-    sy += row_w * y;
-  }
-  if (sw <= 0) return;
-  // Offsets added as one integer: the same blob in a window and in the whole frame gives the
-  // same bits.
-  blob->centroid_px = cv::Point2d(sx / sw + (padded.x + origin.x), sy / sw + (padded.y + origin.y));
 }
 
 void ColourTracker::complete_blobs(const cv::Mat& frame, cv::Rect region,
@@ -609,23 +681,12 @@ void ColourTracker::complete_blobs(const cv::Mat& frame, cv::Rect region,
   blobs->insert(blobs->end(), pending_.begin(), pending_.end());
 }
 
-void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
-                                   std::vector<ColourBlob>* blobs) {
-  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
-  region &= frame_rect;
-  const int coarse_cols = region.width / factor;
-  const int coarse_rows = region.height / factor;
-  if (coarse_cols < 4 || coarse_rows < 4) {
-    complete_blobs(frame, region, blobs);
-    return;
-  }
-  // One pixel per cell of factor x factor pixels (its centre). Sampling, not averaging: a blob
-  // of radius >= factor always holds several sample points, and a sample is a real pixel of the
-  // frame, not a mix of marker and background. Columns beyond a multiple of the factor are
-  // covered by the last cell's window below.
-  const cv::Mat src = frame(cv::Rect(region.x, region.y, coarse_cols * factor, coarse_rows * factor));
-  cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
-  // The pixel cv::resize's INTER_NEAREST_EXACT takes, (i + 1/2) * factor, copied directly.
+namespace {
+
+// One pixel per cell of factor x factor pixels of `src` into `sampled` (one pixel a cell): the
+// pixel cv::resize's INTER_NEAREST_EXACT takes, (i + 1/2) * factor, copied directly.
+void SampleCells(const cv::Mat& src, int factor, cv::Mat& sampled) {
+  const int coarse_cols = sampled.cols, coarse_rows = sampled.rows;
   const int channels = src.channels(), half = factor / 2;
   const size_t row_bytes = static_cast<size_t>(src.cols) * channels;
   for (int y = 0; y < coarse_rows; ++y) {
@@ -647,28 +708,82 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
       for (int x = 0; x < coarse_cols; ++x, in += step) out[x] = in[0];
     }
   }
+}
+
+// Drops the lit samples of `mask` with no lit 8-neighbour from `points`.
+void DropLoneSamples(const cv::Mat& mask, std::vector<cv::Point>& points) {
+  auto alone = [&](const cv::Point& p) {
+    for (int y = std::max(0, p.y - 1); y <= std::min(mask.rows - 1, p.y + 1); ++y) {
+      const uchar* row = mask.ptr<uchar>(y);
+      for (int x = std::max(0, p.x - 1); x <= std::min(mask.cols - 1, p.x + 1); ++x) {
+        if ((x != p.x || y != p.y) && row[x]) return false;
+      }
+    }
+    return true;
+  };
+  points.erase(std::remove_if(points.begin(), points.end(), alone), points.end());
+}
+
+// Merges overlapping windows until none overlap, so a blob is analysed (and completed) once.
+void MergeOverlappingWindows(std::vector<cv::Rect>& windows) {
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (size_t a = 0; a < windows.size() && !merged; ++a) {
+      for (size_t b = a + 1; b < windows.size(); ++b) {
+        if ((windows[a] & windows[b]).empty()) continue;
+        windows[a] |= windows[b];
+        windows.erase(windows.begin() + static_cast<std::ptrdiff_t>(b));
+        merged = true;
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
+                                   std::vector<ColourBlob>* blobs) {
+  const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
+  region &= frame_rect;
+  const int coarse_cols = region.width / factor;
+  const int coarse_rows = region.height / factor;
+  if (coarse_cols < 4 || coarse_rows < 4) {
+    complete_blobs(frame, region, blobs);
+    return;
+  }
+  // One pixel per cell of factor x factor pixels (its centre). Sampling, not averaging: a blob
+  // of radius >= factor always holds several sample points, and a sample is a real pixel of the
+  // frame, not a mix of marker and background. Columns beyond a multiple of the factor are
+  // covered by the last cell's window below.
+  const cv::Mat src = frame(cv::Rect(region.x, region.y, coarse_cols * factor, coarse_rows * factor));
+  cv::Mat sampled = Scratch(coarse_store_, cv::Size(coarse_cols, coarse_rows), src.type());
+  SampleCells(src, factor, sampled);
   const cv::Mat coarse = prepare(sampled, coarse_prepared_store_);
   cv::Mat mask = Scratch(coarse_mask_store_, coarse.size(), CV_8U);
   classify(coarse, true, mask);
-  // Group the candidate cells by tiles of kTile x kTile cells, 8-connected tiles together:
-  // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
   windows_.clear();
   NonZeroPoints(mask, points_);
   // A blob that can be the marker has radius >= factor (as acquire_downsample chooses it), so it
   // holds at least two 8-adjacent sample points: a lone lit sample is a speck of background texture.
-  if (min_blob_radius_px() >= factor) {
-    auto alone = [&](const cv::Point& p) {
-      for (int y = std::max(0, p.y - 1); y <= std::min(mask.rows - 1, p.y + 1); ++y) {
-        const uchar* row = mask.ptr<uchar>(y);
-        for (int x = std::max(0, p.x - 1); x <= std::min(mask.cols - 1, p.x + 1); ++x) {
-          if ((x != p.x || y != p.y) && row[x]) return false;
-        }
-      }
-      return true;
-    };
-    points_.erase(std::remove_if(points_.begin(), points_.end(), alone), points_.end());
-  }
+  if (min_blob_radius_px() >= factor) DropLoneSamples(mask, points_);
   if (points_.empty()) return;
+  cell_group_windows(region, factor, cv::Size(coarse_cols, coarse_rows), frame_rect);
+  MergeOverlappingWindows(windows_);
+  const size_t first = blobs->size();
+  for (const cv::Rect& window : windows_) complete_blobs(frame, window, blobs);
+  // Regions grown around clipped blobs may overlap: keep each blob once.
+  std::sort(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(), CentroidBefore);
+  blobs->erase(std::unique(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(),
+                           SameBlob),
+               blobs->end());
+}
+
+void ColourTracker::cell_group_windows(const cv::Rect& region, int factor, cv::Size cells_size,
+                                       const cv::Rect& frame_rect) {
+  const int coarse_cols = cells_size.width, coarse_rows = cells_size.height;
+  // Group the candidate cells by tiles of kTile x kTile cells, 8-connected tiles together:
+  // labelling a tile grid is ~60x cheaper than labelling the coarse mask itself.
   const cv::Size grid((coarse_cols + kTile - 1) / kTile, (coarse_rows + kTile - 1) / kTile);
   cv::Mat tiles = Scratch(tiles_store_, grid, CV_8U);
   tiles.setTo(0);
@@ -696,26 +811,6 @@ void ColourTracker::coarse_to_fine(const cv::Mat& frame, cv::Rect region, int fa
                           right - x0 * factor, bottom - y0 * factor);
     windows_.push_back(window & frame_rect);
   }
-  // Overlapping windows merge, so a blob is analysed (and completed) once.
-  for (bool merged = true; merged;) {
-    merged = false;
-    for (size_t a = 0; a < windows_.size() && !merged; ++a) {
-      for (size_t b = a + 1; b < windows_.size(); ++b) {
-        if ((windows_[a] & windows_[b]).empty()) continue;
-        windows_[a] |= windows_[b];
-        windows_.erase(windows_.begin() + static_cast<std::ptrdiff_t>(b));
-        merged = true;
-        break;
-      }
-    }
-  }
-  const size_t first = blobs->size();
-  for (const cv::Rect& window : windows_) complete_blobs(frame, window, blobs);
-  // Regions grown around clipped blobs may overlap: keep each blob once.
-  std::sort(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(), CentroidBefore);
-  blobs->erase(std::unique(blobs->begin() + static_cast<std::ptrdiff_t>(first), blobs->end(),
-                           SameBlob),
-               blobs->end());
 }
 
 }  // namespace softsight

@@ -27,14 +27,6 @@ const HsvTables& Tables() {
   return tables;
 }
 
-// The hue numerator N' = N + diff of OpenCV's formula hue = N * 30 / diff (N = g - b when the
-// maximum is red, b - r + 2 diff when green, r - g + 4 diff when blue), shifted so it is >= 0.
-inline int ShiftedNumerator(int b, int g, int r, int v, int diff) {
-  if (v == r) return g - b + diff;
-  if (v == g) return b - r + 3 * diff;
-  return r - g + 5 * diff;
-}
-
 }  // namespace
 
 bool HsvBox::ContainsHue(int hue) const {
@@ -131,7 +123,9 @@ void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
 //  - saturation: OpenCV's S is floor(255 diff / v + e + 1/2) with |e| <= 0.031, so
 //    255 diff >= lo v gives S >= lo, 255 diff <= (lo - 1) v gives S < lo (likewise for hi);
 //  - hue: OpenCV's H is floor(t + e + 1/2), t = 30 N / diff, |e| <= 0.16, so t in [A, B] (an
-//    interval of integers) is in, and t <= A - 1 or t >= B + 1 for every interval is out.
+//    interval of integers) is in, and t <= A - 1 or t >= B + 1 for every interval is out. The
+//    tests use the numerator N' = N + diff of OpenCV's hue = N * 30 / diff (N = g - b when the
+//    maximum is red, b - r + 2 diff when green, r - g + 4 diff when blue), shifted to be >= 0.
 // All products stay below 2^16: 30 N' <= 30 * 6 * 255, 255 diff, (B + 31) diff <= 180 * 255.
 void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
   int x = 0;

@@ -27,50 +27,88 @@ Option<ColourParams> HsvOption(const char* key, HsvRange ColourParams::*range, i
       .AppliesIf([](const ColourParams& p) { return !p.auto_bgr && !p.gray; });
 }
 
+// auto_colour: a nominal [b, g, r] instead of the HSV ranges.
+Option<ColourParams> AutoColourOption() {
+  using P = ColourParams;
+  return CustomOption<P>(
+      "auto_colour", OptionKind::kInts,
+      [](const P& p) -> std::optional<OptionValue> {
+        if (!p.auto_bgr) return std::nullopt;
+        const cv::Vec3b c = *p.auto_bgr;
+        return OptionValue(std::vector<int64_t>{c[0], c[1], c[2]});
+      },
+      [](P& p, const std::optional<OptionValue>& v) {
+        if (!v) {
+          p.auto_bgr.reset();
+          return;
+        }
+        const auto& list = std::get<std::vector<int64_t>>(*v);
+        p.auto_bgr = cv::Vec3b(static_cast<uchar>(list[0]), static_cast<uchar>(list[1]),
+                               static_cast<uchar>(list[2]));
+      },
+      /*optional=*/true)
+      .Count(3)
+      .Range(0, 255)
+      .Doc("nominal [b, g, r] instead of hsv: threshold around it, candidates verified against it");
+}
+
+// gray: a gray-level range instead of the HSV ranges.
+Option<ColourParams> GrayLevelOption() {
+  using P = ColourParams;
+  return CustomOption<P>(
+      "gray", OptionKind::kInts,
+      [](const P& p) -> std::optional<OptionValue> {
+        if (!p.gray) return std::nullopt;
+        return OptionValue(std::vector<int64_t>{p.gray->lo, p.gray->hi});
+      },
+      [](P& p, const std::optional<OptionValue>& v) {
+        if (!v) {
+          p.gray.reset();
+          return;
+        }
+        const auto& list = std::get<std::vector<int64_t>>(*v);
+        p.gray = HsvRange{static_cast<int>(list[0]), static_cast<int>(list[1])};
+      },
+      /*optional=*/true)
+      .Count(2)
+      .Range(0, 255)
+      .Doc("gray-level [lo, hi] instead of hsv: white or black dots, on gray or colour video");
+}
+
+// roi: where the first acquisition looks.
+Option<ColourParams> RoiOption() {
+  using P = ColourParams;
+  return CustomOption<P>(
+      "roi", OptionKind::kInts,
+      [](const P& p) -> std::optional<OptionValue> {
+        if (!p.roi) return std::nullopt;
+        return OptionValue(
+            std::vector<int64_t>{p.roi->x, p.roi->y, p.roi->width, p.roi->height});
+      },
+      [](P& p, const std::optional<OptionValue>& v) {
+        if (!v) {
+          p.roi.reset();
+          return;
+        }
+        const auto& r = std::get<std::vector<int64_t>>(*v);
+        p.roi = cv::Rect(static_cast<int>(r[0]), static_cast<int>(r[1]),
+                         static_cast<int>(r[2]), static_cast<int>(r[3]));
+      },
+      /*optional=*/true)
+      .Count(4)
+      .Range(0, 65535)
+      .Unit("px")
+      .Doc("[x, y, w, h] where the first acquisition looks (a dragged rectangle)");
+}
+
 OptionTable<ColourParams> MakeColourTable() {
   using P = ColourParams;
   return {
       HsvOption("hsv.h", &P::h, 179, "hue [lo, hi], OpenCV's 0..179; lo > hi wraps round red"),
       HsvOption("hsv.s", &P::s, 255, "saturation [lo, hi]"),
       HsvOption("hsv.v", &P::v, 255, "value (brightness) [lo, hi]"),
-      CustomOption<P>(
-          "auto_colour", OptionKind::kInts,
-          [](const P& p) -> std::optional<OptionValue> {
-            if (!p.auto_bgr) return std::nullopt;
-            const cv::Vec3b c = *p.auto_bgr;
-            return OptionValue(std::vector<int64_t>{c[0], c[1], c[2]});
-          },
-          [](P& p, const std::optional<OptionValue>& v) {
-            if (!v) {
-              p.auto_bgr.reset();
-              return;
-            }
-            const auto& list = std::get<std::vector<int64_t>>(*v);
-            p.auto_bgr = cv::Vec3b(static_cast<uchar>(list[0]), static_cast<uchar>(list[1]),
-                                   static_cast<uchar>(list[2]));
-          },
-          /*optional=*/true)
-          .Count(3)
-          .Range(0, 255)
-          .Doc("nominal [b, g, r] instead of hsv: threshold around it, candidates verified against it"),
-      CustomOption<P>(
-          "gray", OptionKind::kInts,
-          [](const P& p) -> std::optional<OptionValue> {
-            if (!p.gray) return std::nullopt;
-            return OptionValue(std::vector<int64_t>{p.gray->lo, p.gray->hi});
-          },
-          [](P& p, const std::optional<OptionValue>& v) {
-            if (!v) {
-              p.gray.reset();
-              return;
-            }
-            const auto& list = std::get<std::vector<int64_t>>(*v);
-            p.gray = HsvRange{static_cast<int>(list[0]), static_cast<int>(list[1])};
-          },
-          /*optional=*/true)
-          .Count(2)
-          .Range(0, 255)
-          .Doc("gray-level [lo, hi] instead of hsv: white or black dots, on gray or colour video"),
+      AutoColourOption(),
+      GrayLevelOption(),
       EnumOption<P>("filter.type", &P::filter,
                     std::vector<std::pair<std::string, Filter>>{{"none", Filter::kNone},
                                                                 {"gaussian", Filter::kGaussian},
@@ -124,27 +162,7 @@ OptionTable<ColourParams> MakeColourTable() {
       DoubleOption<P>("adapt_rate", &P::adapt_rate)
           .Range(0, 1)
           .Doc("share per frame by which the learned area, shape and colour follow the marker"),
-      CustomOption<P>(
-          "roi", OptionKind::kInts,
-          [](const P& p) -> std::optional<OptionValue> {
-            if (!p.roi) return std::nullopt;
-            return OptionValue(
-                std::vector<int64_t>{p.roi->x, p.roi->y, p.roi->width, p.roi->height});
-          },
-          [](P& p, const std::optional<OptionValue>& v) {
-            if (!v) {
-              p.roi.reset();
-              return;
-            }
-            const auto& r = std::get<std::vector<int64_t>>(*v);
-            p.roi = cv::Rect(static_cast<int>(r[0]), static_cast<int>(r[1]),
-                             static_cast<int>(r[2]), static_cast<int>(r[3]));
-          },
-          /*optional=*/true)
-          .Count(4)
-          .Range(0, 65535)
-          .Unit("px")
-          .Doc("[x, y, w, h] where the first acquisition looks (a dragged rectangle)"),
+      RoiOption(),
       IntOption<P>("roi_frame", &P::roi_frame)
           .Range(0, 1e9)
           .Doc("frame the roi was picked on: the marker is not started before it (no roi: "

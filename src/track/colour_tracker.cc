@@ -517,14 +517,52 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   // preference for the neighbourhood of the last known position. A runner-up nearly as good
   // makes the marker ambiguous: a coin toss between look-alikes is not a measurement.
   const double diagonal = std::hypot(frame.cols, frame.rows);
+  Ranking ranking = rank_candidates(diagonal);
+  Choice choice;
+  if (!std::isfinite(ranking.best_cost)) {
+    // kLost: nothing whole fits; what fits is partly hidden.
+    if (std::isfinite(ranking.partial_cost)) {
+      choice.status = ranking.partial_at_edge ? MarkerStatus::kOutOfFrame : MarkerStatus::kCovered;
+    }
+    return choice;
+  }
+  ranking.second_cost = std::min(ranking.second_cost, ranking.partial_cost);
+  // Before a model is learned, the misfit knows only the configured ranges and a compact,
+  // contrasted shape: it cannot tell a marker from a look-alike (a glint, a dot of the bench), so
+  // a whole-frame first acquisition needs the one candidate that fits at all.
+  const double margin = !model_ && !acquire_roi_ ? std::numeric_limits<double>::infinity()
+                                                 : params_.ambiguity_margin;
+  const bool by_uniqueness = !model_ && !acquire_roi_;
+  if (std::isfinite(ranking.second_cost) && ranking.second_cost - ranking.best_cost < margin) {
+    return ambiguous_choice(ranking.best_cost, margin, diagonal, by_uniqueness);
+  }
+  if (by_uniqueness && !rivals_.empty()) {
+    if (a_rival_may_be_it(blobs_[ranking.best])) {
+      choice.status = MarkerStatus::kAmbiguous;
+      choice.tied = 2;
+      return choice;
+    }
+    rivals_.clear();
+  }
+  candidates_[ranking.best].verdict = CandidateVerdict::kChosen;
+  choice.blob = blobs_[ranking.best];
+  choice.status = MarkerStatus::kFound;
+  return choice;
+}
+
+double ColourTracker::acquisition_cost(double misfit, const cv::Point2d& position_px,
+                                       double diagonal) const {
+  double cost = misfit;
+  if (last_px_) cost += cv::norm(position_px - *last_px_) / diagonal;
+  return cost;
+}
+
+ColourTracker::Ranking ColourTracker::rank_candidates(double diagonal) {
   const cv::Rect2d roi_area = acquire_roi_ ? cv::Rect2d(acquire_roi_->x - 0.5, acquire_roi_->y - 0.5,
                                                         acquire_roi_->width, acquire_roi_->height)
                                            : cv::Rect2d();
   candidates_.clear();
-  size_t best = 0;
-  double best_cost = std::numeric_limits<double>::infinity(), second_cost = best_cost;
-  double partial_cost = best_cost;  // The best rival partly hidden ...
-  bool partial_at_edge = false;     // ... and whether it is cut by the frame's edge.
+  Ranking ranking;
   for (const ColourBlob& b : blobs_) {
     auto [verdict, misfit] = judge(b);
     if (verdict == CandidateVerdict::kFits && acquire_roi_ && !roi_area.contains(b.centroid_px)) {
@@ -533,88 +571,66 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
     candidates_.push_back(candidate(b, verdict, misfit));
     const bool partial = verdict == CandidateVerdict::kPartial;
     if (verdict != CandidateVerdict::kFits && !partial) continue;
-    double cost = misfit;
-    if (last_px_) cost += cv::norm(b.centroid_px - *last_px_) / diagonal;
+    const double cost = acquisition_cost(misfit, b.centroid_px, diagonal);
     if (partial) {
       // Partly hidden: never the one reported, but a rival (it may be the marker).
-      if (cost < partial_cost) {
-        partial_cost = cost;
-        partial_at_edge = b.at_frame_edge;
+      if (cost < ranking.partial_cost) {
+        ranking.partial_cost = cost;
+        ranking.partial_at_edge = b.at_frame_edge;
       }
       continue;
     }
     const size_t index = candidates_.size() - 1;
-    if (cost < best_cost) {
-      second_cost = best_cost;
-      best = index;
-      best_cost = cost;
-    } else if (cost < second_cost) {
-      second_cost = cost;
+    if (cost < ranking.best_cost) {
+      ranking.second_cost = ranking.best_cost;
+      ranking.best = index;
+      ranking.best_cost = cost;
+    } else if (cost < ranking.second_cost) {
+      ranking.second_cost = cost;
     }
   }
+  return ranking;
+}
+
+ColourTracker::Choice ColourTracker::ambiguous_choice(double best_cost, double margin,
+                                                     double diagonal, bool by_uniqueness) {
   Choice choice;
-  if (!std::isfinite(best_cost)) {
-    // kLost: nothing whole fits; what fits is partly hidden.
-    if (std::isfinite(partial_cost)) {
-      choice.status = partial_at_edge ? MarkerStatus::kOutOfFrame : MarkerStatus::kCovered;
+  choice.status = MarkerStatus::kAmbiguous;
+  if (by_uniqueness) rivals_.clear();
+  for (size_t i = 0; i < candidates_.size(); ++i) {
+    const bool partial = candidates_[i].verdict == CandidateVerdict::kPartial;
+    if (candidates_[i].verdict != CandidateVerdict::kFits && !partial) continue;
+    const double cost = acquisition_cost(candidates_[i].misfit, blobs_[i].centroid_px, diagonal);
+    if (!partial && cost - best_cost < margin) ++choice.tied;
+    if (by_uniqueness) {
+      // A partial rival too: the marker leaving the frame is one.
+      rivals_.push_back({blobs_[i].centroid_px, std::sqrt(blobs_[i].area_px / CV_PI)});
     }
-    return choice;
   }
-  second_cost = std::min(second_cost, partial_cost);
-  // Before a model is learned, the misfit knows only the configured ranges and a compact,
-  // contrasted shape: it cannot tell a marker from a look-alike (a glint, a dot of the bench), so
-  // a whole-frame first acquisition needs the one candidate that fits at all.
-  const double margin = !model_ && !acquire_roi_ ? std::numeric_limits<double>::infinity()
-                                                 : params_.ambiguity_margin;
-  const bool by_uniqueness = !model_ && !acquire_roi_;
-  if (std::isfinite(second_cost) && second_cost - best_cost < margin) {
-    choice.status = MarkerStatus::kAmbiguous;
-    if (by_uniqueness) rivals_.clear();
-    for (size_t i = 0; i < candidates_.size(); ++i) {
-      const bool partial = candidates_[i].verdict == CandidateVerdict::kPartial;
-      if (candidates_[i].verdict != CandidateVerdict::kFits && !partial) continue;
-      double cost = candidates_[i].misfit;
-      if (last_px_) cost += cv::norm(blobs_[i].centroid_px - *last_px_) / diagonal;
-      if (!partial && cost - best_cost < margin) ++choice.tied;
-      if (by_uniqueness) {
-        // A partial rival too: the marker leaving the frame is one.
-        rivals_.push_back({blobs_[i].centroid_px, std::sqrt(blobs_[i].area_px / CV_PI)});
-      }
-    }
-    return choice;
-  }
-  if (by_uniqueness && !rivals_.empty()) {
-    // The one candidate left may be one of those that were tied before, still exactly in its
-    // place (a look-alike of the background does not move; a marker on a bending body does).
-    // If another of them is still there (a blob in its place that no longer fits: the checks told
-    // them apart), the candidate is the marker. If another has vanished, it may have been the
-    // marker (gone, or covered) and the one left a look-alike: as ambiguous as before. A
-    // candidate that has moved, or is in none of their places, is the marker.
-    const ColourBlob& only = blobs_[best];
-    const auto at = [](const cv::Point2d& p, const Rival& rival) {
-      return cv::norm(p - rival.position_px) <= rival.radius_px + 2.0;
-    };
-    bool was_a_rival = false, a_rival_vanished = false;
-    for (const Rival& rival : rivals_) {
-      if (cv::norm(only.centroid_px - rival.position_px) <= kRivalStillPx) {
-        was_a_rival = true;
-        continue;
-      }
-      bool still_there = false;
-      for (const ColourBlob& b : blobs_) still_there = still_there || at(b.centroid_px, rival);
-      a_rival_vanished = a_rival_vanished || !still_there;
-    }
-    if (was_a_rival && a_rival_vanished) {
-      choice.status = MarkerStatus::kAmbiguous;
-      choice.tied = 2;
-      return choice;
-    }
-    rivals_.clear();
-  }
-  candidates_[best].verdict = CandidateVerdict::kChosen;
-  choice.blob = blobs_[best];
-  choice.status = MarkerStatus::kFound;
   return choice;
+}
+
+bool ColourTracker::a_rival_may_be_it(const ColourBlob& only) const {
+  // The one candidate left may be one of those that were tied before, still exactly in its
+  // place (a look-alike of the background does not move; a marker on a bending body does).
+  // If another of them is still there (a blob in its place that no longer fits: the checks told
+  // them apart), the candidate is the marker. If another has vanished, it may have been the
+  // marker (gone, or covered) and the one left a look-alike: as ambiguous as before. A
+  // candidate that has moved, or is in none of their places, is the marker.
+  const auto at = [](const cv::Point2d& p, const Rival& rival) {
+    return cv::norm(p - rival.position_px) <= rival.radius_px + 2.0;
+  };
+  bool was_a_rival = false, a_rival_vanished = false;
+  for (const Rival& rival : rivals_) {
+    if (cv::norm(only.centroid_px - rival.position_px) <= kRivalStillPx) {
+      was_a_rival = true;
+      continue;
+    }
+    bool still_there = false;
+    for (const ColourBlob& b : blobs_) still_there = still_there || at(b.centroid_px, rival);
+    a_rival_vanished = a_rival_vanished || !still_there;
+  }
+  return was_a_rival && a_rival_vanished;
 }
 
 ColourTracker::Choice ColourTracker::relearn(const cv::Point2d& last_seen) {

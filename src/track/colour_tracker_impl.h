@@ -13,6 +13,7 @@
 // whole-frame analysis finds.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -120,8 +121,6 @@ class ColourTracker : public Tracker {
     return model_ ? std::optional<double>(model_->area_px) : std::nullopt;
   }
   const std::optional<ColourModel>& model() const { return model_; }
-  // True when pixels are classified by gray level (`gray`, or a nominal gray `auto_bgr`).
-  bool gray_mode() const { return gray_.has_value(); }
   // The verdict on `blob` and its misfit (sum of the criteria, each 1 at its limit; infinite for a
   // rejection; kPartial is a blob that fits but is partly hidden, with its finite misfit). With
   // `any_brightness` the learned colour's brightness is not held against it (its chroma is).
@@ -149,6 +148,12 @@ class ColourTracker : public Tracker {
   // latter's in the frame.
   void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
+  // The blob's asymmetry_px and hull_asymmetry_px from its mask `own` (whose top-left pixel is
+  // `own_origin` in the frame).
+  void measure_asymmetry(const cv::Mat& own, cv::Point own_origin, ColourBlob* blob);
+  // A partial round blob: the circle of the marker's `radius` fitted to its edge (not where the
+  // frame cuts it), and its centre as the centroid when the fit is good (RimCentre).
+  void fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius, ColourBlob* blob);
   // Fills the holes of the blob's mask `own` (whose top-left pixel is `own_origin` in the frame)
   // and, when there were any, sets the blob's area, centroids and circularity from the filled
   // mask.
@@ -158,6 +163,10 @@ class ColourTracker : public Tracker {
   // Coarse candidates -> full-resolution windows -> complete blobs.
   void coarse_to_fine(const cv::Mat& frame, cv::Rect region, int factor,
                       std::vector<ColourBlob>* blobs);
+  // The full-resolution windows (into windows_) around the groups of the candidate cells
+  // (points_, cells of `factor` x `factor` pixels of `region`, `cells` of them).
+  void cell_group_windows(const cv::Rect& region, int factor, cv::Size cells,
+                          const cv::Rect& frame_rect);
 
   // The outcome of one search: the chosen blob, or why there is none.
   struct Choice {
@@ -183,6 +192,25 @@ class ColourTracker : public Tracker {
   Choice dim_search(const cv::Mat& frame, const cv::Rect& window, const cv::Point2d& predicted,
                     double reach, const cv::Point2d& sliver);
   Choice acquire(const cv::Mat& frame);
+  // An acquisition's candidates (blobs_) ranked by cost: the best whole one, the runner-up's
+  // cost, and the best partly hidden one's (which is never reported, but is a rival).
+  struct Ranking {
+    size_t best = 0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    double second_cost = std::numeric_limits<double>::infinity();
+    double partial_cost = std::numeric_limits<double>::infinity();
+    bool partial_at_edge = false;  // The best partial one is cut by the frame's edge.
+  };
+  // Judges every blob into candidates_ and ranks those that fit; `diagonal` is the frame's.
+  Ranking rank_candidates(double diagonal);
+  // A candidate's cost: its misfit, plus its distance from the last position over `diagonal`.
+  double acquisition_cost(double misfit, const cv::Point2d& position_px, double diagonal) const;
+  // kAmbiguous, with how many whole candidates cost within `margin` of the best; with
+  // `by_uniqueness` every fitting candidate becomes a rival.
+  Choice ambiguous_choice(double best_cost, double margin, double diagonal, bool by_uniqueness);
+  // Whether the one candidate left, `only`, may be a look-alike among the rivals tied before:
+  // it was one of them, in its place still, and another of them has vanished.
+  bool a_rival_may_be_it(const ColourBlob& only) const;
   // After a lasting change of the light: the one blob near where the marker was last seen that
   // fits everything but the learned brightness, if there is exactly one.
   Choice relearn(const cv::Point2d& last_seen);

@@ -80,11 +80,16 @@ float ZnccFromSums(int64_t n, int64_t cross, const int64_t* sum, int64_t sum_sq,
 // Gives the kernels access to the layout without making it public API.
 struct KernelAccess {
   static bool Vectorised(const PreparedTemplate& t) { return t.chunks_per_row_ > 0; }
-  static int FullChunks(const PreparedTemplate& t) { return t.full_chunks_; }
-  static bool HasTail(const PreparedTemplate& t) { return t.has_tail_; }
-  static int TailLo(const PreparedTemplate& t) { return t.tail_lo_; }
-  static int TailHi(const PreparedTemplate& t) { return t.tail_hi_; }
-  static int Rows(const PreparedTemplate& t) { return t.image_.rows; }
+  // What the vector kernels walk: per template row, `full` 16-byte chunks, then (when `tail`)
+  // one chunk of two 8-byte halves at byte offsets `lo` and `hi` of the row.
+  struct Chunks {
+    int rows, full;
+    bool tail;
+    int lo, hi;
+  };
+  static Chunks Layout(const PreparedTemplate& t) {
+    return {t.image_.rows, t.full_chunks_, t.has_tail_, t.tail_lo_, t.tail_hi_};
+  }
   static const uint8_t* Bytes(const PreparedTemplate& t) { return t.bytes_.data(); }
   static const uint8_t* Mask(const PreparedTemplate& t) { return t.mask_.data(); }
   static const int16_t* Words(const PreparedTemplate& t) { return t.words_.data(); }
@@ -94,7 +99,8 @@ struct KernelAccess {
 
 namespace {
 
-// MatchCrossCorrelation with the buffer for the widened image given (defined below).
+// sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC and SSD are built on.
+// The image widened to 16 bits is kept in `widened` (defined below).
 void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                       std::vector<int16_t>& widened);
 
@@ -201,6 +207,33 @@ void SsdFromSums(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& resul
   });
 }
 
+// How many pixels of a template count (all, or the mask's nonzero ones), and the per-channel sums
+// of T and T^2 over them.
+struct CountedSums {
+  int64_t n = 0;
+  int64_t sum[3] = {0, 0, 0};
+  int64_t sum_sq[3] = {0, 0, 0};
+};
+
+CountedSums SumCountedPixels(const cv::Mat& templ, const cv::Mat& mask) {
+  const int cn = templ.channels();
+  CountedSums s;
+  for (int r = 0; r < templ.rows; ++r) {
+    const uint8_t* p = templ.ptr<uint8_t>(r);
+    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(r);
+    for (int j = 0; j < templ.cols; ++j) {
+      if (m && !m[j]) continue;
+      ++s.n;
+      for (int c = 0; c < cn; ++c) {
+        const int64_t v = p[j * cn + c];
+        s.sum[c] += v;
+        s.sum_sq[c] += v * v;
+      }
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
@@ -219,24 +252,10 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   runs_.clear();
 
   const int cn = templ.channels();
-  int64_t n = 0;
-  int64_t sum[3] = {0, 0, 0};
-  int64_t sum_sq[3] = {0, 0, 0};
-  for (int r = 0; r < templ.rows; ++r) {
-    const uint8_t* p = templ.ptr<uint8_t>(r);
-    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(r);
-    for (int j = 0; j < templ.cols; ++j) {
-      if (m && !m[j]) continue;
-      ++n;
-      for (int c = 0; c < cn; ++c) {
-        const int64_t v = p[j * cn + c];
-        sum[c] += v;
-        sum_sq[c] += v * v;
-      }
-    }
-  }
+  const CountedSums sums = SumCountedPixels(templ, mask);
+  const int64_t n = sums.n;
   int64_t variance = 0;
-  for (int c = 0; c < cn; ++c) variance += n * sum_sq[c] - sum[c] * sum[c];
+  for (int c = 0; c < cn; ++c) variance += n * sums.sum_sq[c] - sums.sum[c] * sums.sum[c];
   if (n == 0 || variance <= 0) {
     image_.release();
     mask_image_.release();
@@ -249,38 +268,48 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   } else {
     mask_image_.release();
   }
-  const bool masked = !mask_image_.empty();
   count_ = static_cast<int>(n);
   for (int c = 0; c < 3; ++c) {
-    sum_[c] = sum[c];
-    sum_sq_[c] = sum_sq[c];
+    sum_[c] = sums.sum[c];
+    sum_sq_[c] = sums.sum_sq[c];
   }
   scaled_variance_ = variance;
-  run_rows_.reserve(templ.rows + 1);
-  for (int r = 0; r < templ.rows; ++r) {
+  find_runs();
+  lay_out_chunks();
+  return true;
+}
+
+void PreparedTemplate::find_runs() {
+  const bool masked = !mask_image_.empty();
+  run_rows_.reserve(image_.rows + 1);
+  for (int r = 0; r < image_.rows; ++r) {
     run_rows_.push_back(static_cast<int>(runs_.size()));
     if (!masked) {
-      runs_.push_back({0, templ.cols});
+      runs_.push_back({0, image_.cols});
       continue;
     }
     const uint8_t* m = mask_image_.ptr<uint8_t>(r);
-    for (int j = 0; j < templ.cols;) {
+    for (int j = 0; j < image_.cols;) {
       if (!m[j]) {
         ++j;
         continue;
       }
       const int begin = j;
-      while (j < templ.cols && m[j]) ++j;
+      while (j < image_.cols && m[j]) ++j;
       runs_.push_back({begin, j});
     }
   }
   run_rows_.push_back(static_cast<int>(runs_.size()));
+}
 
-  row_bytes_ = templ.cols * cn;
+void PreparedTemplate::lay_out_chunks() {
+  const int cn = image_.channels();
+  const bool masked = !mask_image_.empty();
+  row_bytes_ = image_.cols * cn;
   full_chunks_ = 0;
   has_tail_ = false;
   chunks_per_row_ = 0;
-  if (row_bytes_ < 8) return true;  // Too narrow for 8-byte loads: scalar kernels.
+  if (row_bytes_ < 8) return;  // Too narrow for 8-byte loads: scalar kernels.
   full_chunks_ = row_bytes_ / 16;
   const int covered = full_chunks_ * 16;
   const int rem = row_bytes_ - covered;
@@ -310,11 +339,11 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
       lane_bytes_[i] = rem >= 8 && b >= covered + 8 ? b : -1;
     }
   }
-  const size_t total = static_cast<size_t>(per_row) * templ.rows;
+  const size_t total = static_cast<size_t>(per_row) * image_.rows;
   bytes_.assign(total, 0);
   mask_.assign(total, 0);
   words_.assign(total, 0);
-  for (int r = 0; r < templ.rows; ++r) {
+  for (int r = 0; r < image_.rows; ++r) {
     const uint8_t* p = image_.ptr<uint8_t>(r);
     const uint8_t* m = masked ? mask_image_.ptr<uint8_t>(r) : nullptr;
     const size_t row = static_cast<size_t>(r) * per_row;
@@ -326,7 +355,6 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
       words_[row + i] = p[b];
     }
   }
-  return true;
 }
 
 void MatchSadReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& result,
@@ -393,10 +421,7 @@ using KA = KernelAccess;
 // masked bytes are zeroed on both sides, so they add |0 - 0| = 0.
 template <bool kMasked>
 inline int SadAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
-  const int rows = KA::Rows(t);
-  const int full = KA::FullChunks(t);
-  const bool tail = KA::HasTail(t);
-  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
   const uint8_t* tb = KA::Bytes(t);
   const uint8_t* tm = KA::Mask(t);
   unsigned acc0 = 0, acc1 = 0;  // Two chains for instruction-level parallelism.
@@ -430,10 +455,7 @@ inline int SadAt(const uint8_t* p, size_t step, const PreparedTemplate& t) {
 template <bool kMasked>
 inline void SadPairAt(const uint8_t* p, int cn, size_t step, const PreparedTemplate& t,
                       int* out) {
-  const int rows = KA::Rows(t);
-  const int full = KA::FullChunks(t);
-  const bool tail = KA::HasTail(t);
-  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
   const uint8_t* tb = KA::Bytes(t);
   const uint8_t* tm = KA::Mask(t);
   unsigned acc0 = 0, acc1 = 0;
@@ -480,10 +502,7 @@ void VectorSadMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& resu
 // of at every placement (which unpacked each byte again for each of the placements covering
 // it) takes the shuffles out of the inner loop, half of its instructions.
 inline int CrossAt(const int16_t* p, size_t step, const PreparedTemplate& t) {
-  const int rows = KA::Rows(t);
-  const int full = KA::FullChunks(t);
-  const bool tail = KA::HasTail(t);
-  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
   const int16_t* tw = KA::Words(t);
   cv::v_int32x4 acc0 = cv::v_setzero_s32(), acc1 = cv::v_setzero_s32();
   for (int r = 0; r < rows; ++r, p += step) {
@@ -503,10 +522,7 @@ inline int CrossAt(const int16_t* p, size_t step, const PreparedTemplate& t) {
 // CrossAt for the four placements x .. x + 3 (pixel stride `cn`) at once: each template chunk is
 // loaded once for the four, and the loop's overhead per row is shared.
 inline void CrossAt4(const int16_t* p, int cn, size_t step, const PreparedTemplate& t, int* out) {
-  const int rows = KA::Rows(t);
-  const int full = KA::FullChunks(t);
-  const bool tail = KA::HasTail(t);
-  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
   const int16_t* tw = KA::Words(t);
   cv::v_int32x4 acc0 = cv::v_setzero_s32(), acc1 = cv::v_setzero_s32();
   cv::v_int32x4 acc2 = cv::v_setzero_s32(), acc3 = cv::v_setzero_s32();
@@ -619,11 +635,6 @@ void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::M
 }
 
 }  // namespace
-
-void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result) {
-  std::vector<int16_t> widened;
-  CrossCorrelation(image, templ, result, widened);
-}
 
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch) {

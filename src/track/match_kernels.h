@@ -63,6 +63,10 @@ class PreparedTemplate {
 
  private:
   friend struct KernelAccess;
+  // The counted pixels' runs of each row (run_rows_, runs_), from mask_image_.
+  void find_runs();
+  // The vector layout (row_bytes_ .. words_) of image_ and mask_image_.
+  void lay_out_chunks();
   cv::Mat image_;
   cv::Mat mask_image_;
   int count_ = 0;
@@ -111,8 +115,6 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
-// sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC is built on.
-void MatchCrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 
 // Slow scalar references, straight from the definitions (ZNCC in double with explicit means).
 // `mask` as in PreparedTemplate::Prepare.

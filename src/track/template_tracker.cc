@@ -514,45 +514,38 @@ std::optional<Hit> TemplateTracker::Refine(const cv::Mat& frame, cv::Point top_l
   return std::nullopt;  // Still climbing: no clear peak here.
 }
 
+namespace {
+
+// The best of the refined hits, with the best distinct rival among them: one placed farther than
+// half the template's smaller side from it.
+Hit BestWithRival(const std::vector<Hit>& hits, const cv::Size& size) {
+  size_t best = 0;
+  for (size_t i = 1; i < hits.size(); ++i) {
+    if (hits[i].similarity > hits[best].similarity) best = i;
+  }
+  Hit m = hits[best];
+  const int distinct = std::max(2, std::min(size.width, size.height) / 2);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const cv::Point d = hits[i].top_left - m.top_left;
+    if ((std::abs(d.x) > distinct || std::abs(d.y) > distinct) && hits[i].zncc > m.rival_zncc) {
+      m.rival_zncc = hits[i].zncc;
+      m.rival_top_left = hits[i].top_left;
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
 // Searches the region around the last known position (the whole frame without one), which
 // grows by search_margin_px per frame lost, coarse-to-fine. The best is returned with the best
 // distinct rival it had, so the caller can refuse an ambiguous acquisition.
 std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
   const PreparedTemplate& templ = search_template();
   const cv::Size size = templ.size();
-  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
-  cv::Rect region = frame_rect;
-  if (last_centre_) {
-    int64_t limit = params_.acquire_radius_px > 0 ? params_.acquire_radius_px
-                                                  : std::max(frame.cols, frame.rows);
-    if (std::isfinite(look_alike_px_)) {
-      limit = std::min<int64_t>(
-          limit, std::max<int64_t>(params_.search_margin_px,
-                                   static_cast<int64_t>(0.5 * look_alike_px_ * rung_scale())));
-    }
-    // The whole radius at once: a marker that outran the tracking window (a cart at 30 px a
-    // frame from rest) moves on while a region growing by a margin per frame follows it. A
-    // look-alike inside the radius makes the search ambiguous, and the session's motion gate
-    // judges where the match lies.
-    region = WindowAround(*last_centre_ + velocity_px_, size, static_cast<int>(limit)) &
-             frame_rect;
-  }
+  const cv::Rect region = AcquisitionRegion(frame, size);
   if (region.width < size.width || region.height < size.height) return std::nullopt;
-
-  // The acquisition pyramid of the search template, rebuilt when that template changed.
-  if (coarse_.empty()) {
-    coarse_.resize(1);
-    cv::Mat level = templ.image();
-    for (int l = 1; l < params_.pyramid_levels; ++l) {
-      cv::Mat down;
-      cv::pyrDown(level, down);
-      if (std::min(down.cols, down.rows) < kMinCoarseTemplatePx) break;
-      PreparedTemplate prepared;
-      if (!prepared.Prepare(down, MaskFor(down.size()))) break;
-      coarse_.push_back(std::move(prepared));
-      level = down;
-    }
-  }
+  BuildAcquisitionPyramid(templ);
   auto pyramid = [&](int l) -> const PreparedTemplate& { return l == 0 ? templ : coarse_[l]; };
   int levels = 1;
   while (levels < static_cast<int>(coarse_.size()) &&
@@ -574,57 +567,84 @@ std::optional<Hit> TemplateTracker::Acquire(const cv::Mat& frame) {
   Similarity(levels_[top], pyramid(top), sim_);
 
   // The best few separated peaks at the coarsest level, each refined level by level.
-  std::vector<cv::Point>& candidates = candidates_;
-  candidates.clear();
-  const cv::Size coarse = pyramid(top).size();
   // A colour tells look-alikes apart: more peaks are refined, those of another colour dropped.
   const int peaks = core_colour_ && frame.type() == CV_8UC3 ? 2 * kCandidates : kCandidates;
-  for (int k = 0; k < peaks; ++k) {
-    cv::Point at;
-    if (!BestIn(sim_, &at)) break;
-    candidates.push_back(at);
-    const cv::Rect suppress(at.x - coarse.width / 2, at.y - coarse.height / 2, coarse.width + 1,
-                            coarse.height + 1);
-    sim_(suppress & cv::Rect(0, 0, sim_.cols, sim_.rows))
-        .setTo(std::numeric_limits<float>::quiet_NaN());
-  }
+  FindCoarsePeaks(pyramid(top).size(), peaks);
   std::vector<Hit> hits;
   hits.reserve(peaks);
-  for (cv::Point p : candidates) {
+  for (cv::Point p : candidates_) {
     int level = top;  // The level `p` is in.
-    for (int l = top - 1; l >= 1; --l) {
-      const cv::Size ts = pyramid(l).size();
-      const cv::Rect window =
-          cv::Rect(2 * p.x - kRefineMarginPx, 2 * p.y - kRefineMarginPx,
-                   ts.width + 2 * kRefineMarginPx, ts.height + 2 * kRefineMarginPx) &
-          cv::Rect(0, 0, levels_[l].cols, levels_[l].rows);
-      if (window.width < ts.width || window.height < ts.height) break;
-      Similarity(levels_[l](window), pyramid(l), level_sim_);
-      cv::Point at;
-      if (!BestIn(level_sim_, &at)) break;
-      p = window.tl() + at;
-      level = l;
-    }
+    p = RefineThroughLevels(p, top, &level);
     std::optional<Hit> m = Refine(frame, region.tl() + p * (1 << level));
     if (m && !OtherColourAt(frame, cv::Point2d(m->top_left) + m->offset + HalfSize(size))) {
       hits.push_back(*m);
     }
   }
   if (hits.empty()) return std::nullopt;
-  size_t best = 0;
-  for (size_t i = 1; i < hits.size(); ++i) {
-    if (hits[i].similarity > hits[best].similarity) best = i;
+  return BestWithRival(hits, size);
+}
+
+cv::Rect TemplateTracker::AcquisitionRegion(const cv::Mat& frame, const cv::Size& size) const {
+  const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
+  if (!last_centre_) return frame_rect;
+  int64_t limit = params_.acquire_radius_px > 0 ? params_.acquire_radius_px
+                                                : std::max(frame.cols, frame.rows);
+  if (std::isfinite(look_alike_px_)) {
+    limit = std::min<int64_t>(
+        limit, std::max<int64_t>(params_.search_margin_px,
+                                 static_cast<int64_t>(0.5 * look_alike_px_ * rung_scale())));
   }
-  Hit m = hits[best];
-  const int distinct = std::max(2, std::min(size.width, size.height) / 2);
-  for (size_t i = 0; i < hits.size(); ++i) {
-    const cv::Point d = hits[i].top_left - m.top_left;
-    if ((std::abs(d.x) > distinct || std::abs(d.y) > distinct) && hits[i].zncc > m.rival_zncc) {
-      m.rival_zncc = hits[i].zncc;
-      m.rival_top_left = hits[i].top_left;
-    }
+  // The whole radius at once: a marker that outran the tracking window (a cart at 30 px a
+  // frame from rest) moves on while a region growing by a margin per frame follows it. A
+  // look-alike inside the radius makes the search ambiguous, and the session's motion gate
+  // judges where the match lies.
+  return WindowAround(*last_centre_ + velocity_px_, size, static_cast<int>(limit)) & frame_rect;
+}
+
+void TemplateTracker::BuildAcquisitionPyramid(const PreparedTemplate& templ) {
+  // Rebuilt only when the search template changed (which empties it).
+  if (!coarse_.empty()) return;
+  coarse_.resize(1);
+  cv::Mat level = templ.image();
+  for (int l = 1; l < params_.pyramid_levels; ++l) {
+    cv::Mat down;
+    cv::pyrDown(level, down);
+    if (std::min(down.cols, down.rows) < kMinCoarseTemplatePx) break;
+    PreparedTemplate prepared;
+    if (!prepared.Prepare(down, MaskFor(down.size()))) break;
+    coarse_.push_back(std::move(prepared));
+    level = down;
   }
-  return m;
+}
+
+void TemplateTracker::FindCoarsePeaks(const cv::Size& coarse, int peaks) {
+  candidates_.clear();
+  for (int k = 0; k < peaks; ++k) {
+    cv::Point at;
+    if (!BestIn(sim_, &at)) break;
+    candidates_.push_back(at);
+    const cv::Rect suppress(at.x - coarse.width / 2, at.y - coarse.height / 2, coarse.width + 1,
+                            coarse.height + 1);
+    sim_(suppress & cv::Rect(0, 0, sim_.cols, sim_.rows))
+        .setTo(std::numeric_limits<float>::quiet_NaN());
+  }
+}
+
+cv::Point TemplateTracker::RefineThroughLevels(cv::Point p, int top, int* level) {
+  for (int l = top - 1; l >= 1; --l) {
+    const cv::Size ts = coarse_[l].size();
+    const cv::Rect window =
+        cv::Rect(2 * p.x - kRefineMarginPx, 2 * p.y - kRefineMarginPx,
+                 ts.width + 2 * kRefineMarginPx, ts.height + 2 * kRefineMarginPx) &
+        cv::Rect(0, 0, levels_[l].cols, levels_[l].rows);
+    if (window.width < ts.width || window.height < ts.height) break;
+    Similarity(levels_[l](window), coarse_[l], level_sim_);
+    cv::Point at;
+    if (!BestIn(level_sim_, &at)) break;
+    p = window.tl() + at;
+    *level = l;
+  }
+  return p;
 }
 
 // Drift correction: the first template at the current scale, matched in a small window around

@@ -104,6 +104,16 @@ class TemplateTracker final : public Tracker {
                             bool find_rival);
   std::optional<Hit> Refine(const cv::Mat& frame, cv::Point top_left);
   std::optional<Hit> Acquire(const cv::Mat& frame);
+  // Where Acquire searches: around the last known position (within the acquire radius, or half
+  // the distance to the nearest look-alike), else the whole frame.
+  cv::Rect AcquisitionRegion(const cv::Mat& frame, const cv::Size& size) const;
+  // The acquisition pyramid of the search template (coarse_), when it is empty.
+  void BuildAcquisitionPyramid(const PreparedTemplate& templ);
+  // The best `peaks` separated peaks of sim_ (a template of `coarse` size) into candidates_.
+  void FindCoarsePeaks(const cv::Size& coarse, int peaks);
+  // Peak `p` of pyramid level `top` refined down to level 1, as far as it goes; *level is the
+  // level the returned point is in.
+  cv::Point RefineThroughLevels(cv::Point p, int top, int* level);
   std::optional<Fix> Measure(const cv::Mat& frame, const cv::Point2d& centre_px);
   double RungZncc(const cv::Mat& frame, int scale, int turn, const cv::Point2d& centre_px);
   void UpdatePose(const cv::Mat& frame, const Fix& fix, int last_turn);
