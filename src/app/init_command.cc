@@ -75,19 +75,11 @@ void CheckOutputs(const std::vector<PathRole>& outputs, const FrameSourceSpec& s
   CheckOutputsAreNotInputs(outputs, inputs);
 }
 
-// The measurement of markers given in body order: the paper's triple for three, a chain (and
-// the triple at its ends and middle) for more, as SceneMeasureOptions does.
+// The measurement of markers given in body order (MeasureOptions::AlongBody).
 MeasureOptions BodyMeasure(const std::vector<MarkerSpec>& markers) {
-  MeasureOptions measure;
-  const size_t n = markers.size();
-  if (n < 3) return measure;
-  measure.base = markers.front().name;
-  measure.middle = markers[n / 2].name;
-  measure.tip = markers.back().name;
-  if (n > 3) {
-    for (const MarkerSpec& m : markers) measure.chain.push_back(m.name);
-  }
-  return measure;
+  std::vector<std::string> names;
+  for (const MarkerSpec& m : markers) names.push_back(m.name);
+  return MeasureOptions::AlongBody(names);
 }
 
 // Frames after the analysed one that init watches to see which end of the body stays put.

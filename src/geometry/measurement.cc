@@ -92,6 +92,17 @@ bool MetricModel::Check(std::string* error) const {
   return true;
 }
 
+MeasureOptions MeasureOptions::AlongBody(const std::vector<std::string>& names_base_to_tip) {
+  MeasureOptions measure;
+  const size_t n = names_base_to_tip.size();
+  if (n < 3) return measure;
+  measure.base = names_base_to_tip.front();
+  measure.middle = names_base_to_tip[n / 2];
+  measure.tip = names_base_to_tip.back();
+  if (n > 3) measure.chain = names_base_to_tip;
+  return measure;
+}
+
 std::vector<std::string> MeasureOptions::inner_markers() const {
   if (chain.size() < 3) return {};
   return std::vector<std::string>(chain.begin() + 1, chain.end() - 1);

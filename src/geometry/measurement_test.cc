@@ -35,6 +35,25 @@ using testing::OnCircle;
 
 MarkerObservation SeenAt(const std::string& name, cv::Point2d p) { return Seen(name, p.x, p.y); }
 
+TEST(MeasureOptionsTest, AlongBodyTakesTheEndsAndTheMiddleAndChainsMoreThanThree) {
+  EXPECT_FALSE(MeasureOptions::AlongBody({"a", "b"}).has_triple());
+  EXPECT_TRUE(MeasureOptions::AlongBody({"a", "b"}).chain.empty());
+  const MeasureOptions three = MeasureOptions::AlongBody({"base", "mid", "tip"});
+  EXPECT_EQ(three.base, "base");
+  EXPECT_EQ(three.middle, "mid");
+  EXPECT_EQ(three.tip, "tip");
+  EXPECT_TRUE(three.chain.empty());
+  const MeasureOptions five = MeasureOptions::AlongBody({"m0", "m1", "m2", "m3", "m4"});
+  EXPECT_EQ(five.base, "m0");
+  EXPECT_EQ(five.middle, "m2");
+  EXPECT_EQ(five.tip, "m4");
+  EXPECT_EQ(five.chain, (std::vector<std::string>{"m0", "m1", "m2", "m3", "m4"}));
+  std::string error;
+  EXPECT_TRUE(five.Check(&error)) << error;
+  // Four: the middle is the third (n / 2), as init and the scenes always chose.
+  EXPECT_EQ(MeasureOptions::AlongBody({"m0", "m1", "m2", "m3"}).middle, "m2");
+}
+
 TEST(MeasurerTest, HalfCircleTripleInAnyOrderWithoutMetric) {
   Measurer measurer(Triple());
   const Measurement m = measurer.measure(

@@ -339,15 +339,9 @@ MeasureOptions SceneMeasureOptions(const SceneOptions& scene) {
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     return scene.markers[a].body_fraction < scene.markers[b].body_fraction;
   });
-  MeasureOptions options;
-  if (order.size() < 3) return options;
-  options.base = scene.markers[order.front()].name;
-  options.middle = scene.markers[order[order.size() / 2]].name;
-  options.tip = scene.markers[order.back()].name;
-  if (order.size() > 3) {
-    for (size_t i : order) options.chain.push_back(scene.markers[i].name);
-  }
-  return options;
+  std::vector<std::string> names;
+  for (size_t i : order) names.push_back(scene.markers[i].name);
+  return MeasureOptions::AlongBody(names);
 }
 
 }  // namespace softsight

@@ -90,18 +90,11 @@ double PathLength(const std::vector<cv::Point2d>& points, const std::vector<size
   return length;
 }
 
-// The triple (and, beyond three, the chain) of markers in body order, as SceneMeasureOptions.
+// The triple (and, beyond three, the chain) of markers in body order (MeasureOptions::AlongBody).
 MeasureOptions BodyMeasure(const std::vector<FoundMarker>& markers) {
-  MeasureOptions measure;
-  const size_t n = markers.size();
-  if (n < 3) return measure;
-  measure.base = markers.front().spec.name;
-  measure.middle = markers[n / 2].spec.name;
-  measure.tip = markers.back().spec.name;
-  if (n > 3) {
-    for (const FoundMarker& m : markers) measure.chain.push_back(m.spec.name);
-  }
-  return measure;
+  std::vector<std::string> names;
+  for (const FoundMarker& m : markers) names.push_back(m.spec.name);
+  return MeasureOptions::AlongBody(names);
 }
 
 // ---- 2 + 3, over all candidates ------------------------------------------------------------

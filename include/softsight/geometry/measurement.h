@@ -52,6 +52,10 @@ struct MeasureOptions {
   std::optional<cv::Point2d> tip_reference_px{};
   MetricModel metric{};
 
+  // Markers named in body order, base to tip: the triple at the ends and the middle, and with
+  // more than three the chain of them all (fewer than three: no triple, no chain).
+  static MeasureOptions AlongBody(const std::vector<std::string>& names_base_to_tip);
+
   bool has_triple() const { return !base.empty() || !middle.empty() || !tip.empty(); }
   // The chain's inner markers chain[1] .. chain[N-2], whose angles inner_angle_deg holds.
   std::vector<std::string> inner_markers() const;
