@@ -107,6 +107,69 @@ void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::M
 // arithmetic is unsigned 32-bit: the prefix sums of a wide image may wrap around, their
 // differences do not (a window's sums fit, see kMaxTemplateValues), so the sums are exact, as
 // summed pixel by pixel.
+// One image row's prefix sums for WindowSums: s[(x + 1) * (kChannels + 1) + c] = the sum of
+// channel c over pixels 0..x, and [.. + kChannels] the sum of their squares over the channels;
+// the first pixel's slots (x = -1) are 0. Unsigned 32-bit, wrapping (see WindowSums).
+template <int kChannels>
+void PrefixRowReference(const uint8_t* __restrict p, int cols, uint32_t* __restrict s) {
+  constexpr int kPerPixel = kChannels + 1;
+  uint32_t acc[kPerPixel] = {};
+  for (int k = 0; k < kPerPixel; ++k) s[k] = 0;
+  for (int x = 0; x < cols; ++x) {
+    s += kPerPixel;
+    for (int c = 0; c < kChannels; ++c) {
+      const uint32_t v = p[x * kChannels + c];
+      acc[c] += v;
+      acc[kChannels] += v * v;
+      s[c] = acc[c];
+    }
+    s[kChannels] = acc[kChannels];
+  }
+}
+
+template <int kChannels>
+void PrefixRow(const uint8_t* __restrict p, int cols, uint32_t* __restrict s) {
+  PrefixRowReference<kChannels>(p, cols, s);
+}
+
+#if CV_SIMD128
+// Gray: 8 pixels at a time, ~3.6 instructions a pixel instead of 10 (the window sums' prefix
+// rows were a tenth of the ZNCC template trackers' instructions). Each pixel's (v, v^2) pair is
+// two 32-bit lanes, so a vector holds two pixels' pairs: adding it shifted up by one pair and the
+// running total (the last pair so far, in both halves) gives the prefix. v^2 <= 65025 fits 16
+// bits. The same wrapping 32-bit sums as the reference, so the same bits.
+template <>
+void PrefixRow<1>(const uint8_t* __restrict p, int cols, uint32_t* __restrict s) {
+  s[0] = 0;
+  s[1] = 0;
+  int x = 0;
+  cv::v_uint32x4 carry = cv::v_setzero_u32();
+  for (; x + 8 <= cols; x += 8) {
+    const cv::v_uint16x8 v = cv::v_load_expand(p + x);
+    const cv::v_uint16x8 sq = cv::v_mul_wrap(v, v);
+    cv::v_uint16x8 pairs[2];  // v0, v0^2, v1, v1^2, ...
+    cv::v_zip(v, sq, pairs[0], pairs[1]);
+    cv::v_uint32x4 w[4];
+    cv::v_expand(pairs[0], w[0], w[1]);
+    cv::v_expand(pairs[1], w[2], w[3]);
+    for (int k = 0; k < 4; ++k) {
+      const cv::v_uint32x4 prefix = w[k] + cv::v_rotate_left<2>(w[k]) + carry;
+      cv::v_store(s + 2 * (x + 1) + 4 * k, prefix);
+      carry = cv::v_combine_high(prefix, prefix);
+    }
+  }
+  // The last pixels a pixel at a time, from the prefix so far (pixel x - 1's, at 2 * x).
+  uint32_t sum = s[2 * x], sum_sq = s[2 * x + 1];
+  for (; x < cols; ++x) {
+    const uint32_t v = p[x];
+    sum += v;
+    sum_sq += v * v;
+    s[2 * (x + 1)] = sum;
+    s[2 * (x + 1) + 1] = sum_sq;
+  }
+}
+#endif
+
 template <int kChannels, typename RowDone>
 void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& scratch,
                 RowDone row_done) {
@@ -116,20 +179,8 @@ void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& sc
   const size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
   scratch.prefix_sum.resize(prefix_step * image.rows);
   for (int y = 0; y < image.rows; ++y) {
-    const uint8_t* __restrict p = image.ptr<uint8_t>(y);
-    uint32_t* __restrict s = scratch.prefix_sum.data() + prefix_step * y;
-    uint32_t acc[kPerPixel] = {};
-    for (int k = 0; k < kPerPixel; ++k) s[k] = 0;
-    for (int x = 0; x < image_cols; ++x) {
-      s += kPerPixel;
-      for (int c = 0; c < kChannels; ++c) {
-        const uint32_t v = p[x * kChannels + c];
-        acc[c] += v;
-        acc[kChannels] += v * v;
-        s[c] = acc[c];
-      }
-      s[kChannels] = acc[kChannels];
-    }
+    PrefixRow<kChannels>(image.ptr<uint8_t>(y), image_cols,
+                         scratch.prefix_sum.data() + prefix_step * y);
   }
   const int row_values = size.width * kPerPixel;
   scratch.row_sum.resize(row_values);
