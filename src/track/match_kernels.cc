@@ -190,13 +190,28 @@ void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& sc
   const int rows = t.size().height;
   for (int y = 0; y < size.height; ++y) {
     std::fill(row_sum, row_sum + row_values, 0u);
-    for (int r = 0; r < rows; ++r) {
+    for (int r = 0; r < rows;) {
       const uint32_t* s = scratch.prefix_sum.data() + prefix_step * (y + r);
-      for (int k = run_rows[r]; k < run_rows[r + 1]; ++k) {
-        const uint32_t* __restrict end = s + runs[k].end * kPerPixel;
-        const uint32_t* __restrict begin = s + runs[k].begin * kPerPixel;
+      const int k = run_rows[r];
+      if (r + 1 < rows && run_rows[r + 1] == k + 1 && run_rows[r + 2] == k + 2) {
+        // Two rows of one run each (a round mask's rows): added together, so the map row's sums
+        // are loaded and stored once for both; the same sums mod 2^32.
+        const uint32_t* __restrict end0 = s + runs[k].end * kPerPixel;
+        const uint32_t* __restrict begin0 = s + runs[k].begin * kPerPixel;
+        const uint32_t* __restrict end1 = s + prefix_step + runs[k + 1].end * kPerPixel;
+        const uint32_t* __restrict begin1 = s + prefix_step + runs[k + 1].begin * kPerPixel;
+        for (int i = 0; i < row_values; ++i) {
+          row_sum[i] += (end0[i] - begin0[i]) + (end1[i] - begin1[i]);
+        }
+        r += 2;
+        continue;
+      }
+      for (int j = k; j < run_rows[r + 1]; ++j) {
+        const uint32_t* __restrict end = s + runs[j].end * kPerPixel;
+        const uint32_t* __restrict begin = s + runs[j].begin * kPerPixel;
         for (int i = 0; i < row_values; ++i) row_sum[i] += end[i] - begin[i];
       }
+      ++r;
     }
     row_done(y, static_cast<const uint32_t*>(row_sum));
   }
