@@ -291,13 +291,17 @@ class BlobMeter {
     // the first edge pixel it takes sets the pass.
     for (auto& bucket : buckets_) bucket.clear();
     ZeroedMask(gray.size(), visited_);
-    const auto likeness = [&](int x, int y) {
-      const int v = gray.at<uint8_t>(y, x);
-      return bright_ ? v : 255 - v;
-    };
-    int level = likeness(seed->x, seed->y);
+    // Pixels through pointers (this runs on every frame's blob, issue 45): 255 - v is v ^ 255.
+    const int flip = bright_ ? 0 : 255;
+    const uint8_t* levels = gray.data;
+    const size_t step = gray.step[0];
+    const uint8_t* inside = mask.data;  // No mask: every pixel of the patch counts.
+    const size_t mask_step = inside ? mask.step[0] : 0;
+    uint8_t* visited = visited_.data;  // Continuous, gray.cols a row.
+    const int cols = gray.cols;
+    int level = levels[seed->y * step + seed->x] ^ flip;
     buckets_[level].push_back(*seed);
-    visited_.at<uint8_t>(*seed) = 1;
+    visited[seed->y * cols + seed->x] = 1;
     core_.clear();
     int pass = -1;
     while (pass < 0) {
@@ -310,15 +314,17 @@ class BlobMeter {
         break;
       }
       if (core_.size() < kCoreSamples) core_.push_back(level);
+      // Off the patch's edge, so the four neighbours are in the patch: only the mask can leave.
       const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
       for (const cv::Point& q : next) {
-        if (visited_.at<uint8_t>(q)) continue;
-        visited_.at<uint8_t>(q) = 1;
-        if (!IsInside(gray, mask, q.x, q.y)) {
+        uint8_t& seen = visited[q.y * cols + q.x];
+        if (seen) continue;
+        seen = 1;
+        if (inside && !inside[q.y * mask_step + q.x]) {
           pass = level;  // The mask's edge: the flood leaves here at this level.
           break;
         }
-        const int l = likeness(q.x, q.y);
+        const int l = levels[q.y * step + q.x] ^ flip;
         buckets_[std::min(l, level)].push_back(q);  // A path's level is its least marker-like.
       }
     }
@@ -368,32 +374,47 @@ class BlobMeter {
     return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
            (mask.data == nullptr || mask.at<uint8_t>(y, x));
   }
-  bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
-    const double v = gray.at<uint8_t>(y, x);
-    return bright_ ? v > threshold : v < threshold;
-  }
   // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
     ZeroedMask(gray.size(), label_);
     stack_.clear();
     stack_.push_back(seed);
-    label_.at<uint8_t>(seed) = 1;
-    box_ = cv::Rect(seed, cv::Size(1, 1));
+    // Through pointers, as Segment's flood; the box as its corners, written to box_ on the way
+    // out (what box_ |= pixel gave).
+    const uint8_t* levels = gray.data;
+    const size_t step = gray.step[0];
+    const uint8_t* inside = mask.data;
+    const size_t mask_step = inside ? mask.step[0] : 0;
+    uint8_t* label = label_.data;  // Continuous, gray.cols a row.
+    const int cols = gray.cols;
+    label[seed.y * cols + seed.x] = 1;
+    int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
+    const auto done = [&](bool separated) {
+      box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+      return separated;
+    };
     while (!stack_.empty()) {
       const cv::Point p = stack_.back();
       stack_.pop_back();
-      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return false;
-      box_ |= cv::Rect(p, cv::Size(1, 1));
+      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return done(false);
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
+      // Off the patch's edge: the four neighbours are in the patch; only the mask can leave.
       const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
       for (const cv::Point& q : next) {
-        if (!IsInside(gray, mask, q.x, q.y)) return false;  // Reaches the mask's edge.
-        if (label_.at<uint8_t>(q) || !IsMarker(gray, q.x, q.y, threshold)) continue;
-        label_.at<uint8_t>(q) = 1;
+        if (inside && !inside[q.y * mask_step + q.x]) return done(false);  // The mask's edge.
+        uint8_t& in = label[q.y * cols + q.x];
+        if (in) continue;
+        const double v = levels[q.y * step + q.x];
+        if (!(bright_ ? v > threshold : v < threshold)) continue;  // IsMarker.
+        in = 1;
         stack_.push_back(q);
       }
     }
-    return true;
+    return done(true);
   }
 
   // The marker's level is the median of its this many most marker-like pixels.
