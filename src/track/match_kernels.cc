@@ -541,12 +541,33 @@ void VectorSadMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& resu
   }
 }
 
-// sum I * T at four placements x .. x + 3 (pixel stride `cn`) of an image already widened to 16
-// bits (`step` values a row): the template words are zero where masked, so no mask is needed.
-// Widening the image once instead of at every placement (which unpacked each byte again for each
-// of the placements covering it) takes the shuffles out of the inner loop, half of its
-// instructions; each template chunk is loaded once for the four, and the loop's overhead per row
-// is shared.
+// sum I * T at one placement of an image already widened to 16 bits (`step` values a row): the
+// template words are zero where masked, so no mask is needed. Widening the image once instead
+// of at every placement (which unpacked each byte again for each of the placements covering
+// it) takes the shuffles out of the inner loop, half of its instructions.
+inline int CrossAt(const int16_t* p, size_t step, const PreparedTemplate& t) {
+  const int rows = KA::Rows(t);
+  const int full = KA::FullChunks(t);
+  const bool tail = KA::HasTail(t);
+  const int lo = KA::TailLo(t), hi = KA::TailHi(t);
+  const int16_t* tw = KA::Words(t);
+  cv::v_int32x4 acc0 = cv::v_setzero_s32(), acc1 = cv::v_setzero_s32();
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < full; ++c, tw += 16) {
+      acc0 = cv::v_dotprod(cv::v_load(p + 16 * c), cv::v_load(tw), acc0);
+      acc1 = cv::v_dotprod(cv::v_load(p + 16 * c + 8), cv::v_load(tw + 8), acc1);
+    }
+    if (tail) {
+      acc0 = cv::v_dotprod(cv::v_load(p + lo), cv::v_load(tw), acc0);
+      acc1 = cv::v_dotprod(cv::v_load(p + hi), cv::v_load(tw + 8), acc1);
+      tw += 16;
+    }
+  }
+  return cv::v_reduce_sum(acc0 + acc1);
+}
+
+// CrossAt for the four placements x .. x + 3 (pixel stride `cn`) at once: each template chunk is
+// loaded once for the four, and the loop's overhead per row is shared.
 inline void CrossAt4(const int16_t* p, int cn, size_t step, const PreparedTemplate& t, int* out) {
   const int rows = KA::Rows(t);
   const int full = KA::FullChunks(t);
@@ -586,12 +607,12 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
                     std::vector<int16_t>& widened) {
   const int cn = t.channels();
   const int row_values = image.cols * cn;
-  // The last one to three placements of a map row are computed four at a time too (CrossAt4
-  // shares each template load between its placements: a third fewer instructions than CrossAt
-  // one at a time for the pose rungs' 3-wide maps); the placements past the map row's end read
-  // up to 3 pixels past the image row, which is the next row, or past the last row, which is
-  // this padding. Their sums are dropped.
-  const size_t pad = static_cast<size_t>(3 * cn);
+  // The last three placements of a map row are computed four at a time too (CrossAt4 shares
+  // each template load between its placements: a third fewer instructions than CrossAt three
+  // times, for the pose rungs' 3-wide maps and the measurement's 7-wide one); the placement past
+  // the map row's end reads a pixel past the image row, which is the next row, or past the last
+  // row, which is this padding. Its sum is dropped. One or two are cheaper one at a time.
+  const size_t pad = static_cast<size_t>(cn);
   const size_t values = static_cast<size_t>(row_values) * image.rows;
   widened.resize(values + pad);
   for (int y = 0; y < image.rows; ++y) {
@@ -605,11 +626,13 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
     const int16_t* p = widened.data() + static_cast<size_t>(row_values) * y;
     int x = 0;
     for (; x + 3 < result.cols; x += 4) CrossAt4(p + x * cn, cn, row_values, t, out + x);
-    if (x < result.cols) {
+    if (result.cols - x == 3) {
       int four[4];
       CrossAt4(p + x * cn, cn, row_values, t, four);
-      std::copy(four, four + (result.cols - x), out + x);
+      std::copy(four, four + 3, out + x);
+      x += 3;
     }
+    for (; x < result.cols; ++x) out[x] = CrossAt(p + x * cn, row_values, t);
   }
 }
 
