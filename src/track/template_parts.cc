@@ -155,6 +155,38 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
   // to the row's nearest label pixel within reach (kNone: none).
   const int top = std::max(0, area.y - kReach), bottom = std::min(label.rows, area.br().y + kReach);
   const int width = area.width;
+#if CV_SIMD128
+  // Each row's distances 16 columns at a time: the nearest label pixel within reach along the
+  // row is at k when one of the pixels k to the left or right is one and none nearer is, so the
+  // distance is kNone, then k for k = 4 .. 0 wherever that pair holds one (as the two passes
+  // below find it, bit for bit). Rows are read from a copy padded with kReach zeros and more
+  // (outside the label's row: no label pixel, as the passes do not look there); the distances'
+  // rows are `stride` long, a multiple of 16, so the last vector stays in the buffer.
+  const int stride = (width + 15) / 16 * 16;
+  const size_t distances = static_cast<size_t>((bottom - top) * stride);
+  row_distance.resize(distances + static_cast<size_t>(stride + 2 * kReach));
+  uint8_t* const padded = row_distance.data() + distances;
+  const int from = area.x - kReach;  // The label column of padded[0].
+  const int copy_begin = std::max(0, from), copy_end = std::min(label.cols, from + stride + 2 * kReach);
+  std::fill(padded, padded + stride + 2 * kReach, uint8_t{0});
+  const cv::v_uint8x16 zero = cv::v_setzero_u8();
+  for (int y = top; y < bottom; ++y) {
+    const uint8_t* row = label.ptr<uint8_t>(y);
+    std::copy(row + copy_begin, row + copy_end, padded + (copy_begin - from));
+    uint8_t* out = row_distance.data() + static_cast<size_t>((y - top) * stride);
+    for (int x = 0; x < width; x += 16) {
+      const uint8_t* at = padded + x + kReach;  // Column area.x + x.
+      cv::v_uint8x16 d = cv::v_setall_u8(static_cast<uint8_t>(kNone));
+      for (int k = kReach; k >= 1; --k) {
+        const cv::v_uint8x16 pair = cv::v_load(at - k) | cv::v_load(at + k);
+        d = cv::v_select(pair != zero, cv::v_setall_u8(static_cast<uint8_t>(k)), d);
+      }
+      d = cv::v_select(cv::v_load(at) != zero, zero, d);
+      cv::v_store(out + x, d);
+    }
+  }
+#else
+  const int stride = width;
   row_distance.resize(static_cast<size_t>((bottom - top) * width));
   for (int y = top; y < bottom; ++y) {
     const uint8_t* row = label.ptr<uint8_t>(y);
@@ -175,6 +207,7 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
       }
     }
   }
+#endif
   // Down the columns, a row at a time across the area (loops the compiler vectorises in 8-bit
   // lanes): the least over the rows within reach of max(their distance along the row, |dy|).
   for (int y = area.y; y < area.br().y; ++y) {
@@ -182,7 +215,7 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
     std::fill(out, out + width, static_cast<uint8_t>(kNone));
     const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
     for (int yy = first; yy <= last; ++yy) {
-      const uint8_t* __restrict along = row_distance.data() + static_cast<size_t>((yy - top) * width);
+      const uint8_t* __restrict along = row_distance.data() + static_cast<size_t>((yy - top) * stride);
       const uint8_t rows_away = static_cast<uint8_t>(std::abs(yy - y));
       for (int x = 0; x < width; ++x) out[x] = std::min(out[x], std::max(along[x], rows_away));
     }

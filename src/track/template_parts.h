@@ -132,7 +132,8 @@ void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& ou
 // The Chebyshev distance (max(|dx|, |dy|)) from each pixel of `area` to the nearest nonzero pixel
 // of `label` (CV_8UC1) at most 4 away, 5 where there is none, into the same pixels of `dist`
 // (CV_8UC1, label's size; nothing else of it is written). Separable: per row, the distance to
-// the row's nearest label pixel (a pass each way), then per pixel the least max(|dy|, that
+// the row's nearest label pixel (16 pixels at a time: the pixels k to either side looked at for
+// k = 4 .. 0; a pass each way without vector code), then per pixel the least max(|dy|, that
 // distance) over the rows within 4, in 8-bit lanes. Looking at the 81 pixels within 4 of each
 // pixel (the reference) was a quarter of the work of three ZNCC templates' frame (issue 45).
 // `row_distance` is reused storage.
