@@ -291,6 +291,23 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   for (int r = 0; r < templ.rows; ++r) {
     const uint8_t* p = templ.ptr<uint8_t>(r);
     const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(r);
+    if (cn == 1) {
+      // Gray (the working template, re-prepared every frame): a row's sums fit 32 bits (at most
+      // kMaxRowBytes levels), summed branch-free so the compiler vectorises the loop; the same
+      // integers as pixel by pixel.
+      uint32_t row_n = 0, row_sum = 0, row_sq = 0;
+      for (int j = 0; j < templ.cols; ++j) {
+        const uint32_t keep = m ? (m[j] != 0) : 1u;
+        const uint32_t v = p[j] * keep;
+        row_n += keep;
+        row_sum += v;
+        row_sq += v * v;
+      }
+      n += row_n;
+      sum[0] += row_sum;
+      sum_sq[0] += row_sq;
+      continue;
+    }
     for (int j = 0; j < templ.cols; ++j) {
       if (m && !m[j]) continue;
       ++n;
@@ -384,7 +401,22 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     const uint8_t* p = image_.ptr<uint8_t>(r);
     const uint8_t* m = masked ? mask_image_.ptr<uint8_t>(r) : nullptr;
     const size_t row = static_cast<size_t>(r) * per_row;
-    for (int i = 0; i < per_row; ++i) {
+    int i = 0;
+    if (cn == 1) {
+      // The full chunks' lanes read the row's bytes in order (lane_bytes_[i] == i): a loop the
+      // compiler vectorises, setting what the loop below sets.
+      uint8_t* __restrict bytes = bytes_.data() + row;
+      uint8_t* __restrict lanes = mask_.data() + row;
+      int16_t* __restrict words = words_.data() + row;
+      for (; i < covered; ++i) {
+        const uint8_t keep = m ? static_cast<uint8_t>(m[i] != 0 ? 0xFF : 0) : uint8_t{0xFF};
+        const uint8_t v = static_cast<uint8_t>(p[i] & keep);
+        bytes[i] = v;
+        lanes[i] = keep;
+        words[i] = v;
+      }
+    }
+    for (; i < per_row; ++i) {
       const int b = lane_bytes_[i];
       if (b < 0 || (m && !m[cn == 1 ? b : b / 3])) continue;
       bytes_[row + i] = p[b];
