@@ -242,16 +242,23 @@ class BlobMeter {
     int fg_n = 0, bg_n = 0;
     dist_.create(gray.size(), CV_8UC1);
     CappedChebyshevDistance(label_, grown, dist_, row_distance_);
+    // Rows through pointers (every frame's blob, issue 45); `grown` lies in the patch, so only
+    // the mask can leave a pixel out. A component pixel (d == 0) is off the patch's edge (Fill),
+    // so its four neighbours are in the patch. The sums are of whole levels: exact in a double.
+    const int cols = label_.cols;  // label_ is continuous.
     for (int y = grown.y; y < grown.br().y; ++y) {
+      const uint8_t* levels = gray.ptr<uint8_t>(y);
+      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+      const uint8_t* distance = dist_.ptr<uint8_t>(y);
+      const uint8_t* label = label_.ptr<uint8_t>(y);
       for (int x = grown.x; x < grown.br().x; ++x) {
-        const int d = dist_.at<uint8_t>(y, x);
-        if (!IsInside(gray, mask, x, y)) continue;
-        if (d == 0 && label_.at<uint8_t>(y - 1, x) && label_.at<uint8_t>(y + 1, x) &&
-            label_.at<uint8_t>(y, x - 1) && label_.at<uint8_t>(y, x + 1)) {
-          fg_sum += gray.at<uint8_t>(y, x);
+        const int d = distance[x];
+        if (inside && !inside[x]) continue;
+        if (d == 0 && label[x - cols] && label[x + cols] && label[x - 1] && label[x + 1]) {
+          fg_sum += levels[x];
           ++fg_n;
         } else if (d == 3 || d == 4) {
-          bg_sum += gray.at<uint8_t>(y, x);
+          bg_sum += levels[x];
           ++bg_n;
         }
       }
@@ -262,9 +269,12 @@ class BlobMeter {
     // Soft centroid over the component grown by 2 px (its anti-aliased rim), inside the mask.
     double sw = 0, sx = 0, sy = 0;
     for (int y = grown.y; y < grown.br().y; ++y) {
+      const uint8_t* levels = gray.ptr<uint8_t>(y);
+      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+      const uint8_t* distance = dist_.ptr<uint8_t>(y);
       for (int x = grown.x; x < grown.br().x; ++x) {
-        if (!IsInside(gray, mask, x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
-        const double w = track_internal::Membership(&gray.at<uint8_t>(y, x), 1, &bg, &fg, 0.0, false);
+        if ((inside && !inside[x]) || distance[x] > 2) continue;
+        const double w = track_internal::Membership(levels + x, 1, &bg, &fg, 0.0, false);
         sw += w;
         sx += w * x;
         sy += w * y;
