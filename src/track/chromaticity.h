@@ -22,13 +22,18 @@ inline cv::Vec3d Chromaticity(double b, double g, double r) {
 // The same of 8-bit levels, bit for bit, without a division a pixel: the scale of each sum of
 // levels (0..765) computed once by the same expression (the sum of three levels is exact in a
 // double, so b + g + r + kChromaDarkLevels is the same double either way).
-inline cv::Vec3d ChromaticityOfLevels(int b, int g, int r) {
+// The table: entry i is the scale of the sum of levels i (0..765).
+inline const std::array<double, 766>& ChromaticityScales() {
   static const std::array<double, 766> scales = [] {
     std::array<double, 766> s{};
     for (int i = 0; i < 766; ++i) s[i] = 1.0 / (static_cast<double>(i) + kChromaDarkLevels);
     return s;
   }();
-  const double scale = scales[static_cast<size_t>(b + g + r)];
+  return scales;
+}
+
+inline cv::Vec3d ChromaticityOfLevels(int b, int g, int r) {
+  const double scale = ChromaticityScales()[static_cast<size_t>(b + g + r)];
   return {b * scale, g * scale, r * scale};
 }
 

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace softsight::template_internal {
@@ -154,6 +155,38 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
   // to the row's nearest label pixel within reach (kNone: none).
   const int top = std::max(0, area.y - kReach), bottom = std::min(label.rows, area.br().y + kReach);
   const int width = area.width;
+#if CV_SIMD128
+  // Each row's distances 16 columns at a time: the nearest label pixel within reach along the
+  // row is at k when one of the pixels k to the left or right is one and none nearer is, so the
+  // distance is kNone, then k for k = 4 .. 0 wherever that pair holds one (as the two passes
+  // below find it, bit for bit). Rows are read from a copy padded with kReach zeros and more
+  // (outside the label's row: no label pixel, as the passes do not look there); the distances'
+  // rows are `stride` long, a multiple of 16, so the last vector stays in the buffer.
+  const int stride = (width + 15) / 16 * 16;
+  const size_t distances = static_cast<size_t>((bottom - top) * stride);
+  row_distance.resize(distances + static_cast<size_t>(stride + 2 * kReach));
+  uint8_t* const padded = row_distance.data() + distances;
+  const int from = area.x - kReach;  // The label column of padded[0].
+  const int copy_begin = std::max(0, from), copy_end = std::min(label.cols, from + stride + 2 * kReach);
+  std::fill(padded, padded + stride + 2 * kReach, uint8_t{0});
+  const cv::v_uint8x16 zero = cv::v_setzero_u8();
+  for (int y = top; y < bottom; ++y) {
+    const uint8_t* row = label.ptr<uint8_t>(y);
+    std::copy(row + copy_begin, row + copy_end, padded + (copy_begin - from));
+    uint8_t* out = row_distance.data() + static_cast<size_t>((y - top) * stride);
+    for (int x = 0; x < width; x += 16) {
+      const uint8_t* at = padded + x + kReach;  // Column area.x + x.
+      cv::v_uint8x16 d = cv::v_setall_u8(static_cast<uint8_t>(kNone));
+      for (int k = kReach; k >= 1; --k) {
+        const cv::v_uint8x16 pair = cv::v_load(at - k) | cv::v_load(at + k);
+        d = cv::v_select(pair != zero, cv::v_setall_u8(static_cast<uint8_t>(k)), d);
+      }
+      d = cv::v_select(cv::v_load(at) != zero, zero, d);
+      cv::v_store(out + x, d);
+    }
+  }
+#else
+  const int stride = width;
   row_distance.resize(static_cast<size_t>((bottom - top) * width));
   for (int y = top; y < bottom; ++y) {
     const uint8_t* row = label.ptr<uint8_t>(y);
@@ -174,6 +207,7 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
       }
     }
   }
+#endif
   // Down the columns, a row at a time across the area (loops the compiler vectorises in 8-bit
   // lanes): the least over the rows within reach of max(their distance along the row, |dy|).
   for (int y = area.y; y < area.br().y; ++y) {
@@ -181,7 +215,7 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
     std::fill(out, out + width, static_cast<uint8_t>(kNone));
     const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
     for (int yy = first; yy <= last; ++yy) {
-      const uint8_t* __restrict along = row_distance.data() + static_cast<size_t>((yy - top) * width);
+      const uint8_t* __restrict along = row_distance.data() + static_cast<size_t>((yy - top) * stride);
       const uint8_t rows_away = static_cast<uint8_t>(std::abs(yy - y));
       for (int x = 0; x < width; ++x) out[x] = std::min(out[x], std::max(along[x], rows_away));
     }
@@ -320,18 +354,97 @@ bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out) {
   return true;
 }
 
-void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
+namespace {
+
+// One pixel of the chroma channel (the reference's, and the vector loop's tail).
+inline uint8_t ChromaLevel(const uint8_t* bgr, const ChromaAxis& chroma, double scale) {
+  const cv::Vec3d c = ChromaticityOfLevels(bgr[0], bgr[1], bgr[2]);
+  return cv::saturate_cast<uint8_t>(40.0 + scale * (c - chroma.background).dot(chroma.axis));
+}
+
+}  // namespace
+
+void ChromaChannelReference(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
   CV_Assert(bgr.type() == CV_8UC3);
   out.create(bgr.size(), CV_8UC1);
   const double scale = 160.0 / chroma.span;
   for (int y = 0; y < bgr.rows; ++y) {
-    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
-    for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3d c = ChromaticityOfLevels(row[x][0], row[x][1], row[x][2]);
-      o[x] = cv::saturate_cast<uint8_t>(40.0 + scale * (c - chroma.background).dot(chroma.axis));
-    }
+    for (int x = 0; x < bgr.cols; ++x) o[x] = ChromaLevel(row + 3 * x, chroma, scale);
   }
+}
+
+// Per pixel, as the reference: c = (b, g, r) * scales[b + g + r]; the dot product of
+// c - background with the axis summed from 0 in channel order (Matx::dot); 40 + scale * it,
+// rounded to nearest even (cvRound: cvtsd2si; here cvtpd2dq) and saturated to 0..255. Each step
+// is one IEEE double operation in both (no FMA: the build does not target it), so the levels are
+// the same bits.
+void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
+#if CV_SIMD128_64F
+  CV_Assert(bgr.type() == CV_8UC3);
+  out.create(bgr.size(), CV_8UC1);
+  const double scale = 160.0 / chroma.span;
+  const double* scales = ChromaticityScales().data();
+  const cv::v_float64x2 bg0 = cv::v_setall_f64(chroma.background[0]);
+  const cv::v_float64x2 bg1 = cv::v_setall_f64(chroma.background[1]);
+  const cv::v_float64x2 bg2 = cv::v_setall_f64(chroma.background[2]);
+  const cv::v_float64x2 ax0 = cv::v_setall_f64(chroma.axis[0]);
+  const cv::v_float64x2 ax1 = cv::v_setall_f64(chroma.axis[1]);
+  const cv::v_float64x2 ax2 = cv::v_setall_f64(chroma.axis[2]);
+  const cv::v_float64x2 gain = cv::v_setall_f64(scale);
+  const cv::v_float64x2 level40 = cv::v_setall_f64(40.0);
+  const cv::v_float64x2 zero = cv::v_setzero_f64();
+  // Two pixels' levels b, g, r and their sums' scales k -> their two values before rounding.
+  const auto two = [&](const cv::v_float64x2& b, const cv::v_float64x2& g,
+                       const cv::v_float64x2& r, const cv::v_float64x2& k) {
+    cv::v_float64x2 dot = zero + (b * k - bg0) * ax0;
+    dot = dot + (g * k - bg1) * ax1;
+    dot = dot + (r * k - bg2) * ax2;
+    return level40 + gain * dot;
+  };
+  alignas(16) uint16_t sums[16];
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    int x = 0;
+    for (; x + 16 <= bgr.cols; x += 16) {
+      cv::v_uint8x16 b8, g8, r8;
+      cv::v_load_deinterleave(row + 3 * x, b8, g8, r8);
+      cv::v_uint16x8 b16[2], g16[2], r16[2];
+      cv::v_expand(b8, b16[0], b16[1]);
+      cv::v_expand(g8, g16[0], g16[1]);
+      cv::v_expand(r8, r16[0], r16[1]);
+      cv::v_store_aligned(sums, b16[0] + g16[0] + r16[0]);
+      cv::v_store_aligned(sums + 8, b16[1] + g16[1] + r16[1]);
+      cv::v_int16x8 packed[2];
+      for (int h = 0; h < 2; ++h) {
+        cv::v_uint32x4 b32[2], g32[2], r32[2];
+        cv::v_expand(b16[h], b32[0], b32[1]);
+        cv::v_expand(g16[h], g32[0], g32[1]);
+        cv::v_expand(r16[h], r32[0], r32[1]);
+        cv::v_int32x4 rounded[2];
+        for (int q = 0; q < 2; ++q) {
+          const uint16_t* s = sums + 8 * h + 4 * q;
+          const cv::v_int32x4 b = cv::v_reinterpret_as_s32(b32[q]);
+          const cv::v_int32x4 g = cv::v_reinterpret_as_s32(g32[q]);
+          const cv::v_int32x4 r = cv::v_reinterpret_as_s32(r32[q]);
+          const cv::v_float64x2 lo = two(cv::v_cvt_f64(b), cv::v_cvt_f64(g), cv::v_cvt_f64(r),
+                                         cv::v_float64x2(scales[s[0]], scales[s[1]]));
+          const cv::v_float64x2 hi =
+              two(cv::v_cvt_f64_high(b), cv::v_cvt_f64_high(g), cv::v_cvt_f64_high(r),
+                  cv::v_float64x2(scales[s[2]], scales[s[3]]));
+          rounded[q] = cv::v_round(lo, hi);
+        }
+        packed[h] = cv::v_pack(rounded[0], rounded[1]);  // Saturated to int16, then
+      }
+      cv::v_store(o + x, cv::v_pack_u(packed[0], packed[1]));  // to 0..255: saturate_cast.
+    }
+    for (; x < bgr.cols; ++x) o[x] = ChromaLevel(row + 3 * x, chroma, scale);
+  }
+#else
+  ChromaChannelReference(bgr, chroma, out);
+#endif
 }
 
 bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv::Vec3d* chroma) {

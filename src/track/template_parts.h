@@ -132,7 +132,8 @@ void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& ou
 // The Chebyshev distance (max(|dx|, |dy|)) from each pixel of `area` to the nearest nonzero pixel
 // of `label` (CV_8UC1) at most 4 away, 5 where there is none, into the same pixels of `dist`
 // (CV_8UC1, label's size; nothing else of it is written). Separable: per row, the distance to
-// the row's nearest label pixel (a pass each way), then per pixel the least max(|dy|, that
+// the row's nearest label pixel (16 pixels at a time: the pixels k to either side looked at for
+// k = 4 .. 0; a pass each way without vector code), then per pixel the least max(|dy|, that
 // distance) over the rows within 4, in 8-bit lanes. Looking at the 81 pixels within 4 of each
 // pixel (the reference) was a quarter of the work of three ZNCC templates' frame (issue 45).
 // `row_distance` is reused storage.
@@ -241,16 +242,23 @@ class BlobMeter {
     int fg_n = 0, bg_n = 0;
     dist_.create(gray.size(), CV_8UC1);
     CappedChebyshevDistance(label_, grown, dist_, row_distance_);
+    // Rows through pointers (every frame's blob, issue 45); `grown` lies in the patch, so only
+    // the mask can leave a pixel out. A component pixel (d == 0) is off the patch's edge (Fill),
+    // so its four neighbours are in the patch. The sums are of whole levels: exact in a double.
+    const int cols = label_.cols;  // label_ is continuous.
     for (int y = grown.y; y < grown.br().y; ++y) {
+      const uint8_t* levels = gray.ptr<uint8_t>(y);
+      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+      const uint8_t* distance = dist_.ptr<uint8_t>(y);
+      const uint8_t* label = label_.ptr<uint8_t>(y);
       for (int x = grown.x; x < grown.br().x; ++x) {
-        const int d = dist_.at<uint8_t>(y, x);
-        if (!IsInside(gray, mask, x, y)) continue;
-        if (d == 0 && label_.at<uint8_t>(y - 1, x) && label_.at<uint8_t>(y + 1, x) &&
-            label_.at<uint8_t>(y, x - 1) && label_.at<uint8_t>(y, x + 1)) {
-          fg_sum += gray.at<uint8_t>(y, x);
+        const int d = distance[x];
+        if (inside && !inside[x]) continue;
+        if (d == 0 && label[x - cols] && label[x + cols] && label[x - 1] && label[x + 1]) {
+          fg_sum += levels[x];
           ++fg_n;
         } else if (d == 3 || d == 4) {
-          bg_sum += gray.at<uint8_t>(y, x);
+          bg_sum += levels[x];
           ++bg_n;
         }
       }
@@ -261,9 +269,12 @@ class BlobMeter {
     // Soft centroid over the component grown by 2 px (its anti-aliased rim), inside the mask.
     double sw = 0, sx = 0, sy = 0;
     for (int y = grown.y; y < grown.br().y; ++y) {
+      const uint8_t* levels = gray.ptr<uint8_t>(y);
+      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+      const uint8_t* distance = dist_.ptr<uint8_t>(y);
       for (int x = grown.x; x < grown.br().x; ++x) {
-        if (!IsInside(gray, mask, x, y) || dist_.at<uint8_t>(y, x) > 2) continue;
-        const double w = track_internal::Membership(&gray.at<uint8_t>(y, x), 1, &bg, &fg, 0.0, false);
+        if ((inside && !inside[x]) || distance[x] > 2) continue;
+        const double w = track_internal::Membership(levels + x, 1, &bg, &fg, 0.0, false);
         sw += w;
         sx += w * x;
         sy += w * y;
@@ -291,13 +302,17 @@ class BlobMeter {
     // the first edge pixel it takes sets the pass.
     for (auto& bucket : buckets_) bucket.clear();
     ZeroedMask(gray.size(), visited_);
-    const auto likeness = [&](int x, int y) {
-      const int v = gray.at<uint8_t>(y, x);
-      return bright_ ? v : 255 - v;
-    };
-    int level = likeness(seed->x, seed->y);
+    // Pixels through pointers (this runs on every frame's blob, issue 45): 255 - v is v ^ 255.
+    const int flip = bright_ ? 0 : 255;
+    const uint8_t* levels = gray.data;
+    const size_t step = gray.step[0];
+    const uint8_t* inside = mask.data;  // No mask: every pixel of the patch counts.
+    const size_t mask_step = inside ? mask.step[0] : 0;
+    uint8_t* visited = visited_.data;  // Continuous, gray.cols a row.
+    const int cols = gray.cols;
+    int level = levels[seed->y * step + seed->x] ^ flip;
     buckets_[level].push_back(*seed);
-    visited_.at<uint8_t>(*seed) = 1;
+    visited[seed->y * cols + seed->x] = 1;
     core_.clear();
     int pass = -1;
     while (pass < 0) {
@@ -310,15 +325,17 @@ class BlobMeter {
         break;
       }
       if (core_.size() < kCoreSamples) core_.push_back(level);
+      // Off the patch's edge, so the four neighbours are in the patch: only the mask can leave.
       const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
       for (const cv::Point& q : next) {
-        if (visited_.at<uint8_t>(q)) continue;
-        visited_.at<uint8_t>(q) = 1;
-        if (!IsInside(gray, mask, q.x, q.y)) {
+        uint8_t& seen = visited[q.y * cols + q.x];
+        if (seen) continue;
+        seen = 1;
+        if (inside && !inside[q.y * mask_step + q.x]) {
           pass = level;  // The mask's edge: the flood leaves here at this level.
           break;
         }
-        const int l = likeness(q.x, q.y);
+        const int l = levels[q.y * step + q.x] ^ flip;
         buckets_[std::min(l, level)].push_back(q);  // A path's level is its least marker-like.
       }
     }
@@ -368,32 +385,47 @@ class BlobMeter {
     return x >= 0 && y >= 0 && x < gray.cols && y < gray.rows &&
            (mask.data == nullptr || mask.at<uint8_t>(y, x));
   }
-  bool IsMarker(const cv::Mat& gray, int x, int y, double threshold) const {
-    const double v = gray.at<uint8_t>(y, x);
-    return bright_ ? v > threshold : v < threshold;
-  }
   // 4-connected flood fill of the marker side from `seed` into label_ (its bounding box in
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
     ZeroedMask(gray.size(), label_);
     stack_.clear();
     stack_.push_back(seed);
-    label_.at<uint8_t>(seed) = 1;
-    box_ = cv::Rect(seed, cv::Size(1, 1));
+    // Through pointers, as Segment's flood; the box as its corners, written to box_ on the way
+    // out (what box_ |= pixel gave).
+    const uint8_t* levels = gray.data;
+    const size_t step = gray.step[0];
+    const uint8_t* inside = mask.data;
+    const size_t mask_step = inside ? mask.step[0] : 0;
+    uint8_t* label = label_.data;  // Continuous, gray.cols a row.
+    const int cols = gray.cols;
+    label[seed.y * cols + seed.x] = 1;
+    int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
+    const auto done = [&](bool separated) {
+      box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+      return separated;
+    };
     while (!stack_.empty()) {
       const cv::Point p = stack_.back();
       stack_.pop_back();
-      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return false;
-      box_ |= cv::Rect(p, cv::Size(1, 1));
+      if (p.x == 0 || p.y == 0 || p.x == gray.cols - 1 || p.y == gray.rows - 1) return done(false);
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
+      // Off the patch's edge: the four neighbours are in the patch; only the mask can leave.
       const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
       for (const cv::Point& q : next) {
-        if (!IsInside(gray, mask, q.x, q.y)) return false;  // Reaches the mask's edge.
-        if (label_.at<uint8_t>(q) || !IsMarker(gray, q.x, q.y, threshold)) continue;
-        label_.at<uint8_t>(q) = 1;
+        if (inside && !inside[q.y * mask_step + q.x]) return done(false);  // The mask's edge.
+        uint8_t& in = label[q.y * cols + q.x];
+        if (in) continue;
+        const double v = levels[q.y * step + q.x];
+        if (!(bright_ ? v > threshold : v < threshold)) continue;  // IsMarker.
+        in = 1;
         stack_.push_back(q);
       }
     }
-    return true;
+    return done(true);
   }
 
   // The marker's level is the median of its this many most marker-like pixels.
@@ -476,8 +508,12 @@ inline constexpr double kMinChromaSpan = 0.05;
 // The axis of `bgr` (a selected template, 8-bit BGR); false when its centre's chromaticity does
 // not differ from its edge's.
 bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out);
-// One 8-bit channel: the background at 40, the marker at 200.
+// One 8-bit channel: the background at 40, the marker at 200. The pixels' arithmetic in double
+// vector lanes, 16 pixels at a time, in the reference's order of operations: bit for bit
+// ChromaChannelReference (the template tracker's blob is measured in it every frame).
 void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
+// The same, a pixel at a time: the definition.
+void ChromaChannelReference(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
 
 
 // The colour of a marker's core: the chromaticity (B, G, R over their sum) of the mean colour of

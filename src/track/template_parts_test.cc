@@ -29,6 +29,55 @@ TEST(TemplateParts, CappedChebyshevDistanceIsTheReferences) {
   }
 }
 
+// The vector chroma channel against its scalar reference, bit for bit: every 8-bit colour, on
+// axes whose levels stay inside 0..255 and ones that saturate both ways, then views of every
+// width from 1 to 40 px (the 16-pixel loop's tail) on random pixels.
+TEST(TemplateParts, ChromaChannelIsTheReferences) {
+  cv::Mat every(4096, 4096, CV_8UC3);
+  for (int y = 0; y < every.rows; ++y) {
+    cv::Vec3b* row = every.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < every.cols; ++x) {
+      const int i = y * every.cols + x;
+      row[x] = cv::Vec3b(static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8),
+                         static_cast<uint8_t>(i >> 16));
+    }
+  }
+  std::vector<ChromaAxis> axes;
+  cv::RNG rng(45);
+  for (double span : {kMinChromaSpan, 0.1, 0.3, 0.7, 1.2}) {
+    ChromaAxis a;
+    const cv::Vec3d bg(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    a.background = bg / (bg[0] + bg[1] + bg[2]);
+    const cv::Vec3d axis(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+    a.axis = axis / std::sqrt(axis.dot(axis));
+    a.span = span;
+    axes.push_back(a);
+  }
+  // One learned from a green disc on gray, as the tracker learns it.
+  cv::Mat selection(32, 32, CV_8UC3, cv::Scalar(120, 120, 120));
+  cv::circle(selection, {16, 16}, 9, cv::Scalar(40, 200, 60), cv::FILLED);
+  ChromaAxis learned;
+  ASSERT_TRUE(LearnChromaAxis(selection, &learned));
+  axes.push_back(learned);
+  cv::Mat fast, reference;
+  for (const ChromaAxis& a : axes) {
+    ChromaChannel(every, a, fast);
+    ChromaChannelReference(every, a, reference);
+    ASSERT_EQ(cv::countNonZero(fast != reference), 0) << a.axis << " " << a.span;
+  }
+  cv::Mat noise(24, 60, CV_8UC3);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  for (int width = 1; width <= 40; ++width) {
+    for (const ChromaAxis& a : axes) {
+      const cv::Mat view = noise(cv::Rect(width % 7, 3, width, 17));
+      ChromaChannel(view, a, fast);
+      ChromaChannelReference(view, a, reference);
+      ASSERT_EQ(fast.size(), view.size());
+      EXPECT_EQ(cv::countNonZero(fast != reference), 0) << width << " " << a.span;
+    }
+  }
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };

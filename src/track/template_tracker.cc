@@ -656,9 +656,12 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   const cv::Size size = rung.templ.size();
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   const cv::Rect window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
+  measured_zncc_ = false;
   if (window.width < size.width || window.height < size.height) return std::nullopt;
   Native(frame, window, fine_);
   Similarity(fine_, rung.templ, fine_sim_);
+  measured_zncc_ = params_.measure == MatchMeasure::kZncc;
+  measured_tl_ = window.tl();
   cv::Point best;
   if (!BestIn(fine_sim_, &best)) return std::nullopt;
   const bool inner_edge = (best.x == 0 && window.x > 0) ||
@@ -721,11 +724,32 @@ double TemplateTracker::RungZncc(const cv::Mat& frame, int scale, int turn,
   return BestIn(rung_sim_, &best) ? rung_sim_.at<float>(best) : kNoRival;
 }
 
+// The ZNCC of each placement is computed from exact integer sums over its own pixels, so the
+// measurement's map of the same rung holds, bit for bit, what RungZncc would compute where its
+// 3x3 placements lie inside it (most frames: the blob moves the match by less than
+// kFineMarginPx - 1): one small match a frame fewer.
+bool TemplateTracker::CurrentRungZnccMeasured(const cv::Mat& frame, const cv::Point2d& centre_px,
+                                              double* zncc) {
+  if (!measured_zncc_) return false;
+  measured_zncc_ = false;  // Used once: the pose search may change the rung.
+  const cv::Size size = current().templ.size();
+  const cv::Rect window = WindowAround(centre_px, size, 1);
+  if ((window & cv::Rect(0, 0, frame.cols, frame.rows)) != window) return false;
+  const cv::Rect placements(window.tl() - measured_tl_, cv::Size(3, 3));
+  if ((placements & cv::Rect(0, 0, fine_sim_.cols, fine_sim_.rows)) != placements) return false;
+  cv::Point best;
+  *zncc = BestIn(fine_sim_(placements), &best) ? fine_sim_(placements).at<float>(best) : kNoRival;
+  return true;
+}
+
 // Scale and turn search: the neighbouring rungs of the ladder (one scale up and down, one turn
 // either way) against the current one, at the match; the best becomes current when it fits
 // better by the hysteresis. The turn found is the marker's spin from the last frame's.
 void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_turn) {
-  const double here = RungZncc(frame, rung_, turn_, fix.centre);
+  double here;
+  if (!CurrentRungZnccMeasured(frame, fix.centre, &here)) {
+    here = RungZncc(frame, rung_, turn_, fix.centre);
+  }
   if (!std::isfinite(here)) return;
   int scale = rung_, turn = turn_;
   double best = here + kScaleHysteresis;

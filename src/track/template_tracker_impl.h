@@ -116,6 +116,9 @@ class TemplateTracker final : public Tracker {
   cv::Point RefineThroughLevels(cv::Point p, int top, int* level);
   std::optional<Fix> Measure(const cv::Mat& frame, const cv::Point2d& centre_px);
   double RungZncc(const cv::Mat& frame, int scale, int turn, const cv::Point2d& centre_px);
+  // RungZncc of the current rung from the measurement's map (fine_sim_), when Measure matched
+  // that rung's ZNCC around every placement RungZncc would try; false otherwise.
+  bool CurrentRungZnccMeasured(const cv::Mat& frame, const cv::Point2d& centre_px, double* zncc);
   void UpdatePose(const cv::Mat& frame, const Fix& fix, int last_turn);
   void TurnedTo();
   void UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px);
@@ -181,6 +184,10 @@ class TemplateTracker final : public Tracker {
 
   // Buffers reused from frame to frame.
   cv::Mat region_, fine_, raw_, sim_, fine_sim_, rung_sim_, patch_, resized_, candidate_, shape_;
+  // fine_sim_ holds the current rung's ZNCC map of the window at measured_tl_ (Measure's, until
+  // the pose search has used it).
+  bool measured_zncc_ = false;
+  cv::Point measured_tl_;
   // The frame around the marker in the matched channel(s), converted once per update: the
   // search, the measurement, the scale search and the template update each look at a window of
   // it (they overlap; converting each on its own was a seventh of the tracker's time).
