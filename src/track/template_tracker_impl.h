@@ -103,6 +103,9 @@ class TemplateTracker final : public Tracker {
   std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
                             bool find_rival);
   std::optional<Hit> Refine(const cv::Mat& frame, cv::Point top_left);
+  // The match in the window kNearMarginPx around `predicted` (the marker's centre), when it
+  // decides the tracking window's search; empty when the whole window must be searched.
+  std::optional<Hit> NearSearch(const cv::Mat& frame, const cv::Point2d& predicted);
   std::optional<Hit> Acquire(const cv::Mat& frame);
   // Where Acquire searches: around the last known position (within the acquire radius, or half
   // the distance to the nearest look-alike), else the whole frame.
