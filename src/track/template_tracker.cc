@@ -140,6 +140,7 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   rung_ = kRungsBelow;
   turn_ = 0;
   turn_step_ = 0;
+  pose_zncc_ = kNoRival;
   Rung& selected = rungs_[RungKey(rung_, turn_)];
   selected.tried = true;
   selected.templ = std::move(first);
@@ -778,6 +779,14 @@ void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_
     here = RungZncc(frame, rung_, turn_, fix.centre);
   }
   if (!std::isfinite(here)) return;
+  // The current rung still fits as well as when its neighbours were last tried: they are tried
+  // again only every kPoseEvery-th frame (the turn steps on by the last spin meanwhile).
+  if (std::isfinite(pose_zncc_) && here >= pose_zncc_ - kPoseDrop && pose_skips_ < kPoseEvery - 1) {
+    ++pose_skips_;
+    return;
+  }
+  pose_skips_ = 0;
+  pose_zncc_ = here;
   int scale = rung_, turn = turn_;
   double best = here + kScaleHysteresis;
   const auto consider = [&](int s, int t) {
@@ -805,6 +814,7 @@ void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_
     turn_step_ = spin;
   }
   if (scale == rung_ && turn == turn_) return;
+  pose_zncc_ = best;
   const bool turned = turn != turn_;
   rung_ = scale;
   turn_ = turn;
@@ -1050,6 +1060,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
   rung_ = saved_.rung;
   turn_ = saved_.turn;
   turn_step_ = saved_.turn_step;
+  pose_zncc_ = kNoRival;
   if (adapts()) RestoreWorkingTemplate();  // It may have blended in the other candidate.
   native_rect_ = cv::Rect();
   const Observation observation =
