@@ -89,6 +89,15 @@ bool RivalIn(const cv::Mat& sim, cv::Point best, int radius, cv::Point* at) {
   return any;
 }
 
+int RivalRadius(const cv::Size& templ) {
+  return std::max(2, std::min(templ.width, templ.height) / 2);
+}
+
+bool NoRivalReachable(int margin_px, cv::Point from_prediction, int rival_radius) {
+  return margin_px + std::abs(from_prediction.x) <= rival_radius &&
+         margin_px + std::abs(from_prediction.y) <= rival_radius;
+}
+
 cv::Mat RoundMask(const cv::Size& size) {
   cv::Mat mask(size, CV_8UC1);
   const cv::Point2d centre = HalfSize(size);

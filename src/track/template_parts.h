@@ -29,6 +29,15 @@ inline constexpr int kRefineMarginPx = 2;          // Search margin per pyramid 
 inline constexpr int kCandidates = 3;              // Coarse peaks refined to full resolution.
 inline constexpr int kMaxRecentre = 4;             // Re-centrings of the final window onto its peak.
 inline constexpr int kFineMarginPx = 3;            // First-template search around the working match.
+// The tracking window is converted with this much around it: the later windows (the
+// measurement, kFineMarginPx around the match; the neighbouring rungs of the scale search; the
+// template update's patch) lie in it while the marker is found near where it was predicted,
+// which is most frames; one that does not is converted on its own. (Converting all of them,
+// kFineMarginPx and more around the whole window, cost more than the few it saves.)
+inline constexpr int kAroundPx = 2;
+// While tracking, the window this far around the predicted place is searched first; the
+// search_margin_px window only when that one does not decide (NearSearchDecides).
+inline constexpr int kNearMarginPx = 4;
 inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
@@ -44,6 +53,10 @@ inline constexpr int kTurns = 72;  // 360 / kTurnStepDeg.
 // about as well turned as not (only the background around it changes), and flickering between
 // turns would move its reported point with each step; a sticker 5 degrees off loses far more.
 inline constexpr double kTurnHysteresis = 0.02;
+// While tracking, the neighbouring rungs are tried every kPoseEvery-th frame, and in any frame
+// where the current rung fits worse by kPoseDrop than at the last try (issue 45).
+inline constexpr int kPoseEvery = 3;
+inline constexpr double kPoseDrop = 0.005;
 // Below this self-match of the turned template there is no centre of symmetry worth reporting.
 inline constexpr double kMinSymmetry = 0.5;
 
@@ -69,6 +82,12 @@ bool BestIn(const cv::Mat& sim, cv::Point* at);
 // second place the template fits. A value on the map's edge counts when it is not below its
 // neighbours inside (it may be the slope of a peak just outside). False when there is none.
 bool RivalIn(const cv::Mat& sim, cv::Point best, int radius, cv::Point* at);
+// How far from the best placement a distinct second peak (RivalIn) of a template this size lies.
+int RivalRadius(const cv::Size& templ);
+// Whether no placement of the window searched `margin_px` around a prediction lies farther than
+// `rival_radius` (RivalIn's sense) from a peak `from_prediction` placements off the prediction:
+// then that window could report no rival to this peak.
+bool NoRivalReachable(int margin_px, cv::Point from_prediction, int rival_radius);
 
 // The ellipse inscribed in a template of `size` (pixel centres within it count).
 cv::Mat RoundMask(const cv::Size& size);

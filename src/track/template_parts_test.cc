@@ -29,6 +29,31 @@ TEST(TemplateParts, CappedChebyshevDistanceIsTheReferences) {
   }
 }
 
+// NoRivalReachable is "RivalIn can find nothing in the whole window": on a map of that window
+// flat but for its peak, every placement beyond the rival radius is a distinct peak RivalIn
+// takes, so it finds one exactly when NoRivalReachable says one is reachable.
+TEST(TemplateParts, NoRivalReachableIsRivalInOnAFlatWindow) {
+  for (int margin = 1; margin <= 9; ++margin) {
+    for (int radius = 2; radius <= 20; ++radius) {
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          if (std::abs(dx) > margin || std::abs(dy) > margin) continue;
+          cv::Mat map(2 * margin + 1, 2 * margin + 1, CV_32F, cv::Scalar(0));
+          const cv::Point best(margin + dx, margin + dy);
+          map.at<float>(best) = 1;
+          cv::Point rival;
+          EXPECT_EQ(RivalIn(map, best, radius, &rival),
+                    !NoRivalReachable(margin, {dx, dy}, radius))
+              << margin << " " << radius << " " << dx << " " << dy;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(RivalRadius(cv::Size(32, 32)), 16);
+  EXPECT_EQ(RivalRadius(cv::Size(21, 40)), 10);
+  EXPECT_EQ(RivalRadius(cv::Size(3, 3)), 2);
+}
+
 // The vector chroma channel against its scalar reference, bit for bit: every 8-bit colour, on
 // axes whose levels stay inside 0..255 and ones that saturate both ways, then views of every
 // width from 1 to 40 px (the 16-pixel loop's tail) on random pixels.

@@ -140,6 +140,7 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   rung_ = kRungsBelow;
   turn_ = 0;
   turn_step_ = 0;
+  pose_zncc_ = kNoRival;
   Rung& selected = rungs_[RungKey(rung_, turn_)];
   selected.tried = true;
   selected.templ = std::move(first);
@@ -486,7 +487,7 @@ std::optional<Hit> TemplateTracker::Search(const cv::Mat& frame, cv::Rect region
                                                   : ZnccAt(region_, best, templ, shape_, zncc_);
   cv::Point rival;
   if (find_rival && params_.ambiguity_margin > 0 &&
-      RivalIn(sim_, best, std::max(2, std::min(size.width, size.height) / 2), &rival)) {
+      RivalIn(sim_, best, RivalRadius(size), &rival)) {
     m.rival_zncc = params_.measure == MatchMeasure::kZncc
                        ? sim_.at<float>(rival)
                        : ZnccAt(region_, rival, templ, shape_, zncc_);
@@ -512,6 +513,33 @@ std::optional<Hit> TemplateTracker::Refine(const cv::Mat& frame, cv::Point top_l
     top_left = m->top_left;
   }
   return std::nullopt;  // Still climbing: no clear peak here.
+}
+
+// Most frames the marker is within a few pixels of where its constant velocity puts it: the
+// window kNearMarginPx around that (81 placements, not the 289 of the default search_margin_px)
+// decides the search when its best lies inside it (not on its edge) and passes min_zncc itself
+// (no allowance: a weak peak may be a look-alike beside a marker that moved elsewhere), and the
+// whole window could hold no distinct rival to it (a template larger than about twice
+// search_margin_px; any size without the ambiguity check). The ZNCC of a placement depends on
+// its pixels alone, so this is the whole window's answer unless a higher peak lies in the rest
+// of the window within the rival radius of this one (issue 45: docs/measurements.md).
+std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::Point2d& predicted) {
+  const int margin = params_.search_margin_px;
+  if (footage_repeats_ || kNearMarginPx >= margin) return std::nullopt;
+  const PreparedTemplate& templ = search_template();
+  const cv::Size size = templ.size();
+  const bool rivals = params_.ambiguity_margin > 0;
+  const int radius = RivalRadius(size);
+  if (rivals && !NoRivalReachable(margin, {0, 0}, radius)) return std::nullopt;
+  const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
+  ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
+                                near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
+  std::optional<Hit> hit = Search(frame, near, templ, false);
+  if (!hit || hit->on_inner_edge || !Accept(*hit)) return std::nullopt;
+  const cv::Point from_prediction =
+      hit->top_left - near.tl() - cv::Point(kNearMarginPx, kNearMarginPx);
+  if (rivals && !NoRivalReachable(margin, from_prediction, radius)) return std::nullopt;
+  return hit;
 }
 
 namespace {
@@ -751,6 +779,14 @@ void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_
     here = RungZncc(frame, rung_, turn_, fix.centre);
   }
   if (!std::isfinite(here)) return;
+  // The current rung still fits as well as when its neighbours were last tried: they are tried
+  // again only every kPoseEvery-th frame (the turn steps on by the last spin meanwhile).
+  if (std::isfinite(pose_zncc_) && here >= pose_zncc_ - kPoseDrop && pose_skips_ < kPoseEvery - 1) {
+    ++pose_skips_;
+    return;
+  }
+  pose_skips_ = 0;
+  pose_zncc_ = here;
   int scale = rung_, turn = turn_;
   double best = here + kScaleHysteresis;
   const auto consider = [&](int s, int t) {
@@ -778,6 +814,7 @@ void TemplateTracker::UpdatePose(const cv::Mat& frame, const Fix& fix, int last_
     turn_step_ = spin;
   }
   if (scale == rung_ && turn == turn_) return;
+  pose_zncc_ = best;
   const bool turned = turn != turn_;
   rung_ = scale;
   turn_ = turn;
@@ -932,25 +969,23 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   }
   std::optional<Hit> hit;
   if (tracking_) {
-    cv::Rect window = WindowAround(*last_centre_ + velocity_px_, search_template().size(),
-                                   params_.search_margin_px);
+    const cv::Point2d predicted = *last_centre_ + velocity_px_;
+    cv::Rect window = WindowAround(predicted, search_template().size(), params_.search_margin_px);
     if (footage_repeats_) {
       window |= WindowAround(*last_centre_, search_template().size(), params_.search_margin_px);
     }
     if ((window & frame_rect).empty()) return Lose(MarkerStatus::kOutOfFrame);
-    // The window and a little around it: the later windows (the measurement, kFineMarginPx
-    // around the match; the neighbouring rungs of the scale search; the template update's
-    // patch) lie in it while the marker is found near where it was predicted, which is most
-    // frames; one that does not is converted on its own. (Converting all of them, kFineMarginPx
-    // and more around the whole window, cost more than the few it saves.)
-    constexpr int kAroundPx = 2;
-    ConvertAround(frame_bgr, cv::Rect(window.x - kAroundPx, window.y - kAroundPx,
-                                      window.width + 2 * kAroundPx, window.height + 2 * kAroundPx));
-    hit = Search(frame_bgr, window, search_template(), true);
-    // Moving faster than the window (its best is on the window's edge, or is no match at all
-    // because the marker left it): acquire.
-    if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), true))) {
-      hit.reset();
+    hit = NearSearch(frame_bgr, predicted);
+    if (!hit) {
+      ConvertAround(frame_bgr, cv::Rect(window.x - kAroundPx, window.y - kAroundPx,
+                                        window.width + 2 * kAroundPx,
+                                        window.height + 2 * kAroundPx));
+      hit = Search(frame_bgr, window, search_template(), true);
+      // Moving faster than the window (its best is on the window's edge, or is no match at all
+      // because the marker left it): acquire.
+      if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), true))) {
+        hit.reset();
+      }
     }
   }
   const bool followed = hit.has_value();
@@ -1025,6 +1060,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
   rung_ = saved_.rung;
   turn_ = saved_.turn;
   turn_step_ = saved_.turn_step;
+  pose_zncc_ = kNoRival;
   if (adapts()) RestoreWorkingTemplate();  // It may have blended in the other candidate.
   native_rect_ = cv::Rect();
   const Observation observation =

@@ -39,6 +39,7 @@ class TemplateTracker final : public Tracker {
     turn_step_ = 0;
     repeats_ = 0;
     lost_frames_ = 0;
+    pose_zncc_ = kNoRival;
   }
 
  private:
@@ -103,6 +104,9 @@ class TemplateTracker final : public Tracker {
   std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
                             bool find_rival);
   std::optional<Hit> Refine(const cv::Mat& frame, cv::Point top_left);
+  // The match in the window kNearMarginPx around `predicted` (the marker's centre), when it
+  // decides the tracking window's search; empty when the whole window must be searched.
+  std::optional<Hit> NearSearch(const cv::Mat& frame, const cv::Point2d& predicted);
   std::optional<Hit> Acquire(const cv::Mat& frame);
   // Where Acquire searches: around the last known position (within the acquire radius, or half
   // the distance to the nearest look-alike), else the whole frame.
@@ -135,6 +139,7 @@ class TemplateTracker final : public Tracker {
     velocity_px_ = {0, 0};
     turn_step_ = 0;
     repeats_ = 0;
+    pose_zncc_ = kNoRival;
     ++lost_frames_;
     return Observation::NotFound(why, candidates);
   }
@@ -149,6 +154,10 @@ class TemplateTracker final : public Tracker {
   int rung_ = 0;                        // The current scale.
   int turn_ = 0;                        // The current turn, in kTurnStepDeg steps.
   int turn_step_ = 0;                   // Turn steps between the last two matches (its spin).
+  // The current rung's ZNCC when the neighbouring rungs were last tried (kNoRival: try them next
+  // frame), and the frames since.
+  double pose_zncc_ = kNoRival;
+  int pose_skips_ = 0;
   int working_key_ = -1;                // The rung the working template's mask belongs to.
   PreparedTemplate working_;            // The updated template (update_rate > 0).
   cv::Mat working_f_;                   // Its CV_32F running blend.

@@ -602,6 +602,72 @@ TEST(TemplateTrackerTest, LookAlikeNeighbourIsNeverTakenForACoveredMarker) {
   }
 }
 
+// The tracking window's near part (kNearMarginPx around the constant-velocity prediction) is
+// searched first; a marker that moves against its prediction by more than that (a jump, a
+// reversal) must be found by the whole window, at its place, as before.
+TEST(TemplateTrackerTest, AMarkerLeavingItsPredictionIsFoundInTheWholeWindow) {
+  for (const char* method : kMethods) {
+    for (const int side : {21, 33}) {  // The near window decides with and without the rival check.
+      SCOPED_TRACE(std::string(method) + " " + std::to_string(side) + " px");
+      MarkerSpec spec;
+      spec.name = "dot";
+      spec.params = ParamsForMethod(method, {});
+      const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+      cv::Point2d a(50.3, 60.6), step(1.3, 0.4);
+      int found = 0, wrong = 0;
+      for (int i = 0; i < 30; ++i) {
+        if (i == 10) a += cv::Point2d(6.6, -0.7);  // 6.6 px past the prediction.
+        if (i == 20) step = -step;                 // Reversed: 2.6 px off, then 1.3, 0.
+        if (i == 25) a += cv::Point2d(-1.2, 7.1);
+        a += step;
+        cv::Mat frame(160, 220, CV_8UC3, cv::Scalar(40, 40, 40));
+        cv::circle(frame, cv::Point(cvRound(a.x * 16), cvRound(a.y * 16)), cvRound(side / 3.0 * 16),
+                   cv::Scalar(230, 230, 230), cv::FILLED, cv::LINE_AA, 4);
+        if (i == 0) tracker->init(frame, RectAround(a, side));
+        const Observation o = tracker->update(frame);
+        if (!o.found()) continue;
+        ++found;
+        if (cv::norm(*o.position_px - a) > 0.3) ++wrong;
+      }
+      EXPECT_EQ(found, 30);
+      EXPECT_EQ(wrong, 0);
+    }
+  }
+}
+
+// The neighbouring rungs (scale, turn) are tried every kPoseEvery-th frame, and at once when the
+// current rung fits worse: a bar that grows 2 % a frame while it turns 5 degrees a frame, then
+// stops turning and shrinks, is followed at its centre in every frame.
+TEST(TemplateTrackerTest, ABarThatGrowsTurnsAndStopsIsFollowedThroughThePoseSearch) {
+  MarkerSpec spec;
+  spec.name = "bar";
+  spec.params = ParamsForMethod("zncc", {});
+  const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+  cv::Point2d c(110.3, 80.6);
+  double scale = 1.0, angle = 0.0;
+  int found = 0, wrong = 0;
+  for (int i = 0; i < 40; ++i) {
+    if (i > 0) {
+      scale *= i < 20 ? 1.02 : 1.0 / 1.02;
+      angle += i < 20 ? 5.0 : 0.0;
+      c += cv::Point2d(0.9, -0.4);
+    }
+    cv::Mat frame(160, 220, CV_8UC3, cv::Scalar(40, 40, 40));
+    cv::Point2f corners[4];
+    cv::RotatedRect(cv::Point2f(c), cv::Size2f(26 * scale, 9 * scale), angle).points(corners);
+    std::vector<cv::Point> poly;
+    for (const cv::Point2f& p : corners) poly.emplace_back(cvRound(p.x * 16), cvRound(p.y * 16));
+    cv::fillConvexPoly(frame, poly, cv::Scalar(60, 200, 230), cv::LINE_AA, 4);
+    if (i == 0) tracker->init(frame, RectAround(c, 33));
+    const Observation o = tracker->update(frame);
+    if (!o.found()) continue;
+    ++found;
+    if (cv::norm(*o.position_px - c) > 0.5) ++wrong;
+  }
+  EXPECT_GE(found, 38);
+  EXPECT_EQ(wrong, 0);
+}
+
 // Footage that repeats every frame three times (a camera delivering a third of the file's
 // rate): the dot stands still for two frames, then moves three frames' worth, faster and faster
 // (4 px more each time, up to 32 px). The velocity is kept over the repeats and the window spans
