@@ -358,6 +358,9 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
   // The window must hold the whole marker with room to move: at least two diameters.
   const double ref_radius = std::sqrt(model_ ? model_->area_px / CV_PI : 0.0);
   const int base = std::max(params_.window_px, static_cast<int>(std::ceil(4.0 * ref_radius)));
+  // Where the marker may be this frame: within its radius (plus a frame's motion) of the
+  // prediction.
+  const double reach = ref_radius + cv::norm(velocity_px_) + 1.0;
   for (int step = 0; step <= params_.widen_steps; ++step) {
     const int side = base << step;
     const cv::Rect window =
@@ -381,8 +384,7 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
       // a blob where the marker should be that fits it in everything but brightness (its tint,
       // size, shape and contrast) is the marker darkened, not a darker look-alike that happens to
       // stand exactly there. Colour only: a gray marker has nothing but its brightness.
-      if (verdict == CandidateVerdict::kColour && !gray_ && model_ &&
-          d <= ref_radius + cv::norm(velocity_px_) + 1.0) {
+      if (verdict == CandidateVerdict::kColour && !gray_ && model_ && d <= reach) {
         const auto [shaded, shaded_misfit] = judge(b, true);
         if (shaded == CandidateVerdict::kFits) {
           verdict = shaded;
@@ -397,18 +399,17 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
       const bool smaller = (verdict == CandidateVerdict::kSize ||
                             verdict == CandidateVerdict::kShape) &&
                            model_ && b.area_px < model_->area_px;
-      if ((smaller || verdict == CandidateVerdict::kPartial) && model_ &&
-          d <= ref_radius + cv::norm(velocity_px_) + 1.0) {
+      const bool piece_where_expected =
+          (smaller || verdict == CandidateVerdict::kPartial) && model_ && d <= reach;
+      if (piece_where_expected) {
         partly_seen_ = true;
         if (b.at_frame_edge) partly_out_ = true;
-        // A sliver of it where it should be is the marker covered, as much as a partial blob:
-        // a whole look-alike farther away is not it.
-        if (d < nearest_partial) sliver_px = b.centroid_px;
-        nearest_partial = std::min(nearest_partial, d);
       }
-      if (verdict == CandidateVerdict::kPartial) {
-        if (d < nearest_partial) sliver_px = b.centroid_px;
-        nearest_partial = std::min(nearest_partial, d);
+      // A sliver of it where it should be is the marker covered, as much as a partial blob
+      // anywhere: a whole look-alike farther away is not it.
+      if ((piece_where_expected || verdict == CandidateVerdict::kPartial) && d < nearest_partial) {
+        nearest_partial = d;
+        sliver_px = b.centroid_px;
       }
       if (verdict != CandidateVerdict::kFits) continue;
       if (d < best_dist) {
@@ -421,7 +422,6 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame) {
     // that is where the marker is, and what is left of it is not measured. A look-alike farther
     // away is not it. Unless what is left is only the brightest part of the marker, the rest
     // fallen below the range's floor: the dim pass measures it whole.
-    const double reach = ref_radius + cv::norm(velocity_px_) + 1.0;
     if (nearest_partial < best_dist) {
       if (nearest_partial <= reach && !partly_out_) {
         return dim_search(frame, window, predicted, reach, sliver_px);
@@ -456,10 +456,11 @@ ColourTracker::Choice ColourTracker::dim_search(const cv::Mat& frame, const cv::
   // The marker darkened is the one blob there that holds the sliver the range saw and fits the
   // marker in all but brightness: size, shape, symmetry (not itself partly hidden), contrast to
   // its surroundings and, for a coloured marker, chroma. Two such blobs: neither is taken.
-  const ColourBlob* only = nullptr;
+  size_t only = 0;
   double only_misfit = 0;
   int fitting = 0;
-  for (const ColourBlob& b : dim_blobs_) {
+  for (size_t i = 0; i < dim_blobs_.size(); ++i) {
+    const ColourBlob& b = dim_blobs_[i];
     if (cv::norm(b.centroid_px - predicted) > reach) continue;
     const cv::Rect& box = b.bbox_px;
     if (!(sliver.x >= box.x && sliver.x <= box.x + box.width - 1 && sliver.y >= box.y &&
@@ -469,28 +470,27 @@ ColourTracker::Choice ColourTracker::dim_search(const cv::Mat& frame, const cv::
     const auto [verdict, misfit] = judge(b, true);
     if (verdict != CandidateVerdict::kFits) continue;
     ++fitting;
-    only = &b;
+    only = i;
     only_misfit = misfit;
   }
   if (fitting != 1) return Choice{};
   // The dim pass's blobs are the candidates now; only the chosen one is judged without its
   // brightness (the others as any search judges them, so none is offered as the marker).
-  ColourBlob chosen = *only;
-  chosen.shaded = true;
-  chosen.dimmed = true;
   std::swap(blobs_, dim_blobs_);
+  blobs_[only].shaded = true;
+  blobs_[only].dimmed = true;
   candidates_.clear();
-  Choice choice;
-  for (ColourBlob& b : blobs_) {
-    if (SameBlob(b, chosen)) {
-      b = chosen;
-      candidates_.push_back(candidate(b, CandidateVerdict::kChosen, only_misfit + kShadowMisfit));
+  for (size_t i = 0; i < blobs_.size(); ++i) {
+    if (i == only) {
+      candidates_.push_back(
+          candidate(blobs_[i], CandidateVerdict::kChosen, only_misfit + kShadowMisfit));
       continue;
     }
-    const auto [verdict, misfit] = judge(b);
-    candidates_.push_back(candidate(b, verdict, misfit));
+    const auto [verdict, misfit] = judge(blobs_[i]);
+    candidates_.push_back(candidate(blobs_[i], verdict, misfit));
   }
-  choice.blob = chosen;
+  Choice choice;
+  choice.blob = blobs_[only];
   choice.status = MarkerStatus::kFound;
   return choice;
 }
