@@ -139,16 +139,24 @@ std::vector<double> SimulateBend(const ActuatorModel& m, const std::vector<doubl
   return out;
 }
 
-// Grid search of (lag, dead time) minimising `cost`: lags 0.01..3 s in 6 % steps, dead times
-// 0..0.4 s in quarter frames. Returns {lag, dead, cost}.
+// The grid of a (parameter, dead time) search: the parameter from `lo` up to `hi` in 6 % steps,
+// dead times from 0 up to `dead_max_s` in quarter frames.
+struct SearchGrid {
+  double lo, hi, dead_max_s;
+};
+// The lags' grid (0.01..3 s) and the duty loop's gains' (0.005..20 per kPa).
+constexpr SearchGrid kLagGrid{0.01, 3.0, 0.4};
+constexpr SearchGrid kDutyGainGrid{0.005, 20.0, 0.2};
+
+// Grid search of (parameter, dead time) minimising `cost`. Returns {parameter, dead, cost}.
 template <typename Cost>
-std::array<double, 3> GridSearch(double frame_s, Cost cost) {
+std::array<double, 3> GridSearch(double frame_s, const SearchGrid& grid, Cost cost) {
   std::array<double, 3> best = {0.0, 0.0, std::numeric_limits<double>::infinity()};
   const double dead_step = std::max(1e-3, frame_s / 4.0);
-  for (double lag = 0.01; lag <= 3.0; lag *= 1.06) {
-    for (double dead = 0.0; dead <= 0.4 + 1e-9; dead += dead_step) {
-      const double c = cost(lag, dead);
-      if (c < best[2]) best = {lag, dead, c};
+  for (double value = grid.lo; value <= grid.hi; value *= 1.06) {
+    for (double dead = 0.0; dead <= grid.dead_max_s + 1e-9; dead += dead_step) {
+      const double c = cost(value, dead);
+      if (c < best[2]) best = {value, dead, c};
     }
   }
   return best;
@@ -292,14 +300,7 @@ void FitDutyLoop(const InnerLoopMeasurement& probe, const InnerLoopGains& gains,
     }
     return sse;
   };
-  std::array<double, 3> best = {0.0, 0.0, std::numeric_limits<double>::infinity()};
-  const double dead_step = std::max(1e-3, frame_s / 4.0);
-  for (double gain = 0.005; gain <= 20.0; gain *= 1.06) {
-    for (double dead = 0.0; dead <= 0.2 + 1e-9; dead += dead_step) {
-      const double c = duty_cost(gain, dead);
-      if (c < best[2]) best = {gain, dead, c};
-    }
-  }
+  const std::array<double, 3> best = GridSearch(frame_s, kDutyGainGrid, duty_cost);
   m->pressure_duty_per_kpa = best[0];
   m->pressure_duty_dead_time_s = best[1];
   m->pressure_duty_rms_kpa = std::sqrt(best[2] / static_cast<double>(t.size()));
@@ -612,7 +613,7 @@ ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
     for (size_t k = 0; k < y.size(); ++k) sse += (y[k] - p[k]) * (y[k] - p[k]);
     return sse;
   };
-  const auto pressure_fit = GridSearch(frame_s, pressure_cost);
+  const auto pressure_fit = GridSearch(frame_s, kLagGrid, pressure_cost);
   m.pressure_lag_s = pressure_fit[0];
   m.pressure_dead_time_s = pressure_fit[1];
   m.pressure_rms_kpa = std::sqrt(pressure_fit[2] / static_cast<double>(t.size()));
@@ -627,7 +628,7 @@ ActuatorModel FitActuatorModel(const IdentificationExperiment& experiment) {
     FitDutyLoop(*probe, experiment.inner_loop_gains(), frames, frame_s, &m);
   }
 
-  const auto bend_fit = GridSearch(frame_s, bend_cost);
+  const auto bend_fit = GridSearch(frame_s, kLagGrid, bend_cost);
   m.lag_s = bend_fit[0];
   m.dead_time_s = bend_fit[1];
   m.dynamic_rms_deg = std::sqrt(bend_fit[2] / static_cast<double>(t.size()));
