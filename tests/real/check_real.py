@@ -125,9 +125,10 @@ def score(track_csv, reference_csv, tol, name_map, triple, ref_sigma):
     return s
 
 
-def run_case(program, name, case, keep):
-    """Tracks and scores every config of one case; returns (ok, [result per config])."""
-    folder = os.path.join(HERE, name)
+def run_case(program, name, case, keep, root=HERE):
+    """Tracks and scores every config of one case (its folder: root/NAME); returns (ok, [result
+    per config])."""
+    folder = os.path.join(root, name)
     out = os.path.join(keep, name) if keep else tempfile.mkdtemp(prefix=f'softsight_real_{name}_')
     os.makedirs(out, exist_ok=True)
     results, ok = [], True

@@ -107,8 +107,7 @@ def main():
         for name in cases:
             with tempfile.TemporaryDirectory(prefix=f'softsight_perturb_{change}_') as root:
                 case = changed_case(name, change, root)
-                check_real.HERE = root
-                _, results = check_real.run_case(program, name, case, None)
+                _, results = check_real.run_case(program, name, case, None, root)
             for s in results:
                 if 'failed' in s:
                     print(f"FAIL {change} {name} {s['config']}: {s['failed']}")
