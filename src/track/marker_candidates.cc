@@ -83,10 +83,16 @@ std::vector<Candidate> FindCandidates(const cv::Mat& frame, const MarkerFinderOp
     }
   } else {
     probe.s = {options.min_saturation, 255};
-    probe.v = {options.min_value, 255};
-    for (int centre = 0; centre < 180; centre += kHueStep) {
-      probe.h = HsvRange::HueAround(centre, kHueReach);
-      bands.push_back(probe);
+    // Each hue band from the value floor, and again from half of it: a blue or violet dome under
+    // warm or side light is dim in value (its largest channel, 24-68 on the side-lit render)
+    // while plainly coloured, and the floor cut it into a sliver that did not stand out. The
+    // dimmer band's blobs face the same verdicts; where one blob fits in both, the larger counts.
+    for (int v_floor : {options.min_value, options.min_value / 2}) {
+      probe.v = {v_floor, 255};
+      for (int centre = 0; centre < 180; centre += kHueStep) {
+        probe.h = HsvRange::HueAround(centre, kHueReach);
+        bands.push_back(probe);
+      }
     }
   }
   std::vector<Candidate> fitting;

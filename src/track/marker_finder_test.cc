@@ -120,5 +120,41 @@ TEST(MarkerFinder, WhiteDotsOnAColourfulBenchAreFoundButALoneBrightBlobIsNot) {
   EXPECT_TRUE(lone.markers.empty());
 }
 
+
+// Three domes on a wooden bench under warm light: red, green, and a blue one whose value (its
+// largest channel) runs from 60 on its lit side down to 26 on its shaded side, as a blue dome
+// does under a warm side lamp: a person sees three markers. The blue one lies mostly below the
+// finder's value floor (40), which cut it into a sliver; it is found whole, at its centre.
+TEST(MarkerFinder, ADimBlueDomeUnderWarmLightIsFoundWhole) {
+  cv::Mat frame(480, 640, CV_8UC3, cv::Scalar(70, 110, 150));  // Warm wood, BGR.
+  cv::Mat noise(frame.size(), CV_16SC3);
+  cv::theRNG().state = 7;
+  cv::randn(noise, 0, 4);
+  const cv::Point2d centres[3] = {{240, 260}, {320, 262}, {400, 258}};
+  const double radius = 9.0;
+  for (int y = 0; y < frame.rows; ++y) {
+    for (int x = 0; x < frame.cols; ++x) {
+      cv::Vec3d bgr = cv::Vec3d(frame.at<cv::Vec3b>(y, x)[0], frame.at<cv::Vec3b>(y, x)[1],
+                                frame.at<cv::Vec3b>(y, x)[2]);
+      for (int k = 0; k < 3; ++k) {
+        if (std::hypot(x - centres[k].x, y - centres[k].y) > radius) continue;
+        if (k == 0) bgr = {40, 45, 190};
+        if (k == 2) bgr = {60, 160, 50};
+        if (k == 1) {  // Lit from the top: value 60 at the top edge, 26 at the bottom.
+          const double v = 60 - 34 * (y - (centres[1].y - radius)) / (2 * radius);
+          bgr = {v, 0.35 * v, 0.25 * v};
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        frame.at<cv::Vec3b>(y, x)[c] = cv::saturate_cast<uchar>(bgr[c] + noise.at<cv::Vec3s>(y, x)[c]);
+      }
+    }
+  }
+  const MarkerFinding finding = FindMarkers(frame, MarkerFinderOptions{});
+  ASSERT_TRUE(finding.ok()) << finding.problem;
+  ASSERT_EQ(finding.markers.size(), 3u);
+  ExpectEachAtOneOf(finding, centres);
+}
+
 }  // namespace
 }  // namespace softsight

@@ -280,9 +280,9 @@ def median(values):
 # (each then tracked with none reported wrong or while covered), or None where it must refuse.
 INIT_EXPECTED = {
     'bench': 3, 'finger': 3, 'fastblur': 3, 'wedge': 5,
-    # blue, dim under the warm side light, stands out from only part of its surroundings (the
-    # per-quarter contrast a tracker with a roi uses finds it; init's whole-ring one does not)
-    'side': 2,
+    # blue, dim under the warm side light (value 24-68): init missed it until its hue bands were
+    # also searched from half the value floor
+    'side': 3,
     # caps of the markers' colours in view: init will not guess which blob is the marker
     'distractors': None,
     # white dots on a colourful bench: no coloured marker, so white or black dots by gray level

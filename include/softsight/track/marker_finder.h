@@ -42,7 +42,8 @@ struct MarkerFinderOptions {
   // The end of the body nearest this point is the base; absent: the end nearer the image border.
   std::optional<cv::Point2d> base_near_px{};
   // Weakest colour a marker may have (8-bit HSV saturation and value). Default 70 / 40: printed
-  // or painted markers are far above; wood, skin and shadows mostly below.
+  // or painted markers are far above; wood, skin and shadows mostly below. Each hue is searched
+  // from min_value and again from half of it (a blue dome under warm light is dim in value).
   int min_saturation = 70;
   int min_value = 40;
   // Marker size limits: area in pixels, and the largest as a fraction of the frame area.
