@@ -36,6 +36,9 @@ MM = 0.001
 # ---------------------------------------------------------------------------------------------
 RGB = dict(red=(0.62, 0.035, 0.04), green=(0.05, 0.38, 0.09), blue=(0.035, 0.09, 0.50),
            yellow=(0.80, 0.60, 0.03), magenta=(0.55, 0.04, 0.38), white=(0.85, 0.85, 0.83))
+# Pale (pastel) pigments, named by hue as a user's pick names them: 8-bit saturation ~60-90 after
+# the camera's gamma, where the saturated ones above are ~200.
+RGB_PALE = dict(red=(0.80, 0.30, 0.33), green=(0.34, 0.66, 0.30), blue=(0.30, 0.42, 0.80))
 
 SCENES = {
     'bench': dict(
@@ -67,6 +70,15 @@ SCENES = {
         what='white domed dots on a dark grey actuator in front of the pegboard',
         layout='side', light='cold_front', markers=['white', 'white', 'white'], dark=True,
         bend=(5, 80, 15, 3), frames=36, codec='mjpg', noise=2.0, seed=7),
+    'pale': dict(
+        what='pale (pastel) glossy domes with sharp highlights, cold front light',
+        layout='side', light='cold_front', markers=['red', 'blue', 'green'], pale=True, gloss=True,
+        bend=(5, 80, 15, 3), frames=36, codec='mjpg', noise=2.5, seed=8),
+    'stickers': dict(
+        what='flat elongated stickers (2:1, along the body) that turn with the bending tip, warm side light',
+        layout='side', light='warm_side', markers=['red', 'blue', 'green'], aspect=2.0, flat=True,
+        s_mm=[14, 50, 86],
+        bend=(5, 100, 15, 3), frames=36, codec='mjpg', noise=3.0, seed=9),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip
@@ -120,15 +132,21 @@ def silicone(dark):
     return m
 
 
-def marker_mat(colour):
-    # Pigmented silicone dome: saturated, a little glossy so the light shows as a highlight.
+def marker_rgb(cfg, colour):
+    return (RGB_PALE if cfg.get('pale') else RGB)[colour]
+
+
+def marker_mat(cfg, colour):
+    # Pigmented silicone dome: saturated, a little glossy so the light shows as a highlight
+    # (`gloss`: a polished one, with a small sharp highlight).
     m, nt, b = node_mat(f'marker_{colour}')
-    b.inputs['Base Color'].default_value = (*RGB[colour], 1)
+    rgb = marker_rgb(cfg, colour)
+    b.inputs['Base Color'].default_value = (*rgb, 1)
     b.inputs['Subsurface'].default_value = 0.15
-    b.inputs['Subsurface Color'].default_value = (*RGB[colour], 1)
+    b.inputs['Subsurface Color'].default_value = (*rgb, 1)
     b.inputs['Subsurface Radius'].default_value = (0.6 * MM, 0.4 * MM, 0.3 * MM)
-    b.inputs['Roughness'].default_value = 0.22
-    b.inputs['Specular'].default_value = 0.5
+    b.inputs['Roughness'].default_value = 0.08 if cfg.get('gloss') else 0.22
+    b.inputs['Specular'].default_value = 0.8 if cfg.get('gloss') else 0.5
     return m
 
 
@@ -266,7 +284,7 @@ def actuator_mesh(wedge):
     return me
 
 
-def markers_mesh(positions, colours):
+def markers_mesh(positions, colours, aspect=1.0, height=DOME_H):
     """Domes (flattened half spheres) on the actuator's +z face at the given arc positions. Their
     apex vertex (the centre of the top face) and a ring of top-face points are returned for the
     truth. Two loose vertices at x=0 and x=LENGTH give this mesh the same extent along x as the
@@ -281,7 +299,7 @@ def markers_mesh(positions, colours):
         bmesh.ops.delete(bm, geom=lower, context='VERTS')
         verts = [v for v in verts if v.is_valid]
         for v in verts:
-            v.co = Vector((s + v.co.x * DOME_R, BODY_H / 2 + v.co.y * DOME_R, DEPTH / 2 + v.co.z * DOME_H))
+            v.co = Vector((s + v.co.x * DOME_R * aspect, BODY_H / 2 + v.co.y * DOME_R, DEPTH / 2 + v.co.z * height))
         for f in {f for v in verts for f in v.link_faces}:
             f.material_index = k
             f.smooth = True
@@ -291,12 +309,12 @@ def markers_mesh(positions, colours):
     bm.verts.ensure_lookup_table()
     # apex = highest z per dome; top-face points = vertices within 0.6 R of the apex (around it)
     for k, d in enumerate(info):
-        mine = [v for v in bm.verts if abs(v.co.x - d['s']) <= DOME_R * 1.01 and v.co.z > DEPTH / 2 - 1e-6
-                and abs(v.co.y - BODY_H / 2) <= DOME_R * 1.01]
+        mine = [v for v in bm.verts if abs(v.co.x - d['s']) <= DOME_R * aspect * 1.01
+                and v.co.z > DEPTH / 2 - 1e-6 and abs(v.co.y - BODY_H / 2) <= DOME_R * 1.01]
         apex = max(mine, key=lambda v: v.co.z)
         d['apex'] = apex.index
         d['top'] = [v.index for v in mine
-                    if (Vector((v.co.x, v.co.y)) - Vector((apex.co.x, apex.co.y))).length <= 0.65 * DOME_R]
+                    if (Vector(((v.co.x - apex.co.x) / aspect, v.co.y - apex.co.y))).length <= 0.65 * DOME_R]
         d['rim'] = [v.index for v in mine if abs(v.co.z - DEPTH / 2) < 1e-7]
     me = bpy.data.meshes.new('markers')
     bm.to_mesh(me)
@@ -345,7 +363,7 @@ def build(cfg):
     side = cfg['layout'] == 'side'
     n = len(cfg['markers'])
     # markers evenly along the actuator: 3 at 12/52/92 mm as the lab's, 5 at 10..94 mm
-    s_mm = [12, 52, 92] if n == 3 else [10 + 21 * k for k in range(n)]
+    s_mm = cfg.get('s_mm') or ([12, 52, 92] if n == 3 else [10 + 21 * k for k in range(n)])
 
     act = bpy.data.objects.new('actuator', actuator_mesh(cfg.get('wedge', False)))
     act.data.materials.append(silicone(cfg.get('dark', False)))
@@ -355,10 +373,12 @@ def build(cfg):
     bev.width = 0.7 * MM
     bev.segments = 2
     bev.limit_method = 'ANGLE'
-    mk_me, info = markers_mesh([s * MM for s in s_mm], cfg['markers'])
+    # `flat`: stickers 0.3 mm thick (their top face is still the highest point at the centre)
+    mk_me, info = markers_mesh([s * MM for s in s_mm], cfg['markers'], cfg.get('aspect', 1.0),
+                               0.3 * MM if cfg.get('flat') else DOME_H)
     mk = bpy.data.objects.new('markers', mk_me)
     for c in cfg['markers']:
-        mk.data.materials.append(marker_mat(c))
+        mk.data.materials.append(marker_mat(cfg, c))
     for o in (act, mk):
         scene.collection.objects.link(o)
         bend_modifier(o)
@@ -622,7 +642,9 @@ def main():
               'sees inside the frame; visible = visibility >= 0.5; angle at each inner marker from '
               'the projected centres of its neighbours',
         markers=[dict(index=k, colour=d['colour'], s_mm=s_mm[k], diameter_mm=2 * DOME_R / MM,
-                      nominal_rgb_linear=list(RGB[d['colour']]), bbox_frame0=[round(v, 2) for v in bbox0[k]])
+                      length_mm=2 * DOME_R * cfg.get('aspect', 1.0) / MM,
+                      nominal_rgb_linear=list(marker_rgb(cfg, d['colour'])),
+                      bbox_frame0=[round(v, 2) for v in bbox0[k]])
                  for k, d in enumerate(info)],
         rows=rows)
     with open(os.path.join(a.out, 'truth.json'), 'w') as f:

@@ -89,6 +89,21 @@ CASES = {
     'whitedots': dict(
         what='white domed dots on a dark actuator',
         configs=[('achromatic', 99.0, None), ('pick', 99.0, None), ('zncc', 99.0, None)]),
+    'pale': dict(
+        what='pale (pastel) glossy domes with sharp highlights',
+        # The front light whitens each dome's upper part (saturation 25-40, as the pegboard's
+        # 5-25 with noise): every colour rule leaves it out, or half in, and the centre of what
+        # is left lies 1.5-2.5 px below the apex. Pick's blue (saturation 40-113) is the lower
+        # half of its dome, whose ring holds the whitened half: rejected by contrast.
+        configs=[('pick', 63.0, 'pick reports red and green 1.5-3.2 px below the apex (66 of 69 '
+                                'finds), and blue fails its contrast: the light whitens the upper '
+                                'part of each pale dome'),
+                 ('zncc', 99.0, 'zncc reports 58 of 108 finds 1.5-2.2 px below the apex (the '
+                                'whitened upper part of each dome is left out of its blob)')]),
+    'stickers': dict(
+        what='flat elongated stickers (2:1) turning with the tip, warm side light',
+        # pick: red in frame 11 and blue in frame 13 reported `covered` (fully visible)
+        configs=[('pick', 98.0, None), ('zncc', 99.0, None)]),
 }
 
 
@@ -238,6 +253,7 @@ def box_margins(program, name, margins):
     with open(os.path.join(folder, 'zncc.yaml')) as f:
         config = f.read()
     names, group = config_markers(os.path.join(folder, 'zncc.yaml'))
+    known = dict((c, k) for c, _, k in CASES[name]['configs']).get('zncc')
     ok, lines = True, []
     with tempfile.TemporaryDirectory(prefix=f'softsight_pbr_{name}_') as out:
         for margin in margins:
@@ -258,9 +274,11 @@ def box_margins(program, name, margins):
                 continue
             s = score(csv_path, os.path.join(folder, 'truth.csv'), dict(zip(truth_names, names)), group)
             bad = s['wrong'] or s['reported_covered']
-            ok = ok and not bad
+            # A scene whose zncc config is known to fail (CASES) reports its wrong finds as KNOWN.
+            ok = ok and (not bad or known is not None)
             worst = f" (worst {s['worst'][0]:.1f} px: {s['worst'][2]} in frame {s['worst'][1]})" if s['worst'] else ''
-            lines.append(f"{'FAIL' if bad else 'ok'} {name} zncc boxes margin {margin} px: found "
+            verdict = ('KNOWN' if known is not None else 'FAIL') if bad else 'ok'
+            lines.append(f"{verdict} {name} zncc boxes margin {margin} px: found "
                          f"{s['found']}/{s['visible']} ({100.0 * s['found'] / max(1, s['visible']):.1f} %), "
                          f"wrong (> {TOL:g} px) {s['wrong']}{worst}, reported while covered "
                          f"{s['reported_covered']}, median {median(s['errors']):.2f} px")
@@ -287,6 +305,9 @@ INIT_EXPECTED = {
     'distractors': None,
     # white dots on a colourful bench: no coloured marker, so white or black dots by gray level
     'whitedots': 3,
+    # pastel domes (saturation 40-120) are below the finder's saturation floor (70)
+    'pale': None,
+    'stickers': 3,
 }
 
 
