@@ -612,6 +612,7 @@ void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
   cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
   const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(own_origin);
   blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
+  blob->enclosing_radius_px = circle_radius;
   blob->hull_asymmetry_px = blob->asymmetry_px;
   cv::convexHull(edge_points_, hull_points_);
   const cv::Moments hull = cv::moments(hull_points_);

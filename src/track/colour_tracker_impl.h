@@ -50,6 +50,9 @@ struct ColourBlob {
   // notch out of the blob that shifts its centroid (asymmetry_px) but not its hull's; a cover's
   // straight or convex edge shifts both.
   double hull_asymmetry_px = 0;
+  // The radius of that smallest enclosing circle: the scale of the asymmetry (half the length of
+  // an elongated sticker, where its centre rests on the two ends' pixels).
+  double enclosing_radius_px = 0;
   bool measured = false;           // The colour statistics below are set.
   // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
   // marker should be): its colour is not the marker's under the usual light, and is not learned.

@@ -297,6 +297,46 @@ TEST(ColourTracker, AHighlightBitingTheRimIsPartOfTheMarkerNotACover) {
   }
 }
 
+TEST(ColourTracker, AnElongatedStickerTurningIsNeverTakenForACoveredMarker) {
+  // A 2:1 sticker (semi-axes 14 and 7 px) turning 4 degrees a frame while it drifts: the centre
+  // of its smallest enclosing circle rests on the pixels of its two ends and wobbles with the
+  // pixel grid by more than a disc's of the same area, which the cover test (its centroid's
+  // shift from that centre) used to take for a cover in some frames. Never `covered`, always at
+  // its painted centroid; and a cover over its side is still one. (A cover over one end leaves
+  // what is left about as symmetric as the whole: see docs/measurements.md, not detected.)
+  ColourParams params = RedParams();
+  params.min_circularity = 0.5;
+  ColourTracker tracker(params);
+  auto paint = [](cv::Mat& image, cv::Point2d centre, double angle_deg, cv::Vec3b bgr) {
+    const double c = std::cos(angle_deg * CV_PI / 180), s = std::sin(angle_deg * CV_PI / 180);
+    double sx = 0, sy = 0, n = 0;
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const double u = (x - centre.x) * c + (y - centre.y) * s;
+        const double v = -(x - centre.x) * s + (y - centre.y) * c;
+        if ((u / 14) * (u / 14) + (v / 7) * (v / 7) > 1) continue;
+        image.at<cv::Vec3b>(y, x) = bgr;
+        sx += x, sy += y, n += 1;
+      }
+    }
+    return cv::Point2d(sx / n, sy / n);
+  };
+  for (int i = 0; i < 90; ++i) {
+    cv::Mat image = Background();
+    const cv::Point2d truth =
+        paint(image, {120.3 + 0.37 * i, 110.6 + 0.21 * i}, 4.0 * i, kRed);
+    const Observation obs = tracker.update(image);
+    ASSERT_TRUE(obs.found()) << "frame " << i << ": " << MarkerStatusName(obs.not_found_reason);
+    EXPECT_LT(cv::norm(*obs.position_px - truth), 0.05) << "frame " << i;
+  }
+  cv::Mat covered = Background();
+  paint(covered, {153.6, 129.5}, 0.0, kRed);
+  cv::rectangle(covered, cv::Rect(120, 132, 70, 20), cv::Scalar(120, 120, 120), cv::FILLED);
+  const Observation obs = tracker.update(covered);
+  EXPECT_FALSE(obs.found());
+  EXPECT_EQ(obs.not_found_reason, MarkerStatus::kCovered);
+}
+
 TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {
   cv::Mat image = Background();
   PaintDisc(image, {60, 60}, 12, kRed);  // Larger: once "the marker", now a look-alike.

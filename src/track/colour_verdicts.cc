@@ -52,7 +52,11 @@ std::pair<CandidateVerdict, double> ColourTracker::judge(const ColourBlob& b,
   // marker's.
   bool partial = b.at_frame_edge && !b.rim_placed;
   if (model_ && !b.rim_placed) {
-    const double radius = std::sqrt(model_->area_px / CV_PI);
+    // The asymmetry is measured against the smallest enclosing circle, whose centre an elongated
+    // marker's two ends place: its wobble grows with that circle, not with the area (a 2:1
+    // sticker's is 1.4 times a disc's of the same area). What is left of a covered marker has a
+    // smaller circle than the marker: the learned area's radius bounds it from below.
+    const double radius = std::max(std::sqrt(model_->area_px / CV_PI), b.enclosing_radius_px);
     const double tolerance = std::max(kPartialMinPx, kPartialRadii * radius);
     // Both the blob and its hull: a notch (a highlight, a speck) leaves the hull whole.
     const double limit = model_->asymmetry_px + tolerance;

@@ -102,8 +102,9 @@ CASES = {
                                 'whitened upper part of each dome is left out of its blob)')]),
     'stickers': dict(
         what='flat elongated stickers (2:1) turning with the tip, warm side light',
-        # pick: red in frame 11 and blue in frame 13 reported `covered` (fully visible)
-        configs=[('pick', 98.0, None), ('zncc', 99.0, None)]),
+        # pick: blue in frame 13 reported `covered` while in full view (and red in frame 11 until
+        # the cover test's tolerance scaled with the sticker's enclosing circle, not its area)
+        configs=[('pick', 99.0, None), ('zncc', 99.0, None)]),
 }
 
 
