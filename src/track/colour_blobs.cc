@@ -574,6 +574,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   const double axis2 = axis.dot(axis);
   SetContrast(s, channels, axis2, blob);
   blob->measured = true;
+  measure_fringe(pixels, own, distance, others, padded.tl() + origin, blob);
   // A round marker partly hidden: the circle of its radius through its edge (not where the
   // frame cuts it).
   if (const std::optional<double> radius = rim_radius_px();
@@ -587,6 +588,37 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // same bits.
   blob->centroid_px = cv::Point2d(sums.x / sums.w + (padded.x + origin.x),
                                   sums.y / sums.w + (padded.y + origin.y));
+}
+
+void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
+                                   const cv::Mat& distance, const cv::Mat& others,
+                                   cv::Point own_origin, ColourBlob* blob) const {
+  const int channels = pixels.channels();
+  if (channels != (gray_ ? 1 : 3)) return;
+  double n = 0, sx = 0, sy = 0;
+  for (int y = 0; y < own.rows; ++y) {
+    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* ow = own.ptr<uchar>(y);
+    const uchar* d = distance.ptr<uchar>(y);
+    const uchar* ot = others.ptr<uchar>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      if (ow[x] || ot[x] || d[x] > kReachThirds) continue;  // The blob, another, or beyond the ring.
+      const uchar* c = p + x * channels;
+      bool in = false;
+      if (channels == 1) {
+        in = c[0] >= fringe_gray_.lo && c[0] <= fringe_gray_.hi;
+      } else {
+        const cv::Vec3b hsv = BgrToHsvExact(c[0], c[1], c[2]);
+        in = fringe_box_.Contains(hsv[0], hsv[1], hsv[2]);
+      }
+      if (!in) continue;
+      n += 1, sx += x, sy += y;
+    }
+  }
+  if (n == 0) return;
+  const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(own_origin);
+  const cv::Point2d fringe(sx / n, sy / n);
+  blob->fringe_shift_px = cv::norm(fringe - centre) * n / (blob->area_px + n);
 }
 
 void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,

@@ -113,11 +113,16 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     derived.s = s;
     derived.v = v;
     fine_hsv_ = HsvClassifier(HsvBox::Make(h, s, v));
+    fringe_box_ = HsvBox::Make(h, HsvRange{s.lo / 2, s.hi}, HsvRange{v.lo / 2, v.hi});
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
     if (v.lo >= kDimMinFloor) {
       const int floor = static_cast<int>(v.lo * kDimFloor);
       dim_hsv_ = HsvClassifier(HsvBox::Make(h, s, HsvRange{floor, v.hi}));
     }
+  }
+  if (gray_) {
+    fringe_gray_ = gray_->lo > 0 ? HsvRange{gray_->lo / 2, gray_->hi}
+                                 : HsvRange{0, gray_->hi + (255 - gray_->hi) / 2};
   }
   if (gray_ && gray_->lo >= kDimMinFloor) {
     dim_gray_ = HsvRange{static_cast<int>(gray_->lo * kDimFloor), gray_->hi};
@@ -314,6 +319,7 @@ BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
     evidence.area_px = std::max(blob.area_px, model.area_px);
   } else {
     evidence.centroid_disagreement_px = cv::norm(blob.centroid_px - blob.binary_centroid_px);
+    evidence.fringe_shift_px = blob.fringe_shift_px;
   }
   return evidence;
 }

@@ -53,6 +53,13 @@ struct ColourBlob {
   // The radius of that smallest enclosing circle: the scale of the asymmetry (half the length of
   // an elongated sticker, where its centre rests on the two ends' pixels).
   double enclosing_radius_px = 0;
+  // How far the binary centroid moves when the blob takes in its pale fringe: the pixels just
+  // outside it (within the soft band) that pass the range with its lower bounds of saturation
+  // and brightness halved (a gray range's bound halved, or a dark dot's upper bound raised half
+  // way to white). Where a range's floor cuts through the marker (a lit dome's whitened top, the
+  // flank a lamp leaves in shade, a clipped plateau at a gray floor), what is marker is uncertain
+  // by about this much: it widens the position's sigma, and moves nothing.
+  double fringe_shift_px = 0;
   bool measured = false;           // The colour statistics below are set.
   // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
   // marker should be): its colour is not the marker's under the usual light, and is not learned.
@@ -153,6 +160,11 @@ class ColourTracker : public Tracker {
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
   // The blob's asymmetry_px and hull_asymmetry_px from its mask `own` (whose top-left pixel is
   // `own_origin` in the frame).
+  // ColourBlob::fringe_shift_px of `blob` from the padded box's `pixels`, its mask `own`, its
+  // edge zones `distance` and the other blobs `others`; `own_origin` is the box's place in the
+  // frame.
+  void measure_fringe(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
+                      const cv::Mat& others, cv::Point own_origin, ColourBlob* blob) const;
   void measure_asymmetry(const cv::Mat& own, cv::Point own_origin, ColourBlob* blob);
   // A partial round blob: the circle of the marker's `radius` fitted to its edge (not where the
   // frame cuts it), and its centre as the centroid when the fit is good (RimCentre).
@@ -229,6 +241,9 @@ class ColourTracker : public Tracker {
   // lowering changes nothing (a floor near 0).
   std::optional<HsvClassifier> dim_hsv_;
   std::optional<HsvRange> dim_gray_;
+  // The range with its floors halved (ColourBlob::fringe_shift_px), pixel by pixel.
+  HsvBox fringe_box_;
+  HsvRange fringe_gray_{0, 255};
   bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
   // A window's analysis calls OpenCV functions that may parallelise (gray inRange, a pre-filter,
   // morphology other than 3x3), besides a colour conversion of a frame of the other kind.

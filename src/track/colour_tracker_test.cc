@@ -337,6 +337,34 @@ TEST(ColourTracker, AnElongatedStickerTurningIsNeverTakenForACoveredMarker) {
   EXPECT_EQ(obs.not_found_reason, MarkerStatus::kCovered);
 }
 
+TEST(ColourTracker, APaleFringeTheRangeCutsOffWidensTheSigmaNotThePosition) {
+  // A red dome whose top the light pales: saturation 60 (below the range's 80, above half of it)
+  // over its upper quarter. The blob is the rest and its centroid lies below the dome's centre;
+  // the position stays the blob's, and its sigma covers the dome's centre within 3 sigma, where
+  // the same disc without the pale top (the centroid exact) keeps a sigma under half as large.
+  const cv::Point2d centre(150.5, 120.5);
+  ColourTracker whole_tracker(RedParams()), pale_tracker(RedParams());
+  cv::Mat whole = Background();
+  PaintDisc(whole, centre, 10, kRed);
+  cv::Mat pale = whole.clone();
+  for (int y = 0; y < pale.rows; ++y) {
+    for (int x = 0; x < pale.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) <= 10 && y < centre.y - 5) {
+        pale.at<cv::Vec3b>(y, x) = cv::Vec3b(180, 180, 235);  // Hue red, saturation 60.
+      }
+    }
+  }
+  const cv::Point2d cut = CentroidOfColour(pale, kRed);
+  ASSERT_GT(cut.y - centre.y, 1.0);  // The cut blob's centroid is well off the dome's centre.
+  Observation w, p;
+  for (int i = 0; i < 3; ++i) w = whole_tracker.update(whole), p = pale_tracker.update(pale);
+  ASSERT_TRUE(w.found() && p.found());
+  EXPECT_NEAR(p.position_px->y, cut.y, 1e-9);
+  const double error = cv::norm(*p.position_px - centre);
+  EXPECT_LT(error, 3 * *p.sigma_px) << "sigma " << *p.sigma_px << " px, error " << error << " px";
+  EXPECT_LT(*w.sigma_px, 0.5 * *p.sigma_px);
+}
+
 TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {
   cv::Mat image = Background();
   PaintDisc(image, {60, 60}, 12, kRed);  // Larger: once "the marker", now a look-alike.

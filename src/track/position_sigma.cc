@@ -14,6 +14,7 @@ constexpr double kRimPlacedPerRadius = 0.10;  // A circle fitted to part of a ri
 constexpr double kAsymmetryShare = 0.5;       // Of the excess asymmetry.
 constexpr double kDisagreementShare = 1.0;    // Of the soft and binary centroids' disagreement.
 constexpr double kDefinitionShare = 0.5;      // Of the spread between channels (truth between).
+constexpr double kFringeShare = 0.5;          // Of the pale fringe's pull on the centroid.
 constexpr double kMatchShapePerSize = 0.02;   // A match's drift, per px of the template's half size.
 constexpr double kMatchMisfitPerSize = 0.25;  // Per px of half size and unit of (1 - zncc).
 
@@ -36,8 +37,9 @@ double BlobCentroidSigmaPx(const BlobEvidence& blob) {
   const double asymmetry = kAsymmetryShare * std::max(blob.excess_asymmetry_px, 0.0);
   const double disagreement = kDisagreementShare * blob.centroid_disagreement_px;
   const double definition = kDefinitionShare * blob.definition_spread_px;
+  const double fringe = kFringeShare * blob.fringe_shift_px;
   return std::sqrt(kFloorPx * kFloorPx + shape * shape + noise * noise + asymmetry * asymmetry +
-                   disagreement * disagreement + definition * definition);
+                   disagreement * disagreement + definition * definition + fringe * fringe);
 }
 
 double TemplateMatchSigmaPx(double zncc, double template_width_px, double template_height_px,

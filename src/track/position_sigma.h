@@ -30,6 +30,9 @@ struct BlobEvidence {
   // How far the marker's centre moves between the channels it stands out in (a template's blob
   // in its matched channel and in its chromaticity), px: a bias no frame averages away.
   double definition_spread_px = 0;
+  // How far the centroid moves when the blob takes in the pale fringe just outside its range
+  // (ColourBlob::fringe_shift_px), px.
+  double fringe_shift_px = 0;
 };
 
 // Per axis, px: a colour blob's (or a template's blob's) centroid.

@@ -37,7 +37,7 @@ TOL = 1.5   # px: a report farther than this from the truth is wrong (issue 43)
 # A found position's sigma (<marker>_sigma_px, per axis) must cover its error: at least this share
 # of the found marker-frames within 3 sigma along both axes, none beyond 5 (renderer truth has
 # no error of its own).
-WITHIN_3_SIGMA_FLOOR = 98.0
+WITHIN_3_SIGMA_FLOOR = 99.0
 
 # scene: what it shows, and per config: (config file, floor of found visible marker-frames in %,
 # None or why it is known to fail today). The input is the scene's video.avi or video.mp4.
