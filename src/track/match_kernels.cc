@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <limits>
 
@@ -281,6 +282,17 @@ struct CountedSums {
   int64_t sum_sq[3] = {0, 0, 0};
 };
 
+// Whether two CV_8UC1 masks of one size hold the same bytes.
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size()) return false;
+  for (int y = 0; y < a.rows; ++y) {
+    if (std::memcmp(a.ptr<uint8_t>(y), b.ptr<uint8_t>(y), static_cast<size_t>(a.cols)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
 CountedSums SumCountedPixels(const cv::Mat& templ, const cv::Mat& mask) {
   const int cn = templ.channels();
   CountedSums s;
@@ -331,8 +343,6 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   bytes_.clear();
   mask_.clear();
   words_.clear();
-  run_rows_.clear();
-  runs_.clear();
 
   const int cn = templ.channels();
   const CountedSums sums = SumCountedPixels(templ, mask);
@@ -342,12 +352,20 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   if (n == 0 || variance <= 0) {
     image_.release();
     mask_image_.release();
+    run_rows_.clear();
+    runs_.clear();
     return false;
   }
 
+  // The runs depend on the mask alone: a template re-prepared with the same mask at the same size
+  // (the template update, every frame) keeps them (finding them was a tenth of the update).
+  const bool masked = !mask.empty() && n < static_cast<int64_t>(mask.total());
+  const bool same_runs = !run_rows_.empty() && image_.size() == templ.size() &&
+                         image_.channels() == cn && masked == !mask_image_.empty() &&
+                         (!masked || SameBytes(mask, mask_image_));
   templ.copyTo(image_);  // Continuous.
-  if (!mask.empty() && n < static_cast<int64_t>(mask.total())) {
-    mask.copyTo(mask_image_);
+  if (masked) {
+    if (!same_runs) mask.copyTo(mask_image_);
   } else {
     mask_image_.release();
   }
@@ -357,7 +375,11 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     sum_sq_[c] = sums.sum_sq[c];
   }
   scaled_variance_ = variance;
-  find_runs();
+  if (!same_runs) {
+    run_rows_.clear();
+    runs_.clear();
+    find_runs();
+  }
   lay_out_chunks();
   return true;
 }
@@ -684,6 +706,40 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
   }
 }
 
+// sum I, sum I^2 and sum I * T over the counted pixels of one placement of a gray template at
+// `p` (`step` bytes a row), in the template's chunks: the image bytes masked as the template's
+// (a tail's bytes counted by a full chunk too are masked there), widened, and multiplied in
+// pairs into 32-bit lanes, which hold every sum (kMaxTemplateValues * 255^2 < 2^31).
+void GrayPlacementSums(const uint8_t* p, size_t step, const PreparedTemplate& t, int64_t* sum,
+                       int64_t* sum_sq, int64_t* cross) {
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
+  const uint8_t* tm = KA::Mask(t);
+  const int16_t* tw = KA::Words(t);
+  const cv::v_int16x8 ones = cv::v_setall_s16(1);
+  cv::v_int32x4 s = cv::v_setzero_s32(), q = cv::v_setzero_s32(), x = cv::v_setzero_s32();
+  const auto add = [&](const cv::v_uint8x16& raw) {
+    const cv::v_uint8x16 v = raw & cv::v_load(tm);
+    cv::v_uint16x8 a, b;
+    cv::v_expand(v, a, b);
+    const cv::v_int16x8 ia = cv::v_reinterpret_as_s16(a), ib = cv::v_reinterpret_as_s16(b);
+    s = cv::v_dotprod(ia, ones, s);
+    s = cv::v_dotprod(ib, ones, s);
+    q = cv::v_dotprod(ia, ia, q);
+    q = cv::v_dotprod(ib, ib, q);
+    x = cv::v_dotprod(ia, cv::v_load(tw), x);
+    x = cv::v_dotprod(ib, cv::v_load(tw + 8), x);
+    tm += 16;
+    tw += 16;
+  };
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < full; ++c) add(cv::v_load(p + 16 * c));
+    if (tail) add(cv::v_load_halves(p + lo, p + hi));
+  }
+  *sum = cv::v_reduce_sum(s);
+  *sum_sq = cv::v_reduce_sum(q);
+  *cross = cv::v_reduce_sum(x);
+}
+
 }  // namespace
 
 #endif  // CV_SIMD128
@@ -785,6 +841,29 @@ void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& res
       out[x] = ZnccFromSums(n, cross[x], sums, sum_sq, cn, templ);
     }
   }
+}
+
+bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+                 float* zncc) {
+#if CV_SIMD128
+  if (templ.empty() || templ.channels() != 1 || image.type() != CV_8UC1 ||
+      !KernelAccess::Vectorised(templ)) {
+    return false;
+  }
+  CV_Assert(top_left.x >= 0 && top_left.y >= 0 && top_left.x + templ.size().width <= image.cols &&
+            top_left.y + templ.size().height <= image.rows);
+  int64_t sum = 0, sum_sq = 0, cross = 0;
+  GrayPlacementSums(image.ptr<uint8_t>(top_left.y) + top_left.x, image.step[0], templ, &sum,
+                    &sum_sq, &cross);
+  *zncc = ZnccFromSums(templ.count(), cross, &sum, sum_sq, 1, templ);
+  return true;
+#else
+  (void)image;
+  (void)top_left;
+  (void)templ;
+  (void)zncc;
+  return false;
+#endif
 }
 
 }  // namespace softsight

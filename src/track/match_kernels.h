@@ -115,6 +115,13 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
+// ZNCC of one placement (`top_left`) of a gray template, the value MatchZncc's map holds there,
+// bit for bit (the same exact integer sums), without building a map: no window sums, no
+// widened copy (one placement through MatchZncc cost ten times as much: the template update's
+// drift guard, every frame, issue 45). False (nothing computed) for colour, or a template too
+// narrow for the vector layout, or without vector code: use MatchZncc.
+bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+                 float* zncc);
 
 // Slow scalar references, straight from the definitions (ZNCC in double with explicit means).
 // `mask` as in PreparedTemplate::Prepare.

@@ -114,6 +114,8 @@ cv::Mat RoundMask(const cv::Size& size) {
 
 double ZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
               cv::Mat& result, ZnccScratch& scratch) {
+  float one = 0;
+  if (MatchZnccAt(image, top_left, templ, &one)) return one;  // Gray: the one placement alone.
   MatchZncc(image(cv::Rect(top_left, templ.size())), templ, result, scratch);
   return result.at<float>(0, 0);  // NaN on a flat window: fails every comparison.
 }
