@@ -177,17 +177,45 @@ void PrefixRow<1>(const uint8_t* __restrict p, int cols, uint32_t* __restrict s)
 }
 #endif
 
+// Whether `image` (gray) is a window of the image whose prefix sums `scratch` shares
+// (ShareWindowSums), and where in it (`at`). A window of it has its pixels at the same step
+// from its first pixel; a buffer of its own cannot lie inside the shared image's (both live).
+bool InSharedImage(const cv::Mat& image, const ZnccScratch& scratch, cv::Point* at) {
+  if (scratch.shared_image == nullptr || image.type() != CV_8UC1 ||
+      image.step[0] != scratch.shared_step || image.data < scratch.shared_image) {
+    return false;
+  }
+  const size_t offset = static_cast<size_t>(image.data - scratch.shared_image);
+  const size_t y = offset / scratch.shared_step, x = offset % scratch.shared_step;
+  if (x + static_cast<size_t>(image.cols) > static_cast<size_t>(scratch.shared_size.width) ||
+      y + static_cast<size_t>(image.rows) > static_cast<size_t>(scratch.shared_size.height)) {
+    return false;
+  }
+  *at = cv::Point(static_cast<int>(x), static_cast<int>(y));
+  return true;
+}
+
 template <int kChannels, typename RowDone>
 void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& scratch,
                 RowDone row_done) {
   constexpr int kPerPixel = kChannels + 1;
   const cv::Size size = ResultSize(image, t.size());
   const int image_cols = image.cols;
-  const size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
-  scratch.prefix_sum.resize(prefix_step * image.rows);
-  for (int y = 0; y < image.rows; ++y) {
-    PrefixRow<kChannels>(image.ptr<uint8_t>(y), image_cols,
-                         scratch.prefix_sum.data() + prefix_step * y);
+  size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
+  const uint32_t* prefix = nullptr;  // The image's first pixel's slots (x = -1) in row 0.
+  cv::Point in_shared;
+  if (kChannels == 1 && InSharedImage(image, scratch, &in_shared)) {
+    // The rows' prefix sums from the image this window lies in: a window's sums are differences
+    // of one row's prefix sums, the same (mod 2^32, and exact) from whichever pixel they start.
+    prefix_step = static_cast<size_t>(scratch.shared_size.width + 1) * kPerPixel;
+    prefix = scratch.shared_prefix.data() + prefix_step * in_shared.y + in_shared.x * kPerPixel;
+  } else {
+    scratch.prefix_sum.resize(prefix_step * image.rows);
+    for (int y = 0; y < image.rows; ++y) {
+      PrefixRow<kChannels>(image.ptr<uint8_t>(y), image_cols,
+                           scratch.prefix_sum.data() + prefix_step * y);
+    }
+    prefix = scratch.prefix_sum.data();
   }
   const int row_values = size.width * kPerPixel;
   scratch.row_sum.resize(row_values);
@@ -198,7 +226,7 @@ void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& sc
   for (int y = 0; y < size.height; ++y) {
     std::fill(row_sum, row_sum + row_values, 0u);
     for (int r = 0; r < rows;) {
-      const uint32_t* s = scratch.prefix_sum.data() + prefix_step * (y + r);
+      const uint32_t* s = prefix + prefix_step * (y + r);
       const int k = run_rows[r];
       if (r + 1 < rows && run_rows[r + 1] == k + 1 && run_rows[r + 2] == k + 2) {
         // Two rows of one run each (a round mask's rows): added together, so the map row's sums
@@ -864,6 +892,19 @@ bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplat
   (void)zncc;
   return false;
 #endif
+}
+
+void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch) {
+  scratch.shared_image = nullptr;
+  if (image.type() != CV_8UC1 || image.empty()) return;
+  const size_t prefix_step = static_cast<size_t>(image.cols + 1) * 2;
+  scratch.shared_prefix.resize(prefix_step * image.rows);
+  for (int y = 0; y < image.rows; ++y) {
+    PrefixRow<1>(image.ptr<uint8_t>(y), image.cols, scratch.shared_prefix.data() + prefix_step * y);
+  }
+  scratch.shared_image = image.data;
+  scratch.shared_step = image.step[0];
+  scratch.shared_size = image.size();
 }
 
 }  // namespace softsight

@@ -107,7 +107,21 @@ struct ZnccScratch {
   std::vector<uint32_t> prefix_sum, row_sum;
   std::vector<int> cross_values;
   std::vector<int16_t> widened;  // The image widened to 16 bits for the cross-correlation.
+  // The row prefix sums of one gray image shared by the windows of it matched next
+  // (ShareWindowSums): its first pixel (nullptr: none shared), its step and size.
+  const uint8_t* shared_image = nullptr;
+  size_t shared_step = 0;
+  cv::Size shared_size;
+  std::vector<uint32_t> shared_prefix;
 };
+// Computes the row prefix sums of `image` (CV_8UC1; anything else shares nothing) once, for
+// every window of it that MatchZncc or MatchSsd matches a masked template in with this scratch
+// next: a tracker matches several overlapping windows of the part of a frame it converted (the
+// search, the measurement, the pose rungs), and each computed the prefix sums of its own rows
+// (issue 45). The same sums, the same bits. The caller keeps `image`'s pixels as they are until
+// StopSharingWindowSums (or another ShareWindowSums).
+void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch);
+inline void StopSharingWindowSums(ZnccScratch& scratch) { scratch.shared_image = nullptr; }
 // SSD = sum I^2 - 2 sum I*T + sum T^2, from the window sums and the cross-correlation (exact).
 // Without `scratch`, its buffers are allocated for the call.
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,

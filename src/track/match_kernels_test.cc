@@ -175,6 +175,47 @@ TEST(MatchKernelsTest, ZnccAtOnePlacementIsTheMapsValue) {
   }
 }
 
+// Windows matched in an image whose prefix sums are shared (ShareWindowSums: the tracker's
+// converted part of the frame, itself a window of the frame) give the maps matched without
+// sharing, to the bit: windows inside it, and windows of the frame reaching out of it (which
+// must not take the shared sums), for ZNCC and SSD with masked templates; and after
+// StopSharingWindowSums the image may change.
+TEST(MatchKernelsTest, SharedWindowSumsGiveTheSameMaps) {
+  cv::RNG rng(4547);
+  cv::Mat frame = RandomImage(rng, {70, 60}, 1);
+  const cv::Rect part(6, 5, 44, 41);
+  ZnccScratch shared, fresh;
+  for (int trial = 0; trial < 300; ++trial) {
+    if (trial % 50 == 0) {
+      StopSharingWindowSums(shared);
+      rng.fill(frame, cv::RNG::UNIFORM, 0, 256);  // A new frame in the same buffer.
+      ShareWindowSums(frame(part), shared);
+    }
+    const cv::Size tsize(8 + rng.uniform(0, 26), 5 + rng.uniform(0, 26));
+    const cv::Mat templ = RandomImage(rng, tsize, 1);
+    cv::Mat mask = cv::Mat::zeros(tsize, CV_8UC1);
+    cv::ellipse(mask, cv::Point(tsize.width / 2, tsize.height / 2),
+                cv::Size(tsize.width / 2, tsize.height / 2), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+    PreparedTemplate prepared;
+    if (!prepared.Prepare(templ, mask)) continue;
+    // Inside the shared part half the time, anywhere in the frame otherwise.
+    const cv::Rect area = trial % 2 == 0 ? part : cv::Rect(0, 0, frame.cols, frame.rows);
+    const int w = tsize.width + rng.uniform(0, area.width - tsize.width + 1);
+    const int h = tsize.height + rng.uniform(0, area.height - tsize.height + 1);
+    const cv::Rect window(area.x + rng.uniform(0, area.width - w + 1),
+                          area.y + rng.uniform(0, area.height - h + 1), w, h);
+    cv::Mat a, b;
+    MatchZncc(frame(window), prepared, a, shared);
+    MatchZncc(frame(window).clone(), prepared, b, fresh);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(cv::countNonZero((a != b) & (a == a)), 0) << window;  // NaN where both are.
+    EXPECT_EQ(cv::countNonZero((a == a) != (b == b)), 0) << window;
+    MatchSsd(frame(window), prepared, a, shared);
+    MatchSsd(frame(window).clone(), prepared, b, fresh);
+    EXPECT_EQ(CountDifferent(a, b), 0) << window;
+  }
+}
+
 TEST(MatchKernelsTest, MaskedZnccMatchesReferenceForRoundMasksEmptyRowsAndOnePlacement) {
   // Masks of one run per row, with rows that count nothing, and images of the template's size
   // (one placement: the tracker's drift check); one scratch reused over sizes that shrink and

@@ -33,9 +33,13 @@ namespace template_internal {
 
 // Converts the part `rect` of the frame (clipped to it) for the windows of this update.
 void TemplateTracker::ConvertAround(const cv::Mat& frame, const cv::Rect& rect) {
+  StopSharingWindowSums(zncc_);  // native_ is about to change.
   native_rect_ = rect & cv::Rect(0, 0, frame.cols, frame.rows);
   if (native_rect_.empty()) return;
   ToNative(frame(native_rect_), native_);
+  // The windows matched next (the search, the measurement, the pose rungs) mostly lie in it:
+  // its rows' prefix sums once, not each window's again (a gray native_ only).
+  ShareWindowSums(native_, zncc_);
 }
 
 // The window `rect` of the frame in the matched channel(s): a view of the part converted this
@@ -958,6 +962,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   if (rungs_.empty()) return Observation::NotFound(MarkerStatus::kNotStarted);  // No template.
   const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
   native_rect_ = cv::Rect();  // A new frame: nothing converted yet.
+  StopSharingWindowSums(zncc_);  // Nor summed (the last frame's pixels may have changed).
   frame_ = frame_bgr;  // A header: adopt() verifies another candidate on this frame.
   saved_ = State{last_centre_, velocity_px_, tracking_, repeats_, lost_frames_,
                  rung_,        turn_,        turn_step_};
@@ -1063,6 +1068,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
   pose_zncc_ = kNoRival;
   if (adapts()) RestoreWorkingTemplate();  // It may have blended in the other candidate.
   native_rect_ = cv::Rect();
+  StopSharingWindowSums(zncc_);
   const Observation observation =
       Verify(frame_, weighed_centres_[index], 1.0 - weighed_[index].misfit, turn_);
   if (!observation.found()) return std::nullopt;
