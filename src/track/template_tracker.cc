@@ -527,14 +527,39 @@ std::optional<Hit> TemplateTracker::Refine(const cv::Mat& frame, cv::Point top_l
 // search_margin_px; any size without the ambiguity check). The ZNCC of a placement depends on
 // its pixels alone, so this is the whole window's answer unless a higher peak lies in the rest
 // of the window within the rival radius of this one (issue 45: docs/measurements.md).
+// On footage that repeats frames the whole window spans the marker's last place too (a repeated
+// frame shows it there): the near window around the prediction decides the same way when no
+// placement of that wider window lies farther than the rival radius from its peak (a repeated
+// frame puts the marker more than kNearMarginPx off a prediction that moved on: the peak is then
+// on the near window's edge, or none, and the whole window is searched). ViSP's mire-2 repeats
+// frames: four of its five dots searched their whole window in every frame (issue 45).
 std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::Point2d& predicted) {
   const int margin = params_.search_margin_px;
-  if (footage_repeats_ || kNearMarginPx >= margin) return std::nullopt;
+  if (kNearMarginPx >= margin) return std::nullopt;
   const PreparedTemplate& templ = search_template();
   const cv::Size size = templ.size();
   const bool rivals = params_.ambiguity_margin > 0;
   const int radius = RivalRadius(size);
-  if (rivals && !NoRivalReachable(margin, {0, 0}, radius)) return std::nullopt;
+  // The whole window's placements (top-left corners, both ends included) on repeating footage.
+  cv::Rect placements;
+  if (footage_repeats_) {
+    const cv::Rect window =
+        WindowAround(predicted, size, margin) | WindowAround(*last_centre_, size, margin);
+    placements = cv::Rect(window.x, window.y, window.width - size.width, window.height - size.height);
+  }
+  // No placement of the whole window lies farther than the rival radius from `peak` (per axis).
+  const auto no_rival_reachable = [&](cv::Point peak) {
+    return peak.x - placements.x <= radius && placements.br().x - peak.x <= radius &&
+           peak.y - placements.y <= radius && placements.br().y - peak.y <= radius;
+  };
+  if (rivals) {
+    // Even a peak at the window's centre could have a rival: the near window cannot decide.
+    if (footage_repeats_ ? !no_rival_reachable(placements.tl() + cv::Point(placements.width / 2,
+                                                                             placements.height / 2))
+                         : !NoRivalReachable(margin, {0, 0}, radius)) {
+      return std::nullopt;
+    }
+  }
   const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
   ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
                                 near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
@@ -542,7 +567,10 @@ std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::P
   if (!hit || hit->on_inner_edge || !Accept(*hit)) return std::nullopt;
   const cv::Point from_prediction =
       hit->top_left - near.tl() - cv::Point(kNearMarginPx, kNearMarginPx);
-  if (rivals && !NoRivalReachable(margin, from_prediction, radius)) return std::nullopt;
+  if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
+                                   : NoRivalReachable(margin, from_prediction, radius))) {
+    return std::nullopt;
+  }
   return hit;
 }
 
