@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <limits>
 
@@ -176,17 +177,45 @@ void PrefixRow<1>(const uint8_t* __restrict p, int cols, uint32_t* __restrict s)
 }
 #endif
 
+// Whether `image` (gray) is a window of the image whose prefix sums `scratch` shares
+// (ShareWindowSums), and where in it (`at`). A window of it has its pixels at the same step
+// from its first pixel; a buffer of its own cannot lie inside the shared image's (both live).
+bool InSharedImage(const cv::Mat& image, const ZnccScratch& scratch, cv::Point* at) {
+  if (scratch.shared_image == nullptr || image.type() != CV_8UC1 ||
+      image.step[0] != scratch.shared_step || image.data < scratch.shared_image) {
+    return false;
+  }
+  const size_t offset = static_cast<size_t>(image.data - scratch.shared_image);
+  const size_t y = offset / scratch.shared_step, x = offset % scratch.shared_step;
+  if (x + static_cast<size_t>(image.cols) > static_cast<size_t>(scratch.shared_size.width) ||
+      y + static_cast<size_t>(image.rows) > static_cast<size_t>(scratch.shared_size.height)) {
+    return false;
+  }
+  *at = cv::Point(static_cast<int>(x), static_cast<int>(y));
+  return true;
+}
+
 template <int kChannels, typename RowDone>
 void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& scratch,
                 RowDone row_done) {
   constexpr int kPerPixel = kChannels + 1;
   const cv::Size size = ResultSize(image, t.size());
   const int image_cols = image.cols;
-  const size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
-  scratch.prefix_sum.resize(prefix_step * image.rows);
-  for (int y = 0; y < image.rows; ++y) {
-    PrefixRow<kChannels>(image.ptr<uint8_t>(y), image_cols,
-                         scratch.prefix_sum.data() + prefix_step * y);
+  size_t prefix_step = static_cast<size_t>(image_cols + 1) * kPerPixel;
+  const uint32_t* prefix = nullptr;  // The image's first pixel's slots (x = -1) in row 0.
+  cv::Point in_shared;
+  if (kChannels == 1 && InSharedImage(image, scratch, &in_shared)) {
+    // The rows' prefix sums from the image this window lies in: a window's sums are differences
+    // of one row's prefix sums, the same (mod 2^32, and exact) from whichever pixel they start.
+    prefix_step = static_cast<size_t>(scratch.shared_size.width + 1) * kPerPixel;
+    prefix = scratch.shared_prefix.data() + prefix_step * in_shared.y + in_shared.x * kPerPixel;
+  } else {
+    scratch.prefix_sum.resize(prefix_step * image.rows);
+    for (int y = 0; y < image.rows; ++y) {
+      PrefixRow<kChannels>(image.ptr<uint8_t>(y), image_cols,
+                           scratch.prefix_sum.data() + prefix_step * y);
+    }
+    prefix = scratch.prefix_sum.data();
   }
   const int row_values = size.width * kPerPixel;
   scratch.row_sum.resize(row_values);
@@ -197,7 +226,7 @@ void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& sc
   for (int y = 0; y < size.height; ++y) {
     std::fill(row_sum, row_sum + row_values, 0u);
     for (int r = 0; r < rows;) {
-      const uint32_t* s = scratch.prefix_sum.data() + prefix_step * (y + r);
+      const uint32_t* s = prefix + prefix_step * (y + r);
       const int k = run_rows[r];
       if (r + 1 < rows && run_rows[r + 1] == k + 1 && run_rows[r + 2] == k + 2) {
         // Two rows of one run each (a round mask's rows): added together, so the map row's sums
@@ -281,6 +310,17 @@ struct CountedSums {
   int64_t sum_sq[3] = {0, 0, 0};
 };
 
+// Whether two CV_8UC1 masks of one size hold the same bytes.
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size()) return false;
+  for (int y = 0; y < a.rows; ++y) {
+    if (std::memcmp(a.ptr<uint8_t>(y), b.ptr<uint8_t>(y), static_cast<size_t>(a.cols)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
 CountedSums SumCountedPixels(const cv::Mat& templ, const cv::Mat& mask) {
   const int cn = templ.channels();
   CountedSums s;
@@ -331,8 +371,6 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   bytes_.clear();
   mask_.clear();
   words_.clear();
-  run_rows_.clear();
-  runs_.clear();
 
   const int cn = templ.channels();
   const CountedSums sums = SumCountedPixels(templ, mask);
@@ -342,12 +380,20 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
   if (n == 0 || variance <= 0) {
     image_.release();
     mask_image_.release();
+    run_rows_.clear();
+    runs_.clear();
     return false;
   }
 
+  // The runs depend on the mask alone: a template re-prepared with the same mask at the same size
+  // (the template update, every frame) keeps them (finding them was a tenth of the update).
+  const bool masked = !mask.empty() && n < static_cast<int64_t>(mask.total());
+  const bool same_runs = !run_rows_.empty() && image_.size() == templ.size() &&
+                         image_.channels() == cn && masked == !mask_image_.empty() &&
+                         (!masked || SameBytes(mask, mask_image_));
   templ.copyTo(image_);  // Continuous.
-  if (!mask.empty() && n < static_cast<int64_t>(mask.total())) {
-    mask.copyTo(mask_image_);
+  if (masked) {
+    if (!same_runs) mask.copyTo(mask_image_);
   } else {
     mask_image_.release();
   }
@@ -357,7 +403,11 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     sum_sq_[c] = sums.sum_sq[c];
   }
   scaled_variance_ = variance;
-  find_runs();
+  if (!same_runs) {
+    run_rows_.clear();
+    runs_.clear();
+    find_runs();
+  }
   lay_out_chunks();
   return true;
 }
@@ -684,6 +734,40 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
   }
 }
 
+// sum I, sum I^2 and sum I * T over the counted pixels of one placement of a gray template at
+// `p` (`step` bytes a row), in the template's chunks: the image bytes masked as the template's
+// (a tail's bytes counted by a full chunk too are masked there), widened, and multiplied in
+// pairs into 32-bit lanes, which hold every sum (kMaxTemplateValues * 255^2 < 2^31).
+void GrayPlacementSums(const uint8_t* p, size_t step, const PreparedTemplate& t, int64_t* sum,
+                       int64_t* sum_sq, int64_t* cross) {
+  const auto [rows, full, tail, lo, hi] = KA::Layout(t);
+  const uint8_t* tm = KA::Mask(t);
+  const int16_t* tw = KA::Words(t);
+  const cv::v_int16x8 ones = cv::v_setall_s16(1);
+  cv::v_int32x4 s = cv::v_setzero_s32(), q = cv::v_setzero_s32(), x = cv::v_setzero_s32();
+  const auto add = [&](const cv::v_uint8x16& raw) {
+    const cv::v_uint8x16 v = raw & cv::v_load(tm);
+    cv::v_uint16x8 a, b;
+    cv::v_expand(v, a, b);
+    const cv::v_int16x8 ia = cv::v_reinterpret_as_s16(a), ib = cv::v_reinterpret_as_s16(b);
+    s = cv::v_dotprod(ia, ones, s);
+    s = cv::v_dotprod(ib, ones, s);
+    q = cv::v_dotprod(ia, ia, q);
+    q = cv::v_dotprod(ib, ib, q);
+    x = cv::v_dotprod(ia, cv::v_load(tw), x);
+    x = cv::v_dotprod(ib, cv::v_load(tw + 8), x);
+    tm += 16;
+    tw += 16;
+  };
+  for (int r = 0; r < rows; ++r, p += step) {
+    for (int c = 0; c < full; ++c) add(cv::v_load(p + 16 * c));
+    if (tail) add(cv::v_load_halves(p + lo, p + hi));
+  }
+  *sum = cv::v_reduce_sum(s);
+  *sum_sq = cv::v_reduce_sum(q);
+  *cross = cv::v_reduce_sum(x);
+}
+
 }  // namespace
 
 #endif  // CV_SIMD128
@@ -785,6 +869,42 @@ void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& res
       out[x] = ZnccFromSums(n, cross[x], sums, sum_sq, cn, templ);
     }
   }
+}
+
+bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+                 float* zncc) {
+#if CV_SIMD128
+  if (templ.empty() || templ.channels() != 1 || image.type() != CV_8UC1 ||
+      !KernelAccess::Vectorised(templ)) {
+    return false;
+  }
+  CV_Assert(top_left.x >= 0 && top_left.y >= 0 && top_left.x + templ.size().width <= image.cols &&
+            top_left.y + templ.size().height <= image.rows);
+  int64_t sum = 0, sum_sq = 0, cross = 0;
+  GrayPlacementSums(image.ptr<uint8_t>(top_left.y) + top_left.x, image.step[0], templ, &sum,
+                    &sum_sq, &cross);
+  *zncc = ZnccFromSums(templ.count(), cross, &sum, sum_sq, 1, templ);
+  return true;
+#else
+  (void)image;
+  (void)top_left;
+  (void)templ;
+  (void)zncc;
+  return false;
+#endif
+}
+
+void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch) {
+  scratch.shared_image = nullptr;
+  if (image.type() != CV_8UC1 || image.empty()) return;
+  const size_t prefix_step = static_cast<size_t>(image.cols + 1) * 2;
+  scratch.shared_prefix.resize(prefix_step * image.rows);
+  for (int y = 0; y < image.rows; ++y) {
+    PrefixRow<1>(image.ptr<uint8_t>(y), image.cols, scratch.shared_prefix.data() + prefix_step * y);
+  }
+  scratch.shared_image = image.data;
+  scratch.shared_step = image.step[0];
+  scratch.shared_size = image.size();
 }
 
 }  // namespace softsight

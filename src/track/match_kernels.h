@@ -107,7 +107,21 @@ struct ZnccScratch {
   std::vector<uint32_t> prefix_sum, row_sum;
   std::vector<int> cross_values;
   std::vector<int16_t> widened;  // The image widened to 16 bits for the cross-correlation.
+  // The row prefix sums of one gray image shared by the windows of it matched next
+  // (ShareWindowSums): its first pixel (nullptr: none shared), its step and size.
+  const uint8_t* shared_image = nullptr;
+  size_t shared_step = 0;
+  cv::Size shared_size;
+  std::vector<uint32_t> shared_prefix;
 };
+// Computes the row prefix sums of `image` (CV_8UC1; anything else shares nothing) once, for
+// every window of it that MatchZncc or MatchSsd matches a masked template in with this scratch
+// next: a tracker matches several overlapping windows of the part of a frame it converted (the
+// search, the measurement, the pose rungs), and each computed the prefix sums of its own rows
+// (issue 45). The same sums, the same bits. The caller keeps `image`'s pixels as they are until
+// StopSharingWindowSums (or another ShareWindowSums).
+void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch);
+inline void StopSharingWindowSums(ZnccScratch& scratch) { scratch.shared_image = nullptr; }
 // SSD = sum I^2 - 2 sum I*T + sum T^2, from the window sums and the cross-correlation (exact).
 // Without `scratch`, its buffers are allocated for the call.
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
@@ -115,6 +129,13 @@ void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& resu
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result);
 void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
                ZnccScratch& scratch);
+// ZNCC of one placement (`top_left`) of a gray template, the value MatchZncc's map holds there,
+// bit for bit (the same exact integer sums), without building a map: no window sums, no
+// widened copy (one placement through MatchZncc cost ten times as much: the template update's
+// drift guard, every frame, issue 45). False (nothing computed) for colour, or a template too
+// narrow for the vector layout, or without vector code: use MatchZncc.
+bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
+                 float* zncc);
 
 // Slow scalar references, straight from the definitions (ZNCC in double with explicit means).
 // `mask` as in PreparedTemplate::Prepare.

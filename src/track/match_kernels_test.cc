@@ -112,6 +112,110 @@ cv::Mat EllipseMask(cv::Size size) {
   return mask;
 }
 
+// One placement of a gray template (MatchZnccAt) is the value MatchZncc's map holds there, to
+// the bit, at every placement of every layout, masked and not, and near the reference; colour
+// and too-narrow templates are left to MatchZncc. One PreparedTemplate is re-prepared with
+// masks that alternate (its runs kept only while the mask is the same) and still matches as a
+// fresh one does.
+TEST(MatchKernelsTest, ZnccAtOnePlacementIsTheMapsValue) {
+  cv::RNG rng(4546);
+  ZnccScratch scratch;
+  PreparedTemplate reused;
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(Name(c));
+    const cv::Mat image = RandomImage(rng, {c.width + 5, c.height + 4}, c.channels);
+    for (int trial = 0; trial < 6; ++trial) {
+      cv::Mat templ = RandomImage(rng, {c.width, c.height}, c.channels);
+      if (trial == 5) templ = image(cv::Rect(2, 1, c.width, c.height)).clone();  // A perfect fit.
+      cv::Mat mask;
+      if (trial % 3 == 1) {
+        mask = cv::Mat::zeros(templ.size(), CV_8UC1);
+        cv::ellipse(mask, cv::Point(c.width / 2, c.height / 2),
+                    cv::Size(std::max(1, c.width / 2), std::max(1, c.height / 2)), 0, 0, 360,
+                    cv::Scalar(255), cv::FILLED);
+      } else if (trial % 3 == 2) {
+        cv::Mat noise(templ.size(), CV_8UC1);
+        rng.fill(noise, cv::RNG::UNIFORM, 0, 4);
+        mask = noise > 0;  // Three pixels in four, scattered.
+      }
+      PreparedTemplate prepared;
+      ASSERT_TRUE(prepared.Prepare(templ, mask));
+      ASSERT_TRUE(reused.Prepare(templ, mask));
+      cv::Mat map, reused_map, reference;
+      MatchZncc(image, prepared, map, scratch);
+      MatchZncc(image, reused, reused_map, scratch);
+      int nan_mismatch = 0;
+      EXPECT_EQ(MaxZnccError(map, reused_map, &nan_mismatch), 0.0);
+      EXPECT_EQ(nan_mismatch, 0);
+      MatchZnccReference(image, templ, reference, mask);
+      for (int y = 0; y < map.rows; ++y) {
+        for (int x = 0; x < map.cols; ++x) {
+          float one = -7;
+          const bool done = MatchZnccAt(image, {x, y}, prepared, &one);
+          if (c.channels == 3 || c.width < 8) {
+            EXPECT_FALSE(done);
+            continue;
+          }
+          ASSERT_TRUE(done);
+          const float expected = map.at<float>(y, x);
+          if (std::isnan(expected)) {
+            EXPECT_TRUE(std::isnan(one));
+          } else {
+            EXPECT_EQ(one, expected) << x << "," << y;
+            EXPECT_NEAR(one, reference.at<float>(y, x), 1e-4);
+          }
+        }
+      }
+      if (trial == 5 && c.channels == 1 && c.width >= 8) {
+        float one = 0;
+        ASSERT_TRUE(MatchZnccAt(image, {2, 1}, prepared, &one));
+        EXPECT_FLOAT_EQ(one, 1.0f);  // The template where it was cut from.
+      }
+    }
+  }
+}
+
+// Windows matched in an image whose prefix sums are shared (ShareWindowSums: the tracker's
+// converted part of the frame, itself a window of the frame) give the maps matched without
+// sharing, to the bit: windows inside it, and windows of the frame reaching out of it (which
+// must not take the shared sums), for ZNCC and SSD with masked templates; and after
+// StopSharingWindowSums the image may change.
+TEST(MatchKernelsTest, SharedWindowSumsGiveTheSameMaps) {
+  cv::RNG rng(4547);
+  cv::Mat frame = RandomImage(rng, {70, 60}, 1);
+  const cv::Rect part(6, 5, 44, 41);
+  ZnccScratch shared, fresh;
+  for (int trial = 0; trial < 300; ++trial) {
+    if (trial % 50 == 0) {
+      StopSharingWindowSums(shared);
+      rng.fill(frame, cv::RNG::UNIFORM, 0, 256);  // A new frame in the same buffer.
+      ShareWindowSums(frame(part), shared);
+    }
+    const cv::Size tsize(8 + rng.uniform(0, 26), 5 + rng.uniform(0, 26));
+    const cv::Mat templ = RandomImage(rng, tsize, 1);
+    cv::Mat mask = cv::Mat::zeros(tsize, CV_8UC1);
+    cv::ellipse(mask, cv::Point(tsize.width / 2, tsize.height / 2),
+                cv::Size(tsize.width / 2, tsize.height / 2), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+    PreparedTemplate prepared;
+    if (!prepared.Prepare(templ, mask)) continue;
+    // Inside the shared part half the time, anywhere in the frame otherwise.
+    const cv::Rect area = trial % 2 == 0 ? part : cv::Rect(0, 0, frame.cols, frame.rows);
+    const int w = tsize.width + rng.uniform(0, area.width - tsize.width + 1);
+    const int h = tsize.height + rng.uniform(0, area.height - tsize.height + 1);
+    const cv::Rect window(area.x + rng.uniform(0, area.width - w + 1),
+                          area.y + rng.uniform(0, area.height - h + 1), w, h);
+    cv::Mat a, b;
+    MatchZncc(frame(window), prepared, a, shared);
+    MatchZncc(frame(window).clone(), prepared, b, fresh);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(cv::countNonZero((a != b) & (a == a)), 0) << window;  // NaN where both are.
+    EXPECT_EQ(cv::countNonZero((a == a) != (b == b)), 0) << window;
+    MatchSsd(frame(window), prepared, a, shared);
+    MatchSsd(frame(window).clone(), prepared, b, fresh);
+    EXPECT_EQ(CountDifferent(a, b), 0) << window;
+  }
+}
+
 TEST(MatchKernelsTest, MaskedZnccMatchesReferenceForRoundMasksEmptyRowsAndOnePlacement) {
   // Masks of one run per row, with rows that count nothing, and images of the template's size
   // (one placement: the tracker's drift check); one scratch reused over sizes that shrink and

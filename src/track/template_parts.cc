@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -113,6 +114,8 @@ cv::Mat RoundMask(const cv::Size& size) {
 
 double ZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
               cv::Mat& result, ZnccScratch& scratch) {
+  float one = 0;
+  if (MatchZnccAt(image, top_left, templ, &one)) return one;  // Gray: the one placement alone.
   MatchZncc(image(cv::Rect(top_left, templ.size())), templ, result, scratch);
   return result.at<float>(0, 0);  // NaN on a flat window: fails every comparison.
 }
@@ -217,8 +220,26 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
     }
   }
 #endif
-  // Down the columns, a row at a time across the area (loops the compiler vectorises in 8-bit
-  // lanes): the least over the rows within reach of max(their distance along the row, |dy|).
+  // Down the columns, a row at a time across the area: the least over the rows within reach of
+  // max(their distance along the row, |dy|).
+#if CV_SIMD128
+  // In whole vectors of the rows' stride, into the padded row's buffer (no longer needed), then
+  // the area's width of it into `dist`: a loop over the width alone left the last width % 16
+  // columns to scalar code, most of this function's work at the blobs' widths (issue 45).
+  for (int y = area.y; y < area.br().y; ++y) {
+    const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
+    for (int x = 0; x < width; x += 16) {
+      cv::v_uint8x16 d = cv::v_setall_u8(static_cast<uint8_t>(kNone));
+      for (int yy = first; yy <= last; ++yy) {
+        const cv::v_uint8x16 along =
+            cv::v_load(row_distance.data() + static_cast<size_t>((yy - top) * stride) + x);
+        d = cv::v_min(d, cv::v_max(along, cv::v_setall_u8(static_cast<uint8_t>(std::abs(yy - y)))));
+      }
+      cv::v_store(padded + x, d);
+    }
+    std::memcpy(dist.ptr<uint8_t>(y) + area.x, padded, static_cast<size_t>(width));
+  }
+#else
   for (int y = area.y; y < area.br().y; ++y) {
     uint8_t* __restrict out = dist.ptr<uint8_t>(y) + area.x;
     std::fill(out, out + width, static_cast<uint8_t>(kNone));
@@ -229,6 +250,7 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
       for (int x = 0; x < width; ++x) out[x] = std::min(out[x], std::max(along[x], rows_away));
     }
   }
+#endif
 }
 
 void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist) {
@@ -478,6 +500,109 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
   const double total = sum[0] + sum[1] + sum[2];
   if (!(total >= kDarkCoreLevels * n)) return false;
   *chroma = sum / total;
+  return true;
+}
+
+void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
+  const int cols = gray.cols, rows = gray.rows;
+  const int area = cols * rows;
+  if (edge_size_ != gray.size()) {
+    // The patch's edge pixels, for this size (the tracker's patch keeps its size while the
+    // scale does).
+    edge_.assign(static_cast<size_t>(area), 0);
+    for (int x = 0; x < cols; ++x) edge_[x] = edge_[static_cast<size_t>(area - cols + x)] = 1;
+    for (int y = 0; y < rows; ++y) edge_[y * cols] = edge_[y * cols + cols - 1] = 1;
+    edge_size_ = gray.size();
+  }
+  if (next_.size() < static_cast<size_t>(area)) next_.resize(static_cast<size_t>(area));
+  heads_.fill(-1);
+  ZeroedMask(gray.size(), visited_);
+  const int flip = bright_ ? 0 : 255;
+  const uint8_t* levels = gray.data;  // Continuous: pixel i at levels[i].
+  uint8_t* visited = visited_.data;
+  const uint8_t* edge = edge_.data();
+  int* next = next_.data();
+  int* heads = heads_.data();
+  const int start = seed.y * cols + seed.x;
+  int level = levels[start] ^ flip;
+  next[start] = -1;
+  heads[level] = start;
+  visited[start] = 1;
+  core_.clear();
+  *pass = -1;
+  const int offsets[4] = {1, -1, cols, -cols};  // The reference's order: +x, -x, +y, -y.
+  for (;;) {
+    while (level >= 0 && heads[level] < 0) --level;
+    if (level < 0) return;
+    const int p = heads[level];
+    heads[level] = next[p];
+    if (edge[p]) {
+      *pass = level;
+      return;
+    }
+    if (core_.size() < kCoreSamples) core_.push_back(level);
+    // Off the patch's edge: the four neighbours are in the patch.
+    for (const int offset : offsets) {
+      const int q = p + offset;
+      if (visited[q]) continue;
+      visited[q] = 1;
+      const int l = std::min(levels[q] ^ flip, level);  // A path's level is its least marker-like.
+      next[q] = heads[l];
+      heads[l] = q;
+    }
+  }
+}
+
+bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
+  ZeroedMask(gray.size(), label_);
+  const int cols = gray.cols, rows = gray.rows;
+  const int flip = bright_ ? 0 : 255;
+  const uint8_t* levels = gray.data;  // Continuous, as label_.
+  uint8_t* label = label_.data;
+  const auto marker = [&](int i) { return (levels[i] ^ flip) > cut; };
+  int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
+  int64_t count = 0, sum_x = 0, sum_y = 0;
+  stack_.clear();
+  stack_.push_back(seed);
+  bool first = true;  // The seed counts whatever its level (as Fill labels it).
+  while (!stack_.empty()) {
+    const cv::Point p = stack_.back();
+    stack_.pop_back();
+    const int row = p.y * cols;
+    if (label[row + p.x]) continue;  // Its span was filled from another seed.
+    if (!first && !marker(row + p.x)) continue;
+    first = false;
+    // The whole span of marker pixels through p: a component pixel on the patch's edge is not
+    // separated from its surroundings (Fill's answer, whatever it had filled by then).
+    if (p.y == 0 || p.y == rows - 1) return false;
+    int left = p.x, right = p.x;
+    while (left > 0 && marker(row + left - 1)) --left;
+    while (right < cols - 1 && marker(row + right + 1)) ++right;
+    if (left == 0 || right == cols - 1) return false;
+    std::memset(label + row + left, 1, static_cast<size_t>(right - left + 1));
+    const int64_t length = right - left + 1;
+    count += length;
+    sum_x += (static_cast<int64_t>(left) + right) * length / 2;
+    sum_y += static_cast<int64_t>(p.y) * length;
+    x0 = std::min(x0, left);
+    x1 = std::max(x1, right);
+    y0 = std::min(y0, p.y);
+    y1 = std::max(y1, p.y);
+    // A seed for each run of unfilled marker pixels beside the span, above and below.
+    for (const int y : {p.y - 1, p.y + 1}) {
+      const int r = y * cols;
+      for (int x = left; x <= right; ++x) {
+        if (label[r + x] || !marker(r + x)) continue;
+        stack_.push_back({x, y});
+        while (x + 1 <= right && !label[r + x + 1] && marker(r + x + 1)) ++x;
+      }
+    }
+  }
+  box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  fill_count_ = count;
+  fill_sum_x_ = sum_x;
+  fill_sum_y_ = sum_y;
+  filled_moments_ = true;
   return true;
 }
 

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -234,12 +235,30 @@ class BlobMeter {
   bool Locate(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess,
               cv::Point2d* centroid, double* area) {
     if (!Segment(gray, mask, guess, &located_low_, &located_high_)) return false;
-    const cv::Moments m = cv::moments(label_(box_), true);
-    if (!(m.m00 > 0)) return false;
-    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
-    *area = m.m00;
+    double m00 = 0, m10 = 0, m01 = 0;
+    if (filled_moments_) {
+      // FillUnmasked counted the component as it filled it: the binary moments cv::moments
+      // gives, exact whole numbers (relative to the box), without a pass over label_.
+      m00 = static_cast<double>(fill_count_);
+      m10 = static_cast<double>(fill_sum_x_ - fill_count_ * box_.x);
+      m01 = static_cast<double>(fill_sum_y_ - fill_count_ * box_.y);
+    } else {
+      const cv::Moments m = cv::moments(label_(box_), true);
+      m00 = m.m00;
+      m10 = m.m10;
+      m01 = m.m01;
+    }
+    if (!(m00 > 0)) return false;
+    *centroid = cv::Point2d(box_.tl()) + cv::Point2d(m10 / m00, m01 / m00);
+    *area = m00;
     return true;
   }
+
+  // Tests only: segment with the reference flood and fill (the pixel-at-a-time priority queue
+  // of vectors and the stack fill, Segment's definition) even where the fast ones apply.
+  void use_reference(bool reference) { reference_ = reference; }
+  // After Segment: the component's pixels (1) and its box (what the tests compare).
+  const cv::Mat& label() const { return label_; }
 
   double area() const { return area_; }  // At selection, px.
   // The bounding box of the component the last Segment found (patch coordinates): after Learn,
@@ -315,8 +334,17 @@ class BlobMeter {
   // round). False when the marker does not stand out by kMinBlobContrast from its pass.
   bool Segment(const cv::Mat& gray, const cv::Mat& mask, const cv::Point2d& guess, double* low,
                double* high) {
+    filled_moments_ = false;
     const std::optional<cv::Point> seed = ExtremeNear(gray, mask, guess);
     if (!seed) return false;
+    // Every frame's blob is unmasked (BlobShift), in a continuous patch: there the flood and the
+    // fill run on pixel indices (issue 45: the vector-of-points flood, the fill and cv::moments
+    // were 16 % of a frame of three ZNCC templates). Same component, same levels, same bits.
+    if (!reference_ && mask.empty() && gray.isContinuous()) {
+      int pass = -1;
+      FloodUnmasked(gray, *seed, &pass);
+      return Cut(gray, mask, *seed, pass, low, high);
+    }
     // A priority flood from the seed, most marker-like first (256 buckets of marker-likeness):
     // the first edge pixel it takes sets the pass.
     for (auto& bucket : buckets_) bucket.clear();
@@ -358,6 +386,12 @@ class BlobMeter {
         buckets_[std::min(l, level)].push_back(q);  // A path's level is its least marker-like.
       }
     }
+    return Cut(gray, mask, *seed, pass, low, high);
+  }
+  // Segment's end, once the flood has found the pass and the core's levels (core_): the cut and
+  // the component above it.
+  bool Cut(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, int pass, double* low,
+           double* high) {
     if (pass < 0 || core_.empty()) return false;
     // The marker's own level: the median of its most marker-like pixels (robust to one glint).
     std::nth_element(core_.begin(), core_.begin() + core_.size() / 2, core_.end());
@@ -369,8 +403,23 @@ class BlobMeter {
     const double pass_level = bright_ ? pass : 255 - pass;
     *low = std::min(marker_level, pass_level);
     *high = std::max(marker_level, pass_level);
-    return Fill(gray, mask, *seed, bright_ ? cut : 255 - cut);
+    if (!reference_ && mask.empty() && gray.isContinuous()) {
+      // In marker-likeness (v ^ flip) a whole level is beyond the cut exactly when it is above
+      // its whole part: v > cut for a bright marker, 255 - v > cut for a dark one.
+      return FillUnmasked(gray, seed, static_cast<int>(std::floor(cut)));
+    }
+    return Fill(gray, mask, seed, bright_ ? cut : 255 - cut);
   }
+  // Segment's priority flood for an unmasked, continuous patch: the same pushes and pops in the
+  // same order (each bucket last in, first out) as the reference above, on pixel indices, with
+  // the buckets as lists threaded through next_ (a pixel is pushed at most once) instead of
+  // vectors of points. Sets core_ and *pass (-1: none).
+  void FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass);
+  // Fill's component for an unmasked, continuous patch, a row span at a time: the pixels whose
+  // marker-likeness is above `cut` 4-connected to `seed` (which counts, as in Fill) into label_
+  // and box_, with their count and coordinate sums for Locate. False when it reaches the patch's
+  // edge.
+  bool FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut);
   // The most marker-like pixel within 2 px of `guess` (the nearest of equals).
   std::optional<cv::Point> ExtremeNear(const cv::Mat& gray, const cv::Mat& mask,
                                        const cv::Point2d& guess) const {
@@ -455,6 +504,17 @@ class BlobMeter {
   double learned_contrast_ = 0;
   double range_ = 0;
   double located_low_ = 0, located_high_ = 0;  // The last Locate's levels, for MeasureLocated.
+  bool reference_ = false;  // use_reference.
+  // FillUnmasked's count and coordinate sums of the component (frame of the patch), valid when
+  // filled_moments_.
+  bool filled_moments_ = false;
+  int64_t fill_count_ = 0, fill_sum_x_ = 0, fill_sum_y_ = 0;
+  // FloodUnmasked's storage, kept from call to call: the buckets' first pixels, each pixel's
+  // next one in its bucket, and the patch's edge pixels (1) for the patch size edge_size_.
+  std::array<int, 256> heads_{};
+  std::vector<int> next_;
+  std::vector<uint8_t> edge_;
+  cv::Size edge_size_;
   cv::Mat label_, dist_, visited_;
   std::vector<uint8_t> row_distance_;  // CappedChebyshevDistance's scratch.
   cv::Rect box_;

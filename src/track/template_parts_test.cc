@@ -2,6 +2,7 @@
 // offset and the template's centre of symmetry, against exact truth.
 #include "track/template_parts.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -27,6 +28,73 @@ TEST(TemplateParts, CappedChebyshevDistanceIsTheReferences) {
     CappedChebyshevDistanceReference(label, area, reference);
     EXPECT_EQ(cv::countNonZero(fast != reference), 0) << size << " " << area << " " << density;
   }
+}
+
+// The flood and fill on pixel indices (every frame's blob: unmasked, continuous) are the
+// reference's: the same answer, levels, component, box, centroids and areas, on discs bright and
+// dark, whole, cut by the patch's edge or touching it, on noise of several strengths, guessed
+// on and off their centre; and the disc's centroid is where it was drawn.
+TEST(TemplateParts, BlobMeterFastSegmentIsTheReferences) {
+  cv::RNG rng(4545);
+  int located = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    const cv::Size size(8 + rng.uniform(0, 48), 8 + rng.uniform(0, 48));
+    const bool bright = trial % 2 == 0;
+    const int background = rng.uniform(20, 236), marker = bright ? rng.uniform(background, 256)
+                                                                 : rng.uniform(0, background + 1);
+    const cv::Point2d centre(rng.uniform(0.0, size.width - 1.0), rng.uniform(0.0, size.height - 1.0));
+    const double radius = rng.uniform(0.5, 0.45 * std::min(size.width, size.height));
+    cv::Mat gray(size, CV_8UC1);
+    cv::Mat noise(size, CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, (trial / 2) % 3 == 0 ? 1.0 : (trial / 2) % 3 == 1 ? 4.0 : 12.0);
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        const double d = std::hypot(x - centre.x, y - centre.y);
+        const double inside = std::clamp(radius + 0.5 - d, 0.0, 1.0);
+        gray.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(
+            background + inside * (marker - background) + noise.at<float>(y, x));
+      }
+    }
+    // A meter of the disc's polarity: learned on a clean disc of its own.
+    cv::Mat learn(33, 33, CV_8UC1, cv::Scalar(background));
+    cv::circle(learn, {16, 16}, 6, cv::Scalar(marker), cv::FILLED);
+    BlobMeter fast;
+    cv::Point2d learned;
+    if (std::abs(marker - background) < 20 || !fast.Learn(learn, RoundMask(learn.size()), &learned)) {
+      continue;
+    }
+    BlobMeter reference = fast;
+    reference.use_reference(true);
+    const cv::Point2d guess = centre + cv::Point2d(rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0));
+    cv::Point2d c_fast, c_ref;
+    double a_fast = -1, a_ref = -1;
+    const bool ok_fast = fast.Locate(gray, cv::Mat(), guess, &c_fast, &a_fast);
+    const bool ok_ref = reference.Locate(gray, cv::Mat(), guess, &c_ref, &a_ref);
+    ASSERT_EQ(ok_fast, ok_ref) << trial;
+    if (!ok_fast) continue;
+    ++located;
+    EXPECT_EQ(c_fast, c_ref) << trial;
+    EXPECT_EQ(a_fast, a_ref) << trial;
+    EXPECT_EQ(fast.blob_box(), reference.blob_box()) << trial;
+    EXPECT_EQ(cv::countNonZero(fast.label() != reference.label()), 0) << trial;
+    ASSERT_EQ(fast.MeasureLocated(gray, cv::Mat(), &c_fast, &a_fast),
+              reference.MeasureLocated(gray, cv::Mat(), &c_ref, &a_ref)) << trial;
+    EXPECT_EQ(c_fast, c_ref) << trial;
+    EXPECT_EQ(a_fast, a_ref) << trial;
+    ASSERT_EQ(fast.Measure(gray, cv::Mat(), guess, &c_fast, &a_fast),
+              reference.Measure(gray, cv::Mat(), guess, &c_ref, &a_ref)) << trial;
+    EXPECT_EQ(c_fast, c_ref) << trial;
+    // The truth: a clear disc well inside the patch is measured at its centre.
+    const bool clear = (trial / 2) % 3 == 0 && radius >= 3 && std::abs(marker - background) >= 60 &&
+                       centre.x - radius > 6 && centre.y - radius > 6 &&
+                       centre.x + radius < size.width - 7 && centre.y + radius < size.height - 7;
+    if (clear) {
+      EXPECT_TRUE(fast.Measure(gray, cv::Mat(), guess, &c_fast, &a_fast)) << trial;
+      EXPECT_NEAR(c_fast.x, centre.x, 0.1) << trial;
+      EXPECT_NEAR(c_fast.y, centre.y, 0.1) << trial;
+    }
+  }
+  EXPECT_GT(located, 100);  // The comparison met many blobs, not only refusals.
 }
 
 // NoRivalReachable is "RivalIn can find nothing in the whole window": on a map of that window

@@ -33,9 +33,13 @@ namespace template_internal {
 
 // Converts the part `rect` of the frame (clipped to it) for the windows of this update.
 void TemplateTracker::ConvertAround(const cv::Mat& frame, const cv::Rect& rect) {
+  StopSharingWindowSums(zncc_);  // native_ is about to change.
   native_rect_ = rect & cv::Rect(0, 0, frame.cols, frame.rows);
   if (native_rect_.empty()) return;
   ToNative(frame(native_rect_), native_);
+  // The windows matched next (the search, the measurement, the pose rungs) mostly lie in it:
+  // its rows' prefix sums once, not each window's again (a gray native_ only).
+  ShareWindowSums(native_, zncc_);
 }
 
 // The window `rect` of the frame in the matched channel(s): a view of the part converted this
@@ -523,14 +527,39 @@ std::optional<Hit> TemplateTracker::Refine(const cv::Mat& frame, cv::Point top_l
 // search_margin_px; any size without the ambiguity check). The ZNCC of a placement depends on
 // its pixels alone, so this is the whole window's answer unless a higher peak lies in the rest
 // of the window within the rival radius of this one (issue 45: docs/measurements.md).
+// On footage that repeats frames the whole window spans the marker's last place too (a repeated
+// frame shows it there): the near window around the prediction decides the same way when no
+// placement of that wider window lies farther than the rival radius from its peak (a repeated
+// frame puts the marker more than kNearMarginPx off a prediction that moved on: the peak is then
+// on the near window's edge, or none, and the whole window is searched). ViSP's mire-2 repeats
+// frames: four of its five dots searched their whole window in every frame (issue 45).
 std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::Point2d& predicted) {
   const int margin = params_.search_margin_px;
-  if (footage_repeats_ || kNearMarginPx >= margin) return std::nullopt;
+  if (kNearMarginPx >= margin) return std::nullopt;
   const PreparedTemplate& templ = search_template();
   const cv::Size size = templ.size();
   const bool rivals = params_.ambiguity_margin > 0;
   const int radius = RivalRadius(size);
-  if (rivals && !NoRivalReachable(margin, {0, 0}, radius)) return std::nullopt;
+  // The whole window's placements (top-left corners, both ends included) on repeating footage.
+  cv::Rect placements;
+  if (footage_repeats_) {
+    const cv::Rect window =
+        WindowAround(predicted, size, margin) | WindowAround(*last_centre_, size, margin);
+    placements = cv::Rect(window.x, window.y, window.width - size.width, window.height - size.height);
+  }
+  // No placement of the whole window lies farther than the rival radius from `peak` (per axis).
+  const auto no_rival_reachable = [&](cv::Point peak) {
+    return peak.x - placements.x <= radius && placements.br().x - peak.x <= radius &&
+           peak.y - placements.y <= radius && placements.br().y - peak.y <= radius;
+  };
+  if (rivals) {
+    // Even a peak at the window's centre could have a rival: the near window cannot decide.
+    if (footage_repeats_ ? !no_rival_reachable(placements.tl() + cv::Point(placements.width / 2,
+                                                                             placements.height / 2))
+                         : !NoRivalReachable(margin, {0, 0}, radius)) {
+      return std::nullopt;
+    }
+  }
   const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
   ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
                                 near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
@@ -538,7 +567,10 @@ std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::P
   if (!hit || hit->on_inner_edge || !Accept(*hit)) return std::nullopt;
   const cv::Point from_prediction =
       hit->top_left - near.tl() - cv::Point(kNearMarginPx, kNearMarginPx);
-  if (rivals && !NoRivalReachable(margin, from_prediction, radius)) return std::nullopt;
+  if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
+                                   : NoRivalReachable(margin, from_prediction, radius))) {
+    return std::nullopt;
+  }
   return hit;
 }
 
@@ -958,6 +990,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   if (rungs_.empty()) return Observation::NotFound(MarkerStatus::kNotStarted);  // No template.
   const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
   native_rect_ = cv::Rect();  // A new frame: nothing converted yet.
+  StopSharingWindowSums(zncc_);  // Nor summed (the last frame's pixels may have changed).
   frame_ = frame_bgr;  // A header: adopt() verifies another candidate on this frame.
   saved_ = State{last_centre_, velocity_px_, tracking_, repeats_, lost_frames_,
                  rung_,        turn_,        turn_step_};
@@ -1063,6 +1096,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
   pose_zncc_ = kNoRival;
   if (adapts()) RestoreWorkingTemplate();  // It may have blended in the other candidate.
   native_rect_ = cv::Rect();
+  StopSharingWindowSums(zncc_);
   const Observation observation =
       Verify(frame_, weighed_centres_[index], 1.0 - weighed_[index].misfit, turn_);
   if (!observation.found()) return std::nullopt;

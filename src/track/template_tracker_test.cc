@@ -635,6 +635,42 @@ TEST(TemplateTrackerTest, AMarkerLeavingItsPredictionIsFoundInTheWholeWindow) {
   }
 }
 
+// On footage that repeats frames the near window decides too, within the window spanning the
+// marker's last place and its prediction: a dot moving 1.7 px a frame shown twice per frame
+// (still, then a step of two frames' worth) is found at its place in every frame, through a
+// jump past the prediction and a reversal as well.
+TEST(TemplateTrackerTest, FootageThatRepeatsFramesIsFoundAtItsPlaceNearThePrediction) {
+  for (const char* method : kMethods) {
+    for (const int side : {21, 33}) {
+      SCOPED_TRACE(std::string(method) + " " + std::to_string(side) + " px");
+      MarkerSpec spec;
+      spec.name = "dot";
+      spec.params = ParamsForMethod(method, {});
+      const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+      cv::Point2d a(50.3, 60.6), step(1.7, 0.6);
+      int found = 0, wrong = 0, frames = 0;
+      for (int i = 0; i < 30; ++i) {
+        if (i == 12) a += cv::Point2d(6.6, -0.7);  // Past the prediction.
+        if (i == 20) step = -step;                 // Reversed.
+        a += step;
+        cv::Mat frame(160, 220, CV_8UC3, cv::Scalar(40, 40, 40));
+        cv::circle(frame, cv::Point(cvRound(a.x * 16), cvRound(a.y * 16)), cvRound(side / 3.0 * 16),
+                   cv::Scalar(230, 230, 230), cv::FILLED, cv::LINE_AA, 4);
+        for (int repeat = 0; repeat < 2; ++repeat) {
+          if (i == 0 && repeat == 0) tracker->init(frame, RectAround(a, side));
+          ++frames;
+          const Observation o = tracker->update(frame);
+          if (!o.found()) continue;
+          ++found;
+          if (cv::norm(*o.position_px - a) > 0.3) ++wrong;
+        }
+      }
+      EXPECT_EQ(found, frames);
+      EXPECT_EQ(wrong, 0);
+    }
+  }
+}
+
 // The neighbouring rungs (scale, turn) are tried every kPoseEvery-th frame, and at once when the
 // current rung fits worse: a bar that grows 2 % a frame while it turns 5 degrees a frame, then
 // stops turning and shrinks, is followed at its centre in every frame.
