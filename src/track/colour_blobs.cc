@@ -273,7 +273,9 @@ struct RingStatistics {
   std::array<cv::Matx33d, kRingQuarters> quarter_chroma_outer{};
 };
 
-void AddChromaticity(const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
+// Inlined: a call a pixel (GCC kept it out of the loop below) was a third of its cost (issue 45).
+[[gnu::always_inline]] inline void AddChromaticity(const uchar* c, cv::Vec3d& sum,
+                                                   cv::Matx33d& outer) {
   const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
   sum += chroma;
   for (int k = 0; k < 3; ++k) {
@@ -321,6 +323,10 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
   std::array<int64_t, 6> core_outer_i{};
   std::array<std::array<int64_t, 3>, kSectors> sector_sum_i{};
   std::array<std::array<int64_t, 6>, kRingQuarters> quarter_outer_i{};
+  // The core's chromaticity sums in locals (registers), not through `s`, which the compiler
+  // cannot keep out of memory across the loop.
+  cv::Vec3d core_chroma_sum = s.core_chroma_sum;
+  cv::Matx33d core_chroma_outer = s.core_chroma_outer;
   for (int y = 0; y < own.rows; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
@@ -330,7 +336,7 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
       const uchar* c = p + x * channels;
       if (ow[x] == 255 && d[x] > core_depth) {
         AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
-        if (chromatic) AddChromaticity(c, s.core_chroma_sum, s.core_chroma_outer);
+        if (chromatic) AddChromaticity(c, core_chroma_sum, core_chroma_outer);
         s.core_n += 1;
       } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
@@ -345,6 +351,8 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
       }
     }
   }
+  s.core_chroma_sum = core_chroma_sum;
+  s.core_chroma_outer = core_chroma_outer;
   for (int k = 0; k < channels; ++k) {
     s.core_sum[k] = static_cast<double>(core_sum_i[k]);
     s.core_sq[k] = static_cast<double>(core_outer_i[LowerTriangle(k, k)]);
@@ -613,6 +621,10 @@ void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
   const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(own_origin);
   blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
   blob->hull_asymmetry_px = blob->asymmetry_px;
+  // The hull's asymmetry is read only of a blob more asymmetric than a learned marker by
+  // kPartialMinPx at least (judge(): both must exceed the limit, which is never below it): the
+  // hull of a blob within that is not worth its sixth of the asymmetry's cost (issue 45).
+  if (blob->asymmetry_px <= kPartialMinPx) return;
   cv::convexHull(edge_points_, hull_points_);
   const cv::Moments hull = cv::moments(hull_points_);
   if (hull.m00 > 0) {
