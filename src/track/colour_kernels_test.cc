@@ -137,7 +137,8 @@ TEST(ColourKernels, OpenClose3x3IsMorphologyEx) {
   cv::RNG rng(11);
   cv::Mat scratch;
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(1, 9), cv::Size(9, 1), cv::Size(17, 5),
-                              cv::Size(16, 16), cv::Size(64, 48), cv::Size(83, 29)}) {
+                              cv::Size(16, 16), cv::Size(31, 7), cv::Size(64, 48),
+                              cv::Size(83, 29)}) {
     for (const double density : {0.1, 0.5, 0.9}) {
       for (const bool cross : {true, false}) {
         cv::Mat noise(size, CV_32F), mask;
