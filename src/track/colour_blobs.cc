@@ -552,7 +552,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // it to the outside): a blob of one run in each of its rows (a disc, most markers) has none.
   const RunLabeller::Component& drawn = labeller_.components()[static_cast<size_t>(component)];
   if (drawn.run_count > drawn.box.height) FillHoles(own, padded.tl() + origin, blob);
-  measure_asymmetry(own, padded.tl() + origin, blob);
+  measure_asymmetry(component, padded.tl() - labelled_tl, padded.tl() + origin, blob);
   cv::Mat distance = Scratch(distance_store_, size, CV_8U);
   EdgeZones(own, distance, zone_store_);
   const cv::Mat pixels = filtered(padded);
@@ -586,7 +586,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // frame cuts it).
   if (const std::optional<double> radius = rim_radius_px();
       radius && blob->area_px < kWholeRimFraction * model_->area_px) {
-    fit_rim(own, padded.tl() + origin, *radius, blob);
+    fit_rim(own, component, padded.tl() - labelled_tl, padded.tl() + origin, *radius, blob);
   }
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
   const WeightedSums sums = SoftCentroidSums(pixels, own, distance, others, sector_of, s, *blob);
@@ -597,22 +597,24 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
                                   sums.y / sums.w + (padded.y + origin.y));
 }
 
-void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
+void ColourTracker::measure_asymmetry(int component, cv::Point own_tl, cv::Point own_origin,
                                       ColourBlob* blob) {
   // The binary centroid against the centre of the smallest circle around the blob (its convex
-  // hull's points are among each row's leftmost and rightmost pixels).
+  // hull's points are among each row's leftmost and rightmost pixels). A row's ends are its
+  // first run's start and its last run's end (the runs are in raster order; a filled hole lies
+  // between them), in the blob's mask's coordinates: the same points a scan of the mask finds,
+  // without the scan (issue 45).
   edge_points_.clear();
-  for (int y = 0; y < own.rows; ++y) {
-    const uchar* row = own.ptr<uchar>(y);
-    int first = -1, last = -1;
-    for (int x = 0; x < own.cols; ++x) {
-      if (!row[x]) continue;
-      if (first < 0) first = x;
-      last = x;
-    }
-    if (first < 0) continue;
-    edge_points_.emplace_back(first, y);
-    if (last != first) edge_points_.emplace_back(last, y);
+  const RunLabeller::Component& comp = labeller_.components()[static_cast<size_t>(component)];
+  const RunLabeller::Run* runs = labeller_.runs().data() + comp.first_run;
+  for (int k = 0; k < comp.run_count;) {
+    const int y = runs[k].y;
+    const int first = runs[k].x0 - own_tl.x;
+    while (k + 1 < comp.run_count && runs[k + 1].y == y) ++k;
+    const int last = runs[k].x1 - 1 - own_tl.x;
+    ++k;
+    edge_points_.emplace_back(first, y - own_tl.y);
+    if (last != first) edge_points_.emplace_back(last, y - own_tl.y);
   }
   if (edge_points_.empty()) return;
   cv::Point2f circle_centre;
@@ -633,13 +635,18 @@ void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
   }
 }
 
-void ColourTracker::fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius,
-                            ColourBlob* blob) {
+void ColourTracker::fit_rim(const cv::Mat& own, int component, cv::Point own_tl,
+                            cv::Point frame_origin, double radius, ColourBlob* blob) {
+  // The edge pixels in raster order: the blob's pixels with a 4-neighbour outside it, visited
+  // along the component's runs (raster order) instead of over its whole box. A filled hole's
+  // pixels (not in the runs) are never edge pixels: their 4-neighbours are the blob or the hole.
   edge_points_.clear();
-  for (int y = 0; y < own.rows; ++y) {
+  const RunLabeller::Component& comp = labeller_.components()[static_cast<size_t>(component)];
+  const RunLabeller::Run* runs = labeller_.runs().data() + comp.first_run;
+  for (int k = 0; k < comp.run_count; ++k) {
+    const int y = runs[k].y - own_tl.y;
     const uchar* ow = own.ptr<uchar>(y);
-    for (int x = 0; x < own.cols; ++x) {
-      if (!ow[x]) continue;
+    for (int x = runs[k].x0 - own_tl.x; x < runs[k].x1 - own_tl.x; ++x) {
       const bool edge = x == 0 || y == 0 || x == own.cols - 1 || y == own.rows - 1 ||
                         !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
                         !own.ptr<uchar>(y + 1)[x];
