@@ -22,14 +22,14 @@ int CountRimInliers(const std::vector<cv::Point2d>& pts, const cv::Point2d& c, d
 #if CV_SIMD128_64F
   // Two points at a time, each with the scalar reference's operations in its order (p - c, then
   // x^2 + y^2, sqrt, |d - r| <= tol: IEEE sqrt and no fused multiply-add), so the same
-  // comparisons. Every 16 points, stop when the points left cannot take the count past `best`.
+  // comparisons. Every 32 points, stop when the points left cannot take the count past `best`.
   static_assert(sizeof(cv::Point2d) == 2 * sizeof(double));
   const double* xy = reinterpret_cast<const double*>(pts.data());
   const cv::v_float64x2 cx = cv::v_setall_f64(c.x), cy = cv::v_setall_f64(c.y);
   const cv::v_float64x2 vr = cv::v_setall_f64(r), vtol = cv::v_setall_f64(tol);
   const int pairs_end = n & ~1;
   while (i < pairs_end) {
-    const int block_end = std::min(pairs_end, i + 16);
+    const int block_end = std::min(pairs_end, i + 32);
     // An inlier's comparison is all ones, -1 as an integer lane: subtracted, it counts.
     cv::v_int64x2 inliers = cv::v_setzero_s64();
     for (; i < block_end; i += 2) {
