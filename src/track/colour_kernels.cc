@@ -513,25 +513,36 @@ void RunLabeller::Label(const cv::Mat& mask) {
   for (int y = 0; y < mask.rows; ++y) {
     const uchar* row = mask.ptr<uchar>(y);
     const size_t begin = runs_.size();
+    // Each run's start (the next nonzero pixel) and end (the next 0 after it), found 16 pixels
+    // at a time: the first such pixel of a chunk is the lowest bit of its comparison's sign
+    // mask. Pixel by pixel inside the runs, the scan was a third of the labelling on the
+    // tracker's windows, whose masks are mostly runs (issue 45).
     int x = 0;
-    int start = -1;  // Start of the run being read, or -1.
     while (x < w) {
 #if CV_SIMD128
-      // Skip 16 pixels at a time while outside a run and they are all 0.
-      if (start < 0) {
-        while (x + 16 <= w && !cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) x += 16;
-        if (x >= w) break;
+      for (; x + 16 <= w; x += 16) {
+        const int lit = cv::v_signmask(cv::v_load(row + x) != cv::v_setzero_u8());
+        if (lit) {
+          x += __builtin_ctz(static_cast<unsigned>(lit));
+          break;
+        }
       }
 #endif
-      if (row[x]) {
-        if (start < 0) start = x;
-      } else if (start >= 0) {
-        runs_.push_back({y, start, x});
-        start = -1;
+      while (x < w && !row[x]) ++x;
+      if (x >= w) break;
+      const int start = x;
+#if CV_SIMD128
+      for (; x + 16 <= w; x += 16) {
+        const int dark = cv::v_signmask(cv::v_load(row + x) == cv::v_setzero_u8());
+        if (dark) {
+          x += __builtin_ctz(static_cast<unsigned>(dark));
+          break;
+        }
       }
-      ++x;
+#endif
+      while (x < w && row[x]) ++x;
+      runs_.push_back({y, start, x});
     }
-    if (start >= 0) runs_.push_back({y, start, w});
     // Union with the runs of the row above that touch (8-connected: columns overlap or meet
     // diagonally). Both lists are sorted by x0.
     size_t p = prev_begin;

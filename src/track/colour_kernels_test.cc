@@ -301,7 +301,8 @@ TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
   };
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(40, 1), cv::Size(1, 40), cv::Size(33, 17),
                               cv::Size(64, 64), cv::Size(200, 90)}) {
-    for (const double density : {0.05, 0.3, 0.6, 0.95}) {
+    // Up to whole rows lit (runs longer than 16 pixels, ending at the row's end).
+    for (const double density : {0.0, 0.05, 0.3, 0.6, 0.95, 0.99, 1.0}) {
       cv::Mat noise(size, CV_32F);
       rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
       cv::Mat parent(size.height + 2, size.width + 6, CV_8U, cv::Scalar(255));
