@@ -452,8 +452,13 @@ cv::Rect NonZeroBounds(const cv::Mat& mask) {
     int x = 0;
     // First nonzero column of the row, then the last one (only beyond the extent known so far).
 #if CV_SIMD128
-    while (x + 16 <= mask.cols && !cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) {
-      x += 16;
+    // The first nonzero of the first chunk with one: the lowest bit of its sign mask.
+    for (; x + 16 <= mask.cols; x += 16) {
+      const int lit = cv::v_signmask(cv::v_load(row + x) != cv::v_setzero_u8());
+      if (lit) {
+        x += __builtin_ctz(static_cast<unsigned>(lit));
+        break;
+      }
     }
 #endif
     while (x < mask.cols && !row[x]) ++x;
@@ -699,10 +704,16 @@ void EdgeZones(const cv::Mat& own, cv::Mat& zones, cv::Mat& scratch) {
     uchar* ar = a + static_cast<size_t>(y + kPad) * stride + kPad;
     uchar* br = b + static_cast<size_t>(y + kPad) * stride + kPad;
     int x = 0;
-    for (; x + 16 <= w; x += 16) {
+    const auto sixteen = [&](int x) {
       const v_uint8x16 blob = v_load(in + x) == k255;
       v_store(ar + x, blob);
       v_store(br + x, ~blob);
+    };
+    for (; x + 16 <= w; x += 16) sixteen(x);
+    // The row's rest as its last 16 pixels again (the same values where they overlap).
+    if (x < w && w >= 16) {
+      sixteen(w - 16);
+      x = w;
     }
     for (; x < w; ++x) {
       ar[x] = in[x] == 255 ? 255 : 0;
