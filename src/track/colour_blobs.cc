@@ -273,7 +273,7 @@ struct RingStatistics {
   std::array<cv::Matx33d, kRingQuarters> quarter_chroma_outer{};
 };
 
-// Inlined: a call a pixel (GCC kept it out of the loop below) was a third of its cost (issue 45).
+// Inlined: GCC left it a call per pixel of the loop below (issue 45; a few percent of it).
 [[gnu::always_inline]] inline void AddChromaticity(const uchar* c, cv::Vec3d& sum,
                                                    cv::Matx33d& outer) {
   const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
