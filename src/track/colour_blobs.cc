@@ -643,17 +643,21 @@ void ColourTracker::fit_rim(const cv::Mat& own, int component, cv::Point own_tl,
   edge_points_.clear();
   const RunLabeller::Component& comp = labeller_.components()[static_cast<size_t>(component)];
   const RunLabeller::Run* runs = labeller_.runs().data() + comp.first_run;
+  // Pixels on the frame's edge are left out (the frame cut the blob there, not a cover): a row
+  // on it at once, its first and last columns pixel by pixel.
   for (int k = 0; k < comp.run_count; ++k) {
     const int y = runs[k].y - own_tl.y;
+    const int fy = y + frame_origin.y;
+    if (fy == 0 || fy == frame_size_.height - 1) continue;
     const uchar* ow = own.ptr<uchar>(y);
+    const bool border_row = y == 0 || y == own.rows - 1;  // Then no row above or below.
+    const uchar* up = border_row ? ow : own.ptr<uchar>(y - 1);
+    const uchar* down = border_row ? ow : own.ptr<uchar>(y + 1);
     for (int x = runs[k].x0 - own_tl.x; x < runs[k].x1 - own_tl.x; ++x) {
-      const bool edge = x == 0 || y == 0 || x == own.cols - 1 || y == own.rows - 1 ||
-                        !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
-                        !own.ptr<uchar>(y + 1)[x];
-      const int fx = x + frame_origin.x, fy = y + frame_origin.y;
-      const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
-                                 fy == frame_size_.height - 1;
-      if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
+      const bool edge = border_row || x == 0 || x == own.cols - 1 || !ow[x - 1] || !ow[x + 1] ||
+                        !up[x] || !down[x];
+      const int fx = x + frame_origin.x;
+      if (edge && fx != 0 && fx != frame_size_.width - 1) edge_points_.emplace_back(fx, fy);
     }
   }
   rim_points_.assign(edge_points_.begin(), edge_points_.end());
