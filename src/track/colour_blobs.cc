@@ -309,12 +309,14 @@ int LowerTriangle(int k, int l) { return k * (k + 1) / 2 + l; }
 // zones), `others` (every blob of the mask). Core pixels are the blob's deeper than `core_depth`
 // (a filled hole is not the marker's colour); ring pixels lie outside every blob, beyond the soft
 // band and within the ring's reach.
-RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
-                                    const cv::Mat& distance, const cv::Mat& others, int core_depth,
-                                    const RingSectors& sector_of) {
+// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf.
+template <int kChannels>
+RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
+                                      const cv::Mat& distance, const cv::Mat& others,
+                                      int core_depth, const RingSectors& sector_of) {
   RingStatistics s;
-  const int channels = pixels.channels();
-  const bool chromatic = channels == 3;
+  constexpr int channels = kChannels;
+  constexpr bool chromatic = channels == 3;
   // The levels' sums and second moments are sums of integers, accumulated as integers: every
   // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
   // so the totals are the same bits in any order. Ring sums per sector, second moments per
@@ -374,6 +376,14 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
     s.ring_sq[k] = static_cast<double>(ring_squares);
   }
   return s;
+}
+
+RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
+                                    const cv::Mat& distance, const cv::Mat& others, int core_depth,
+                                    const RingSectors& sector_of) {
+  return pixels.channels() == 3
+             ? GatherRingStatisticsOf<3>(pixels, own, distance, others, core_depth, sector_of)
+             : GatherRingStatisticsOf<1>(pixels, own, distance, others, core_depth, sector_of);
 }
 
 // The spread (RMS) along `direction` of `n` values with mean `mean` and second moments `second`
@@ -485,10 +495,14 @@ struct WeightedSums {
 // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
 // pixel's colour lies between its local background (0) and the core colour (1), on the line
 // through them. Pixels of other blobs count 0.
-WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
-                              const cv::Mat& others, const RingSectors& sector_of,
-                              const RingStatistics& s, const ColourBlob& blob) {
-  const int channels = pixels.channels();
+// The channels are a constant of the template (3 or 1): the per-channel loops below unroll, the
+// same operations in the same order as with a count known only at run time (issue 45).
+template <int kChannels>
+WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
+                                const cv::Mat& distance, const cv::Mat& others,
+                                const RingSectors& sector_of, const RingStatistics& s,
+                                const ColourBlob& blob) {
+  constexpr int channels = kChannels;
   std::array<cv::Vec3d, kSectors> sector_mean;
   for (int i = 0; i < kSectors; ++i) {
     sector_mean[i] = s.sector_n[i] >= 2 ? s.sector_sum[i] / s.sector_n[i] : blob.ring_colour;
@@ -529,6 +543,14 @@ WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const c
     sums.y += row_w * y;
   }
   return sums;
+}
+
+WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
+                              const cv::Mat& others, const RingSectors& sector_of,
+                              const RingStatistics& s, const ColourBlob& blob) {
+  return pixels.channels() == 3
+             ? SoftCentroidSumsOf<3>(pixels, own, distance, others, sector_of, s, blob)
+             : SoftCentroidSumsOf<1>(pixels, own, distance, others, sector_of, s, blob);
 }
 
 }  // namespace
