@@ -329,6 +329,8 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
   // cannot keep out of memory across the loop.
   cv::Vec3d core_chroma_sum = s.core_chroma_sum;
   cv::Matx33d core_chroma_outer = s.core_chroma_outer;
+  // Counts as integers (a double's count of ones is that integer exactly).
+  int core_n = 0, ring_n = 0;
   for (int y = 0; y < own.rows; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
@@ -339,7 +341,7 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
       if (ow[x] == 255 && d[x] > core_depth) {
         AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
         if (chromatic) AddChromaticity(c, core_chroma_sum, core_chroma_outer);
-        s.core_n += 1;
+        ++core_n;
       } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
         AddLevels(c, channels, sector_sum_i[sector].data(),
@@ -349,12 +351,14 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
           AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
         }
         ++s.sector_n[sector];
-        s.ring_n += 1;
+        ++ring_n;
       }
     }
   }
   s.core_chroma_sum = core_chroma_sum;
   s.core_chroma_outer = core_chroma_outer;
+  s.core_n = core_n;
+  s.ring_n = ring_n;
   for (int k = 0; k < channels; ++k) {
     s.core_sum[k] = static_cast<double>(core_sum_i[k]);
     s.core_sq[k] = static_cast<double>(core_outer_i[LowerTriangle(k, k)]);
