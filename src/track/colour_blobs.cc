@@ -273,7 +273,9 @@ struct RingStatistics {
   std::array<cv::Matx33d, kRingQuarters> quarter_chroma_outer{};
 };
 
-void AddChromaticity(const uchar* c, cv::Vec3d& sum, cv::Matx33d& outer) {
+// Inlined: GCC left it a call per pixel of the loop below (issue 45; a few percent of it).
+[[gnu::always_inline]] inline void AddChromaticity(const uchar* c, cv::Vec3d& sum,
+                                                   cv::Matx33d& outer) {
   const cv::Vec3d chroma = ChromaticityOfLevels(c[0], c[1], c[2]);
   sum += chroma;
   for (int k = 0; k < 3; ++k) {
@@ -307,12 +309,14 @@ int LowerTriangle(int k, int l) { return k * (k + 1) / 2 + l; }
 // zones), `others` (every blob of the mask). Core pixels are the blob's deeper than `core_depth`
 // (a filled hole is not the marker's colour); ring pixels lie outside every blob, beyond the soft
 // band and within the ring's reach.
-RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
-                                    const cv::Mat& distance, const cv::Mat& others, int core_depth,
-                                    const RingSectors& sector_of) {
+// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf.
+template <int kChannels>
+RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
+                                      const cv::Mat& distance, const cv::Mat& others,
+                                      int core_depth, const RingSectors& sector_of) {
   RingStatistics s;
-  const int channels = pixels.channels();
-  const bool chromatic = channels == 3;
+  constexpr int channels = kChannels;
+  constexpr bool chromatic = channels == 3;
   // The levels' sums and second moments are sums of integers, accumulated as integers: every
   // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
   // so the totals are the same bits in any order. Ring sums per sector, second moments per
@@ -321,6 +325,12 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
   std::array<int64_t, 6> core_outer_i{};
   std::array<std::array<int64_t, 3>, kSectors> sector_sum_i{};
   std::array<std::array<int64_t, 6>, kRingQuarters> quarter_outer_i{};
+  // The core's chromaticity sums in locals (registers), not through `s`, which the compiler
+  // cannot keep out of memory across the loop.
+  cv::Vec3d core_chroma_sum = s.core_chroma_sum;
+  cv::Matx33d core_chroma_outer = s.core_chroma_outer;
+  // Counts as integers (a double's count of ones is that integer exactly).
+  int core_n = 0, ring_n = 0;
   for (int y = 0; y < own.rows; ++y) {
     const uchar* p = pixels.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
@@ -330,8 +340,8 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
       const uchar* c = p + x * channels;
       if (ow[x] == 255 && d[x] > core_depth) {
         AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
-        if (chromatic) AddChromaticity(c, s.core_chroma_sum, s.core_chroma_outer);
-        s.core_n += 1;
+        if (chromatic) AddChromaticity(c, core_chroma_sum, core_chroma_outer);
+        ++core_n;
       } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
         AddLevels(c, channels, sector_sum_i[sector].data(),
@@ -341,10 +351,14 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
           AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
         }
         ++s.sector_n[sector];
-        s.ring_n += 1;
+        ++ring_n;
       }
     }
   }
+  s.core_chroma_sum = core_chroma_sum;
+  s.core_chroma_outer = core_chroma_outer;
+  s.core_n = core_n;
+  s.ring_n = ring_n;
   for (int k = 0; k < channels; ++k) {
     s.core_sum[k] = static_cast<double>(core_sum_i[k]);
     s.core_sq[k] = static_cast<double>(core_outer_i[LowerTriangle(k, k)]);
@@ -366,6 +380,14 @@ RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
     s.ring_sq[k] = static_cast<double>(ring_squares);
   }
   return s;
+}
+
+RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
+                                    const cv::Mat& distance, const cv::Mat& others, int core_depth,
+                                    const RingSectors& sector_of) {
+  return pixels.channels() == 3
+             ? GatherRingStatisticsOf<3>(pixels, own, distance, others, core_depth, sector_of)
+             : GatherRingStatisticsOf<1>(pixels, own, distance, others, core_depth, sector_of);
 }
 
 // The spread (RMS) along `direction` of `n` values with mean `mean` and second moments `second`
@@ -477,10 +499,14 @@ struct WeightedSums {
 // Pass 2: the soft centroid. Deep inside counts 1; near the edge, the membership: where the
 // pixel's colour lies between its local background (0) and the core colour (1), on the line
 // through them. Pixels of other blobs count 0.
-WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
-                              const cv::Mat& others, const RingSectors& sector_of,
-                              const RingStatistics& s, const ColourBlob& blob) {
-  const int channels = pixels.channels();
+// The channels are a constant of the template (3 or 1): the per-channel loops below unroll, the
+// same operations in the same order as with a count known only at run time (issue 45).
+template <int kChannels>
+WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
+                                const cv::Mat& distance, const cv::Mat& others,
+                                const RingSectors& sector_of, const RingStatistics& s,
+                                const ColourBlob& blob) {
+  constexpr int channels = kChannels;
   std::array<cv::Vec3d, kSectors> sector_mean;
   for (int i = 0; i < kSectors; ++i) {
     sector_mean[i] = s.sector_n[i] >= 2 ? s.sector_sum[i] / s.sector_n[i] : blob.ring_colour;
@@ -523,6 +549,14 @@ WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const c
   return sums;
 }
 
+WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
+                              const cv::Mat& others, const RingSectors& sector_of,
+                              const RingStatistics& s, const ColourBlob& blob) {
+  return pixels.channels() == 3
+             ? SoftCentroidSumsOf<3>(pixels, own, distance, others, sector_of, s, blob)
+             : SoftCentroidSumsOf<1>(pixels, own, distance, others, sector_of, s, blob);
+}
+
 }  // namespace
 
 void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int component,
@@ -544,7 +578,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // it to the outside): a blob of one run in each of its rows (a disc, most markers) has none.
   const RunLabeller::Component& drawn = labeller_.components()[static_cast<size_t>(component)];
   if (drawn.run_count > drawn.box.height) FillHoles(own, padded.tl() + origin, blob);
-  measure_asymmetry(own, padded.tl() + origin, blob);
+  measure_asymmetry(component, padded.tl() - labelled_tl, padded.tl() + origin, blob);
   cv::Mat distance = Scratch(distance_store_, size, CV_8U);
   EdgeZones(own, distance, zone_store_);
   const cv::Mat pixels = filtered(padded);
@@ -579,7 +613,7 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // frame cuts it).
   if (const std::optional<double> radius = rim_radius_px();
       radius && blob->area_px < kWholeRimFraction * model_->area_px) {
-    fit_rim(own, padded.tl() + origin, *radius, blob);
+    fit_rim(own, component, padded.tl() - labelled_tl, padded.tl() + origin, *radius, blob);
   }
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
   const WeightedSums sums = SoftCentroidSums(pixels, own, distance, others, sector_of, s, *blob);
@@ -621,22 +655,24 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
   blob->fringe_shift_px = cv::norm(fringe - centre) * n / (blob->area_px + n);
 }
 
-void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
+void ColourTracker::measure_asymmetry(int component, cv::Point own_tl, cv::Point own_origin,
                                       ColourBlob* blob) {
   // The binary centroid against the centre of the smallest circle around the blob (its convex
-  // hull's points are among each row's leftmost and rightmost pixels).
+  // hull's points are among each row's leftmost and rightmost pixels). A row's ends are its
+  // first run's start and its last run's end (the runs are in raster order; a filled hole lies
+  // between them), in the blob's mask's coordinates: the same points a scan of the mask finds,
+  // without the scan (issue 45).
   edge_points_.clear();
-  for (int y = 0; y < own.rows; ++y) {
-    const uchar* row = own.ptr<uchar>(y);
-    int first = -1, last = -1;
-    for (int x = 0; x < own.cols; ++x) {
-      if (!row[x]) continue;
-      if (first < 0) first = x;
-      last = x;
-    }
-    if (first < 0) continue;
-    edge_points_.emplace_back(first, y);
-    if (last != first) edge_points_.emplace_back(last, y);
+  const RunLabeller::Component& comp = labeller_.components()[static_cast<size_t>(component)];
+  const RunLabeller::Run* runs = labeller_.runs().data() + comp.first_run;
+  for (int k = 0; k < comp.run_count;) {
+    const int y = runs[k].y;
+    const int first = runs[k].x0 - own_tl.x;
+    while (k + 1 < comp.run_count && runs[k + 1].y == y) ++k;
+    const int last = runs[k].x1 - 1 - own_tl.x;
+    ++k;
+    edge_points_.emplace_back(first, y - own_tl.y);
+    if (last != first) edge_points_.emplace_back(last, y - own_tl.y);
   }
   if (edge_points_.empty()) return;
   cv::Point2f circle_centre;
@@ -646,6 +682,10 @@ void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
   blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
   blob->enclosing_radius_px = circle_radius;
   blob->hull_asymmetry_px = blob->asymmetry_px;
+  // The hull's asymmetry is read only of a blob more asymmetric than a learned marker by
+  // kPartialMinPx at least (judge(): both must exceed the limit, which is never below it): the
+  // hull of a blob within that is not worth its sixth of the asymmetry's cost (issue 45).
+  if (blob->asymmetry_px <= kPartialMinPx) return;
   cv::convexHull(edge_points_, hull_points_);
   const cv::Moments hull = cv::moments(hull_points_);
   if (hull.m00 > 0) {
@@ -654,20 +694,29 @@ void ColourTracker::measure_asymmetry(const cv::Mat& own, cv::Point own_origin,
   }
 }
 
-void ColourTracker::fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius,
-                            ColourBlob* blob) {
+void ColourTracker::fit_rim(const cv::Mat& own, int component, cv::Point own_tl,
+                            cv::Point frame_origin, double radius, ColourBlob* blob) {
+  // The edge pixels in raster order: the blob's pixels with a 4-neighbour outside it, visited
+  // along the component's runs (raster order) instead of over its whole box. A filled hole's
+  // pixels (not in the runs) are never edge pixels: their 4-neighbours are the blob or the hole.
   edge_points_.clear();
-  for (int y = 0; y < own.rows; ++y) {
+  const RunLabeller::Component& comp = labeller_.components()[static_cast<size_t>(component)];
+  const RunLabeller::Run* runs = labeller_.runs().data() + comp.first_run;
+  // Pixels on the frame's edge are left out (the frame cut the blob there, not a cover): a row
+  // on it at once, its first and last columns pixel by pixel.
+  for (int k = 0; k < comp.run_count; ++k) {
+    const int y = runs[k].y - own_tl.y;
+    const int fy = y + frame_origin.y;
+    if (fy == 0 || fy == frame_size_.height - 1) continue;
     const uchar* ow = own.ptr<uchar>(y);
-    for (int x = 0; x < own.cols; ++x) {
-      if (!ow[x]) continue;
-      const bool edge = x == 0 || y == 0 || x == own.cols - 1 || y == own.rows - 1 ||
-                        !ow[x - 1] || !ow[x + 1] || !own.ptr<uchar>(y - 1)[x] ||
-                        !own.ptr<uchar>(y + 1)[x];
-      const int fx = x + frame_origin.x, fy = y + frame_origin.y;
-      const bool at_frame_edge = fx == 0 || fy == 0 || fx == frame_size_.width - 1 ||
-                                 fy == frame_size_.height - 1;
-      if (edge && !at_frame_edge) edge_points_.emplace_back(fx, fy);
+    const bool border_row = y == 0 || y == own.rows - 1;  // Then no row above or below.
+    const uchar* up = border_row ? ow : own.ptr<uchar>(y - 1);
+    const uchar* down = border_row ? ow : own.ptr<uchar>(y + 1);
+    for (int x = runs[k].x0 - own_tl.x; x < runs[k].x1 - own_tl.x; ++x) {
+      const bool edge = border_row || x == 0 || x == own.cols - 1 || !ow[x - 1] || !ow[x + 1] ||
+                        !up[x] || !down[x];
+      const int fx = x + frame_origin.x;
+      if (edge && fx != 0 && fx != frame_size_.width - 1) edge_points_.emplace_back(fx, fy);
     }
   }
   rim_points_.assign(edge_points_.begin(), edge_points_.end());

@@ -137,7 +137,8 @@ TEST(ColourKernels, OpenClose3x3IsMorphologyEx) {
   cv::RNG rng(11);
   cv::Mat scratch;
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(1, 9), cv::Size(9, 1), cv::Size(17, 5),
-                              cv::Size(16, 16), cv::Size(64, 48), cv::Size(83, 29)}) {
+                              cv::Size(16, 16), cv::Size(31, 7), cv::Size(64, 48),
+                              cv::Size(83, 29)}) {
     for (const double density : {0.1, 0.5, 0.9}) {
       for (const bool cross : {true, false}) {
         cv::Mat noise(size, CV_32F), mask;
@@ -300,7 +301,8 @@ TEST(ColourKernels, RunLabellerFindsConnectedComponentsWithStats) {
   };
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(40, 1), cv::Size(1, 40), cv::Size(33, 17),
                               cv::Size(64, 64), cv::Size(200, 90)}) {
-    for (const double density : {0.05, 0.3, 0.6, 0.95}) {
+    // Up to whole rows lit (runs longer than 16 pixels, ending at the row's end).
+    for (const double density : {0.0, 0.05, 0.3, 0.6, 0.95, 0.99, 1.0}) {
       cv::Mat noise(size, CV_32F);
       rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
       cv::Mat parent(size.height + 2, size.width + 6, CV_8U, cv::Scalar(255));

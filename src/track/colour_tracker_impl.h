@@ -158,17 +158,21 @@ class ColourTracker : public Tracker {
   // latter's in the frame.
   void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
-  // The blob's asymmetry_px and hull_asymmetry_px from its mask `own` (whose top-left pixel is
-  // `own_origin` in the frame).
   // ColourBlob::fringe_shift_px of `blob` from the padded box's `pixels`, its mask `own`, its
   // edge zones `distance` and the other blobs `others`; `own_origin` is the box's place in the
   // frame.
   void measure_fringe(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
                       const cv::Mat& others, cv::Point own_origin, ColourBlob* blob) const;
-  void measure_asymmetry(const cv::Mat& own, cv::Point own_origin, ColourBlob* blob);
+  // The blob's asymmetry_px and hull_asymmetry_px from the labeller's `component` (its runs,
+  // drawn into the blob's mask whose top-left pixel is `own_origin` in the frame and `own_tl` in
+  // the labelled mask).
+  void measure_asymmetry(int component, cv::Point own_tl, cv::Point own_origin, ColourBlob* blob);
   // A partial round blob: the circle of the marker's `radius` fitted to its edge (not where the
   // frame cuts it), and its centre as the centroid when the fit is good (RimCentre).
-  void fit_rim(const cv::Mat& own, cv::Point frame_origin, double radius, ColourBlob* blob);
+  // `own` is the blob's mask (holes filled), drawn from the labeller's `component` (whose runs
+  // give its pixels) with its top-left pixel at `own_tl` in the labelled mask.
+  void fit_rim(const cv::Mat& own, int component, cv::Point own_tl, cv::Point frame_origin,
+               double radius, ColourBlob* blob);
   // Fills the holes of the blob's mask `own` (whose top-left pixel is `own_origin` in the frame)
   // and, when there were any, sets the blob's area, centroids and circularity from the filled
   // mask.

@@ -28,6 +28,17 @@ std::optional<RimFit> FitRimOfRadius(const std::vector<cv::Point2d>& edge_px, do
                                      double inlier_px = 0.75,
                                      std::vector<double>* scratch = nullptr);
 
+// How many of `edge_px` lie within `tol` of the circle of radius `r` about `c` (|p - c| - r, as
+// cv::norm gives it): FitRimOfRadius's test of each candidate circle, which was nine tenths of it
+// (issue 45). Two points at a time (OpenCV universal intrinsics, the same IEEE operations as the
+// reference), and only as far as needed to beat `best`: the count when it exceeds `best`,
+// otherwise some count no larger than `best` (the fit asks only whether a candidate beats the
+// best so far). The reference: every point, one at a time, the exact count.
+int CountRimInliers(const std::vector<cv::Point2d>& edge_px, const cv::Point2d& c, double r,
+                    double tol, int best);
+int CountRimInliersReference(const std::vector<cv::Point2d>& edge_px, const cv::Point2d& c,
+                             double r, double tol);
+
 // How far the edge that is not on the fitted circle bulges outwards (px) beyond the straight line
 // joining its two ends. A disc cut by a straight edge leaves a chord (0); a finger or a paddle
 // pushes the edge inwards (negative); a whole marker seen in perspective (an ellipse narrower than

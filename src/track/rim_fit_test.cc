@@ -97,5 +97,38 @@ TEST(RimFit, ACutLeavesAStraightEdgeOffTheCircleAndASlantedDiscABulgingOne) {
   }
 }
 
+// The vector inlier count against its scalar reference: the same count whenever it beats `best`
+// (and none above `best` when it does not), on rasterised rims whose distances fall exactly on
+// the tolerance's edge as well as on random points, every length from 0 to 70 (odd tails, blocks).
+TEST(RimFit, TheVectorInlierCountAgreesWithItsReference) {
+  cv::RNG rng(45);
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = trial % 71;
+    std::vector<cv::Point2d> pts;
+    for (int i = 0; i < n; ++i) {
+      if (trial % 2) {
+        pts.emplace_back(rng.uniform(0, 40), rng.uniform(0, 40));  // Pixel centres: ties.
+      } else {
+        pts.emplace_back(rng.uniform(0.0, 40.0), rng.uniform(0.0, 40.0));
+      }
+    }
+    const cv::Point2d c = trial % 3 ? cv::Point2d(rng.uniform(5, 35), rng.uniform(5, 35))
+                                    : cv::Point2d(rng.uniform(5.0, 35.0), rng.uniform(5.0, 35.0));
+    const double r = trial % 4 ? rng.uniform(1, 20) : rng.uniform(1.0, 20.0);
+    const double tol = trial % 5 ? 0.75 : 1.0;
+    const int exact = CountRimInliersReference(pts, c, r, tol);
+    EXPECT_EQ(CountRimInliers(pts, c, r, tol, -1), exact) << "trial " << trial;
+    EXPECT_EQ(CountRimInliers(pts, c, r, tol, 0), exact > 0 ? exact : 0) << "trial " << trial;
+    for (const int best : {exact - 1, exact, exact + 1, n / 2, n}) {
+      const int counted = CountRimInliers(pts, c, r, tol, best);
+      if (exact > best) {
+        EXPECT_EQ(counted, exact) << "trial " << trial << " best " << best;
+      } else {
+        EXPECT_LE(counted, best) << "trial " << trial << " best " << best;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace softsight
