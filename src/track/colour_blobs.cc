@@ -629,25 +629,27 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
                                    cv::Point own_origin, ColourBlob* blob) const {
   const int channels = pixels.channels();
   if (channels != (gray_ ? 1 : 3)) return;
+  // The relaxed range over the whole padded box at once (the vector classifier), read where the
+  // ring reaches.
+  cv::Mat relaxed = Scratch(fringe_store_, pixels.size(), CV_8U);
+  if (channels == 3) {
+    fringe_hsv_.Classify(pixels, relaxed);
+  } else {
+    cv::inRange(pixels, fringe_gray_.lo, fringe_gray_.hi, relaxed);
+  }
   double n = 0, sx = 0, sy = 0;
   for (int y = 0; y < own.rows; ++y) {
-    const uchar* p = pixels.ptr<uchar>(y);
+    const uchar* in = relaxed.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
+    int row_n = 0, row_sx = 0;
     for (int x = 0; x < own.cols; ++x) {
-      if (ow[x] || ot[x] || d[x] > kReachThirds) continue;  // The blob, another, or beyond the ring.
-      const uchar* c = p + x * channels;
-      bool in = false;
-      if (channels == 1) {
-        in = c[0] >= fringe_gray_.lo && c[0] <= fringe_gray_.hi;
-      } else {
-        const cv::Vec3b hsv = BgrToHsvExact(c[0], c[1], c[2]);
-        in = fringe_box_.Contains(hsv[0], hsv[1], hsv[2]);
-      }
-      if (!in) continue;
-      n += 1, sx += x, sy += y;
+      // In the relaxed range, not the blob or another, within the ring's reach.
+      if (!in[x] || ow[x] || ot[x] || d[x] > kReachThirds) continue;
+      ++row_n, row_sx += x;
     }
+    n += row_n, sx += row_sx, sy += static_cast<double>(row_n) * y;
   }
   if (n == 0) return;
   const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(own_origin);

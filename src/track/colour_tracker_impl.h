@@ -245,8 +245,8 @@ class ColourTracker : public Tracker {
   // lowering changes nothing (a floor near 0).
   std::optional<HsvClassifier> dim_hsv_;
   std::optional<HsvRange> dim_gray_;
-  // The range with its floors halved (ColourBlob::fringe_shift_px), pixel by pixel.
-  HsvBox fringe_box_;
+  // The range with its floors halved (ColourBlob::fringe_shift_px).
+  HsvClassifier fringe_hsv_;
   HsvRange fringe_gray_{0, 255};
   bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
   // A window's analysis calls OpenCV functions that may parallelise (gray inRange, a pre-filter,
@@ -298,6 +298,7 @@ class ColourTracker : public Tracker {
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
   cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
+  mutable cv::Mat fringe_store_;  // measure_fringe's classification of the padded box.
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;
