@@ -677,18 +677,20 @@ void ColourTracker::measure_asymmetry(int component, cv::Point own_tl, cv::Point
     if (last != first) edge_points_.emplace_back(last, y - own_tl.y);
   }
   if (edge_points_.empty()) return;
+  // The smallest enclosing circle of the points is that of their convex hull's vertices: a
+  // fraction of the points, and OpenCV's incremental algorithm costs about the square of their
+  // number in raster order (issue 45).
+  cv::convexHull(edge_points_, hull_points_);
   cv::Point2f circle_centre;
   float circle_radius = 0.0f;
-  cv::minEnclosingCircle(edge_points_, circle_centre, circle_radius);
+  cv::minEnclosingCircle(hull_points_, circle_centre, circle_radius);
   const cv::Point2d binary_centre = blob->binary_centroid_px - cv::Point2d(own_origin);
   blob->asymmetry_px = cv::norm(cv::Point2d(circle_centre) - binary_centre);
   blob->enclosing_radius_px = circle_radius;
   blob->hull_asymmetry_px = blob->asymmetry_px;
   // The hull's asymmetry is read only of a blob more asymmetric than a learned marker by
-  // kPartialMinPx at least (judge(): both must exceed the limit, which is never below it): the
-  // hull of a blob within that is not worth its sixth of the asymmetry's cost (issue 45).
+  // kPartialMinPx at least (judge(): both must exceed the limit, which is never below it).
   if (blob->asymmetry_px <= kPartialMinPx) return;
-  cv::convexHull(edge_points_, hull_points_);
   const cv::Moments hull = cv::moments(hull_points_);
   if (hull.m00 > 0) {
     const cv::Point2d hull_centre(hull.m10 / hull.m00, hull.m01 / hull.m00);
