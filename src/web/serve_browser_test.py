@@ -545,9 +545,14 @@ def test_compare(page, recording_csv):
     for message in ("{type: 'seek', position: %d}" % frame, "{type: 'pause'}",
                     "{type: 'seek', position: %d}" % frame):
         page.state("window.softsight.send(%s)" % message)
+    # The readout is written by the same redraw that draws the compared markers: waited for with
+    # them (a redraw of the frame before the seek settled may be the last one handled when the
+    # markers count is first 3).
     page.wait("the seek to a recorded frame, compared", "window.softsight.shownPosition === %d && "
               "window.softsight.row(%d) !== null && window.softsight.compareDrawn === 3 && "
-              "window.softsight.comparePlotted > 0" % (frame, frame))
+              "window.softsight.comparePlotted > 0 && "
+              "document.getElementById('comparereadout').textContent.includes('frame %d ')"
+              % (frame, frame, frame))
     other = page.state("window.softsight.compareRow(%d)" % frame)
     check(other is not None and other["frame"] == frame, "frame %d compared with %s" % (frame, other and other["frame"]))
     row = page.state("window.softsight.row(%d)" % frame)
