@@ -626,16 +626,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
 
 void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
                                    const cv::Mat& distance, const cv::Mat& others,
-                                   cv::Point own_origin, ColourBlob* blob) const {
-  const int channels = pixels.channels();
-  if (channels != (gray_ ? 1 : 3)) return;
+                                   cv::Point own_origin, ColourBlob* blob) {
   // The relaxed range over the whole padded box at once (the vector classifier), read where the
-  // ring reaches.
+  // ring reaches. `pixels` has the channels of the tracker's mode (prepare()).
   cv::Mat relaxed = Scratch(fringe_store_, pixels.size(), CV_8U);
-  if (channels == 3) {
-    fringe_hsv_.Classify(pixels, relaxed);
-  } else {
+  if (gray_) {
     cv::inRange(pixels, fringe_gray_.lo, fringe_gray_.hi, relaxed);
+  } else {
+    fringe_hsv_.Classify(pixels, relaxed);
   }
   double n = 0, sx = 0, sy = 0;
   for (int y = 0; y < own.rows; ++y) {

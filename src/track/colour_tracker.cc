@@ -113,7 +113,8 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     derived.s = s;
     derived.v = v;
     fine_hsv_ = HsvClassifier(HsvBox::Make(h, s, v));
-    fringe_hsv_ = HsvClassifier(HsvBox::Make(h, HsvRange{s.lo / 2, s.hi}, HsvRange{v.lo / 2, v.hi}));
+    fringe_hsv_ =
+        HsvClassifier(HsvBox::Make(h, HsvRange{s.lo / 2, s.hi}, HsvRange{v.lo / 2, v.hi}));
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
     if (v.lo >= kDimMinFloor) {
       const int floor = static_cast<int>(v.lo * kDimFloor);

@@ -162,7 +162,7 @@ class ColourTracker : public Tracker {
   // edge zones `distance` and the other blobs `others`; `own_origin` is the box's place in the
   // frame.
   void measure_fringe(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
-                      const cv::Mat& others, cv::Point own_origin, ColourBlob* blob) const;
+                      const cv::Mat& others, cv::Point own_origin, ColourBlob* blob);
   // The blob's asymmetry_px and hull_asymmetry_px from the labeller's `component` (its runs,
   // drawn into the blob's mask whose top-left pixel is `own_origin` in the frame and `own_tl` in
   // the labelled mask).
@@ -298,7 +298,7 @@ class ColourTracker : public Tracker {
   // Buffers reused frame to frame: raw storage behind Mat headers of the size each frame needs.
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
   cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
-  mutable cv::Mat fringe_store_;  // measure_fringe's classification of the padded box.
+  cv::Mat fringe_store_;  // measure_fringe's classification of the padded box.
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;

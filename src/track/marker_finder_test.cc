@@ -146,7 +146,8 @@ TEST(MarkerFinder, ADimBlueDomeUnderWarmLightIsFoundWhole) {
         }
       }
       for (int c = 0; c < 3; ++c) {
-        frame.at<cv::Vec3b>(y, x)[c] = cv::saturate_cast<uchar>(bgr[c] + noise.at<cv::Vec3s>(y, x)[c]);
+        frame.at<cv::Vec3b>(y, x)[c] =
+            cv::saturate_cast<uchar>(bgr[c] + noise.at<cv::Vec3s>(y, x)[c]);
       }
     }
   }
