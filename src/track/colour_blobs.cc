@@ -622,6 +622,10 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   // same bits.
   blob->centroid_px = cv::Point2d(sums.x / sums.w + (padded.x + origin.x),
                                   sums.y / sums.w + (padded.y + origin.y));
+  if (fringe_places_ && !blob->rim_placed) {
+    blob->centroid_px += blob->fringe_pull_px;
+    blob->fringe_placed = true;
+  }
 }
 
 void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
@@ -635,24 +639,32 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
   } else {
     fringe_hsv_.Classify(pixels, relaxed);
   }
-  double n = 0, sx = 0, sy = 0;
+  // All of the fringe (the sigma's term), and its part beyond the soft band (the position's:
+  // the band's pixels already weigh in the soft centroid by their membership, and an
+  // anti-aliased rim's row of half-saturated pixels is no fringe: counted again, it moved a
+  // clean rendered disc's soft centroid by 0.05 px RMS).
+  double n = 0, sx = 0, sy = 0, far_n = 0, far_sx = 0, far_sy = 0;
   for (int y = 0; y < own.rows; ++y) {
     const uchar* in = relaxed.ptr<uchar>(y);
     const uchar* ow = own.ptr<uchar>(y);
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
-    int row_n = 0, row_sx = 0;
+    int row_n = 0, row_sx = 0, far_row_n = 0, far_row_sx = 0;
     for (int x = 0; x < own.cols; ++x) {
       // In the relaxed range, not the blob or another, within the ring's reach.
       if (!in[x] || ow[x] || ot[x] || d[x] > kReachThirds) continue;
       ++row_n, row_sx += x;
+      if (d[x] > kNearThirds) ++far_row_n, far_row_sx += x;
     }
     n += row_n, sx += row_sx, sy += static_cast<double>(row_n) * y;
+    far_n += far_row_n, far_sx += far_row_sx, far_sy += static_cast<double>(far_row_n) * y;
   }
   if (n == 0) return;
   const cv::Point2d centre = blob->binary_centroid_px - cv::Point2d(own_origin);
-  const cv::Point2d fringe(sx / n, sy / n);
-  blob->fringe_shift_px = cv::norm(fringe - centre) * n / (blob->area_px + n);
+  blob->fringe_shift_px = cv::norm(cv::Point2d(sx / n, sy / n) - centre) * n / (blob->area_px + n);
+  if (far_n == 0) return;
+  blob->fringe_pull_px =
+      (cv::Point2d(far_sx / far_n, far_sy / far_n) - centre) * (far_n / (blob->area_px + far_n));
 }
 
 void ColourTracker::measure_asymmetry(int component, cv::Point own_tl, cv::Point own_origin,

@@ -113,6 +113,7 @@ ColourTracker::ColourTracker(const ColourParams& params) : params_(params) {
     derived.s = s;
     derived.v = v;
     fine_hsv_ = HsvClassifier(HsvBox::Make(h, s, v));
+    fringe_places_ = s.lo > 0 && !h.covers_all_hues();
     fringe_hsv_ =
         HsvClassifier(HsvBox::Make(h, HsvRange{s.lo / 2, s.hi}, HsvRange{v.lo / 2, v.hi}));
     coarse_hsv_ = HsvClassifier(filtered ? CoarseBox(derived) : HsvBox::Make(h, s, v));
@@ -319,7 +320,10 @@ BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
   if (blob.rim_placed) {
     evidence.area_px = std::max(blob.area_px, model.area_px);
   } else {
-    evidence.centroid_disagreement_px = cv::norm(blob.centroid_px - blob.binary_centroid_px);
+    // The soft centroid's own disagreement: the fringe's step is the fringe's term.
+    const cv::Point2d placed = blob.fringe_placed ? blob.fringe_pull_px : cv::Point2d();
+    evidence.centroid_disagreement_px =
+        cv::norm(blob.centroid_px - placed - blob.binary_centroid_px);
     evidence.fringe_shift_px = blob.fringe_shift_px;
   }
   return evidence;

@@ -54,12 +54,19 @@ struct ColourBlob {
   // an elongated sticker, where its centre rests on the two ends' pixels).
   double enclosing_radius_px = 0;
   // How far the binary centroid moves when the blob takes in its pale fringe: the pixels just
-  // outside it (within the soft band) that pass the range with its lower bounds of saturation
-  // and brightness halved (a gray range's bound halved, or a dark dot's upper bound raised half
-  // way to white). Where a range's floor cuts through the marker (a lit dome's whitened top, the
-  // flank a lamp leaves in shade, a clipped plateau at a gray floor), what is marker is uncertain
-  // by about this much: it widens the position's sigma, and moves nothing.
+  // outside it (within the ring's reach, 4 px) that pass the range with its lower bounds of
+  // saturation and brightness halved (a gray range's bound halved, or a dark dot's upper bound
+  // raised half way to white). Where a range's floor cuts through the marker (a lit dome's
+  // whitened top, the flank a lamp leaves in shade, a clipped plateau at a gray floor), what is
+  // marker is uncertain by about this much: it widens the position's sigma.
   double fringe_shift_px = 0;
+  // The same move (its direction too) from the fringe's pixels beyond the soft band, which the
+  // soft centroid does not weigh. Where the range names a hue, the fringe is paler or darker
+  // marker colour (not any bright or dark surface) and the soft centroid takes it in: the band's
+  // pixels by their membership, these beyond it whole (fringe_placed). The sigma's half of the
+  // whole fringe's shift says how far the edge may still lie either way.
+  cv::Point2d fringe_pull_px;
+  bool fringe_placed = false;  // centroid_px includes fringe_pull_px.
   bool measured = false;           // The colour statistics below are set.
   // Taken as the tracked marker in a shadow (it fits in everything but brightness where the
   // marker should be): its colour is not the marker's under the usual light, and is not learned.
@@ -158,7 +165,7 @@ class ColourTracker : public Tracker {
   // latter's in the frame.
   void measure(const cv::Mat& filtered, const cv::Mat& mask, int component, const cv::Rect& box,
                cv::Point labelled_tl, cv::Point origin, ColourBlob* blob);
-  // ColourBlob::fringe_shift_px of `blob` from the padded box's `pixels`, its mask `own`, its
+  // ColourBlob::fringe_shift_px and fringe_pull_px of `blob` from the padded box's `pixels`, its mask `own`, its
   // edge zones `distance` and the other blobs `others`; `own_origin` is the box's place in the
   // frame.
   void measure_fringe(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
@@ -245,9 +252,11 @@ class ColourTracker : public Tracker {
   // lowering changes nothing (a floor near 0).
   std::optional<HsvClassifier> dim_hsv_;
   std::optional<HsvRange> dim_gray_;
-  // The range with its floors halved (ColourBlob::fringe_shift_px).
+  // The range with its floors halved (ColourBlob::fringe_shift_px), and whether it moves the soft
+  // centroid: a hue range with a saturation floor.
   HsvClassifier fringe_hsv_;
   HsvRange fringe_gray_{0, 255};
+  bool fringe_places_ = false;
   bool morph_cross_ = false, morph_square_ = false;  // kernel_ is 3x3: the vector kernel applies.
   // A window's analysis calls OpenCV functions that may parallelise (gray inRange, a pre-filter,
   // morphology other than 3x3), besides a colour conversion of a frame of the other kind.

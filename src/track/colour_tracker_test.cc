@@ -337,16 +337,12 @@ TEST(ColourTracker, AnElongatedStickerTurningIsNeverTakenForACoveredMarker) {
   EXPECT_EQ(obs.not_found_reason, MarkerStatus::kCovered);
 }
 
-TEST(ColourTracker, APaleFringeTheRangeCutsOffWidensTheSigmaNotThePosition) {
-  // A red dome whose top the light pales: saturation 60 (below the range's 80, above half of it)
-  // over its upper quarter. The blob is the rest and its centroid lies below the dome's centre;
-  // the position stays the blob's, and its sigma covers the dome's centre within 3 sigma, where
-  // the same disc without the pale top (the centroid exact) keeps a sigma under half as large.
-  const cv::Point2d centre(150.5, 120.5);
-  ColourTracker whole_tracker(RedParams()), pale_tracker(RedParams());
-  cv::Mat whole = Background();
-  PaintDisc(whole, centre, 10, kRed);
-  cv::Mat pale = whole.clone();
+// A red disc of radius 10 at `centre` whose top the light pales: saturation 60 (below
+// RedParams' floor of 80, above half of it) over its upper quarter.
+cv::Mat PaleTopDisc(const cv::Point2d& centre, cv::Mat* whole) {
+  *whole = Background();
+  PaintDisc(*whole, centre, 10, kRed);
+  cv::Mat pale = whole->clone();
   for (int y = 0; y < pale.rows; ++y) {
     for (int x = 0; x < pale.cols; ++x) {
       if (std::hypot(x - centre.x, y - centre.y) <= 10 && y < centre.y - 5) {
@@ -354,6 +350,17 @@ TEST(ColourTracker, APaleFringeTheRangeCutsOffWidensTheSigmaNotThePosition) {
       }
     }
   }
+  return pale;
+}
+
+TEST(ColourTracker, APaleFringeTheRangeCutsOffWidensTheSigmaNotTheBinaryCentroid) {
+  // The blob is the rest of the disc and its centroid lies below the dome's centre. The paper's
+  // binary centroid stays the blob's; its sigma covers the dome's centre within 3 sigma, where
+  // the same disc without the pale top (the centroid exact) keeps a sigma under half as large.
+  const cv::Point2d centre(150.5, 120.5);
+  ColourTracker whole_tracker(RedParams()), pale_tracker(RedParams());
+  cv::Mat whole;
+  const cv::Mat pale = PaleTopDisc(centre, &whole);
   const cv::Point2d cut = CentroidOfColour(pale, kRed);
   ASSERT_GT(cut.y - centre.y, 1.0);  // The cut blob's centroid is well off the dome's centre.
   Observation w, p;
@@ -363,6 +370,27 @@ TEST(ColourTracker, APaleFringeTheRangeCutsOffWidensTheSigmaNotThePosition) {
   const double error = cv::norm(*p.position_px - centre);
   EXPECT_LT(error, 3 * *p.sigma_px) << "sigma " << *p.sigma_px << " px, error " << error << " px";
   EXPECT_LT(*w.sigma_px, 0.5 * *p.sigma_px);
+}
+
+TEST(ColourTracker, TheSoftCentroidOfAHueRangeTakesInThePaleFringe) {
+  // The soft centroid of a range that names a hue takes in the pale top beyond its soft band:
+  // nearer the dome's centre than the cut blob's centroid, not past it, and the sigma still
+  // covers the centre. A whole disc has no fringe and does not move.
+  const cv::Point2d centre(150.5, 120.5);
+  ColourParams soft = RedParams();
+  soft.centroid = ColourParams::Centroid::kSoft;
+  ColourTracker whole_tracker(soft), pale_tracker(soft), cut_tracker(RedParams());
+  cv::Mat whole;
+  const cv::Mat pale = PaleTopDisc(centre, &whole);
+  const double cut_error = CentroidOfColour(pale, kRed).y - centre.y;
+  Observation w, p;
+  for (int i = 0; i < 3; ++i) w = whole_tracker.update(whole), p = pale_tracker.update(pale);
+  ASSERT_TRUE(w.found() && p.found());
+  EXPECT_LT(cv::norm(*w.position_px - centre), 0.05);
+  const double error = cv::norm(*p.position_px - centre);
+  EXPECT_LT(error, 0.7 * cut_error) << "cut " << cut_error << " px off";
+  EXPECT_GT(p.position_px->y, centre.y);  // The top is paler, not gone: not past the centre.
+  EXPECT_LT(error, 3 * *p.sigma_px) << "sigma " << *p.sigma_px << " px, error " << error << " px";
 }
 
 TEST(ColourTracker, RoiAndHintRestrictTheFirstAcquisition) {

@@ -71,6 +71,10 @@ struct ColourParams {
   // kSoft: pixels within 2 px of the blob's edge count by their membership, the projection of
   // their colour on the line from the blob's local background colour (a ring 3-4 px outside) to
   // its core colour, clamped to 0..1: anti-aliased and blurred edges then weigh what they cover.
+  // With a range that names a hue and a saturation floor, the centroid also takes in the pale
+  // fringe beyond those 2 px (pixels up to 4 px outside the blob that pass the range with its
+  // saturation and brightness floors halved: a lit dome's whitened top, a shaded flank), which
+  // the floor cut off the marker; the sigma covers the edge lying anywhere between the two cuts.
   // kBinary: the paper's centroid of the binary mask (exact for hard-edged, unblurred markers).
   enum class Centroid { kSoft, kBinary };
   Centroid centroid = Centroid::kSoft;
