@@ -79,6 +79,11 @@ SCENES = {
         layout='side', light='warm_side', markers=['red', 'blue', 'green'], aspect=2.0, flat=True,
         s_mm=[14, 50, 86],
         bend=(5, 100, 15, 3), frames=36, codec='mjpg', noise=3.0, seed=9),
+    'hard': dict(
+        what='everything at once: dim warm side light, distractors of the markers\' colours, a finger '
+             'over the middle marker, a fast bend with motion blur',
+        layout='side', light='warm_side', markers=['red', 'blue', 'green'], distractors=True,
+        finger=True, bend=(5, 110, 12, 2), frames=36, codec='mjpg', noise=4.0, seed=10, shutter=0.5),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip
