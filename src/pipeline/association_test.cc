@@ -167,6 +167,26 @@ TEST(MarkerTracks, AReportOnAnotherMarkersPredictedPlaceIsNotBelieved) {
   EXPECT_TRUE(m[1].observation.found());
 }
 
+TEST(MarkerTracks, AMarkerBackFromBehindACoverIsNotClaimedByAnotherCoastingThere) {
+  // Both markers go behind a finger for 9 frames; marker 1 comes out where it was last seen
+  // (the actuator bent back), its own tracker recognising it. Marker 0, still hidden, has coasted
+  // onto that place with a gate grown wide, but its tracker did not list it: it is marker 1's.
+  MarkerTracks tracks = TwoMovingTracks(10);
+  const std::vector<MarkerCandidate> none;
+  for (int f = 0; f < 9; ++f) {
+    std::vector<MarkerObservation> hidden = Reports({std::nullopt, std::nullopt});
+    tracks.associate(hidden, {&none, &none});
+    tracks.commit(hidden);
+  }
+  // (Not exactly there: that would be a repeated frame.)
+  std::vector<MarkerObservation> m = Reports({std::nullopt, cv::Point2d(191.5, 0.8)});
+  const std::vector<MarkerCandidate> b = {Candidate({191.5, 0.8}, CandidateVerdict::kChosen)};
+  const auto& d = tracks.associate(m, {&none, &b});
+  EXPECT_EQ(d[1].action, MarkerTracks::Decision::Action::kKeep);
+  EXPECT_TRUE(m[1].observation.found());
+  EXPECT_FALSE(m[0].observation.found());
+}
+
 TEST(MarkerTracks, ACandidateTheTrackerDidNotChooseIsAdoptedWhereTheMotionSaysTheMarkerIs) {
   MarkerTracks tracks = TwoMovingTracks(10);
   // Marker 0's tracker chose the twin at marker 1's place; its own marker was a candidate too.

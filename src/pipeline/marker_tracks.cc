@@ -261,10 +261,13 @@ void MarkerTracks::add_unlisted_in_gates() {
   // A candidate inside a started marker's gate proper (its prediction, not a coasting reach) that
   // its tracker did not list (lost, or covered, this frame) is still that marker's to explain:
   // it may take it (and stays not found: its tracker did not verify it), so a marker coasting
-  // with a wide reach does not take the place another marker was just predicted at.
+  // with a wide reach does not take the place another marker was just predicted at. Only a
+  // marker believed in the last frame has such a gate: one coasting for a while has a gate grown
+  // wide with it (a finger over it for ten frames: 47 px), and its tracker's silence there is no
+  // claim on the place another marker's own tracker recognises.
   for (size_t j = 0; j < tracks_.size(); ++j) {
     const Track& t = tracks_[j];
-    if (!t.motion.started()) continue;
+    if (!t.motion.started() || t.misses > 0) continue;
     for (size_t k = 0; k < pooled_.size(); ++k) {
       const cv::Point2d p = pooled_[k].position_px;
       bool listed = false;

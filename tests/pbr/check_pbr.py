@@ -110,8 +110,10 @@ CASES = {
     'hard': dict(
         what='everything at once: dim warm side light, distractors, a finger, a fast blurred bend',
         configs=[('pick', 99.0, None),
-                 # zncc: green lost in 2 frames as it comes out from behind the finger
-                 ('zncc', 97.0, None)]),
+                 # zncc: green refused in 2 frames as it came out from behind the finger until a
+                 # marker coasting for a while (blue, behind it too) no longer claimed every place
+                 # its grown gate held that its tracker did not list
+                 ('zncc', 99.0, None)]),
 }
 
 
