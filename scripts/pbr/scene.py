@@ -84,6 +84,12 @@ SCENES = {
              'over the middle marker, a fast bend with motion blur',
         layout='side', light='warm_side', markers=['red', 'blue', 'green'], distractors=True,
         finger=True, bend=(5, 110, 12, 2), frames=36, codec='mjpg', noise=4.0, seed=10, shutter=0.5),
+    'wedgehard': dict(
+        what='the 5-colour wedge from above under the warm side lamp, a finger over its second '
+             'marker, a fast bend with motion blur',
+        layout='top', light='warm_side', markers=['red', 'yellow', 'green', 'blue', 'magenta'],
+        wedge=True, finger=True, bend=(5, 110, 12, 2), frames=36, codec='mjpg', noise=4.0,
+        seed=11, shutter=0.5),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip
