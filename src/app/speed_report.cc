@@ -2,7 +2,9 @@
 // each figure beside references measured in the same run on the same file, so the ratios hold
 // on another (or a busier) machine. Prints Markdown table rows for the README (scripts/bench.sh).
 //   - one BGR -> gray pass over the video's first frame (the per-frame reference of every table),
-//   - a bare decode loop of the file (OpenFrameSource, nothing else),
+//   - a bare decode loop of the file: OpenCV's FFmpeg reader and nothing else (not
+//     OpenFrameSource: a file's source also runs the damage probe, a second decode of a
+//     compressed file, which is `track`'s cost, not the decoder's),
 //   - `track`'s pipeline (CSV written) with decoding in line, then decoding on its own thread
 //     (ReadAheadSource, as `track` runs), wall time per frame,
 //   - the tracking alone (median proc_ms of the same runs),
@@ -12,6 +14,8 @@
 //     already keep every core busy, and then max(decode, track) is out of reach).
 // Each is the median of `kRepeats` runs. A benchmark, not a test: it asserts nothing.
 // softsight_speed_report --decode VIDEO: the bare decode loop alone, once (for its peak memory).
+// softsight_speed_report --source VIDEO: the file's FrameSource alone (the decode, the damage
+// probe and the key-frame checks), once: what of `track`'s cost is reading.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,6 +30,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "softsight/config/config.h"
 #include "softsight/io/frame_source.h"
@@ -76,6 +81,17 @@ struct Pass {
 };
 
 Pass DecodeOnly(const std::string& video) {
+  cv::VideoCapture capture(video, cv::CAP_FFMPEG);
+  cv::Mat image;
+  int64_t frames = 0;
+  const auto start = Clock::now();
+  const double cpu_start = ProcessCpuMs();
+  while (capture.read(image)) ++frames;
+  const double n = static_cast<double>(std::max<int64_t>(frames, 1));
+  return {MsSince(start) / n, 0.0, frames, (ProcessCpuMs() - cpu_start) / n};
+}
+
+Pass SourceOnly(const std::string& video) {
   std::unique_ptr<FrameSource> source = OpenFrameSource({video, {}, 30.0});
   Frame frame;
   int64_t frames = 0;
@@ -101,6 +117,12 @@ Pass Track(const TrackingConfig& config, const std::string& video, const std::st
 }
 
 int Main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--source") {
+    const Pass read = SourceOnly(argv[2]);
+    std::printf("%lld frames, %.3f ms/frame, CPU %.3f ms/frame\n",
+                static_cast<long long>(read.frames), read.ms_per_frame, read.cpu_ms_per_frame);
+    return 0;
+  }
   if (argc == 3 && std::string(argv[1]) == "--decode") {
     // The bare decode loop alone, in a process of its own: its peak memory (/usr/bin/time -v)
     // and CPU time beside `softsight track`'s on the same file (scripts/bench.sh).
@@ -112,7 +134,8 @@ int Main(int argc, char** argv) {
   }
   if (argc != 4) {
     std::cerr << "usage: softsight_speed_report CONFIG VIDEO OUT_DIR\n"
-                 "       softsight_speed_report --decode VIDEO\n";
+                 "       softsight_speed_report --decode VIDEO\n"
+                 "       softsight_speed_report --source VIDEO\n";
     return 2;
   }
   const TrackingConfig config = LoadTrackingConfig(argv[1]);
