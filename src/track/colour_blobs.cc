@@ -91,6 +91,66 @@ void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
                     [&](const cv::Range&) { analyse_region(frame, region, blobs, dimmed); });
 }
 
+cv::Rect ColourTracker::ClassifyRegion(const cv::Mat& filtered, cv::Mat& mask,
+                                      const cv::Rect& inner, bool dimmed) {
+  const cv::Rect all(cv::Point(0, 0), mask.size());
+  // The margin around the region feeds the pre-filter, the morphology near the region's border
+  //  and the ring of a blob near it. Without a pre-filter each mask pixel is its own pixel's
+  //  test, and the margin matters only when the region's own marker-coloured pixels come within
+  //  `guard` of a side that has a margin: the four morphology passes (radius r each) carry a
+  //  margin pixel at most 4r into the region, and a pixel there depends on nothing deeper than
+  //  8r; a blob's padded box reaches kRingOuter + 1 beyond it, and the morphology grows a blob by
+  //  r at most. So when the region's pixels keep `guard` away from every side with a margin, the
+  //  region is what a pass over the margin too would make of it, bit for bit, and the margin
+  //  (a third of a window at VGA, 18 px of 82) is never classified (issue 45).
+  if (params_.filter != ColourParams::Filter::kNone || inner == all) {
+    classify(filtered, false, mask, dimmed);
+    return NonZeroBounds(mask);
+  }
+  const int morph_radius = kernel_.empty() ? 0 : params_.morph_size / 2;
+  const int guard = std::max(margin_px_, 8 * morph_radius + 1);
+  const auto near_a_margin = [&](cv::Rect bounds) {
+    bounds += inner.tl();
+    return (inner.x > 0 && bounds.x - inner.x < guard) ||
+           (inner.y > 0 && bounds.y - inner.y < guard) ||
+           (inner.br().x < all.width && inner.br().x - bounds.br().x < guard) ||
+           (inner.br().y < all.height && inner.br().y - bounds.br().y < guard);
+  };
+  cv::Mat inner_mask = mask(inner);
+  if (margin_was_needed_) {
+    // The last region needed its margin (clutter of the marker's colour all over, as on a
+    // poster-covered wall): most likely this one does too, and classifying it in one pass costs
+    // less than the region and then its margin's strips. Whether it still does is a scan of the
+    // region's mask (a sixteenth of classifying it). Either way the result is the same.
+    classify(filtered, false, mask, dimmed);
+    const cv::Rect inner_bounds = NonZeroBounds(inner_mask);
+    margin_was_needed_ = !inner_bounds.empty() && near_a_margin(inner_bounds);
+    return NonZeroBounds(mask);
+  }
+  classify(filtered(inner), false, inner_mask, dimmed);
+  const cv::Rect bounds = NonZeroBounds(inner_mask);
+  if (bounds.empty()) return bounds;  // Margin pixels alone set nothing inside (see above).
+  margin_was_needed_ = near_a_margin(bounds);
+  if (!margin_was_needed_) return bounds + inner.tl();
+  // The margin's strips: above and below the region at full width, and beside it (each as at
+  // least 16 columns, overlapping the region, whose pixels get the same result again: a strip
+  // narrower than a vector would take the scalar test).
+  const auto strip = [&](const cv::Rect& r) {
+    const cv::Rect part = r & all;
+    if (part.empty()) return;
+    cv::Mat part_mask = mask(part);
+    classify(filtered(part), false, part_mask, dimmed);
+  };
+  strip(cv::Rect(0, 0, all.width, inner.y));
+  strip(cv::Rect(0, inner.br().y, all.width, all.height - inner.br().y));
+  if (inner.x > 0) strip(cv::Rect(0, inner.y, std::max(inner.x, 16), inner.height));
+  if (inner.br().x < all.width) {
+    const int width = std::max(all.width - inner.br().x, 16);
+    strip(cv::Rect(all.width - width, inner.y, width, inner.height));
+  }
+  return NonZeroBounds(mask);
+}
+
 void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
                                    std::vector<ColourBlob>* blobs, bool dimmed) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
@@ -114,15 +174,15 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
 
   // 2. Binarise.
   cv::Mat mask = Scratch(mask_store_, extended.size(), CV_8U);
-  classify(filtered, false, mask, dimmed);
+  const cv::Rect extended_local(cv::Point(0, 0), extended.size());
+  const cv::Rect inner_local(region.tl() - extended.tl(), region.size());
+  cv::Rect active = ClassifyRegion(filtered, mask, inner_local, dimmed);
+  if (active.empty()) return;
 
   // 3. Opening then closing, only where it can change anything: outside the bounding box of the
   //    marker-coloured pixels the mask is 0 and stays 0 (opening only removes, closing only fills
   //    between pixels), so morphology and labelling work on that box plus the reach of the four
   //    passes. Beyond the box the parent mask holds zeros, exactly what a whole pass would read.
-  const cv::Rect extended_local(cv::Point(0, 0), extended.size());
-  cv::Rect active = NonZeroBounds(mask);
-  if (active.empty()) return;
   if (!kernel_.empty()) {
     const int reach = 4 * (params_.morph_size / 2) + 1;
     active = cv::Rect(active.x - reach, active.y - reach, active.width + 2 * reach,
@@ -142,7 +202,6 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
 
   // 4. Blobs of the region proper (the margin only fed the filters); the region is 0 outside
   //    `labelled`, so its components are the region's components.
-  const cv::Rect inner_local(region.tl() - extended.tl(), region.size());
   const cv::Rect labelled = active & inner_local;
   if (labelled.empty()) return;
   const cv::Point offset = labelled.tl() - inner_local.tl();  // Of `labelled` in the region.
