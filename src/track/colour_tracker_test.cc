@@ -950,6 +950,65 @@ TEST(ColourTrackerScene, WindowedEqualsWholeFrameAndCoarseEqualsFullResolution) 
   }
 }
 
+TEST(ColourTrackerScene, WindowsWithoutAFilterEqualTheWholeFrameBitForBit) {
+  // Without a pre-filter a window's margin is classified only when the window's own pixels of
+  // the marker's colour come near its sides (ColourTracker::ClassifyRegion); either way its
+  // result is the whole frame's, bit for bit. Specks of the markers' colours scattered around
+  // them bring some windows' pixels near their sides and leave others clear.
+  NoiseOptions noise;
+  noise.sigma = 3.0;
+  SyntheticScene scene(BendingScene(60), noise);
+  const cv::Scalar specks[] = {cv::Scalar(40, 40, 220), cv::Scalar(220, 60, 40),
+                               cv::Scalar(50, 200, 50)};
+  cv::RNG rng(45);
+  for (const ColourParams::Centroid centroid :
+       {ColourParams::Centroid::kBinary, ColourParams::Centroid::kSoft}) {
+    for (const char* name : {"red", "blue", "green"}) {
+      ColourParams windowed = ParamsFor(name);
+      windowed.centroid = centroid;
+      ColourParams whole = windowed;
+      whole.window_px = 0;
+      whole.acquire_downsample = 1;  // The frame as one region, its margin all beyond it.
+      ColourTracker a(windowed), b(whole);
+      cv::Mat image;
+      int compared = 0;
+      for (int f = 0; f < 60; f += 2) {
+        const SceneTruth truth = scene.render(f, image);
+        // Around each marker, from well inside its window to beyond the window's side.
+        for (const MarkerTruth& marker : truth.markers) {
+          if (!marker.centroid_px) continue;
+          for (int k = 0; k < 12; ++k) {
+            const double angle = rng.uniform(0.0, 2 * CV_PI), distance = rng.uniform(22.0, 48.0);
+            const cv::Point at(cvRound(marker.centroid_px->x + distance * std::cos(angle)),
+                               cvRound(marker.centroid_px->y + distance * std::sin(angle)));
+            cv::circle(image, at, rng.uniform(2, 5), specks[rng.uniform(0, 3)], cv::FILLED);
+          }
+        }
+        const Observation oa = a.update(image), ob = b.update(image);
+        ASSERT_EQ(oa.found(), ob.found()) << name << " frame " << f;
+        if (oa.found()) {
+          EXPECT_EQ(oa.position_px->x, ob.position_px->x) << name << " " << f;
+          EXPECT_EQ(oa.position_px->y, ob.position_px->y) << name << " " << f;
+          EXPECT_EQ(*oa.score, *ob.score) << name << " " << f;
+        }
+        // Every blob the window saw whole is a blob of the whole frame, measured the same (the
+        // same tracker, so the same learned model).
+        std::vector<ColourBlob> blobs;
+        a.find_blobs(image, 1, &blobs);
+        for (const MarkerCandidate& c : a.candidates()) {
+          if (c.verdict == CandidateVerdict::kClipped) continue;
+          const bool same = std::any_of(blobs.begin(), blobs.end(), [&](const ColourBlob& b) {
+            return b.centroid_px == c.position_px && b.area_px == c.area_px;
+          });
+          EXPECT_TRUE(same) << name << " frame " << f << " blob at " << c.position_px;
+          ++compared;
+        }
+      }
+      EXPECT_GE(compared, 30) << name;
+    }
+  }
+}
+
 TEST(ColourTrackerScene, CoarseCandidatesFindEveryAcceptableBlob) {
   // Noise and a half-covered marker: the coarse-to-fine search must return exactly the blobs
   // of the full-resolution search that are large and round enough to count as the marker.
