@@ -58,6 +58,11 @@ bool ColourTracker::membership(const cv::Mat& frame_bgr, cv::Mat& mask) const {
 }
 
 void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask, bool dimmed) {
+  if (!gray_ && src.channels() == 1) {
+    // A flat region's plane (analyse_region): each level stands for the BGR pixel (v, v, v).
+    (dimmed ? *dim_hsv_ : coarse ? coarse_hsv_ : fine_hsv_).ClassifyFlat(src, mask);
+    return;
+  }
   if (gray_) {
     const HsvRange& g = dimmed ? *dim_gray_ : coarse ? *coarse_gray_ : *gray_;
     cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
@@ -95,14 +100,14 @@ cv::Rect ColourTracker::ClassifyRegion(const cv::Mat& filtered, cv::Mat& mask,
                                       const cv::Rect& inner, bool dimmed) {
   const cv::Rect all(cv::Point(0, 0), mask.size());
   // The margin around the region feeds the pre-filter, the morphology near the region's border
-  //  and the ring of a blob near it. Without a pre-filter each mask pixel is its own pixel's
-  //  test, and the margin matters only when the region's own marker-coloured pixels come within
-  //  `guard` of a side that has a margin: the four morphology passes (radius r each) carry a
-  //  margin pixel at most 4r into the region, and a pixel there depends on nothing deeper than
-  //  8r; a blob's padded box reaches kRingOuter + 1 beyond it, and the morphology grows a blob by
-  //  r at most. So when the region's pixels keep `guard` away from every side with a margin, the
-  //  region is what a pass over the margin too would make of it, bit for bit, and the margin
-  //  (a third of a window at VGA, 18 px of 82) is never classified (issue 45).
+  // and the ring of a blob near it. Without a pre-filter each mask pixel is its own pixel's
+  // test, and the margin matters only when the region's own marker-coloured pixels come within
+  // `guard` of a side that has a margin: the four morphology passes (radius r each) carry a
+  // margin pixel at most 4r into the region, and a pixel there depends on nothing deeper than
+  // 8r; a blob's padded box reaches kRingOuter + 1 beyond it, and the morphology grows a blob by
+  // r at most. So when the region's pixels keep `guard` away from every side with a margin, the
+  // region is what a pass over the margin too would make of it, bit for bit, and the margin
+  // (a third of a window at VGA, 18 px of 82) is never classified (issue 45).
   if (params_.filter != ColourParams::Filter::kNone || inner == all) {
     classify(filtered, false, mask, dimmed);
     return NonZeroBounds(mask);
@@ -160,7 +165,18 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
       frame_rect;
   // A view into the frame (when it has the channels the classifier needs), so near the frame's
   // edges the filter sees the same border as a whole-frame pass would.
-  const cv::Mat src = prepare(frame(extended), prepared_store_);
+  cv::Mat src = prepare(frame(extended), prepared_store_);
+  // A gray recording handed over as BGR (b == g == r in the whole region): the colour pipeline
+  // reads one plane instead of three interleaved ones, every result the same (the classifier's
+  // and the measurement's flat paths). A colour region stops the check at its first chunk.
+  flat_pixels_ = false;
+  if (!gray_ && params_.filter == ColourParams::Filter::kNone && src.channels() == 3) {
+    cv::Mat plane = Scratch(flat_store_, extended.size(), CV_8U);
+    if (ExtractFlatPlane(src, plane)) {
+      src = plane;
+      flat_pixels_ = true;
+    }
+  }
 
   // 1. Filter.
   cv::Mat filtered = src;
@@ -297,7 +313,8 @@ constexpr int kRingQuarters = 4;
 // continuous coordinate in [0, kSectors).
 struct RingSectors {
   cv::Point2d centre;  // The blob's binary centroid, in the pixels' coordinates.
-  double operator()(int x, int y) const {
+  // Inlined: with the flat variants of its two callers GCC made it a call per ring pixel.
+  [[gnu::always_inline]] double operator()(int x, int y) const {
     const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
     return std::clamp(u, 0.0, kSectors - 1e-9);
   }
@@ -342,6 +359,14 @@ struct RingStatistics {
   }
 }
 
+// AddChromaticity's first channel of the flat pixel (v, v, v): its sum and its product (0, 0),
+// the same numbers the three channels' add (GatherRingStatisticsOf copies them over).
+[[gnu::always_inline]] inline void AddFlatChromaticity(int v, cv::Vec3d& sum, cv::Matx33d& outer) {
+  const double chroma = ChromaticityOfLevels(v, v, v)[0];
+  sum[0] += chroma;
+  outer(0, 0) += chroma * chroma;
+}
+
 // Adds a pixel's levels to integer sums and lower-triangle second moments: (0,0) (1,0) (1,1)
 // (2,0) (2,1) (2,2).
 void AddLevels(const uchar* c, int channels, int64_t* sum, int64_t* outer) {
@@ -368,13 +393,19 @@ int LowerTriangle(int k, int l) { return k * (k + 1) / 2 + l; }
 // zones), `others` (every blob of the mask). Core pixels are the blob's deeper than `core_depth`
 // (a filled hole is not the marker's colour); ring pixels lie outside every blob, beyond the soft
 // band and within the ring's reach.
-// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf.
-template <int kChannels>
+// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf. With kFlat,
+// `pixels` is a flat region's one plane (ColourTracker::flat_pixels_), each level v the BGR
+// pixel (v, v, v): every channel's sum, every second moment and every chromaticity's sum and
+// product then adds the same numbers in the same order, so the first is accumulated and copied
+// to the others at the end, bit for bit what the three channels give.
+template <int kChannels, bool kFlat = false>
 RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
                                       const cv::Mat& distance, const cv::Mat& others,
                                       int core_depth, const RingSectors& sector_of) {
+  static_assert(!kFlat || kChannels == 3);
   RingStatistics s;
   constexpr int channels = kChannels;
+  constexpr int stored = kFlat ? 1 : kChannels;  // Bytes a pixel in `pixels`.
   constexpr bool chromatic = channels == 3;
   // The levels' sums and second moments are sums of integers, accumulated as integers: every
   // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
@@ -396,23 +427,48 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     for (int x = 0; x < own.cols; ++x) {
-      const uchar* c = p + x * channels;
+      const uchar* c = p + x * stored;
       if (ow[x] == 255 && d[x] > core_depth) {
-        AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
-        if (chromatic) AddChromaticity(c, core_chroma_sum, core_chroma_outer);
+        AddLevels(c, stored, core_sum_i.data(), core_outer_i.data());
+        if (kFlat) {
+          AddFlatChromaticity(c[0], core_chroma_sum, core_chroma_outer);
+        } else if (chromatic) {
+          AddChromaticity(c, core_chroma_sum, core_chroma_outer);
+        }
         ++core_n;
       } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
         const int sector = static_cast<int>(sector_of(x, y));
-        AddLevels(c, channels, sector_sum_i[sector].data(),
+        AddLevels(c, stored, sector_sum_i[sector].data(),
                   quarter_outer_i[sector * kRingQuarters / kSectors].data());
-        if (chromatic) {
-          const int quarter = sector * kRingQuarters / kSectors;
+        const int quarter = sector * kRingQuarters / kSectors;
+        if (kFlat) {
+          AddFlatChromaticity(c[0], s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
+        } else if (chromatic) {
           AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
         }
         ++s.sector_n[sector];
         ++ring_n;
       }
     }
+  }
+  if (kFlat) {  // The first channel's sums and moments are every channel's.
+    const auto copy = [](int64_t* sum, int64_t* outer) {
+      sum[1] = sum[2] = sum[0];
+      for (int i = 1; i < 6; ++i) outer[i] = outer[0];
+    };
+    const auto copy_chroma = [](cv::Vec3d& sum, cv::Matx33d& outer) {
+      sum[1] = sum[2] = sum[0];
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l <= k; ++l) outer(k, l) = outer(0, 0);
+      }
+    };
+    copy(core_sum_i.data(), core_outer_i.data());
+    for (int i = 0; i < kSectors; ++i) sector_sum_i[i][1] = sector_sum_i[i][2] = sector_sum_i[i][0];
+    for (int q = 0; q < kRingQuarters; ++q) {
+      for (int i = 1; i < 6; ++i) quarter_outer_i[q][i] = quarter_outer_i[q][0];
+      copy_chroma(s.quarter_chroma_sum[q], s.quarter_chroma_outer[q]);
+    }
+    copy_chroma(core_chroma_sum, core_chroma_outer);
   }
   s.core_chroma_sum = core_chroma_sum;
   s.core_chroma_outer = core_chroma_outer;
@@ -441,9 +497,12 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
   return s;
 }
 
-RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
+RingStatistics GatherRingStatistics(const cv::Mat& pixels, bool flat, const cv::Mat& own,
                                     const cv::Mat& distance, const cv::Mat& others, int core_depth,
                                     const RingSectors& sector_of) {
+  if (flat) {
+    return GatherRingStatisticsOf<3, true>(pixels, own, distance, others, core_depth, sector_of);
+  }
   return pixels.channels() == 3
              ? GatherRingStatisticsOf<3>(pixels, own, distance, others, core_depth, sector_of)
              : GatherRingStatisticsOf<1>(pixels, own, distance, others, core_depth, sector_of);
@@ -560,12 +619,16 @@ struct WeightedSums {
 // through them. Pixels of other blobs count 0.
 // The channels are a constant of the template (3 or 1): the per-channel loops below unroll, the
 // same operations in the same order as with a count known only at run time (issue 45).
-template <int kChannels>
+// With kFlat, `pixels` is a flat region's plane (see GatherRingStatisticsOf): a level is read
+// once and handed on as its three channels.
+template <int kChannels, bool kFlat = false>
 WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
                                 const cv::Mat& distance, const cv::Mat& others,
                                 const RingSectors& sector_of, const RingStatistics& s,
                                 const ColourBlob& blob) {
+  static_assert(!kFlat || kChannels == 3);
   constexpr int channels = kChannels;
+  constexpr int stored = kFlat ? 1 : kChannels;
   std::array<cv::Vec3d, kSectors> sector_mean;
   for (int i = 0; i < kSectors; ++i) {
     sector_mean[i] = s.sector_n[i] >= 2 ? s.sector_sum[i] / s.sector_n[i] : blob.ring_colour;
@@ -583,7 +646,9 @@ WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
       double w = 1.0;
       if (!(ow[x] && dist[x] > kNearThirds)) {
         if (ot[x] && !ow[x]) continue;
-        const uchar* c = p + x * channels;
+        const uchar* at = p + x * stored;
+        const uchar flat[3] = {at[0], at[0], at[0]};
+        const uchar* c = kFlat ? flat : at;
         // Sector centres sit at i + 0.5.
         const double u = sector_of(x, y) - 0.5;
         const double lower = std::floor(u);
@@ -608,9 +673,13 @@ WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
   return sums;
 }
 
-WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
-                              const cv::Mat& others, const RingSectors& sector_of,
-                              const RingStatistics& s, const ColourBlob& blob) {
+WeightedSums SoftCentroidSums(const cv::Mat& pixels, bool flat, const cv::Mat& own,
+                              const cv::Mat& distance, const cv::Mat& others,
+                              const RingSectors& sector_of, const RingStatistics& s,
+                              const ColourBlob& blob) {
+  if (flat) {
+    return SoftCentroidSumsOf<3, true>(pixels, own, distance, others, sector_of, s, blob);
+  }
   return pixels.channels() == 3
              ? SoftCentroidSumsOf<3>(pixels, own, distance, others, sector_of, s, blob)
              : SoftCentroidSumsOf<1>(pixels, own, distance, others, sector_of, s, blob);
@@ -642,14 +711,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   EdgeZones(own, distance, zone_store_);
   const cv::Mat pixels = filtered(padded);
   const cv::Mat others = mask(padded);
-  const int channels = pixels.channels();
+  const int channels = flat_pixels_ ? 3 : pixels.channels();
   const RingSectors sector_of{blob->binary_centroid_px - cv::Point2d(padded.tl() + origin)};
 
   // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
   const bool pure_core = HasDeepCore(own, distance);
   const int core_depth = pure_core ? kNearThirds : 0;
-  const RingStatistics s = GatherRingStatistics(pixels, own, distance, others, core_depth,
-                                                sector_of);
+  const RingStatistics s = GatherRingStatistics(pixels, flat_pixels_, own, distance, others,
+                                                core_depth, sector_of);
   if (s.core_n < 1 || s.ring_n < 3) return;  // Crowded by other blobs: no local background.
   double core_var = 0, ring_var = 0;
   for (int k = 0; k < channels; ++k) {
@@ -675,7 +744,8 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     fit_rim(own, component, padded.tl() - labelled_tl, padded.tl() + origin, *radius, blob);
   }
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
-  const WeightedSums sums = SoftCentroidSums(pixels, own, distance, others, sector_of, s, *blob);
+  const WeightedSums sums =
+      SoftCentroidSums(pixels, flat_pixels_, own, distance, others, sector_of, s, *blob);
   if (sums.w <= 0) return;
   // Offsets added as one integer: the same blob in a window and in the whole frame gives the
   // same bits.
@@ -687,10 +757,13 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
                                    const cv::Mat& distance, const cv::Mat& others,
                                    cv::Point own_origin, ColourBlob* blob) {
   // The relaxed range over the whole padded box at once (the vector classifier), read where the
-  // ring reaches. `pixels` has the channels of the tracker's mode (prepare()).
+  // ring reaches. `pixels` has the channels of the tracker's mode (prepare()), or is a flat
+  // region's plane (flat_pixels_).
   cv::Mat relaxed = Scratch(fringe_store_, pixels.size(), CV_8U);
   if (gray_) {
     cv::inRange(pixels, fringe_gray_.lo, fringe_gray_.hi, relaxed);
+  } else if (flat_pixels_) {
+    fringe_hsv_.ClassifyFlat(pixels, relaxed);
   } else {
     fringe_hsv_.Classify(pixels, relaxed);
   }

@@ -101,6 +101,81 @@ void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
   }
 }
 
+void HsvClassifier::ClassifyFlatScalar(const cv::Mat& gray, cv::Mat& mask) const {
+  CV_Assert(gray.type() == CV_8UC1 && mask.type() == CV_8UC1 && mask.size() == gray.size());
+  for (int y = 0; y < gray.rows; ++y) {
+    const uchar* p = gray.ptr<uchar>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < gray.cols; ++x) {
+      const cv::Vec3b hsv = BgrToHsvExact(p[x], p[x], p[x]);
+      m[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+    }
+  }
+}
+
+void HsvClassifier::ClassifyFlat(const cv::Mat& gray, cv::Mat& mask) const {
+  CV_Assert(gray.type() == CV_8UC1 && mask.type() == CV_8UC1 && mask.size() == gray.size());
+  // BgrToHsvExact(v, v, v) is (0, 0, v) exactly: in when the box holds hue 0 and saturation 0
+  // (gray_in_), and v in its value range.
+  const uchar lo = static_cast<uchar>(box_.v.lo), hi = static_cast<uchar>(box_.v.hi);
+  for (int y = 0; y < gray.rows; ++y) {
+    const uchar* p = gray.ptr<uchar>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    if (!gray_in_) {
+      std::memset(m, 0, static_cast<size_t>(gray.cols));
+      continue;
+    }
+    int x = 0;
+#if CV_SIMD128
+    const cv::v_uint8x16 v_lo = cv::v_setall_u8(lo), v_hi = cv::v_setall_u8(hi);
+    for (; x + 16 <= gray.cols; x += 16) {
+      const cv::v_uint8x16 v = cv::v_load(p + x);
+      cv::v_store(m + x, (v >= v_lo) & (v <= v_hi));
+    }
+#endif
+    for (; x < gray.cols; ++x) m[x] = p[x] >= lo && p[x] <= hi ? 255 : 0;
+  }
+}
+
+bool ExtractFlatPlaneReference(const cv::Mat& bgr, cv::Mat& plane) {
+  CV_Assert(bgr.type() == CV_8UC3 && plane.type() == CV_8UC1 && plane.size() == bgr.size());
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* p = bgr.ptr<cv::Vec3b>(y);
+    uchar* out = plane.ptr<uchar>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      if (p[x][0] != p[x][1] || p[x][1] != p[x][2]) return false;
+      out[x] = p[x][0];
+    }
+  }
+  return true;
+}
+
+bool ExtractFlatPlane(const cv::Mat& bgr, cv::Mat& plane) {
+  CV_Assert(bgr.type() == CV_8UC3 && plane.type() == CV_8UC1 && plane.size() == bgr.size());
+  const int n = bgr.cols;
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uchar* p = bgr.ptr<uchar>(y);
+    uchar* out = plane.ptr<uchar>(y);
+    int x = 0;
+#if CV_SIMD128
+    // The row's last pixels as its last 16 again (the same values where they overlap).
+    for (; x < n && n >= 16; x += 16) {
+      if (x + 16 > n) x = n - 16;
+      cv::v_uint8x16 b, g, r;
+      cv::v_load_deinterleave(p + 3 * x, b, g, r);
+      if (!cv::v_check_all((b == g) & (g == r))) return false;
+      cv::v_store(out + x, b);
+    }
+#endif
+    for (; x < n; ++x) {
+      const uchar* c = p + 3 * x;
+      if (c[0] != c[1] || c[1] != c[2]) return false;
+      out[x] = c[0];
+    }
+  }
+  return true;
+}
+
 void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
   CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
   // A window's rows are short, separate streams of the frame, which is usually not in the cache

@@ -308,6 +308,10 @@ class ColourTracker : public Tracker {
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
   cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
   cv::Mat fringe_store_;  // measure_fringe's classification of the padded box.
+  // analyse_region's region as one plane when it is flat (b == g == r), and whether it is: the
+  // measurement then reads each level as the BGR pixel (v, v, v).
+  cv::Mat flat_store_;
+  bool flat_pixels_ = false;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;

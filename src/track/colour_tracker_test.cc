@@ -1009,6 +1009,53 @@ TEST(ColourTrackerScene, WindowsWithoutAFilterEqualTheWholeFrameBitForBit) {
   }
 }
 
+TEST(ColourTracker, AGrayRecordingHandedOverAsBgrIsMeasuredFromOnePlaneBitForBit) {
+  // A white dot on a textured gray background, as mire-2's gray frames come as BGR: the flat
+  // windows are classified and measured from one plane (ColourTracker::flat_pixels_). The same
+  // frames with one background pixel off gray beside the dot take the three-channel path; every
+  // position, score and sigma is the same to the last bit.
+  ColourParams params;
+  params.s = {0, 60};
+  params.v = {170, 255};
+  ColourTracker flat(params), colour(params);
+  cv::RNG rng(45);
+  int compared = 0;
+  for (int f = 0; f < 24; ++f) {
+    cv::Mat levels(120, 160, CV_8U);
+    rng.fill(levels, cv::RNG::NORMAL, 70, 12);
+    const cv::Point2d centre(60 + 1.7 * f, 50 + 0.9 * f);
+    // Anti-aliased: 16 x 16 subsamples a pixel.
+    for (int y = 0; y < levels.rows; ++y) {
+      for (int x = 0; x < levels.cols; ++x) {
+        int inside = 0;
+        for (int k = 0; k < 256; ++k) {
+          const double dx = x - 0.5 + (k % 16 + 0.5) / 16 - centre.x;
+          const double dy = y - 0.5 + (k / 16 + 0.5) / 16 - centre.y;
+          inside += dx * dx + dy * dy <= 7.5 * 7.5;
+        }
+        if (inside > 0) {
+          levels.at<uchar>(y, x) = cv::saturate_cast<uchar>(
+              levels.at<uchar>(y, x) + (225 - levels.at<uchar>(y, x)) * inside / 256);
+        }
+      }
+    }
+    cv::Mat bgr;
+    cv::cvtColor(levels, bgr, cv::COLOR_GRAY2BGR);
+    cv::Mat off = bgr.clone();
+    off.at<cv::Vec3b>(cvRound(centre.y), cvRound(centre.x) + 20)[1] ^= 1;  // Dark either way.
+    const Observation a = flat.update(bgr), b = colour.update(off);
+    ASSERT_EQ(a.found(), b.found()) << f;
+    if (!a.found()) continue;
+    EXPECT_EQ(a.position_px->x, b.position_px->x) << f;
+    EXPECT_EQ(a.position_px->y, b.position_px->y) << f;
+    EXPECT_EQ(*a.score, *b.score) << f;
+    EXPECT_EQ(*a.sigma_px, *b.sigma_px) << f;
+    EXPECT_NEAR(a.position_px->x, centre.x, 0.2) << f;
+    ++compared;
+  }
+  EXPECT_GE(compared, 20);
+}
+
 TEST(ColourTrackerScene, CoarseCandidatesFindEveryAcceptableBlob) {
   // Noise and a half-covered marker: the coarse-to-fine search must return exactly the blobs
   // of the full-resolution search that are large and round enough to count as the marker.
