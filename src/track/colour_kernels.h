@@ -56,7 +56,7 @@ class HsvClassifier {
   void ClassifyFlatScalar(const cv::Mat& gray, cv::Mat& mask) const;
 
  private:
-  void ClassifyRow(const uchar* bgr, uchar* mask, int n) const;
+  void ClassifyRows(const cv::Mat& bgr, cv::Mat& mask) const;
 
   HsvBox box_;
   bool full_hue_ = false;
