@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -823,7 +824,21 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     int row_n = 0, row_sx = 0;
-    for (int x = 0; x < own.cols; ++x) {
+    int x = 0;
+#if CV_SIMD128
+    // 16 pixels tested at once, the fringe's visited by their bits (integer sums: any order).
+    for (; x + 16 <= own.cols; x += 16) {
+      using namespace cv;
+      const v_uint8x16 zero = v_setzero_u8();
+      const v_uint8x16 fringe = (v_load(in + x) != zero) & (v_load(ow + x) == zero) &
+                                (v_load(ot + x) == zero) &
+                                (v_load(d + x) <= v_setall_u8(kReachThirds));
+      for (unsigned bits = static_cast<unsigned>(v_signmask(fringe)); bits; bits &= bits - 1) {
+        ++row_n, row_sx += x + __builtin_ctz(bits);
+      }
+    }
+#endif
+    for (; x < own.cols; ++x) {
       // In the relaxed range, not the blob or another, within the ring's reach.
       if (!in[x] || ow[x] || ot[x] || d[x] > kReachThirds) continue;
       ++row_n, row_sx += x;
