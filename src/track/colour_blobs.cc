@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -58,6 +59,11 @@ bool ColourTracker::membership(const cv::Mat& frame_bgr, cv::Mat& mask) const {
 }
 
 void ColourTracker::classify(const cv::Mat& src, bool coarse, cv::Mat& mask, bool dimmed) {
+  if (!gray_ && src.channels() == 1) {
+    // A flat region's plane (analyse_region): each level stands for the BGR pixel (v, v, v).
+    (dimmed ? *dim_hsv_ : coarse ? coarse_hsv_ : fine_hsv_).ClassifyFlat(src, mask);
+    return;
+  }
   if (gray_) {
     const HsvRange& g = dimmed ? *dim_gray_ : coarse ? *coarse_gray_ : *gray_;
     cv::inRange(src, cv::Scalar(g.lo), cv::Scalar(g.hi), mask);
@@ -91,6 +97,66 @@ void ColourTracker::analyse(const cv::Mat& frame, cv::Rect region,
                     [&](const cv::Range&) { analyse_region(frame, region, blobs, dimmed); });
 }
 
+cv::Rect ColourTracker::ClassifyRegion(const cv::Mat& filtered, cv::Mat& mask,
+                                      const cv::Rect& inner, bool dimmed) {
+  const cv::Rect all(cv::Point(0, 0), mask.size());
+  // The margin around the region feeds the pre-filter, the morphology near the region's border
+  // and the ring of a blob near it. Without a pre-filter each mask pixel is its own pixel's
+  // test, and the margin matters only when the region's own marker-coloured pixels come within
+  // `guard` of a side that has a margin: the four morphology passes (radius r each) carry a
+  // margin pixel at most 4r into the region, and a pixel there depends on nothing deeper than
+  // 8r; a blob's padded box reaches kRingOuter + 1 beyond it, and the morphology grows a blob by
+  // r at most. So when the region's pixels keep `guard` away from every side with a margin, the
+  // region is what a pass over the margin too would make of it, bit for bit, and the margin
+  // (a third of a window at VGA, 18 px of 82) is never classified (issue 45).
+  if (params_.filter != ColourParams::Filter::kNone || inner == all) {
+    classify(filtered, false, mask, dimmed);
+    return NonZeroBounds(mask);
+  }
+  const int morph_radius = kernel_.empty() ? 0 : params_.morph_size / 2;
+  const int guard = std::max(margin_px_, 8 * morph_radius + 1);
+  const auto near_a_margin = [&](cv::Rect bounds) {
+    bounds += inner.tl();
+    return (inner.x > 0 && bounds.x - inner.x < guard) ||
+           (inner.y > 0 && bounds.y - inner.y < guard) ||
+           (inner.br().x < all.width && inner.br().x - bounds.br().x < guard) ||
+           (inner.br().y < all.height && inner.br().y - bounds.br().y < guard);
+  };
+  cv::Mat inner_mask = mask(inner);
+  if (margin_was_needed_) {
+    // The last region needed its margin (clutter of the marker's colour all over, as on a
+    // poster-covered wall): most likely this one does too, and classifying it in one pass costs
+    // less than the region and then its margin's strips. Whether it still does is a scan of the
+    // region's mask (a sixteenth of classifying it). Either way the result is the same.
+    classify(filtered, false, mask, dimmed);
+    const cv::Rect inner_bounds = NonZeroBounds(inner_mask);
+    margin_was_needed_ = !inner_bounds.empty() && near_a_margin(inner_bounds);
+    return NonZeroBounds(mask);
+  }
+  classify(filtered(inner), false, inner_mask, dimmed);
+  const cv::Rect bounds = NonZeroBounds(inner_mask);
+  if (bounds.empty()) return bounds;  // Margin pixels alone set nothing inside (see above).
+  margin_was_needed_ = near_a_margin(bounds);
+  if (!margin_was_needed_) return bounds + inner.tl();
+  // The margin's strips: above and below the region at full width, and beside it (each as at
+  // least 16 columns, overlapping the region, whose pixels get the same result again: a strip
+  // narrower than a vector would take the scalar test).
+  const auto strip = [&](const cv::Rect& r) {
+    const cv::Rect part = r & all;
+    if (part.empty()) return;
+    cv::Mat part_mask = mask(part);
+    classify(filtered(part), false, part_mask, dimmed);
+  };
+  strip(cv::Rect(0, 0, all.width, inner.y));
+  strip(cv::Rect(0, inner.br().y, all.width, all.height - inner.br().y));
+  if (inner.x > 0) strip(cv::Rect(0, inner.y, std::max(inner.x, 16), inner.height));
+  if (inner.br().x < all.width) {
+    const int width = std::max(all.width - inner.br().x, 16);
+    strip(cv::Rect(all.width - width, inner.y, width, inner.height));
+  }
+  return NonZeroBounds(mask);
+}
+
 void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
                                    std::vector<ColourBlob>* blobs, bool dimmed) {
   const cv::Rect frame_rect(cv::Point(0, 0), frame.size());
@@ -100,7 +166,18 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
       frame_rect;
   // A view into the frame (when it has the channels the classifier needs), so near the frame's
   // edges the filter sees the same border as a whole-frame pass would.
-  const cv::Mat src = prepare(frame(extended), prepared_store_);
+  cv::Mat src = prepare(frame(extended), prepared_store_);
+  // A gray recording handed over as BGR (b == g == r in the whole region): the colour pipeline
+  // reads one plane instead of three interleaved ones, every result the same (the classifier's
+  // and the measurement's flat paths). A colour region stops the check at its first chunk.
+  flat_pixels_ = false;
+  if (!gray_ && params_.filter == ColourParams::Filter::kNone && src.channels() == 3) {
+    cv::Mat plane = Scratch(flat_store_, extended.size(), CV_8U);
+    if (ExtractFlatPlane(src, plane)) {
+      src = plane;
+      flat_pixels_ = true;
+    }
+  }
 
   // 1. Filter.
   cv::Mat filtered = src;
@@ -114,15 +191,15 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
 
   // 2. Binarise.
   cv::Mat mask = Scratch(mask_store_, extended.size(), CV_8U);
-  classify(filtered, false, mask, dimmed);
+  const cv::Rect extended_local(cv::Point(0, 0), extended.size());
+  const cv::Rect inner_local(region.tl() - extended.tl(), region.size());
+  cv::Rect active = ClassifyRegion(filtered, mask, inner_local, dimmed);
+  if (active.empty()) return;
 
   // 3. Opening then closing, only where it can change anything: outside the bounding box of the
   //    marker-coloured pixels the mask is 0 and stays 0 (opening only removes, closing only fills
   //    between pixels), so morphology and labelling work on that box plus the reach of the four
   //    passes. Beyond the box the parent mask holds zeros, exactly what a whole pass would read.
-  const cv::Rect extended_local(cv::Point(0, 0), extended.size());
-  cv::Rect active = NonZeroBounds(mask);
-  if (active.empty()) return;
   if (!kernel_.empty()) {
     const int reach = 4 * (params_.morph_size / 2) + 1;
     active = cv::Rect(active.x - reach, active.y - reach, active.width + 2 * reach,
@@ -142,7 +219,6 @@ void ColourTracker::analyse_region(const cv::Mat& frame, const cv::Rect& region,
 
   // 4. Blobs of the region proper (the margin only fed the filters); the region is 0 outside
   //    `labelled`, so its components are the region's components.
-  const cv::Rect inner_local(region.tl() - extended.tl(), region.size());
   const cv::Rect labelled = active & inner_local;
   if (labelled.empty()) return;
   const cv::Point offset = labelled.tl() - inner_local.tl();  // Of `labelled` in the region.
@@ -238,7 +314,8 @@ constexpr int kRingQuarters = 4;
 // continuous coordinate in [0, kSectors).
 struct RingSectors {
   cv::Point2d centre;  // The blob's binary centroid, in the pixels' coordinates.
-  double operator()(int x, int y) const {
+  // Inlined: with the flat variants of its two callers GCC made it a call per ring pixel.
+  [[gnu::always_inline]] double operator()(int x, int y) const {
     const double u = DiamondAngle(x - centre.x, y - centre.y) * (kSectors / 4.0);
     return std::clamp(u, 0.0, kSectors - 1e-9);
   }
@@ -283,6 +360,14 @@ struct RingStatistics {
   }
 }
 
+// AddChromaticity's first channel of the flat pixel (v, v, v): its sum and its product (0, 0),
+// the same numbers the three channels' add (GatherRingStatisticsOf copies them over).
+[[gnu::always_inline]] inline void AddFlatChromaticity(int v, cv::Vec3d& sum, cv::Matx33d& outer) {
+  const double chroma = ChromaticityOfLevels(v, v, v)[0];
+  sum[0] += chroma;
+  outer(0, 0) += chroma * chroma;
+}
+
 // Adds a pixel's levels to integer sums and lower-triangle second moments: (0,0) (1,0) (1,1)
 // (2,0) (2,1) (2,2).
 void AddLevels(const uchar* c, int channels, int64_t* sum, int64_t* outer) {
@@ -309,13 +394,19 @@ int LowerTriangle(int k, int l) { return k * (k + 1) / 2 + l; }
 // zones), `others` (every blob of the mask). Core pixels are the blob's deeper than `core_depth`
 // (a filled hole is not the marker's colour); ring pixels lie outside every blob, beyond the soft
 // band and within the ring's reach.
-// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf.
-template <int kChannels>
+// The channels are a constant of the template (3 or 1), as in SoftCentroidSumsOf. With kFlat,
+// `pixels` is a flat region's one plane (ColourTracker::flat_pixels_), each level v the BGR
+// pixel (v, v, v): every channel's sum, every second moment and every chromaticity's sum and
+// product then adds the same numbers in the same order, so the first is accumulated and copied
+// to the others at the end, bit for bit what the three channels give.
+template <int kChannels, bool kFlat = false>
 RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
                                       const cv::Mat& distance, const cv::Mat& others,
                                       int core_depth, const RingSectors& sector_of) {
+  static_assert(!kFlat || kChannels == 3);
   RingStatistics s;
   constexpr int channels = kChannels;
+  constexpr int stored = kFlat ? 1 : kChannels;  // Bytes a pixel in `pixels`.
   constexpr bool chromatic = channels == 3;
   // The levels' sums and second moments are sums of integers, accumulated as integers: every
   // partial sum of the doubles they were summed in before was an exact integer (far below 2^53),
@@ -336,24 +427,78 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
     const uchar* ow = own.ptr<uchar>(y);
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
-    for (int x = 0; x < own.cols; ++x) {
-      const uchar* c = p + x * channels;
-      if (ow[x] == 255 && d[x] > core_depth) {
-        AddLevels(c, channels, core_sum_i.data(), core_outer_i.data());
-        if (chromatic) AddChromaticity(c, core_chroma_sum, core_chroma_outer);
-        ++core_n;
-      } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
-        const int sector = static_cast<int>(sector_of(x, y));
-        AddLevels(c, channels, sector_sum_i[sector].data(),
-                  quarter_outer_i[sector * kRingQuarters / kSectors].data());
-        if (chromatic) {
-          const int quarter = sector * kRingQuarters / kSectors;
-          AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
-        }
-        ++s.sector_n[sector];
-        ++ring_n;
+    const auto core_pixel = [&](int x) {
+      const uchar* c = p + x * stored;
+      AddLevels(c, stored, core_sum_i.data(), core_outer_i.data());
+      if (kFlat) {
+        AddFlatChromaticity(c[0], core_chroma_sum, core_chroma_outer);
+      } else if (chromatic) {
+        AddChromaticity(c, core_chroma_sum, core_chroma_outer);
+      }
+      ++core_n;
+    };
+    const auto ring_pixel = [&](int x) {
+      const uchar* c = p + x * stored;
+      const int sector = static_cast<int>(sector_of(x, y));
+      AddLevels(c, stored, sector_sum_i[sector].data(),
+                quarter_outer_i[sector * kRingQuarters / kSectors].data());
+      const int quarter = sector * kRingQuarters / kSectors;
+      if (kFlat) {
+        AddFlatChromaticity(c[0], s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
+      } else if (chromatic) {
+        AddChromaticity(c, s.quarter_chroma_sum[quarter], s.quarter_chroma_outer[quarter]);
+      }
+      ++s.sector_n[sector];
+      ++ring_n;
+    };
+    int x = 0;
+#if CV_SIMD128
+    // 16 pixels sorted at once into the core's and the ring's, each then visited by its bit, in
+    // raster order (the core's and the ring's sums are apart, so each adds its pixels in the
+    // order the loop below would): most of the padded box is neither, and the tests pixel by
+    // pixel were a third of the pass (issue 45).
+    for (; x + 16 <= own.cols; x += 16) {
+      using namespace cv;
+      const v_uint8x16 o = v_load(ow + x), dd = v_load(d + x), t = v_load(ot + x);
+      const v_uint8x16 zero = v_setzero_u8();
+      const v_uint8x16 core = (o == v_setall_u8(255)) &
+                              (dd > v_setall_u8(static_cast<uchar>(core_depth)));
+      const v_uint8x16 ring = (o == zero) & (dd > v_setall_u8(kNearThirds)) &
+                              (dd <= v_setall_u8(kReachThirds)) & (t == zero);
+      for (unsigned bits = static_cast<unsigned>(v_signmask(core)); bits; bits &= bits - 1) {
+        core_pixel(x + __builtin_ctz(bits));
+      }
+      for (unsigned bits = static_cast<unsigned>(v_signmask(ring)); bits; bits &= bits - 1) {
+        ring_pixel(x + __builtin_ctz(bits));
       }
     }
+#endif
+    for (; x < own.cols; ++x) {
+      if (ow[x] == 255 && d[x] > core_depth) {
+        core_pixel(x);
+      } else if (!ow[x] && d[x] > kNearThirds && d[x] <= kReachThirds && !ot[x]) {
+        ring_pixel(x);
+      }
+    }
+  }
+  if (kFlat) {  // The first channel's sums and moments are every channel's.
+    const auto copy = [](int64_t* sum, int64_t* outer) {
+      sum[1] = sum[2] = sum[0];
+      for (int i = 1; i < 6; ++i) outer[i] = outer[0];
+    };
+    const auto copy_chroma = [](cv::Vec3d& sum, cv::Matx33d& outer) {
+      sum[1] = sum[2] = sum[0];
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l <= k; ++l) outer(k, l) = outer(0, 0);
+      }
+    };
+    copy(core_sum_i.data(), core_outer_i.data());
+    for (int i = 0; i < kSectors; ++i) sector_sum_i[i][1] = sector_sum_i[i][2] = sector_sum_i[i][0];
+    for (int q = 0; q < kRingQuarters; ++q) {
+      for (int i = 1; i < 6; ++i) quarter_outer_i[q][i] = quarter_outer_i[q][0];
+      copy_chroma(s.quarter_chroma_sum[q], s.quarter_chroma_outer[q]);
+    }
+    copy_chroma(core_chroma_sum, core_chroma_outer);
   }
   s.core_chroma_sum = core_chroma_sum;
   s.core_chroma_outer = core_chroma_outer;
@@ -382,9 +527,12 @@ RingStatistics GatherRingStatisticsOf(const cv::Mat& pixels, const cv::Mat& own,
   return s;
 }
 
-RingStatistics GatherRingStatistics(const cv::Mat& pixels, const cv::Mat& own,
+RingStatistics GatherRingStatistics(const cv::Mat& pixels, bool flat, const cv::Mat& own,
                                     const cv::Mat& distance, const cv::Mat& others, int core_depth,
                                     const RingSectors& sector_of) {
+  if (flat) {
+    return GatherRingStatisticsOf<3, true>(pixels, own, distance, others, core_depth, sector_of);
+  }
   return pixels.channels() == 3
              ? GatherRingStatisticsOf<3>(pixels, own, distance, others, core_depth, sector_of)
              : GatherRingStatisticsOf<1>(pixels, own, distance, others, core_depth, sector_of);
@@ -501,12 +649,16 @@ struct WeightedSums {
 // through them. Pixels of other blobs count 0.
 // The channels are a constant of the template (3 or 1): the per-channel loops below unroll, the
 // same operations in the same order as with a count known only at run time (issue 45).
-template <int kChannels>
+// With kFlat, `pixels` is a flat region's plane (see GatherRingStatisticsOf): a level is read
+// once and handed on as its three channels.
+template <int kChannels, bool kFlat = false>
 WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
                                 const cv::Mat& distance, const cv::Mat& others,
                                 const RingSectors& sector_of, const RingStatistics& s,
                                 const ColourBlob& blob) {
+  static_assert(!kFlat || kChannels == 3);
   constexpr int channels = kChannels;
+  constexpr int stored = kFlat ? 1 : kChannels;
   std::array<cv::Vec3d, kSectors> sector_mean;
   for (int i = 0; i < kSectors; ++i) {
     sector_mean[i] = s.sector_n[i] >= 2 ? s.sector_sum[i] / s.sector_n[i] : blob.ring_colour;
@@ -519,12 +671,14 @@ WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
     const uchar* dist = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     double row_w = 0, row_x = 0;
-    for (int x = 0; x < own.cols; ++x) {
-      if (!ow[x] && dist[x] > kNearThirds) continue;  // Beyond the band.
+    // A pixel's weight: 1 deep inside, its membership in the band (of its own blob or outside
+    // every other one); others add nothing.
+    const auto add = [&](int x) {
       double w = 1.0;
       if (!(ow[x] && dist[x] > kNearThirds)) {
-        if (ot[x] && !ow[x]) continue;
-        const uchar* c = p + x * channels;
+        const uchar* at = p + x * stored;
+        const uchar flat[3] = {at[0], at[0], at[0]};
+        const uchar* c = kFlat ? flat : at;
         // Sector centres sit at i + 0.5.
         const double u = sector_of(x, y) - 0.5;
         const double lower = std::floor(u);
@@ -541,6 +695,26 @@ WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
       }
       row_w += w;
       row_x += w * x;
+    };
+    int x = 0;
+#if CV_SIMD128
+    // 16 pixels sorted at once, those that weigh visited by their bits in raster order (the
+    // same sums in the same order): beyond the band, most of the padded box, adds nothing.
+    for (; x + 16 <= own.cols; x += 16) {
+      using namespace cv;
+      const v_uint8x16 zero = v_setzero_u8();
+      const v_uint8x16 in = v_load(ow + x) != zero;
+      const v_uint8x16 beyond = v_load(dist + x) > v_setall_u8(kNearThirds);
+      const v_uint8x16 weighs = (in & beyond) | (~beyond & (in | (v_load(ot + x) == zero)));
+      for (unsigned bits = static_cast<unsigned>(v_signmask(weighs)); bits; bits &= bits - 1) {
+        add(x + __builtin_ctz(bits));
+      }
+    }
+#endif
+    for (; x < own.cols; ++x) {
+      if (!ow[x] && dist[x] > kNearThirds) continue;  // Beyond the band.
+      if (!(ow[x] && dist[x] > kNearThirds) && ot[x] && !ow[x]) continue;  // Another blob's.
+      add(x);
     }
     sums.w += row_w;
     sums.x += row_x;
@@ -549,9 +723,13 @@ WeightedSums SoftCentroidSumsOf(const cv::Mat& pixels, const cv::Mat& own,
   return sums;
 }
 
-WeightedSums SoftCentroidSums(const cv::Mat& pixels, const cv::Mat& own, const cv::Mat& distance,
-                              const cv::Mat& others, const RingSectors& sector_of,
-                              const RingStatistics& s, const ColourBlob& blob) {
+WeightedSums SoftCentroidSums(const cv::Mat& pixels, bool flat, const cv::Mat& own,
+                              const cv::Mat& distance, const cv::Mat& others,
+                              const RingSectors& sector_of, const RingStatistics& s,
+                              const ColourBlob& blob) {
+  if (flat) {
+    return SoftCentroidSumsOf<3, true>(pixels, own, distance, others, sector_of, s, blob);
+  }
   return pixels.channels() == 3
              ? SoftCentroidSumsOf<3>(pixels, own, distance, others, sector_of, s, blob)
              : SoftCentroidSumsOf<1>(pixels, own, distance, others, sector_of, s, blob);
@@ -583,14 +761,14 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
   EdgeZones(own, distance, zone_store_);
   const cv::Mat pixels = filtered(padded);
   const cv::Mat others = mask(padded);
-  const int channels = pixels.channels();
+  const int channels = flat_pixels_ ? 3 : pixels.channels();
   const RingSectors sector_of{blob->binary_centroid_px - cv::Point2d(padded.tl() + origin)};
 
   // The core: deeper than kSoftBand, or the whole blob when it is too small to have such pixels.
   const bool pure_core = HasDeepCore(own, distance);
   const int core_depth = pure_core ? kNearThirds : 0;
-  const RingStatistics s = GatherRingStatistics(pixels, own, distance, others, core_depth,
-                                                sector_of);
+  const RingStatistics s = GatherRingStatistics(pixels, flat_pixels_, own, distance, others,
+                                                core_depth, sector_of);
   if (s.core_n < 1 || s.ring_n < 3) return;  // Crowded by other blobs: no local background.
   double core_var = 0, ring_var = 0;
   for (int k = 0; k < channels; ++k) {
@@ -616,7 +794,8 @@ void ColourTracker::measure(const cv::Mat& filtered, const cv::Mat& mask, int co
     fit_rim(own, component, padded.tl() - labelled_tl, padded.tl() + origin, *radius, blob);
   }
   if (params_.centroid == ColourParams::Centroid::kBinary || axis2 < 1.0) return;
-  const WeightedSums sums = SoftCentroidSums(pixels, own, distance, others, sector_of, s, *blob);
+  const WeightedSums sums =
+      SoftCentroidSums(pixels, flat_pixels_, own, distance, others, sector_of, s, *blob);
   if (sums.w <= 0) return;
   // Offsets added as one integer: the same blob in a window and in the whole frame gives the
   // same bits.
@@ -632,10 +811,13 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
                                    const cv::Mat& distance, const cv::Mat& others,
                                    cv::Point own_origin, ColourBlob* blob) {
   // The relaxed range over the whole padded box at once (the vector classifier), read where the
-  // ring reaches. `pixels` has the channels of the tracker's mode (prepare()).
+  // ring reaches. `pixels` has the channels of the tracker's mode (prepare()), or is a flat
+  // region's plane (flat_pixels_).
   cv::Mat relaxed = Scratch(fringe_store_, pixels.size(), CV_8U);
   if (gray_) {
     cv::inRange(pixels, fringe_gray_.lo, fringe_gray_.hi, relaxed);
+  } else if (flat_pixels_) {
+    fringe_hsv_.ClassifyFlat(pixels, relaxed);
   } else {
     fringe_hsv_.Classify(pixels, relaxed);
   }
@@ -650,7 +832,25 @@ void ColourTracker::measure_fringe(const cv::Mat& pixels, const cv::Mat& own,
     const uchar* d = distance.ptr<uchar>(y);
     const uchar* ot = others.ptr<uchar>(y);
     int row_n = 0, row_sx = 0, far_row_n = 0, far_row_sx = 0;
-    for (int x = 0; x < own.cols; ++x) {
+    int x = 0;
+#if CV_SIMD128
+    // 16 pixels tested at once, the fringe's visited by their bits (integer sums: any order).
+    for (; x + 16 <= own.cols; x += 16) {
+      using namespace cv;
+      const v_uint8x16 zero = v_setzero_u8();
+      const v_uint8x16 dist = v_load(d + x);
+      const v_uint8x16 fringe = (v_load(in + x) != zero) & (v_load(ow + x) == zero) &
+                                (v_load(ot + x) == zero) & (dist <= v_setall_u8(kReachThirds));
+      for (unsigned bits = static_cast<unsigned>(v_signmask(fringe)); bits; bits &= bits - 1) {
+        ++row_n, row_sx += x + __builtin_ctz(bits);
+      }
+      const v_uint8x16 far = fringe & (dist > v_setall_u8(kNearThirds));
+      for (unsigned bits = static_cast<unsigned>(v_signmask(far)); bits; bits &= bits - 1) {
+        ++far_row_n, far_row_sx += x + __builtin_ctz(bits);
+      }
+    }
+#endif
+    for (; x < own.cols; ++x) {
       // In the relaxed range, not the blob or another, within the ring's reach.
       if (!in[x] || ow[x] || ot[x] || d[x] > kReachThirds) continue;
       ++row_n, row_sx += x;

@@ -101,20 +101,98 @@ void HsvClassifier::ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const {
   }
 }
 
-void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
-  CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
-  // A window's rows are short, separate streams of the frame, which is usually not in the cache
-  // yet: the hardware prefetcher does not follow them, and waiting for the loads was a good part
-  // of the classifier's time. The rows two ahead are asked for while this one is classified.
-  const size_t row_bytes = static_cast<size_t>(bgr.cols) * 3;
+void HsvClassifier::ClassifyFlatScalar(const cv::Mat& gray, cv::Mat& mask) const {
+  CV_Assert(gray.type() == CV_8UC1 && mask.type() == CV_8UC1 && mask.size() == gray.size());
+  for (int y = 0; y < gray.rows; ++y) {
+    const uchar* p = gray.ptr<uchar>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < gray.cols; ++x) {
+      const cv::Vec3b hsv = BgrToHsvExact(p[x], p[x], p[x]);
+      m[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+    }
+  }
+}
+
+void HsvClassifier::ClassifyFlat(const cv::Mat& gray, cv::Mat& mask) const {
+  CV_Assert(gray.type() == CV_8UC1 && mask.type() == CV_8UC1 && mask.size() == gray.size());
+  // BgrToHsvExact(v, v, v) is (0, 0, v) exactly: in when the box holds hue 0 and saturation 0
+  // (gray_in_), and v in its value range.
+  const uchar lo = static_cast<uchar>(box_.v.lo), hi = static_cast<uchar>(box_.v.hi);
+  for (int y = 0; y < gray.rows; ++y) {
+    const uchar* p = gray.ptr<uchar>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    if (!gray_in_) {
+      std::memset(m, 0, static_cast<size_t>(gray.cols));
+      continue;
+    }
+    int x = 0;
+#if CV_SIMD128
+    const cv::v_uint8x16 v_lo = cv::v_setall_u8(lo), v_hi = cv::v_setall_u8(hi);
+    for (; x + 16 <= gray.cols; x += 16) {
+      const cv::v_uint8x16 v = cv::v_load(p + x);
+      cv::v_store(m + x, (v >= v_lo) & (v <= v_hi));
+    }
+#endif
+    for (; x < gray.cols; ++x) m[x] = p[x] >= lo && p[x] <= hi ? 255 : 0;
+  }
+}
+
+bool ExtractFlatPlaneReference(const cv::Mat& bgr, cv::Mat& plane) {
+  CV_Assert(bgr.type() == CV_8UC3 && plane.type() == CV_8UC1 && plane.size() == bgr.size());
   for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* p = bgr.ptr<cv::Vec3b>(y);
+    uchar* out = plane.ptr<uchar>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      if (p[x][0] != p[x][1] || p[x][1] != p[x][2]) return false;
+      out[x] = p[x][0];
+    }
+  }
+  return true;
+}
+
+bool ExtractFlatPlane(const cv::Mat& bgr, cv::Mat& plane) {
+  CV_Assert(bgr.type() == CV_8UC3 && plane.type() == CV_8UC1 && plane.size() == bgr.size());
+  const int n = bgr.cols;
+  const size_t row_bytes = static_cast<size_t>(n) * 3;
+  for (int y = 0; y < bgr.rows; ++y) {
+    // The region's rows are separate streams of a frame usually not in the cache: the rows two
+    // ahead are asked for while this one is read, as Classify does (without it this pass, the
+    // first to touch the region, waited on every row's loads: 0.235 -> 0.215 ms a frame on
+    // mire-2).
     if (y + 2 < bgr.rows) {
       const uchar* ahead = bgr.ptr<uchar>(y + 2);
       for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
       __builtin_prefetch(ahead + row_bytes - 1);
     }
-    ClassifyRow(bgr.ptr<uchar>(y), mask.ptr<uchar>(y), bgr.cols);
+    const uchar* p = bgr.ptr<uchar>(y);
+    uchar* out = plane.ptr<uchar>(y);
+    int x = 0;
+#if CV_SIMD128
+    // The row's last pixels as its last 16 again (the same values where they overlap).
+    for (; x < n && n >= 16; x += 16) {
+      if (x + 16 > n) x = n - 16;
+      cv::v_uint8x16 b, g, r;
+      cv::v_load_deinterleave(p + 3 * x, b, g, r);
+      if (!cv::v_check_all((b == g) & (g == r))) return false;
+      cv::v_store(out + x, b);
+    }
+#endif
+    for (; x < n; ++x) {
+      const uchar* c = p + 3 * x;
+      if (c[0] != c[1] || c[1] != c[2]) return false;
+      out[x] = c[0];
+    }
   }
+  return true;
+}
+
+void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
+  CV_Assert(bgr.type() == CV_8UC3 && mask.type() == CV_8UC1 && mask.size() == bgr.size());
+  // A window's rows are short, separate streams of the frame, which is usually not in the cache
+  // yet: the hardware prefetcher does not follow them, and waiting for the loads was a good part
+  // of the classifier's time. The rows two ahead are asked for while this one is classified
+  // (ClassifyRows).
+  ClassifyRows(bgr, mask);
 }
 
 // The vector path decides each pixel from exact integer inequalities where they are conclusive,
@@ -127,8 +205,11 @@ void HsvClassifier::Classify(const cv::Mat& bgr, cv::Mat& mask) const {
 //    tests use the numerator N' = N + diff of OpenCV's hue = N * 30 / diff (N = g - b when the
 //    maximum is red, b - r + 2 diff when green, r - g + 4 diff when blue), shifted to be >= 0.
 // All products stay below 2^16: 30 N' <= 30 * 6 * 255, 255 diff, (B + 31) diff <= 180 * 255.
-void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
-  int x = 0;
+// The box's constants are set up once for all the rows: per row, they were a tenth of the
+// classifier's instructions on the tracker's windows (issue 45).
+void HsvClassifier::ClassifyRows(const cv::Mat& image, cv::Mat& mask_image) const {
+  const int n = image.cols;
+  const size_t row_bytes = static_cast<size_t>(n) * 3;
 #if CV_SIMD128
   using namespace cv;
   const v_uint8x16 v_lo = v_setall_u8(static_cast<uchar>(box_.v.lo));
@@ -198,76 +279,88 @@ void HsvClassifier::ClassifyRow(const uchar* bgr, uchar* mask, int n) const {
     out |= ~hue_near;
   };
 
-  for (; x < n && n >= 16; x += 16) {
-    // The row's last pixels: the last 16 again, overlapping the previous chunk (each pixel's
-    // result depends on it alone), so no pixel of a row of 16 or more takes the scalar formula
-    // for being in the tail (on the tracker's windows, a tenth of the pixels did).
-    if (x + 16 > n) x = n - 16;
-    v_uint8x16 b8, g8, r8;
-    v_load_deinterleave(bgr + 3 * x, b8, g8, r8);
-    const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
-    const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
-    const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
-    // 16 flat pixels (a gray recording handed over as BGR: b == g == r): hue 0 and saturation 0
-    // exactly, so each is in by its value alone, as the flat case below decides it.
-    if (v_check_all(d8 == v_setzero_u8())) {
-      v_store(mask + x, gray_in & v_ok);
-      continue;
-    }
-    // Most pixels of a scene are far from the marker's hue, value or saturation: when all 16
-    // are out on those alone (exact, as above), the full test is not needed. First (8-bit, the
-    // cheapest) when none of the 16 has its largest channel in a sector whose hues reach the box
-    // (decide() would find none of them near a hue interval; a flat pixel has no hue).
-    if (sectors_can_fail) {
-      const v_uint8x16 is_r = v8 == r8, is_g = (v8 == g8) & ~is_r, is_b = ~(is_r | is_g);
-      const v_uint8x16 may_be_in = (is_r & sector_r) | (is_g & sector_g) | (is_b & sector_b) |
-                                   ((d8 == v_setzero_u8()) & gray_in);
-      if (!v_check_any(v_ok & may_be_in)) {
-        v_store(mask + x, v_setzero_u8());
-        continue;
-      }
-    }
-    v_uint16x8 vv0, vv1, d0, d1;
-    v_expand(v8, vv0, vv1);
-    v_expand(d8, d0, d1);
-    const v_uint16x8 s255_0 = v_mul_wrap(d0, k255), s255_1 = v_mul_wrap(d1, k255);
-    v_uint16x8 above_lo1_0 = all16, above_lo1_1 = all16;
-    if (s_lo_can_fail) {
-      above_lo1_0 = ~at_most(s255_0, v_mul_wrap(s_lo1, vv0));
-      above_lo1_1 = ~at_most(s255_1, v_mul_wrap(s_lo1, vv1));
-      if (!v_check_any(v_ok & v_pack(above_lo1_0, above_lo1_1))) {
-        v_store(mask + x, v_setzero_u8());
-        continue;
-      }
-    }
-    v_uint16x8 b0, b1, g0, g1, r0, r1;
-    v_expand(b8, b0, b1);
-    v_expand(g8, g0, g1);
-    v_expand(r8, r0, r1);
-    v_uint16x8 in0, in1, out0, out1;
-    decide(b0, g0, r0, vv0, d0, s255_0, above_lo1_0, in0, out0);
-    decide(b1, g1, r1, vv1, d1, s255_1, above_lo1_1, in1, out1);
-    v_uint8x16 in = v_pack(in0, in1) & v_ok;
-    v_uint8x16 out = v_pack(out0, out1) | ~v_ok;
-    // max == min: hue 0 and saturation 0 exactly.
-    const v_uint8x16 flat = d8 == v_setzero_u8();
-    in = v_select(flat, gray_in & v_ok, in);
-    out = v_select(flat, ~in, out);
-    v_store(mask + x, in);
-    const v_uint8x16 open = ~(in | out);
-    // The undecided pixels, one bit each: visited by their bits rather than by 16 tests.
-    for (int bits = v_signmask(open); bits != 0; bits &= bits - 1) {
-      const int k = __builtin_ctz(static_cast<unsigned>(bits));
-      const uchar* p = bgr + 3 * (x + k);
-      const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
-      mask[x + k] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
-    }
-  }
 #endif
-  for (; x < n; ++x) {
-    const uchar* p = bgr + 3 * x;
-    const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
-    mask[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+  for (int y = 0; y < image.rows; ++y) {
+    if (y + 2 < image.rows) {
+      const uchar* ahead = image.ptr<uchar>(y + 2);
+      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
+      __builtin_prefetch(ahead + row_bytes - 1);
+    }
+    const uchar* bgr = image.ptr<uchar>(y);
+    uchar* mask = mask_image.ptr<uchar>(y);
+    int x = 0;
+#if CV_SIMD128
+    for (; x < n && n >= 16; x += 16) {
+      // The row's last pixels: the last 16 again, overlapping the previous chunk (each pixel's
+      // result depends on it alone), so no pixel of a row of 16 or more takes the scalar formula
+      // for being in the tail (on the tracker's windows, a tenth of the pixels did).
+      if (x + 16 > n) x = n - 16;
+      v_uint8x16 b8, g8, r8;
+      v_load_deinterleave(bgr + 3 * x, b8, g8, r8);
+      const v_uint8x16 v8 = v_max(b8, v_max(g8, r8));
+      const v_uint8x16 d8 = v_sub_wrap(v8, v_min(b8, v_min(g8, r8)));
+      const v_uint8x16 v_ok = (v8 >= v_lo) & (v8 <= v_hi);
+      // 16 flat pixels (a gray recording handed over as BGR: b == g == r): hue 0 and saturation 0
+      // exactly, so each is in by its value alone, as the flat case below decides it.
+      if (v_check_all(d8 == v_setzero_u8())) {
+        v_store(mask + x, gray_in & v_ok);
+        continue;
+      }
+      // Most pixels of a scene are far from the marker's hue, value or saturation: when all 16
+      // are out on those alone (exact, as above), the full test is not needed. First (8-bit, the
+      // cheapest) when none of the 16 has its largest channel in a sector whose hues reach the box
+      // (decide() would find none of them near a hue interval; a flat pixel has no hue).
+      if (sectors_can_fail) {
+        const v_uint8x16 is_r = v8 == r8, is_g = (v8 == g8) & ~is_r, is_b = ~(is_r | is_g);
+        const v_uint8x16 may_be_in = (is_r & sector_r) | (is_g & sector_g) | (is_b & sector_b) |
+                                     ((d8 == v_setzero_u8()) & gray_in);
+        if (!v_check_any(v_ok & may_be_in)) {
+          v_store(mask + x, v_setzero_u8());
+          continue;
+        }
+      }
+      v_uint16x8 vv0, vv1, d0, d1;
+      v_expand(v8, vv0, vv1);
+      v_expand(d8, d0, d1);
+      const v_uint16x8 s255_0 = v_mul_wrap(d0, k255), s255_1 = v_mul_wrap(d1, k255);
+      v_uint16x8 above_lo1_0 = all16, above_lo1_1 = all16;
+      if (s_lo_can_fail) {
+        above_lo1_0 = ~at_most(s255_0, v_mul_wrap(s_lo1, vv0));
+        above_lo1_1 = ~at_most(s255_1, v_mul_wrap(s_lo1, vv1));
+        if (!v_check_any(v_ok & v_pack(above_lo1_0, above_lo1_1))) {
+          v_store(mask + x, v_setzero_u8());
+          continue;
+        }
+      }
+      v_uint16x8 b0, b1, g0, g1, r0, r1;
+      v_expand(b8, b0, b1);
+      v_expand(g8, g0, g1);
+      v_expand(r8, r0, r1);
+      v_uint16x8 in0, in1, out0, out1;
+      decide(b0, g0, r0, vv0, d0, s255_0, above_lo1_0, in0, out0);
+      decide(b1, g1, r1, vv1, d1, s255_1, above_lo1_1, in1, out1);
+      v_uint8x16 in = v_pack(in0, in1) & v_ok;
+      v_uint8x16 out = v_pack(out0, out1) | ~v_ok;
+      // max == min: hue 0 and saturation 0 exactly.
+      const v_uint8x16 flat = d8 == v_setzero_u8();
+      in = v_select(flat, gray_in & v_ok, in);
+      out = v_select(flat, ~in, out);
+      v_store(mask + x, in);
+      const v_uint8x16 open = ~(in | out);
+      // The undecided pixels, one bit each: visited by their bits rather than by 16 tests.
+      for (int bits = v_signmask(open); bits != 0; bits &= bits - 1) {
+        const int k = __builtin_ctz(static_cast<unsigned>(bits));
+        const uchar* p = bgr + 3 * (x + k);
+        const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+        mask[x + k] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+      }
+    }
+#endif
+    for (; x < n; ++x) {
+      const uchar* p = bgr + 3 * x;
+      const cv::Vec3b hsv = BgrToHsvExact(p[0], p[1], p[2]);
+      mask[x] = box_.Contains(hsv[0], hsv[1], hsv[2]) ? 255 : 0;
+    }
   }
 }
 

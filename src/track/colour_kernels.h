@@ -47,9 +47,16 @@ class HsvClassifier {
   void Classify(const cv::Mat& bgr, cv::Mat& mask) const;
   // The scalar reference: BgrToHsvExact and Contains, pixel by pixel.
   void ClassifyScalar(const cv::Mat& bgr, cv::Mat& mask) const;
+  // The same of a gray image (CV_8UC1) whose every pixel stands for the BGR pixel (v, v, v): a
+  // flat pixel's hue and saturation are 0, so it is in when the box holds them and v is in the
+  // box's value range. A gray recording handed over as BGR is classified from one of its planes
+  // (ExtractFlatPlane), not from three interleaved ones (issue 45).
+  void ClassifyFlat(const cv::Mat& gray, cv::Mat& mask) const;
+  // The scalar reference: BgrToHsvExact(v, v, v) and Contains, pixel by pixel.
+  void ClassifyFlatScalar(const cv::Mat& gray, cv::Mat& mask) const;
 
  private:
-  void ClassifyRow(const uchar* bgr, uchar* mask, int n) const;
+  void ClassifyRows(const cv::Mat& bgr, cv::Mat& mask) const;
 
   HsvBox box_;
   bool full_hue_ = false;
@@ -62,6 +69,13 @@ class HsvClassifier {
   // in the box or within a unit of it; 16 pixels of none of those sectors are out at once.
   int hue_sectors_ = 7;
 };
+
+// Whether every pixel of `bgr` (CV_8UC3, any strides) has b == g == r (a gray recording handed
+// over as BGR); if so, its one plane into `plane` (CV_8UC1 of its size, allocated by the caller).
+// Stops at the first chunk of 16 that is not flat (a colour frame costs a few loads); `plane` is
+// then left partly written. 16 pixels at a time; ExtractFlatPlaneReference is the obvious loop.
+bool ExtractFlatPlane(const cv::Mat& bgr, cv::Mat& plane);
+bool ExtractFlatPlaneReference(const cv::Mat& bgr, cv::Mat& plane);
 
 // The OpenCV route the classifier replaces, for tests and benchmarks: cvtColor to HSV, a hue LUT
 // for a wrapping range, inRange. `mask` is allocated when needed.

@@ -133,6 +133,52 @@ TEST(ColourKernels, GrayFramesHandedOverAsBgrAreClassifiedAsTheScalarReference) 
   }
 }
 
+TEST(ColourKernels, AFlatRegionsPlaneIsClassifiedAsItsBgrPixels) {
+  // ExtractFlatPlane finds a gray recording handed over as BGR and gives its plane; ClassifyFlat
+  // of the plane is Classify of the BGR pixels (and its scalar reference) for every level and
+  // box, in rows of several widths and views. A pixel with b, g, r not all equal anywhere (first
+  // chunk, a row's overlapping last chunk, the scalar tail) makes the region not flat.
+  const HsvBox boxes[] = {
+      {{0, 179}, {0, 60}, {170, 255}},  {{0, 179}, {0, 40}, {200, 255}},
+      {{0, 0}, {0, 0}, {0, 255}},       {{170, 10}, {0, 255}, {40, 200}},
+      {{45, 85}, {80, 255}, {40, 255}}, {{0, 179}, {1, 255}, {0, 255}},
+  };
+  cv::RNG rng(45);
+  cv::Mat levels(40, 300, CV_8U);
+  rng.fill(levels, cv::RNG::UNIFORM, 0, 256);
+  for (int x = 0; x < 256; ++x) levels.at<uchar>(0, x) = static_cast<uchar>(x);  // Every level.
+  cv::Mat bgr;
+  cv::cvtColor(levels, bgr, cv::COLOR_GRAY2BGR);
+  for (const cv::Rect& r : {cv::Rect(0, 0, 300, 40), cv::Rect(3, 5, 37, 11), cv::Rect(1, 1, 15, 3),
+                            cv::Rect(0, 0, 16, 40), cv::Rect(250, 2, 50, 30)}) {
+    const cv::Mat view = bgr(r);
+    cv::Mat plane(view.size(), CV_8U), reference_plane(view.size(), CV_8U);
+    ASSERT_TRUE(ExtractFlatPlane(view, plane)) << r;
+    ASSERT_TRUE(ExtractFlatPlaneReference(view, reference_plane)) << r;
+    EXPECT_EQ(cv::countNonZero(plane != levels(r)), 0) << r;
+    EXPECT_EQ(cv::countNonZero(reference_plane != levels(r)), 0) << r;
+    for (const HsvBox& box : boxes) {
+      const HsvClassifier classifier(box);
+      cv::Mat flat(view.size(), CV_8U), flat_scalar(view.size(), CV_8U), of_bgr(view.size(), CV_8U);
+      classifier.ClassifyFlat(plane, flat);
+      classifier.ClassifyFlatScalar(plane, flat_scalar);
+      classifier.Classify(view, of_bgr);
+      EXPECT_EQ(cv::countNonZero(flat != flat_scalar), 0) << Name(box) << " " << r;
+      EXPECT_EQ(cv::countNonZero(flat != of_bgr), 0) << Name(box) << " " << r;
+    }
+    // One channel of one pixel off: first pixel, middle, a row's end, the last pixel.
+    for (const cv::Point at : {cv::Point(0, 0), cv::Point(r.width / 2, r.height / 2),
+                               cv::Point(r.width - 1, 0), cv::Point(r.width - 1, r.height - 1)}) {
+      for (int channel = 0; channel < 3; ++channel) {
+        cv::Mat changed = view.clone();
+        changed.at<cv::Vec3b>(at)[channel] ^= 1;
+        EXPECT_FALSE(ExtractFlatPlane(changed, plane)) << r << " " << at << " " << channel;
+        EXPECT_FALSE(ExtractFlatPlaneReference(changed, plane)) << r << " " << at;
+      }
+    }
+  }
+}
+
 TEST(ColourKernels, OpenClose3x3IsMorphologyEx) {
   cv::RNG rng(11);
   cv::Mat scratch;

@@ -160,6 +160,12 @@ class ColourTracker : public Tracker {
   cv::Mat prepare(const cv::Mat& src, cv::Mat& store);
   // Marker mask of `src` (prepared, filtered) into `mask`.
   void classify(const cv::Mat& src, bool coarse, cv::Mat& mask, bool dimmed = false);
+  // The fine mask of an analysed region into `mask` (the size of `filtered`, the region `inner`
+  // with its margin around it) and the bounding box of its nonzero pixels, which is all the
+  // rest of the region's analysis reads of it; the margin is classified only when that can
+  // change the region's result (see colour_blobs.cc).
+  cv::Rect ClassifyRegion(const cv::Mat& filtered, cv::Mat& mask, const cv::Rect& inner,
+                          bool dimmed);
   // Colour statistics and soft centroid of the labeller's `component`, whose box in the labelled
   // mask is `box`; `labelled_tl` is that mask's origin in `filtered` / `mask`, `origin` the
   // latter's in the frame.
@@ -247,6 +253,9 @@ class ColourTracker : public Tracker {
   ColourParams params_;
   cv::Mat kernel_;          // Morphology structuring element.
   int margin_px_ = 0;       // Filter radius + 4 morphology radii (+1).
+  // Whether the last region analysed needed its margin classified (ClassifyRegion: which way
+  // it classifies the next one; the result is the same either way).
+  bool margin_was_needed_ = false;
   HsvClassifier fine_hsv_, coarse_hsv_;  // The marker test, and the lenient coarse one.
   // The marker test with the brightness floor lowered (kDimFloor), for the dim pass; absent when
   // lowering changes nothing (a floor near 0).
@@ -308,6 +317,10 @@ class ColourTracker : public Tracker {
   cv::Mat filtered_store_, mask_store_, morph_store_, blob_store_;
   cv::Mat prepared_store_, coarse_prepared_store_, distance_store_, zone_store_;
   cv::Mat fringe_store_;  // measure_fringe's classification of the padded box.
+  // analyse_region's region as one plane when it is flat (b == g == r), and whether it is: the
+  // measurement then reads each level as the BGR pixel (v, v, v).
+  cv::Mat flat_store_;
+  bool flat_pixels_ = false;
   cv::Mat coarse_store_, coarse_mask_store_, coarse_labels_store_, tiles_store_;
   cv::Mat coarse_stats_, coarse_centroids_;
   RunLabeller labeller_;

@@ -978,6 +978,112 @@ TEST(ColourTrackerScene, WindowedEqualsWholeFrameAndCoarseEqualsFullResolution) 
   }
 }
 
+TEST(ColourTrackerScene, WindowsWithoutAFilterEqualTheWholeFrameBitForBit) {
+  // Without a pre-filter a window's margin is classified only when the window's own pixels of
+  // the marker's colour come near its sides (ColourTracker::ClassifyRegion); either way its
+  // result is the whole frame's, bit for bit. Specks of the markers' colours scattered around
+  // them bring some windows' pixels near their sides and leave others clear.
+  NoiseOptions noise;
+  noise.sigma = 3.0;
+  SyntheticScene scene(BendingScene(60), noise);
+  const cv::Scalar specks[] = {cv::Scalar(40, 40, 220), cv::Scalar(220, 60, 40),
+                               cv::Scalar(50, 200, 50)};
+  cv::RNG rng(45);
+  for (const ColourParams::Centroid centroid :
+       {ColourParams::Centroid::kBinary, ColourParams::Centroid::kSoft}) {
+    for (const char* name : {"red", "blue", "green"}) {
+      ColourParams windowed = ParamsFor(name);
+      windowed.centroid = centroid;
+      ColourParams whole = windowed;
+      whole.window_px = 0;
+      whole.acquire_downsample = 1;  // The frame as one region, its margin all beyond it.
+      ColourTracker a(windowed), b(whole);
+      cv::Mat image;
+      int compared = 0;
+      for (int f = 0; f < 60; f += 2) {
+        const SceneTruth truth = scene.render(f, image);
+        // Around each marker, from well inside its window to beyond the window's side.
+        for (const MarkerTruth& marker : truth.markers) {
+          if (!marker.centroid_px) continue;
+          for (int k = 0; k < 12; ++k) {
+            const double angle = rng.uniform(0.0, 2 * CV_PI), distance = rng.uniform(22.0, 48.0);
+            const cv::Point at(cvRound(marker.centroid_px->x + distance * std::cos(angle)),
+                               cvRound(marker.centroid_px->y + distance * std::sin(angle)));
+            cv::circle(image, at, rng.uniform(2, 5), specks[rng.uniform(0, 3)], cv::FILLED);
+          }
+        }
+        const Observation oa = a.update(image), ob = b.update(image);
+        ASSERT_EQ(oa.found(), ob.found()) << name << " frame " << f;
+        if (oa.found()) {
+          EXPECT_EQ(oa.position_px->x, ob.position_px->x) << name << " " << f;
+          EXPECT_EQ(oa.position_px->y, ob.position_px->y) << name << " " << f;
+          EXPECT_EQ(*oa.score, *ob.score) << name << " " << f;
+        }
+        // Every blob the window saw whole is a blob of the whole frame, measured the same (the
+        // same tracker, so the same learned model).
+        std::vector<ColourBlob> blobs;
+        a.find_blobs(image, 1, &blobs);
+        for (const MarkerCandidate& c : a.candidates()) {
+          if (c.verdict == CandidateVerdict::kClipped) continue;
+          const bool same = std::any_of(blobs.begin(), blobs.end(), [&](const ColourBlob& b) {
+            return b.centroid_px == c.position_px && b.area_px == c.area_px;
+          });
+          EXPECT_TRUE(same) << name << " frame " << f << " blob at " << c.position_px;
+          ++compared;
+        }
+      }
+      EXPECT_GE(compared, 30) << name;
+    }
+  }
+}
+
+TEST(ColourTracker, AGrayRecordingHandedOverAsBgrIsMeasuredFromOnePlaneBitForBit) {
+  // A white dot on a textured gray background, as mire-2's gray frames come as BGR: the flat
+  // windows are classified and measured from one plane (ColourTracker::flat_pixels_). The same
+  // frames with one background pixel off gray beside the dot take the three-channel path; every
+  // position, score and sigma is the same to the last bit.
+  ColourParams params;
+  params.s = {0, 60};
+  params.v = {170, 255};
+  ColourTracker flat(params), colour(params);
+  cv::RNG rng(45);
+  int compared = 0;
+  for (int f = 0; f < 24; ++f) {
+    cv::Mat levels(120, 160, CV_8U);
+    rng.fill(levels, cv::RNG::NORMAL, 70, 12);
+    const cv::Point2d centre(60 + 1.7 * f, 50 + 0.9 * f);
+    // Anti-aliased: 16 x 16 subsamples a pixel.
+    for (int y = 0; y < levels.rows; ++y) {
+      for (int x = 0; x < levels.cols; ++x) {
+        int inside = 0;
+        for (int k = 0; k < 256; ++k) {
+          const double dx = x - 0.5 + (k % 16 + 0.5) / 16 - centre.x;
+          const double dy = y - 0.5 + (k / 16 + 0.5) / 16 - centre.y;
+          inside += dx * dx + dy * dy <= 7.5 * 7.5;
+        }
+        if (inside > 0) {
+          levels.at<uchar>(y, x) = cv::saturate_cast<uchar>(
+              levels.at<uchar>(y, x) + (225 - levels.at<uchar>(y, x)) * inside / 256);
+        }
+      }
+    }
+    cv::Mat bgr;
+    cv::cvtColor(levels, bgr, cv::COLOR_GRAY2BGR);
+    cv::Mat off = bgr.clone();
+    off.at<cv::Vec3b>(cvRound(centre.y), cvRound(centre.x) + 20)[1] ^= 1;  // Dark either way.
+    const Observation a = flat.update(bgr), b = colour.update(off);
+    ASSERT_EQ(a.found(), b.found()) << f;
+    if (!a.found()) continue;
+    EXPECT_EQ(a.position_px->x, b.position_px->x) << f;
+    EXPECT_EQ(a.position_px->y, b.position_px->y) << f;
+    EXPECT_EQ(*a.score, *b.score) << f;
+    EXPECT_EQ(*a.sigma_px, *b.sigma_px) << f;
+    EXPECT_NEAR(a.position_px->x, centre.x, 0.2) << f;
+    ++compared;
+  }
+  EXPECT_GE(compared, 20);
+}
+
 TEST(ColourTrackerScene, CoarseCandidatesFindEveryAcceptableBlob) {
   // Noise and a half-covered marker: the coarse-to-fine search must return exactly the blobs
   // of the full-resolution search that are large and round enough to count as the marker.
