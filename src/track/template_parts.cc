@@ -273,7 +273,7 @@ void BlobChannelOf(const cv::Mat& native, const cv::Mat& projection, cv::Mat& ou
   if (native.channels() == 1) {
     out = native;
   } else if (!projection.empty()) {
-    cv::transform(native, out, projection);
+    ProjectLevels(native, projection, out);
   } else {
     cv::cvtColor(native, out, cv::COLOR_BGR2GRAY);
   }
@@ -295,6 +295,76 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   for (int c = 0; c < 3; ++c) offset -= 255.0 * std::min(0.0, axis[c]);
   cv::Mat m = (cv::Mat_<float>(1, 4) << axis[0], axis[1], axis[2], offset);
   return m;
+}
+
+void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) {
+  CV_Assert(bgr.type() == CV_8UC3 && projection.type() == CV_32FC1 && projection.total() == 4);
+  out.create(bgr.size(), CV_8UC1);
+  const float* m = projection.ptr<float>();
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const uint8_t* p = row + 3 * x;
+      // One IEEE float operation at a time (volatile: no contraction into a fused multiply-add
+      // whatever the build targets), the vector lanes' order.
+      volatile float acc = m[0] * static_cast<float>(p[0]);
+      acc = acc + m[1] * static_cast<float>(p[1]);
+      acc = acc + m[2] * static_cast<float>(p[2]);
+      acc = acc + m[3];
+      o[x] = cv::saturate_cast<uint8_t>(static_cast<float>(acc));
+    }
+  }
+}
+
+void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) {
+#if CV_SIMD128
+  CV_Assert(bgr.type() == CV_8UC3 && projection.type() == CV_32FC1 && projection.total() == 4);
+  if (bgr.cols < 16) {
+    ProjectLevelsReference(bgr, projection, out);
+    return;
+  }
+  // `out` may be reallocated here only (create keeps a buffer of the same size and type: the
+  // tracker's windows reuse theirs from frame to frame).
+  out.create(bgr.size(), CV_8UC1);
+  const float* m = projection.ptr<float>();
+  const cv::v_float32x4 wb = cv::v_setall_f32(m[0]), wg = cv::v_setall_f32(m[1]);
+  const cv::v_float32x4 wr = cv::v_setall_f32(m[2]), offset = cv::v_setall_f32(m[3]);
+  // Four pixels' levels, widened to 32 bits, -> their rounded projections.
+  const auto four = [&](const cv::v_uint32x4& b, const cv::v_uint32x4& g,
+                        const cv::v_uint32x4& r) {
+    cv::v_float32x4 acc = wb * cv::v_cvt_f32(cv::v_reinterpret_as_s32(b));
+    acc = acc + wg * cv::v_cvt_f32(cv::v_reinterpret_as_s32(g));
+    acc = acc + wr * cv::v_cvt_f32(cv::v_reinterpret_as_s32(r));
+    return cv::v_round(acc + offset);  // Nearest even, as cvRound.
+  };
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    // The last 16 pixels overlap the ones before them when the width is no multiple of 16: the
+    // same pixels give the same levels, and nothing outside the row is read.
+    for (int x = 0; x < bgr.cols; x += 16) {
+      if (x + 16 > bgr.cols) x = bgr.cols - 16;
+      cv::v_uint8x16 b8, g8, r8;
+      cv::v_load_deinterleave(row + 3 * x, b8, g8, r8);
+      cv::v_uint16x8 b16[2], g16[2], r16[2];
+      cv::v_expand(b8, b16[0], b16[1]);
+      cv::v_expand(g8, g16[0], g16[1]);
+      cv::v_expand(r8, r16[0], r16[1]);
+      cv::v_int16x8 packed[2];
+      for (int h = 0; h < 2; ++h) {
+        cv::v_uint32x4 b32[2], g32[2], r32[2];
+        cv::v_expand(b16[h], b32[0], b32[1]);
+        cv::v_expand(g16[h], g32[0], g32[1]);
+        cv::v_expand(r16[h], r32[0], r32[1]);
+        packed[h] = cv::v_pack(four(b32[0], g32[0], r32[0]), four(b32[1], g32[1], r32[1]));
+      }
+      cv::v_store(o + x, cv::v_pack_u(packed[0], packed[1]));  // Saturated: saturate_cast.
+    }
+  }
+#else
+  ProjectLevelsReference(bgr, projection, out);
+#endif
 }
 
 void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_deg,

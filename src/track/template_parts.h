@@ -564,6 +564,18 @@ struct Fix {
 // mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
 cv::Mat ContrastProjection(const cv::Mat& bgr);
 
+// `bgr` (8-bit BGR) projected with `projection` (1x4 CV_32F: B, G, R weights and an offset, as
+// ContrastProjection and MarkerProjection make), as cv::transform does: per pixel, in float,
+// ((wb * B + wg * G) + wr * R) + offset, rounded to nearest even and saturated to 0..255, 16
+// pixels at a time in float vector lanes. cv::transform's 3-to-1 projection is scalar (~35
+// instructions a pixel; the template tracker converts its windows with it every frame, issue 45)
+// and OpenCV's build may fuse its multiply-adds, so a level may differ from cv::transform's by 1
+// where the sum lies within a rounding of a half (tens in millions of pixels); bit for bit
+// ProjectLevelsReference.
+void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out);
+// The same, a pixel at a time: the definition.
+void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out);
+
 // The single channel a selected box (BGR, with the template's `mask`) shows its marker in best:
 // of the principal colour axis (ContrastProjection), luma (an empty matrix) and the axis from the
 // box's edge colour to its centre's, the one in which the blob at the centre is most isolated

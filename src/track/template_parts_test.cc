@@ -171,6 +171,56 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
   }
 }
 
+// The vector projection against its scalar reference, bit for bit (every 8-bit colour, on the
+// axes ContrastProjection learns and ones with negative weights; views of every width 1-40 px,
+// the overlapping last vector), and against cv::transform within a level.
+TEST(TemplateParts, ProjectLevelsIsTheReferences) {
+  cv::Mat every(4096, 4096, CV_8UC3);
+  for (int y = 0; y < every.rows; ++y) {
+    cv::Vec3b* row = every.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < every.cols; ++x) {
+      const int i = y * every.cols + x;
+      row[x] = cv::Vec3b(static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8),
+                         static_cast<uint8_t>(i >> 16));
+    }
+  }
+  std::vector<cv::Mat> projections;
+  cv::Mat selection(32, 32, CV_8UC3, cv::Scalar(120, 120, 120));
+  cv::circle(selection, {16, 16}, 9, cv::Scalar(40, 200, 60), cv::FILLED);
+  projections.push_back(ContrastProjection(selection));
+  cv::Mat gray_selection(32, 32, CV_8UC3, cv::Scalar(30, 30, 30));
+  cv::circle(gray_selection, {16, 16}, 9, cv::Scalar(220, 220, 220), cv::FILLED);
+  projections.push_back(ContrastProjection(gray_selection));
+  projections.push_back((cv::Mat_<float>(1, 4) << 0.5f, -0.3f, 0.2f, 76.5f));
+  projections.push_back((cv::Mat_<float>(1, 4) << -0.2f, -0.2f, 0.6f, 102.0f));
+  projections.push_back((cv::Mat_<float>(1, 4) << 0.7f, 0.7f, 0.7f, -20.0f));  // Saturates.
+  cv::Mat fast, reference, opencv;
+  for (const cv::Mat& m : projections) {
+    ASSERT_EQ(m.type(), CV_32FC1);
+    ProjectLevels(every, m, fast);
+    ProjectLevelsReference(every, m, reference);
+    ASSERT_EQ(cv::countNonZero(fast != reference), 0) << m;
+    cv::transform(every, opencv, m);
+    cv::Mat difference;
+    cv::absdiff(fast, opencv, difference);
+    double most = 0;
+    cv::minMaxLoc(difference, nullptr, &most);
+    EXPECT_LE(most, 1.0) << m;
+  }
+  cv::Mat noise(24, 60, CV_8UC3);
+  cv::RNG rng(45);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  for (int width = 1; width <= 40; ++width) {
+    for (const cv::Mat& m : projections) {
+      const cv::Mat view = noise(cv::Rect(width % 7, 3, width, 17));
+      ProjectLevels(view, m, fast);
+      ProjectLevelsReference(view, m, reference);
+      ASSERT_EQ(fast.size(), view.size());
+      EXPECT_EQ(cv::countNonZero(fast != reference), 0) << width << " " << m;
+    }
+  }
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };

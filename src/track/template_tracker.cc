@@ -65,7 +65,7 @@ void TemplateTracker::ToNative(const cv::Mat& frame, cv::Mat& out) const {
   } else if (params_.colour) {
     out = frame;  // A header only: the kernels read strided regions.
   } else if (!projection_.empty()) {
-    cv::transform(frame, out, projection_);
+    ProjectLevels(frame, projection_, out);  // cv::transform, in vector lanes.
   } else {
     cv::cvtColor(frame, out, cv::COLOR_BGR2GRAY);
   }
