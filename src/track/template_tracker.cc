@@ -563,15 +563,21 @@ std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::P
   const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
   ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
                                 near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
-  std::optional<Hit> hit = Search(frame, near, templ, false);
-  if (!hit || hit->on_inner_edge || !Accept(*hit)) return std::nullopt;
-  const cv::Point from_prediction =
-      hit->top_left - near.tl() - cv::Point(kNearMarginPx, kNearMarginPx);
-  if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
-                                   : NoRivalReachable(margin, from_prediction, radius))) {
-    return std::nullopt;
+  // The small window first, the near window when the small one does not decide (its best on its
+  // edge, not accepted, or a rival possible): both lie in the part converted above.
+  for (const int near_margin : {kFirstNearMarginPx, kNearMarginPx}) {
+    const cv::Rect window = WindowAround(predicted, size, near_margin);
+    std::optional<Hit> hit = Search(frame, window, templ, false);
+    if (!hit || hit->on_inner_edge || !Accept(*hit)) continue;
+    const cv::Point from_prediction =
+        hit->top_left - window.tl() - cv::Point(near_margin, near_margin);
+    if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
+                                     : NoRivalReachable(margin, from_prediction, radius))) {
+      continue;
+    }
+    return hit;
   }
-  return hit;
+  return std::nullopt;
 }
 
 namespace {
@@ -715,19 +721,30 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
-  const cv::Rect window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
   measured_zncc_ = false;
-  if (window.width < size.width || window.height < size.height) return std::nullopt;
-  Native(frame, window, fine_);
-  Similarity(fine_, rung.templ, fine_sim_);
-  measured_zncc_ = params_.measure == MatchMeasure::kZncc;
-  measured_tl_ = window.tl();
+  // kFirstFineMarginPx around the match first: its best inside it is the answer (a peak of the
+  // first template the working one's match is within a pixel or two of); else the whole
+  // kFineMarginPx window decides as before.
+  cv::Rect window;
   cv::Point best;
-  if (!BestIn(fine_sim_, &best)) return std::nullopt;
-  const bool inner_edge = (best.x == 0 && window.x > 0) ||
-                          (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
-                          (best.y == 0 && window.y > 0) ||
-                          (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
+  bool inner_edge = false;
+  for (const int fine_margin : {kFirstFineMarginPx, kFineMarginPx}) {
+    window = WindowAround(centre_px, size, fine_margin) & frame_rect;
+    if (window.width < size.width || window.height < size.height) return std::nullopt;
+    Native(frame, window, fine_);
+    Similarity(fine_, rung.templ, fine_sim_);
+    measured_zncc_ = params_.measure == MatchMeasure::kZncc;
+    measured_tl_ = window.tl();
+    if (!BestIn(fine_sim_, &best)) {
+      if (fine_margin == kFineMarginPx) return std::nullopt;
+      continue;
+    }
+    inner_edge = (best.x == 0 && window.x > 0) ||
+                 (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
+                 (best.y == 0 && window.y > 0) ||
+                 (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
+    if (!inner_edge) break;
+  }
   cv::Point2d top_left;
   if (!inner_edge) {
     top_left = cv::Point2d(window.tl() + best) +
