@@ -39,14 +39,14 @@ inline constexpr int kAroundPx = 2;
 // While tracking, the window this far around the predicted place is searched first; the
 // search_margin_px window only when that one does not decide (NearSearchDecides).
 inline constexpr int kNearMarginPx = 4;
-// ... and before it, the window this far around the prediction (25 placements, not 81), which
-// decides when its best lies inside it and would decide the near window: a peak inside it is
-// the near window's unless a higher one lies within kNearMarginPx of the prediction too (two
-// peaks a few pixels apart: not a marker's dot). Most frames the prediction is within a pixel.
-inline constexpr int kFirstNearMarginPx = 2;
-// The measurement likewise tries this much around the working template's match before
-// kFineMarginPx (the first and the working template mostly agree to a pixel).
-inline constexpr int kFirstFineMarginPx = 2;
+// ... and before it, a window this far around the prediction, moved onto its best while that
+// lies on its edge (9 placements a try, not 81): it decides when its best lies inside it within
+// the near window, a local peak of it, its best unless a higher peak lies within kNearMarginPx
+// of the prediction too (two peaks a few pixels apart: not a marker's dot).
+inline constexpr int kFirstNearMarginPx = 1;
+// The measurement climbs likewise from the working template's match within kFineMarginPx (the
+// first and the working template mostly agree to a pixel).
+inline constexpr int kFirstFineMarginPx = 1;
 inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.

@@ -563,21 +563,39 @@ std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::P
   const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
   ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
                                 near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
-  // The small window first, the near window when the small one does not decide (its best on its
-  // edge, not accepted, or a rival possible): both lie in the part converted above.
-  for (const int near_margin : {kFirstNearMarginPx, kNearMarginPx}) {
-    const cv::Rect window = WindowAround(predicted, size, near_margin);
+  const cv::Point predicted_tl = near.tl() + cv::Point(kNearMarginPx, kNearMarginPx);
+  // Whether `hit` decides: passed, and no rival reachable.
+  const auto decides = [&](const Hit& hit) {
+    if (!Accept(hit)) return false;
+    const cv::Point from_prediction = hit.top_left - predicted_tl;
+    return !rivals || (footage_repeats_ ? no_rival_reachable(hit.top_left)
+                                        : NoRivalReachable(margin, from_prediction, radius));
+  };
+  // Climbing first: the kFirstNearMarginPx window around the prediction, moved onto its best
+  // while that lies on its edge, as long as it stays inside the near window (each placement's
+  // score depends on its pixels alone: a peak inside the window that climbed to it is a local
+  // peak of the near window, its best unless a higher one lies within kNearMarginPx of the
+  // prediction too: two peaks a few pixels apart, not a marker). Most frames the prediction is
+  // within a pixel: 9 placements, not 81.
+  cv::Point at(0, 0);  // The climbing window's centre, from the prediction.
+  for (int step = 0; step <= 2 * kNearMarginPx; ++step) {
+    const cv::Rect window = WindowAround(predicted, size, kFirstNearMarginPx) + at;
     std::optional<Hit> hit = Search(frame, window, templ, false);
-    if (!hit || hit->on_inner_edge || !Accept(*hit)) continue;
-    const cv::Point from_prediction =
-        hit->top_left - window.tl() - cv::Point(near_margin, near_margin);
-    if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
-                                     : NoRivalReachable(margin, from_prediction, radius))) {
-      continue;
+    if (!hit) break;
+    if (!hit->on_inner_edge) {
+      if (decides(*hit)) return hit;
+      break;
     }
-    return hit;
+    at = hit->top_left - predicted_tl;
+    if (std::abs(at.x) > kNearMarginPx - kFirstNearMarginPx ||
+        std::abs(at.y) > kNearMarginPx - kFirstNearMarginPx) {
+      break;
+    }
   }
-  return std::nullopt;
+  // The near window whole when the climb did not decide.
+  std::optional<Hit> hit = Search(frame, near, templ, false);
+  if (!hit || hit->on_inner_edge || !decides(*hit)) return std::nullopt;
+  return hit;
 }
 
 namespace {
@@ -722,29 +740,44 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   const cv::Size size = rung.templ.size();
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
   measured_zncc_ = false;
-  // kFirstFineMarginPx around the match first: its best inside it is the answer (a peak of the
-  // first template the working one's match is within a pixel or two of); else the whole
-  // kFineMarginPx window decides as before.
+  // Climbing first, as NearSearch: the kFirstFineMarginPx window around the match, moved onto
+  // its best while that lies on its edge, inside the kFineMarginPx window (the first template's
+  // peak, which the working one's match is mostly within a pixel of); the whole kFineMarginPx
+  // window decides as before when the climb leaves it.
   cv::Rect window;
   cv::Point best;
-  bool inner_edge = false;
-  for (const int fine_margin : {kFirstFineMarginPx, kFineMarginPx}) {
-    window = WindowAround(centre_px, size, fine_margin) & frame_rect;
-    if (window.width < size.width || window.height < size.height) return std::nullopt;
+  bool inner_edge = true;
+  const cv::Rect centred = WindowAround(centre_px, size, 0);
+  cv::Point at(0, 0);  // The climbing window's centre, from the match.
+  for (int step = 0; step <= 2 * kFineMarginPx && inner_edge; ++step) {
+    window = (WindowAround(centre_px, size, kFirstFineMarginPx) + at) & frame_rect;
+    if (window.width < size.width || window.height < size.height) break;
     Native(frame, window, fine_);
     Similarity(fine_, rung.templ, fine_sim_);
-    measured_zncc_ = params_.measure == MatchMeasure::kZncc;
-    measured_tl_ = window.tl();
-    if (!BestIn(fine_sim_, &best)) {
-      if (fine_margin == kFineMarginPx) return std::nullopt;
-      continue;
-    }
+    if (!BestIn(fine_sim_, &best)) break;
     inner_edge = (best.x == 0 && window.x > 0) ||
                  (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
                  (best.y == 0 && window.y > 0) ||
                  (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
-    if (!inner_edge) break;
+    at = window.tl() + best - centred.tl();
+    if (std::abs(at.x) > kFineMarginPx - kFirstFineMarginPx ||
+        std::abs(at.y) > kFineMarginPx - kFirstFineMarginPx) {
+      break;
+    }
   }
+  if (inner_edge) {
+    window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
+    if (window.width < size.width || window.height < size.height) return std::nullopt;
+    Native(frame, window, fine_);
+    Similarity(fine_, rung.templ, fine_sim_);
+    if (!BestIn(fine_sim_, &best)) return std::nullopt;
+    inner_edge = (best.x == 0 && window.x > 0) ||
+                 (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
+                 (best.y == 0 && window.y > 0) ||
+                 (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
+  }
+  measured_zncc_ = params_.measure == MatchMeasure::kZncc;
+  measured_tl_ = window.tl();
   cv::Point2d top_left;
   if (!inner_edge) {
     top_left = cv::Point2d(window.tl() + best) +
