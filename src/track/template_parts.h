@@ -607,9 +607,9 @@ inline constexpr double kMinChromaSpan = 0.05;
 // The axis of `bgr` (a selected template, 8-bit BGR); false when its centre's chromaticity does
 // not differ from its edge's.
 bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out);
-// One 8-bit channel: the background at 40, the marker at 200. The pixels' arithmetic in double
-// vector lanes, 16 pixels at a time, in the reference's order of operations: bit for bit
-// ChromaChannelReference (the template tracker's blob is measured in it every frame).
+// One 8-bit channel: the background at 40, the marker at 200. The pixels' arithmetic in float
+// vector lanes, 16 pixels at a time: ChromaChannelReference's levels to within one (the template
+// tracker's blob is measured in it every frame).
 void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
 // The same, a pixel at a time: the definition.
 void ChromaChannelReference(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);

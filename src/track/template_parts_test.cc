@@ -122,7 +122,7 @@ TEST(TemplateParts, NoRivalReachableIsRivalInOnAFlatWindow) {
   EXPECT_EQ(RivalRadius(cv::Size(3, 3)), 2);
 }
 
-// The vector chroma channel against its scalar reference, bit for bit: every 8-bit colour, on
+// The vector chroma channel against its scalar reference, within a level: every 8-bit colour, on
 // axes whose levels stay inside 0..255 and ones that saturate both ways, then views of every
 // width from 1 to 40 px (the 16-pixel loop's tail) on random pixels.
 TEST(TemplateParts, ChromaChannelIsTheReferences) {
@@ -152,11 +152,17 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
   ChromaAxis learned;
   ASSERT_TRUE(LearnChromaAxis(selection, &learned));
   axes.push_back(learned);
-  cv::Mat fast, reference;
+  cv::Mat fast, reference, difference;
   for (const ChromaAxis& a : axes) {
     ChromaChannel(every, a, fast);
     ChromaChannelReference(every, a, reference);
-    ASSERT_EQ(cv::countNonZero(fast != reference), 0) << a.axis << " " << a.span;
+    // Float lanes against the double reference: a level apart at most, and seldom.
+    cv::absdiff(fast, reference, difference);
+    double most = 0;
+    cv::minMaxLoc(difference, nullptr, &most);
+    EXPECT_LE(most, 1.0) << a.axis << " " << a.span;
+    EXPECT_LE(cv::countNonZero(difference), static_cast<int>(every.total() / 1000))
+        << a.axis << " " << a.span;
   }
   cv::Mat noise(24, 60, CV_8UC3);
   rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
@@ -166,7 +172,10 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
       ChromaChannel(view, a, fast);
       ChromaChannelReference(view, a, reference);
       ASSERT_EQ(fast.size(), view.size());
-      EXPECT_EQ(cv::countNonZero(fast != reference), 0) << width << " " << a.span;
+      cv::absdiff(fast, reference, difference);
+      double most = 0;
+      cv::minMaxLoc(difference, nullptr, &most);
+      EXPECT_LE(most, 1.0) << width << " " << a.span;
     }
   }
 }
