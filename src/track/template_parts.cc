@@ -297,6 +297,70 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   return m;
 }
 
+void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,
+                         cv::Mat& running, cv::Mat& rounded, cv::Mat& patch) {
+  cv::getRectSubPix(image, running.size(), centre, patch, CV_32F);
+  cv::addWeighted(running, 1.0 - rate, patch, rate, 0.0, running);
+  running.convertTo(rounded, CV_8U);
+}
+
+void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv::Mat& running,
+                cv::Mat& rounded) {
+  const cv::Size size = running.size();
+  // getRectSubPix's placement: its top-left sample at the centre (as a float) less half the
+  // size less a half, split into whole pixels and the bilinear fractions.
+  const cv::Point2f c(static_cast<float>(centre.x) - (size.width - 1) * 0.5f,
+                      static_cast<float>(centre.y) - (size.height - 1) * 0.5f);
+  const cv::Point ip(cvFloor(c.x), cvFloor(c.y));
+  if (image.type() != CV_8UC1 || running.type() != CV_32FC1 || size.width < 8 || ip.x < 0 ||
+      ip.y < 0 || ip.x + size.width + 1 > image.cols || ip.y + size.height + 1 > image.rows) {
+    cv::Mat patch;  // Colour, or a placement at the image's edge: rare (not every frame).
+    BlendPatchReference(image, centre, rate, running, rounded, patch);
+    return;
+  }
+  const float a = c.x - static_cast<float>(ip.x), b = c.y - static_cast<float>(ip.y);
+  const float w00 = (1.f - a) * (1.f - b), w01 = a * (1.f - b), w10 = (1.f - a) * b, w11 = a * b;
+  const float keep = static_cast<float>(1.0 - rate), take = static_cast<float>(rate);
+  rounded.create(size, CV_8UC1);  // Kept from frame to frame: the same size.
+  const auto pixel = [&](const uint8_t* p0, const uint8_t* p1, int x, float* r, uint8_t* o) {
+    const float sample = ((p0[x] * w00 + p0[x + 1] * w01) + p1[x] * w10) + p1[x + 1] * w11;
+    r[x] = r[x] * keep + sample * take;
+    o[x] = cv::saturate_cast<uint8_t>(r[x]);
+  };
+  for (int y = 0; y < size.height; ++y) {
+    const uint8_t* p0 = image.ptr<uint8_t>(ip.y + y) + ip.x;
+    const uint8_t* p1 = image.ptr<uint8_t>(ip.y + y + 1) + ip.x;
+    float* r = running.ptr<float>(y);
+    uint8_t* o = rounded.ptr<uint8_t>(y);
+    int x = 0;
+#if CV_SIMD128
+    const cv::v_float32x4 v00 = cv::v_setall_f32(w00), v01 = cv::v_setall_f32(w01);
+    const cv::v_float32x4 v10 = cv::v_setall_f32(w10), v11 = cv::v_setall_f32(w11);
+    const cv::v_float32x4 vkeep = cv::v_setall_f32(keep), vtake = cv::v_setall_f32(take);
+    // Four levels at `p` as floats.
+    const auto floats = [](const uint8_t* p) {
+      return cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(p)));
+    };
+    // Each running value is read and written once (the tail is scalar: a vector overlapping the
+    // last ones would blend them twice).
+    for (; x + 8 <= size.width; x += 8) {
+      cv::v_int32x4 level[2];
+      for (int h = 0; h < 2; ++h) {
+        const int k = x + 4 * h;
+        const cv::v_float32x4 sample =
+            ((floats(p0 + k) * v00 + floats(p0 + k + 1) * v01) + floats(p1 + k) * v10) +
+            floats(p1 + k + 1) * v11;
+        const cv::v_float32x4 blended = cv::v_load(r + k) * vkeep + sample * vtake;
+        cv::v_store(r + k, blended);
+        level[h] = cv::v_round(blended);
+      }
+      cv::v_pack_u_store(o + x, cv::v_pack(level[0], level[1]));
+    }
+#endif
+    for (; x < size.width; ++x) pixel(p0, p1, x, r, o);
+  }
+}
+
 void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) {
   CV_Assert(bgr.type() == CV_8UC3 && projection.type() == CV_32FC1 && projection.total() == 4);
   out.create(bgr.size(), CV_8UC1);

@@ -572,6 +572,23 @@ struct Fix {
 // mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
 cv::Mat ContrastProjection(const cv::Mat& bgr);
 
+// The template update's blend: the patch of `running`'s size centred at `centre` (in `image`'s
+// pixels, its geometric centre, as cv::getRectSubPix places it) sampled bilinearly from `image`
+// (CV_8UC1 or CV_8UC3), blended into `running` (CV_32F of the patch's channels) as
+// running * (1 - rate) + patch * rate, and `running` rounded (nearest even, saturated) into
+// `rounded` (CV_8U). The patch must lie inside `image` with a pixel to spare right and below.
+// Gray in float vector lanes, 8 pixels at a time, without the patch's buffer: the three OpenCV
+// calls of BlendPatchReference cost ~40 instructions a pixel (the template update, every frame,
+// issue 45). The same float arithmetic but for the order of the bilinear weights' products
+// (and OpenCV's build may fuse multiply-adds): `running` within a few float roundings of the
+// reference's, `rounded` within a level. Colour runs the reference.
+void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv::Mat& running,
+                cv::Mat& rounded);
+// The definition: cv::getRectSubPix (CV_32F), cv::addWeighted and convertTo(CV_8U), with
+// `patch` as the first one's buffer.
+void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,
+                         cv::Mat& running, cv::Mat& rounded, cv::Mat& patch);
+
 // `bgr` (8-bit BGR) projected with `projection` (1x4 CV_32F: B, G, R weights and an offset, as
 // ContrastProjection and MarkerProjection make), as cv::transform does: per pixel, in float,
 // ((wb * B + wg * G) + wr * R) + offset, rounded to nearest even and saturated to 0..255, 16

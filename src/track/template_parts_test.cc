@@ -230,6 +230,42 @@ TEST(TemplateParts, ProjectLevelsIsTheReferences) {
   }
 }
 
+// The fused template blend against getRectSubPix, addWeighted and convertTo: gray patches of
+// widths 3-40 (the 8-pixel loop, its scalar tail, the reference below 8) at sub-pixel centres
+// and at the image's edge (the reference's border), blended ten times in a row, and colour.
+TEST(TemplateParts, BlendPatchIsTheReferences) {
+  cv::RNG rng(45);
+  cv::Mat gray(60, 70, CV_8UC1), bgr(60, 70, CV_8UC3);
+  rng.fill(gray, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+  for (const cv::Mat* image : {&gray, &bgr}) {
+    for (int width = 3; width <= 40; ++width) {
+      const cv::Size size(width, 5 + width % 11);
+      cv::Mat start(size, CV_32FC(image->channels()));
+      rng.fill(start, cv::RNG::UNIFORM, 0.0, 255.0);
+      cv::Mat fast = start.clone(), reference = start.clone(), fast8, reference8, patch;
+      for (int k = 0; k < 10; ++k) {
+        const bool edge = k == 9;
+        const cv::Point2d centre(edge ? 1.3 : rng.uniform(width / 2.0 + 1, 69.0 - width / 2.0 - 2),
+                                 rng.uniform(size.height / 2.0 + 1, 59.0 - size.height / 2.0 - 2));
+        const double rate = k % 2 ? 0.5 : rng.uniform(0.05, 0.95);
+        BlendPatch(*image, centre, rate, fast, fast8);
+        BlendPatchReference(*image, centre, rate, reference, reference8, patch);
+        ASSERT_EQ(fast.size(), size);
+        ASSERT_EQ(fast8.type(), reference8.type());
+        cv::Mat difference;
+        cv::absdiff(fast, reference, difference);
+        double most = 0;
+        cv::minMaxLoc(difference.reshape(1), nullptr, &most);
+        EXPECT_LE(most, 1e-3) << width << " " << k;
+        cv::absdiff(fast8, reference8, difference);
+        cv::minMaxLoc(difference.reshape(1), nullptr, &most);
+        EXPECT_LE(most, 1.0) << width << " " << k;
+      }
+    }
+  }
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };

@@ -1009,8 +1009,6 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
   const cv::Rect around = WindowAround(centre_px, size, 2);
   if ((around & cv::Rect(0, 0, frame.cols, frame.rows)) != around) return;
   Native(frame, around, region_);
-  // getRectSubPix centres the patch on its geometric centre, which centre_px is.
-  cv::getRectSubPix(region_, size, centre_px - cv::Point2d(around.tl()), patch_, CV_32F);
   if (working_key_ != RungKey(rung_, turn_)) {
     // The scale or turn changed: the running template follows its size and mask before the blend
     // (its pixels follow a turn through the blend itself).
@@ -1021,9 +1019,10 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
     working_mask_ = rung.templ.mask().empty() ? cv::Mat() : rung.templ.mask().clone();
     working_key_ = RungKey(rung_, turn_);
   }
-  cv::addWeighted(working_f_, 1.0 - params_.update_rate, patch_, params_.update_rate, 0.0,
-                  working_f_);
-  working_f_.convertTo(candidate_, CV_8U);
+  // The patch centred on centre_px (its geometric centre, as getRectSubPix places it) blended
+  // in, and rounded into the candidate, in one pass (BlendPatch).
+  BlendPatch(region_, centre_px - cv::Point2d(around.tl()), params_.update_rate, working_f_,
+             candidate_);
   // Drift guard: the updated template must still resemble the first at this scale.
   const double similarity = ZnccAt(candidate_, {0, 0}, rung.templ, shape_, zncc_);
   if (!(similarity >= params_.drift_min_zncc) || !working_.Prepare(candidate_, working_mask_)) {
