@@ -297,6 +297,181 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   return m;
 }
 
+BlobRimSums RimLevelSumsReference(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                                  const cv::Mat& label, const cv::Rect& grown) {
+  BlobRimSums sums;
+  const int cols = label.cols;  // label is continuous.
+  for (int y = grown.y; y < grown.br().y; ++y) {
+    const uint8_t* levels = gray.ptr<uint8_t>(y);
+    const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+    const uint8_t* distance = dist.ptr<uint8_t>(y);
+    const uint8_t* in = label.ptr<uint8_t>(y);
+    for (int x = grown.x; x < grown.br().x; ++x) {
+      const int d = distance[x];
+      if (inside && !inside[x]) continue;
+      if (d == 0 && in[x - cols] && in[x + cols] && in[x - 1] && in[x + 1]) {
+        sums.fg_sum += levels[x];
+        ++sums.fg_n;
+      } else if (d == 3 || d == 4) {
+        sums.bg_sum += levels[x];
+        ++sums.bg_n;
+      }
+    }
+  }
+  return sums;
+}
+
+BlobRimSums RimLevelSums(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                         const cv::Mat& label, const cv::Rect& grown) {
+#if CV_SIMD128
+  if (!mask.empty() || grown.width < 18) return RimLevelSumsReference(gray, mask, dist, label, grown);
+  // The patch's first and last rows and columns a pixel at a time (their neighbours' reads
+  // would leave the patch; none of them is a component pixel, see above), the rest 16 pixels
+  // at a time: the counts and sums of whole levels in integer lanes, exact.
+  const int cols = label.cols;
+  const int x0 = std::max(grown.x, 1), x1 = std::min(grown.br().x, gray.cols - 1);
+  BlobRimSums sums;
+  const auto scalar = [&](int y, int from, int to) {
+    const BlobRimSums part =
+        RimLevelSumsReference(gray, mask, dist, label, cv::Rect(from, y, to - from, 1));
+    sums.fg_sum += part.fg_sum;
+    sums.fg_n += part.fg_n;
+    sums.bg_sum += part.bg_sum;
+    sums.bg_n += part.bg_n;
+  };
+  const cv::v_uint8x16 zero = cv::v_setzero_u8(), three = cv::v_setall_u8(3),
+                       four = cv::v_setall_u8(4), one = cv::v_setall_u8(1);
+  unsigned fg_sum = 0, bg_sum = 0, fg_n = 0, bg_n = 0;  // Exact: at most 255 a pixel.
+  for (int y = grown.y; y < grown.br().y; ++y) {
+    if (y == 0 || y == gray.rows - 1 || x1 - x0 < 16) {
+      scalar(y, grown.x, grown.br().x);
+      continue;
+    }
+    if (grown.x < x0) scalar(y, grown.x, x0);
+    if (x1 < grown.br().x) scalar(y, x1, grown.br().x);
+    const uint8_t* levels = gray.ptr<uint8_t>(y);
+    const uint8_t* distance = dist.ptr<uint8_t>(y);
+    const uint8_t* in = label.ptr<uint8_t>(y);
+    // The last 16 pixels start where the ones before them ended (no pixel counted twice).
+    for (int x = x0; x < x1;) {
+      const int at = std::min(x, x1 - 16);
+      const cv::v_uint8x16 d = cv::v_load(distance + at);
+      cv::v_uint8x16 fg = (d == zero) & (cv::v_load(in + at - cols) != zero) &
+                          (cv::v_load(in + at + cols) != zero) &
+                          (cv::v_load(in + at - 1) != zero) & (cv::v_load(in + at + 1) != zero);
+      cv::v_uint8x16 bg = (d == three) | (d == four);
+      if (at < x) {  // The overlap: drop the lanes already counted.
+        alignas(16) uint8_t fresh[16];
+        for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
+        const cv::v_uint8x16 keep = cv::v_load_aligned(fresh);
+        fg &= keep;
+        bg &= keep;
+      }
+      const cv::v_uint8x16 v = cv::v_load(levels + at);
+      // Sums of 16 levels (psadbw against zero) and of the lanes' ones.
+      fg_sum += cv::v_reduce_sad(v & fg, zero);
+      bg_sum += cv::v_reduce_sad(v & bg, zero);
+      fg_n += cv::v_reduce_sad(one & fg, zero);
+      bg_n += cv::v_reduce_sad(one & bg, zero);
+      x = at + 16;
+    }
+  }
+  sums.fg_sum += fg_sum;
+  sums.bg_sum += bg_sum;
+  sums.fg_n += static_cast<int>(fg_n);
+  sums.bg_n += static_cast<int>(bg_n);
+  return sums;
+#else
+  return RimLevelSumsReference(gray, mask, dist, label, grown);
+#endif
+}
+
+SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
+                                       const cv::Mat& dist, const cv::Rect& grown, double bg,
+                                       double fg) {
+  SoftCentroidSums sums;
+  for (int y = grown.y; y < grown.br().y; ++y) {
+    const uint8_t* levels = gray.ptr<uint8_t>(y);
+    const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
+    const uint8_t* distance = dist.ptr<uint8_t>(y);
+    for (int x = grown.x; x < grown.br().x; ++x) {
+      if ((inside && !inside[x]) || distance[x] > 2) continue;
+      const double w = track_internal::Membership(levels + x, 1, &bg, &fg, 0.0, false);
+      sums.w += w;
+      sums.x += w * x;
+      sums.y += w * y;
+    }
+  }
+  return sums;
+}
+
+SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                              const cv::Rect& grown, double bg, double fg) {
+#if CV_SIMD128_64F
+  const double d = fg - bg, den = d * d;
+  // Membership with one channel and no deadband: clamp((v - bg) * d / den, 0, 1), 0 when the
+  // levels are too alike (then every weight is 0).
+  if (!mask.empty() || grown.width < 16 || !(den > 1.0)) {
+    return SoftCentroidReference(gray, mask, dist, grown, bg, fg);
+  }
+  const cv::v_float64x2 vbg = cv::v_setall_f64(bg), vd = cv::v_setall_f64(d);
+  const cv::v_float64x2 vden = cv::v_setall_f64(den), zero = cv::v_setzero_f64();
+  const cv::v_float64x2 unit = cv::v_setall_f64(1.0);
+  const cv::v_uint8x16 near = cv::v_setall_u8(2);
+  cv::v_float64x2 sw = zero, sx = zero, sy = zero;
+  alignas(16) uint8_t fresh[16];
+  for (int y = grown.y; y < grown.br().y; ++y) {
+    const uint8_t* levels = gray.ptr<uint8_t>(y);
+    const uint8_t* distance = dist.ptr<uint8_t>(y);
+    const cv::v_float64x2 vy = cv::v_setall_f64(static_cast<double>(y));
+    cv::v_float64x2 rw = zero, rx = zero;  // The row's sums of w and w * x.
+    for (int x = grown.x; x < grown.br().x;) {
+      const int at = std::min(x, grown.br().x - 16);  // The last 16 overlap: lanes dropped.
+      cv::v_uint8x16 counted = cv::v_load(distance + at) <= near;
+      if (at < x) {
+        for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
+        counted &= cv::v_load_aligned(fresh);
+      }
+      // Uncounted pixels' weights are set to 0 (adding 0 leaves the sums as they were).
+      const cv::v_uint8x16 v = cv::v_load(levels + at);
+      cv::v_uint16x8 v16[2], c16[2];
+      cv::v_expand(v, v16[0], v16[1]);
+      cv::v_expand(counted, c16[0], c16[1]);
+      for (int h = 0; h < 2; ++h) {
+        cv::v_uint32x4 v32[2], c32[2];
+        cv::v_expand(v16[h], v32[0], v32[1]);
+        cv::v_expand(c16[h], c32[0], c32[1]);
+        for (int q = 0; q < 2; ++q) {
+          const cv::v_int32x4 level = cv::v_reinterpret_as_s32(v32[q]);
+          const cv::v_int32x4 take = cv::v_reinterpret_as_s32(c32[q]);
+          const cv::v_float64x2 halves[2] = {cv::v_cvt_f64(level), cv::v_cvt_f64_high(level)};
+          const cv::v_float64x2 keeps[2] = {cv::v_cvt_f64(take), cv::v_cvt_f64_high(take)};
+          for (int e = 0; e < 2; ++e) {
+            const int x_first = at + 8 * h + 4 * q + 2 * e;
+            cv::v_float64x2 w = cv::v_min(cv::v_max(((halves[e] - vbg) * vd) / vden, zero), unit);
+            w = cv::v_select(keeps[e] != zero, w, zero);
+            const cv::v_float64x2 xs(static_cast<double>(x_first), static_cast<double>(x_first + 1));
+            rw += w;
+            rx += w * xs;
+          }
+        }
+      }
+      x = at + 16;
+    }
+    sw += rw;
+    sx += rx;
+    sy += rw * vy;
+  }
+  SoftCentroidSums sums;
+  sums.w = cv::v_reduce_sum(sw);
+  sums.x = cv::v_reduce_sum(sx);
+  sums.y = cv::v_reduce_sum(sy);
+  return sums;
+#else
+  return SoftCentroidReference(gray, mask, dist, grown, bg, fg);
+#endif
+}
+
 void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,
                          cv::Mat& running, cv::Mat& rounded, cv::Mat& patch) {
   cv::getRectSubPix(image, running.size(), centre, patch, CV_32F);

@@ -172,6 +172,34 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
 // The reference: every pixel within 4 of each pixel looked at.
 void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist);
 
+// BlobMeter's passes over the pixels of `grown` (inside `gray`, CV_8UC1, and `mask`, empty or
+// CV_8UC1 of its size; `dist` the capped Chebyshev distance to the component `label`, both of
+// gray's size and continuous). The levels right at the blob: the sums and counts of the marker's
+// interior (the component's pixels whose 4 neighbours are all in it) and of the ring 3-4 px
+// outside it. A component pixel (distance 0) is off the patch's edge, so its four neighbours are
+// in the patch. The sums are of whole levels: exact in a double, and the same in vector lanes.
+struct BlobRimSums {
+  double fg_sum = 0, bg_sum = 0;
+  int fg_n = 0, bg_n = 0;
+};
+BlobRimSums RimLevelSums(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                         const cv::Mat& label, const cv::Rect& grown);
+BlobRimSums RimLevelSumsReference(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                                  const cv::Mat& label, const cv::Rect& grown);
+// The soft centroid's sums over the pixels within 2 px of the component (distance <= 2) inside the
+// mask: each pixel's Membership between `bg` and `fg` (w), and w * x, w * y. Unmasked in double
+// vector lanes, two pixels a vector: each w is the reference's, bit for bit, summed in another
+// order (w * y as a row's sum of w times y; the sums agree to ~1e-15 of themselves). The blob is
+// measured in every frame (issue 45).
+struct SoftCentroidSums {
+  double w = 0, x = 0, y = 0;
+};
+SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                              const cv::Rect& grown, double bg, double fg);
+SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
+                                       const cv::Mat& dist, const cv::Rect& grown, double bg,
+                                       double fg);
+
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
@@ -286,48 +314,15 @@ class BlobMeter {
     // from what is at the rim.
     const cv::Rect grown = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
                            cv::Rect(0, 0, gray.cols, gray.rows);
-    double fg_sum = 0, bg_sum = 0;
-    int fg_n = 0, bg_n = 0;
     dist_.create(gray.size(), CV_8UC1);
     CappedChebyshevDistance(label_, grown, dist_, row_distance_);
-    // Rows through pointers (every frame's blob, issue 45); `grown` lies in the patch, so only
-    // the mask can leave a pixel out. A component pixel (d == 0) is off the patch's edge (Fill),
-    // so its four neighbours are in the patch. The sums are of whole levels: exact in a double.
-    const int cols = label_.cols;  // label_ is continuous.
-    for (int y = grown.y; y < grown.br().y; ++y) {
-      const uint8_t* levels = gray.ptr<uint8_t>(y);
-      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
-      const uint8_t* distance = dist_.ptr<uint8_t>(y);
-      const uint8_t* label = label_.ptr<uint8_t>(y);
-      for (int x = grown.x; x < grown.br().x; ++x) {
-        const int d = distance[x];
-        if (inside && !inside[x]) continue;
-        if (d == 0 && label[x - cols] && label[x + cols] && label[x - 1] && label[x + 1]) {
-          fg_sum += levels[x];
-          ++fg_n;
-        } else if (d == 3 || d == 4) {
-          bg_sum += levels[x];
-          ++bg_n;
-        }
-      }
-    }
-    const double fg = fg_n > 0 ? fg_sum / fg_n : (bright_ ? high : low);
-    const double bg = bg_n > 0 ? bg_sum / bg_n : (bright_ ? low : high);
+    const BlobRimSums rim = RimLevelSums(gray, mask, dist_, label_, grown);
+    const double fg = rim.fg_n > 0 ? rim.fg_sum / rim.fg_n : (bright_ ? high : low);
+    const double bg = rim.bg_n > 0 ? rim.bg_sum / rim.bg_n : (bright_ ? low : high);
     if (!(std::abs(fg - bg) >= kMinBlobContrast)) return false;
     // Soft centroid over the component grown by 2 px (its anti-aliased rim), inside the mask.
-    double sw = 0, sx = 0, sy = 0;
-    for (int y = grown.y; y < grown.br().y; ++y) {
-      const uint8_t* levels = gray.ptr<uint8_t>(y);
-      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
-      const uint8_t* distance = dist_.ptr<uint8_t>(y);
-      for (int x = grown.x; x < grown.br().x; ++x) {
-        if ((inside && !inside[x]) || distance[x] > 2) continue;
-        const double w = track_internal::Membership(levels + x, 1, &bg, &fg, 0.0, false);
-        sw += w;
-        sx += w * x;
-        sy += w * y;
-      }
-    }
+    const SoftCentroidSums soft = SoftCentroid(gray, mask, dist_, grown, bg, fg);
+    const double sw = soft.w, sx = soft.x, sy = soft.y;
     if (!(sw > 0)) return false;
     *centroid = {sx / sw, sy / sw};
     *area = sw;

@@ -266,6 +266,49 @@ TEST(TemplateParts, BlendPatchIsTheReferences) {
   }
 }
 
+// The blob measurement's pixel passes in vector lanes against their references: discs of radius
+// 2-14 anywhere in a noisy patch (at its edges too), grown boxes of every width from the blob's
+// to the patch's: the rim's sums exactly, the soft centroid's within 1e-12 of themselves.
+TEST(TemplateParts, BlobPassesAreTheReferences) {
+  cv::RNG rng(45);
+  std::vector<uint8_t> scratch;
+  for (int trial = 0; trial < 300; ++trial) {
+    const cv::Size size(rng.uniform(20, 70), rng.uniform(12, 50));
+    cv::Mat gray(size, CV_8UC1);
+    rng.fill(gray, cv::RNG::UNIFORM, 0, 256);
+    cv::Mat label = cv::Mat::zeros(size, CV_8UC1);
+    const int radius = rng.uniform(2, 15);
+    const cv::Point centre(rng.uniform(1, size.width - 1), rng.uniform(1, size.height - 1));
+    cv::circle(label, centre, radius, cv::Scalar(1), cv::FILLED);
+    // A component pixel is off the patch's edge (as BlobMeter's fill leaves it).
+    label.row(0).setTo(0);
+    label.row(size.height - 1).setTo(0);
+    label.col(0).setTo(0);
+    label.col(size.width - 1).setTo(0);
+    const cv::Rect box = cv::boundingRect(label);
+    const int grow = rng.uniform(0, 12);
+    const cv::Rect grown = cv::Rect(box.x - grow, box.y - grow, box.width + 2 * grow,
+                                    box.height + 2 * grow) & cv::Rect(0, 0, size.width, size.height);
+    if (grown.empty()) continue;
+    cv::Mat dist(size, CV_8UC1, cv::Scalar(9));
+    CappedChebyshevDistance(label, grown, dist, scratch);
+    const BlobRimSums fast = RimLevelSums(gray, cv::Mat(), dist, label, grown);
+    const BlobRimSums reference = RimLevelSumsReference(gray, cv::Mat(), dist, label, grown);
+    EXPECT_EQ(fast.fg_sum, reference.fg_sum) << trial;
+    EXPECT_EQ(fast.fg_n, reference.fg_n) << trial;
+    EXPECT_EQ(fast.bg_sum, reference.bg_sum) << trial;
+    EXPECT_EQ(fast.bg_n, reference.bg_n) << trial;
+    const double bg = rng.uniform(0.0, 120.0), fg = bg + (trial % 7 == 0 ? 0.5 : rng.uniform(5.0, 130.0));
+    for (const auto& [low, high] : {std::pair{bg, fg}, std::pair{fg, bg}}) {
+      const SoftCentroidSums a = SoftCentroid(gray, cv::Mat(), dist, grown, low, high);
+      const SoftCentroidSums b = SoftCentroidReference(gray, cv::Mat(), dist, grown, low, high);
+      EXPECT_NEAR(a.w, b.w, 1e-12 * std::max(1.0, std::abs(b.w))) << trial;
+      EXPECT_NEAR(a.x, b.x, 1e-12 * std::max(1.0, std::abs(b.x))) << trial;
+      EXPECT_NEAR(a.y, b.y, 1e-12 * std::max(1.0, std::abs(b.y))) << trial;
+    }
+  }
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };
