@@ -297,6 +297,71 @@ cv::Mat ContrastProjection(const cv::Mat& bgr) {
   return m;
 }
 
+void LookAlikeZncc(const cv::Mat& image, const PreparedTemplate& templ,
+                   const PreparedTemplate* half, double floor, cv::Mat& sim,
+                   LookAlikeScratch& scratch, ZnccScratch& zncc) {
+  const cv::Size size = templ.size();
+  const cv::Size map_size(image.cols - size.width + 1, image.rows - size.height + 1);
+  if (half == nullptr) {
+    MatchZncc(image, templ, sim, zncc);
+    return;
+  }
+  cv::pyrDown(image, scratch.half_image);
+  if (scratch.half_image.cols < half->size().width ||
+      scratch.half_image.rows < half->size().height) {
+    MatchZncc(image, templ, sim, zncc);
+    return;
+  }
+  MatchZncc(scratch.half_image, *half, scratch.half_sim, zncc);
+  // The full-resolution placements to match: blocks around the half-resolution ones that pass.
+  scratch.wanted.create(map_size, CV_8UC1);
+  scratch.wanted.setTo(0);
+  const float pass = static_cast<float>(floor - kLookAlikeSlack);
+  int passed = 0;
+  for (int y = 0; y < scratch.half_sim.rows; ++y) {
+    const float* row = scratch.half_sim.ptr<float>(y);
+    for (int x = 0; x < scratch.half_sim.cols; ++x) {
+      if (!(row[x] >= pass)) continue;
+      ++passed;
+      const cv::Rect block(2 * x - kLookAlikeReachPx, 2 * y - kLookAlikeReachPx,
+                           2 * kLookAlikeReachPx + 1, 2 * kLookAlikeReachPx + 1);
+      scratch.wanted(block & cv::Rect(0, 0, map_size.width, map_size.height)).setTo(1);
+    }
+  }
+  if (passed * 8 > static_cast<int>(scratch.half_sim.total())) {  // Mostly alike: all of it.
+    MatchZncc(image, templ, sim, zncc);
+    return;
+  }
+  sim.create(map_size, CV_32F);
+  sim.setTo(std::numeric_limits<float>::quiet_NaN());
+  // Each band of rows with wanted placements matched as one window over their columns' span
+  // (a placement's ZNCC depends on its own pixels only: the values are the whole map's).
+  const cv::Mat& wanted = scratch.wanted;
+  for (int y = 0; y < map_size.height;) {
+    int y_end = y, x_begin = map_size.width, x_end = 0;
+    for (; y_end < map_size.height; ++y_end) {
+      const uint8_t* r = wanted.ptr<uint8_t>(y_end);
+      int first = 0;
+      while (first < map_size.width && !r[first]) ++first;
+      if (first == map_size.width) break;
+      int last = map_size.width - 1;
+      while (!r[last]) --last;
+      x_begin = std::min(x_begin, first);
+      x_end = std::max(x_end, last + 1);
+    }
+    if (y_end == y) {  // A row without wanted placements.
+      ++y;
+      continue;
+    }
+    const cv::Rect placements(x_begin, y, x_end - x_begin, y_end - y);
+    const cv::Rect window(placements.x, placements.y, placements.width + size.width - 1,
+                          placements.height + size.height - 1);
+    MatchZncc(image(window), templ, scratch.part, zncc);
+    scratch.part.copyTo(sim(placements));
+    y = y_end;
+  }
+}
+
 BlobRimSums RimLevelSumsReference(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
                                   const cv::Mat& label, const cv::Rect& grown) {
   BlobRimSums sums;

@@ -47,6 +47,10 @@ inline constexpr int kFirstNearMarginPx = 1;
 // The measurement climbs likewise from the working template's match within kFineMarginPx (the
 // first and the working template mostly agree to a pixel).
 inline constexpr int kFirstFineMarginPx = 1;
+// The look-alike scan matches at full resolution only within this many pixels of the places its
+// half-resolution template fits by min_zncc less this much (LookAlikeZncc).
+inline constexpr double kLookAlikeSlack = 0.3;
+inline constexpr int kLookAlikeReachPx = 4;
 inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
@@ -171,6 +175,21 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
                              std::vector<uint8_t>& row_distance);
 // The reference: every pixel within 4 of each pixel looked at.
 void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist);
+
+// The ZNCC map of `templ` over `image` (gray or colour, as MatchZncc) where the look-alike scan
+// reads it (MatchZncc's values there, bit for bit): every placement within kLookAlikeReachPx of
+// one whose match with `half` (the template's half-resolution level, its pyramid's; nullptr:
+// none) over the image's half-resolution level scores `floor` - kLookAlikeSlack or more; NaN
+// (no match) elsewhere. A place the full-resolution template fits by `floor` fits its
+// half-resolution one about as well (both smoothed alike). The whole map was matched before, a
+// tenth of mire-2's instructions for its five templates, once (issue 45). The whole map when
+// there is no half-resolution level or it passes more than an eighth of its places.
+struct LookAlikeScratch {
+  cv::Mat half_image, half_sim, wanted, part;
+};
+void LookAlikeZncc(const cv::Mat& image, const PreparedTemplate& templ,
+                   const PreparedTemplate* half, double floor, cv::Mat& sim,
+                   LookAlikeScratch& scratch, ZnccScratch& zncc);
 
 // BlobMeter's passes over the pixels of `grown` (inside `gray`, CV_8UC1, and `mask`, empty or
 // CV_8UC1 of its size; `dist` the capped Chebyshev distance to the component `label`, both of

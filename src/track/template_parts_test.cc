@@ -309,6 +309,66 @@ TEST(TemplateParts, BlobPassesAreTheReferences) {
   }
 }
 
+// The look-alike scan's map against the whole map: on noisy pictures of a template's disc
+// among twins, other discs and blobs, every placement the whole map scores min_zncc or more at,
+// and its 8 neighbours, hold the whole map's value bit for bit.
+TEST(TemplateParts, LookAlikeZnccHoldsTheWholeMapsPeaks) {
+  cv::RNG rng(45);
+  for (int trial = 0; trial < 12; ++trial) {
+    cv::Mat image(160, 200, CV_8UC1, cv::Scalar(rng.uniform(30, 90)));
+    const int radius = rng.uniform(5, 12);
+    for (int k = 0; k < 6; ++k) {
+      const cv::Point at(rng.uniform(20, 180), rng.uniform(20, 140));
+      cv::circle(image, at, k < 3 ? radius : rng.uniform(3, 16),
+                 cv::Scalar(rng.uniform(150, 250)), cv::FILLED, cv::LINE_AA);
+    }
+    cv::Mat noise(image.size(), CV_8UC1);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 6);
+    cv::add(image, noise, image);  // Saturating; noise of one sign only is enough here.
+    cv::Mat picture(image.size(), CV_8UC1, cv::Scalar(60));
+    cv::circle(picture, {100, 80}, radius, cv::Scalar(200), cv::FILLED, cv::LINE_AA);
+    const int side = 2 * radius + 9;
+    const cv::Mat cut = picture(cv::Rect(100 - side / 2, 80 - side / 2, side, side));
+    PreparedTemplate templ, half;
+    ASSERT_TRUE(templ.Prepare(cut, RoundMask(cut.size())));
+    cv::Mat down;
+    cv::pyrDown(cut, down);
+    ASSERT_TRUE(half.Prepare(down, RoundMask(down.size())));
+    cv::Mat whole, pruned;
+    ZnccScratch zncc;
+    LookAlikeScratch scratch;
+    MatchZncc(image, templ, whole, zncc);
+    LookAlikeZncc(image, templ, &half, 0.8, pruned, scratch, zncc);
+    ASSERT_EQ(pruned.size(), whole.size());
+    int peaks = 0;
+    for (int y = 0; y < whole.rows; ++y) {
+      for (int x = 0; x < whole.cols; ++x) {
+        if (!(whole.at<float>(y, x) >= 0.8f)) continue;
+        ++peaks;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const cv::Point p(x + dx, y + dy);
+            if (!cv::Rect(0, 0, whole.cols, whole.rows).contains(p)) continue;
+            const float a = whole.at<float>(p), b = pruned.at<float>(p);
+            EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << trial << " " << p;
+          }
+        }
+      }
+    }
+    EXPECT_GT(peaks, 0) << trial;
+  }
+  // Without a half-resolution level: the whole map.
+  cv::Mat image(40, 40, CV_8UC1), whole, pruned;
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  PreparedTemplate templ;
+  ASSERT_TRUE(templ.Prepare(image(cv::Rect(5, 5, 9, 9)).clone()));
+  ZnccScratch zncc;
+  LookAlikeScratch scratch;
+  MatchZncc(image, templ, whole, zncc);
+  LookAlikeZncc(image, templ, nullptr, 0.8, pruned, scratch, zncc);
+  EXPECT_EQ(cv::countNonZero(whole != pruned), 0);
+}
+
 TEST(TemplateParts, PeakOffsetRecoversTheVertexOfAParabolaAndOfAV) {
   for (const double vertex : {-0.4, -0.1, 0.0, 0.25, 0.45}) {
     const auto parabola = [vertex](double x) { return 10.0 - 3.0 * (x - vertex) * (x - vertex); };

@@ -396,7 +396,7 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
   const cv::Rect region = WindowAround(centre_px, size, radius) & cv::Rect(0, 0, frame.cols, frame.rows);
   if (region.width < size.width || region.height < size.height) return;
   Native(frame, region, region_);
-  MatchZncc(region_, templ, sim_, zncc_);
+  LookAlikeMap(templ);
   const cv::Point2d own = centre_px - HalfSize(size) - cv::Point2d(region.tl());
   const int distinct = std::max(2, std::min(size.width, size.height) / 2);
   // A look-alike is a place the tracker would accept as its marker (ZNCC >= min_zncc): a corner
@@ -420,6 +420,17 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
       if (peak) look_alike_px_ = d / rung_scale();
     }
   }
+}
+
+// The look-alike scan's map (LookAlikeZncc), with the acquisition pyramid's first level.
+void TemplateTracker::LookAlikeMap(const PreparedTemplate& templ) {
+  if (params_.measure != MatchMeasure::kZncc) {
+    MatchZncc(region_, templ, sim_, zncc_);
+    return;
+  }
+  BuildAcquisitionPyramid(templ);
+  LookAlikeZncc(region_, templ, coarse_.size() > 1 ? &coarse_[1] : nullptr, params_.min_zncc,
+                sim_, look_alike_scratch_, zncc_);
 }
 
 void TemplateTracker::Similarity(const cv::Mat& image, const PreparedTemplate& templ,
