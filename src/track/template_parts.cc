@@ -545,7 +545,7 @@ void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double
 }
 
 void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv::Mat& running,
-                cv::Mat& rounded) {
+                cv::Mat& rounded, cv::Mat& patch) {
   const cv::Size size = running.size();
   // getRectSubPix's placement: its top-left sample at the centre (as a float) less half the
   // size less a half, split into whole pixels and the bilinear fractions.
@@ -554,7 +554,6 @@ void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv
   const cv::Point ip(cvFloor(c.x), cvFloor(c.y));
   if (image.type() != CV_8UC1 || running.type() != CV_32FC1 || size.width < 8 || ip.x < 0 ||
       ip.y < 0 || ip.x + size.width + 1 > image.cols || ip.y + size.height + 1 > image.rows) {
-    cv::Mat patch;  // Colour, or a placement at the image's edge: rare (not every frame).
     BlendPatchReference(image, centre, rate, running, rounded, patch);
     return;
   }

@@ -597,9 +597,10 @@ cv::Mat ContrastProjection(const cv::Mat& bgr);
 // calls of BlendPatchReference cost ~40 instructions a pixel (the template update, every frame,
 // issue 45). The same float arithmetic but for the order of the bilinear weights' products
 // (and OpenCV's build may fuse multiply-adds): `running` within a few float roundings of the
-// reference's, `rounded` within a level. Colour runs the reference.
+// reference's, `rounded` within a level. Colour, or a patch at the image's edge, runs the
+// reference with `patch` as its buffer (kept by the caller: no allocation from frame to frame).
 void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv::Mat& running,
-                cv::Mat& rounded);
+                cv::Mat& rounded, cv::Mat& patch);
 // The definition: cv::getRectSubPix (CV_32F), cv::addWeighted and convertTo(CV_8U), with
 // `patch` as the first one's buffer.
 void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,

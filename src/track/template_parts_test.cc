@@ -249,7 +249,7 @@ TEST(TemplateParts, BlendPatchIsTheReferences) {
         const cv::Point2d centre(edge ? 1.3 : rng.uniform(width / 2.0 + 1, 69.0 - width / 2.0 - 2),
                                  rng.uniform(size.height / 2.0 + 1, 59.0 - size.height / 2.0 - 2));
         const double rate = k % 2 ? 0.5 : rng.uniform(0.05, 0.95);
-        BlendPatch(*image, centre, rate, fast, fast8);
+        BlendPatch(*image, centre, rate, fast, fast8, patch);
         BlendPatchReference(*image, centre, rate, reference, reference8, patch);
         ASSERT_EQ(fast.size(), size);
         ASSERT_EQ(fast8.type(), reference8.type());

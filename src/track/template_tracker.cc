@@ -1033,7 +1033,7 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
   // The patch centred on centre_px (its geometric centre, as getRectSubPix places it) blended
   // in, and rounded into the candidate, in one pass (BlendPatch).
   BlendPatch(region_, centre_px - cv::Point2d(around.tl()), params_.update_rate, working_f_,
-             candidate_);
+             candidate_, patch_);
   // Drift guard: the updated template must still resemble the first at this scale.
   const double similarity = ZnccAt(candidate_, {0, 0}, rung.templ, shape_, zncc_);
   if (!(similarity >= params_.drift_min_zncc) || !working_.Prepare(candidate_, working_mask_)) {
