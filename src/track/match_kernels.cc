@@ -407,9 +407,43 @@ bool PreparedTemplate::Prepare(const cv::Mat& templ, const cv::Mat& mask) {
     run_rows_.clear();
     runs_.clear();
     find_runs();
+    lay_out_chunks();
+  } else {
+    lay_out_bytes();
   }
-  lay_out_chunks();
   return true;
+}
+
+// The same size, channels and mask as the last layout (the template update, every frame): the
+// lanes' bytes (lane_bytes_) and mask (mask_) are as they were; only the values change, so each
+// lane's value is its byte masked by its lane's mask, what lay_out_chunks writes (it cleared and
+// rewrote all three every frame: half of the template update's preparation, issue 45).
+void PreparedTemplate::lay_out_bytes() {
+  if (chunks_per_row_ == 0) return;  // Scalar kernels: no layout.
+  const int cn = image_.channels();
+  const int per_row = chunks_per_row_ * 16;
+  const int covered = full_chunks_ * 16;
+  for (int r = 0; r < image_.rows; ++r) {
+    const uint8_t* p = image_.ptr<uint8_t>(r);
+    const size_t row = static_cast<size_t>(r) * per_row;
+    uint8_t* __restrict bytes = bytes_.data() + row;
+    const uint8_t* __restrict lanes = mask_.data() + row;
+    int16_t* __restrict words = words_.data() + row;
+    int i = 0;
+    if (cn == 1) {
+      for (; i < covered; ++i) {  // Lane i reads byte i: vectorised.
+        const uint8_t v = static_cast<uint8_t>(p[i] & lanes[i]);
+        bytes[i] = v;
+        words[i] = v;
+      }
+    }
+    for (; i < per_row; ++i) {
+      const int b = lane_bytes_[i];
+      const uint8_t v = b < 0 ? uint8_t{0} : static_cast<uint8_t>(p[b] & lanes[i]);
+      bytes[i] = v;
+      words[i] = v;
+    }
+  }
 }
 
 void PreparedTemplate::find_runs() {

@@ -67,6 +67,8 @@ class PreparedTemplate {
   void find_runs();
   // The vector layout (row_bytes_ .. words_) of image_ and mask_image_.
   void lay_out_chunks();
+  // The same for new pixels of the laid-out size, channels and mask: bytes_ and words_ only.
+  void lay_out_bytes();
   cv::Mat image_;
   cv::Mat mask_image_;
   int count_ = 0;

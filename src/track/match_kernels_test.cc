@@ -117,6 +117,45 @@ cv::Mat EllipseMask(cv::Size size) {
 // and too-narrow templates are left to MatchZncc. One PreparedTemplate is re-prepared with
 // masks that alternate (its runs kept only while the mask is the same) and still matches as a
 // fresh one does.
+// A template re-prepared with new pixels of the same size, channels and mask (the template
+// update: only its values laid out again) matches as one prepared afresh, bit for bit: gray and
+// colour, masked and not, every width 3-40 (full chunks, 8-byte halves, the scalar layout).
+TEST(MatchKernelsTest, RePreparedTemplateMatchesAsAFreshOne) {
+  cv::RNG rng(45);
+  for (const int type : {CV_8UC1, CV_8UC3}) {
+    for (int width = 3; width <= 40; ++width) {
+      const cv::Size size(width, 4 + width % 9);
+      if (type == CV_8UC3 && size.area() * 3 > kMaxTemplateValues) continue;
+      cv::Mat mask(size, CV_8UC1);
+      rng.fill(mask, cv::RNG::UNIFORM, 0, 2);
+      mask.at<uint8_t>(0, 0) = 1;
+      mask.at<uint8_t>(size.height - 1, size.width - 1) = 1;
+      for (const bool masked : {false, true}) {
+        const cv::Mat m = masked ? mask : cv::Mat();
+        cv::Mat first(size, type), second(size, type), image(size.height + 7, size.width + 9, type);
+        rng.fill(first, cv::RNG::UNIFORM, 0, 256);
+        rng.fill(second, cv::RNG::UNIFORM, 0, 256);
+        rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+        PreparedTemplate reused, fresh;
+        ASSERT_TRUE(reused.Prepare(first, m));
+        ASSERT_TRUE(reused.Prepare(second, m));
+        ASSERT_TRUE(fresh.Prepare(second, m));
+        cv::Mat a, b;
+        ZnccScratch scratch;
+        MatchSad(image, reused, a);
+        MatchSad(image, fresh, b);
+        EXPECT_EQ(cv::countNonZero(a != b), 0) << width << " " << masked;
+        MatchZncc(image, reused, a, scratch);
+        MatchZncc(image, fresh, b, scratch);
+        EXPECT_EQ(cv::countNonZero(a != b), 0) << width << " " << masked;
+        MatchSsd(image, reused, a, scratch);
+        MatchSsd(image, fresh, b, scratch);
+        EXPECT_EQ(cv::countNonZero(a != b), 0) << width << " " << masked;
+      }
+    }
+  }
+}
+
 TEST(MatchKernelsTest, ZnccAtOnePlacementIsTheMapsValue) {
   cv::RNG rng(4546);
   ZnccScratch scratch;

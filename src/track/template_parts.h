@@ -39,6 +39,18 @@ inline constexpr int kAroundPx = 2;
 // While tracking, the window this far around the predicted place is searched first; the
 // search_margin_px window only when that one does not decide (NearSearchDecides).
 inline constexpr int kNearMarginPx = 4;
+// ... and before it, a window this far around the prediction, moved onto its best while that
+// lies on its edge (9 placements a try, not 81): it decides when its best lies inside it within
+// the near window, a local peak of it, its best unless a higher peak lies within kNearMarginPx
+// of the prediction too (two peaks a few pixels apart: not a marker's dot).
+inline constexpr int kFirstNearMarginPx = 1;
+// The measurement climbs likewise from the working template's match within kFineMarginPx (the
+// first and the working template mostly agree to a pixel).
+inline constexpr int kFirstFineMarginPx = 1;
+// The look-alike scan matches at full resolution only within this many pixels of the places its
+// half-resolution template fits by min_zncc less this much (LookAlikeZncc).
+inline constexpr double kLookAlikeSlack = 0.3;
+inline constexpr int kLookAlikeReachPx = 4;
 inline constexpr double kScaleStep = 1.05;         // Ratio between neighbouring rungs of the ladder.
 inline constexpr int kRungsBelow = 19;             // 1.05^-19 = 0.40.
 inline constexpr int kRungsAbove = 28;             // 1.05^28 = 3.92.
@@ -55,8 +67,10 @@ inline constexpr int kTurns = 72;  // 360 / kTurnStepDeg.
 // turns would move its reported point with each step; a sticker 5 degrees off loses far more.
 inline constexpr double kTurnHysteresis = 0.02;
 // While tracking, the neighbouring rungs are tried every kPoseEvery-th frame, and in any frame
-// where the current rung fits worse by kPoseDrop than at the last try (issue 45).
-inline constexpr int kPoseEvery = 3;
+// where the current rung fits worse by kPoseDrop than at the last try (issue 45). Every 6th, not
+// 3rd: half the pose search's work; the real and rendered sets' tables the same but the pale
+// domes' median, 1.553 -> 1.570 px (a known-failing case, its rungs taking over a frame later).
+inline constexpr int kPoseEvery = 6;
 inline constexpr double kPoseDrop = 0.005;
 // Below this self-match of the turned template there is no centre of symmetry worth reporting.
 inline constexpr double kMinSymmetry = 0.5;
@@ -161,6 +175,49 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
                              std::vector<uint8_t>& row_distance);
 // The reference: every pixel within 4 of each pixel looked at.
 void CappedChebyshevDistanceReference(const cv::Mat& label, const cv::Rect& area, cv::Mat& dist);
+
+// The ZNCC map of `templ` over `image` (gray or colour, as MatchZncc) where the look-alike scan
+// reads it (MatchZncc's values there, bit for bit): every placement within kLookAlikeReachPx of
+// one whose match with `half` (the template's half-resolution level, its pyramid's; nullptr:
+// none) over the image's half-resolution level scores `floor` - kLookAlikeSlack or more; NaN
+// (no match) elsewhere. A place the full-resolution template fits by `floor` fits its
+// half-resolution one about as well (both smoothed alike). The whole map was matched before, a
+// tenth of mire-2's instructions for its five templates, once (issue 45). The whole map when
+// there is no half-resolution level or it passes more than an eighth of its places.
+struct LookAlikeScratch {
+  cv::Mat half_image, half_sim, wanted, part;
+};
+void LookAlikeZncc(const cv::Mat& image, const PreparedTemplate& templ,
+                   const PreparedTemplate* half, double floor, cv::Mat& sim,
+                   LookAlikeScratch& scratch, ZnccScratch& zncc);
+
+// BlobMeter's passes over the pixels of `grown` (inside `gray`, CV_8UC1, and `mask`, empty or
+// CV_8UC1 of its size; `dist` the capped Chebyshev distance to the component `label`, both of
+// gray's size and continuous). The levels right at the blob: the sums and counts of the marker's
+// interior (the component's pixels whose 4 neighbours are all in it) and of the ring 3-4 px
+// outside it. A component pixel (distance 0) is off the patch's edge, so its four neighbours are
+// in the patch. The sums are of whole levels: exact in a double, and the same in vector lanes.
+struct BlobRimSums {
+  double fg_sum = 0, bg_sum = 0;
+  int fg_n = 0, bg_n = 0;
+};
+BlobRimSums RimLevelSums(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                         const cv::Mat& label, const cv::Rect& grown);
+BlobRimSums RimLevelSumsReference(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                                  const cv::Mat& label, const cv::Rect& grown);
+// The soft centroid's sums over the pixels within 2 px of the component (distance <= 2) inside the
+// mask: each pixel's Membership between `bg` and `fg` (w), and w * x, w * y. Unmasked in double
+// vector lanes, two pixels a vector: each w is the reference's, bit for bit, summed in another
+// order (w * y as a row's sum of w times y; the sums agree to ~1e-15 of themselves). The blob is
+// measured in every frame (issue 45).
+struct SoftCentroidSums {
+  double w = 0, x = 0, y = 0;
+};
+SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                              const cv::Rect& grown, double bg, double fg);
+SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
+                                       const cv::Mat& dist, const cv::Rect& grown, double bg,
+                                       double fg);
 
 class BlobMeter {
  public:
@@ -276,48 +333,15 @@ class BlobMeter {
     // from what is at the rim.
     const cv::Rect grown = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
                            cv::Rect(0, 0, gray.cols, gray.rows);
-    double fg_sum = 0, bg_sum = 0;
-    int fg_n = 0, bg_n = 0;
     dist_.create(gray.size(), CV_8UC1);
     CappedChebyshevDistance(label_, grown, dist_, row_distance_);
-    // Rows through pointers (every frame's blob, issue 45); `grown` lies in the patch, so only
-    // the mask can leave a pixel out. A component pixel (d == 0) is off the patch's edge (Fill),
-    // so its four neighbours are in the patch. The sums are of whole levels: exact in a double.
-    const int cols = label_.cols;  // label_ is continuous.
-    for (int y = grown.y; y < grown.br().y; ++y) {
-      const uint8_t* levels = gray.ptr<uint8_t>(y);
-      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
-      const uint8_t* distance = dist_.ptr<uint8_t>(y);
-      const uint8_t* label = label_.ptr<uint8_t>(y);
-      for (int x = grown.x; x < grown.br().x; ++x) {
-        const int d = distance[x];
-        if (inside && !inside[x]) continue;
-        if (d == 0 && label[x - cols] && label[x + cols] && label[x - 1] && label[x + 1]) {
-          fg_sum += levels[x];
-          ++fg_n;
-        } else if (d == 3 || d == 4) {
-          bg_sum += levels[x];
-          ++bg_n;
-        }
-      }
-    }
-    const double fg = fg_n > 0 ? fg_sum / fg_n : (bright_ ? high : low);
-    const double bg = bg_n > 0 ? bg_sum / bg_n : (bright_ ? low : high);
+    const BlobRimSums rim = RimLevelSums(gray, mask, dist_, label_, grown);
+    const double fg = rim.fg_n > 0 ? rim.fg_sum / rim.fg_n : (bright_ ? high : low);
+    const double bg = rim.bg_n > 0 ? rim.bg_sum / rim.bg_n : (bright_ ? low : high);
     if (!(std::abs(fg - bg) >= kMinBlobContrast)) return false;
     // Soft centroid over the component grown by 2 px (its anti-aliased rim), inside the mask.
-    double sw = 0, sx = 0, sy = 0;
-    for (int y = grown.y; y < grown.br().y; ++y) {
-      const uint8_t* levels = gray.ptr<uint8_t>(y);
-      const uint8_t* inside = mask.data ? mask.ptr<uint8_t>(y) : nullptr;
-      const uint8_t* distance = dist_.ptr<uint8_t>(y);
-      for (int x = grown.x; x < grown.br().x; ++x) {
-        if ((inside && !inside[x]) || distance[x] > 2) continue;
-        const double w = track_internal::Membership(levels + x, 1, &bg, &fg, 0.0, false);
-        sw += w;
-        sx += w * x;
-        sy += w * y;
-      }
-    }
+    const SoftCentroidSums soft = SoftCentroid(gray, mask, dist_, grown, bg, fg);
+    const double sw = soft.w, sx = soft.x, sy = soft.y;
     if (!(sw > 0)) return false;
     *centroid = {sx / sw, sy / sw};
     *area = sw;
@@ -564,6 +588,36 @@ struct Fix {
 // mono camera) the axis is (1, 1, 1) / 3: the channel mean, which is luma there.
 cv::Mat ContrastProjection(const cv::Mat& bgr);
 
+// The template update's blend: the patch of `running`'s size centred at `centre` (in `image`'s
+// pixels, its geometric centre, as cv::getRectSubPix places it) sampled bilinearly from `image`
+// (CV_8UC1 or CV_8UC3), blended into `running` (CV_32F of the patch's channels) as
+// running * (1 - rate) + patch * rate, and `running` rounded (nearest even, saturated) into
+// `rounded` (CV_8U). The patch must lie inside `image` with a pixel to spare right and below.
+// Gray in float vector lanes, 8 pixels at a time, without the patch's buffer: the three OpenCV
+// calls of BlendPatchReference cost ~40 instructions a pixel (the template update, every frame,
+// issue 45). The same float arithmetic but for the order of the bilinear weights' products
+// (and OpenCV's build may fuse multiply-adds): `running` within a few float roundings of the
+// reference's, `rounded` within a level. Colour, or a patch at the image's edge, runs the
+// reference with `patch` as its buffer (kept by the caller: no allocation from frame to frame).
+void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv::Mat& running,
+                cv::Mat& rounded, cv::Mat& patch);
+// The definition: cv::getRectSubPix (CV_32F), cv::addWeighted and convertTo(CV_8U), with
+// `patch` as the first one's buffer.
+void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,
+                         cv::Mat& running, cv::Mat& rounded, cv::Mat& patch);
+
+// `bgr` (8-bit BGR) projected with `projection` (1x4 CV_32F: B, G, R weights and an offset, as
+// ContrastProjection and MarkerProjection make), as cv::transform does: per pixel, in float,
+// ((wb * B + wg * G) + wr * R) + offset, rounded to nearest even and saturated to 0..255, 16
+// pixels at a time in float vector lanes. cv::transform's 3-to-1 projection is scalar (~35
+// instructions a pixel; the template tracker converts its windows with it every frame, issue 45)
+// and OpenCV's build may fuse its multiply-adds, so a level may differ from cv::transform's by 1
+// where the sum lies within a rounding of a half (tens in millions of pixels); bit for bit
+// ProjectLevelsReference.
+void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out);
+// The same, a pixel at a time: the definition.
+void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out);
+
 // The single channel a selected box (BGR, with the template's `mask`) shows its marker in best:
 // of the principal colour axis (ContrastProjection), luma (an empty matrix) and the axis from the
 // box's edge colour to its centre's, the one in which the blob at the centre is most isolated
@@ -587,9 +641,9 @@ inline constexpr double kMinChromaSpan = 0.05;
 // The axis of `bgr` (a selected template, 8-bit BGR); false when its centre's chromaticity does
 // not differ from its edge's.
 bool LearnChromaAxis(const cv::Mat& bgr, ChromaAxis* out);
-// One 8-bit channel: the background at 40, the marker at 200. The pixels' arithmetic in double
-// vector lanes, 16 pixels at a time, in the reference's order of operations: bit for bit
-// ChromaChannelReference (the template tracker's blob is measured in it every frame).
+// One 8-bit channel: the background at 40, the marker at 200. The pixels' arithmetic in float
+// vector lanes, 16 pixels at a time: ChromaChannelReference's levels to within one (the template
+// tracker's blob is measured in it every frame).
 void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);
 // The same, a pixel at a time: the definition.
 void ChromaChannelReference(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out);

@@ -65,7 +65,7 @@ void TemplateTracker::ToNative(const cv::Mat& frame, cv::Mat& out) const {
   } else if (params_.colour) {
     out = frame;  // A header only: the kernels read strided regions.
   } else if (!projection_.empty()) {
-    cv::transform(frame, out, projection_);
+    ProjectLevels(frame, projection_, out);  // cv::transform, in vector lanes.
   } else {
     cv::cvtColor(frame, out, cv::COLOR_BGR2GRAY);
   }
@@ -396,7 +396,7 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
   const cv::Rect region = WindowAround(centre_px, size, radius) & cv::Rect(0, 0, frame.cols, frame.rows);
   if (region.width < size.width || region.height < size.height) return;
   Native(frame, region, region_);
-  MatchZncc(region_, templ, sim_, zncc_);
+  LookAlikeMap(templ);
   const cv::Point2d own = centre_px - HalfSize(size) - cv::Point2d(region.tl());
   const int distinct = std::max(2, std::min(size.width, size.height) / 2);
   // A look-alike is a place the tracker would accept as its marker (ZNCC >= min_zncc): a corner
@@ -420,6 +420,17 @@ void TemplateTracker::ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d&
       if (peak) look_alike_px_ = d / rung_scale();
     }
   }
+}
+
+// The look-alike scan's map (LookAlikeZncc), with the acquisition pyramid's first level.
+void TemplateTracker::LookAlikeMap(const PreparedTemplate& templ) {
+  if (params_.measure != MatchMeasure::kZncc) {
+    MatchZncc(region_, templ, sim_, zncc_);
+    return;
+  }
+  BuildAcquisitionPyramid(templ);
+  LookAlikeZncc(region_, templ, coarse_.size() > 1 ? &coarse_[1] : nullptr, params_.min_zncc,
+                sim_, look_alike_scratch_, zncc_);
 }
 
 void TemplateTracker::Similarity(const cv::Mat& image, const PreparedTemplate& templ,
@@ -563,14 +574,38 @@ std::optional<Hit> TemplateTracker::NearSearch(const cv::Mat& frame, const cv::P
   const cv::Rect near = WindowAround(predicted, size, kNearMarginPx);
   ConvertAround(frame, cv::Rect(near.x - kAroundPx, near.y - kAroundPx,
                                 near.width + 2 * kAroundPx, near.height + 2 * kAroundPx));
-  std::optional<Hit> hit = Search(frame, near, templ, false);
-  if (!hit || hit->on_inner_edge || !Accept(*hit)) return std::nullopt;
-  const cv::Point from_prediction =
-      hit->top_left - near.tl() - cv::Point(kNearMarginPx, kNearMarginPx);
-  if (rivals && !(footage_repeats_ ? no_rival_reachable(hit->top_left)
-                                   : NoRivalReachable(margin, from_prediction, radius))) {
-    return std::nullopt;
+  const cv::Point predicted_tl = near.tl() + cv::Point(kNearMarginPx, kNearMarginPx);
+  // Whether `hit` decides: passed, and no rival reachable.
+  const auto decides = [&](const Hit& hit) {
+    if (!Accept(hit)) return false;
+    const cv::Point from_prediction = hit.top_left - predicted_tl;
+    return !rivals || (footage_repeats_ ? no_rival_reachable(hit.top_left)
+                                        : NoRivalReachable(margin, from_prediction, radius));
+  };
+  // Climbing first: the kFirstNearMarginPx window around the prediction, moved onto its best
+  // while that lies on its edge, as long as it stays inside the near window (each placement's
+  // score depends on its pixels alone: a peak inside the window that climbed to it is a local
+  // peak of the near window, its best unless a higher one lies within kNearMarginPx of the
+  // prediction too: two peaks a few pixels apart, not a marker). Most frames the prediction is
+  // within a pixel: 9 placements, not 81.
+  cv::Point at(0, 0);  // The climbing window's centre, from the prediction.
+  for (int step = 0; step <= 2 * kNearMarginPx; ++step) {
+    const cv::Rect window = WindowAround(predicted, size, kFirstNearMarginPx) + at;
+    std::optional<Hit> hit = Search(frame, window, templ, false);
+    if (!hit) break;
+    if (!hit->on_inner_edge) {
+      if (decides(*hit)) return hit;
+      break;
+    }
+    at = hit->top_left - predicted_tl;
+    if (std::abs(at.x) > kNearMarginPx - kFirstNearMarginPx ||
+        std::abs(at.y) > kNearMarginPx - kFirstNearMarginPx) {
+      break;
+    }
   }
+  // The near window whole when the climb did not decide.
+  std::optional<Hit> hit = Search(frame, near, templ, false);
+  if (!hit || hit->on_inner_edge || !decides(*hit)) return std::nullopt;
   return hit;
 }
 
@@ -715,19 +750,45 @@ std::optional<Fix> TemplateTracker::Measure(const cv::Mat& frame, const cv::Poin
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   const cv::Rect frame_rect(0, 0, frame.cols, frame.rows);
-  const cv::Rect window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
   measured_zncc_ = false;
-  if (window.width < size.width || window.height < size.height) return std::nullopt;
-  Native(frame, window, fine_);
-  Similarity(fine_, rung.templ, fine_sim_);
+  // Climbing first, as NearSearch: the kFirstFineMarginPx window around the match, moved onto
+  // its best while that lies on its edge, inside the kFineMarginPx window (the first template's
+  // peak, which the working one's match is mostly within a pixel of); the whole kFineMarginPx
+  // window decides as before when the climb leaves it.
+  cv::Rect window;
+  cv::Point best;
+  bool inner_edge = true;
+  const cv::Rect centred = WindowAround(centre_px, size, 0);
+  cv::Point at(0, 0);  // The climbing window's centre, from the match.
+  for (int step = 0; step <= 2 * kFineMarginPx && inner_edge; ++step) {
+    window = (WindowAround(centre_px, size, kFirstFineMarginPx) + at) & frame_rect;
+    if (window.width < size.width || window.height < size.height) break;
+    Native(frame, window, fine_);
+    Similarity(fine_, rung.templ, fine_sim_);
+    if (!BestIn(fine_sim_, &best)) break;
+    inner_edge = (best.x == 0 && window.x > 0) ||
+                 (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
+                 (best.y == 0 && window.y > 0) ||
+                 (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
+    at = window.tl() + best - centred.tl();
+    if (std::abs(at.x) > kFineMarginPx - kFirstFineMarginPx ||
+        std::abs(at.y) > kFineMarginPx - kFirstFineMarginPx) {
+      break;
+    }
+  }
+  if (inner_edge) {
+    window = WindowAround(centre_px, size, kFineMarginPx) & frame_rect;
+    if (window.width < size.width || window.height < size.height) return std::nullopt;
+    Native(frame, window, fine_);
+    Similarity(fine_, rung.templ, fine_sim_);
+    if (!BestIn(fine_sim_, &best)) return std::nullopt;
+    inner_edge = (best.x == 0 && window.x > 0) ||
+                 (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
+                 (best.y == 0 && window.y > 0) ||
+                 (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
+  }
   measured_zncc_ = params_.measure == MatchMeasure::kZncc;
   measured_tl_ = window.tl();
-  cv::Point best;
-  if (!BestIn(fine_sim_, &best)) return std::nullopt;
-  const bool inner_edge = (best.x == 0 && window.x > 0) ||
-                          (best.x == fine_sim_.cols - 1 && window.br().x < frame.cols) ||
-                          (best.y == 0 && window.y > 0) ||
-                          (best.y == fine_sim_.rows - 1 && window.br().y < frame.rows);
   cv::Point2d top_left;
   if (!inner_edge) {
     top_left = cv::Point2d(window.tl() + best) +
@@ -959,8 +1020,6 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
   const cv::Rect around = WindowAround(centre_px, size, 2);
   if ((around & cv::Rect(0, 0, frame.cols, frame.rows)) != around) return;
   Native(frame, around, region_);
-  // getRectSubPix centres the patch on its geometric centre, which centre_px is.
-  cv::getRectSubPix(region_, size, centre_px - cv::Point2d(around.tl()), patch_, CV_32F);
   if (working_key_ != RungKey(rung_, turn_)) {
     // The scale or turn changed: the running template follows its size and mask before the blend
     // (its pixels follow a turn through the blend itself).
@@ -971,9 +1030,10 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
     working_mask_ = rung.templ.mask().empty() ? cv::Mat() : rung.templ.mask().clone();
     working_key_ = RungKey(rung_, turn_);
   }
-  cv::addWeighted(working_f_, 1.0 - params_.update_rate, patch_, params_.update_rate, 0.0,
-                  working_f_);
-  working_f_.convertTo(candidate_, CV_8U);
+  // The patch centred on centre_px (its geometric centre, as getRectSubPix places it) blended
+  // in, and rounded into the candidate, in one pass (BlendPatch).
+  BlendPatch(region_, centre_px - cv::Point2d(around.tl()), params_.update_rate, working_f_,
+             candidate_, patch_);
   // Drift guard: the updated template must still resemble the first at this scale.
   const double similarity = ZnccAt(candidate_, {0, 0}, rung.templ, shape_, zncc_);
   if (!(similarity >= params_.drift_min_zncc) || !working_.Prepare(candidate_, working_mask_)) {

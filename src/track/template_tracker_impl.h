@@ -128,6 +128,8 @@ class TemplateTracker final : public Tracker {
   void UpdateTemplate(const cv::Mat& frame, const cv::Point2d& centre_px);
   void RestoreWorkingTemplate();
   void ScanForLookAlikes(const cv::Mat& frame, const cv::Point2d& centre_px);
+  // ScanForLookAlikes's map of the search template `templ` over region_, into sim_.
+  void LookAlikeMap(const PreparedTemplate& templ);
   // Lists a place the template fits (its centre in the frame) among the candidates weighed.
   void Weigh(const cv::Point2d& centre_px, double zncc, CandidateVerdict verdict);
   // Verifies the match centred at `matched` and, when it holds, moves the tracker on to it.
@@ -205,6 +207,7 @@ class TemplateTracker final : public Tracker {
   std::vector<cv::Mat> levels_;
   std::vector<cv::Point> candidates_;
   cv::Mat level_sim_;
+  LookAlikeScratch look_alike_scratch_;
   cv::Mat projection_;  // Gray only: 1x4 BGR weights + offset, or empty for plain luma.
   ZnccScratch zncc_;
   // The marker's blob in the template: every match is verified against it (BlobShift).
