@@ -620,27 +620,13 @@ void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::M
   }
 }
 
-void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) {
 #if CV_SIMD128
-  CV_Assert(bgr.type() == CV_8UC3 && projection.type() == CV_32FC1 && projection.total() == 4);
-  if (bgr.cols < 16) {
-    ProjectLevelsReference(bgr, projection, out);
-    return;
-  }
-  // `out` may be reallocated here only (create keeps a buffer of the same size and type: the
-  // tracker's windows reuse theirs from frame to frame).
-  out.create(bgr.size(), CV_8UC1);
-  const float* m = projection.ptr<float>();
-  const cv::v_float32x4 wb = cv::v_setall_f32(m[0]), wg = cv::v_setall_f32(m[1]);
-  const cv::v_float32x4 wr = cv::v_setall_f32(m[2]), offset = cv::v_setall_f32(m[3]);
-  // Four pixels' levels, widened to 32 bits, -> their rounded projections.
-  const auto four = [&](const cv::v_uint32x4& b, const cv::v_uint32x4& g,
-                        const cv::v_uint32x4& r) {
-    cv::v_float32x4 acc = wb * cv::v_cvt_f32(cv::v_reinterpret_as_s32(b));
-    acc = acc + wg * cv::v_cvt_f32(cv::v_reinterpret_as_s32(g));
-    acc = acc + wr * cv::v_cvt_f32(cv::v_reinterpret_as_s32(r));
-    return cv::v_round(acc + offset);  // Nearest even, as cvRound.
-  };
+// Each BGR pixel of `bgr` (CV_8UC3, at least 16 wide) -> one level of `out` (CV_8UC1, same size),
+// 16 pixels at a time: `four(b, g, r)` turns four pixels' channels, widened to 32 bits, into
+// their four levels (v_int32x4), which are packed with saturation (saturate_cast).
+namespace {
+template <typename Four>
+void MapBgrRows16(const cv::Mat& bgr, cv::Mat& out, const Four& four) {
   for (int y = 0; y < bgr.rows; ++y) {
     const uint8_t* row = bgr.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
@@ -665,6 +651,32 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
       cv::v_store(o + x, cv::v_pack_u(packed[0], packed[1]));  // Saturated: saturate_cast.
     }
   }
+}
+}  // namespace
+#endif
+
+void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) {
+#if CV_SIMD128
+  CV_Assert(bgr.type() == CV_8UC3 && projection.type() == CV_32FC1 && projection.total() == 4);
+  if (bgr.cols < 16) {
+    ProjectLevelsReference(bgr, projection, out);
+    return;
+  }
+  // `out` may be reallocated here only (create keeps a buffer of the same size and type: the
+  // tracker's windows reuse theirs from frame to frame).
+  out.create(bgr.size(), CV_8UC1);
+  const float* m = projection.ptr<float>();
+  const cv::v_float32x4 wb = cv::v_setall_f32(m[0]), wg = cv::v_setall_f32(m[1]);
+  const cv::v_float32x4 wr = cv::v_setall_f32(m[2]), offset = cv::v_setall_f32(m[3]);
+  // Four pixels' levels, widened to 32 bits, -> their rounded projections.
+  const auto four = [&](const cv::v_uint32x4& b, const cv::v_uint32x4& g,
+                        const cv::v_uint32x4& r) {
+    cv::v_float32x4 acc = wb * cv::v_cvt_f32(cv::v_reinterpret_as_s32(b));
+    acc = acc + wg * cv::v_cvt_f32(cv::v_reinterpret_as_s32(g));
+    acc = acc + wr * cv::v_cvt_f32(cv::v_reinterpret_as_s32(r));
+    return cv::v_round(acc + offset);  // Nearest even, as cvRound.
+  };
+  MapBgrRows16(bgr, out, four);
 #else
   ProjectLevelsReference(bgr, projection, out);
 #endif
@@ -813,30 +825,7 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
     const cv::v_float32x4 sum = b + g + r + dark;
     return cv::v_round(level40 + gain * (dot / sum - along));
   };
-  for (int y = 0; y < bgr.rows; ++y) {
-    const uint8_t* row = bgr.ptr<uint8_t>(y);
-    uint8_t* o = out.ptr<uint8_t>(y);
-    // The last 16 pixels overlap the ones before them when the width is no multiple of 16: the
-    // same pixels give the same levels, and nothing outside the row is read.
-    for (int x = 0; x < bgr.cols; x += 16) {
-      if (x + 16 > bgr.cols) x = bgr.cols - 16;
-      cv::v_uint8x16 b8, g8, r8;
-      cv::v_load_deinterleave(row + 3 * x, b8, g8, r8);
-      cv::v_uint16x8 b16[2], g16[2], r16[2];
-      cv::v_expand(b8, b16[0], b16[1]);
-      cv::v_expand(g8, g16[0], g16[1]);
-      cv::v_expand(r8, r16[0], r16[1]);
-      cv::v_int16x8 packed[2];
-      for (int h = 0; h < 2; ++h) {
-        cv::v_uint32x4 b32[2], g32[2], r32[2];
-        cv::v_expand(b16[h], b32[0], b32[1]);
-        cv::v_expand(g16[h], g32[0], g32[1]);
-        cv::v_expand(r16[h], r32[0], r32[1]);
-        packed[h] = cv::v_pack(four(b32[0], g32[0], r32[0]), four(b32[1], g32[1], r32[1]));
-      }
-      cv::v_store(o + x, cv::v_pack_u(packed[0], packed[1]));  // Saturated: saturate_cast.
-    }
-  }
+  MapBgrRows16(bgr, out, four);
 #else
   ChromaChannelReference(bgr, chroma, out);
 #endif
