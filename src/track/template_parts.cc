@@ -576,9 +576,13 @@ void BlendPatch(const cv::Mat& image, const cv::Point2d& centre, double rate, cv
     const cv::v_float32x4 v00 = cv::v_setall_f32(w00), v01 = cv::v_setall_f32(w01);
     const cv::v_float32x4 v10 = cv::v_setall_f32(w10), v11 = cv::v_setall_f32(w11);
     const cv::v_float32x4 vkeep = cv::v_setall_f32(keep), vtake = cv::v_setall_f32(take);
-    // Four levels at `p` as floats.
+    // Four levels at `p` as floats. (Through an aligned copy: OpenCV's v_load_expand_q reads the
+    // four bytes as one int, which a pointer at any column need not align; the copy compiles to
+    // the same single load.)
     const auto floats = [](const uint8_t* p) {
-      return cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(p)));
+      alignas(4) uint8_t four[4];
+      std::memcpy(four, p, sizeof four);
+      return cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(four)));
     };
     // Each running value is read and written once (the tail is scalar: a vector overlapping the
     // last ones would blend them twice).
