@@ -80,26 +80,27 @@ struct Pass {
   double cpu_ms_per_frame = 0.0;  // The process's, every thread.
 };
 
-Pass DecodeOnly(const std::string& video) {
-  cv::VideoCapture capture(video, cv::CAP_FFMPEG);
-  cv::Mat image;
+// Reads every frame by `read_one` (true while there is one), timed per frame.
+template <typename ReadOne>
+Pass TimeReads(ReadOne read_one) {
   int64_t frames = 0;
   const auto start = Clock::now();
   const double cpu_start = ProcessCpuMs();
-  while (capture.read(image)) ++frames;
+  while (read_one()) ++frames;
   const double n = static_cast<double>(std::max<int64_t>(frames, 1));
   return {MsSince(start) / n, 0.0, frames, (ProcessCpuMs() - cpu_start) / n};
+}
+
+Pass DecodeOnly(const std::string& video) {
+  cv::VideoCapture capture(video, cv::CAP_FFMPEG);
+  cv::Mat image;
+  return TimeReads([&] { return capture.read(image); });
 }
 
 Pass SourceOnly(const std::string& video) {
   std::unique_ptr<FrameSource> source = OpenFrameSource({video, {}, 30.0});
   Frame frame;
-  int64_t frames = 0;
-  const auto start = Clock::now();
-  const double cpu_start = ProcessCpuMs();
-  while (source->read(frame)) ++frames;
-  const double n = static_cast<double>(std::max<int64_t>(frames, 1));
-  return {MsSince(start) / n, 0.0, frames, (ProcessCpuMs() - cpu_start) / n};
+  return TimeReads([&] { return source->read(frame); });
 }
 
 Pass Track(const TrackingConfig& config, const std::string& video, const std::string& csv,
@@ -117,19 +118,11 @@ Pass Track(const TrackingConfig& config, const std::string& video, const std::st
 }
 
 int Main(int argc, char** argv) {
-  if (argc == 3 && std::string(argv[1]) == "--source") {
-    const Pass read = SourceOnly(argv[2]);
+  const std::string mode = argc == 3 ? argv[1] : "";
+  if (mode == "--source" || mode == "--decode") {
+    const Pass read = mode == "--source" ? SourceOnly(argv[2]) : DecodeOnly(argv[2]);
     std::printf("%lld frames, %.3f ms/frame, CPU %.3f ms/frame\n",
                 static_cast<long long>(read.frames), read.ms_per_frame, read.cpu_ms_per_frame);
-    return 0;
-  }
-  if (argc == 3 && std::string(argv[1]) == "--decode") {
-    // The bare decode loop alone, in a process of its own: its peak memory (/usr/bin/time -v)
-    // and CPU time beside `softsight track`'s on the same file (scripts/bench.sh).
-    const Pass decoded = DecodeOnly(argv[2]);
-    std::printf("%lld frames, %.3f ms/frame, CPU %.3f ms/frame\n",
-                static_cast<long long>(decoded.frames), decoded.ms_per_frame,
-                decoded.cpu_ms_per_frame);
     return 0;
   }
   if (argc != 4) {

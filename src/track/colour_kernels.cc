@@ -27,6 +27,16 @@ const HsvTables& Tables() {
   return tables;
 }
 
+// Asks for row y + 2 of `image` (row_bytes long) while row y is read: a region's rows are
+// separate streams of a frame usually not in the cache, and a pass that is the first to touch
+// them otherwise waits on every row's loads.
+void PrefetchTwoRowsAhead(const cv::Mat& image, int y, size_t row_bytes) {
+  if (y + 2 >= image.rows) return;
+  const uchar* ahead = image.ptr<uchar>(y + 2);
+  for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
+  __builtin_prefetch(ahead + row_bytes - 1);
+}
+
 }  // namespace
 
 bool HsvBox::ContainsHue(int hue) const {
@@ -155,15 +165,9 @@ bool ExtractFlatPlane(const cv::Mat& bgr, cv::Mat& plane) {
   const int n = bgr.cols;
   const size_t row_bytes = static_cast<size_t>(n) * 3;
   for (int y = 0; y < bgr.rows; ++y) {
-    // The region's rows are separate streams of a frame usually not in the cache: the rows two
-    // ahead are asked for while this one is read, as Classify does (without it this pass, the
-    // first to touch the region, waited on every row's loads: 0.235 -> 0.215 ms a frame on
-    // mire-2).
-    if (y + 2 < bgr.rows) {
-      const uchar* ahead = bgr.ptr<uchar>(y + 2);
-      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
-      __builtin_prefetch(ahead + row_bytes - 1);
-    }
+    // As Classify does (without it this pass, the first to touch the region, waited on every
+    // row's loads: 0.235 -> 0.215 ms a frame on mire-2).
+    PrefetchTwoRowsAhead(bgr, y, row_bytes);
     const uchar* p = bgr.ptr<uchar>(y);
     uchar* out = plane.ptr<uchar>(y);
     int x = 0;
@@ -281,11 +285,7 @@ void HsvClassifier::ClassifyRows(const cv::Mat& image, cv::Mat& mask_image) cons
 
 #endif
   for (int y = 0; y < image.rows; ++y) {
-    if (y + 2 < image.rows) {
-      const uchar* ahead = image.ptr<uchar>(y + 2);
-      for (size_t i = 0; i < row_bytes; i += 64) __builtin_prefetch(ahead + i);
-      __builtin_prefetch(ahead + row_bytes - 1);
-    }
+    PrefetchTwoRowsAhead(image, y, row_bytes);
     const uchar* bgr = image.ptr<uchar>(y);
     uchar* mask = mask_image.ptr<uchar>(y);
     int x = 0;

@@ -122,10 +122,8 @@ TEST(TemplateParts, NoRivalReachableIsRivalInOnAFlatWindow) {
   EXPECT_EQ(RivalRadius(cv::Size(3, 3)), 2);
 }
 
-// The vector chroma channel against its scalar reference, within a level: every 8-bit colour, on
-// axes whose levels stay inside 0..255 and ones that saturate both ways, then views of every
-// width from 1 to 40 px (the 16-pixel loop's tail) on random pixels.
-TEST(TemplateParts, ChromaChannelIsTheReferences) {
+// Every 8-bit BGR colour once: a 4096 x 4096 image.
+cv::Mat EveryBgrColour() {
   cv::Mat every(4096, 4096, CV_8UC3);
   for (int y = 0; y < every.rows; ++y) {
     cv::Vec3b* row = every.ptr<cv::Vec3b>(y);
@@ -135,6 +133,14 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
                          static_cast<uint8_t>(i >> 16));
     }
   }
+  return every;
+}
+
+// The vector chroma channel against its scalar reference, within a level: every 8-bit colour, on
+// axes whose levels stay inside 0..255 and ones that saturate both ways, then views of every
+// width from 1 to 40 px (the 16-pixel loop's tail) on random pixels.
+TEST(TemplateParts, ChromaChannelIsTheReferences) {
+  const cv::Mat every = EveryBgrColour();
   std::vector<ChromaAxis> axes;
   cv::RNG rng(45);
   for (double span : {kMinChromaSpan, 0.1, 0.3, 0.7, 1.2}) {
@@ -184,15 +190,7 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
 // axes ContrastProjection learns and ones with negative weights; views of every width 1-40 px,
 // the overlapping last vector), and against cv::transform within a level.
 TEST(TemplateParts, ProjectLevelsIsTheReferences) {
-  cv::Mat every(4096, 4096, CV_8UC3);
-  for (int y = 0; y < every.rows; ++y) {
-    cv::Vec3b* row = every.ptr<cv::Vec3b>(y);
-    for (int x = 0; x < every.cols; ++x) {
-      const int i = y * every.cols + x;
-      row[x] = cv::Vec3b(static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8),
-                         static_cast<uint8_t>(i >> 16));
-    }
-  }
+  const cv::Mat every = EveryBgrColour();
   std::vector<cv::Mat> projections;
   cv::Mat selection(32, 32, CV_8UC3, cv::Scalar(120, 120, 120));
   cv::circle(selection, {16, 16}, 9, cv::Scalar(40, 200, 60), cv::FILLED);
