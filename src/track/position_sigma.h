@@ -31,8 +31,9 @@ struct BlobEvidence {
   // in its matched channel and in its chromaticity), px: a bias no frame averages away.
   double definition_spread_px = 0;
   // How far the centroid moves when the blob takes in the pale fringe just outside its range
-  // (ColourBlob::fringe_shift_px), px. A colour blob's soft centroid may stand half way
-  // (ColourBlob::fringe_placed), and the truth lies within about half of it either way.
+  // (ColourBlob::fringe_shift_px), px. A colour blob's soft centroid may have taken in the part
+  // beyond its soft band (ColourBlob::fringe_placed); the edge may still lie anywhere between
+  // the two cuts, which half of this covers.
   double fringe_shift_px = 0;
 };
 
