@@ -13,7 +13,7 @@ the video as a camera would (MJPG in .avi or H.264 in .mp4), and writes into OUT
   scene.json              the scene's settings and conventions
   pick.yaml               `softsight pick --at` the frame-0 centres, as clicks in `live` give them
   zncc.yaml               a box per marker (its frame-0 outline + 6 px), as dragged in `live`
-  achromatic.yaml         (white dots only) a gray range with a roi per dot, as examples/markers.yaml
+  achromatic.yaml         (white or black dots only) a gray range with a roi per dot, as examples/markers.yaml
 Needs numpy and OpenCV; no Blender.
 """
 import argparse
@@ -174,6 +174,14 @@ def main():
             for name, b in zip(names, boxes):
                 f.write(f'  - name: {name}\n    hsv: {{h: [0, 179], s: [0, 60], v: [170, 255]}}\n'
                         f'    roi: {b}\n')
+            f.write(body + '\n')
+    if set(colours) == {'black'}:
+        with open(os.path.join(a.out, 'achromatic.yaml'), 'w') as f:
+            f.write('# Black dots by darkness alone (the gray range examples/markers.yaml gives for '
+                    'black dots),\n# a roi per dot: its frame-0 outline plus '
+                    f'{MARGIN} px.\nmarkers:\n')
+            for name, b in zip(names, boxes):
+                f.write(f'  - name: {name}\n    gray: [0, 50]\n    roi: {b}\n')
             f.write(body + '\n')
     print(f'post.py: {a.out}: {video} {os.path.getsize(os.path.join(a.out, video)) / 1e6:.2f} MB, '
           f'{meta["frames"]} frames, markers {", ".join(names)}')

@@ -35,7 +35,8 @@ MM = 0.001
 #         rises and falls with a smooth (cosine) profile, so speed peaks mid-way.
 # ---------------------------------------------------------------------------------------------
 RGB = dict(red=(0.62, 0.035, 0.04), green=(0.05, 0.38, 0.09), blue=(0.035, 0.09, 0.50),
-           yellow=(0.80, 0.60, 0.03), magenta=(0.55, 0.04, 0.38), white=(0.85, 0.85, 0.83))
+           yellow=(0.80, 0.60, 0.03), magenta=(0.55, 0.04, 0.38), white=(0.85, 0.85, 0.83),
+           black=(0.02, 0.02, 0.022))
 # Pale (pastel) pigments, named by hue as a user's pick names them: 8-bit saturation ~60-90 after
 # the camera's gamma, where the saturated ones above are ~200.
 RGB_PALE = dict(red=(0.80, 0.30, 0.33), green=(0.34, 0.66, 0.30), blue=(0.30, 0.42, 0.80))
@@ -90,6 +91,11 @@ SCENES = {
         layout='top', light='warm_side', markers=['red', 'yellow', 'green', 'blue', 'magenta'],
         wedge=True, finger=True, bend=(5, 110, 12, 2), frames=36, codec='mjpg', noise=4.0,
         seed=11, shutter=0.5),
+    'blackdots': dict(
+        what='flat black ink dots on the milky actuator under the warm side lamp, whose ribs cast '
+             'shadows as dark as the dots',
+        layout='side', light='warm_side', markers=['black', 'black', 'black'], flat=True,
+        bend=(5, 90, 15, 3), frames=36, codec='mjpg', noise=3.0, seed=12),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip

@@ -9,6 +9,11 @@ namespace softsight {
 namespace {
 
 constexpr int kHueCount = HsvRange::kHueCycle;  // OpenCV's 8-bit hue: 0..179, two degrees per step.
+// The least chroma (largest minus smallest of a pixel's B, G, R: saturation x value / 255) whose
+// hue means something: 8-bit hue moves in steps of 60 / chroma degrees, and noise of 2-3 levels
+// turns a pixel of chroma 10 through 30 degrees. A dim saturated marker under a side lamp (value
+// 50, saturation 130) has 25.
+constexpr int kMinHueChroma = 16;
 
 // Linear-interpolated percentile of sorted values, `percent` in [0, 100].
 double Percentile(const std::vector<double>& sorted, double percent) {
@@ -71,16 +76,21 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   };
   if (hsv_samples.empty()) return fail("no pixels to sample");
 
-  // Only saturated pixels carry a hue; grey rim or background pixels would scatter it.
+  // Only saturated pixels carry a hue; grey rim or background pixels would scatter it. And only
+  // pixels whose channels differ by kMinHueChroma levels or more: a black dot's pixels (levels
+  // 5-20, a few apart under tinted light) are "saturated" by noise, their hue the light's.
   std::vector<cv::Vec3b> coloured;
   coloured.reserve(hsv_samples.size());
   for (const cv::Vec3b& p : hsv_samples) {
-    if (p[1] >= options.min_saturation) coloured.push_back(p);
+    if (p[1] >= options.min_saturation && p[1] * p[2] >= kMinHueChroma * 255) {
+      coloured.push_back(p);
+    }
   }
   if (coloured.size() * 2 < hsv_samples.size()) {
     return fail("not a coloured marker: only " + std::to_string(coloured.size()) + " of " +
-                std::to_string(hsv_samples.size()) +
-                " pixels have saturation >= " + std::to_string(options.min_saturation));
+                std::to_string(hsv_samples.size()) + " pixels have saturation >= " +
+                std::to_string(options.min_saturation) + " and channels " +
+                std::to_string(kMinHueChroma) + " or more levels apart");
   }
 
   // Circular mean of the hue, then every hue as a signed offset from it in [-90, 90): the
@@ -117,7 +127,8 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   } else {
     pick.h = {HsvRange::WrapHue(lo), HsvRange::WrapHue(hi)};
   }
-  // Saturation never goes below min_saturation: below it the hue test means nothing.
+  // Saturation does not go below min_saturation here: below it the hue of a few sampled pixels
+  // means little. (PickHsvRange lowers it for a pale marker on paler surroundings.)
   pick.s = LinearRange(std::move(sat), options, options.saturation_margin, options.min_saturation);
   std::sort(val.begin(), val.end());  // Once, for the margin's range and the darkest light's.
   const int darkest =
@@ -200,6 +211,108 @@ std::optional<HsvPick> PickGrayDot(const cv::Mat& bgr, cv::Point2d click_px, int
   return pick;
 }
 
+// The lowest saturation floor a pale marker's range may get: below it the hue of an 8-bit pixel
+// (steps of 60 / S degrees) is noise, and white or gray surfaces pass any hue range.
+constexpr int kLowestSaturationFloor = 16;
+// How far the marker's saturation must stand above its surroundings' for the floor to drop.
+constexpr int kMinSaturationContrast = 20;
+// How far the lower floor must move the centre of the blob at the click for it to be taken: a
+// part of the marker on one side was cut off. A rim that only widens all round (the blur at a
+// saturated marker's edge) moves it less, and widening the range for it only lets in more of
+// the surroundings.
+constexpr double kMinCentreShiftPx = 1.0 / 3.0;
+
+// A pale marker (a light pigment, or a lit dome whose top the light whitens) has a part less
+// saturated than the pick's floor of min_saturation, and a range that cuts it off moves the
+// marker's centre towards its saturated part. When the surroundings are paler still, the floor
+// drops to a third of the way from them to the marker's sampled pixels (their 10th percentile):
+// - where the marker ends: the first 3 px ring around the click of which less than a quarter
+//   passes the pick's range; the surroundings start one ring further (that ring holds the
+//   blurred rim) and reach 30 px out;
+// - the surroundings' saturation: the 99th percentile, over their pixels, of the saturation a
+//   pixel needs to pass the range (none where its hue or value fails it), so a surface of the
+//   marker's hue nearby keeps the floor where it was and other hues do not matter.
+// The lower floor is taken only when it moves the centre of the blob at the click (the marker
+// had a part cut off on one side), by kMinCentreShiftPx or more.
+void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px,
+                                        const std::vector<cv::Vec3b>& disc, int radius,
+                                        HsvPick* pick) {
+  if (pick->s.lo <= kLowestSaturationFloor) return;
+  std::vector<double> disc_sat;
+  for (const cv::Vec3b& p : disc) {
+    if (HsvInRange(p, pick->h, pick->s, pick->v)) disc_sat.push_back(p[1]);
+  }
+  if (disc_sat.size() < 8) return;
+  std::sort(disc_sat.begin(), disc_sat.end());
+  const double disc_lo = Percentile(disc_sat, 10);
+
+  constexpr int kRingWidth = 3, kFarthest = 30;
+  const int outer = radius + kFarthest + kRingWidth;
+  const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
+  const cv::Rect box = cv::Rect(centre.x - outer, centre.y - outer, 2 * outer + 1, 2 * outer + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (box.empty()) return;
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  const int ring_count = (kFarthest - 3) / kRingWidth + 1;
+  std::vector<int> ring_total(ring_count, 0), ring_passing(ring_count, 0);
+  std::vector<std::vector<double>> ring_needs(ring_count);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const double d = std::hypot(box.x + x - click_px.x, box.y + y - click_px.y) - radius - 3;
+      if (d < 0) continue;
+      const int k = static_cast<int>(d) / kRingWidth;
+      if (k >= ring_count) continue;
+      const cv::Vec3b& p = hsv.at<cv::Vec3b>(y, x);
+      ++ring_total[k];
+      ring_passing[k] += HsvInRange(p, pick->h, pick->s, pick->v);
+      // The saturation the pixel needs to pass the range: none (0) when its hue or value fails.
+      ring_needs[k].push_back(pick->h.contains_hue(p[0]) && pick->v.contains(p[2]) ? p[1] : 0);
+    }
+  }
+  int edge = 0;
+  while (edge < ring_count && 4 * ring_passing[edge] >= ring_total[edge]) ++edge;
+  if (edge + 1 >= ring_count) return;  // The marker fills the rings: nothing to compare with.
+  std::vector<double> beyond;
+  // The ring where the marker ends still holds its blurred rim: the surroundings start beyond.
+  for (int k = edge + 1; k < ring_count; ++k) {
+    beyond.insert(beyond.end(), ring_needs[k].begin(), ring_needs[k].end());
+  }
+  if (beyond.size() < 24) return;
+  std::sort(beyond.begin(), beyond.end());
+  const double surroundings = Percentile(beyond, 99);
+  if (disc_lo - surroundings < kMinSaturationContrast) return;
+  const int floor = std::max(kLowestSaturationFloor,
+                             static_cast<int>(std::ceil(surroundings + (disc_lo - surroundings) / 3)));
+  if (floor >= pick->s.lo) return;
+  const cv::Point click(centre.x - box.x, centre.y - box.y);
+  if (!cv::Rect(0, 0, hsv.cols, hsv.rows).contains(click)) return;
+  // The centroid of the blob through the click at saturation floor `s_lo` (nothing when the
+  // click's pixel does not pass).
+  auto blob_centroid = [&](int s_lo) -> std::optional<cv::Point2d> {
+    const HsvRange s{s_lo, pick->s.hi};
+    cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
+    for (int y = 0; y < hsv.rows; ++y) {
+      for (int x = 0; x < hsv.cols; ++x) {
+        if (HsvInRange(hsv.at<cv::Vec3b>(y, x), pick->h, s, pick->v)) {
+          mask.at<uchar>(y + 1, x + 1) = 0;
+        }
+      }
+    }
+    if (mask.at<uchar>(click.y + 1, click.x + 1) != 0) return std::nullopt;
+    cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
+    cv::floodFill(canvas, mask, click, cv::Scalar(255), nullptr, cv::Scalar(), cv::Scalar(),
+                  8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+    const cv::Moments m = cv::moments(mask == 255, true);
+    if (!(m.m00 > 0)) return std::nullopt;
+    return cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+  };
+  const auto before = blob_centroid(pick->s.lo), after = blob_centroid(floor);
+  if (!before || !after) return;
+  if (cv::norm(*after - *before) < kMinCentreShiftPx) return;
+  pick->s.lo = floor;
+}
+
 }  // namespace
 
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
@@ -228,6 +341,9 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   std::optional<HsvPick> pick = PickHsvFromSamples(samples, options, &why);
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
     pick = PickGrayDot(bgr, click_px, options.radius_px, &why);
+  } else if (pick && pick->s.lo == options.min_saturation) {
+    // The sampled saturations reach the floor: the marker may be paler in places than the disc.
+    LowerSaturationFloorToSurroundings(bgr, click_px, samples, options.radius_px, &*pick);
   }
   if (!pick && why_not != nullptr) *why_not = why;
   return pick;

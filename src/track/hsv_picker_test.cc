@@ -249,3 +249,110 @@ TEST(HsvPickerTest, AWhiteOrBlackDotGivesAGrayLevelRangeBetweenItAndItsSurroundi
 
 }  // namespace
 }  // namespace softsight
+
+namespace softsight {
+namespace {
+
+// An 81x81 white bench (value 240, a warm tint of saturation 0..8) with a green disc of radius
+// 10 at (40, 40): saturation 75 +- 8, its top third (y < 37) whitened by the light to
+// `top_saturation` +- 3 (a pale dome under a front lamp). `surround_saturation` > 0 paints the
+// bench in the disc's own hue at that saturation instead.
+cv::Mat PaleDomeImage(int top_saturation, int surround_saturation) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> tint(0, 8), small(-3, 3), noise(-8, 8);
+  cv::Mat hsv(81, 81, CV_8UC3);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool inside = (x - 40) * (x - 40) + (y - 40) * (y - 40) <= 10 * 10;
+      cv::Vec3b& p = hsv.at<cv::Vec3b>(y, x);
+      if (inside && y < 37) {
+        p = cv::Vec3b(60, cv::saturate_cast<uchar>(top_saturation + small(rng)), 245);
+      } else if (inside) {
+        p = cv::Vec3b(60, cv::saturate_cast<uchar>(75 + noise(rng)), 225);
+      } else if (surround_saturation > 0) {
+        p = cv::Vec3b(60, cv::saturate_cast<uchar>(surround_saturation + small(rng)), 240);
+      } else {
+        p = cv::Vec3b(20, cv::saturate_cast<uchar>(tint(rng)), 240);
+      }
+    }
+  }
+  return ToBgr(hsv);
+}
+
+// The centroid of the pixels the pick accepts within 14 px of (40, 40).
+cv::Point2d AcceptedCentroid(const cv::Mat& bgr, const HsvPick& pick) {
+  cv::Mat hsv;
+  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);
+  double n = 0, sx = 0, sy = 0;
+  for (int y = 26; y <= 54; ++y) {
+    for (int x = 26; x <= 54; ++x) {
+      if (HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v)) ++n, sx += x, sy += y;
+    }
+  }
+  return n > 0 ? cv::Point2d(sx / n, sy / n) : cv::Point2d(-1, -1);
+}
+
+TEST(HsvPickerTest, APaleMarkersFloorDropsTowardsItsPalerSurroundings) {
+  // Clicked on its saturated lower part, a pale dome's range reaches down to its whitened top
+  // (saturation 32), which the floor of min_saturation cut off: the accepted pixels' centre is
+  // the disc's, not 2 px below it; the white bench stays out.
+  const cv::Mat image = PaleDomeImage(32, 0);
+  const auto pick = PickHsvRange(image, {40, 44}, HsvPickOptions{});
+  ASSERT_TRUE(pick);
+  EXPECT_LT(pick->s.lo, 32 - 3);
+  EXPECT_GT(pick->s.lo, 8);
+  EXPECT_LT(cv::norm(AcceptedCentroid(image, *pick) - cv::Point2d(40, 40)), 0.3);
+  EXPECT_DOUBLE_EQ(AcceptedFraction(image, *pick, {40, 40}, 12, false), 0.0);
+  // The floor of min_saturation would have cut the top off.
+  HsvPick cut = *pick;
+  cut.s.lo = HsvPickOptions{}.min_saturation;
+  EXPECT_GT(AcceptedCentroid(image, cut).y - 40, 1.5);
+}
+
+TEST(HsvPickerTest, TheFloorStaysWhereTheSurroundingsShareTheMarkersHueOrNothingWasCut) {
+  // A bench of the marker's own hue at saturation 34: a lower floor would let it in.
+  const auto on_green = PickHsvRange(PaleDomeImage(32, 34), {40, 44}, HsvPickOptions{});
+  ASSERT_TRUE(on_green);
+  EXPECT_EQ(on_green->s.lo, HsvPickOptions{}.min_saturation);
+  // A saturated disc whose rim the lens blurred all round: a lower floor widens the blob evenly
+  // and leaves its centre where it was, so the floor stays.
+  cv::Mat blurred;
+  cv::GaussianBlur(PaleDomeImage(75, 0), blurred, cv::Size(0, 0), 1.5);
+  const auto rim = PickHsvRange(blurred, {40, 40}, HsvPickOptions{});
+  ASSERT_TRUE(rim);
+  EXPECT_EQ(rim->s.lo, HsvPickOptions{}.min_saturation);
+}
+
+}  // namespace
+}  // namespace softsight
+
+namespace softsight {
+namespace {
+
+TEST(HsvPickerTest, AnInkDotUnderWarmLightIsBlackNotRed) {
+  // A black ink dot lit by a warm lamp: levels 5-20, red a few above blue, so its saturation is
+  // 100-200 (noise and tint over a tiny value) and its hue the lamp's. It is a black dot.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> noise(-3, 3);
+  cv::Mat image(80, 80, CV_8UC3);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      const bool dot = (x - 40) * (x - 40) + (y - 40) * (y - 40) <= 9 * 9;
+      const cv::Vec3i level = dot ? cv::Vec3i(6, 10, 16) : cv::Vec3i(70, 100, 130);
+      const int n = noise(rng);
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(level[0] + n),
+                                            cv::saturate_cast<uchar>(level[1] + n),
+                                            cv::saturate_cast<uchar>(level[2] + n));
+    }
+  }
+  std::string why;
+  const auto pick = PickHsvRange(image, {40, 40}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(pick) << why;
+  ASSERT_TRUE(pick->gray) << "picked as " << PickName(*pick);
+  EXPECT_EQ(PickName(*pick), "black");
+  EXPECT_GT(pick->gray->hi, 20);   // Above the dot ...
+  EXPECT_LT(pick->gray->hi, 100);  // ... and below the body's gray level (about 107).
+}
+
+}  // namespace
+}  // namespace softsight

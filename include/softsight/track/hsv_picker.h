@@ -36,7 +36,9 @@ struct HsvPickOptions {
   // marker from a look-alike of the same hue in another light. Default 0.4; 1 keeps the margin only.
   double darkest_light = 0.4;
   // Pixels less saturated than this have no meaningful hue; they do not vote for the hue range.
-  // A patch where fewer than half the pixels reach it is not a coloured marker. Default 40.
+  // A patch where fewer than half the pixels reach it is not a coloured marker. Default 40. It is
+  // also the range's saturation floor, except for a pale marker on paler surroundings
+  // (PickHsvRange).
   int min_saturation = 40;
 
   // Returns true when every field is usable; otherwise false with `error` naming the field.
@@ -64,7 +66,10 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
 // Picks ranges from the disc of `options.radius_px` around `click_px` (pixel-centre convention)
 // in a BGR image. Pixels outside the image are skipped. A patch without colour is a white or
 // black dot when its gray levels (10th to 90th percentile) all lie at least 20 above (or below)
-// those of a ring 3 to 6 px outside the disc: the pick is then a gray-level range.
+// those of a ring 3 to 6 px outside the disc: the pick is then a gray-level range. A pale
+// marker whose saturation reaches min_saturation gets a lower floor (down to 16) when its
+// surroundings are paler still and the floor cut a part of it off (a dome's whitened top): the
+// saturation floor then lies a third of the way from the surroundings' to the marker's.
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
                                     const HsvPickOptions& options, std::string* why_not = nullptr);
 
