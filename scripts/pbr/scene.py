@@ -36,7 +36,8 @@ MM = 0.001
 # ---------------------------------------------------------------------------------------------
 RGB = dict(red=(0.62, 0.035, 0.04), green=(0.05, 0.38, 0.09), blue=(0.035, 0.09, 0.50),
            yellow=(0.80, 0.60, 0.03), magenta=(0.55, 0.04, 0.38), white=(0.85, 0.85, 0.83),
-           black=(0.02, 0.02, 0.022))
+           black=(0.02, 0.02, 0.022), orange=(0.80, 0.20, 0.02), cyan=(0.02, 0.42, 0.52),
+           purple=(0.22, 0.05, 0.48))
 # Pale (pastel) pigments, named by hue as a user's pick names them: 8-bit saturation ~60-90 after
 # the camera's gamma, where the saturated ones above are ~200.
 RGB_PALE = dict(red=(0.80, 0.30, 0.33), green=(0.34, 0.66, 0.30), blue=(0.30, 0.42, 0.80))
@@ -96,6 +97,11 @@ SCENES = {
              'shadows as dark as the dots',
         layout='side', light='warm_side', markers=['black', 'black', 'black'], flat=True,
         bend=(5, 90, 15, 3), frames=36, codec='mjpg', noise=3.0, seed=12),
+    'mat': dict(
+        what='orange, cyan and purple markers on the actuator lying on a green self-healing cutting '
+             'mat (white 10 mm grid), seen from above',
+        layout='top', light='neutral_top', markers=['orange', 'cyan', 'purple'], bench='mat',
+        bend=(5, 90, 15, 3), frames=36, codec='mjpg', noise=2.5, seed=13),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip
@@ -210,6 +216,48 @@ def wood_mat():
     L.new(wave.outputs['Fac'], bump.inputs['Height'])
     L.new(bump.outputs['Normal'], b.inputs['Normal'])
     b.inputs['Roughness'].default_value = 0.55
+    return m
+
+
+def cutting_mat():
+    # A green self-healing cutting mat: a slightly mottled matte green with thin light lines every
+    # 10 mm (world x and y), as on many lab benches.
+    m, nt, b = node_mat('cutting_mat')
+    N, L = nt.nodes, nt.links
+    geo = N.new('ShaderNodeNewGeometry')
+    sep = N.new('ShaderNodeSeparateXYZ')
+    L.new(geo.outputs['Position'], sep.inputs['Vector'])
+    lines = []
+    for axis in ('X', 'Y'):
+        scale = N.new('ShaderNodeMath')
+        scale.operation = 'MULTIPLY'
+        scale.inputs[1].default_value = 100.0          # one cell per 10 mm
+        L.new(sep.outputs[axis], scale.inputs[0])
+        frac = N.new('ShaderNodeMath')
+        frac.operation = 'FRACT'
+        L.new(scale.outputs[0], frac.inputs[0])
+        line = N.new('ShaderNodeMath')
+        line.operation = 'LESS_THAN'
+        line.inputs[1].default_value = 0.05            # 0.5 mm wide
+        L.new(frac.outputs[0], line.inputs[0])
+        lines.append(line)
+    either = N.new('ShaderNodeMath')
+    either.operation = 'MAXIMUM'
+    L.new(lines[0].outputs[0], either.inputs[0])
+    L.new(lines[1].outputs[0], either.inputs[1])
+    noise = N.new('ShaderNodeTexNoise')
+    noise.inputs['Scale'].default_value = 80.0
+    mottle = N.new('ShaderNodeMixRGB')
+    mottle.blend_type = 'MULTIPLY'
+    mottle.inputs['Fac'].default_value = 0.15
+    mottle.inputs['Color1'].default_value = (0.04, 0.20, 0.10, 1)
+    L.new(noise.outputs['Color'], mottle.inputs['Color2'])
+    mix = N.new('ShaderNodeMixRGB')
+    mix.inputs['Color2'].default_value = (0.60, 0.68, 0.62, 1)
+    L.new(either.outputs[0], mix.inputs['Fac'])
+    L.new(mottle.outputs['Color'], mix.inputs['Color1'])
+    L.new(mix.outputs['Color'], b.inputs['Base Color'])
+    b.inputs['Roughness'].default_value = 0.7
     return m
 
 
@@ -416,7 +464,7 @@ def build(cfg):
     bpy.ops.mesh.primitive_plane_add(size=1.0, location=(40 * MM, 60 * MM, 0))
     bench = bpy.context.object
     bench.scale = (0.8, 0.6, 1)
-    bench.data.materials.append(wood_mat())
+    bench.data.materials.append(cutting_mat() if cfg.get('bench') == 'mat' else wood_mat())
     metal = plain_mat('clamp', (0.12, 0.12, 0.13), rough=0.35, metal=0.7)
     if side:
         bpy.ops.mesh.primitive_cube_add(size=1, location=(-12 * MM, 0, 37 * MM))

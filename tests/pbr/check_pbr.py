@@ -94,6 +94,9 @@ CASES = {
     'blackdots': dict(
         what='flat black ink dots on the milky actuator, warm side light, rib shadows as dark',
         configs=[('achromatic', 99.0, None), ('pick', 99.0, None), ('zncc', 99.0, None)]),
+    'mat': dict(
+        what='orange, cyan and purple markers on a green cutting mat with a white grid, from above',
+        configs=[('pick', 99.0, None), ('zncc', 99.0, None)]),
     'pale': dict(
         what='pale (pastel) glossy domes with sharp highlights',
         # The front light whitens each dome's upper part (saturation 10-40, the bench's 0-13 with
@@ -329,6 +332,7 @@ INIT_EXPECTED = {
     'whitedots': 3,
     # the pegboard's holes are dark dots as well, dozens of them: init will not guess
     'blackdots': None,
+    'mat': 3,
     # pastel domes (saturation 40-120) are below the finder's saturation floor (70)
     'pale': None,
     'stickers': 3,
