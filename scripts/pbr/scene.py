@@ -102,6 +102,11 @@ SCENES = {
              'mat (white 10 mm grid), seen from above',
         layout='top', light='neutral_top', markers=['orange', 'cyan', 'purple'], bench='mat',
         bend=(5, 90, 15, 3), frames=36, codec='mjpg', noise=2.5, seed=13),
+    'hd': dict(
+        what='a 1280x720 webcam recording in H.264: the bench under the ceiling panel, a fast bend '
+             'to 110 deg (the tip moves up to 45 px a frame) with motion blur',
+        layout='side', light='cold_front', markers=['red', 'blue', 'green'], size=(1280, 720),
+        bend=(5, 110, 12, 2), frames=36, codec='h264', noise=3.0, seed=14, shutter=0.5),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip
@@ -111,7 +116,7 @@ RIB_H = 6 * MM           # how far the chambers (ribs) stand out on the convex s
 DOME_R = 4.5 * MM        # marker radius (9 mm discs, as the lab's)
 DOME_H = 1.6 * MM        # height of the dome above the face
 HFOV = 55.0              # camera's horizontal field of view, degrees
-WIDTH, HEIGHT, FPS = 640, 480, 30
+WIDTH, HEIGHT, FPS = 640, 480, 30  # a scene's `size` replaces the first two
 
 
 def parse():
@@ -684,6 +689,8 @@ def moving_box(scene, cam, objects, frames, margin=36):
 def main():
     a = parse()
     cfg = SCENES[a.scene]
+    global WIDTH, HEIGHT
+    WIDTH, HEIGHT = cfg.get('size', (WIDTH, HEIGHT))
     act, mk, cam, info, s_mm = build(cfg)
     setup_render(cfg, a)
     scene = bpy.context.scene
