@@ -70,7 +70,7 @@ set(_softsight_pc_track opencv4)
 set(_softsight_pc_sim opencv4)
 set(_softsight_pc_calib opencv4)
 set(_softsight_pc_control libserial)
-set(_softsight_pc_io opencv4 libavutil libavcodec libavformat)
+set(_softsight_pc_io opencv4 libavutil libavcodec libavformat libswscale)
 # Aravis (GenICam cameras), when the build has it: static users link it too.
 if(ARAVIS_FOUND)
   list(APPEND _softsight_pc_io aravis-0.8)
@@ -83,7 +83,7 @@ set(_softsight_libs_track -lopencv_imgproc)
 set(_softsight_libs_sim -lopencv_calib3d -lopencv_imgproc)
 set(_softsight_libs_calib -lopencv_calib3d -lopencv_imgproc)
 set(_softsight_libs_control -lserial -pthread)
-set(_softsight_libs_io -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lavformat -lavcodec -lavutil
+set(_softsight_libs_io -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lavformat -lavcodec -lswscale -lavutil
     -pthread)
 if(ARAVIS_FOUND)
   list(APPEND _softsight_libs_io -laravis-0.8 -lgobject-2.0 -lglib-2.0)

@@ -14,6 +14,7 @@ PACKAGES=(
   libopencv-dev          # image processing, video I/O, calibration, GUI (OpenCV 4.6)
   libavutil-dev          # FFmpeg's log (OpenCV decodes with FFmpeg): which frames a decoder found damaged
   libavcodec-dev libavformat-dev  # FFmpeg's own marks of the frames it concealed damage in
+  libswscale-dev         # H.264/MPEG-4 frames converted to BGR as OpenCV does (io/libav_video_reader.h)
   libyaml-cpp-dev        # configuration files
   libcli11-dev           # command-line parsing
   libserial-dev          # serial link to the pneumatic board

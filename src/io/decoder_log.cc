@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <vector>
 
@@ -27,8 +28,17 @@ bool Ignored(const void* context) {
   return std::find(g_ignored.begin(), g_ignored.end(), context) != g_ignored.end();
 }
 
+// FFmpeg's error concealment (libavcodec/error_resilience.c: H.264, MPEG-4, MPEG-2 ...) says
+// "concealing N DC, N AC, N MV errors in P frame" at info level, exactly when it marks the frame
+// concealed (decode_error_flags). With frame threads that mark is copied to another thread's
+// picture before it is set and often never reaches the frame handed out (FFmpeg 5: H.264 with
+// B-frames), while this message always comes, from the thread that conceals: it is counted.
+bool ConcealmentMessage(int level, const char* format) {
+  return level == AV_LOG_INFO && std::strncmp(format, "concealing ", 11) == 0;
+}
+
 extern "C" void OnDecoderLog(void* context, int level, const char* format, va_list args) {
-  if (level > AV_LOG_ERROR || Ignored(context)) return;
+  if ((level > AV_LOG_ERROR && !ConcealmentMessage(level, format)) || Ignored(context)) return;
   char text[256];
   std::vsnprintf(text, sizeof(text), format, args);
   std::string message = text;

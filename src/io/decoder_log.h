@@ -11,7 +11,9 @@
 namespace softsight {
 
 // Installs the capturing av_log callback (once per process; later calls do nothing). Messages
-// at error level or worse are counted; all others are dropped, as OpenCV's AV_LOG_ERROR level did.
+// at error level or worse are counted, and error concealment's "concealing ... errors in P frame"
+// (info level: the frame was concealed); all others are dropped, as OpenCV's AV_LOG_ERROR level
+// did.
 void CaptureDecoderErrors();
 
 // How many error messages the decoders have logged so far in this process (any thread: FFmpeg's

@@ -24,6 +24,7 @@
 #include "io/damaged_band.h"
 #include "io/decode_probe.h"
 #include "io/decoder_log.h"
+#include "io/libav_video_reader.h"
 #include "io/sequence_pattern.h"
 #include "softsight/core/error.h"
 #include "softsight/sim/builtin_scenes.h"
@@ -119,13 +120,13 @@ bool MotionJpegCodec(double fourcc_property) {
 }
 
 // A video file. Two kinds of damage FFmpeg does not report through OpenCV are caught here:
-// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice), or marked as
-//   concealed (DecodeProbe), is damaged: it gets no row (its garbage would be measured as if it
-//   were real), later frames keep their numbers, and the end of the run reports how many there
-//   were. Intra-only decoders conceal damage without a mark: a Motion JPEG frame whose coded
-//   data does not fill its picture (io/jpeg_scan.h, checked by the probe), and an intra-only
-//   frame with a band of rows from its edge whose colours all moved at once
-//   (io/damaged_band.h), are damaged too;
+// - a frame its decoder logged an error for (a corrupt JPEG, a broken slice) or its concealing
+//   of damage, or marked as concealed (LibavVideoReader, or DecodeProbe), is damaged: it gets no
+//   row (its garbage would be measured as if it were real), later frames keep their numbers,
+//   and the end of the run reports how many there were. Intra-only decoders conceal damage
+//   without a mark: a Motion JPEG frame whose coded data does not fill its picture
+//   (io/jpeg_scan.h, checked by the probe), and an intra-only frame with a band of rows from its
+//   edge whose colours all moved at once (io/damaged_band.h), are damaged too;
 // - a file cut short: the last frame decoded before the cut may be half a frame or a stale copy
 //   of an earlier one (FFmpeg's frame threads hand back an old buffer when the last packet is
 //   cut), so frames are read one ahead, and when the stream ends short of the header's frame
@@ -157,7 +158,20 @@ class VideoFileSource : public FrameSource {
     if (!intra_only) {
       decoder_lag_frames_ =
           std::clamp<int64_t>(int64_t{std::thread::hardware_concurrency()} - 1, 0, 15);
-      probe_ = std::make_unique<DecodeProbe>(path);
+      // A predicting codec's frames need the decoder's own word on damage (see the class
+      // comment): read by LibavVideoReader, which gives VideoCapture's frames (the header's
+      // figures above stay OpenCV's) and, from the same decoding, its marks and messages. A file
+      // OpenCV would rotate (metadata), or one the reader cannot open, is read by VideoCapture,
+      // its marks from a second decoding (DecodeProbe).
+      if (capture_.get(cv::CAP_PROP_ORIENTATION_META) == 0.0) {
+        reader_ = std::make_unique<LibavVideoReader>(path);
+        if (reader_->opened()) {
+          capture_.release();
+        } else {
+          reader_.reset();
+        }
+      }
+      if (!reader_) probe_ = std::make_unique<DecodeProbe>(path);
     }
     if (intra_only) damaged_band_.emplace();
     if (MotionJpegCodec(fourcc)) {
@@ -209,7 +223,12 @@ class VideoFileSource : public FrameSource {
     // OpenCV's FFmpeg seek: av_seek_frame to a key frame at or before the target, then decoding
     // forward to it by the frames' timestamps (exact for the intra-only codecs the recordings use,
     // HuffYUV, FFV1, MJPG, in AVI and MKV: FrameSourceTest.SeekToShowsTheFrameReadingForwardShows).
-    if (!capture_.set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(position))) return false;
+    // LibavVideoReader seeks by the same steps (libav_video_reader.h), and its marks go on.
+    if (reader_) {
+      reader_->seek(position);
+    } else if (!capture_.set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(position))) {
+      return false;
+    }
     // The probe decodes from the start: a seek would wait for it to get there. From here on the
     // decoder's log alone tells damage.
     probe_.reset();
@@ -245,16 +264,22 @@ class VideoFileSource : public FrameSource {
     return true;
   }
 
+  // The next frame the decoder returns into `image`; false when there is none.
+  bool read_frame(cv::Mat& image) {
+    if (reader_) return reader_->read(image);
+    return capture_.read(image) && !image.empty();
+  }
+
   // Decodes the next undamaged frame into `out`; false at the end of the stream.
   bool decode(Decoded& out) {
     while (true) {
       const uint64_t errors_before = DecoderErrorCount();
-      if (!capture_.read(out.image) || out.image.empty()) {
+      if (!read_frame(out.image)) {
         // Tell "the stream ended" from "a frame failed to decode": a decoder that can still grab
         // a later frame skipped a broken one.
         bool later_frame_decodes = false;
         for (int attempt = 0; attempt < 3 && !later_frame_decodes; ++attempt) {
-          later_frame_decodes = capture_.grab();
+          later_frame_decodes = reader_ ? reader_->grab() : capture_.grab();
         }
         if (later_frame_decodes) {
           throw InputError(path_ + ": frame " + std::to_string(next_index_) +
@@ -264,7 +289,8 @@ class VideoFileSource : public FrameSource {
       }
       ++decoded_;
       const int64_t index = next_index_++;
-      const bool concealed = probe_ && probe_->concealed(index).value_or(false);
+      const bool concealed =
+          reader_ ? reader_->concealed() : probe_ && probe_->concealed(index).value_or(false);
       const bool reported = DecoderErrorCount() != errors_before || concealed;
       // Told of every frame, so that the next one is compared with this one.
       const bool band = damaged_band_ && damaged_band_->damaged(out.image, reported);
@@ -276,9 +302,10 @@ class VideoFileSource : public FrameSource {
         // In a codec that predicts frames from earlier ones (MPEG-4, H.264), the damage goes on
         // in every frame decoded from the damaged one, silently, until the next key frame; and
         // its frame threads decode up to decoder_lag_frames_ frames past the one read() returns
-        // and complain from there, so the damaged frame is this one or one of those.
-        suspect_until_ =
-            std::max(suspect_until_, key_frames_->next_after(index + decoder_lag_frames_));
+        // (and B-frames' references before them: the reader knows how many) and complain from
+        // there, so the damaged frame is this one or one of those.
+        const int64_t lag = reader_ ? reader_->frames_decoded_ahead() : decoder_lag_frames_;
+        suspect_until_ = std::max(suspect_until_, key_frames_->next_after(index + lag));
         last_decoded_left_out_ = true;
         continue;
       }
@@ -289,7 +316,8 @@ class VideoFileSource : public FrameSource {
       }
       last_decoded_left_out_ = false;
       out.index = index;
-      const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      const double pos_ms =
+          reader_ ? reader_->position_ms() : capture_.get(cv::CAP_PROP_POS_MSEC);
       // Container timestamps when the demuxer has them; the nominal rate otherwise.
       out.time_s = (pos_ms > 0 || index == 0) ? pos_ms / 1000.0 : index / fps_.value_or(30.0);
       if (index > 0 && out.time_s <= last_time_s_) out.time_s = index / fps_.value_or(30.0);
@@ -326,7 +354,9 @@ class VideoFileSource : public FrameSource {
   }
 
   std::string path_;
-  cv::VideoCapture capture_;
+  cv::VideoCapture capture_;  // Released when reader_ reads the frames.
+  // A predicting codec's frames, with the decoder's damage marks (io/libav_video_reader.h).
+  std::unique_ptr<LibavVideoReader> reader_;
   Decoded current_, next_;  // One frame ahead (see the class comment); swapped, never copied.
   bool started_ = false, have_current_ = false, have_next_ = false;
   std::optional<std::string> pending_error_;  // Thrown by the read after the frame before it.
@@ -336,8 +366,8 @@ class VideoFileSource : public FrameSource {
   int64_t first_damaged_ = 0;
   bool last_decoded_left_out_ = false;  // The last frame the decoder returned was damaged.
   std::unique_ptr<KeyFrameIndex> key_frames_;
-  // Which frames the decoder concealed damage in (predicting codecs and Motion JPEG; none after
-  // a seek).
+  // Which frames the decoder concealed damage in (Motion JPEG, and predicting codecs that
+  // reader_ does not read; none after a seek).
   std::unique_ptr<DecodeProbe> probe_;
   // Intra-only codecs: damage concealed from one row on (io/damaged_band.h).
   std::optional<DamagedBand> damaged_band_;
