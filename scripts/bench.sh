@@ -242,11 +242,12 @@ PYEOF
 # not held back by more than one key-frame group): a VGA and a 1080p rendering re-encoded as H.264
 # with a key frame every 250 frames (libx264's default; softsight_h264_clip), `softsight track`
 # (CSV only) beside a bare decode loop of the file (OpenCV's FFmpeg reader, nothing else) and the
-# file's frame source alone (that decode plus the damage probe's second decode and the key-frame
-# checks), each in a process of its own under /usr/bin/time (wall, CPU, peak RSS), alternated,
-# median of 5 rounds; how long rows waited for their group's check: the CSV's latency_row_ms (a
-# file's frame is stamped as it is tracked). (Until 2026-12-07 the reference was the frame source,
-# probe included, and the ratios were 1.07-1.25x.)
+# file's frame source alone (its own decode, io/libav_video_reader.h, with the decoder's damage
+# marks, and the key-frame checks), each in a process of its own under /usr/bin/time (wall, CPU,
+# peak RSS), alternated, median of 5 rounds; how long rows waited for their group's check: the
+# CSV's latency_row_ms (a file's frame is stamped as it is tracked). (Until 2026-12-07 the
+# reference was the frame source, which then ran a second decode for the damage marks, and the
+# ratios were 1.07-1.25x; against the bare decode they were 1.50x.)
 cmake --build build --target softsight_h264_clip >/dev/null
 for size in 640x480 1920x1080; do
   [ -f "$WORK/h264_$size.mp4" ] && continue
@@ -267,7 +268,7 @@ def timed(cmd):
         wall, user, system, rss_kb = t.read().split()[-4:]
     return float(wall), float(user) + float(system), int(rss_kb) / 1024
 print("| what | `track` | bare decode of the same file, in the same run | the file's frame source alone "
-      "(decode + damage probe) | target |")
+      "(decode + damage checks) | target |")
 print("| --- | --- | --- | --- | --- |")
 for size in ("640x480", "1920x1080"):
     clip = os.path.join(work, f"h264_{size}.mp4")

@@ -3,8 +3,8 @@
 // on another (or a busier) machine. Prints Markdown table rows for the README (scripts/bench.sh).
 //   - one BGR -> gray pass over the video's first frame (the per-frame reference of every table),
 //   - a bare decode loop of the file: OpenCV's FFmpeg reader and nothing else (not
-//     OpenFrameSource: a file's source also runs the damage probe, a second decode of a
-//     compressed file, which is `track`'s cost, not the decoder's),
+//     OpenFrameSource: a file's source also checks for damage (the decoder's marks, key frames,
+//     a Motion JPEG's coded data), which is `track`'s cost, not the decoder's),
 //   - `track`'s pipeline (CSV written) with decoding in line, then decoding on its own thread
 //     (ReadAheadSource, as `track` runs), wall time per frame,
 //   - the tracking alone (median proc_ms of the same runs),
@@ -14,8 +14,8 @@
 //     already keep every core busy, and then max(decode, track) is out of reach).
 // Each is the median of `kRepeats` runs. A benchmark, not a test: it asserts nothing.
 // softsight_speed_report --decode VIDEO: the bare decode loop alone, once (for its peak memory).
-// softsight_speed_report --source VIDEO: the file's FrameSource alone (the decode, the damage
-// probe and the key-frame checks), once: what of `track`'s cost is reading.
+// softsight_speed_report --source VIDEO: the file's FrameSource alone (the decode and the damage
+// and key-frame checks), once: what of `track`'s cost is reading.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
