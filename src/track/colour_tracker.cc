@@ -380,9 +380,10 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame,
   const double reach = ref_radius + cv::norm(velocity_px_) + 1.0;
   // Where the last frame's prediction was good (the marker found within `miss` px of it), first a
   // window just large enough for the marker where this frame's prediction puts it, if it errs by
-  // up to twice as much (with the ring around it): issue 45, a quarter of the pixels or less, on
-  // mire-2 a 30 px window instead of 64 for the small dots, which share the default window with
-  // the card's bright edge and the poster. It is taken only when it settles the frame as the
+  // up to twice as much (with the ring around it), when that is at most three quarters of the
+  // window's side (a try that fails costs its pixels too). Issue 45: on mire-2 a 30 px window
+  // instead of 64 for the small dots, which share the default window with the card's bright edge
+  // and the poster, and 56 instead of 80 for the large one. It is taken only when it settles the
   // first window would: a verified blob chosen, nothing partial or cut by its border nearer to
   // the prediction, and the chosen blob nearer to the prediction than the tight window's border,
   // so every blob the first window holds nearer than it lies in the tight one, whole (then the
@@ -393,7 +394,7 @@ ColourTracker::Choice ColourTracker::track_in_windows(const cv::Mat& frame,
   if (last_miss && tight_window_) {
     tight_side = 2 * static_cast<int>(std::ceil(ref_radius + 2.0 * std::max(*last_miss, 1.0) +
                                                 kRingOuter + 2));
-    if (2 * tight_side > base) tight_side = 0;
+    if (4 * tight_side > 3 * base) tight_side = 0;
   }
   for (int step = tight_side > 0 ? -1 : 0; step <= params_.widen_steps; ++step) {
     const bool tight = step < 0;
