@@ -145,6 +145,8 @@ class ColourTracker : public Tracker {
                                             bool any_brightness = false) const;
   // Bounded side of the last region searched (for tests of the windowing).
   const cv::Rect& last_search_px() const { return last_search_px_; }
+  // Tests only: without the tight first window (track_in_windows), the windows it stands for.
+  void use_tight_window(bool use) { tight_window_ = use; }
 
  private:
   // Full-resolution pipeline on `region` (clipped to the frame); appends every blob with its
@@ -216,7 +218,8 @@ class ColourTracker : public Tracker {
   std::optional<double> rim_radius_px() const;
   void check_frame(const cv::Mat& frame) const;
   Observation search(const cv::Mat& frame);  // update() without the snapshot.
-  Choice track_in_windows(const cv::Mat& frame);
+  // `last_miss`: how far from its prediction the last frame's window found the marker.
+  Choice track_in_windows(const cv::Mat& frame, std::optional<double> last_miss);
   // The marker darker than its range's floor where it should be (a shadow, the dim edge of the
   // light): `window`, around `predicted`, classified with the floor lowered; the one blob within
   // `reach` that fits the marker in everything but brightness, whole, around the sliver of it
@@ -300,6 +303,10 @@ class ColourTracker : public Tracker {
   std::optional<cv::Point2d> last_seen_px_;
   cv::Size frame_size_;
   cv::Rect last_search_px_;
+  // How far from the prediction the last frame's window chose the marker (absent when it was
+  // not so found): how tight a first window this frame may try (track_in_windows).
+  std::optional<double> last_miss_px_;
+  bool tight_window_ = true;
 
   // What the tracker knew before the last update() reported, so adopt() can report another of
   // its candidates as if it had chosen that one.

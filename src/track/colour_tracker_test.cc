@@ -482,6 +482,61 @@ TEST(ColourTracker, BlobCutByTheWindowWidensInsteadOfClipping) {
   EXPECT_GT(tracker.last_search_px().width, 32);
 }
 
+TEST(ColourTracker, TheTightFirstWindowReportsWhatTheWindowWould) {
+  // Issue 45: where the last prediction was good, a window just large enough for the marker is
+  // tried first, and taken only when it settles the frame as the default window would. A red
+  // disc moving with jerks, a red twin wandering 16 to 32 px from it, a red bar that crosses the
+  // marker's neighbourhood and covers part of it for a few frames: every report and every chosen
+  // candidate the same to the last bit as without the tight window.
+  const ColourParams p = ParamsFor("red");
+  ColourTracker tight(p), plain(p);
+  plain.use_tight_window(false);
+  cv::RNG rng(45);
+  cv::Point2d centre(80.3, 90.6);
+  int tight_windows = 0, found = 0;
+  for (int f = 0; f < 60; ++f) {
+    cv::Mat image = Background();
+    centre += cv::Point2d(rng.uniform(0.0, 4.0), rng.uniform(-2.0, 2.0));
+    const double angle = 0.3 * f;
+    const double twin_distance = 24.0 + 8.0 * std::sin(0.7 * f);
+    PaintDisc(image, centre + twin_distance * cv::Point2d(std::cos(angle), std::sin(angle)), 6,
+              kRed);
+    PaintDisc(image, centre, 6, kRed);
+    if (f >= 20 && f < 40) {  // A bar moving across, over the marker's edge for a few frames.
+      const int x = cvRound(centre.x) - 30 + 2 * (f - 20);
+      cv::rectangle(image, cv::Rect(x, cvRound(centre.y) - 20, 5, 40),
+                    cv::Scalar(kRed[0], kRed[1], kRed[2]), cv::FILLED);
+    }
+    if (f == 0) {  // The marker, not its twin.
+      const cv::Rect roi(cvRound(centre.x) - 10, cvRound(centre.y) - 10, 20, 20);
+      tight.init(image, roi);
+      plain.init(image, roi);
+    }
+    const Observation a = tight.update(image), b = plain.update(image);
+    ASSERT_EQ(a.found(), b.found()) << f;
+    EXPECT_EQ(a.status(), b.status()) << f;
+    if (a.found()) {
+      ++found;
+      EXPECT_EQ(a.position_px->x, b.position_px->x) << f;
+      EXPECT_EQ(a.position_px->y, b.position_px->y) << f;
+      EXPECT_EQ(a.score, b.score) << f;
+      EXPECT_EQ(a.sigma_px, b.sigma_px) << f;
+      if (tight.last_search_px().width < plain.last_search_px().width) ++tight_windows;
+    }
+    const auto chosen = [](const std::vector<MarkerCandidate>& list) {
+      std::optional<cv::Point2d> at;
+      for (const MarkerCandidate& c : list) {
+        if (c.verdict == CandidateVerdict::kChosen) at = c.position_px;
+      }
+      return at;
+    };
+    EXPECT_EQ(chosen(tight.candidates()), chosen(plain.candidates())) << f;
+  }
+  EXPECT_GE(found, 50);
+  EXPECT_GE(tight_windows, 15);  // It was used (20 of the 60 frames), and not everywhere.
+  EXPECT_LT(tight_windows, found);
+}
+
 TEST(ColourTracker, ConstantVelocityKeepsAFastMarkerInTheSmallWindow) {
   ColourParams p = RedParams();
   p.window_px = 32;

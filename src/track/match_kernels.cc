@@ -5,6 +5,7 @@
 #include <cstring>
 #include <cstdlib>
 #include <limits>
+#include <type_traits>
 
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
@@ -217,38 +218,55 @@ void WindowSums(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& sc
     }
     prefix = scratch.prefix_sum.data();
   }
-  const int row_values = size.width * kPerPixel;
-  scratch.row_sum.resize(row_values);
+  const int map_values = size.width * kPerPixel;
+  scratch.row_sum.resize(map_values);
   uint32_t* __restrict row_sum = scratch.row_sum.data();
   const std::vector<int>& run_rows = KernelAccess::RunRows(t);
   const auto* runs = KernelAccess::Runs(t);
   const int rows = t.size().height;
-  for (int y = 0; y < size.height; ++y) {
-    std::fill(row_sum, row_sum + row_values, 0u);
-    for (int r = 0; r < rows;) {
-      const uint32_t* s = prefix + prefix_step * (y + r);
-      const int k = run_rows[r];
-      if (r + 1 < rows && run_rows[r + 1] == k + 1 && run_rows[r + 2] == k + 2) {
-        // Two rows of one run each (a round mask's rows): added together, so the map row's sums
-        // are loaded and stored once for both; the same sums mod 2^32.
-        const uint32_t* __restrict end0 = s + runs[k].end * kPerPixel;
-        const uint32_t* __restrict begin0 = s + runs[k].begin * kPerPixel;
-        const uint32_t* __restrict end1 = s + prefix_step + runs[k + 1].end * kPerPixel;
-        const uint32_t* __restrict begin1 = s + prefix_step + runs[k + 1].begin * kPerPixel;
-        for (int i = 0; i < row_values; ++i) {
-          row_sum[i] += (end0[i] - begin0[i]) + (end1[i] - begin1[i]);
+  // kValues: the map row's values when known at compile time (0: map_values). The tracker's
+  // searches are 3 placements wide (the climbs, the pose rungs: 6 gray values) or 7 (the
+  // measurement's window): with the count a constant the loops below are a few vector operations
+  // each; with a variable one the compiler's vector loop and its remainder cost more than the
+  // additions (issue 45: these loops were 0.13M of the 2.37M instructions a frame of ZNCC on
+  // mire-2). The same additions, in the same order.
+  const auto sums = [&](auto values) {
+    constexpr int kValues = decltype(values)::value;
+    const int row_values = kValues > 0 ? kValues : map_values;
+    for (int y = 0; y < size.height; ++y) {
+      std::fill(row_sum, row_sum + row_values, 0u);
+      for (int r = 0; r < rows;) {
+        const uint32_t* s = prefix + prefix_step * (y + r);
+        const int k = run_rows[r];
+        if (r + 1 < rows && run_rows[r + 1] == k + 1 && run_rows[r + 2] == k + 2) {
+          // Two rows of one run each (a round mask's rows): added together, so the map row's
+          // sums are loaded and stored once for both; the same sums mod 2^32.
+          const uint32_t* __restrict end0 = s + runs[k].end * kPerPixel;
+          const uint32_t* __restrict begin0 = s + runs[k].begin * kPerPixel;
+          const uint32_t* __restrict end1 = s + prefix_step + runs[k + 1].end * kPerPixel;
+          const uint32_t* __restrict begin1 = s + prefix_step + runs[k + 1].begin * kPerPixel;
+          for (int i = 0; i < row_values; ++i) {
+            row_sum[i] += (end0[i] - begin0[i]) + (end1[i] - begin1[i]);
+          }
+          r += 2;
+          continue;
         }
-        r += 2;
-        continue;
+        for (int j = k; j < run_rows[r + 1]; ++j) {
+          const uint32_t* __restrict end = s + runs[j].end * kPerPixel;
+          const uint32_t* __restrict begin = s + runs[j].begin * kPerPixel;
+          for (int i = 0; i < row_values; ++i) row_sum[i] += end[i] - begin[i];
+        }
+        ++r;
       }
-      for (int j = k; j < run_rows[r + 1]; ++j) {
-        const uint32_t* __restrict end = s + runs[j].end * kPerPixel;
-        const uint32_t* __restrict begin = s + runs[j].begin * kPerPixel;
-        for (int i = 0; i < row_values; ++i) row_sum[i] += end[i] - begin[i];
-      }
-      ++r;
+      row_done(y, static_cast<const uint32_t*>(row_sum));
     }
-    row_done(y, static_cast<const uint32_t*>(row_sum));
+  };
+  if (map_values == 3 * kPerPixel) {
+    sums(std::integral_constant<int, 3 * kPerPixel>{});
+  } else if (map_values == 7 * kPerPixel) {
+    sums(std::integral_constant<int, 7 * kPerPixel>{});
+  } else {
+    sums(std::integral_constant<int, 0>{});
   }
 }
 

@@ -1,6 +1,7 @@
 #include "track/template_parts.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -629,8 +630,9 @@ void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::M
 // 16 pixels at a time: `four(b, g, r)` turns four pixels' channels, widened to 32 bits, into
 // their four levels (v_int32x4), which are packed with saturation (saturate_cast).
 namespace {
-template <typename Four>
-void MapBgrRows16(const cv::Mat& bgr, cv::Mat& out, const Four& four) {
+// `shortcut(pixels, levels)`, when it returns true, has written the 16 pixels' levels another way.
+template <typename Four, typename Shortcut>
+void MapBgrRows16(const cv::Mat& bgr, cv::Mat& out, const Four& four, const Shortcut& shortcut) {
   for (int y = 0; y < bgr.rows; ++y) {
     const uint8_t* row = bgr.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
@@ -638,6 +640,7 @@ void MapBgrRows16(const cv::Mat& bgr, cv::Mat& out, const Four& four) {
     // same pixels give the same levels, and nothing outside the row is read.
     for (int x = 0; x < bgr.cols; x += 16) {
       if (x + 16 > bgr.cols) x = bgr.cols - 16;
+      if (shortcut(row + 3 * x, o + x)) continue;
       cv::v_uint8x16 b8, g8, r8;
       cv::v_load_deinterleave(row + 3 * x, b8, g8, r8);
       cv::v_uint16x8 b16[2], g16[2], r16[2];
@@ -680,7 +683,53 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
     acc = acc + wr * cv::v_cvt_f32(cv::v_reinterpret_as_s32(r));
     return cv::v_round(acc + offset);  // Nearest even, as cvRound.
   };
-  MapBgrRows16(bgr, out, four);
+  // A gray pixel's (v, v, v) level, for each v, from `four` itself, saturated as MapBgrRows16's
+  // packs saturate: the same bits. Kept per thread for the last few projections (each tracker's
+  // is set once, a session has a few; a table costs a few hundred pixels' projections).
+  struct GrayTable {
+    float m[4] = {0, 0, 0, 0};
+    bool valid = false;
+    uint8_t level[256] = {};
+  };
+  thread_local std::array<GrayTable, 8> tables;
+  thread_local size_t next_table = 0;
+  GrayTable* found = nullptr;
+  for (GrayTable& t : tables) {
+    if (t.valid && std::memcmp(t.m, m, sizeof(t.m)) == 0) found = &t;
+  }
+  if (found == nullptr) {
+    found = &tables[next_table];
+    next_table = (next_table + 1) % tables.size();
+    for (int v = 0; v < 256; v += 4) {
+      const cv::v_uint32x4 levels(v, v + 1, v + 2, v + 3);
+      int projected[4];
+      cv::v_store(projected, four(levels, levels, levels));
+      for (int k = 0; k < 4; ++k) {
+        found->level[v + k] = static_cast<uint8_t>(std::clamp(projected[k], 0, 255));
+      }
+    }
+    std::memcpy(found->m, m, sizeof(found->m));
+    found->valid = true;
+  }
+  const GrayTable& table = *found;
+  // A gray recording handed over as BGR (ViSP's mire-2): a run of 16 gray pixels is looked up,
+  // at a third of the projection's instructions (issue 45: the projection was a tenth of the
+  // ZNCC session there). Gray: each of the 48 bytes but every third equals the byte after it.
+  const cv::v_uint8x16 ignore0(0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0);
+  const cv::v_uint8x16 ignore1(0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0);
+  const cv::v_uint8x16 ignore2(255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255);
+  const auto gray16 = [&](const uint8_t* p, uint8_t* o) {
+    const cv::v_uint8x16 c0 = cv::v_load(p), c1 = cv::v_load(p + 16), c2 = cv::v_load(p + 32);
+    const cv::v_uint8x16 next0 = cv::v_extract<1>(c0, c1), next1 = cv::v_extract<1>(c1, c2);
+    const cv::v_uint8x16 next2 = cv::v_extract<1>(c2, c2);  // Its last byte is ignored.
+    if (!cv::v_check_all(((c0 == next0) | ignore0) & ((c1 == next1) | ignore1) &
+                         ((c2 == next2) | ignore2))) {
+      return false;
+    }
+    for (int k = 0; k < 16; ++k) o[k] = table.level[p[3 * k]];
+    return true;
+  };
+  MapBgrRows16(bgr, out, four, gray16);
 #else
   ProjectLevelsReference(bgr, projection, out);
 #endif
@@ -829,7 +878,7 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
     const cv::v_float32x4 sum = b + g + r + dark;
     return cv::v_round(level40 + gain * (dot / sum - along));
   };
-  MapBgrRows16(bgr, out, four);
+  MapBgrRows16(bgr, out, four, [](const uint8_t*, uint8_t*) { return false; });
 #else
   ChromaChannelReference(bgr, chroma, out);
 #endif

@@ -188,7 +188,7 @@ TEST(TemplateParts, ChromaChannelIsTheReferences) {
 
 // The vector projection against its scalar reference, bit for bit (every 8-bit colour, on the
 // axes ContrastProjection learns and ones with negative weights; views of every width 1-40 px,
-// the overlapping last vector), and against cv::transform within a level.
+// the overlapping last vector; gray runs, looked up), and against cv::transform within a level.
 TEST(TemplateParts, ProjectLevelsIsTheReferences) {
   const cv::Mat every = EveryBgrColour();
   std::vector<cv::Mat> projections;
@@ -224,6 +224,29 @@ TEST(TemplateParts, ProjectLevelsIsTheReferences) {
       ProjectLevelsReference(view, m, reference);
       ASSERT_EQ(fast.size(), view.size());
       EXPECT_EQ(cv::countNonZero(fast != reference), 0) << width << " " << m;
+    }
+  }
+  // Gray pixels (b == g == r, looked up in a table of the projection's levels, 16 at a time)
+  // beside colour ones: every level, runs of 16 gray pixels broken by one channel off by one at
+  // each place of the run, on each channel; the projections alternating, as the trackers of a
+  // session call them.
+  cv::Mat levels(24, 64, CV_8U);
+  for (int i = 0; i < static_cast<int>(levels.total()); ++i) levels.data[i] = (i * 7) & 255;
+  cv::Mat gray;
+  cv::cvtColor(levels, gray, cv::COLOR_GRAY2BGR);
+  for (int y = 0; y < gray.rows; y += 2) {
+    cv::Vec3b& p = gray.at<cv::Vec3b>(y, (5 * y) % gray.cols);
+    p[y % 3] = static_cast<uchar>(p[y % 3] ^ 1);
+  }
+  for (int round = 0; round < 2; ++round) {
+    for (int width = 1; width <= 48; ++width) {
+      for (const cv::Mat& m : projections) {
+        const cv::Mat view = gray(cv::Rect(width % 11, 1, width, 21));
+        ProjectLevels(view, m, fast);
+        ProjectLevelsReference(view, m, reference);
+        ASSERT_EQ(fast.size(), view.size());
+        EXPECT_EQ(cv::countNonZero(fast != reference), 0) << width << " " << m;
+      }
     }
   }
 }

@@ -52,6 +52,36 @@ void TemplateTracker::Native(const cv::Mat& frame, const cv::Rect& rect, cv::Mat
   }
   // `out` may still be a view of native_: converting into it would overwrite that.
   if (!out.empty() && out.datastart == native_.datastart) out.release();
+  const cv::Rect overlap = rect & native_rect_;
+  if (frame.channels() == 3 && !params_.colour && overlap.area() * 2 > rect.area()) {
+    // Mostly converted already (the blob's window around the match, a pose rung's window: a
+    // few pixels beyond the near search's, issue 45: their conversion was 7 % of a frame of
+    // ViSP's mire-2 in ZNCC): the part inside native_ copied, only the strips around it
+    // converted. The conversion is per pixel, so every level is the one a whole conversion
+    // gives.
+    out.create(rect.size(), CV_8UC1);
+    native_(overlap - native_rect_.tl()).copyTo(out(overlap - rect.tl()));
+    const auto convert = [&](const cv::Rect& strip) {
+      if (strip.empty()) return;
+      cv::Mat part = out(strip - rect.tl());  // Of the right size and type: written in place.
+      ToNative(frame(strip), part);
+      CV_DbgAssert(part.data == out.ptr(strip.y - rect.y, strip.x - rect.x));
+    };
+    convert(cv::Rect(rect.x, rect.y, rect.width, overlap.y - rect.y));  // Above.
+    convert(cv::Rect(rect.x, overlap.br().y, rect.width, rect.br().y - overlap.br().y));  // Below.
+    // Beside it, as at least 16 columns (the vector kernel's; a narrower strip would take the
+    // scalar reference, at several times the cost), overlapping the copied part with the same
+    // levels.
+    const int wide = std::min(16, rect.width);
+    if (overlap.x > rect.x) {
+      convert(cv::Rect(rect.x, overlap.y, std::max(overlap.x - rect.x, wide), overlap.height));
+    }
+    if (overlap.br().x < rect.br().x) {
+      const int width = std::max(rect.br().x - overlap.br().x, wide);
+      convert(cv::Rect(rect.br().x - width, overlap.y, width, overlap.height));
+    }
+    return;
+  }
   ToNative(frame(rect), out);
 }
 
