@@ -1,6 +1,7 @@
 #include "softsight/track/hsv_picker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <opencv2/imgproc.hpp>
@@ -14,6 +15,14 @@ constexpr int kHueCount = HsvRange::kHueCycle;  // OpenCV's 8-bit hue: 0..179, t
 // turns a pixel of chroma 10 through 30 degrees. A dim saturated marker under a side lamp (value
 // 50, saturation 130) has 25.
 constexpr int kMinHueChroma = 16;
+// How far (hue steps, 2 degrees each) a sampled pixel's hue may lie from the most common one to
+// count as the marker's: a dome's hue moves 5-15 steps between its lit and shaded sides (red
+// under a warm lamp 165-10), the next colour a person would name lies 25-30 away.
+constexpr int kHueClusterHalfWidth = 20;
+// A click farther than this from the centre of the marker's blob through it is re-centred there
+// (px), within this reach of the click (a marker up to about 80 px across).
+constexpr double kRecentrePx = 2.0;
+constexpr int kRecentreReachPx = 48;
 
 // Linear-interpolated percentile of sorted values, `percent` in [0, 100].
 double Percentile(const std::vector<double>& sorted, double percent) {
@@ -92,6 +101,28 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
                 std::to_string(options.min_saturation) + " and channels " +
                 std::to_string(kMinHueChroma) + " or more levels apart");
   }
+
+  // The marker's hue is the most common one (a histogram smoothed over 7 steps, around the
+  // circle), and only the pixels within kHueClusterHalfWidth of it are the marker's: a click off
+  // its centre samples its surroundings too (orange wood beside a blue dome, a shaded rib, the
+  // next marker), and their hues in the percentiles would stretch the range over other colours.
+  std::array<int, kHueCount> histogram{};
+  for (const cv::Vec3b& p : coloured) ++histogram[p[0] % kHueCount];
+  int mode = 0, mode_count = -1;
+  for (int h = 0; h < kHueCount; ++h) {
+    int count = 0;
+    for (int d = -3; d <= 3; ++d) count += histogram[(h + d + kHueCount) % kHueCount];
+    if (count > mode_count) mode = h, mode_count = count;
+  }
+  const auto hue_distance = [](int a, int b) {
+    const int d = std::abs(a - b) % kHueCount;
+    return std::min(d, kHueCount - d);
+  };
+  coloured.erase(std::remove_if(coloured.begin(), coloured.end(),
+                                [&](const cv::Vec3b& p) {
+                                  return hue_distance(p[0], mode) > kHueClusterHalfWidth;
+                                }),
+                 coloured.end());
 
   // Circular mean of the hue, then every hue as a signed offset from it in [-90, 90): the
   // percentiles of the offsets are well defined whether or not the colour straddles 0.
@@ -313,39 +344,108 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   pick->s.lo = floor;
 }
 
+// The HSV pixels of the disc of radius `r` around `at` (pixel-centre convention) inside `bgr`.
+std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
+  const cv::Point centre(cvRound(at.x), cvRound(at.y));
+  const cv::Rect box = cv::Rect(centre.x - r, centre.y - r, 2 * r + 1, 2 * r + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  std::vector<cv::Vec3b> samples;
+  if (box.empty()) return samples;
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const double dx = box.x + x - at.x, dy = box.y + y - at.y;
+      if (dx * dx + dy * dy <= (r + 0.5) * (r + 0.5)) samples.push_back(hsv.at<cv::Vec3b>(y, x));
+    }
+  }
+  return samples;
+}
+
+// The centroid of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at
+// `at`, within kRecentreReachPx of it; nothing when that pixel fails, or the blob reaches the
+// edge of that area (not a marker-sized blob: a surface of the marker's colour, or the range
+// let the surroundings in).
+std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+  const cv::Point centre(cvRound(at.x), cvRound(at.y));
+  const int reach = kRecentreReachPx;
+  const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
+  const cv::Rect box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (!box.contains(centre)) return std::nullopt;
+  // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
+  // hue, saturation and value.
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool passes = pick.gray ? pick.gray->contains(hsv.at<uchar>(y, x))
+                                    : HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v);
+      if (passes) mask.at<uchar>(y + 1, x + 1) = 0;
+    }
+  }
+  const cv::Point seed = centre - box.tl();
+  if (mask.at<uchar>(seed.y + 1, seed.x + 1) != 0) return std::nullopt;
+  cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
+  cv::Rect filled;
+  cv::floodFill(canvas, mask, seed, cv::Scalar(255), &filled, cv::Scalar(), cv::Scalar(),
+                8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  if (filled.x == 0 || filled.y == 0 || filled.br().x == hsv.cols || filled.br().y == hsv.rows) {
+    return std::nullopt;
+  }
+  const cv::Moments m = cv::moments(mask == 255, true);
+  if (!(m.m00 > 0)) return std::nullopt;
+  // The mask is the box's, one pixel larger on every side.
+  return cv::Point2d(box.x + m.m10 / m.m00 - 1, box.y + m.m01 / m.m00 - 1);
+}
+
 }  // namespace
 
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
                                     const HsvPickOptions& options, std::string* why_not) {
   CV_Assert(bgr.type() == CV_8UC3);
   const int r = options.radius_px;
-  const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
-  const cv::Rect box = cv::Rect(centre.x - r, centre.y - r, 2 * r + 1, 2 * r + 1) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
-  std::vector<cv::Vec3b> samples;
-  if (!box.empty()) {
-    cv::Mat hsv;
-    cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
-    for (int y = 0; y < hsv.rows; ++y) {
-      for (int x = 0; x < hsv.cols; ++x) {
-        const double dx = box.x + x - click_px.x, dy = box.y + y - click_px.y;
-        if (dx * dx + dy * dy <= (r + 0.5) * (r + 0.5)) samples.push_back(hsv.at<cv::Vec3b>(y, x));
-      }
-    }
-  }
+  std::vector<cv::Vec3b> samples = SampleDisc(bgr, click_px, r);
   if (samples.empty()) {
     if (why_not != nullptr) *why_not = "the click is outside the image";
     return std::nullopt;
   }
   std::string why;
   std::optional<HsvPick> pick = PickHsvFromSamples(samples, options, &why);
+  cv::Point2d sampled_at = click_px;
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
     pick = PickGrayDot(bgr, click_px, options.radius_px, &why);
-  } else if (pick && pick->s.lo == options.min_saturation) {
-    // The sampled saturations reach the floor: the marker may be paler in places than the disc.
-    LowerSaturationFloorToSurroundings(bgr, click_px, samples, options.radius_px, &*pick);
+    // Off a white or black dot's centre: its rings are measured from the dot's centre instead.
+    const std::optional<cv::Point2d> centre =
+        pick ? BlobCentroidAt(bgr, click_px, *pick) : std::nullopt;
+    if (centre && cv::norm(*centre - click_px) > kRecentrePx) {
+      std::string unused = why;
+      if (auto repick = PickGrayDot(bgr, *centre, options.radius_px, &unused)) {
+        pick = repick;
+        sampled_at = *centre;
+      }
+    }
+  } else if (pick) {
+    // A click off the marker's centre samples its rim and what is around it (a shaded flank, its
+    // shadow, the bench): ranges wide enough to take those in. The marker's centre is the centre
+    // of the blob those ranges give through the click; the ranges are picked again there.
+    const std::optional<cv::Point2d> centre = BlobCentroidAt(bgr, click_px, *pick);
+    if (centre && cv::norm(*centre - click_px) > kRecentrePx) {
+      std::vector<cv::Vec3b> resampled = SampleDisc(bgr, *centre, r);
+      std::optional<HsvPick> repick = PickHsvFromSamples(resampled, options, nullptr);
+      if (repick) {
+        pick = repick;
+        samples = std::move(resampled);
+        sampled_at = *centre;
+      }
+    }
+    if (pick->s.lo == options.min_saturation) {
+      // The sampled saturations reach the floor: the marker may be paler in places than the disc.
+      LowerSaturationFloorToSurroundings(bgr, sampled_at, samples, options.radius_px, &*pick);
+    }
   }
   if (!pick && why_not != nullptr) *why_not = why;
+  if (pick) pick->sampled_at_px = sampled_at;
   return pick;
 }
 
@@ -357,7 +457,8 @@ std::optional<MarkerColourPick> PickMarkerColourAt(const cv::Mat& bgr, cv::Point
   MarkerColourPick pick;
   pick.ranges = *ranges;
   const int side = std::max(1, box_side_px);
-  pick.roi = cv::Rect(cvRound(click_px.x) - side / 2, cvRound(click_px.y) - side / 2, side, side) &
+  const cv::Point2d at = ranges->sampled_at_px;
+  pick.roi = cv::Rect(cvRound(at.x) - side / 2, cvRound(at.y) - side / 2, side, side) &
              cv::Rect(0, 0, bgr.cols, bgr.rows);
   return pick;
 }

@@ -356,3 +356,39 @@ TEST(HsvPickerTest, AnInkDotUnderWarmLightIsBlackNotRed) {
 
 }  // namespace
 }  // namespace softsight
+
+namespace softsight {
+namespace {
+
+TEST(HsvPickerTest, AClickOffTheMarkersCentreIsSampledAgainAtItsCentre) {
+  // A blue disc of radius 10 at (40, 40) on orange wood, clicked 5 px left of its centre, as a
+  // hurried click lands: the first disc of samples holds wood too. The ranges are taken again
+  // at the centre of the blob they give, so they hold no wood, and the search box is centred
+  // on the marker.
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> noise(-6, 6);
+  cv::Mat hsv(81, 81, CV_8UC3);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool inside = (x - 40) * (x - 40) + (y - 40) * (y - 40) <= 10 * 10;
+      hsv.at<cv::Vec3b>(y, x) =
+          inside ? cv::Vec3b(110 + noise(rng) / 3, cv::saturate_cast<uchar>(200 + noise(rng)), 150)
+                 : cv::Vec3b(14 + noise(rng) / 3, cv::saturate_cast<uchar>(150 + noise(rng)), 170);
+    }
+  }
+  const cv::Mat image = ToBgr(hsv);
+  std::string why;
+  const auto pick = PickMarkerColourAt(image, {35, 40}, HsvPickOptions{}, 24, &why);
+  ASSERT_TRUE(pick) << why;
+  EXPECT_LT(cv::norm(pick->ranges.sampled_at_px - cv::Point2d(40, 40)), 0.5);
+  EXPECT_FALSE(pick->ranges.h.contains_hue(14)) << pick->ranges.h.lo << ".." << pick->ranges.h.hi;
+  EXPECT_TRUE(pick->ranges.h.contains_hue(110));
+  EXPECT_EQ(pick->roi, cv::Rect(28, 28, 24, 24));
+  // A click within 2 px of the centre samples where it landed.
+  const auto near = PickHsvRange(image, {41, 39}, HsvPickOptions{});
+  ASSERT_TRUE(near);
+  EXPECT_EQ(near->sampled_at_px, cv::Point2d(41, 39));
+}
+
+}  // namespace
+}  // namespace softsight

@@ -55,6 +55,9 @@ struct HsvPick {
   int sample_count = 0;     // Pixels sampled inside the image.
   double hue_spread = 0.0;  // Width of the hue percentile interval before margins, hue units.
   std::optional<HsvRange> gray{};
+  // Where the pixels were sampled (PickHsvRange): the click, or, for a click off a coloured
+  // marker's centre, the centre of the blob the first pick gives through it.
+  cv::Point2d sampled_at_px{};
 };
 
 // Picks ranges from HSV samples (CV_8UC3 pixels as produced by cv::cvtColor(BGR2HSV)). Returns
@@ -67,6 +70,8 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
 // in a BGR image. Pixels outside the image are skipped. A patch without colour is a white or
 // black dot when its gray levels (10th to 90th percentile) all lie at least 20 above (or below)
 // those of a ring 3 to 6 px outside the disc: the pick is then a gray-level range. A pale
+// marker clicked more than 2 px off its centre is sampled again at the centre of the blob the
+// first pick gives through the click (its rim and surroundings would widen the ranges). A pale
 // marker whose saturation reaches min_saturation gets a lower floor (down to 16) when its
 // surroundings are paler still and the floor cut a part of it off (a dome's whitened top): the
 // saturation floor then lies a third of the way from the surroundings' to the marker's.
@@ -75,7 +80,7 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
 
 // What a click on a marker in `live` gives, and `softsight pick` reproduces: the ranges picked
 // from the pixels around the click (PickHsvRange) and the square search box of `box_side_px`
-// centred on the clicked pixel (clipped to the image), where the colour tracker looks for the
+// centred on the sampled pixel (the click, or the marker's centre; clipped to the image), where the colour tracker looks for the
 // marker first.
 struct MarkerColourPick {
   HsvPick ranges{};
