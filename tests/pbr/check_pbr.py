@@ -330,6 +330,50 @@ def median(values):
     return v[len(v) // 2] if v else float('nan')
 
 
+def click_offsets(program, name, offsets):
+    """Clicks as people make them: `softsight pick --at` each marker's frame-0 centre moved by each
+    offset (dx, dy px), then tracked. A pick may be refused, and a marker may go unfound (the user
+    clicks again), but nothing may be reported beyond the tolerance or while covered, except where
+    the scene's pick config is known to fail. Returns (ok, lines)."""
+    folder = os.path.join(HERE, name)
+    video = scene_video(folder)
+    with open(os.path.join(folder, 'truth.csv'), newline='') as f:
+        rows = list(csv.DictReader(f))
+    truth_names = list(dict.fromkeys(r['marker'] for r in rows))
+    first = {r['marker']: (float(r['x']), float(r['y'])) for r in rows if r['frame'] == '0'}
+    known = dict((c, k) for c, _, k in CASES[name]['configs']).get('pick')
+    ok, lines = True, []
+    with tempfile.TemporaryDirectory(prefix=f'softsight_pbr_{name}_') as out:
+        for dx, dy in offsets:
+            label = f'{name} pick {dx:+d},{dy:+d} px off'
+            cfg, csv_path = os.path.join(out, 'pick.yaml'), os.path.join(out, 'pick.csv')
+            ats = [arg for m in truth_names
+                   for arg in ('--at', f'{first[m][0] + dx:.0f},{first[m][1] + dy:.0f}')]
+            done = subprocess.run([program, 'pick', '-i', video, '--frame', '0', *ats, '-o', cfg],
+                                  cwd=folder, capture_output=True, text=True)
+            if done.returncode != 0:
+                last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
+                lines.append(f'ok {label}: refused ({last[:100]})')
+                continue
+            done = subprocess.run([program, 'track', '-c', cfg, '-i', video, '--csv', csv_path, '--quiet'],
+                                  cwd=folder, capture_output=True, text=True)
+            if done.returncode != 0:
+                last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
+                lines.append(f'FAIL {label}: track exited {done.returncode}: {last}')
+                ok = False
+                continue
+            names, group = config_markers(cfg)
+            s = score(csv_path, os.path.join(folder, 'truth.csv'), dict(zip(truth_names, names)), group)
+            bad = s['wrong'] or s['reported_covered']
+            ok = ok and (not bad or known is not None)
+            worst = f" (worst {s['worst'][0]:.1f} px: {s['worst'][2]} in frame {s['worst'][1]})" if s['worst'] else ''
+            verdict = ('KNOWN' if known is not None else 'FAIL') if bad else 'ok'
+            lines.append(f"{verdict} {label}: found {s['found']}/{s['visible']} "
+                         f"({100.0 * s['found'] / max(1, s['visible']):.1f} %), wrong (> {TOL:g} px) "
+                         f"{s['wrong']}{worst}, reported while covered {s['reported_covered']}")
+    return ok, lines
+
+
 # `softsight init` as a new user runs it on frame 0 of each scene: how many markers it must write
 # (each then tracked with none reported wrong or while covered), or None where it must refuse.
 INIT_EXPECTED = {
@@ -417,6 +461,9 @@ def main():
     parser.add_argument('--keep', help='keep the CSVs and logs in this folder')
     parser.add_argument('--box-margins', help='instead: ZNCC boxes drawn around each marker with these '
                         'margins (px, comma-separated; 0 = tight), each accepted and never wrong')
+    parser.add_argument('--click-offsets', help='instead: `softsight pick --at` each frame-0 centre moved '
+                        'by these offsets (DX,DY px; several separated by spaces or semicolons), '
+                        'never wrong')
     parser.add_argument('--init', action='store_true', help='instead: `softsight init` on frame 0, '
                         'the markers it must write (or its refusal), then tracked with none wrong')
     a = parser.parse_args()
@@ -430,6 +477,13 @@ def main():
             ok, line = init_scene(program, name)
             all_ok = all_ok and ok
             print(line)
+        return 0 if all_ok else 1
+    if a.click_offsets:
+        offsets = [tuple(int(v) for v in o.split(',')) for o in re.split(r'[;\s]+', a.click_offsets.strip())]
+        for name in a.scene or list(CASES):
+            ok, lines = click_offsets(program, name, offsets)
+            all_ok = all_ok and ok
+            print('\n'.join(lines))
         return 0 if all_ok else 1
     if a.box_margins:
         margins = [int(m) for m in a.box_margins.split(',')]
