@@ -72,6 +72,13 @@ inline constexpr double kTurnHysteresis = 0.02;
 // domes' median, 1.553 -> 1.570 px (a known-failing case, its rungs taking over a frame later).
 inline constexpr int kPoseEvery = 6;
 inline constexpr double kPoseDrop = 0.005;
+// The working template is not blended with a frame's patch where it already matched that patch
+// with at least this ZNCC (ZNCC measure only: SAD and SSD follow the light's levels too): the
+// blend would change little, and the update (conversion, blend, drift guard, preparation) was
+// 13 % of a frame of ViSP's mire-2, whose large dot matches so in most frames (issue 45). A
+// change of the marker's look (pose, blur, shading) drops the match below it, and the update
+// follows as before.
+inline constexpr double kSteadyWorkingZncc = 0.98;
 // Below this self-match of the turned template there is no centre of symmetry worth reporting.
 inline constexpr double kMinSymmetry = 0.5;
 

@@ -1145,7 +1145,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     scan_pending_ = false;
     ScanForLookAlikes(frame_bgr, cv::Point2d(hit->top_left) + HalfSize(search_template().size()));
   }
-  Observation observation = Verify(frame_bgr, matched, hit->score, last_turn);
+  Observation observation = Verify(frame_bgr, matched, hit->score, last_turn, hit->zncc);
   if (observation.found()) {
     weighed_.front().verdict = CandidateVerdict::kChosen;
     weighed_.front().position_px = *observation.position_px;
@@ -1188,7 +1188,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
   native_rect_ = cv::Rect();
   StopSharingWindowSums(zncc_);
   const Observation observation =
-      Verify(frame_, weighed_centres_[index], 1.0 - weighed_[index].misfit, turn_);
+      Verify(frame_, weighed_centres_[index], 1.0 - weighed_[index].misfit, turn_, kNoRival);
   if (!observation.found()) return std::nullopt;
   for (MarkerCandidate& c : weighed_) {
     if (c.verdict == CandidateVerdict::kChosen) c.verdict = CandidateVerdict::kFits;
@@ -1201,7 +1201,7 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
 // The first template's measurement at the working template's match `matched` (its centre), the
 // drift guard, the template's blob, then the tracker's state moves on to it.
 Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched,
-                                    double score, int last_turn) {
+                                    double score, int last_turn, double working_zncc) {
   const std::optional<Fix> fix = Measure(frame_bgr, matched);
   // SAD and SSD compare grey levels with the first template too: they do not cancel a change of
   // light, and a position they measure against a template the light has left is biased.
@@ -1240,7 +1240,11 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   tracking_ = true;
   lost_frames_ = 0;
   if (params_.scale_search || params_.turn_search) UpdatePose(frame_bgr, at, last_turn);
-  if (adapts()) UpdateTemplate(frame_bgr, at.centre);
+  // Blended only where the working template no longer shows what the frame shows at the match
+  // (kSteadyWorkingZncc), or the pose search changed its rung (it follows the rung's size there).
+  const bool steady = params_.measure == MatchMeasure::kZncc &&
+                      working_zncc >= kSteadyWorkingZncc && working_key_ == RungKey(rung_, turn_);
+  if (adapts() && !steady) UpdateTemplate(frame_bgr, at.centre);
   Observation observation;
   observation.position_px = at.reported;
   observation.score = score;

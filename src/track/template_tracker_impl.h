@@ -133,8 +133,9 @@ class TemplateTracker final : public Tracker {
   // Lists a place the template fits (its centre in the frame) among the candidates weighed.
   void Weigh(const cv::Point2d& centre_px, double zncc, CandidateVerdict verdict);
   // Verifies the match centred at `matched` and, when it holds, moves the tracker on to it.
+  // `working_zncc` is the working template's ZNCC there (kNoRival: not matched with it).
   Observation Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched, double score,
-                     int last_turn);
+                     int last_turn, double working_zncc);
   double rung_scale() const { return std::pow(kScaleStep, rung_ - kRungsBelow); }
   Observation Lose(MarkerStatus why, int candidates = 0) {
     tracking_ = false;  // Keep last_centre_: the next acquisition looks around it.
