@@ -253,6 +253,61 @@ constexpr int kMinSaturationContrast = 20;
 // the surroundings.
 constexpr double kMinCentreShiftPx = 1.0 / 3.0;
 
+// The HSV pixels of the disc of radius `r` around `at` (pixel-centre convention) inside `bgr`.
+std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
+  const cv::Point centre(cvRound(at.x), cvRound(at.y));
+  const cv::Rect box = cv::Rect(centre.x - r, centre.y - r, 2 * r + 1, 2 * r + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  std::vector<cv::Vec3b> samples;
+  if (box.empty()) return samples;
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const double dx = box.x + x - at.x, dy = box.y + y - at.y;
+      if (dx * dx + dy * dy <= (r + 0.5) * (r + 0.5)) samples.push_back(hsv.at<cv::Vec3b>(y, x));
+    }
+  }
+  return samples;
+}
+
+// The centroid of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at
+// `at`, within kRecentreReachPx of it; nothing when that pixel fails, or the blob reaches the
+// edge of that area (not a marker-sized blob: a surface of the marker's colour, or the range
+// let the surroundings in).
+std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+  const cv::Point centre(cvRound(at.x), cvRound(at.y));
+  const int reach = kRecentreReachPx;
+  const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
+  const cv::Rect box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (!box.contains(centre)) return std::nullopt;
+  // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
+  // hue, saturation and value.
+  cv::Mat hsv;
+  cv::cvtColor(bgr(box), hsv, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool passes = pick.gray ? pick.gray->contains(hsv.at<uchar>(y, x))
+                                    : HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v);
+      if (passes) mask.at<uchar>(y + 1, x + 1) = 0;
+    }
+  }
+  const cv::Point seed = centre - box.tl();
+  if (mask.at<uchar>(seed.y + 1, seed.x + 1) != 0) return std::nullopt;
+  cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
+  cv::Rect filled;
+  cv::floodFill(canvas, mask, seed, cv::Scalar(255), &filled, cv::Scalar(), cv::Scalar(),
+                8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  if (filled.x == 0 || filled.y == 0 || filled.br().x == hsv.cols || filled.br().y == hsv.rows) {
+    return std::nullopt;
+  }
+  const cv::Moments m = cv::moments(mask == 255, true);
+  if (!(m.m00 > 0)) return std::nullopt;
+  // The mask is the box's, one pixel larger on every side.
+  return cv::Point2d(box.x + m.m10 / m.m00 - 1, box.y + m.m01 / m.m00 - 1);
+}
+
 // A pale marker (a light pigment, or a lit dome whose top the light whitens) has a part less
 // saturated than the pick's floor of min_saturation, and a range that cuts it off moves the
 // marker's centre towards its saturated part. When the surroundings are paler still, the floor
@@ -313,90 +368,17 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   std::sort(beyond.begin(), beyond.end());
   const double surroundings = Percentile(beyond, 99);
   if (disc_lo - surroundings < kMinSaturationContrast) return;
-  const int floor = std::max(kLowestSaturationFloor,
-                             static_cast<int>(std::ceil(surroundings + (disc_lo - surroundings) / 3)));
+  const int floor = std::max(
+      kLowestSaturationFloor,
+      static_cast<int>(std::ceil(surroundings + (disc_lo - surroundings) / 3)));
   if (floor >= pick->s.lo) return;
-  const cv::Point click(centre.x - box.x, centre.y - box.y);
-  if (!cv::Rect(0, 0, hsv.cols, hsv.rows).contains(click)) return;
-  // The centroid of the blob through the click at saturation floor `s_lo` (nothing when the
-  // click's pixel does not pass).
-  auto blob_centroid = [&](int s_lo) -> std::optional<cv::Point2d> {
-    const HsvRange s{s_lo, pick->s.hi};
-    cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
-    for (int y = 0; y < hsv.rows; ++y) {
-      for (int x = 0; x < hsv.cols; ++x) {
-        if (HsvInRange(hsv.at<cv::Vec3b>(y, x), pick->h, s, pick->v)) {
-          mask.at<uchar>(y + 1, x + 1) = 0;
-        }
-      }
-    }
-    if (mask.at<uchar>(click.y + 1, click.x + 1) != 0) return std::nullopt;
-    cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
-    cv::floodFill(canvas, mask, click, cv::Scalar(255), nullptr, cv::Scalar(), cv::Scalar(),
-                  8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-    const cv::Moments m = cv::moments(mask == 255, true);
-    if (!(m.m00 > 0)) return std::nullopt;
-    return cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
-  };
-  const auto before = blob_centroid(pick->s.lo), after = blob_centroid(floor);
+  HsvPick lower = *pick;
+  lower.s.lo = floor;
+  const auto before = BlobCentroidAt(bgr, click_px, *pick);
+  const auto after = BlobCentroidAt(bgr, click_px, lower);
   if (!before || !after) return;
   if (cv::norm(*after - *before) < kMinCentreShiftPx) return;
   pick->s.lo = floor;
-}
-
-// The HSV pixels of the disc of radius `r` around `at` (pixel-centre convention) inside `bgr`.
-std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
-  const cv::Point centre(cvRound(at.x), cvRound(at.y));
-  const cv::Rect box = cv::Rect(centre.x - r, centre.y - r, 2 * r + 1, 2 * r + 1) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
-  std::vector<cv::Vec3b> samples;
-  if (box.empty()) return samples;
-  cv::Mat hsv;
-  cv::cvtColor(bgr(box), hsv, cv::COLOR_BGR2HSV);
-  for (int y = 0; y < hsv.rows; ++y) {
-    for (int x = 0; x < hsv.cols; ++x) {
-      const double dx = box.x + x - at.x, dy = box.y + y - at.y;
-      if (dx * dx + dy * dy <= (r + 0.5) * (r + 0.5)) samples.push_back(hsv.at<cv::Vec3b>(y, x));
-    }
-  }
-  return samples;
-}
-
-// The centroid of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at
-// `at`, within kRecentreReachPx of it; nothing when that pixel fails, or the blob reaches the
-// edge of that area (not a marker-sized blob: a surface of the marker's colour, or the range
-// let the surroundings in).
-std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
-  const cv::Point centre(cvRound(at.x), cvRound(at.y));
-  const int reach = kRecentreReachPx;
-  const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
-  const cv::Rect box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (!box.contains(centre)) return std::nullopt;
-  // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
-  // hue, saturation and value.
-  cv::Mat hsv;
-  cv::cvtColor(bgr(box), hsv, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
-  cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
-  for (int y = 0; y < hsv.rows; ++y) {
-    for (int x = 0; x < hsv.cols; ++x) {
-      const bool passes = pick.gray ? pick.gray->contains(hsv.at<uchar>(y, x))
-                                    : HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v);
-      if (passes) mask.at<uchar>(y + 1, x + 1) = 0;
-    }
-  }
-  const cv::Point seed = centre - box.tl();
-  if (mask.at<uchar>(seed.y + 1, seed.x + 1) != 0) return std::nullopt;
-  cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
-  cv::Rect filled;
-  cv::floodFill(canvas, mask, seed, cv::Scalar(255), &filled, cv::Scalar(), cv::Scalar(),
-                8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-  if (filled.x == 0 || filled.y == 0 || filled.br().x == hsv.cols || filled.br().y == hsv.rows) {
-    return std::nullopt;
-  }
-  const cv::Moments m = cv::moments(mask == 255, true);
-  if (!(m.m00 > 0)) return std::nullopt;
-  // The mask is the box's, one pixel larger on every side.
-  return cv::Point2d(box.x + m.m10 / m.m00 - 1, box.y + m.m01 / m.m00 - 1);
 }
 
 }  // namespace

@@ -80,8 +80,8 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
 
 // What a click on a marker in `live` gives, and `softsight pick` reproduces: the ranges picked
 // from the pixels around the click (PickHsvRange) and the square search box of `box_side_px`
-// centred on the sampled pixel (the click, or the marker's centre; clipped to the image), where the colour tracker looks for the
-// marker first.
+// centred where the pixels were sampled (the click, or the marker's centre; clipped to the
+// image), where the colour tracker looks for the marker first.
 struct MarkerColourPick {
   HsvPick ranges{};
   cv::Rect roi{};
