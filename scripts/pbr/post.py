@@ -166,22 +166,19 @@ def main():
         for name, b in zip(names, boxes):
             f.write(f'  - name: {name}\n    method: zncc\n    template: {{frame: 0, rect: {b}}}\n')
         f.write(body + '\n')
-    if set(colours) == {'white'}:
+    # White or black dots: a range by gray level alone, as examples/markers.yaml gives them.
+    achromatic = {
+        'white': ('White dots by brightness alone (the gray range of examples/markers.yaml, as '
+                  'tests/real/mire2)', 'hsv: {h: [0, 179], s: [0, 60], v: [170, 255]}'),
+        'black': ('Black dots by darkness alone (the gray range examples/markers.yaml gives for '
+                  'black dots)', 'gray: [0, 50]'),
+    }.get(colours[0]) if len(set(colours)) == 1 else None
+    if achromatic:
+        what, rule = achromatic
         with open(os.path.join(a.out, 'achromatic.yaml'), 'w') as f:
-            f.write('# White dots by brightness alone (the gray range of examples/markers.yaml, as '
-                    'tests/real/mire2),\n# a roi per dot: its frame-0 outline plus '
-                    f'{MARGIN} px.\nmarkers:\n')
+            f.write(f'# {what},\n# a roi per dot: its frame-0 outline plus {MARGIN} px.\nmarkers:\n')
             for name, b in zip(names, boxes):
-                f.write(f'  - name: {name}\n    hsv: {{h: [0, 179], s: [0, 60], v: [170, 255]}}\n'
-                        f'    roi: {b}\n')
-            f.write(body + '\n')
-    if set(colours) == {'black'}:
-        with open(os.path.join(a.out, 'achromatic.yaml'), 'w') as f:
-            f.write('# Black dots by darkness alone (the gray range examples/markers.yaml gives for '
-                    'black dots),\n# a roi per dot: its frame-0 outline plus '
-                    f'{MARGIN} px.\nmarkers:\n')
-            for name, b in zip(names, boxes):
-                f.write(f'  - name: {name}\n    gray: [0, 50]\n    roi: {b}\n')
+                f.write(f'  - name: {name}\n    {rule}\n    roi: {b}\n')
             f.write(body + '\n')
     print(f'post.py: {a.out}: {video} {os.path.getsize(os.path.join(a.out, video)) / 1e6:.2f} MB, '
           f'{meta["frames"]} frames, markers {", ".join(names)}')
