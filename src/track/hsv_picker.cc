@@ -395,8 +395,33 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   std::string why;
   std::optional<HsvPick> pick = PickHsvFromSamples(samples, options, &why);
   cv::Point2d sampled_at = click_px;
+  bool gray = false;
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
     pick = PickGrayDot(bgr, click_px, options.radius_px, &why);
+    gray = true;
+  }
+  if (!pick && r > 1) {
+    // A click near a marker's rim: the disc holds as much of the surroundings as of the marker.
+    // The half disc at the click may show it; it is then sampled again at its centre (below).
+    std::string unused;
+    const std::vector<cv::Vec3b> inner = SampleDisc(bgr, click_px, r / 2);
+    std::optional<HsvPick> small = PickHsvFromSamples(inner, options, &unused);
+    gray = !small;
+    if (!small) small = PickGrayDot(bgr, click_px, r / 2, &unused);
+    const std::optional<cv::Point2d> centre =
+        small ? BlobCentroidAt(bgr, click_px, *small) : std::nullopt;
+    if (centre) {
+      std::vector<cv::Vec3b> resampled = SampleDisc(bgr, *centre, r);
+      std::optional<HsvPick> repick = gray ? PickGrayDot(bgr, *centre, r, &unused)
+                                           : PickHsvFromSamples(resampled, options, nullptr);
+      if (repick) {
+        pick = repick;
+        samples = std::move(resampled);
+        sampled_at = click_px = *centre;
+      }
+    }
+  }
+  if (pick && gray) {
     // Off a white or black dot's centre: its rings are measured from the dot's centre instead.
     const std::optional<cv::Point2d> centre =
         pick ? BlobCentroidAt(bgr, click_px, *pick) : std::nullopt;

@@ -392,3 +392,21 @@ TEST(HsvPickerTest, AClickOffTheMarkersCentreIsSampledAgainAtItsCentre) {
 
 }  // namespace
 }  // namespace softsight
+
+namespace softsight {
+namespace {
+
+TEST(HsvPickerTest, AClickNearADotsRimFindsTheDot) {
+  // 5 px off the centre of a white dot of radius 8: the disc of samples is half bench, so the
+  // dot does not stand out from it; the half disc at the click does, and the ranges are taken
+  // at the dot's centre.
+  std::string why;
+  const auto white = PickHsvRange(GrayDotImage(235), {45, 40}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(white) << why;
+  ASSERT_TRUE(white->gray);
+  EXPECT_EQ(PickName(*white), "white");
+  EXPECT_LT(cv::norm(white->sampled_at_px - cv::Point2d(40, 40)), 0.5);
+}
+
+}  // namespace
+}  // namespace softsight
