@@ -621,12 +621,13 @@ class TrackStereoWindowTest : public LiveWindowTest {
     options.frame_count = kFrames;
     options.max_bend_deg = 90.0;
     scene_ = std::make_unique<StereoScene>(MakeStereoRig(), options);
-    // 2 fps: played at its pace, the window is on screen for 6 s, time to press keys on a
-    // loaded machine too (the pause ends the wait).
+    // 1 fps: played at its pace, the window is on screen for 12 s, time to press keys on a
+    // loaded machine too (the pause ends the wait; at 2 fps a clean-clone CI run beside the
+    // sanitizer build ended before xdotool's key arrived).
     FrameWriterOptions left_video, right_video;
     left_video.path = (dir_ / "left.avi").string();
     right_video.path = (dir_ / "right.avi").string();
-    left_video.fps = right_video.fps = 2.0;
+    left_video.fps = right_video.fps = 1.0;
     FrameWriter left_writer(left_video), right_writer(right_video);
     cv::Mat left, right;
     for (int i = 0; i < kFrames; ++i) {
@@ -688,7 +689,7 @@ TEST_F(TrackStereoWindowTest, BothViewsOnScreenAndSpacePausesAndQStops) {
   const std::string display = StartXvfb("1400x900x24");
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
   const std::vector<std::string> env = {"DISPLAY=" + display};
-  // Paced at 2 fps: pause once the window is up, look at it, then stop it with q.
+  // Paced at 1 fps: pause once the window is up, look at it, then stop it with q.
   std::vector<std::string> paced = Command("stopped.csv");
   paced.push_back("--window");
   live_ = Spawn(paced, env, true);
