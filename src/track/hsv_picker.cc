@@ -397,58 +397,48 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   cv::Point2d sampled_at = click_px;
   bool gray = false;
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
-    pick = PickGrayDot(bgr, click_px, options.radius_px, &why);
+    pick = PickGrayDot(bgr, click_px, r, &why);
     gray = true;
   }
+  // The pick of the same kind (a white or black dot's, or a coloured marker's) from the whole
+  // disc at `at`, the marker's centre; a coloured marker's samples go to `disc`.
+  const auto pick_at = [&](cv::Point2d at, std::vector<cv::Vec3b>* disc) {
+    std::string unused = why;
+    if (gray) return PickGrayDot(bgr, at, r, &unused);
+    *disc = SampleDisc(bgr, at, r);
+    return PickHsvFromSamples(*disc, options, nullptr);
+  };
+  // Takes the pick at the centre of the blob `first` gives through `from`, if there is one and
+  // it is farther than `beyond` px, and the pick there succeeds.
+  const auto recentre = [&](const HsvPick& first, cv::Point2d from, double beyond) {
+    const std::optional<cv::Point2d> centre = BlobCentroidAt(bgr, from, first);
+    if (!centre || cv::norm(*centre - from) <= beyond) return;
+    std::vector<cv::Vec3b> resampled;
+    if (std::optional<HsvPick> repick = pick_at(*centre, &resampled)) {
+      pick = repick;
+      if (!gray) samples = std::move(resampled);
+      sampled_at = *centre;
+    }
+  };
   if (!pick && r > 1) {
     // A click near a marker's rim: the disc holds as much of the surroundings as of the marker.
-    // The half disc at the click may show it; it is then sampled again at its centre (below).
+    // The half disc at the click may show it; it is then sampled at the centre of its blob.
     std::string unused;
-    const std::vector<cv::Vec3b> inner = SampleDisc(bgr, click_px, r / 2);
-    std::optional<HsvPick> small = PickHsvFromSamples(inner, options, &unused);
+    std::optional<HsvPick> small = PickHsvFromSamples(SampleDisc(bgr, click_px, r / 2), options,
+                                                      &unused);
     gray = !small;
     if (!small) small = PickGrayDot(bgr, click_px, r / 2, &unused);
-    const std::optional<cv::Point2d> centre =
-        small ? BlobCentroidAt(bgr, click_px, *small) : std::nullopt;
-    if (centre) {
-      std::vector<cv::Vec3b> resampled = SampleDisc(bgr, *centre, r);
-      std::optional<HsvPick> repick = gray ? PickGrayDot(bgr, *centre, r, &unused)
-                                           : PickHsvFromSamples(resampled, options, nullptr);
-      if (repick) {
-        pick = repick;
-        samples = std::move(resampled);
-        sampled_at = click_px = *centre;
-      }
-    }
+    if (small) recentre(*small, click_px, -1.0);
   }
-  if (pick && gray) {
-    // Off a white or black dot's centre: its rings are measured from the dot's centre instead.
-    const std::optional<cv::Point2d> centre =
-        pick ? BlobCentroidAt(bgr, click_px, *pick) : std::nullopt;
-    if (centre && cv::norm(*centre - click_px) > kRecentrePx) {
-      std::string unused = why;
-      if (auto repick = PickGrayDot(bgr, *centre, options.radius_px, &unused)) {
-        pick = repick;
-        sampled_at = *centre;
-      }
-    }
-  } else if (pick) {
+  if (pick) {
     // A click off the marker's centre samples its rim and what is around it (a shaded flank, its
-    // shadow, the bench): ranges wide enough to take those in. The marker's centre is the centre
-    // of the blob those ranges give through the click; the ranges are picked again there.
-    const std::optional<cv::Point2d> centre = BlobCentroidAt(bgr, click_px, *pick);
-    if (centre && cv::norm(*centre - click_px) > kRecentrePx) {
-      std::vector<cv::Vec3b> resampled = SampleDisc(bgr, *centre, r);
-      std::optional<HsvPick> repick = PickHsvFromSamples(resampled, options, nullptr);
-      if (repick) {
-        pick = repick;
-        samples = std::move(resampled);
-        sampled_at = *centre;
-      }
-    }
-    if (pick->s.lo == options.min_saturation) {
+    // shadow, the bench; a white or black dot's rings measured from the wrong point): ranges
+    // wide enough to take those in. The marker's centre is the centre of the blob those ranges
+    // give through the click; the ranges are picked again there.
+    recentre(*pick, sampled_at, kRecentrePx);
+    if (!gray && pick->s.lo == options.min_saturation) {
       // The sampled saturations reach the floor: the marker may be paler in places than the disc.
-      LowerSaturationFloorToSurroundings(bgr, sampled_at, samples, options.radius_px, &*pick);
+      LowerSaturationFloorToSurroundings(bgr, sampled_at, samples, r, &*pick);
     }
   }
   if (!pick && why_not != nullptr) *why_not = why;
