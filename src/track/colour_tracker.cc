@@ -588,6 +588,17 @@ ColourTracker::Choice ColourTracker::acquire(const cv::Mat& frame) {
   if (std::isfinite(ranking.second_cost) && ranking.second_cost - ranking.best_cost < margin) {
     return ambiguous_choice(ranking.best_cost, margin, diagonal, by_uniqueness);
   }
+  // The first acquisition learns the marker's size and shape from the blob it takes: a piece of
+  // a marker split by compression or noise (a round corner of it, 5 px off its centre) would
+  // then be the model, and the whole marker too large to fit it ever after. A larger blob of the
+  // same range (twice its area or more: not a neighbouring marker of about its size) right beside
+  // the best one means the marker may be that blob, or the two of them:
+  // not found until a frame shows it whole.
+  if (!model_ && acquire_roi_ && a_larger_piece_beside(ranking.best)) {
+    choice.status = MarkerStatus::kAmbiguous;
+    choice.tied = 2;
+    return choice;
+  }
   if (by_uniqueness && !rivals_.empty()) {
     if (a_rival_may_be_it(blobs_[ranking.best])) {
       choice.status = MarkerStatus::kAmbiguous;
@@ -660,6 +671,25 @@ ColourTracker::Choice ColourTracker::ambiguous_choice(double best_cost, double m
     }
   }
   return choice;
+}
+
+bool ColourTracker::a_larger_piece_beside(size_t chosen) const {
+  const ColourBlob& best = blobs_[chosen];
+  const cv::Rect& a = best.bbox_px;
+  for (size_t i = 0; i < blobs_.size(); ++i) {
+    const ColourBlob& other = blobs_[i];
+    const cv::Rect& b = other.bbox_px;
+    // A piece of the marker the person boxed lies in the box with it: a surface of the range
+    // reaching out of the box (a bright board behind white dots) or the next marker is no piece.
+    if (i == chosen || other.clipped || other.area_px < kPieceAreaRatio * best.area_px ||
+        (b & *acquire_roi_) != b) {
+      continue;
+    }
+    const int dx = std::max({0, a.x - (b.x + b.width), b.x - (a.x + a.width)});
+    const int dy = std::max({0, a.y - (b.y + b.height), b.y - (a.y + a.height)});
+    if (std::hypot(dx, dy) <= kPieceGapPx) return true;
+  }
+  return false;
 }
 
 bool ColourTracker::a_rival_may_be_it(const ColourBlob& only) const {

@@ -246,6 +246,9 @@ class ColourTracker : public Tracker {
   // Whether the one candidate left, `only`, may be a look-alike among the rivals tied before:
   // it was one of them, in its place still, and another of them has vanished.
   bool a_rival_may_be_it(const ColourBlob& only) const;
+  // Whether a blob kPieceAreaRatio times blobs_[chosen]'s area or more (of any shape) lies
+  // beside it (within kPieceGapPx) in the roi.
+  bool a_larger_piece_beside(size_t chosen) const;
   // After a lasting change of the light: the one blob near where the marker was last seen that
   // fits everything but the learned brightness, if there is exactly one.
   Choice relearn(const cv::Point2d& last_seen);

@@ -120,6 +120,13 @@ constexpr int kHoldCoveredFrames = 30;
 // a model or roi) has not moved since: it is that candidate (sensor noise moves a static blob's
 // centroid by hundredths of a pixel).
 constexpr double kRivalStillPx = 0.5;
+// Two blobs of the marker's range whose boxes come within this of each other, in the roi
+// (px) may be pieces of one marker that compression or noise split (a dim dome whose middle lost
+// its colour in JPEG's blocks; see ColourTracker::a_larger_piece_beside) ...
+constexpr double kPieceGapPx = 3.0;
+// ... when the other blob has at least this multiple of its area (markers of about one size side
+// by side, as a plate's dots, are not pieces of each other).
+constexpr double kPieceAreaRatio = 2.0;
 
 // A marker lost this many frames in a row, with exactly one candidate near where it was last
 // seen that fits it in everything but brightness (same chroma, size, shape, contrast), is taken

@@ -23,6 +23,15 @@ constexpr int kHueClusterHalfWidth = 20;
 // (px), within this reach of the click (a marker up to about 80 px across).
 constexpr double kRecentrePx = 2.0;
 constexpr int kRecentreReachPx = 48;
+// The near surroundings of a picked marker (SurroundingsPassing): from this far beyond its blob
+// (past the blurred rim) to this far (px).
+constexpr int kSurroundingsNearPx = 3;
+constexpr int kSurroundingsFarPx = 10;
+// A coloured pick whose range passes at least this much of the marker's near surroundings is
+// weighed against the white or black dot's (PickHsvRange).
+constexpr double kLeakyColourPick = 0.05;
+// A pick whose range passes this much of the marker's near surroundings is refused.
+constexpr double kInseparablePick = 0.5;
 
 // Linear-interpolated percentile of sorted values, `percent` in [0, 100].
 double Percentile(const std::vector<double>& sorted, double percent) {
@@ -271,41 +280,100 @@ std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
   return samples;
 }
 
-// The centroid of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at
-// `at`, within kRecentreReachPx of it; nothing when that pixel fails, or the blob reaches the
-// edge of that area (not a marker-sized blob: a surface of the marker's colour, or the range
-// let the surroundings in).
-std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+// The blob of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at `at`,
+// within kRecentreReachPx of it, with the pixels around it that pass too.
+struct BlobAtClick {
+  cv::Rect box;        // The searched area (within the image), in image pixels.
+  cv::Mat passes;      // CV_8U over `box`: 255 where a pixel passes the ranges.
+  cv::Mat blob;        // CV_8U over `box`: 255 on the blob.
+};
+
+// Nothing when the pixel at `at` fails (and every one within `seed_reach` px of it: the blob is
+// then the one through the nearest that passes), or the blob reaches the edge of the searched
+// area (not a marker-sized blob: a surface of the marker's colour, or the range let the
+// surroundings in).
+std::optional<BlobAtClick> BlobAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick,
+                                  int seed_reach = 0) {
   const cv::Point centre(cvRound(at.x), cvRound(at.y));
   const int reach = kRecentreReachPx;
   const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
-  const cv::Rect box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (!box.contains(centre)) return std::nullopt;
+  BlobAtClick found;
+  found.box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (!found.box.contains(centre)) return std::nullopt;
   // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
   // hue, saturation and value.
-  cv::Mat hsv;
-  cv::cvtColor(bgr(box), hsv, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
-  cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
-  for (int y = 0; y < hsv.rows; ++y) {
-    for (int x = 0; x < hsv.cols; ++x) {
-      const bool passes = pick.gray ? pick.gray->contains(hsv.at<uchar>(y, x))
-                                    : HsvInRange(hsv.at<cv::Vec3b>(y, x), pick.h, pick.s, pick.v);
-      if (passes) mask.at<uchar>(y + 1, x + 1) = 0;
+  cv::Mat converted;
+  cv::cvtColor(bgr(found.box), converted, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  found.passes = cv::Mat(converted.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < converted.rows; ++y) {
+    for (int x = 0; x < converted.cols; ++x) {
+      const bool passes = pick.gray ? pick.gray->contains(converted.at<uchar>(y, x))
+                                    : HsvInRange(converted.at<cv::Vec3b>(y, x), pick.h, pick.s,
+                                                 pick.v);
+      if (passes) found.passes.at<uchar>(y, x) = 255;
     }
   }
-  const cv::Point seed = centre - box.tl();
-  if (mask.at<uchar>(seed.y + 1, seed.x + 1) != 0) return std::nullopt;
-  cv::Mat canvas(hsv.size(), CV_8U, cv::Scalar(0));
+  cv::Point seed = centre - found.box.tl();
+  if (!found.passes.at<uchar>(seed)) {
+    // A highlight or a speck at the click: the nearest pixel that passes.
+    int best = seed_reach * seed_reach + 1;
+    const cv::Point click = seed;
+    for (int dy = -seed_reach; dy <= seed_reach; ++dy) {
+      for (int dx = -seed_reach; dx <= seed_reach; ++dx) {
+        const cv::Point p = click + cv::Point(dx, dy);
+        if (dx * dx + dy * dy < best && p.inside(cv::Rect(cv::Point(), converted.size())) &&
+            found.passes.at<uchar>(p)) {
+          best = dx * dx + dy * dy;
+          seed = p;
+        }
+      }
+    }
+    if (seed == click) return std::nullopt;
+  }
+  // floodFill's mask is one pixel larger on every side; 0 fills.
+  cv::Mat mask(converted.rows + 2, converted.cols + 2, CV_8U, cv::Scalar(1));
+  mask(cv::Rect(1, 1, converted.cols, converted.rows)).setTo(0, found.passes);
+  // A flat canvas: only the mask bounds the fill.
+  cv::Mat canvas(converted.size(), CV_8U, cv::Scalar(0));
   cv::Rect filled;
   cv::floodFill(canvas, mask, seed, cv::Scalar(255), &filled, cv::Scalar(), cv::Scalar(),
                 8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-  if (filled.x == 0 || filled.y == 0 || filled.br().x == hsv.cols || filled.br().y == hsv.rows) {
+  if (filled.x == 0 || filled.y == 0 || filled.br().x == converted.cols ||
+      filled.br().y == converted.rows) {
     return std::nullopt;
   }
-  const cv::Moments m = cv::moments(mask == 255, true);
+  found.blob = mask(cv::Rect(1, 1, converted.cols, converted.rows)) == 255;
+  return found;
+}
+
+// The centroid of BlobAt's blob.
+std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+  const std::optional<BlobAtClick> found = BlobAt(bgr, at, pick);
+  if (!found) return std::nullopt;
+  const cv::Moments m = cv::moments(found->blob, true);
   if (!(m.m00 > 0)) return std::nullopt;
-  // The mask is the box's, one pixel larger on every side.
-  return cv::Point2d(box.x + m.m10 / m.m00 - 1, box.y + m.m01 / m.m00 - 1);
+  return cv::Point2d(found->box.x + m.m10 / m.m00, found->box.y + m.m01 / m.m00);
+}
+
+// How well `pick`'s ranges tell the marker at `at` from what is around it: the fraction of its
+// near surroundings (the pixels 3 to 10 px beyond the blob at `at`, or at the pixel nearest to
+// it within the sampled disc that passes) that pass them, 1 when there is no marker-sized blob
+// there. A range that passes its surroundings joins the marker to them
+// as soon as it moves or the light changes.
+double SurroundingsPassing(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick,
+                           int sample_radius) {
+  const std::optional<BlobAtClick> found = BlobAt(bgr, at, pick, sample_radius);
+  if (!found) return 1.0;
+  const auto grown = [&](int r) {
+    cv::Mat out;
+    cv::dilate(found->blob, out,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+    return out;
+  };
+  const cv::Mat ring = grown(kSurroundingsFarPx) & ~grown(kSurroundingsNearPx - 1);
+  const int total = cv::countNonZero(ring);
+  if (total == 0) return 1.0;
+  return static_cast<double>(cv::countNonZero(ring & found->passes)) / total;
 }
 
 // A pale marker (a light pigment, or a lit dome whose top the light whitens) has a part less
@@ -436,9 +504,58 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
     // wide enough to take those in. The marker's centre is the centre of the blob those ranges
     // give through the click; the ranges are picked again there.
     recentre(*pick, sampled_at, kRecentrePx);
+    if (!gray && r > 1 && SurroundingsPassing(bgr, sampled_at, *pick, r) >= kInseparablePick) {
+      // A click near a coloured marker's rim may give ranges wide enough for its shadow and the
+      // bench beside it, which then join it. The half disc at the click holds less of them: its
+      // ranges, sampled again at the centre of the blob they give, are taken if they tell the
+      // marker from its surroundings.
+      if (std::optional<HsvPick> small =
+              PickHsvFromSamples(SampleDisc(bgr, click_px, r / 2), options, nullptr)) {
+        const std::optional<HsvPick> wide = pick;
+        const cv::Point2d wide_at = sampled_at;
+        std::vector<cv::Vec3b> wide_samples = samples;
+        pick.reset();
+        recentre(*small, click_px, -1.0);
+        if (!pick || SurroundingsPassing(bgr, sampled_at, *pick, r) >= kInseparablePick) {
+          pick = wide;
+          sampled_at = wide_at;
+          samples = std::move(wide_samples);
+        }
+      }
+    }
     if (!gray && pick->s.lo == options.min_saturation) {
       // The sampled saturations reach the floor: the marker may be paler in places than the disc.
       LowerSaturationFloorToSurroundings(bgr, sampled_at, samples, r, &*pick);
+    }
+    if (!gray) {
+      // A white dot under tinted light (a warm lamp, a camera without white balance) takes the
+      // light's colour, and so do the surfaces around it; sensor noise gives a black dot's
+      // pixels hues. Such a colour range passes the marker's surroundings too (or not the
+      // marker: noise), while the dot stands out from them by its gray level. The pick that
+      // tells the marker from its near surroundings better is the marker's kind; a colour range
+      // that passes little of them stays (a red dome is also darker than white silicone).
+      const double colour_passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
+      if (colour_passing >= kLeakyColourPick) {
+        std::string unused = why;
+        std::optional<HsvPick> dot = PickGrayDot(bgr, sampled_at, r, &unused);
+        if (dot && SurroundingsPassing(bgr, sampled_at, *dot, r) < colour_passing) {
+          pick = dot;
+          gray = true;
+          recentre(*pick, sampled_at, kRecentrePx);
+        }
+      }
+    }
+    // Found means verified, from the pick on: a range that passes most of what surrounds the
+    // marker (a pale dome's colour under a lamp of its tint, which the white silicone takes
+    // too) tracks the surroundings, not the marker.
+    const double passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
+    if (passing >= kInseparablePick) {
+      why = "the " + PickName(*pick) + " range picked here passes " +
+            (passing >= 1.0 ? std::string("the surroundings too (its blob is not marker-sized)")
+                            : std::to_string(static_cast<int>(std::lround(100 * passing))) +
+                                  " % of the pixels around the marker") +
+            ": it would not tell the marker from them (drag a template box around it instead)";
+      pick.reset();
     }
   }
   if (!pick && why_not != nullptr) *why_not = why;

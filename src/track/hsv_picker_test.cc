@@ -354,6 +354,50 @@ TEST(HsvPickerTest, AnInkDotUnderWarmLightIsBlackNotRed) {
   EXPECT_LT(pick->gray->hi, 100);  // ... and below the body's gray level (about 107).
 }
 
+TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
+  // A white dot under a warm lamp (a camera without white balance): (170, 215, 250), saturation
+  // 82, on a darker surface of the same tint (60, 85, 110), saturation 116. Half the dot's pixels
+  // and more are "coloured", and the range they give passes the surface too: a blob as large as
+  // the surface, no marker. By its gray level (217 against 89) the dot stands out alone.
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> noise(-4, 4);
+  cv::Mat image(100, 100, CV_8UC3);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      const bool dot = (x - 50) * (x - 50) + (y - 50) * (y - 50) <= 9 * 9;
+      const cv::Vec3i level = dot ? cv::Vec3i(170, 215, 250) : cv::Vec3i(60, 85, 110);
+      const int n = noise(rng);
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(level[0] + n),
+                                            cv::saturate_cast<uchar>(level[1] + n),
+                                            cv::saturate_cast<uchar>(level[2] + n));
+    }
+  }
+  std::string why;
+  const auto coloured = PickHsvFromSamples(
+      [&] {
+        cv::Mat hsv;
+        cv::cvtColor(image(cv::Rect(46, 46, 9, 9)), hsv, cv::COLOR_BGR2HSV);
+        return std::vector<cv::Vec3b>(hsv.begin<cv::Vec3b>(), hsv.end<cv::Vec3b>());
+      }(),
+      HsvPickOptions{}, &why);
+  ASSERT_TRUE(coloured) << "the dot's pixels alone read as a colour: " << why;
+  const auto pick = PickHsvRange(image, {50, 50}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(pick) << why;
+  ASSERT_TRUE(pick->gray) << "picked as " << PickName(*pick);
+  EXPECT_EQ(PickName(*pick), "white");
+  EXPECT_GT(pick->gray->lo, 100);  // Above the surface ...
+  EXPECT_LT(pick->gray->lo, 200);  // ... and below the dot.
+
+  // A red dome on white silicone is darker than the silicone too, but its colour range passes
+  // nothing around it: it stays a colour.
+  cv::Mat red(100, 100, CV_8UC3, cv::Scalar(225, 230, 235));
+  cv::circle(red, {50, 50}, 9, cv::Scalar(40, 40, 200), cv::FILLED);
+  const auto dome = PickHsvRange(red, {50, 50}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(dome) << why;
+  EXPECT_FALSE(dome->gray);
+  EXPECT_EQ(PickName(*dome), "red");
+}
+
 }  // namespace
 }  // namespace softsight
 

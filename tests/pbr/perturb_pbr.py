@@ -1,0 +1,208 @@
+#!/usr/bin/python3
+"""The physically based scenes under other light and other cameras: does trust hold off our renders?
+
+Each scene of check_pbr.py is copied with every frame changed one way (dimmer, brighter, a warm or
+a cold white balance, light falling off across the frame, sensor noise, heavy JPEG, a smaller
+sensor), then set up as a user would on the changed footage (`softsight pick --at` each marker's
+frame-0 centre, rounded to whole pixels; the scene's ZNCC boxes, scaled with the frame), tracked
+and scored against the same truth (scaled with the frame). Finds may be lost (a dim blue dome may
+fall below what a pick can separate from the bench); what must not appear is a marker reported
+found beyond the tolerance (1.5 px, scaled with the frame) or while covered. This is a
+measurement, not a test (the suite runs check_pbr.py on the scenes as rendered): its table is
+docs/measurements.md's "The rendered scenes under other light and other cameras".
+
+usage: perturb_pbr.py --softsight PROGRAM [--change NAME ...] [--scene NAME ...] [--markdown]
+Changes: dim60 (levels x 0.6), bright (x 1.2 + 20, clipped), warm (red x 1.15, blue x 0.75: a
+tungsten lamp without white balance), cold (red x 0.8, blue x 1.15), gradient (x 1.0 at the left
+edge falling to x 0.55 at the right), noise8 (Gaussian, sigma 8 levels), jpeg30 (JPEG at quality
+30), scale75 (the frame resized to 0.75 of its size, as a lower-resolution camera). Needs
+python3-opencv and numpy. Exit status: 0 when nothing was reported beyond tolerance or while
+covered, 1 otherwise, 2 on a usage error.
+"""
+import argparse
+import csv
+import importlib.util
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import cv2
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+_spec = importlib.util.spec_from_file_location('check_pbr', os.path.join(HERE, 'check_pbr.py'))
+check_pbr = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(check_pbr)
+
+CHANGES = ['dim60', 'bright', 'warm', 'cold', 'gradient', 'noise8', 'jpeg30', 'scale75']
+
+
+def scale_of(change):
+    return 0.75 if change == 'scale75' else 1.0
+
+
+def change_frame(image, change, rng):
+    """One frame (BGR) changed one way."""
+    if change == 'jpeg30':
+        ok, buf = cv2.imencode('.jpg', image, [cv2.IMWRITE_JPEG_QUALITY, 30])
+        return cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    if change == 'scale75':
+        size = (round(image.shape[1] * 0.75), round(image.shape[0] * 0.75))
+        return cv2.resize(image, size, interpolation=cv2.INTER_AREA)
+    levels = image.astype(np.float32)
+    if change == 'dim60':
+        levels *= 0.6
+    elif change == 'bright':
+        levels = levels * 1.2 + 20
+    elif change == 'warm':
+        levels *= np.array([0.75, 1.0, 1.15], np.float32)
+    elif change == 'cold':
+        levels *= np.array([1.15, 1.0, 0.8], np.float32)
+    elif change == 'gradient':
+        levels *= np.linspace(1.0, 0.55, image.shape[1], dtype=np.float32)[None, :, None]
+    elif change == 'noise8':
+        levels += rng.normal(0.0, 8.0, levels.shape).astype(np.float32)
+    return np.clip(np.rint(levels), 0, 255).astype(np.uint8)
+
+
+def to_scaled(v, s):
+    """A pixel coordinate (pixel centres at integers) in a frame resized by s."""
+    return (v + 0.5) * s - 0.5
+
+
+def changed_scene(name, change, root):
+    """Writes scene `name` changed one way into root/: the frames as a lossless PNG sequence (the
+    change is the only loss on top of the scene's own codec), truth.csv scaled with the frame, and
+    zncc.yaml with its boxes scaled. Returns the folder."""
+    folder = os.path.join(HERE, name)
+    target = os.path.join(root, f'{name}_{change}')
+    os.makedirs(os.path.join(target, 'frames'))
+    rng = np.random.default_rng(1)
+    cap = cv2.VideoCapture(os.path.join(folder, check_pbr.scene_video(folder)))
+    index = 0
+    while True:
+        ok, frame = cap.read()
+        if not ok:
+            break
+        cv2.imwrite(os.path.join(target, 'frames', f'{index:04d}.png'), change_frame(frame, change, rng))
+        index += 1
+    s = scale_of(change)
+    with open(os.path.join(folder, 'truth.csv'), newline='') as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        r['x'], r['y'] = f"{to_scaled(float(r['x']), s):.4f}", f"{to_scaled(float(r['y']), s):.4f}"
+    with open(os.path.join(target, 'truth.csv'), 'w', newline='') as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+
+    def scaled_rect(m):
+        x, y, w, h = (int(v) for v in m.group(2).split(','))
+        x0, y0 = round(x * s), round(y * s)
+        return f'{m.group(1)}[{x0}, {y0}, {round((x + w) * s) - x0}, {round((y + h) * s) - y0}]'
+
+    with open(os.path.join(folder, 'zncc.yaml')) as f:
+        zncc = re.sub(r'(rect:\s*)\[([^\]]*)\]', scaled_rect, f.read())
+    with open(os.path.join(target, 'zncc.yaml'), 'w') as f:
+        f.write(zncc)
+    return target
+
+
+def run_case(program, name, change, root):
+    """Picks and tracks one changed scene; returns [(config, score or failure text)]."""
+    target = changed_scene(name, change, root)
+    s = scale_of(change)
+    truth_csv = os.path.join(target, 'truth.csv')
+    with open(truth_csv, newline='') as f:
+        rows = list(csv.DictReader(f))
+    truth_names = list(dict.fromkeys(r['marker'] for r in rows))
+    first = {r['marker']: (float(r['x']), float(r['y'])) for r in rows if r['frame'] == '0'}
+    video = os.path.join('frames', '%04d.png')
+    results = []
+    ats = [a for m in truth_names for a in ('--at', f'{first[m][0]:.0f},{first[m][1]:.0f}')]
+    done = subprocess.run([program, 'pick', '-i', video, '--frame', '0', *ats, '-o', 'pick.yaml'],
+                          cwd=target, capture_output=True, text=True)
+    configs = ['zncc']
+    if done.returncode == 0:
+        configs.insert(0, 'pick')
+    else:
+        last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
+        results.append(('pick', f'refused: {last[:90]}'))
+    for cfg in configs:
+        out = os.path.join(target, f'{cfg}.csv')
+        done = subprocess.run([program, 'track', '-c', f'{cfg}.yaml', '-i', video, '--csv', out,
+                               '--quiet'], cwd=target, capture_output=True, text=True)
+        if done.returncode != 0:
+            last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
+            results.append((cfg, f'track exited {done.returncode}: {last[:90]}'))
+            continue
+        names, group = check_pbr.config_markers(os.path.join(target, f'{cfg}.yaml'))
+        tolerance = check_pbr.TOL * s
+        saved, check_pbr.TOL = check_pbr.TOL, tolerance
+        try:
+            sc = check_pbr.score(out, truth_csv, dict(zip(truth_names, names)), group)
+        finally:
+            check_pbr.TOL = saved
+        sc['tolerance'] = tolerance
+        results.append((cfg, sc))
+    return results
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--softsight', required=True, help='the softsight program to measure')
+    parser.add_argument('--change', action='append', choices=CHANGES, help='one change (repeatable)')
+    parser.add_argument('--scene', action='append', choices=sorted(check_pbr.CASES),
+                        help='one scene (repeatable)')
+    parser.add_argument('--markdown', action='store_true', help='print a table instead of log lines')
+    parser.add_argument('--keep', help='keep the changed scenes, configs and CSVs in this folder')
+    args = parser.parse_args()
+    program = os.path.abspath(args.softsight)
+    if not os.access(program, os.X_OK):
+        print(f'perturb_pbr.py: --softsight {args.softsight}: not an executable', file=sys.stderr)
+        return 2
+    changes = args.change or CHANGES
+    scenes = args.scene or list(check_pbr.CASES)
+    bad = 0
+    table = []
+    root = args.keep or tempfile.mkdtemp(prefix='softsight_perturb_pbr_')
+    os.makedirs(root, exist_ok=True)
+    try:
+        for name in scenes:
+            for change in changes:
+                for cfg, s in run_case(program, name, change, root):
+                    if isinstance(s, str):
+                        line = f'{name} {change} {cfg}: {s}'
+                        table.append((name, change, cfg, s, '', '', ''))
+                    else:
+                        wrong = s['wrong'] + s['reported_covered']
+                        bad += wrong
+                        worst = (f" (worst {s['worst'][0]:.2f} px: {s['worst'][2]} in frame "
+                                 f"{s['worst'][1]})" if s['worst'] else '')
+                        rate = 100.0 * s['found'] / max(1, s['visible'])
+                        line = (f"{'FAIL' if wrong else 'ok'} {name} {change} {cfg}: found "
+                                f"{s['found']}/{s['visible']} ({rate:.1f} %), wrong (> "
+                                f"{s['tolerance']:.3g} px) {s['wrong']}{worst}, reported while "
+                                f"covered {s['reported_covered']}")
+                        sigma = 100.0 * s['within_3_sigma'] / max(1, s['found'])
+                        table.append((name, change, cfg, f"{s['found']}/{s['visible']} = {rate:.1f} %",
+                                      f"{s['wrong']}{worst}", str(s['reported_covered']),
+                                      f'{sigma:.1f} %'))
+                    if not args.markdown:
+                        print(line, flush=True)
+    finally:
+        if not args.keep:
+            subprocess.run(['rm', '-rf', root])
+    if args.markdown:
+        print('| scene | change | config | found | wrong (> 1.5 px x scale) | reported while covered '
+              '| within 3 sigma |')
+        print('| --- | --- | --- | --- | --- | --- | --- |')
+        for row in table:
+            print('| ' + ' | '.join(row) + ' |')
+    return 1 if bad else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
