@@ -274,17 +274,20 @@ std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
 // The centroid of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at
 // `at`, within kRecentreReachPx of it; nothing when that pixel fails, or the blob reaches the
 // edge of that area (not a marker-sized blob: a surface of the marker's colour, or the range
-// let the surroundings in).
-std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+// let the surroundings in). `converted`: the image's pixels over `converted_box` in the pick's
+// colour space (gray for a white or black dot's pick, else HSV), a box inside the image that
+// holds that area as far as the image does; a caller that has converted a larger box already
+// passes it, so that no pixel is converted twice.
+std::optional<cv::Point2d> BlobCentroidIn(const cv::Mat& converted, const cv::Rect& converted_box,
+                                          cv::Point2d at, const HsvPick& pick) {
   const cv::Point centre(cvRound(at.x), cvRound(at.y));
   const int reach = kRecentreReachPx;
   const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
-  const cv::Rect box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = area & converted_box;
   if (!box.contains(centre)) return std::nullopt;
   // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
   // hue, saturation and value.
-  cv::Mat hsv;
-  cv::cvtColor(bgr(box), hsv, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  const cv::Mat hsv = converted(box - converted_box.tl());
   cv::Mat mask(hsv.rows + 2, hsv.cols + 2, CV_8U, cv::Scalar(1));  // floodFill's mask: 0 fills.
   for (int y = 0; y < hsv.rows; ++y) {
     for (int x = 0; x < hsv.cols; ++x) {
@@ -306,6 +309,18 @@ std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, co
   if (!(m.m00 > 0)) return std::nullopt;
   // The mask is the box's, one pixel larger on every side.
   return cv::Point2d(box.x + m.m10 / m.m00 - 1, box.y + m.m01 / m.m00 - 1);
+}
+
+// BlobCentroidIn, converting just the area it looks in.
+std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+  const cv::Point centre(cvRound(at.x), cvRound(at.y));
+  const int reach = kRecentreReachPx;
+  const cv::Rect box = cv::Rect(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (!box.contains(centre)) return std::nullopt;
+  cv::Mat converted;
+  cv::cvtColor(bgr(box), converted, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  return BlobCentroidIn(converted, box, at, pick);
 }
 
 // A pale marker (a light pigment, or a lit dome whose top the light whitens) has a part less
@@ -335,7 +350,11 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   constexpr int kRingWidth = 3, kFarthest = 30;
   const int outer = radius + kFarthest + kRingWidth;
   const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
-  const cv::Rect box = cv::Rect(centre.x - outer, centre.y - outer, 2 * outer + 1, 2 * outer + 1) &
+  // The box holds the rings and the area BlobCentroidIn looks in below, which is larger for a
+  // radius under 15 px: it is converted once for both (the pixels beyond the rings are passed
+  // over).
+  const int half = std::max(outer, kRecentreReachPx);
+  const cv::Rect box = cv::Rect(centre.x - half, centre.y - half, 2 * half + 1, 2 * half + 1) &
                        cv::Rect(0, 0, bgr.cols, bgr.rows);
   if (box.empty()) return;
   cv::Mat hsv;
@@ -374,8 +393,8 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   if (floor >= pick->s.lo) return;
   HsvPick lower = *pick;
   lower.s.lo = floor;
-  const auto before = BlobCentroidAt(bgr, click_px, *pick);
-  const auto after = BlobCentroidAt(bgr, click_px, lower);
+  const auto before = BlobCentroidIn(hsv, box, click_px, *pick);
+  const auto after = BlobCentroidIn(hsv, box, click_px, lower);
   if (!before || !after) return;
   if (cv::norm(*after - *before) < kMinCentreShiftPx) return;
   pick->s.lo = floor;
