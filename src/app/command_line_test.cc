@@ -15,6 +15,7 @@
 
 #include "app/command_line.h"
 #include "app/command_table.h"
+#include "app/commands_plugin.h"
 #include "app/commands.h"
 #include "app/help_format.h"
 #include "app/program_test_util.h"
@@ -26,21 +27,6 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::TempDir;
-
-// Every command of the commands plugin (plugin_commands.cc; `live` is the live plugin's own).
-const std::vector<CommandSetup>& PluginCommands() {
-  static const std::vector<CommandSetup> commands = {
-      {"demo", SetupDemoCommand},           {"track", SetupTrackCommand},
-      {"init", SetupInitCommand},           {"pick", SetupPickCommand},
-      {"synth", SetupSynthCommand},         {"evaluate", SetupEvaluateCommand},
-      {"calibrate", SetupCalibrateCommand}, {"control", SetupControlCommand},
-      {"identify", SetupIdentifyCommand},   {"rig", SetupRigCommand},
-      {"plot", SetupPlotCommand},           {"config", SetupConfigCommand},
-      {"cameras", SetupCamerasCommand},     {"listen", SetupListenCommand},
-      {"track-stereo", SetupTrackStereoCommand},
-  };
-  return commands;
-}
 
 struct ParsedLine {
   int exit_code;
@@ -54,7 +40,7 @@ ParsedLine RunWords(std::vector<std::string> words) {
   for (std::string& word : words) argv.push_back(word.data());
   ::testing::internal::CaptureStderr();
   const int exit_code =
-      RunCommandLine(static_cast<int>(argv.size()), argv.data(), PluginCommands());
+      RunCommandLine(static_cast<int>(argv.size()), argv.data(), CommandsPluginCommands());
   return {exit_code, ::testing::internal::GetCapturedStderr()};
 }
 
@@ -102,7 +88,7 @@ TEST(CommandLine, AMistypedOptionIsNamedWithTheNearestOneBeforeWhatItLeftOut) {
 
 // Every command's options, not only track's: a typo of each one's -o.
 TEST(CommandLine, EveryCommandNamesItsMistypedOptions) {
-  for (const CommandSetup& command : PluginCommands()) {
+  for (const CommandSetup& command : CommandsPluginCommands()) {
     const ParsedLine parsed = RunWords({command.name, "--outptu", "x"});
     EXPECT_EQ(parsed.exit_code, 2) << command.name;
     EXPECT_THAT(parsed.stderr_text, HasSubstr(std::string("softsight ") + command.name +
@@ -123,7 +109,7 @@ TEST(CommandLine, DashOIsEveryCommandsMainOutputUnderItsOldNamesToo) {
       {"rig", {}},                        {"config", {}},
       {"cameras", {}},
   };
-  for (const CommandSetup& command : PluginCommands()) {
+  for (const CommandSetup& command : CommandsPluginCommands()) {
     CLI::App app;
     CLI::App* sub = app.add_subcommand(command.name);
     command.setup(*sub);
@@ -174,7 +160,7 @@ TEST(CommandLine, HelpTextWrapsAtSpacesAndKeepsItsIndents) {
 // before) stay within the width, in their column.
 TEST(CommandLine, EveryCommandsHelpFitsTheWidth) {
   for (const size_t width : {size_t{80}, size_t{60}}) {
-    for (const CommandSetup& command : PluginCommands()) {
+    for (const CommandSetup& command : CommandsPluginCommands()) {
       CLI::App app{kProgramDescription};
       app.formatter(std::make_shared<WrappingFormatter>(width));
       CLI::App* sub = app.add_subcommand(command.name, FindCommand(command.name)->summary);

@@ -5,32 +5,16 @@
 // writer has no H.264 key-frame interval setting in 4.6 (it writes a key frame every 12 frames),
 // and Debian's OpenCV is all the project builds on. A benchmark tool: not installed, not tested.
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
-#include <opencv2/imgproc.hpp>
-
-extern "C" {
-#include <libavcodec/avcodec.h>
-#include <libavformat/avformat.h>
-#include <libavutil/opt.h>
-}
-
+#include "io/h264_writer.h"
 #include "softsight/io/frame_source.h"
 
 namespace {
-
-void Check(int rc, const char* what) {
-  if (rc < 0) {
-    char text[128];
-    av_strerror(rc, text, sizeof text);
-    throw std::runtime_error(std::string(what) + ": " + text);
-  }
-}
 
 int Main(int argc, char** argv) {
   if (argc < 3) {
@@ -43,72 +27,21 @@ int Main(int argc, char** argv) {
   const double fps = source->fps().value_or(30.0);
   softsight::Frame frame;
   if (!source->read(frame)) throw std::runtime_error("no frames");
+  // 4:2:0 chroma wants an even size: an odd last row or column is left out.
   const int w = frame.image.cols & ~1, h = frame.image.rows & ~1;
 
-  AVFormatContext* format = nullptr;
-  Check(avformat_alloc_output_context2(&format, nullptr, "mp4", output.c_str()), "output");
-  const AVCodec* codec = avcodec_find_encoder_by_name("libx264");
-  if (!codec) codec = avcodec_find_encoder(AV_CODEC_ID_H264);
-  if (!codec) throw std::runtime_error("no H.264 encoder in this FFmpeg");
-  AVStream* stream = avformat_new_stream(format, nullptr);
-  AVCodecContext* enc = avcodec_alloc_context3(codec);
-  enc->width = w;
-  enc->height = h;
-  enc->pix_fmt = AV_PIX_FMT_YUV420P;
-  enc->time_base = AVRational{1, static_cast<int>(fps + 0.5)};
-  enc->framerate = AVRational{static_cast<int>(fps + 0.5), 1};
-  enc->gop_size = gop;
-  enc->max_b_frames = 2;
-  if (format->oformat->flags & AVFMT_GLOBALHEADER) enc->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  av_opt_set(enc->priv_data, "preset", "veryfast", 0);
-  av_opt_set(enc->priv_data, "crf", "20", 0);
-  Check(avcodec_open2(enc, codec, nullptr), "encoder");
-  Check(avcodec_parameters_from_context(stream->codecpar, enc), "parameters");
-  stream->time_base = enc->time_base;
-  Check(avio_open(&format->pb, output.c_str(), AVIO_FLAG_WRITE), output.c_str());
-  Check(avformat_write_header(format, nullptr), "header");
-
-  AVFrame* picture = av_frame_alloc();
-  picture->format = AV_PIX_FMT_YUV420P;
-  picture->width = w;
-  picture->height = h;
-  Check(av_frame_get_buffer(picture, 0), "frame");
-  AVPacket* packet = av_packet_alloc();
-  const auto drain = [&] {
-    while (avcodec_receive_packet(enc, packet) == 0) {
-      av_packet_rescale_ts(packet, enc->time_base, stream->time_base);
-      packet->stream_index = stream->index;
-      Check(av_interleaved_write_frame(format, packet), "write");
-    }
-  };
-  cv::Mat yuv;
-  int64_t n = 0;
+  softsight::H264WriterOptions options;
+  options.size = {w, h};
+  options.fps = static_cast<int>(fps + 0.5);
+  options.gop = gop;
+  options.crf = "20";
+  softsight::H264Writer writer(output, options);
   do {
-    cv::cvtColor(frame.image(cv::Rect(0, 0, w, h)), yuv, cv::COLOR_BGR2YUV_I420);
-    Check(av_frame_make_writable(picture), "writable");
-    for (int y = 0; y < h; ++y) {
-      std::memcpy(picture->data[0] + y * picture->linesize[0], yuv.ptr(y), w);
-    }
-    const uchar* u = yuv.ptr(h);
-    const uchar* v = u + (w / 2) * (h / 2);
-    for (int y = 0; y < h / 2; ++y) {
-      std::memcpy(picture->data[1] + y * picture->linesize[1], u + y * (w / 2), w / 2);
-      std::memcpy(picture->data[2] + y * picture->linesize[2], v + y * (w / 2), w / 2);
-    }
-    picture->pts = n++;
-    Check(avcodec_send_frame(enc, picture), "encode");
-    drain();
+    writer.write(frame.image(cv::Rect(0, 0, w, h)));
   } while (source->read(frame));
-  Check(avcodec_send_frame(enc, nullptr), "flush");
-  drain();
-  Check(av_write_trailer(format), "trailer");
-  avio_closep(&format->pb);
-  av_packet_free(&packet);
-  av_frame_free(&picture);
-  avcodec_free_context(&enc);
-  avformat_free_context(format);
+  writer.finish();
   std::printf("%s: %lld frames %dx%d, H.264 (%s), a key frame every %d\n", output.c_str(),
-              static_cast<long long>(n), w, h, codec->name, gop);
+              static_cast<long long>(writer.frames()), w, h, writer.encoder(), gop);
   return 0;
 }
 

@@ -280,6 +280,12 @@ std::vector<cv::Vec3b> SampleDisc(const cv::Mat& bgr, cv::Point2d at, int r) {
   return samples;
 }
 
+// The area a blob at `centre` is looked for in (BlobIn): kRecentreReachPx around it.
+cv::Rect SearchedArea(cv::Point centre) {
+  const int reach = kRecentreReachPx;
+  return cv::Rect(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
+}
+
 // The blob of the pixels that pass `pick`'s ranges and are joined (8 ways) to the one at `at`,
 // within kRecentreReachPx of it, with the pixels around it that pass too.
 struct BlobAtClick {
@@ -291,19 +297,20 @@ struct BlobAtClick {
 // Nothing when the pixel at `at` fails (and every one within `seed_reach` px of it: the blob is
 // then the one through the nearest that passes), or the blob reaches the edge of the searched
 // area (not a marker-sized blob: a surface of the marker's colour, or the range let the
-// surroundings in).
-std::optional<BlobAtClick> BlobAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick,
-                                  int seed_reach = 0) {
+// surroundings in). `converted_image`: the image's pixels over `converted_box` in the pick's
+// colour space (gray for a white or black dot's pick, else HSV), a box inside the image that
+// holds the searched area as far as the image does (a caller that has converted a larger box
+// already passes it: no pixel is converted twice).
+std::optional<BlobAtClick> BlobIn(const cv::Mat& converted_image, const cv::Rect& converted_box,
+                                  cv::Point2d at, const HsvPick& pick, int seed_reach = 0) {
   const cv::Point centre(cvRound(at.x), cvRound(at.y));
-  const int reach = kRecentreReachPx;
-  const cv::Rect area(centre.x - reach, centre.y - reach, 2 * reach + 1, 2 * reach + 1);
+  const cv::Rect area = SearchedArea(centre);
   BlobAtClick found;
-  found.box = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  found.box = area & converted_box;
   if (!found.box.contains(centre)) return std::nullopt;
   // The pixels that pass: a white or black dot's by their gray level, a coloured marker's by
   // hue, saturation and value.
-  cv::Mat converted;
-  cv::cvtColor(bgr(found.box), converted, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  const cv::Mat converted = converted_image(found.box - converted_box.tl());
   found.passes = cv::Mat(converted.size(), CV_8U, cv::Scalar(0));
   for (int y = 0; y < converted.rows; ++y) {
     for (int x = 0; x < converted.cols; ++x) {
@@ -346,20 +353,34 @@ std::optional<BlobAtClick> BlobAt(const cv::Mat& bgr, cv::Point2d at, const HsvP
   return found;
 }
 
-// The centroid of BlobAt's blob.
-std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
-  const std::optional<BlobAtClick> found = BlobAt(bgr, at, pick);
+// BlobIn, converting just the area it looks in.
+std::optional<BlobAtClick> BlobAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick,
+                                  int seed_reach = 0) {
+  const cv::Rect box =
+      SearchedArea(cv::Point(cvRound(at.x), cvRound(at.y))) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (box.empty()) return std::nullopt;
+  cv::Mat converted;
+  cv::cvtColor(bgr(box), converted, pick.gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2HSV);
+  return BlobIn(converted, box, at, pick, seed_reach);
+}
+
+// The centroid of a blob BlobIn or BlobAt found.
+std::optional<cv::Point2d> CentroidOf(const std::optional<BlobAtClick>& found) {
   if (!found) return std::nullopt;
   const cv::Moments m = cv::moments(found->blob, true);
   if (!(m.m00 > 0)) return std::nullopt;
   return cv::Point2d(found->box.x + m.m10 / m.m00, found->box.y + m.m01 / m.m00);
 }
 
+std::optional<cv::Point2d> BlobCentroidAt(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick) {
+  return CentroidOf(BlobAt(bgr, at, pick));
+}
+
 // How well `pick`'s ranges tell the marker at `at` from what is around it: the fraction of its
 // near surroundings (the pixels 3 to 10 px beyond the blob at `at`, or at the pixel nearest to
 // it within the sampled disc that passes) that pass them, 1 when there is no marker-sized blob
-// there. A range that passes its surroundings joins the marker to them
-// as soon as it moves or the light changes.
+// there. A range that passes its surroundings joins the marker to them as soon as it moves or
+// the light changes.
 double SurroundingsPassing(const cv::Mat& bgr, cv::Point2d at, const HsvPick& pick,
                            int sample_radius) {
   const std::optional<BlobAtClick> found = BlobAt(bgr, at, pick, sample_radius);
@@ -403,7 +424,11 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   constexpr int kRingWidth = 3, kFarthest = 30;
   const int outer = radius + kFarthest + kRingWidth;
   const cv::Point centre(cvRound(click_px.x), cvRound(click_px.y));
-  const cv::Rect box = cv::Rect(centre.x - outer, centre.y - outer, 2 * outer + 1, 2 * outer + 1) &
+  // The box holds the rings and the area the blob at the click is looked for in below, which is
+  // larger for a radius under 15 px: it is converted once for both (the pixels beyond the rings
+  // are passed over).
+  const int half = std::max(outer, kRecentreReachPx);
+  const cv::Rect box = cv::Rect(centre.x - half, centre.y - half, 2 * half + 1, 2 * half + 1) &
                        cv::Rect(0, 0, bgr.cols, bgr.rows);
   if (box.empty()) return;
   cv::Mat hsv;
@@ -442,8 +467,8 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   if (floor >= pick->s.lo) return;
   HsvPick lower = *pick;
   lower.s.lo = floor;
-  const auto before = BlobCentroidAt(bgr, click_px, *pick);
-  const auto after = BlobCentroidAt(bgr, click_px, lower);
+  const auto before = CentroidOf(BlobIn(hsv, box, click_px, *pick));
+  const auto after = CentroidOf(BlobIn(hsv, box, click_px, lower));
   if (!before || !after) return;
   if (cv::norm(*after - *before) < kMinCentreShiftPx) return;
   pick->s.lo = floor;

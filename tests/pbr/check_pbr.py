@@ -276,6 +276,31 @@ def run_scene(program, name, case, keep):
     return ok, results
 
 
+def track_and_judge(program, folder, video, cfg, csv_path, truth_names, known, label, failure,
+                    with_median=False):
+    """The tail the box-margin and click-offset sweeps share: tracks the scene's video with the
+    config `cfg` into `csv_path`, scores it and words the verdict, `label` naming the case. Any
+    report beyond the tolerance or while covered fails, or is KNOWN where the scene's config is
+    known to fail (`known`, from CASES); a track that exits non-zero fails, worded by `failure`
+    ({code}: its exit status, {last}: its last message). Returns (ok, line)."""
+    done = subprocess.run([program, 'track', '-c', cfg, '-i', video, '--csv', csv_path, '--quiet'],
+                          cwd=folder, capture_output=True, text=True)
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
+        return False, f'FAIL {label}: ' + failure.format(code=done.returncode, last=last)
+    names, group = config_markers(cfg)
+    s = score(csv_path, os.path.join(folder, 'truth.csv'), dict(zip(truth_names, names)), group)
+    bad = s['wrong'] or s['reported_covered']
+    worst = f" (worst {s['worst'][0]:.1f} px: {s['worst'][2]} in frame {s['worst'][1]})" if s['worst'] else ''
+    verdict = ('KNOWN' if known is not None else 'FAIL') if bad else 'ok'
+    line = (f"{verdict} {label}: found {s['found']}/{s['visible']} "
+            f"({100.0 * s['found'] / max(1, s['visible']):.1f} %), wrong (> {TOL:g} px) "
+            f"{s['wrong']}{worst}, reported while covered {s['reported_covered']}")
+    if with_median:
+        line += f", median {median(s['errors']):.2f} px"
+    return not bad or known is not None, line
+
+
 def box_margins(program, name, margins):
     """Template boxes as people drag them: each marker's frame-0 outline (scene.json) grown by each
     margin (0: tight around the marker), in the scene's zncc config. Every box must be accepted and
@@ -288,7 +313,6 @@ def box_margins(program, name, margins):
         truth_names = list(dict.fromkeys(r['marker'] for r in csv.DictReader(f)))
     with open(os.path.join(folder, 'zncc.yaml')) as f:
         config = f.read()
-    names, group = config_markers(os.path.join(folder, 'zncc.yaml'))
     known = dict((c, k) for c, _, k in CASES[name]['configs']).get('zncc')
     ok, lines = True, []
     with tempfile.TemporaryDirectory(prefix=f'softsight_pbr_{name}_') as out:
@@ -301,23 +325,11 @@ def box_margins(program, name, margins):
             cfg, csv_path = os.path.join(out, f'm{margin}.yaml'), os.path.join(out, f'm{margin}.csv')
             with open(cfg, 'w') as f:
                 f.write(text)
-            done = subprocess.run([program, 'track', '-c', cfg, '-i', video, '--csv', csv_path, '--quiet'],
-                                  cwd=folder, capture_output=True, text=True)
-            if done.returncode != 0:
-                last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
-                lines.append(f'FAIL {name} zncc boxes margin {margin} px: refused: {last}')
-                ok = False
-                continue
-            s = score(csv_path, os.path.join(folder, 'truth.csv'), dict(zip(truth_names, names)), group)
-            bad = s['wrong'] or s['reported_covered']
-            # A scene whose zncc config is known to fail (CASES) reports its wrong finds as KNOWN.
-            ok = ok and (not bad or known is not None)
-            worst = f" (worst {s['worst'][0]:.1f} px: {s['worst'][2]} in frame {s['worst'][1]})" if s['worst'] else ''
-            verdict = ('KNOWN' if known is not None else 'FAIL') if bad else 'ok'
-            lines.append(f"{verdict} {name} zncc boxes margin {margin} px: found "
-                         f"{s['found']}/{s['visible']} ({100.0 * s['found'] / max(1, s['visible']):.1f} %), "
-                         f"wrong (> {TOL:g} px) {s['wrong']}{worst}, reported while covered "
-                         f"{s['reported_covered']}, median {median(s['errors']):.2f} px")
+            one_ok, line = track_and_judge(program, folder, video, cfg, csv_path, truth_names, known,
+                                           f'{name} zncc boxes margin {margin} px',
+                                           'refused: {last}', with_median=True)
+            ok = ok and one_ok
+            lines.append(line)
     return ok, lines
 
 
@@ -355,22 +367,10 @@ def click_offsets(program, name, offsets):
                 last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
                 lines.append(f'ok {label}: refused ({last[:100]})')
                 continue
-            done = subprocess.run([program, 'track', '-c', cfg, '-i', video, '--csv', csv_path, '--quiet'],
-                                  cwd=folder, capture_output=True, text=True)
-            if done.returncode != 0:
-                last = (done.stderr.strip().splitlines() or ['(no message)'])[-1]
-                lines.append(f'FAIL {label}: track exited {done.returncode}: {last}')
-                ok = False
-                continue
-            names, group = config_markers(cfg)
-            s = score(csv_path, os.path.join(folder, 'truth.csv'), dict(zip(truth_names, names)), group)
-            bad = s['wrong'] or s['reported_covered']
-            ok = ok and (not bad or known is not None)
-            worst = f" (worst {s['worst'][0]:.1f} px: {s['worst'][2]} in frame {s['worst'][1]})" if s['worst'] else ''
-            verdict = ('KNOWN' if known is not None else 'FAIL') if bad else 'ok'
-            lines.append(f"{verdict} {label}: found {s['found']}/{s['visible']} "
-                         f"({100.0 * s['found'] / max(1, s['visible']):.1f} %), wrong (> {TOL:g} px) "
-                         f"{s['wrong']}{worst}, reported while covered {s['reported_covered']}")
+            one_ok, line = track_and_judge(program, folder, video, cfg, csv_path, truth_names, known,
+                                           label, 'track exited {code}: {last}')
+            ok = ok and one_ok
+            lines.append(line)
     return ok, lines
 
 
