@@ -11,13 +11,16 @@ found beyond the tolerance (1.5 px, scaled with the frame) or while covered. Thi
 measurement, not a test (the suite runs check_pbr.py on the scenes as rendered): its table is
 docs/measurements.md's "The rendered scenes under other light and other cameras".
 
-usage: perturb_pbr.py --softsight PROGRAM [--change NAME ...] [--scene NAME ...] [--markdown]
+usage: perturb_pbr.py --softsight PROGRAM [--change NAME ...] [--scene NAME ...] [--case SCENE:CHANGE ...]
+                      [--config pick|zncc ...] [--floor PERCENT] [--markdown] [--keep DIR]
 Changes: dim60 (levels x 0.6), bright (x 1.2 + 20, clipped), warm (red x 1.15, blue x 0.75: a
 tungsten lamp without white balance), cold (red x 0.8, blue x 1.15), gradient (x 1.0 at the left
 edge falling to x 0.55 at the right), noise8 (Gaussian, sigma 8 levels), jpeg30 (JPEG at quality
 30), scale75 (the frame resized to 0.75 of its size, as a lower-resolution camera). Needs
-python3-opencv and numpy. Exit status: 0 when nothing was reported beyond tolerance or while
-covered, 1 otherwise, 2 on a usage error.
+python3-opencv and numpy. With --floor (the suite's `pbr_scene.perturbed`, on the cases it names),
+a refused pick or a config finding less than that share of the visible marker-frames fails too.
+Exit status: 0 when nothing was reported beyond tolerance or while covered (and every floor was
+met), 1 otherwise, 2 on a usage error.
 """
 import argparse
 import csv
@@ -150,12 +153,55 @@ def run_case(program, name, change, root):
     return results
 
 
+def print_markdown(table):
+    """A summary per change and config, then every run with a report beyond tolerance or refused."""
+    print('| change | config | runs | found | wrong (> 1.5 px x scale) | runs with wrong reports | '
+          'worst | refused or failed |')
+    print('| --- | --- | --- | --- | --- | --- | --- | --- |')
+    for change in CHANGES:
+        for cfg in ('pick', 'zncc'):
+            rows = [r for r in table if r['change'] == change and r['config'] == cfg]
+            if not rows:
+                continue
+            scored = [r for r in rows if 'score' in r]
+            found = sum(r['score']['found'] for r in scored)
+            visible = sum(r['score']['visible'] for r in scored)
+            wrong = sum(r['score']['wrong'] for r in scored)
+            worst = max((r['score']['worst'] for r in scored if r['score']['worst']), default=None)
+            worst_text = (f"{worst[0]:.2f} px ({[r['scene'] for r in scored if r['score']['worst'] == worst][0]}, "
+                          f"{worst[2]})" if worst else '-')
+            print(f"| {change} | {cfg} | {len(rows)} | {found}/{visible} = "
+                  f"{100.0 * found / max(1, visible):.1f} % | {wrong} | "
+                  f"{sum(1 for r in scored if r['score']['wrong'])} | {worst_text} | "
+                  f"{len(rows) - len(scored)} |")
+    print()
+    print('| scene | change | config | found | wrong (> 1.5 px x scale) | worst | within 3 sigma |')
+    print('| --- | --- | --- | --- | --- | --- | --- |')
+    for r in table:
+        if 'score' not in r:
+            print(f"| {r['scene']} | {r['change']} | {r['config']} | {r['failure']} | | | |")
+            continue
+        sc = r['score']
+        if not sc['wrong'] and not sc['reported_covered']:
+            continue
+        worst = f"{sc['worst'][0]:.2f} px ({sc['worst'][2]}, frame {sc['worst'][1]})"
+        print(f"| {r['scene']} | {r['change']} | {r['config']} | {sc['found']}/{sc['visible']} = "
+              f"{100.0 * sc['found'] / max(1, sc['visible']):.1f} % | {sc['wrong']} | {worst} | "
+              f"{100.0 * sc['within_3_sigma'] / max(1, sc['found']):.1f} % |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--softsight', required=True, help='the softsight program to measure')
     parser.add_argument('--change', action='append', choices=CHANGES, help='one change (repeatable)')
     parser.add_argument('--scene', action='append', choices=sorted(check_pbr.CASES),
                         help='one scene (repeatable)')
+    parser.add_argument('--case', action='append', metavar='SCENE:CHANGE',
+                        help='one scene with one change (repeatable; instead of --scene/--change)')
+    parser.add_argument('--config', action='append', choices=['pick', 'zncc'],
+                        help='only this config (repeatable; default both)')
+    parser.add_argument('--floor', type=float, help='also fail on a refused pick or a found rate '
+                        'below this percentage')
     parser.add_argument('--markdown', action='store_true', help='print a table instead of log lines')
     parser.add_argument('--keep', help='keep the changed scenes, configs and CSVs in this folder')
     args = parser.parse_args()
@@ -163,44 +209,52 @@ def main():
     if not os.access(program, os.X_OK):
         print(f'perturb_pbr.py: --softsight {args.softsight}: not an executable', file=sys.stderr)
         return 2
-    changes = args.change or CHANGES
-    scenes = args.scene or list(check_pbr.CASES)
+    cases = [(name, change) for name in (args.scene or list(check_pbr.CASES))
+             for change in (args.change or CHANGES)]
+    if args.case:
+        cases = []
+        for c in args.case:
+            name, _, change = c.partition(':')
+            if name not in check_pbr.CASES or change not in CHANGES:
+                print(f'perturb_pbr.py: --case {c}: not SCENE:CHANGE with a scene of check_pbr.py '
+                      f'and a change of {", ".join(CHANGES)}', file=sys.stderr)
+                return 2
+            cases.append((name, change))
     bad = 0
     table = []
     root = args.keep or tempfile.mkdtemp(prefix='softsight_perturb_pbr_')
     os.makedirs(root, exist_ok=True)
     try:
-        for name in scenes:
-            for change in changes:
-                for cfg, s in run_case(program, name, change, root):
-                    if isinstance(s, str):
-                        line = f'{name} {change} {cfg}: {s}'
-                        table.append((name, change, cfg, s, '', '', ''))
-                    else:
-                        wrong = s['wrong'] + s['reported_covered']
-                        bad += wrong
-                        worst = (f" (worst {s['worst'][0]:.2f} px: {s['worst'][2]} in frame "
-                                 f"{s['worst'][1]})" if s['worst'] else '')
-                        rate = 100.0 * s['found'] / max(1, s['visible'])
-                        line = (f"{'FAIL' if wrong else 'ok'} {name} {change} {cfg}: found "
-                                f"{s['found']}/{s['visible']} ({rate:.1f} %), wrong (> "
-                                f"{s['tolerance']:.3g} px) {s['wrong']}{worst}, reported while "
-                                f"covered {s['reported_covered']}")
-                        sigma = 100.0 * s['within_3_sigma'] / max(1, s['found'])
-                        table.append((name, change, cfg, f"{s['found']}/{s['visible']} = {rate:.1f} %",
-                                      f"{s['wrong']}{worst}", str(s['reported_covered']),
-                                      f'{sigma:.1f} %'))
-                    if not args.markdown:
-                        print(line, flush=True)
+        for name, change in cases:
+            for cfg, s in run_case(program, name, change, root):
+                if args.config and cfg not in args.config:
+                    continue
+                if isinstance(s, str):
+                    # A track that exits with an error always fails; a refused pick under a floor.
+                    short = s.startswith('track exited') or (args.floor is not None and cfg == 'pick')
+                    bad += short
+                    line = f"{'FAIL ' if short else ''}{name} {change} {cfg}: {s}"
+                    table.append(dict(scene=name, change=change, config=cfg, failure=s))
+                else:
+                    wrong = s['wrong'] + s['reported_covered']
+                    rate = 100.0 * s['found'] / max(1, s['visible'])
+                    short = args.floor is not None and rate < args.floor
+                    bad += wrong + short
+                    worst = (f" (worst {s['worst'][0]:.2f} px: {s['worst'][2]} in frame "
+                             f"{s['worst'][1]})" if s['worst'] else '')
+                    floor = f', floor {args.floor:g} %' if args.floor is not None else ''
+                    line = (f"{'FAIL' if wrong or short else 'ok'} {name} {change} {cfg}: found "
+                            f"{s['found']}/{s['visible']} ({rate:.1f} %{floor}), wrong "
+                            f"(> {s['tolerance']:.3g} px) {s['wrong']}{worst}, reported while "
+                            f"covered {s['reported_covered']}")
+                    table.append(dict(scene=name, change=change, config=cfg, score=s))
+                if not args.markdown:
+                    print(line, flush=True)
     finally:
         if not args.keep:
             subprocess.run(['rm', '-rf', root])
     if args.markdown:
-        print('| scene | change | config | found | wrong (> 1.5 px x scale) | reported while covered '
-              '| within 3 sigma |')
-        print('| --- | --- | --- | --- | --- | --- | --- |')
-        for row in table:
-            print('| ' + ' | '.join(row) + ' |')
+        print_markdown(table)
     return 1 if bad else 0
 
 
