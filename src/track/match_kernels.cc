@@ -10,6 +10,15 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+// The AVX2 cross-correlation: functions compiled for AVX2 by their target attribute, called only
+// where the processor reports it (GCC and Clang on x86-64; elsewhere the 128-bit kernel only).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && CV_SIMD128
+#define SOFTSIGHT_AVX2_CROSS 1
+#include <immintrin.h>
+#else
+#define SOFTSIGHT_AVX2_CROSS 0
+#endif
+
 namespace softsight {
 
 namespace {
@@ -753,6 +762,113 @@ inline void CrossAt4(const int16_t* p, int cn, size_t step, const PreparedTempla
   out[3] = cv::v_reduce_sum(acc3);
 }
 
+#if SOFTSIGHT_AVX2_CROSS
+// The 128-bit kernels above, 16 template words a 256-bit lane pair: the chunk's low 8 words
+// against the image at its first offset, its high 8 at its second, as CrossAt pairs them (a
+// full chunk: 16 consecutive words; the tail: `lo` and `hi`). Half the multiply-adds and loads
+// of the 128-bit kernels, for the same exact integer sums (products of levels <= 255 summed in
+// 32-bit lanes below 2^31, in any order): the correlation was a fifth of a ZNCC frame of ViSP's
+// mire-2, its large dot's 72x54 template at up to 1.2x (issue 45).
+__attribute__((target("avx2"))) inline __m256i Avx2Pair(const int16_t* lo, const int16_t* hi) {
+  return _mm256_inserti128_si256(
+      _mm256_castsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(lo))),
+      _mm_loadu_si128(reinterpret_cast<const __m128i*>(hi)), 1);
+}
+
+__attribute__((target("avx2"))) inline __m256i Avx2Load(const int16_t* p) {
+  return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+
+__attribute__((target("avx2"))) inline int Avx2Sum(__m256i v) {
+  __m128i s = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+  s = _mm_add_epi32(s, _mm_shuffle_epi32(s, 0x4E));
+  s = _mm_add_epi32(s, _mm_shuffle_epi32(s, 0xB1));
+  return _mm_cvtsi128_si32(s);
+}
+
+// CrossAt4 in 256-bit lanes: the placements x .. x + 3 (pixel stride `cn`).
+__attribute__((target("avx2"))) void Avx2CrossAt4(const int16_t* p, int cn, size_t step,
+                                                   const int16_t* tw,
+                                                   const KernelAccess::Chunks& layout, int* out) {
+  __m256i acc0 = _mm256_setzero_si256(), acc1 = _mm256_setzero_si256();
+  __m256i acc2 = _mm256_setzero_si256(), acc3 = _mm256_setzero_si256();
+  for (int r = 0; r < layout.rows; ++r, p += step) {
+    const int16_t* p1 = p + cn;
+    const int16_t* p2 = p + 2 * cn;
+    const int16_t* p3 = p + 3 * cn;
+    for (int c = 0; c < layout.full; ++c, tw += 16) {
+      const __m256i w = Avx2Load(tw);
+      const int a = 16 * c;
+      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Load(p + a), w));
+      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Load(p1 + a), w));
+      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Load(p2 + a), w));
+      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Load(p3 + a), w));
+    }
+    if (layout.tail) {
+      const __m256i w = Avx2Load(tw);
+      const int lo = layout.lo, hi = layout.hi;
+      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Pair(p + lo, p + hi), w));
+      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Pair(p1 + lo, p1 + hi), w));
+      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Pair(p2 + lo, p2 + hi), w));
+      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Pair(p3 + lo, p3 + hi), w));
+      tw += 16;
+    }
+  }
+  out[0] = Avx2Sum(acc0);
+  out[1] = Avx2Sum(acc1);
+  out[2] = Avx2Sum(acc2);
+  out[3] = Avx2Sum(acc3);
+}
+
+// CrossAt in 256-bit lanes.
+__attribute__((target("avx2"))) int Avx2CrossAt(const int16_t* p, size_t step, const int16_t* tw,
+                                                const KernelAccess::Chunks& layout) {
+  __m256i acc = _mm256_setzero_si256();
+  for (int r = 0; r < layout.rows; ++r, p += step) {
+    for (int c = 0; c < layout.full; ++c, tw += 16) {
+      acc = _mm256_add_epi32(acc, _mm256_madd_epi16(Avx2Load(p + 16 * c), Avx2Load(tw)));
+    }
+    if (layout.tail) {
+      acc = _mm256_add_epi32(
+          acc, _mm256_madd_epi16(Avx2Pair(p + layout.lo, p + layout.hi), Avx2Load(tw)));
+      tw += 16;
+    }
+  }
+  return Avx2Sum(acc);
+}
+
+// VectorCrossMap's placements (after its widening), in 256-bit lanes: the same placements four
+// at a time, the same reads (the 16 words of a chunk are the two 8-word loads of CrossAt).
+__attribute__((target("avx2"))) void Avx2CrossRows(const int16_t* widened, int row_values,
+                                                   int cn, const PreparedTemplate& t,
+                                                   cv::Mat& result) {
+  const KernelAccess::Chunks layout = KA::Layout(t);
+  const int16_t* tw = KA::Words(t);
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    const int16_t* p = widened + static_cast<size_t>(row_values) * y;
+    int x = 0;
+    for (; x + 3 < result.cols; x += 4) {
+      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, out + x);
+    }
+    if (result.cols - x == 3) {
+      int four[4];
+      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, four);
+      std::copy(four, four + 3, out + x);
+      x += 3;
+    }
+    for (; x < result.cols; ++x) {
+      out[x] = Avx2CrossAt(p + x * cn, static_cast<size_t>(row_values), tw, layout);
+    }
+  }
+}
+
+bool& WideCrossKernel() {
+  static bool on = __builtin_cpu_supports("avx2");
+  return on;
+}
+#endif
+
 void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
                     std::vector<int16_t>& widened) {
   const int cn = t.channels();
@@ -771,6 +887,12 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
     for (int i = 0; i < row_values; ++i) w[i] = p[i];
   }
   std::fill(widened.begin() + static_cast<std::ptrdiff_t>(values), widened.end(), int16_t{0});
+#if SOFTSIGHT_AVX2_CROSS
+  if (WideCrossKernel()) {
+    Avx2CrossRows(widened.data(), row_values, cn, t, result);
+    return;
+  }
+#endif
   for (int y = 0; y < result.rows; ++y) {
     int* out = result.ptr<int>(y);
     const int16_t* p = widened.data() + static_cast<size_t>(row_values) * y;
@@ -943,6 +1065,22 @@ bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplat
   (void)templ;
   (void)zncc;
   return false;
+#endif
+}
+
+bool WideCrossKernelAvailable() {
+#if SOFTSIGHT_AVX2_CROSS
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+void UseWideCrossKernel(bool on) {
+#if SOFTSIGHT_AVX2_CROSS
+  WideCrossKernel() = on && __builtin_cpu_supports("avx2");
+#else
+  (void)on;
 #endif
 }
 

@@ -139,6 +139,13 @@ void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& res
 bool MatchZnccAt(const cv::Mat& image, cv::Point top_left, const PreparedTemplate& templ,
                  float* zncc);
 
+// The cross-correlation (MatchZncc's and MatchSsd's sum I * T) runs in 256-bit AVX2 lanes where
+// the processor has them (asked at run time: the build itself targets the baseline), else in
+// 128-bit lanes; the same exact integer sums. Tests only: whether the AVX2 kernel can run here,
+// and a switch to the 128-bit one (on: the default where it can run).
+bool WideCrossKernelAvailable();
+void UseWideCrossKernel(bool on);
+
 // Slow scalar references, straight from the definitions (ZNCC in double with explicit means).
 // `mask` as in PreparedTemplate::Prepare.
 void MatchSadReference(const cv::Mat& image, const cv::Mat& templ, cv::Mat& result,

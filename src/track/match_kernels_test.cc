@@ -3,7 +3,9 @@
 #include "track/match_kernels.h"
 
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -330,6 +332,50 @@ TEST(MatchKernelsTest, WindowSumsAndCrossCorrelationExactForEveryRowLength) {
             }
           }
         }
+      }
+    }
+  }
+}
+
+// The AVX2 cross-correlation (where the processor has it) gives the 128-bit kernel's maps bit for
+// bit: SSD exactly the reference's, ZNCC the same floats, for every chunk layout (the cases'
+// widths, and mire-2's large dot's 72x54 template at 1.2x), gray and colour, masked or not, maps
+// 1 to 9 placements wide (the three-wide remainder reads the widened image's padding).
+TEST(MatchKernelsTest, WideCrossKernelGivesTheSameMaps) {
+  if (!WideCrossKernelAvailable()) GTEST_SKIP() << "no AVX2 on this processor";
+  cv::RNG rng(4545);
+  PreparedTemplate prepared;
+  ZnccScratch scratch;
+  cv::Mat wide_ssd, wide_zncc, narrow_ssd, narrow_zncc, reference;
+  std::vector<Case> cases(std::begin(kCases), std::end(kCases));
+  cases.push_back({72, 54, 1});
+  cases.push_back({86, 65, 1});
+  cases.push_back({25, 22, 3});
+  for (const Case& c : cases) {
+    const cv::Size templ_size(c.width, c.height);
+    const cv::Mat templ = RandomImage(rng, templ_size, c.channels);
+    for (const cv::Mat& mask : {EllipseMask(templ_size), cv::Mat()}) {
+      if (!prepared.Prepare(templ, mask)) continue;
+      for (int extra = 0; extra < 9; ++extra) {
+        SCOPED_TRACE(Name(c) + (mask.empty() ? " unmasked" : " masked") + ", " +
+                     std::to_string(extra + 1) + " placements wide");
+        cv::Mat frame = RandomImage(rng, {c.width + extra + 6, c.height + 5}, c.channels);
+        if (extra % 4 == 3) frame.setTo(cv::Scalar::all(255));
+        frame.at<uint8_t>(1, 2 * c.channels) = 0;  // Not flat.
+        const cv::Mat image = frame(cv::Rect(2, 1, c.width + extra, c.height + 3));
+        UseWideCrossKernel(true);
+        MatchSsd(image, prepared, wide_ssd, scratch);
+        MatchZncc(image, prepared, wide_zncc, scratch);
+        UseWideCrossKernel(false);
+        MatchSsd(image, prepared, narrow_ssd, scratch);
+        MatchZncc(image, prepared, narrow_zncc, scratch);
+        UseWideCrossKernel(true);
+        MatchSsdReference(image, templ, reference, mask);
+        EXPECT_EQ(CountDifferent(wide_ssd, reference), 0);
+        EXPECT_EQ(CountDifferent(wide_ssd, narrow_ssd), 0);
+        ASSERT_EQ(wide_zncc.size(), narrow_zncc.size());
+        EXPECT_EQ(std::memcmp(wide_zncc.data, narrow_zncc.data, wide_zncc.total() * sizeof(float)),
+                  0);
       }
     }
   }

@@ -10,6 +10,15 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+// ProjectLevels' byte shuffle for gray runs: a function compiled for SSSE3 by its target
+// attribute, called only where the processor reports it (GCC and Clang on x86-64).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && CV_SIMD128
+#define SOFTSIGHT_SSSE3_GRAY 1
+#include <immintrin.h>
+#else
+#define SOFTSIGHT_SSSE3_GRAY 0
+#endif
+
 namespace softsight::template_internal {
 
 std::string RectText(const cv::Rect& r) {
@@ -625,6 +634,44 @@ void ProjectLevelsReference(const cv::Mat& bgr, const cv::Mat& projection, cv::M
   }
 }
 
+#if SOFTSIGHT_SSSE3_GRAY
+namespace {
+// When the 16 BGR pixels at `p` (48 bytes) are gray, their first bytes into `o` and true: the
+// levels of 16 gray pixels when the projection leaves a gray level as it is (a gray recording
+// handed over as BGR, with the gray selection's projection of equal weights). The gray test of
+// ProjectLevels' gray16 (each byte but every third equals the byte after it) with one-instruction
+// byte alignment, then three byte shuffles instead of 16 lookups.
+__attribute__((target("ssse3"))) bool GrayFirstOfThree16(const uint8_t* p, uint8_t* o) {
+  const __m128i c0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+  const __m128i c1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16));
+  const __m128i c2 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 32));
+  // Byte i of next_k is byte i + 1 of the 48 (the last one, past them, is ignored).
+  const __m128i next0 = _mm_alignr_epi8(c1, c0, 1), next1 = _mm_alignr_epi8(c2, c1, 1);
+  const __m128i next2 = _mm_srli_si128(c2, 1);
+  const __m128i ignore0 = _mm_setr_epi8(0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0);
+  const __m128i ignore1 = _mm_setr_epi8(0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0);
+  const __m128i ignore2 = _mm_setr_epi8(-1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1);
+  const __m128i same = _mm_and_si128(
+      _mm_and_si128(_mm_or_si128(_mm_cmpeq_epi8(c0, next0), ignore0),
+                    _mm_or_si128(_mm_cmpeq_epi8(c1, next1), ignore1)),
+      _mm_or_si128(_mm_cmpeq_epi8(c2, next2), ignore2));
+  if (_mm_movemask_epi8(same) != 0xFFFF) return false;
+  const __m128i m0 = _mm_setr_epi8(0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+  const __m128i m1 = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14, -1, -1, -1, -1, -1);
+  const __m128i m2 = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 1, 4, 7, 10, 13);
+  const __m128i levels = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(c0, m0), _mm_shuffle_epi8(c1, m1)),
+                                      _mm_shuffle_epi8(c2, m2));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(o), levels);
+  return true;
+}
+
+bool HasSsse3() {
+  static const bool has = __builtin_cpu_supports("ssse3");
+  return has;
+}
+}  // namespace
+#endif
+
 #if CV_SIMD128
 // Each BGR pixel of `bgr` (CV_8UC3, at least 16 wide) -> one level of `out` (CV_8UC1, same size),
 // 16 pixels at a time: `four(b, g, r)` turns four pixels' channels, widened to 32 bits, into
@@ -689,6 +736,7 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
   struct GrayTable {
     float m[4] = {0, 0, 0, 0};
     bool valid = false;
+    bool identity = false;  // level[v] == v for every v.
     uint8_t level[256] = {};
   };
   thread_local std::array<GrayTable, 8> tables;
@@ -708,10 +756,15 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
         found->level[v + k] = static_cast<uint8_t>(std::clamp(projected[k], 0, 255));
       }
     }
+    found->identity = true;
+    for (int v = 0; v < 256; ++v) found->identity = found->identity && found->level[v] == v;
     std::memcpy(found->m, m, sizeof(found->m));
     found->valid = true;
   }
   const GrayTable& table = *found;
+#if SOFTSIGHT_SSSE3_GRAY
+  const bool identity = table.identity && HasSsse3();
+#endif
   // A gray recording handed over as BGR (ViSP's mire-2): a run of 16 gray pixels is looked up,
   // at a third of the projection's instructions (issue 45: the projection was a tenth of the
   // ZNCC session there). Gray: each of the 48 bytes but every third equals the byte after it.
@@ -719,6 +772,12 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
   const cv::v_uint8x16 ignore1(0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0);
   const cv::v_uint8x16 ignore2(255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255);
   const auto gray16 = [&](const uint8_t* p, uint8_t* o) {
+#if SOFTSIGHT_SSSE3_GRAY
+    // The table leaves every level as it is (the gray selection's equal weights, issue 45: the
+    // test and lookups were most of the projection's instructions on mire-2): the levels are the
+    // bytes.
+    if (identity) return GrayFirstOfThree16(p, o);
+#endif
     const cv::v_uint8x16 c0 = cv::v_load(p), c1 = cv::v_load(p + 16), c2 = cv::v_load(p + 32);
     const cv::v_uint8x16 next0 = cv::v_extract<1>(c0, c1), next1 = cv::v_extract<1>(c1, c2);
     const cv::v_uint8x16 next2 = cv::v_extract<1>(c2, c2);  // Its last byte is ignored.

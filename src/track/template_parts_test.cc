@@ -201,6 +201,8 @@ TEST(TemplateParts, ProjectLevelsIsTheReferences) {
   projections.push_back((cv::Mat_<float>(1, 4) << 0.5f, -0.3f, 0.2f, 76.5f));
   projections.push_back((cv::Mat_<float>(1, 4) << -0.2f, -0.2f, 0.6f, 102.0f));
   projections.push_back((cv::Mat_<float>(1, 4) << 0.7f, 0.7f, 0.7f, -20.0f));  // Saturates.
+  // Equal weights: a gray level projects to itself (the gray runs' bytes are copied).
+  projections.push_back((cv::Mat_<float>(1, 4) << 1.0f / 3, 1.0f / 3, 1.0f / 3, 0.0f));
   cv::Mat fast, reference, opencv;
   for (const cv::Mat& m : projections) {
     ASSERT_EQ(m.type(), CV_32FC1);

@@ -988,6 +988,15 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
     Native(frame, at, blob_native_);
     BlobChannel(blob_native_, blob_gray_);
   }
+  // A gray window inside the part converted this update is a view of it, with that part's row
+  // step: BlobMeter's pixel-index flood and span fill need a continuous patch, and took the
+  // reference flood (points in vectors), fill and cv::moments there, several times the work
+  // (issue 45: a quarter of ViSP's mire-2 blob checks, the small dots'). The same pixels
+  // copied: the same component, levels and bits.
+  if (!blob_gray_.isContinuous()) {
+    blob_gray_.copyTo(blob_continuous_);
+    blob_gray_ = blob_continuous_;
+  }
   // Where the template puts its blob (patch coordinates): the learned centroid at this rung.
   const cv::Point2d expected =
       fix.centre - HalfSize(size) - cv::Point2d(at.tl()) + rung.blob_anchor;

@@ -233,6 +233,7 @@ class TemplateTracker final : public Tracker {
   double core_radius_px_ = 0.0;  // The core disc's radius, in the selected template.
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;
+  cv::Mat blob_continuous_;  // blob_gray_ copied when it is a view (BlobShift).
 };
 
 }  // namespace softsight::template_internal
