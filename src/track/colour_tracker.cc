@@ -320,6 +320,8 @@ BlobEvidence EvidenceOf(const ColourBlob& blob, const ColourModel& model) {
     evidence.noise_levels = 0.5 * (blob.core_sigma + blob.ring_sigma);
     evidence.contrast_levels = cv::norm(blob.core_colour - blob.ring_colour);
     evidence.excess_asymmetry_px = blob.asymmetry_px - model.asymmetry_px;
+    // (Not for a blob placed by its rim: the fitted circle's centre does not rest on symmetry.)
+    if (!blob.rim_placed) evidence.own_asymmetry_px = blob.asymmetry_px;
   }
   evidence.rim_placed = blob.rim_placed;
   if (blob.rim_placed) {

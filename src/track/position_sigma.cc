@@ -11,7 +11,7 @@ namespace {
 constexpr double kFloorPx = 0.05;            // Quantisation and compression: any position.
 constexpr double kBlobShapePerRadius = 0.04;  // Segmentation bias, per px of the blob's radius.
 constexpr double kRimPlacedPerRadius = 0.10;  // A circle fitted to part of a rim.
-constexpr double kAsymmetryShare = 0.5;       // Of the excess asymmetry.
+constexpr double kAsymmetryShare = 0.5;       // Of the excess (or the blob's own) asymmetry.
 constexpr double kDisagreementShare = 1.0;    // Of the soft and binary centroids' disagreement.
 constexpr double kDefinitionShare = 0.5;      // Of the spread between channels (truth between).
 constexpr double kFringeShare = 0.5;          // Of the pale fringe's pull on the centroid.
@@ -34,7 +34,8 @@ double BlobCentroidSigmaPx(const BlobEvidence& blob) {
   const double r = Radius(blob.area_px);
   const double shape = (blob.rim_placed ? kRimPlacedPerRadius : kBlobShapePerRadius) * r;
   const double noise = NoiseSigmaPx(blob);
-  const double asymmetry = kAsymmetryShare * std::max(blob.excess_asymmetry_px, 0.0);
+  const double asymmetry =
+      kAsymmetryShare * std::max({blob.excess_asymmetry_px, blob.own_asymmetry_px, 0.0});
   const double disagreement = kDisagreementShare * blob.centroid_disagreement_px;
   const double definition = kDefinitionShare * blob.definition_spread_px;
   const double fringe = kFringeShare * blob.fringe_shift_px;

@@ -21,6 +21,11 @@ struct BlobEvidence {
   // How much more asymmetric the blob is than the marker when whole (a part covered, cut, or
   // smeared by motion), px.
   double excess_asymmetry_px = 0;
+  // How far the blob's centroid lies from the centre of its smallest enclosing circle, px: about
+  // 0 for a whole disc, ellipse or any shape symmetric about its centre, as markers are. A blob
+  // learned asymmetric (a dome whose lit top the range left out, a crescent of a marker whose top
+  // the exposure clipped to white) has its centre somewhere between the two, whatever the model.
+  double own_asymmetry_px = 0;
   bool rim_placed = false;     // The centre is a circle fitted to part of the rim.
   // How far the reported (soft) centroid lies from the mask's own (binary) one, px. On a flat
   // printed dot both agree to a few hundredths; where they part, what is marker and what is not

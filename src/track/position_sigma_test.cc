@@ -31,6 +31,20 @@ TEST(PositionSigma, ABlobsSigmaGrowsWithSizeNoisePartialViewAndARimFit) {
   EXPECT_GT(BlobCentroidSigmaPx(rim), base);
 }
 
+TEST(PositionSigma, ABlobLearnedAsymmetricIsNoSurerForItsModelBeingSo) {
+  // A crescent: a dome whose top the exposure clipped to white, its centroid 3 px from the centre
+  // of its smallest enclosing circle. Learned so in its first frame, it is no more asymmetric than
+  // its model (excess 0), but the marker's centre still lies somewhere between the two.
+  const double base = BlobCentroidSigmaPx(Disc(8));
+  BlobEvidence crescent = Disc(8);
+  crescent.own_asymmetry_px = 3;
+  EXPECT_GE(BlobCentroidSigmaPx(crescent), 1.5);
+  // A whole disc's own asymmetry is the pixel grid's few tenths: its sigma barely moves.
+  BlobEvidence whole = Disc(8);
+  whole.own_asymmetry_px = 0.2;
+  EXPECT_LT(BlobCentroidSigmaPx(whole), base + 0.05);
+}
+
 TEST(PositionSigma, ABlobsSigmaCoversTheSoftAndBinaryCentroidsDisagreement) {
   // A lit dome: its pale flank counts little in the soft centroid, its shaded one, outside the hue
   // range, counts in it alone; the two centroids part by 0.9 px and the truth lies about as far

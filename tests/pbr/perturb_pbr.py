@@ -248,8 +248,8 @@ def main():
                             f"(> {s['tolerance']:.3g} px) {s['wrong']}{worst}, reported while "
                             f"covered {s['reported_covered']}")
                     table.append(dict(scene=name, change=change, config=cfg, score=s))
-                if not args.markdown:
-                    print(line, flush=True)
+                # With --markdown the table goes to stdout at the end, the progress to stderr.
+                print(line, file=sys.stderr if args.markdown else sys.stdout, flush=True)
     finally:
         if not args.keep:
             subprocess.run(['rm', '-rf', root])
