@@ -50,7 +50,12 @@ int RunPlugin(const CommandInfo& command, int argc, char** argv) {
   std::string why;
   for (const std::filesystem::path& path : PluginCandidates(plugin_name)) {
     if (!std::filesystem::exists(path)) continue;
-    void* plugin = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    // Lazy: a function of the ~260 libraries the plugin links is bound when first called, not
+    // all at load (RTLD_NOW bound every one, ~65M instructions, a tenth of the load; a bare
+    // program's libraries are bound lazily too). The plugin and softsight's own libraries are
+    // linked with -z now (src/app/CMakeLists.txt, cmake/softsight.cmake): their calls are still
+    // all bound here, so one missing from a library fails this dlopen with the line below.
+    void* plugin = dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
     if (plugin == nullptr) {
       why = dlerror();
       break;

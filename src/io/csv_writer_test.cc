@@ -4,7 +4,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -165,6 +172,44 @@ TEST(CsvWriter, FileSizeLimitLeavesOnlyCompleteRows) {
   for (size_t i = 1; i < lines.size(); ++i) {
     EXPECT_EQ(testing::SplitCsv(lines[i]).size(), columns) << "row " << i;
   }
+}
+
+
+// AppendCsvNumber prints "%.Nf" and "%.Ng" with std::to_chars (issue 45): the text must be
+// snprintf's, byte for byte, or the CSVs would change.
+TEST(CsvColumns, NumbersPrintAsSnprintfPrintsThem) {
+  std::vector<double> values = {0.0, -0.0, 0.5, 1.5, 2.5, -2.5, 0.00005, 0.00015, 0.000049999,
+                                1e-300, 123.45675, 179.8817, -58102.58215, 1e15, 1e21, 1e22,
+                                1e300, -1e300, 9.99995, 0.1 + 0.2, 1.0 / 3.0,
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::quiet_NaN(),
+                                -std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::denorm_min(),
+                                std::numeric_limits<double>::max()};
+  uint64_t state = 45;
+  for (int i = 0; i < 20000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double unit = static_cast<double>(state >> 11) / 9007199254740992.0;
+    // Pixel-sized values, and wider magnitudes; on the grid of ties of 3-6 decimals too.
+    values.push_back((unit - 0.3) * 4000.0);
+    values.push_back(std::ldexp(unit - 0.5, static_cast<int>(state % 120) - 60));
+    values.push_back(std::round((unit - 0.5) * 2e7) / 2e4 + 0.00005);
+  }
+  for (const char* format : {"%.3f", "%.4f", "%.6f", "%.6g", "%.10g", "%.0f", "%.12f", "%.0g"}) {
+    for (const double value : values) {
+      char expected[64];
+      std::snprintf(expected, sizeof(expected), format, value);
+      std::string row = "x,";
+      AppendCsvNumber(row, value, format);
+      ASSERT_EQ(row, std::string("x,") + expected) << format << " of " << value;
+    }
+  }
+  std::string row;
+  AppendCsvNumber(row, std::nullopt, "%.4f");
+  EXPECT_EQ(row, "");
+  AppendCsvNumber(row, 2.0, "%5.1f");  // Not a format of the fast path: snprintf's text.
+  EXPECT_EQ(row, "  2.0");
 }
 
 }  // namespace

@@ -31,11 +31,23 @@ int DecoderThreads() {
 
 }  // namespace
 
-LibavVideoReader::LibavVideoReader(const std::string& path) : pts_(AV_NOPTS_VALUE) {
+LibavVideoReader::LibavVideoReader(const std::string& path, bool (*wanted_tag)(uint32_t))
+    : pts_(AV_NOPTS_VALUE) {
   format_ = avformat_alloc_context();
   if (format_ == nullptr) return;
   // On failure avformat_open_input frees the context (and sets it to null).
   if (avformat_open_input(&format_, path.c_str(), nullptr, nullptr) != 0) return;
+  if (wanted_tag != nullptr) {
+    // The header's streams (AVI, MP4, MKV list theirs there): the first video one's tag.
+    uint32_t tag = 0;
+    for (unsigned i = 0; i < format_->nb_streams; ++i) {
+      if (format_->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_VIDEO) {
+        tag = format_->streams[i]->codecpar->codec_tag;
+        break;
+      }
+    }
+    if (tag == 0 || !wanted_tag(tag)) return;
+  }
   if (avformat_find_stream_info(format_, nullptr) < 0) return;
   // OpenCV takes the first video stream (not av_find_best_stream's choice).
   for (unsigned i = 0; i < format_->nb_streams; ++i) {
@@ -170,6 +182,38 @@ bool LibavVideoReader::read(cv::Mat& bgr) {
   cv::Mat(height_, width_, CV_8UC3, bgr_->data[0], static_cast<size_t>(bgr_->linesize[0]))
       .copyTo(bgr);
   return true;
+}
+
+std::optional<LibavVideoReader::Header> LibavVideoReader::unrotated_header() const {
+  if (codec_ == nullptr) return std::nullopt;
+  AVStream* stream = format_->streams[stream_];
+  // OpenCV 4.6's CAP_PROP_FOURCC is the codec tag when there is one (else a name it looks up).
+  const uint32_t tag = stream->codecpar->codec_tag;
+  if (tag == 0) return std::nullopt;
+  // Its rotation comes from the display matrix (or, with older FFmpeg, the "rotate" tag).
+  if (av_stream_get_side_data(stream, AV_PKT_DATA_DISPLAYMATRIX, nullptr) != nullptr ||
+      av_dict_get(stream->metadata, "rotate", nullptr, 0) != nullptr) {
+    return std::nullopt;
+  }
+  // OpenCV 4.6's get_fps(): the stream's average frame rate (its fallback, when that is 0, is
+  // left to VideoCapture), and get_total_frames(): the header's count, else the duration times
+  // that rate.
+  constexpr double kEpsZero = 0.000025;  // OpenCV's eps_zero.
+  const double fps = ToDouble(stream->avg_frame_rate);
+  if (fps < kEpsZero) return std::nullopt;
+  int64_t frames = stream->nb_frames;
+  if (frames == 0) {
+    double duration = static_cast<double>(format_->duration) / AV_TIME_BASE;
+    if (duration < kEpsZero) {
+      duration = static_cast<double>(stream->duration) * ToDouble(stream->time_base);
+    }
+    frames = static_cast<int64_t>(std::floor(duration * fps + 0.5));
+  }
+  Header header;
+  header.frame_count = static_cast<double>(frames);
+  header.fps = fps;
+  header.fourcc = tag;
+  return header;
 }
 
 int64_t LibavVideoReader::frames_decoded_ahead() const {

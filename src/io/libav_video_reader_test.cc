@@ -75,6 +75,14 @@ void ExpectSameAsVideoCapture(const std::string& path, int64_t expected_frames,
   ASSERT_TRUE(reader.opened()) << path;
   cv::VideoCapture capture(path, cv::CAP_FFMPEG);
   ASSERT_TRUE(capture.isOpened()) << path;
+  // The header's figures, where the reader gives them, are VideoCapture's (VideoFileSource then
+  // opens no VideoCapture).
+  if (const std::optional<LibavVideoReader::Header> header = reader.unrotated_header()) {
+    EXPECT_EQ(header->frame_count, capture.get(cv::CAP_PROP_FRAME_COUNT)) << path;
+    EXPECT_EQ(header->fps, capture.get(cv::CAP_PROP_FPS)) << path;
+    EXPECT_EQ(header->fourcc, static_cast<uint32_t>(capture.get(cv::CAP_PROP_FOURCC))) << path;
+    EXPECT_EQ(capture.get(cv::CAP_PROP_ORIENTATION_META), 0.0) << path;
+  }
   if (seek_to >= 0) {
     reader.seek(seek_to);
     ASSERT_TRUE(capture.set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(seek_to)));
@@ -120,6 +128,30 @@ TEST(LibavVideoReader, GivesVideoCapturesFramesOfMpeg4) {
   for (const char* name : {"clip.mp4", "clip.avi"}) {
     ExpectSameAsVideoCapture(WriteWithOpenCv(dir.file(name), "mp4v", {320, 240}, 30), 30);
   }
+}
+
+// H.264 in MP4 and MPEG-4 in MP4 and AVI name their codec by a tag: the reader gives the header's
+// figures (checked against VideoCapture's in ExpectSameAsVideoCapture), and opens such a file
+// only when the tag is wanted; a file whose tag is not wanted is left closed.
+TEST(LibavVideoReader, GivesTheHeaderOfAFileWhoseContainerTagsItsCodec) {
+  TempDir dir;
+  const auto capture_fps = [](const std::string& path) {
+    return cv::VideoCapture(path, cv::CAP_FFMPEG).get(cv::CAP_PROP_FPS);
+  };
+  const std::string h264 = WriteH264(dir.file("clip.mp4"), {320, 240}, 20, 12);
+  const std::string mpeg4 = WriteWithOpenCv(dir.file("clip.avi"), "mp4v", {320, 240}, 20);
+  const std::string huffyuv = WriteWithOpenCv(dir.file("huffyuv.avi"), "HFYU", {320, 240}, 5);
+  for (const std::string& path : {h264, mpeg4}) {
+    LibavVideoReader reader(path, [](uint32_t tag) { return tag != 0; });
+    ASSERT_TRUE(reader.opened()) << path;
+    const std::optional<LibavVideoReader::Header> header = reader.unrotated_header();
+    ASSERT_TRUE(header.has_value()) << path;
+    EXPECT_EQ(header->frame_count, 20.0) << path;
+    EXPECT_EQ(header->fps, capture_fps(path)) << path;
+    ExpectSameAsVideoCapture(path, 20);
+  }
+  EXPECT_FALSE(LibavVideoReader(huffyuv, [](uint32_t tag) { return tag != 0x55594648; }).opened());
+  EXPECT_TRUE(LibavVideoReader(huffyuv, [](uint32_t tag) { return tag == 0x55594648; }).opened());
 }
 
 TEST(LibavVideoReader, SeeksWhereVideoCaptureSeeks) {
