@@ -263,8 +263,15 @@ class BlobMeter {
     double lo = 0, hi = 0;
     cv::minMaxLoc(gray, &lo, &hi, nullptr, nullptr, mask.empty() ? cv::noArray() : mask);
     range_ = hi - lo;
+    asymmetry_ = Asymmetry();
     return true;
   }
+
+  // After Learn: how far the learned blob's centroid lies from the centre of its smallest
+  // enclosing circle, px (about 0 for a whole disc or any shape symmetric about its centre). A
+  // crescent (a pale dome whose top the exposure clipped to white) puts the marker's centre
+  // anywhere between the two: the reference point of every match carries that (the sigma's).
+  double asymmetry_px() const { return asymmetry_; }
 
   // How much the learned blob stands out, after Learn: the levels between it and the level at
   // which it would join its surroundings, as a fraction of the patch's whole range of levels (a
@@ -330,6 +337,19 @@ class BlobMeter {
   const cv::Rect& blob_box() const { return box_; }
 
  private:
+  // The learned component's (label_ over box_) asymmetry_px.
+  double Asymmetry() const {
+    std::vector<cv::Point> points;
+    cv::findNonZero(label_(box_), points);
+    if (points.size() < 3) return 0.0;
+    cv::Point2f centre;
+    float radius = 0;
+    cv::minEnclosingCircle(points, centre, radius);
+    const cv::Moments m = cv::moments(label_(box_), true);
+    if (!(m.m00 > 0)) return 0.0;
+    return cv::norm(cv::Point2d(m.m10 / m.m00, m.m01 / m.m00) - cv::Point2d(centre));
+  }
+
   // Measure's work once Segment has found the component (label_, box_) and its levels.
   bool MeasureSegmented(const cv::Mat& gray, const cv::Mat& mask, double low, double high,
                         cv::Point2d* centroid, double* area) {
@@ -534,6 +554,7 @@ class BlobMeter {
   double contrast_ = 0;
   double learned_contrast_ = 0;
   double range_ = 0;
+  double asymmetry_ = 0;  // asymmetry_px(); once, at Learn.
   double located_low_ = 0, located_high_ = 0;  // The last Locate's levels, for MeasureLocated.
   bool reference_ = false;  // use_reference.
   // FillUnmasked's count and coordinate sums of the component (frame of the patch), valid when

@@ -1262,6 +1262,7 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
     blob.area_px = blob_.area() * rung_scale() * rung_scale();
     blob.centroid_disagreement_px = blob_disagreement_px_;
     blob.definition_spread_px = anchor_spread_px_ * rung_scale();
+    blob.own_asymmetry_px = blob_.asymmetry_px() * rung_scale();
   }
   const cv::Size size = current().templ.size();
   observation.sigma_px = TemplateMatchSigmaPx(fix->zncc, size.width, size.height, blob);

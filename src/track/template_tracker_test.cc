@@ -559,6 +559,47 @@ TEST(TemplateTrackerTest, AMarkerWhoseChannelsPutItsCentreApartCarriesThatInItsS
   }
 }
 
+// A dome whose top the exposure clipped to the background's white: what the box shows of it is
+// the disc less its top, whose centroid lies 1-2 px below the marker's centre. The match reports
+// that centroid in every frame; its sigma carries the blob's asymmetry.
+TEST(TemplateTrackerTest, ACrescentOfAMarkerCarriesItsAsymmetryInItsSigma) {
+  const cv::Point2d centre(60.3, 50.6);
+  constexpr double kRadius = 8.0;
+  auto render = [&](bool clipped) {
+    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(250, 250, 250));
+    for (int y = 0; y < frame.rows; ++y) {
+      for (int x = 0; x < frame.cols; ++x) {
+        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
+        if (clipped && y < centre.y - 3) continue;  // The top, white as the background.
+        frame.at<cv::Vec3b>(y, x) = cv::Vec3b(60, 160, 60);
+      }
+    }
+    return frame;
+  };
+  double sigma_whole = 0;
+  for (const bool clipped : {false, true}) {
+    SCOPED_TRACE(clipped ? "top clipped" : "whole");
+    const cv::Mat frame = render(clipped);
+    MarkerSpec spec;
+    spec.name = "dome";
+    spec.params = ParamsForMethod("zncc", {TemplateParams{}});
+    std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+    tracker->init(frame, RectAround(centre, 25));
+    const Observation o = tracker->update(frame);
+    ASSERT_TRUE(o.found());
+    ASSERT_TRUE(o.sigma_px.has_value());
+    const double error = cv::norm(*o.position_px - centre);
+    if (!clipped) {
+      sigma_whole = *o.sigma_px;
+      EXPECT_LT(error, 0.2);
+    } else {
+      EXPECT_GT(error, 1.0);  // The centroid of what shows, not the dome's centre.
+      EXPECT_LE(error, 3 * *o.sigma_px) << "error " << error << " px, sigma " << *o.sigma_px;
+      EXPECT_GT(*o.sigma_px, sigma_whole + 0.5);
+    }
+  }
+}
+
 // Two white dots on a dark card, drawn anti-aliased at sub-pixel centres (cv::circle with 4
 // fractional bits): look-alikes, as the dots on a hand-held plate are.
 cv::Mat TwoDots(cv::Point2d a, cv::Point2d b, double radius, std::optional<cv::Rect> cover = {}) {
