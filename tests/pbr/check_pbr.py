@@ -169,10 +169,10 @@ def angle_at(a, b, c):
     return min(d, 360 - d)
 
 
-def score(track_csv, truth_csv, name_map, group):
-    """Scores one CSV against the truth: per marker-frame found/visible, wrong (> TOL), reported
-    while covered (found with visibility < 0.5), distances; the angle error at each inner marker
-    of the triple or chain in the frames where it and its two neighbours are found."""
+def score(track_csv, truth_csv, name_map, group, tolerance=TOL):
+    """Scores one CSV against the truth: per marker-frame found/visible, wrong (> tolerance, px),
+    reported while covered (found with visibility < 0.5), distances; the angle error at each inner
+    marker of the triple or chain in the frames where it and its two neighbours are found."""
     with open(track_csv, newline='') as f:
         rows = {int(r['frame']): r for r in csv.DictReader(f)}
     with open(truth_csv, newline='') as f:
@@ -205,7 +205,7 @@ def score(track_csv, truth_csv, name_map, group):
         normalised = max(abs(ex), abs(ey)) / float(row[f'{name}_sigma_px'])
         s['within_3_sigma'] += normalised <= 3
         s['beyond_5_sigma'] += normalised > 5
-        if d > TOL:
+        if d > tolerance:
             s['wrong'] += 1
             if s['worst'] is None or d > s['worst'][0]:
                 s['worst'] = (d, r['frame'], r['marker'])

@@ -35,9 +35,18 @@ import cv2
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-_spec = importlib.util.spec_from_file_location('check_pbr', os.path.join(HERE, 'check_pbr.py'))
-check_pbr = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(check_pbr)
+
+
+def _load(name, path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+check_pbr = _load('check_pbr', os.path.join(HERE, 'check_pbr.py'))
+# The changes the real footage gets (dim60, bright, gradient, noise8, jpeg30) are its own.
+perturb_real = _load('perturb_real', os.path.join(HERE, '..', 'real', 'perturb_real.py'))
 
 CHANGES = ['dim60', 'bright', 'warm', 'cold', 'gradient', 'noise8', 'jpeg30', 'scale75']
 
@@ -47,27 +56,16 @@ def scale_of(change):
 
 
 def change_frame(image, change, rng):
-    """One frame (BGR) changed one way."""
-    if change == 'jpeg30':
-        ok, buf = cv2.imencode('.jpg', image, [cv2.IMWRITE_JPEG_QUALITY, 30])
-        return cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    """One frame (BGR) changed one way: a colour cast or a smaller sensor here, the rest as
+    perturb_real.py changes the real footage."""
     if change == 'scale75':
         size = (round(image.shape[1] * 0.75), round(image.shape[0] * 0.75))
         return cv2.resize(image, size, interpolation=cv2.INTER_AREA)
-    levels = image.astype(np.float32)
-    if change == 'dim60':
-        levels *= 0.6
-    elif change == 'bright':
-        levels = levels * 1.2 + 20
-    elif change == 'warm':
-        levels *= np.array([0.75, 1.0, 1.15], np.float32)
-    elif change == 'cold':
-        levels *= np.array([1.15, 1.0, 0.8], np.float32)
-    elif change == 'gradient':
-        levels *= np.linspace(1.0, 0.55, image.shape[1], dtype=np.float32)[None, :, None]
-    elif change == 'noise8':
-        levels += rng.normal(0.0, 8.0, levels.shape).astype(np.float32)
-    return np.clip(np.rint(levels), 0, 255).astype(np.uint8)
+    if change in ('warm', 'cold'):
+        gains = [0.75, 1.0, 1.15] if change == 'warm' else [1.15, 1.0, 0.8]  # B, G, R
+        levels = image.astype(np.float32) * np.array(gains, np.float32)
+        return np.clip(np.rint(levels), 0, 255).astype(np.uint8)
+    return perturb_real.change_frame(image, change, rng)
 
 
 def to_scaled(v, s):
@@ -143,11 +141,7 @@ def run_case(program, name, change, root):
             continue
         names, group = check_pbr.config_markers(os.path.join(target, f'{cfg}.yaml'))
         tolerance = check_pbr.TOL * s
-        saved, check_pbr.TOL = check_pbr.TOL, tolerance
-        try:
-            sc = check_pbr.score(out, truth_csv, dict(zip(truth_names, names)), group)
-        finally:
-            check_pbr.TOL = saved
+        sc = check_pbr.score(out, truth_csv, dict(zip(truth_names, names)), group, tolerance)
         sc['tolerance'] = tolerance
         results.append((cfg, sc))
     return results
