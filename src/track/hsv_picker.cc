@@ -502,24 +502,28 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
     return PickHsvFromSamples(*disc, options, nullptr);
   };
   // Takes the pick at the centre of the blob `first` gives through `from`, if there is one and
-  // it is farther than `beyond` px, and the pick there succeeds.
+  // it is farther than `beyond` px, and the pick there succeeds: true when it took it.
   const auto recentre = [&](const HsvPick& first, cv::Point2d from, double beyond) {
     const std::optional<cv::Point2d> centre = BlobCentroidAt(bgr, from, first);
-    if (!centre || cv::norm(*centre - from) <= beyond) return;
+    if (!centre || cv::norm(*centre - from) <= beyond) return false;
     std::vector<cv::Vec3b> resampled;
-    if (std::optional<HsvPick> repick = pick_at(*centre, &resampled)) {
-      pick = repick;
-      if (!gray) samples = std::move(resampled);
-      sampled_at = *centre;
-    }
+    std::optional<HsvPick> repick = pick_at(*centre, &resampled);
+    if (!repick) return false;
+    pick = repick;
+    if (!gray) samples = std::move(resampled);
+    sampled_at = *centre;
+    return true;
+  };
+  // A click near a marker's rim: the disc holds as much of the surroundings as of the marker.
+  // The half disc at the click holds less of them.
+  const auto half_disc_colour_pick = [&] {
+    return PickHsvFromSamples(SampleDisc(bgr, click_px, r / 2), options, nullptr);
   };
   if (!pick && r > 1) {
-    // A click near a marker's rim: the disc holds as much of the surroundings as of the marker.
-    // The half disc at the click may show it; it is then sampled at the centre of its blob.
-    std::string unused;
-    std::optional<HsvPick> small = PickHsvFromSamples(SampleDisc(bgr, click_px, r / 2), options,
-                                                      &unused);
+    // The half disc may show the marker; it is then sampled at the centre of its blob.
+    std::optional<HsvPick> small = half_disc_colour_pick();
     gray = !small;
+    std::string unused;
     if (!small) small = PickGrayDot(bgr, click_px, r / 2, &unused);
     if (small) recentre(*small, click_px, -1.0);
   }
@@ -529,51 +533,58 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
     // wide enough to take those in. The marker's centre is the centre of the blob those ranges
     // give through the click; the ranges are picked again there.
     recentre(*pick, sampled_at, kRecentrePx);
-    if (!gray && r > 1 && SurroundingsPassing(bgr, sampled_at, *pick, r) >= kInseparablePick) {
+    // How much of the marker's near surroundings the pick's range passes, for the pick as it
+    // stands (measured again whenever the pick or where it was sampled changes).
+    double passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
+    if (!gray && r > 1 && passing >= kInseparablePick) {
       // A click near a coloured marker's rim may give ranges wide enough for its shadow and the
-      // bench beside it, which then join it. The half disc at the click holds less of them: its
-      // ranges, sampled again at the centre of the blob they give, are taken if they tell the
-      // marker from its surroundings.
-      if (std::optional<HsvPick> small =
-              PickHsvFromSamples(SampleDisc(bgr, click_px, r / 2), options, nullptr)) {
+      // bench beside it, which then join it. The half disc's ranges, sampled again at the centre
+      // of the blob they give, are taken if they tell the marker from its surroundings.
+      if (std::optional<HsvPick> small = half_disc_colour_pick()) {
         const std::optional<HsvPick> wide = pick;
         const cv::Point2d wide_at = sampled_at;
         std::vector<cv::Vec3b> wide_samples = samples;
         pick.reset();
         recentre(*small, click_px, -1.0);
-        if (!pick || SurroundingsPassing(bgr, sampled_at, *pick, r) >= kInseparablePick) {
+        const double narrow = pick ? SurroundingsPassing(bgr, sampled_at, *pick, r) : 1.0;
+        if (narrow >= kInseparablePick) {
           pick = wide;
           sampled_at = wide_at;
           samples = std::move(wide_samples);
+        } else {
+          passing = narrow;
         }
       }
     }
     if (!gray && pick->s.lo == options.min_saturation) {
       // The sampled saturations reach the floor: the marker may be paler in places than the disc.
       LowerSaturationFloorToSurroundings(bgr, sampled_at, samples, r, &*pick);
+      if (pick->s.lo != options.min_saturation) {
+        passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
+      }
     }
-    if (!gray) {
+    if (!gray && passing >= kLeakyColourPick) {
       // A white dot under tinted light (a warm lamp, a camera without white balance) takes the
       // light's colour, and so do the surfaces around it; sensor noise gives a black dot's
       // pixels hues. Such a colour range passes the marker's surroundings too (or not the
       // marker: noise), while the dot stands out from them by its gray level. The pick that
       // tells the marker from its near surroundings better is the marker's kind; a colour range
       // that passes little of them stays (a red dome is also darker than white silicone).
-      const double colour_passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
-      if (colour_passing >= kLeakyColourPick) {
-        std::string unused = why;
-        std::optional<HsvPick> dot = PickGrayDot(bgr, sampled_at, r, &unused);
-        if (dot && SurroundingsPassing(bgr, sampled_at, *dot, r) < colour_passing) {
+      std::string unused = why;
+      if (std::optional<HsvPick> dot = PickGrayDot(bgr, sampled_at, r, &unused)) {
+        const double dot_passing = SurroundingsPassing(bgr, sampled_at, *dot, r);
+        if (dot_passing < passing) {
           pick = dot;
           gray = true;
-          recentre(*pick, sampled_at, kRecentrePx);
+          passing = recentre(*pick, sampled_at, kRecentrePx)
+                        ? SurroundingsPassing(bgr, sampled_at, *pick, r)
+                        : dot_passing;
         }
       }
     }
     // Found means verified, from the pick on: a range that passes most of what surrounds the
     // marker (a pale dome's colour under a lamp of its tint, which the white silicone takes
     // too) tracks the surroundings, not the marker.
-    const double passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
     if (passing >= kInseparablePick) {
       why = "the " + PickName(*pick) + " range picked here passes " +
             (passing >= 1.0 ? std::string("the surroundings too (its blob is not marker-sized)")
