@@ -329,22 +329,29 @@ TEST(HsvPickerTest, TheFloorStaysWhereTheSurroundingsShareTheMarkersHueOrNothing
 namespace softsight {
 namespace {
 
-TEST(HsvPickerTest, AnInkDotUnderWarmLightIsBlackNotRed) {
-  // A black ink dot lit by a warm lamp: levels 5-20, red a few above blue, so its saturation is
-  // 100-200 (noise and tint over a tiny value) and its hue the lamp's. It is a black dot.
-  std::mt19937 rng(11);
-  std::uniform_int_distribution<int> noise(-3, 3);
-  cv::Mat image(80, 80, CV_8UC3);
+// A square image `side` px wide: a dot of radius 9 at its centre, of BGR levels `dot`, on `ground`,
+// each pixel's three channels moved by the same noise, uniform in -spread..spread (seed `seed`).
+cv::Mat TintedDotImage(int side, cv::Vec3i dot, cv::Vec3i ground, int spread, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> noise(-spread, spread);
+  cv::Mat image(side, side, CV_8UC3);
+  const int c = side / 2;
   for (int y = 0; y < image.rows; ++y) {
     for (int x = 0; x < image.cols; ++x) {
-      const bool dot = (x - 40) * (x - 40) + (y - 40) * (y - 40) <= 9 * 9;
-      const cv::Vec3i level = dot ? cv::Vec3i(6, 10, 16) : cv::Vec3i(70, 100, 130);
+      const cv::Vec3i level = (x - c) * (x - c) + (y - c) * (y - c) <= 9 * 9 ? dot : ground;
       const int n = noise(rng);
       image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(level[0] + n),
                                             cv::saturate_cast<uchar>(level[1] + n),
                                             cv::saturate_cast<uchar>(level[2] + n));
     }
   }
+  return image;
+}
+
+TEST(HsvPickerTest, AnInkDotUnderWarmLightIsBlackNotRed) {
+  // A black ink dot lit by a warm lamp: levels 5-20, red a few above blue, so its saturation is
+  // 100-200 (noise and tint over a tiny value) and its hue the lamp's. It is a black dot.
+  const cv::Mat image = TintedDotImage(80, {6, 10, 16}, {70, 100, 130}, 3, 11);
   std::string why;
   const auto pick = PickHsvRange(image, {40, 40}, HsvPickOptions{}, &why);
   ASSERT_TRUE(pick) << why;
@@ -359,19 +366,7 @@ TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
   // 82, on a darker surface of the same tint (60, 85, 110), saturation 116. Half the dot's pixels
   // and more are "coloured", and the range they give passes the surface too: a blob as large as
   // the surface, no marker. By its gray level (217 against 89) the dot stands out alone.
-  std::mt19937 rng(7);
-  std::uniform_int_distribution<int> noise(-4, 4);
-  cv::Mat image(100, 100, CV_8UC3);
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < image.cols; ++x) {
-      const bool dot = (x - 50) * (x - 50) + (y - 50) * (y - 50) <= 9 * 9;
-      const cv::Vec3i level = dot ? cv::Vec3i(170, 215, 250) : cv::Vec3i(60, 85, 110);
-      const int n = noise(rng);
-      image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(level[0] + n),
-                                            cv::saturate_cast<uchar>(level[1] + n),
-                                            cv::saturate_cast<uchar>(level[2] + n));
-    }
-  }
+  const cv::Mat image = TintedDotImage(100, {170, 215, 250}, {60, 85, 110}, 4, 7);
   std::string why;
   const auto coloured = PickHsvFromSamples(
       [&] {
