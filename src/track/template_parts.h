@@ -149,6 +149,13 @@ inline constexpr double kMinBlobContrast = 12.0;  // Grey levels between marker 
 // A selected template holds this much of the marker's surroundings on every side of its blob
 // (px): the background's level is read 3-4 px outside the blob (BlobMeter::MeasureSegmented).
 inline constexpr int kMinSurroundPx = 4;
+// A person drags a box around the marker, so the box's centre lies on it: the blob a selection
+// reports the marker's centre from lies at most this many of its own radii (of a disc of its
+// area) from the centre of the box dragged. A blob farther off is a piece of the marker (a pale
+// dome's shaded rim where the exposure clipped the rest to white: 5.9 px off a 32 px box around
+// a dome of radius 10, 1.3 of its radius) or something beside it. Boxes drawn around whole
+// markers, 0-12 px margins, on every rendered and real scene: at most 0.40.
+inline constexpr double kMaxBlobOffBoxCentre = 0.75;
 // Of a template's bright and dark blobs at its centre, the one this many times larger is the
 // marker (the other a highlight on it, or a dark fleck), whichever stands out more.
 inline constexpr double kMarkerOverGlint = 3.0;

@@ -249,21 +249,34 @@ TemplateTracker::BoxVerdict TemplateTracker::JudgeBox(const cv::Mat& native,
   BlobMeter meter;
   cv::Point2d centroid;
   const cv::Mat mask = MaskFor(native.size());
-  if (LearnTemplateBlob(native, mask, &projection, &meter, &centroid)) {
-    return {true, centroid, meter.learned_contrast(), meter.blob_box(), meter.area()};
+  const bool in_gray = LearnTemplateBlob(native, mask, &projection, &meter, &centroid);
+  if (in_gray) {
+    verdict = {true,     centroid, meter.learned_contrast(), meter.blob_box(), meter.area(),
+               centroid, meter.area()};
+  } else {
+    verdict.contrast = meter.learned_contrast();
   }
-  verdict.contrast = meter.learned_contrast();
   // A coloured marker may stand out only in its chromaticity where a groove, a shadow or wood
-  // grain beside it is as dark as it in the matched channel: SetTemplate measures its blob there.
+  // grain beside it is as dark as it in the matched channel: SetTemplate measures its blob there,
+  // and reports from it wherever it stands out more there (the same choice as SetTemplate's).
   ChromaAxis chroma;
   if (!selection_bgr.empty() && LearnChromaAxis(selection_bgr, &chroma)) {
     ChromaChannel(selection_bgr, chroma, channel);
     BlobMeter colour_meter;
-    if (colour_meter.Learn(channel, mask, &centroid)) {
-      return {true, centroid, colour_meter.learned_contrast(), colour_meter.blob_box(),
-              colour_meter.area()};
+    cv::Point2d colour_centroid;
+    if (colour_meter.Learn(channel, mask, &colour_centroid)) {
+      if (!in_gray) {
+        return {true,           colour_centroid,     colour_meter.learned_contrast(),
+                colour_meter.blob_box(), colour_meter.area(), colour_centroid,
+                colour_meter.area()};
+      }
+      if (colour_meter.isolation() > meter.isolation()) {
+        verdict.reported_centroid = colour_centroid;
+        verdict.reported_area = colour_meter.area();
+      }
+    } else if (!in_gray) {
+      verdict.contrast = std::max(verdict.contrast, colour_meter.learned_contrast());
     }
-    verdict.contrast = std::max(verdict.contrast, colour_meter.learned_contrast());
   }
   return verdict;
 }
@@ -283,13 +296,29 @@ void TemplateTracker::PrepareSelection(const cv::Mat& frame_bgr, const cv::Rect&
 // every side of it in the template. A box drawn tight around the marker shows only what stands
 // out inside it (a domed disc's highlight): its rim reaches the box's edge, so the disc itself
 // needs a wider box to stand out from. Empty when no box shows a marker so; `contrast` gets the
-// most levels anything at the centre stood out by.
+// most levels anything at the centre stood out by, `off_centre` how far (in its own radii) from
+// the centre of the box dragged lay the farthest blob refused for that alone.
 cv::Rect TemplateTracker::BoxShowingTheMarker(const cv::Mat& frame_bgr, const cv::Rect& hint,
-                                              cv::Mat& native, double* contrast) {
+                                              cv::Mat& native, double* contrast,
+                                              double* off_centre) {
   const cv::Rect frame_rect(0, 0, frame_bgr.cols, frame_bgr.rows);
   const int side = std::min(hint.width, hint.height);
   const int rim = std::max(2, side / 6);  // How far a blob may stick out of the box dragged.
   const cv::Rect allowed(hint.x - rim, hint.y - rim, hint.width + 2 * rim, hint.height + 2 * rim);
+  const cv::Point2d hint_centre = cv::Point2d(hint.tl()) + HalfSize(hint.size());
+  const bool hint_at_frame_edge = (hint & frame_rect) != hint || hint.x == 0 || hint.y == 0 ||
+                                  hint.br().x == frame_rect.width ||
+                                  hint.br().y == frame_rect.height;
+  *off_centre = 0;  // The most any blob otherwise acceptable lay off the box's centre, in radii.
+  // The reported blob lies on the box's centre (kMaxBlobOffBoxCentre); a box cut by the frame's
+  // edge may hold only part of a marker, whose centre is then anywhere in it.
+  const auto centred = [&](const BoxVerdict& v, const cv::Rect& box) {
+    if (hint_at_frame_edge || v.reported_area <= 0) return true;
+    const double off = cv::norm(v.reported_centroid + cv::Point2d(box.tl()) - hint_centre) /
+                       std::sqrt(v.reported_area / CV_PI);
+    *off_centre = std::max(*off_centre, off);
+    return off <= kMaxBlobOffBoxCentre;
+  };
   const auto acceptable = [&](const BoxVerdict& v, const cv::Rect& box) {
     const cv::Rect blob = v.blob_box + box.tl();
     const cv::Point2d at = v.centroid + cv::Point2d(box.tl());
@@ -299,7 +328,8 @@ cv::Rect TemplateTracker::BoxShowingTheMarker(const cv::Mat& frame_bgr, const cv
            (blob.x - box.x >= kMinSurroundPx || box.x == 0) &&
            (blob.y - box.y >= kMinSurroundPx || box.y == 0) &&
            (box.br().x - blob.br().x >= kMinSurroundPx || box.br().x == frame_rect.width) &&
-           (box.br().y - blob.br().y >= kMinSurroundPx || box.br().y == frame_rect.height);
+           (box.br().y - blob.br().y >= kMinSurroundPx || box.br().y == frame_rect.height) &&
+           centred(v, box);
   };
   *contrast = 0;
   cv::Rect best;
@@ -343,10 +373,16 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
       // standing out from its surroundings. A box of background (or cutting a marker) would be
       // matched wherever that background looks alike, and never lost.
       double contrast = 0;
-      const cv::Rect box = BoxShowingTheMarker(frame_bgr, hint, native, &contrast);
+      double off_centre = 0;
+      const cv::Rect box = BoxShowingTheMarker(frame_bgr, hint, native, &contrast, &off_centre);
       if (box.empty()) {
-        char measured[160];
-        if (contrast >= kMinBlobContrast) {
+        char measured[200];
+        if (off_centre > kMaxBlobOffBoxCentre) {
+          std::snprintf(measured, sizeof measured,
+                        "what stands out in it lies %.1f of its own radii from the box's centre, "
+                        "at most %.2f allowed: a piece of the marker, or something beside it",
+                        off_centre, kMaxBlobOffBoxCentre);
+        } else if (contrast >= kMinBlobContrast) {
           std::snprintf(measured, sizeof measured,
                         "what stands out at its centre, by %.0f levels, is no blob lying "
                         "inside the box with its surroundings, even with the box widened",
@@ -357,7 +393,8 @@ void TemplateTracker::init(const cv::Mat& frame_bgr, const cv::Rect& hint) {
                         "most, %.0f needed", contrast, kMinBlobContrast);
         }
         throw InputError("the box " + RectText(hint) + " holds no marker (" + measured +
-                         "): drag it around a marker, with some background on every side");
+                         "): drag it around a marker, centred on it, with some background on "
+                         "every side");
       }
       SetTemplate(native.clone(), "template rect " + RectText(box),
                   frame_bgr.channels() == 3 ? frame_bgr(box) : cv::Mat());

@@ -73,12 +73,16 @@ class TemplateTracker final : public Tracker {
     double contrast = 0;   // Levels it stands out by (the most seen when there is no marker).
     cv::Rect blob_box;     // The blob's bounding box, in the box.
     double area = 0;       // The blob's, px.
+    // The blob SetTemplate will report the marker's centre from (the matched channel's, or the
+    // chromaticity's where the marker stands out more there), in the box, and its area.
+    cv::Point2d reported_centroid;
+    double reported_area = 0;
   };
   BoxVerdict JudgeBox(const cv::Mat& native, const cv::Mat& selection_bgr) const;
   // Sets projection_ for a selection at `box` and cuts its native pixels.
   void PrepareSelection(const cv::Mat& frame_bgr, const cv::Rect& box, cv::Mat& native);
   cv::Rect BoxShowingTheMarker(const cv::Mat& frame_bgr, const cv::Rect& hint, cv::Mat& native,
-                               double* contrast);
+                               double* contrast, double* off_centre);
   // A point of the selected template in a rung of `size`. Template coordinates scale about the
   // pixel edges: u' + 0.5 = (u + 0.5) * size'/size.
   cv::Point2d ToRung(const cv::Point2d& p, const cv::Size& size) const {

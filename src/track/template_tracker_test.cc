@@ -600,6 +600,56 @@ TEST(TemplateTrackerTest, ACrescentOfAMarkerCarriesItsAsymmetryInItsSigma) {
   }
 }
 
+// A pale dome that a bright exposure clipped to the background's white but for a piece of its
+// shaded lower rim: a box a person drags around the dome has that piece 6 px below its centre,
+// and the piece's own centroid, reported as the marker's centre, would be as far off in every
+// frame. The box is refused, saying so. Around the piece itself, or lopsided around a whole disc
+// (1 px of margin on one side, 9 on the other), a box is accepted.
+TEST(TemplateTrackerTest, ABoxWhoseOnlyBlobLiesOffItsCentreIsRefused) {
+  const cv::Point2d centre(60.3, 50.6);
+  constexpr double kRadius = 10.0;
+  auto render = [&](double keep_below_px) {
+    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(250, 250, 250));
+    for (int y = 0; y < frame.rows; ++y) {
+      for (int x = 0; x < frame.cols; ++x) {
+        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
+        // Above the cut, clipped nearly to the background's white.
+        frame.at<cv::Vec3b>(y, x) =
+            y < centre.y + keep_below_px ? cv::Vec3b(238, 246, 238) : cv::Vec3b(90, 170, 90);
+      }
+    }
+    return frame;
+  };
+  const cv::Mat piece = render(2.0);
+  for (const char* method : kMethods) {
+    SCOPED_TRACE(method);
+    MarkerSpec spec;
+    spec.name = "dome";
+    spec.params = ParamsForMethod(method, {TemplateParams{}});
+    std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+    try {
+      tracker->init(piece, RectAround(centre, 33));
+      ADD_FAILURE() << "a box whose blob is a piece 6 px off its centre was accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("holds no marker"), std::string::npos) << what;
+      EXPECT_NE(what.find("from the box's centre"), std::string::npos) << what;
+    }
+    // Centred on the piece, the box shows a marker: the piece.
+    std::unique_ptr<Tracker> on_piece = CreateTracker(spec);
+    EXPECT_NO_THROW(on_piece->init(piece, RectAround(centre + cv::Point2d(0, 7), 21)));
+    // A whole disc in a lopsided box.
+    const cv::Mat whole = render(-kRadius - 1);
+    std::unique_ptr<Tracker> lopsided = CreateTracker(spec);
+    const cv::Rect box(cvRound(centre.x - kRadius) - 1, cvRound(centre.y - kRadius) - 1,
+                       2 * cvRound(kRadius) + 11, 2 * cvRound(kRadius) + 11);
+    ASSERT_NO_THROW(lopsided->init(whole, box));
+    const Observation o = lopsided->update(whole);
+    ASSERT_TRUE(o.found());
+    EXPECT_LT(cv::norm(*o.position_px - centre), 0.3);
+  }
+}
+
 // Two white dots on a dark card, drawn anti-aliased at sub-pixel centres (cv::circle with 4
 // fractional bits): look-alikes, as the dots on a hand-held plate are.
 cv::Mat TwoDots(cv::Point2d a, cv::Point2d b, double radius, std::optional<cv::Rect> cover = {}) {
