@@ -20,7 +20,8 @@ JOBS=${JOBS:-2}
 SAMPLES=${SAMPLES:-12}
 SOFTSIGHT=${SOFTSIGHT:-$ROOT/build/src/app/softsight}
 PY=${PYTHON:-/usr/bin/python3}
-ALL=(bench side distractors finger fastblur wedge whitedots pale stickers hard wedgehard blackdots mat hd)
+ALL=(bench side distractors finger fastblur wedge whitedots pale stickers hard wedgehard blackdots mat hd
+     darkdomes wood960)
 if [ $# -gt 0 ]; then SCENES=("$@"); else SCENES=("${ALL[@]}"); fi
 mkdir -p "$WORK"
 

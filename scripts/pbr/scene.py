@@ -107,6 +107,16 @@ SCENES = {
              'to 110 deg (the tip moves up to 45 px a frame) with motion blur',
         layout='side', light='cold_front', markers=['red', 'blue', 'green'], size=(1280, 720),
         bend=(5, 110, 12, 2), frames=36, codec='h264', noise=3.0, seed=14, shutter=0.5),
+    'darkdomes': dict(
+        what='orange, cyan and purple domes on a dark grey actuator under the dim warm side lamp, '
+             'a fast blurred bend',
+        layout='side', light='warm_side', markers=['orange', 'cyan', 'purple'], dark=True,
+        bend=(5, 100, 12, 2), frames=36, codec='mjpg', noise=4.0, seed=21, shutter=0.5),
+    'wood960': dict(
+        what='yellow, blue and red domes on the actuator lying on the wooden bench (yellow the '
+             'wood\'s hue), seen from above under the ceiling panel, 960x540 H.264',
+        layout='top', light='cold_front', markers=['yellow', 'blue', 'red'], size=(960, 540),
+        bend=(5, 90, 15, 3), frames=36, codec='h264', noise=3.0, seed=22, shutter=0.5),
 }
 
 LENGTH = 100 * MM        # actuator length from the clamp to the tip

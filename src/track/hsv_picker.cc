@@ -474,6 +474,32 @@ void LowerSaturationFloorToSurroundings(const cv::Mat& bgr, cv::Point2d click_px
   pick->s.lo = floor;
 }
 
+// Whether the sampled disc (HSV) could be a white or black dot that tinted light or sensor noise
+// gives a hue, so that its gray range may be the marker's kind: a white dot takes no more than
+// the light's tint (median saturation 55-71 under a warm or cold cast without white balance,
+// where a 2700 K lamp reaches about 120), a black dot's channels stay close whatever their hue
+// (median chroma 13-19 with noise of sigma 8). A pigment is more saturated than either: an
+// orange dome on a dark actuator under the warm lamp has 247 and chroma 101, and its gray range
+// (anything lit) took it for a white dot, 2-2.8 px off.
+constexpr int kMaxTintedWhiteSaturation = 140;
+constexpr int kMaxNoisyBlackChroma = 2 * kMinHueChroma;
+
+bool CouldBeTintedGrayDot(const std::vector<cv::Vec3b>& hsv_samples) {
+  if (hsv_samples.empty()) return false;
+  std::vector<int> saturation, chroma;
+  saturation.reserve(hsv_samples.size());
+  chroma.reserve(hsv_samples.size());
+  for (const cv::Vec3b& p : hsv_samples) {
+    saturation.push_back(p[1]);
+    chroma.push_back(p[1] * p[2] / 255);  // max - min of the channels.
+  }
+  const auto median = [](std::vector<int>& v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  return median(saturation) < kMaxTintedWhiteSaturation || median(chroma) < kMaxNoisyBlackChroma;
+}
+
 }  // namespace
 
 std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
@@ -563,7 +589,7 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
         passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
       }
     }
-    if (!gray && passing >= kLeakyColourPick) {
+    if (!gray && passing >= kLeakyColourPick && CouldBeTintedGrayDot(samples)) {
       // A white dot under tinted light (a warm lamp, a camera without white balance) takes the
       // light's colour, and so do the surfaces around it; sensor noise gives a black dot's
       // pixels hues. Such a colour range passes the marker's surroundings too (or not the

@@ -393,6 +393,26 @@ TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
   EXPECT_EQ(PickName(*dome), "red");
 }
 
+// An orange dome on a dark actuator under a warm lamp from the right: the lamp lights a band of
+// the actuator on the dome's right a dark orange, which its colour range passes (a quarter of its
+// near surroundings), while "anything lit", a white dot's gray range, passes none of them. The
+// dome's saturation (about 247) is a pigment's, beyond any white's tint: it stays orange. (It was
+// taken for a white dot on a physically based render of such a scene, 2-2.8 px off.)
+TEST(HsvPickerTest, AnOrangeDomeOnADarkSurfaceLitInItsHueIsOrangeNotWhite) {
+  cv::Mat image = TintedDotImage(100, {3, 43, 108}, {4, 6, 10}, 2, 3);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 56; x < image.cols; ++x) {
+      const double d = std::hypot(x - 50, y - 50);
+      if (d > 12 && d < 20) image.at<cv::Vec3b>(y, x) = cv::Vec3b(5, 20, 50);
+    }
+  }
+  std::string why;
+  const auto pick = PickHsvRange(image, {50, 50}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(pick) << why;
+  EXPECT_FALSE(pick->gray) << "picked as " << PickName(*pick);
+  EXPECT_EQ(PickName(*pick), "orange");
+}
+
 }  // namespace
 }  // namespace softsight
 

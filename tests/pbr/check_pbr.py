@@ -140,6 +140,21 @@ CASES = {
                                 'each dome'),
                  ('zncc', 95.0, 'zncc loses red in 9 frames beside the finger and reports it 1.55 px '
                                 'off in frame 12')]),
+    'darkdomes': dict(
+        what='orange, cyan and purple domes on a dark actuator, dim warm side lamp, fast blurred bend',
+        # The lamp low on the right lights each dome's right flank; its left one is as dark as the
+        # actuator, so what a camera (and a person) sees of the dome is centred 1.5-2 px right of
+        # the apex. (Pick took the orange dome for a white dot until a pigment's saturation ruled
+        # out a tinted white: 2-2.8 px off, 1 beyond 5 sigma.)
+        configs=[('pick', 99.0, 'pick reports 97 of 108 finds 1.5-3.4 px right of the apex, 92.6 % '
+                                'within 3 sigma: the dark actuator hides each dome\'s shaded flank'),
+                 ('zncc', 99.0, 'zncc reports 29 of 108 finds 1.5-1.8 px right of the apex (within '
+                                '3 sigma), as pick')]),
+    'wood960': dict(
+        what='yellow, blue and red domes on wood from above, ceiling panel, 960x540 H.264',
+        configs=[('pick', 99.0, None),
+                 ('zncc', 99.0, 'zncc reports 3 of 108 finds 1.5-1.65 px off (yellow, the wood\'s '
+                                'hue, 1.1 px above the apex in every frame; within 3 sigma)')]),
 }
 
 
@@ -392,6 +407,10 @@ INIT_EXPECTED = {
     # pastel domes (saturation 40-120) are below the finder's saturation floor (70)
     'pale': None,
     'stickers': 3,
+    # the orange dome is not written: under the warm lamp its shaded flank is as dark as the
+    # actuator and its lit one of the lamp's hue (a click on it is picked)
+    'darkdomes': 2,
+    'wood960': 3,
     # the caps of the markers' colours again: init will not guess
     'hard': None,
     'wedgehard': 5,
@@ -403,6 +422,8 @@ INIT_KNOWN = {
     'hd': '6 reports 1.5-2.3 px off (green in the bent pose), as pick',
     # (fastblur's blurred tip was 1.5-2.0 px off in 3 frames until the soft centroid took in the
     # pale fringe.)
+    'darkdomes': 'cyan and purple reported 1.5-2 px right of the apex, as by pick (the dark '
+                 'actuator hides each dome\'s shaded flank)',
     'wedgehard': '5 reports 1.5-1.7 px off: domes seen from above under a low side lamp, the '
                  'shaded flank or the lit one outside the written ranges',
 }
