@@ -84,8 +84,23 @@ bool HsvPickOptions::Check(std::string* error) const {
   return true;
 }
 
+namespace {
+std::optional<HsvPick> PickHsvFromSamplesWithChroma(const std::vector<cv::Vec3b>& hsv_samples,
+                                                    const HsvPickOptions& options,
+                                                    int min_chroma, std::string* why_not);
+}  // namespace
+
 std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samples,
                                           const HsvPickOptions& options, std::string* why_not) {
+  return PickHsvFromSamplesWithChroma(hsv_samples, options, kMinHueChroma, why_not);
+}
+
+namespace {
+// PickHsvFromSamples with the channels' least spread for a pixel to carry a hue (kMinHueChroma
+// there) as a parameter.
+std::optional<HsvPick> PickHsvFromSamplesWithChroma(const std::vector<cv::Vec3b>& hsv_samples,
+                                                    const HsvPickOptions& options,
+                                                    int min_chroma, std::string* why_not) {
   std::string error;
   CV_Assert(options.Check(&error));
   auto fail = [&](const std::string& message) -> std::optional<HsvPick> {
@@ -100,7 +115,7 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   std::vector<cv::Vec3b> coloured;
   coloured.reserve(hsv_samples.size());
   for (const cv::Vec3b& p : hsv_samples) {
-    if (p[1] >= options.min_saturation && p[1] * p[2] >= kMinHueChroma * 255) {
+    if (p[1] >= options.min_saturation && p[1] * p[2] >= min_chroma * 255) {
       coloured.push_back(p);
     }
   }
@@ -108,7 +123,7 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
     return fail("not a coloured marker: only " + std::to_string(coloured.size()) + " of " +
                 std::to_string(hsv_samples.size()) + " pixels have saturation >= " +
                 std::to_string(options.min_saturation) + " and channels " +
-                std::to_string(kMinHueChroma) + " or more levels apart");
+                std::to_string(min_chroma) + " or more levels apart");
   }
 
   // The marker's hue is the most common one (a histogram smoothed over 7 steps, around the
@@ -176,6 +191,7 @@ std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samp
   pick.v = {std::min(LinearRange(std::move(val), options, options.value_margin, 0).lo, darkest), 255};
   return pick;
 }
+}  // namespace
 
 namespace {
 
@@ -518,6 +534,22 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
     pick = PickGrayDot(bgr, click_px, r, &why);
     gray = true;
+    // A dim coloured dome (blue under a warm lamp, its channels 8-15 levels apart) is no colour
+    // by the channels' spread a hue needs, and dark as a black dot; but the dark range takes in
+    // its shadow and the grooves beside it, where its hue does not. Its colour, read from the
+    // pixels with half that spread, is taken if it tells the marker from its near surroundings
+    // better than the gray range does.
+    if (pick && r > 1) {
+      if (std::optional<HsvPick> dim =
+              PickHsvFromSamplesWithChroma(samples, options, kMinHueChroma / 2, nullptr)) {
+        const double dim_passing = SurroundingsPassing(bgr, click_px, *dim, r);
+        if (dim_passing < kLeakyColourPick &&
+            dim_passing <= SurroundingsPassing(bgr, click_px, *pick, r)) {
+          pick = dim;
+          gray = false;
+        }
+      }
+    }
   }
   // The pick of the same kind (a white or black dot's, or a coloured marker's) from the whole
   // disc at `at`, the marker's centre; a coloured marker's samples go to `disc`.

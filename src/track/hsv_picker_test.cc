@@ -393,6 +393,26 @@ TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
   EXPECT_EQ(PickName(*dome), "red");
 }
 
+// A blue dome under a warm lamp without white balance: dim, its channels about 11 levels apart
+// (40, 30, 29), too little for a hue by the usual spread, and dark as a black dot; its shadow on
+// the wood beside it is as dark. The gray range of a black dot takes the shadow in (the centre
+// 1.8 px off on a physically based render); the dome's colour, read with half the spread, does
+// not, so the pick is blue.
+TEST(HsvPickerTest, ADimBlueDomeBesideItsShadowIsBlueNotBlack) {
+  cv::Mat image = TintedDotImage(100, {40, 30, 29}, {40, 90, 150}, 2, 5);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < 47; ++x) {
+      const double d = std::hypot(x - 50, y - 50);
+      if (d > 9.5 && d < 16) image.at<cv::Vec3b>(y, x) = cv::Vec3b(20, 28, 36);
+    }
+  }
+  std::string why;
+  const auto pick = PickHsvRange(image, {50, 50}, HsvPickOptions{}, &why);
+  ASSERT_TRUE(pick) << why;
+  EXPECT_FALSE(pick->gray) << "picked as " << PickName(*pick);
+  EXPECT_EQ(PickName(*pick), "blue");
+}
+
 // An orange dome on a dark actuator under a warm lamp from the right: the lamp lights a band of
 // the actuator on the dome's right a dark orange, which its colour range passes (a quarter of its
 // near surroundings), while "anything lit", a white dot's gray range, passes none of them. The
