@@ -393,6 +393,19 @@ TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
   EXPECT_EQ(PickName(*dome), "red");
 }
 
+// Paints `colour` over the pixels of `image` in columns [x_from, x_to) that lie between `inner`
+// and `outer` px from its centre (a shadow or a lit band beside a TintedDotImage's dot).
+void PaintBand(cv::Mat& image, double inner, double outer, int x_from, int x_to,
+               const cv::Vec3b& colour) {
+  const double c = image.cols / 2;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = x_from; x < x_to; ++x) {
+      const double d = std::hypot(x - c, y - c);
+      if (d > inner && d < outer) image.at<cv::Vec3b>(y, x) = colour;
+    }
+  }
+}
+
 // A blue dome under a warm lamp without white balance: dim, its channels about 11 levels apart
 // (40, 30, 29), too little for a hue by the usual spread, and dark as a black dot; its shadow on
 // the wood beside it is as dark. The gray range of a black dot takes the shadow in (the centre
@@ -400,12 +413,7 @@ TEST(HsvPickerTest, AWhiteDotUnderTintedLightOnASurfaceOfItsTintIsWhite) {
 // not, so the pick is blue.
 TEST(HsvPickerTest, ADimBlueDomeBesideItsShadowIsBlueNotBlack) {
   cv::Mat image = TintedDotImage(100, {40, 30, 29}, {40, 90, 150}, 2, 5);
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < 47; ++x) {
-      const double d = std::hypot(x - 50, y - 50);
-      if (d > 9.5 && d < 16) image.at<cv::Vec3b>(y, x) = cv::Vec3b(20, 28, 36);
-    }
-  }
+  PaintBand(image, 9.5, 16, 0, 47, {20, 28, 36});  // The shadow, on the left.
   std::string why;
   const auto pick = PickHsvRange(image, {50, 50}, HsvPickOptions{}, &why);
   ASSERT_TRUE(pick) << why;
@@ -420,12 +428,7 @@ TEST(HsvPickerTest, ADimBlueDomeBesideItsShadowIsBlueNotBlack) {
 // taken for a white dot on a physically based render of such a scene, 2-2.8 px off.)
 TEST(HsvPickerTest, AnOrangeDomeOnADarkSurfaceLitInItsHueIsOrangeNotWhite) {
   cv::Mat image = TintedDotImage(100, {3, 43, 108}, {4, 6, 10}, 2, 3);
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 56; x < image.cols; ++x) {
-      const double d = std::hypot(x - 50, y - 50);
-      if (d > 12 && d < 20) image.at<cv::Vec3b>(y, x) = cv::Vec3b(5, 20, 50);
-    }
-  }
+  PaintBand(image, 12, 20, 56, image.cols, {5, 20, 50});  // The lit band, on the right.
   std::string why;
   const auto pick = PickHsvRange(image, {50, 50}, HsvPickOptions{}, &why);
   ASSERT_TRUE(pick) << why;

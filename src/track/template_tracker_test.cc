@@ -517,6 +517,23 @@ TEST(TemplateTrackerTest, MinimalConfigReportsTheMarkerCentreToATenthOfAPixel) {
   EXPECT_LE(paper.rms_px, 0.1);
 }
 
+// A 120x100 frame of `background` with the disc of `radius` px about `centre` painted by
+// `colour_at(x, y)`: the pixel's colour, or none to leave the background there.
+template <typename ColourAt>
+cv::Mat DiscFrame(const cv::Point2d& centre, double radius, const cv::Scalar& background,
+                  ColourAt colour_at) {
+  cv::Mat frame(100, 120, CV_8UC3, background);
+  for (int y = 0; y < frame.rows; ++y) {
+    for (int x = 0; x < frame.cols; ++x) {
+      if (std::hypot(x - centre.x, y - centre.y) > radius) continue;
+      if (const std::optional<cv::Vec3b> colour = colour_at(x, y)) {
+        frame.at<cv::Vec3b>(y, x) = *colour;
+      }
+    }
+  }
+  return frame;
+}
+
 // A yellow disc on a green cart, its right half in shade: in gray only its lit half stands out
 // (a centroid 0.42 radii left of the disc's centre), in chromaticity the whole disc does. Which
 // is the marker's centre is uncertain by that much, and the position's sigma says so: the
@@ -526,15 +543,11 @@ TEST(TemplateTrackerTest, AMarkerWhoseChannelsPutItsCentreApartCarriesThatInItsS
   const cv::Point2d centre(60.3, 50.6);
   constexpr double kRadius = 7.0;
   auto render = [&](bool shaded) {
-    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(60, 140, 60));
-    for (int y = 0; y < frame.rows; ++y) {
-      for (int x = 0; x < frame.cols; ++x) {
-        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
-        const bool dark = shaded && x > centre.x;
-        frame.at<cv::Vec3b>(y, x) = dark ? cv::Vec3b(15, 95, 105) : cv::Vec3b(40, 200, 220);
-      }
-    }
-    return frame;
+    return DiscFrame(centre, kRadius, cv::Scalar(60, 140, 60),
+                     [&](int x, int) -> std::optional<cv::Vec3b> {
+                       const bool dark = shaded && x > centre.x;
+                       return dark ? cv::Vec3b(15, 95, 105) : cv::Vec3b(40, 200, 220);
+                     });
   };
   double sigma_even = 0;
   for (const bool shaded : {false, true}) {
@@ -566,15 +579,12 @@ TEST(TemplateTrackerTest, ACrescentOfAMarkerCarriesItsAsymmetryInItsSigma) {
   const cv::Point2d centre(60.3, 50.6);
   constexpr double kRadius = 8.0;
   auto render = [&](bool clipped) {
-    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(250, 250, 250));
-    for (int y = 0; y < frame.rows; ++y) {
-      for (int x = 0; x < frame.cols; ++x) {
-        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
-        if (clipped && y < centre.y - 3) continue;  // The top, white as the background.
-        frame.at<cv::Vec3b>(y, x) = cv::Vec3b(60, 160, 60);
-      }
-    }
-    return frame;
+    return DiscFrame(centre, kRadius, cv::Scalar(250, 250, 250),
+                     [&](int, int y) -> std::optional<cv::Vec3b> {
+                       // The top, white as the background.
+                       if (clipped && y < centre.y - 3) return std::nullopt;
+                       return cv::Vec3b(60, 160, 60);
+                     });
   };
   double sigma_whole = 0;
   for (const bool clipped : {false, true}) {
@@ -609,16 +619,12 @@ TEST(TemplateTrackerTest, ABoxWhoseOnlyBlobLiesOffItsCentreIsRefused) {
   const cv::Point2d centre(60.3, 50.6);
   constexpr double kRadius = 10.0;
   auto render = [&](double keep_below_px) {
-    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(250, 250, 250));
-    for (int y = 0; y < frame.rows; ++y) {
-      for (int x = 0; x < frame.cols; ++x) {
-        if (std::hypot(x - centre.x, y - centre.y) > kRadius) continue;
-        // Above the cut, clipped nearly to the background's white.
-        frame.at<cv::Vec3b>(y, x) =
-            y < centre.y + keep_below_px ? cv::Vec3b(238, 246, 238) : cv::Vec3b(90, 170, 90);
-      }
-    }
-    return frame;
+    return DiscFrame(centre, kRadius, cv::Scalar(250, 250, 250),
+                     [&](int, int y) -> std::optional<cv::Vec3b> {
+                       // Above the cut, clipped nearly to the background's white.
+                       return y < centre.y + keep_below_px ? cv::Vec3b(238, 246, 238)
+                                                           : cv::Vec3b(90, 170, 90);
+                     });
   };
   const cv::Mat piece = render(2.0);
   for (const char* method : kMethods) {
