@@ -786,38 +786,42 @@ __attribute__((target("avx2"))) inline int Avx2Sum(__m256i v) {
   return _mm_cvtsi128_si32(s);
 }
 
-// CrossAt4 in 256-bit lanes: the placements x .. x + 3 (pixel stride `cn`).
-__attribute__((target("avx2"))) void Avx2CrossAt4(const int16_t* p, int cn, size_t step,
-                                                   const int16_t* tw,
-                                                   const KernelAccess::Chunks& layout, int* out) {
-  __m256i acc0 = _mm256_setzero_si256(), acc1 = _mm256_setzero_si256();
-  __m256i acc2 = _mm256_setzero_si256(), acc3 = _mm256_setzero_si256();
+// Avx2CrossAt4 for kN placements side by side (3: the last three of a map row, the whole row of
+// the pose rungs' and the measurement's 3-wide maps, which were four placements with the fourth
+// dropped: a quarter of their work, issue 45). Each placement's sum is its own, as in CrossAt.
+template <int kN>
+__attribute__((target("avx2"))) inline void Avx2CrossAtN(const int16_t* p, int cn, size_t step,
+                                                         const int16_t* tw,
+                                                         const KernelAccess::Chunks& layout,
+                                                         int* out) {
+  __m256i acc[kN];
+  for (int k = 0; k < kN; ++k) acc[k] = _mm256_setzero_si256();
   for (int r = 0; r < layout.rows; ++r, p += step) {
-    const int16_t* p1 = p + cn;
-    const int16_t* p2 = p + 2 * cn;
-    const int16_t* p3 = p + 3 * cn;
     for (int c = 0; c < layout.full; ++c, tw += 16) {
       const __m256i w = Avx2Load(tw);
       const int a = 16 * c;
-      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Load(p + a), w));
-      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Load(p1 + a), w));
-      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Load(p2 + a), w));
-      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Load(p3 + a), w));
+      for (int k = 0; k < kN; ++k) {
+        acc[k] = _mm256_add_epi32(acc[k], _mm256_madd_epi16(Avx2Load(p + k * cn + a), w));
+      }
     }
     if (layout.tail) {
       const __m256i w = Avx2Load(tw);
       const int lo = layout.lo, hi = layout.hi;
-      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Pair(p + lo, p + hi), w));
-      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Pair(p1 + lo, p1 + hi), w));
-      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Pair(p2 + lo, p2 + hi), w));
-      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Pair(p3 + lo, p3 + hi), w));
+      for (int k = 0; k < kN; ++k) {
+        acc[k] = _mm256_add_epi32(acc[k],
+                                  _mm256_madd_epi16(Avx2Pair(p + k * cn + lo, p + k * cn + hi), w));
+      }
       tw += 16;
     }
   }
-  out[0] = Avx2Sum(acc0);
-  out[1] = Avx2Sum(acc1);
-  out[2] = Avx2Sum(acc2);
-  out[3] = Avx2Sum(acc3);
+  for (int k = 0; k < kN; ++k) out[k] = Avx2Sum(acc[k]);
+}
+
+// CrossAt4 in 256-bit lanes: the placements x .. x + 3 (pixel stride `cn`).
+__attribute__((target("avx2"))) void Avx2CrossAt4(const int16_t* p, int cn, size_t step,
+                                                   const int16_t* tw,
+                                                   const KernelAccess::Chunks& layout, int* out) {
+  Avx2CrossAtN<4>(p, cn, step, tw, layout, out);
 }
 
 // CrossAt in 256-bit lanes.
@@ -852,9 +856,7 @@ __attribute__((target("avx2"))) void Avx2CrossRows(const int16_t* widened, int r
       Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, out + x);
     }
     if (result.cols - x == 3) {
-      int four[4];
-      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, four);
-      std::copy(four, four + 3, out + x);
+      Avx2CrossAtN<3>(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, out + x);
       x += 3;
     }
     for (; x < result.cols; ++x) {
@@ -877,7 +879,8 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
   // each template load between its placements: a third fewer instructions than CrossAt three
   // times, for the pose rungs' 3-wide maps and the measurement's 7-wide one); the placement past
   // the map row's end reads a pixel past the image row, which is the next row, or past the last
-  // row, which is this padding. Its sum is dropped. One or two are cheaper one at a time.
+  // row, which is this padding. Its sum is dropped. One or two are cheaper one at a time. (The
+  // 256-bit kernel computes the three alone: Avx2CrossAtN<3>.)
   const size_t pad = static_cast<size_t>(cn);
   const size_t values = static_cast<size_t>(row_values) * image.rows;
   widened.resize(values + pad);

@@ -794,13 +794,17 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
 #endif
 }
 
+cv::Mat ScaledTemplate(const cv::Mat& original, const cv::Size& size) {
+  if (size == original.size()) return original;
+  cv::Mat scaled;
+  const bool smaller = size.area() < original.size().area();
+  cv::resize(original, scaled, size, 0, 0, smaller ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return scaled;
+}
+
 void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_deg,
                     const cv::Mat& shape, cv::Mat* out, cv::Mat* mask, cv::Matx23d* map) {
-  cv::Mat scaled = original;
-  if (size != original.size()) {
-    const bool smaller = size.area() < original.size().area();
-    cv::resize(original, scaled, size, 0, 0, smaller ? cv::INTER_AREA : cv::INTER_LINEAR);
-  }
+  const cv::Mat scaled = ScaledTemplate(original, size);
   if (turn_deg == 0.0) {
     *out = scaled.clone();
     *mask = shape.empty() ? cv::Mat() : shape.clone();
@@ -950,18 +954,31 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
                      static_cast<int>(std::floor(centre.y - r)),
                      static_cast<int>(std::ceil(2 * r)) + 2, static_cast<int>(std::ceil(2 * r)) + 2);
   if ((box & cv::Rect(0, 0, bgr.cols, bgr.rows)) != box) return false;
-  cv::Vec3d sum(0, 0, 0);
+  // Whole levels summed in integers: the double sums they were are exact (far below 2^53), so
+  // the same. A row's pixels within the radius are one run (the distance grows with |dx| on
+  // either side of the centre), found by the same test from both ends of the box's row, and
+  // summed without a test each (issue 45: this ran on every frame's match, per pixel in doubles).
+  const auto outside = [&](int x, int y) {
+    const double dx = x - centre.x, dy = y - centre.y;
+    return dx * dx + dy * dy > r * r;
+  };
+  int64_t sum_b = 0, sum_g = 0, sum_r = 0;
   int n = 0;
   for (int y = box.y; y < box.br().y; ++y) {
-    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
-    for (int x = box.x; x < box.br().x; ++x) {
-      const double dx = x - centre.x, dy = y - centre.y;
-      if (dx * dx + dy * dy > r * r) continue;
-      sum += cv::Vec3d(row[x][0], row[x][1], row[x][2]);
-      ++n;
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    int x0 = box.x, x1 = box.br().x - 1;  // Inclusive.
+    while (x0 <= x1 && outside(x0, y)) ++x0;
+    while (x1 >= x0 && outside(x1, y)) --x1;
+    for (int x = x0; x <= x1; ++x) {
+      sum_b += row[3 * x];
+      sum_g += row[3 * x + 1];
+      sum_r += row[3 * x + 2];
     }
+    n += std::max(0, x1 - x0 + 1);
   }
   if (n == 0) return false;
+  const cv::Vec3d sum(static_cast<double>(sum_b), static_cast<double>(sum_g),
+                      static_cast<double>(sum_r));
   const double total = sum[0] + sum[1] + sum[2];
   if (!(total >= kDarkCoreLevels * n)) return false;
   *chroma = sum / total;
@@ -990,32 +1007,50 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   int* heads = heads_.data();
   const int start = seed.y * cols + seed.x;
   int level = levels[start] ^ flip;
+  // The current level's bucket is held in `top` (its first pixel), not in heads[level]: most
+  // pushes go to it and every pop takes from it, and through memory each waited for the store
+  // before it (issue 45: the flood was a fifth of a frame's time on ViSP's mire-2, for a tenth
+  // of its instructions). A level's bucket is left for good once empty (levels only go down),
+  // so heads[level] is never read again and need not be written back. Same pushes and pops, in
+  // the same order.
   next[start] = -1;
-  heads[level] = start;
+  int top = start;
   visited[start] = 1;
-  core_.clear();
+  int core[kCoreSamples];
+  size_t cores = 0;
   *pass = -1;
   const int offsets[4] = {1, -1, cols, -cols};  // The reference's order: +x, -x, +y, -y.
   for (;;) {
-    while (level >= 0 && heads[level] < 0) --level;
-    if (level < 0) return;
-    const int p = heads[level];
-    heads[level] = next[p];
+    while (top < 0) {
+      if (--level < 0) {
+        core_.assign(core, core + cores);
+        return;
+      }
+      top = heads[level];
+    }
+    const int p = top;
+    top = next[p];
     if (edge[p]) {
       *pass = level;
-      return;
+      break;
     }
-    if (core_.size() < kCoreSamples) core_.push_back(level);
+    if (cores < kCoreSamples) core[cores++] = level;
     // Off the patch's edge: the four neighbours are in the patch.
     for (const int offset : offsets) {
       const int q = p + offset;
       if (visited[q]) continue;
       visited[q] = 1;
-      const int l = std::min(levels[q] ^ flip, level);  // A path's level is its least marker-like.
-      next[q] = heads[l];
-      heads[l] = q;
+      const int l = levels[q] ^ flip;  // A path's level is its least marker-like.
+      if (l >= level) {
+        next[q] = top;
+        top = q;
+      } else {
+        next[q] = heads[l];
+        heads[l] = q;
+      }
     }
   }
+  core_.assign(core, core + cores);
 }
 
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {

@@ -171,6 +171,7 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
     if (strength >= kMinSymmetry) anchor_px_ = centre;
   }
   rungs_.clear();
+  scaled_.clear();
   rung_ = kRungsBelow;
   turn_ = 0;
   turn_step_ = 0;
@@ -205,7 +206,14 @@ const Rung* TemplateTracker::RungAt(int scale, int turn) {
         size.width * original_.channels() <= kMaxTemplateRowBytes) {
       cv::Mat turned, mask;
       cv::Matx23d map;
-      TurnedTemplate(original_, size, turn * kTurnStepDeg, MaskFor(size), &turned, &mask, &map);
+      auto [at, fresh] = scaled_.try_emplace(scale);
+      if (fresh) {
+        at->second.image = ScaledTemplate(original_, size);
+        at->second.mask = MaskFor(size);
+      }
+      // Already of `size`: TurnedTemplate scales it no further.
+      TurnedTemplate(at->second.image, size, turn * kTurnStepDeg, at->second.mask, &turned, &mask,
+                     &map);
       if (rung.templ.Prepare(turned, mask)) {
         rung.anchor = Apply(map, ToRung(anchor_px_, size));
         rung.blob_anchor = Apply(map, ToRung(blob_anchor_px_, size));

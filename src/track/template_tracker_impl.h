@@ -154,6 +154,13 @@ class TemplateTracker final : public Tracker {
   // the selection's) and turn (0 .. kTurns - 1), prepared on first use (a map: the references
   // RungAt hands out stay valid). The current rung always exists.
   std::map<int, Rung> rungs_;
+  // Per scale of the ladder, the first template scaled to it and the mask at its size, from which
+  // each of its turns is made (RungAt: the scale's resize and mask were made again for every turn
+  // tried, issue 45). Emptied with rungs_.
+  struct Scaled {
+    cv::Mat image, mask;
+  };
+  std::map<int, Scaled> scaled_;
   int rung_ = 0;                        // The current scale.
   int turn_ = 0;                        // The current turn, in kTurnStepDeg steps.
   int turn_step_ = 0;                   // Turn steps between the last two matches (its spin).
