@@ -376,6 +376,11 @@ TEST(TemplateParts, BlobPassesAreTheReferences) {
       EXPECT_NEAR(a.w, b.w, 1e-12 * std::max(1.0, std::abs(b.w))) << trial;
       EXPECT_NEAR(a.x, b.x, 1e-12 * std::max(1.0, std::abs(b.x))) << trial;
       EXPECT_NEAR(a.y, b.y, 1e-12 * std::max(1.0, std::abs(b.y))) << trial;
+      // The weights read from the levels' table are the computed ones, added in the same order.
+      const SoftCentroidSums c = SoftCentroidComputed(gray, cv::Mat(), dist, grown, low, high);
+      EXPECT_EQ(a.w, c.w) << trial;
+      EXPECT_EQ(a.x, c.x) << trial;
+      EXPECT_EQ(a.y, c.y) << trial;
     }
   }
 }
