@@ -236,18 +236,35 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
   // In whole vectors of the rows' stride, into the padded row's buffer (no longer needed), then
   // the area's width of it into `dist`: a loop over the width alone left the last width % 16
   // columns to scalar code, most of this function's work at the blobs' widths (issue 45).
+  // The rows k above and below taken together: max(min(a, b), k) is min(max(a, k), max(b, k)),
+  // so the least over both of max(distance, k) is one max a pair of rows, with k a constant
+  // (issue 45: a row's |dy| was made into a vector for every row and chunk). A row beyond the
+  // area's reach has no label pixel within reach: kNone, which changes no minimum.
+  const size_t none_row = row_distance.size();
+  row_distance.resize(none_row + static_cast<size_t>(stride), static_cast<uint8_t>(kNone));
+  std::fill(row_distance.begin() + static_cast<std::ptrdiff_t>(none_row), row_distance.end(),
+            static_cast<uint8_t>(kNone));
+  uint8_t* const scratch_row = row_distance.data() + distances;  // The padded row, no longer needed.
+  const auto row_at = [&](int yy) -> const uint8_t* {
+    return row_distance.data() +
+           (yy >= top && yy < bottom ? static_cast<size_t>((yy - top) * stride) : none_row);
+  };
+  const cv::v_uint8x16 reach[kReach + 1] = {
+      cv::v_setall_u8(0), cv::v_setall_u8(1), cv::v_setall_u8(2), cv::v_setall_u8(3),
+      cv::v_setall_u8(4)};
   for (int y = area.y; y < area.br().y; ++y) {
-    const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
+    const uint8_t* rows_at[2 * kReach + 1];
+    for (int k = -kReach; k <= kReach; ++k) rows_at[k + kReach] = row_at(y + k);
     for (int x = 0; x < width; x += 16) {
-      cv::v_uint8x16 d = cv::v_setall_u8(static_cast<uint8_t>(kNone));
-      for (int yy = first; yy <= last; ++yy) {
-        const cv::v_uint8x16 along =
-            cv::v_load(row_distance.data() + static_cast<size_t>((yy - top) * stride) + x);
-        d = cv::v_min(d, cv::v_max(along, cv::v_setall_u8(static_cast<uint8_t>(std::abs(yy - y)))));
+      cv::v_uint8x16 d = cv::v_load(rows_at[kReach] + x);  // Its own row: k = 0.
+      for (int k = 1; k <= kReach; ++k) {
+        const cv::v_uint8x16 pair =
+            cv::v_min(cv::v_load(rows_at[kReach - k] + x), cv::v_load(rows_at[kReach + k] + x));
+        d = cv::v_min(d, cv::v_max(pair, reach[k]));
       }
-      cv::v_store(padded + x, d);
+      cv::v_store(scratch_row + x, d);
     }
-    std::memcpy(dist.ptr<uint8_t>(y) + area.x, padded, static_cast<size_t>(width));
+    std::memcpy(dist.ptr<uint8_t>(y) + area.x, scratch_row, static_cast<size_t>(width));
   }
 #else
   for (int y = area.y; y < area.br().y; ++y) {
