@@ -4,6 +4,15 @@
 #include <cstdlib>
 #include <cstring>
 
+// GatherSamples' byte shuffle: a function compiled for SSSE3 by its target attribute, taken when
+// the processor has it (the build targets SSE2 only: no -march).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTSIGHT_SSSE3_GATHER 1
+#include <immintrin.h>
+#else
+#define SOFTSIGHT_SSSE3_GATHER 0
+#endif
+
 namespace softsight {
 namespace {
 
@@ -148,12 +157,48 @@ void SummariseFrameReference(const cv::Mat& bgr, const CellGrid& grid,
 
 namespace {
 
+#if SOFTSIGHT_SSSE3_GATHER
+// 16 samples `stride` bytes apart from `p` into b, g and r: each sample's four bytes in one 32-bit
+// read (its B, G, R and the next pixel's first byte, unused), a vector's four samples sorted into
+// runs of B, G and R by one byte shuffle, and the four vectors' runs put together (issue 45: the
+// byte-at-a-time gather was a fifth of the summary's instructions).
+__attribute__((target("ssse3"))) void GatherSamples16(const uint8_t* p, size_t stride, uint8_t* b,
+                                                      uint8_t* g, uint8_t* r) {
+  const __m128i sort = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+  __m128i v[4];
+  for (size_t k = 0; k < 4; ++k) {
+    int32_t w[4];
+    for (size_t i = 0; i < 4; ++i) std::memcpy(&w[i], p + (4 * k + i) * stride, 4);
+    v[k] = _mm_shuffle_epi8(_mm_setr_epi32(w[0], w[1], w[2], w[3]), sort);  // B4 G4 R4 -
+  }
+  const __m128i bg_low = _mm_unpacklo_epi32(v[0], v[1]);   // B0-3 B4-7 G0-3 G4-7
+  const __m128i bg_high = _mm_unpacklo_epi32(v[2], v[3]);  // B8-11 B12-15 G8-11 G12-15
+  const __m128i r_low = _mm_unpackhi_epi32(v[0], v[1]);    // R0-3 R4-7 - -
+  const __m128i r_high = _mm_unpackhi_epi32(v[2], v[3]);   // R8-11 R12-15 - -
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(b), _mm_unpacklo_epi64(bg_low, bg_high));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(g), _mm_unpackhi_epi64(bg_low, bg_high));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(r), _mm_unpacklo_epi64(r_low, r_high));
+}
+
+bool HasSsse3() {
+  static const bool has = __builtin_cpu_supports("ssse3");
+  return has;
+}
+#endif
+
 // One sampled row of the frame (`n` samples `stride` bytes apart from `row`) into the planes b, g
 // and r, and each plane's padding sample (index -1) a copy of its first.
 void GatherSamples(const uint8_t* row, size_t stride, size_t n, uint8_t* b, uint8_t* g,
                    uint8_t* r) {
-  const uint8_t* p = row;
   size_t j = 0;
+#if SOFTSIGHT_SSSE3_GATHER
+  // Sixteen at a time while the block's last sample is not the row's last: a sample's 32-bit read
+  // takes the byte after it, which the row's last pixel may not have.
+  if (HasSsse3()) {
+    for (; j + 16 < n; j += 16) GatherSamples16(row + j * stride, stride, b + j, g + j, r + j);
+  }
+#endif
+  const uint8_t* p = row + j * stride;
   for (; j + 4 <= n; j += 4, p += 4 * stride) {  // Four at a time: a quarter of the loop's own work.
     for (size_t k = 0; k < 4; ++k) {
       b[j + k] = p[k * stride];

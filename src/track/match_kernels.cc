@@ -111,9 +111,10 @@ struct KernelAccess {
 namespace {
 
 // sum I * T for every placement (CV_32S, exact): the cross-correlation ZNCC and SSD are built on.
-// The image widened to 16 bits is kept in `widened` (defined below).
+// The image widened to 16 bits is kept in the scratch, or read from its shared image's (defined
+// below).
 void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
-                      std::vector<int16_t>& widened);
+                      ZnccScratch& scratch);
 
 // Window sums over the template's counted pixels, one map row at a time: calls
 // `row_done(y, sums)` for each row y of the map, sums[x * (kChannels + 1) + c] = sum of channel c
@@ -284,7 +285,7 @@ cv::Mat CrossMap(const cv::Mat& image, const PreparedTemplate& t, ZnccScratch& s
   const cv::Size size = ResultSize(image, t.size());
   scratch.cross_values.resize(size.area());
   cv::Mat cross(size, CV_32S, scratch.cross_values.data());
-  CrossCorrelation(image, t, cross, scratch.widened);
+  CrossCorrelation(image, t, cross, scratch);
   return cross;
 }
 
@@ -786,38 +787,42 @@ __attribute__((target("avx2"))) inline int Avx2Sum(__m256i v) {
   return _mm_cvtsi128_si32(s);
 }
 
-// CrossAt4 in 256-bit lanes: the placements x .. x + 3 (pixel stride `cn`).
-__attribute__((target("avx2"))) void Avx2CrossAt4(const int16_t* p, int cn, size_t step,
-                                                   const int16_t* tw,
-                                                   const KernelAccess::Chunks& layout, int* out) {
-  __m256i acc0 = _mm256_setzero_si256(), acc1 = _mm256_setzero_si256();
-  __m256i acc2 = _mm256_setzero_si256(), acc3 = _mm256_setzero_si256();
+// Avx2CrossAt4 for kN placements side by side (3: the last three of a map row, the whole row of
+// the pose rungs' and the measurement's 3-wide maps, which were four placements with the fourth
+// dropped: a quarter of their work, issue 45). Each placement's sum is its own, as in CrossAt.
+template <int kN>
+__attribute__((target("avx2"))) inline void Avx2CrossAtN(const int16_t* p, int cn, size_t step,
+                                                         const int16_t* tw,
+                                                         const KernelAccess::Chunks& layout,
+                                                         int* out) {
+  __m256i acc[kN];
+  for (int k = 0; k < kN; ++k) acc[k] = _mm256_setzero_si256();
   for (int r = 0; r < layout.rows; ++r, p += step) {
-    const int16_t* p1 = p + cn;
-    const int16_t* p2 = p + 2 * cn;
-    const int16_t* p3 = p + 3 * cn;
     for (int c = 0; c < layout.full; ++c, tw += 16) {
       const __m256i w = Avx2Load(tw);
       const int a = 16 * c;
-      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Load(p + a), w));
-      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Load(p1 + a), w));
-      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Load(p2 + a), w));
-      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Load(p3 + a), w));
+      for (int k = 0; k < kN; ++k) {
+        acc[k] = _mm256_add_epi32(acc[k], _mm256_madd_epi16(Avx2Load(p + k * cn + a), w));
+      }
     }
     if (layout.tail) {
       const __m256i w = Avx2Load(tw);
       const int lo = layout.lo, hi = layout.hi;
-      acc0 = _mm256_add_epi32(acc0, _mm256_madd_epi16(Avx2Pair(p + lo, p + hi), w));
-      acc1 = _mm256_add_epi32(acc1, _mm256_madd_epi16(Avx2Pair(p1 + lo, p1 + hi), w));
-      acc2 = _mm256_add_epi32(acc2, _mm256_madd_epi16(Avx2Pair(p2 + lo, p2 + hi), w));
-      acc3 = _mm256_add_epi32(acc3, _mm256_madd_epi16(Avx2Pair(p3 + lo, p3 + hi), w));
+      for (int k = 0; k < kN; ++k) {
+        acc[k] = _mm256_add_epi32(acc[k],
+                                  _mm256_madd_epi16(Avx2Pair(p + k * cn + lo, p + k * cn + hi), w));
+      }
       tw += 16;
     }
   }
-  out[0] = Avx2Sum(acc0);
-  out[1] = Avx2Sum(acc1);
-  out[2] = Avx2Sum(acc2);
-  out[3] = Avx2Sum(acc3);
+  for (int k = 0; k < kN; ++k) out[k] = Avx2Sum(acc[k]);
+}
+
+// CrossAt4 in 256-bit lanes: the placements x .. x + 3 (pixel stride `cn`).
+__attribute__((target("avx2"))) void Avx2CrossAt4(const int16_t* p, int cn, size_t step,
+                                                   const int16_t* tw,
+                                                   const KernelAccess::Chunks& layout, int* out) {
+  Avx2CrossAtN<4>(p, cn, step, tw, layout, out);
 }
 
 // CrossAt in 256-bit lanes.
@@ -837,28 +842,25 @@ __attribute__((target("avx2"))) int Avx2CrossAt(const int16_t* p, size_t step, c
   return Avx2Sum(acc);
 }
 
-// VectorCrossMap's placements (after its widening), in 256-bit lanes: the same placements four
+// CrossRows' placements (rows `step` values apart), in 256-bit lanes: the same placements four
 // at a time, the same reads (the 16 words of a chunk are the two 8-word loads of CrossAt).
-__attribute__((target("avx2"))) void Avx2CrossRows(const int16_t* widened, int row_values,
-                                                   int cn, const PreparedTemplate& t,
+__attribute__((target("avx2"))) void Avx2CrossRows(const int16_t* widened, int step, int cn, const PreparedTemplate& t,
                                                    cv::Mat& result) {
   const KernelAccess::Chunks layout = KA::Layout(t);
   const int16_t* tw = KA::Words(t);
   for (int y = 0; y < result.rows; ++y) {
     int* out = result.ptr<int>(y);
-    const int16_t* p = widened + static_cast<size_t>(row_values) * y;
+    const int16_t* p = widened + static_cast<size_t>(step) * y;
     int x = 0;
     for (; x + 3 < result.cols; x += 4) {
-      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, out + x);
+      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(step), tw, layout, out + x);
     }
     if (result.cols - x == 3) {
-      int four[4];
-      Avx2CrossAt4(p + x * cn, cn, static_cast<size_t>(row_values), tw, layout, four);
-      std::copy(four, four + 3, out + x);
+      Avx2CrossAtN<3>(p + x * cn, cn, static_cast<size_t>(step), tw, layout, out + x);
       x += 3;
     }
     for (; x < result.cols; ++x) {
-      out[x] = Avx2CrossAt(p + x * cn, static_cast<size_t>(row_values), tw, layout);
+      out[x] = Avx2CrossAt(p + x * cn, static_cast<size_t>(step), tw, layout);
     }
   }
 }
@@ -869,15 +871,65 @@ bool& WideCrossKernel() {
 }
 #endif
 
+// The map's placements from widened rows `step` values apart (a placement's row y at
+// widened + step * y).
+void CrossRows(const int16_t* widened, int step, int cn, const PreparedTemplate& t,
+               cv::Mat& result) {
+#if SOFTSIGHT_AVX2_CROSS
+  if (WideCrossKernel()) {
+    Avx2CrossRows(widened, step, cn, t, result);
+    return;
+  }
+#endif
+  for (int y = 0; y < result.rows; ++y) {
+    int* out = result.ptr<int>(y);
+    const int16_t* p = widened + static_cast<size_t>(step) * y;
+    int x = 0;
+    for (; x + 3 < result.cols; x += 4) CrossAt4(p + x * cn, cn, step, t, out + x);
+    if (result.cols - x == 3) {
+      int four[4];
+      CrossAt4(p + x * cn, cn, step, t, four);
+      std::copy(four, four + 3, out + x);
+      x += 3;
+    }
+    for (; x < result.cols; ++x) out[x] = CrossAt(p + x * cn, step, t);
+  }
+}
+
 void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& result,
-                    std::vector<int16_t>& widened) {
+                    ZnccScratch& scratch) {
   const int cn = t.channels();
   const int row_values = image.cols * cn;
+  cv::Point at;
+  if (cn == 1 && InSharedImage(image, scratch, &at)) {
+    // A window of the shared image (the tracker's search, measurement and pose rungs match
+    // several of the part it converted): that image is widened once, and each window's rows are
+    // read from it at its step. The same values, so the same sums; a placement's reads past its
+    // window's row (CrossAt4's dropped fourth) land in the shared rows or its padding.
+    const size_t step = static_cast<size_t>(scratch.shared_size.width);
+    if (!scratch.shared_widened_ready) {
+      const size_t values = step * static_cast<size_t>(scratch.shared_size.height);
+      scratch.shared_widened.resize(values + 1);  // Mostly the size it had: no new values.
+      for (int y = 0; y < scratch.shared_size.height; ++y) {
+        const uint8_t* p = scratch.shared_image + scratch.shared_step * static_cast<size_t>(y);
+        int16_t* w = scratch.shared_widened.data() + step * static_cast<size_t>(y);
+        for (size_t i = 0; i < step; ++i) w[i] = p[i];
+      }
+      scratch.shared_widened[values] = 0;
+      scratch.shared_widened_ready = true;
+    }
+    CrossRows(scratch.shared_widened.data() + step * static_cast<size_t>(at.y) +
+                  static_cast<size_t>(at.x),
+              static_cast<int>(step), cn, t, result);
+    return;
+  }
+  std::vector<int16_t>& widened = scratch.widened;
   // The last three placements of a map row are computed four at a time too (CrossAt4 shares
   // each template load between its placements: a third fewer instructions than CrossAt three
   // times, for the pose rungs' 3-wide maps and the measurement's 7-wide one); the placement past
   // the map row's end reads a pixel past the image row, which is the next row, or past the last
-  // row, which is this padding. Its sum is dropped. One or two are cheaper one at a time.
+  // row, which is this padding. Its sum is dropped. One or two are cheaper one at a time. (The
+  // 256-bit kernel computes the three alone: Avx2CrossAtN<3>.)
   const size_t pad = static_cast<size_t>(cn);
   const size_t values = static_cast<size_t>(row_values) * image.rows;
   widened.resize(values + pad);
@@ -887,25 +939,7 @@ void VectorCrossMap(const cv::Mat& image, const PreparedTemplate& t, cv::Mat& re
     for (int i = 0; i < row_values; ++i) w[i] = p[i];
   }
   std::fill(widened.begin() + static_cast<std::ptrdiff_t>(values), widened.end(), int16_t{0});
-#if SOFTSIGHT_AVX2_CROSS
-  if (WideCrossKernel()) {
-    Avx2CrossRows(widened.data(), row_values, cn, t, result);
-    return;
-  }
-#endif
-  for (int y = 0; y < result.rows; ++y) {
-    int* out = result.ptr<int>(y);
-    const int16_t* p = widened.data() + static_cast<size_t>(row_values) * y;
-    int x = 0;
-    for (; x + 3 < result.cols; x += 4) CrossAt4(p + x * cn, cn, row_values, t, out + x);
-    if (result.cols - x == 3) {
-      int four[4];
-      CrossAt4(p + x * cn, cn, row_values, t, four);
-      std::copy(four, four + 3, out + x);
-      x += 3;
-    }
-    for (; x < result.cols; ++x) out[x] = CrossAt(p + x * cn, row_values, t);
-  }
+  CrossRows(widened.data(), row_values, cn, t, result);
 }
 
 // sum I, sum I^2 and sum I * T over the counted pixels of one placement of a gray template at
@@ -990,17 +1024,17 @@ namespace {
 
 // ZNCC keeps the widened image in its scratch.
 void CrossCorrelation(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,
-                      std::vector<int16_t>& widened) {
+                      ZnccScratch& scratch) {
   CV_Assert(!templ.empty());
   CheckInputs(image, templ.image(), templ.mask());
 #if CV_SIMD128
   if (KernelAccess::Vectorised(templ)) {
     result.create(ResultSize(image, templ.size()), CV_32S);
-    VectorCrossMap(image, templ, result, widened);
+    VectorCrossMap(image, templ, result, scratch);
     return;
   }
 #endif
-  (void)widened;
+  (void)scratch;
   ScalarMap(image, templ.image(), templ.mask(), result, Product);
 }
 
@@ -1019,7 +1053,7 @@ void MatchZncc(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& res
     }
     return;
   }
-  CrossCorrelation(image, templ, scratch.cross, scratch.widened);
+  CrossCorrelation(image, templ, scratch.cross, scratch);
   // Window sums from integral images: exact (32-bit sums, 64-bit float squares < 2^53).
   cv::integral(image, scratch.sum, scratch.sum_sq, CV_32S, CV_64F);
   result.create(scratch.cross.size(), CV_32F);
@@ -1086,6 +1120,7 @@ void UseWideCrossKernel(bool on) {
 
 void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch) {
   scratch.shared_image = nullptr;
+  scratch.shared_widened_ready = false;  // Widened again on first use.
   if (image.type() != CV_8UC1 || image.empty()) return;
   const size_t prefix_step = static_cast<size_t>(image.cols + 1) * 2;
   scratch.shared_prefix.resize(prefix_step * image.rows);

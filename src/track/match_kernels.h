@@ -115,6 +115,11 @@ struct ZnccScratch {
   size_t shared_step = 0;
   cv::Size shared_size;
   std::vector<uint32_t> shared_prefix;
+  // The shared image widened to 16 bits for the cross-correlation of its windows (widened on the
+  // first window matched, then read by each: every window was widened on its own, issue 45),
+  // with one value of padding after it; valid when shared_widened_ready.
+  std::vector<int16_t> shared_widened;
+  bool shared_widened_ready = false;
 };
 // Computes the row prefix sums of `image` (CV_8UC1; anything else shares nothing) once, for
 // every window of it that MatchZncc or MatchSsd matches a masked template in with this scratch
@@ -123,7 +128,10 @@ struct ZnccScratch {
 // (issue 45). The same sums, the same bits. The caller keeps `image`'s pixels as they are until
 // StopSharingWindowSums (or another ShareWindowSums).
 void ShareWindowSums(const cv::Mat& image, ZnccScratch& scratch);
-inline void StopSharingWindowSums(ZnccScratch& scratch) { scratch.shared_image = nullptr; }
+inline void StopSharingWindowSums(ZnccScratch& scratch) {
+  scratch.shared_image = nullptr;
+  scratch.shared_widened_ready = false;
+}
 // SSD = sum I^2 - 2 sum I*T + sum T^2, from the window sums and the cross-correlation (exact).
 // Without `scratch`, its buffers are allocated for the call.
 void MatchSsd(const cv::Mat& image, const PreparedTemplate& templ, cv::Mat& result,

@@ -220,13 +220,15 @@ TEST(MatchKernelsTest, ZnccAtOnePlacementIsTheMapsValue) {
 // converted part of the frame, itself a window of the frame) give the maps matched without
 // sharing, to the bit: windows inside it, and windows of the frame reaching out of it (which
 // must not take the shared sums), for ZNCC and SSD with masked templates; and after
-// StopSharingWindowSums the image may change.
+// StopSharingWindowSums the image may change. The cross-correlation reads the shared image's
+// widened rows: with the 256-bit kernel and without.
 TEST(MatchKernelsTest, SharedWindowSumsGiveTheSameMaps) {
   cv::RNG rng(4547);
   cv::Mat frame = RandomImage(rng, {70, 60}, 1);
   const cv::Rect part(6, 5, 44, 41);
   ZnccScratch shared, fresh;
-  for (int trial = 0; trial < 300; ++trial) {
+  for (int trial = 0; trial < 600; ++trial) {
+    UseWideCrossKernel(trial < 300 && WideCrossKernelAvailable());
     if (trial % 50 == 0) {
       StopSharingWindowSums(shared);
       rng.fill(frame, cv::RNG::UNIFORM, 0, 256);  // A new frame in the same buffer.
@@ -255,6 +257,7 @@ TEST(MatchKernelsTest, SharedWindowSumsGiveTheSameMaps) {
     MatchSsd(frame(window).clone(), prepared, b, fresh);
     EXPECT_EQ(CountDifferent(a, b), 0) << window;
   }
+  UseWideCrossKernel(WideCrossKernelAvailable());
 }
 
 TEST(MatchKernelsTest, MaskedZnccMatchesReferenceForRoundMasksEmptyRowsAndOnePlacement) {

@@ -236,18 +236,35 @@ void CappedChebyshevDistance(const cv::Mat& label, const cv::Rect& area, cv::Mat
   // In whole vectors of the rows' stride, into the padded row's buffer (no longer needed), then
   // the area's width of it into `dist`: a loop over the width alone left the last width % 16
   // columns to scalar code, most of this function's work at the blobs' widths (issue 45).
+  // The rows k above and below taken together: max(min(a, b), k) is min(max(a, k), max(b, k)),
+  // so the least over both of max(distance, k) is one max a pair of rows, with k a constant
+  // (issue 45: a row's |dy| was made into a vector for every row and chunk). A row beyond the
+  // area's reach has no label pixel within reach: kNone, which changes no minimum.
+  const size_t none_row = row_distance.size();
+  row_distance.resize(none_row + static_cast<size_t>(stride), static_cast<uint8_t>(kNone));
+  std::fill(row_distance.begin() + static_cast<std::ptrdiff_t>(none_row), row_distance.end(),
+            static_cast<uint8_t>(kNone));
+  uint8_t* const scratch_row = row_distance.data() + distances;  // The padded row, no longer needed.
+  const auto row_at = [&](int yy) -> const uint8_t* {
+    return row_distance.data() +
+           (yy >= top && yy < bottom ? static_cast<size_t>((yy - top) * stride) : none_row);
+  };
+  const cv::v_uint8x16 reach[kReach + 1] = {
+      cv::v_setall_u8(0), cv::v_setall_u8(1), cv::v_setall_u8(2), cv::v_setall_u8(3),
+      cv::v_setall_u8(4)};
   for (int y = area.y; y < area.br().y; ++y) {
-    const int first = std::max(top, y - kReach), last = std::min(bottom - 1, y + kReach);
+    const uint8_t* rows_at[2 * kReach + 1];
+    for (int k = -kReach; k <= kReach; ++k) rows_at[k + kReach] = row_at(y + k);
     for (int x = 0; x < width; x += 16) {
-      cv::v_uint8x16 d = cv::v_setall_u8(static_cast<uint8_t>(kNone));
-      for (int yy = first; yy <= last; ++yy) {
-        const cv::v_uint8x16 along =
-            cv::v_load(row_distance.data() + static_cast<size_t>((yy - top) * stride) + x);
-        d = cv::v_min(d, cv::v_max(along, cv::v_setall_u8(static_cast<uint8_t>(std::abs(yy - y)))));
+      cv::v_uint8x16 d = cv::v_load(rows_at[kReach] + x);  // Its own row: k = 0.
+      for (int k = 1; k <= kReach; ++k) {
+        const cv::v_uint8x16 pair =
+            cv::v_min(cv::v_load(rows_at[kReach - k] + x), cv::v_load(rows_at[kReach + k] + x));
+        d = cv::v_min(d, cv::v_max(pair, reach[k]));
       }
-      cv::v_store(padded + x, d);
+      cv::v_store(scratch_row + x, d);
     }
-    std::memcpy(dist.ptr<uint8_t>(y) + area.x, padded, static_cast<size_t>(width));
+    std::memcpy(dist.ptr<uint8_t>(y) + area.x, scratch_row, static_cast<size_t>(width));
   }
 #else
   for (int y = area.y; y < area.br().y; ++y) {
@@ -480,8 +497,9 @@ SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
   return sums;
 }
 
-SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
-                              const cv::Rect& grown, double bg, double fg) {
+namespace {
+SoftCentroidSums SoftCentroidLanes(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                                   const cv::Rect& grown, double bg, double fg, bool table_ok) {
 #if CV_SIMD128_64F
   const double d = fg - bg, den = d * d;
   // Membership with one channel and no deadband: clamp((v - bg) * d / den, 0, 1), 0 when the
@@ -495,6 +513,61 @@ SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv
   const cv::v_uint8x16 near = cv::v_setall_u8(2);
   cv::v_float64x2 sw = zero, sx = zero, sy = zero;
   alignas(16) uint8_t fresh[16];
+  // The weight is a function of the level alone: on the large blobs (the whole 16-pixel chunks of
+  // the box, overlaps counted, cover at least two tables), each level's weight is computed once,
+  // by the same operations, into a table (the uncounted pixels' 0 in its second half), and the
+  // pixels' weights are read from it: no division a pixel (issue 45: the soft centroid was a
+  // twentieth of a frame's time on ViSP's mire-2). The same weights, added in the same order.
+  const int chunks_per_row = (grown.width + 15) / 16;
+  if (table_ok && chunks_per_row * grown.height * 16 >= 2 * 256) {
+    alignas(16) double table[512];
+    for (int v = 0; v < 256; v += 2) {
+      const cv::v_float64x2 level(static_cast<double>(v), static_cast<double>(v + 1));
+      cv::v_store(table + v, cv::v_min(cv::v_max(((level - vbg) * vd) / vden, zero), unit));
+      cv::v_store(table + 256 + v, zero);
+    }
+    const cv::v_uint16x8 uncounted_offset = cv::v_setall_u16(256);
+    alignas(16) uint16_t index[16];
+    for (int y = grown.y; y < grown.br().y; ++y) {
+      const uint8_t* levels = gray.ptr<uint8_t>(y);
+      const uint8_t* distance = dist.ptr<uint8_t>(y);
+      const cv::v_float64x2 vy = cv::v_setall_f64(static_cast<double>(y));
+      cv::v_float64x2 rw = zero, rx = zero;  // The row's sums of w and w * x.
+      for (int x = grown.x; x < grown.br().x;) {
+        const int at = std::min(x, grown.br().x - 16);  // The last 16 overlap: lanes dropped.
+        cv::v_uint8x16 counted = cv::v_load(distance + at) <= near;
+        if (at < x) {
+          for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
+          counted &= cv::v_load_aligned(fresh);
+        }
+        // Each pixel's table index: its level, in the second half when it is not counted.
+        cv::v_uint16x8 v16[2], c16[2];
+        cv::v_expand(cv::v_load(levels + at), v16[0], v16[1]);
+        cv::v_expand(counted, c16[0], c16[1]);
+        for (int h = 0; h < 2; ++h) {
+          cv::v_store_aligned(index + 8 * h,
+                              v16[h] + (uncounted_offset & (c16[h] == cv::v_setzero_u16())));
+        }
+        cv::v_float64x2 xs(static_cast<double>(at), static_cast<double>(at + 1));
+        const cv::v_float64x2 two = cv::v_setall_f64(2.0);
+        for (int e = 0; e < 16; e += 2) {
+          const cv::v_float64x2 w(table[index[e]], table[index[e + 1]]);
+          rw += w;
+          rx += w * xs;
+          xs += two;  // Whole numbers: exact.
+        }
+        x = at + 16;
+      }
+      sw += rw;
+      sx += rx;
+      sy += rw * vy;
+    }
+    SoftCentroidSums sums;
+    sums.w = cv::v_reduce_sum(sw);
+    sums.x = cv::v_reduce_sum(sx);
+    sums.y = cv::v_reduce_sum(sy);
+    return sums;
+  }
   for (int y = grown.y; y < grown.br().y; ++y) {
     const uint8_t* levels = gray.ptr<uint8_t>(y);
     const uint8_t* distance = dist.ptr<uint8_t>(y);
@@ -545,6 +618,18 @@ SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv
 #else
   return SoftCentroidReference(gray, mask, dist, grown, bg, fg);
 #endif
+}
+}  // namespace
+
+SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
+                              const cv::Rect& grown, double bg, double fg) {
+  return SoftCentroidLanes(gray, mask, dist, grown, bg, fg, true);
+}
+
+SoftCentroidSums SoftCentroidComputed(const cv::Mat& gray, const cv::Mat& mask,
+                                      const cv::Mat& dist, const cv::Rect& grown, double bg,
+                                      double fg) {
+  return SoftCentroidLanes(gray, mask, dist, grown, bg, fg, false);
 }
 
 void BlendPatchReference(const cv::Mat& image, const cv::Point2d& centre, double rate,
@@ -662,6 +747,19 @@ __attribute__((target("ssse3"))) bool GrayFirstOfThree16(const uint8_t* p, uint8
   const __m128i levels = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(c0, m0), _mm_shuffle_epi8(c1, m1)),
                                       _mm_shuffle_epi8(c2, m2));
   _mm_storeu_si128(reinterpret_cast<__m128i*>(o), levels);
+  return true;
+}
+
+// GrayFirstOfThree16 along a whole row (at least 16 pixels; the last 16 overlap the ones before
+// them, as MapBgrRows16's), in one call: called once per 16 pixels, the call cost about as much
+// as its work (issue 45). False at the first 16 pixels that are not gray, some of the row then
+// written: the caller converts the row again the general way, to the same levels.
+__attribute__((target("ssse3"))) bool GrayFirstOfThreeRow(const uint8_t* row, uint8_t* o,
+                                                          int cols) {
+  for (int x = 0; x < cols; x += 16) {
+    if (x + 16 > cols) x = cols - 16;
+    if (!GrayFirstOfThree16(row + 3 * x, o + x)) return false;
+  }
   return true;
 }
 
@@ -788,19 +886,33 @@ void ProjectLevels(const cv::Mat& bgr, const cv::Mat& projection, cv::Mat& out) 
     for (int k = 0; k < 16; ++k) o[k] = table.level[p[3 * k]];
     return true;
   };
+#if SOFTSIGHT_SSSE3_GRAY
+  if (identity) {
+    for (int y = 0; y < bgr.rows; ++y) {
+      if (GrayFirstOfThreeRow(bgr.ptr<uint8_t>(y), out.ptr<uint8_t>(y), bgr.cols)) continue;
+      cv::Mat out_row = out.row(y);  // A header of the row: written in place.
+      MapBgrRows16(bgr.row(y), out_row, four, gray16);
+    }
+    return;
+  }
+#endif
   MapBgrRows16(bgr, out, four, gray16);
 #else
   ProjectLevelsReference(bgr, projection, out);
 #endif
 }
 
+cv::Mat ScaledTemplate(const cv::Mat& original, const cv::Size& size) {
+  if (size == original.size()) return original;
+  cv::Mat scaled;
+  const bool smaller = size.area() < original.size().area();
+  cv::resize(original, scaled, size, 0, 0, smaller ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return scaled;
+}
+
 void TurnedTemplate(const cv::Mat& original, const cv::Size& size, double turn_deg,
                     const cv::Mat& shape, cv::Mat* out, cv::Mat* mask, cv::Matx23d* map) {
-  cv::Mat scaled = original;
-  if (size != original.size()) {
-    const bool smaller = size.area() < original.size().area();
-    cv::resize(original, scaled, size, 0, 0, smaller ? cv::INTER_AREA : cv::INTER_LINEAR);
-  }
+  const cv::Mat scaled = ScaledTemplate(original, size);
   if (turn_deg == 0.0) {
     *out = scaled.clone();
     *mask = shape.empty() ? cv::Mat() : shape.clone();
@@ -950,18 +1062,31 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
                      static_cast<int>(std::floor(centre.y - r)),
                      static_cast<int>(std::ceil(2 * r)) + 2, static_cast<int>(std::ceil(2 * r)) + 2);
   if ((box & cv::Rect(0, 0, bgr.cols, bgr.rows)) != box) return false;
-  cv::Vec3d sum(0, 0, 0);
+  // Whole levels summed in integers: the double sums they were are exact (far below 2^53), so
+  // the same. A row's pixels within the radius are one run (the distance grows with |dx| on
+  // either side of the centre), found by the same test from both ends of the box's row, and
+  // summed without a test each (issue 45: this ran on every frame's match, per pixel in doubles).
+  const auto outside = [&](int x, int y) {
+    const double dx = x - centre.x, dy = y - centre.y;
+    return dx * dx + dy * dy > r * r;
+  };
+  int64_t sum_b = 0, sum_g = 0, sum_r = 0;
   int n = 0;
   for (int y = box.y; y < box.br().y; ++y) {
-    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
-    for (int x = box.x; x < box.br().x; ++x) {
-      const double dx = x - centre.x, dy = y - centre.y;
-      if (dx * dx + dy * dy > r * r) continue;
-      sum += cv::Vec3d(row[x][0], row[x][1], row[x][2]);
-      ++n;
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    int x0 = box.x, x1 = box.br().x - 1;  // Inclusive.
+    while (x0 <= x1 && outside(x0, y)) ++x0;
+    while (x1 >= x0 && outside(x1, y)) --x1;
+    for (int x = x0; x <= x1; ++x) {
+      sum_b += row[3 * x];
+      sum_g += row[3 * x + 1];
+      sum_r += row[3 * x + 2];
     }
+    n += std::max(0, x1 - x0 + 1);
   }
   if (n == 0) return false;
+  const cv::Vec3d sum(static_cast<double>(sum_b), static_cast<double>(sum_g),
+                      static_cast<double>(sum_r));
   const double total = sum[0] + sum[1] + sum[2];
   if (!(total >= kDarkCoreLevels * n)) return false;
   *chroma = sum / total;
@@ -990,32 +1115,50 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   int* heads = heads_.data();
   const int start = seed.y * cols + seed.x;
   int level = levels[start] ^ flip;
+  // The current level's bucket is held in `top` (its first pixel), not in heads[level]: most
+  // pushes go to it and every pop takes from it, and through memory each waited for the store
+  // before it (issue 45: the flood was a fifth of a frame's time on ViSP's mire-2, for a tenth
+  // of its instructions). A level's bucket is left for good once empty (levels only go down),
+  // so heads[level] is never read again and need not be written back. Same pushes and pops, in
+  // the same order.
   next[start] = -1;
-  heads[level] = start;
+  int top = start;
   visited[start] = 1;
-  core_.clear();
+  int core[kCoreSamples];
+  size_t cores = 0;
   *pass = -1;
   const int offsets[4] = {1, -1, cols, -cols};  // The reference's order: +x, -x, +y, -y.
   for (;;) {
-    while (level >= 0 && heads[level] < 0) --level;
-    if (level < 0) return;
-    const int p = heads[level];
-    heads[level] = next[p];
+    while (top < 0) {
+      if (--level < 0) {
+        core_.assign(core, core + cores);
+        return;
+      }
+      top = heads[level];
+    }
+    const int p = top;
+    top = next[p];
     if (edge[p]) {
       *pass = level;
-      return;
+      break;
     }
-    if (core_.size() < kCoreSamples) core_.push_back(level);
+    if (cores < kCoreSamples) core[cores++] = level;
     // Off the patch's edge: the four neighbours are in the patch.
     for (const int offset : offsets) {
       const int q = p + offset;
       if (visited[q]) continue;
       visited[q] = 1;
-      const int l = std::min(levels[q] ^ flip, level);  // A path's level is its least marker-like.
-      next[q] = heads[l];
-      heads[l] = q;
+      const int l = levels[q] ^ flip;  // A path's level is its least marker-like.
+      if (l >= level) {
+        next[q] = top;
+        top = q;
+      } else {
+        next[q] = heads[l];
+        heads[l] = q;
+      }
     }
   }
+  core_.assign(core, core + cores);
 }
 
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
@@ -1025,6 +1168,12 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
   const uint8_t* levels = gray.data;  // Continuous, as label_.
   uint8_t* label = label_.data;
   const auto marker = [&](int i) { return (levels[i] ^ flip) > cut; };
+#if CV_SIMD128
+  // marker() for the 16 pixels from i (0xFF lanes): whole levels, so in 8-bit lanes exactly.
+  const cv::v_uint8x16 flip16 = cv::v_setall_u8(static_cast<uint8_t>(flip));
+  const cv::v_uint8x16 cut16 = cv::v_setall_u8(static_cast<uint8_t>(std::clamp(cut, 0, 255)));
+  const auto markers = [&](int i) { return (cv::v_load(levels + i) ^ flip16) > cut16; };
+#endif
   int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
   int64_t count = 0, sum_x = 0, sum_y = 0;
   stack_.clear();
@@ -1042,6 +1191,18 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     if (p.y == 0 || p.y == rows - 1) return false;
     int left = p.x, right = p.x;
     while (left > 0 && marker(row + left - 1)) --left;
+#if CV_SIMD128
+    // Rightwards 16 pixels at a time while they are all the marker's, then to the first that is
+    // not (issue 45: the fill's scans were a twentieth of a frame of ViSP's mire-2 in ZNCC).
+    while (right + 16 <= cols - 1) {
+      const unsigned run = static_cast<unsigned>(cv::v_signmask(markers(row + right + 1)));
+      if (run != 0xFFFFu) {
+        right += __builtin_ctz(~run);
+        break;
+      }
+      right += 16;
+    }
+#endif
     while (right < cols - 1 && marker(row + right + 1)) ++right;
     if (left == 0 || right == cols - 1) return false;
     std::memset(label + row + left, 1, static_cast<size_t>(right - left + 1));
@@ -1053,13 +1214,28 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     x1 = std::max(x1, right);
     y0 = std::min(y0, p.y);
     y1 = std::max(y1, p.y);
-    // A seed for each run of unfilled marker pixels beside the span, above and below.
+    // A seed for each run of unfilled marker pixels beside the span, above and below: the first
+    // pixel of each, left to right (16 pixels at a time: a run starts where a pixel is one and
+    // the one before it is not).
     for (const int y : {p.y - 1, p.y + 1}) {
       const int r = y * cols;
-      for (int x = left; x <= right; ++x) {
-        if (label[r + x] || !marker(r + x)) continue;
-        stack_.push_back({x, y});
-        while (x + 1 <= right && !label[r + x + 1] && marker(r + x + 1)) ++x;
+      bool in_run = false;  // The pixel before x is an unfilled marker pixel of [left, right].
+      int x = left;
+#if CV_SIMD128
+      for (; x + 16 <= right + 1; x += 16) {
+        const cv::v_uint8x16 unfilled = cv::v_load(label + r + x) == cv::v_setzero_u8();
+        const unsigned run = static_cast<unsigned>(cv::v_signmask(unfilled & markers(r + x)));
+        for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
+             starts &= starts - 1) {
+          stack_.push_back({x + __builtin_ctz(starts), y});
+        }
+        in_run = (run >> 15) & 1u;
+      }
+#endif
+      for (; x <= right; ++x) {
+        const bool in = !label[r + x] && marker(r + x);
+        if (in && !in_run) stack_.push_back({x, y});
+        in_run = in;
       }
     }
   }

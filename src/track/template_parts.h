@@ -232,6 +232,11 @@ SoftCentroidSums SoftCentroid(const cv::Mat& gray, const cv::Mat& mask, const cv
 SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
                                        const cv::Mat& dist, const cv::Rect& grown, double bg,
                                        double fg);
+// SoftCentroid with every pixel's weight computed in its lanes, never read from the table of the
+// levels' weights it takes on large boxes: the same sums to the bit (the tests compare them).
+SoftCentroidSums SoftCentroidComputed(const cv::Mat& gray, const cv::Mat& mask,
+                                      const cv::Mat& dist, const cv::Rect& grown, double bg,
+                                      double fg);
 
 class BlobMeter {
  public:
@@ -602,6 +607,9 @@ struct Rung {
   cv::Point2d blob_anchor;  // The template's blob's centroid, likewise.
 };
 
+// The first template `original` scaled to `size` as TurnedTemplate scales it (a header of it when
+// of that size already).
+cv::Mat ScaledTemplate(const cv::Mat& original, const cv::Size& size);
 // The first template `original` scaled to `size` and turned by `turn_deg` about its centre (a
 // positive angle turns +x towards +y: clockwise on the screen, y pointing down), into `out`,
 // with its mask: `shape` (the round mask at `size`, or empty) cut to the pixels that come from

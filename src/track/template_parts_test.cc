@@ -97,6 +97,54 @@ TEST(TemplateParts, BlobMeterFastSegmentIsTheReferences) {
   EXPECT_GT(located, 100);  // The comparison met many blobs, not only refusals.
 }
 
+// CoreColour as it was first written: every pixel of the box tested and summed in doubles.
+bool CoreColourPerPixel(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
+                        cv::Vec3d* chroma) {
+  const double r = std::max(radius, 1.0);
+  const cv::Rect box(static_cast<int>(std::floor(centre.x - r)),
+                     static_cast<int>(std::floor(centre.y - r)),
+                     static_cast<int>(std::ceil(2 * r)) + 2, static_cast<int>(std::ceil(2 * r)) + 2);
+  if ((box & cv::Rect(0, 0, bgr.cols, bgr.rows)) != box) return false;
+  cv::Vec3d sum(0, 0, 0);
+  int n = 0;
+  for (int y = box.y; y < box.br().y; ++y) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    for (int x = box.x; x < box.br().x; ++x) {
+      const double dx = x - centre.x, dy = y - centre.y;
+      if (dx * dx + dy * dy > r * r) continue;
+      sum += cv::Vec3d(row[x][0], row[x][1], row[x][2]);
+      ++n;
+    }
+  }
+  if (n == 0) return false;
+  const double total = sum[0] + sum[1] + sum[2];
+  if (!(total >= kDarkCoreLevels * n)) return false;
+  *chroma = sum / total;
+  return true;
+}
+
+// CoreColour's runs and integer sums are the per-pixel double sums, bit for bit: random pictures,
+// centres on and between pixels, radii from below 1 to beyond the picture, dark cores refused.
+TEST(TemplateParts, CoreColourIsThePerPixelSum) {
+  cv::RNG rng(45);
+  int measured = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    cv::Mat bgr(24 + rng.uniform(0, 40), 24 + rng.uniform(0, 40), CV_8UC3);
+    rng.fill(bgr, cv::RNG::UNIFORM, 0, trial % 5 == 0 ? 20 : 256);
+    const cv::Point2d centre =
+        trial % 3 == 0 ? cv::Point2d(rng.uniform(0, bgr.cols), rng.uniform(0, bgr.rows))
+                       : cv::Point2d(rng.uniform(-2.0, bgr.cols + 2.0), rng.uniform(-2.0, bgr.rows + 2.0));
+    const double radius = trial % 7 == 0 ? rng.uniform(0.0, 1.5) : rng.uniform(0.5, 20.0);
+    cv::Vec3d fast(-1, -1, -1), reference(-1, -1, -1);
+    const bool ok = CoreColour(bgr, centre, radius, &fast);
+    ASSERT_EQ(ok, CoreColourPerPixel(bgr, centre, radius, &reference)) << trial;
+    if (!ok) continue;
+    ++measured;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(fast[c], reference[c]) << trial;
+  }
+  EXPECT_GT(measured, 500);
+}
+
 // NoRivalReachable is "RivalIn can find nothing in the whole window": on a map of that window
 // flat but for its peak, every placement beyond the rival radius is a distinct peak RivalIn
 // takes, so it finds one exactly when NoRivalReachable says one is reachable.
@@ -328,6 +376,11 @@ TEST(TemplateParts, BlobPassesAreTheReferences) {
       EXPECT_NEAR(a.w, b.w, 1e-12 * std::max(1.0, std::abs(b.w))) << trial;
       EXPECT_NEAR(a.x, b.x, 1e-12 * std::max(1.0, std::abs(b.x))) << trial;
       EXPECT_NEAR(a.y, b.y, 1e-12 * std::max(1.0, std::abs(b.y))) << trial;
+      // The weights read from the levels' table are the computed ones, added in the same order.
+      const SoftCentroidSums c = SoftCentroidComputed(gray, cv::Mat(), dist, grown, low, high);
+      EXPECT_EQ(a.w, c.w) << trial;
+      EXPECT_EQ(a.x, c.x) << trial;
+      EXPECT_EQ(a.y, c.y) << trial;
     }
   }
 }

@@ -171,6 +171,7 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
     if (strength >= kMinSymmetry) anchor_px_ = centre;
   }
   rungs_.clear();
+  scaled_.clear();
   rung_ = kRungsBelow;
   turn_ = 0;
   turn_step_ = 0;
@@ -205,7 +206,14 @@ const Rung* TemplateTracker::RungAt(int scale, int turn) {
         size.width * original_.channels() <= kMaxTemplateRowBytes) {
       cv::Mat turned, mask;
       cv::Matx23d map;
-      TurnedTemplate(original_, size, turn * kTurnStepDeg, MaskFor(size), &turned, &mask, &map);
+      auto [at, fresh] = scaled_.try_emplace(scale);
+      if (fresh) {
+        at->second.image = ScaledTemplate(original_, size);
+        at->second.mask = MaskFor(size);
+      }
+      // Already of `size`: TurnedTemplate scales it no further.
+      TurnedTemplate(at->second.image, size, turn * kTurnStepDeg, at->second.mask, &turned, &mask,
+                     &map);
       if (rung.templ.Prepare(turned, mask)) {
         rung.anchor = Apply(map, ToRung(anchor_px_, size));
         rung.blob_anchor = Apply(map, ToRung(blob_anchor_px_, size));
@@ -1117,6 +1125,27 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
     return;
   }
   coarse_.clear();  // The acquisition pyramid is rebuilt from the new template when needed.
+}
+
+void TemplateTracker::prefetch(const cv::Mat& frame_bgr) const {
+  if (!tracking_ || !last_centre_ || rungs_.empty()) return;
+  // What update reads first when the marker is where its motion puts it: the near search's
+  // converted part and the blob's window around it (the larger of their margins), every cache
+  // line of each row's part.
+  const cv::Size size = current().templ.size();
+  const int grow = std::max(kMinSurroundPx, std::min(size.width, size.height) / 4);
+  const int margin = std::max(kNearMarginPx + kAroundPx, grow) + 1;
+  const cv::Rect rect = WindowAround(*last_centre_ + velocity_px_, size, margin) &
+                        cv::Rect(0, 0, frame_bgr.cols, frame_bgr.rows);
+  if (rect.empty()) return;
+  const size_t pixel = frame_bgr.elemSize();
+  for (int y = rect.y; y < rect.br().y; ++y) {
+    const uintptr_t begin = reinterpret_cast<uintptr_t>(frame_bgr.ptr(y, rect.x));
+    const uintptr_t end = begin + pixel * static_cast<size_t>(rect.width);
+    for (uintptr_t line = begin & ~uintptr_t{63}; line < end; line += 64) {
+      __builtin_prefetch(reinterpret_cast<const char*>(line));
+    }
+  }
 }
 
 Observation TemplateTracker::update(const cv::Mat& frame_bgr) {

@@ -29,6 +29,7 @@ class TemplateTracker final : public Tracker {
   Observation update(const cv::Mat& frame_bgr) override;
   const std::vector<MarkerCandidate>& candidates() const override { return weighed_; }
   std::optional<Observation> adopt(size_t index) override;
+  void prefetch(const cv::Mat& frame_bgr) const override;
   // The box the template was cut from at the last init with a box: the box dragged, or that box
   // widened to hold the marker's surroundings (BoxShowingTheMarker). Empty after init from an image.
   const cv::Rect& selection_box() const { return selection_box_; }
@@ -158,6 +159,13 @@ class TemplateTracker final : public Tracker {
   // the selection's) and turn (0 .. kTurns - 1), prepared on first use (a map: the references
   // RungAt hands out stay valid). The current rung always exists.
   std::map<int, Rung> rungs_;
+  // Per scale of the ladder, the first template scaled to it and the mask at its size, from which
+  // each of its turns is made (RungAt: the scale's resize and mask were made again for every turn
+  // tried, issue 45). Emptied with rungs_.
+  struct Scaled {
+    cv::Mat image, mask;
+  };
+  std::map<int, Scaled> scaled_;
   int rung_ = 0;                        // The current scale.
   int turn_ = 0;                        // The current turn, in kTurnStepDeg steps.
   int turn_step_ = 0;                   // Turn steps between the last two matches (its spin).
