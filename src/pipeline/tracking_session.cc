@@ -134,13 +134,7 @@ const FrameResult& TrackingSession::process(const Frame& frame) {
     }
     tracks_->skip();
   } else {
-    // Each tracker's first pixels are asked for while the one before it works (issue 45: on
-    // ViSP's mire-2 in ZNCC, converting the first window around each marker waited for memory a
-    // tenth of a frame's time; asked for before the frame-change detector's pass, the pixels
-    // were no nearer by then).
-    if (!trackers_.empty() && initialised_[0]) trackers_[0]->prefetch(frame.image);
     for (size_t i = 0; i < trackers_.size(); ++i) {
-      if (i + 1 < trackers_.size() && initialised_[i + 1]) trackers_[i + 1]->prefetch(frame.image);
       if (initialised_[i]) result_.markers[i].observation = trackers_[i]->update(frame.image);
       candidate_lists_[i] = initialised_[i] ? &trackers_[i]->candidates() : nullptr;
     }

@@ -1127,27 +1127,6 @@ void TemplateTracker::UpdateTemplate(const cv::Mat& frame, const cv::Point2d& ce
   coarse_.clear();  // The acquisition pyramid is rebuilt from the new template when needed.
 }
 
-void TemplateTracker::prefetch(const cv::Mat& frame_bgr) const {
-  if (!tracking_ || !last_centre_ || rungs_.empty()) return;
-  // What update reads first when the marker is where its motion puts it: the near search's
-  // converted part and the blob's window around it (the larger of their margins), every cache
-  // line of each row's part.
-  const cv::Size size = current().templ.size();
-  const int grow = std::max(kMinSurroundPx, std::min(size.width, size.height) / 4);
-  const int margin = std::max(kNearMarginPx + kAroundPx, grow) + 1;
-  const cv::Rect rect = WindowAround(*last_centre_ + velocity_px_, size, margin) &
-                        cv::Rect(0, 0, frame_bgr.cols, frame_bgr.rows);
-  if (rect.empty()) return;
-  const size_t pixel = frame_bgr.elemSize();
-  for (int y = rect.y; y < rect.br().y; ++y) {
-    const uintptr_t begin = reinterpret_cast<uintptr_t>(frame_bgr.ptr(y, rect.x));
-    const uintptr_t end = begin + pixel * static_cast<size_t>(rect.width);
-    for (uintptr_t line = begin & ~uintptr_t{63}; line < end; line += 64) {
-      __builtin_prefetch(reinterpret_cast<const char*>(line));
-    }
-  }
-}
-
 Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
   CV_Assert(frame_bgr.type() == CV_8UC3 || frame_bgr.type() == CV_8UC1);
   weighed_.clear();

@@ -29,7 +29,6 @@ class TemplateTracker final : public Tracker {
   Observation update(const cv::Mat& frame_bgr) override;
   const std::vector<MarkerCandidate>& candidates() const override { return weighed_; }
   std::optional<Observation> adopt(size_t index) override;
-  void prefetch(const cv::Mat& frame_bgr) const override;
   // The box the template was cut from at the last init with a box: the box dragged, or that box
   // widened to hold the marker's surroundings (BoxShowingTheMarker). Empty after init from an image.
   const cv::Rect& selection_box() const { return selection_box_; }

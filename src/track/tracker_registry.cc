@@ -105,7 +105,6 @@ bool Tracker::membership(const cv::Mat& /*frame_bgr*/, cv::Mat& /*mask*/) const 
 std::optional<Observation> Tracker::adopt(size_t /*index*/) { return std::nullopt; }
 
 std::optional<cv::Rect> Tracker::search_region() const { return std::nullopt; }
-void Tracker::prefetch(const cv::Mat&) const {}
 
 const char* CandidateVerdictName(CandidateVerdict verdict) {
   switch (verdict) {

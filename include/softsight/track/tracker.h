@@ -94,11 +94,6 @@ class Tracker {
   virtual bool membership(const cv::Mat& frame_bgr, cv::Mat& mask) const;
   // The region the last update() searched, when the tracker restricts its search to one.
   virtual std::optional<cv::Rect> search_region() const;
-  // A hint that update(frame_bgr) comes soon, changing nothing the tracker computes: it may ask
-  // the memory for the pixels that update reads first (the session gives it to the next tracker
-  // while the one before it updates: a frame just decoded, or larger than the caches, is in none
-  // of them, issue 45). Does nothing unless a tracker says otherwise.
-  virtual void prefetch(const cv::Mat& frame_bgr) const;
 };
 
 class TrackerKind;  // What a kind of marker is to the program: softsight/track/tracker_kind.h.
