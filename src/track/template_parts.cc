@@ -498,6 +498,49 @@ SoftCentroidSums SoftCentroidReference(const cv::Mat& gray, const cv::Mat& mask,
 }
 
 namespace {
+#if CV_SIMD128_64F
+// The soft centroid's sums over `grown`, 16 pixels at a time: `weigh(v16, c16, at, rw, rx)` adds
+// the weights of the chunk of levels starting at column `at` (`v16`, widened to 16 bits, its two
+// halves) of the pixels `c16` marks (all ones: within the soft band, and not yet added, for the
+// last chunk of a row overlaps the one before it) to the row's sums of w and w * x, in the
+// order of x.
+template <typename WeighChunk>
+SoftCentroidSums SumChunks(const cv::Mat& gray, const cv::Mat& dist, const cv::Rect& grown,
+                           WeighChunk weigh) {
+  const cv::v_float64x2 zero = cv::v_setzero_f64();
+  const cv::v_uint8x16 near = cv::v_setall_u8(2);
+  cv::v_float64x2 sw = zero, sx = zero, sy = zero;
+  alignas(16) uint8_t fresh[16];
+  for (int y = grown.y; y < grown.br().y; ++y) {
+    const uint8_t* levels = gray.ptr<uint8_t>(y);
+    const uint8_t* distance = dist.ptr<uint8_t>(y);
+    const cv::v_float64x2 vy = cv::v_setall_f64(static_cast<double>(y));
+    cv::v_float64x2 rw = zero, rx = zero;  // The row's sums of w and w * x.
+    for (int x = grown.x; x < grown.br().x;) {
+      const int at = std::min(x, grown.br().x - 16);  // The last 16 overlap: lanes dropped.
+      cv::v_uint8x16 counted = cv::v_load(distance + at) <= near;
+      if (at < x) {
+        for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
+        counted &= cv::v_load_aligned(fresh);
+      }
+      cv::v_uint16x8 v16[2], c16[2];
+      cv::v_expand(cv::v_load(levels + at), v16[0], v16[1]);
+      cv::v_expand(counted, c16[0], c16[1]);
+      weigh(v16, c16, at, rw, rx);
+      x = at + 16;
+    }
+    sw += rw;
+    sx += rx;
+    sy += rw * vy;
+  }
+  SoftCentroidSums sums;
+  sums.w = cv::v_reduce_sum(sw);
+  sums.x = cv::v_reduce_sum(sx);
+  sums.y = cv::v_reduce_sum(sy);
+  return sums;
+}
+#endif
+
 SoftCentroidSums SoftCentroidLanes(const cv::Mat& gray, const cv::Mat& mask, const cv::Mat& dist,
                                    const cv::Rect& grown, double bg, double fg, bool table_ok) {
 #if CV_SIMD128_64F
@@ -510,9 +553,6 @@ SoftCentroidSums SoftCentroidLanes(const cv::Mat& gray, const cv::Mat& mask, con
   const cv::v_float64x2 vbg = cv::v_setall_f64(bg), vd = cv::v_setall_f64(d);
   const cv::v_float64x2 vden = cv::v_setall_f64(den), zero = cv::v_setzero_f64();
   const cv::v_float64x2 unit = cv::v_setall_f64(1.0);
-  const cv::v_uint8x16 near = cv::v_setall_u8(2);
-  cv::v_float64x2 sw = zero, sx = zero, sy = zero;
-  alignas(16) uint8_t fresh[16];
   // The weight is a function of the level alone: on the large blobs (the whole 16-pixel chunks of
   // the box, overlaps counted, cover at least two tables), each level's weight is computed once,
   // by the same operations, into a table (the uncounted pixels' 0 in its second half), and the
@@ -528,93 +568,55 @@ SoftCentroidSums SoftCentroidLanes(const cv::Mat& gray, const cv::Mat& mask, con
     }
     const cv::v_uint16x8 uncounted_offset = cv::v_setall_u16(256);
     alignas(16) uint16_t index[16];
-    for (int y = grown.y; y < grown.br().y; ++y) {
-      const uint8_t* levels = gray.ptr<uint8_t>(y);
-      const uint8_t* distance = dist.ptr<uint8_t>(y);
-      const cv::v_float64x2 vy = cv::v_setall_f64(static_cast<double>(y));
-      cv::v_float64x2 rw = zero, rx = zero;  // The row's sums of w and w * x.
-      for (int x = grown.x; x < grown.br().x;) {
-        const int at = std::min(x, grown.br().x - 16);  // The last 16 overlap: lanes dropped.
-        cv::v_uint8x16 counted = cv::v_load(distance + at) <= near;
-        if (at < x) {
-          for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
-          counted &= cv::v_load_aligned(fresh);
-        }
-        // Each pixel's table index: its level, in the second half when it is not counted.
-        cv::v_uint16x8 v16[2], c16[2];
-        cv::v_expand(cv::v_load(levels + at), v16[0], v16[1]);
-        cv::v_expand(counted, c16[0], c16[1]);
-        for (int h = 0; h < 2; ++h) {
-          cv::v_store_aligned(index + 8 * h,
-                              v16[h] + (uncounted_offset & (c16[h] == cv::v_setzero_u16())));
-        }
-        cv::v_float64x2 xs(static_cast<double>(at), static_cast<double>(at + 1));
-        const cv::v_float64x2 two = cv::v_setall_f64(2.0);
-        for (int e = 0; e < 16; e += 2) {
-          const cv::v_float64x2 w(table[index[e]], table[index[e + 1]]);
-          rw += w;
-          rx += w * xs;
-          xs += two;  // Whole numbers: exact.
-        }
-        x = at + 16;
-      }
-      sw += rw;
-      sx += rx;
-      sy += rw * vy;
-    }
-    SoftCentroidSums sums;
-    sums.w = cv::v_reduce_sum(sw);
-    sums.x = cv::v_reduce_sum(sx);
-    sums.y = cv::v_reduce_sum(sy);
-    return sums;
+    return SumChunks(gray, dist, grown,
+                     [&](const cv::v_uint16x8 (&v16)[2], const cv::v_uint16x8 (&c16)[2], int at,
+                         cv::v_float64x2& rw, cv::v_float64x2& rx) {
+                       // Each pixel's table index: its level, in the second half when it is not
+                       // counted.
+                       for (int h = 0; h < 2; ++h) {
+                         cv::v_store_aligned(
+                             index + 8 * h,
+                             v16[h] + (uncounted_offset & (c16[h] == cv::v_setzero_u16())));
+                       }
+                       cv::v_float64x2 xs(static_cast<double>(at), static_cast<double>(at + 1));
+                       const cv::v_float64x2 two = cv::v_setall_f64(2.0);
+                       for (int e = 0; e < 16; e += 2) {
+                         const cv::v_float64x2 w(table[index[e]], table[index[e + 1]]);
+                         rw += w;
+                         rx += w * xs;
+                         xs += two;  // Whole numbers: exact.
+                       }
+                     });
   }
-  for (int y = grown.y; y < grown.br().y; ++y) {
-    const uint8_t* levels = gray.ptr<uint8_t>(y);
-    const uint8_t* distance = dist.ptr<uint8_t>(y);
-    const cv::v_float64x2 vy = cv::v_setall_f64(static_cast<double>(y));
-    cv::v_float64x2 rw = zero, rx = zero;  // The row's sums of w and w * x.
-    for (int x = grown.x; x < grown.br().x;) {
-      const int at = std::min(x, grown.br().x - 16);  // The last 16 overlap: lanes dropped.
-      cv::v_uint8x16 counted = cv::v_load(distance + at) <= near;
-      if (at < x) {
-        for (int k = 0; k < 16; ++k) fresh[k] = at + k >= x ? 0xFF : 0;
-        counted &= cv::v_load_aligned(fresh);
-      }
-      // Uncounted pixels' weights are set to 0 (adding 0 leaves the sums as they were).
-      const cv::v_uint8x16 v = cv::v_load(levels + at);
-      cv::v_uint16x8 v16[2], c16[2];
-      cv::v_expand(v, v16[0], v16[1]);
-      cv::v_expand(counted, c16[0], c16[1]);
-      for (int h = 0; h < 2; ++h) {
-        cv::v_uint32x4 v32[2], c32[2];
-        cv::v_expand(v16[h], v32[0], v32[1]);
-        cv::v_expand(c16[h], c32[0], c32[1]);
-        for (int q = 0; q < 2; ++q) {
-          const cv::v_int32x4 level = cv::v_reinterpret_as_s32(v32[q]);
-          const cv::v_int32x4 take = cv::v_reinterpret_as_s32(c32[q]);
-          const cv::v_float64x2 halves[2] = {cv::v_cvt_f64(level), cv::v_cvt_f64_high(level)};
-          const cv::v_float64x2 keeps[2] = {cv::v_cvt_f64(take), cv::v_cvt_f64_high(take)};
-          for (int e = 0; e < 2; ++e) {
-            const int x_first = at + 8 * h + 4 * q + 2 * e;
-            cv::v_float64x2 w = cv::v_min(cv::v_max(((halves[e] - vbg) * vd) / vden, zero), unit);
-            w = cv::v_select(keeps[e] != zero, w, zero);
-            const cv::v_float64x2 xs(static_cast<double>(x_first), static_cast<double>(x_first + 1));
-            rw += w;
-            rx += w * xs;
-          }
-        }
-      }
-      x = at + 16;
-    }
-    sw += rw;
-    sx += rx;
-    sy += rw * vy;
-  }
-  SoftCentroidSums sums;
-  sums.w = cv::v_reduce_sum(sw);
-  sums.x = cv::v_reduce_sum(sx);
-  sums.y = cv::v_reduce_sum(sy);
-  return sums;
+  return SumChunks(gray, dist, grown,
+                   [&](const cv::v_uint16x8 (&v16)[2], const cv::v_uint16x8 (&c16)[2], int at,
+                       cv::v_float64x2& rw, cv::v_float64x2& rx) {
+                     // Uncounted pixels' weights are set to 0 (adding 0 leaves the sums as they
+                     // were).
+                     for (int h = 0; h < 2; ++h) {
+                       cv::v_uint32x4 v32[2], c32[2];
+                       cv::v_expand(v16[h], v32[0], v32[1]);
+                       cv::v_expand(c16[h], c32[0], c32[1]);
+                       for (int q = 0; q < 2; ++q) {
+                         const cv::v_int32x4 level = cv::v_reinterpret_as_s32(v32[q]);
+                         const cv::v_int32x4 take = cv::v_reinterpret_as_s32(c32[q]);
+                         const cv::v_float64x2 halves[2] = {cv::v_cvt_f64(level),
+                                                            cv::v_cvt_f64_high(level)};
+                         const cv::v_float64x2 keeps[2] = {cv::v_cvt_f64(take),
+                                                           cv::v_cvt_f64_high(take)};
+                         for (int e = 0; e < 2; ++e) {
+                           const int x_first = at + 8 * h + 4 * q + 2 * e;
+                           cv::v_float64x2 w =
+                               cv::v_min(cv::v_max(((halves[e] - vbg) * vd) / vden, zero), unit);
+                           w = cv::v_select(keeps[e] != zero, w, zero);
+                           const cv::v_float64x2 xs(static_cast<double>(x_first),
+                                                    static_cast<double>(x_first + 1));
+                           rw += w;
+                           rx += w * xs;
+                         }
+                       }
+                     }
+                   });
 #else
   return SoftCentroidReference(gray, mask, dist, grown, bg, fg);
 #endif
