@@ -31,6 +31,45 @@ const char* TemplateReportName(TemplateReport report) {
 
 namespace template_internal {
 
+namespace {
+// What a selected template shows of its marker: its blob in the matched channel and, for a
+// coloured selection, in its chromaticity. SetTemplate learns from it, and JudgeBox asks of the
+// same blob whether a box is centred on it.
+struct SelectionBlobs {
+  bool in_gray = false;
+  BlobMeter gray;
+  cv::Point2d gray_centroid;
+  cv::Mat projection;  // The BGR weights giving the matched channel's blob channel.
+  bool has_axis = false;
+  ChromaAxis axis;
+  bool in_chroma = false;
+  BlobMeter chroma;
+  cv::Point2d chroma_centroid;
+  // The marker's centre is reported from its chromaticity's blob where it stands out more there
+  // than in the matched channel (a shaded coloured dome: 0.59-0.77 against 0.24-0.43); a yellow
+  // dot on a green cart, already clear in the matched channel, keeps it (its chromaticity blurs
+  // with the motion).
+  bool chroma_reports() const {
+    return in_chroma && (!in_gray || chroma.isolation() > gray.isolation());
+  }
+};
+
+// `selection_bgr`: the selection's BGR pixels (of the template's size), or empty.
+SelectionBlobs MeasureSelection(const cv::Mat& templ, const cv::Mat& mask,
+                                const cv::Mat& selection_bgr) {
+  SelectionBlobs seen;
+  seen.in_gray = LearnTemplateBlob(templ, mask, &seen.projection, &seen.gray, &seen.gray_centroid);
+  if (!selection_bgr.empty() && selection_bgr.size() == templ.size() &&
+      LearnChromaAxis(selection_bgr, &seen.axis)) {
+    seen.has_axis = true;
+    cv::Mat channel;
+    ChromaChannel(selection_bgr, seen.axis, channel);
+    seen.in_chroma = seen.chroma.Learn(channel, mask, &seen.chroma_centroid);
+  }
+  return seen;
+}
+}  // namespace
+
 // Converts the part `rect` of the frame (clipped to it) for the windows of this update.
 void TemplateTracker::ConvertAround(const cv::Mat& frame, const cv::Rect& rect) {
   StopSharingWindowSums(zncc_);  // native_ is about to change.
@@ -123,30 +162,22 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
   anchor_px_ = HalfSize(templ.size());
   // The marker's blob in the template (its foreground), whatever point is reported: every
   // match must contain it (see BlobShift).
-  blob_ok_ = LearnTemplateBlob(templ, MaskFor(templ.size()), &blob_projection_, &blob_,
-                               &blob_anchor_px_);
-  chroma_ok_ = false;
-  anchor_spread_px_ = 0.0;
-  if (!selection_bgr.empty() && selection_bgr.size() == templ.size() &&
-      LearnChromaAxis(selection_bgr, &chroma_)) {
-    cv::Mat channel;
-    ChromaChannel(selection_bgr, chroma_, channel);
-    BlobMeter meter;
-    cv::Point2d centroid;
-    const bool in_chroma = meter.Learn(channel, MaskFor(templ.size()), &centroid);
-    // Both channels show the marker but put its centre apart (a dome's shaded flank is dark in
-    // gray and of the marker's tint in chroma; the two carts' yellow dots, 1.8-2.2 px): which
-    // of the two is the marker's centre is uncertain by that much, in every frame.
-    if (in_chroma && blob_ok_) anchor_spread_px_ = cv::norm(centroid - blob_anchor_px_);
-    // Taken where the marker stands out more in its chromaticity than in the matched channel (a
-    // shaded coloured dome: 0.59-0.77 against 0.24-0.43); a yellow dot on a green cart, already
-    // clear in the matched channel, keeps it (its chromaticity blurs with the motion).
-    if (in_chroma && (!blob_ok_ || meter.isolation() > blob_.isolation())) {
-      blob_ = meter;
-      blob_anchor_px_ = centroid;
-      blob_ok_ = true;
-      chroma_ok_ = true;
-    }
+  const SelectionBlobs seen = MeasureSelection(templ, MaskFor(templ.size()), selection_bgr);
+  blob_ok_ = seen.in_gray;
+  blob_ = seen.gray;
+  blob_anchor_px_ = seen.gray_centroid;
+  blob_projection_ = seen.projection;
+  if (seen.has_axis) chroma_ = seen.axis;
+  // Both channels show the marker but put its centre apart (a dome's shaded flank is dark in
+  // gray and of the marker's tint in chroma; the two carts' yellow dots, 1.8-2.2 px): which of
+  // the two is the marker's centre is uncertain by that much, in every frame.
+  anchor_spread_px_ =
+      seen.in_chroma && seen.in_gray ? cv::norm(seen.chroma_centroid - seen.gray_centroid) : 0.0;
+  chroma_ok_ = seen.chroma_reports();
+  if (chroma_ok_) {
+    blob_ = seen.chroma;
+    blob_anchor_px_ = seen.chroma_centroid;
+    blob_ok_ = true;
   }
   core_colour_.reset();
   if (!selection_bgr.empty() && selection_bgr.size() == templ.size()) {
@@ -252,40 +283,24 @@ bool TemplateTracker::start(const Frame& frame) {
 
 TemplateTracker::BoxVerdict TemplateTracker::JudgeBox(const cv::Mat& native,
                                                       const cv::Mat& selection_bgr) const {
-  BoxVerdict verdict;
-  cv::Mat projection, channel;
-  BlobMeter meter;
-  cv::Point2d centroid;
-  const cv::Mat mask = MaskFor(native.size());
-  const bool in_gray = LearnTemplateBlob(native, mask, &projection, &meter, &centroid);
-  if (in_gray) {
-    verdict = {true,     centroid, meter.learned_contrast(), meter.blob_box(), meter.area(),
-               centroid, meter.area()};
-  } else {
-    verdict.contrast = meter.learned_contrast();
-  }
   // A coloured marker may stand out only in its chromaticity where a groove, a shadow or wood
-  // grain beside it is as dark as it in the matched channel: SetTemplate measures its blob there,
-  // and reports from it wherever it stands out more there (the same choice as SetTemplate's).
-  ChromaAxis chroma;
-  if (!selection_bgr.empty() && LearnChromaAxis(selection_bgr, &chroma)) {
-    ChromaChannel(selection_bgr, chroma, channel);
-    BlobMeter colour_meter;
-    cv::Point2d colour_centroid;
-    if (colour_meter.Learn(channel, mask, &colour_centroid)) {
-      if (!in_gray) {
-        return {true,           colour_centroid,     colour_meter.learned_contrast(),
-                colour_meter.blob_box(), colour_meter.area(), colour_centroid,
-                colour_meter.area()};
-      }
-      if (colour_meter.isolation() > meter.isolation()) {
-        verdict.reported_centroid = colour_centroid;
-        verdict.reported_area = colour_meter.area();
-      }
-    } else if (!in_gray) {
-      verdict.contrast = std::max(verdict.contrast, colour_meter.learned_contrast());
-    }
+  // grain beside it is as dark as it in the matched channel: SetTemplate measures its blob there.
+  const SelectionBlobs seen = MeasureSelection(native, MaskFor(native.size()), selection_bgr);
+  BoxVerdict verdict;
+  if (!seen.in_gray && !seen.in_chroma) {
+    verdict.contrast = std::max(seen.gray.learned_contrast(),
+                                seen.has_axis ? seen.chroma.learned_contrast() : 0.0);
+    return verdict;
   }
+  const BlobMeter& found = seen.in_gray ? seen.gray : seen.chroma;
+  verdict.marker = true;
+  verdict.centroid = seen.in_gray ? seen.gray_centroid : seen.chroma_centroid;
+  verdict.contrast = found.learned_contrast();
+  verdict.blob_box = found.blob_box();
+  verdict.area = found.area();
+  const bool chroma = seen.chroma_reports();
+  verdict.reported_centroid = chroma ? seen.chroma_centroid : seen.gray_centroid;
+  verdict.reported_area = chroma ? seen.chroma.area() : seen.gray.area();
   return verdict;
 }
 
