@@ -85,17 +85,6 @@ bool HsvPickOptions::Check(std::string* error) const {
 }
 
 namespace {
-std::optional<HsvPick> PickHsvFromSamplesWithChroma(const std::vector<cv::Vec3b>& hsv_samples,
-                                                    const HsvPickOptions& options,
-                                                    int min_chroma, std::string* why_not);
-}  // namespace
-
-std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samples,
-                                          const HsvPickOptions& options, std::string* why_not) {
-  return PickHsvFromSamplesWithChroma(hsv_samples, options, kMinHueChroma, why_not);
-}
-
-namespace {
 // PickHsvFromSamples with the channels' least spread for a pixel to carry a hue (kMinHueChroma
 // there) as a parameter.
 std::optional<HsvPick> PickHsvFromSamplesWithChroma(const std::vector<cv::Vec3b>& hsv_samples,
@@ -192,6 +181,11 @@ std::optional<HsvPick> PickHsvFromSamplesWithChroma(const std::vector<cv::Vec3b>
   return pick;
 }
 }  // namespace
+
+std::optional<HsvPick> PickHsvFromSamples(const std::vector<cv::Vec3b>& hsv_samples,
+                                          const HsvPickOptions& options, std::string* why_not) {
+  return PickHsvFromSamplesWithChroma(hsv_samples, options, kMinHueChroma, why_not);
+}
 
 namespace {
 
@@ -531,6 +525,8 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
   std::optional<HsvPick> pick = PickHsvFromSamples(samples, options, &why);
   cv::Point2d sampled_at = click_px;
   bool gray = false;
+  // How much of its surroundings the pick passes at the click, where already measured.
+  std::optional<double> passing_at_click;
   if (!pick && why.rfind("not a coloured marker", 0) == 0) {
     pick = PickGrayDot(bgr, click_px, r, &why);
     gray = true;
@@ -543,10 +539,12 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
       if (std::optional<HsvPick> dim =
               PickHsvFromSamplesWithChroma(samples, options, kMinHueChroma / 2, nullptr)) {
         const double dim_passing = SurroundingsPassing(bgr, click_px, *dim, r);
-        if (dim_passing < kLeakyColourPick &&
-            dim_passing <= SurroundingsPassing(bgr, click_px, *pick, r)) {
+        const double gray_passing = SurroundingsPassing(bgr, click_px, *pick, r);
+        passing_at_click = gray_passing;
+        if (dim_passing < kLeakyColourPick && dim_passing <= gray_passing) {
           pick = dim;
           gray = false;
+          passing_at_click = dim_passing;
         }
       }
     }
@@ -590,10 +588,12 @@ std::optional<HsvPick> PickHsvRange(const cv::Mat& bgr, cv::Point2d click_px,
     // shadow, the bench; a white or black dot's rings measured from the wrong point): ranges
     // wide enough to take those in. The marker's centre is the centre of the blob those ranges
     // give through the click; the ranges are picked again there.
-    recentre(*pick, sampled_at, kRecentrePx);
+    const bool recentred = recentre(*pick, sampled_at, kRecentrePx);
     // How much of the marker's near surroundings the pick's range passes, for the pick as it
     // stands (measured again whenever the pick or where it was sampled changes).
-    double passing = SurroundingsPassing(bgr, sampled_at, *pick, r);
+    double passing = !recentred && passing_at_click
+                         ? *passing_at_click
+                         : SurroundingsPassing(bgr, sampled_at, *pick, r);
     if (!gray && r > 1 && passing >= kInseparablePick) {
       // A click near a coloured marker's rim may give ranges wide enough for its shadow and the
       // bench beside it, which then join it. The half disc's ranges, sampled again at the centre
