@@ -1057,6 +1057,60 @@ void ChromaChannel(const cv::Mat& bgr, const ChromaAxis& chroma, cv::Mat& out) {
 #endif
 }
 
+void LogChromaticity(const cv::Mat& bgr, cv::Mat& out) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  static const std::array<float, 256> kLog = [] {
+    std::array<float, 256> table{};
+    for (int v = 0; v < 256; ++v) table[v] = static_cast<float>(std::log(v + kLogChromaDarkLevels));
+    return table;
+  }();
+  out.create(bgr.size(), CV_32FC2);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* in = bgr.ptr<uint8_t>(y);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < bgr.cols; ++x, in += 3, o += 2) {
+      const float g = kLog[in[1]];
+      o[0] = kLog[in[2]] - g;
+      o[1] = kLog[in[0]] - g;
+    }
+  }
+}
+
+double TwoChannelZncc(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  CV_Assert(a.type() == CV_32FC2 && b.type() == CV_32FC2 && a.size() == b.size());
+  CV_Assert(mask.empty() || (mask.type() == CV_8UC1 && mask.size() == a.size()));
+  // Sums of each channel, of squares and of products, in doubles: a template holds at most a few
+  // thousand pixels.
+  double n = 0;
+  cv::Vec2d sa(0, 0), sb(0, 0), saa(0, 0), sbb(0, 0), sab(0, 0);
+  for (int y = 0; y < a.rows; ++y) {
+    const cv::Vec2f* pa = a.ptr<cv::Vec2f>(y);
+    const cv::Vec2f* pb = b.ptr<cv::Vec2f>(y);
+    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
+    for (int x = 0; x < a.cols; ++x) {
+      if (m != nullptr && m[x] == 0) continue;
+      n += 1;
+      for (int c = 0; c < 2; ++c) {
+        sa[c] += pa[x][c];
+        sb[c] += pb[x][c];
+        saa[c] += double(pa[x][c]) * pa[x][c];
+        sbb[c] += double(pb[x][c]) * pb[x][c];
+        sab[c] += double(pa[x][c]) * pb[x][c];
+      }
+    }
+  }
+  if (n < 2) return kNoRival;
+  double cross = 0, va = 0, vb = 0;
+  for (int c = 0; c < 2; ++c) {
+    cross += sab[c] - sa[c] * sb[c] / n;
+    va += saa[c] - sa[c] * sa[c] / n;
+    vb += sbb[c] - sb[c] * sb[c] / n;
+  }
+  // No variation (below float rounding of the sums): no shape to compare.
+  if (!(va > 1e-9 * n && vb > 1e-9 * n)) return kNoRival;
+  return cross / std::sqrt(va * vb);
+}
+
 bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv::Vec3d* chroma) {
   CV_Assert(bgr.type() == CV_8UC3);
   const double r = std::max(radius, 1.0);

@@ -713,6 +713,21 @@ inline constexpr double kSameColourDistance = 0.06;
 inline constexpr double kMinCoreChroma = 0.06;
 inline constexpr double kColourZnccAllowance = 0.1;
 
+// A colour picture's log-chromaticity, CV_32FC2: per pixel log((r + k) / (g + k)) and
+// log((b + k) / (g + k)), k = kLogChromaDarkLevels. A shadow falling on part of a template, or a
+// change of the light's strength, scales a pixel's three channels alike and leaves these
+// unchanged; a colour cast scales each channel by its own factor, which adds a constant that
+// ZNCC cancels. k damps the ratios of dark pixels, whose noise is a large part of their levels.
+inline constexpr double kLogChromaDarkLevels = 8.0;
+// How far (px, per axis) from a match accepted in log-chromaticity alone its place is measured
+// there again: the gray-level peak a shadow pulled off the marker lies within a pixel or two.
+inline constexpr int kShadeFreeReachPx = 2;
+void LogChromaticity(const cv::Mat& bgr, cv::Mat& out);
+// ZNCC of two pictures of the same size and type, CV_32FC2, over both channels (each channel's
+// mean removed), counting the pixels `mask` (CV_8U, or empty: all) sets; kNoRival when either
+// shows no variation there.
+double TwoChannelZncc(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
+
 // The marker's blob in a selected template (its foreground): the channel it shows best
 // (`projection`: MarkerProjection on colour, else empty) and the blob learned in it. False
 // when the template shows none.

@@ -524,5 +524,39 @@ TEST(TemplateParts, ATurnedRectangleMasksWhatCameFromOutsideIt) {
   EXPECT_LT(cv::countNonZero(mask), cv::countNonZero(round));
 }
 
+// Log-chromaticity is what a shadow leaves: a picture whose right half gets 0.4 of its light
+// matches the lit one by about 1 in it, where its gray levels no longer match. Another colour
+// pattern does not, nor does a picture without variation (it cannot be judged).
+TEST(TemplateParts, LogChromaticityMatchesAPictureAcrossAShadow) {
+  cv::Mat lit(21, 21, CV_8UC3, cv::Scalar(150, 190, 215));
+  cv::circle(lit, cv::Point(10, 10), 6, cv::Scalar(40, 45, 200), cv::FILLED);
+  cv::Mat shaded = lit.clone();
+  cv::Mat right = shaded(cv::Rect(8, 0, 13, 21));
+  right.convertTo(right, -1, 0.4);
+  cv::Mat a, b;
+  LogChromaticity(lit, a);
+  LogChromaticity(shaded, b);
+  ASSERT_EQ(a.type(), CV_32FC2);
+  EXPECT_GT(TwoChannelZncc(a, b, cv::Mat()), 0.97);
+  // Its gray levels: far apart.
+  cv::Mat gray_lit, gray_shaded, gray_zncc;
+  cv::cvtColor(lit, gray_lit, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(shaded, gray_shaded, cv::COLOR_BGR2GRAY);
+  cv::matchTemplate(gray_shaded, gray_lit, gray_zncc, cv::TM_CCOEFF_NORMED);
+  EXPECT_LT(gray_zncc.at<float>(0, 0), 0.8);
+  // A green disc in the red one's place.
+  cv::Mat other(21, 21, CV_8UC3, cv::Scalar(150, 190, 215));
+  cv::circle(other, cv::Point(10, 10), 6, cv::Scalar(60, 190, 60), cv::FILLED);
+  cv::Mat c;
+  LogChromaticity(other, c);
+  EXPECT_LT(TwoChannelZncc(a, c, cv::Mat()), 0.5);
+  // Only the pixels the mask sets count: outside the disc, both are the same bench.
+  cv::Mat ring(21, 21, CV_8UC1, cv::Scalar(255));
+  cv::circle(ring, cv::Point(10, 10), 8, cv::Scalar(0), cv::FILLED);
+  cv::Mat bench(21, 21, CV_8UC3, cv::Scalar(150, 190, 215)), flat;
+  LogChromaticity(bench, flat);
+  EXPECT_EQ(TwoChannelZncc(a, flat, ring), kNoRival);
+}
+
 }  // namespace
 }  // namespace softsight::template_internal

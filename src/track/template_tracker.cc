@@ -1,6 +1,7 @@
 #include "softsight/track/template_tracker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -187,6 +188,14 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
                                              : std::min(templ.cols, templ.rows) / 6.0);
     cv::Vec3d chroma;
     if (CoreColour(selection_bgr, core, core_radius_px_, &chroma)) core_colour_ = chroma;
+  }
+  shade_free_.release();
+  if (core_colour_) {
+    const cv::Vec3d from_grey = *core_colour_ - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
+    if (std::sqrt(from_grey.dot(from_grey)) >= kMinCoreChroma) {
+      LogChromaticity(selection_bgr, shade_free_);
+      shade_free_key_ = -1;
+    }
   }
   blob_reported_ = blob_ok_ && (params_.report == TemplateReport::kCentre ||
                                 (chroma_ok_ && params_.report == TemplateReport::kSymmetry));
@@ -562,6 +571,69 @@ bool TemplateTracker::Accept(const Hit& m, bool colour_agrees, bool followed) co
     case MatchMeasure::kZncc: return true;
   }
   return false;
+}
+
+bool TemplateTracker::AcceptOn(const cv::Mat& frame, const Hit& m, bool followed, bool* shaded) {
+  const bool colour_agrees = ColourAgreesAt(frame, m);
+  *shaded = false;
+  if (Accept(m, colour_agrees, followed)) return true;
+  if (!followed || !colour_agrees) return false;
+  const std::optional<ShadeFreePeak> peak = ShadeFreePeakNear(frame, m.top_left);
+  if (!peak || !(peak->zncc >= params_.min_zncc)) return false;
+  shade_free_peak_ = *peak;
+  *shaded = true;
+  return true;
+}
+
+// The first template's log-chromaticity at the placements within kShadeFreeReachPx of `origin`
+// (a top-left corner), compared by ZNCC with the frame's (converted once for all of them), the
+// best placed to a fraction of a pixel by a parabola through it and its neighbours on each axis.
+// Absent when it cannot be judged (gray footage, a grey marker: its chromaticity is its
+// surroundings' and the camera noise's), or the best lies on the edge of the placements tried
+// (not a peak of them) or not wholly in the frame.
+std::optional<TemplateTracker::ShadeFreePeak> TemplateTracker::ShadeFreePeakNear(
+    const cv::Mat& frame, cv::Point origin) {
+  if (shade_free_.empty() || frame.type() != CV_8UC3) return std::nullopt;
+  constexpr int kReach = kShadeFreeReachPx;
+  constexpr int kSide = 2 * kReach + 1;
+  const cv::Size size = current().templ.size();
+  const cv::Rect region = cv::Rect(origin - cv::Point(kReach, kReach),
+                                   size + cv::Size(2 * kReach, 2 * kReach)) &
+                          cv::Rect(0, 0, frame.cols, frame.rows);
+  // The first template at the current rung's scale and turn, as RungAt made the rung from it,
+  // kept while the rung stays.
+  const int key = RungKey(rung_, turn_);
+  if (shade_free_key_ != key) {
+    cv::Matx23d map;
+    TurnedTemplate(shade_free_, size, turn_ * kTurnStepDeg, MaskFor(size), &shade_free_rung_,
+                   &shade_free_mask_, &map);
+    shade_free_key_ = key;
+  }
+  LogChromaticity(frame(region), shade_free_region_);
+  std::array<double, kSide * kSide> zncc;
+  int best = 0;
+  for (int i = 0; i < kSide * kSide; ++i) {
+    const cv::Rect place(origin + cv::Point(i % kSide - kReach, i / kSide - kReach), size);
+    zncc[i] = (place & region) == place
+                  ? TwoChannelZncc(shade_free_rung_, shade_free_region_(place - region.tl()),
+                                   shade_free_mask_)
+                  : kNoRival;
+    if (zncc[i] > zncc[best]) best = i;
+  }
+  const int bx = best % kSide, by = best / kSide;
+  if (bx == 0 || by == 0 || bx == kSide - 1 || by == kSide - 1 || zncc[best] == kNoRival) {
+    return std::nullopt;
+  }
+  const auto vertex = [](double before, double at, double after) {
+    const double curvature = before - 2 * at + after;
+    return curvature < 0 ? std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5) : 0.0;
+  };
+  ShadeFreePeak peak;
+  peak.zncc = zncc[best];
+  peak.top_left = cv::Point2d(origin + cv::Point(bx - kReach, by - kReach)) +
+                  cv::Point2d(vertex(zncc[best - 1], zncc[best], zncc[best + 1]),
+                              vertex(zncc[best - kSide], zncc[best], zncc[best + kSide]));
+  return peak;
 }
 
 cv::Rect TemplateTracker::WindowAround(const cv::Point2d& centre_px, const cv::Size& size,
@@ -1160,6 +1232,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     TurnedTo();
   }
   std::optional<Hit> hit;
+  bool shaded = false;  // Accepted in log-chromaticity alone (AcceptOn).
   if (tracking_) {
     const cv::Point2d predicted = *last_centre_ + velocity_px_;
     cv::Rect window = WindowAround(predicted, search_template().size(), params_.search_margin_px);
@@ -1175,14 +1248,14 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
       hit = Search(frame_bgr, window, search_template(), true);
       // Moving faster than the window (its best is on the window's edge, or is no match at all
       // because the marker left it): acquire.
-      if (hit && (hit->on_inner_edge || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), true))) {
+      if (hit && (hit->on_inner_edge || !AcceptOn(frame_bgr, *hit, true, &shaded))) {
         hit.reset();
       }
     }
   }
   const bool followed = hit.has_value();
   if (!hit) hit = Acquire(frame_bgr);
-  if (!hit || !Accept(*hit, ColourAgreesAt(frame_bgr, *hit), followed)) {
+  if (!hit || !AcceptOn(frame_bgr, *hit, followed, &shaded)) {
     return Lose(MarkerStatus::kLost);
   }
   // Of another colour than the marker: a look-alike (a blue disc for the green one's gray
@@ -1214,7 +1287,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     scan_pending_ = false;
     ScanForLookAlikes(frame_bgr, cv::Point2d(hit->top_left) + HalfSize(search_template().size()));
   }
-  Observation observation = Verify(frame_bgr, matched, hit->score, last_turn, hit->zncc);
+  Observation observation = Verify(frame_bgr, matched, hit->score, last_turn, hit->zncc, shaded);
   if (observation.found()) {
     weighed_.front().verdict = CandidateVerdict::kChosen;
     weighed_.front().position_px = *observation.position_px;
@@ -1270,7 +1343,9 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
 // The first template's measurement at the working template's match `matched` (its centre), the
 // drift guard, the template's blob, then the tracker's state moves on to it.
 Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched,
-                                    double score, int last_turn, double working_zncc) {
+                                    double score, int last_turn, double working_zncc,
+                                    bool shaded) {
+  if (shaded) return VerifyShaded(score);
   const std::optional<Fix> fix = Measure(frame_bgr, matched);
   // SAD and SSD compare grey levels with the first template too: they do not cancel a change of
   // light, and a position they measure against a template the light has left is biased.
@@ -1326,6 +1401,28 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   }
   const cv::Size size = current().templ.size();
   observation.sigma_px = TemplateMatchSigmaPx(fix->zncc, size.width, size.height, blob);
+  return observation;
+}
+
+// The match accepted in log-chromaticity alone (AcceptOn measured its place there: the gray
+// levels a shadow changed neither place nor measure it; the template's blob, cut by the shadow,
+// would put the centre off towards the lit side). The pose and the working template are left as
+// they were.
+Observation TemplateTracker::VerifyShaded(double score) {
+  const ShadeFreePeak& peak = shade_free_peak_;
+  const cv::Size size = current().templ.size();
+  const cv::Point2d centre = peak.top_left + HalfSize(size);
+  const cv::Point2d step = tracking_ ? centre - *last_centre_ : cv::Point2d(0, 0);
+  repeats_ = 0;
+  velocity_px_ = step;
+  turn_step_ = 0;  // The turn was not measured: looked for as it is.
+  last_centre_ = centre;
+  tracking_ = true;
+  lost_frames_ = 0;
+  Observation observation;
+  observation.position_px = peak.top_left + current().anchor;
+  observation.score = score;
+  observation.sigma_px = TemplateMatchSigmaPx(peak.zncc, size.width, size.height, BlobEvidence());
   return observation;
 }
 

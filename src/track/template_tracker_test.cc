@@ -656,6 +656,58 @@ TEST(TemplateTrackerTest, ABoxWhoseOnlyBlobLiesOffItsCentreIsRefused) {
   }
 }
 
+// A red dome on a beige bench with a groove above it, followed while the shadow of a hand falls
+// across its surroundings: from frame 4 the bench left of the dome and below it, up to a pixel
+// or two from its rim, gets 0.4 of its light. The box's gray levels (mostly bench, near half of
+// it in the shadow) no longer match the template well enough (the marker was lost from frame 4);
+// its log-chromaticity, which a shadow leaves unchanged, matches and places the dome. Every frame
+// is found within half a pixel. The shadow does not make a marker of what is not one: once the
+// dome has gone, the shadowed bench is not reported.
+TEST(TemplateTrackerTest, AMarkerInAShadowThatFallsAcrossItsSurroundingsIsFollowed) {
+  constexpr double kRadius = 7.0;
+  const auto render = [&](const cv::Point2d& centre, bool shadow, bool dome) {
+    cv::Mat frame(100, 120, CV_8UC3, cv::Scalar(150, 190, 215));
+    cv::rectangle(frame, cv::Rect(0, cvRound(centre.y) - 13, 120, 3), cv::Scalar(95, 120, 140),
+                  cv::FILLED);
+    if (dome) {
+      cv::circle(frame, cv::Point(cvRound(centre.x * 16), cvRound(centre.y * 16)),
+                 cvRound(kRadius * 16), cv::Scalar(40, 45, 200), cv::FILLED, cv::LINE_AA, 4);
+    }
+    if (shadow) {
+      // Left of the dome and below it, up to a pixel from its rim.
+      const int left_edge = cvRound(centre.x - kRadius) - 1;
+      const int top_edge = cvRound(centre.y + kRadius) + 2;
+      cv::Mat left = frame(cv::Rect(0, 0, left_edge, frame.rows));
+      left.convertTo(left, -1, 0.4);
+      cv::Mat below = frame(cv::Rect(left_edge, top_edge, frame.cols - left_edge, frame.rows - top_edge));
+      below.convertTo(below, -1, 0.4);
+    }
+    return frame;
+  };
+  for (const bool colour : {false, true}) {
+    SCOPED_TRACE(colour ? "colour" : "gray");
+    MarkerSpec spec;
+    spec.name = "red";
+    TemplateParams params;
+    params.colour = colour;
+    spec.params = ParamsForMethod("zncc", {params});
+    const std::unique_ptr<Tracker> tracker = CreateTracker(spec);
+    int found = 0;
+    for (int i = 0; i < 14; ++i) {
+      const cv::Point2d centre(52.3 + 0.4 * i, 50.6 + 0.2 * i);
+      const cv::Mat frame = render(centre, i >= 4, true);
+      if (i == 0) tracker->init(frame, RectAround(centre, 33));
+      const Observation o = tracker->update(frame);
+      if (!o.found()) continue;
+      ++found;
+      EXPECT_LT(cv::norm(*o.position_px - centre), 0.5) << "frame " << i;
+    }
+    EXPECT_EQ(found, 14);
+    const Observation gone = tracker->update(render(cv::Point2d(58.3, 53.6), true, false));
+    EXPECT_FALSE(gone.found());
+  }
+}
+
 // Two white dots on a dark card, drawn anti-aliased at sub-pixel centres (cv::circle with 4
 // fractional bits): look-alikes, as the dots on a hand-held plate are.
 cv::Mat TwoDots(cv::Point2d a, cv::Point2d b, double radius, std::optional<cv::Rect> cover = {}) {
