@@ -165,6 +165,13 @@ inline constexpr double kBlobDriftAllowance = 0.2;
 // The blob at a match has at least this fraction of the learned blob's area (at the current
 // scale), and at most its inverse: a tilt to 60 degrees halves a disc's area.
 inline constexpr double kMinBlobAreaRatio = 0.4;
+// A blob at a match with less than this fraction of the learned area is cut (Verify): its
+// centroid is not the marker's centre.
+inline constexpr double kCutBlobAreaRatio = 0.8;
+// How far the gray-level match (ZNCC with the first template) lies below the log-chromaticity
+// one where the light changed across the marker (a shadow over part of it): 0.38-0.42 measured
+// there, at most 0.23 where a match loses both together (motion blur, a turn, perspective).
+inline constexpr double kShadedZnccGap = 0.3;
 // A match may move onto its blob by at least this much (px; more for larger templates).
 inline constexpr double kMinBlobShiftPx = 2.0;
 // A blob this close to where the match puts it agrees with the match (px). Beyond it, the

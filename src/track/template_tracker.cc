@@ -1102,6 +1102,7 @@ void TemplateTracker::TurnedTo() {
 // learned blob's at this scale, or one farther than a quarter of the template.
 std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, const Fix& fix) {
   blob_disagreement_px_ = 0.0;  // This frame's, set below where both centroids are measured.
+  blob_area_ratio_ = 1.0;
   const Rung& rung = current();
   const cv::Size size = rung.templ.size();
   // Measured on the template's place and some of its surroundings, unmasked: a marker seen at a
@@ -1139,6 +1140,7 @@ std::optional<cv::Point2d> TemplateTracker::BlobShift(const cv::Mat& frame, cons
     return std::nullopt;
   }
   const double learned = blob_.area() * rung_scale() * rung_scale();
+  blob_area_ratio_ = area / learned;
   if (!(area >= kMinBlobAreaRatio * learned && area <= learned / kMinBlobAreaRatio)) {
     return std::nullopt;
   }
@@ -1372,6 +1374,23 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
     at.centre += *shift;
     at.reported += *shift;
   }
+  // A blob well below the marker's area at a match that holds is cut: a shadow across part of a
+  // dome leaves only its lit part, or only its shaded part, in the blob's channel, and that
+  // part's centroid is not the marker's centre (2.2-2.5 px off for half a disc). Where the first
+  // template matches as well as a match must in log-chromaticity, which the shadow leaves as it
+  // was, and far better than in gray levels (the light changed across the marker, not its
+  // look: kShadedZnccGap), the marker is placed there.
+  bool placed_shade_free = false;
+  if (blob_ok_ && blob_area_ratio_ < kCutBlobAreaRatio) {
+    const cv::Size size = current().templ.size();
+    const std::optional<ShadeFreePeak> peak =
+        ShadeFreePeakNear(frame_bgr, WindowAround(fix->centre, size, 0).tl());
+    if (peak && peak->zncc >= params_.min_zncc && peak->zncc - fix->zncc >= kShadedZnccGap) {
+      at.centre = peak->top_left + HalfSize(size);
+      at.reported = peak->top_left + current().anchor;
+      placed_shade_free = true;
+    }
+  }
   const cv::Point2d step = tracking_ ? at.centre - *last_centre_ : cv::Point2d(0, 0);
   if (tracking_ && IsRepeatedFrame(step, velocity_px_, repeats_)) {
     ++repeats_;  // A repeated frame: the velocity is the next new frame's.
@@ -1393,7 +1412,7 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   observation.position_px = at.reported;
   observation.score = score;
   BlobEvidence blob;
-  if (blob_ok_) {
+  if (blob_ok_ && !placed_shade_free) {
     blob.area_px = blob_.area() * rung_scale() * rung_scale();
     blob.centroid_disagreement_px = blob_disagreement_px_;
     blob.definition_spread_px = anchor_spread_px_ * rung_scale();

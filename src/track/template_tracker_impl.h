@@ -242,6 +242,8 @@ class TemplateTracker final : public Tracker {
   // This frame's blob: how far its soft centroid lies from its binary one (0 when only the
   // binary one was needed: the match already on the blob).
   double blob_disagreement_px_ = 0.0;
+  // This frame's blob's area over the learned one (at the current scale), or 1 where not measured.
+  double blob_area_ratio_ = 1.0;
   bool chroma_ok_ = false;              // ... measured in its chromaticity (chroma_).
   ChromaAxis chroma_;
   // The blob's centroid, measured in every frame, is the reported point (report: centre, or a
