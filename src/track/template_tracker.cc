@@ -33,6 +33,10 @@ const char* TemplateReportName(TemplateReport report) {
 namespace template_internal {
 
 namespace {
+// How much less isolated a marker may stand out in its chromaticity than in the matched channel
+// and still be reported from it (SelectionBlobs::chroma_reports).
+constexpr double kIsolationTie = 0.03;
+
 // What a selected template shows of its marker: its blob in the matched channel and, for a
 // coloured selection, in its chromaticity. SetTemplate learns from it, and JudgeBox asks of the
 // same blob whether a box is centred on it.
@@ -46,12 +50,19 @@ struct SelectionBlobs {
   bool in_chroma = false;
   BlobMeter chroma;
   cv::Point2d chroma_centroid;
+  // The gray blob's core is of a colour (kMinCoreChroma or more from grey), not a white or black
+  // dot's, whose chromaticity is its surroundings' and the camera noise's.
+  bool coloured = false;
   // The marker's centre is reported from its chromaticity's blob where it stands out more there
-  // than in the matched channel (a shaded coloured dome: 0.59-0.77 against 0.24-0.43); a yellow
-  // dot on a green cart, already clear in the matched channel, keeps it (its chromaticity blurs
-  // with the motion).
+  // than in the matched channel (a shaded coloured dome: 0.59-0.77 against 0.24-0.43), and a
+  // coloured marker's also on a tie (within kIsolationTie): its chromaticity, which shading
+  // leaves, not its gray levels (a yellow dome on wood stands out 0.58 and 0.59, and its gray blob,
+  // pulled towards the light by the dome's lit top, lay 1.2 px above its centre in every frame). A
+  // yellow dot on a green cart, clearly better in the matched channel (0.51 against 0.46), keeps it
+  // (its chromaticity blurs with the motion).
   bool chroma_reports() const {
-    return in_chroma && (!in_gray || chroma.isolation() > gray.isolation());
+    const double tie = coloured ? kIsolationTie : 0.0;
+    return in_chroma && (!in_gray || chroma.isolation() > gray.isolation() - tie);
   }
 };
 
@@ -66,6 +77,13 @@ SelectionBlobs MeasureSelection(const cv::Mat& templ, const cv::Mat& mask,
     cv::Mat channel;
     ChromaChannel(selection_bgr, seen.axis, channel);
     seen.in_chroma = seen.chroma.Learn(channel, mask, &seen.chroma_centroid);
+    cv::Vec3d core;
+    if (seen.in_gray &&
+        CoreColour(selection_bgr, seen.gray_centroid,
+                   std::max(1.5, 0.6 * std::sqrt(seen.gray.area() / CV_PI)), &core)) {
+      const cv::Vec3d from_grey = core - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
+      seen.coloured = std::sqrt(from_grey.dot(from_grey)) >= kMinCoreChroma;
+    }
   }
   return seen;
 }
