@@ -1095,6 +1095,92 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
   return true;
 }
 
+namespace {
+// The row spans of FillUnmasked's fill on a continuous 8-bit patch of `total` pixels, `cols` a
+// row: a pixel is the marker's when its marker-likeness (level ^ flip) is above `above`. The
+// spans are a dot's rows, mostly under 16 pixels wide: the seeds beside a span and the scan
+// leftwards are taken 16 pixels at a time too, a span's last chunk masked to it, where the
+// pixel-at-a-time tails cost ~20 instructions a pixel (issue 45: the fill took ~480
+// instructions a span on ViSP's mire-2). The same span, and the same seeds in the same order
+// (left to right), as a pixel at a time: Fill's component (the tests compare them).
+struct SpanScan {
+  const uint8_t* levels;
+  int cols;
+  int total;
+  int flip;
+  int above;
+#if CV_SIMD128
+  cv::v_uint8x16 flip16, above16;
+#endif
+  SpanScan(const uint8_t* levels_in, int cols_in, int total_in, int flip_in, int above_in)
+      : levels(levels_in), cols(cols_in), total(total_in), flip(flip_in), above(above_in) {
+#if CV_SIMD128
+    flip16 = cv::v_setall_u8(static_cast<uint8_t>(flip));
+    above16 = cv::v_setall_u8(static_cast<uint8_t>(std::clamp(above, 0, 255)));
+#endif
+  }
+  bool marker(int i) const { return (levels[i] ^ flip) > above; }
+#if CV_SIMD128
+  // marker() for the 16 pixels from i, as a bit each (whole levels: exact in 8-bit lanes).
+  unsigned markers16(int i) const {
+    return static_cast<unsigned>(cv::v_signmask((cv::v_load(levels + i) ^ flip16) > above16));
+  }
+#endif
+  // The first column of the run of marker pixels that ends at `x` (a marker pixel) in the row
+  // starting at pixel `row`.
+  int Left(int row, int x) const {
+#if CV_SIMD128
+    while (x >= 16) {
+      const unsigned run = markers16(row + x - 16);
+      // Bit 15 is the pixel left of x: the marker pixels next to it are ~run's leading zeros
+      // once its 16 bits are shifted to the top.
+      if (run != 0xFFFFu) return x - __builtin_clz(~run << 16);
+      x -= 16;
+    }
+#endif
+    while (x > 0 && marker(row + x - 1)) --x;
+    return x;
+  }
+  // The last column of the run that starts at `x`.
+  int Right(int row, int x) const {
+#if CV_SIMD128
+    while (x + 16 <= cols - 1) {
+      const unsigned run = markers16(row + x + 1);
+      if (run != 0xFFFFu) return x + __builtin_ctz(~run);
+      x += 16;
+    }
+#endif
+    while (x < cols - 1 && marker(row + x + 1)) ++x;
+    return x;
+  }
+  // `push(x)` for the first pixel of each run, left to right, of the marker pixels of columns
+  // left..right of the row starting at pixel `r` that `open` (for one pixel) and `open16` (a
+  // bit each for the 16 from a pixel) let in.
+  template <typename Open, typename Open16, typename Push>
+  void Seeds(int r, int left, int right, const Open& open, const Open16& open16,
+             const Push& push) const {
+    bool in_run = false;  // The pixel before x is an open marker pixel of [left, right].
+    int x = left;
+#if CV_SIMD128
+    for (; x <= right && r + x + 16 <= total; x += 16) {
+      unsigned run = open16(r + x) & markers16(r + x);
+      if (right + 1 - x < 16) run &= (1u << (right + 1 - x)) - 1u;  // The span's last chunk.
+      for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
+           starts &= starts - 1) {
+        push(x + __builtin_ctz(starts));
+      }
+      in_run = (run >> 15) & 1u;
+    }
+#endif
+    for (; x <= right; ++x) {
+      const bool in = open(r + x) && marker(r + x);
+      if (in && !in_run) push(x);
+      in_run = in;
+    }
+  }
+};
+}  // namespace
+
 void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   const int cols = gray.cols, rows = gray.rows;
   const int area = cols * rows;
@@ -1166,15 +1252,16 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
   ZeroedMask(gray.size(), label_);
   const int cols = gray.cols, rows = gray.rows;
-  const int flip = bright_ ? 0 : 255;
-  const uint8_t* levels = gray.data;  // Continuous, as label_.
-  uint8_t* label = label_.data;
-  const auto marker = [&](int i) { return (levels[i] ^ flip) > cut; };
+  uint8_t* label = label_.data;  // Continuous, as gray.
+  // In marker-likeness (v ^ flip) a pixel is the marker's when above `cut`.
+  const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, cut);
+  const auto unfilled = [&](int i) { return label[i] == 0; };
 #if CV_SIMD128
-  // marker() for the 16 pixels from i (0xFF lanes): whole levels, so in 8-bit lanes exactly.
-  const cv::v_uint8x16 flip16 = cv::v_setall_u8(static_cast<uint8_t>(flip));
-  const cv::v_uint8x16 cut16 = cv::v_setall_u8(static_cast<uint8_t>(std::clamp(cut, 0, 255)));
-  const auto markers = [&](int i) { return (cv::v_load(levels + i) ^ flip16) > cut16; };
+  const auto unfilled16 = [&](int i) {
+    return static_cast<unsigned>(cv::v_signmask(cv::v_load(label + i) == cv::v_setzero_u8()));
+  };
+#else
+  const auto unfilled16 = [](int) { return 0u; };
 #endif
   int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
   int64_t count = 0, sum_x = 0, sum_y = 0;
@@ -1186,26 +1273,12 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     stack_.pop_back();
     const int row = p.y * cols;
     if (label[row + p.x]) continue;  // Its span was filled from another seed.
-    if (!first && !marker(row + p.x)) continue;
+    if (!first && !scan.marker(row + p.x)) continue;
     first = false;
     // The whole span of marker pixels through p: a component pixel on the patch's edge is not
     // separated from its surroundings (Fill's answer, whatever it had filled by then).
     if (p.y == 0 || p.y == rows - 1) return false;
-    int left = p.x, right = p.x;
-    while (left > 0 && marker(row + left - 1)) --left;
-#if CV_SIMD128
-    // Rightwards 16 pixels at a time while they are all the marker's, then to the first that is
-    // not (issue 45: the fill's scans were a twentieth of a frame of ViSP's mire-2 in ZNCC).
-    while (right + 16 <= cols - 1) {
-      const unsigned run = static_cast<unsigned>(cv::v_signmask(markers(row + right + 1)));
-      if (run != 0xFFFFu) {
-        right += __builtin_ctz(~run);
-        break;
-      }
-      right += 16;
-    }
-#endif
-    while (right < cols - 1 && marker(row + right + 1)) ++right;
+    const int left = scan.Left(row, p.x), right = scan.Right(row, p.x);
     if (left == 0 || right == cols - 1) return false;
     std::memset(label + row + left, 1, static_cast<size_t>(right - left + 1));
     const int64_t length = right - left + 1;
@@ -1216,29 +1289,10 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     x1 = std::max(x1, right);
     y0 = std::min(y0, p.y);
     y1 = std::max(y1, p.y);
-    // A seed for each run of unfilled marker pixels beside the span, above and below: the first
-    // pixel of each, left to right (16 pixels at a time: a run starts where a pixel is one and
-    // the one before it is not).
+    // A seed for each run of unfilled marker pixels beside the span, above and below.
     for (const int y : {p.y - 1, p.y + 1}) {
-      const int r = y * cols;
-      bool in_run = false;  // The pixel before x is an unfilled marker pixel of [left, right].
-      int x = left;
-#if CV_SIMD128
-      for (; x + 16 <= right + 1; x += 16) {
-        const cv::v_uint8x16 unfilled = cv::v_load(label + r + x) == cv::v_setzero_u8();
-        const unsigned run = static_cast<unsigned>(cv::v_signmask(unfilled & markers(r + x)));
-        for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
-             starts &= starts - 1) {
-          stack_.push_back({x + __builtin_ctz(starts), y});
-        }
-        in_run = (run >> 15) & 1u;
-      }
-#endif
-      for (; x <= right; ++x) {
-        const bool in = !label[r + x] && marker(r + x);
-        if (in && !in_run) stack_.push_back({x, y});
-        in_run = in;
-      }
+      scan.Seeds(y * cols, left, right, unfilled, unfilled16,
+                 [&](int x) { stack_.push_back({x, y}); });
     }
   }
   box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
