@@ -1096,13 +1096,14 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
 }
 
 namespace {
-// The row spans of FillUnmasked's fill on a continuous 8-bit patch of `total` pixels, `cols` a
-// row: a pixel is the marker's when its marker-likeness (level ^ flip) is above `above`. The
-// spans are a dot's rows, mostly under 16 pixels wide: the seeds beside a span and the scan
-// leftwards are taken 16 pixels at a time too, a span's last chunk masked to it, where the
-// pixel-at-a-time tails cost ~20 instructions a pixel (issue 45: the fill took ~480
+// The row spans of FillUnmasked's and ReachesEdge's fills on a continuous 8-bit patch of `total`
+// pixels, `cols` a row: a pixel is the marker's when its marker-likeness (level ^ flip) is above
+// `above`. The spans are a dot's rows, mostly under 16 pixels wide: the seeds beside a span and
+// the scan leftwards are taken 16 pixels at a time too, a span's last chunk masked to it, where
+// the pixel-at-a-time tails cost ~20 instructions a pixel (issue 45: the fills took ~400-480
 // instructions a span on ViSP's mire-2). The same span, and the same seeds in the same order
-// (left to right), as a pixel at a time: Fill's component (the tests compare them).
+// (left to right), as a pixel at a time: Fill's component and the reference flood's pass (the
+// tests compare them).
 struct SpanScan {
   const uint8_t* levels;
   int cols;
@@ -1230,7 +1231,24 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
       *pass = level;
       break;
     }
-    if (cores < kCoreSamples) core[cores++] = level;
+    if (cores < kCoreSamples) {
+      core[cores++] = level;
+      if (cores == kCoreSamples) {
+        // The core is taken (the rest of the flood only looks for the pass), and every pixel
+        // more marker-like than `level` has been taken without reaching the edge: the pass is
+        // at most `level`. The flood would take the rest of the marker's pixels one at a time
+        // (issue 45: a sixth of the ZNCC session's time on ViSP's mire-2); fills of whole row
+        // spans find the same level in a few tries. The flood goes on from here when they
+        // cannot (the budget: a quarter of the patch's pixels as spans).
+        const int found = PassByFills(gray, seed, level, area / 4);
+        if (found >= 0) {
+          ++passes_by_fills_;
+          *pass = found;
+          break;
+        }
+        ++fills_given_up_;
+      }
+    }
     // Off the patch's edge: the four neighbours are in the patch.
     for (const int offset : offsets) {
       const int q = p + offset;
@@ -1247,6 +1265,85 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
     }
   }
   core_.assign(core, core + cores);
+  last_pass_ = *pass;
+}
+
+int BlobMeter::PassByFills(const cv::Mat& gray, cv::Point seed, int upper, int budget) {
+  // Whether the level-t fill reaches the edge only falls as t rises, and t = 0 takes every
+  // pixel: the pass is the last t that reaches it. From the last pass g: g, then g + 1 (the
+  // usual answer in two fills), else outwards in doubling steps and halving between.
+  int lo = 0;          // Reaches the edge.
+  int hi = upper + 1;  // Does not (the flood has taken everything above `upper`).
+  const auto test = [&](int t) {
+    const int r = ReachesEdge(gray, seed, t, &budget);
+    if (r > 0) lo = t;
+    if (r == 0) hi = t;
+    return r;
+  };
+  const int g = std::clamp(last_pass_, 0, upper);
+  if (g > 0 && test(g) < 0) return -1;
+  if (lo == g) {
+    for (int step = 1; hi - lo > 1; step *= 2) {  // Upwards until a fill does not reach.
+      const int t = std::min(g + step, hi - 1);
+      if (test(t) < 0) return -1;
+      if (hi == t) break;
+    }
+  } else {
+    for (int step = 1; hi - lo > 1; step *= 2) {  // Downwards until one does.
+      const int t = std::max(g - step, lo + 1);
+      if (test(t) < 0) return -1;
+      if (lo == t) break;
+    }
+  }
+  while (hi - lo > 1) {
+    if (test(lo + (hi - lo) / 2) < 0) return -1;
+  }
+  return lo;
+}
+
+int BlobMeter::ReachesEdge(const cv::Mat& gray, cv::Point seed, int t, int* budget) {
+  const int cols = gray.cols, rows = gray.rows;
+  if (marks_size_ != gray.size()) {
+    marks_.assign(static_cast<size_t>(cols) * rows, 0);
+    marks_size_ = gray.size();
+    mark_ = 0;
+  }
+  if (++mark_ == 0) {  // Wrapped: the old marks would read as this fill's.
+    std::fill(marks_.begin(), marks_.end(), 0);
+    mark_ = 1;
+  }
+  uint8_t* marks = marks_.data();
+  const uint8_t mark = mark_;
+  // Marker-likeness t or more: above t - 1.
+  const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, t - 1);
+  const auto unmarked = [&](int i) { return marks[i] != mark; };
+#if CV_SIMD128
+  const cv::v_uint8x16 mark16 = cv::v_setall_u8(mark);
+  const auto unmarked16 = [&](int i) {
+    return static_cast<unsigned>(cv::v_signmask(cv::v_load(marks + i) != mark16));
+  };
+#else
+  const auto unmarked16 = [](int) { return 0u; };
+#endif
+  stack_.clear();
+  stack_.push_back(seed);  // Of level t or more: t is at most the flood's level.
+  while (!stack_.empty()) {
+    const cv::Point p = stack_.back();
+    stack_.pop_back();
+    const int row = p.y * cols;
+    if (marks[row + p.x] == mark) continue;  // Its span was marked from another seed.
+    if (--*budget < 0) return -1;
+    if (p.y == 0 || p.y == rows - 1) return 1;
+    const int left = scan.Left(row, p.x), right = scan.Right(row, p.x);
+    if (left == 0 || right == cols - 1) return 1;
+    std::memset(marks + row + left, mark, static_cast<size_t>(right - left + 1));
+    // A seed for each run of unmarked pixels of level t or more beside the span.
+    for (const int y : {p.y - 1, p.y + 1}) {
+      scan.Seeds(y * cols, left, right, unmarked, unmarked16,
+                 [&](int x) { stack_.push_back({x, y}); });
+    }
+  }
+  return 0;
 }
 
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
