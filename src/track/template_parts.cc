@@ -1154,28 +1154,35 @@ struct SpanScan {
     while (x < cols - 1 && marker(row + x + 1)) ++x;
     return x;
   }
-  // `push(x)` for the first pixel of each run, left to right, of the marker pixels of columns
-  // left..right of the row starting at pixel `r` that `open` (for one pixel) and `open16` (a
-  // bit each for the 16 from a pixel) let in.
-  template <typename Open, typename Open16, typename Push>
-  void Seeds(int r, int left, int right, const Open& open, const Open16& open16,
-             const Push& push) const {
+  // Pushes onto `stack` the first pixel ({x, y}) of each run, left to right, of the marker
+  // pixels of columns left..right of row y whose `visited` byte (a patch-sized array beside
+  // `levels`) is not `tag`: the fill's seeds beside a span. Plain pointers and a tag, no
+  // callbacks: with them the compiler kept the loop's state on the stack.
+  void Seeds(int y, int left, int right, const uint8_t* visited, uint8_t tag,
+             std::vector<cv::Point>& stack) const {
+    const int r = y * cols;
+    const uint8_t* row_levels = levels + r;
+    const uint8_t* row_visited = visited + r;
     bool in_run = false;  // The pixel before x is an open marker pixel of [left, right].
     int x = left;
 #if CV_SIMD128
-    for (; x <= right && r + x + 16 <= total; x += 16) {
-      unsigned run = open16(r + x) & markers16(r + x);
+    const cv::v_uint8x16 tag16 = cv::v_setall_u8(tag);
+    const int last_load = total - r - 16;  // The last x whose 16 pixels lie in the patch.
+    for (; x <= right && x <= last_load; x += 16) {
+      const cv::v_uint8x16 open = (cv::v_load(row_visited + x) != tag16) &
+                                  ((cv::v_load(row_levels + x) ^ flip16) > above16);
+      unsigned run = static_cast<unsigned>(cv::v_signmask(open));
       if (right + 1 - x < 16) run &= (1u << (right + 1 - x)) - 1u;  // The span's last chunk.
       for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
            starts &= starts - 1) {
-        push(x + __builtin_ctz(starts));
+        stack.push_back({x + __builtin_ctz(starts), y});
       }
       in_run = (run >> 15) & 1u;
     }
 #endif
     for (; x <= right; ++x) {
-      const bool in = open(r + x) && marker(r + x);
-      if (in && !in_run) push(x);
+      const bool in = row_visited[x] != tag && marker(r + x);
+      if (in && !in_run) stack.push_back({x, y});
       in_run = in;
     }
   }
@@ -1316,15 +1323,11 @@ int BlobMeter::ReachesEdge(const cv::Mat& gray, cv::Point seed, int t, int* budg
   const uint8_t mark = mark_;
   // Marker-likeness t or more: above t - 1.
   const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, t - 1);
-  const auto unmarked = [&](int i) { return marks[i] != mark; };
-#if CV_SIMD128
-  const cv::v_uint8x16 mark16 = cv::v_setall_u8(mark);
-  const auto unmarked16 = [&](int i) {
-    return static_cast<unsigned>(cv::v_signmask(cv::v_load(marks + i) != mark16));
+  int spans = *budget;  // A local: through the pointer it was loaded and stored every span.
+  const auto done = [&](int answer) {
+    *budget = spans;
+    return answer;
   };
-#else
-  const auto unmarked16 = [](int) { return 0u; };
-#endif
   stack_.clear();
   stack_.push_back(seed);  // Of level t or more: t is at most the flood's level.
   while (!stack_.empty()) {
@@ -1332,18 +1335,17 @@ int BlobMeter::ReachesEdge(const cv::Mat& gray, cv::Point seed, int t, int* budg
     stack_.pop_back();
     const int row = p.y * cols;
     if (marks[row + p.x] == mark) continue;  // Its span was marked from another seed.
-    if (--*budget < 0) return -1;
-    if (p.y == 0 || p.y == rows - 1) return 1;
+    if (--spans < 0) return done(-1);
+    if (p.y == 0 || p.y == rows - 1) return done(1);
     const int left = scan.Left(row, p.x), right = scan.Right(row, p.x);
-    if (left == 0 || right == cols - 1) return 1;
+    if (left == 0 || right == cols - 1) return done(1);
     std::memset(marks + row + left, mark, static_cast<size_t>(right - left + 1));
     // A seed for each run of unmarked pixels of level t or more beside the span.
     for (const int y : {p.y - 1, p.y + 1}) {
-      scan.Seeds(y * cols, left, right, unmarked, unmarked16,
-                 [&](int x) { stack_.push_back({x, y}); });
+      scan.Seeds(y, left, right, marks, mark, stack_);
     }
   }
-  return 0;
+  return done(0);
 }
 
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
@@ -1352,14 +1354,6 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
   uint8_t* label = label_.data;  // Continuous, as gray.
   // In marker-likeness (v ^ flip) a pixel is the marker's when above `cut`.
   const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, cut);
-  const auto unfilled = [&](int i) { return label[i] == 0; };
-#if CV_SIMD128
-  const auto unfilled16 = [&](int i) {
-    return static_cast<unsigned>(cv::v_signmask(cv::v_load(label + i) == cv::v_setzero_u8()));
-  };
-#else
-  const auto unfilled16 = [](int) { return 0u; };
-#endif
   int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
   int64_t count = 0, sum_x = 0, sum_y = 0;
   stack_.clear();
@@ -1388,8 +1382,7 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     y1 = std::max(y1, p.y);
     // A seed for each run of unfilled marker pixels beside the span, above and below.
     for (const int y : {p.y - 1, p.y + 1}) {
-      scan.Seeds(y * cols, left, right, unfilled, unfilled16,
-                 [&](int x) { stack_.push_back({x, y}); });
+      scan.Seeds(y, left, right, label, 1, stack_);  // Filled pixels are 1.
     }
   }
   box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
