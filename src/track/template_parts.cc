@@ -1149,6 +1149,100 @@ bool CoreColour(const cv::Mat& bgr, const cv::Point2d& centre, double radius, cv
   return true;
 }
 
+namespace {
+// The row spans of FillUnmasked's and ReachesEdge's fills on a continuous 8-bit patch of `total`
+// pixels, `cols` a row: a pixel is the marker's when its marker-likeness (level ^ flip) is above
+// `above`. The spans are a dot's rows, mostly under 16 pixels wide: the seeds beside a span and
+// the scan leftwards are taken 16 pixels at a time too, a span's last chunk masked to it, where
+// the pixel-at-a-time tails cost ~20 instructions a pixel (issue 45: the fills took ~400-480
+// instructions a span on ViSP's mire-2). The same span, and the same seeds in the same order
+// (left to right), as a pixel at a time: Fill's component and the reference flood's pass (the
+// tests compare them).
+struct SpanScan {
+  const uint8_t* levels;
+  int cols;
+  int total;
+  int flip;
+  int above;
+#if CV_SIMD128
+  cv::v_uint8x16 flip16, above16;
+#endif
+  SpanScan(const uint8_t* levels_in, int cols_in, int total_in, int flip_in, int above_in)
+      : levels(levels_in), cols(cols_in), total(total_in), flip(flip_in), above(above_in) {
+#if CV_SIMD128
+    flip16 = cv::v_setall_u8(static_cast<uint8_t>(flip));
+    above16 = cv::v_setall_u8(static_cast<uint8_t>(std::clamp(above, 0, 255)));
+#endif
+  }
+  bool marker(int i) const { return (levels[i] ^ flip) > above; }
+#if CV_SIMD128
+  // marker() for the 16 pixels from i, as a bit each (whole levels: exact in 8-bit lanes).
+  unsigned markers16(int i) const {
+    return static_cast<unsigned>(cv::v_signmask((cv::v_load(levels + i) ^ flip16) > above16));
+  }
+#endif
+  // The first column of the run of marker pixels that ends at `x` (a marker pixel) in the row
+  // starting at pixel `row`.
+  int Left(int row, int x) const {
+#if CV_SIMD128
+    while (x >= 16) {
+      const unsigned run = markers16(row + x - 16);
+      // Bit 15 is the pixel left of x: the marker pixels next to it are ~run's leading zeros
+      // once its 16 bits are shifted to the top.
+      if (run != 0xFFFFu) return x - __builtin_clz(~run << 16);
+      x -= 16;
+    }
+#endif
+    while (x > 0 && marker(row + x - 1)) --x;
+    return x;
+  }
+  // The last column of the run that starts at `x`.
+  int Right(int row, int x) const {
+#if CV_SIMD128
+    while (x + 16 <= cols - 1) {
+      const unsigned run = markers16(row + x + 1);
+      if (run != 0xFFFFu) return x + __builtin_ctz(~run);
+      x += 16;
+    }
+#endif
+    while (x < cols - 1 && marker(row + x + 1)) ++x;
+    return x;
+  }
+  // Pushes onto `stack` the first pixel ({x, y}) of each run, left to right, of the marker
+  // pixels of columns left..right of row y whose `visited` byte (a patch-sized array beside
+  // `levels`) is not `tag`: the fill's seeds beside a span. Plain pointers and a tag, no
+  // callbacks: with them the compiler kept the loop's state on the stack.
+  void Seeds(int y, int left, int right, const uint8_t* visited, uint8_t tag,
+             std::vector<cv::Point>& stack) const {
+    const int r = y * cols;
+    const uint8_t* row_levels = levels + r;
+    const uint8_t* row_visited = visited + r;
+    bool in_run = false;  // The pixel before x is an open marker pixel of [left, right].
+    int x = left;
+#if CV_SIMD128
+    const cv::v_uint8x16 tag16 = cv::v_setall_u8(tag);
+    const int last_load = total - r - 16;  // The last x whose 16 pixels lie in the patch.
+    for (; x <= right && x <= last_load; x += 16) {
+      const cv::v_uint8x16 open = (cv::v_load(row_visited + x) != tag16) &
+                                  ((cv::v_load(row_levels + x) ^ flip16) > above16);
+      unsigned run = static_cast<unsigned>(cv::v_signmask(open));
+      if (right + 1 - x < 16) run &= (1u << (right + 1 - x)) - 1u;  // The span's last chunk.
+      for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
+           starts &= starts - 1) {
+        stack.push_back({x + __builtin_ctz(starts), y});
+      }
+      in_run = (run >> 15) & 1u;
+    }
+#endif
+    for (; x <= right; ++x) {
+      const bool in = row_visited[x] != tag && marker(r + x);
+      if (in && !in_run) stack.push_back({x, y});
+      in_run = in;
+    }
+  }
+};
+}  // namespace
+
 void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   const int cols = gray.cols, rows = gray.rows;
   const int area = cols * rows;
@@ -1198,7 +1292,24 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
       *pass = level;
       break;
     }
-    if (cores < kCoreSamples) core[cores++] = level;
+    if (cores < kCoreSamples) {
+      core[cores++] = level;
+      if (cores == kCoreSamples) {
+        // The core is taken (the rest of the flood only looks for the pass), and every pixel
+        // more marker-like than `level` has been taken without reaching the edge: the pass is
+        // at most `level`. The flood would take the rest of the marker's pixels one at a time
+        // (issue 45: a sixth of the ZNCC session's time on ViSP's mire-2); fills of whole row
+        // spans find the same level in a few tries. The flood goes on from here when they
+        // cannot (the budget: a quarter of the patch's pixels as spans).
+        const int found = PassByFills(gray, seed, level, area / 4);
+        if (found >= 0) {
+          ++passes_by_fills_;
+          *pass = found;
+          break;
+        }
+        ++fills_given_up_;
+      }
+    }
     // Off the patch's edge: the four neighbours are in the patch.
     for (const int offset : offsets) {
       const int q = p + offset;
@@ -1215,21 +1326,88 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
     }
   }
   core_.assign(core, core + cores);
+  last_pass_ = *pass;
+}
+
+int BlobMeter::PassByFills(const cv::Mat& gray, cv::Point seed, int upper, int budget) {
+  // Whether the level-t fill reaches the edge only falls as t rises, and t = 0 takes every
+  // pixel: the pass is the last t that reaches it. From the last pass g: g, then g + 1 (the
+  // usual answer in two fills), else outwards in doubling steps and halving between.
+  int lo = 0;          // Reaches the edge.
+  int hi = upper + 1;  // Does not (the flood has taken everything above `upper`).
+  const auto test = [&](int t) {
+    const int r = ReachesEdge(gray, seed, t, &budget);
+    if (r > 0) lo = t;
+    if (r == 0) hi = t;
+    return r;
+  };
+  const int g = std::clamp(last_pass_, 0, upper);
+  if (g > 0 && test(g) < 0) return -1;
+  if (lo == g) {
+    for (int step = 1; hi - lo > 1; step *= 2) {  // Upwards until a fill does not reach.
+      const int t = std::min(g + step, hi - 1);
+      if (test(t) < 0) return -1;
+      if (hi == t) break;
+    }
+  } else {
+    for (int step = 1; hi - lo > 1; step *= 2) {  // Downwards until one does.
+      const int t = std::max(g - step, lo + 1);
+      if (test(t) < 0) return -1;
+      if (lo == t) break;
+    }
+  }
+  while (hi - lo > 1) {
+    if (test(lo + (hi - lo) / 2) < 0) return -1;
+  }
+  return lo;
+}
+
+int BlobMeter::ReachesEdge(const cv::Mat& gray, cv::Point seed, int t, int* budget) {
+  const int cols = gray.cols, rows = gray.rows;
+  if (marks_size_ != gray.size()) {
+    marks_.assign(static_cast<size_t>(cols) * rows, 0);
+    marks_size_ = gray.size();
+    mark_ = 0;
+  }
+  if (++mark_ == 0) {  // Wrapped: the old marks would read as this fill's.
+    std::fill(marks_.begin(), marks_.end(), 0);
+    mark_ = 1;
+  }
+  uint8_t* marks = marks_.data();
+  const uint8_t mark = mark_;
+  // Marker-likeness t or more: above t - 1.
+  const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, t - 1);
+  int spans = *budget;  // A local: through the pointer it was loaded and stored every span.
+  const auto done = [&](int answer) {
+    *budget = spans;
+    return answer;
+  };
+  stack_.clear();
+  stack_.push_back(seed);  // Of level t or more: t is at most the flood's level.
+  while (!stack_.empty()) {
+    const cv::Point p = stack_.back();
+    stack_.pop_back();
+    const int row = p.y * cols;
+    if (marks[row + p.x] == mark) continue;  // Its span was marked from another seed.
+    if (--spans < 0) return done(-1);
+    if (p.y == 0 || p.y == rows - 1) return done(1);
+    const int left = scan.Left(row, p.x), right = scan.Right(row, p.x);
+    if (left == 0 || right == cols - 1) return done(1);
+    std::memset(marks + row + left, mark, static_cast<size_t>(right - left + 1));
+    // A seed for each run of unmarked pixels of level t or more beside the span.
+    for (const int y : {p.y - 1, p.y + 1}) {
+      scan.Seeds(y, left, right, marks, mark, stack_);
+    }
+  }
+  return done(0);
 }
 
 bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
   ZeroedMask(gray.size(), label_);
   const int cols = gray.cols, rows = gray.rows;
-  const int flip = bright_ ? 0 : 255;
-  const uint8_t* levels = gray.data;  // Continuous, as label_.
-  uint8_t* label = label_.data;
-  const auto marker = [&](int i) { return (levels[i] ^ flip) > cut; };
-#if CV_SIMD128
-  // marker() for the 16 pixels from i (0xFF lanes): whole levels, so in 8-bit lanes exactly.
-  const cv::v_uint8x16 flip16 = cv::v_setall_u8(static_cast<uint8_t>(flip));
-  const cv::v_uint8x16 cut16 = cv::v_setall_u8(static_cast<uint8_t>(std::clamp(cut, 0, 255)));
-  const auto markers = [&](int i) { return (cv::v_load(levels + i) ^ flip16) > cut16; };
-#endif
+  uint8_t* label = label_.data;  // Continuous, as gray.
+  // In marker-likeness (v ^ flip) a pixel is the marker's when above `cut`.
+  const SpanScan scan(gray.data, cols, cols * rows, bright_ ? 0 : 255, cut);
   int x0 = seed.x, y0 = seed.y, x1 = seed.x, y1 = seed.y;  // Inclusive.
   int64_t count = 0, sum_x = 0, sum_y = 0;
   stack_.clear();
@@ -1240,26 +1418,12 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     stack_.pop_back();
     const int row = p.y * cols;
     if (label[row + p.x]) continue;  // Its span was filled from another seed.
-    if (!first && !marker(row + p.x)) continue;
+    if (!first && !scan.marker(row + p.x)) continue;
     first = false;
     // The whole span of marker pixels through p: a component pixel on the patch's edge is not
     // separated from its surroundings (Fill's answer, whatever it had filled by then).
     if (p.y == 0 || p.y == rows - 1) return false;
-    int left = p.x, right = p.x;
-    while (left > 0 && marker(row + left - 1)) --left;
-#if CV_SIMD128
-    // Rightwards 16 pixels at a time while they are all the marker's, then to the first that is
-    // not (issue 45: the fill's scans were a twentieth of a frame of ViSP's mire-2 in ZNCC).
-    while (right + 16 <= cols - 1) {
-      const unsigned run = static_cast<unsigned>(cv::v_signmask(markers(row + right + 1)));
-      if (run != 0xFFFFu) {
-        right += __builtin_ctz(~run);
-        break;
-      }
-      right += 16;
-    }
-#endif
-    while (right < cols - 1 && marker(row + right + 1)) ++right;
+    const int left = scan.Left(row, p.x), right = scan.Right(row, p.x);
     if (left == 0 || right == cols - 1) return false;
     std::memset(label + row + left, 1, static_cast<size_t>(right - left + 1));
     const int64_t length = right - left + 1;
@@ -1270,29 +1434,9 @@ bool BlobMeter::FillUnmasked(const cv::Mat& gray, cv::Point seed, int cut) {
     x1 = std::max(x1, right);
     y0 = std::min(y0, p.y);
     y1 = std::max(y1, p.y);
-    // A seed for each run of unfilled marker pixels beside the span, above and below: the first
-    // pixel of each, left to right (16 pixels at a time: a run starts where a pixel is one and
-    // the one before it is not).
+    // A seed for each run of unfilled marker pixels beside the span, above and below.
     for (const int y : {p.y - 1, p.y + 1}) {
-      const int r = y * cols;
-      bool in_run = false;  // The pixel before x is an unfilled marker pixel of [left, right].
-      int x = left;
-#if CV_SIMD128
-      for (; x + 16 <= right + 1; x += 16) {
-        const cv::v_uint8x16 unfilled = cv::v_load(label + r + x) == cv::v_setzero_u8();
-        const unsigned run = static_cast<unsigned>(cv::v_signmask(unfilled & markers(r + x)));
-        for (unsigned starts = run & ~((run << 1) | (in_run ? 1u : 0u)); starts != 0;
-             starts &= starts - 1) {
-          stack_.push_back({x + __builtin_ctz(starts), y});
-        }
-        in_run = (run >> 15) & 1u;
-      }
-#endif
-      for (; x <= right; ++x) {
-        const bool in = !label[r + x] && marker(r + x);
-        if (in && !in_run) stack_.push_back({x, y});
-        in_run = in;
-      }
+      scan.Seeds(y, left, right, label, 1, stack_);  // Filled pixels are 1.
     }
   }
   box_ = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);

@@ -347,6 +347,10 @@ class BlobMeter {
   // Tests only: segment with the reference flood and fill (the pixel-at-a-time priority queue
   // of vectors and the stack fill, Segment's definition) even where the fast ones apply.
   void use_reference(bool reference) { reference_ = reference; }
+  // Tests only: how many floods took their pass from PassByFills, and how many went on to the
+  // edge when the fills ran out of budget.
+  int passes_by_fills() const { return passes_by_fills_; }
+  int fills_given_up() const { return fills_given_up_; }
   // After Segment: the component's pixels (1) and its box (what the tests compare).
   const cv::Mat& label() const { return label_; }
 
@@ -485,6 +489,18 @@ class BlobMeter {
   // the buckets as lists threaded through next_ (a pixel is pushed at most once) instead of
   // vectors of points. Sets core_ and *pass (-1: none).
   void FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass);
+  // The pass of FloodUnmasked's patch without the rest of its flood, once the flood has taken
+  // its core: the greatest marker-likeness t for which the pixels of t or more 4-connected to
+  // `seed` reach the patch's edge (a path's level is its least marker-like pixel, so that is the
+  // level at which the flood would leave), no greater than `upper` (the flood's level, which no
+  // pixel left above it reaches the edge from). Searched from the last patch's pass by fills
+  // of those pixels a row span at a time. -1 when the fills took more than `budget` spans (a
+  // patch of short spans, say noise: the flood is cheaper there).
+  int PassByFills(const cv::Mat& gray, cv::Point seed, int upper, int budget);
+  // PassByFills' question for one level t (1..255): 1 when the pixels of marker-likeness t or
+  // more 4-connected to `seed` (which is one) reach the patch's edge, 0 when not, -1 when
+  // *budget (spans) ran out first.
+  int ReachesEdge(const cv::Mat& gray, cv::Point seed, int t, int* budget);
   // Fill's component for an unmasked, continuous patch, a row span at a time: the pixels whose
   // marker-likeness is above `cut` 4-connected to `seed` (which counts, as in Fill) into label_
   // and box_, with their count and coordinate sums for Locate. False when it reaches the patch's
@@ -584,6 +600,14 @@ class BlobMeter {
   // next one in its bucket, and the patch's edge pixels (1) for the patch size edge_size_.
   std::array<int, 256> heads_{};
   std::vector<int> next_;
+  // PassByFills' start: the last pass found (patches of one marker in consecutive frames mostly
+  // leave at the same level, or one off), and its fills' marks: a pixel is in the current fill
+  // when it holds mark_ (the marks cleared only when mark_ wraps, or the patch's size changes).
+  int last_pass_ = -1;
+  int passes_by_fills_ = 0, fills_given_up_ = 0;
+  std::vector<uint8_t> marks_;
+  uint8_t mark_ = 0;
+  cv::Size marks_size_;
   std::vector<uint8_t> edge_;
   cv::Size edge_size_;
   cv::Mat label_, dist_, visited_;

@@ -97,6 +97,80 @@ TEST(TemplateParts, BlobMeterFastSegmentIsTheReferences) {
   EXPECT_GT(located, 100);  // The comparison met many blobs, not only refusals.
 }
 
+// FloodUnmasked's pass from PassByFills (searched from the last patch's pass) is the whole
+// flood's: one meter follows a disc through frames whose levels, size, noise and place change
+// (the pass moves by 0, 1 or many levels from one to the next), against the reference flood.
+// Both ways of the fast flood are taken: the fills, and the flood on to the edge where noise
+// breaks the patch into more spans than the fills' budget.
+TEST(TemplateParts, BlobMeterPassByFillsIsTheFloods) {
+  cv::RNG rng(4546);
+  int located = 0, floods = 0, by_fills = 0, given_up = 0;
+  BlobMeter fast;
+  BlobMeter reference;
+  for (int sequence = 0; sequence < 24; ++sequence) {
+    const bool bright = sequence % 2 == 0;
+    int background = rng.uniform(30, 226);
+    int marker = bright ? rng.uniform(std::min(background + 40, 255), 256)
+                        : rng.uniform(0, std::max(background - 40, 1));
+    cv::Mat learn(33, 33, CV_8UC1, cv::Scalar(background));
+    cv::circle(learn, {16, 16}, 6, cv::Scalar(marker), cv::FILLED);
+    by_fills += fast.passes_by_fills();
+    given_up += fast.fills_given_up();
+    fast = BlobMeter();
+    cv::Point2d learned;
+    ASSERT_TRUE(fast.Learn(learn, RoundMask(learn.size()), &learned)) << sequence;
+    reference = fast;
+    reference.use_reference(true);
+    const cv::Size size(20 + rng.uniform(0, 60), 20 + rng.uniform(0, 60));
+    cv::Point2d centre(size.width / 2.0, size.height / 2.0);
+    const double radius0 = rng.uniform(2.0, 0.3 * std::min(size.width, size.height));
+    for (int frame = 0; frame < 40; ++frame) {
+      // Small steps most frames, a jump now and then.
+      const bool jump = rng.uniform(0, 8) == 0;
+      const int step = jump ? 40 : 3;
+      background = std::clamp(background + rng.uniform(-step, step + 1), 0, 255);
+      marker = std::clamp(marker + rng.uniform(-step, step + 1), 0, 255);
+      centre += cv::Point2d(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+      centre.x = std::clamp(centre.x, 1.0, size.width - 2.0);
+      centre.y = std::clamp(centre.y, 1.0, size.height - 2.0);
+      const double radius = radius0 * rng.uniform(0.9, 1.1);
+      const double sigma = frame % 5 == 4 ? 60.0 : frame % 5 == 3 ? 12.0 : rng.uniform(0.0, 3.0);
+      cv::Mat noise(size, CV_32F);
+      rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+      cv::Mat gray(size, CV_8UC1);
+      for (int y = 0; y < size.height; ++y) {
+        for (int x = 0; x < size.width; ++x) {
+          const double d = std::hypot(x - centre.x, y - centre.y);
+          const double inside = std::clamp(radius + 0.5 - d, 0.0, 1.0);
+          // A gradient across the background: the pass lies on one side.
+          const double shade = 0.3 * (x - size.width / 2.0);
+          gray.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(
+              background + shade + inside * (marker - background - shade) + noise.at<float>(y, x));
+        }
+      }
+      const cv::Point2d guess =
+          centre + cv::Point2d(rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0));
+      cv::Point2d c_fast, c_ref;
+      double a_fast = -1, a_ref = -1;
+      const bool ok_fast = fast.Locate(gray, cv::Mat(), guess, &c_fast, &a_fast);
+      const bool ok_ref = reference.Locate(gray, cv::Mat(), guess, &c_ref, &a_ref);
+      ++floods;
+      ASSERT_EQ(ok_fast, ok_ref) << sequence << " " << frame;
+      if (!ok_fast) continue;
+      ++located;
+      EXPECT_EQ(c_fast, c_ref) << sequence << " " << frame;
+      EXPECT_EQ(a_fast, a_ref) << sequence << " " << frame;
+      EXPECT_EQ(fast.blob_box(), reference.blob_box()) << sequence << " " << frame;
+      EXPECT_EQ(cv::countNonZero(fast.label() != reference.label()), 0) << sequence << " " << frame;
+    }
+  }
+  by_fills += fast.passes_by_fills();
+  given_up += fast.fills_given_up();
+  EXPECT_GT(located, 300);  // Of 960 floods: 836 blobs; 925 passes by fills, 35 given up.
+  EXPECT_GT(by_fills, 480);
+  EXPECT_GT(given_up, 10);
+}
+
 // CoreColour as it was first written: every pixel of the box tested and summed in doubles.
 bool CoreColourPerPixel(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
                         cv::Vec3d* chroma) {
