@@ -1256,10 +1256,22 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   }
   if (next_.size() < static_cast<size_t>(area)) next_.resize(static_cast<size_t>(area));
   heads_.fill(-1);
-  ZeroedMask(gray.size(), visited_);
+  // A pixel is visited when its byte holds this flood's tag: the bytes are cleared only when the
+  // tag wraps or the patch's size changes, not for every flood (issue 45: clearing the patch took
+  // a third as many instructions as the flood, which mostly stops after its core's 9 pixels).
+  if (seen_size_ != gray.size()) {
+    seen_.assign(static_cast<size_t>(area), 0);
+    seen_size_ = gray.size();
+    seen_tag_ = 0;
+  }
+  if (++seen_tag_ == 0) {  // Wrapped: the old tags would read as this flood's.
+    std::fill(seen_.begin(), seen_.end(), 0);
+    seen_tag_ = 1;
+  }
+  const uint8_t tag = seen_tag_;
   const int flip = bright_ ? 0 : 255;
   const uint8_t* levels = gray.data;  // Continuous: pixel i at levels[i].
-  uint8_t* visited = visited_.data;
+  uint8_t* visited = seen_.data();
   const uint8_t* edge = edge_.data();
   int* next = next_.data();
   int* heads = heads_.data();
@@ -1273,7 +1285,7 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
   // the same order.
   next[start] = -1;
   int top = start;
-  visited[start] = 1;
+  visited[start] = tag;
   int core[kCoreSamples];
   size_t cores = 0;
   *pass = -1;
@@ -1313,8 +1325,8 @@ void BlobMeter::FloodUnmasked(const cv::Mat& gray, cv::Point seed, int* pass) {
     // Off the patch's edge: the four neighbours are in the patch.
     for (const int offset : offsets) {
       const int q = p + offset;
-      if (visited[q]) continue;
-      visited[q] = 1;
+      if (visited[q] == tag) continue;
+      visited[q] = tag;
       const int l = levels[q] ^ flip;  // A path's level is its least marker-like.
       if (l >= level) {
         next[q] = top;

@@ -610,6 +610,11 @@ class BlobMeter {
   cv::Size marks_size_;
   std::vector<uint8_t> edge_;
   cv::Size edge_size_;
+  // FloodUnmasked's visited pixels: those whose byte is seen_tag_ (a vector, not a cv::Mat: a
+  // copy of the meter gets its own bytes, where a cv::Mat's would be shared and its tags mixed).
+  std::vector<uint8_t> seen_;
+  cv::Size seen_size_;
+  uint8_t seen_tag_ = 0;
   cv::Mat label_, dist_, visited_;
   std::vector<uint8_t> row_distance_;  // CappedChebyshevDistance's scratch.
   cv::Rect box_;
