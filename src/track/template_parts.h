@@ -245,6 +245,20 @@ SoftCentroidSums SoftCentroidComputed(const cv::Mat& gray, const cv::Mat& mask,
                                       const cv::Mat& dist, const cv::Rect& grown, double bg,
                                       double fg);
 
+// A cv::Mat whose copies have their own pixels (cv::Mat's share them): BlobMeter's label_, which
+// FillUnmasked clears only where its last component was, would otherwise hold a copy's marks
+// there too.
+struct OwnPixels : cv::Mat {
+  OwnPixels() = default;
+  OwnPixels(const OwnPixels& other) : cv::Mat(other.clone()) {}
+  OwnPixels& operator=(const OwnPixels& other) {
+    if (this != &other) other.copyTo(*this);
+    return *this;
+  }
+  OwnPixels(OwnPixels&&) = default;
+  OwnPixels& operator=(OwnPixels&&) = default;
+};
+
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
@@ -543,6 +557,8 @@ class BlobMeter {
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
     ZeroedMask(gray.size(), label_);
+    // Its pixels are marked as they are pushed, some outside box_ when it stops at an edge.
+    label_dirty_ = cv::Rect(0, 0, gray.cols, gray.rows);
     stack_.clear();
     stack_.push_back(seed);
     // Through pointers, as Segment's flood; the box as its corners, written to box_ on the way
@@ -615,7 +631,11 @@ class BlobMeter {
   std::vector<uint8_t> seen_;
   cv::Size seen_size_;
   uint8_t seen_tag_ = 0;
-  cv::Mat label_, dist_, visited_;
+  OwnPixels label_;
+  // Where label_ may hold marks (the rest is 0): FillUnmasked clears only there, not the whole
+  // patch (issue 45: clearing it took more instructions than the fill's component).
+  cv::Rect label_dirty_;
+  cv::Mat dist_, visited_;
   std::vector<uint8_t> row_distance_;  // CappedChebyshevDistance's scratch.
   cv::Rect box_;
   std::vector<cv::Point> stack_;
