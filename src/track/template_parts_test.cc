@@ -231,6 +231,44 @@ TEST(TemplateParts, BlobMeterKeepsNothingFromPatchToPatch) {
   EXPECT_GT(refused, 20);
 }
 
+// asymmetry_px, measured on first use from the component Learn kept, is that of the learned
+// component however many patches the meter (or a copy of it) measured since: a crescent (a disc
+// with a bite out of one side), its centroid away from its enclosing circle's centre.
+TEST(TemplateParts, BlobMeterAsymmetryIsTheLearnedBlobs) {
+  cv::Mat learn(41, 41, CV_8UC1, cv::Scalar(50));
+  cv::circle(learn, {20, 20}, 9, cv::Scalar(210), cv::FILLED);
+  cv::circle(learn, {27, 20}, 6, cv::Scalar(50), cv::FILLED);
+  BlobMeter meter;
+  cv::Point2d learned;
+  ASSERT_TRUE(meter.Learn(learn, RoundMask(learn.size()), &learned));
+  // What it was measured as at Learn: the learned component's centroid against the centre of
+  // the smallest circle enclosing its pixels.
+  std::vector<cv::Point> points;
+  const cv::Mat blob = meter.label()(meter.blob_box());
+  cv::findNonZero(blob, points);
+  cv::Point2f centre;
+  float radius = 0;
+  cv::minEnclosingCircle(points, centre, radius);
+  const cv::Moments m = cv::moments(blob, true);
+  const double expected =
+      cv::norm(cv::Point2d(m.m10 / m.m00, m.m01 / m.m00) - cv::Point2d(centre));
+  ASSERT_GT(expected, 1.0);
+  BlobMeter copy = meter;
+  // Other blobs measured since (a whole disc: symmetric).
+  cv::Mat gray(37, 45, CV_8UC1, cv::Scalar(50));
+  cv::circle(gray, {22, 18}, 7, cv::Scalar(220), cv::FILLED);
+  cv::Point2d at;
+  double area = 0;
+  for (BlobMeter* m2 : {&meter, &copy}) {
+    ASSERT_TRUE(m2->Locate(gray, cv::Mat(), {22, 18}, &at, &area));
+    ASSERT_TRUE(m2->Measure(gray, cv::Mat(), {22, 18}, &at, &area));
+  }
+  EXPECT_EQ(meter.asymmetry_px(), expected);
+  EXPECT_EQ(copy.asymmetry_px(), expected);
+  EXPECT_EQ(meter.asymmetry_px(), expected);  // Once measured, kept.
+  EXPECT_EQ(BlobMeter().asymmetry_px(), 0.0);  // Nothing learned.
+}
+
 // CoreColour as it was first written: every pixel of the box tested and summed in doubles.
 bool CoreColourPerPixel(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
                         cv::Vec3d* chroma) {
