@@ -245,6 +245,20 @@ SoftCentroidSums SoftCentroidComputed(const cv::Mat& gray, const cv::Mat& mask,
                                       const cv::Mat& dist, const cv::Rect& grown, double bg,
                                       double fg);
 
+// A cv::Mat whose copies have their own pixels (cv::Mat's share them): BlobMeter's label_, which
+// FillUnmasked clears only where its last component was, would otherwise hold a copy's marks
+// there too.
+struct OwnPixels : cv::Mat {
+  OwnPixels() = default;
+  OwnPixels(const OwnPixels& other) : cv::Mat(other.clone()) {}
+  OwnPixels& operator=(const OwnPixels& other) {
+    if (this != &other) other.copyTo(*this);
+    return *this;
+  }
+  OwnPixels(OwnPixels&&) = default;
+  OwnPixels& operator=(OwnPixels&&) = default;
+};
+
 class BlobMeter {
  public:
   // Learns the marker's polarity from the selected template (one channel): true when its centre
@@ -282,7 +296,12 @@ class BlobMeter {
     double lo = 0, hi = 0;
     cv::minMaxLoc(gray, &lo, &hi, nullptr, nullptr, mask.empty() ? cv::noArray() : mask);
     range_ = hi - lo;
-    asymmetry_ = Asymmetry();
+    // The component is kept for asymmetry_px, measured there on first use: most meters are
+    // learned to judge a box (JudgeBox) or for the channel SetTemplate does not keep, and never
+    // asked (issue 45: the smallest enclosing circle of its pixels cost ~0.75M instructions a
+    // meter, 4 % of the ZNCC session's on ViSP's mire-2).
+    label_(box_).copyTo(learned_blob_);
+    asymmetry_known_ = false;
     return true;
   }
 
@@ -290,7 +309,13 @@ class BlobMeter {
   // enclosing circle, px (about 0 for a whole disc or any shape symmetric about its centre). A
   // crescent (a pale dome whose top the exposure clipped to white) puts the marker's centre
   // anywhere between the two: the reference point of every match carries that (the sigma's).
-  double asymmetry_px() const { return asymmetry_; }
+  double asymmetry_px() {
+    if (!asymmetry_known_) {
+      asymmetry_ = Asymmetry(learned_blob_);
+      asymmetry_known_ = true;
+    }
+    return asymmetry_;
+  }
 
   // How much the learned blob stands out, after Learn: the levels between it and the level at
   // which it would join its surroundings, as a fraction of the patch's whole range of levels (a
@@ -360,15 +385,15 @@ class BlobMeter {
   const cv::Rect& blob_box() const { return box_; }
 
  private:
-  // The learned component's (label_ over box_) asymmetry_px.
-  double Asymmetry() const {
+  // asymmetry_px of the learned component `blob` (label_ over box_ at Learn).
+  static double Asymmetry(const cv::Mat& blob) {
     std::vector<cv::Point> points;
-    cv::findNonZero(label_(box_), points);
+    cv::findNonZero(blob, points);
     if (points.size() < 3) return 0.0;
     cv::Point2f centre;
     float radius = 0;
     cv::minEnclosingCircle(points, centre, radius);
-    const cv::Moments m = cv::moments(label_(box_), true);
+    const cv::Moments m = cv::moments(blob, true);
     if (!(m.m00 > 0)) return 0.0;
     return cv::norm(cv::Point2d(m.m10 / m.m00, m.m01 / m.m00) - cv::Point2d(centre));
   }
@@ -543,6 +568,8 @@ class BlobMeter {
   // box_). False when it reaches the patch's or the mask's edge: not separated there.
   bool Fill(const cv::Mat& gray, const cv::Mat& mask, cv::Point seed, double threshold) {
     ZeroedMask(gray.size(), label_);
+    // Its pixels are marked as they are pushed, some outside box_ when it stops at an edge.
+    label_dirty_ = cv::Rect(0, 0, gray.cols, gray.rows);
     stack_.clear();
     stack_.push_back(seed);
     // Through pointers, as Segment's flood; the box as its corners, written to box_ on the way
@@ -589,7 +616,9 @@ class BlobMeter {
   double contrast_ = 0;
   double learned_contrast_ = 0;
   double range_ = 0;
-  double asymmetry_ = 0;  // asymmetry_px(); once, at Learn.
+  double asymmetry_ = 0;  // asymmetry_px(), once asymmetry_known_.
+  bool asymmetry_known_ = true;  // Nothing learned: 0.
+  OwnPixels learned_blob_;  // Learn's component (label_ over box_), for asymmetry_px.
   double located_low_ = 0, located_high_ = 0;  // The last Locate's levels, for MeasureLocated.
   bool reference_ = false;  // use_reference.
   // FillUnmasked's count and coordinate sums of the component (frame of the patch), valid when
@@ -610,7 +639,16 @@ class BlobMeter {
   cv::Size marks_size_;
   std::vector<uint8_t> edge_;
   cv::Size edge_size_;
-  cv::Mat label_, dist_, visited_;
+  // FloodUnmasked's visited pixels: those whose byte is seen_tag_ (a vector, not a cv::Mat: a
+  // copy of the meter gets its own bytes, where a cv::Mat's would be shared and its tags mixed).
+  std::vector<uint8_t> seen_;
+  cv::Size seen_size_;
+  uint8_t seen_tag_ = 0;
+  OwnPixels label_;
+  // Where label_ may hold marks (the rest is 0): FillUnmasked clears only there, not the whole
+  // patch (issue 45: clearing it took more instructions than the fill's component).
+  cv::Rect label_dirty_;
+  cv::Mat dist_, visited_;
   std::vector<uint8_t> row_distance_;  // CappedChebyshevDistance's scratch.
   cv::Rect box_;
   std::vector<cv::Point> stack_;

@@ -171,6 +171,104 @@ TEST(TemplateParts, BlobMeterPassByFillsIsTheFloods) {
   EXPECT_GT(given_up, 10);
 }
 
+// One meter measuring many patches of one size, as the tracker's does frame after frame: its
+// flood's visited tags (cleared only when they wrap, every 255 floods) and its fill's label
+// (cleared only where the last component was) leave nothing of one patch in the next: each
+// patch's answer, levels, component and box are those of a reference meter fresh for it.
+TEST(TemplateParts, BlobMeterKeepsNothingFromPatchToPatch) {
+  cv::RNG rng(4547);
+  cv::Mat learn(33, 33, CV_8UC1, cv::Scalar(60));
+  cv::circle(learn, {16, 16}, 6, cv::Scalar(200), cv::FILLED);
+  BlobMeter fast;
+  cv::Point2d learned;
+  ASSERT_TRUE(fast.Learn(learn, RoundMask(learn.size()), &learned));
+  const BlobMeter learned_meter = fast;
+  const cv::Size size(41, 37);
+  int located = 0, refused = 0;
+  for (int patch = 0; patch < 1200; ++patch) {
+    // Discs of many sizes, every other one at the patch's middle (over the last floods' tags and
+    // the last components), the others anywhere, some cut by the patch's edge, on noise of
+    // several strengths: components large and small, found and refused, in turn.
+    const cv::Point2d centre =
+        patch % 2 == 1
+            ? cv::Point2d(rng.uniform(2.0, size.width - 3.0), rng.uniform(2.0, size.height - 3.0))
+            : cv::Point2d(20.3, 18.6);
+    const double radius = rng.uniform(1.0, 14.0);
+    const double sigma = patch % 3 == 0 ? 1.0 : patch % 3 == 1 ? 6.0 : 25.0;
+    cv::Mat noise(size, CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+    cv::Mat gray(size, CV_8UC1);
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        const double inside = std::clamp(radius + 0.5 - std::hypot(x - centre.x, y - centre.y), 0.0, 1.0);
+        gray.at<uint8_t>(y, x) =
+            cv::saturate_cast<uint8_t>(60 + 0.5 * x + inside * 140 + noise.at<float>(y, x));
+      }
+    }
+    BlobMeter reference = learned_meter;
+    reference.use_reference(true);
+    const cv::Point2d guess = centre;
+    cv::Point2d c_fast, c_ref;
+    double a_fast = -1, a_ref = -1;
+    const bool ok_fast = fast.Locate(gray, cv::Mat(), guess, &c_fast, &a_fast);
+    const bool ok_ref = reference.Locate(gray, cv::Mat(), guess, &c_ref, &a_ref);
+    ASSERT_EQ(ok_fast, ok_ref) << patch;
+    if (!ok_fast) {
+      ++refused;
+      continue;
+    }
+    ++located;
+    EXPECT_EQ(c_fast, c_ref) << patch;
+    EXPECT_EQ(a_fast, a_ref) << patch;
+    EXPECT_EQ(fast.blob_box(), reference.blob_box()) << patch;
+    EXPECT_EQ(cv::countNonZero(fast.label() != reference.label()), 0) << patch;
+    ASSERT_EQ(fast.MeasureLocated(gray, cv::Mat(), &c_fast, &a_fast),
+              reference.MeasureLocated(gray, cv::Mat(), &c_ref, &a_ref)) << patch;
+    EXPECT_EQ(c_fast, c_ref) << patch;
+    EXPECT_EQ(a_fast, a_ref) << patch;
+  }
+  EXPECT_GT(located, 300);
+  EXPECT_GT(refused, 20);
+}
+
+// asymmetry_px, measured on first use from the component Learn kept, is that of the learned
+// component however many patches the meter (or a copy of it) measured since: a crescent (a disc
+// with a bite out of one side), its centroid away from its enclosing circle's centre.
+TEST(TemplateParts, BlobMeterAsymmetryIsTheLearnedBlobs) {
+  cv::Mat learn(41, 41, CV_8UC1, cv::Scalar(50));
+  cv::circle(learn, {20, 20}, 9, cv::Scalar(210), cv::FILLED);
+  cv::circle(learn, {27, 20}, 6, cv::Scalar(50), cv::FILLED);
+  BlobMeter meter;
+  cv::Point2d learned;
+  ASSERT_TRUE(meter.Learn(learn, RoundMask(learn.size()), &learned));
+  // What it was measured as at Learn: the learned component's centroid against the centre of
+  // the smallest circle enclosing its pixels.
+  std::vector<cv::Point> points;
+  const cv::Mat blob = meter.label()(meter.blob_box());
+  cv::findNonZero(blob, points);
+  cv::Point2f centre;
+  float radius = 0;
+  cv::minEnclosingCircle(points, centre, radius);
+  const cv::Moments m = cv::moments(blob, true);
+  const double expected =
+      cv::norm(cv::Point2d(m.m10 / m.m00, m.m01 / m.m00) - cv::Point2d(centre));
+  ASSERT_GT(expected, 1.0);
+  BlobMeter copy = meter;
+  // Other blobs measured since (a whole disc: symmetric).
+  cv::Mat gray(37, 45, CV_8UC1, cv::Scalar(50));
+  cv::circle(gray, {22, 18}, 7, cv::Scalar(220), cv::FILLED);
+  cv::Point2d at;
+  double area = 0;
+  for (BlobMeter* m2 : {&meter, &copy}) {
+    ASSERT_TRUE(m2->Locate(gray, cv::Mat(), {22, 18}, &at, &area));
+    ASSERT_TRUE(m2->Measure(gray, cv::Mat(), {22, 18}, &at, &area));
+  }
+  EXPECT_EQ(meter.asymmetry_px(), expected);
+  EXPECT_EQ(copy.asymmetry_px(), expected);
+  EXPECT_EQ(meter.asymmetry_px(), expected);  // Once measured, kept.
+  EXPECT_EQ(BlobMeter().asymmetry_px(), 0.0);  // Nothing learned.
+}
+
 // CoreColour as it was first written: every pixel of the box tested and summed in doubles.
 bool CoreColourPerPixel(const cv::Mat& bgr, const cv::Point2d& centre, double radius,
                         cv::Vec3d* chroma) {
