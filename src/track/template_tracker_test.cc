@@ -723,7 +723,9 @@ TEST(TemplateTrackerTest, AMarkerInAShadowThatFallsAcrossItsSurroundingsIsFollow
     SCOPED_TRACE(std::string(method) + (colour ? " colour" : " gray"));
     std::unique_ptr<Tracker> tracker;
     const int found = FoundWithinHalfAPixel(method, Shade::kAroundIt, colour, &tracker);
-    if (std::string(method) == "zncc" || !colour) EXPECT_EQ(found, 14);
+    if (std::string(method) == "zncc" || !colour) {
+      EXPECT_EQ(found, 14);
+    }
     const Observation gone =
         tracker->update(DomeInShade(cv::Point2d(58.3, 53.6), Shade::kAroundIt, false));
     EXPECT_FALSE(gone.found());
@@ -743,7 +745,9 @@ TEST(TemplateTrackerTest, AMarkerHalfInAShadowIsPlacedWhereItIsNotWhereItsLitPar
       SCOPED_TRACE(std::string(method) + (colour ? " colour" : " gray"));
       std::unique_ptr<Tracker> tracker;
       const int found = FoundWithinHalfAPixel(method, Shade::kAcrossIt, colour, &tracker);
-      if (std::string(method) == "zncc") EXPECT_EQ(found, 14);
+      if (std::string(method) == "zncc") {
+        EXPECT_EQ(found, 14);
+      }
     }
   }
 }
