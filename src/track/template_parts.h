@@ -780,6 +780,12 @@ inline constexpr double kOtherColourDistance = 0.15;
 // place agrees with a white dot's colour.
 inline constexpr double kSameColourDistance = 0.06;
 inline constexpr double kMinCoreChroma = 0.06;
+// Whether a core's chromaticity (CoreColour) is a coloured marker's: kMinCoreChroma or more from
+// grey. A white or black dot's chromaticity is its surroundings' and the camera noise's.
+inline bool IsColouredCore(const cv::Vec3d& chroma) {
+  const cv::Vec3d from_grey = chroma - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
+  return std::sqrt(from_grey.dot(from_grey)) >= kMinCoreChroma;
+}
 inline constexpr double kColourZnccAllowance = 0.1;
 
 // A colour picture's log-chromaticity, CV_32FC2: per pixel log((r + k) / (g + k)) and

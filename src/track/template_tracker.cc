@@ -81,8 +81,7 @@ SelectionBlobs MeasureSelection(const cv::Mat& templ, const cv::Mat& mask,
     if (seen.in_gray &&
         CoreColour(selection_bgr, seen.gray_centroid,
                    std::max(1.5, 0.6 * std::sqrt(seen.gray.area() / CV_PI)), &core)) {
-      const cv::Vec3d from_grey = core - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
-      seen.coloured = std::sqrt(from_grey.dot(from_grey)) >= kMinCoreChroma;
+      seen.coloured = IsColouredCore(core);
     }
   }
   return seen;
@@ -208,12 +207,9 @@ void TemplateTracker::SetTemplate(const cv::Mat& templ, const std::string& where
     if (CoreColour(selection_bgr, core, core_radius_px_, &chroma)) core_colour_ = chroma;
   }
   shade_free_.release();
-  if (core_colour_) {
-    const cv::Vec3d from_grey = *core_colour_ - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
-    if (std::sqrt(from_grey.dot(from_grey)) >= kMinCoreChroma) {
-      LogChromaticity(selection_bgr, shade_free_);
-      shade_free_key_ = -1;
-    }
+  if (core_colour_ && IsColouredCore(*core_colour_)) {
+    LogChromaticity(selection_bgr, shade_free_);
+    shade_free_key_ = -1;
   }
   blob_reported_ = blob_ok_ && (params_.report == TemplateReport::kCentre ||
                                 (chroma_ok_ && params_.report == TemplateReport::kSymmetry));
@@ -1193,8 +1189,7 @@ std::optional<double> TemplateTracker::ColourDistanceAt(const cv::Mat& frame,
 bool TemplateTracker::ColourAgreesAt(const cv::Mat& frame, const Hit& hit) const {
   // A grey marker's colour is every grey place's: agreeing with it says nothing.
   if (!core_colour_) return false;
-  const cv::Vec3d from_grey = *core_colour_ - cv::Vec3d(1.0, 1.0, 1.0) / 3.0;
-  if (std::sqrt(from_grey.dot(from_grey)) < kMinCoreChroma) return false;
+  if (!IsColouredCore(*core_colour_)) return false;
   const std::optional<double> distance = ColourDistanceAt(
       frame, cv::Point2d(hit.top_left) + hit.offset + HalfSize(search_template().size()));
   return distance && *distance <= kSameColourDistance;
