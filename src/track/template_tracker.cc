@@ -587,15 +587,15 @@ bool TemplateTracker::Accept(const Hit& m, bool colour_agrees, bool followed) co
   return false;
 }
 
-bool TemplateTracker::AcceptOn(const cv::Mat& frame, const Hit& m, bool followed, bool* shaded) {
+bool TemplateTracker::AcceptOn(const cv::Mat& frame, const Hit& m, bool followed,
+                               std::optional<ShadeFreePeak>* shaded) {
   const bool colour_agrees = ColourAgreesAt(frame, m);
-  *shaded = false;
+  shaded->reset();
   if (Accept(m, colour_agrees, followed)) return true;
   if (!followed || !colour_agrees) return false;
   const std::optional<ShadeFreePeak> peak = ShadeFreePeakNear(frame, m.top_left);
   if (!peak || !(peak->zncc >= params_.min_zncc)) return false;
-  shade_free_peak_ = *peak;
-  *shaded = true;
+  *shaded = peak;
   return true;
 }
 
@@ -1247,7 +1247,7 @@ Observation TemplateTracker::update(const cv::Mat& frame_bgr) {
     TurnedTo();
   }
   std::optional<Hit> hit;
-  bool shaded = false;  // Accepted in log-chromaticity alone (AcceptOn).
+  std::optional<ShadeFreePeak> shaded;  // Accepted in log-chromaticity alone (AcceptOn).
   if (tracking_) {
     const cv::Point2d predicted = *last_centre_ + velocity_px_;
     cv::Rect window = WindowAround(predicted, search_template().size(), params_.search_margin_px);
@@ -1359,8 +1359,8 @@ std::optional<Observation> TemplateTracker::adopt(size_t index) {
 // drift guard, the template's blob, then the tracker's state moves on to it.
 Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched,
                                     double score, int last_turn, double working_zncc,
-                                    bool shaded) {
-  if (shaded) return VerifyShaded(score);
+                                    const std::optional<ShadeFreePeak>& shaded) {
+  if (shaded) return VerifyShaded(*shaded, score);
   const std::optional<Fix> fix = Measure(frame_bgr, matched);
   // SAD and SSD compare grey levels with the first template too: they do not cancel a change of
   // light, and a position they measure against a template the light has left is biased.
@@ -1436,12 +1436,11 @@ Observation TemplateTracker::Verify(const cv::Mat& frame_bgr, const cv::Point2d&
   return observation;
 }
 
-// The match accepted in log-chromaticity alone (AcceptOn measured its place there: the gray
+// The match accepted in log-chromaticity alone at `peak` (AcceptOn measured its place there: the gray
 // levels a shadow changed neither place nor measure it; the template's blob, cut by the shadow,
 // would put the centre off towards the lit side). The pose and the working template are left as
 // they were.
-Observation TemplateTracker::VerifyShaded(double score) {
-  const ShadeFreePeak& peak = shade_free_peak_;
+Observation TemplateTracker::VerifyShaded(const ShadeFreePeak& peak, double score) {
   const cv::Size size = current().templ.size();
   const cv::Point2d centre = peak.top_left + HalfSize(size);
   const cv::Point2d step = tracking_ ? centre - *last_centre_ : cv::Point2d(0, 0);

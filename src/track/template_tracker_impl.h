@@ -108,13 +108,14 @@ class TemplateTracker final : public Tracker {
   // the motion put it) whose core shows the marker's colour also passes when a place within
   // kShadeFreeReachPx of it matches the first template in log-chromaticity by min_zncc
   // (ShadeFreePeakNear): a shadow across the marker's surroundings pulls its gray-level match far
-  // below what a person sees. *shaded: accepted so, the peak in shade_free_peak_ (Verify then
+  // below what a person sees. *shaded: the peak it was accepted at so, else empty (Verify then
   // measures the marker there: VerifyShaded).
-  bool AcceptOn(const cv::Mat& frame, const Hit& m, bool followed, bool* shaded);
   struct ShadeFreePeak {
     cv::Point2d top_left;  // The template's top-left corner, px (sub-pixel).
     double zncc = 0;
   };
+  bool AcceptOn(const cv::Mat& frame, const Hit& m, bool followed,
+                std::optional<ShadeFreePeak>* shaded);
   std::optional<ShadeFreePeak> ShadeFreePeakNear(const cv::Mat& frame, cv::Point origin);
   cv::Rect WindowAround(const cv::Point2d& centre_px, const cv::Size& size, int margin_px) const;
   std::optional<Hit> Search(const cv::Mat& frame, cv::Rect region, const PreparedTemplate& templ,
@@ -150,10 +151,12 @@ class TemplateTracker final : public Tracker {
   void Weigh(const cv::Point2d& centre_px, double zncc, CandidateVerdict verdict);
   // Verifies the match centred at `matched` and, when it holds, moves the tracker on to it.
   // `working_zncc` is the working template's ZNCC there (kNoRival: not matched with it).
-  // `shaded`: the match was accepted in log-chromaticity alone; VerifyShaded measures it.
+  // `shaded`: the match was accepted in log-chromaticity alone, at that peak; VerifyShaded
+  // measures it there.
   Observation Verify(const cv::Mat& frame_bgr, const cv::Point2d& matched, double score,
-                     int last_turn, double working_zncc, bool shaded = false);
-  Observation VerifyShaded(double score);
+                     int last_turn, double working_zncc,
+                     const std::optional<ShadeFreePeak>& shaded = std::nullopt);
+  Observation VerifyShaded(const ShadeFreePeak& peak, double score);
   double rung_scale() const { return std::pow(kScaleStep, rung_ - kRungsBelow); }
   Observation Lose(MarkerStatus why, int candidates = 0) {
     tracking_ = false;  // Keep last_centre_: the next acquisition looks around it.
@@ -263,7 +266,6 @@ class TemplateTracker final : public Tracker {
   // frame's region around a match, for ShadeFreePeakNear.
   cv::Mat shade_free_, shade_free_rung_, shade_free_mask_, shade_free_region_;
   int shade_free_key_ = -1;
-  ShadeFreePeak shade_free_peak_;  // The last match AcceptOn accepted in log-chromaticity alone.
   cv::Mat blob_projection_;  // Colour: BGR weights giving the blob channel; else empty.
   cv::Mat blob_native_, blob_gray_;
   cv::Mat blob_continuous_;  // blob_gray_ copied when it is a view (BlobShift).
